@@ -1,0 +1,44 @@
+"""The ``roughfe`` command: argparse subcommands, one library call each.
+
+Each module listed in ``_SUBCOMMAND_MODULES`` defines ``register(subparsers)``, which
+adds its subcommand(s) and sets ``func`` (a callable taking the parsed arguments and
+returning an exit code). No physics lives here: a subcommand parses, calls the library,
+writes outputs and prints a summary.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from ..errors import RoughfeError
+
+# Explicit, ordered list (no import-time registration magic).
+_SUBCOMMAND_MODULES = (
+    "surface_cmds",   # generate, info
+    "demo_cmd",       # demo
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="roughfe",
+        description="Contact mechanics of rough surfaces: generation, BEM contact, FEM "
+                    "cross-validation, leakage and surface roughness genomics. SI units.")
+    from .. import __version__
+    parser.add_argument("--version", action="version", version=f"roughfe {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for name in _SUBCOMMAND_MODULES:
+        importlib.import_module(f"{__name__}.{name}").register(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except RoughfeError as exc:
+        print(f"roughfe {args.command}: error: {exc}", file=sys.stderr)
+        return 2

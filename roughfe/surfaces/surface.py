@@ -1,0 +1,144 @@
+"""The one data type for rough profiles (1D) and surfaces (2D).
+
+Conventions (fixed here, once, for the whole package):
+
+* ``heights`` are in metres. A profile has shape ``(nx,)``; a surface has shape
+  ``(nx, ny)`` with axis 0 along x and axis 1 along y (``heights[i, j]`` is the height
+  at ``x = i*dx, y = j*dy``).
+* ``size`` is the physical extent of the grid in metres, one entry per axis, and
+  ``spacing = size / n``: every sample is the centre of a cell of width ``dx`` (the
+  boundary-element view: the nominal area is ``n*dx`` (profile, per unit depth) or
+  ``nx*ny*dx*dy``). This is SurfaceTopography's convention too. Generators that are
+  defined on ``n`` nodes spanning a length ``L`` end to end (RMD: ``2**m + 1`` nodes
+  over ``L``) therefore produce ``size = n * L / (n - 1)``; they say so.
+* ``periodic`` says whether the heights repeat with period ``size`` (required by the
+  periodic FFT contact operators, honoured by the statistics).
+* ``metadata`` holds JSON-safe facts only (generator name, parameters, seed, source
+  file); units are never stored there: they are SI by definition of the fields.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+
+from ..errors import InputError
+
+
+def _as_size(size, ndim):
+    sizes = np.atleast_1d(np.asarray(size, dtype=float)).ravel()
+    if sizes.size == 1 and ndim == 2:
+        sizes = np.repeat(sizes, 2)
+    if sizes.size != ndim:
+        raise InputError(
+            f"size must have one entry per axis of the heights ({ndim}), got {size!r}")
+    for k, s in enumerate(sizes):
+        if not (np.isfinite(s) and s > 0):
+            raise InputError(f"size[{k}] must be finite and > 0 (metres), got {s!r}")
+    return tuple(float(s) for s in sizes)
+
+
+@dataclass(frozen=True, eq=False)
+class Surface:
+    """A rough profile or surface: heights in metres on a regular grid.
+
+    Parameters
+    ----------
+    heights : array_like, shape (nx,) or (nx, ny)
+        Heights in metres. Must be finite; at least 2 points along each axis.
+    size : float or sequence of float
+        Physical size in metres of each axis (``nx*dx`` and ``ny*dy``). A single
+        number for a surface means a square.
+    periodic : bool
+        Whether the heights are periodic with period ``size``.
+    metadata : mapping, optional
+        JSON-safe information (generator, parameters, seed, source file, ...).
+
+    The heights are copied into a read-only array: a ``Surface`` never changes.
+    """
+
+    heights: np.ndarray
+    size: tuple
+    periodic: bool = False
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self):
+        try:
+            h = np.array(self.heights, dtype=float, copy=True)
+        except (TypeError, ValueError):
+            raise InputError("heights must be a numeric array of metres") from None
+        if h.ndim not in (1, 2):
+            raise InputError(
+                f"heights must be 1D (profile) or 2D (surface), got an array of shape {h.shape}")
+        if min(h.shape) < 2:
+            raise InputError(f"heights need at least 2 points along each axis, got shape {h.shape}")
+        bad = ~np.isfinite(h)
+        if bad.any():
+            idx = tuple(int(i) for i in np.argwhere(bad)[0])
+            raise InputError(
+                f"heights must be finite: {int(bad.sum())} non-finite value(s), first at index "
+                f"{idx} = {h[idx]!r}")
+        h.setflags(write=False)
+        object.__setattr__(self, "heights", h)
+        object.__setattr__(self, "size", _as_size(self.size, h.ndim))
+        object.__setattr__(self, "periodic", bool(self.periodic))
+        object.__setattr__(self, "metadata", dict(self.metadata or {}))
+
+    # -- geometry -------------------------------------------------------------------
+    @property
+    def ndim(self) -> int:
+        """1 for a profile, 2 for a surface."""
+        return self.heights.ndim
+
+    @property
+    def shape(self) -> tuple:
+        return self.heights.shape
+
+    @property
+    def spacing(self) -> tuple:
+        """Grid spacing per axis in metres, ``size / n``."""
+        return tuple(s / n for s, n in zip(self.size, self.shape))
+
+    @property
+    def cell_area(self) -> float:
+        """Area of one grid cell: ``dx`` (m, per unit depth) for a profile, ``dx*dy`` (m^2)."""
+        return float(np.prod(self.spacing))
+
+    @property
+    def nominal_area(self) -> float:
+        """Nominal (apparent) contact area ``A_n``: ``Lx`` (m, per unit depth) or ``Lx*Ly`` (m^2)."""
+        return float(np.prod(self.size))
+
+    def coordinates(self):
+        """Cell-centre coordinates, one 1D array per axis, starting at 0 (metres)."""
+        return tuple(np.arange(n) * d for n, d in zip(self.shape, self.spacing))
+
+    # -- derived surfaces -----------------------------------------------------------
+    def with_heights(self, heights, **metadata) -> "Surface":
+        """A new surface on the same grid with other heights (metadata updated)."""
+        heights = np.asarray(heights, dtype=float)
+        if heights.shape != self.shape:
+            raise InputError(f"new heights have shape {heights.shape}, expected {self.shape}")
+        return Surface(heights, self.size, self.periodic, {**self.metadata, **metadata})
+
+    def scaled(self, factor: float) -> "Surface":
+        """Heights multiplied by ``factor`` (same grid)."""
+        return self.with_heights(self.heights * float(factor))
+
+    def detrended(self, mode: str = "mean") -> "Surface":
+        """Remove the mean (``"mean"``) or the least-squares plane/line (``"plane"``)."""
+        h = self.heights
+        if mode == "mean":
+            return self.with_heights(h - h.mean(), detrend="mean")
+        if mode == "plane":
+            coords = np.meshgrid(*self.coordinates(), indexing="ij")
+            a = np.column_stack([np.ones(h.size)] + [c.ravel() for c in coords])
+            coef, *_ = np.linalg.lstsq(a, h.ravel(), rcond=None)
+            return self.with_heights(h - (a @ coef).reshape(h.shape), detrend="plane")
+        raise InputError(f"detrend mode must be 'mean' or 'plane', got {mode!r}")
+
+    def __repr__(self):
+        kind = "profile" if self.ndim == 1 else "surface"
+        return (f"Surface({kind}, shape={self.shape}, size={self.size} m, "
+                f"periodic={self.periodic})")

@@ -1,0 +1,70 @@
+"""The one-way data flow of STYLE.md (a): packages import only leftward.
+
+surfaces -> bem -> fem -> leakage -> genomics -> study -> plotting -> cli
+(errors, writers and reference are the base layer, importable from anywhere.)
+dolfinx, petsc4py, mpi4py.futures aside, gmsh and ufl are imported only inside roughfe/fem.
+"""
+import ast
+from pathlib import Path
+
+import pytest
+
+PKG = Path(__file__).resolve().parents[1] / "roughfe"
+ORDER = ["errors", "writers", "reference", "surfaces", "bem", "fem", "leakage",
+         "genomics", "study", "plotting", "cli"]
+BASE = {"errors", "writers", "reference", "__init__"}
+FEM_ONLY = {"dolfinx", "petsc4py", "gmsh", "ufl", "basix", "ffcx"}
+
+
+def _layer(parts):
+    """Layer index of a module given its path parts below roughfe/."""
+    head = parts[0].removesuffix(".py")
+    if head in BASE:
+        return -1, head
+    if head not in ORDER:
+        pytest.fail(f"roughfe/{'/'.join(parts)} is not in a known layer {ORDER}")
+    return ORDER.index(head), head
+
+
+def _imports(path):
+    tree = ast.parse(path.read_text(), filename=str(path))
+    rel = path.relative_to(PKG).parts
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                yield node.lineno, alias.name
+        elif isinstance(node, ast.ImportFrom):
+            if node.level == 0:
+                yield node.lineno, node.module or ""
+            else:
+                base = list(rel[:-1])
+                if node.level > 1:
+                    base = base[: len(base) - (node.level - 1)]
+                mod = ".".join(["roughfe", *base, *(node.module.split(".") if node.module else [])])
+                if not node.module:
+                    for alias in node.names:
+                        yield node.lineno, f"{mod}.{alias.name}"
+                else:
+                    yield node.lineno, mod
+
+
+def test_imports_flow_one_way():
+    bad = []
+    for path in sorted(PKG.rglob("*.py")):
+        rel = path.relative_to(PKG).parts
+        if rel == ("__init__.py",):
+            continue
+        me, my_name = _layer(rel)
+        for lineno, mod in _imports(path):
+            top = mod.split(".")[0]
+            if top in FEM_ONLY and my_name != "fem":
+                bad.append(f"{path.relative_to(PKG.parent)}:{lineno} imports {mod} outside roughfe/fem")
+            if top != "roughfe" or mod == "roughfe":
+                continue
+            target = mod.split(".")[1]
+            if target in BASE or target == "__version__":
+                continue
+            other, _ = _layer([target])
+            if other > me:
+                bad.append(f"{path.relative_to(PKG.parent)}:{lineno} imports {mod} (rightward)")
+    assert not bad, "backward imports:\n" + "\n".join(bad)
