@@ -34,7 +34,7 @@ if [ -n "$missing" ]; then
   echo "[bootstrap] installing Debian packages:$missing"
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing >/dev/null
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
 fi
 
 stamp_value="$(cat pyproject.toml tools/bootstrap.sh tools/constraints.txt | sha256sum | cut -c1-16)-$EXTRAS"
