@@ -17,6 +17,7 @@ from ..errors import RoughfeError
 _SUBCOMMAND_MODULES = (
     "surface_cmds",   # generate, info
     "demo_cmd",       # demo
+    "validate_cmd",   # validate
 )
 
 
