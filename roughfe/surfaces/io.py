@@ -1,0 +1,267 @@
+"""Reading and writing rough surfaces: native ``.npz``, plain matrices, instrument files.
+
+All readers live in one ordered table, :data:`READERS` (STYLE.md habit 3): the first
+entry whose suffixes match the file name reads it; SurfaceTopography's
+``open_topography`` is the last entry and the fallback for every other suffix (it reads
+30+ instrument formats: ``.x3p .sur .opd .plu .di .datx .xyz ...``).
+
+Native format (``.npz``, ``format = "roughfe-surface"``, ``version = 1``)
+------------------------------------------------------------------------
+A numpy ``.npz`` archive (no pickles) with the arrays
+
+``format``    str, ``"roughfe-surface"``
+``version``   int, ``1``
+``heights``   float64, shape ``(nx,)`` or ``(nx, ny)``, metres, axis 0 = x
+``size``      float64, shape ``(ndim,)``, metres (``n * spacing`` per axis)
+``periodic``  bool
+``metadata``  str, JSON text of the JSON-safe metadata mapping
+
+Plain matrices (``.npy``, ``.txt``, ``.csv``, ``.dat``) carry heights only (taken to be
+metres): the physical ``size`` must be given explicitly, and ``periodic`` defaults to
+False.
+
+Instrument files are converted to SI: lengths and heights are rescaled from the unit
+stored in the file to metres. Missing (undefined) points are filled by SurfaceTopography's
+harmonic interpolation and their number recorded in ``metadata["filled_points"]``.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FileFormatError, InputError
+from ..writers import atomic_path
+from .surface import Surface
+
+NATIVE_FORMAT = "roughfe-surface"
+NATIVE_VERSION = 1
+
+
+# -- JSON-safe metadata ------------------------------------------------------------------
+def json_safe(value, depth=0):
+    """Return a JSON-serialisable copy of ``value`` (dicts, lists, numbers, strings).
+
+    Dates become ISO strings, numpy scalars/arrays plain numbers/lists, non-finite
+    floats and unknown objects their ``str``. Nesting deeper than 8 levels is cut.
+    """
+    if depth > 8:
+        return str(value)
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if np.isfinite(v) else str(v)
+    if isinstance(value, (_dt.datetime, _dt.date)):
+        return value.isoformat()
+    if isinstance(value, np.ndarray):
+        return json_safe(value.tolist(), depth + 1) if value.size <= 64 else f"array{value.shape}"
+    if isinstance(value, dict):
+        return {str(k): json_safe(v, depth + 1) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v, depth + 1) for v in value]
+    return str(value)
+
+
+# -- native npz --------------------------------------------------------------------------
+def _read_native(path, size, periodic, channel):
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            keys = set(data.files)
+            missing = {"format", "version", "heights", "size", "periodic", "metadata"} - keys
+            if missing:
+                raise FileFormatError(
+                    f"{path}: not a roughfe surface file (missing arrays {sorted(missing)}); "
+                    f"a plain height matrix should be saved as .npy with an explicit size")
+            fmt, version = str(data["format"]), int(data["version"])
+            if fmt != NATIVE_FORMAT or version > NATIVE_VERSION:
+                raise FileFormatError(
+                    f"{path}: format {fmt!r} version {version} is not readable by this roughfe "
+                    f"(reads {NATIVE_FORMAT!r} up to version {NATIVE_VERSION})")
+            heights = np.array(data["heights"], dtype=float)
+            file_size = tuple(float(s) for s in np.atleast_1d(data["size"]))
+            file_periodic = bool(data["periodic"])
+            metadata = json.loads(str(data["metadata"]))
+    except (OSError, ValueError) as exc:
+        if isinstance(exc, FileFormatError):
+            raise
+        raise FileFormatError(f"{path}: cannot read as .npz ({exc})") from None
+    return Surface(heights, file_size if size is None else size,
+                   file_periodic if periodic is None else periodic, metadata)
+
+
+def save_surface(surface: Surface, path) -> Path:
+    """Write ``surface`` to ``path`` in the native ``.npz`` format (atomically).
+
+    Parameters
+    ----------
+    surface : Surface
+    path : str or Path
+        Target file; the suffix must be ``.npz``.
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+    if path.suffix.lower() != ".npz":
+        raise InputError(f"save_surface writes the native .npz format; got file name {str(path)!r}")
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, format=np.array(NATIVE_FORMAT), version=np.array(NATIVE_VERSION),
+                     heights=surface.heights, size=np.asarray(surface.size, dtype=float),
+                     periodic=np.array(surface.periodic),
+                     metadata=np.array(json.dumps(json_safe(dict(surface.metadata)))))
+    return path
+
+
+# -- plain matrices ----------------------------------------------------------------------
+def _plain_surface(heights, path, size, periodic):
+    if size is None:
+        raise InputError(
+            f"{path}: a plain height matrix has no physical size; give size=(LX[, LY]) in metres "
+            f"(command line: --size LX [LY])")
+    heights = np.asarray(heights)
+    if heights.ndim == 2 and 1 in heights.shape:
+        heights = heights.ravel()
+    return Surface(heights, size, bool(periodic) if periodic is not None else False,
+                   {"source": str(path), "reader": "plain matrix"})
+
+
+def _read_npy(path, size, periodic, channel):
+    try:
+        heights = np.load(path, allow_pickle=False)
+    except (OSError, ValueError) as exc:
+        raise FileFormatError(f"{path}: cannot read as .npy ({exc})") from None
+    return _plain_surface(heights, path, size, periodic)
+
+
+def _read_text(path, size, periodic, channel):
+    delimiter = "," if Path(path).suffix.lower() == ".csv" else None
+    try:
+        heights = np.loadtxt(path, delimiter=delimiter, ndmin=2)
+    except (OSError, ValueError) as exc:
+        raise FileFormatError(f"{path}: cannot read as a plain text matrix ({exc})") from None
+    return _plain_surface(heights, path, size, periodic)
+
+
+# -- SurfaceTopography (instrument files) ---------------------------------------------
+def _choose_channel(reader, channel, path):
+    channels = reader.channels
+    if channel is None:
+        return reader.default_channel
+    if isinstance(channel, str) and not channel.lstrip("-").isdigit():
+        named = [c for c in channels if c.name == channel]
+        if not named:
+            raise InputError(f"{path}: no channel named {channel!r}; channels are "
+                             f"{[c.name for c in channels]}")
+        return named[0]
+    index = int(channel)
+    if not 0 <= index < len(channels):
+        raise InputError(f"{path}: channel index {index} out of range 0..{len(channels) - 1} "
+                         f"(channels {[c.name for c in channels]})")
+    return channels[index]
+
+
+def _read_instrument(path, size, periodic, channel):
+    try:
+        from SurfaceTopography import open_topography
+    except ImportError:
+        raise FileFormatError(
+            f"{path}: reading instrument files needs SurfaceTopography (pip install "
+            f"SurfaceTopography); it is not installed") from None
+    try:
+        reader = open_topography(str(path))
+    except Exception as exc:      # ST raises many types for unknown formats
+        raise FileFormatError(f"{path}: no reader recognises this file ({exc})") from None
+    ch = _choose_channel(reader, channel, path)
+    if ch.dim not in (1, 2):
+        raise FileFormatError(f"{path}: channel {ch.name!r} has dimension {ch.dim}, not 1 or 2")
+    kwargs = {"channel_index": ch.index}
+    if ch.physical_sizes is None:
+        if size is None:
+            raise InputError(f"{path}: the file gives no physical size; give size=(LX[, LY]) "
+                             f"in metres (--size)")
+        kwargs["physical_sizes"] = tuple(np.atleast_1d(size).astype(float))
+    unit = ch.unit if isinstance(ch.unit, str) else None
+    if unit is None and isinstance(ch.unit, tuple) and ch.unit and isinstance(ch.unit[0], str):
+        unit = ch.unit[0]
+    if unit is None:
+        kwargs["unit"] = "m"
+        unit = "m (assumed: the file gives no unit)"
+    topo = reader.topography(**kwargs)
+    filled = 0
+    if topo.has_undefined_data:
+        filled = int(np.ma.getmaskarray(topo.heights()).sum())
+        topo = topo.interpolate_undefined_data()
+    topo_m = topo.to_unit("m")
+    heights = np.ma.getdata(topo_m.heights()).astype(float)
+    file_size = tuple(float(s) for s in np.atleast_1d(topo_m.physical_sizes))
+    info = topo.info or {}
+    metadata = {
+        "source": str(path), "reader": type(reader).__name__,
+        "channel": {"index": int(ch.index), "name": str(ch.name)},
+        "unit_in_file": unit, "filled_points": filled,
+        "instrument": json_safe(info.get("instrument", {})),
+    }
+    if "acquisition_time" in info:
+        metadata["acquisition_time"] = json_safe(info["acquisition_time"])
+    if size is not None and ch.physical_sizes is not None:
+        metadata["size_in_file"] = list(file_size)
+    return Surface(heights, file_size if size is None else size,
+                   bool(topo.is_periodic) if periodic is None else periodic, metadata)
+
+
+# -- the one ordered table ----------------------------------------------------------------
+#: (suffixes, reader, description). Order matters: native first (our own format, exact),
+#: then plain matrices (need an explicit size), then SurfaceTopography for everything else
+#: (``None`` = any suffix). ``.txt``/``.csv`` are plain matrices here; instrument text
+#: exports with headers (``.asc``, ``.xyz``) go to SurfaceTopography.
+READERS = (
+    ((".npz",), _read_native, "roughfe native surface (heights, size, periodic, metadata)"),
+    ((".npy",), _read_npy, "plain numpy height matrix in metres (needs size)"),
+    ((".txt", ".csv", ".dat"), _read_text, "plain text height matrix in metres (needs size)"),
+    (None, _read_instrument, "instrument file via SurfaceTopography.open_topography"),
+)
+
+
+def load_surface(path, size=None, periodic=None, channel=None) -> Surface:
+    """Read a profile or surface from ``path`` and return a :class:`Surface` in SI units.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.npz`` (native), ``.npy``/``.txt``/``.csv``/``.dat`` (plain height matrix in
+        metres, axis 0 = x) or any instrument file SurfaceTopography reads.
+    size : float or (float, float), optional
+        Physical size in metres (``n * spacing`` per axis). Required for plain matrices
+        and for instrument files without a size; otherwise it overrides the file's size.
+    periodic : bool, optional
+        Overrides the periodic flag (default: the file's flag, False for plain matrices).
+    channel : int or str, optional
+        Channel index or name of a multi-channel instrument file (default: the file's
+        default channel, usually the first height channel).
+
+    Returns
+    -------
+    Surface
+
+    Raises
+    ------
+    InputError
+        Missing file, missing size for a plain matrix, unknown channel.
+    FileFormatError
+        The file cannot be parsed.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"surface file {str(path)!r} does not exist")
+    suffix = path.suffix.lower()
+    for suffixes, reader, _ in READERS:
+        if suffixes is None or suffix in suffixes:
+            return reader(path, size, periodic, channel)
+    raise FileFormatError(f"{path}: no reader for suffix {suffix!r}")  # unreachable: fallback
