@@ -1,0 +1,2 @@
+"""Surface roughness genomics: genomes, chromosomes, sequencing (genomics I), macro/micro
+roughness, the genome database and roughness design (genomics II). Thesis Chapters 3-4."""

@@ -1,0 +1,337 @@
+"""Response curves, targets, the similarity score (thesis Eq. 4.1) and the amplitude rescaling (Eq. 4.2).
+
+A *response curve* is what roughness design compares: the normal contact stiffness
+``K(p) = dp/dDelta`` (Pa/m) and the area fraction ``A(p) = A_r/A_n`` (-) of one profile,
+sampled at the ``n_t`` far-field displacements ``Delta_j = j/n_t * (peak-valley amplitude)``
+(thesis Sec. 4.2.1), as functions of the mean contact pressure ``p`` (Pa, >= 0 in
+compression).
+
+Scaling law behind Eq. (4.2)
+----------------------------
+In frictionless linear-elastic contact under displacement control, multiply the heights
+``h`` by ``eta > 0`` and impose ``eta * Delta``. The gap ``g = h - Delta + u`` with the
+elastic displacement ``u = G * p`` (``G`` linear) becomes ``eta * g`` when ``p`` becomes
+``eta * p``: the complementarity conditions ``g >= 0, p >= 0, g p = 0`` are invariant
+under a positive factor, and the solution is unique, so the contact set is unchanged.
+Hence ``p -> eta p``, ``A(p) -> A`` (same contact set) and ``K = dp/dDelta -> K`` (both
+scale with ``eta``): the curves of a profile with amplitude gene ``eta * A`` are the
+curves of the original one stretched along the pressure axis,
+
+    K_eta(p) = K_1(p / eta),   A_eta(p) = A_1(p / eta),   p_max -> eta p_max.
+
+Choosing ``eta = p_max^t / p_max^i`` (Eq. 4.2) puts the profile on the target's pressure
+range without a new BEM solution (:meth:`ResponseCurve.rescaled`);
+``tests/test_design_bem.py`` checks it against an independent BEM run.
+"""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from ..errors import FileFormatError, InputError
+
+Quantity = Literal["K", "A"]
+QUANTITIES = ("K", "A")
+#: physical name and SI unit of each design quantity
+QUANTITY_LABELS = {"K": ("normal contact stiffness K = dp/dDelta", "Pa/m"),
+                   "A": ("contact area fraction A = A_r/A_n", "-")}
+
+
+def _check_quantity(quantity):
+    if quantity not in QUANTITIES:
+        raise InputError(f"quantity must be one of {QUANTITIES} (stiffness K(p) or area A(p)), "
+                         f"got {quantity!r}")
+    return quantity
+
+
+def _readonly(a):
+    a = np.array(a, dtype=float, copy=True).ravel()
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class ResponseCurve:
+    """K(p) and A(p) of one profile on its own pressure range (thesis Sec. 4.2.1).
+
+    Parameters
+    ----------
+    pressure : array_like, shape (n,)
+        Mean contact pressure p (Pa) at the loading steps, strictly increasing, > 0.
+    stiffness : array_like, shape (n,)
+        Normal contact stiffness K(p) = dp/dDelta (Pa/m).
+    area_fraction : array_like, shape (n,)
+        Real-to-nominal contact area A(p) (-).
+
+    Steps without contact (p = 0) are not part of a curve: Eq. (4.1) divides by the
+    target, and every rescaling (Eq. 4.2) keeps p = 0 fixed.
+    """
+
+    pressure: np.ndarray
+    stiffness: np.ndarray
+    area_fraction: np.ndarray
+
+    def __post_init__(self):
+        p, k, a = (_readonly(v) for v in (self.pressure, self.stiffness, self.area_fraction))
+        if not (p.size == k.size == a.size) or p.size < 2:
+            raise InputError(f"pressure, stiffness and area_fraction need the same length >= 2, "
+                             f"got {p.size}, {k.size}, {a.size}")
+        for name, v in (("pressure", p), ("stiffness", k), ("area_fraction", a)):
+            if not np.all(np.isfinite(v)):
+                raise InputError(f"response curve {name} has non-finite values: {v}")
+        if np.any(p <= 0) or np.any(np.diff(p) <= 0):
+            raise InputError(f"response curve pressure must be > 0 and strictly increasing (Pa), "
+                             f"got {p}")
+        object.__setattr__(self, "pressure", p)
+        object.__setattr__(self, "stiffness", k)
+        object.__setattr__(self, "area_fraction", a)
+
+    @property
+    def p_max(self) -> float:
+        """Largest pressure of the curve (Pa): the one reached at Delta = peak-valley amplitude."""
+        return float(self.pressure[-1])
+
+    def values(self, quantity: Quantity) -> np.ndarray:
+        """``K`` (Pa/m) or ``A`` (-) along the curve."""
+        return self.stiffness if _check_quantity(quantity) == "K" else self.area_fraction
+
+    def rescaled(self, factor: float) -> "ResponseCurve":
+        """The curve of the same profile with heights times ``factor`` (Eq. 4.2 scaling law).
+
+        Pressure scales with ``factor``; K and A do not (see the module docstring).
+        """
+        factor = float(factor)
+        if not (np.isfinite(factor) and factor > 0):
+            raise InputError(f"rescaling factor must be finite and > 0, got {factor!r}")
+        return ResponseCurve(self.pressure * factor, self.stiffness, self.area_fraction)
+
+    def to_target_range(self, p_max_target: float) -> "ResponseCurve":
+        """Rescale with ``eta = p_max^t / p_max^i`` (Eq. 4.2) so that ``p_max`` is the target's."""
+        return self.rescaled(amplitude_factor(p_max_target, self.p_max))
+
+    def to_dict(self) -> dict:
+        return {"pressure": self.pressure.tolist(), "stiffness": self.stiffness.tolist(),
+                "area_fraction": self.area_fraction.tolist()}
+
+    @classmethod
+    def from_dict(cls, d) -> "ResponseCurve":
+        return cls(d["pressure"], d["stiffness"], d["area_fraction"])
+
+
+def amplitude_factor(p_max_target: float, p_max_i: float) -> float:
+    """Factor ``p_max^t / p_max^i`` of Eq. (4.2): multiply the amplitude gene A_i by it.
+
+    Parameters
+    ----------
+    p_max_target, p_max_i : float
+        Maximum pressures (Pa) of the target and of the i-th profile, both > 0.
+    """
+    for name, v in (("p_max_target", p_max_target), ("p_max_i", p_max_i)):
+        if not (np.isfinite(v) and v > 0):
+            raise InputError(f"{name} must be finite and > 0 (Pa), got {v!r}")
+    return float(p_max_target) / float(p_max_i)
+
+
+@dataclass(frozen=True, eq=False)
+class Target:
+    """A target response y_t(p) (thesis Sec. 4.2.1): values of K or A at given pressures.
+
+    Parameters
+    ----------
+    pressure : array_like
+        Mean contact pressures (Pa), >= 0; sorted on construction.
+    values : array_like
+        Target K (Pa/m) or A (-) at those pressures: finite and >= 0; where p > 0 it
+        must be > 0 because Eq. (4.1) divides by it. Points at p = 0 are dropped.
+    quantity : {"K", "A"}
+    name : str
+        Label used in reports (e.g. ``"y_t1"``).
+    metadata : dict
+        JSON-safe provenance (how the target was made).
+    """
+
+    pressure: np.ndarray
+    values: np.ndarray
+    quantity: str = "K"
+    name: str = "target"
+    metadata: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        _check_quantity(self.quantity)
+        try:
+            p = np.asarray(self.pressure, dtype=float).ravel()
+            y = np.asarray(self.values, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise InputError("target pressure and values must be numbers") from None
+        if p.size != y.size:
+            raise InputError(f"target pressure ({p.size}) and values ({y.size}) differ in length")
+        for name, v in (("pressure", p), ("values", y)):
+            bad = ~np.isfinite(v)
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                raise InputError(f"target {name} must be finite: entry {i} is {v[i]!r}")
+            neg = v < 0
+            if neg.any():
+                i = int(np.flatnonzero(neg)[0])
+                raise InputError(f"target {name} must be >= 0: entry {i} is {v[i]!r}")
+        keep = p > 0
+        p, y = p[keep], y[keep]
+        if p.size < 2:
+            raise InputError(f"a target needs at least 2 points with p > 0, got {p.size}")
+        zero = y <= 0
+        if zero.any():
+            i = int(np.flatnonzero(zero)[0])
+            raise InputError(f"target values must be > 0 where p > 0 (Eq. 4.1 divides by them): "
+                             f"value {y[i]!r} at p = {p[i]!r} Pa")
+        order = np.argsort(p, kind="stable")
+        p, y = p[order], y[order]
+        if np.any(np.diff(p) == 0):
+            raise InputError("target pressures must be distinct")
+        object.__setattr__(self, "pressure", _readonly(p))
+        object.__setattr__(self, "values", _readonly(y))
+        object.__setattr__(self, "metadata", dict(self.metadata or {}))
+
+    @property
+    def p_max(self) -> float:
+        """Largest target pressure p_max^t (Pa)."""
+        return float(self.pressure[-1])
+
+    def check_pbar(self, pbar: float) -> float:
+        """Return ``pbar`` if it splits the target range ``(p_min, p_max)`` into two parts."""
+        try:
+            v = float(pbar)
+        except (TypeError, ValueError):
+            raise InputError(f"pbar must be a pressure in Pa, got {pbar!r}") from None
+        lo, hi = float(self.pressure[0]), self.p_max
+        if not (lo < v < hi):
+            raise InputError(f"pbar must lie inside the target pressure range ({lo:.6g}, {hi:.6g}) "
+                             f"Pa so that [0, pbar] and [pbar, p_max] both hold target points; "
+                             f"got {v!r}")
+        return v
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "quantity": self.quantity, "pressure": self.pressure.tolist(),
+                "values": self.values.tolist(), "metadata": self.metadata}
+
+    @classmethod
+    def from_dict(cls, d) -> "Target":
+        return cls(d["pressure"], d["values"], d.get("quantity", "K"), d.get("name", "target"),
+                   d.get("metadata", {}))
+
+    @classmethod
+    def from_curve(cls, curve: ResponseCurve, quantity: Quantity = "K", name="target",
+                   **metadata) -> "Target":
+        """The K(p) or A(p) of a computed curve used as a target (e.g. y_t1)."""
+        return cls(curve.pressure, curve.values(quantity), quantity, name, metadata)
+
+
+def similarity(target: Target, curve: ResponseCurve, p_range=(0.0, np.inf), *,
+               rescale: bool = True) -> float:
+    """Similarity score ``s = 1 - || (y_t - y_i) / y_t ||_inf`` (thesis Eq. 4.1).
+
+    Parameters
+    ----------
+    target : Target
+        y_t at its pressures (Pa).
+    curve : ResponseCurve
+        Response of the i-th profile.
+    p_range : (float, float)
+        Closed pressure interval (Pa) in which the score is computed: ``(0, pbar)`` and
+        ``(pbar, p_max)`` give the two scores of Algs. 5-7.
+    rescale : bool
+        Apply Eq. (4.2) first so that ``p_max^i = p_max^t`` (the thesis always does).
+
+    Returns
+    -------
+    float
+        ``s <= 1``; 1 means identical curves at the target points in ``p_range``.
+
+    Notes
+    -----
+    The infinity norm is taken over the target's own points inside ``p_range``; y_i is
+    interpolated linearly in p on the curve (after rescaling the two share p_max, and
+    below the curve's first pressure the first value is used).
+    """
+    if rescale:
+        curve = curve.to_target_range(target.p_max)
+    lo, hi = float(p_range[0]), float(p_range[1])
+    sel = (target.pressure >= lo) & (target.pressure <= hi)
+    if not sel.any():
+        raise InputError(f"no target point lies in the pressure range [{lo:.6g}, {hi:.6g}] Pa "
+                         f"(target spans {target.pressure[0]:.6g} .. {target.p_max:.6g} Pa)")
+    p, yt = target.pressure[sel], target.values[sel]
+    yi = np.interp(p, curve.pressure, curve.values(target.quantity))
+    return float(1.0 - np.max(np.abs((yt - yi) / yt)))
+
+
+def split_ranges(target: Target, pbar: float):
+    """The two pressure intervals ``[0, pbar]`` and ``[pbar, p_max^t]`` of Algs. 5-7."""
+    pbar = target.check_pbar(pbar)
+    return (0.0, pbar), (pbar, target.p_max)
+
+
+def linear_then_flat_target(p_max: float, pbar: float, plateau: float, n_points: int = 20,
+                            quantity: Quantity = "K", name: str = "y_t2") -> Target:
+    """Target y_t2 of thesis Sec. 4.3.2: y grows linearly with p up to ``pbar``, then is flat.
+
+    Parameters
+    ----------
+    p_max : float
+        Largest target pressure (Pa).
+    pbar : float
+        Threshold pressure (Pa), ``0 < pbar < p_max``.
+    plateau : float
+        Value of y for ``p >= pbar`` (Pa/m for K).
+    n_points : int
+        Number of equally spaced pressures ``p_j = j p_max / n_points``, j = 1..n_points
+        (the n_t loading steps of the thesis).
+    """
+    if not (0 < pbar < p_max and np.isfinite(p_max)):
+        raise InputError(f"need 0 < pbar < p_max, got pbar={pbar!r}, p_max={p_max!r}")
+    if not (np.isfinite(plateau) and plateau > 0):
+        raise InputError(f"plateau must be finite and > 0, got {plateau!r}")
+    if int(n_points) < 2:
+        raise InputError(f"n_points must be >= 2, got {n_points!r}")
+    p = p_max * np.arange(1, int(n_points) + 1) / int(n_points)
+    y = plateau * np.minimum(p / pbar, 1.0)
+    return Target(p, y, quantity, name, {"kind": "linear_then_flat", "pbar": float(pbar),
+                                         "plateau": float(plateau), "p_max": float(p_max)})
+
+
+def read_target_csv(path, quantity: Quantity = "K", name=None) -> Target:
+    """Read a target from a CSV file with two columns: pressure (Pa), value (K in Pa/m or A).
+
+    Lines starting with ``#`` and a non-numeric header line are skipped.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"target file {path} does not exist")
+    rows = []
+    with path.open(newline="") as fh:
+        for k, row in enumerate(csv.reader(fh)):
+            if not row or row[0].lstrip().startswith("#"):
+                continue
+            try:
+                rows.append([float(row[0]), float(row[1])])
+            except (ValueError, IndexError):
+                if rows or k > 1:
+                    raise FileFormatError(f"{path}: line {k + 1} is not 'pressure,value': "
+                                          f"{row!r}") from None
+    if not rows:
+        raise FileFormatError(f"{path}: no 'pressure,value' rows found")
+    a = np.asarray(rows)
+    return Target(a[:, 0], a[:, 1], quantity, name or path.stem, {"source": str(path)})
+
+
+def write_target_csv(path, target: Target):
+    """Write ``target`` as 'pressure_Pa,value' CSV atomically (readable by :func:`read_target_csv`)."""
+    from ..writers import write_text
+    unit = QUANTITY_LABELS[target.quantity][1]
+    lines = [f"# {target.name}: {QUANTITY_LABELS[target.quantity][0]} ({unit}) vs pressure (Pa)",
+             "pressure_Pa,value"]
+    lines += [f"{p:.17g},{y:.17g}" for p, y in zip(target.pressure, target.values)]
+    return write_text(path, "\n".join(lines) + "\n")

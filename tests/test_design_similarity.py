@@ -1,0 +1,66 @@
+"""Similarity score (Eq. 4.1), amplitude rescaling (Eq. 4.2) and targets: maths only, no BEM."""
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.genomics.similarity import (ResponseCurve, Target, amplitude_factor,
+                                         linear_then_flat_target, read_target_csv, similarity,
+                                         split_ranges, write_target_csv)
+
+
+def _curve(scale=1.0, k0=2.0):
+    p = np.linspace(0.1, 1.0, 10)
+    return ResponseCurve(p * scale, k0 * np.sqrt(p), np.minimum(p, 1.0) * 0.5)
+
+
+def test_identical_curves_score_one_and_relative_error_is_inf_norm():
+    c = _curve()
+    t = Target.from_curve(c, "K")
+    assert similarity(t, c) == pytest.approx(1.0, abs=1e-14)
+    # a curve 3 % too stiff everywhere, 10 % at one point -> s = 0.9 (the worst point)
+    k = c.stiffness * 1.03
+    k[4] = c.stiffness[4] * 0.9
+    assert similarity(t, ResponseCurve(c.pressure, k, c.area_fraction)) == pytest.approx(0.9)
+
+
+def test_rescaling_is_a_stretch_of_the_pressure_axis():
+    """Eq. (4.2): heights x eta -> p x eta, K and A unchanged; scoring rescales first."""
+    c = _curve()
+    t = Target.from_curve(c, "A")
+    stretched = c.rescaled(3.7)
+    assert stretched.p_max == pytest.approx(3.7 * c.p_max)
+    np.testing.assert_array_equal(stretched.stiffness, c.stiffness)
+    assert amplitude_factor(t.p_max, stretched.p_max) == pytest.approx(1 / 3.7)
+    assert similarity(t, stretched) == pytest.approx(1.0, abs=1e-12)
+    assert similarity(t, stretched, rescale=False) < 0.5
+
+
+def test_partial_ranges_pick_the_right_points():
+    c = _curve()
+    t = Target.from_curve(c, "K")
+    k = c.stiffness.copy()
+    k[-3:] *= 1.2          # wrong only at high pressure
+    bad = ResponseCurve(c.pressure, k, c.area_fraction)
+    low, high = split_ranges(t, 0.65)
+    assert similarity(t, bad, low) == pytest.approx(1.0)
+    assert similarity(t, bad, high) == pytest.approx(0.8)
+    assert similarity(t, bad) == pytest.approx(0.8)
+
+
+def test_target_y_t2_shape_and_bad_inputs(tmp_path):
+    t = linear_then_flat_target(p_max=2.0, pbar=0.5, plateau=4.0, n_points=20)
+    assert t.values[0] == pytest.approx(4.0 * 0.1 / 0.5)
+    assert np.all(t.values[t.pressure >= 0.5] == 4.0)
+    path = write_target_csv(tmp_path / "t.csv", t)
+    back = read_target_csv(path)
+    np.testing.assert_allclose(back.values, t.values)
+    with pytest.raises(InputError, match="finite"):
+        Target([0.1, 0.2], [1.0, np.nan])
+    with pytest.raises(InputError, match=">= 0"):
+        Target([0.1, 0.2], [1.0, -1.0])
+    with pytest.raises(InputError, match="> 0 where p > 0"):
+        Target([0.1, 0.2], [1.0, 0.0])
+    with pytest.raises(InputError, match="pbar"):
+        t.check_pbar(2.5)
+    with pytest.raises(InputError, match="quantity"):
+        Target([0.1, 0.2], [1.0, 2.0], quantity="E")
