@@ -1,0 +1,64 @@
+"""Genome, Eq. 3.1-3.5: index ranges of Table 1, Z(0) = 0, chromosome sum, JSON round trip."""
+import numpy as np
+import pytest
+
+from roughfe.errors import FileFormatError, InputError
+from roughfe.genomics.genome import (Genome, chromosome_heights, chromosome_range, load_genome,
+                                     node_coordinates, realize, save_genome, table1_genome)
+
+
+def test_table1_index_ranges_from_eq_3_5():
+    # Table 1: lambda1 = L_10x = 1 mm, gamma = 1.5, N = 512.
+    assert chromosome_range(1.5, 1e-3, 1e-3, 512) == (1, 16)
+    assert chromosome_range(1.5, 1e-3, 5e-4, 512) == (2, 18)
+    assert chromosome_range(1.5, 1e-3, 1e-4, 512) == (6, 22)
+    g = table1_genome(rng=3)
+    assert [g.chromosome_range(g.length_of(s)) for s in ("10x", "20x", "100x")] == \
+        [(1, 16), (2, 18), (6, 22)]
+
+
+def test_realisation_is_sum_of_chromosomes_and_vanishes_at_origin():
+    g = table1_genome(rng=1)
+    s = realize(g, scale="20x")
+    x = node_coordinates(5e-4, 512)
+    assert s.shape == (512,)
+    assert np.isclose(s.spacing[0], 5e-4 / 511, rtol=1e-14)     # delta = L/(N-1)
+    assert np.isclose(s.size[0], 512 * 5e-4 / 511, rtol=1e-14)  # Surface cell convention
+    assert x[256] == 0.0 and s.heights[256] == 0.0               # Z(0) = 0 exactly
+    chrom = chromosome_heights(g, x, np.arange(2, 19))            # Eq. 3.2
+    np.testing.assert_allclose(chrom.sum(axis=0), s.heights, atol=1e-15 * np.abs(chrom).max() * 50)
+    # Eq. 3.1 written out directly for chromosome n = 5, ridge by ridge
+    n = 5
+    G = 1.0 * np.sqrt(np.log(1.5) / 8) * (2 * np.pi / 1e-3) ** -0.75
+    q = 2 * np.pi / 1e-3 * 1.5 ** (n - 1)
+    phi = g.phases[:, n - 1]
+    direct = G * 1.5 ** ((1 - n) * 0.75) * (np.cos(phi)[:, None] - np.cos(q * x + phi[:, None])).sum(0)
+    np.testing.assert_allclose(chrom[n - 2], direct, rtol=0, atol=1e-12 * np.abs(direct).max())
+
+
+def test_nested_realisations_share_nodes():
+    g = table1_genome(rng=2)
+    z10, z20 = realize(g, scale="10x"), realize(g, scale="20x")
+    x10, x20 = node_coordinates(1e-3, 512), node_coordinates(5e-4, 512)
+    d = 5e-4 / 511
+    common = np.isin(np.round(x10 / d).astype(int), np.round(x20 / d).astype(int))
+    np.testing.assert_allclose(x10[common], x20[np.isin(np.round(x20 / d), np.round(x10 / d))], rtol=1e-12)
+    assert common.sum() == 256
+    assert z10.metadata["n_s"] == 1 and z20.metadata["n_f"] == 18
+
+
+def test_json_round_trip_and_errors(tmp_path):
+    g = table1_genome(rng=4)
+    path = save_genome(g, tmp_path / "g.json")
+    back = load_genome(path)
+    assert (back.A, back.H, back.gamma, back.lambda1, back.M) == (g.A, g.H, g.gamma, g.lambda1, 8)
+    np.testing.assert_array_equal(back.phases, g.phases)
+    with pytest.raises(InputError, match="gamma"):
+        Genome(A=1, H=0.7, gamma=1.0, lambda1=1e-3, phases=np.zeros((2, 3)))
+    with pytest.raises(InputError, match="H"):
+        Genome(A=1, H=-0.1, gamma=1.5, lambda1=1e-3, phases=np.zeros((2, 3)))
+    with pytest.raises(InputError, match="phases"):
+        realize(g, length=1e-5)          # needs chromosomes beyond n = 22
+    bad = g.to_dict() | {"version": 99}
+    with pytest.raises(FileFormatError, match="version"):
+        Genome.from_dict(bad)
