@@ -1,4 +1,21 @@
-"""Rough profiles and surfaces: the data type, generators, readers and statistics."""
-from .surface import Surface
+"""Rough profiles and surfaces: the data type, generators, readers and statistics.
 
-__all__ = ["Surface"]
+Generators (each takes ``rng`` = Generator or seed and records the seed):
+:func:`rmd_surface`/:func:`rmd_profile` (thesis Sec. 2.1.1), :func:`wm_profile`
+(Eq. 2.1), :func:`mwm_surface` (Eq. 2.2/3.17), :func:`spectral_surface`/
+:func:`spectral_profile` (Fourier filtering). I/O: :func:`load_surface`,
+:func:`save_surface`. Statistics: :mod:`roughfe.surfaces.stats`.
+"""
+from .io import load_surface, save_surface
+from .rmd import rmd_profile, rmd_surface
+from .spectral import spectral_profile, spectral_surface
+from .stats import fit_hurst, power_spectrum, spectral_moments, surface_statistics
+from .surface import Surface
+from .wm import mwm_coefficients, mwm_surface, resolve_rng, wm_profile, wm_series
+
+__all__ = [
+    "Surface", "load_surface", "save_surface",
+    "rmd_surface", "rmd_profile", "wm_profile", "mwm_surface", "mwm_coefficients", "wm_series",
+    "spectral_surface", "spectral_profile", "resolve_rng",
+    "power_spectrum", "spectral_moments", "fit_hurst", "surface_statistics",
+]

@@ -275,9 +275,21 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     if n < 3:
         return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
                         f"only {n} PSD points in q_range; widen it")
-    lq, lc = np.log(psd.q[sel]), np.log(psd.C[sel])
-    # uniform weight per decade: annuli/wavenumbers are linearly spaced (density ~ q)
-    slope, intercept = np.polyfit(lq, lc, 1, w=1 / np.sqrt(psd.q[sel]))
+    # Average C over logarithmic bins (10 per decade, weighted by the q-space measure)
+    # before the log-log fit: every decade then counts the same, and averaging before
+    # taking the log removes the scatter (and log-bias) of single Fourier modes.
+    q, c, w = psd.q[sel], psd.C[sel], psd.weight[sel]
+    nb = max(int(np.ceil(10 * np.log10(q[-1] / q[0]))), 1)
+    idx = np.minimum((np.log(q / q[0]) / np.log(q[-1] / q[0]) * nb).astype(int), nb - 1) \
+        if q[-1] > q[0] else np.zeros(q.size, int)
+    wsum = np.bincount(idx, weights=w, minlength=nb)
+    full = wsum > 0
+    lq = np.log(np.bincount(idx, weights=q * w, minlength=nb)[full] / wsum[full])
+    lc = np.log(np.bincount(idx, weights=c * w, minlength=nb)[full] / wsum[full])
+    if lq.size < 2:
+        return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
+                        "q_range spans less than two logarithmic bins; widen it")
+    slope, intercept = np.polyfit(lq, lc, 1)
     d = surface.ndim
     hurst = -slope / 2 - 1 if d == 2 else (-slope - 1) / 2
     ok = 0 < hurst < 1

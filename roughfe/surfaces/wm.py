@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_finite_positive, check_in_open_interval
+from .surface import Surface
 
 
 def wm_series(coords, amplitudes, wavenumbers, phases, angles=None, chunk=1 << 20):
@@ -73,3 +74,185 @@ def wm_series(coords, amplitudes, wavenumbers, phases, angles=None, chunk=1 << 2
             acc += np.cos(np.multiply.outer(s, q) + phases[m]) @ amplitudes[m]
         out[sl] = offset - acc
     return out.reshape(out_shape)
+
+
+# -- random sources ------------------------------------------------------------------------
+def resolve_rng(rng):
+    """``(generator, seed)`` from a numpy Generator, an integer seed or None.
+
+    An integer is used as the seed and returned for the metadata. ``None`` draws a fresh
+    seed from the operating system's entropy (so the result is still reproducible from
+    its metadata). A Generator is used as is; its seed is unknown (``None``).
+    """
+    if isinstance(rng, np.random.Generator):
+        return rng, None
+    if rng is None:
+        seed = int(np.random.SeedSequence().entropy % (2 ** 63))
+        return np.random.default_rng(seed), seed
+    if isinstance(rng, bool) or not isinstance(rng, (int, np.integer)) or rng < 0:
+        raise InputError(f"rng must be a numpy Generator, a non-negative integer seed or None, "
+                         f"got {rng!r}")
+    return np.random.default_rng(int(rng)), int(rng)
+
+
+# -- WM profile (Eq. 2.1) and MWM surface (Eq. 2.2 / 3.17) ---------------------------------
+def _grid(n, length, ndim):
+    length = check_finite_positive("length L (m)", length)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+        raise InputError(f"n (grid points per side) must be an integer >= 2, got {n!r}")
+    x = np.arange(int(n)) * length / n
+    return (x,) if ndim == 1 else (x[:, None], x[None, :]), length
+
+
+def _check_gamma_hurst(gamma, hurst):
+    gamma = float(gamma)
+    if not (np.isfinite(gamma) and gamma > 1):
+        raise InputError(f"gamma (frequency density) must be > 1, got {gamma!r}")
+    return gamma, check_in_open_interval("hurst H", hurst, 0.0, 1.0)
+
+
+def wm_profile(n, length, hurst, gamma=1.5, amplitude=1e-6, q0=None, k_range=None, rng=None):
+    """Weierstrass-Mandelbrot profile, thesis Eq. (2.1), truncated to ``k1 <= k <= k2``.
+
+    ``W(x) = A sum_k gamma**(-H k) [cos(phi_k) - cos(q0 gamma**k x - phi_k)]``
+
+    Eq. (2.1) writes the wavenumber as ``gamma**k`` (per unit length); ``q0`` (rad/m)
+    carries that unit (default ``2 pi / L``, so ``k = 0`` is the wave spanning the
+    profile). ``W(0) = 0`` exactly. The sign convention of the phase (``- phi_k`` here,
+    ``+ phi`` in :func:`wm_series`) is immaterial for uniform random phases.
+
+    Parameters
+    ----------
+    n : int
+        Number of points; ``x = i L / n``.
+    length : float
+        Profile length ``L`` (m), ``Surface.size``.
+    hurst : float
+        Hurst exponent ``H`` in (0, 1), ``D = 2 - H``.
+    gamma : float
+        Frequency density ``gamma > 1`` (1.5 after Malcai et al.).
+    amplitude : float
+        ``A`` (m).
+    q0 : float, optional
+        Base angular wavenumber (rad/m); default ``2 pi / L``.
+    k_range : (int, int), optional
+        ``(k1, k2)``; default: all ``k`` with ``2 pi / L <= q0 gamma**k <= pi n / L``
+        (from the profile length to the Nyquist wavenumber, Majumdar & Bhushan 1991).
+    rng : Generator or int, optional
+        Source of the phases ``phi_k ~ U[0, 2 pi)``; the seed is recorded.
+
+    Returns
+    -------
+    Surface
+        Non-periodic profile (m).
+    """
+    (x,), length = _grid(n, length, 1)
+    gamma, hurst = _check_gamma_hurst(gamma, hurst)
+    q0 = 2 * np.pi / length if q0 is None else float(q0)
+    if not (np.isfinite(q0) and q0 > 0):
+        raise InputError(f"q0 must be > 0 (rad/m), got {q0!r}")
+    if k_range is None:
+        k1 = int(np.ceil(np.log(2 * np.pi / length / q0) / np.log(gamma) - 1e-9))
+        k2 = int(np.floor(np.log(np.pi * n / length / q0) / np.log(gamma) + 1e-9))
+    else:
+        k1, k2 = (int(k) for k in k_range)
+    if k2 < k1:
+        raise InputError(f"k_range must satisfy k1 <= k2, got ({k1}, {k2})")
+    gen, seed = resolve_rng(rng)
+    k = np.arange(k1, k2 + 1)
+    phases = gen.uniform(0, 2 * np.pi, k.size)
+    amps = float(amplitude) * gamma ** (-hurst * k)
+    h = wm_series(x, amps[None, :], q0 * gamma ** k, -phases[None, :])
+    meta = {"generator": "wm", "equation": "thesis Eq. (2.1)", "hurst": hurst, "gamma": gamma,
+            "amplitude_A": float(amplitude), "q0": q0, "k_range": [k1, k2], "seed": seed}
+    return Surface(h, length, periodic=False, metadata=meta)
+
+
+def mwm_coefficients(hurst, gamma, wavelength, n_range, ridges, amplitude=1.0, anisotropy=None):
+    """Amplitudes ``(M, n_c)`` and wavenumbers ``(n_c,)`` of the MWM sum, Eq. (3.17).
+
+    ``a[m, n] = A alpha_m sqrt(log10(gamma) / M) (2 pi / lambda)**(-H) gamma**((1-n) H)``,
+    ``q_n = (2 pi / lambda) gamma**(n-1)`` for ``n_s <= n <= n_f``. ``log`` is base 10
+    as the thesis states below Eq. (2.2). Eq. (2.2) is the same sum with
+    ``A_m = alpha_m A (2 pi / lambda)**(-H)`` and an infinite range of ``n``.
+    """
+    gamma, hurst = _check_gamma_hurst(gamma, hurst)
+    wavelength = check_finite_positive("wavelength lambda (m)", wavelength)
+    if isinstance(ridges, bool) or not isinstance(ridges, (int, np.integer)) or ridges < 1:
+        raise InputError(f"ridges M must be an integer >= 1, got {ridges!r}")
+    n_s, n_f = (int(v) for v in n_range)
+    if n_f < n_s:
+        raise InputError(f"n_range must satisfy n_s <= n_f, got ({n_s}, {n_f})")
+    alpha = np.ones(ridges) if anisotropy is None else np.asarray(anisotropy, float).ravel()
+    if alpha.size != ridges or not np.all(np.isfinite(alpha)) or np.any(alpha <= 0):
+        raise InputError(f"anisotropy must hold M = {ridges} positive factors a_m, got {anisotropy!r}")
+    nn = np.arange(n_s, n_f + 1)
+    q_base = 2 * np.pi / wavelength
+    scale = float(amplitude) * np.sqrt(np.log10(gamma) / ridges) * q_base ** (-hurst)
+    amps = scale * alpha[:, None] * gamma ** ((1 - nn) * hurst)[None, :]
+    return amps, q_base * gamma ** (nn - 1.0)
+
+
+def mwm_surface(n, length, hurst, gamma=1.5, wavelength=None, n_range=None, ridges=10,
+                amplitude=1e-6, anisotropy=None, angles=None, rng=None):
+    """Multivariate Weierstrass-Mandelbrot surface, thesis Eq. (2.2) / (3.17).
+
+    ``Z(x, y) = sum_n sum_m a[m, n] [cos(phi_mn) - cos(q_n (x cos th_m + y sin th_m) + phi_mn)]``
+    with ``a`` and ``q_n`` of :func:`mwm_coefficients`. The thesis writes the ridge
+    coordinate as ``sqrt(x^2 + y^2) cos(theta_m)``; that is a typo for the projection
+    ``n_m . x = x cos(theta_m) + y sin(theta_m)`` on the ridge direction (Ausloos & Berman
+    1985; Eq. 2.2 writes the scalar product), which is used here. ``Z(0, 0) = 0``.
+
+    Parameters
+    ----------
+    n : int
+        Grid points per side; ``x = i L / n``.
+    length : float
+        Side ``L`` (m), ``Surface.size``.
+    hurst, gamma : float
+        ``H`` in (0, 1) (``D = 3 - H``), ``gamma > 1``.
+    wavelength : float, optional
+        ``lambda`` (m), the longest wave (``n = 1``); default ``L``.
+    n_range : (int, int), optional
+        ``(n_s, n_f)``; default from ``1`` to the last ``n`` with ``q_n <= pi n / L``
+        (Nyquist).
+    ridges : int
+        Number of ridges ``M``.
+    amplitude : float
+        ``A`` of Eq. (3.17) (unit m^(1-H), so that ``a`` is in metres).
+    anisotropy : array of M floats, optional
+        Factors ``alpha_m`` (0.85..1.15 for anisotropic surfaces); default ones.
+    angles : array of M floats or "random", optional
+        Ridge angles ``theta_m`` (rad). Default ``pi m / M`` (Ausloos & Berman);
+        ``"random"`` draws them uniformly in [0, pi).
+    rng : Generator or int, optional
+        Source of the phases ``phi_mn ~ U[0, 2 pi)``; the seed is recorded.
+
+    Returns
+    -------
+    Surface
+        Non-periodic surface (m).
+    """
+    (x, y), length = _grid(n, length, 2)
+    wavelength = length if wavelength is None else wavelength
+    gamma, hurst = _check_gamma_hurst(gamma, hurst)
+    if n_range is None:
+        n_f = 1 + int(np.floor(np.log(np.pi * n / length * float(wavelength) / (2 * np.pi))
+                               / np.log(gamma) + 1e-9))
+        n_range = (1, max(n_f, 1))
+    amps, q = mwm_coefficients(hurst, gamma, wavelength, n_range, ridges, amplitude, anisotropy)
+    gen, seed = resolve_rng(rng)
+    if angles is None:
+        theta = np.pi * np.arange(1, ridges + 1) / ridges
+    elif isinstance(angles, str) and angles == "random":
+        theta = gen.uniform(0, np.pi, ridges)
+    else:
+        theta = np.asarray(angles, dtype=float).ravel()
+    phases = gen.uniform(0, 2 * np.pi, amps.shape)
+    h = wm_series((x, y), amps, q, phases, angles=theta)
+    meta = {"generator": "mwm", "equation": "thesis Eq. (2.2)/(3.17)", "hurst": hurst,
+            "gamma": gamma, "wavelength": float(wavelength), "n_range": list(n_range),
+            "ridges": int(ridges), "amplitude_A": float(amplitude),
+            "anisotropy": None if anisotropy is None else [float(a) for a in np.ravel(anisotropy)],
+            "angles": [float(t) for t in theta], "seed": seed}
+    return Surface(h, (length, length), periodic=False, metadata=meta)

@@ -1,0 +1,136 @@
+"""Self-affine periodic surfaces and profiles by Fourier filtering.
+
+The standard input of Tamaas and contact.engineering (Persson et al. 2005; Jacobs,
+Junge & Pastewka 2017). The target PSD (normalisation of :mod:`roughfe.surfaces.stats`)
+is isotropic with a roll-off:
+
+    C(q) = C0                                  q_l <= |q| <  q_r
+    C(q) = C0 (|q| / q_r)**(-(d + 2H))         q_r <= |q| <= q_s
+    C(q) = 0                                   otherwise (and at q = 0)
+
+with ``d`` the topological dimension: ``q**-2(1+H)`` for a surface, ``q**-(1+2H)`` for a
+profile (both self-affine with Hurst exponent ``H``).
+
+The Fourier coefficients are ``h~(q) = sqrt(C(q) dqx dqy) xi(q)``, where ``xi`` is the
+(normalised) DFT of real white noise: it is Hermitian (``xi(-q) = conj xi(q)``) by
+construction, so the heights are real. ``amplitudes="gaussian"`` keeps the Gaussian
+modulus of ``xi`` (a Gaussian random field, ``E|xi|^2 = 1``); ``"fixed"`` keeps only its
+random phase (``|xi| = 1``: the PSD of one realisation is exactly the target). Modes at
+the Nyquist wavenumber of an even grid are set to zero (their slope is undefined).
+``C0`` is then chosen so that the rms height or the rms slope (gradient) of the
+realisation equals the target exactly (both computed as in :mod:`.stats`, spectrally for
+periodic data). The result is periodic with period ``size``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError, check_finite_positive, check_in_open_interval
+from .stats import angular_wavevectors, rms_height as _rms_height, rms_slope as _rms_slope
+from .surface import Surface
+from .wm import resolve_rng
+
+
+def self_affine_psd(q, hurst, q_roll, q_short, q_long=0.0, ndim=2):
+    """Shape of the isotropic PSD above with ``C0 = 1`` (dimensionless), at ``|q|`` (rad/m).
+
+    Exponent ``-(ndim + 2 H)``: ``ndim = 2`` surface, ``ndim = 1`` profile.
+    """
+    q = np.asarray(q, dtype=float)
+    c = np.where(q < q_roll, 1.0, (np.maximum(q, q_roll) / q_roll) ** (-(ndim + 2.0 * hurst)))
+    return np.where((q >= q_long) & (q <= q_short) & (q > 0), c, 0.0)
+
+
+def _shape_and_size(n, size, ndim):
+    shape = (int(n),) * ndim if np.ndim(n) == 0 else tuple(int(v) for v in n)
+    if len(shape) != ndim or any(v < 2 for v in shape):
+        raise InputError(f"n must give {ndim} grid size(s) >= 2, got {n!r}")
+    sizes = np.broadcast_to(np.asarray(size, dtype=float), (ndim,))
+    return shape, tuple(check_finite_positive(f"size[{k}] (m)", s) for k, s in enumerate(sizes))
+
+
+def _synthesise(ndim, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_short,
+                amplitudes, rng):
+    shape, size = _shape_and_size(n, size, ndim)
+    hurst = check_in_open_interval("hurst H", hurst, 0.0, 1.0)
+    if (rms_height is None) == (rms_slope is None):
+        raise InputError("give exactly one of rms_height (m) and rms_slope (-), "
+                         f"got rms_height={rms_height!r}, rms_slope={rms_slope!r}")
+    target = check_finite_positive("rms_height (m)" if rms_slope is None else "rms_slope",
+                                   rms_height if rms_slope is None else rms_slope)
+    if amplitudes not in ("gaussian", "fixed"):
+        raise InputError(f"amplitudes must be 'gaussian' or 'fixed', got {amplitudes!r}")
+    q_min = 2 * np.pi / max(size)
+    q_nyq = min(np.pi * nn / s for nn, s in zip(shape, size))
+    q_roll = q_min if q_roll is None else check_finite_positive("q_roll (rad/m)", q_roll)
+    q_short = q_nyq if q_short is None else check_finite_positive("q_short (rad/m)", q_short)
+    q_long = 0.0 if q_long is None else float(q_long)
+    if not (0 <= q_long <= q_roll < q_short):
+        raise InputError(f"wavenumbers must satisfy 0 <= q_long <= q_roll < q_short (rad/m), got "
+                         f"q_long={q_long!r}, q_roll={q_roll!r}, q_short={q_short!r}")
+    gen, seed = resolve_rng(rng)
+    noise = np.fft.rfftn(gen.standard_normal(shape)) / np.sqrt(np.prod(shape))   # E|xi|^2 = 1
+    if amplitudes == "fixed":
+        noise = np.exp(1j * np.angle(noise))
+    qs = list(angular_wavevectors(shape, size))
+    qs[-1] = qs[-1][..., : shape[-1] // 2 + 1]          # rfft keeps q_last >= 0
+    qs[-1] = np.abs(qs[-1])
+    qabs = np.sqrt(sum(q ** 2 for q in qs))
+    filt = np.sqrt(self_affine_psd(qabs, hurst, q_roll, q_short, q_long, ndim))
+    for axis, nn in enumerate(shape):                    # drop Nyquist modes of even axes
+        if nn % 2 == 0:
+            idx = [slice(None)] * ndim
+            idx[axis] = nn // 2
+            filt[tuple(idx)] = 0.0
+    if not np.any(filt > 0):
+        raise InputError(f"no Fourier mode lies in [q_long, q_short] = [{q_long}, {q_short}] rad/m "
+                         f"on this grid")
+    h = np.fft.irfftn(noise * filt, s=shape, axes=tuple(range(ndim)))
+    meta = {"generator": "spectral", "hurst": hurst, "q_long": q_long, "q_roll": q_roll,
+            "q_short": q_short, "amplitudes": amplitudes, "rms_height_target": rms_height,
+            "rms_slope_target": rms_slope, "seed": seed}
+    unit = Surface(h, size, periodic=True)
+    achieved = _rms_height(unit) if rms_slope is None else _rms_slope(unit)
+    return Surface(h * (target / achieved), size, periodic=True, metadata=meta)
+
+
+def spectral_surface(n, size, hurst, rms_height=None, rms_slope=None, q_long=None, q_roll=None,
+                     q_short=None, amplitudes="gaussian", rng=None) -> Surface:
+    """Periodic self-affine surface by Fourier filtering (PSD in the module docstring).
+
+    Parameters
+    ----------
+    n : int or (int, int)
+        Grid points per axis.
+    size : float or (float, float)
+        Period ``L`` per axis (m).
+    hurst : float
+        Hurst exponent ``H`` in (0, 1); ``C ~ q**(-2(1+H))``, ``D = 3 - H``.
+    rms_height, rms_slope : float
+        Exactly one target: rms height (m) or rms gradient (-).
+    q_long, q_roll, q_short : float, optional
+        Long-wavelength cut-off ``q_l`` (default 0), roll-off ``q_r`` (default
+        ``2 pi / L``: no plateau) and short-wavelength cut-off ``q_s`` (default Nyquist
+        ``pi n / L``), rad/m.
+    amplitudes : {"gaussian", "fixed"}
+        Gaussian random field, or random phases with the exact target PSD.
+    rng : Generator or int, optional
+        Random source or seed (recorded).
+
+    Returns
+    -------
+    Surface
+        Periodic surface, mean zero (m).
+    """
+    return _synthesise(2, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_short,
+                       amplitudes, rng)
+
+
+def spectral_profile(n, size, hurst, rms_height=None, rms_slope=None, q_long=None, q_roll=None,
+                     q_short=None, amplitudes="gaussian", rng=None) -> Surface:
+    """Periodic self-affine profile, ``C ~ q**(-(1+2H))`` above ``q_r`` (``D = 2 - H``).
+
+    Parameters as in :func:`spectral_surface`, one axis; ``rms_slope`` is ``sqrt<h'^2>``.
+    """
+    return _synthesise(1, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_short,
+                       amplitudes, rng)
