@@ -1,0 +1,445 @@
+"""Frictionless contact of a plane-strain elastic body with a rigid rough/flat obstacle.
+
+The FEM cross-validation of the BEM (thesis Sec. 2.2, Eq. 2.3-2.7). A body meshed by
+:func:`roughfe.fem.mesh.mesh_profile` (width W, depth H_d; lateral rollers u_x = 0 at
+x = 0, W and a roller bottom u_y = 0) is pushed up against a rigid obstacle that is
+lowered by the approach Delta. For each top vertex i (profile sample i) the initial gap
+is ``g0_i = max(h) - h_i``, and the non-penetration condition reads
+
+    u_y,i <= g0_i - Delta                                          (Signorini, Eq. 2.5)
+
+in both geometric formulations: (a) ``"flat"`` body + rough rigid obstacle (small slope,
+the BEM assumptions) and (b) ``"profile"`` body with the rough top + rigid flat (finite
+slopes; the flat is vertical-normal, so the same nodal condition is exact for it).
+
+Weak form (plane strain, linear elasticity): find u with u_x = 0 on left/right and
+u_y = 0 on the bottom such that
+
+    a(u, v) = integral_Omega sigma(u) : eps(v) dA = integral_top t . v ds  for all v,
+    sigma(u) = lambda tr(eps(u)) I + 2 mu eps(u),   eps(u) = sym(grad u),
+
+with the contact traction t from one of two solvers:
+
+* ``"vi"``: PETSc SNES ``vinewtonrsls`` (reduced-space active set) with upper bounds
+  ``g0 - Delta`` on the owned top vertical DOFs (+-inf elsewhere), line search
+  ``basic`` (``bt`` stalls with DIVERGED_LINE_SEARCH on large steps), LU by MUMPS.
+* ``"penalty"``: residual ``a(u, v) + kappa integral_top <u_y - g>_+ v_y ds`` with
+  kappa = k E / delta (k = ``penalty_factor``, delta the top element size), integrated
+  with the nodal (2-point Gauss-Lobatto-Legendre) rule. For P1 elements that rule makes
+  the term diagonal, ``kappa w_i <u_y,i - g_i>_+`` with trapezoidal weights w_i (dx, and
+  dx/2 at the ends), which is what is assembled here (no form recompilation per step).
+  Newton (SNES ``newtonls``, line search ``basic``) with the exact generalized Jacobian.
+
+Everything is solved in non-dimensional units (coordinates / W, displacements / height
+range, E = 1): the SNES VI active-set test uses absolute tolerances, and displacements of
+1e-7 m made most steps fail. Results are converted back to SI.
+
+Outputs per load step (:class:`FemContactResult`, same field names as the BEM result):
+the nodal contact forces are the reaction ``-(K u)_y`` on the top vertical DOFs (N/m);
+the load is their sum, the mean pressure load / W; ``pressure = force / w_i``; contact
+vertices give A* = sum(w_i in contact) / W. Delta is corrected for the finite depth: a
+uniform pressure p on a roller-supported layer of depth H_d shortens it by exactly
+p H_d / M, M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) (the P-wave/oedometric modulus), and by
+Betti's theorem the mean top displacement under any pressure distribution is
+-p_mean H_d / M. So ``delta_corrected = Delta - p_mean H_d / M`` is the approach with
+zero mean elastic displacement: the convention of the periodic half-plane BEM. The
+stiffness K = dp/dDelta_corrected (thesis Eq. 2.7) is computed over a sweep.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Literal, Mapping
+
+import numpy as np
+
+from ..errors import InputError, NoConvergenceError, check_finite_positive, check_in_open_interval
+from .mesh import FACET_TAGS, ProfileMesh
+from .petsc_tools import LU_MUMPS, apply_options, check_snes, unique_prefix
+
+Method = Literal["vi", "penalty"]
+METHODS = ("vi", "penalty")
+REFERENCES = ("Benson S.J., Munson T.S. (2006) Optim. Methods Softw. 21:155-168 (SNES VI)",
+              "Wriggers P. (2006) Computational Contact Mechanics, Springer (penalty)",
+              "Johnson K.L. (1985) Contact Mechanics, Sec. 13.2 (Westergaard)")
+
+
+@dataclass(frozen=True)
+class ElasticMaterial:
+    """Isotropic linear elastic body in plane strain.
+
+    Attributes
+    ----------
+    youngs_modulus : float
+        E (Pa).
+    poisson_ratio : float
+        nu, -1 < nu < 0.5.
+    """
+
+    youngs_modulus: float
+    poisson_ratio: float = 0.3
+
+    def __post_init__(self):
+        check_finite_positive("youngs_modulus", self.youngs_modulus)
+        check_in_open_interval("poisson_ratio", self.poisson_ratio, -1.0, 0.5)
+
+    @property
+    def e_star(self) -> float:
+        """Plane-strain modulus E* = E / (1 - nu^2) (Pa): a rigid obstacle on this body."""
+        return self.youngs_modulus / (1.0 - self.poisson_ratio ** 2)
+
+    @property
+    def p_wave_modulus(self) -> float:
+        """M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) (Pa): uniaxial-strain (layer) modulus."""
+        E, nu = self.youngs_modulus, self.poisson_ratio
+        return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+
+
+@dataclass(frozen=True)
+class FemSolverOptions:
+    """Numerical options of the FEM contact solvers (physical data live elsewhere).
+
+    Attributes
+    ----------
+    method : {"vi", "penalty"}
+        SNES variational inequality or penalty + Newton.
+    penalty_factor : float
+        k in kappa = k E / delta (1e3-1e4 recommended).
+    rtol, atol : float
+        SNES relative / absolute residual tolerances (non-dimensional residual).
+    max_it : int
+        SNES iteration limit per load step.
+    petsc_options : mapping, optional
+        Extra PETSc options (without prefix) overriding the defaults, e.g.
+        ``{"snes_linesearch_type": "bt"}``.
+    """
+
+    method: Method = "vi"
+    penalty_factor: float = 1e4
+    rtol: float = 1e-10
+    atol: float = 1e-12
+    max_it: int = 50
+    petsc_options: Mapping | None = None
+
+    def __post_init__(self):
+        if self.method not in METHODS:
+            raise InputError(f"method must be one of {METHODS}, got {self.method!r}")
+        check_finite_positive("penalty_factor", self.penalty_factor)
+        if int(self.max_it) < 1:
+            raise InputError(f"max_it must be >= 1, got {self.max_it!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class FemContactResult:
+    """One FEM contact solution; field names follow the BEM ``ContactResult``.
+
+    Attributes
+    ----------
+    x : ndarray (n,)
+        Positions of the top vertices (m).
+    pressure : ndarray (n,)
+        Contact pressure (Pa), nodal force / tributary length, >= 0 in compression.
+    gap : ndarray (n,)
+        Gap to the obstacle (m), >= 0 (penalty: negative by the penetration).
+    contact : ndarray (n,) of bool
+        Vertices in contact.
+    displacement : ndarray (n,)
+        Vertical displacement u_y of the top vertices (m), positive upwards.
+    delta : float
+        Imposed approach Delta (m), measured from first touch of the highest sample.
+    delta_corrected : float
+        Delta - mean_pressure * layer_compliance (m): the half-plane approach.
+    layer_compliance : float
+        H_d / M (m/Pa).
+    load : float
+        Total contact force per unit depth (N/m), from the nodal reaction.
+    mean_pressure : float
+        load / W (Pa).
+    area_fraction : float
+        A* = contact_area / W.
+    contact_area : float
+        Contact length per unit depth (m).
+    n_contact : int
+        Number of top vertices in contact.
+    stiffness : float
+        K = dp/d delta_corrected (Pa/m); NaN for a single solve, set by a sweep.
+    success, message, nit
+        As in scipy's OptimizeResult (nit = SNES iterations).
+    method, formulation : str
+        Contact solver and geometric formulation.
+    fields : dict or None
+        Full-field data for pictures (when ``keep_fields``): ``points`` (m, (N, 2)),
+        ``cells`` ((C, 3) vertex indices), ``displacement`` (m, (N, 2)),
+        ``stress_yy`` (Pa, per cell), and ``formulation``.
+    references : tuple of str
+    """
+
+    x: np.ndarray
+    pressure: np.ndarray
+    gap: np.ndarray
+    contact: np.ndarray
+    displacement: np.ndarray
+    delta: float
+    delta_corrected: float
+    layer_compliance: float
+    load: float
+    mean_pressure: float
+    area_fraction: float
+    contact_area: float
+    n_contact: int
+    stiffness: float
+    success: bool
+    message: str
+    nit: int
+    method: str
+    formulation: str
+    fields: dict | None = None
+    references: tuple = field(default=REFERENCES)
+
+
+class _ContactProblem:
+    """Assembled stiffness, top DOFs and one configured SNES (internal, per mesh+method)."""
+
+    def __init__(self, pmesh: ProfileMesh, material: ElasticMaterial, options: FemSolverOptions):
+        import ufl
+        from dolfinx import fem
+        from dolfinx.fem.petsc import assemble_matrix
+        from petsc4py import PETSc
+
+        self.pmesh, self.material, self.options = pmesh, material, options
+        mesh = pmesh.mesh
+        h = pmesh.heights
+        self.u_ref = float(h.max() - h.min())
+        if not self.u_ref > 0:
+            raise InputError("the profile is flat (max(h) == min(h)): there is no contact problem")
+        nu = material.poisson_ratio
+        V = fem.VectorFunctionSpace(mesh, ("CG", 1))
+        self.V = V
+        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+        lam = nu / ((1 + nu) * (1 - 2 * nu))          # Lame constants for E = 1
+        mu = 1.0 / (2 * (1 + nu))
+
+        def eps(w):
+            return ufl.sym(ufl.grad(w))
+
+        def sigma(w):
+            return lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2 * mu * eps(w)
+
+        a = fem.form(ufl.inner(sigma(u), eps(v)) * ufl.dx)
+        fdim = mesh.topology.dim - 1
+        ft = pmesh.facet_tags
+        bcs = []
+        for name, comp in (("left", 0), ("right", 0), ("bottom", 1)):
+            facets = ft.find(FACET_TAGS[name])
+            dofs = fem.locate_dofs_topological(V.sub(comp), fdim, facets)
+            bcs.append(fem.dirichletbc(PETSc.ScalarType(0), dofs, V.sub(comp)))
+        self.K = assemble_matrix(a, bcs=bcs)
+        self.K.assemble()
+
+        # owned top vertices -> profile sample index
+        bs = V.dofmap.index_map_bs
+        n_owned = V.dofmap.index_map.size_local
+        blocks = fem.locate_dofs_topological(V, fdim, ft.find(FACET_TAGS["top"]))
+        blocks = blocks[blocks < n_owned]
+        xy = V.tabulate_dof_coordinates()[blocks, :2]
+        n = h.size
+        idx = np.rint(xy[:, 0] * (n - 1)).astype(np.int64)
+        if np.any(np.abs(xy[:, 0] * (n - 1) - idx) > 1e-6):
+            raise InputError("top vertices of the mesh do not coincide with the profile samples")
+        self.sample = idx
+        self.top_dofs = (bs * blocks + 1).astype(np.int32)       # local u_y DOFs (owned)
+        w = np.full(n, 1.0 / (n - 1))                            # trapezoid weights / W
+        w[[0, -1]] *= 0.5
+        self.weights = w[idx]
+        self.gap0 = (h.max() - h[idx]) / self.u_ref
+        self.x, self.y = self.K.createVecs()
+        self.x.set(0.0)
+        self.r = self.x.duplicate()
+        self.kappa = options.penalty_factor * (n - 1)         # k E/delta in units E/W
+        self.snes = self._make_snes()
+
+    # -- SNES ---------------------------------------------------------------------------
+    def _residual(self, snes, x, F):
+        self.K.mult(x, F)
+        if self.options.method == "penalty":
+            pen = np.maximum(x.array_r[self.top_dofs] - self.bound, 0.0)
+            F.array[self.top_dofs] += self.kappa * self.weights * pen
+
+    def _jacobian(self, snes, x, J, P):
+        if self.options.method == "penalty":
+            self.K.copy(J, structure=J.Structure.SAME_NONZERO_PATTERN)
+            active = (x.array_r[self.top_dofs] > self.bound).astype(float)
+            d = J.createVecLeft()
+            d.set(0.0)
+            d.array[self.top_dofs] = self.kappa * self.weights * active
+            J.setDiagonal(d, addv=True)
+            J.assemble()
+
+    def _make_snes(self):
+        from petsc4py import PETSc
+
+        opt = self.options
+        snes = PETSc.SNES().create(self.K.getComm())
+        J = self.K if opt.method == "vi" else self.K.duplicate(copy=True)
+        snes.setFunction(self._residual, self.r)
+        snes.setJacobian(self._jacobian, J, J)
+        snes.setTolerances(rtol=opt.rtol, atol=opt.atol, max_it=int(opt.max_it))
+        defaults = {"snes_type": "vinewtonrsls" if opt.method == "vi" else "newtonls",
+                    "snes_linesearch_type": "basic", **LU_MUMPS}
+        ksp_keys = {"ksp_type", "pc_type", "pc_factor_mat_solver_type"}
+        petsc = {**defaults, **dict(opt.petsc_options or {})}
+        prefix = unique_prefix(opt.method)
+        apply_options(snes, prefix, {k: v for k, v in petsc.items() if k not in ksp_keys})
+        ksp = snes.getKSP()
+        apply_options(ksp, prefix, {k: v for k, v in petsc.items() if k in ksp_keys})
+        self.lower = self.x.duplicate()
+        self.upper = self.x.duplicate()
+        self.lower.set(-PETSc.INFINITY)
+        self.upper.set(PETSc.INFINITY)
+        return snes
+
+    # -- one load step ----------------------------------------------------------------
+    def solve(self, delta: float, keep_fields: bool = False) -> FemContactResult:
+        """Solve for the approach ``delta`` (m), starting from the previous solution."""
+        self.bound = self.gap0 - float(delta) / self.u_ref
+        if self.options.method == "vi":
+            self.upper.array[self.top_dofs] = self.bound
+            self.snes.setVariableBounds(self.lower, self.upper)
+        self.snes.solve(None, self.x)
+        what = (f"FEM contact ({self.options.method}, {self.pmesh.formulation}) at "
+                f"delta = {float(delta):.6g} m")
+        nit = check_snes(self.snes, what)
+        return self._result(float(delta), nit, what, keep_fields)
+
+    def _gather(self, local):
+        """Top-vertex values of all ranks, ordered by profile sample."""
+        comm = self.pmesh.mesh.comm
+        idx = np.concatenate(comm.allgather(self.sample))
+        val = np.concatenate(comm.allgather(np.asarray(local, dtype=float)))
+        out = np.empty(self.pmesh.heights.size)
+        out[idx] = val
+        return out
+
+    def _result(self, delta, nit, what, keep_fields):
+        pm, mat = self.pmesh, self.material
+        E, W = mat.youngs_modulus, pm.width
+        self.K.mult(self.x, self.y)
+        uy_hat = self.x.array_r[self.top_dofs]
+        if self.options.method == "vi":
+            force_hat = -self.y.array_r[self.top_dofs]
+        else:
+            force_hat = self.kappa * self.weights * np.maximum(uy_hat - self.bound, 0.0)
+        force = self._gather(force_hat) * E * self.u_ref              # N/m per vertex
+        uy = self._gather(uy_hat) * self.u_ref
+        w = np.full(pm.heights.size, pm.element_size)
+        w[[0, -1]] *= 0.5
+        pressure = np.maximum(force, 0.0) / w
+        gap = (pm.heights.max() - pm.heights) - delta - uy
+        tol = 1e-8 * self.u_ref
+        contact = gap <= tol if self.options.method == "vi" else gap < 0.0
+        load = float(force.sum())
+        mean_p = load / W
+        compliance = pm.depth / mat.p_wave_modulus
+        area = float(w[contact].sum())
+        fields = self._fields() if keep_fields else None
+        return FemContactResult(
+            x=pm.x.copy(), pressure=pressure, gap=gap, contact=contact, displacement=uy,
+            delta=delta, delta_corrected=delta - mean_p * compliance,
+            layer_compliance=compliance, load=load, mean_pressure=mean_p,
+            area_fraction=area / W, contact_area=area, n_contact=int(contact.sum()),
+            stiffness=float("nan"), success=True, message=f"{what}: converged", nit=nit,
+            method=self.options.method, formulation=pm.formulation, fields=fields)
+
+    def _fields(self):
+        """Vertices, triangles, displacement (m) and cell-wise sigma_yy (Pa), serial."""
+        pm, mat = self.pmesh, self.material
+        if pm.mesh.comm.size > 1:
+            return None
+        pts = self.V.tabulate_dof_coordinates()[:, :2] * pm.length_scale
+        cells = self.V.dofmap.list.array.reshape(-1, 3).astype(np.int64)
+        disp = self.x.array_r.reshape(-1, 2) * self.u_ref
+        return {"points": pts, "cells": cells, "displacement": disp,
+                "stress_yy": cell_stress_yy(pts, cells, disp, mat),
+                "formulation": pm.formulation}
+
+
+def cell_stress_yy(points, cells, displacement, material: ElasticMaterial):
+    """sigma_yy (Pa) of each linear triangle (constant strain), plane strain.
+
+    sigma_yy = lambda (eps_xx + eps_yy) + 2 mu eps_yy from the exact P1 gradients.
+    """
+    p = points[cells]                                  # (C, 3, 2)
+    u = displacement[cells]                            # (C, 3, 2)
+    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    jac = np.stack([d1, d2], axis=-1)                  # columns: edge vectors
+    du = np.stack([u[:, 1] - u[:, 0], u[:, 2] - u[:, 0]], axis=-1)   # (C, 2 comps, 2 edges)
+    grad = du @ np.linalg.inv(jac)                     # du_i/dx_j
+    E, nu = material.youngs_modulus, material.poisson_ratio
+    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
+    mu = E / (2 * (1 + nu))
+    return lam * (grad[:, 0, 0] + grad[:, 1, 1]) + 2 * mu * grad[:, 1, 1]
+
+
+def stiffness_along(delta, mean_pressure):
+    """K = dp/dDelta (Pa/m) along a sweep by second-order finite differences (Eq. 2.7).
+
+    ``np.gradient`` on the (possibly non-uniform) Delta values; one-sided at the ends.
+    """
+    delta = np.asarray(delta, dtype=float)
+    p = np.asarray(mean_pressure, dtype=float)
+    if delta.size < 2:
+        return np.full(delta.shape, np.nan)
+    return np.gradient(p, delta, edge_order=1 if delta.size < 3 else 2)
+
+
+def fem_contact_sweep(pmesh: ProfileMesh, material: ElasticMaterial, deltas,
+                      options: FemSolverOptions | None = None, keep_fields=()):
+    """Solve the FEM contact problem for increasing approaches ``deltas`` (m).
+
+    Each step starts from the previous solution (load stepping). The stiffness
+    K = dp/d delta_corrected is filled in from the whole sweep.
+
+    Parameters
+    ----------
+    pmesh : ProfileMesh
+    material : ElasticMaterial
+    deltas : array_like
+        Strictly increasing approaches Delta >= 0 (m).
+    options : FemSolverOptions, optional
+    keep_fields : iterable of int
+        Indices of the steps whose full fields (mesh, displacement, sigma_yy) are kept.
+
+    Returns
+    -------
+    list of FemContactResult
+
+    Raises
+    ------
+    NoConvergenceError
+        Naming the SNES converged reason of the failed step; ``result`` holds the list
+        of the steps solved before it.
+    """
+    options = FemSolverOptions() if options is None else options
+    deltas = np.asarray(deltas, dtype=float).ravel()
+    if deltas.size == 0 or not np.all(np.isfinite(deltas)) or np.any(deltas < 0):
+        raise InputError(f"deltas must be a non-empty list of finite values >= 0 (m), got {deltas!r}")
+    if np.any(np.diff(deltas) <= 0):
+        raise InputError("deltas must be strictly increasing (load stepping)")
+    keep = {int(k) % deltas.size for k in keep_fields}
+    problem = _ContactProblem(pmesh, material, options)
+    results = []
+    try:
+        for k, d in enumerate(deltas):
+            results.append(problem.solve(d, keep_fields=k in keep))
+    except NoConvergenceError as exc:
+        raise NoConvergenceError(str(exc), result=results) from None
+    finally:
+        problem.snes.destroy()
+    K = stiffness_along([r.delta_corrected for r in results], [r.mean_pressure for r in results])
+    return [replace(r, stiffness=float(k)) for r, k in zip(results, K)]
+
+
+def fem_solve_contact(pmesh: ProfileMesh, material: ElasticMaterial, delta: float,
+                      options: FemSolverOptions | None = None, keep_fields=False):
+    """One FEM contact solve at approach ``delta`` (m), from the undeformed state."""
+    return fem_contact_sweep(pmesh, material, [delta], options,
+                             keep_fields=(0,) if keep_fields else ())[0]
