@@ -1,0 +1,384 @@
+"""Reynolds thin-film flow on a gap field with dolfinx (thesis Sec. 2.3.2, Eq. 2.10-2.12).
+
+The steady, incompressible Reynolds equation for the volume flux per unit width
+``q = h U / 2 - h^3/(12 mu) grad p`` (Eq. 2.11 divided by the constant density) and
+mass conservation ``div q = 0`` (Eq. 2.10) give (Eq. 2.12)::
+
+    div( h^3/(12 mu) grad p ) = div( h U / 2 )      on  [0, Lx] x [0, Ly]
+
+Weak form, for every test function ``v`` that vanishes on the inlet and outlet::
+
+    int h^3/(12 mu) grad p . grad v dx  =  int (h/2) U . grad v dx
+
+(the remaining boundary term is the normal flux ``q.n``, zero on the two side walls:
+no-flux, or periodic when asked).
+
+Discretisation
+--------------
+* A quadrilateral mesh with one cell per grid sample of the gap field (the BEM grid:
+  sample ``gap[i, j]`` is the cell ``[i dx, (i+1) dx] x [j dy, (j+1) dy]``), the gap
+  ``h`` constant per cell (DG0) and the pressure ``p`` in Q1 (one value per cell corner,
+  ``(nx+1) x (ny+1)`` vertices).
+* ``p = p_in`` on the inlet side, ``p = p_out`` on the outlet side (``x = 0`` and
+  ``x = Lx`` for ``direction="x"``; ``y = 0`` and ``y = Ly`` for ``"y"``).
+* Cells in contact have ``h = 0``: vertices that touch no open cell, and whole pockets
+  of open cells that reach neither inlet nor outlet, make the matrix singular (one
+  constant null vector per such component). Each such component is found by
+  connected-component labelling of the vertex graph (open cells join their four
+  corners) and one vertex of it is pinned; its pressure is then undetermined by the
+  boundary data and is returned as NaN. No artificial minimum gap is used (``h_min``
+  is an option: it biases the flux).
+* Periodic side walls are imposed algebraically: the vertices of the last row are
+  identified with the first one through a restriction matrix ``P`` (``K_r = P^T K P``),
+  which also removes the Dirichlet and pinned unknowns. The reduced matrix is SPD; it
+  is solved with CG + BoomerAMG (hypre) by default.
+* Leak rate by the consistent (weak-form) flux: with the full residual
+  ``r = K p - b`` and ``w`` linear from 1 on the inlet to 0 on the outlet,
+  ``Q = w . r`` (m^3/s), which is exact for the discrete problem; the inlet and outlet
+  sums of ``r`` are returned too (they agree to the solver tolerance).
+
+Note: with Q1 pressure, two open cells that touch only at a corner share a pressure
+unknown and exchange flux through that vertex. The network analysis of
+:mod:`roughfe.leakage.network` uses the saddle-point rule instead (thesis Fig. 13);
+the two may disagree on whether a gap field percolates.
+
+The mesh, function spaces and compiled forms are cached per grid (shape and size), so
+a sweep over loads on one surface builds them once. dolfinx runs here on
+``MPI.COMM_SELF`` (one process per solve; parallelism is over tasks).
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Mapping, Optional
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ..errors import InputError, NoConvergenceError, check_finite_positive
+
+DEFAULT_PETSC_OPTIONS = {
+    "ksp_type": "cg",
+    "pc_type": "hypre",
+    "pc_hypre_type": "boomeramg",
+    "ksp_rtol": 1e-10,
+    "ksp_atol": 0.0,
+    "ksp_max_it": 2000,
+}
+
+
+@dataclass(frozen=True, eq=False)
+class ReynoldsFESolution:
+    """Raw finite-element solution of the Reynolds equation on a grid.
+
+    Attributes
+    ----------
+    pressure : ndarray, shape (nx+1, ny+1)
+        Q1 nodal pressure in Pa at the cell corners (axis 0 = x). NaN where the pressure
+        is not determined by the inlet/outlet data (inside contact and trapped pockets).
+    pressure_pinned : ndarray, shape (nx+1, ny+1)
+        The same with the pinned values kept (finite everywhere), for flux evaluation.
+    connected : ndarray of bool, shape (nx+1, ny+1)
+        Vertices connected to the inlet or the outlet through open cells.
+    residual : ndarray, shape (nx+1, ny+1)
+        Nodal flux residual ``K p - b`` in m^3/s (non-zero on inlet/outlet only).
+    flow_rate : float
+        Consistent leak rate ``Q`` in m^3/s (positive from inlet to outlet).
+    inlet_flow, outlet_flow : float
+        Flow in through the inlet and out through the outlet (m^3/s).
+    percolates : bool
+        Whether the inlet and outlet are connected through open cells with Q1 (corner)
+        conduction.
+    success, message, nit : bool, str, int
+        Solver status (scipy OptimizeResult-like); ``nit`` is the number of Krylov
+        iterations (0 when there was nothing to solve).
+    """
+
+    pressure: np.ndarray
+    pressure_pinned: np.ndarray
+    connected: np.ndarray
+    residual: np.ndarray
+    flow_rate: float
+    inlet_flow: float
+    outlet_flow: float
+    percolates: bool
+    success: bool
+    message: str
+    nit: int
+
+
+def _serial_partitioner(comm, nparts, tdim, cells, ghost_mode):
+    from dolfinx import cpp
+    return cpp.graph.AdjacencyList_int32(np.zeros(cells.num_nodes, dtype=np.int32))
+
+
+@dataclass(frozen=True, eq=False)
+class _GridSpace:
+    """dolfinx objects for one grid (cached): mesh, spaces, forms and index maps."""
+
+    mesh: object
+    h: object          # DG0 Function: gap (m)
+    mu: object         # Constant: viscosity (Pa s)
+    velocity: object   # Constant vector: wall velocity (m/s)
+    a: object          # compiled stiffness form
+    L: object          # compiled Couette load form
+    dof_of_vertex: np.ndarray   # (nx+1)*(ny+1) structured vertex -> Q1 dof
+    dof_of_cell: np.ndarray     # nx*ny structured cell -> DG0 dof
+
+
+@functools.lru_cache(maxsize=2)
+def _grid_space(nx: int, ny: int, lx: float, ly: float) -> _GridSpace:
+    from mpi4py import MPI
+    import ufl
+    from dolfinx import fem, mesh
+    from petsc4py import PETSc
+
+    msh = mesh.create_rectangle(
+        MPI.COMM_SELF, [np.array([0.0, 0.0]), np.array([lx, ly])], [nx, ny],
+        mesh.CellType.quadrilateral, mesh.GhostMode.none, _serial_partitioner)
+    V = fem.FunctionSpace(msh, ("Lagrange", 1))
+    W = fem.FunctionSpace(msh, ("DG", 0))
+    h = fem.Function(W, name="gap")
+    mu = fem.Constant(msh, PETSc.ScalarType(1.0))
+    velocity = fem.Constant(msh, np.zeros(2, dtype=PETSc.ScalarType))
+    p, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    conductance = h**3 / (12.0 * mu)                       # h^3/(12 mu), Eq. 2.11
+    a = fem.form(conductance * ufl.inner(ufl.grad(p), ufl.grad(v)) * ufl.dx)
+    L = fem.form(0.5 * h * ufl.inner(velocity, ufl.grad(v)) * ufl.dx)   # Couette, Eq. 2.12
+
+    dx, dy = lx / nx, ly / ny
+    xv = V.tabulate_dof_coordinates()
+    iv = np.rint(xv[:, 0] / dx).astype(np.int64)
+    jv = np.rint(xv[:, 1] / dy).astype(np.int64)
+    dof_of_vertex = np.empty((nx + 1) * (ny + 1), dtype=np.int32)
+    dof_of_vertex[iv * (ny + 1) + jv] = np.arange(xv.shape[0], dtype=np.int32)
+    xc = W.tabulate_dof_coordinates()
+    ic = np.floor(xc[:, 0] / dx).astype(np.int64)
+    jc = np.floor(xc[:, 1] / dy).astype(np.int64)
+    dof_of_cell = np.empty(nx * ny, dtype=np.int32)
+    dof_of_cell[ic * ny + jc] = np.arange(xc.shape[0], dtype=np.int32)
+    return _GridSpace(msh, h, mu, velocity, a, L, dof_of_vertex, dof_of_cell)
+
+
+def vertex_components(open_cells: np.ndarray, *, periodic_axis: Optional[int] = None):
+    """Connected components of the Q1 vertex graph of a grid of cells.
+
+    Every open cell joins its four corners (Q1 conduction, including corner-only
+    contacts between cells). ``periodic_axis`` identifies the last vertex row along that
+    axis with the first.
+
+    Parameters
+    ----------
+    open_cells : ndarray of bool, shape (nx, ny)
+    periodic_axis : {None, 0, 1}
+
+    Returns
+    -------
+    labels : ndarray of int, shape (nx+1, ny+1)
+        Component label of each vertex.
+    """
+    nx, ny = open_cells.shape
+    nv = (nx + 1) * (ny + 1)
+    vid = np.arange(nv).reshape(nx + 1, ny + 1)
+    o = open_cells
+    rows = [vid[:-1, :-1][o], vid[1:, :-1][o], vid[:-1, :-1][o]]
+    cols = [vid[1:, 1:][o], vid[:-1, 1:][o], vid[1:, :-1][o]]
+    if periodic_axis == 0:
+        rows.append(vid[-1, :])
+        cols.append(vid[0, :])
+    elif periodic_axis == 1:
+        rows.append(vid[:, -1])
+        cols.append(vid[:, 0])
+    r = np.concatenate(rows)
+    c = np.concatenate(cols)
+    graph = sp.coo_matrix((np.ones(r.size, dtype=np.int8), (r, c)), shape=(nv, nv))
+    _, labels = connected_components(graph, directed=False)
+    return labels.reshape(nx + 1, ny + 1)
+
+
+def _petsc_aij(matrix: sp.csr_matrix):
+    from petsc4py import PETSc
+    m = matrix.tocsr()
+    m.sort_indices()
+    return PETSc.Mat().createAIJ(
+        size=m.shape, csr=(m.indptr.astype(PETSc.IntType), m.indices.astype(PETSc.IntType),
+                           m.data.astype(PETSc.ScalarType)), comm=PETSc.COMM_SELF)
+
+
+def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
+                      p_in: float = 1.0, p_out: float = 0.0, periodic: bool = False,
+                      wall_velocity=(0.0, 0.0), h_min: float = 0.0,
+                      petsc_options: Optional[Mapping] = None) -> ReynoldsFESolution:
+    """Solve the Reynolds equation (Eq. 2.12) on a gap field with Q1 finite elements.
+
+    Parameters
+    ----------
+    gap : ndarray, shape (nx, ny)
+        Local film thickness ``h`` in m per grid cell (>= 0; 0 in contact).
+    spacing : (float, float)
+        Cell size ``(dx, dy)`` in m.
+    direction : {"x", "y"}
+        Pressure drop along axis 0 (``"x"``) or axis 1 (``"y"``).
+    mu : float
+        Dynamic viscosity in Pa s.
+    p_in, p_out : float
+        Pressures on the inlet (coordinate 0) and outlet (coordinate L) sides, Pa.
+    periodic : bool
+        Periodic side walls (the two sides parallel to the flow); no-flux otherwise.
+    wall_velocity : (float, float)
+        Sliding velocity ``U`` of one wall in m/s (Couette term of Eq. 2.11-2.12).
+    h_min : float
+        Optional minimum gap in m applied to every cell (0: none, the default; a
+        positive value makes contact cells conduct and biases the flux).
+    petsc_options : mapping, optional
+        PETSc options overriding :data:`DEFAULT_PETSC_OPTIONS` (prefix-free keys).
+
+    Returns
+    -------
+    ReynoldsFESolution
+    """
+    from petsc4py import PETSc
+    import dolfinx.fem.petsc as fem_petsc
+
+    gap = np.asarray(gap, dtype=float)
+    if gap.ndim != 2 or min(gap.shape) < 1:
+        raise InputError(f"gap must be a 2D array (nx, ny) of metres, got shape {gap.shape}")
+    if not np.all(np.isfinite(gap)) or gap.min() < 0:
+        raise InputError(f"gap must be finite and >= 0 (m), got min {np.nanmin(gap)!r} "
+                         f"and {int((~np.isfinite(gap)).sum())} non-finite value(s)")
+    if direction not in ("x", "y"):
+        raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
+    mu = check_finite_positive("mu", mu)
+    dx, dy = (check_finite_positive("spacing", s) for s in spacing)
+    if not (np.isfinite(p_in) and np.isfinite(p_out)):
+        raise InputError(f"p_in and p_out must be finite (Pa), got {p_in!r}, {p_out!r}")
+    u = np.asarray(wall_velocity, dtype=float).reshape(-1)
+    if u.size != 2 or not np.all(np.isfinite(u)):
+        raise InputError(f"wall_velocity must be two finite numbers (m/s), got {wall_velocity!r}")
+    if not (h_min >= 0 and np.isfinite(h_min)):
+        raise InputError(f"h_min must be finite and >= 0 (m), got {h_min!r}")
+
+    h = np.maximum(gap, h_min) if h_min > 0 else gap
+    nx, ny = h.shape
+    axis = 0 if direction == "x" else 1
+    space = _grid_space(nx, ny, nx * dx, ny * dy)
+
+    # -- assemble the full (Neumann) matrix and the Couette load -------------------------
+    space.h.x.array[space.dof_of_cell] = h.ravel()
+    space.mu.value = mu
+    space.velocity.value = u
+    K = fem_petsc.assemble_matrix(space.a)
+    K.assemble()
+    nv = (nx + 1) * (ny + 1)
+    b_dof = np.zeros(nv)
+    if np.any(u != 0.0):
+        bvec = fem_petsc.assemble_vector(space.L)
+        b_dof = bvec.array.copy()                            # dolfinx dof order
+        bvec.destroy()
+
+    # -- structured bookkeeping: Dirichlet, periodic images, floating components -------
+    vshape = (nx + 1, ny + 1)
+    coord = np.indices(vshape)[axis]
+    n_flow = vshape[axis] - 1
+    inlet = (coord == 0).ravel()
+    outlet = (coord == n_flow).ravel()
+    periodic_axis = 1 - axis if periodic else None
+    labels = vertex_components(h > 0, periodic_axis=periodic_axis).ravel()
+    live = np.zeros(labels.max() + 1, dtype=bool)
+    live[labels[inlet | outlet]] = True
+    connected = live[labels]
+    percolates = bool(np.intersect1d(labels[inlet], labels[outlet]).size)
+
+    # master vertex of each vertex (periodic images point to the first row)
+    master = np.arange(nv).reshape(vshape)
+    if periodic_axis == 0:
+        master[-1, :] = master[0, :]
+    elif periodic_axis == 1:
+        master[:, -1] = master[:, 0]
+    master = master.ravel()
+    fixed = inlet | outlet
+    # pin the first vertex (master) of each floating component
+    floating = ~connected
+    first = np.full(live.size, -1, dtype=np.int64)
+    idx = np.flatnonzero(floating & (master == np.arange(nv)))
+    first[labels[idx[::-1]]] = idx[::-1]
+    pinned = np.zeros(nv, dtype=bool)
+    pinned[first[first >= 0]] = True
+    is_master = master == np.arange(nv)
+    fixed_v = fixed | pinned[master]
+    free_master = is_master & ~fixed_v
+    n_red = int(free_master.sum())
+    red = np.full(nv, -1, dtype=np.int64)
+    red[free_master] = np.arange(n_red)
+    red_of_vertex = np.where(fixed_v, -1, red[master])
+    # pinned vertices of floating components take p_out (their level is arbitrary)
+    p_fixed = np.where(inlet, p_in, p_out)
+
+    # restriction P: dof (dolfinx numbering) -> reduced unknown
+    dofs = space.dof_of_vertex
+    keep = red_of_vertex >= 0
+    P = sp.csr_matrix((np.ones(int(keep.sum())), (dofs[keep], red_of_vertex[keep])),
+                      shape=(nv, max(n_red, 1)))
+    # Dirichlet/pinned lift, in dof order
+    lift = np.zeros(nv)
+    fixed_all = ~keep
+    lift[dofs[fixed_all]] = p_fixed[fixed_all]
+
+    Kl = K.createVecLeft()
+    Kl.setArray(lift)
+    Klift = K.createVecLeft()
+    K.mult(Kl, Klift)
+    rhs_full = b_dof - Klift.array
+
+    p_dof = lift.copy()
+    nit, success, message = 0, True, "nothing to solve: every pressure unknown is fixed"
+    if n_red > 0:
+        Pm = _petsc_aij(P)
+        Kr = K.PtAP(Pm)
+        rhs = Kr.createVecLeft()
+        rhs.setArray(P.T @ rhs_full)
+        x = Kr.createVecRight()
+        ksp = PETSc.KSP().create(PETSc.COMM_SELF)
+        ksp.setOptionsPrefix("roughfe_reynolds_")
+        opts = PETSc.Options()
+        options = {**DEFAULT_PETSC_OPTIONS, **dict(petsc_options or {})}
+        for key, val in options.items():
+            opts[f"roughfe_reynolds_{key}"] = val
+        ksp.setOperators(Kr)
+        ksp.setFromOptions()
+        for key in options:
+            opts.delValue(f"roughfe_reynolds_{key}")
+        ksp.solve(rhs, x)
+        reason = ksp.getConvergedReason()
+        nit = int(ksp.getIterationNumber())
+        rnorm = float(ksp.getResidualNorm())
+        success = reason > 0
+        message = (f"KSP {ksp.getType()}/{ksp.getPC().getType()} converged (reason {reason}) "
+                   f"in {nit} iterations, residual norm {rnorm:.3e}" if success else
+                   f"KSP {ksp.getType()}/{ksp.getPC().getType()} failed (reason {reason}) "
+                   f"after {nit} iterations, residual norm {rnorm:.3e}")
+        p_dof = lift + P @ x.array
+        for obj in (ksp, x, rhs, Kr, Pm):
+            obj.destroy()
+    # full residual r = K p - b (flux into the domain at inlet/outlet vertices)
+    Kl.setArray(p_dof)
+    K.mult(Kl, Klift)
+    r_dof = Klift.array - b_dof
+    for obj in (Kl, Klift, K):
+        obj.destroy()
+
+    p = p_dof[dofs]                      # structured vertex order
+    r = r_dof[dofs]
+    if not success:
+        raise NoConvergenceError(f"Reynolds solve: {message}")
+    w = 1.0 - coord.ravel() / n_flow     # linear weight, 1 at inlet, 0 at outlet
+    q = float(w @ r)
+    q_in = float(r[inlet].sum())
+    q_out = float(-r[outlet].sum())
+    p_out_field = np.where(connected, p, np.nan).reshape(vshape)
+    return ReynoldsFESolution(
+        pressure=p_out_field, pressure_pinned=p.reshape(vshape),
+        connected=connected.reshape(vshape), residual=r.reshape(vshape),
+        flow_rate=q, inlet_flow=q_in, outlet_flow=q_out, percolates=percolates,
+        success=success, message=message, nit=nit)
