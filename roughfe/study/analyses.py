@@ -1,0 +1,138 @@
+"""The explicit registry of analyses a study can run.
+
+``ANALYSES`` maps a name to an :class:`Analysis`: the dotted path ``"module:function"``
+of a task function, a version string and a one-line description. Nothing is imported
+until a task runs (or the runner checks the parameters before submitting), so a missing
+or not-yet-installed analysis gives a clear error at run time, not at import time.
+
+A task function is called as ``function(**params, seed=seed)`` and returns one JSON-safe
+record (a dict) or a list of them; each record becomes one row of the collected table,
+next to the task's parameters and seed. Bump ``version`` when an analysis changes its
+results: the version is part of each task's content key, so old results are not reused.
+"""
+from __future__ import annotations
+
+import importlib
+import inspect
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """One registered analysis.
+
+    Attributes
+    ----------
+    target : str
+        ``"package.module:function"`` of the task function.
+    version : str
+        Part of every task key; change it when the results change.
+    description : str
+        One line for ``--help`` and ``roughfe study run --list``.
+    """
+
+    target: str
+    version: str
+    description: str
+
+
+ANALYSES = {
+    "selftest": Analysis(
+        "roughfe.study.analyses:selftest_task", "1",
+        "analytic function of x, y (cheap; options to sleep and to fail) for testing the runner"),
+    "contact_sweep": Analysis(
+        "roughfe.study.analyses:contact_sweep_task", "1",
+        "generate a random surface, run the BEM load sweep (roughfe.bem.contact_sweep)"),
+    "leakage": Analysis(
+        "roughfe.leakage.study:leakage_task", "1",
+        "leakage of one surface over approach steps (thesis Sec. 2.4)"),
+    "genome_db": Analysis(
+        "roughfe.genomics.database:genome_entry_task", "1",
+        "one entry of the surface-genome database (sequencing + BEM sweep)"),
+}
+
+
+def resolve(name: str):
+    """Import and return the task function of analysis ``name``.
+
+    Raises :class:`InputError` naming the analysis and the module when it cannot be
+    imported (for example when that part of roughfe is not installed yet).
+    """
+    if name not in ANALYSES:
+        raise InputError(f"analysis {name!r} is unknown; choose from {sorted(ANALYSES)}")
+    module_name, _, attr = ANALYSES[name].target.partition(":")
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise InputError(f"analysis {name!r} needs {ANALYSES[name].target}, which cannot be "
+                         f"imported here: {exc}") from None
+    try:
+        return getattr(module, attr)
+    except AttributeError:
+        raise InputError(f"analysis {name!r}: {module_name} has no function {attr!r}") from None
+
+
+def check_parameters(name: str, params) -> None:
+    """Raise :class:`InputError` unless ``function(**params, seed=...)`` can bind.
+
+    Run by the driver before any task is submitted, so that a typo in a spec fails at
+    once with the allowed names instead of failing every task on the workers.
+    """
+    func = resolve(name)
+    sig = inspect.signature(func)
+    try:
+        sig.bind(**params, seed=0)
+    except TypeError as exc:
+        allowed = [p for p in sig.parameters if p != "seed"]
+        raise InputError(f"analysis {name!r} does not accept the parameters "
+                         f"{sorted(params)}: {exc}; its parameters are {allowed}") from None
+
+
+def as_records(value, name: str) -> list[dict]:
+    """Normalise a task's return value to a list of dicts (one table row each)."""
+    if isinstance(value, dict):
+        return [value]
+    if isinstance(value, (list, tuple)) and all(isinstance(v, dict) for v in value):
+        return list(value)
+    to_records = getattr(value, "to_records", None)
+    if callable(to_records):
+        return as_records(to_records(), name)
+    raise TypeError(f"analysis {name!r} returned {type(value).__name__}; a task must return "
+                    "a dict, a list of dicts or an object with to_records()")
+
+
+def selftest_task(*, x, seed, y=0.0, n_records=3, sleep=0.0, fail_x=()):
+    """Cheap deterministic task to test executors, resume and failure handling.
+
+    Parameters
+    ----------
+    x, y : float
+        Inputs of the analytic value ``f = x**2 + y * step``.
+    seed : int
+        Seeds ``u``, a uniform draw per record (checks that seeds are passed through).
+    n_records : int
+        Number of records (rows) returned.
+    sleep : float
+        Seconds to sleep first (to make a study slow enough to interrupt).
+    fail_x : float or list of float
+        Raise ``ValueError`` when ``x`` equals one of these (a task that always fails).
+
+    Returns
+    -------
+    list of dict
+        ``{"step", "f", "u"}`` per record.
+    """
+    fails = fail_x if isinstance(fail_x, (list, tuple)) else [fail_x]
+    if x in fails:
+        raise ValueError(f"selftest asked to fail at x={x!r}")
+    if sleep:
+        time.sleep(float(sleep))
+    rng = np.random.default_rng(seed)
+    u = rng.random(int(n_records))
+    return [{"step": k, "f": float(x) ** 2 + float(y) * k, "u": float(u[k])}
+            for k in range(int(n_records))]

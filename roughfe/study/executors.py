@@ -1,0 +1,220 @@
+"""Executors for studies behind one ``concurrent.futures``-style interface.
+
+Each executor has ``submit(fn, *args) -> future`` (the future has ``result()``),
+``completed()`` (an ``as_completed`` iterator to which futures can be added while
+iterating), ``n_workers``, ``name`` and ``shutdown()``; each is a context manager.
+No engine is home-made:
+
+``local``
+    :class:`concurrent.futures.ProcessPoolExecutor` sized to the cores available.
+``dask``
+    ``distributed.Client`` to a running scheduler (``scheduler="tcp://host:8786"``, e.g.
+    started by dask-jobqueue on SLURM) or to a ``LocalCluster`` of ``workers`` processes
+    (one thread each, no dashboard) when no address is given.
+``mpi``
+    :class:`mpi4py.futures.MPIPoolExecutor`, run under
+    ``mpirun -n K python -m mpi4py.futures $(which roughfe) study run ... --executor mpi``
+    (rank 0 drives, K-1 ranks work). Give the ``roughfe`` script's path, not
+    ``-m roughfe.cli``: mpi4py's workers re-run the main module, and the script is the
+    entry point guarded by ``if __name__ == "__main__"``.
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import multiprocessing
+import os
+import threading
+import time
+
+from ..errors import InputError
+
+EXECUTORS = ("local", "dask", "mpi")
+
+
+def available_cores() -> int:
+    """Number of cores this process may use (affinity-aware)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def _check_workers(workers):
+    if workers is None:
+        return None
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise InputError(f"workers must be an integer >= 1, got {workers!r}")
+    return workers
+
+
+class _FuturesCompletion:
+    """``as_completed`` over concurrent.futures futures that accepts additions."""
+
+    def __init__(self):
+        self._pending = set()
+
+    def add(self, future):
+        self._pending.add(future)
+
+    def __iter__(self):
+        while self._pending:
+            done, self._pending = cf.wait(self._pending, return_when=cf.FIRST_COMPLETED)
+            yield from done
+
+
+def _init_worker(parent_pid):
+    """Worker initializer: one BLAS/OpenMP thread, and exit when the driver is gone.
+
+    One thread per worker process avoids oversubscribing the cores (numpy is not yet
+    imported when this runs in a fresh ``spawn`` worker). The watchdog makes workers
+    leave after the driver is killed (``kill -9``) instead of lingering as orphans.
+    """
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
+
+    def watch():
+        while True:
+            time.sleep(0.5)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="roughfe-parent-watch", daemon=True).start()
+
+
+class _Base:
+    name = ""
+    n_workers = 1
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.shutdown()
+        return False
+
+    def describe(self) -> str:
+        """One line for logs: executor name and worker count."""
+        return f"{self.name} executor, {self.n_workers} worker(s)"
+
+
+class LocalExecutor(_Base):
+    """A process pool on this machine (``workers`` defaults to the available cores).
+
+    Workers are started with ``spawn`` (clean interpreters, no inherited threads) and
+    exit by themselves if the driver dies.
+    """
+
+    name = "local"
+
+    def __init__(self, workers=None):
+        self.n_workers = _check_workers(workers) or available_cores()
+        self._pool = self._new_pool()
+
+    def _new_pool(self):
+        return cf.ProcessPoolExecutor(
+            max_workers=self.n_workers, mp_context=multiprocessing.get_context("spawn"),
+            initializer=_init_worker, initargs=(os.getpid(),))
+
+    def submit(self, fn, *args):
+        try:
+            return self._pool.submit(fn, *args)
+        except cf.process.BrokenProcessPool:
+            # A worker died (segfault, out of memory): its tasks are reported failed by
+            # their futures; start a fresh pool for the rest of the study.
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = self._new_pool()
+            return self._pool.submit(fn, *args)
+
+    def completed(self):
+        return _FuturesCompletion()
+
+    def shutdown(self):
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+class DaskExecutor(_Base):
+    """dask.distributed: a running scheduler at ``scheduler``, or a LocalCluster."""
+
+    name = "dask"
+
+    def __init__(self, workers=None, scheduler=None):
+        try:
+            import distributed
+        except ImportError:
+            raise InputError("the dask executor needs dask.distributed: "
+                             "pip install 'dask[distributed]' (the 'study' extra)") from None
+        self._distributed = distributed
+        workers = _check_workers(workers)
+        self._cluster = None
+        if scheduler:
+            try:
+                self._client = distributed.Client(scheduler, timeout="30s")
+            except (OSError, TimeoutError) as exc:
+                raise InputError(f"cannot reach the dask scheduler at {scheduler!r}: {exc}") from None
+            self.n_workers = max(1, len(self._client.scheduler_info()["workers"]))
+        else:
+            self.n_workers = workers or available_cores()
+            self._cluster = distributed.LocalCluster(
+                n_workers=self.n_workers, threads_per_worker=1, processes=True,
+                dashboard_address=None)
+            self._client = distributed.Client(self._cluster)
+
+    def submit(self, fn, *args):
+        # pure=False: a resubmitted (retried) task must run again, not reuse a key.
+        return self._client.submit(fn, *args, pure=False)
+
+    def completed(self):
+        return self._distributed.as_completed()
+
+    def describe(self):
+        where = self._client.scheduler.address if self._cluster is None else "LocalCluster"
+        return f"dask executor ({where}), {self.n_workers} worker(s)"
+
+    def shutdown(self):
+        self._client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+
+
+class MPIExecutor(_Base):
+    """mpi4py.futures under ``mpirun ... python -m mpi4py.futures`` (K-1 workers)."""
+
+    name = "mpi"
+
+    def __init__(self, workers=None):
+        try:
+            from mpi4py import MPI
+            from mpi4py.futures import MPIPoolExecutor
+        except ImportError:
+            raise InputError("the mpi executor needs mpi4py (Debian: python3-mpi4py)") from None
+        size = MPI.COMM_WORLD.Get_size()
+        if size < 2:
+            raise InputError(
+                "the mpi executor must run under mpirun with mpi4py.futures, e.g. "
+                "`mpirun -n 3 python -m mpi4py.futures $(which roughfe) study run SPEC "
+                "--executor mpi` (as root add --allow-run-as-root; more ranks than cores "
+                "needs --oversubscribe); MPI world size here is 1")
+        self.n_workers = size - 1
+        self._pool = MPIPoolExecutor()
+
+    def submit(self, fn, *args):
+        return self._pool.submit(fn, *args)
+
+    def completed(self):
+        return _FuturesCompletion()
+
+    def shutdown(self):
+        self._pool.shutdown(wait=True)
+
+
+def make_executor(kind="local", *, workers=None, scheduler=None):
+    """Create the executor ``kind`` (one of ``local``, ``dask``, ``mpi``)."""
+    if kind not in EXECUTORS:
+        raise InputError(f"executor must be one of {list(EXECUTORS)}, got {kind!r}")
+    if scheduler and kind != "dask":
+        raise InputError(f"--scheduler is for the dask executor, not {kind!r}")
+    if kind == "local":
+        return LocalExecutor(workers)
+    if kind == "dask":
+        return DaskExecutor(workers, scheduler)
+    return MPIExecutor(workers)

@@ -1,0 +1,224 @@
+"""Run a study: submit the missing tasks to an executor, store each result atomically.
+
+The driver (this module) owns every file of the study folder; workers only compute and
+return JSON-safe records, so workers need no access to the study folder. A task whose
+``results/<key>.json`` exists is skipped, hence a study killed at any moment resumes
+where it stopped and ends with the same table as an uninterrupted run.
+"""
+from __future__ import annotations
+
+import collections
+import json
+import os
+import socket
+import sys
+import time
+import traceback
+from dataclasses import dataclass
+
+from .. import __version__
+from ..writers import to_json_text, write_json
+from . import store
+from .analyses import ANALYSES, as_records, check_parameters, resolve
+from .executors import make_executor
+
+INDEX_EVERY_S = 2.0
+
+
+def execute_task(analysis: str, params: dict, seed: int) -> dict:
+    """Run one task on a worker; never raises (errors are returned as data).
+
+    Returns
+    -------
+    dict
+        ``ok``; ``records`` (JSON-safe list of dicts) or ``error`` and ``traceback``;
+        ``elapsed_s``, ``host`` and ``pid`` of the worker.
+    """
+    t0 = time.perf_counter()
+    out = {"host": socket.gethostname(), "pid": os.getpid()}
+    try:
+        func = resolve(analysis)
+        records = as_records(func(**params, seed=seed), analysis)
+        out.update(ok=True, records=json.loads(to_json_text(records)))
+    except Exception as exc:  # a failing task is data for the driver, not a crash
+        out.update(ok=False, error=f"{type(exc).__name__}: {exc}",
+                   traceback=traceback.format_exc())
+    out["elapsed_s"] = time.perf_counter() - t0
+    return out
+
+
+@dataclass(frozen=True)
+class StudySummary:
+    """What one ``run`` did.
+
+    Attributes
+    ----------
+    n_tasks : int
+        Tasks in the study.
+    n_cached : int
+        Tasks already done before this run (skipped).
+    n_done : int
+        Tasks finished by this run.
+    n_failed : int
+        Tasks still failing after ``max_attempts`` attempts in this run.
+    n_retries : int
+        Failed attempts that were retried.
+    wall_s : float
+        Wall time of this run (seconds), executor start-up included.
+    task_s : float
+        Sum of the worker wall times of the tasks finished by this run.
+    executor : str
+        Executor description.
+    """
+
+    n_tasks: int
+    n_cached: int
+    n_done: int
+    n_failed: int
+    n_retries: int
+    wall_s: float
+    task_s: float
+    executor: str
+
+    @property
+    def complete(self) -> bool:
+        return self.n_cached + self.n_done == self.n_tasks
+
+    def describe(self) -> str:
+        mean = self.task_s / self.n_done if self.n_done else float("nan")
+        return (f"{self.n_tasks} tasks: {self.n_cached} already done, {self.n_done} computed, "
+                f"{self.n_failed} failed ({self.n_retries} retries); wall {self.wall_s:.1f} s, "
+                f"mean cost {mean:.3g} s/task on the workers; {self.executor}")
+
+
+class _Progress:
+    """tqdm bar with done/failed counts, or nothing."""
+
+    def __init__(self, enabled, total, initial, name):
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, initial=initial, desc=name, unit="task",
+                            file=sys.stderr, dynamic_ncols=True)
+
+    def update(self, n, done, failed):
+        if self.bar is not None:
+            self.bar.set_postfix(done=done, failed=failed, refresh=False)
+            self.bar.update(n)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=True,
+              log=None) -> StudySummary:
+    """Run every missing task of ``spec`` and store the results in ``spec.output``.
+
+    Parameters
+    ----------
+    spec : StudySpec
+    executor : {"local", "dask", "mpi"}
+    workers : int, optional
+        Worker count (local: process pool; dask: LocalCluster size). Default: cores.
+    scheduler : str, optional
+        Address of a running dask scheduler (dask only).
+    progress : bool
+        Show a tqdm bar (done/failed counts, ETA) on stderr.
+    log : callable, optional
+        Receives one-line messages (e.g. ``print``).
+
+    Returns
+    -------
+    StudySummary
+        Failed tasks are recorded in ``failures/`` and counted, never raised.
+    """
+    log = log or (lambda message: None)
+    t_start = time.perf_counter()
+    tasks = spec.tasks()
+    check_parameters(spec.analysis, tasks[0].params)
+    outdir = spec.output
+    with store.study_lock(outdir):
+        store.write_study(outdir, spec, tasks, __version__)
+        keys = [t.key for t in tasks]
+        done = store.done_keys(outdir)
+        todo = [t for t in tasks if t.key not in done]
+        n_cached = len(tasks) - len(todo)
+        counts = collections.Counter()
+        description = "nothing to run"
+        if todo:
+            log(f"study {spec.name!r}: {len(tasks)} tasks, {n_cached} already done, "
+                f"{len(todo)} to run")
+            with make_executor(executor, workers=workers, scheduler=scheduler) as ex:
+                description = ex.describe()
+                log(description)
+                _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
+                       n_cached=n_cached)
+        store.write_index(outdir, keys)
+    summary = StudySummary(n_tasks=len(tasks), n_cached=n_cached, n_done=counts["done"],
+                           n_failed=counts["failed"], n_retries=counts["retries"],
+                           wall_s=time.perf_counter() - t_start, task_s=counts["task_s"],
+                           executor=description)
+    log(summary.describe())
+    return summary
+
+
+def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached):
+    """Submit ``todo`` through ``ex`` with a bounded window; retry; store results."""
+    outdir = spec.output
+    queue = collections.deque(todo)
+    attempts = collections.Counter()
+    inflight = {}
+    completion = ex.completed()
+    window = max(4, 2 * ex.n_workers)
+
+    def refill():
+        while queue and len(inflight) < window:
+            task = queue.popleft()
+            future = ex.submit(execute_task, spec.analysis, dict(task.params), task.seed)
+            inflight[future] = task
+            completion.add(future)
+
+    bar = _Progress(progress, n_total, n_cached, spec.name)
+    last_index = time.monotonic()
+    try:
+        refill()
+        for future in completion:
+            task = inflight.pop(future)
+            try:
+                out = future.result()
+            except Exception as exc:  # the worker died or the executor lost the task
+                out = {"ok": False, "error": f"{type(exc).__name__}: {exc} (worker lost)",
+                       "traceback": "".join(traceback.format_exception(exc)),
+                       "elapsed_s": 0.0, "host": "?", "pid": -1}
+            attempts[task.key] += 1
+            if out["ok"]:
+                write_json(store.result_path(outdir, task.key), {
+                    "key": task.key, "index": task.index, "analysis": spec.analysis,
+                    "analysis_version": ANALYSES[spec.analysis].version,
+                    "code_version": __version__, "params": dict(task.params),
+                    "seed": task.seed, "records": out["records"],
+                    "elapsed_s": out["elapsed_s"], "host": out["host"],
+                    "attempts": attempts[task.key]})
+                store.clear_failure(outdir, task.key)
+                counts["done"] += 1
+                counts["task_s"] += out["elapsed_s"]
+                bar.update(1, counts["done"] + n_cached, counts["failed"])
+            else:
+                store.record_failure(outdir, task, {
+                    "error": out["error"], "traceback": out["traceback"],
+                    "host": out["host"], "elapsed_s": out["elapsed_s"],
+                    "time": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())})
+                if attempts[task.key] < spec.max_attempts:
+                    counts["retries"] += 1
+                    queue.append(task)
+                else:
+                    counts["failed"] += 1
+                    bar.update(1, counts["done"] + n_cached, counts["failed"])
+            if time.monotonic() - last_index > INDEX_EVERY_S:
+                store.write_index(outdir, keys)
+                last_index = time.monotonic()
+            refill()
+    finally:
+        bar.close()

@@ -1,0 +1,269 @@
+"""The results store of a study: one folder, plain JSON, every file written atomically.
+
+::
+
+    OUTDIR/study.json          the spec and the full task list (index, key, params, seed)
+    OUTDIR/index.json          manifest: keys done, keys failed (rewritten every few seconds)
+    OUTDIR/results/<key>.json  one finished task: its records and provenance
+    OUTDIR/failures/<key>.json one failing task: every attempt's error and traceback
+    OUTDIR/table.csv           the tidy table written by ``collect``
+    OUTDIR/.lock               held (flock) by the running driver
+
+The result files are the truth: a task is done if and only if ``results/<key>.json``
+exists (atomic rename, so it is complete). ``index.json`` is a convenience summary that
+may lag by a few seconds after a crash; ``status`` and ``run`` rebuild it from the files.
+"""
+from __future__ import annotations
+
+import contextlib
+import csv
+import importlib.util
+import io
+import json
+import os
+import statistics
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import FileFormatError, InputError
+from ..writers import write_json, write_text
+from .spec import canonical_json, spec_from_mapping
+
+
+def study_file(outdir) -> Path:
+    return Path(outdir) / "study.json"
+
+
+def result_path(outdir, key) -> Path:
+    return Path(outdir) / "results" / f"{key}.json"
+
+
+def failure_path(outdir, key) -> Path:
+    return Path(outdir) / "failures" / f"{key}.json"
+
+
+@contextlib.contextmanager
+def study_lock(outdir):
+    """Hold an exclusive lock on ``OUTDIR/.lock`` (released by the OS if the driver dies)."""
+    import fcntl
+
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    with open(outdir / ".lock", "w") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise InputError(f"another `roughfe study run` is using {outdir} (it holds "
+                             f"{outdir / '.lock'}); wait for it or use another output") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def write_study(outdir, spec, tasks, code_version):
+    """Write ``study.json``: the spec and the task list (index, key, params, seed)."""
+    write_json(study_file(outdir), {
+        "spec": spec.to_dict(), "code_version": code_version, "n_tasks": len(tasks),
+        "tasks": [{"index": t.index, "key": t.key, "params": dict(t.params), "seed": t.seed}
+                  for t in tasks]})
+
+
+def read_study(outdir) -> dict:
+    """Read ``study.json`` of a study folder."""
+    path = study_file(outdir)
+    if not path.is_file():
+        raise InputError(f"{outdir} is not a study folder: {path} is missing "
+                         "(run `roughfe study run SPEC.toml` first)")
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise FileFormatError(f"{path} is not valid JSON: {exc}") from None
+    data["spec_obj"] = spec_from_mapping(data["spec"])
+    return data
+
+
+def read_result(outdir, key):
+    """The stored result of task ``key``, or None if it is not (completely) there."""
+    try:
+        return json.loads(result_path(outdir, key).read_text())
+    except (FileNotFoundError, json.JSONDecodeError):
+        return None
+
+
+def done_keys(outdir) -> set:
+    """Keys with a result file (the truth about what is done)."""
+    folder = Path(outdir) / "results"
+    if not folder.is_dir():
+        return set()
+    return {p.stem for p in folder.glob("*.json")}
+
+
+def failed_keys(outdir) -> set:
+    folder = Path(outdir) / "failures"
+    if not folder.is_dir():
+        return set()
+    return {p.stem for p in folder.glob("*.json")}
+
+
+def record_failure(outdir, task, attempt: dict) -> int:
+    """Append one failed attempt to ``failures/<key>.json``; return the attempt count."""
+    path = failure_path(outdir, task.key)
+    try:
+        data = json.loads(path.read_text())
+    except (FileNotFoundError, json.JSONDecodeError):
+        data = {"key": task.key, "index": task.index, "params": dict(task.params),
+                "seed": task.seed, "attempts": []}
+    data["attempts"].append(attempt)
+    write_json(path, data)
+    return len(data["attempts"])
+
+
+def clear_failure(outdir, key):
+    """Forget the failures of a task that has now succeeded."""
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(failure_path(outdir, key))
+
+
+def write_index(outdir, keys_in_order):
+    """Rewrite ``index.json`` from the result and failure files."""
+    done, failed = done_keys(outdir), failed_keys(outdir) - done_keys(outdir)
+    write_json(Path(outdir) / "index.json", {
+        "n_tasks": len(keys_in_order),
+        "n_done": sum(k in done for k in keys_in_order),
+        "n_failed": sum(k in failed for k in keys_in_order),
+        "done": [k for k in keys_in_order if k in done],
+        "failed": [k for k in keys_in_order if k in failed]})
+
+
+@dataclass(frozen=True)
+class StudyStatus:
+    """What a study folder holds.
+
+    Attributes
+    ----------
+    name, analysis : str
+    n_tasks, n_done, n_failed, n_missing : int
+        ``n_failed`` counts tasks with a recorded failure and no result;
+        ``n_missing`` counts tasks never attempted or interrupted.
+    failures : tuple of (int, dict, str)
+        (task index, parameters, last error line) of each failed task.
+    cost_s : tuple of float
+        Wall time in seconds of each finished task on its worker.
+    """
+
+    name: str
+    analysis: str
+    n_tasks: int
+    n_done: int
+    n_failed: int
+    n_missing: int
+    failures: tuple
+    cost_s: tuple
+
+    def describe(self) -> str:
+        """Human-readable multi-line summary."""
+        lines = [f"study {self.name!r} (analysis {self.analysis}): {self.n_done}/{self.n_tasks} "
+                 f"done, {self.n_failed} failed, {self.n_missing} missing"]
+        if self.cost_s:
+            lines.append(f"cost per task: mean {statistics.fmean(self.cost_s):.3g} s, median "
+                         f"{statistics.median(self.cost_s):.3g} s, max {max(self.cost_s):.3g} s "
+                         f"(worker wall time, {len(self.cost_s)} tasks)")
+        for index, params, error in self.failures:
+            lines.append(f"  failed task {index} {canonical_json(params)}: {error}")
+        return "\n".join(lines)
+
+
+def study_status(outdir) -> StudyStatus:
+    """Status of the study in ``outdir`` from its files."""
+    data = read_study(outdir)
+    done, failed = done_keys(outdir), failed_keys(outdir)
+    failures, costs = [], []
+    n_done = n_failed = 0
+    for t in data["tasks"]:
+        if t["key"] in done:
+            n_done += 1
+            result = read_result(outdir, t["key"])
+            if result is not None and "elapsed_s" in result:
+                costs.append(float(result["elapsed_s"]))
+        elif t["key"] in failed:
+            n_failed += 1
+            try:
+                last = json.loads(failure_path(outdir, t["key"]).read_text())["attempts"][-1]
+                error = last.get("error", "?")
+            except (FileNotFoundError, json.JSONDecodeError, KeyError, IndexError):
+                error = "?"
+            failures.append((t["index"], t["params"], error))
+    spec = data["spec"]["study"]
+    return StudyStatus(name=spec["name"], analysis=spec["analysis"], n_tasks=len(data["tasks"]),
+                       n_done=n_done, n_failed=n_failed,
+                       n_missing=len(data["tasks"]) - n_done - n_failed,
+                       failures=tuple(failures), cost_s=tuple(costs))
+
+
+def _cell(value):
+    if value is None:
+        return ""
+    if isinstance(value, (list, dict)):
+        return canonical_json(value)
+    return value
+
+
+def table_rows(outdir):
+    """Tidy rows of all finished tasks, in task order.
+
+    Each row has ``task`` (grid index), ``key``, the parameters, ``seed`` and then one
+    record's fields. A record field named like a parameter is dropped when equal to it
+    and kept as ``<name>_result`` otherwise. Returns (columns, rows, n_missing).
+    """
+    data = read_study(outdir)
+    columns, rows, missing = {}, [], 0
+    for t in data["tasks"]:
+        result = read_result(outdir, t["key"])
+        if result is None:
+            missing += 1
+            continue
+        head = {"task": t["index"], "key": t["key"], **t["params"], "seed": t["seed"]}
+        for record in result["records"]:
+            row = dict(head)
+            for name, value in record.items():
+                if name in head:
+                    if canonical_json(value) == canonical_json(head[name]):
+                        continue
+                    name = f"{name}_result"
+                row[name] = value
+            for name in row:
+                columns.setdefault(name, None)
+            rows.append(row)
+    return list(columns), rows, missing
+
+
+def collect(outdir, *, parquet=True):
+    """Write ``table.csv`` (and ``table.parquet`` if pyarrow is importable).
+
+    Returns (paths written, number of rows, number of tasks without a result, note),
+    where ``note`` says why Parquet was not written (or is empty).
+    """
+    outdir = Path(outdir)
+    columns, rows, missing = table_rows(outdir)
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow([_cell(row.get(c)) for c in columns])
+    paths = [write_text(outdir / "table.csv", buf.getvalue())]
+    note = ""
+    if parquet:
+        if importlib.util.find_spec("pyarrow") is None:
+            note = "Parquet not written: pyarrow is not installed (pip install pyarrow)"
+        else:
+            import pandas as pd
+
+            from ..writers import atomic_path
+
+            frame = pd.DataFrame([{c: _cell(r.get(c)) for c in columns} for r in rows],
+                                 columns=columns)
+            with atomic_path(outdir / "table.parquet") as tmp:
+                frame.to_parquet(tmp, index=False)
+            paths.append(outdir / "table.parquet")
+    return paths, len(rows), missing, note
