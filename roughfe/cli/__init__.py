@@ -18,6 +18,7 @@ _SUBCOMMAND_MODULES = (
     "surface_cmds",   # generate, info
     "demo_cmd",       # demo
     "validate_cmd",   # validate
+    "study_cmd",      # study run|status|collect
 )
 
 
