@@ -1,0 +1,107 @@
+"""Figures of rough surfaces: 3D render (pyvista, off-screen), profiles and PSDs (matplotlib).
+
+Plotting reads surfaces and statistics computed elsewhere; it never generates or solves.
+Lengths are shown in micrometres.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
+
+UM = 1e6   # metres -> micrometres
+
+
+def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
+                   window_size=(1000, 800)):
+    """Off-screen 3D render of a surface warped by its height, with a colour bar in um.
+
+    Parameters
+    ----------
+    surface : Surface
+        A 2D surface (m).
+    path : str or Path
+        PNG file to write (atomically).
+    title : str, optional
+        Text in the upper-left corner.
+    exaggeration : float, optional
+        Vertical exaggeration of the heights; default: peak-to-valley shown as 25 % of
+        the larger lateral size. The colour bar always shows true heights in um.
+
+    Returns
+    -------
+    Path
+    """
+    import pyvista as pv
+
+    if surface.ndim != 2:
+        raise ValueError(f"render_surface needs a 2D surface, got a profile {surface.shape}")
+    x, y = (c * UM for c in surface.coordinates())
+    h = (surface.heights - surface.heights.mean()) * UM
+    ptp = float(np.ptp(h)) or 1.0
+    if exaggeration is None:
+        exaggeration = 0.25 * max(surface.size) * UM / ptp
+    xx, yy = np.meshgrid(x, y, indexing="ij")
+    grid = pv.StructuredGrid(xx, yy, h * exaggeration)
+    grid["height (um)"] = h.ravel(order="F")
+    plotter = offscreen_plotter(window_size=window_size)
+    plotter.add_mesh(grid, scalars="height (um)", cmap=cmap, smooth_shading=True,
+                     scalar_bar_args={"title": "height (um)", "vertical": True,
+                                      "position_x": 0.86, "position_y": 0.15,
+                                      "height": 0.7, "fmt": "%.3g"})
+    label = title or ""
+    label += (f"\n{surface.size[0] * UM:.4g} um x {surface.size[1] * UM:.4g} um, "
+              f"vertical exaggeration x{exaggeration:.3g}")
+    plotter.add_text(label.strip(), position="upper_left", font_size=11)
+    plotter.set_background("white")
+    plotter.camera_position = "iso"
+    plotter.camera.zoom(1.35)
+    return save_screenshot(plotter, path)
+
+
+def plot_profile(surface, path, title=None, axis=0):
+    """Line plot of a profile, or of the middle row (``axis=0``: along x) of a surface."""
+    if surface.ndim == 1:
+        x, h = surface.coordinates()[0], surface.heights
+    else:
+        mid = surface.shape[1 - axis] // 2
+        h = surface.heights[:, mid] if axis == 0 else surface.heights[mid, :]
+        x = surface.coordinates()[axis]
+    fig, ax = new_figure(figsize=(7, 3))
+    ax.plot(x * UM, (h - h.mean()) * UM, lw=0.8)
+    ax.set_xlabel(f"{'xy'[axis]} (um)")
+    ax.set_ylabel("height (um)")
+    ax.set_title(title or ("profile" if surface.ndim == 1 else f"profile through the middle, along {'xy'[axis]}"))
+    ax.grid(alpha=0.3)
+    return save_figure(fig, path)
+
+
+def plot_psd(spectra, path, title=None, fits=None):
+    """Log-log plot of power spectra.
+
+    Parameters
+    ----------
+    spectra : mapping of label -> PowerSpectrum
+        Computed with :func:`roughfe.surfaces.stats.power_spectrum`.
+    path : str or Path
+        PNG file.
+    fits : mapping of label -> HurstFit, optional
+        Drawn as dashed power laws over their ``q_range`` with the fitted H.
+    """
+    fig, ax = new_figure(figsize=(6, 4.5))
+    units = set()
+    for label, psd in spectra.items():
+        units.add(psd.ndim)
+        ax.loglog(psd.q, psd.C, ".", ms=3, label=label)
+        fit = (fits or {}).get(label)
+        if fit is not None and fit.success:
+            qf = np.geomspace(*fit.q_range, 20)
+            ax.loglog(qf, fit.prefactor * qf ** fit.slope, "k--", lw=1,
+                      label=f"fit: H = {fit.hurst:.3f}, D = {fit.fractal_dimension:.3f}")
+    ax.set_xlabel("wavenumber q (rad/m)")
+    unit = "m$^4$" if units == {2} else ("m$^3$" if units == {1} else "m$^3$ or m$^4$")
+    ax.set_ylabel(f"PSD C(q) ({unit})")
+    ax.set_title(title or "power spectral density")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    return save_figure(fig, path)
