@@ -208,9 +208,8 @@ class _ContactProblem:
         self.pmesh, self.material, self.options = pmesh, material, options
         mesh = pmesh.mesh
         h = pmesh.heights
-        self.u_ref = float(h.max() - h.min())
-        if not self.u_ref > 0:
-            raise InputError("the profile is flat (max(h) == min(h)): there is no contact problem")
+        # displacement unit: the height range (a flat profile -- a flat punch -- uses W/1000)
+        self.u_ref = float(h.max() - h.min()) or 1e-3 * pmesh.width
         nu = material.poisson_ratio
         V = fem.VectorFunctionSpace(mesh, ("CG", 1))
         self.V = V
@@ -377,6 +376,31 @@ def cell_stress_yy(points, cells, displacement, material: ElasticMaterial):
     lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     mu = E / (2 * (1 + nu))
     return lam * (grad[:, 0, 0] + grad[:, 1, 1]) + 2 * mu * grad[:, 1, 1]
+
+
+def contact_edge(x, gap, contact):
+    """Position (m) of the first contact -> separation edge, to sub-element accuracy.
+
+    Near a smooth contact edge at ``a`` the gap opens as ``(x - a)^(3/2)`` (square-root
+    pressure singularity), so ``gap^(2/3)`` is linear in ``x``: it is extrapolated to zero
+    from the first two open vertices beyond the last contact vertex ``j`` and the result
+    is clipped to ``[x_j, x_{j+1}]``. Returns NaN when there is no such edge.
+    Used for the Westergaard contact half-width (contact centred on x = 0).
+    """
+    x, gap, contact = (np.asarray(v) for v in (x, gap, contact))
+    if not contact[0]:
+        return float("nan")
+    open_ = np.flatnonzero(~contact)
+    if open_.size == 0:
+        return float("nan")
+    j = open_[0] - 1
+    if j + 2 >= x.size:
+        return float(x[j + 1])
+    s1, s2 = np.maximum(gap[j + 1:j + 3], 0.0) ** (2.0 / 3.0)
+    if not s2 > s1:
+        return float(x[j + 1])
+    a = x[j + 1] - s1 * (x[j + 2] - x[j + 1]) / (s2 - s1)
+    return float(np.clip(a, x[j], x[j + 1]))
 
 
 def stiffness_along(delta, mean_pressure):

@@ -1,0 +1,148 @@
+"""FEM contact (roughfe.fem) against analytic solutions and against itself.
+
+Budget: all FEM tests together < 60 s on 2 cores (each mesh here has < 4000 triangles).
+"""
+import numpy as np
+import pytest
+
+pytest.importorskip("dolfinx")
+
+from roughfe.errors import InputError, NoConvergenceError  # noqa: E402
+from roughfe.fem import FACET_TAGS, mesh_profile, mirrored_profile  # noqa: E402
+from roughfe.fem.contact import (ElasticMaterial, FemSolverOptions, contact_edge,  # noqa: E402
+                                 fem_contact_sweep, fem_solve_contact)
+from roughfe.reference import westergaard  # noqa: E402
+from roughfe.surfaces import Surface  # noqa: E402
+
+pytestmark = pytest.mark.fem
+
+LAM, G = 1e-3, 1e-6                       # Westergaard wavelength and amplitude (m)
+MAT = ElasticMaterial(youngs_modulus=1e9, poisson_ratio=0.3)
+
+
+def cosine_half_period(n):
+    """g cos(2 pi x / lambda) on [0, lambda/2] with n samples; mirrored it is the cosine."""
+    dx = (LAM / 2) / (n - 1)
+    x = np.arange(n) * dx
+    return Surface(G * np.cos(2 * np.pi * x / LAM), n * dx)
+
+
+@pytest.fixture(scope="module")
+def westergaard_mesh():
+    return mesh_profile(cosine_half_period(129), growth=0.1)
+
+
+def test_westergaard_width_and_mean_gap(westergaard_mesh):
+    """Coarse graded mesh (dx = lambda/256, growth 0.1): contact half-width within 1 %
+    of Westergaard (measured 0.1-0.4 %), and the mean gap, which tests the finite-depth
+    correction of Delta, within 2 % of g (1 - s + s ln s) (measured 0.1-0.5 %)."""
+    pm = westergaard_mesh
+    res = fem_contact_sweep(pm, MAT, np.array([0.4, 1.0, 1.6]) * G)
+    for r in res:
+        ref = westergaard(G, LAM, MAT.e_star, r.mean_pressure)
+        a = contact_edge(r.x, r.gap, r.contact)
+        assert abs(a / ref.half_width - 1) < 0.01, (a, ref.half_width)
+        w = np.full(r.x.size, 1.0 / (r.x.size - 1))
+        w[[0, -1]] *= 0.5
+        mean_gap = float(np.sum(w * r.gap))
+        assert mean_gap == pytest.approx(ref.mean_gap, rel=0.02, abs=0.002 * G)
+        # the corrected approach equals h_max - mean(h) - mean gap (Betti, exact)
+        h = pm.heights
+        assert r.delta_corrected == pytest.approx(h.max() - np.sum(w * h) - mean_gap, rel=1e-6)
+    # pressure rises with the approach, the stiffness is positive
+    assert np.all(np.diff([r.mean_pressure for r in res]) > 0)
+    assert all(r.stiffness > 0 for r in res)
+
+
+def random_profile(n, seed):
+    """A smooth random profile (sum of 6 cosines with seeded phases), ~1 um rms."""
+    rng = np.random.default_rng(seed)
+    dx = 1e-3 / (n - 1)
+    x = np.arange(n) * dx
+    k = np.arange(1, 7)
+    h = (1e-6 * k[:, None] ** -1.5 * np.cos(np.pi * k[:, None] * x / 1e-3 * 2
+                                            + rng.uniform(0, 2 * np.pi, 6)[:, None])).sum(0)
+    return Surface(h, n * dx, metadata={"seed": seed})
+
+
+def test_vi_and_penalty_agree():
+    """VI and penalty (k = 1e4) on a random profile: mean pressure within 1e-4 (target
+    0.5 %; measured 6e-6, the penalty penetration p/(k E/delta)), the same contact
+    vertices up to one at an edge, nodal pressures within 0.1 % of the peak."""
+    pm = mesh_profile(random_profile(65, seed=4), growth=0.1)
+    hr = np.ptp(pm.heights)
+    deltas = np.array([0.1, 0.3, 0.5]) * hr
+    vi = fem_contact_sweep(pm, MAT, deltas, FemSolverOptions(method="vi"))
+    pen = fem_contact_sweep(pm, MAT, deltas, FemSolverOptions(method="penalty",
+                                                              penalty_factor=1e4))
+    for a, b in zip(vi, pen):
+        assert b.mean_pressure == pytest.approx(a.mean_pressure, rel=1e-4)
+        assert np.sum(a.contact != b.contact) <= 1
+        assert np.max(np.abs(a.pressure - b.pressure)) < 1e-3 * a.pressure.max()
+        assert a.success and b.success and a.nit <= 20 and b.nit <= 20
+    assert vi[-1].n_contact > vi[0].n_contact >= 1
+
+
+@pytest.mark.parametrize("formulation", ["flat", "profile"])
+def test_uniform_layer_compliance_exact(formulation):
+    """A flat punch on a roller-supported layer is uniaxial strain: p = M Delta / H_d
+    exactly, so delta_corrected = 0, uniform pressure and sigma_yy = -p in every cell."""
+    n, L = 17, 1e-3
+    flat = Surface(np.zeros(n), n * L / (n - 1))
+    pm = mesh_profile(flat, depth=0.7e-3, growth=0.3, formulation=formulation)
+    delta = 2e-6
+    r = fem_solve_contact(pm, MAT, delta, keep_fields=True)
+    M = MAT.youngs_modulus * 0.7 / (1.3 * 0.4)
+    p = M * delta / 0.7e-3
+    assert r.mean_pressure == pytest.approx(p, rel=1e-10)
+    assert r.layer_compliance == pytest.approx(0.7e-3 / M, rel=1e-14)
+    assert abs(r.delta_corrected) < 1e-10 * delta
+    assert np.allclose(r.pressure, p, rtol=1e-9)
+    assert r.n_contact == n and r.area_fraction == pytest.approx(1.0)
+    assert np.allclose(r.fields["stress_yy"], -p, rtol=1e-8)
+
+
+@pytest.mark.parametrize("formulation", ["flat", "profile"])
+def test_facet_tags_on_the_right_edges(formulation):
+    surf = random_profile(33, seed=1)
+    pm = mesh_profile(surf, depth=1.5e-3, growth=0.2, formulation=formulation)
+    mesh, ft = pm.mesh, pm.facet_tags
+    mesh.topology.create_connectivity(1, 0)
+    f2v = mesh.topology.connectivity(1, 0)
+    X = mesh.geometry.x[:, :2] * pm.length_scale
+    top_y = 0.0 if formulation == "flat" else surf.heights - surf.heights.mean()
+    for name, tag in FACET_TAGS.items():
+        facets = ft.find(tag)
+        pts = np.array([X[f2v.links(f)] for f in facets])          # (F, 2 vertices, 2)
+        if name == "top":
+            assert facets.size == 32
+            xi = pts[..., 0] / pm.element_size
+            assert np.allclose(xi, np.rint(xi), atol=1e-8)
+            expect = np.broadcast_to(top_y, (33,))[np.rint(xi).astype(int)]
+            assert np.allclose(pts[..., 1], expect, atol=1e-12)
+        elif name == "bottom":
+            assert np.allclose(pts[..., 1], -1.5e-3)
+        elif name == "left":
+            assert np.allclose(pts[..., 0], 0.0)
+        else:
+            assert np.allclose(pts[..., 0], pm.width)
+    # tags are disjoint and cover exactly the exterior facets
+    assert np.unique(ft.indices).size == ft.indices.size
+
+
+def test_forced_non_convergence_names_the_snes_reason():
+    pm = mesh_profile(random_profile(33, seed=2), growth=0.3)
+    opts = FemSolverOptions(method="vi", max_it=1)
+    with pytest.raises(NoConvergenceError, match="DIVERGED_MAX_IT"):
+        fem_contact_sweep(pm, MAT, [0.5 * np.ptp(pm.heights)], opts)
+
+
+def test_mirrored_profile_and_bad_input():
+    s = Surface(np.array([0.0, 1.0, 3.0, 2.0]) * 1e-6, 4e-3)
+    m = mirrored_profile(s)
+    assert m.periodic and m.shape == (6,) and m.size[0] == pytest.approx(6e-3)
+    assert np.allclose(m.heights * 1e6, [0, 1, 3, 2, 3, 1])
+    with pytest.raises(InputError, match="formulation"):
+        mesh_profile(s, formulation="curved")
+    with pytest.raises(InputError, match="method"):
+        FemSolverOptions(method="lagrange")
