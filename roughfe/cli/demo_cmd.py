@@ -3,29 +3,80 @@
 The demo is an ordered tuple of sections, :data:`SECTIONS`. Each section is a function
 ``section(outdir, context) -> str`` that writes its files into ``outdir`` and returns
 markdown text for ``index.md``; ``context`` is a dict shared by the sections (the first
-section puts the demo surface in ``context["surface"]``), so later sections can use
-earlier results. To extend the demo, add a function and append it to ``SECTIONS``.
+section puts the demo surface in ``context["surface"]``, a :class:`Surface`), so later
+sections can use earlier results. To extend the demo, write a function and append it to
+``SECTIONS``.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-from ..surfaces.stats import surface_statistics
-from ..writers import write_text
+from ..surfaces.io import load_surface, save_surface
+from ..surfaces.rmd import rmd_surface
+from ..surfaces.stats import fit_hurst, power_spectrum, surface_statistics
+from ..writers import write_json, write_text
+
+# Measured topographies shipped beside the repository (../shared/data/topographies).
+_TOPOGRAPHIES = Path(__file__).resolve().parents[3] / "shared" / "data" / "topographies"
+_MEASURED_FILE = "x3p-2.x3p"
+
+
+def _stats_table(stats) -> str:
+    rows = (("rms height Sq", f"{stats.rms_height * 1e6:.4g} um"),
+            ("peak-to-valley", f"{stats.peak_to_valley * 1e6:.4g} um"),
+            ("rms slope", f"{stats.rms_slope:.4g}"),
+            ("rms curvature", f"{stats.rms_curvature * 1e-6:.4g} 1/um"),
+            ("spectral moments m0, m2, m4",
+             f"{stats.m0:.4g} m^2, {stats.m2:.4g}, {stats.m4:.4g} 1/m^2"),
+            ("Nayak bandwidth alpha", f"{stats.nayak_alpha:.4g}"),
+            ("Hurst exponent H (PSD fit)", f"{stats.hurst:.3f}"),
+            ("fractal dimension D = 3 - H", f"{stats.fractal_dimension:.3f}"))
+    return "| quantity | value |\n|---|---|\n" + "\n".join(f"| {a} | {b} |" for a, b in rows)
+
+
+def _figures(surface, outdir, stem, title):
+    from ..plotting.surfaces import plot_psd, render_surface
+    render = render_surface(surface, outdir / f"{stem}_render.png", title=title)
+    fit = fit_hurst(surface)
+    psd = plot_psd({title: power_spectrum(surface)}, outdir / f"{stem}_psd.png",
+                   title=f"{title}: radially averaged PSD", fits={title: fit})
+    return render.name, psd.name
 
 
 def section_surface(outdir: Path, context: dict) -> str:
-    """RMD surface of thesis Fig. 7 (D = 2.3, m = 7, L = 0.1 mm) and its statistics."""
-    from ..surfaces.rmd import rmd_surface
+    """RMD surface of thesis Fig. 7 (D = 2.3, m = 7, L = 0.1 mm, seed 0) and its statistics."""
     surface = rmd_surface(m=7, fractal_dimension=2.3, length=1e-4, rng=0)
     context["surface"] = surface
-    s = surface_statistics(surface)
-    return (f"## RMD surface (thesis Fig. 7)\n\nD = 2.3, m = 7, L = 0.1 mm, seed 0: "
-            f"{surface.shape[0]} x {surface.shape[1]} points, rms height "
-            f"{s.rms_height * 1e6:.4g} um, fitted D = {s.fractal_dimension:.3f}\n")
+    save_surface(surface, outdir / "rmd_surface.npz")
+    stats = surface_statistics(surface)
+    write_json(outdir / "rmd_statistics.json", stats.as_dict())
+    render, psd = _figures(surface, outdir, "rmd", "RMD D = 2.3, m = 7")
+    return (f"## RMD rough surface (thesis Sec. 2.1.1, Fig. 7)\n\n"
+            f"D = 2.3, m = 7 ({surface.shape[0]} x {surface.shape[1]} points), L = 0.1 mm end to "
+            f"end (size {surface.size[0] * 1e6:.4g} um = (2^m+1) L / 2^m), seed 0. "
+            f"Heights: `rmd_surface.npz`; statistics: `rmd_statistics.json`.\n\n"
+            f"{_stats_table(stats)}\n\n![RMD surface]({render})\n\n![PSD]({psd})\n")
 
 
-SECTIONS = (section_surface,)
+def section_measured(outdir: Path, context: dict) -> str:
+    """One measured instrument file (ISO 25178 .x3p) read through SurfaceTopography."""
+    path = _TOPOGRAPHIES / _MEASURED_FILE
+    if not path.is_file():
+        return (f"## Measured surface\n\nskipped: {path} not found (the measured topographies "
+                f"live in ../shared/data/topographies beside the repository).\n")
+    surface = load_surface(path).detrended("plane")
+    context["measured_surface"] = surface
+    stats = surface_statistics(surface)
+    write_json(outdir / "measured_statistics.json", stats.as_dict())
+    render, psd = _figures(surface, outdir, "measured", f"measured {_MEASURED_FILE}")
+    return (f"## Measured surface ({_MEASURED_FILE}, {surface.metadata.get('reader')})\n\n"
+            f"{surface.shape[0]} x {surface.shape[1]} points, "
+            f"{surface.size[0] * 1e6:.4g} um x {surface.size[1] * 1e6:.4g} um, unit in file "
+            f"{surface.metadata.get('unit_in_file')}, plane removed, Hann-windowed PSD.\n\n"
+            f"{_stats_table(stats)}\n\n![measured surface]({render})\n\n![PSD]({psd})\n")
+
+
+SECTIONS = (section_surface, section_measured)
 
 
 def run_demo(outdir) -> Path:
@@ -33,9 +84,10 @@ def run_demo(outdir) -> Path:
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     context: dict = {}
-    parts = ["# roughfe demo\n"]
+    parts = ["# roughfe demo\n\nGenerated by `roughfe demo` (`make demo`). SI units; "
+             "lengths in the figures in micrometres.\n"]
     for section in SECTIONS:
-        print(f"demo: {section.__name__}")
+        print(f"demo: {section.__name__}", flush=True)
         parts.append(section(outdir, context))
     return write_text(outdir / "index.md", "\n".join(parts))
 

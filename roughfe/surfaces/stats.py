@@ -26,7 +26,8 @@ SurfaceTopography and Tamaas.
 Spectral moments follow Nayak (1971) for an isotropic surface, ``m_n`` being the moments
 of a profile cut in any direction: profile ``m_n = sum q^n |h~|^2``; surface
 ``m0 = sum |h~|^2``, ``m2 = (1/2) sum |q|^2 |h~|^2``, ``m4 = (3/8) sum |q|^4 |h~|^2``
-(the averages of cos^2 and cos^4 over the direction). Nayak's bandwidth parameter is
+(the averages of cos^2 and cos^4 over the direction); see :func:`spectral_moments` for
+how they are evaluated on non-periodic data. Nayak's bandwidth parameter is
 ``alpha = m0 m4 / m2^2`` (>= 1.5 for a surface; large for broad spectra).
 
 The Hurst exponent is fitted on the PSD (log-log least squares, uniform weight per
@@ -165,19 +166,23 @@ def power_spectrum(surface: Surface, window="auto", nbins=None) -> PowerSpectrum
 
 
 # -- moments and rms values ------------------------------------------------------------
-def spectral_moments(surface: Surface, window="auto"):
+def spectral_moments(surface: Surface):
     """Nayak's spectral moments ``(m0, m2, m4)`` (m^2, dimensionless, m^-2).
 
     Profile: ``m_n = sum q^n |h~|^2``. Surface (isotropic average over the direction of
     a profile cut): ``m0 = sum |h~|^2``, ``m2 = 1/2 sum |q|^2 |h~|^2``,
-    ``m4 = 3/8 sum |q|^4 |h~|^2``.
+    ``m4 = 3/8 sum |q|^4 |h~|^2``. By Parseval these are ``m0 = Rq^2`` and, for a
+    profile, ``m2 = <h'^2>``, ``m4 = <h''^2>``; for a surface ``m2 = <|grad h|^2> / 2``
+    and ``m4 = 3/8 <(lap h)^2> = 3/2 <(lap h / 2)^2>``. They are computed through those
+    identities from :func:`rms_height`, :func:`rms_slope` and :func:`rms_curvature`,
+    i.e. spectrally for periodic data and by finite differences for non-periodic data
+    (whose spectral derivatives would be dominated by the jump at the edges).
     """
-    power, qs = _fourier_power(surface, _default_window(surface, window))
-    q2 = sum(q ** 2 for q in qs)
-    m0, s2, s4 = float(power.sum()), float(np.sum(q2 * power)), float(np.sum(q2 ** 2 * power))
+    m0 = rms_height(surface) ** 2
+    slope2, curv2 = rms_slope(surface) ** 2, rms_curvature(surface) ** 2
     if surface.ndim == 1:
-        return m0, s2, s4
-    return m0, 0.5 * s2, 0.375 * s4
+        return m0, slope2, curv2
+    return m0, 0.5 * slope2, 1.5 * curv2
 
 
 def rms_height(surface: Surface) -> float:
@@ -301,7 +306,11 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
 # -- everything at once ------------------------------------------------------------------
 @dataclass(frozen=True)
 class SurfaceStatistics:
-    """Summary statistics of a profile or surface (SI units; see each function)."""
+    """Summary statistics of a profile or surface (SI units; see each function).
+
+    ``hurst``/``fractal_dimension`` come from :func:`fit_hurst`; ``hurst_success`` is
+    False when the fitted H is outside (0, 1) (the data are not self-affine there).
+    """
 
     ndim: int
     shape: tuple
@@ -321,6 +330,7 @@ class SurfaceStatistics:
     hurst: float
     fractal_dimension: float
     hurst_q_range: tuple
+    hurst_success: bool
 
     def as_dict(self) -> dict:
         """JSON-safe dict (NaN becomes None)."""
@@ -348,4 +358,5 @@ def surface_statistics(surface: Surface, q_range=None) -> SurfaceStatistics:
         skewness=float(np.mean(dev ** 3) / rq ** 3) if rq > 0 else float("nan"),
         kurtosis=float(np.mean(dev ** 4) / rq ** 4) if rq > 0 else float("nan"),
         m0=m0, m2=m2, m4=m4, nayak_alpha=m0 * m4 / m2 ** 2 if m2 > 0 else float("nan"),
-        hurst=fit.hurst, fractal_dimension=fit.fractal_dimension, hurst_q_range=fit.q_range)
+        hurst=fit.hurst, fractal_dimension=fit.fractal_dimension, hurst_q_range=fit.q_range,
+        hurst_success=fit.success)
