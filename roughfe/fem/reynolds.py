@@ -57,6 +57,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
+from .petsc_tools import apply_options, reason_name, unique_prefix
 
 DEFAULT_PETSC_OPTIONS = {
     "ksp_type": "cg",
@@ -340,24 +341,16 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         rhs.setArray(P.T @ rhs_full)
         x = Kr.createVecRight()
         ksp = PETSc.KSP().create(PETSc.COMM_SELF)
-        ksp.setOptionsPrefix("roughfe_reynolds_")
-        opts = PETSc.Options()
-        options = {**DEFAULT_PETSC_OPTIONS, **dict(petsc_options or {})}
-        for key, val in options.items():
-            opts[f"roughfe_reynolds_{key}"] = val
         ksp.setOperators(Kr)
-        ksp.setFromOptions()
-        for key in options:
-            opts.delValue(f"roughfe_reynolds_{key}")
+        apply_options(ksp, unique_prefix("reynolds"),
+                      {**DEFAULT_PETSC_OPTIONS, **dict(petsc_options or {})})
         ksp.solve(rhs, x)
         reason = ksp.getConvergedReason()
         nit = int(ksp.getIterationNumber())
-        rnorm = float(ksp.getResidualNorm())
         success = reason > 0
-        message = (f"KSP {ksp.getType()}/{ksp.getPC().getType()} converged (reason {reason}) "
-                   f"in {nit} iterations, residual norm {rnorm:.3e}" if success else
-                   f"KSP {ksp.getType()}/{ksp.getPC().getType()} failed (reason {reason}) "
-                   f"after {nit} iterations, residual norm {rnorm:.3e}")
+        message = (f"KSP {ksp.getType()}/{ksp.getPC().getType()} "
+                   f"{reason_name(PETSc.KSP.ConvergedReason, reason)} in {nit} iterations, "
+                   f"residual norm {ksp.getResidualNorm():.3e}")
         p_dof = lift + P @ x.array
         for obj in (ksp, x, rhs, Kr, Pm):
             obj.destroy()

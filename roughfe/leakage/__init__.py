@@ -1,0 +1,17 @@
+"""Leakage through a rough contact (thesis Sec. 2.3-2.4).
+
+* :func:`free_volume_network` -> :class:`NetworkResult`: free volume, percolating and
+  trapped domains by Algorithm 1 with the saddle-point rule (Eq. 2.8, 2.15-2.16).
+* :func:`reynolds_flow` -> :class:`ReynoldsResult`: leak rate from the Reynolds equation
+  (Eq. 2.10-2.12) solved with dolfinx (Q1 pressure, DG0 gap).
+* :func:`analyse_leakage` / :func:`leakage_of_contact` -> :class:`LeakageResult`: both on
+  one gap field (for example a BEM ``ContactResult``).
+* :mod:`roughfe.leakage.study`: the percolation study of Sec. 2.4.2-2.4.5.
+"""
+from .analysis import LeakageResult, analyse_leakage, leakage_of_contact
+from .network import DirectionalNetwork, NetworkResult, directional_network, free_volume_network
+from .reynolds import ReynoldsResult, hydraulic_aperture, reynolds_flow
+
+__all__ = ["free_volume_network", "directional_network", "NetworkResult", "DirectionalNetwork",
+           "reynolds_flow", "ReynoldsResult", "hydraulic_aperture", "analyse_leakage",
+           "leakage_of_contact", "LeakageResult"]

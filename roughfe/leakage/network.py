@@ -1,0 +1,369 @@
+"""Percolating and trapped free-volume networks (thesis Sec. 2.4.1, Algorithm 1, Eq. 2.8, 2.15-2.16).
+
+The gap field of a contact solution is cut into *cross-sections* and *channels*, and
+the channels that lie on open paths from the inlet side to the outlet side form the
+percolating domain ``U_p``; the rest of the free volume ``U`` is the non-percolating
+(trapped) domain ``U_np = U - U_p``.
+
+How Algorithm 1 is implemented here (the thesis gives Matlab-style loops over grid
+lines; the same definitions are evaluated with array operations and a graph):
+
+1. **Cells.** One cell per grid sample (the :class:`~roughfe.surfaces.Surface`
+   convention: a sample is the centre of a ``dx x dy`` cell, as a BEM element). The
+   free-volume domain ``U`` is the set of cells that are not in contact and have a gap
+   above ``gap_tol`` (default 0); each contributes the prism ``v_i = gap_i dx dy`` and
+   ``V = sum v_i`` (Eq. 2.8).
+2. **Cross-sections.** For a flow along axis ``a``, the grid lines normal to the flow
+   are the rows ``index_a = const``. A cross-section is a maximal run of consecutive
+   open cells along such a row, bounded by contact cells or by the domain edge
+   ("cross-sections are limited by two neighbouring asperities"). Runs are labelled at
+   once with a cumulative sum of run starts; with ``periodic=True`` a run that touches
+   both ends of its row is one cross-section.
+3. **Channels.** Two cross-sections on neighbouring rows are connected by a channel
+   when they share at least one transverse index (the thesis' case ``n_c > 2``: the
+   boundary elements between them have open corners on both sides). The channel volume
+   is the volume of the shared cells, ``V_c = sum (v_a + v_b)/2``, and the hydraulic
+   diameter ``D_h = V_c / (dx dy)`` (the thesis' ``V/delta^2``, a length).
+4. **Saddle rule (Fig. 13).** Two cells on neighbouring rows that touch only at a
+   corner (the other two cells of that 2 x 2 element closed: the thesis' ``n_c = 2``)
+   are connected only when the element centre is a saddle point: its height on the
+   mean plane of the element, ``d_zc = (w_1 + w_2 + w_3 + w_4)/4`` (closed corners have
+   ``w = 0``), must lie below both open corners, i.e. the two open gaps differ by less
+   than a factor 3 (Fig. 13a); otherwise (Fig. 13b) there is no connection. Its
+   hydraulic diameter is ``D_h = (sqrt(2)/2) d_zc``: the thesis writes
+   ``(sqrt(2)/2) delta d_zc`` in the text and ``d_zc sqrt(2)/4`` in Alg. 1, which are
+   inconsistent with each other and (the first) with ``D_h`` being a length; we keep the
+   text's factor and drop ``delta``. ``D_h`` never changes ``U_p`` unless
+   ``min_hydraulic_diameter > 0`` (the thesis uses no threshold).
+5. **Open paths.** The cross-sections are the nodes of a graph, the channels its edges,
+   plus a virtual inlet node joined to every cross-section of the first row and a
+   virtual outlet node joined to every cross-section of the last row. The network
+   percolates when inlet and outlet are in one connected component. "Open paths are
+   obtained by iterating C recursively, excluding channels that present only one
+   connection": cross-sections with fewer than two connections are removed
+   repeatedly (dead ends, Fig. 11-12: the connection 6-7 is non-percolating). What
+   remains in the inlet-outlet component is ``U_p^a``. A dead-end *loop* hanging on a
+   single cross-section survives this recursion, as in the thesis.
+6. **Union over directions.** ``U_p = U_p^x u U_p^y`` (Sec. 2.4.2), ``V_p = sum over U_p``
+   (Eq. 2.15), ``V_np = V - V_p`` (Eq. 2.16), made dimensionless with ``L^2 sigma``
+   (``L^2`` the nominal area, ``sigma`` the rms height of the undeformed surface).
+
+The domain edge parallel to the flow is a wall (or periodic); the flow direction is
+never periodic (inlet and outlet are distinct sides).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ..errors import InputError, check_finite_positive
+
+_AXES = {"x": 0, "y": 1}
+
+
+@dataclass(frozen=True, eq=False)
+class DirectionalNetwork:
+    """Cross-section/channel network for one flow direction (Alg. 1).
+
+    Attributes
+    ----------
+    direction : {"x", "y"}
+        Flow along axis 0 (``"x"``) or axis 1 (``"y"``).
+    percolates : bool
+        Whether an open path joins the inlet side (index 0) to the outlet side.
+    percolating : ndarray of bool, shape (nx, ny)
+        Cells of ``U_p^i`` (cross-sections left after removing dead ends).
+    section : ndarray of int, shape (nx, ny)
+        Cross-section label of each open cell, -1 elsewhere.
+    channels : ndarray of int, shape (n_channels, 2)
+        Cross-section pairs joined by a channel (upstream row first).
+    hydraulic_diameter : ndarray, shape (n_channels,)
+        ``D_h`` of each channel in m.
+    saddle : ndarray of bool, shape (n_channels,)
+        Channels that exist through a saddle point (diagonal-only contact, Fig. 13a).
+    n_rejected_diagonals : int
+        Diagonal-only contacts without a saddle point (Fig. 13b): no channel.
+    n_pruning_passes : int
+        Passes of the dead-end removal (the recursion depth of the thesis' step).
+    """
+
+    direction: str
+    percolates: bool
+    percolating: np.ndarray
+    section: np.ndarray
+    channels: np.ndarray
+    hydraulic_diameter: np.ndarray
+    saddle: np.ndarray
+    n_rejected_diagonals: int
+    n_pruning_passes: int
+
+    @property
+    def n_sections(self) -> int:
+        return int(self.section.max() + 1) if self.section.size else 0
+
+
+@dataclass(frozen=True, eq=False)
+class NetworkResult:
+    """Free volume and its percolating/trapped parts (Eq. 2.8, 2.15, 2.16).
+
+    Volumes are in m^3; the ``*_star`` values are divided by ``L^2 sigma`` (nominal
+    area times the rms height of the undeformed surface) and are ``None`` when no
+    ``sigma`` was given.
+
+    Attributes
+    ----------
+    open : ndarray of bool
+        Free-volume cells ``U``.
+    percolating : ndarray of bool
+        ``U_p``, union over the analysed directions.
+    trapped : ndarray of bool
+        ``U_np = U - U_p``.
+    volume, percolating_volume, trapped_volume : float
+        ``V``, ``V_p``, ``V_np`` (m^3); ``V_p + V_np = V``.
+    free_volume_star, percolating_volume_star, trapped_volume_star : float or None
+        ``V*``, ``V_p*``, ``V_np*``.
+    directions : dict
+        :class:`DirectionalNetwork` per analysed direction (``"x"``, ``"y"``).
+    """
+
+    open: np.ndarray
+    percolating: np.ndarray
+    trapped: np.ndarray
+    volume: float
+    percolating_volume: float
+    trapped_volume: float
+    free_volume_star: Optional[float]
+    percolating_volume_star: Optional[float]
+    trapped_volume_star: Optional[float]
+    directions: dict
+
+    def percolates(self, direction: str) -> Optional[bool]:
+        """Whether the network percolates along ``direction`` (None: not analysed)."""
+        net = self.directions.get(direction)
+        return None if net is None else bool(net.percolates)
+
+
+def _sections(o: np.ndarray, periodic: bool) -> np.ndarray:
+    """Label runs of open cells along axis 1, row by row (-1 for closed cells)."""
+    nl, nt = o.shape
+    start = o.copy()
+    start[:, 1:] &= ~o[:, :-1]
+    lab = np.cumsum(start.ravel()).reshape(nl, nt) - 1
+    lab = np.where(o, lab, -1)
+    n = int(start.sum())
+    if periodic and n:
+        remap = np.arange(n)
+        wrap = o[:, 0] & o[:, -1] & ~o.all(axis=1)
+        remap[lab[wrap, -1]] = lab[wrap, 0]
+        lab = np.where(o, remap[np.maximum(lab, 0)], -1)
+        used, lab_c = np.unique(lab[o], return_inverse=True)
+        lab = lab.copy()
+        lab[o] = lab_c
+    return lab
+
+
+def _diagonal_pairs(o, g, shift, periodic):
+    """Diagonal-only contacts between rows l and l+1 (cells (l,t) and (l+1,t+shift)).
+
+    Returns the indices ``(l, t)`` of the upstream cell, the saddle flag and ``d_zc``.
+    """
+    nl, nt = o.shape
+    # element made of (l, t), (l, t2), (l+1, t), (l+1, t2) with t2 = t + 1
+    a, b = o[:-1], o[1:]
+    ga, gb = g[:-1], g[1:]
+    if periodic:
+        a2, b2 = np.roll(a, -1, axis=1), np.roll(b, -1, axis=1)
+        ga2, gb2 = np.roll(ga, -1, axis=1), np.roll(gb, -1, axis=1)
+    else:
+        a, b, ga, gb = a[:, :-1], b[:, :-1], ga[:, :-1], gb[:, :-1]
+        a2, b2 = o[:-1, 1:], o[1:, 1:]
+        ga2, gb2 = g[:-1, 1:], g[1:, 1:]
+    if shift == 1:      # (l, t) -> (l+1, t+1); (l+1, t) and (l, t+1) closed
+        diag = a & b2 & ~b & ~a2
+        w1, w4 = ga, gb2
+    else:               # (l, t+1) -> (l+1, t); (l, t) and (l+1, t+1) closed
+        diag = a2 & b & ~a & ~b2
+        w1, w4 = ga2, gb
+    d_zc = 0.25 * (ga + ga2 + gb + gb2)          # element centre on its mean plane
+    saddle = diag & (np.minimum(w1, w4) > d_zc)
+    return diag, saddle, d_zc
+
+
+def directional_network(open_cells, gap, spacing, direction: str = "x", *,
+                        periodic: bool = False,
+                        min_hydraulic_diameter: float = 0.0) -> DirectionalNetwork:
+    """Cross-sections, channels and the percolating domain for one flow direction (Alg. 1).
+
+    Parameters
+    ----------
+    open_cells : ndarray of bool, shape (nx, ny)
+        Free-volume cells ``U``.
+    gap : ndarray, shape (nx, ny)
+        Gap in m (0 in contact); used for volumes, ``D_h`` and the saddle rule.
+    spacing : (float, float)
+        Cell size ``(dx, dy)`` in m.
+    direction : {"x", "y"}
+        Flow along axis 0 or axis 1; the inlet is the side at index 0.
+    periodic : bool
+        Periodic side walls (the sides parallel to the flow).
+    min_hydraulic_diameter : float
+        Channels with ``D_h`` below this (m) are dropped (thesis: 0, no threshold).
+
+    Returns
+    -------
+    DirectionalNetwork
+    """
+    if direction not in _AXES:
+        raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
+    axis = _AXES[direction]
+    o = np.asarray(open_cells, dtype=bool)
+    g = np.asarray(gap, dtype=float)
+    g = np.where(o, g, 0.0)                      # closed cells have w = 0 (Fig. 13)
+    if axis == 1:
+        o, g = o.T, g.T
+    nl, nt = o.shape
+    cell_area = float(np.prod(spacing))
+    sec = _sections(o, periodic)
+    nsec = int(sec.max() + 1) if o.any() else 0
+
+    # straight channels: shared transverse indices between neighbouring rows
+    both = o[:-1] & o[1:]
+    sa, sb = sec[:-1][both], sec[1:][both]
+    vol = 0.5 * (g[:-1][both] + g[1:][both]) * cell_area
+    pair = sa.astype(np.int64) * max(nsec, 1) + sb
+    upair, inv = np.unique(pair, return_inverse=True)
+    v_ch = np.bincount(inv, weights=vol, minlength=upair.size)
+    straight = np.column_stack([upair // max(nsec, 1), upair % max(nsec, 1)])
+    dh_straight = v_ch / cell_area
+
+    # diagonal-only contacts: saddle rule (Fig. 13)
+    diag_pairs, diag_dh = [], []
+    n_rejected = 0
+    for shift in (1, -1):
+        diag, saddle, d_zc = _diagonal_pairs(o, g, shift, periodic)
+        n_rejected += int((diag & ~saddle).sum())
+        l, t = np.nonzero(saddle)
+        t2 = (t + 1) % nt
+        if shift == 1:
+            up, down = sec[l, t], sec[l + 1, t2]
+        else:
+            up, down = sec[l, t2], sec[l + 1, t]
+        diag_pairs.append(np.column_stack([up, down]))
+        diag_dh.append(np.sqrt(2.0) / 2.0 * d_zc[l, t])
+    channels = np.concatenate([straight.reshape(-1, 2)] + diag_pairs).astype(np.int64)
+    dh = np.concatenate([dh_straight] + diag_dh)
+    is_saddle = np.concatenate([np.zeros(len(straight), bool)]
+                               + [np.ones(len(p), bool) for p in diag_pairs])
+    keep = dh >= min_hydraulic_diameter
+    channels, dh, is_saddle = channels[keep], dh[keep], is_saddle[keep]
+
+    # graph of cross-sections + virtual inlet (nsec) and outlet (nsec + 1)
+    inlet, outlet = nsec, nsec + 1
+    first = np.unique(sec[0][o[0]])
+    last = np.unique(sec[-1][o[-1]])
+    edges = np.concatenate([
+        np.unique(channels, axis=0) if len(channels) else np.empty((0, 2), np.int64),
+        np.column_stack([np.full(first.size, inlet), first]),
+        np.column_stack([last, np.full(last.size, outlet)])]).astype(np.int64)
+    nn = nsec + 2
+    graph = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(nn, nn))
+    _, comp = connected_components(graph, directed=False)
+    percolates = bool(comp[inlet] == comp[outlet])
+
+    alive = np.zeros(nn, dtype=bool)
+    passes = 0
+    if percolates:
+        alive = comp == comp[inlet]
+        anchor = np.zeros(nn, dtype=bool)
+        anchor[[inlet, outlet]] = True
+        while True:
+            e_alive = alive[edges[:, 0]] & alive[edges[:, 1]]
+            deg = (np.bincount(edges[e_alive, 0], minlength=nn)
+                   + np.bincount(edges[e_alive, 1], minlength=nn))
+            dead_end = alive & ~anchor & (deg < 2)
+            if not dead_end.any():
+                break
+            alive &= ~dead_end
+            passes += 1
+    perc = np.zeros_like(o)
+    perc[o] = alive[sec[o]]
+    if axis == 1:
+        perc, sec = perc.T, sec.T
+    return DirectionalNetwork(
+        direction=direction, percolates=percolates, percolating=np.ascontiguousarray(perc),
+        section=np.ascontiguousarray(sec), channels=channels, hydraulic_diameter=dh,
+        saddle=is_saddle, n_rejected_diagonals=n_rejected, n_pruning_passes=passes)
+
+
+def free_volume_network(gap, contact, spacing, *, directions: Sequence[str] = ("x", "y"),
+                        periodic: bool = False, sigma: Optional[float] = None,
+                        gap_tol: float = 0.0,
+                        min_hydraulic_diameter: float = 0.0) -> NetworkResult:
+    """Free volume ``V`` and its percolating/trapped parts (Eq. 2.8, 2.15-2.16, Alg. 1).
+
+    Parameters
+    ----------
+    gap : ndarray, shape (nx, ny)
+        Gap between the deformed surfaces in m (>= 0), one value per grid cell.
+    contact : ndarray of bool, shape (nx, ny), or None
+        Contact mask (closed cells). ``None``: cells with ``gap <= gap_tol`` are closed.
+    spacing : (float, float)
+        Grid spacing ``(dx, dy)`` in m.
+    directions : sequence of {"x", "y"}
+        Flow directions whose percolating domains are united into ``U_p``.
+    periodic : bool
+        Periodic side walls for each flow direction.
+    sigma : float, optional
+        Rms height of the undeformed surface in m, for ``V* = V/(L^2 sigma)``.
+    gap_tol : float
+        Cells with ``gap <= gap_tol`` (m) are not free volume (thesis: "w > 0 or greater
+        than a given threshold").
+    min_hydraulic_diameter : float
+        Channel threshold in m (see :func:`directional_network`).
+
+    Returns
+    -------
+    NetworkResult
+    """
+    g = np.asarray(gap, dtype=float)
+    if g.ndim != 2:
+        raise InputError(f"gap must be a 2D array (nx, ny) of metres, got shape {g.shape}")
+    if not np.all(np.isfinite(g)) or g.min() < 0:
+        raise InputError("gap must be finite and >= 0 (m); got min "
+                         f"{np.nanmin(g)!r} and {int((~np.isfinite(g)).sum())} non-finite value(s)")
+    if len(spacing) != 2:
+        raise InputError(f"spacing must be (dx, dy) in m, got {spacing!r}")
+    dx, dy = (check_finite_positive("spacing", s) for s in spacing)
+    if not directions or any(d not in _AXES for d in directions):
+        raise InputError(f"directions must be a non-empty subset of ('x', 'y'), got {directions!r}")
+    closed = g <= gap_tol
+    if contact is not None:
+        c = np.asarray(contact, dtype=bool)
+        if c.shape != g.shape:
+            raise InputError(f"contact mask has shape {c.shape}, gap has shape {g.shape}")
+        closed = closed | c
+    open_cells = ~closed
+    nets = {d: directional_network(open_cells, g, (dx, dy), d, periodic=periodic,
+                                   min_hydraulic_diameter=min_hydraulic_diameter)
+            for d in dict.fromkeys(directions)}
+    perc = np.zeros_like(open_cells)
+    for net in nets.values():
+        perc |= net.percolating
+    trapped = open_cells & ~perc
+    v = np.where(open_cells, g, 0.0) * dx * dy
+    volume = float(v.sum())
+    v_p = float(v[perc].sum())
+    v_np = float(v[trapped].sum())
+    if sigma is not None:
+        scale = check_finite_positive("sigma", sigma) * g.shape[0] * dx * g.shape[1] * dy
+        stars = (volume / scale, v_p / scale, v_np / scale)
+    else:
+        stars = (None, None, None)
+    return NetworkResult(open=open_cells, percolating=perc, trapped=trapped, volume=volume,
+                         percolating_volume=v_p, trapped_volume=v_np,
+                         free_volume_star=stars[0], percolating_volume_star=stars[1],
+                         trapped_volume_star=stars[2], directions=nets)

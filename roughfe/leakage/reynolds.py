@@ -1,0 +1,167 @@
+"""Leak rate through a gap field from the Reynolds equation (thesis Eq. 2.10-2.12).
+
+A thin wrapper around the finite-element solve of :mod:`roughfe.fem.reynolds` (Q1
+pressure at the cell corners, gap constant per cell, CG + BoomerAMG) that returns the
+leak rate, the hydraulic aperture and the pressure and flux fields as a frozen
+:class:`ReynoldsResult`. The flux per unit width at each cell centre is Eq. 2.11
+divided by the (constant) density, ``q = h U/2 - h^3/(12 mu) grad p`` (m^2/s), with
+the Q1 pressure gradient evaluated at the cell centre.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping, Optional
+
+import numpy as np
+
+from ..errors import InputError, check_finite_positive
+from ..fem.reynolds import solve_reynolds_fe
+
+
+@dataclass(frozen=True, eq=False)
+class ReynoldsResult:
+    """Steady Reynolds flow through a gap field (Eq. 2.12).
+
+    Attributes
+    ----------
+    direction : {"x", "y"}
+        Axis of the imposed pressure drop (inlet at coordinate 0).
+    leak_rate : float
+        Volumetric leak rate ``Q`` in m^3/s from the consistent weak-form flux.
+    hydraulic_aperture : float or None
+        ``h_eff = (12 mu Q L_flow / (W dp))^(1/3)`` in m: the parallel-plate gap with the
+        same leak rate (0 when nothing flows; None without a pressure drop).
+    inlet_flow, outlet_flow : float
+        Flow through the inlet and the outlet (m^3/s); equal up to the solver tolerance.
+    pressure : ndarray, shape (nx+1, ny+1)
+        Pressure at the cell corners in Pa; NaN where the inlet/outlet data do not
+        determine it (inside contact, trapped pockets).
+    flux : ndarray, shape (nx, ny, 2)
+        Flux per unit width ``q`` at the cell centres (m^2/s), components (x, y).
+    percolates : bool
+        Inlet and outlet connected through open cells with Q1 conduction (cells touching
+        at a corner conduct).
+    pressure_drop, mu : float
+        ``p_in - p_out`` (Pa) and viscosity (Pa s).
+    flow_length, width : float
+        Domain length along and across the flow (m).
+    success, message, nit : bool, str, int
+        Linear solver report.
+    """
+
+    direction: str
+    leak_rate: float
+    hydraulic_aperture: Optional[float]
+    inlet_flow: float
+    outlet_flow: float
+    pressure: np.ndarray
+    flux: np.ndarray
+    percolates: bool
+    pressure_drop: float
+    mu: float
+    flow_length: float
+    width: float
+    success: bool
+    message: str
+    nit: int
+
+    @property
+    def flux_magnitude(self) -> np.ndarray:
+        """``|q|`` per cell (m^2/s)."""
+        return np.hypot(self.flux[..., 0], self.flux[..., 1])
+
+
+def hydraulic_aperture(leak_rate: float, *, mu: float, pressure_drop: float,
+                       flow_length: float, width: float) -> float:
+    """Parallel-plate gap with the same leak rate, ``(12 mu Q L / (W dp))^(1/3)`` (m).
+
+    Inverts the exact parallel-plate law ``Q = h^3 W dp / (12 mu L)``; returns 0 for
+    ``Q <= 0``.
+    """
+    dp = check_finite_positive("pressure_drop", pressure_drop)
+    return float(np.cbrt(max(leak_rate, 0.0) * 12.0 * mu * flow_length / (width * dp)))
+
+
+def cell_flux(pressure, gap, spacing, *, mu: float, wall_velocity=(0.0, 0.0)) -> np.ndarray:
+    """Flux per unit width at the cell centres, ``q = h U/2 - h^3/(12 mu) grad p`` (Eq. 2.11).
+
+    Parameters
+    ----------
+    pressure : ndarray, shape (nx+1, ny+1)
+        Q1 nodal pressure (Pa), finite.
+    gap : ndarray, shape (nx, ny)
+        Gap per cell (m).
+    spacing : (float, float)
+        ``(dx, dy)`` in m.
+
+    Returns
+    -------
+    ndarray, shape (nx, ny, 2)
+        ``(q_x, q_y)`` in m^2/s.
+    """
+    p = np.asarray(pressure, dtype=float)
+    dx, dy = spacing
+    dpdx = 0.5 * ((p[1:, :-1] - p[:-1, :-1]) + (p[1:, 1:] - p[:-1, 1:])) / dx
+    dpdy = 0.5 * ((p[:-1, 1:] - p[:-1, :-1]) + (p[1:, 1:] - p[1:, :-1])) / dy
+    h = np.asarray(gap, dtype=float)
+    k = h**3 / (12.0 * mu)
+    u = np.asarray(wall_velocity, dtype=float)
+    return np.stack([0.5 * h * u[0] - k * dpdx, 0.5 * h * u[1] - k * dpdy], axis=-1)
+
+
+def reynolds_flow(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
+                  pressure_drop: float = 1.0, p_out: float = 0.0, periodic: bool = False,
+                  wall_velocity=(0.0, 0.0), h_min: float = 0.0,
+                  petsc_options: Optional[Mapping] = None) -> ReynoldsResult:
+    """Solve Eq. 2.12 on a gap field and return the leak rate and the flow fields.
+
+    Parameters
+    ----------
+    gap : ndarray, shape (nx, ny)
+        Gap in m per grid cell (0 in contact), e.g. ``ContactResult.gap``.
+    spacing : (float, float)
+        Grid spacing ``(dx, dy)`` in m.
+    direction : {"x", "y"}
+        Flow axis; the inlet is the side at coordinate 0.
+    mu : float
+        Dynamic viscosity in Pa s (water at 20 C: 1.0e-3).
+    pressure_drop : float
+        ``p_in - p_out`` in Pa (>= 0; 0 only with a wall velocity).
+    p_out : float
+        Outlet pressure in Pa (the leak rate depends only on the drop).
+    periodic : bool
+        Periodic side walls; no-flux walls otherwise.
+    wall_velocity : (float, float)
+        Sliding velocity of one wall in m/s (Couette term).
+    h_min : float
+        Optional minimum gap (m); 0 by default (a positive value biases the flux).
+    petsc_options : mapping, optional
+        Overrides of :data:`roughfe.fem.reynolds.DEFAULT_PETSC_OPTIONS`.
+
+    Returns
+    -------
+    ReynoldsResult
+    """
+    dp = float(pressure_drop)
+    if not (np.isfinite(dp) and dp >= 0):
+        raise InputError(f"pressure_drop must be finite and >= 0 (Pa), got {pressure_drop!r}")
+    if dp == 0 and not np.any(np.asarray(wall_velocity, float) != 0):
+        raise InputError("pressure_drop is 0 and there is no wall velocity: nothing drives the flow")
+    sol = solve_reynolds_fe(gap, spacing, direction=direction, mu=mu, p_in=p_out + dp,
+                            p_out=p_out, periodic=periodic, wall_velocity=wall_velocity,
+                            h_min=h_min, petsc_options=petsc_options)
+    g = np.asarray(gap, dtype=float)
+    h = np.maximum(g, h_min) if h_min > 0 else g
+    nx, ny = g.shape
+    lengths = (nx * spacing[0], ny * spacing[1])
+    axis = 0 if direction == "x" else 1
+    flow_length, width = lengths[axis], lengths[1 - axis]
+    flux = cell_flux(sol.pressure_pinned, h, spacing, mu=mu, wall_velocity=wall_velocity)
+    aperture = (hydraulic_aperture(sol.flow_rate, mu=mu, pressure_drop=dp,
+                                   flow_length=flow_length, width=width) if dp > 0 else None)
+    return ReynoldsResult(
+        direction=direction, leak_rate=sol.flow_rate, hydraulic_aperture=aperture,
+        inlet_flow=sol.inlet_flow, outlet_flow=sol.outlet_flow, pressure=sol.pressure,
+        flux=flux, percolates=sol.percolates, pressure_drop=dp, mu=float(mu),
+        flow_length=flow_length, width=width, success=sol.success, message=sol.message,
+        nit=sol.nit)
