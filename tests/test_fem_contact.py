@@ -9,15 +9,16 @@ pytest.importorskip("dolfinx")
 
 from roughfe.errors import InputError, NoConvergenceError  # noqa: E402
 from roughfe.fem import FACET_TAGS, mesh_profile, mirrored_profile  # noqa: E402
-from roughfe.fem.contact import (ElasticMaterial, FemSolverOptions, contact_edge,  # noqa: E402
-                                 fem_contact_sweep, fem_solve_contact)
+from roughfe.bem import Material  # noqa: E402
+from roughfe.fem.contact import (FemSolverOptions, contact_edge, fem_contact_sweep,  # noqa: E402
+                                 fem_solve_contact, p_wave_modulus)
 from roughfe.reference import westergaard  # noqa: E402
 from roughfe.surfaces import Surface  # noqa: E402
 
 pytestmark = pytest.mark.fem
 
 LAM, G = 1e-3, 1e-6                       # Westergaard wavelength and amplitude (m)
-MAT = ElasticMaterial(youngs_modulus=1e9, poisson_ratio=0.3)
+MAT = Material(E=1e9, nu=0.3)
 
 
 def cosine_half_period(n):
@@ -37,21 +38,23 @@ def test_westergaard_width_and_mean_gap(westergaard_mesh):
     of Westergaard (measured 0.1-0.4 %), and the mean gap, which tests the finite-depth
     correction of Delta, within 2 % of g (1 - s + s ln s) (measured 0.1-0.5 %)."""
     pm = westergaard_mesh
-    res = fem_contact_sweep(pm, MAT, np.array([0.4, 1.0, 1.6]) * G)
+    sweep = fem_contact_sweep(pm, MAT, np.array([0.4, 1.0, 1.6]) * G)
+    res = sweep.results
     for r in res:
-        ref = westergaard(G, LAM, MAT.e_star, r.mean_pressure)
+        ref = westergaard(G, LAM, MAT.E_star, r.mean_pressure)
         a = contact_edge(r.x, r.gap, r.contact)
         assert abs(a / ref.half_width - 1) < 0.01, (a, ref.half_width)
         w = np.full(r.x.size, 1.0 / (r.x.size - 1))
         w[[0, -1]] *= 0.5
         mean_gap = float(np.sum(w * r.gap))
         assert mean_gap == pytest.approx(ref.mean_gap, rel=0.02, abs=0.002 * G)
-        # the corrected approach equals h_max - mean(h) - mean gap (Betti, exact)
-        h = pm.heights
-        assert r.delta_corrected == pytest.approx(h.max() - np.sum(w * h) - mean_gap, rel=1e-6)
+        assert r.mean_gap == pytest.approx(mean_gap, rel=1e-12)
+        # the corrected approach equals max h - mean h - mean gap (Betti, exact)
+        assert r.mean_plane_separation == pytest.approx(mean_gap, rel=1e-6)
+        assert np.sum(w * r.displacement) == pytest.approx(0.0, abs=1e-9 * G)
     # pressure rises with the approach, the stiffness is positive
-    assert np.all(np.diff([r.mean_pressure for r in res]) > 0)
-    assert all(r.stiffness > 0 for r in res)
+    assert np.all(np.diff(sweep.mean_pressure) > 0) and np.all(sweep.stiffness > 0)
+    assert np.all(sweep.delta < sweep.delta_applied)
 
 
 def random_profile(n, seed):
@@ -72,9 +75,9 @@ def test_vi_and_penalty_agree():
     pm = mesh_profile(random_profile(65, seed=4), growth=0.1)
     hr = np.ptp(pm.heights)
     deltas = np.array([0.1, 0.3, 0.5]) * hr
-    vi = fem_contact_sweep(pm, MAT, deltas, FemSolverOptions(method="vi"))
+    vi = fem_contact_sweep(pm, MAT, deltas, FemSolverOptions(method="vi")).results
     pen = fem_contact_sweep(pm, MAT, deltas, FemSolverOptions(method="penalty",
-                                                              penalty_factor=1e4))
+                                                              penalty_factor=1e4)).results
     for a, b in zip(vi, pen):
         assert b.mean_pressure == pytest.approx(a.mean_pressure, rel=1e-4)
         assert np.sum(a.contact != b.contact) <= 1
@@ -92,11 +95,12 @@ def test_uniform_layer_compliance_exact(formulation):
     pm = mesh_profile(flat, depth=0.7e-3, growth=0.3, formulation=formulation)
     delta = 2e-6
     r = fem_solve_contact(pm, MAT, delta, keep_fields=True)
-    M = MAT.youngs_modulus * 0.7 / (1.3 * 0.4)
+    M = MAT.E * 0.7 / (1.3 * 0.4)
+    assert p_wave_modulus(MAT) == pytest.approx(M, rel=1e-15)
     p = M * delta / 0.7e-3
     assert r.mean_pressure == pytest.approx(p, rel=1e-10)
     assert r.layer_compliance == pytest.approx(0.7e-3 / M, rel=1e-14)
-    assert abs(r.delta_corrected) < 1e-10 * delta
+    assert abs(r.delta) < 1e-10 * delta and r.delta_applied == delta
     assert np.allclose(r.pressure, p, rtol=1e-9)
     assert r.n_contact == n and r.area_fraction == pytest.approx(1.0)
     assert np.allclose(r.fields["stress_yy"], -p, rtol=1e-8)
@@ -146,3 +150,5 @@ def test_mirrored_profile_and_bad_input():
         mesh_profile(s, formulation="curved")
     with pytest.raises(InputError, match="method"):
         FemSolverOptions(method="lagrange")
+    with pytest.raises(InputError, match="nu < 0.5"):
+        fem_solve_contact(mesh_profile(s), Material(E=1e9, nu=0.5), 1e-7)

@@ -52,7 +52,9 @@ from typing import Literal, Mapping
 
 import numpy as np
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive, check_in_open_interval
+from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..bem import Material
+from ..bem.sweep import central_differences
 from .mesh import FACET_TAGS, ProfileMesh
 from .petsc_tools import LU_MUMPS, apply_options, check_snes, unique_prefix
 
@@ -63,35 +65,22 @@ REFERENCES = ("Benson S.J., Munson T.S. (2006) Optim. Methods Softw. 21:155-168 
               "Johnson K.L. (1985) Contact Mechanics, Sec. 13.2 (Westergaard)")
 
 
-@dataclass(frozen=True)
-class ElasticMaterial:
-    """Isotropic linear elastic body in plane strain.
+def p_wave_modulus(material: Material) -> float:
+    """M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) (Pa): the uniaxial-strain (layer) modulus.
 
-    Attributes
-    ----------
-    youngs_modulus : float
-        E (Pa).
-    poisson_ratio : float
-        nu, -1 < nu < 0.5.
+    A roller-supported layer of depth H_d under a uniform pressure p shortens by p H_d / M.
     """
+    E, nu = material.E, material.nu
+    return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 
-    youngs_modulus: float
-    poisson_ratio: float = 0.3
 
-    def __post_init__(self):
-        check_finite_positive("youngs_modulus", self.youngs_modulus)
-        check_in_open_interval("poisson_ratio", self.poisson_ratio, -1.0, 0.5)
-
-    @property
-    def e_star(self) -> float:
-        """Plane-strain modulus E* = E / (1 - nu^2) (Pa): a rigid obstacle on this body."""
-        return self.youngs_modulus / (1.0 - self.poisson_ratio ** 2)
-
-    @property
-    def p_wave_modulus(self) -> float:
-        """M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) (Pa): uniaxial-strain (layer) modulus."""
-        E, nu = self.youngs_modulus, self.poisson_ratio
-        return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+def _check_material(material) -> Material:
+    if not isinstance(material, Material):
+        raise InputError(f"material must be a roughfe.bem.Material, got {type(material).__name__}")
+    if material.nu >= 0.5:
+        raise InputError(f"the P1 displacement FEM needs nu < 0.5 (it locks when incompressible), "
+                         f"got nu = {material.nu!r}")
+    return material
 
 
 @dataclass(frozen=True)
@@ -130,76 +119,134 @@ class FemSolverOptions:
 
 @dataclass(frozen=True, eq=False)
 class FemContactResult:
-    """One FEM contact solution; field names follow the BEM ``ContactResult``.
+    """One FEM contact solution. Fields shared with :class:`roughfe.bem.ContactResult`
+    have the same names, units, signs and conventions.
 
     Attributes
     ----------
     x : ndarray (n,)
-        Positions of the top vertices (m).
+        Positions of the top vertices (m), ``x[i] = i dx``.
     pressure : ndarray (n,)
-        Contact pressure (Pa), nodal force / tributary length, >= 0 in compression.
+        Contact pressure (Pa): nodal reaction / tributary length (dx; dx/2 at the ends).
+    displacement : ndarray (n,)
+        Normal displacement of the body surface in the BEM convention (m): positive into
+        the body, zero mean: ``-u_y - mean_pressure * layer_compliance``.
     gap : ndarray (n,)
-        Gap to the obstacle (m), >= 0 (penalty: negative by the penetration).
+        ``displacement + max h - h - delta`` (m), >= 0 (penalty: >= -penetration).
     contact : ndarray (n,) of bool
         Vertices in contact.
-    displacement : ndarray (n,)
-        Vertical displacement u_y of the top vertices (m), positive upwards.
     delta : float
-        Imposed approach Delta (m), measured from first touch of the highest sample.
-    delta_corrected : float
-        Delta - mean_pressure * layer_compliance (m): the half-plane approach.
+        Half-plane approach (m): the imposed ``delta_applied`` minus the uniform layer
+        shortening ``mean_pressure * layer_compliance`` (the BEM's Delta).
+    delta_applied : float
+        Approach imposed on the finite layer (m), from first touch of the highest sample.
     layer_compliance : float
-        H_d / M (m/Pa).
+        H_d / M (m/Pa), see :func:`p_wave_modulus`.
     load : float
-        Total contact force per unit depth (N/m), from the nodal reaction.
+        Total contact force per unit depth (N/m), the sum of the nodal reactions.
     mean_pressure : float
-        load / W (Pa).
+        load / W (Pa), W = (n-1) dx.
     area_fraction : float
         A* = contact_area / W.
     contact_area : float
-        Contact length per unit depth (m).
+        Contact length per unit depth (m): tributary lengths of the contact vertices.
     n_contact : int
         Number of top vertices in contact.
+    mean_gap : float
+        Trapezoidal mean of the gap over W (m) (= the mean over the mirrored period).
+    mean_plane_separation : float
+        d = max h - mean h - delta (m), mean h trapezoidal; equals mean_gap (Betti).
     stiffness : float
-        K = dp/d delta_corrected (Pa/m); NaN for a single solve, set by a sweep.
-    success, message, nit
-        As in scipy's OptimizeResult (nit = SNES iterations).
-    method, formulation : str
-        Contact solver and geometric formulation.
+        K = dp/d delta (Pa/m, Eq. 2.7) by central differences over a sweep; NaN alone.
+    success, message, nit, residual
+        As in scipy's OptimizeResult: nit SNES iterations, residual the final SNES
+        residual norm (non-dimensional).
+    solver : str
+        ``"fem-vi"`` or ``"fem-penalty"``.
+    formulation : str
+        ``"flat"`` (a) or ``"profile"`` (b).
+    e_star : float
+        E / (1 - nu^2) (Pa).
+    size, spacing : tuple
+        ``(W,)`` and ``(dx,)`` (m).
+    periodic : bool
+        False: the FEM body has rollers (it equals the periodic mirrored problem).
     fields : dict or None
-        Full-field data for pictures (when ``keep_fields``): ``points`` (m, (N, 2)),
-        ``cells`` ((C, 3) vertex indices), ``displacement`` (m, (N, 2)),
-        ``stress_yy`` (Pa, per cell), and ``formulation``.
+        Full fields for pictures (``keep_fields``, serial only): ``points`` (m, (N, 2),
+        undeformed), ``cells`` ((C, 3)), ``displacement`` (m, (N, 2), u_x and u_y),
+        ``stress_yy`` (Pa, per cell), ``formulation``.
     references : tuple of str
     """
 
     x: np.ndarray
     pressure: np.ndarray
+    displacement: np.ndarray
     gap: np.ndarray
     contact: np.ndarray
-    displacement: np.ndarray
     delta: float
-    delta_corrected: float
+    delta_applied: float
     layer_compliance: float
     load: float
     mean_pressure: float
     area_fraction: float
     contact_area: float
     n_contact: int
+    mean_gap: float
+    mean_plane_separation: float
     stiffness: float
     success: bool
     message: str
     nit: int
-    method: str
+    residual: float
+    solver: str
     formulation: str
+    e_star: float
+    size: tuple
+    spacing: tuple
+    periodic: bool = False
     fields: dict | None = None
     references: tuple = field(default=REFERENCES)
+
+    def scalars(self) -> dict:
+        """The scalar fields as a JSON-safe dict (non-finite values -> None)."""
+        out = {}
+        for key in ("delta", "delta_applied", "layer_compliance", "load", "mean_pressure",
+                    "area_fraction", "contact_area", "n_contact", "mean_gap",
+                    "mean_plane_separation", "stiffness", "nit", "residual"):
+            v = getattr(self, key)
+            out[key] = (int(v) if isinstance(v, (int, np.integer))
+                        else (float(v) if np.isfinite(v) else None))
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class FemSweepResult:
+    """A FEM loading sweep; array names follow :class:`roughfe.bem.SweepResult`.
+
+    Attributes
+    ----------
+    results : tuple of FemContactResult
+    delta, delta_applied, mean_pressure, load, area_fraction, stiffness, mean_gap : ndarray
+        Step values (see :class:`FemContactResult`); ``stiffness`` = dp/d delta by
+        central differences (second order inside, one-sided at the ends).
+    n_contact : ndarray of int
+    """
+
+    results: tuple
+    delta: np.ndarray
+    delta_applied: np.ndarray
+    mean_pressure: np.ndarray
+    load: np.ndarray
+    area_fraction: np.ndarray
+    stiffness: np.ndarray
+    mean_gap: np.ndarray
+    n_contact: np.ndarray
 
 
 class _ContactProblem:
     """Assembled stiffness, top DOFs and one configured SNES (internal, per mesh+method)."""
 
-    def __init__(self, pmesh: ProfileMesh, material: ElasticMaterial, options: FemSolverOptions):
+    def __init__(self, pmesh: ProfileMesh, material: Material, options: FemSolverOptions):
         import ufl
         from dolfinx import fem
         from dolfinx.fem.petsc import assemble_matrix
@@ -210,7 +257,7 @@ class _ContactProblem:
         h = pmesh.heights
         # displacement unit: the height range (a flat profile -- a flat punch -- uses W/1000)
         self.u_ref = float(h.max() - h.min()) or 1e-3 * pmesh.width
-        nu = material.poisson_ratio
+        nu = material.nu
         V = fem.VectorFunctionSpace(mesh, ("CG", 1))
         self.V = V
         u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
@@ -318,35 +365,38 @@ class _ContactProblem:
         out[idx] = val
         return out
 
-    def _result(self, delta, nit, what, keep_fields):
+    def _result(self, delta_applied, nit, what, keep_fields):
         pm, mat = self.pmesh, self.material
-        E, W = mat.youngs_modulus, pm.width
+        W, h = pm.width, pm.heights
         self.K.mult(self.x, self.y)
         uy_hat = self.x.array_r[self.top_dofs]
         if self.options.method == "vi":
             force_hat = -self.y.array_r[self.top_dofs]
         else:
             force_hat = self.kappa * self.weights * np.maximum(uy_hat - self.bound, 0.0)
-        force = self._gather(force_hat) * E * self.u_ref              # N/m per vertex
+        force = self._gather(force_hat) * mat.E * self.u_ref              # N/m per vertex
         uy = self._gather(uy_hat) * self.u_ref
-        w = np.full(pm.heights.size, pm.element_size)
+        w = np.full(h.size, pm.element_size)                              # tributary (m)
         w[[0, -1]] *= 0.5
-        pressure = np.maximum(force, 0.0) / w
-        gap = (pm.heights.max() - pm.heights) - delta - uy
-        tol = 1e-8 * self.u_ref
-        contact = gap <= tol if self.options.method == "vi" else gap < 0.0
         load = float(force.sum())
         mean_p = load / W
-        compliance = pm.depth / mat.p_wave_modulus
+        compliance = pm.depth / p_wave_modulus(mat)
+        delta = delta_applied - mean_p * compliance
+        disp = -uy - mean_p * compliance
+        gap = disp + h.max() - h - delta
+        contact = (gap <= 1e-8 * self.u_ref) if self.options.method == "vi" else gap < 0.0
         area = float(w[contact].sum())
-        fields = self._fields() if keep_fields else None
+        mean_h = float(np.sum(w * h)) / W
         return FemContactResult(
-            x=pm.x.copy(), pressure=pressure, gap=gap, contact=contact, displacement=uy,
-            delta=delta, delta_corrected=delta - mean_p * compliance,
+            x=pm.x.copy(), pressure=np.maximum(force, 0.0) / w, displacement=disp, gap=gap,
+            contact=contact, delta=delta, delta_applied=delta_applied,
             layer_compliance=compliance, load=load, mean_pressure=mean_p,
             area_fraction=area / W, contact_area=area, n_contact=int(contact.sum()),
+            mean_gap=float(np.sum(w * gap)) / W, mean_plane_separation=h.max() - mean_h - delta,
             stiffness=float("nan"), success=True, message=f"{what}: converged", nit=nit,
-            method=self.options.method, formulation=pm.formulation, fields=fields)
+            residual=float(self.snes.getFunctionNorm()), solver=f"fem-{self.options.method}",
+            formulation=pm.formulation, e_star=mat.E_star, size=(W,), spacing=(pm.element_size,),
+            fields=self._fields() if keep_fields else None)
 
     def _fields(self):
         """Vertices, triangles, displacement (m) and cell-wise sigma_yy (Pa), serial."""
@@ -361,7 +411,7 @@ class _ContactProblem:
                 "formulation": pm.formulation}
 
 
-def cell_stress_yy(points, cells, displacement, material: ElasticMaterial):
+def cell_stress_yy(points, cells, displacement, material: Material):
     """sigma_yy (Pa) of each linear triangle (constant strain), plane strain.
 
     sigma_yy = lambda (eps_xx + eps_yy) + 2 mu eps_yy from the exact P1 gradients.
@@ -372,7 +422,7 @@ def cell_stress_yy(points, cells, displacement, material: ElasticMaterial):
     jac = np.stack([d1, d2], axis=-1)                  # columns: edge vectors
     du = np.stack([u[:, 1] - u[:, 0], u[:, 2] - u[:, 0]], axis=-1)   # (C, 2 comps, 2 edges)
     grad = du @ np.linalg.inv(jac)                     # du_i/dx_j
-    E, nu = material.youngs_modulus, material.poisson_ratio
+    E, nu = material.E, material.nu
     lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     mu = E / (2 * (1 + nu))
     return lam * (grad[:, 0, 0] + grad[:, 1, 1]) + 2 * mu * grad[:, 1, 1]
@@ -403,38 +453,24 @@ def contact_edge(x, gap, contact):
     return float(np.clip(a, x[j], x[j + 1]))
 
 
-def stiffness_along(delta, mean_pressure):
-    """K = dp/dDelta (Pa/m) along a sweep by second-order finite differences (Eq. 2.7).
+def fem_contact_sweep(pmesh: ProfileMesh, material: Material, applied_deltas,
+                      options: FemSolverOptions | None = None, keep_fields=()) -> FemSweepResult:
+    """Solve the FEM contact problem for increasing imposed approaches (load stepping).
 
-    ``np.gradient`` on the (possibly non-uniform) Delta values; one-sided at the ends.
-    """
-    delta = np.asarray(delta, dtype=float)
-    p = np.asarray(mean_pressure, dtype=float)
-    if delta.size < 2:
-        return np.full(delta.shape, np.nan)
-    return np.gradient(p, delta, edge_order=1 if delta.size < 3 else 2)
-
-
-def fem_contact_sweep(pmesh: ProfileMesh, material: ElasticMaterial, deltas,
-                      options: FemSolverOptions | None = None, keep_fields=()):
-    """Solve the FEM contact problem for increasing approaches ``deltas`` (m).
-
-    Each step starts from the previous solution (load stepping). The stiffness
-    K = dp/d delta_corrected is filled in from the whole sweep.
+    Each step starts from the previous solution. The stiffness K = dp/d delta over the
+    half-plane approach ``delta`` is filled in from the whole sweep.
 
     Parameters
     ----------
     pmesh : ProfileMesh
-    material : ElasticMaterial
-    deltas : array_like
-        Strictly increasing approaches Delta >= 0 (m).
+    material : roughfe.bem.Material
+        E (Pa) and nu < 0.5 of the body (the obstacle is rigid).
+    applied_deltas : array_like
+        Strictly increasing approaches imposed on the layer, Delta >= 0 (m). To aim at a
+        half-plane approach delta with mean pressure p, impose delta + p H_d / M.
     options : FemSolverOptions, optional
     keep_fields : iterable of int
         Indices of the steps whose full fields (mesh, displacement, sigma_yy) are kept.
-
-    Returns
-    -------
-    list of FemContactResult
 
     Raises
     ------
@@ -442,12 +478,14 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: ElasticMaterial, deltas,
         Naming the SNES converged reason of the failed step; ``result`` holds the list
         of the steps solved before it.
     """
+    material = _check_material(material)
     options = FemSolverOptions() if options is None else options
-    deltas = np.asarray(deltas, dtype=float).ravel()
+    deltas = np.asarray(applied_deltas, dtype=float).ravel()
     if deltas.size == 0 or not np.all(np.isfinite(deltas)) or np.any(deltas < 0):
-        raise InputError(f"deltas must be a non-empty list of finite values >= 0 (m), got {deltas!r}")
+        raise InputError(f"applied_deltas must be a non-empty list of finite values >= 0 (m), "
+                         f"got {deltas!r}")
     if np.any(np.diff(deltas) <= 0):
-        raise InputError("deltas must be strictly increasing (load stepping)")
+        raise InputError("applied_deltas must be strictly increasing (load stepping)")
     keep = {int(k) % deltas.size for k in keep_fields}
     problem = _ContactProblem(pmesh, material, options)
     results = []
@@ -458,12 +496,18 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: ElasticMaterial, deltas,
         raise NoConvergenceError(str(exc), result=results) from None
     finally:
         problem.snes.destroy()
-    K = stiffness_along([r.delta_corrected for r in results], [r.mean_pressure for r in results])
-    return [replace(r, stiffness=float(k)) for r, k in zip(results, K)]
+    arr = {k: np.array([getattr(r, k) for r in results], float)
+           for k in ("delta", "delta_applied", "mean_pressure", "load", "area_fraction",
+                     "mean_gap")}
+    K = central_differences(arr["delta"], arr["mean_pressure"])
+    results = tuple(replace(r, stiffness=float(k)) for r, k in zip(results, K))
+    return FemSweepResult(results=results, stiffness=K,
+                          n_contact=np.array([r.n_contact for r in results]), **arr)
 
 
-def fem_solve_contact(pmesh: ProfileMesh, material: ElasticMaterial, delta: float,
-                      options: FemSolverOptions | None = None, keep_fields=False):
-    """One FEM contact solve at approach ``delta`` (m), from the undeformed state."""
-    return fem_contact_sweep(pmesh, material, [delta], options,
-                             keep_fields=(0,) if keep_fields else ())[0]
+def fem_solve_contact(pmesh: ProfileMesh, material: Material, applied_delta: float,
+                      options: FemSolverOptions | None = None,
+                      keep_fields: bool = False) -> FemContactResult:
+    """One FEM contact solve at the imposed approach ``applied_delta`` (m)."""
+    return fem_contact_sweep(pmesh, material, [applied_delta], options,
+                             keep_fields=(0,) if keep_fields else ()).results[0]
