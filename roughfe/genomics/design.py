@@ -1,0 +1,715 @@
+"""Roughness design for a target K(p)/A(p) (thesis Sec. 4.2-4.4, Algs. 3-7).
+
+A designed profile is a :class:`Design`: a sum of *parts*, each a set of chromosomes
+(Eq. 3.2) of one genome, realised at the database length L with N nodes, multiplied by
+the part's Eq. (4.2) factor (the amplitude that put its genome on the target pressure
+range in Alg. 3) and by one overall factor ``scale`` (Eq. 4.2 applied to the sum).
+A single-part design is an ordinary genome with amplitude gene ``scale*weight*A``
+(:meth:`Design.as_genome`); cross-overs of genomes with different (gamma, H) are not one
+MWM genome, so the design JSON stores every part's versioned genome JSON.
+
+Algorithms
+----------
+* :func:`score_database` -- Alg. 3. The database curves are stored at A = 1; Eq. (4.2)
+  rescales a curve exactly by stretching its pressure axis (see
+  :mod:`roughfe.genomics.similarity`), so scoring needs no new BEM solution.
+* :func:`sog` (Alg. 4), :func:`gco` (Alg. 5), :func:`cco` (Alg. 6), :func:`mcco` (Alg. 7),
+  each with the stages of Sec. 4.3.1: "GCMMA 0" (selection/cross-over), "GCMMA 1"
+  (GCMMA on the macro-scale phases; all phases for CCO) and "GCMMA 2" (GCMMA on the
+  micro-scale phases; CCO repeats stage 1).
+* Alg. 2 on a cross-over (Alg. 5 Step 13) needs the K_n(p) of every chromosome of the
+  new genome: a chromosome of a part is the parent's chromosome times a positive factor,
+  whose curve is the parent's stretched in p (Eq. 4.2), and c_n rescales it anyway, so
+  the stored chromosome curves of the parents are reused with the new complete curve.
+
+GCMMA (Svanberg 2002) is mmapy's ``gcmmasub`` with the usual outer/inner loop
+(:func:`gcmma_maximize`): variables are the phases, bounded to +-10 % of their start
+(thesis) or, with ``bound="period"``, to +-10 % of 2 pi (a relative bound on an angle
+depends on its arbitrary origin and freezes phases near 0: the thesis choice is kept as
+the default because it is what the thesis reports); gradients by forward finite
+differences as in the thesis. The objective is written as minimising ``(1 - s)^2``:
+for ``s`` in (0, 1] that is maximising ``s^2`` (thesis), and unlike ``-s^2`` it stays
+right when a poor start has ``s < 0``. Eq. (4.2) is re-applied at every evaluation.
+The best point ever evaluated is returned (GCMMA is not monotone on this non-smooth
+infinity-norm objective).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from ..errors import InputError
+from ..surfaces.surface import Surface
+from .database import DatabaseEntry, DatabaseSettings
+from .genome import Genome, realize
+from .macro_micro import classify, profile_response
+from .similarity import ResponseCurve, Target, similarity, split_ranges
+
+DESIGN_FORMAT = "roughfe-design"
+DESIGN_VERSION = 1
+METHODS = ("sog", "gco", "cco", "mcco")
+REFERENCES = ("Borri C. (2019) Surface roughness genomics, PhD thesis, IMT Lucca, Ch. 4",
+              "Svanberg K. (2002) SIAM J. Optim. 12(2):555-573 (GCMMA)")
+
+
+# ---------------------------------------------------------------------------------------
+# designed genomes
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class DesignPart:
+    """Chromosomes ``chromosomes`` (indices n) of ``genome`` times ``weight`` (-)."""
+
+    genome: Genome
+    chromosomes: tuple
+    weight: float = 1.0
+    label: str = ""
+
+    def __post_init__(self):
+        ch = tuple(sorted({int(n) for n in self.chromosomes}))
+        if not ch:
+            raise InputError(f"design part {self.label!r} has no chromosomes")
+        object.__setattr__(self, "chromosomes", ch)
+        if not (np.isfinite(self.weight) and self.weight > 0):
+            raise InputError(f"part weight must be finite and > 0, got {self.weight!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class Design:
+    """A designed rough profile: ``scale * sum_parts weight * sum_{n in part} C_n(x)``.
+
+    Parameters
+    ----------
+    parts : tuple of DesignPart
+    scale : float
+        Overall Eq. (4.2) factor (-).
+    length : float
+        Observation length L (m).
+    n_nodes : int
+        Nodes N (spacing L/(N-1), the genome node convention).
+    name : str
+        Provenance, e.g. ``"5-1+2-2"``.
+    """
+
+    parts: tuple
+    scale: float = 1.0
+    length: float = 849.42e-6
+    n_nodes: int = 512
+    name: str = ""
+
+    def __post_init__(self):
+        object.__setattr__(self, "parts", tuple(self.parts))
+        if not self.parts:
+            raise InputError("a design needs at least one part")
+        if not (np.isfinite(self.scale) and self.scale > 0):
+            raise InputError(f"design scale must be finite and > 0, got {self.scale!r}")
+
+    # -- geometry ----------------------------------------------------------------------
+    def keys(self, which="all") -> list:
+        """Phase variables ``(part, row m, chromosome n)``; ``which`` = "all" or a per-part
+        list of chromosome sets."""
+        out = []
+        for k, part in enumerate(self.parts):
+            chosen = part.chromosomes if which == "all" else tuple(which[k])
+            for n in chosen:
+                if n in part.chromosomes:
+                    out.extend((k, m, int(n)) for m in range(part.genome.M))
+        return out
+
+    def phase_values(self, keys) -> np.ndarray:
+        """Current phases (rad) of the variables ``keys``."""
+        return np.array([self.parts[k].genome.phases[m, n - self.parts[k].genome.n_first]
+                         for k, m, n in keys])
+
+    def with_phases(self, keys, values) -> "Design":
+        """A new design with the phases of ``keys`` set to ``values`` (rad)."""
+        phases = [np.array(p.genome.phases) for p in self.parts]
+        for (k, m, n), v in zip(keys, np.asarray(values, dtype=float)):
+            phases[k][m, n - self.parts[k].genome.n_first] = v
+        parts = tuple(replace(p, genome=replace(p.genome, phases=ph))
+                      for p, ph in zip(self.parts, phases))
+        return replace(self, parts=parts)
+
+    def rescaled(self, factor) -> "Design":
+        return replace(self, scale=self.scale * float(factor))
+
+    def part_surface(self, k) -> Surface:
+        """Part ``k`` alone (with its weight and the overall scale)."""
+        part = self.parts[k]
+        s = realize(part.genome, self.length, self.n_nodes, chromosomes=part.chromosomes)
+        return s.scaled(self.scale * part.weight)
+
+    def chromosome_surface(self, k, n) -> Surface:
+        part = self.parts[k]
+        s = realize(part.genome, self.length, self.n_nodes, chromosomes=[n])
+        return s.scaled(self.scale * part.weight)
+
+    def surface(self) -> Surface:
+        """The designed profile (heights in m) on the genome nodes."""
+        surfs = [self.part_surface(k) for k in range(len(self.parts))]
+        h = np.sum([s.heights for s in surfs], axis=0)
+        meta = {"generator": "roughfe.design", "name": self.name, "length": self.length,
+                "n_nodes": self.n_nodes, "x0": surfs[0].metadata["x0"],
+                "parts": [{"label": p.label, "chromosomes": list(p.chromosomes)}
+                          for p in self.parts]}
+        return Surface(h, surfs[0].size, periodic=False, metadata=meta)
+
+    def as_genome(self) -> Optional[Genome]:
+        """The single genome equal to this design when it has one part, else None."""
+        if len(self.parts) != 1:
+            return None
+        p = self.parts[0]
+        g = p.genome
+        return replace(g, A=g.A * p.weight * self.scale,
+                       metadata={**g.metadata, "design": self.name,
+                                 "chromosomes": list(p.chromosomes)})
+
+    # -- JSON --------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        return {"format": DESIGN_FORMAT, "version": DESIGN_VERSION, "name": self.name,
+                "scale": self.scale, "length": self.length, "n_nodes": self.n_nodes,
+                "parts": [{"label": p.label, "weight": p.weight,
+                           "chromosomes": list(p.chromosomes), "genome": p.genome.to_dict()}
+                          for p in self.parts]}
+
+    @classmethod
+    def from_dict(cls, d) -> "Design":
+        if d.get("format") != DESIGN_FORMAT or int(d.get("version", 0)) > DESIGN_VERSION:
+            raise InputError(f"not a readable {DESIGN_FORMAT} object (format={d.get('format')!r}, "
+                             f"version={d.get('version')!r})")
+        parts = tuple(DesignPart(Genome.from_dict(p["genome"]), tuple(p["chromosomes"]),
+                                 float(p["weight"]), p.get("label", "")) for p in d["parts"])
+        return cls(parts, float(d["scale"]), float(d["length"]), int(d["n_nodes"]),
+                   d.get("name", ""))
+
+
+def entry_design(entry: DatabaseEntry, settings: DatabaseSettings, weight=1.0,
+                 chromosomes=None) -> Design:
+    """A database genome (or some of its chromosomes) as a one-part design."""
+    g = Genome.from_dict(entry.genome)
+    ch = tuple(chromosomes) if chromosomes is not None else tuple(entry.macro) + tuple(entry.micro)
+    return Design((DesignPart(g, ch, float(weight), entry.label),), 1.0, settings.length,
+                  settings.n_nodes, entry.label)
+
+
+def combine(a: Design, b: Design) -> Design:
+    """Cross-over: the sum of two designs (Algs. 5-7 Step 6); scales folded into weights."""
+    parts = tuple(replace(p, weight=p.weight * d.scale) for d in (a, b) for p in d.parts)
+    return Design(parts, 1.0, a.length, a.n_nodes, f"{a.name}+{b.name}")
+
+
+# ---------------------------------------------------------------------------------------
+# objective: Eq. 4.1 after Eq. 4.2, one or two targets
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class Objective:
+    """What a design is scored against.
+
+    ``targets[0]`` sets p_max^t (Eq. 4.2). With two targets (M-CCO) the score is the
+    product f = s(y_t1, .) * s(y_t3, .) (Alg. 7 Step 10); the second target is read on
+    the same rescaled curve, so it must not extend beyond p_max^t of the first.
+    """
+
+    targets: tuple
+    p_range: tuple = (0.0, math.inf)
+
+    def __post_init__(self):
+        t = tuple(self.targets)
+        if not 1 <= len(t) <= 2:
+            raise InputError(f"one or two targets, got {len(t)}")
+        if len(t) == 2 and t[1].p_max > t[0].p_max * (1 + 1e-6):
+            raise InputError(f"the second target reaches p = {t[1].p_max:.6g} Pa beyond the "
+                             f"first target's p_max = {t[0].p_max:.6g} Pa (Eq. 4.2 matches one "
+                             f"p_max)")
+        object.__setattr__(self, "targets", t)
+
+    @property
+    def p_max(self) -> float:
+        return self.targets[0].p_max
+
+    def scores(self, curve: ResponseCurve) -> tuple:
+        """Similarity per target (Eq. 4.1) after Eq. (4.2)."""
+        c = curve.to_target_range(self.p_max)
+        return tuple(similarity(t, c, self.p_range, rescale=False) for t in self.targets)
+
+    def __call__(self, curve: ResponseCurve) -> float:
+        return float(np.prod(self.scores(curve)))
+
+
+class Evaluator:
+    """Counts and runs the BEM response of designs (``Surface -> ResponseCurve``)."""
+
+    def __init__(self, settings: DatabaseSettings, response=None):
+        self.settings = settings
+        self.response = response or (lambda s: profile_response(
+            s, youngs_modulus=settings.youngs_modulus, poisson=settings.poisson,
+            n_steps=settings.n_steps, kernel=settings.kernel))
+        self.n_sweeps = 0
+
+    def __call__(self, design: Design) -> ResponseCurve:
+        self.n_sweeps += 1
+        return self.response(design.surface())
+
+
+# ---------------------------------------------------------------------------------------
+# GCMMA
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class GcmmaResult:
+    """Best point of a GCMMA run (scipy-like report)."""
+
+    x: np.ndarray
+    fun: float
+    x0: np.ndarray
+    fun0: float
+    history: tuple
+    nit: int
+    nfev: int
+    success: bool
+    message: str
+
+
+def gcmma_maximize(fun: Callable[[np.ndarray], float], x0, lower, upper, *, n_it: int = 5,
+                   eps: float = 0.02, grad: Optional[Callable] = None, f0=None,
+                   max_inner: int = 5) -> GcmmaResult:
+    """Maximise a score ``s = fun(x) <= 1`` in a box with GCMMA (mmapy ``gcmmasub``).
+
+    Minimises ``(1 - s)^2`` with ``n_it`` outer iterations; variables are mapped to the
+    unit box; gradients by forward differences of step ``eps`` (unit-box units) unless
+    ``grad(x) -> ds/dx`` is given. Returns the best evaluated point.
+    """
+    from mmapy import asymp, concheck, gcmmasub, raaupdate
+    x0 = np.asarray(x0, float)
+    lo, hi = np.asarray(lower, float), np.asarray(upper, float)
+    width = hi - lo
+    if np.any(width <= 0):
+        raise InputError("GCMMA bounds need upper > lower for every variable")
+    n, m = x0.size, 1
+    nfev = [0]
+
+    def s_of(u):
+        nfev[0] += 1
+        return float(fun(lo + u.ravel() * width))
+
+    def obj(s):
+        return (1.0 - s) ** 2
+
+    def f_and_grad(u, s):
+        if grad is not None:
+            ds = np.asarray(grad(lo + u.ravel() * width), float) * width
+        else:
+            ds = np.empty(n)
+            for j in range(n):
+                up = u.copy()
+                step = eps if up[j, 0] + eps <= 1.0 else -eps
+                up[j, 0] += step
+                ds[j] = (s_of(up) - s) / step
+        return np.array([[obj(s)]]), (-2.0 * (1.0 - s) * ds).reshape(n, 1)
+
+    u = ((x0 - lo) / width).reshape(n, 1)
+    s0 = float(f0) if f0 is not None else s_of(u)
+    best_u, best_s = u.copy(), s0
+    history = [s0]
+    xmin, xmax = np.zeros((n, 1)), np.ones((n, 1))
+    low, upp = xmin.copy(), xmax.copy()
+    xold1, xold2 = u.copy(), u.copy()
+    a0, a, c, d = 1.0, np.zeros((m, 1)), 1000.0 * np.ones((m, 1)), np.ones((m, 1))
+    raa0, raa, raa0eps, raaeps, epsimin = 0.01, 0.01 * np.ones((m, 1)), 1e-6, 1e-6 * np.ones((m, 1)), 1e-7
+    fval, dfdx = -np.ones((m, 1)), np.zeros((m, n))
+    s = s0
+    f0val, df0dx = f_and_grad(u, s)
+    it = 0
+    for it in range(1, int(n_it) + 1):
+        low, upp, raa0, raa = asymp(it, n, u, xold1, xold2, xmin, xmax, low, upp, raa0, raa,
+                                    raa0eps, raaeps, df0dx, dfdx)
+        xmma, *_, f0app, fapp = gcmmasub(m, n, it, epsimin, u, xmin, xmax, low, upp, raa0, raa,
+                                         f0val, df0dx, fval, dfdx, a0, a, c, d)
+        s_new = s_of(xmma)
+        f0new = np.array([[obj(s_new)]])
+        conserv = concheck(m, epsimin, f0app, f0new, fapp, fval)
+        inner = 0
+        while conserv == 0 and inner < max_inner:
+            inner += 1
+            raa0, raa = raaupdate(xmma, u, xmin, xmax, low, upp, f0new, fval, f0app, fapp, raa0,
+                                  raa, raa0eps, raaeps, epsimin)
+            xmma, *_, f0app, fapp = gcmmasub(m, n, it, epsimin, u, xmin, xmax, low, upp, raa0,
+                                             raa, f0val, df0dx, fval, dfdx, a0, a, c, d)
+            s_new = s_of(xmma)
+            f0new = np.array([[obj(s_new)]])
+            conserv = concheck(m, epsimin, f0app, f0new, fapp, fval)
+        xold2, xold1, u, s = xold1, u, np.clip(xmma, 0.0, 1.0), s_new
+        history.append(s)
+        if s > best_s:
+            best_u, best_s = u.copy(), s
+        if it < n_it:
+            f0val, df0dx = f_and_grad(u, s)
+    return GcmmaResult(lo + best_u.ravel() * width, best_s, x0, s0, tuple(history), it,
+                       nfev[0], True, f"GCMMA: {it} outer iterations, best s = {best_s:.6f} "
+                       f"(start {s0:.6f})")
+
+
+def phase_bounds(phi0, fraction: float = 0.1, bound: str = "start"):
+    """Box for the phases: +-fraction*|phi0| ("start", thesis) or +-fraction*2 pi ("period").
+
+    A floor of 1e-3 rad keeps the box open for phases that start at 0.
+    """
+    phi0 = np.asarray(phi0, float)
+    if bound == "start":
+        half = np.maximum(fraction * np.abs(phi0), 1e-3)
+    elif bound == "period":
+        half = np.full(phi0.shape, fraction * 2 * np.pi)
+    else:
+        raise InputError(f"bound must be 'start' or 'period', got {bound!r}")
+    return phi0 - half, phi0 + half
+
+
+@dataclass(frozen=True)
+class GcmmaOptions:
+    """Numerical options of the GCMMA stages (Sec. 4.3.1).
+
+    ``n_it``: outer iterations per stage (thesis: SOG 5, GCO/CCO 3, stage 2: 1);
+    ``fraction``/``bound``: phase box (see :func:`phase_bounds`); ``eps``: forward
+    difference step in unit-box units; ``n_micro``: at most this many micro-scale
+    chromosomes per part (the longest wavelengths, largest amplitudes) enter stage 2.
+    """
+
+    n_it_sog: int = 5
+    n_it_cross: int = 3
+    n_it_micro: int = 1
+    fraction: float = 0.1
+    bound: str = "start"
+    eps: float = 0.02
+    n_micro: int = 6
+
+
+def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evaluator, n_it: int,
+                    options: GcmmaOptions, f0=None):
+    """One GCMMA stage on the phases ``keys`` of ``design``; returns (design, s, GcmmaResult)."""
+    if not keys or n_it <= 0:
+        s = f0 if f0 is not None else objective(evaluate(design))
+        return design, float(s), None
+    phi0 = design.phase_values(keys)
+    lo, hi = phase_bounds(phi0, options.fraction, options.bound)
+    res = gcmma_maximize(lambda x: objective(evaluate(design.with_phases(keys, x))), phi0, lo,
+                         hi, n_it=n_it, eps=options.eps, f0=f0)
+    return design.with_phases(keys, res.x), float(res.fun), res
+
+
+# ---------------------------------------------------------------------------------------
+# Alg. 3 and the selections
+# ---------------------------------------------------------------------------------------
+def score_database(entries: Sequence[DatabaseEntry], target: Target, p_range=(0.0, math.inf)
+                   ) -> np.ndarray:
+    """Alg. 3: s_i of every database genome after Eq. (4.2), in ``p_range`` (Pa)."""
+    if not entries:
+        raise InputError("the genome database is empty: build it first ('roughfe db build')")
+    return np.array([similarity(target, e.curve, p_range) for e in entries])
+
+
+def _select(scores, threshold, fallback):
+    """Indices with score > threshold, best first; the ``fallback`` best if none pass."""
+    order = np.argsort(-scores, kind="stable")
+    chosen = [int(i) for i in order if scores[i] > threshold]
+    return (chosen if chosen else [int(i) for i in order[:fallback]]), bool(chosen)
+
+
+@dataclass(frozen=True, eq=False)
+class Candidate:
+    """One of the (up to three) final designs of a method, with its score per stage."""
+
+    design: Design
+    stages: tuple           # scores at GCMMA 0, 1, 2
+    scores: tuple           # final similarity per target
+    curve: ResponseCurve    # final response on the target range (Eq. 4.2 applied)
+    macro: tuple            # variables of stage 1, per part
+    micro: tuple            # variables of stage 2, per part
+    origin: str
+
+
+@dataclass(frozen=True, eq=False)
+class DesignResult:
+    """Output of SOG / GCO / CCO / M-CCO (scipy-like: success, message, nit = BEM sweeps)."""
+
+    method: str
+    candidates: tuple
+    objective: Objective
+    pbar: Optional[float]
+    database_scores: dict
+    n_cross: int
+    n_cross_above: int
+    selection_passed: bool
+    success: bool
+    message: str
+    nit: int
+    elapsed: float
+    references: tuple = REFERENCES
+
+    @property
+    def best(self) -> Candidate:
+        return self.candidates[0]
+
+
+def _macro_micro_of(design: Design, curve: ResponseCurve, entries_by_label, threshold):
+    """Alg. 2 on a (cross-over) design from the parents' stored chromosome curves."""
+    chroms, curves = [], []
+    for k, part in enumerate(design.parts):
+        e = entries_by_label[part.label]
+        n_s = int(e.genome.get("n_first", 1))
+        for n in part.chromosomes:
+            chroms.append((k, n))
+            curves.append(e.chromosome_curves[n - n_s])
+    res = classify(curve, curves, np.arange(len(chroms)), threshold)
+    macro = [[] for _ in design.parts]
+    micro = [[] for _ in design.parts]
+    for j, c in enumerate(res.corr_k):
+        k, n = chroms[j]
+        (macro if c > threshold else micro)[k].append(n)
+    return tuple(tuple(x) for x in macro), tuple(tuple(x) for x in micro)
+
+
+def _limit_micro(micro, n_micro):
+    return tuple(tuple(sorted(m)[:n_micro]) for m in micro)
+
+
+def _finish(design, s_stages, objective, evaluate, macro, micro, origin):
+    curve = evaluate(design)
+    eta = objective.p_max / curve.p_max
+    design = design.rescaled(eta)
+    curve = curve.rescaled(eta)
+    return Candidate(design, tuple(float(s) for s in s_stages), objective.scores(curve), curve,
+                     macro, micro, origin)
+
+
+def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, entries_by_label,
+                         threshold, stage1="macro"):
+    """GCMMA 1 and 2 for each start ``(design, s0, curve0, origin)``; best first."""
+    out = []
+    for design, s0, curve0, origin in starts:
+        macro, micro = _macro_micro_of(design, curve0, entries_by_label, threshold)
+        if stage1 == "all":
+            keys1 = design.keys("all")
+        else:
+            keys1 = design.keys(macro)
+        d1, s1, _ = optimise_phases(design, keys1, objective, evaluate, n_it1, options, f0=s0)
+        if s1 < s0:
+            d1, s1 = design, s0
+        if stage1 == "all" or n_it2 <= 0:
+            d2, s2 = d1, s1
+        else:
+            keys2 = d1.keys(_limit_micro(micro, options.n_micro))
+            d2, s2, _ = optimise_phases(d1, keys2, objective, evaluate, n_it2, options, f0=s1)
+            if s2 < s1:
+                d2, s2 = d1, s1
+        out.append(_finish(d2, (s0, s1, s2), objective, evaluate, macro, micro, origin))
+    out.sort(key=lambda c: -float(np.prod(c.scores)))
+    return tuple(out)
+
+
+def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evaluate, t0):
+    best = cands[0]
+    msg = (f"{method}: best {best.origin} s = {np.prod(best.scores):.4f} "
+           f"(stages {', '.join(f'{s:.4f}' for s in best.stages)})"
+           + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used"))
+    return DesignResult(method, cands, objective, pbar, dbs, n_cross, n_above, passed, True, msg,
+                        evaluate.n_sweeps, time.perf_counter() - t0)
+
+
+def _check_entries(entries):
+    if not entries:
+        raise InputError("the genome database is empty: build it first ('roughfe db build')")
+    return list(entries), {e.label: e for e in entries}
+
+
+def sog(entries, target: Target, settings: DatabaseSettings, *, evaluate=None,
+        options: GcmmaOptions = GcmmaOptions(), n_best: int = 3) -> DesignResult:
+    """Simple Optimisation of Genes (Alg. 4).
+
+    The ``n_best`` genomes with the largest s (Alg. 3) are optimised with GCMMA on the
+    phases of their macro-scale chromosomes (Alg. 2, stored in the database; stage 1,
+    ``n_it_sog`` iterations), then on their micro-scale phases (stage 2).
+    """
+    t0 = time.perf_counter()
+    entries, by_label = _check_entries(entries)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target,))
+    s = score_database(entries, target)
+    starts = []
+    for i in np.argsort(-s, kind="stable")[:n_best]:
+        e = entries[int(i)]
+        d = entry_design(e, settings, weight=target.p_max / e.p_max)
+        starts.append((d, float(s[i]), e.curve.rescaled(target.p_max / e.p_max), e.label))
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_sog,
+                                 options.n_it_micro, by_label, settings.threshold)
+    return _result("sog", cands, objective, None, {"s": s.tolist()}, 0, 0, True, evaluate, t0)
+
+
+def _cross(entries, by_label, objective, settings, evaluate, sets, parts_of, n_best, max_set):
+    """Steps 5-12 of Algs. 5-7: every pair of U1 x U2, rescaled (Eq. 4.2), scored."""
+    u1, u2 = (s[:max_set] if max_set else s for s in sets)
+    pool = []
+    for i1 in u1:
+        for i2 in u2:
+            e1, e2 = entries[i1], entries[i2]
+            d1 = entry_design(e1, settings, objective.p_max / e1.p_max, parts_of[0](e1))
+            d2 = entry_design(e2, settings, objective.p_max / e2.p_max, parts_of[1](e2))
+            d = combine(d1, d2)
+            curve = evaluate(d)
+            pool.append((objective(curve), d, curve, f"{e1.label}+{e2.label}"))
+    pool.sort(key=lambda t: -t[0])
+    starts = [(d, s, c, o) for s, d, c, o in pool[:n_best]]
+    return starts, len(pool), sum(1 for t in pool if t[0] > 0.95)
+
+
+def _two_range_sets(entries, target, pbar, threshold=0.95, fallback=3):
+    r1, r2 = split_ranges(target, pbar)
+    s1, s2 = score_database(entries, target, r1), score_database(entries, target, r2)
+    u1, ok1 = _select(s1, threshold, fallback)
+    u2, ok2 = _select(s2, threshold, fallback)
+    return (s1, s2), (u1, u2), ok1 and ok2
+
+
+def gco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, evaluate=None,
+        options: GcmmaOptions = GcmmaOptions(), n_best: int = 3, max_set: Optional[int] = 8
+        ) -> DesignResult:
+    """Genome Cross-Over (Alg. 5).
+
+    U1/U2: genomes with s > 0.95 on [0, pbar] / [pbar, p_max^t] (the 3 best of a range
+    if none passes; at most ``max_set`` per set, None = all as in the thesis); every
+    pair U1 x U2 is summed (each at its Eq. 4.2 amplitude), rescaled and scored; the
+    ``n_best`` best go through GCMMA on their macro phases (Alg. 2 on the new genome),
+    then their micro phases.
+    """
+    t0 = time.perf_counter()
+    entries, by_label = _check_entries(entries)
+    pbar = target.check_pbar(pbar)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target,))
+    (s1, s2), sets, passed = _two_range_sets(entries, target, pbar)
+    every = (lambda e: None, lambda e: None)
+    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
+                                      every, n_best, max_set)
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
+                                 options.n_it_micro, by_label, settings.threshold)
+    return _result("gco", cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
+                   n_cross, n_above, passed, evaluate, t0)
+
+
+def cco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, evaluate=None,
+        options: GcmmaOptions = GcmmaOptions(), n_best: int = 3, max_set: Optional[int] = 8
+        ) -> DesignResult:
+    """Chromosomes Cross-Over (Alg. 6): as GCO with the macro-scale chromosomes only;
+    GCMMA on all their phases (stage 1); stage 2 repeats stage 1 (thesis Sec. 4.3.1)."""
+    t0 = time.perf_counter()
+    entries, by_label = _check_entries(entries)
+    pbar = target.check_pbar(pbar)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target,))
+    (s1, s2), sets, passed = _two_range_sets(entries, target, pbar)
+    macro = (lambda e: e.macro or e.micro[:1], lambda e: e.macro or e.micro[:1])
+    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
+                                      macro, n_best, max_set)
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross, 0,
+                                 by_label, settings.threshold, stage1="all")
+    return _result("cco", cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
+                   n_cross, n_above, passed, evaluate, t0)
+
+
+def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings, *,
+         evaluate=None, options: GcmmaOptions = GcmmaOptions(), n_best: int = 3,
+         max_set: Optional[int] = 8) -> DesignResult:
+    """Mixed Chromosomes Cross-Over (Alg. 7) for a K(p) target and an A(p) target.
+
+    U1: macro chromosomes of genomes with s(y_t1, K) > 0.95; U2: micro chromosomes of
+    genomes with s(y_t3, A) > 0.95 (the 3 best if none passes); every pair summed,
+    rescaled, scored with f = s_K * s_A; the ``n_best`` best get GCMMA on their macro
+    phases, then on their micro phases, objective f.
+    """
+    t0 = time.perf_counter()
+    if target_k.quantity != "K" or target_a.quantity != "A":
+        raise InputError(f"M-CCO needs a K(p) target and an A(p) target, got "
+                         f"{target_k.quantity!r} and {target_a.quantity!r}")
+    entries, by_label = _check_entries(entries)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target_k, target_a))
+    s1, s2 = score_database(entries, target_k), score_database(entries, target_a)
+    u1, ok1 = _select(s1, 0.95, 3)
+    u2, ok2 = _select(s2, 0.95, 3)
+    parts = (lambda e: e.macro or e.micro[:1], lambda e: e.micro or e.macro[-1:])
+    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate,
+                                      (u1, u2), parts, n_best, max_set)
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
+                                 options.n_it_micro, by_label, settings.threshold)
+    return _result("mcco", cands, objective, None, {"s1": s1.tolist(), "s2": s2.tolist()},
+                   n_cross, n_above, ok1 and ok2, evaluate, t0)
+
+
+def run_design(method: str, entries, targets, settings: DatabaseSettings, *, pbar=None,
+               evaluate=None, options: GcmmaOptions = GcmmaOptions(), **kw) -> DesignResult:
+    """Dispatch to :func:`sog`, :func:`gco`, :func:`cco` or :func:`mcco` (the CLI entry)."""
+    targets = list(targets)
+    if method not in METHODS:
+        raise InputError(f"method must be one of {METHODS}, got {method!r}")
+    if method == "mcco":
+        if len(targets) != 2:
+            raise InputError("mcco needs two targets: K(p) (--target) and A(p) (--second-target)")
+        return mcco(entries, targets[0], targets[1], settings, evaluate=evaluate,
+                    options=options, **kw)
+    if len(targets) != 1:
+        raise InputError(f"{method} takes one target, got {len(targets)}")
+    if method == "sog":
+        return sog(entries, targets[0], settings, evaluate=evaluate, options=options, **kw)
+    if pbar is None:
+        raise InputError(f"{method} needs the threshold pressure pbar (Pa)")
+    fn = gco if method == "gco" else cco
+    return fn(entries, targets[0], pbar, settings, evaluate=evaluate, options=options, **kw)
+
+
+# ---------------------------------------------------------------------------------------
+# reproducibility and the thesis targets
+# ---------------------------------------------------------------------------------------
+def rescore(design: Design, targets, settings: DatabaseSettings, response=None) -> tuple:
+    """Independent check: realise a saved design, run a fresh BEM sweep *without* any
+    rescaling and return the similarity per target (must equal the reported scores)."""
+    evaluate = Evaluator(settings, response)
+    curve = evaluate(design)
+    return tuple(similarity(t, curve, rescale=False) for t in targets)
+
+
+#: the genome behind target y_t1 (not in the Sobol database: gamma, H off the Sobol points,
+#: phases from a different generator), fixed here and recorded in every report.
+Y_T1_GENES = {"gamma": 1.55, "H": 0.8, "A": 1.0, "phase_seed": 20190}
+
+
+def target_genome_t1(settings: DatabaseSettings) -> Genome:
+    """Genome of y_t1: M = 1, lambda = L, phases ``default_rng(20190).uniform(0, 2 pi)``."""
+    from .database import make_genome
+    g = make_genome(Y_T1_GENES["gamma"], Y_T1_GENES["H"], Y_T1_GENES["phase_seed"], settings,
+                    amplitude=Y_T1_GENES["A"])
+    return replace(g, metadata={"role": "target y_t1", **Y_T1_GENES})
+
+
+def thesis_targets(settings: DatabaseSettings, response=None, *, pbar2_fraction=0.53 / 1.6):
+    """Targets of Sec. 4.3-4.4: y_t1 (K of :func:`target_genome_t1`), y_t3 (its A(p)) and
+    y_t2 (K linear in p up to pbar, flat after, on the same pressure range).
+
+    The thesis gives p in its own units and no p_max^t; reading p_max^t ~ 1.6e-4 off
+    Figs. 57-59, ``pbar2_fraction = 0.53/1.6`` places pbar = 0.53e-4 at the same fraction
+    of p_max^t. The plateau of y_t2 is y_t1 at pbar. Returns ``(t1, t2, t3, curve)``.
+    """
+
+    evaluate = Evaluator(settings, response)
+    g = target_genome_t1(settings)
+    d = Design((DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "y_t1"),), 1.0,
+               settings.length, settings.n_nodes, "y_t1")
+    curve = evaluate(d)
+    meta = {"genome": g.to_dict(), "settings": settings.to_dict()}
+    t1 = Target(curve.pressure, curve.stiffness, "K", "y_t1", meta)
+    t3 = Target(curve.pressure, curve.area_fraction, "A", "y_t3", meta)
+    pbar = pbar2_fraction * curve.p_max
+    plateau = float(np.interp(pbar, curve.pressure, curve.stiffness))
+    from .similarity import linear_then_flat_target as ltf
+    t2 = ltf(curve.p_max, pbar, plateau, n_points=settings.n_steps, name="y_t2")
+    return t1, t2, t3, curve
