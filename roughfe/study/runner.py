@@ -137,7 +137,7 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     log = log or (lambda message: None)
     t_start = time.perf_counter()
     tasks = spec.tasks()
-    check_parameters(spec.analysis, tasks[0].params)
+    check_parameters(spec.analysis, tasks[0].kwargs)
     outdir = spec.output
     with store.study_lock(outdir):
         store.write_study(outdir, spec, tasks, __version__)
@@ -176,7 +176,7 @@ def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached):
     def refill():
         while queue and len(inflight) < window:
             task = queue.popleft()
-            future = ex.submit(execute_task, spec.analysis, dict(task.params), task.seed)
+            future = ex.submit(execute_task, spec.analysis, task.kwargs, task.seed)
             inflight[future] = task
             completion.add(future)
 

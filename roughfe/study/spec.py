@@ -22,7 +22,9 @@ Each task gets a seed derived by SHA-256 from the base seed, the analysis and th
 values of the ``seed_from`` parameters (never Python's salted ``hash()``). Leaving a
 parameter out of ``seed_from`` keeps the same random surface across its values, e.g.
 the same realisation refined over resolutions ``m``. A parameter named ``seed`` in the
-grid or fixed table is used as given instead.
+grid or fixed table is used as given instead. A grid parameter named ``replica``
+(e.g. ``replica = [0, 1, ..., 19]`` for 20 surfaces per point) only selects the seed and
+labels the rows: it is not passed to the analysis.
 
 Each task is stored under a content key: SHA-256 of the canonical JSON of the analysis,
 its version, the roughfe version, the parameters and the seed. Identical work always
@@ -43,6 +45,7 @@ from .. import __version__
 from ..errors import InputError
 
 SECTIONS = {"study", "grid", "fixed"}
+RUNNER_ONLY = ("replica",)  # parameters that select seeds but are not passed to the analysis
 STUDY_KEYS = {"name", "analysis", "output", "seed", "seed_from", "max_attempts"}
 
 
@@ -113,6 +116,11 @@ class Task:
     params: Mapping[str, Any]
     seed: int
     key: str
+
+    @property
+    def kwargs(self) -> dict:
+        """Keyword arguments of the analysis call (``params`` minus runner-only ones)."""
+        return {k: v for k, v in self.params.items() if k not in RUNNER_ONLY}
 
 
 @dataclass(frozen=True)
