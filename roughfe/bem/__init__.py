@@ -1,0 +1,19 @@
+"""Boundary-element contact solver (thesis Sec. 2.2, Eq. 2.3-2.8).
+
+Public API (stable):
+
+* :class:`Material` and :func:`composite` -- elastic constants, E* (Pa).
+* :func:`solve_contact` -> :class:`ContactResult` -- one contact problem under an
+  imposed approach ``delta`` (m) or ``mean_pressure`` (Pa).
+* :func:`contact_sweep` -> :class:`SweepResult` -- warm-started loading sweeps
+  (A(p), K(p), V*(d/sigma)); ``SweepResult.to_records()`` for results.json.
+* :func:`influence_operator` -- the operators u = H p (``"spectral"``, ``"strip"``,
+  ``"thesis"``, ``"love"``).
+"""
+from .contact import ContactResult, solve_contact
+from .material import Material, composite
+from .operators import KERNELS, InfluenceOperator, influence_operator
+from .sweep import RECORD_KEYS, SweepResult, contact_sweep
+
+__all__ = ["Material", "composite", "solve_contact", "ContactResult", "contact_sweep",
+           "SweepResult", "RECORD_KEYS", "influence_operator", "InfluenceOperator", "KERNELS"]

@@ -1,0 +1,400 @@
+"""Frictionless normal contact of a rigid rough surface on an elastic half-space by the
+BEM (thesis Sec. 2.2, Eq. 2.3-2.8): :func:`solve_contact` -> :class:`ContactResult`.
+
+Geometry and signs (SI): heights h (m, axis 0 = x) point towards the elastic body; the
+flat elastic half-space first touches the highest point (Delta = 0) and is then pushed
+by the far-field approach Delta (m). Pressure p >= 0 is compressive; the displacement
+u = H p (m) of the half-space surface points away from the rough surface; the gap is
+
+    g = u + max(h) - h - Delta >= 0,      p g = 0.
+
+The mean plane separation is d = max(h) - mean(h) - Delta (the distance between the
+undeformed flat and the mean plane of the rough surface, as in Greenwood-Williamson
+and Paggi & He 2015); with the periodic kernel mean(u) = 0, so d equals the mean gap.
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from ..errors import InputError
+from ..surfaces.stats import rms_height
+from ..surfaces.surface import Surface
+from .material import Material
+from .operators import KERNELS, InfluenceOperator, influence_operator
+from .solvers import (SolverOutput, dense_solve, kkt_residual, polonsky_keer,
+                      restricted_cg, solve_spd)
+
+SOLVERS = ("auto", "dense", "nnls", "pk")
+#: largest number of grid points solved with the dense solvers by ``solver="auto"``
+DENSE_MAX_POINTS = 2048
+
+REFERENCES = (
+    "Bemporad A., Paggi M. (2015) Int. J. Solids Struct. 69-70:94-105 (NNLS BEM)",
+    "Polonsky I.A., Keer L.M. (1999) Wear 231:206-219 (constrained CG)",
+    "Paggi M., He Q.-C. (2015) Wear 336-337:86-95 (free volume, Eq. 2.8)",
+)
+
+
+@dataclass(frozen=True, eq=False)
+class ContactResult:
+    """Solution of one contact problem (all SI).
+
+    Fields
+    ------
+    pressure : ndarray
+        Contact pressure p (Pa), >= 0, grid shape.
+    displacement : ndarray
+        Normal surface displacement u = H p of the elastic body (m).
+    gap : ndarray
+        g = u + max h - h - Delta (m), >= 0 (round-off clipped at 0).
+    contact : ndarray of bool
+        Contact mask, ``pressure > 0``.
+    delta : float
+        Approach Delta from first contact (m).
+    load : float
+        Total load P = mean_pressure * A_n: N for surfaces, N/m for profiles.
+    mean_pressure : float
+        p = P / A_n (Pa).
+    area_fraction : float
+        A* = A_r / A_n.
+    contact_area : float
+        A_r = n_c * cell area (m^2; m per unit depth for profiles).
+    n_contact : int
+        Number of contact points n_c.
+    mean_gap : float
+        Mean of the gap over the nominal area (m).
+    mean_plane_separation : float
+        d = max h - mean h - Delta (m).
+    free_volume : float
+        V = sum of gap prisms over points with g > 0 (Eq. 2.8): m^3, or m^2 per unit
+        depth for profiles (= mean_gap * A_n).
+    free_volume_star : float
+        V* = V / (A_n sigma), sigma the rms height.
+    stiffness : float
+        Exact incremental contact stiffness K = d p / d Delta (Eq. 2.7) in Pa/m, from
+        the converged contact set c: H_cc x = 1, K = sum(x) / N. ``inf`` at full
+        contact of a periodic surface; NaN if not computed.
+    success, message, nit, residual :
+        Convergence report (relative KKT residual, see :mod:`roughfe.bem.solvers`).
+    kernel, solver : str
+        Influence operator and solver used.
+    e_star : float
+        Composite modulus (Pa).
+    rms_height : float
+        sigma (m).
+    size, spacing : tuple
+        Physical size and grid spacing per axis (m).
+    periodic : bool
+        Whether the periodic operator was used.
+    references : tuple of str
+    """
+
+    pressure: np.ndarray
+    displacement: np.ndarray
+    gap: np.ndarray
+    contact: np.ndarray
+    delta: float
+    load: float
+    mean_pressure: float
+    area_fraction: float
+    contact_area: float
+    n_contact: int
+    mean_gap: float
+    mean_plane_separation: float
+    free_volume: float
+    free_volume_star: float
+    stiffness: float
+    success: bool
+    message: str
+    nit: int
+    residual: float
+    kernel: str
+    solver: str
+    e_star: float
+    rms_height: float
+    size: tuple
+    spacing: tuple
+    periodic: bool
+    references: tuple
+
+    @property
+    def full_contact(self) -> bool:
+        """True when every point is in contact (A* = 1)."""
+        return self.n_contact == self.pressure.size
+
+    def scalars(self) -> dict:
+        """The scalar fields as a JSON-safe dict (non-finite values -> None)."""
+        out = {}
+        for key in ("delta", "load", "mean_pressure", "area_fraction", "contact_area",
+                    "n_contact", "mean_gap", "mean_plane_separation", "free_volume",
+                    "free_volume_star", "stiffness", "nit", "residual"):
+            v = getattr(self, key)
+            out[key] = (int(v) if isinstance(v, (int, np.integer))
+                        else (float(v) if np.isfinite(v) else None))
+        return out
+
+
+# -- cached operators ---------------------------------------------------------------------
+@functools.lru_cache(maxsize=16)
+def _operator(shape, size, e_star, kernel) -> InfluenceOperator:
+    return influence_operator(shape, size, e_star, kernel)
+
+
+@functools.lru_cache(maxsize=4)
+def _dense(op: InfluenceOperator) -> np.ndarray:
+    return op.dense()
+
+
+def _choose_kernel(surface: Surface, kernel: str) -> str:
+    if kernel == "auto":
+        if surface.periodic:
+            return "spectral"
+        return "strip" if surface.ndim == 1 else "love"
+    if kernel not in KERNELS:
+        raise InputError(f"kernel must be 'auto' or one of {KERNELS}, got {kernel!r}")
+    if kernel == "spectral" and not surface.periodic:
+        raise InputError("kernel 'spectral' is periodic and needs a periodic surface "
+                         "(Surface(..., periodic=True)); use 'strip'/'love' otherwise")
+    return kernel
+
+
+def _choose_solver(n_points: int, op: InfluenceOperator, solver: str) -> str:
+    if solver not in SOLVERS:
+        raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    if solver == "auto":
+        return "dense" if n_points <= DENSE_MAX_POINTS else "pk"
+    if solver == "nnls" and op.periodic:
+        raise InputError("solver 'nnls' (Cholesky + Lawson-Hanson) needs a positive definite "
+                         "operator: not the periodic one (its mean mode is free); use 'dense'")
+    return solver
+
+
+def _check_surface(surface):
+    if not isinstance(surface, Surface):
+        raise InputError(f"surface must be a roughfe Surface, got {type(surface).__name__}")
+    if np.ptp(surface.heights) == 0.0:
+        raise InputError("the surface is flat (constant heights): contact of a flat on a "
+                         "flat is uniform and has no rough-contact solution")
+
+
+def _check_target(delta, mean_pressure):
+    if (delta is None) == (mean_pressure is None):
+        raise InputError("give exactly one of delta (approach, m) or mean_pressure (Pa)")
+    if delta is not None:
+        try:
+            d = float(delta)
+        except (TypeError, ValueError):
+            raise InputError(f"delta must be a number of metres >= 0, got {delta!r}") from None
+        if not (np.isfinite(d) and d >= 0):
+            raise InputError(f"delta (approach from first contact, m) must be finite and "
+                             f">= 0, got {delta!r}")
+        return d, None
+    try:
+        pm = float(mean_pressure)
+    except (TypeError, ValueError):
+        raise InputError(f"mean_pressure must be a number of Pa > 0, got {mean_pressure!r}") \
+            from None
+    if not (np.isfinite(pm) and pm > 0):
+        raise InputError(f"mean_pressure (Pa) must be finite and > 0, got {mean_pressure!r}")
+    return None, pm
+
+
+def _periodic_full_contact(op, h):
+    """Zero-mean pressure p' with H p' = h - mean h (exact, spectral), shape of h."""
+    import scipy.fft
+    hh = scipy.fft.rfftn(h - h.mean())
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ph = np.where(op.spectrum > 0, hh / np.where(op.spectrum > 0, op.spectrum, 1), 0)
+    return scipy.fft.irfftn(ph, s=h.shape)
+
+
+def _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter):
+    """Displacement control on the periodic operator, in the gap variable.
+
+    With mean(u) = 0 an imposed Delta is an imposed mean gap gbar = max h - mean h -
+    Delta. The problem min 1/2 u'Ku s.t. gap w = u - s >= 0, mean(w) = gbar (K = H^-1
+    the stiffness operator, E*|q|/2, s = Delta + b) has the structure of the
+    load-controlled problem with (pressure, compliance) -> (gap, stiffness), and the
+    pressure p = K u + pbar is the multiplier (as Tamaas' PolonskyKeerRey does for an
+    imposed gap). The primal form would have to find the mean pressure through a
+    direction of zero curvature, which stalls the CG.
+    """
+    import scipy.fft
+    from .solvers import polonsky_keer
+    shape = b.shape
+    inv = np.where(op.spectrum > 0, 1.0 / np.where(op.spectrum > 0, op.spectrum, 1.0), 0.0)
+
+    def stiff(v):
+        return scipy.fft.irfftn(scipy.fft.rfftn(v) * inv, s=shape)
+
+    s = delta + b
+    gbar = -float(s.mean())
+    Ks = stiff(s)
+    w0 = None
+    if initial is not None and np.any(initial > 0):
+        w0 = np.maximum(op.apply(initial) - s, 0.0)
+        w0[initial > 0] = 0.0
+        if w0.mean() <= 0:
+            w0 = None
+    pscale = float(np.ptp(Ks)) or 1.0
+    o = polonsky_keer(stiff, -Ks, pscale, mean_pressure=gbar, initial=w0,
+                      diagonal=1.0 / op.diagonal, tol=tol, max_iter=max_iter)
+    w = o.pressure
+    u = w + s
+    p = np.maximum(stiff(u) - o.delta, 0.0)
+    p[w > 0] = 0.0
+    res = kkt_residual(p, op.apply(p) - s, scale)
+    return SolverOutput(p, op.apply(p), delta, o.nit, max(res, o.residual), "pk")
+
+
+def _stiffness(op, solver, p, w, scale):
+    """Exact incremental stiffness dp/dDelta (Pa/m) from the contact set."""
+    c = p > 0
+    if not c.any():
+        c = w <= 1e-12 * scale
+    n = p.size
+    if op.periodic and c.all():
+        return float("inf")
+    if solver in ("dense", "nnls"):
+        idx = np.flatnonzero(c.ravel())
+        x = solve_spd(_dense(op)[np.ix_(idx, idx)], np.ones(idx.size))
+        return float(x.sum()) / n
+    x, _ = restricted_cg(op.apply, c, np.ones(p.shape))
+    return float(x.sum()) / n
+
+
+def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pressure=None,
+                  kernel: str = "auto", solver: str = "auto", tol: float = 1e-10,
+                  max_iter: Optional[int] = None, initial=None,
+                  compute_stiffness: bool = True) -> ContactResult:
+    """Solve the frictionless contact of a rigid rough surface on an elastic half-space.
+
+    Displacement control (``delta``) or load control (``mean_pressure``), Eq. 2.5-2.6.
+
+    Parameters
+    ----------
+    surface : Surface
+        Profile (plane strain, per unit depth) or surface; heights in m.
+    material : Material
+        Elastic body; its ``E_star`` (Pa) enters the influence operator.
+    delta : float, optional
+        Approach from first contact Delta >= 0 (m). For a periodic surface Delta can not
+        exceed max h - mean h (full contact; the mean displacement is zero there, see
+        :mod:`roughfe.bem.operators`); at that value the smallest full-contact
+        pressure is returned.
+    mean_pressure : float, optional
+        Imposed mean pressure p > 0 over the nominal area (Pa). Above the full-contact
+        pressure of a periodic surface the state is full contact (A* = 1).
+    kernel : {"auto", "spectral", "strip", "thesis", "love"}
+        Influence operator; "auto" = "spectral" for periodic surfaces, "strip"
+        (profiles) / "love" (surfaces) otherwise.
+    solver : {"auto", "dense", "nnls", "pk"}
+        "dense": block principal pivoting on the dense matrix (warm-startable);
+        "nnls": Bemporad & Paggi's Cholesky + scipy NNLS (non-periodic kernels);
+        "pk": matrix-free Polonsky-Keer CG with FFT products. "auto": dense up to
+        ``DENSE_MAX_POINTS`` points, pk above.
+    tol : float
+        Relative KKT residual to reach.
+    max_iter : int, optional
+        Iteration limit (pk CG iterations / Newton steps of dense load control).
+    initial : ndarray, optional
+        Initial pressure (Pa), e.g. the previous step of a sweep.
+    compute_stiffness : bool
+        Compute the exact incremental stiffness (one extra solve on the contact set).
+
+    Raises
+    ------
+    InputError (a ValueError)
+        Bad input (see the messages).
+    NoConvergenceError (a RuntimeError)
+        The tolerance was not reached; its ``result`` holds the last iterate.
+    """
+    _check_surface(surface)
+    if not isinstance(material, Material):
+        raise InputError(f"material must be a roughfe.bem.Material, got {material!r}")
+    delta, mean_pressure = _check_target(delta, mean_pressure)
+    kernel = _choose_kernel(surface, kernel)
+    op = _operator(surface.shape, surface.size, material.E_star, kernel)
+    solver = _choose_solver(surface.heights.size, op, solver)
+    h = surface.heights
+    hmax = float(h.max())
+    b = h - hmax
+    scale = float(np.ptp(h))
+    if initial is not None:
+        initial = np.asarray(initial, dtype=float)
+        if initial.shape != h.shape:
+            raise InputError(f"initial pressure has shape {initial.shape}, expected {h.shape}")
+
+    out = None
+    if op.periodic:
+        delta_full = hmax - float(h.mean())
+        if delta is not None and delta > delta_full * (1 + 1e-12):
+            raise InputError(
+                f"delta = {delta:.6g} m exceeds max h - mean h = {delta_full:.6g} m: for a "
+                f"periodic surface (zero mean displacement) that is full contact already; "
+                f"impose a mean_pressure to go beyond it")
+        if delta is not None and delta >= delta_full * (1 - 1e-12) \
+                or mean_pressure is not None:
+            p0 = _periodic_full_contact(op, h)
+            p_full = -float(p0.min())
+            if delta is not None or mean_pressure >= p_full:
+                level = p_full if delta is not None else mean_pressure
+                p = p0 + level
+                p[p < 0] = 0.0
+                out = SolverOutput(p, h - h.mean(), delta_full, 0, 0.0, "closed form")
+    if out is None:
+        if solver == "pk" and op.periodic and delta is not None:
+            out = _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter or 20000)
+        elif solver == "pk":
+            out = polonsky_keer(op.apply, b, scale, delta=delta, mean_pressure=mean_pressure,
+                                initial=initial, diagonal=op.diagonal, tol=tol,
+                                max_iter=max_iter or 20000)
+        else:
+            H = _dense(op)
+            if initial is None:
+                # a rough matrix-free solve gives the contact set: pivoting then needs
+                # only a few exchanges (the answer is still the exact pivoting solution)
+                initial = solve_contact(surface, material, delta=delta,
+                                        mean_pressure=mean_pressure, kernel=kernel,
+                                        solver="pk", tol=1e-4, compute_stiffness=False,
+                                        max_iter=2000).pressure
+            o = dense_solve(H, b.ravel(), scale, delta=delta, mean_pressure=mean_pressure,
+                            initial=initial, method="nnls" if solver == "nnls" else "bpp",
+                            tol=tol, max_iter=max_iter or 100)
+            out = SolverOutput(o.pressure.reshape(h.shape), o.displacement.reshape(h.shape),
+                               o.delta, o.nit, o.residual, solver)
+    return _result(surface, material, op, solver, out, scale, compute_stiffness)
+
+
+def _result(surface, material, op, solver, out, scale, compute_stiffness):
+    h = surface.heights
+    p, u, d = out.pressure, out.displacement, out.delta
+    w = u + h.max() - h - d
+    # closed-form full contact at the least pressure: one point has p = 0 and g = 0
+    contact = p > 0 if out.solver != "closed form" else np.ones(p.shape, bool)
+    gap = np.where(contact, 0.0, np.maximum(w, 0.0))
+    n = p.size
+    nc = int(contact.sum())
+    pm = float(p.mean())
+    sigma = rms_height(surface)
+    A = surface.nominal_area
+    mean_gap = float(gap.mean())
+    K = _stiffness(op, solver, p, w, scale) if compute_stiffness else float("nan")
+    for arr in (p, u, gap, contact):
+        arr.setflags(write=False)
+    return ContactResult(
+        pressure=p, displacement=u, gap=gap, contact=contact, delta=float(d),
+        load=pm * A, mean_pressure=pm, area_fraction=nc / n,
+        contact_area=nc * surface.cell_area, n_contact=nc, mean_gap=mean_gap,
+        mean_plane_separation=float(h.max() - h.mean() - d),
+        free_volume=float(gap[gap > 0].sum()) * surface.cell_area,
+        free_volume_star=mean_gap / sigma, stiffness=K, success=True,
+        message=("full contact" if nc == n else "converged") + f" ({out.solver})",
+        nit=int(out.nit), residual=float(out.residual), kernel=op.name,
+        solver=out.solver, e_star=material.E_star, rms_height=sigma,
+        size=tuple(surface.size), spacing=tuple(surface.spacing),
+        periodic=op.periodic, references=REFERENCES + op.references)

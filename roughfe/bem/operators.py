@@ -1,0 +1,193 @@
+"""Influence operators u = H p of the BEM (thesis Eq. 2.3-2.4): pressure (Pa) -> normal
+surface displacement (m) of an elastic half-space (surfaces) or half-plane in plane
+strain (profiles), for pressures that are uniform over each grid cell.
+
+Every operator is a discrete convolution, stored as its real-space kernel ``kernel``
+(m/Pa, the displacement of cell ``i`` under a unit pressure on cell ``j`` at offset
+``i - j``) on a grid of shape ``fft_shape`` and the kernel's real FFT ``spectrum``:
+
+* periodic kernels (``"spectral"``) live on the grid itself (``fft_shape == shape``);
+  ``apply`` is a circular convolution.
+* non-periodic kernels (``"strip"``, ``"thesis"``, ``"love"``) live on a zero-padded
+  grid of twice the size (DC-FFT, Liu, Wang & Liu 2000): offsets ``0..n-1`` are stored
+  at ``0..n-1`` and ``-(n-1)..-1`` at ``n+1..2n-1``; the linear convolution of the
+  ``n``-point pressure is then exact.
+
+Kernels (``kernel=`` in :func:`roughfe.bem.solve_contact`):
+
+``"spectral"`` (periodic profiles and surfaces)
+    u(q) = 2 p(q) / (E* |q|) for q != 0 (Johnson 1985; Stanley & Kato 1997), applied to
+    the sampled pressure. The q = 0 mode is set to zero: a uniform pressure on a
+    periodic half-space has no finite displacement, so the *mean displacement is zero
+    by convention* and the mean pressure is an independent unknown, fixed either by
+    the imposed mean pressure (load control) or by the approach Delta (displacement
+    control; then Delta = max h - mean h - mean gap).
+``"strip"`` (non-periodic profiles)
+    Uniform pressure on each strip of width dx of an elastic half-plane (plane strain):
+    H(r) = (2/(pi E*)) int_{r-dx/2}^{r+dx/2} ln(L/|t|) dt. The 2D displacement is defined
+    up to a constant; it is fixed by taking the displacement of a line load as zero at a
+    distance L = the profile length (``size[0]``). The same matrix gives loads and
+    stiffness, so they are consistent; the load-approach curve shifts with the choice
+    of L (a genuine property of 2D elasticity), contact areas and pressures do not
+    depend on it for a prescribed load.
+``"thesis"`` (non-periodic profiles and surfaces)
+    Eq. 2.4 of the thesis, H_ij = 2/(pi E* delta) arcsin(delta / (2 |x_j - x_i|)) per
+    unit force (Borri-Brunetto et al. 2001): the displacement at distance r outside a
+    rigid circular punch of diameter delta carrying a force F = p * (cell area). It
+    is the 3D (Boussinesq) point-load kernel 1/(pi E* r) at r >> delta, i.e. a line of
+    patches in 3D, not a plane-strain profile (whose kernel is logarithmic). The
+    diagonal is the punch displacement F/(E* delta) (arcsin argument clipped to 1).
+    delta = dx for a profile (force p dx^2 per patch: a strip of width dx), and
+    sqrt(dx dy) for a surface.
+``"love"`` (non-periodic surfaces)
+    Love's exact displacement of a uniformly loaded rectangle dx x dy (Love 1929;
+    Johnson 1985, Eq. 3.25), see :func:`roughfe.reference.uniform_rectangle_displacement`.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.fft
+
+from ..errors import InputError
+from ..reference import uniform_rectangle_displacement, uniform_strip_displacement
+from ..surfaces.stats import angular_wavevectors
+
+KERNELS = ("spectral", "strip", "thesis", "love")
+WORKERS = max(1, min(4, os.cpu_count() or 1))
+
+_KERNEL_REFERENCES = {
+    "spectral": ("Stanley H.M., Kato T. (1997) J. Tribol. 119:481-485",),
+    "strip": ("Johnson K.L. (1985) Contact Mechanics, Eq. 2.25",),
+    "thesis": ("Borri-Brunetto M., Chiaia B., Ciavarella M. (2001) Comput. Methods Appl. "
+               "Mech. Eng. 190:6053-6073", "thesis Eq. 2.4"),
+    "love": ("Love A.E.H. (1929) Phil. Trans. R. Soc. A 228:377-420",
+             "Liu S., Wang Q., Liu G. (2000) Wear 243:101-111 (DC-FFT)"),
+}
+
+
+@dataclass(frozen=True, eq=False)
+class InfluenceOperator:
+    """The linear map u = H p (m per Pa) on a grid of ``shape`` cells.
+
+    Attributes
+    ----------
+    name : str
+        One of ``KERNELS``.
+    shape : tuple
+        Grid shape of pressure and displacement.
+    spacing : tuple
+        Cell size per axis (m).
+    periodic : bool
+        True for the circulant (spectral) operator; its q = 0 mode is zero.
+    e_star : float
+        E* (Pa).
+    kernel : ndarray
+        Real-space kernel on ``fft_shape`` (m/Pa).
+    spectrum : ndarray
+        ``rfftn(kernel)``: the multiplier of ``rfftn(p)`` (m/Pa).
+    """
+
+    name: str
+    shape: tuple
+    spacing: tuple
+    periodic: bool
+    e_star: float
+    kernel: np.ndarray
+    spectrum: np.ndarray
+
+    @property
+    def fft_shape(self) -> tuple:
+        return self.kernel.shape
+
+    @property
+    def diagonal(self) -> float:
+        """Self-influence H_ii (m/Pa)."""
+        return float(self.kernel.flat[0])
+
+    @property
+    def references(self) -> tuple:
+        return _KERNEL_REFERENCES[self.name]
+
+    def apply(self, p):
+        """Displacement u = H p (m) of the pressure ``p`` (Pa, array of ``shape``)."""
+        axes = tuple(range(p.ndim))
+        ph = scipy.fft.rfftn(p, s=self.fft_shape, axes=axes, workers=WORKERS)
+        ph *= self.spectrum
+        u = scipy.fft.irfftn(ph, s=self.fft_shape, axes=axes, workers=WORKERS)
+        if self.periodic:
+            return u
+        return u[tuple(slice(0, n) for n in self.shape)]
+
+    def dense(self, index=None):
+        """The dense matrix H (m/Pa), rows and columns in C order of the grid.
+
+        ``index`` (flat indices) restricts it to those cells. Memory: 8 N^2 bytes.
+        """
+        idx = np.indices(self.shape).reshape(len(self.shape), -1)
+        if index is not None:
+            idx = idx[:, np.asarray(index)]
+        diff = [(idx[a][:, None] - idx[a][None, :]) % self.fft_shape[a]
+                for a in range(len(self.shape))]
+        return self.kernel[tuple(diff)]
+
+
+def _offsets(n, d):
+    """Signed offsets (m) of the DC-FFT padded grid of 2n points (index n unused -> 0)."""
+    k = np.arange(2 * n)
+    return np.where(k < n, k, k - 2 * n) * d
+
+
+def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOperator:
+    """Build the influence operator of a grid ``shape`` of physical ``size`` (m).
+
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(n,)`` for a profile, ``(nx, ny)`` for a surface.
+    size : tuple of float
+        Physical size per axis (m), ``n * spacing``.
+    e_star : float
+        Composite modulus E* (Pa).
+    kernel : str
+        ``"spectral"`` (periodic), ``"strip"`` (profile), ``"thesis"`` (Eq. 2.4),
+        ``"love"`` (surface); see the module docstring.
+    """
+    shape = tuple(int(n) for n in shape)
+    size = tuple(float(s) for s in size)
+    ndim = len(shape)
+    spacing = tuple(s / n for s, n in zip(size, shape))
+    if kernel not in KERNELS:
+        raise InputError(f"kernel must be one of {KERNELS} or 'auto', got {kernel!r}")
+    if kernel == "spectral":
+        qs = angular_wavevectors(shape, size)
+        qs = [q[..., : shape[-1] // 2 + 1] if a == ndim - 1 else q for a, q in enumerate(qs)]
+        qmod = np.sqrt(sum(q ** 2 for q in qs))
+        with np.errstate(divide="ignore"):
+            spec = np.where(qmod > 0, 2.0 / (e_star * qmod), 0.0)
+        kern = scipy.fft.irfftn(spec, s=shape)
+        return InfluenceOperator(kernel, shape, spacing, True, e_star, kern, spec)
+    if kernel == "strip":
+        if ndim != 1:
+            raise InputError("kernel 'strip' is for profiles (1D); use 'love' or 'spectral' "
+                             "for surfaces")
+        r = _offsets(shape[0], spacing[0])
+        kern = uniform_strip_displacement(r, spacing[0] / 2, e_star, 1.0, size[0])
+    elif kernel == "thesis":
+        grids = np.meshgrid(*[_offsets(n, d) for n, d in zip(shape, spacing)], indexing="ij")
+        r = np.sqrt(sum(g ** 2 for g in grids))
+        delta = float(np.prod(spacing)) ** (1.0 / ndim)
+        arg = np.where(r > 0, np.minimum(1.0, delta / (2 * np.where(r > 0, r, 1.0))), 1.0)
+        # force on a patch p * delta^2 -> displacement 2 F / (pi E* delta) arcsin(...)
+        kern = 2 * delta / (np.pi * e_star) * np.arcsin(arg)
+    else:  # love
+        if ndim != 2:
+            raise InputError("kernel 'love' is for surfaces (2D); use 'strip' or 'thesis' "
+                             "for profiles")
+        x, y = np.meshgrid(_offsets(shape[0], spacing[0]), _offsets(shape[1], spacing[1]),
+                           indexing="ij")
+        kern = uniform_rectangle_displacement(x, y, spacing[0] / 2, spacing[1] / 2, e_star)
+    spec = scipy.fft.rfftn(kern)
+    return InfluenceOperator(kernel, shape, spacing, False, e_star, kern, spec)

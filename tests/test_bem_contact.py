@@ -1,0 +1,206 @@
+"""BEM contact solver: analytic solutions, agreement of solvers, invariances, bad input."""
+import numpy as np
+import pytest
+
+from roughfe.bem import Material, composite, contact_sweep, influence_operator, solve_contact
+from roughfe.errors import InputError
+from roughfe.reference import hertz_cylinder, hertz_sphere, westergaard
+from roughfe.surfaces import Surface
+
+MAT = Material(1.0e9, 0.3)
+
+
+def random_surface(shape, size, seed, hurst=0.8, periodic=True):
+    """Self-affine Gaussian surface by spectral filtering of seeded white noise (m)."""
+    rng = np.random.default_rng(seed)
+    noise = np.fft.rfftn(rng.standard_normal(shape))
+    qs = np.meshgrid(*[np.fft.fftfreq(n) for n in shape[:-1]], np.fft.rfftfreq(shape[-1]),
+                     indexing="ij")
+    q = np.sqrt(sum(x ** 2 for x in qs))
+    q[(0,) * len(shape)] = np.inf
+    h = np.fft.irfftn(noise * q ** (-(hurst + len(shape) / 2)), s=shape)
+    return Surface(1e-6 * h / h.std(), size, periodic=periodic, metadata={"seed": seed})
+
+
+def sinusoid(n, wavelength=1e-3, amplitude=1e-6):
+    x = np.arange(n) * wavelength / n
+    return Surface(amplitude * np.cos(2 * np.pi * x / wavelength), wavelength, periodic=True)
+
+
+# -- analytic solutions -------------------------------------------------------------------
+@pytest.mark.parametrize("s", [0.3, 0.6, 0.9])
+def test_westergaard_half_width_and_mean_gap(s):
+    surf = sinusoid(1024)
+    ref = westergaard(1e-6, 1e-3, MAT.E_star, s * np.pi * MAT.E_star * 1e-6 / 1e-3)
+    r = solve_contact(surf, MAT, mean_pressure=ref.mean_pressure)
+    # the contact length is counted in whole cells: 1 cell of 1024 at each end at most
+    assert r.area_fraction * 1e-3 / 2 == pytest.approx(ref.half_width, rel=5e-3)
+    assert r.mean_gap == pytest.approx(ref.mean_gap, rel=5e-3)
+    # periodic convention: mean displacement zero, so d equals the mean gap
+    assert r.mean_plane_separation == pytest.approx(r.mean_gap, rel=1e-9)
+    assert r.mean_pressure == pytest.approx(ref.mean_pressure, rel=1e-12)
+
+
+def test_westergaard_full_contact_is_a_valid_state():
+    surf = sinusoid(256)
+    p_star = np.pi * MAT.E_star * 1e-6 / 1e-3
+    r = solve_contact(surf, MAT, mean_pressure=1.2 * p_star)
+    assert r.success and r.area_fraction == 1.0 and r.full_contact
+    ref = westergaard(1e-6, 1e-3, MAT.E_star, 1.2 * p_star)
+    x = surf.coordinates()[0]
+    assert np.allclose(r.pressure, ref.pressure(x), rtol=1e-10, atol=1e-9 * p_star)
+    assert r.mean_gap == 0.0 and np.isinf(r.stiffness)
+    # the largest approach of a periodic surface is full contact at the least pressure
+    r2 = solve_contact(surf, MAT, delta=1e-6)
+    assert r2.area_fraction == 1.0
+    assert r2.mean_pressure == pytest.approx(p_star, rel=1e-3)
+    with pytest.raises(ValueError, match="exceeds"):
+        solve_contact(surf, MAT, delta=1.1e-6)
+
+
+def test_hertz_sphere_non_periodic_256():
+    n, L, R = 256, 1e-3, 1e-2
+    x = (np.arange(n) - n // 2) * L / n
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    surf = Surface(-(X ** 2 + Y ** 2) / (2 * R), L, periodic=False)
+    delta = 1.5e-6
+    r = solve_contact(surf, MAT, delta=delta)
+    ref = hertz_sphere(R, MAT.E_star, approach=delta)
+    assert r.kernel == "love" and r.solver == "pk"
+    assert np.sqrt(r.contact_area / np.pi) == pytest.approx(ref.contact_radius, rel=1e-2)
+    assert r.load == pytest.approx(ref.load, rel=1e-2)
+    assert r.pressure.max() == pytest.approx(ref.peak_pressure, rel=1e-2)
+    # stiffness dP/dDelta = 2 E* a; ours is per unit nominal area
+    assert r.stiffness * L * L == pytest.approx(ref.stiffness, rel=2e-2)
+
+
+def test_hertz_line_contact_half_width():
+    n, L, R = 2048, 1e-3, 1e-2
+    x = (np.arange(n) - n // 2) * L / n
+    surf = Surface(-x ** 2 / (2 * R), L, periodic=False)
+    r = solve_contact(surf, MAT, mean_pressure=2e5, kernel="strip")
+    ref = hertz_cylinder(R, MAT.E_star, r.load)
+    assert r.contact_area / 2 == pytest.approx(ref.contact_radius, rel=1e-2)
+    assert r.pressure.max() == pytest.approx(ref.peak_pressure, rel=1e-2)
+
+
+# -- solvers agree ------------------------------------------------------------------------
+@pytest.mark.parametrize("periodic,kernel,shape", [
+    (True, "spectral", (24, 24)), (False, "love", (24, 24)), (False, "thesis", (20, 20)),
+    (False, "strip", (256,)), (False, "thesis", (256,)), (True, "spectral", (256,))])
+def test_dense_and_matrix_free_agree(periodic, kernel, shape):
+    surf = random_surface(shape, [1e-4] * len(shape), seed=7, periodic=periodic)
+    dmax = np.ptp(surf.heights) if not periodic else surf.heights.max() - surf.heights.mean()
+    for control in ("delta", "mean_pressure"):
+        kw = {"delta": 0.3 * dmax}
+        if control == "mean_pressure":
+            kw = {"mean_pressure": solve_contact(surf, MAT, kernel=kernel, **kw).mean_pressure}
+        a = solve_contact(surf, MAT, kernel=kernel, solver="dense", tol=1e-13, **kw)
+        b = solve_contact(surf, MAT, kernel=kernel, solver="pk", tol=1e-13, **kw)
+        assert 0 < a.area_fraction < 1
+        assert np.array_equal(a.contact, b.contact)
+        assert np.max(np.abs(a.pressure - b.pressure)) <= 1e-8 * a.pressure.max()
+        assert b.delta == pytest.approx(a.delta, rel=1e-8)
+        assert b.stiffness == pytest.approx(a.stiffness, rel=1e-6)
+
+
+def test_nnls_reproduces_pivoting():
+    surf = random_surface((256,), 1e-4, seed=3, periodic=False)
+    a = solve_contact(surf, MAT, delta=0.4 * np.ptp(surf.heights), solver="dense")
+    b = solve_contact(surf, MAT, delta=0.4 * np.ptp(surf.heights), solver="nnls")
+    assert np.max(np.abs(a.pressure - b.pressure)) <= 1e-9 * a.pressure.max()
+
+
+def test_load_and_displacement_control_give_the_same_state():
+    surf = random_surface((64, 64), 1e-4, seed=11)
+    a = solve_contact(surf, MAT, mean_pressure=1e6)
+    b = solve_contact(surf, MAT, delta=a.delta)
+    assert b.mean_pressure == pytest.approx(1e6, rel=1e-7)
+    assert np.array_equal(a.contact, b.contact)
+    assert b.mean_gap == pytest.approx(a.mean_gap, rel=1e-8)
+
+
+def test_scale_invariance():
+    surf = random_surface((64, 64), 1e-4, seed=5, periodic=False)
+    a = solve_contact(surf, MAT, delta=0.5e-6)
+    eta = 3.7
+    b = solve_contact(surf.scaled(eta), MAT, delta=eta * 0.5e-6)
+    assert b.area_fraction == a.area_fraction
+    assert b.mean_pressure == pytest.approx(eta * a.mean_pressure, rel=1e-7)
+    assert b.stiffness == pytest.approx(a.stiffness, rel=1e-6)
+    assert b.free_volume_star == pytest.approx(a.free_volume_star, rel=1e-7)
+
+
+def test_mesh_convergence_of_area_fraction():
+    ref = westergaard(1e-6, 1e-3, MAT.E_star, 0.2 * np.pi * MAT.E_star * 1e-6 / 1e-3)
+    ns = (64, 256, 1024, 4096)
+    res = [solve_contact(sinusoid(n), MAT, mean_pressure=ref.mean_pressure) for n in ns]
+    # A* is a count of cells: its error is bounded by about one cell per contact edge
+    for n, r in zip(ns, res):
+        assert abs(r.area_fraction - ref.area_fraction) <= 2.0 / n
+    # the mean gap (an integral) converges monotonically, faster than 1/n
+    errs = [abs(r.mean_gap / ref.mean_gap - 1) for r in res]
+    assert all(e2 < e1 / 4 for e1, e2 in zip(errs, errs[1:]))
+
+
+def test_sweep_stiffness_exact_vs_finite_differences_and_records():
+    surf = random_surface((512,), 1e-4, seed=2, periodic=False)
+    sweep = contact_sweep(surf, MAT, n_steps=20)
+    assert sweep.success and len(sweep.results) == 20
+    assert np.all(np.diff(sweep.area_fraction) >= 0) and np.all(np.diff(sweep.mean_pressure) > 0)
+    # exact and finite-difference stiffness agree within the discretisation of the sweep
+    k, kfd = sweep.stiffness[1:-1], sweep.stiffness_fd[1:-1]
+    assert np.median(np.abs(kfd / k - 1)) < 0.05
+    # d p / d Delta is the slope: the mean pressure is the integral of K over Delta
+    p_int = np.concatenate([[0], np.cumsum(np.diff(sweep.delta) * 0.5 * (k := sweep.stiffness)[1:]
+                                           + np.diff(sweep.delta) * 0.5 * k[:-1])])
+    assert p_int[-1] + sweep.mean_pressure[0] == pytest.approx(sweep.mean_pressure[-1], rel=0.05)
+    recs = sweep.to_records()
+    assert list(recs[0]) == ["delta", "load", "mean_pressure", "area_fraction", "n_contact",
+                             "stiffness", "stiffness_fd", "mean_gap", "mean_plane_separation",
+                             "free_volume", "free_volume_star", "iterations", "residual"]
+    # V = mean gap * A_n, the free volume of Eq. 2.8
+    r = sweep.results[5]
+    assert r.free_volume == pytest.approx(r.mean_gap * 1e-4, rel=1e-12)
+
+
+def test_composite_modulus_has_the_squares():
+    m = composite(200e9, 0.3, 70e9, 0.33)
+    assert m.E_star == pytest.approx(1 / ((1 - 0.09) / 200e9 + (1 - 0.33 ** 2) / 70e9))
+    assert composite(1e9, 0.5, float("inf"), 0.2).E_star == pytest.approx(1e9 / 0.75)
+
+
+# -- bad input ----------------------------------------------------------------------------
+@pytest.mark.parametrize("kwargs", [
+    {"delta": -1e-7}, {"delta": float("nan")}, {"mean_pressure": 0.0},
+    {"mean_pressure": -1.0}, {"mean_pressure": float("inf")}, {},
+    {"delta": 1e-7, "mean_pressure": 1.0}, {"delta": 1e-7, "kernel": "nope"},
+    {"delta": 1e-7, "solver": "nope"}, {"delta": 1e-7, "kernel": "love"}])
+def test_bad_input_raises_value_error(kwargs):
+    with pytest.raises(ValueError):
+        solve_contact(sinusoid(64), MAT, **kwargs)
+
+
+def test_bad_material_and_surfaces():
+    for E, nu in [(0.0, 0.3), (-1.0, 0.3), (1e9, 0.6), (1e9, -1.0), (float("nan"), 0.3)]:
+        with pytest.raises(ValueError):
+            Material(E, nu)
+    with pytest.raises(ValueError, match="flat"):
+        solve_contact(Surface(np.ones(32), 1.0), MAT, delta=0.0)
+    with pytest.raises(ValueError):
+        Surface(np.array([0.0, np.nan, 1.0]), 1.0)
+    with pytest.raises(ValueError, match="periodic"):
+        solve_contact(Surface(np.arange(8.0), 1.0), MAT, delta=0.1, kernel="spectral")
+
+
+def test_operator_symmetry_and_positivity():
+    for kernel, shape in [("love", (12, 10)), ("strip", (64,)), ("thesis", (64,)),
+                          ("thesis", (10, 10))]:
+        H = influence_operator(shape, [1e-3] * len(shape), 1e9, kernel).dense()
+        assert np.allclose(H, H.T, rtol=0, atol=1e-12 * H.max())
+        assert np.linalg.eigvalsh(H).min() > 0
+    op = influence_operator((16, 16), (1e-3, 1e-3), 1e9, "spectral")
+    p = np.random.default_rng(0).random((16, 16))
+    assert np.allclose(op.dense() @ p.ravel(), op.apply(p).ravel(), rtol=1e-12, atol=0)
+    # a uniform pressure does not move a periodic surface (zero mean mode)
+    assert np.allclose(op.apply(np.ones((16, 16))), 0.0, atol=1e-25)
