@@ -1,0 +1,151 @@
+"""Reynolds thin-film flow with dolfinx (thesis Eq. 2.10-2.12): exact solutions and balances.
+
+Q1 pressure with a gap constant per cell reproduces piecewise-linear pressures exactly,
+so the parallel-plate law, strips in series (harmonic mean of h^3) and in parallel
+(arithmetic mean of h^3) and plane Couette flow must hold to solver tolerance
+(rtol 1e-9: the CG tolerance is 1e-10 relative to the right-hand side).
+"""
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.leakage import analyse_leakage, hydraulic_aperture, reynolds_flow
+
+MU = 1.0e-3          # Pa s (water)
+DP = 1.0e3           # Pa
+H = 2.0e-6           # m
+DX, DY = 1.0e-6, 1.5e-6
+
+
+def plates(h, w, dp, l):
+    """Parallel plates: Q = h^3 W dp / (12 mu L)."""
+    return h**3 * w * dp / (12 * MU * l)
+
+
+@pytest.mark.parametrize("direction", ["x", "y"])
+def test_parallel_plates_exact(direction):
+    nx, ny = 12, 7
+    r = reynolds_flow(np.full((nx, ny), H), (DX, DY), direction=direction, mu=MU,
+                      pressure_drop=DP, p_out=2e5)
+    lx, ly = nx * DX, ny * DY
+    l, w = (lx, ly) if direction == "x" else (ly, lx)
+    q = plates(H, w, DP, l)
+    assert r.leak_rate == pytest.approx(q, rel=1e-9)
+    assert r.inlet_flow == pytest.approx(q, rel=1e-9)
+    assert r.outlet_flow == pytest.approx(q, rel=1e-9)
+    assert r.hydraulic_aperture == pytest.approx(H, rel=1e-9)
+    # uniform flux per unit width q = h^3 dp/(12 mu L) along the flow, none across
+    axis = 0 if direction == "x" else 1
+    assert np.allclose(r.flux[..., axis], q / w, rtol=1e-8)
+    assert np.allclose(r.flux[..., 1 - axis], 0.0, atol=1e-7 * q / w)   # CG rtol 1e-10
+    assert np.nanmin(r.pressure) == pytest.approx(2e5) and np.nanmax(r.pressure) == pytest.approx(2e5 + DP)
+
+
+def test_strips_in_series_harmonic_mean():
+    nx, ny = 10, 4
+    h1, h2, n1 = H, 0.5 * H, 4                      # first 4 rows h1, then h2
+    g = np.full((nx, ny), h2)
+    g[:n1] = h1
+    r = reynolds_flow(g, (DX, DY), direction="x", mu=MU, pressure_drop=DP)
+    l1, l2, w = n1 * DX, (nx - n1) * DX, ny * DY
+    q = w * DP / (12 * MU) / (l1 / h1**3 + l2 / h2**3)
+    assert r.leak_rate == pytest.approx(q, rel=1e-9)
+
+
+def test_strips_in_parallel_arithmetic_mean():
+    nx, ny = 9, 6
+    g = np.full((nx, ny), H)
+    g[:, :2] = 3 * H
+    r = reynolds_flow(g, (DX, DY), direction="x", mu=MU, pressure_drop=DP)
+    q = plates(3 * H, 2 * DY, DP, nx * DX) + plates(H, 4 * DY, DP, nx * DX)
+    assert r.leak_rate == pytest.approx(q, rel=1e-9)
+
+
+def test_blocked_barrier_gives_zero_flow_without_nan():
+    g = np.full((12, 8), H)
+    g[5] = 0.0                                     # a contact line across the flow
+    g[9, 2:5] = 0.0                                # plus a closed pocket border
+    r = reynolds_flow(g, (DX, DY), direction="x", mu=MU, pressure_drop=DP)
+    q_open = plates(H, 8 * DY, DP, 12 * DX)
+    assert np.isfinite(r.leak_rate) and abs(r.leak_rate) < 1e-10 * q_open
+    assert r.percolates is False and r.hydraulic_aperture < 1e-3 * H
+    assert np.all(np.isfinite(r.flux))
+    # along y the same field percolates
+    ry = reynolds_flow(g, (DX, DY), direction="y", mu=MU, pressure_drop=DP)
+    assert ry.percolates and ry.leak_rate > 0
+
+
+def test_contact_islands_flux_balance_and_bounds():
+    # a rough gap with ~30 % contact: isolated contact cells and trapped pockets
+    rng = np.random.default_rng(7)
+    g = np.maximum(rng.standard_normal((40, 30)) + 0.5, 0.0) * H
+    # square cells: the Q1 stiffness is then an M-matrix (no positive off-diagonal
+    # entries; with aspect ratio > sqrt(2) it is not, and p may overshoot slightly)
+    r = reynolds_flow(g, (DX, DX), direction="x", mu=MU, pressure_drop=DP)
+    assert r.percolates and r.leak_rate > 0
+    # conservation: what enters at the inlet leaves at the outlet
+    assert r.outlet_flow == pytest.approx(r.inlet_flow, rel=1e-8)
+    assert r.leak_rate == pytest.approx(r.inlet_flow, rel=1e-8)
+    # maximum principle: p_out <= p <= p_in where the pressure is determined
+    p = r.pressure[np.isfinite(r.pressure)]
+    assert p.min() >= -1e-9 * DP and p.max() <= DP * (1 + 1e-9)
+    # bounded by the parallel-plate flows of the smallest and largest open gap
+    q_max = plates(g.max(), 30 * DX, DP, 40 * DX)
+    assert 0 < r.leak_rate < q_max
+    # reversing the flow direction (mirror the field) gives the same leak rate
+    rm = reynolds_flow(g[::-1], (DX, DX), direction="x", mu=MU, pressure_drop=DP)
+    assert rm.leak_rate == pytest.approx(r.leak_rate, rel=1e-8)
+    # transposition symmetry: y-flow of g is x-flow of g.T
+    rt = reynolds_flow(g.T, (DX, DX), direction="y", mu=MU, pressure_drop=DP)
+    assert rt.leak_rate == pytest.approx(r.leak_rate, rel=1e-8)
+
+
+def test_periodic_side_walls():
+    # a channel that crosses the side edge percolates only with periodic walls
+    g = np.zeros((8, 6))
+    g[:4, 0] = H
+    g[3:, 5] = H                       # shares the y = 0 / y = Ly edge with column 0
+    assert reynolds_flow(g, (DX, DY), mu=MU, pressure_drop=DP).percolates is False
+    rp = reynolds_flow(g, (DX, DY), mu=MU, pressure_drop=DP, periodic=True)
+    assert rp.percolates and rp.leak_rate > 0
+    assert rp.outlet_flow == pytest.approx(rp.inlet_flow, rel=1e-8)
+    # constant gap: periodic walls change nothing (no transverse flow anyway)
+    q = reynolds_flow(np.full((8, 6), H), (DX, DY), mu=MU, pressure_drop=DP, periodic=True)
+    assert q.leak_rate == pytest.approx(plates(H, 6 * DY, DP, 8 * DX), rel=1e-9)
+
+
+def test_couette_flow():
+    # no pressure drop, one wall sliding along x at U: Q = h U W / 2, p = 0
+    u = 0.2
+    r = reynolds_flow(np.full((6, 5), H), (DX, DY), mu=MU, pressure_drop=0.0,
+                      wall_velocity=(u, 0.0))
+    assert r.leak_rate == pytest.approx(H * u * 5 * DY / 2, rel=1e-12)
+    assert np.allclose(r.pressure, 0.0, atol=1e-9)
+    assert r.hydraulic_aperture is None
+
+
+def test_hydraulic_aperture_inverts_plate_law():
+    q = plates(H, 3e-5, DP, 7e-5)
+    assert hydraulic_aperture(q, mu=MU, pressure_drop=DP, flow_length=7e-5,
+                              width=3e-5) == pytest.approx(H, rel=1e-14)
+
+
+def test_analysis_record_is_json_safe():
+    from roughfe.writers import to_json_text
+    g = np.full((6, 6), H)
+    g[2, :3] = 0
+    res = analyse_leakage(g, None, (DX, DX), direction="both", sigma=H, mu=MU, pressure_drop=DP)
+    rec = res.record()
+    to_json_text(rec)
+    assert rec["percolates_x"] and rec["percolates_y"]
+    assert rec["percolates_q1_x"] == rec["percolates_x"]
+    assert rec["leak_rate"] == pytest.approx(0.5 * (rec["leak_rate_x"] + rec["leak_rate_y"]))
+
+
+def test_bad_input_is_named():
+    with pytest.raises(InputError, match="mu"):
+        reynolds_flow(np.ones((3, 3)), (DX, DY), mu=-1)
+    with pytest.raises(InputError, match="direction"):
+        reynolds_flow(np.ones((3, 3)), (DX, DY), direction="z")
+    with pytest.raises(InputError, match="nothing drives"):
+        reynolds_flow(np.ones((3, 3)), (DX, DY), pressure_drop=0.0)
