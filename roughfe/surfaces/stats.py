@@ -41,7 +41,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_finite_positive
 from .surface import Surface
 
 
@@ -119,7 +119,7 @@ class PowerSpectrum:
         return float(np.sum(self.C * self.weight))
 
 
-def power_spectrum(surface: Surface, window="auto", nbins=None) -> PowerSpectrum:
+def power_spectrum(surface: Surface, window="auto", bin_width=None) -> PowerSpectrum:
     """PSD of a profile, or radially averaged PSD of a surface (normalisation above).
 
     Parameters
@@ -129,9 +129,10 @@ def power_spectrum(surface: Surface, window="auto", nbins=None) -> PowerSpectrum
         ``"auto"``: none for periodic data, a Hann window (normalised to keep the
         mean-square height) for non-periodic data, which otherwise leak the edge jump
         as a spurious ``q^-2`` tail.
-    nbins : int, optional
-        Surfaces: number of annuli of equal width between 0 and the largest ``|q|``
-        (default: ``max(nx, ny)``, i.e. width ~ ``2 pi / L``).
+    bin_width : float, optional
+        Surfaces: width ``w`` (rad/m) of the annuli ``[(k - 1/2) w, (k + 1/2) w)``,
+        ``k >= 1``; default ``2 pi / max(Lx, Ly)``. Each annulus reports the mean ``|q|``
+        of its Fourier modes.
 
     Returns
     -------
@@ -150,11 +151,10 @@ def power_spectrum(surface: Surface, window="auto", nbins=None) -> PowerSpectrum
     cell = float(np.prod([2 * np.pi / s for s in surface.size]))
     qabs = np.sqrt(qs[0] ** 2 + qs[1] ** 2).ravel()
     p = power.ravel()
-    nbins = int(max(surface.shape) if nbins is None else nbins)
-    if nbins < 1:
-        raise InputError(f"nbins must be >= 1, got {nbins}")
-    edges = np.linspace(0.0, qabs.max() * (1 + 1e-12), nbins + 1)
-    idx = np.digitize(qabs, edges) - 1
+    width = 2 * np.pi / max(surface.size) if bin_width is None else bin_width
+    width = check_finite_positive("bin_width (rad/m)", width)
+    idx = np.floor(qabs / width + 0.5).astype(int)          # annulus k: [(k-1/2)w, (k+1/2)w)
+    nbins = int(idx.max()) + 1
     keep = qabs > 0
     idx, qk, pk = idx[keep], qabs[keep], p[keep]
     count = np.bincount(idx, minlength=nbins).astype(float)

@@ -1,0 +1,118 @@
+"""Statistics: PSD normalisation (Parseval), spectral moments, Nayak alpha, rms values."""
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.surfaces import Surface, fit_hurst, power_spectrum, spectral_moments, surface_statistics
+from roughfe.surfaces.stats import peak_to_valley, rms_curvature, rms_height, rms_slope
+
+
+def _noise_surface(shape, size, periodic, seed=0):
+    rng = np.random.default_rng(seed)
+    return Surface(rng.standard_normal(shape) * 1e-6, size, periodic=periodic)
+
+
+@pytest.mark.parametrize("shape, size", [((257,), 2e-3), ((256,), 1e-3), ((64, 48), (1e-4, 7e-5)),
+                                         ((33, 33), 1e-4)])
+def test_parseval_identity(shape, size):
+    """sum(C * weight) equals the mean-square height about the mean, for any grid."""
+    s = _noise_surface(shape, size, periodic=True)
+    psd = power_spectrum(s)
+    assert psd.window == "none"
+    h = s.heights - s.heights.mean()
+    assert psd.mean_square == pytest.approx(np.mean(h ** 2), rel=1e-12)
+    assert np.all(np.diff(psd.q) > 0) and psd.q[0] > 0
+
+
+def test_psd_of_a_sine_is_one_line_with_its_mean_square():
+    n, length, k, a = 200, 1e-3, 7, 2e-6
+    x = np.arange(n) * length / n
+    p = Surface(a * np.sin(2 * np.pi * k * x / length), length, periodic=True)
+    psd = power_spectrum(p)
+    energy = psd.C * psd.weight
+    assert np.argmax(energy) == k - 1 and psd.q[k - 1] == pytest.approx(2 * np.pi * k / length)
+    assert energy[k - 1] == pytest.approx(a ** 2 / 2, rel=1e-12)
+    assert energy.sum() - energy[k - 1] < 1e-12 * energy.sum()
+    # two-sided density: C(q_k) = |h~|^2 / dq with |h~| = a / 2
+    assert psd.C[k - 1] == pytest.approx((a / 2) ** 2 / (2 * np.pi / length), rel=1e-12)
+
+
+def test_radial_psd_of_a_plane_wave_surface():
+    n, length, a = 64, 1e-4, 1e-6
+    x = np.arange(n) * length / n
+    h = a * np.cos(2 * np.pi * 3 * x[:, None] / length + 2 * np.pi * 4 * x[None, :] / length)
+    psd = power_spectrum(Surface(h, length, periodic=True))
+    energy = psd.C * psd.weight
+    i = np.argmax(energy)
+    # annulus k = 5 (|(3, 4)| = 5) reports the mean |q| of its modes: within half a bin
+    assert abs(psd.q[i] - 2 * np.pi * 5 / length) < 0.5 * 2 * np.pi / length
+    assert energy[i] == pytest.approx(a ** 2 / 2, rel=1e-10)
+
+
+def test_moments_and_nayak_alpha_narrow_band():
+    """A single wave: profile m0, m2, m4 = a^2/2 (1, q^2, q^4), alpha = 1; a surface made
+    of one wave has the isotropic-average alpha = 1.5 (Nayak's lower bound)."""
+    n, length, k, a = 128, 1e-4, 5, 1e-6
+    q = 2 * np.pi * k / length
+    x = np.arange(n) * length / n
+    p = Surface(a * np.cos(q * x + 0.3), length, periodic=True)
+    m0, m2, m4 = spectral_moments(p)
+    np.testing.assert_allclose([m0, m2, m4], [a * a / 2, a * a * q ** 2 / 2, a * a * q ** 4 / 2],
+                               rtol=1e-10)
+    assert rms_slope(p) == pytest.approx(a * q / np.sqrt(2), rel=1e-10)
+    assert rms_curvature(p) == pytest.approx(a * q * q / np.sqrt(2), rel=1e-10)
+    s = Surface(np.repeat(a * np.cos(q * x)[:, None], 16, axis=1), (length, length / 8), periodic=True)
+    st = surface_statistics(s)
+    assert st.nayak_alpha == pytest.approx(1.5, rel=1e-10)
+    assert st.rms_slope == pytest.approx(a * q / np.sqrt(2), rel=1e-10)
+
+
+def test_nonperiodic_slope_and_curvature_by_finite_differences():
+    """Non-periodic data use difference quotients: a smooth, non-periodic wave
+    (fine grid, 3.3 periods) gives the analytic rms slope/curvature within 1 %."""
+    n, length = 4000, 1e-3
+    q = 2 * np.pi * 3.3 / length
+    x = np.arange(n) * length / n
+    h = 1e-6 * np.sin(q * x)
+    p = Surface(h, length, periodic=False)
+    slope_exact = np.sqrt(np.mean((1e-6 * q * np.cos(q * x)) ** 2))
+    curv_exact = np.sqrt(np.mean((1e-6 * q * q * np.sin(q * x)) ** 2))
+    assert rms_slope(p) == pytest.approx(slope_exact, rel=0.01)
+    assert rms_curvature(p) == pytest.approx(curv_exact, rel=0.01)
+    assert peak_to_valley(p) == pytest.approx(2e-6, rel=1e-3)
+
+
+def test_periodic_and_nonperiodic_moments_agree_on_smooth_data():
+    """The two evaluations of m2, m4 (spectral vs difference quotients) agree on a
+    band-limited periodic surface."""
+    from roughfe.surfaces import spectral_surface
+    n, length = 256, 1e-4
+    s = spectral_surface(n, length, 0.8, rms_height=1e-6, q_short=np.pi * n / length / 10, rng=1)
+    per = spectral_moments(s)
+    non = spectral_moments(Surface(s.heights, s.size, periodic=False))
+    np.testing.assert_allclose(non, per, rtol=0.05)
+
+
+def test_hurst_fit_recovers_exact_power_law():
+    """A surface whose Fourier amplitudes follow C ~ q^-2(1+H) exactly."""
+    from roughfe.surfaces import spectral_surface
+    for hurst in (0.2, 0.5, 0.9):
+        fit = fit_hurst(spectral_surface(128, 1e-4, hurst, rms_height=1e-6, amplitudes="fixed", rng=0))
+        assert fit.success and fit.hurst == pytest.approx(hurst, abs=0.02)
+        assert fit.fractal_dimension == pytest.approx(3 - hurst, abs=0.02)
+
+
+def test_hurst_fit_flags_non_self_affine_and_bad_range():
+    s = _noise_surface((64, 64), 1e-4, periodic=True)      # white noise: H = -1
+    fit = fit_hurst(s)
+    assert not fit.success and "outside (0, 1)" in fit.message
+    with pytest.raises(InputError, match="q_range"):
+        fit_hurst(s, q_range=(1e6, 1e5))
+
+
+def test_statistics_are_json_safe():
+    import json
+    st = surface_statistics(_noise_surface((32, 32), 1e-4, periodic=False))
+    text = json.dumps(st.as_dict(), allow_nan=False)
+    assert '"rms_height"' in text
+    assert st.rms_height == pytest.approx(rms_height(_noise_surface((32, 32), 1e-4, False)))
