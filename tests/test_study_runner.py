@@ -86,7 +86,7 @@ def test_seed_is_a_stable_hash():
     # Fixed value: a change of the hashing scheme would silently change every surface.
     assert derive_seed(7, "selftest", {"x": 1.5, "replica": 1}) == \
         derive_seed(7, "selftest", {"replica": 1, "x": 1.5})
-    assert derive_seed(2026, "selftest", {"x": 1.0}) == 2622393190594217440
+    assert derive_seed(2026, "selftest", {"x": 1.0}) == 1280465425094832
     assert derive_seed(2026, "selftest", {"x": 1.0}) != derive_seed(2027, "selftest", {"x": 1.0})
 
 

@@ -52,8 +52,9 @@ ANALYSES = {
         "roughfe.leakage.study:leakage_task", "1",
         "leakage of one surface over approach steps (thesis Sec. 2.4)"),
     "genome_db": Analysis(
-        "roughfe.genomics.database:genome_entry_task", "1",
-        "one entry of the surface-genome database (sequencing + BEM sweep)"),
+        "roughfe.study.analyses:genome_db_task", "1",
+        "one entry of the genome database: WM genome, Alg. 2 macro/micro, BEM sweep "
+        "(roughfe.genomics.database.genome_entry_task)"),
 }
 
 
@@ -136,3 +137,73 @@ def selftest_task(*, x, seed, y=0.0, n_records=3, sleep=0.0, fail_x=()):
     u = rng.random(int(n_records))
     return [{"step": k, "f": float(x) ** 2 + float(y) * k, "u": float(u[k])}
             for k in range(int(n_records))]
+
+
+def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, length=1.0e-3,
+                       rms_height=1.0e-6, youngs_modulus=1.0e9, poisson=0.3, n_steps=10,
+                       kernel="auto", solver="auto", tol=1e-10):
+    """Generate one random surface and run the BEM loading sweep on it.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the surface generator (recorded in the rows).
+    generator : {"rmd", "spectral"}
+        ``rmd``: :func:`roughfe.surfaces.rmd_surface` (thesis Sec. 2.1.1, ``2**m + 1``
+        nodes over ``length``, not periodic); ``spectral``: the periodic Fourier-filtered
+        :func:`roughfe.surfaces.spectral_surface` with ``2**m`` points over ``length``.
+    fractal_dimension : float
+        D in (2, 3); Hurst exponent H = 3 - D.
+    m : int
+        Resolution level.
+    length : float
+        Lateral size (m).
+    rms_height : float
+        Rms height the surface is scaled to (m).
+    youngs_modulus, poisson : float
+        Elastic solid against a rigid surface (Pa, -).
+    n_steps, kernel, solver, tol
+        As in :func:`roughfe.bem.contact_sweep`.
+
+    Returns
+    -------
+    list of dict
+        One record per approach step: ``step`` and :data:`roughfe.bem.RECORD_KEYS` (SI).
+    """
+    from ..bem import Material, contact_sweep
+    from ..surfaces import rmd_surface, spectral_surface
+
+    if generator == "rmd":
+        surface = rmd_surface(m, fractal_dimension, length, rng=seed, rms_height=rms_height)
+    elif generator == "spectral":
+        surface = spectral_surface(2 ** int(m), length, 3.0 - float(fractal_dimension),
+                                   rms_height=rms_height, rng=seed)
+    else:
+        raise InputError(f"generator must be 'rmd' or 'spectral', got {generator!r}")
+    sweep = contact_sweep(surface, Material(youngs_modulus, poisson), n_steps=n_steps,
+                          kernel=kernel, solver=solver, tol=tol)
+    return [{"step": k, **record} for k, record in enumerate(sweep.to_records())]
+
+
+def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=None,
+                   length=849.42e-6, n_nodes=512, youngs_modulus=1.0e6, poisson=0.0,
+                   n_steps=20, threshold=0.95, kernel="auto"):
+    """One genome-database entry: the study seed draws the WM phases.
+
+    Calls :func:`roughfe.genomics.database.genome_entry_task` with ``phases=seed`` and
+    ``label`` (default ``"genome-<seed>"``). The full entry (genome, curves,
+    chromosome curves, correlations) is stored in the task's result file; the table
+    shows its scalars and the macro/micro chromosome lists as JSON text.
+
+    Returns
+    -------
+    dict
+        The database record of ``genome_entry_task``.
+    """
+    from ..genomics.database import genome_entry_task
+
+    return genome_entry_task(
+        gamma, hurst, seed, label=label if label is not None else f"genome-{seed}",
+        source="study", amplitude=amplitude, lambda1=lambda1, length=length, n_nodes=n_nodes,
+        youngs_modulus=youngs_modulus, poisson=poisson, n_steps=n_steps, threshold=threshold,
+        kernel=kernel)

@@ -64,13 +64,15 @@ def sha256_hex(obj) -> str:
 
 
 def derive_seed(base_seed: int, analysis: str, values: Mapping[str, Any]) -> int:
-    """Deterministic 63-bit seed from the study seed, the analysis and some parameters.
+    """Deterministic seed in ``[0, 2**53)`` from the study seed, the analysis and parameters.
 
     Stable across processes, machines and Python versions (SHA-256 of canonical JSON).
+    53 bits keep the seed exact wherever it passes through a float (JSON readers,
+    spreadsheets, ``float(seed) == int(seed)`` checks).
     """
     digest = sha256_hex({"base_seed": int(base_seed), "analysis": analysis,
                          "values": dict(values)})
-    return int(digest[:16], 16) & (2**63 - 1)
+    return int(digest[:14], 16) >> 3
 
 
 def _check_value(where: str, value):

@@ -1,0 +1,67 @@
+"""The registered analyses run through the study runner (tiny sizes; about 5 s)."""
+import json
+
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.study import ANALYSES, collect, run_study, spec_from_mapping, study_status
+from roughfe.study.analyses import check_parameters, resolve
+
+
+def test_every_registered_target_is_a_module_function_path():
+    for name, analysis in ANALYSES.items():
+        module, sep, attr = analysis.target.partition(":")
+        assert sep == ":" and module.startswith("roughfe.") and attr.isidentifier(), name
+
+
+def test_missing_analysis_module_is_a_clear_error(monkeypatch):
+    from roughfe.study import analyses
+
+    monkeypatch.setitem(analyses.ANALYSES, "ghost",
+                        analyses.Analysis("roughfe.nowhere.module:task", "1", "absent"))
+    with pytest.raises(InputError, match="'ghost' needs roughfe.nowhere.module:task"):
+        resolve("ghost")
+
+
+def test_tiny_contact_sweep_study_runs_and_is_reproducible(tmp_path):
+    pytest.importorskip("roughfe.bem")
+    study = {"study": {"analysis": "contact_sweep", "output": str(tmp_path / "a"), "seed": 3,
+                       "seed_from": ["fractal_dimension", "replica"]},
+             "grid": {"fractal_dimension": [2.2, 2.6], "replica": [0, 1]},
+             "fixed": {"m": 4, "n_steps": 3, "rms_height": 1e-6, "length": 1e-3}}
+    summary = run_study(spec_from_mapping(study), workers=2, progress=False)
+    assert summary.complete and summary.n_done == 4
+    paths, n_rows, missing, _ = collect(tmp_path / "a", parquet=False)
+    assert (n_rows, missing) == (4 * 3, 0)
+    header = paths[0].read_text().splitlines()[0].split(",")
+    for column in ("fractal_dimension", "replica", "seed", "step", "mean_pressure",
+                   "area_fraction"):
+        assert column in header
+    rows = [dict(zip(header, line.split(","))) for line in paths[0].read_text().splitlines()[1:]]
+    # loading sweep: the contact area grows with the approach
+    for task in {r["task"] for r in rows}:
+        areas = [float(r["area_fraction"]) for r in rows if r["task"] == task]
+        assert areas == sorted(areas) and areas[-1] > 0
+    # a second folder with the same spec reproduces the same table bit for bit
+    study["study"]["output"] = str(tmp_path / "b")
+    run_study(spec_from_mapping(study), workers=1, progress=False)
+    assert collect(tmp_path / "b", parquet=False)[0][0].read_text() == paths[0].read_text()
+
+
+def test_contact_sweep_rejects_unknown_generator_per_task(tmp_path):
+    pytest.importorskip("roughfe.bem")
+    study = {"study": {"analysis": "contact_sweep", "output": str(tmp_path / "g"),
+                       "max_attempts": 1},
+             "grid": {"generator": ["rmd", "fourier"]}, "fixed": {"m": 3, "n_steps": 2}}
+    summary = run_study(spec_from_mapping(study), workers=1, progress=False)
+    assert (summary.n_done, summary.n_failed) == (1, 1)
+    (failure,) = study_status(tmp_path / "g").failures
+    assert failure[1] == {"generator": "fourier", "m": 3, "n_steps": 2}
+    assert "generator must be 'rmd' or 'spectral'" in failure[2]
+
+
+def test_genome_db_parameters_bind():
+    pytest.importorskip("roughfe.genomics.database")
+    check_parameters("genome_db", {"gamma": 1.5, "hurst": 0.7, "n_nodes": 64, "n_steps": 3})
+    with pytest.raises(InputError, match="does not accept"):
+        check_parameters("genome_db", {"gamma": 1.5})
