@@ -1,0 +1,165 @@
+"""Figures of the BEM/FEM cross-validation (reads results, never solves).
+
+* :func:`plot_area_stiffness` -- A*(p) and K(p) curves of several methods overlaid.
+* :func:`plot_pressures` -- pressure along the profile at a few loads, BEM vs FEM.
+* :func:`plot_westergaard` -- contact half-width error and pressure vs Westergaard.
+* :func:`render_deformed_mesh` -- pyvista off-screen picture of the deformed FEM mesh
+  coloured by sigma_yy (from ``FemContactResult.fields``).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
+
+def _pyvista():
+    """pyvista, imported off-screen (same environment as plotting.common.offscreen_plotter)."""
+    import os
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+    import pyvista
+    return pyvista
+
+
+_pyvista()          # vtk before dolfinx, see render_deformed_mesh
+
+_STYLES = ("-", "--", ":", "-.", (0, (5, 1)), (0, (1, 3)))
+
+
+def plot_area_stiffness(curves, path, title="") -> Path:
+    """Overlay A*(p) and K(p) of several methods.
+
+    Parameters
+    ----------
+    curves : sequence of dict
+        Each with ``label``, ``mean_pressure`` (Pa), ``area_fraction`` and ``stiffness``
+        (Pa/m) arrays; optional ``marker``.
+    path : path
+        PNG file.
+    """
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
+    for k, c in enumerate(curves):
+        p = np.asarray(c["mean_pressure"]) / 1e6
+        kw = dict(ls=_STYLES[k % len(_STYLES)], marker=c.get("marker", "o"), ms=3,
+                  label=c["label"])
+        ax1.plot(p, c["area_fraction"], **kw)
+        ax2.plot(p, np.asarray(c["stiffness"]) / 1e12, **kw)
+    ax1.set(xlabel="mean pressure p (MPa)", ylabel="A* = A_r / A_n", title="A*(p)")
+    ax2.set(xlabel="mean pressure p (MPa)", ylabel="K = dp/dDelta (MPa/um)", title="K(p)")
+    for ax in (ax1, ax2):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+def plot_pressures(x, series, path, title="") -> Path:
+    """Pressure along the profile.
+
+    Parameters
+    ----------
+    x : ndarray
+        Positions (m).
+    series : sequence of dict
+        Each with ``label``, ``pressure`` (Pa, same length as x) and optional ``color``
+        and ``style`` (``"line"`` or ``"points"``).
+    """
+    fig, ax = new_figure(figsize=(10, 4))
+    for s in series:
+        kw = {"color": s.get("color"), "label": s["label"]}
+        if s.get("style", "line") == "points":
+            ax.plot(np.asarray(x) * 1e3, np.asarray(s["pressure"]) / 1e6, "o", ms=2.5, mfc="none", **kw)
+        else:
+            ax.plot(np.asarray(x) * 1e3, np.asarray(s["pressure"]) / 1e6, "-", lw=1, **kw)
+    ax.set(xlabel="x (mm)", ylabel="pressure (MPa)", title=title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
+    return save_figure(fig, path)
+
+
+def plot_westergaard(p_star_ratio, width_errors, x, pressure_pairs, path) -> Path:
+    """Westergaard check: half-width error vs p/p* and the pressure profiles.
+
+    Parameters
+    ----------
+    p_star_ratio : ndarray
+        p / p* of the load steps.
+    width_errors : dict label -> ndarray
+        Relative half-width errors (a_num / a_ref - 1) per step.
+    x : ndarray
+        Positions (m).
+    pressure_pairs : sequence of (label, numerical pressure, analytic pressure)
+    """
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
+    for k, (label, err) in enumerate(width_errors.items()):
+        ax1.plot(p_star_ratio, 100 * np.asarray(err), marker="os^"[k % 3], ls=_STYLES[k], label=label)
+    ax1.axhspan(-0.5, 0.5, color="g", alpha=0.1, label="target +-0.5 %")
+    ax1.set(xlabel="p / p*", ylabel="a / a_Westergaard - 1 (%)", title="contact half-width")
+    for k, (label, num, ref) in enumerate(pressure_pairs):
+        line, = ax2.plot(np.asarray(x) * 1e3, np.asarray(ref) / 1e6, "-", lw=1)
+        ax2.plot(np.asarray(x) * 1e3, np.asarray(num) / 1e6, "o", ms=2.5, mfc="none",
+                 color=line.get_color(), label=label)
+    ax2.set(xlabel="x (mm)", ylabel="pressure (MPa)",
+            title="pressure: FEM (points), Westergaard (lines)")
+    for ax in (ax1, ax2):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    return save_figure(fig, path)
+
+
+def render_deformed_mesh(fields, path, *, magnification=None, title="sigma_yy (MPa)",
+                         top_fraction=0.35, window_size=(1400, 700)) -> Path:
+    """pyvista off-screen picture of the deformed FEM mesh coloured by sigma_yy.
+
+    Parameters
+    ----------
+    fields : dict
+        ``FemContactResult.fields``: ``points`` (m), ``cells``, ``displacement`` (m),
+        ``stress_yy`` (Pa, per cell).
+    path : path
+        PNG file.
+    magnification : float, optional
+        Displacement magnification; default makes the largest displacement 3 % of the
+        body width.
+    top_fraction : float
+        Only cells within ``top_fraction * W`` of the top are shown (the stresses of a
+        rough contact are confined near the surface).
+
+    Note: with the Debian dolfinx and the vtk wheel in one process, vtk must be imported
+    before dolfinx (the other order aborts in vtk's std::regex); this module therefore
+    imports pyvista at import time: import it before running a FEM solve.
+    """
+    pv = _pyvista()
+    pts = np.asarray(fields["points"], float)
+    disp = np.asarray(fields["displacement"], float)
+    cells = np.asarray(fields["cells"], np.int64)
+    width = np.ptp(pts[:, 0])
+    if magnification is None:
+        umax = np.abs(disp).max()
+        magnification = 0.03 * width / umax if umax > 0 else 1.0
+    pts3 = np.zeros((pts.shape[0], 3))
+    pts3[:, :2] = (pts + magnification * disp) / width
+    y_top = pts[:, 1].max()
+    keep = pts[cells, 1].mean(axis=1) > y_top - top_fraction * width
+    cells = cells[keep]
+    used, cells = np.unique(cells, return_inverse=True)
+    cells = cells.reshape(-1, 3)
+    pts3 = pts3[used]
+    conn = np.hstack([np.full((cells.shape[0], 1), 3), cells]).ravel()
+    grid = pv.UnstructuredGrid(conn, np.full(cells.shape[0], pv.CellType.TRIANGLE, np.uint8), pts3)
+    grid.cell_data["sigma_yy (MPa)"] = np.asarray(fields["stress_yy"])[keep] / 1e6
+    s = grid.cell_data["sigma_yy (MPa)"]
+    lo = float(np.percentile(s, 1))
+    plotter = offscreen_plotter(window_size=window_size)
+    plotter.add_mesh(grid, scalars="sigma_yy (MPa)", cmap="viridis", clim=(lo, 0.0),
+                     show_edges=True, edge_color="grey", line_width=0.2,
+                     scalar_bar_args={"title": title})
+    plotter.add_text(f"deformed mesh, displacements x{magnification:.3g}; coordinates / W",
+                     font_size=10)
+    plotter.view_xy()
+    plotter.reset_camera()
+    plotter.camera.zoom(1.6)
+    return save_screenshot(plotter, path)
