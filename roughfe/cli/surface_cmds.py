@@ -37,8 +37,12 @@ def format_table(stats: dict) -> str:
     lines = []
     for key, label, unit, scale in _TABLE:
         v = stats[key]
-        if key in ("hurst", "fractal_dimension") and not stats["hurst_success"] and v is not None:
-            lines.append(f"{label:<28s} n/a (PSD fit gives H = {stats['hurst']:.3g}, outside (0, 1))")
+        if key in ("hurst", "fractal_dimension") and not stats["hurst_success"]:
+            if v is None:
+                lines.append(f"{label:<28s} n/a (too few PSD points to fit)")
+                continue
+            lines.append(f"{label:<28s} n/a (PSD fit gives H = {stats['hurst']:.3g}, "
+                         f"outside (0, 1))")
             continue
         if v is None:
             text = "n/a"

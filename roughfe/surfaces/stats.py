@@ -271,7 +271,12 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     """
     psd = power_spectrum(surface, window=window)
     if q_range is None:
-        q_range = (4 * 2 * np.pi / max(surface.size), np.pi / (2 * max(surface.spacing)))
+        qlo, qhi = 4 * 2 * np.pi / max(surface.size), np.pi / (2 * max(surface.spacing))
+        if qlo >= qhi:
+            return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), 0, False,
+                            "grid too small for the default q_range (needs > 16 points per "
+                            "side); give q_range")
+        q_range = (qlo, qhi)
     qlo, qhi = (float(v) for v in q_range)
     if not (0 < qlo < qhi):
         raise InputError(f"q_range must satisfy 0 < q_min < q_max (rad/m), got {q_range!r}")

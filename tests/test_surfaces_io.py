@@ -1,0 +1,113 @@
+"""Reading and writing surfaces: native npz round trip, plain matrices, instrument files."""
+import json
+
+import numpy as np
+import pytest
+
+from roughfe.errors import FileFormatError, InputError
+from roughfe.surfaces import Surface, load_surface, save_surface
+from roughfe.surfaces.io import READERS
+from roughfe.surfaces.stats import rms_height
+
+# From ../shared/data/topographies/README.md: grid, physical size (m), rms height (m).
+# sur-2.sur: the README says 31.2 um, but the file's data unit is mm and its heights have
+# a standard deviation of 3.12e-5 mm = 31.2 nm (read with SurfaceTopography's raw
+# metadata: data_unit 'mm'); the README's unit is a slip, 31.2 nm is asserted.
+# opd-1.opd has 116 undefined points (README: none); they are filled and counted.
+MEASURED = {
+    "x3p-2.x3p": ((650, 650), (82.98e-6, 204.48e-6), 77.3e-9, "m"),
+    "sur-2.sur": ((563, 484), (1.961e-3, 1.686e-3), 31.2e-9, "mm"),
+    "opd-1.opd": ((640, 480), (125.9e-6, 94.4e-6), 8.36e-9, "mm"),
+    "plu-1.plu": ((768, 576), (1274.9e-6, 956.2e-6), 2.83e-6, "µm"),
+    "di-1.di": ((512, 512), (500e-9, 500e-9), 9.95e-9, "nm"),
+}
+
+
+def test_npz_round_trip(tmp_path):
+    rng = np.random.default_rng(0)
+    s = Surface(rng.standard_normal((9, 7)) * 1e-6, (3e-4, 2e-4), periodic=True,
+                metadata={"generator": "test", "seed": 3, "nested": {"a": [1, 2.5]}})
+    path = save_surface(s, tmp_path / "s.npz")
+    t = load_surface(path)
+    np.testing.assert_array_equal(t.heights, s.heights)
+    assert t.size == s.size and t.periodic is True and t.metadata == s.metadata
+    with np.load(path, allow_pickle=False) as data:          # documented, pickle-free format
+        assert str(data["format"]) == "roughfe-surface" and int(data["version"]) == 1
+    # profile, and overrides of size / periodic
+    p = Surface(np.arange(5.0) * 1e-9, 1e-6)
+    q = load_surface(save_surface(p, tmp_path / "p.npz"), size=2e-6, periodic=True)
+    assert q.ndim == 1 and q.size == (2e-6,) and q.periodic
+
+
+def test_save_is_atomic_and_checks_suffix(tmp_path):
+    s = Surface(np.zeros((2, 2)), 1.0)
+    with pytest.raises(InputError, match="npz"):
+        save_surface(s, tmp_path / "s.npy")
+    save_surface(s, tmp_path / "s.npz")
+    assert [f.name for f in tmp_path.iterdir()] == ["s.npz"]      # no temporary left over
+
+
+@pytest.mark.parametrize("suffix", [".npy", ".txt", ".csv"])
+def test_plain_matrices_need_a_size(tmp_path, suffix):
+    h = np.arange(12.0).reshape(4, 3) * 1e-9
+    path = tmp_path / f"h{suffix}"
+    if suffix == ".npy":
+        np.save(path, h)
+    else:
+        np.savetxt(path, h, delimiter="," if suffix == ".csv" else " ")
+    with pytest.raises(ValueError) as info:
+        load_surface(path)
+    assert "size" in str(info.value) and path.name in str(info.value)
+    s = load_surface(path, size=(4e-6, 3e-6))
+    np.testing.assert_allclose(s.heights, h, rtol=1e-15)
+    assert s.size == (4e-6, 3e-6) and s.periodic is False
+    assert load_surface(path, size=1e-6, periodic=True).periodic
+
+
+def test_bad_files(tmp_path):
+    with pytest.raises(InputError, match="does not exist"):
+        load_surface(tmp_path / "missing.npz")
+    np.savez(tmp_path / "other.npz", x=np.zeros(3))
+    with pytest.raises(FileFormatError, match="not a roughfe surface"):
+        load_surface(tmp_path / "other.npz")
+    np.save(tmp_path / "cube.npy", np.zeros((2, 2, 2)))
+    with pytest.raises(ValueError, match=r"\(2, 2, 2\)"):
+        load_surface(tmp_path / "cube.npy", size=1.0)
+    np.save(tmp_path / "nan.npy", np.array([[0.0, np.nan], [1.0, 2.0]]))
+    with pytest.raises(ValueError, match="finite"):
+        load_surface(tmp_path / "nan.npy", size=1.0)
+    (tmp_path / "junk.xyz9").write_text("not a topography\n")
+    with pytest.raises(FileFormatError, match="no reader"):
+        load_surface(tmp_path / "junk.xyz9")
+
+
+def test_reader_table_is_ordered_with_fallback_last():
+    assert READERS[0][0] == (".npz",)
+    assert READERS[-1][0] is None and all(r[0] is not None for r in READERS[:-1])
+
+
+@pytest.mark.parametrize("name", sorted(MEASURED))
+def test_instrument_files_in_si(topographies_dir, name):
+    shape, size, rms, unit = MEASURED[name]
+    s = load_surface(topographies_dir / name)
+    assert s.shape == shape
+    np.testing.assert_allclose(s.size, size, rtol=2e-3)     # README gives 4 digits
+    assert rms_height(s) == pytest.approx(rms, rel=0.01)
+    assert s.metadata["unit_in_file"] == unit and not s.periodic
+    json.dumps(s.metadata, allow_nan=False)                  # JSON-safe instrument metadata
+    if name == "opd-1.opd":
+        assert s.metadata["filled_points"] == 116
+
+
+def test_multichannel_choice(topographies_dir):
+    path = topographies_dir / "di-1.di"
+    first = load_surface(path)
+    second = load_surface(path, channel=1)
+    by_name = load_surface(path, channel="Height")
+    assert second.metadata["channel"]["index"] == 1
+    np.testing.assert_array_equal(by_name.heights, first.heights)
+    assert not np.array_equal(first.heights, second.heights)
+    with pytest.raises(InputError, match="out of range"):
+        load_surface(path, channel=9)
+    with pytest.raises(InputError, match="no channel named"):
+        load_surface(path, channel="Nope")
