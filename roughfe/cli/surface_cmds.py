@@ -94,7 +94,7 @@ def _make_mwm(a):
 def _make_spectral(a):
     make = spectral_profile if a.profile else spectral_surface
     rms_h = a.rms_height if (a.rms_height is not None or a.rms_slope is not None) else 1e-6
-    return make(a.n, a.length, a.hurst, rms_height=None if a.rms_slope else rms_h,
+    return make(a.n, a.length, a.hurst, rms_height=rms_h,
                 rms_slope=a.rms_slope, q_long=a.q_long, q_roll=a.q_roll, q_short=a.q_short,
                 amplitudes="fixed" if a.fixed_amplitudes else "gaussian", rng=a.seed)
 
@@ -112,7 +112,8 @@ def _generate(args) -> int:
     if not args.no_png:
         from ..plotting.surfaces import plot_profile, render_surface
         png = out.with_suffix(".png")
-        title = f"{args.model} surface"
+        kind = "surface" if surface.ndim == 2 else "profile"
+        title = f"{args.model} {kind}, seed {surface.metadata.get('seed')}"
         (render_surface if surface.ndim == 2 else plot_profile)(surface, png, title=title)
         print(f"wrote {png}")
     return 0

@@ -55,12 +55,16 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
     plotter.add_text(label.strip(), position="upper_left", font_size=11)
     plotter.set_background("white")
     plotter.camera_position = "iso"
-    plotter.camera.zoom(1.35)
+    aspect = max(surface.size) / min(surface.size)
+    plotter.camera.zoom(1.35 / aspect ** 0.25)     # long surfaces need more room
     return save_screenshot(plotter, path)
 
 
 def plot_profile(surface, path, title=None, axis=0):
-    """Line plot of a profile, or of the middle row (``axis=0``: along x) of a surface."""
+    """Line plot of a profile, or of the middle row (``axis=0``: along x) of a surface.
+
+    Heights are plotted as stored (um), so e.g. ``W(0) = 0`` of a WM profile is visible.
+    """
     if surface.ndim == 1:
         x, h = surface.coordinates()[0], surface.heights
     else:
@@ -68,7 +72,7 @@ def plot_profile(surface, path, title=None, axis=0):
         h = surface.heights[:, mid] if axis == 0 else surface.heights[mid, :]
         x = surface.coordinates()[axis]
     fig, ax = new_figure(figsize=(7, 3))
-    ax.plot(x * UM, (h - h.mean()) * UM, lw=0.8)
+    ax.plot(x * UM, h * UM, lw=0.8)
     ax.set_xlabel(f"{'xy'[axis]} (um)")
     ax.set_ylabel("height (um)")
     ax.set_title(title or ("profile" if surface.ndim == 1 else f"profile through the middle, along {'xy'[axis]}"))
