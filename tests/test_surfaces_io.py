@@ -1,5 +1,6 @@
 """Reading and writing surfaces: native npz round trip, plain matrices, instrument files."""
 import json
+import pickle
 
 import numpy as np
 import pytest
@@ -95,6 +96,8 @@ def test_instrument_files_in_si(topographies_dir, name):
     assert rms_height(s) == pytest.approx(rms, rel=0.01)
     assert s.metadata["unit_in_file"] == unit and not s.periodic
     json.dumps(s.metadata, allow_nan=False)                  # JSON-safe instrument metadata
+    t = pickle.loads(pickle.dumps(s))                         # picklable (dask/MPI studies)
+    np.testing.assert_array_equal(t.heights, s.heights)
     if name == "opd-1.opd":
         assert s.metadata["filled_points"] == 116
 
