@@ -1,0 +1,648 @@
+"""Genome sequencing of rough profiles from nested acquisitions (thesis Sec. 3.3.1, Eq. 3.5-3.16).
+
+Input: two or more acquisitions of the same profile at observation lengths
+L_1 > L_2 > ... (e.g. 10x, 20x, 100x), each with the same number of nodes N, centred on
+the same point x = 0 (node coordinates from ``metadata["x0"]`` or the genome node
+convention of :mod:`roughfe.genomics.genome`).
+
+What a profile can and cannot tell (the thesis is loose here)
+-------------------------------------------------------------
+By the reduced form (Eq. 3.7-3.8, :mod:`roughfe.genomics.chromosomes`) every chromosome
+of a *profile* is exactly one cosine,
+
+    C_n(x) = c_n [cos(theta_n) - cos(q_n x + theta_n)],
+    c_n e^{i theta_n} = G gamma^{(1-n) H} sum_m e^{i phi_{m,n}},
+
+so the heights depend on (A, M, Phi) only through the complex amplitudes c_n e^{i theta_n}.
+Consequences, stated once:
+
+* gamma and lambda1 (the wavenumber lattice) and every c_n, theta_n are identifiable,
+  exactly for WM data. With the lattice known the fit is *linear*: Eq. (3.12)-(3.16) with
+  the phasor sums as unknowns, (eta, xi) -> c_n (cos theta_n, sin theta_n), needs no
+  constraint eta^2 + xi^2 = 1, no fmincon, no (eta, xi) vs angle choice, and uses all
+  nodes of all acquisitions (the thesis's low-pass behaviour came from 128 fitting nodes).
+  Only (ln q_1, ln gamma) are nonlinear: they are refined by variable projection
+  (scipy ``least_squares`` on the residual of the linear solve).
+* M and the individual phi_{m,n} are *not* identifiable from profiles: any M phasors
+  with the same sum give the same heights (the thesis's P_m(alpha) is flat in M up to
+  optimiser noise). A and H enter only through the mean trend of |c_n|: with random phases
+  |sum_m e^{i phi}|^2 / M is ~ exponentially distributed with mean 1 (independent of M), so
+  A and H are *statistical* estimates with an error set by the number of chromosomes
+  (about 5-10 % on H for the 22 chromosomes of Table 1), whatever the fitting method.
+  They are estimated here by maximum likelihood (:func:`amplitude_genes`); M by
+  maximum likelihood over 2..20 using the distribution of the resultant of M random unit
+  phasors (weak: M = 8 and M = 12 are nearly indistinguishable); the phases are then
+  *one* set of M phasors per chromosome with the fitted sum (drawn from a seeded rng),
+  so the sequenced genome reproduces the acquisitions exactly and has the fitted genes.
+
+Steps (:func:`sequence_profiles`)
+---------------------------------
+1. PSD of each acquisition (Hann window, ``roughfe.surfaces.stats.power_spectrum``) and
+   its peaks: the vertices of the upper convex hull of the log-log PSD (quickhull,
+   ``scipy.spatial.ConvexHull``, as the thesis) plus the prominent local maxima,
+   located to sub-bin precision by a parabola in log PSD.
+2. gamma (Eq. 3.6): the peaks of all acquisitions lie on one lattice
+   ln q_n = ln q_1 + (n-1) ln gamma; ln gamma is the period of a comb fitted to the peak
+   abscissae (largest period with near-maximal coherence), refined by regression.
+3. lambda1 so that n_s = 1 for the coarsest acquisition (Eq. 3.5): lambda1 in [L_1, gamma L_1).
+4. Variable projection with continuation in the highest chromosome index (the basin of
+   ln gamma shrinks like 1/n), restarts from the best comb periods; the lattice label is
+   finally chosen among the shifts compatible with step 3 by the residual.
+5. Genes A, H (maximum likelihood on c_n, M-free), M, phases; Z_d = Z_1 - Z_2 at the
+   common nodes; relative rms errors of the realisations of the sequenced genome; a
+   quality report (success is False, with a message, when the relative rms error of any
+   acquisition exceeds ``rms_tolerance``: the profile is not WM-like).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+from scipy.linalg import lstsq as scipy_lstsq
+from scipy.optimize import least_squares, minimize_scalar
+from scipy.signal import find_peaks
+from scipy.spatial import ConvexHull, QhullError
+
+from ..errors import InputError
+from ..surfaces.stats import power_spectrum
+from ..surfaces.surface import Surface
+from .genome import Genome, chromosome_range, observation_coordinates, profile_heights
+
+MIN_NODES = 32
+
+
+# -- data checks -------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class Acquisition:
+    """One acquisition: node abscissae x (m), heights z (m), observation length L = (N-1) dx."""
+
+    x: np.ndarray
+    z: np.ndarray
+    length: float
+
+
+def acquisitions_from_surfaces(surfaces) -> list:
+    """Check nested acquisitions and return them sorted from coarsest to finest.
+
+    Raises InputError for: fewer than 2 profiles, 2D data, different N, fewer than
+    ``MIN_NODES`` nodes, equal lengths, windows that are not nested around x = 0, or
+    scales that do not overlap (the finer window shorter than two coarse spacings).
+    """
+    surfaces = list(surfaces)
+    if len(surfaces) < 2:
+        raise InputError(f"sequencing needs at least 2 nested acquisitions, got {len(surfaces)}")
+    for k, s in enumerate(surfaces):
+        if not isinstance(s, Surface):
+            raise InputError(f"acquisition {k} must be a roughfe Surface, got {type(s).__name__}")
+        if s.ndim != 1:
+            raise InputError(f"acquisition {k} must be a profile (1D heights), got shape {s.shape}")
+    sizes = {s.shape[0] for s in surfaces}
+    if len(sizes) != 1:
+        raise InputError(f"all acquisitions must have the same number of nodes N (Sec. 3.2: N = 512 "
+                         f"at every scale), got N = {[s.shape[0] for s in surfaces]}")
+    n = sizes.pop()
+    if n < MIN_NODES:
+        raise InputError(f"too few points: N = {n} nodes per acquisition, at least {MIN_NODES} are needed")
+    acq = []
+    for s in surfaces:
+        x = observation_coordinates(s)
+        acq.append(Acquisition(x, np.asarray(s.heights, dtype=float), float((n - 1) * s.spacing[0])))
+    acq.sort(key=lambda a: -a.length)
+    for a, b in zip(acq, acq[1:]):
+        if not b.length < a.length * (1 - 1e-9):
+            raise InputError(f"acquisitions must have different observation lengths, got two of "
+                             f"{a.length:.6g} m")
+        tol = 1e-6 * a.length
+        if b.x[0] < a.x[0] - tol or b.x[-1] > a.x[-1] + tol:
+            raise InputError(f"acquisition of length {b.length:.6g} m ([{b.x[0]:.4g}, {b.x[-1]:.4g}] m) is "
+                             f"not nested inside the one of length {a.length:.6g} m "
+                             f"([{a.x[0]:.4g}, {a.x[-1]:.4g}] m)")
+        dx = a.length / (n - 1)
+        if b.length <= 2 * dx:
+            raise InputError(f"non-overlapping scales: the finer window {b.length:.4g} m is not longer than "
+                             f"two spacings {2 * dx:.4g} m of the coarser acquisition, so they share no "
+                             f"wavelength")
+    return acq
+
+
+# -- step 1: PSD peaks ---------------------------------------------------------------------
+@dataclass(frozen=True)
+class SpectrumPeaks:
+    """PSD of one acquisition and its peaks.
+
+    Attributes: q (rad/m), C (m^3, ``roughfe.surfaces.stats`` convention), hull (indices
+    of the upper-convex-hull vertices), peak_q (refined peak wavenumbers, rad/m),
+    peak_C (PSD at the peaks, m^3).
+    """
+
+    q: np.ndarray
+    C: np.ndarray
+    hull: np.ndarray
+    peak_q: np.ndarray
+    peak_C: np.ndarray
+
+
+def upper_hull(q, C) -> np.ndarray:
+    """Indices of the vertices of the upper convex hull of (log q, log C) (quickhull)."""
+    pts = np.column_stack([np.log(q), np.log(np.maximum(C, np.finfo(float).tiny))])
+    try:
+        hull = ConvexHull(pts)
+    except (QhullError, ValueError):
+        return np.arange(q.size)
+    upper = set()
+    for simplex, eq in zip(hull.simplices, hull.equations):
+        if eq[1] > 0:                                      # outward normal points up
+            upper.update(int(i) for i in simplex)
+    return np.array(sorted(upper), dtype=int)
+
+
+def spectrum_peaks(acq: Acquisition, min_bin=4, prominence=2.0) -> SpectrumPeaks:
+    """PSD (Hann window) of an acquisition, its upper hull and its refined peaks.
+
+    A peak is an upper-hull vertex or a local maximum of ln C with a prominence of at
+    least ``prominence`` (natural-log units), at FFT bin >= ``min_bin`` (lower bins are not
+    resolved by the window). Its wavenumber is refined by a parabola through ln C at the
+    three bins around it.
+    """
+    n = acq.z.size
+    spec = power_spectrum(Surface(acq.z, n * acq.length / (n - 1)), window="hann")
+    q, C = spec.q, np.maximum(spec.C, np.finfo(float).tiny)
+    logc = np.log(C)
+    hull = upper_hull(q, C)
+    found, _ = find_peaks(logc, prominence=prominence)
+    cand = np.union1d(found, hull[(hull > 0) & (hull < q.size - 1)])
+    cand = cand[(cand >= min_bin - 1) & (cand < q.size - 1)]
+    cand = cand[(logc[cand] >= logc[cand - 1]) & (logc[cand] >= logc[cand + 1])]
+    dq = q[1] - q[0]
+    ym, y0, yp = logc[cand - 1], logc[cand], logc[cand + 1]
+    den = ym - 2 * y0 + yp
+    shift = np.where(den < 0, 0.5 * (ym - yp) / np.where(den < 0, den, -1.0), 0.0)
+    return SpectrumPeaks(q, C, hull, q[cand] + np.clip(shift, -0.5, 0.5) * dq, C[cand])
+
+
+# -- step 2-3: the lattice -----------------------------------------------------------------
+def comb_periods(log_q, weights=None, gamma_range=(1.05, 4.0), n_grid=6000, n_best=3):
+    """Candidate ln(gamma): periods T of a comb fitted to the peak abscissae ln q (Eq. 3.6).
+
+    Coherence S(T) = |sum w e^{2 pi i ln q / T}| / sum w is 1 for a perfect lattice of
+    period T and also for T/2, T/3, ... ; the candidates are the local maxima of S with
+    S >= 0.75 max S, largest periods first (the fundamental), at most ``n_best``.
+    Returns (periods, coherences, reference ln q).
+    """
+    log_q = np.asarray(log_q, dtype=float)
+    w = np.ones_like(log_q) if weights is None else np.asarray(weights, dtype=float)
+    periods = np.linspace(math.log(gamma_range[0]), math.log(gamma_range[1]), n_grid)
+    ph = np.exp(2j * np.pi * np.outer(1.0 / periods, log_q))
+    s = np.abs(ph @ w) / w.sum()
+    loc = np.flatnonzero((s[1:-1] >= s[:-2]) & (s[1:-1] >= s[2:])) + 1
+    if loc.size == 0:
+        loc = np.array([int(np.argmax(s))])
+    keep = loc[s[loc] >= 0.75 * s[loc].max()]
+    keep = keep[np.argsort(-periods[keep])][:n_best]
+    refs = []
+    for k in keep:
+        phase = np.angle(ph[k] @ w)
+        refs.append(phase / (2 * np.pi) * periods[k])
+    return periods[keep], s[keep], np.array(refs)
+
+
+def _lattice_from_period(log_q, period, ref, coarse_length, weights=None):
+    """Refine (ln q1, ln gamma) by weighted regression on the lattice indices; q1 so that n_s = 1.
+
+    Peaks farther than 0.15 period from the lattice (aliased lines, leakage) are dropped
+    iteratively; ``weights`` (the peak bin numbers: the relative precision of a peak
+    grows with its bin) weight the regression.
+    """
+    w = np.ones_like(log_q) if weights is None else np.asarray(weights, dtype=float)
+    keep = np.ones(log_q.size, dtype=bool)
+    for _ in range(5):
+        k = np.round((log_q - ref) / period)
+        dev = np.abs(log_q - ref - k * period)
+        keep = dev < 0.15 * period
+        if np.unique(k[keep]).size < 2:
+            break
+        slope, icpt = np.polyfit(k[keep], log_q[keep], 1, w=np.sqrt(w[keep]))
+        if not (0.5 * period < slope < 2 * period):
+            break
+        period, ref = slope, icpt
+    return _label_q1(ref, period, coarse_length), period
+
+
+def _label_q1(log_q_any, period, coarse_length):
+    """The lattice point ln q1 with lambda1 = 2 pi / q1 in [L_1, gamma L_1) (n_s = 1, Eq. 3.5)."""
+    top = math.log(2 * math.pi / coarse_length)          # q1 <= 2 pi / L1
+    return log_q_any + math.floor((top - log_q_any) / period + 1e-9) * period
+
+
+# -- step 4: variable projection -----------------------------------------------------------
+def _ranges(log_q1, log_gamma, acqs, n_nodes):
+    lam1 = 2 * math.pi / math.exp(log_q1)
+    return [chromosome_range(math.exp(log_gamma), lam1, a.length, n_nodes) for a in acqs]
+
+
+@dataclass(frozen=True, eq=False)
+class _Design:
+    n: np.ndarray             # union of chromosome indices
+    rows: list                # (matrix, weighted heights) per acquisition
+
+
+def _design(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
+    lo = min(r[0] for r in ranges)
+    hi = max(r[1] for r in ranges) if n_cap is None else min(n_cap, max(r[1] for r in ranges))
+    n = np.arange(lo, hi + 1)
+    q = np.exp(log_q1 + (n - 1) * log_gamma)
+    blocks = []
+    for a, (ns, nf), w in zip(acqs, ranges, weights):
+        on = (n >= ns) & (n <= nf)
+        arg = np.multiply.outer(a.x, q)
+        m = np.zeros((a.x.size, 2 * n.size))
+        m[:, 0::2] = np.where(on, 1.0 - np.cos(arg), 0.0)
+        m[:, 1::2] = np.where(on, np.sin(arg), 0.0)
+        blocks.append(m * w)
+    return n, np.vstack(blocks)
+
+
+def _solve_linear(mat, rhs):
+    scale = np.linalg.norm(mat, axis=0)
+    scale[scale == 0] = 1.0
+    coef, *_ = scipy_lstsq(mat / scale, rhs, cond=1e-12, lapack_driver="gelsy",
+                           check_finite=False)   # pivoted QR: ~3x faster than SVD here
+    return coef / scale
+
+
+def _vp_residual(params, acqs, ranges, weights, rhs, n_cap):
+    n, mat = _design(params[0], params[1], acqs, ranges, weights, n_cap)
+    coef = _solve_linear(mat, rhs)
+    return rhs - mat @ coef
+
+
+def _first_cap(log_q1, log_gamma, lo, hi, coarse_length, rel_error=1e-3):
+    """Highest chromosome index whose phase error over the coarsest window stays below ~1.5 rad.
+
+    With relative errors ~``rel_error`` per lattice step on the PSD estimates of
+    (ln q1, ln gamma), chromosome n is off by ~(n + 2) rel_error in ln q_n, i.e. a phase
+    error q_n L_1 (n + 2) rel_error over the coarsest window.
+    """
+    cap = lo + 2
+    for n in range(lo + 2, hi + 1):
+        qn = math.exp(log_q1 + (n - 1) * log_gamma)
+        if qn * coarse_length * (n + 2) * rel_error < 1.5:
+            cap = n
+    return min(cap, hi)
+
+
+def _fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=400):
+    """Variable projection with continuation in the highest chromosome index.
+
+    The continuation starts at the highest chromosome that the PSD estimate already
+    places within ~1.5 rad over the coarsest window (:func:`_first_cap`) -- starting lower
+    lets the unresolved longest waves drag gamma away -- and adds one chromosome per step
+    (each step shrinks the error enough for the next one).
+    """
+    ranges = _ranges(log_q1, log_gamma, acqs, n_nodes)
+    lo = min(r[0] for r in ranges)
+    hi = max(r[1] for r in ranges)
+    p = np.array([log_q1, log_gamma])
+    nit = 0
+    caps = list(range(_first_cap(log_q1, log_gamma, lo, hi, acqs[0].length), hi + 1))
+    if len(caps) > 12:                    # many chromosomes (gamma near 1): coarser continuation
+        caps = sorted(set(np.linspace(caps[0], hi, 12).round().astype(int).tolist()))
+    for cap in caps:
+        if nit >= budget:
+            break
+        res = least_squares(_vp_residual, p, args=(acqs, ranges, weights, rhs, cap),
+                            x_scale=np.array([1e-3, 1e-3]), diff_step=1e-9,
+                            max_nfev=max(5, min(30, budget - nit)),
+                            xtol=1e-15, ftol=1e-15, gtol=1e-15)
+        nit += res.nfev + 2 * (res.njev or 0)
+        if res.x[1] > 0:
+            p = res.x
+    return p, nit
+
+
+# -- step 5: genes ---------------------------------------------------------------------------
+def amplitude_genes(n, c, gamma, lambda1):
+    """Maximum-likelihood A (m^(1-H)) and H from the chromosome amplitudes c_n (m).
+
+    Model: c_n^2 = s_n u_n with s_n = A^2 ln(gamma) q_1^(-2H) gamma^(2(1-n)H) (the mean of
+    c_n^2 over random phases, Eq. 3.1 / 3.13 -- independent of M) and u_n ~ Exp(1). The
+    log-likelihood -sum(ln s_n + c_n^2 / s_n) is maximised in closed form over A^2 for
+    each H and numerically over H in (0, 3].
+    """
+    n = np.asarray(n, dtype=float)
+    c2 = np.asarray(c, dtype=float) ** 2
+    keep = c2 > 0
+    n, c2 = n[keep], c2[keep]
+    if n.size < 2:
+        raise InputError("at least two chromosomes with non-zero amplitude are needed for A and H")
+    lg = math.log(gamma)
+    q1 = 2 * math.pi / lambda1
+
+    def s0(h):                       # closed-form ML value of A^2 ln(gamma) q1^(-2H)
+        return np.mean(c2 * gamma ** (2 * (n - 1) * h))
+
+    def nll(h):
+        s = s0(h) * gamma ** (-2 * (n - 1) * h)
+        return float(np.sum(np.log(s) + c2 / s))
+
+    h = minimize_scalar(nll, bounds=(1e-3, 3.0), method="bounded", options={"xatol": 1e-10}).x
+    a = math.sqrt(s0(h) / lg) * q1 ** h
+    return a, float(h)
+
+
+def _resultant_samples(m, n_samples, rng):
+    phi = rng.uniform(0, 2 * np.pi, size=(n_samples, m))
+    return np.abs(np.exp(1j * phi).sum(axis=1)) / math.sqrt(m)
+
+
+def ridge_likelihood(u, M_values=tuple(range(2, 21)), *, rng, n_samples=20000):
+    """Log-likelihood of M for normalised chromosome amplitudes u_n = |sum_m e^{i phi}| / sqrt(M).
+
+    The density of the resultant of M random unit phasors is estimated by a histogram of
+    ``n_samples`` seeded draws (Kluyver's distribution). Values of u above sqrt(M) are
+    impossible for that M (log-likelihood -inf).
+    """
+    gen = np.random.default_rng(rng)
+    u = np.asarray(u, dtype=float)
+    edges = np.linspace(0, math.sqrt(max(M_values)) + 1e-9, 121)
+    out = []
+    for m in M_values:
+        hist, _ = np.histogram(_resultant_samples(int(m), n_samples, gen), bins=edges, density=True)
+        idx = np.clip(np.digitize(u, edges) - 1, 0, hist.size - 1)
+        dens = hist[idx]
+        bad = (u > math.sqrt(m) * (1 + 1e-9)) | (dens <= 0)
+        out.append(-np.inf if bad.any() else float(np.sum(np.log(dens))))
+    return np.array(out)
+
+
+def phases_with_sums(target, M, *, rng, attempts=200):
+    """M phases per column whose unit phasors sum to ``target`` (complex, |target| <= M).
+
+    M - 2 phases are drawn uniformly from ``rng``; the last two close the sum (two unit
+    vectors reach any w with |w| <= 2). A symmetric fan is the fallback when random draws
+    fail (|target| close to M). Returns an (M, len(target)) matrix in [0, 2 pi).
+    """
+    target = np.asarray(target, dtype=complex).ravel()
+    M = int(M)
+    if np.any(np.abs(target) > M * (1 + 1e-12)):
+        raise InputError(f"a sum of {M} unit phasors cannot exceed {M} in modulus "
+                         f"(max |target| = {np.abs(target).max():.4g})")
+    out = np.empty((M, target.size))
+    for k, t in enumerate(target):
+        done = False
+        if M >= 2:
+            for _ in range(attempts):
+                phi = rng.uniform(0, 2 * np.pi, size=M - 2)
+                w = t - np.exp(1j * phi).sum()
+                r = abs(w)
+                if r <= 2.0 and r > 1e-12:
+                    half = math.acos(min(1.0, r / 2))
+                    base = math.atan2(w.imag, w.real)
+                    out[:, k] = np.concatenate([phi, [base + half, base - half]])
+                    done = True
+                    break
+        if not done:                      # fan: phases theta +- beta (and theta for odd M)
+            r, theta = abs(t), math.atan2(t.imag, t.real)
+            if M == 1:
+                out[:, k] = theta
+                continue
+            odd = M % 2
+            cb = (r - odd) / (M - odd)
+            beta = math.acos(min(1.0, max(-1.0, cb)))
+            signs = np.array([1.0, -1.0] * (M // 2) + [0.0] * odd)
+            out[:, k] = theta + signs * beta
+    return np.mod(out, 2 * np.pi)
+
+
+# -- result ---------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class SequencingResult:
+    """Sequenced genome and its quality report (scipy OptimizeResult-like).
+
+    Attributes
+    ----------
+    genome : Genome
+        Sequenced genome (phases: one set consistent with the fitted chromosome sums).
+    success : bool
+        True when every acquisition is reproduced within ``rms_tolerance``.
+    message : str
+    nit : int
+        Residual evaluations of the nonlinear (lattice) fit.
+    n : ndarray of int
+        Chromosome indices fitted (union over acquisitions).
+    amplitudes, phases : ndarray
+        c_n (m) and theta_n (rad) of the reduced chromosomes (Eq. 3.7-3.8).
+    ranges : list of (int, int)
+        (n_s, n_f) per acquisition, coarsest first (Eq. 3.5).
+    lengths : ndarray
+        Observation lengths (m), coarsest first.
+    rms_errors : ndarray
+        rms(Z_i - Z_i^seq) / rms(Z_i) per acquisition (relative, -).
+    x, heights, fitted : list of ndarray
+        Nodes (m), measured and sequenced heights (m) per acquisition.
+    zd_x, zd, zd_fit : ndarray
+        Z_d = Z_1 - Z_2 at the common nodes of the two coarsest acquisitions and its
+        sequenced counterpart (m); empty when they share no node.
+    spectra : list of SpectrumPeaks
+    gamma_psd, H_psd : float
+        gamma from the PSD peaks alone (comb, step 2) and H from the slope of the upper
+        hull peaks (log C ~ -2H log q, Eq. 3.11): the thesis's estimates, for comparison.
+    M_loglik : ndarray
+        Log-likelihood of M = 2..20 (flat-ish: M is weakly identifiable).
+    seed : int or None
+    elapsed : float
+        Wall time (s).
+    """
+
+    genome: Genome
+    success: bool
+    message: str
+    nit: int
+    n: np.ndarray
+    amplitudes: np.ndarray
+    phases: np.ndarray
+    ranges: list
+    lengths: np.ndarray
+    rms_errors: np.ndarray
+    x: list
+    heights: list
+    fitted: list
+    zd_x: np.ndarray
+    zd: np.ndarray
+    zd_fit: np.ndarray
+    spectra: list
+    gamma_psd: float
+    H_psd: float
+    M_loglik: np.ndarray
+    seed: Optional[int] = None
+    elapsed: float = 0.0
+    references: tuple = field(default=("thesis Sec. 3.3.1, Eq. 3.5-3.16",))
+
+    def report(self) -> dict:
+        """JSON-safe summary (genes, rms errors, ranges, diagnostics)."""
+        g = self.genome
+        return {"success": bool(self.success), "message": self.message, "nit": int(self.nit),
+                "genes": {"A": g.A, "H": g.H, "gamma": g.gamma, "lambda1": g.lambda1, "M": g.M},
+                "lengths": self.lengths.tolist(), "ranges": [list(r) for r in self.ranges],
+                "rms_errors": self.rms_errors.tolist(),
+                "zd_rms": float(np.sqrt(np.mean(self.zd ** 2))) if self.zd.size else None,
+                "zd_rms_error": (float(np.sqrt(np.mean((self.zd - self.zd_fit) ** 2))
+                                       / max(np.sqrt(np.mean(self.zd ** 2)), 1e-300))
+                                 if self.zd.size else None),
+                "gamma_psd": self.gamma_psd, "H_psd": self.H_psd,
+                "M_loglik": [None if not np.isfinite(v) else float(v) for v in self.M_loglik],
+                "seed": self.seed, "elapsed_s": self.elapsed}
+
+
+def _rel_rms(z, fit):
+    rz = math.sqrt(float(np.mean(z ** 2)))
+    return math.sqrt(float(np.mean((z - fit) ** 2))) / rz if rz > 0 else math.inf
+
+
+def _hull_slope_H(spectra):
+    """H from the upper-hull peaks: ln C = const - 2H ln q (Eq. 3.11), all acquisitions."""
+    lq, lc = [], []
+    for sp in spectra:
+        h = sp.hull[(sp.hull > 2) & (sp.hull < sp.q.size - 2)]
+        lq.append(np.log(sp.q[h]))
+        lc.append(np.log(sp.C[h]))
+    lq, lc = np.concatenate(lq), np.concatenate(lc)
+    if lq.size < 2:
+        return float("nan")
+    return float(-np.polyfit(lq, lc, 1)[0] / 2)
+
+
+def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restarts=3) -> SequencingResult:
+    """Sequence the genome of a profile from nested acquisitions (Sec. 3.3.1).
+
+    Parameters
+    ----------
+    surfaces : sequence of Surface
+        Two or more profiles of the same N nodes at observation lengths L_1 > L_2 > ...,
+        centred on x = 0 (see :func:`acquisitions_from_surfaces` for the checks).
+    seed : int
+        Seeds the M likelihood and the phase draws (the fit itself is deterministic).
+    M : int, optional
+        Number of ridges of the sequenced genome. Default: maximum likelihood over 2..20
+        (weakly identifiable, see the module notes).
+    rms_tolerance : float
+        Relative rms error above which the result is flagged ``success = False``.
+    n_restarts : int
+        Number of comb periods (gamma candidates) tried; the lowest residual wins.
+
+    Returns
+    -------
+    SequencingResult
+    """
+    t0 = time.perf_counter()
+    acqs = acquisitions_from_surfaces(surfaces)
+    n_nodes = acqs[0].z.size
+    rng = np.random.default_rng(seed)
+    weights = [1.0 / max(math.sqrt(float(np.mean(a.z ** 2))), 1e-300) for a in acqs]
+    rhs = np.concatenate([a.z * w for a, w in zip(acqs, weights)])
+
+    # 1-2. spectra, peaks and the comb
+    spectra = [spectrum_peaks(a) for a in acqs]
+    log_q = np.concatenate([np.log(s.peak_q) for s in spectra])
+    messages = []
+    if log_q.size < 3:
+        messages.append(f"only {log_q.size} PSD peaks found: the spectrum is not a discrete WM spectrum")
+        periods, coh, refs = np.array([math.log(1.5)]), np.array([0.0]), np.array([math.log(2 * math.pi / acqs[0].length)])
+    else:
+        periods, coh, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
+    bins = np.concatenate([s.peak_q / (s.q[1] - s.q[0]) for s in spectra])
+    gamma_psd = float(math.exp(periods[0]))
+
+    # 3-4. lattice fit with restarts
+    best = None
+    nit = 0
+    for period, ref in zip(periods, refs):
+        if log_q.size >= 3:
+            lq1, lg = _lattice_from_period(log_q, period, ref, acqs[0].length, bins)
+        else:
+            lq1, lg = _label_q1(ref, period, acqs[0].length), period
+        if not (math.log(1.0 + 1e-3) < lg < math.log(10.0)):
+            continue
+        p, k = _fit_lattice(lq1, lg, acqs, n_nodes, weights, rhs)
+        nit += k
+        # lattice label compatible with n_s = 1 for the coarsest acquisition
+        for shift in (0.0, -1.0, 1.0):
+            cand = np.array([p[0] + shift * p[1], p[1]])
+            lam1 = 2 * math.pi / math.exp(cand[0])
+            if not (acqs[0].length * (1 - 1e-6) <= lam1 < math.exp(cand[1]) * acqs[0].length * (1 + 1e-6)):
+                continue
+            if not (1.0 < math.exp(cand[1]) <= 10.0):
+                continue
+            ranges = _ranges(cand[0], cand[1], acqs, n_nodes)
+            if ranges[0][0] != 1:
+                continue
+            r = _vp_residual(cand, acqs, ranges, weights, rhs, None)
+            n_par = 2 * (max(rr[1] for rr in ranges) - 1 + 1) + 2
+            cost = r.size * math.log(max(float(r @ r) / r.size, 1e-300)) + n_par * math.log(r.size)  # BIC
+            if best is None or cost < best[0]:
+                best = (cost, cand, ranges)
+        if best is not None and best[0] < r.size * math.log(1e-20):
+            break                              # exact fit (WM data): no restart needed
+    if best is None:
+        raise InputError("sequencing found no admissible wavenumber lattice (gamma in (1, 10]) in the PSD "
+                         "peaks; the acquisitions are not WM-like")
+    _, (lq1, lg), ranges = best
+    gamma, lam1 = math.exp(lg), 2 * math.pi / math.exp(lq1)
+    n, mat = _design(lq1, lg, acqs, ranges, weights)
+    coef = _solve_linear(mat, rhs)
+    cvec = coef[0::2] + 1j * coef[1::2]
+    amps, thetas = np.abs(cvec), np.angle(cvec)
+
+    # 5. genes
+    A, H = amplitude_genes(n, amps, gamma, lam1)
+    m_values = tuple(range(2, 21))
+    g1 = Genome(A=A, H=H, gamma=gamma, lambda1=lam1, phases=np.zeros((1, n.size)), n_first=int(n[0]))
+    unit = g1.prefactor * gamma ** ((1.0 - n) * H)       # G(M=1) gamma^((1-n)H)
+    u = amps / unit                                     # = |sum_m e^{i phi}| / sqrt(M)
+    loglik = ridge_likelihood(u, m_values, rng=rng)
+    if M is None:
+        M = m_values[int(np.argmax(loglik))] if np.isfinite(loglik).any() else \
+            max(2, int(math.ceil(float(np.max(u)) ** 2)))
+    M = int(M)
+    if M < 1:
+        raise InputError(f"M must be >= 1, got {M}")
+    target = u * math.sqrt(M) * np.exp(1j * thetas)
+    over = np.abs(target) > M
+    if over.any():
+        messages.append(f"{int(over.sum())} chromosome amplitude(s) exceed what M = {M} ridges can carry "
+                        f"with A = {A:.4g}; they were clipped (the realisation is not exact)")
+        target = np.where(over, target / np.abs(target) * M, target)
+    phases = phases_with_sums(target, M, rng=rng)
+    genome = Genome(A=A, H=H, gamma=gamma, lambda1=lam1, phases=phases, n_first=int(n[0]),
+                    metadata={"generator": "sequence_profiles", "seed": int(seed),
+                              "lengths": [a.length for a in acqs], "n_nodes": n_nodes})
+
+    # quality
+    fitted = [profile_heights(genome, a.x, np.arange(r[0], r[1] + 1)) for a, r in zip(acqs, ranges)]
+    rms = np.array([_rel_rms(a.z, f) for a, f in zip(acqs, fitted)])
+    d = acqs[1].x[1] - acqs[1].x[0]
+    k0 = np.round(acqs[0].x / d)
+    k1 = np.round(acqs[1].x / d)
+    on0 = np.isin(k0, k1) & (np.abs(acqs[0].x / d - k0) < 1e-6)
+    on1 = np.isin(k1, k0[on0])
+    zd_x = acqs[0].x[on0]
+    zd = acqs[0].z[on0] - acqs[1].z[on1]
+    zd_fit = fitted[0][on0] - fitted[1][on1]
+    ok = bool(np.all(rms <= rms_tolerance))
+    if not ok:
+        messages.insert(0, "not WM-like: relative rms error " +
+                        ", ".join(f"{e:.3g}" for e in rms) + f" exceeds {rms_tolerance:g}")
+    message = "; ".join(messages) if messages else \
+        "sequenced: relative rms errors " + ", ".join(f"{e:.2e}" for e in rms)
+    meta_report = {"rms_errors": rms.tolist(), "success": ok}
+    genome = Genome(A=A, H=H, gamma=gamma, lambda1=lam1, phases=phases, n_first=int(n[0]),
+                    metadata={**genome.metadata, "sequencing": meta_report})
+    return SequencingResult(
+        genome=genome, success=ok, message=message, nit=nit, n=n, amplitudes=amps, phases=thetas,
+        ranges=ranges, lengths=np.array([a.length for a in acqs]), rms_errors=rms,
+        x=[a.x for a in acqs], heights=[a.z for a in acqs], fitted=fitted, zd_x=zd_x, zd=zd,
+        zd_fit=zd_fit, spectra=spectra, gamma_psd=gamma_psd, H_psd=_hull_slope_H(spectra),
+        M_loglik=loglik, seed=int(seed), elapsed=time.perf_counter() - t0)
