@@ -80,6 +80,22 @@ def test_wm_psd_peaks_and_amplitude_ratio():
                                rtol=1e-8)
 
 
+def test_wm_psd_peaks_for_non_harmonic_gamma():
+    """gamma = 1.5: the waves fall between Fourier modes; with a Hann window each line
+    is a narrow peak within half a mode spacing of q_k = q0 gamma**k, and the line
+    energies (summed over +-3 modes) fall by gamma**(-2H) from one to the next."""
+    hurst, gamma, n, length = 0.7, 1.5, 2 ** 14, 1e-3
+    p = wm_profile(n, length, hurst, gamma=gamma, amplitude=1e-6, k_range=(8, 20), rng=3)
+    psd = power_spectrum(p, window="hann")
+    dq = 2 * np.pi / length
+    q_k = dq * gamma ** np.arange(8, 21)
+    bands = [np.abs(psd.q - q) <= 3 * dq for q in q_k]
+    peaks = np.array([psd.q[b][np.argmax(psd.C[b])] for b in bands])
+    assert np.all(np.abs(peaks - q_k) <= 0.5 * dq)
+    energy = np.array([np.sum((psd.C * psd.weight)[b]) for b in bands])
+    np.testing.assert_allclose(energy[1:] / energy[:-1], gamma ** (-2 * hurst), rtol=5e-3)
+
+
 def test_mwm_peaks_at_qn_with_eq_317_amplitudes():
     """Ridges along x and y, gamma = 2, lambda = L: the 2D spectrum has lines at
     q_n = (2 pi / lambda) gamma**(n-1) on both axes with |h~|^2 = a_mn**2 / 4 (Eq. 3.17)."""
