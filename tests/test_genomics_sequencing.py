@@ -1,0 +1,92 @@
+"""Sequencing (Sec. 3.3.1): exact recovery of the identifiable genes of the Table 1 genome,
+M-free maximum likelihood of A and H, quality report on non-WM data, clear input errors."""
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.genomics.chromosomes import reduced_chromosome
+from roughfe.genomics.genome import realize, table1_genome
+from roughfe.genomics.sequencing import (amplitude_genes, phases_with_sums, ridge_likelihood,
+                                         sequence_profiles)
+from roughfe.surfaces.surface import Surface
+
+
+@pytest.fixture(scope="module")
+def table1():
+    g = table1_genome(rng=0)
+    acq = [realize(g, scale=s) for s in ("20x", "10x", "100x")]      # any order
+    return g, acq, sequence_profiles(acq, seed=0)
+
+
+def test_lattice_and_chromosomes_are_recovered_exactly(table1):
+    g, acq, res = table1
+    assert res.success, res.message
+    assert abs(res.genome.gamma / 1.5 - 1) < 1e-9                  # goal 1 %: exact lattice
+    assert abs(res.genome.lambda1 / 1e-3 - 1) < 1e-9              # n_s = 1 at 10x
+    assert res.ranges == [(1, 16), (2, 18), (6, 22)]              # Table 1
+    assert np.all(res.rms_errors < 1e-9)                            # goal < 2 % (thesis 3-5 %)
+    k, theta = reduced_chromosome(g, res.n)
+    c_true = k * 1.5 ** ((1 - res.n) * 0.75)
+    np.testing.assert_allclose(res.amplitudes, c_true, rtol=0, atol=1e-9 * c_true.max())
+    # the sequenced genome realises the true profiles at every scale
+    for s in acq:
+        z = realize(res.genome, length=s.metadata["length"]).heights
+        np.testing.assert_allclose(z, s.heights, atol=1e-9 * np.abs(s.heights).max())
+    # Z_d = Z_10x - Z_20x on the 256 shared nodes (exact: Z(0) = 0)
+    assert res.zd.size == 256
+    np.testing.assert_allclose(res.zd_fit, res.zd, atol=1e-9 * np.abs(res.zd).max())
+
+
+def test_A_and_H_are_the_ml_estimate_of_the_true_chromosomes(table1):
+    g, _, res = table1
+    k, _ = reduced_chromosome(g, res.n)
+    a, h = amplitude_genes(res.n, k * 1.5 ** ((1 - res.n) * 0.75), 1.5, 1e-3)
+    assert abs(res.genome.H - h) < 1e-6 and abs(res.genome.A / a - 1) < 1e-5
+    # the statistical spread of one realisation (22 chromosomes): H within 10 %
+    assert abs(res.genome.H / 0.75 - 1) < 0.1
+
+
+def test_amplitude_genes_are_unbiased_for_many_chromosomes():
+    rng = np.random.default_rng(5)
+    A, H, gamma, lam = 2.0, 0.6, 1.1, 1e-3
+    n = np.arange(1, 601)
+    M = 8
+    phi = rng.uniform(0, 2 * np.pi, size=(M, n.size))
+    G = A * np.sqrt(np.log(gamma) / M) * (2 * np.pi / lam) ** -H
+    c = G * gamma ** ((1 - n) * H) * np.abs(np.exp(1j * phi).sum(0))
+    a, h = amplitude_genes(n, c, gamma, lam)
+    assert abs(h / H - 1) < 0.01 and abs(a / A - 1) < 0.08
+
+
+def test_phases_reproduce_the_sums_and_M_likelihood_separates_extremes():
+    rng = np.random.default_rng(1)
+    target = np.array([0.3 + 0.1j, -2.5 + 1j, 7.9 + 0j, 0j])
+    phi = phases_with_sums(target, 8, rng=rng)
+    np.testing.assert_allclose(np.exp(1j * phi).sum(0), target, atol=1e-12)
+    u = np.abs(np.exp(1j * rng.uniform(0, 2 * np.pi, (2000, 2))).sum(1)) / np.sqrt(2)
+    ll = ridge_likelihood(u, (2, 20), rng=0)
+    assert ll[0] > ll[1]
+
+
+def test_white_noise_returns_a_quality_report():
+    rng = np.random.default_rng(1)
+    acq = [Surface(rng.normal(size=128) * 1e-6, 128 * L / 127) for L in (1e-3, 5e-4)]
+    res = sequence_profiles(acq, seed=0)
+    assert not res.success and "not WM-like" in res.message
+    assert np.all(res.rms_errors > 0.3)
+
+
+def test_bad_input_is_reported():
+    g = table1_genome(rng=0)
+    a = realize(g, scale="10x")
+    with pytest.raises(InputError, match="same number of nodes"):
+        sequence_profiles([a, realize(g, scale="20x", n_nodes=256)])
+    with pytest.raises(InputError, match="at least 2"):
+        sequence_profiles([a])
+    with pytest.raises(InputError, match="too few points"):
+        sequence_profiles([realize(g, scale="10x", n_nodes=16), realize(g, scale="20x", n_nodes=16)])
+    with pytest.raises(InputError, match="non-overlapping scales"):
+        sequence_profiles([a, realize(table1_genome(rng=0, n_max=40), length=2e-3 / 511)])
+    shifted = Surface(a.heights, a.size, metadata={**a.metadata, "x0": 0.0})
+    with pytest.raises(InputError, match="not nested"):
+        sequence_profiles([shifted, realize(g, scale="100x")][::-1] + [realize(g, scale="20x")])
