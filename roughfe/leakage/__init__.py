@@ -8,10 +8,11 @@
   one gap field (for example a BEM ``ContactResult``).
 * :mod:`roughfe.leakage.study`: the percolation study of Sec. 2.4.2-2.4.5.
 """
-from .analysis import LeakageResult, analyse_leakage, leakage_of_contact
+from .analysis import (LeakageResult, LeakageSweep, analyse_leakage, leakage_of_contact,
+                       leakage_sweep)
 from .network import DirectionalNetwork, NetworkResult, directional_network, free_volume_network
 from .reynolds import ReynoldsResult, hydraulic_aperture, reynolds_flow
 
 __all__ = ["free_volume_network", "directional_network", "NetworkResult", "DirectionalNetwork",
            "reynolds_flow", "ReynoldsResult", "hydraulic_aperture", "analyse_leakage",
-           "leakage_of_contact", "LeakageResult"]
+           "leakage_of_contact", "LeakageResult", "leakage_sweep", "LeakageSweep"]

@@ -162,3 +162,62 @@ def leakage_of_contact(contact_result, **kwargs) -> LeakageResult:
     kwargs.setdefault("sigma", float(contact_result.rms_height))
     return analyse_leakage(contact_result.gap, contact_result.contact,
                            tuple(contact_result.spacing), **kwargs)
+
+
+@dataclass(frozen=True, eq=False)
+class LeakageSweep:
+    """Contact (BEM) and leakage results over a sequence of loads on one surface.
+
+    Attributes
+    ----------
+    contacts : tuple of roughfe.bem.ContactResult
+    leakages : tuple of LeakageResult
+    """
+
+    contacts: tuple
+    leakages: tuple
+
+    @property
+    def success(self) -> bool:
+        return all(c.success for c in self.contacts) and all(lk.success for lk in self.leakages)
+
+    def records(self) -> list:
+        """One JSON-safe dict per step: contact scalars + :meth:`LeakageResult.record`."""
+        out = []
+        for k, (c, lk) in enumerate(zip(self.contacts, self.leakages)):
+            rec = {"step": k, **c.scalars(),
+                   "separation_star": float(c.mean_plane_separation / c.rms_height),
+                   "contact_success": bool(c.success)}
+            rec.update(lk.record())       # the network's free volume replaces the BEM one
+            out.append(rec)
+        return out
+
+
+def leakage_sweep(surface, material, *, deltas=None, pressures=None, kernel: str = "auto",
+                  **leak_kwargs) -> LeakageSweep:
+    """BEM contact at each approach or mean pressure, then :func:`leakage_of_contact`.
+
+    Parameters
+    ----------
+    surface : roughfe.surfaces.Surface
+        2D surface (heights in m).
+    material : roughfe.bem.Material
+        Elastic body (Pa).
+    deltas, pressures : sequence of float
+        Approaches Delta (m) or mean contact pressures (Pa); exactly one.
+    kernel : str
+        BEM influence operator (:func:`roughfe.bem.solve_contact`).
+    **leak_kwargs
+        Passed to :func:`analyse_leakage` (``direction``, ``mu``, ``pressure_drop``,
+        ``reynolds``, ``sigma``, ...).
+    """
+    from ..bem import contact_sweep
+
+    if surface.ndim != 2:
+        raise InputError(f"leakage needs a 2D surface, got {surface!r}")
+    if (deltas is None) == (pressures is None):
+        raise InputError("give exactly one of deltas (m) or pressures (Pa)")
+    sweep = contact_sweep(surface, material, deltas=deltas, pressures=pressures, kernel=kernel,
+                          compute_stiffness=False)
+    leaks = tuple(leakage_of_contact(c, **leak_kwargs) for c in sweep.results)
+    return LeakageSweep(contacts=tuple(sweep.results), leakages=leaks)

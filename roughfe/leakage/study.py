@@ -18,12 +18,12 @@ from typing import Iterable, Optional
 
 import numpy as np
 
-from ..bem import Material, contact_sweep
+from ..bem import Material
 from ..errors import InputError
 from ..surfaces.rmd import rmd_surface
 from ..surfaces.stats import spectral_moments
 from ..surfaces.surface import Surface
-from .analysis import leakage_of_contact
+from .analysis import leakage_sweep
 
 #: thesis values (Sec. 2.4): fractal dimensions and resolutions
 THESIS_D = (2.1, 2.3, 2.5, 2.7, 2.9)
@@ -85,22 +85,17 @@ def leakage_task(D: float, m: int, seed: int, n_steps: int = 6, L: float = 1.0e-
     h_s = float(np.ptp(surface.heights))
     m0_ref, m2_ref, _ = spectral_moments(surface)
     deltas = h_s * np.arange(1, n_steps + 1) / n_steps
-    sweep = contact_sweep(surface, Material(E, nu), deltas=deltas, kernel=kernel,
-                          compute_stiffness=False)
+    sweep = leakage_sweep(surface, Material(E, nu), deltas=deltas, kernel=kernel,
+                          direction=direction, mu=mu, pressure_drop=pressure_drop,
+                          reynolds=reynolds, sigma=sigma)
     records = []
-    for k, c in enumerate(sweep.results):
-        leak = leakage_of_contact(c, direction=direction, mu=mu, pressure_drop=pressure_drop,
-                                  reynolds=reynolds, sigma=sigma)
+    for rec, c in zip(sweep.records(), sweep.contacts):
         # deformed topography of the elastic rough body seen from the rigid plane: the gap
         m0, m2, _ = spectral_moments(Surface(c.gap, surface.size, surface.periodic))
-        rec = {"D": float(D), "m": int(m), "seed": int(seed), "step": k,
-               "delta": float(c.delta), "delta_star": float(c.delta / h_s),
-               "mean_pressure": float(c.mean_pressure), "area_fraction": float(c.area_fraction),
-               "mean_plane_separation": float(c.mean_plane_separation),
-               "separation_star": float(c.mean_plane_separation / sigma),
-               "m0_star": float(m0 / m0_ref), "m2_star": float(m2 / m2_ref),
-               "contact_success": bool(c.success)}
-        rec.update(leak.record())
+        rec.update({"D": float(D), "m": int(m), "seed": int(seed),
+                    "delta_star": float(c.delta / h_s),
+                    "separation_star": float(c.mean_plane_separation / sigma),
+                    "m0_star": float(m0 / m0_ref), "m2_star": float(m2 / m2_ref)})
         records.append(rec)
     return records
 

@@ -1,0 +1,232 @@
+"""Figures of the leakage analysis (thesis Fig. 14-24): maps and study curves.
+
+Reads arrays and JSON-safe records only; never solves. Maps are pyvista off-screen
+renders seen from above (x to the right, y up, lengths in micrometres); curves are
+matplotlib figures. Every file is written atomically (roughfe.plotting.common).
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
+
+# Load vtk before dolfinx can be loaded: with dolfinx 0.5.2 (Debian) loaded first, vtk
+# 9.7's label formatting (std::regex in vtk::is_printf_format, used by scalar bars and
+# axes) aborts the process with std::bad_alloc; loaded in this order it works.
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+import pyvista  # noqa: E402,F401
+
+UM = 1e6
+
+
+def _image(shape, size):
+    import pyvista as pv
+    nx, ny = shape
+    return pv.ImageData(dimensions=(nx + 1, ny + 1, 1),
+                        spacing=(size[0] / nx * UM, size[1] / ny * UM, 1.0))
+
+
+def _cells(a):
+    """(nx, ny) array -> VTK cell order (x fastest)."""
+    a = np.asarray(a)
+    return a.reshape(a.shape[0] * a.shape[1], *a.shape[2:], order="F") if a.ndim == 2 else \
+        a.transpose(1, 0, *range(2, a.ndim)).reshape(a.shape[0] * a.shape[1], *a.shape[2:])
+
+
+def _finish(plotter, title, path, size):
+    # no cube-axes labels: vtk's label formatting aborts (std::bad_alloc in its regex)
+    # in processes that also loaded dolfinx; the size goes into the caption instead
+    plotter.add_text(f"{title}\nx to the right, y up; {size[0] * UM:.4g} x {size[1] * UM:.4g} um",
+                     font_size=10, position="upper_edge")
+    plotter.view_xy()
+    plotter.camera.zoom(0.9)
+    return save_screenshot(plotter, path)
+
+
+def network_map(gap, percolating, trapped, size, path, *, title="free-volume network"):
+    """Gap map with contact black, percolating cells white to blue (by gap) and trapped
+    cells red, like thesis Fig. 16-17.
+
+    Parameters
+    ----------
+    gap : ndarray, shape (nx, ny)
+        Gap in m.
+    percolating, trapped : ndarray of bool
+        ``U_p`` and ``U_np``; every other cell is drawn as contact.
+    size : (float, float)
+        Physical size in m.
+    path : path-like
+        PNG file.
+    """
+    g = np.asarray(gap, float)
+    rgb = np.zeros(g.shape + (3,))
+    gmax = g[percolating].max() if np.any(percolating) else 1.0
+    t = np.clip(g / gmax, 0.0, 1.0) if gmax > 0 else np.zeros_like(g)
+    blue = np.stack([1.0 - 0.85 * t, 1.0 - 0.6 * t, np.ones_like(t)], axis=-1)
+    rgb[percolating] = blue[percolating]
+    rgb[trapped] = (0.85, 0.1, 0.1)
+    img = _image(g.shape, size)
+    img.cell_data["colour"] = (_cells(rgb) * 255).astype(np.uint8)
+    pl = offscreen_plotter(window_size=(900, 900))
+    pl.add_mesh(img, scalars="colour", rgb=True, show_scalar_bar=False, lighting=False)
+    n_p, n_t, n_c = int(np.sum(percolating)), int(np.sum(trapped)), int(
+        g.size - np.sum(percolating) - np.sum(trapped))
+    return _finish(pl, f"{title}\nblack: contact ({n_c})  white-blue: percolating ({n_p})  "
+                       f"red: trapped ({n_t})", path, size)
+
+
+def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)"):
+    """Q1 nodal pressure (NaN where undetermined: grey)."""
+    p = np.asarray(pressure, float)
+    img = _image((p.shape[0] - 1, p.shape[1] - 1), size)
+    img.point_data["p (Pa)"] = p.ravel(order="F")
+    pl = offscreen_plotter(window_size=(900, 900))
+    pl.add_mesh(img, scalars="p (Pa)", cmap="viridis", nan_color="grey", lighting=False,
+                scalar_bar_args={"vertical": True, "title": "p (Pa)"})
+    return _finish(pl, title, path, size)
+
+
+def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
+    """Cell flux magnitude on a log colour scale (cells without flow: black)."""
+    q = np.asarray(flux_magnitude, float)
+    pos = q[q > 0]
+    floor = pos.max() * 1e-8 if pos.size else 1.0
+    img = _image(q.shape, size)
+    img.cell_data["log10 |q|"] = _cells(np.log10(np.maximum(q, floor)))
+    pl = offscreen_plotter(window_size=(900, 900))
+    pl.add_mesh(img, scalars="log10 |q|", cmap="inferno", lighting=False,
+                scalar_bar_args={"vertical": True, "title": "log10 q"})
+    return _finish(pl, title, path, size)
+
+
+def steps_figure(steps, path):
+    """Leak rate and volumes over the load steps of ``roughfe leak`` (results.json steps)."""
+    a = np.array([s["area_fraction"] for s in steps], float)
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
+    for d, mk in (("x", "o-"), ("y", "s--")):
+        q = [s.get(f"leak_rate_{d}") for s in steps]
+        if any(v is not None for v in q):
+            ax1.semilogy(a, [np.nan if v is None or v <= 0 else v for v in q], mk, label=d)
+    ax1.set_xlabel("A* = A_r / A_n")
+    ax1.set_ylabel("leak rate Q (m$^3$/s)")
+    ax1.legend(title="flow")
+    for key, label in (("free_volume_star", "V*"), ("percolating_volume_star", "V$_p$*"),
+                       ("trapped_volume_star", "$\\bar V_p$*")):
+        vals = [s.get(key) for s in steps]
+        if all(v is not None for v in vals):
+            ax2.plot(a, vals, "o-", label=label)
+    ax2.set_xlabel("A* = A_r / A_n")
+    ax2.set_ylabel("dimensionless volume")
+    ax2.legend()
+    return save_figure(fig, path)
+
+
+def _by(curves, key):
+    out = {}
+    for c in curves:
+        out.setdefault(c[key], []).append(c)
+    return out
+
+
+def _series(rows, x, y):
+    xs = np.array([r[x] if r[x] is not None else np.nan for r in rows], float)
+    ys = np.array([r[y] if r[y] is not None else np.nan for r in rows], float)
+    return xs, ys
+
+
+def study_figures(summary, outdir) -> list:
+    """Figures of the Sec. 2.4 study from :func:`roughfe.leakage.study.summarise`.
+
+    Writes (PNG): ``vp_vs_separation`` (Fig. 14a,b), ``vnp_vs_separation`` (Fig. 15),
+    ``moments`` (Fig. 19), ``vp_vs_moments`` (Fig. 20-21), ``volumes_vs_vstar`` (Fig. 22),
+    ``fits_g_beta`` (Fig. 24), ``leak_rate_vs_area`` (Q vs A*). Curves use the finest
+    resolution m present unless stated. Returns the paths.
+    """
+    outdir = Path(outdir)
+    curves = summary["curves"]
+    m_max = max(c["m"] for c in curves)
+    fine = [c for c in curves if c["m"] == m_max]
+    byD = _by(fine, "D")
+    paths = []
+
+    def per_d(ax, x, y, logy=False, err=None):
+        for D, rows in sorted(byD.items()):
+            xs, ys = _series(rows, x, y)
+            if err:
+                _, es = _series(rows, x, err)
+                ax.errorbar(xs, ys, yerr=es, marker="o", capsize=2, label=f"D={D:g}")
+            else:
+                ax.plot(xs, ys, "o-", label=f"D={D:g}")
+        if logy:
+            ax.set_yscale("log")
+        ax.legend(fontsize=8)
+
+    for name, key, label in (("vp_vs_separation", "percolating_volume_star", "V$_p$*"),
+                             ("vnp_vs_separation", "trapped_volume_star", "$\\bar V_p$*")):
+        fig, (a1, a2) = new_figure(1, 2, figsize=(10, 4))
+        per_d(a1, "separation_star_mean", f"{key}_mean", logy=(key == "trapped_volume_star"))
+        a1.set_xlabel("d/$\\sigma$")
+        a1.set_ylabel(f"{label} (mean, m={m_max})")
+        per_d(a2, "separation_star_mean", f"{key}_std")
+        a2.set_xlabel("d/$\\sigma$")
+        a2.set_ylabel(f"std of {label}")
+        paths.append(save_figure(fig, outdir / f"{name}.png"))
+
+    fig, (a1, a2) = new_figure(1, 2, figsize=(10, 4))
+    per_d(a1, "separation_star_mean", "m0_star_mean")
+    per_d(a2, "separation_star_mean", "m2_star_mean")
+    a1.set_xlabel("d/$\\sigma$"), a1.set_ylabel("m$_0$* = m$_0$/m$_{00}$")
+    a2.set_xlabel("d/$\\sigma$"), a2.set_ylabel("m$_2$* = m$_2$/m$_{20}$")
+    paths.append(save_figure(fig, outdir / "moments.png"))
+
+    fig, axes = new_figure(2, 2, figsize=(10, 8))
+    per_d(axes[0, 0], "m0_star_mean", "percolating_volume_star_mean")
+    per_d(axes[0, 1], "m2_star_mean", "percolating_volume_star_mean")
+    per_d(axes[1, 0], "m0_star_mean", "trapped_volume_star_mean", logy=True)
+    per_d(axes[1, 1], "m2_star_mean", "trapped_volume_star_mean", logy=True)
+    for ax, xl, yl in ((axes[0, 0], "m$_0$*", "V$_p$*"), (axes[0, 1], "m$_2$*", "V$_p$*"),
+                       (axes[1, 0], "m$_0$*", "$\\bar V_p$*"), (axes[1, 1], "m$_2$*", "$\\bar V_p$*")):
+        ax.set_xlabel(xl), ax.set_ylabel(yl)
+    paths.append(save_figure(fig, outdir / "vp_vs_moments.png"))
+
+    ds = sorted({c["D"] for c in curves})
+    fig, axes = new_figure(2, len(ds), figsize=(3.2 * len(ds), 6), squeeze=False)
+    for j, D in enumerate(ds):
+        for m, rows in sorted(_by([c for c in curves if c["D"] == D], "m").items()):
+            xs, ys = _series(rows, "free_volume_star_mean", "percolating_volume_star_mean")
+            axes[0, j].plot(xs, ys, "o-", label=f"m={m}")
+            xs, ys = _series(rows, "free_volume_star_mean", "trapped_volume_star_mean")
+            axes[1, j].plot(xs, np.where(ys > 0, ys, np.nan), "o-", label=f"m={m}")
+        axes[0, j].set_title(f"D={D:g}")
+        axes[1, j].set_yscale("log")
+        axes[1, j].set_xlabel("V*")
+        axes[0, j].legend(fontsize=7)
+    axes[0, 0].set_ylabel("V$_p$*")
+    axes[1, 0].set_ylabel("$\\bar V_p$*")
+    paths.append(save_figure(fig, outdir / "volumes_vs_vstar.png"))
+
+    fig, (a1, a2) = new_figure(1, 2, figsize=(10, 4))
+    for D, rows in sorted(_by(summary["fits"], "D").items()):
+        ms = [r["m"] for r in rows]
+        a1.plot(ms, [np.nan if r["g"] is None else r["g"] for r in rows], "o-", label=f"D={D:g}")
+        a2.plot(ms, [np.nan if r["beta"] is None else r["beta"] for r in rows], "o-",
+                label=f"D={D:g}")
+    a1.set_xlabel("m"), a1.set_ylabel("g = dV$_p$*/dV*  (Eq. 2.17)")
+    a2.set_xlabel("m"), a2.set_ylabel("$\\beta$:  $\\bar V_p$* = (V*)$^\\beta$")
+    a1.legend(fontsize=8), a2.legend(fontsize=8)
+    paths.append(save_figure(fig, outdir / "fits_g_beta.png"))
+
+    fig, ax = new_figure(figsize=(6, 4.5))
+    for D, rows in sorted(byD.items()):
+        xs, ys = _series(rows, "area_fraction_mean", "leak_rate_mean")
+        ax.plot(xs, np.where(ys > 0, ys, np.nan), "o-", label=f"D={D:g}")
+    ax.set_yscale("log")
+    ax.set_xlabel("A* = A$_r$/A$_n$")
+    ax.set_ylabel(f"leak rate Q (m$^3$/s), mean, m={m_max}")
+    ax.legend(fontsize=8)
+    paths.append(save_figure(fig, outdir / "leak_rate_vs_area.png"))
+    return paths
