@@ -19,6 +19,7 @@ _SUBCOMMAND_MODULES = (
     "demo_cmd",       # demo
     "validate_cmd",   # validate
     "study_cmd",      # study run|status|collect
+    "leak_cmd",       # leak, leak-study
 )
 
 
