@@ -164,7 +164,8 @@ def spectrum_peaks(acq: Acquisition, min_bin=4, prominence=2.0) -> SpectrumPeaks
 
     A peak is an upper-hull vertex or a local maximum of ln C with a prominence of at
     least ``prominence`` (natural-log units), at FFT bin >= ``min_bin`` (lower bins are not
-    resolved by the window). Its wavenumber is refined by a parabola through ln C at the
+    resolved by the window) and below 0.8 times the Nyquist wavenumber (aliases of the
+    sub-Nyquist chromosomes of Eq. 3.5 crowd there). Its wavenumber is refined by a parabola through ln C at the
     three bins around it.
     """
     n = acq.z.size
@@ -174,7 +175,8 @@ def spectrum_peaks(acq: Acquisition, min_bin=4, prominence=2.0) -> SpectrumPeaks
     hull = upper_hull(q, C)
     found, _ = find_peaks(logc, prominence=prominence)
     cand = np.union1d(found, hull[(hull > 0) & (hull < q.size - 1)])
-    cand = cand[(cand >= min_bin - 1) & (cand < q.size - 1)]
+    # lower bins are unresolved; lines near Nyquist are often aliases of shorter waves
+    cand = cand[(cand >= min_bin - 1) & (cand < int(0.8 * q.size))]
     cand = cand[(logc[cand] >= logc[cand - 1]) & (logc[cand] >= logc[cand + 1])]
     dq = q[1] - q[0]
     ym, y0, yp = logc[cand - 1], logc[cand], logc[cand + 1]
@@ -279,44 +281,60 @@ def _vp_residual(params, acqs, ranges, weights, rhs, n_cap):
     return rhs - mat @ coef
 
 
-def _first_cap(log_q1, log_gamma, lo, hi, coarse_length, rel_error=1e-3):
-    """Highest chromosome index whose phase error over the coarsest window stays below ~1.5 rad.
-
-    With relative errors ~``rel_error`` per lattice step on the PSD estimates of
-    (ln q1, ln gamma), chromosome n is off by ~(n + 2) rel_error in ln q_n, i.e. a phase
-    error q_n L_1 (n + 2) rel_error over the coarsest window.
-    """
-    cap = lo + 2
-    for n in range(lo + 2, hi + 1):
-        qn = math.exp(log_q1 + (n - 1) * log_gamma)
-        if qn * coarse_length * (n + 2) * rel_error < 1.5:
+def _first_cap(log_q1, log_gamma, lo, hi, coarse_length, cycles=30.0):
+    """First continuation index: the last chromosome with at most ``cycles`` periods in L_1."""
+    cap = lo + 3
+    for n in range(lo + 3, hi + 1):
+        if math.exp(log_q1 + (n - 1) * log_gamma) * coarse_length <= 2 * math.pi * cycles:
             cap = n
     return min(cap, hi)
 
 
-def _fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=400):
+def _scan(p, cap, acqs, ranges, weights, rhs, span=(0.015, 0.03), shape=(31, 13)):
+    """Grid search of (ln gamma, ln q_cap) around ``p`` at continuation index ``cap``.
+
+    Scanning ln q_cap (the wavenumber of the highest fitted chromosome) rather than ln q1
+    decouples the two parameters. The grid is fine enough to land in the basin of the
+    local least-squares fit (phase steps below ~0.5 rad at ``cap`` over L_1).
+    """
+    lq_cap = p[0] + (cap - 1) * p[1]
+    best = (math.inf, p)
+    for lg in p[1] + np.linspace(-span[0], span[0], shape[0]) * p[1] / max(p[1], 1e-12) * 1.0:
+        for lqc in lq_cap + np.linspace(-span[1], span[1], shape[1]):
+            cand = np.array([lqc - (cap - 1) * lg, lg])
+            if cand[1] <= 0:
+                continue
+            r = _vp_residual(cand, acqs, ranges, weights, rhs, cap)
+            c = float(r @ r)
+            if c < best[0]:
+                best = (c, cand)
+    return best[1], shape[0] * shape[1]
+
+
+def _fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600):
     """Variable projection with continuation in the highest chromosome index.
 
-    The continuation starts at the highest chromosome that the PSD estimate already
-    places within ~1.5 rad over the coarsest window (:func:`_first_cap`) -- starting lower
-    lets the unresolved longest waves drag gamma away -- and adds one chromosome per step
+    The continuation starts at the last chromosome with <= 30 periods in the coarsest
+    window (:func:`_first_cap`), where a grid search (:func:`_scan`) absorbs the error
+    of the PSD estimate -- starting lower lets the unresolved longest waves drag gamma
+    away, starting higher leaves the basin -- and then adds one chromosome per step
     (each step shrinks the error enough for the next one).
     """
     ranges = _ranges(log_q1, log_gamma, acqs, n_nodes)
     lo = min(r[0] for r in ranges)
     hi = max(r[1] for r in ranges)
     p = np.array([log_q1, log_gamma])
-    nit = 0
-    caps = list(range(_first_cap(log_q1, log_gamma, lo, hi, acqs[0].length), hi + 1))
-    if len(caps) > 12:                    # many chromosomes (gamma near 1): coarser continuation
-        caps = sorted(set(np.linspace(caps[0], hi, 12).round().astype(int).tolist()))
+    first = _first_cap(log_q1, log_gamma, lo, hi, acqs[0].length)
+    p, nit = _scan(p, first, acqs, ranges, weights, rhs)
+    caps = list(range(first, hi + 1))
+    if len(caps) > 16:                    # many chromosomes (gamma near 1): coarser continuation
+        caps = sorted(set(np.linspace(caps[0], hi, 16).round().astype(int).tolist()))
     for cap in caps:
-        if nit >= budget:
+        if nit >= budget + 403:
             break
         res = least_squares(_vp_residual, p, args=(acqs, ranges, weights, rhs, cap),
                             x_scale=np.array([1e-3, 1e-3]), diff_step=1e-9,
-                            max_nfev=max(5, min(30, budget - nit)),
-                            xtol=1e-15, ftol=1e-15, gtol=1e-15)
+                            max_nfev=30, xtol=1e-15, ftol=1e-15, gtol=1e-15)
         nit += res.nfev + 2 * (res.njev or 0)
         if res.x[1] > 0:
             p = res.x

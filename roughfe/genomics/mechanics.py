@@ -1,0 +1,189 @@
+"""Contact mechanics of chromosomes (thesis Sec. 3.4.1-3.4.2, Fig. 36-39, 44-45).
+
+For one realisation of a genome: the K(p) and A(p) curves (BEM, ``n_steps`` equispaced
+approaches up to each profile's own peak-valley amplitude, E = 210 MPa as the thesis) of
+
+* the complete profile,
+* every chromosome C_n alone (Fig. 36, 44),
+* every top-down partial sum C_{n_s} + ... + C_n and bottom-up partial sum
+  C_{n_f} + ... + C_n (Fig. 37-38),
+
+and the correlation coefficients c_n of each of those curves with the complete one
+(Fig. 39, 45). The curves are :class:`~roughfe.genomics.similarity.ResponseCurve` and
+the BEM call and c_n are :func:`~roughfe.genomics.macro_micro.profile_response` and
+:func:`~roughfe.genomics.macro_micro.correlation` (shared with roughness design): c_n is
+Pearson's coefficient on the complete profile's pressures after the Eq. (4.2) stretch.
+
+Kernels: ``"thesis"`` is Eq. (2.4) (a line of 3D punch patches), ``"strip"`` the
+plane-strain half-plane of a profile; they give different pressures for the same
+profile (see :mod:`roughfe.bem.operators`), so both are offered and labelled.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from ..surfaces.surface import Surface
+from .chromosomes import reconstruction
+from .genome import DEFAULT_NODES, Genome, realize
+from .macro_micro import correlation, profile_response
+from .similarity import ResponseCurve
+
+THESIS_YOUNGS_MODULUS = 210e6     # Pa (Sec. 3.4.1)
+
+
+def response(surface: Surface, *, youngs_modulus=THESIS_YOUNGS_MODULUS, poisson=0.0,
+             kernel="thesis", n_steps=20) -> ResponseCurve:
+    """K(p) (Pa/m) and A(p) (-) of a profile: ``n_steps`` equal approaches up to its peak-valley."""
+    return profile_response(surface, youngs_modulus=youngs_modulus, poisson=poisson,
+                            n_steps=n_steps, kernel=kernel)
+
+
+def curve_difference(reference: ResponseCurve, other: ResponseCurve) -> dict:
+    """Largest relative differences of K and A of ``other`` vs ``reference`` (-).
+
+    ``other`` is interpolated (linearly) at the reference pressures inside its own range;
+    differences are |y_o - y_r| / max|y_r| (A and K normalised by their largest value, so
+    a zero area at first contact does not blow up the ratio).
+    """
+    p = reference.pressure
+    inside = (p >= other.pressure[0]) & (p <= other.pressure[-1])
+    if inside.sum() < 2:
+        raise InputError("the two response curves share fewer than 2 pressures")
+    out = {}
+    for q in ("K", "A"):
+        yr = reference.values(q)[inside]
+        yo = np.interp(p[inside], other.pressure, other.values(q))
+        out[q] = float(np.max(np.abs(yo - yr)) / max(np.max(np.abs(yr)), 1e-300))
+    out["n_points"] = int(inside.sum())
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class ChromosomeMechanics:
+    """Contact curves of a realisation, its chromosomes and TD/BU partial sums.
+
+    Attributes
+    ----------
+    length : float
+        Observation length (m).
+    kernel : str
+    youngs_modulus, poisson : float
+    indices : ndarray of int
+        Chromosomes n_s..n_f of the realisation (Eq. 3.5).
+    complete : ResponseCurve
+    chromosome_curves, td_curves, bu_curves : tuple of ResponseCurve or None
+        Curve of C_n; of the TD sum ending at n; of the BU sum ending at n (same order as
+        ``indices`` for chromosomes and TD; BU in the order n_f, n_f - 1, ...). None where
+        the profile is flat (no contact curve).
+    c_chromosome, c_td, c_bu : dict
+        ``{"K": ndarray, "A": ndarray}`` correlation coefficients c_n (NaN where None).
+    success, message, nit : scipy-like report; nit = number of BEM sweeps.
+    elapsed : float
+        Wall time (s).
+    """
+
+    length: float
+    kernel: str
+    youngs_modulus: float
+    poisson: float
+    indices: np.ndarray
+    complete: ResponseCurve
+    chromosome_curves: tuple
+    td_curves: tuple
+    bu_curves: tuple
+    c_chromosome: dict
+    c_td: dict
+    c_bu: dict
+    success: bool
+    message: str
+    nit: int
+    elapsed: float = 0.0
+    references: tuple = field(default=("thesis Sec. 3.4.1, Fig. 36-39",))
+
+    def to_dict(self) -> dict:
+        """JSON-safe curves and coefficients."""
+        def curves(cs):
+            return [None if c is None else c.to_dict() for c in cs]
+
+        def coeffs(d):
+            return {k: [None if not np.isfinite(v) else float(v) for v in d[k]] for k in d}
+        return {"length": self.length, "kernel": self.kernel, "youngs_modulus": self.youngs_modulus,
+                "poisson": self.poisson, "indices": self.indices.tolist(),
+                "complete": self.complete.to_dict(), "chromosomes": curves(self.chromosome_curves),
+                "td": curves(self.td_curves), "bu": curves(self.bu_curves),
+                "c_chromosome": coeffs(self.c_chromosome), "c_td": coeffs(self.c_td),
+                "c_bu": coeffs(self.c_bu), "success": self.success, "message": self.message,
+                "nit": self.nit, "elapsed_s": self.elapsed}
+
+
+def _curve_or_none(x0, z, length, n_nodes, **kw):
+    if np.ptp(z) <= 1e-12 * max(np.max(np.abs(z)), 1e-300):
+        return None
+    surf = Surface(z, n_nodes * length / (n_nodes - 1), metadata={"x0": float(x0), "length": length})
+    return response(surf, **kw)
+
+
+def _coeffs(complete, curves):
+    out = {}
+    for q in ("K", "A"):
+        out[q] = np.array([np.nan if c is None else correlation(complete, c, q) for c in curves])
+    return out
+
+
+def chromosome_mechanics(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, scale=None,
+                         youngs_modulus=THESIS_YOUNGS_MODULUS, poisson=0.0, kernel="thesis",
+                         n_steps=20, max_chromosomes=None, partial_sums=True) -> ChromosomeMechanics:
+    """A(p), K(p) of a realisation, of each chromosome and of each TD and BU partial sum.
+
+    Parameters
+    ----------
+    genome : Genome
+    length : float, optional
+        Observation length L (m); or ``scale`` ("10x", "20x", "100x").
+    n_nodes : int
+        Nodes N.
+    youngs_modulus, poisson : float
+        Elastic body (Pa, -); the thesis uses E* = 210 MPa.
+    kernel : {"thesis", "strip", ...}
+        BEM influence kernel (:func:`roughfe.bem.solve_contact`).
+    n_steps : int
+        Equal approaches up to each profile's peak-valley amplitude (20 in the thesis).
+    max_chromosomes : int, optional
+        Only the first ``max_chromosomes`` single-chromosome curves (the thesis shows 10).
+    partial_sums : bool
+        Also compute every TD and BU partial sum (2 n_c sweeps).
+    """
+    t0 = time.perf_counter()
+    if (length is None) == (scale is None):
+        raise InputError("give exactly one of length (m) or scale ('10x', '20x', '100x')")
+    if scale is not None:
+        length = genome.length_of(scale)
+    kw = dict(youngs_modulus=youngs_modulus, poisson=poisson, kernel=kernel, n_steps=n_steps)
+    td = reconstruction(genome, length, n_nodes, order="td")
+    x0 = float(td.x[0])
+    complete = _curve_or_none(x0, td.complete, length, n_nodes, **kw)
+    if complete is None:
+        raise InputError("the realisation is flat: no contact curve")
+    nit = 1
+    k = len(td.indices) if max_chromosomes is None else max(1, min(int(max_chromosomes), len(td.indices)))
+    chrom = tuple(_curve_or_none(x0, td.chromosomes[j], length, n_nodes, **kw) for j in range(k))
+    nit += k
+    if partial_sums:
+        bu = reconstruction(genome, length, n_nodes, order="bu")
+        td_c = tuple(_curve_or_none(x0, z, length, n_nodes, **kw) for z in td.partial_sums)
+        bu_c = tuple(_curve_or_none(x0, z, length, n_nodes, **kw) for z in bu.partial_sums)
+        nit += 2 * len(td.indices)
+    else:
+        td_c = bu_c = ()
+    return ChromosomeMechanics(
+        length=float(length), kernel=kernel, youngs_modulus=float(youngs_modulus),
+        poisson=float(poisson), indices=td.indices.copy(), complete=complete,
+        chromosome_curves=chrom, td_curves=td_c, bu_curves=bu_c,
+        c_chromosome=_coeffs(complete, chrom), c_td=_coeffs(complete, td_c),
+        c_bu=_coeffs(complete, bu_c), success=True,
+        message=f"{nit} BEM sweeps ({kernel} kernel, {n_steps} steps each)", nit=nit,
+        elapsed=time.perf_counter() - t0)

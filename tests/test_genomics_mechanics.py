@@ -1,0 +1,41 @@
+"""Mechanics of chromosomes (Sec. 3.4.1): TD/BU sums end at the complete curve (c_n = 1), and the
+sequenced genome has the A(p), K(p) of the true one (goal: within 2 %)."""
+import numpy as np
+import pytest
+
+from roughfe.genomics.genome import realize, table1_genome
+from roughfe.genomics.mechanics import chromosome_mechanics, curve_difference, response
+from roughfe.genomics.sequencing import sequence_profiles
+
+N = 128   # small grids keep the BEM sweeps cheap; the physics checks do not depend on N
+
+
+@pytest.fixture(scope="module")
+def genome():
+    return table1_genome(rng=0)
+
+
+def test_partial_sums_end_at_the_complete_profile(genome):
+    mech = chromosome_mechanics(genome, scale="10x", n_nodes=N, kernel="thesis", n_steps=8,
+                                max_chromosomes=2)
+    assert list(mech.indices) == list(range(1, 13))         # Eq. 3.5 with N = 128
+    for last in (mech.td_curves[-1], mech.bu_curves[-1]):
+        d = curve_difference(mech.complete, last)
+        assert d["K"] < 1e-9 and d["A"] < 1e-12
+    assert mech.c_td["K"][-1] == pytest.approx(1.0, abs=1e-12)
+    assert mech.c_bu["A"][-1] == pytest.approx(1.0, abs=1e-12)
+    # a single chromosome is one cosine: its first contact is one point, area grows smoothly
+    c1 = mech.chromosome_curves[0]
+    assert np.all(np.diff(c1.area_fraction) >= 0) and np.all(np.diff(c1.pressure) > 0)
+    assert mech.nit == 1 + 2 + 2 * 12
+
+
+def test_sequenced_genome_has_the_true_contact_curves(genome):
+    acq = [realize(genome, scale=s, n_nodes=N) for s in ("10x", "20x")]
+    res = sequence_profiles(acq, seed=1)
+    assert res.success, res.message
+    for kernel in ("thesis", "strip"):
+        true = response(acq[0], kernel=kernel, n_steps=10)
+        seq = response(realize(res.genome, scale="10x", n_nodes=N), kernel=kernel, n_steps=10)
+        d = curve_difference(true, seq)
+        assert d["K"] < 1e-6 and d["A"] < 1e-9, (kernel, d)
