@@ -90,3 +90,20 @@ def test_bad_input_is_reported():
     shifted = Surface(a.heights, a.size, metadata={**a.metadata, "x0": 0.0})
     with pytest.raises(InputError, match="not nested"):
         sequence_profiles([shifted, realize(g, scale="100x")][::-1] + [realize(g, scale="20x")])
+
+
+def test_measured_profile_is_sequenced_with_an_honest_report(topographies_dir):
+    from roughfe.genomics.natural import _cell_means, nested_acquisitions, sequence_measured
+    from roughfe.surfaces.io import load_surface
+    # the pixel average of a line is the line at the node (exact)
+    x = np.linspace(-1, 1, 11)
+    assert np.allclose(_cell_means(x, 3 * x + 1, np.array([-0.5, 0.0, 0.3]), 0.1), [-0.5, 1.0, 1.9])
+    surf = load_surface(topographies_dir / "plu-1.plu")
+    acq = nested_acquisitions(surf, n_nodes=128)
+    assert [a.shape[0] for a in acq] == [128] * 3
+    assert all(a.heights[64] == 0.0 for a in acq)                 # Z(0) = 0 at the common centre
+    assert acq[0].metadata["length"] / acq[2].metadata["length"] == pytest.approx(5.0)
+    res = sequence_measured(surf, n_nodes=128, kernels=())
+    assert res.sequencing.rms_errors.shape == (3,)
+    assert np.all(np.isfinite(res.sequencing.rms_errors))
+    assert res.success == bool(np.all(res.sequencing.rms_errors <= 0.05))

@@ -299,7 +299,7 @@ def _scan(p, cap, acqs, ranges, weights, rhs, span=(0.015, 0.03), shape=(31, 13)
     """
     lq_cap = p[0] + (cap - 1) * p[1]
     best = (math.inf, p)
-    for lg in p[1] + np.linspace(-span[0], span[0], shape[0]) * p[1] / max(p[1], 1e-12) * 1.0:
+    for lg in p[1] + np.linspace(-span[0], span[0], shape[0]):
         for lqc in lq_cap + np.linspace(-span[1], span[1], shape[1]):
             cand = np.array([lqc - (cap - 1) * lg, lg])
             if cand[1] <= 0:
