@@ -121,7 +121,6 @@ def _leak_study(args) -> int:
     summary = run_study(spec, executor=args.executor, workers=args.workers,
                         progress=not args.no_progress,
                         log=lambda msg: print(msg, file=sys.stderr))
-    print(summary.describe())
     _, rows, missing = table_rows(out)
     if not rows:
         raise InputError(f"no task of the study in {out} finished; see `roughfe study status {out}`")

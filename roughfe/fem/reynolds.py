@@ -85,7 +85,8 @@ class ReynoldsFESolution:
     residual : ndarray, shape (nx+1, ny+1)
         Nodal flux residual ``K p - b`` in m^3/s (non-zero on inlet/outlet only).
     flow_rate : float
-        Consistent leak rate ``Q`` in m^3/s (positive from inlet to outlet).
+        Consistent leak rate ``Q`` in m^3/s (positive from inlet to outlet); exactly 0
+        when inlet and outlet are not connected and there is no wall velocity.
     inlet_flow, outlet_flow : float
         Flow in through the inlet and out through the outlet (m^3/s).
     percolates : bool
@@ -367,6 +368,10 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         raise NoConvergenceError(f"Reynolds solve: {message}")
     w = 1.0 - coord.ravel() / n_flow     # linear weight, 1 at inlet, 0 at outlet
     q = float(w @ r)
+    if not percolates and not np.any(u != 0.0):
+        # inlet and outlet lie in different components of the open network: no through
+        # flow, exactly (the computed sum is round-off, ~1e-30 m^3/s)
+        q = 0.0
     q_in = float(r[inlet].sum())
     q_out = float(-r[outlet].sum())
     p_out_field = np.where(connected, p, np.nan).reshape(vshape)

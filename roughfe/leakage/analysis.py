@@ -98,8 +98,10 @@ class LeakageResult:
             rec[f"leak_rate_{d}"] = None if flow is None else flow.leak_rate
             rec[f"hydraulic_aperture_{d}"] = None if flow is None else flow.hydraulic_aperture
             rec[f"percolates_q1_{d}"] = None if flow is None else flow.percolates
+            # relative inlet/outlet mismatch; None without through-flow (both ~round-off)
             rec[f"flow_imbalance_{d}"] = (
-                None if flow is None else abs(flow.inlet_flow - flow.outlet_flow)
+                None if flow is None or not flow.percolates
+                else abs(flow.inlet_flow - flow.outlet_flow)
                 / max(abs(flow.inlet_flow), abs(flow.outlet_flow), 1e-300))
             rec[f"reynolds_nit_{d}"] = None if flow is None else flow.nit
         return rec

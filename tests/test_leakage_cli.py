@@ -1,0 +1,62 @@
+"""``roughfe leak`` and ``roughfe leak-study`` end to end on tiny RMD surfaces."""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from roughfe.surfaces.io import save_surface
+from roughfe.surfaces.rmd import rmd_surface
+
+STEP_KEYS = {"delta", "mean_pressure", "area_fraction", "leak_rate", "hydraulic_aperture",
+             "percolates_x", "percolates_y", "free_volume_star", "percolating_volume_star",
+             "trapped_volume_star"}
+
+
+def test_leak_command_writes_results_fields_and_figures(tmp_path):
+    s = rmd_surface(4, 2.3, 1e-4, rng=5)
+    path = save_surface(s, tmp_path / "s.npz")
+    out = tmp_path / "out"
+    deltas = [0.2 * np.ptp(s.heights), 0.6 * np.ptp(s.heights)]
+    # a fresh process: pyvista must be loaded before dolfinx (see roughfe.plotting.leakage)
+    env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": "vtkEGLRenderWindow",
+           "PYVISTA_OFF_SCREEN": "true", "MPLBACKEND": "Agg"}
+    proc = subprocess.run(
+        [sys.executable, "-m", "roughfe.cli", "leak", str(path), "--delta", *map(str, deltas),
+         "--direction", "x", "--mu", "1e-3", "-o", str(out)],
+        capture_output=True, text=True, env=env, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    res = json.loads((out / "results.json").read_text())
+    assert res["inputs"]["delta"] == pytest.approx(deltas)
+    steps = res["steps"]
+    assert len(steps) == 2 and STEP_KEYS <= set(steps[0])
+    assert steps[0]["percolates_y"] is None            # not analysed
+    # more load: more contact, less free volume, smaller leak rate
+    assert steps[1]["area_fraction"] > steps[0]["area_fraction"]
+    assert steps[1]["free_volume_star"] < steps[0]["free_volume_star"]
+    assert steps[1]["leak_rate"] < steps[0]["leak_rate"]
+    with np.load(out / "fields" / "step_000.npz") as f:
+        assert f["gap"].shape == s.shape and f["fluid_pressure_x"].shape == (18, 18)
+        assert f["flux_x"].shape == s.shape + (2,) and "flux_y" not in f
+        assert not (f["percolating"] & f["trapped"]).any()
+    for name in ("step_000_network.png", "step_001_pressure_x.png", "step_000_flux_x.png",
+                 "steps.png"):
+        assert (out / "figures" / name).stat().st_size > 5000
+
+
+def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
+    from roughfe.cli import main
+    out = tmp_path / "study"
+    argv = ["leak-study", "--D", "2.3", "2.7", "--m", "3", "--surfaces", "2",
+            "--workers", "1", "--no-progress", "-o", str(out)]
+    assert main(argv) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["n_records"] == 2 * 2 * 6
+    assert {(f["D"], f["m"]) for f in summary["fits"]} == {(2.3, 3), (2.7, 3)}
+    assert (out / "figures" / "fits_g_beta.png").stat().st_size > 5000
+    # rerun: every task is already done, the summary is the same
+    assert main(argv) == 0
+    assert json.loads((out / "summary.json").read_text()) == summary
+    assert "4 already done" in capsys.readouterr().err
