@@ -384,7 +384,12 @@ class _ContactProblem:
         delta = delta_applied - mean_p * compliance
         disp = -uy - mean_p * compliance
         gap = disp + h.max() - h - delta
-        contact = (gap <= 1e-8 * self.u_ref) if self.options.method == "vi" else gap < 0.0
+        # as in the BEM, a vertex is in contact when it carries a positive pressure; for the
+        # VI that means closed (to round-off) and pushed, for the penalty penetrating
+        if self.options.method == "vi":
+            contact = (gap <= 1e-8 * self.u_ref) & (force > 0.0)
+        else:
+            contact = gap < 0.0
         area = float(w[contact].sum())
         mean_h = float(np.sum(w * h)) / W
         return FemContactResult(
