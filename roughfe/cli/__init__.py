@@ -20,6 +20,7 @@ _SUBCOMMAND_MODULES = (
     "validate_cmd",   # validate
     "study_cmd",      # study run|status|collect
     "leak_cmd",       # leak, leak-study
+    "genome_cmd",     # genome example|realize|sequence|mechanics|natural|validity
 )
 
 
