@@ -253,3 +253,18 @@ def test_unknown_parameter_fails_before_any_task(tmp_path):
     with pytest.raises(InputError, match="does not accept the parameters"):
         run_study(spec, progress=False)
     assert not (tmp_path / "o").exists()
+
+
+def test_worker_crash_charges_only_the_crashing_task(tmp_path):
+    # x = 2.5 kills its worker process; the pool breaks and every task in flight is lost.
+    # Lost tasks are rerun alone, so only the crashing task uses up its attempts.
+    out = tmp_path / "crash"
+    spec = spec_from_mapping({
+        "study": {"analysis": "selftest", "output": str(out), "max_attempts": 2},
+        "grid": {"x": [0.5, 1.5, 2.5, 3.5]}, "fixed": {"crash_x": 2.5, "sleep": 0.1}})
+    summary = run_study(spec, executor="local", workers=2, progress=False)
+    assert (summary.n_done, summary.n_failed) == (3, 1)
+    (failure,) = study_status(out).failures
+    assert failure[1]["x"] == 2.5 and "worker lost" in failure[2]
+    attempts = json.loads(next((out / "failures").glob("*.json")).read_text())["attempts"]
+    assert len(attempts) == 2

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+import os
 import time
 from dataclasses import dataclass
 
@@ -107,7 +108,7 @@ def as_records(value, name: str) -> list[dict]:
                     "a dict, a list of dicts or an object with to_records()")
 
 
-def selftest_task(*, x, seed, y=0.0, n_records=3, sleep=0.0, fail_x=()):
+def selftest_task(*, x, seed, y=0.0, n_records=3, sleep=0.0, fail_x=(), crash_x=()):
     """Cheap deterministic task to test executors, resume and failure handling.
 
     Parameters
@@ -122,6 +123,9 @@ def selftest_task(*, x, seed, y=0.0, n_records=3, sleep=0.0, fail_x=()):
         Seconds to sleep first (to make a study slow enough to interrupt).
     fail_x : float or list of float
         Raise ``ValueError`` when ``x`` equals one of these (a task that always fails).
+    crash_x : float or list of float
+        Kill the worker process (``os._exit(3)``, like a segfault) when ``x`` equals one
+        of these, after ``sleep``.
 
     Returns
     -------
@@ -133,6 +137,8 @@ def selftest_task(*, x, seed, y=0.0, n_records=3, sleep=0.0, fail_x=()):
         raise ValueError(f"selftest asked to fail at x={x!r}")
     if sleep:
         time.sleep(float(sleep))
+    if x in (crash_x if isinstance(crash_x, (list, tuple)) else [crash_x]):
+        os._exit(3)
     rng = np.random.default_rng(seed)
     u = rng.random(int(n_records))
     return [{"step": k, "f": float(x) ** 2 + float(y) * k, "u": float(u[k])}

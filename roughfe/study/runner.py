@@ -165,33 +165,51 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
 
 
 def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached):
-    """Submit ``todo`` through ``ex`` with a bounded window; retry; store results."""
+    """Submit ``todo`` through ``ex`` with a bounded window; retry; store results.
+
+    A task that raises is charged one attempt and requeued until ``max_attempts``.
+    A task whose worker died (segfault, out of memory, killed) cannot be blamed while
+    other tasks shared the pool: it is marked suspect, not charged, and rerun alone
+    (nothing else in flight), so that only the task that kills its worker when alone
+    is charged, and innocent neighbours never exhaust their attempts.
+    """
     outdir = spec.output
     queue = collections.deque(todo)
+    suspects = collections.deque()
     attempts = collections.Counter()
     inflight = {}
     completion = ex.completed()
     window = max(4, 2 * ex.n_workers)
 
+    def submit(task, alone):
+        future = ex.submit(execute_task, spec.analysis, task.kwargs, task.seed)
+        inflight[future] = (task, alone)
+        completion.add(future)
+
     def refill():
+        if suspects:  # run suspects one at a time, with nothing else in flight
+            if not inflight:
+                submit(suspects.popleft(), alone=True)
+            return
         while queue and len(inflight) < window:
-            task = queue.popleft()
-            future = ex.submit(execute_task, spec.analysis, task.kwargs, task.seed)
-            inflight[future] = task
-            completion.add(future)
+            submit(queue.popleft(), alone=False)
 
     bar = _Progress(progress, n_total, n_cached, spec.name)
     last_index = time.monotonic()
     try:
         refill()
         for future in completion:
-            task = inflight.pop(future)
+            task, alone = inflight.pop(future)
             try:
                 out = future.result()
             except Exception as exc:  # the worker died or the executor lost the task
                 out = {"ok": False, "error": f"{type(exc).__name__}: {exc} (worker lost)",
                        "traceback": "".join(traceback.format_exception(exc)),
-                       "elapsed_s": 0.0, "host": "?", "pid": -1}
+                       "elapsed_s": 0.0, "host": "?", "pid": -1, "lost": True}
+                if not alone and attempts[task.key] < spec.max_attempts:
+                    suspects.append(task)
+                    refill()
+                    continue
             attempts[task.key] += 1
             if out["ok"]:
                 write_json(store.result_path(outdir, task.key), {
@@ -212,7 +230,7 @@ def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached):
                     "time": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())})
                 if attempts[task.key] < spec.max_attempts:
                     counts["retries"] += 1
-                    queue.append(task)
+                    (suspects if out.get("lost") else queue).append(task)
                 else:
                     counts["failed"] += 1
                     bar.update(1, counts["done"] + n_cached, counts["failed"])
