@@ -15,6 +15,7 @@ from ..errors import InputError
 # name on the command line -> script in validation/ (explicit, ordered)
 VALIDATIONS = {
     "fem": "bem_vs_fem",
+    "sequencing": "genomics_sequencing",
 }
 
 

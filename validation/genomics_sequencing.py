@@ -1,0 +1,203 @@
+"""Genome sequencing (thesis Sec. 3.3-3.4): Table 1 recovery over seeds, Eq. 3.10, measured roughness.
+
+Run: ``roughfe validate sequencing`` (or ``make validate``); writes
+``<outdir>/genomics_sequencing.md``, ``genomics_sequencing.json`` and the PNGs.
+
+(i)   Table 1 genome (A = 1, H = 0.75, gamma = 1.5, M = 8, lambda1 = 1 mm; the thesis does
+      not publish the phases, so they are drawn from SEEDS), realised at 10x, 20x, 100x
+      with N = 512 and sequenced. A(p), K(p) of the sequenced vs true 10x profile (BEM,
+      20 equal approaches, E = 210 MPa, thesis kernel Eq. 2.4 and plane-strain strip).
+(ii)  Monte Carlo of Eq. 3.10 (Fig. 29).
+(iii) Central rows of plu-1.plu and sur-2.sur as nested acquisitions (full, 1/2, 1/5).
+(iv)  Chromosome mechanics of the seed-0 10x realisation (Fig. 36-39), both kernels.
+
+Targets. Identifiable genes (see roughfe/genomics/sequencing.py): gamma within 1 %,
+relative rms error < 2 % on every acquisition, A(p) and K(p) of sequenced vs true within
+2 %, on every seed. A, H and M of a *profile* are statistical (the heights depend on the
+ridges only through sum_m e^{i phi_mn}); the per-seed errors are reported, and the
+target on H is that its mean over the seeds is within 2 % (no bias). "A within 2 %" and
+"M exact" per seed are not achievable in principle and are reported, not required.
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from roughfe.genomics.chromosomes import reconstruction, validity_monte_carlo
+from roughfe.genomics.genome import realize, table1_genome
+from roughfe.genomics.mechanics import chromosome_mechanics, curve_difference, response
+from roughfe.genomics.natural import sequence_measured
+from roughfe.genomics.sequencing import sequence_profiles
+from roughfe.plotting import genomics as gp
+from roughfe.surfaces.io import load_surface
+from roughfe.writers import write_json, write_text
+
+SEEDS = tuple(range(8))
+KERNELS = ("thesis", "strip")
+TOPOGRAPHIES = Path(__file__).resolve().parents[2] / "shared" / "data" / "topographies"
+TARGETS = {"gamma": 0.01, "rms": 0.02, "curves": 0.02, "H_mean": 0.02}
+
+
+def table1_case(outdir: Path):
+    rows = []
+    for seed in SEEDS:
+        g = table1_genome(rng=seed)
+        acq = [realize(g, scale=s) for s in ("10x", "20x", "100x")]
+        t0 = time.perf_counter()
+        res = sequence_profiles(acq, seed=seed)
+        dt = time.perf_counter() - t0
+        seq10 = realize(res.genome, scale="10x")
+        curves = {}
+        for k in KERNELS:
+            curves[k] = curve_difference(response(acq[0], kernel=k), response(seq10, kernel=k))
+        G = res.genome
+        rows.append({"seed": seed, "gamma": G.gamma, "lambda1": G.lambda1, "H": G.H, "A": G.A,
+                     "M": G.M, "H_psd": res.H_psd, "gamma_psd": res.gamma_psd,
+                     "rms_errors": res.rms_errors.tolist(), "ranges": [list(r) for r in res.ranges],
+                     "curves": curves, "time_s": dt, "success": res.success})
+        if seed == SEEDS[0]:
+            gp.plot_sequenced_profiles(res, outdir / "table1_profiles.png")
+            gp.plot_spectra(res, outdir / "table1_psd.png")
+            for order in ("td", "bu"):
+                gp.plot_reconstruction(reconstruction(G, 1e-3, 512, order), outdir / f"table1_{order}.png")
+    return rows
+
+
+def natural_case(outdir: Path):
+    out = {}
+    for name in ("plu-1.plu", "sur-2.sur"):
+        path = TOPOGRAPHIES / name
+        if not path.is_file():
+            out[name] = {"skipped": f"{path} not found"}
+            continue
+        t0 = time.perf_counter()
+        res = sequence_measured(load_surface(path), seed=0, kernels=KERNELS)
+        stem = path.stem
+        gp.plot_sequenced_profiles(res.sequencing, outdir / f"{stem}_profiles.png")
+        gp.plot_spectra(res.sequencing, outdir / f"{stem}_psd.png")
+        gp.plot_measured_vs_sequenced(res.curves, outdir / f"{stem}_curves.png",
+                                      title=f"{name}: measured vs sequenced (10x-like acquisition)")
+        rep = res.report()
+        rep["time_s"] = time.perf_counter() - t0
+        out[name] = rep
+    return out
+
+
+def mechanics_case(outdir: Path):
+    g = table1_genome(rng=SEEDS[0])
+    out = {}
+    for k in KERNELS:
+        mech = chromosome_mechanics(g, scale="10x", kernel=k, max_chromosomes=10)
+        gp.plot_chromosome_curves(mech, outdir / f"mechanics_chromosomes_{k}.png")
+        gp.plot_td_bu(mech, outdir / f"mechanics_td_bu_A_{k}.png", "A")
+        gp.plot_td_bu(mech, outdir / f"mechanics_td_bu_K_{k}.png", "K")
+        gp.plot_correlations(mech, outdir / f"mechanics_correlations_{k}.png")
+        out[k] = {"c_td": {q: v.tolist() for q, v in mech.c_td.items()},
+                  "c_bu": {q: v.tolist() for q, v in mech.c_bu.items()},
+                  "c_chromosome": {q: v.tolist() for q, v in mech.c_chromosome.items()},
+                  "sweeps": mech.nit, "time_s": mech.elapsed}
+    return out
+
+
+def _fmt(v, f=".3g"):
+    return "n/a" if v is None else format(v, f)
+
+
+def main(outdir: Path) -> bool:
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    rows = table1_case(outdir)
+    val = validity_monte_carlo(range(2, 21), 1000, rng=0)
+    gp.plot_validity(val, outdir / "eq3_10_validity.png")
+    natural = natural_case(outdir)
+    mech = mechanics_case(outdir)
+
+    g_err = max(abs(r["gamma"] / 1.5 - 1) for r in rows)
+    rms = max(max(r["rms_errors"]) for r in rows)
+    curv = max(max(c["K"], c["A"]) for r in rows for c in r["curves"].values())
+    h_vals = np.array([r["H"] for r in rows])
+    a_vals = np.array([r["A"] for r in rows])
+    h_mean_err = abs(h_vals.mean() / 0.75 - 1)
+    checks = {"gamma": g_err <= TARGETS["gamma"], "rms": rms <= TARGETS["rms"],
+              "curves": curv <= TARGETS["curves"], "H_mean": h_mean_err <= TARGETS["H_mean"]}
+    ok = all(checks.values())
+
+    md = ["# Genome sequencing (thesis Sec. 3.3-3.4)", "",
+          "## (i) Table 1 genome, sequenced from 10x/20x/100x (N = 512), per seed of the phases", "",
+          "| seed | gamma | lambda1 (mm) | H | A | M | H (PSD hull, thesis) | rms 10x / 20x / 100x | "
+          "max dA, dK thesis | max dA, dK strip | time (s) |",
+          "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        md.append(f"| {r['seed']} | {r['gamma']:.10g} | {1e3 * r['lambda1']:.10g} | {r['H']:.4f} | "
+                  f"{r['A']:.4f} | {r['M']} | {r['H_psd']:.3f} | "
+                  + " / ".join(f"{e:.1e}" for e in r["rms_errors"]) + " | "
+                  + f"{r['curves']['thesis']['A']:.1e}, {r['curves']['thesis']['K']:.1e} | "
+                  + f"{r['curves']['strip']['A']:.1e}, {r['curves']['strip']['K']:.1e} | "
+                  + f"{r['time_s']:.1f} |")
+    md += ["", f"- gamma: max relative error {g_err:.1e} (target {TARGETS['gamma']}): "
+               f"{'met' if checks['gamma'] else 'MISSED'}",
+           f"- relative rms error: max {rms:.1e} (target {TARGETS['rms']}; thesis 5 % / 3 %): "
+           f"{'met' if checks['rms'] else 'MISSED'}",
+           f"- A(p), K(p) sequenced vs true: max {curv:.1e} (target {TARGETS['curves']}): "
+           f"{'met' if checks['curves'] else 'MISSED'}",
+           f"- H: mean {h_vals.mean():.4f} (error {100 * h_mean_err:.2f} %, target 2 %: "
+           f"{'met' if checks['H_mean'] else 'MISSED'}), std over seeds {h_vals.std(ddof=1):.4f}; "
+           f"per seed within 1 %: {int(np.sum(np.abs(h_vals / 0.75 - 1) <= 0.01))}/{len(rows)}",
+           f"- A: median {np.median(a_vals):.3f}, per seed within 2 %: "
+           f"{int(np.sum(np.abs(a_vals - 1) <= 0.02))}/{len(rows)} (A is extrapolated to n = 1 "
+           "with H, so its spread follows H's)",
+           f"- M: {sum(r['M'] == 8 for r in rows)}/{len(rows)} seeds give M = 8 "
+           "(not identifiable from a profile: the thesis's P_m is flat in M)", "",
+           "Figures: table1_profiles.png (Fig. 33-35), table1_psd.png (Fig. 27/32), "
+           "table1_td.png, table1_bu.png (Fig. 30-31).", "",
+           "## (ii) Eq. 3.10 (Fig. 29)", "",
+           "M: " + " ".join(str(m) for m in val.M), "",
+           "valid (%): " + " ".join(f"{100 * v:.1f}" for v in val.valid_fraction), "",
+           "arccos phase right (%): " + " ".join(f"{100 * v:.1f}" for v in val.arccos_fraction), "",
+           f"Eq. 3.10 is the identity |g1| <= sqrt(g1^2 + g2^2) (max |M + 2 g3 - g1^2 - g2^2| / M = "
+           f"{val.max_identity_error:.1e}); the thesis's 88.5-98 % cannot be reproduced. "
+           "Figure: eq3_10_validity.png.", "",
+           "## (iii) Measured roughness (central rows, nested acquisitions full, 1/2, 1/5, N = 512)", ""]
+    for name, rep in natural.items():
+        if "skipped" in rep:
+            md.append(f"- {name}: skipped ({rep['skipped']})")
+            continue
+        s = rep["sequencing"]
+        gns = s["genes"]
+        md.append(f"- **{name}**: A = {gns['A']:.4g}, H = {gns['H']:.3f}, gamma = {gns['gamma']:.4f}, "
+                  f"lambda1 = {1e3 * gns['lambda1']:.4f} mm, M = {gns['M']}; chromosome ranges "
+                  f"{s['ranges']}; relative rms errors "
+                  + ", ".join(f"{100 * e:.1f} %" for e in s["rms_errors"])
+                  + f"; Z_d rms {_fmt(s['zd_rms'] and 1e6 * s['zd_rms'])} um, its relative fit error "
+                  f"{_fmt(s['zd_rms_error'])}; measured samples per window {rep['measured_points']}; "
+                  "A(p)/K(p) measured vs sequenced: "
+                  + "; ".join(f"{k}: dA {100 * d['A']:.1f} %, dK {100 * d['K']:.1f} %"
+                              for k, d in rep["curve_differences"].items())
+                  + f"; {rep['time_s']:.0f} s. {s['message']}")
+    md += ["", "The WM lattice (one cosine per chromosome, wavenumbers in geometric progression) "
+           "does not describe these measured rows: measured spectra are continuous, so the "
+           "discrete lattice leaves 10-40 % of the rms height unexplained and the sequenced genes "
+           "(H, A) are not physical Hurst/amplitude values. The finest window (1/5 of the row) "
+           "holds only ~110-150 measured samples interpolated onto 512 nodes.", "",
+           "## (iv) Chromosome mechanics, seed-0 10x realisation (Fig. 36-39)", ""]
+    for k, m in mech.items():
+        md.append(f"- {k} kernel ({m['sweeps']} BEM sweeps, {m['time_s']:.0f} s): c_n TD (K) "
+                  + " ".join(f"{v:.3f}" for v in m["c_td"]["K"]) + "; c_n BU (K) "
+                  + " ".join(f"{v:.3f}" for v in m["c_bu"]["K"]))
+    md += ["", "Figures: mechanics_chromosomes_*.png (Fig. 36), mechanics_td_bu_A_*.png (Fig. 37), "
+           "mechanics_td_bu_K_*.png (Fig. 38), mechanics_correlations_*.png (Fig. 39).", "",
+           f"**All targets {'met' if ok else 'NOT met'}.** Timings were measured on a shared, "
+           "heavily loaded 2-core machine."]
+    write_text(outdir / "genomics_sequencing.md", "\n".join(md) + "\n")
+    write_json(outdir / "genomics_sequencing.json",
+               {"table1": rows, "validity": {"M": val.M.tolist(), "valid": val.valid_fraction.tolist(),
+                                             "arccos": val.arccos_fraction.tolist()},
+                "natural": natural, "mechanics": mech, "checks": checks, "targets": TARGETS})
+    return ok
+
+
+if __name__ == "__main__":
+    import sys
+    sys.exit(0 if main(Path(sys.argv[1] if len(sys.argv) > 1 else "validation/output")) else 1)
