@@ -25,15 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-# vtk must be loaded before dolfinx (see roughfe.plotting.fem): import plotting first.
-from roughfe.plotting import fem as fplot  # noqa: E402  (before any dolfinx import)
-from roughfe.bem import Material, contact_sweep  # noqa: E402
-from roughfe.fem import mesh_profile, mirrored_profile  # noqa: E402
-from roughfe.fem.contact import (FemSolverOptions, contact_edge, fem_contact_sweep,  # noqa: E402
-                                 p_wave_modulus)
-from roughfe.reference import westergaard  # noqa: E402
-from roughfe.surfaces import Surface  # noqa: E402
-from roughfe.writers import write_json, write_text  # noqa: E402
+from roughfe.bem import Material, contact_sweep
+from roughfe.fem import mesh_profile, mirrored_profile
+from roughfe.fem.contact import FemSolverOptions, contact_edge, fem_contact_sweep, p_wave_modulus
+from roughfe.plotting import fem as fplot
+from roughfe.reference import westergaard
+from roughfe.surfaces import Surface
+from roughfe.writers import write_json, write_text
 
 MATERIAL = Material(E=210e9, nu=0.3)
 GROWTH = 0.03                 # element-size growth with depth (<= 0.14 % on Westergaard)

@@ -8,22 +8,15 @@
 """
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
-
-def _pyvista():
-    """pyvista, imported off-screen (same environment as plotting.common.offscreen_plotter)."""
-    import os
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
-    import pyvista
-    return pyvista
-
-
-_pyvista()          # vtk before dolfinx, see render_deformed_mesh
 
 _STYLES = ("-", "--", ":", "-.", (0, (5, 1)), (0, (1, 3)))
 
@@ -110,8 +103,8 @@ def plot_westergaard(p_star_ratio, width_errors, x, pressure_pairs, path) -> Pat
     return save_figure(fig, path)
 
 
-def render_deformed_mesh(fields, path, *, magnification=None, title="sigma_yy (MPa)",
-                         top_fraction=0.35, window_size=(1400, 700)) -> Path:
+def render_deformed_mesh(fields, path, *, magnification=None, top_fraction=0.35,
+                         window_size=(1400, 700)) -> Path:
     """pyvista off-screen picture of the deformed FEM mesh coloured by sigma_yy.
 
     Parameters
@@ -128,11 +121,39 @@ def render_deformed_mesh(fields, path, *, magnification=None, title="sigma_yy (M
         Only cells within ``top_fraction * W`` of the top are shown (the stresses of a
         rough contact are confined near the surface).
 
-    Note: with the Debian dolfinx and the vtk wheel in one process, vtk must be imported
-    before dolfinx (the other order aborts in vtk's std::regex); this module therefore
-    imports pyvista at import time: import it before running a FEM solve.
+    Debian's dolfinx and the vtk wheel cannot render in one process once dolfinx is
+    loaded (vtk aborts in its std::regex): when ``dolfinx`` is imported, the picture is
+    rendered by a fresh interpreter from a temporary ``.npz`` of the fields.
     """
-    pv = _pyvista()
+    path = Path(path)
+    arrays = {k: np.asarray(fields[k]) for k in ("points", "cells", "displacement", "stress_yy")}
+    if "dolfinx" not in sys.modules:
+        return _render(arrays, path, magnification, top_fraction, window_size)
+    with tempfile.TemporaryDirectory() as tmp:
+        npz = Path(tmp) / "fields.npz"
+        np.savez(npz, **arrays)
+        code = ("import sys, numpy as np; from roughfe.plotting.fem import _render; "
+                "from pathlib import Path; a = dict(np.load(sys.argv[1])); "
+                "m = None if sys.argv[3] == 'None' else float(sys.argv[3]); "
+                "_render(a, Path(sys.argv[2]), m, float(sys.argv[4]), "
+                "(int(sys.argv[5]), int(sys.argv[6])))")
+        env = dict(os.environ)
+        root = str(Path(__file__).resolve().parents[2])
+        env["PYTHONPATH"] = os.pathsep.join([root, env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+        env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        env.setdefault("PYVISTA_OFF_SCREEN", "true")
+        proc = subprocess.run([sys.executable, "-c", code, str(npz), str(path), str(magnification),
+                               str(top_fraction), *map(str, window_size)],
+                              env=env, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"rendering {path} failed: {proc.stderr[-2000:]}")
+    return path
+
+
+def _render(fields, path, magnification, top_fraction, window_size) -> Path:
+    plotter = offscreen_plotter(window_size=window_size)
+    import pyvista as pv
+
     pts = np.asarray(fields["points"], float)
     disp = np.asarray(fields["displacement"], float)
     cells = np.asarray(fields["cells"], np.int64)
@@ -150,13 +171,11 @@ def render_deformed_mesh(fields, path, *, magnification=None, title="sigma_yy (M
     pts3 = pts3[used]
     conn = np.hstack([np.full((cells.shape[0], 1), 3), cells]).ravel()
     grid = pv.UnstructuredGrid(conn, np.full(cells.shape[0], pv.CellType.TRIANGLE, np.uint8), pts3)
-    grid.cell_data["sigma_yy (MPa)"] = np.asarray(fields["stress_yy"])[keep] / 1e6
-    s = grid.cell_data["sigma_yy (MPa)"]
-    lo = float(np.percentile(s, 1))
-    plotter = offscreen_plotter(window_size=window_size)
-    plotter.add_mesh(grid, scalars="sigma_yy (MPa)", cmap="viridis", clim=(lo, 0.0),
-                     show_edges=True, edge_color="grey", line_width=0.2,
-                     scalar_bar_args={"title": title})
+    name = "sigma_yy (MPa)"
+    grid.cell_data[name] = np.asarray(fields["stress_yy"])[keep] / 1e6
+    lo = float(np.percentile(grid.cell_data[name], 1))
+    plotter.add_mesh(grid, scalars=name, cmap="viridis", clim=(lo, 0.0), show_edges=True,
+                     edge_color="grey", line_width=0.2, scalar_bar_args={"title": name})
     plotter.add_text(f"deformed mesh, displacements x{magnification:.3g}; coordinates / W",
                      font_size=10)
     plotter.view_xy()
