@@ -1,10 +1,10 @@
-"""The registered analyses run through the study runner (tiny sizes; about 5 s)."""
-import json
+"""The registered analyses run through the study runner (tiny sizes; 10-20 s on 2 busy cores)."""
 
 import pytest
 
 from roughfe.errors import InputError
-from roughfe.study import ANALYSES, collect, run_study, spec_from_mapping, study_status
+from roughfe.study import (ANALYSES, collect, run_study, spec_from_mapping, study_status,
+                           table_rows)
 from roughfe.study.analyses import check_parameters, resolve
 
 
@@ -65,3 +65,18 @@ def test_genome_db_parameters_bind():
     check_parameters("genome_db", {"gamma": 1.5, "hurst": 0.7, "n_nodes": 64, "n_steps": 3})
     with pytest.raises(InputError, match="does not accept"):
         check_parameters("genome_db", {"gamma": 1.5})
+
+
+def test_tiny_leakage_study_keeps_the_seed_across_D(tmp_path):
+    pytest.importorskip("roughfe.leakage.study")
+    study = {"study": {"analysis": "leakage", "output": str(tmp_path / "leak"), "seed": 5,
+                       "seed_from": ["replica"]},
+             "grid": {"D": [2.3, 2.7], "replica": [0, 1]},
+             "fixed": {"m": 3, "n_steps": 2, "reynolds": False}}
+    summary = run_study(spec_from_mapping(study), workers=2, progress=False)
+    assert summary.complete, study_status(tmp_path / "leak").describe()
+    _, rows, missing = table_rows(tmp_path / "leak")
+    assert missing == 0 and len(rows) == 4 * 2
+    seeds = {(r["D"], r["replica"]): r["seed"] for r in rows}
+    assert seeds[(2.3, 0)] == seeds[(2.7, 0)] != seeds[(2.3, 1)]
+    assert all("free_volume_star" in r and "D_result" not in r for r in rows)

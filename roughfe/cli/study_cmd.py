@@ -63,7 +63,8 @@ def register(sub):
                    help="local: process pool on this machine (default); dask: dask.distributed "
                         "(LocalCluster, or --scheduler); mpi: mpi4py.futures under mpirun")
     r.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                   help="address of a running dask scheduler, e.g. tcp://head:8786 (dask only)")
+                   help="a running dask scheduler: address (tcp://head:8786) or scheduler "
+                        "file (*.json, from `dask scheduler --scheduler-file`); dask only")
     r.add_argument("--workers", type=int, default=None, metavar="N",
                    help="worker processes for local and a dask LocalCluster (default: cores)")
     r.add_argument("-o", "--output", default=None, metavar="OUTDIR",

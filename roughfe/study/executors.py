@@ -8,9 +8,10 @@ No engine is home-made:
 ``local``
     :class:`concurrent.futures.ProcessPoolExecutor` sized to the cores available.
 ``dask``
-    ``distributed.Client`` to a running scheduler (``scheduler="tcp://host:8786"``, e.g.
-    started by dask-jobqueue on SLURM) or to a ``LocalCluster`` of ``workers`` processes
-    (one thread each, no dashboard) when no address is given.
+    ``distributed.Client`` to a running scheduler (``scheduler="tcp://host:8786"``, or a
+    scheduler file ``scheduler="sched.json"``, e.g. started by dask-jobqueue or
+    ``dask scheduler --scheduler-file`` on SLURM) or to a ``LocalCluster`` of ``workers``
+    processes (one thread each, no dashboard) when no scheduler is given.
 ``mpi``
     :class:`mpi4py.futures.MPIPoolExecutor`, run under
     ``mpirun -n K python -m mpi4py.futures $(which roughfe) study run ... --executor mpi``
@@ -147,8 +148,10 @@ class DaskExecutor(_Base):
         workers = _check_workers(workers)
         self._cluster = None
         if scheduler:
+            where = ({"scheduler_file": str(scheduler)} if str(scheduler).endswith(".json")
+                     else {"address": scheduler})
             try:
-                self._client = distributed.Client(scheduler, timeout="30s")
+                self._client = distributed.Client(**where, timeout="30s")
             except (OSError, TimeoutError) as exc:
                 raise InputError(f"cannot reach the dask scheduler at {scheduler!r}: {exc}") from None
             self.n_workers = max(1, len(self._client.scheduler_info()["workers"]))
