@@ -80,6 +80,8 @@ class DatabaseSettings:
         c_n above which a chromosome is macro-scale (Alg. 2); thesis 0.95.
     kernel : str
         BEM influence kernel passed to :func:`roughfe.bem.contact_sweep`.
+    stiffness : {"fd", "exact"}
+        How K(p) is taken from the sweep (see :func:`roughfe.genomics.macro_micro.profile_response`).
     """
 
     length: float = 849.42e-6
@@ -89,6 +91,7 @@ class DatabaseSettings:
     n_steps: int = 20
     threshold: float = 0.95
     kernel: str = "auto"
+    stiffness: str = "fd"
 
     def __post_init__(self):
         for name in ("length", "youngs_modulus"):
@@ -99,6 +102,8 @@ class DatabaseSettings:
             raise InputError(f"n_nodes must be >= 16, got {self.n_nodes!r}")
         if int(self.n_steps) < 3:
             raise InputError(f"n_steps must be >= 3, got {self.n_steps!r}")
+        if self.stiffness not in ("fd", "exact"):
+            raise InputError(f"stiffness must be 'fd' or 'exact', got {self.stiffness!r}")
         if not (0.0 < self.threshold < 1.0):
             raise InputError(f"threshold must lie in (0, 1), got {self.threshold!r}")
         object.__setattr__(self, "n_nodes", int(self.n_nodes))
@@ -205,7 +210,7 @@ class DatabaseEntry:
 def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=1.0,
                       lambda1=None, length=849.42e-6, n_nodes=512, youngs_modulus=1.0e6,
                       poisson=0.0, n_steps=20, threshold=0.95, kernel="auto",
-                      genome_json=None) -> dict:
+                      stiffness="fd", genome_json=None) -> dict:
     """Realise one genome, run Alg. 2 on it and return its database record (JSON-safe).
 
     Parameters
@@ -219,7 +224,7 @@ def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=
         Unique name of the genome in the database.
     amplitude, lambda1 : float
         Genes A (-) and lambda (m); ``lambda1=None`` means lambda = L (thesis).
-    length, n_nodes, youngs_modulus, poisson, n_steps, threshold, kernel
+    length, n_nodes, youngs_modulus, poisson, n_steps, threshold, kernel, stiffness
         :class:`DatabaseSettings` fields (keywords so a study runner can pass them).
     genome_json : dict, optional
         A complete Genome JSON (e.g. a sequenced genome for ``db extend``); then
@@ -234,7 +239,7 @@ def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=
     from .macro_micro import macro_micro
     from .genome import Genome
     settings = DatabaseSettings(length, n_nodes, youngs_modulus, poisson, n_steps, threshold,
-                                kernel)
+                                kernel, stiffness)
     if genome_json is not None:
         genome = Genome.from_dict(genome_json)
     else:

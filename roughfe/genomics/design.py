@@ -238,6 +238,17 @@ class Objective:
     def __call__(self, curve: ResponseCurve) -> float:
         return float(np.prod(self.scores(curve)))
 
+    def residuals(self, curve: ResponseCurve) -> np.ndarray:
+        """Relative errors (y_t - y_i)/y_t at every target point in ``p_range`` (all
+        targets stacked); ``s = 1 - max |r|`` for one target (Eq. 4.1)."""
+        c = curve.to_target_range(self.p_max)
+        out = []
+        for t in self.targets:
+            sel = (t.pressure >= self.p_range[0]) & (t.pressure <= self.p_range[1])
+            yi = np.interp(t.pressure[sel], c.pressure, c.values(t.quantity))
+            out.append((t.values[sel] - yi) / t.values[sel])
+        return np.concatenate(out)
+
 
 class Evaluator:
     """Counts and runs the BEM response of designs (``Surface -> ResponseCurve``)."""
@@ -246,7 +257,7 @@ class Evaluator:
         self.settings = settings
         self.response = response or (lambda s: profile_response(
             s, youngs_modulus=settings.youngs_modulus, poisson=settings.poisson,
-            n_steps=settings.n_steps, kernel=settings.kernel))
+            n_steps=settings.n_steps, kernel=settings.kernel, stiffness=settings.stiffness))
         self.n_sweeps = 0
 
     def __call__(self, design: Design) -> ResponseCurve:
@@ -351,6 +362,85 @@ def gcmma_maximize(fun: Callable[[np.ndarray], float], x0, lower, upper, *, n_it
                        f"(start {s0:.6f})")
 
 
+def gcmma_minimax(residuals: Callable[[np.ndarray], np.ndarray], score: Callable, x0, lower,
+                  upper, *, n_it: int = 5, eps: float = 0.02, max_inner: int = 5
+                  ) -> GcmmaResult:
+    """Minimise ``max_j |r_j(x)|`` in a box with GCMMA in Svanberg's min-max form.
+
+    The infinity norm of Eq. (4.1) is not differentiable; Svanberg (2002, Sec. 6) writes
+    ``min max_j f_j`` as ``min z  s.t.  f_j(x) - z <= 0`` (``f0 = 0``, ``a0 = a_j = 1``,
+    large ``c_j``), here with ``f_j = +-r_j``. Every residual gets its own
+    forward-difference derivative from the same ``n + 1`` BEM sweeps that the gradient
+    of ``s^2`` costs. ``score(r) -> s`` reports the score of a residual vector.
+    """
+    from mmapy import asymp, concheck, gcmmasub, raaupdate
+    x0 = np.asarray(x0, float)
+    lo, hi = np.asarray(lower, float), np.asarray(upper, float)
+    width = hi - lo
+    if np.any(width <= 0):
+        raise InputError("GCMMA bounds need upper > lower for every variable")
+    n = x0.size
+    nfev = [0]
+
+    def r_of(u):
+        nfev[0] += 1
+        return np.asarray(residuals(lo + u.ravel() * width), float)
+
+    def cons(r):
+        return np.concatenate([r, -r]).reshape(-1, 1)
+
+    def jac(u, r):
+        J = np.empty((r.size, n))
+        for j in range(n):
+            up = u.copy()
+            step = eps if up[j, 0] + eps <= 1.0 else -eps
+            up[j, 0] += step
+            J[:, j] = (r_of(up) - r) / step
+        return np.vstack([J, -J])
+
+    u = ((x0 - lo) / width).reshape(n, 1)
+    r = r_of(u)
+    m = 2 * r.size
+    s0 = float(score(r))
+    best_u, best_s, history = u.copy(), s0, [s0]
+    xmin, xmax = np.zeros((n, 1)), np.ones((n, 1))
+    low, upp = xmin.copy(), xmax.copy()
+    xold1, xold2 = u.copy(), u.copy()
+    a0, a, c, d = 1.0, np.ones((m, 1)), 1000.0 * np.ones((m, 1)), np.zeros((m, 1))
+    raa0, raa, raa0eps, raaeps, epsimin = 0.01, 0.01 * np.ones((m, 1)), 1e-6, 1e-6 * np.ones((m, 1)), 1e-7
+    f0val, df0dx = np.zeros((1, 1)), np.zeros((n, 1))
+    fval, dfdx = cons(r), jac(u, r)
+    it = 0
+    for it in range(1, int(n_it) + 1):
+        low, upp, raa0, raa = asymp(it, n, u, xold1, xold2, xmin, xmax, low, upp, raa0, raa,
+                                    raa0eps, raaeps, df0dx, dfdx)
+        xmma, *_, f0app, fapp = gcmmasub(m, n, it, epsimin, u, xmin, xmax, low, upp, raa0, raa,
+                                         f0val, df0dx, fval, dfdx, a0, a, c, d)
+        r_new = r_of(xmma)
+        fnew = cons(r_new)
+        conserv = concheck(m, epsimin, f0app, np.zeros((1, 1)), fapp, fnew)
+        inner = 0
+        while conserv == 0 and inner < max_inner:
+            inner += 1
+            raa0, raa = raaupdate(xmma, u, xmin, xmax, low, upp, np.zeros((1, 1)), fnew, f0app,
+                                  fapp, raa0, raa, raa0eps, raaeps, epsimin)
+            xmma, *_, f0app, fapp = gcmmasub(m, n, it, epsimin, u, xmin, xmax, low, upp, raa0,
+                                             raa, f0val, df0dx, fval, dfdx, a0, a, c, d)
+            r_new = r_of(xmma)
+            fnew = cons(r_new)
+            conserv = concheck(m, epsimin, f0app, np.zeros((1, 1)), fapp, fnew)
+        xold2, xold1, u, r = xold1, u, np.clip(xmma, 0.0, 1.0), r_new
+        s = float(score(r))
+        history.append(s)
+        if s > best_s:
+            best_u, best_s = u.copy(), s
+        if it < n_it:
+            fval, dfdx = cons(r), jac(u, r)
+    return GcmmaResult(lo + best_u.ravel() * width, best_s, x0, s0, tuple(history), it,
+                       nfev[0], True, f"GCMMA min-max: {it} outer iterations, best s = "
+                       f"{best_s:.6f} (start {s0:.6f})")
+
+
 def phase_bounds(phi0, fraction: float = 0.1, bound: str = "start"):
     """Box for the phases: +-fraction*|phi0| ("start", thesis) or +-fraction*2 pi ("period").
 
@@ -383,6 +473,7 @@ class GcmmaOptions:
     bound: str = "start"
     eps: float = 0.02
     n_micro: int = 6
+    formulation: str = "minimax"
 
 
 def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evaluator, n_it: int,
@@ -393,8 +484,19 @@ def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evalua
         return design, float(s), None
     phi0 = design.phase_values(keys)
     lo, hi = phase_bounds(phi0, options.fraction, options.bound)
-    res = gcmma_maximize(lambda x: objective(evaluate(design.with_phases(keys, x))), phi0, lo,
-                         hi, n_it=n_it, eps=options.eps, f0=f0)
+    if options.formulation == "minimax":
+        def score(r):
+            k = [int(np.sum((t.pressure >= objective.p_range[0]) & (t.pressure <= objective.p_range[1])))
+                 for t in objective.targets]
+            parts = np.split(np.abs(r), np.cumsum(k)[:-1])
+            return float(np.prod([1.0 - p.max() for p in parts]))
+        res = gcmma_minimax(lambda x: objective.residuals(evaluate(design.with_phases(keys, x))),
+                            score, phi0, lo, hi, n_it=n_it, eps=options.eps)
+    elif options.formulation == "thesis":
+        res = gcmma_maximize(lambda x: objective(evaluate(design.with_phases(keys, x))), phi0,
+                             lo, hi, n_it=n_it, eps=options.eps, f0=f0)
+    else:
+        raise InputError(f"formulation must be 'minimax' or 'thesis', got {options.formulation!r}")
     return design.with_phases(keys, res.x), float(res.fun), res
 
 
@@ -697,7 +799,8 @@ def thesis_targets(settings: DatabaseSettings, response=None, *, pbar2_fraction=
 
     The thesis gives p in its own units and no p_max^t; reading p_max^t ~ 1.6e-4 off
     Figs. 57-59, ``pbar2_fraction = 0.53/1.6`` places pbar = 0.53e-4 at the same fraction
-    of p_max^t. The plateau of y_t2 is y_t1 at pbar. Returns ``(t1, t2, t3, curve)``.
+    of p_max^t. y_t2 starts at y_t1's first value (K at first contact is finite), rises
+    linearly to y_t1's value at pbar and stays there. Returns ``(t1, t2, t3, curve)``.
     """
 
     evaluate = Evaluator(settings, response)
@@ -711,5 +814,6 @@ def thesis_targets(settings: DatabaseSettings, response=None, *, pbar2_fraction=
     pbar = pbar2_fraction * curve.p_max
     plateau = float(np.interp(pbar, curve.pressure, curve.stiffness))
     from .similarity import linear_then_flat_target as ltf
-    t2 = ltf(curve.p_max, pbar, plateau, n_points=settings.n_steps, name="y_t2")
+    t2 = ltf(curve.p_max, pbar, plateau, n_points=settings.n_steps, name="y_t2",
+             start=float(curve.stiffness[0]))
     return t1, t2, t3, curve

@@ -275,7 +275,7 @@ def split_ranges(target: Target, pbar: float):
 
 
 def linear_then_flat_target(p_max: float, pbar: float, plateau: float, n_points: int = 20,
-                            quantity: Quantity = "K", name: str = "y_t2") -> Target:
+                            quantity: Quantity = "K", name: str = "y_t2", start=None) -> Target:
     """Target y_t2 of thesis Sec. 4.3.2: y grows linearly with p up to ``pbar``, then is flat.
 
     Parameters
@@ -289,6 +289,12 @@ def linear_then_flat_target(p_max: float, pbar: float, plateau: float, n_points:
     n_points : int
         Number of equally spaced pressures ``p_j = j p_max / n_points``, j = 1..n_points
         (the n_t loading steps of the thesis).
+    start : float, optional
+        Value at the first pressure p_1. Default: the line through the origin,
+        ``y = plateau p / pbar``. A line through the origin asks for K -> 0 at p -> 0,
+        which no rough profile has (K jumps to a finite value at first contact); Eq.
+        (4.1) then scores every profile below 0 at p_1. The thesis' y_t2 (Fig. 57) is
+        "linear" without saying where it starts.
     """
     if not (0 < pbar < p_max and np.isfinite(p_max)):
         raise InputError(f"need 0 < pbar < p_max, got pbar={pbar!r}, p_max={p_max!r}")
@@ -297,9 +303,16 @@ def linear_then_flat_target(p_max: float, pbar: float, plateau: float, n_points:
     if int(n_points) < 2:
         raise InputError(f"n_points must be >= 2, got {n_points!r}")
     p = p_max * np.arange(1, int(n_points) + 1) / int(n_points)
-    y = plateau * np.minimum(p / pbar, 1.0)
+    if start is None:
+        y = plateau * np.minimum(p / pbar, 1.0)
+    else:
+        if not (np.isfinite(start) and start > 0) or pbar <= p[0]:
+            raise InputError(f"start must be finite and > 0 and pbar > p_1, got start={start!r}, "
+                             f"pbar={pbar!r}, p_1={p[0]!r}")
+        y = np.where(p < pbar, start + (plateau - start) * (p - p[0]) / (pbar - p[0]), plateau)
     return Target(p, y, quantity, name, {"kind": "linear_then_flat", "pbar": float(pbar),
-                                         "plateau": float(plateau), "p_max": float(p_max)})
+                                         "plateau": float(plateau), "p_max": float(p_max),
+                                         "start": None if start is None else float(start)})
 
 
 def read_target_csv(path, quantity: Quantity = "K", name=None) -> Target:
