@@ -9,6 +9,15 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
 
+# Load order matters: with Debian's dolfinx and the vtk wheel in one process, vtk must be
+# loaded first, otherwise the first off-screen render aborts (measured: import dolfinx, then
+# render a pyvista scene with a scalar bar -> SIGABRT). Test modules import dolfinx at
+# collection, so vtk is loaded here, before any of them.
+try:
+    import pyvista  # noqa: F401,E402
+except ImportError:  # pragma: no cover - pyvista is a core dependency
+    pass
+
 REPO = Path(__file__).resolve().parents[1]
 TOPOGRAPHIES = REPO.parent / "shared" / "data" / "topographies"
 

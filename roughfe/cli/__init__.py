@@ -38,7 +38,21 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _load_vtk_before_dolfinx():
+    """Load vtk before any subcommand can load dolfinx.
+
+    With Debian's dolfinx 0.5.2 and the vtk wheel in one process, vtk must be loaded
+    first: the other order aborts (SIGABRT) at the first off-screen render. Commands
+    that solve with dolfinx and then draw with pyvista (validate fem, leak) need this.
+    """
+    try:
+        import pyvista  # noqa: F401
+    except ImportError:  # pragma: no cover - pyvista is a core dependency
+        pass
+
+
 def main(argv=None) -> int:
+    _load_vtk_before_dolfinx()
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
