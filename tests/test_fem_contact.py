@@ -157,3 +157,24 @@ def test_mirrored_profile_and_bad_input():
         FemSolverOptions(method="lagrange")
     with pytest.raises(InputError, match="nu < 0.5"):
         fem_solve_contact(mesh_profile(s), Material(E=1e9, nu=0.5), 1e-7)
+
+
+def test_mesh_files_for_inspection(tmp_path):
+    """.msh keeps gmsh's physical groups; the XDMF holds the same triangles in metres."""
+    meshio = pytest.importorskip("meshio")
+    surf = random_profile(33, seed=3)
+    pm = mesh_profile(surf, depth=1e-3, growth=0.2, write_to=tmp_path, name="r33")
+    m = meshio.read(pm.files["xdmf"])
+    tri = m.cells_dict["triangle"]
+    assert tri.shape[0] == pm.n_cells
+    used = m.points[np.unique(tri)]
+    assert used[:, 0].min() == pytest.approx(0.0, abs=1e-15)
+    assert used[:, 0].max() == pytest.approx(pm.width, rel=1e-12)
+    assert used[:, 1].min() == pytest.approx(-1e-3, rel=1e-12)
+    msh = meshio.read(pm.files["msh"])
+    assert set(msh.field_data) >= {"top", "bottom", "left", "right", "body"}
+    # element size grows with depth: the bottom triangles are much larger than the top ones
+    area = 0.5 * np.abs(np.cross(m.points[tri[:, 1], :2] - m.points[tri[:, 0], :2],
+                                 m.points[tri[:, 2], :2] - m.points[tri[:, 0], :2]))
+    yc = m.points[tri, 1].mean(axis=1)
+    assert area[yc < -0.8e-3].mean() > 20 * area[yc > -0.05e-3].mean()
