@@ -31,6 +31,7 @@ import numpy as np
 from ..errors import InputError, check_finite_positive
 from ..surfaces import Surface
 from ..writers import atomic_path
+from .petsc_tools import ensure_jit_cache
 
 FACET_TAGS = {"top": 1, "bottom": 2, "left": 3, "right": 4}
 DOMAIN_TAG = 1
@@ -120,6 +121,7 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
     comm : MPI communicator, optional
         Default ``MPI.COMM_WORLD``; gmsh runs on rank 0 and dolfinx distributes the mesh.
     """
+    ensure_jit_cache()
     import gmsh
     from dolfinx.io import gmshio
     from mpi4py import MPI

@@ -1,4 +1,4 @@
-"""PETSc helpers shared by every dolfinx solver of roughfe.fem (contact, Reynolds).
+"""PETSc/dolfinx helpers shared by every dolfinx solver of roughfe.fem (contact, Reynolds).
 
 Solver options are plain data (dicts) applied under a unique options prefix, so two
 solvers in one process never see each other's options (STYLE.md habit 8), and every
@@ -8,6 +8,10 @@ solve ends with a check of the converged reason that raises
 from __future__ import annotations
 
 import itertools
+import os
+import sys
+import tempfile
+from pathlib import Path
 from typing import Mapping
 
 from ..errors import NoConvergenceError
@@ -16,6 +20,24 @@ _COUNTER = itertools.count()
 
 #: Direct solve with MUMPS (superlu_dist crashed inside the SNES VI with PETSc error 98).
 LU_MUMPS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+
+
+def ensure_jit_cache() -> None:
+    """Point ``XDG_CACHE_HOME`` to a temporary folder if the default cache is not writable.
+
+    dolfinx compiles forms into ``$XDG_CACHE_HOME/fenics`` (default ``~/.cache``) and reads
+    the location when it is first imported, so call this before importing dolfinx.
+    Nothing is changed when the cache is writable or dolfinx is already loaded.
+    """
+    if "dolfinx" in sys.modules:
+        return
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    try:
+        base.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=base):
+            pass
+    except OSError:
+        os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="roughfe-jit-cache-")
 
 
 def unique_prefix(name: str) -> str:
