@@ -21,6 +21,8 @@ _SUBCOMMAND_MODULES = (
     "study_cmd",      # study run|status|collect
     "leak_cmd",       # leak, leak-study
     "genome_cmd",     # genome example|realize|sequence|mechanics|natural|validity
+    "db_cmd",         # db build|extend|list|map
+    "design_cmd",     # design, design-targets
 )
 
 

@@ -157,6 +157,17 @@ class Design:
                           for p in self.parts]}
         return Surface(h, surfs[0].size, periodic=False, metadata=meta)
 
+    def spectrum_lines(self) -> list:
+        """Discrete spectrum ``(q_n (rad/m), a_n (m))`` of every chromosome of every part:
+        a_n = scale * weight * G gamma^((1-n)H) * sqrt(M) (the rms-equivalent amplitude of
+        the M ridges' waves)."""
+        out = []
+        for p in self.parts:
+            for n in p.chromosomes:
+                a = self.scale * p.weight * float(p.genome.wave_amplitude(n)) * math.sqrt(p.genome.M)
+                out.append((float(p.genome.wavenumber(n)), a))
+        return sorted(out)
+
     def as_genome(self) -> Optional[Genome]:
         """The single genome equal to this design when it has one part, else None."""
         if len(self.parts) != 1:
@@ -817,3 +828,60 @@ def thesis_targets(settings: DatabaseSettings, response=None, *, pbar2_fraction=
     t2 = ltf(curve.p_max, pbar, plateau, n_points=settings.n_steps, name="y_t2",
              start=float(curve.stiffness[0]))
     return t1, t2, t3, curve
+
+
+# ---------------------------------------------------------------------------------------
+# result files
+# ---------------------------------------------------------------------------------------
+def result_to_dict(result: DesignResult, settings: DatabaseSettings) -> dict:
+    """JSON-safe report of a design run: candidates, scores per stage, targets, settings."""
+    return {
+        "format": "roughfe-design-result", "version": 1, "method": result.method,
+        "message": result.message, "success": result.success, "nit_bem_sweeps": result.nit,
+        "elapsed_s": result.elapsed, "pbar": result.pbar, "n_cross": result.n_cross,
+        "n_cross_above_0.95": result.n_cross_above,
+        "selection_passed": result.selection_passed,
+        "targets": [t.to_dict() for t in result.objective.targets],
+        "settings": settings.to_dict(), "database_scores": result.database_scores,
+        "candidates": [{"origin": c.origin, "stages": list(c.stages), "scores": list(c.scores),
+                        "score": float(np.prod(c.scores)), "macro": [list(m) for m in c.macro],
+                        "micro": [list(m) for m in c.micro], "curve": c.curve.to_dict(),
+                        "design": c.design.to_dict()} for c in result.candidates],
+        "references": list(result.references)}
+
+
+def write_design_result(result: DesignResult, settings: DatabaseSettings, outdir) -> dict:
+    """Write the best design and the report to ``outdir`` (atomically).
+
+    Files: ``result.json`` (:func:`result_to_dict`), ``design.json`` (the best design,
+    reloadable with :meth:`Design.from_dict`), ``genome.json`` (the roughfe-genome when
+    the design is one genome, else the design JSON again), ``profile.npz`` (native
+    surface file of the designed profile), ``curves.csv`` (p, targets, K, A) and
+    ``stages.csv`` (similarity per candidate and GCMMA stage).
+    """
+    from pathlib import Path
+    from ..surfaces.io import save_surface
+    from ..writers import write_json, write_text
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    best = result.best
+    paths = {"result": write_json(out / "result.json", result_to_dict(result, settings)),
+             "design": write_json(out / "design.json", best.design.to_dict())}
+    g = best.design.as_genome()
+    paths["genome"] = write_json(out / "genome.json", g.to_dict() if g is not None
+                                 else best.design.to_dict())
+    paths["profile"] = save_surface(best.design.surface(), out / "profile.npz")
+    c = best.curve
+    cols = ["pressure_Pa", "K_Pa_per_m", "A"]
+    data = [c.pressure, c.stiffness, c.area_fraction]
+    for t in result.objective.targets:
+        cols.append(f"target_{t.name}_{t.quantity}")
+        data.append(np.interp(c.pressure, t.pressure, t.values, left=np.nan, right=np.nan))
+    lines = [",".join(cols)] + [",".join(f"{v:.10g}" for v in row) for row in zip(*data)]
+    paths["curves"] = write_text(out / "curves.csv", "\n".join(lines) + "\n")
+    rows = ["method,candidate,origin,gcmma0,gcmma1,gcmma2,final"]
+    rows += [f"{result.method},{k + 1},{cand.origin},{cand.stages[0]:.6f},{cand.stages[1]:.6f},"
+             f"{cand.stages[2]:.6f},{float(np.prod(cand.scores)):.6f}"
+             for k, cand in enumerate(result.candidates)]
+    paths["stages"] = write_text(out / "stages.csv", "\n".join(rows) + "\n")
+    return paths

@@ -1,0 +1,104 @@
+"""``roughfe db build|extend|list|map``: the genome database of thesis Sec. 4.1.2."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+
+def _settings(args):
+    from ..genomics.database import DatabaseSettings
+    return DatabaseSettings(length=args.length, n_nodes=args.nodes, youngs_modulus=args.E,
+                            poisson=args.nu, n_steps=args.steps, threshold=args.threshold,
+                            stiffness=args.stiffness)
+
+
+def _build(args) -> int:
+    from ..genomics.database import SobolDesign, build_database
+    design = SobolDesign(seed=args.seed, scramble=not args.no_scramble)
+    n = build_database(args.database, _settings(args), design, workers=args.workers,
+                       progress=not args.quiet, limit=args.limit)
+    print(f"{args.database}: {n} genome(s) computed (finished genomes are kept; rerun to resume)")
+    return 0
+
+
+def _extend(args) -> int:
+    from ..genomics.database import extend_database
+    from ..genomics.genome import load_genome
+    genomes = [load_genome(p) for p in args.genomes]
+    n = extend_database(args.database, genomes, labels_=args.label or None,
+                        workers=args.workers, progress=not args.quiet)
+    print(f"{args.database}: {n} genome(s) added")
+    return 0
+
+
+def _list(args) -> int:
+    from ..genomics.database import read_settings, summary_table
+    rows = summary_table(args.database)
+    if args.json:
+        print(json.dumps({"settings": read_settings(args.database).to_dict(), "genomes": rows},
+                         indent=2))
+        return 0
+    print(f"{'label':>7} {'source':>7} {'gamma':>7} {'H':>6} {'n_c':>4} {'p_max (Pa)':>12}  macro n")
+    for r in rows:
+        print(f"{r['label']:>7} {r['source']:>7} {r['gamma']:7.4f} {r['H']:6.3f} {r['n_c']:4d} "
+              f"{r['p_max']:12.5g}  {r['macro']}")
+    print(f"{len(rows)} genome(s)")
+    return 0
+
+
+def _map(args) -> int:
+    from ..genomics.database import summary_table
+    from ..plotting.design import plot_genetic_map, plot_map_summary
+    rows = summary_table(args.database)
+    if not rows:
+        from ..errors import InputError
+        raise InputError(f"the genome database {args.database} holds no genomes")
+    out = Path(args.output)
+    a = plot_genetic_map(rows, out / "genetic_map.png")
+    b = plot_map_summary(rows, out / "genetic_map_summary.png")
+    print(f"wrote {a} and {b}")
+    return 0
+
+
+def register(sub):
+    p = sub.add_parser("db", help="genome database: build (Sobol design), extend, list, map",
+                       description=__doc__)
+    dsub = p.add_subparsers(dest="db_command", metavar="ACTION")
+    dsub.required = True
+
+    b = dsub.add_parser("build", help="build or resume the Sobol genome database (Sec. 4.1.2)")
+    b.add_argument("database", help="SQLite file (created if missing; an interrupted build resumes)")
+    g = b.add_argument_group("realisation and contact settings (stored in the database)")
+    g.add_argument("--length", type=float, default=849.42e-6, help="observation length L = lambda (m)")
+    g.add_argument("--nodes", type=int, default=512, help="nodes N per profile")
+    g.add_argument("--E", type=float, default=1.0e6, help="Young's modulus (Pa)")
+    g.add_argument("--nu", type=float, default=0.0, help="Poisson's ratio")
+    g.add_argument("--steps", type=int, default=20, help="n_t approaches to the peak-valley height")
+    g.add_argument("--threshold", type=float, default=0.95, help="c_n threshold of Alg. 2")
+    g.add_argument("--stiffness", choices=("fd", "exact"), default="fd",
+                   help="K(p) by differences over the steps (thesis) or exact per step")
+    s = b.add_argument_group("Sobol design")
+    s.add_argument("--seed", type=int, default=20240, help="Sobol scrambling seed (recorded)")
+    s.add_argument("--no-scramble", action="store_true", help="unscrambled Sobol sequences")
+    s.add_argument("--limit", type=int, default=None, help="build only the first K genomes")
+    b.add_argument("--workers", type=int, default=1, help="worker processes")
+    b.add_argument("--quiet", action="store_true", help="no progress bar")
+    b.set_defaults(func=_build)
+
+    e = dsub.add_parser("extend", help="add genome JSON files (e.g. sequenced genomes)")
+    e.add_argument("database", help="existing SQLite genome database")
+    e.add_argument("genomes", nargs="+", help="roughfe-genome JSON files")
+    e.add_argument("--label", action="append", help="label per genome (repeat); default x-<k>")
+    e.add_argument("--workers", type=int, default=1, help="worker processes")
+    e.add_argument("--quiet", action="store_true", help="no progress bar")
+    e.set_defaults(func=_extend)
+
+    li = dsub.add_parser("list", help="list the genomes with genes, p_max and macro chromosomes")
+    li.add_argument("database", help="SQLite genome database")
+    li.add_argument("--json", action="store_true", help="print JSON (settings and rows)")
+    li.set_defaults(func=_list)
+
+    m = dsub.add_parser("map", help="genetic map (Fig. 54) and its summary (Fig. 55)")
+    m.add_argument("database", help="SQLite genome database")
+    m.add_argument("-o", "--output", default="db-map", help="output folder for the figures")
+    m.set_defaults(func=_map)

@@ -1,0 +1,101 @@
+"""``roughfe design``: design a rough profile whose K(p) and/or A(p) hit a target
+(thesis Sec. 4.2-4.4: SOG, GCO, CCO, M-CCO), and ``roughfe design-targets``: write the
+thesis targets y_t1, y_t2, y_t3 as CSV for a database's settings."""
+from __future__ import annotations
+
+from pathlib import Path
+
+BUILTIN = ("y_t1", "y_t2", "y_t3")
+
+
+def _target(spec, quantity, settings, cache):
+    from ..genomics.design import thesis_targets
+    from ..genomics.similarity import read_target_csv
+    if spec in BUILTIN and not Path(spec).exists():
+        if "t" not in cache:
+            cache["t"] = thesis_targets(settings)
+        t1, t2, t3, _ = cache["t"]
+        return {"y_t1": t1, "y_t2": t2, "y_t3": t3}[spec]
+    return read_target_csv(spec, quantity)
+
+
+def _run(args) -> int:
+    from ..errors import InputError
+    from ..genomics.database import load_entries, read_settings
+    from ..genomics.design import GcmmaOptions, run_design, write_design_result
+    from ..plotting.design import plot_design_curves, plot_profiles, plot_psds, plot_stages
+    settings = read_settings(args.db)
+    entries = load_entries(args.db)
+    cache = {}
+    targets = [_target(args.target, args.quantity, settings, cache)]
+    if args.second_target:
+        targets.append(_target(args.second_target, args.second_quantity, settings, cache))
+    if args.method == "mcco" and len(targets) == 2 and targets[0].quantity == "A":
+        targets.reverse()
+    if args.method != "mcco" and args.second_target:
+        raise InputError("--second-target is used by --method mcco only")
+    options = GcmmaOptions(bound=args.bound, formulation=args.formulation, eps=args.eps,
+                           **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
+                              if args.iterations else {}))
+    result = run_design(args.method, entries, targets, settings, pbar=args.pbar, options=options)
+    out = Path(args.output)
+    paths = write_design_result(result, settings, out)
+    if not args.no_figures:
+        best = result.best.design
+        plot_design_curves([result], out / "curves.png", title=result.message)
+        plot_stages([result], out / "stages.png")
+        plot_profiles({result.method: best.surface()}, out / "profile.png")
+        plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
+    print(result.message)
+    for k, c in enumerate(result.candidates, 1):
+        print(f"  ({k}) {c.origin:>16}  GCMMA 0/1/2: " + " ".join(f"{s:.4f}" for s in c.stages)
+              + "  per target: " + " ".join(f"{s:.4f}" for s in c.scores))
+    print(f"{result.nit} BEM sweeps in {result.elapsed:.1f} s; wrote {paths['design'].parent}/")
+    return 0
+
+
+def _targets(args) -> int:
+    from ..genomics.database import read_settings
+    from ..genomics.design import thesis_targets
+    from ..genomics.similarity import write_target_csv
+    t1, t2, t3, _ = thesis_targets(read_settings(args.db))
+    out = Path(args.output)
+    for t in (t1, t2, t3):
+        print(write_target_csv(out / f"{t.name}.csv", t))
+    print(f"pbar of y_t2: {t2.metadata['pbar']:.6g} Pa; p_max^t = {t1.p_max:.6g} Pa")
+    return 0
+
+
+def register(sub):
+    p = sub.add_parser("design", help="design roughness for a target K(p)/A(p) (SOG/GCO/CCO/M-CCO)",
+                       description=__doc__)
+    p.add_argument("--db", required=True, help="SQLite genome database ('roughfe db build')")
+    p.add_argument("--target", required=True,
+                   help="CSV 'pressure_Pa,value' or a thesis target y_t1|y_t2|y_t3")
+    p.add_argument("--quantity", choices=("K", "A"), default="K",
+                   help="what the target CSV holds: stiffness K (Pa/m) or area fraction A")
+    p.add_argument("--second-target", default=None,
+                   help="M-CCO: the second target (CSV or y_t3), usually A(p)")
+    p.add_argument("--second-quantity", choices=("K", "A"), default="A",
+                   help="what the second target CSV holds")
+    p.add_argument("--method", choices=("sog", "gco", "cco", "mcco"), required=True,
+                   help="Alg. 4 (sog), 5 (gco), 6 (cco) or 7 (mcco)")
+    p.add_argument("--pbar", type=float, default=None,
+                   help="threshold pressure (Pa) splitting [0, pbar] and [pbar, p_max] (gco, cco)")
+    g = p.add_argument_group("GCMMA options")
+    g.add_argument("--iterations", type=int, default=None,
+                   help="outer GCMMA iterations of stage 1 (default: thesis, 5 sog / 3 others)")
+    g.add_argument("--bound", choices=("start", "period"), default="start",
+                   help="phase box: +-10%% of the start value (thesis) or of 2 pi")
+    g.add_argument("--formulation", choices=("minimax", "thesis"), default="minimax",
+                   help="min-max form with residual Jacobian, or (1-s)^2 with its gradient")
+    g.add_argument("--eps", type=float, default=0.02,
+                   help="finite-difference step in units of the phase box")
+    p.add_argument("-o", "--output", required=True, help="output folder")
+    p.add_argument("--no-figures", action="store_true", help="skip the figures")
+    p.set_defaults(func=_run)
+
+    t = sub.add_parser("design-targets", help="write the thesis targets y_t1, y_t2, y_t3 as CSV")
+    t.add_argument("--db", required=True, help="SQLite genome database (for L, N, E, n_t)")
+    t.add_argument("-o", "--output", required=True, help="output folder")
+    t.set_defaults(func=_targets)

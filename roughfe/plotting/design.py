@@ -1,0 +1,204 @@
+"""Figures of roughness design (thesis Figs. 47-70): macro/micro roughness, the genetic
+map and its summary, database curves vs targets, similarity per GCMMA stage, sensitivity
+to pbar, designed profiles, their K(p)/A(p) and PSDs. Reads results; never solves."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..surfaces.stats import power_spectrum
+from .common import new_figure, save_figure
+
+_MACRO, _MICRO = "#d62728", "#1f77b4"
+
+
+def plot_macro_micro(mm, path, title="") -> "Path":
+    """Fig. 47/50: c_n of K(p) and A(p) per chromosome with the threshold."""
+    fig, ax = new_figure(figsize=(6.4, 3.6))
+    n = np.asarray(mm.chromosomes)
+    ax.plot(n, mm.corr_k, "ko-", label="K(p)")
+    ax.plot(n, mm.corr_a, "b^-", label="A(p)")
+    ax.axhline(mm.threshold, color="r", ls="--", label=f"threshold {mm.threshold:g}")
+    ax.set_xlabel("chromosome n")
+    ax.set_ylabel("correlation c_n")
+    ax.set_title(title or f"macro: n = {list(mm.macro)}")
+    ax.legend()
+    return save_figure(fig, path)
+
+
+def plot_macro_micro_profiles(x, total, macro, micro, curves, path, title="") -> "Path":
+    """Figs. 48-49: Z, Z_L, Z_S and their K(p), A(p) (``curves``: name -> ResponseCurve)."""
+    fig, axes = new_figure(1, 3, figsize=(13, 3.6))
+    for h, lab, c in ((total, "Z", "k"), (macro, "Z_L (macro)", _MACRO), (micro, "Z_S (micro)", _MICRO)):
+        axes[0].plot(np.asarray(x) * 1e6, np.asarray(h) * 1e6, color=c, lw=1, label=lab)
+    axes[0].set_xlabel("x (um)")
+    axes[0].set_ylabel("height (um)")
+    axes[0].legend()
+    for (name, cur), c in zip(curves.items(), ("k", _MACRO, _MICRO)):
+        axes[1].plot(cur.pressure, cur.stiffness, "o-", ms=3, color=c, label=name)
+        axes[2].plot(cur.pressure, cur.area_fraction, "o-", ms=3, color=c, label=name)
+    axes[1].set_xlabel("p (Pa)")
+    axes[1].set_ylabel("K (Pa/m)")
+    axes[2].set_xlabel("p (Pa)")
+    axes[2].set_ylabel("A = A_r/A_n")
+    axes[1].legend()
+    fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+def plot_genetic_map(rows, path, n_max=None) -> "Path":
+    """Fig. 54: one column per genome, one row per chromosome n; red macro, blue micro.
+
+    ``rows``: dicts with ``label``, ``n_c`` and ``macro`` (as :func:`summary_table`).
+    """
+    n_max = n_max or max(r["n_c"] for r in rows)
+    grid = np.full((n_max, len(rows)), np.nan)
+    for j, r in enumerate(rows):
+        grid[: min(r["n_c"], n_max), j] = 0.0
+        for n in r["macro"]:
+            if n <= n_max:
+                grid[n - 1, j] = 1.0
+    from matplotlib.colors import ListedColormap
+    fig, ax = new_figure(figsize=(max(6, 0.22 * len(rows) + 2), 0.2 * n_max + 2))
+    ax.imshow(grid, cmap=ListedColormap([_MICRO, _MACRO]), vmin=0, vmax=1, aspect="auto",
+              origin="lower", extent=(-0.5, len(rows) - 0.5, 0.5, n_max + 0.5),
+              interpolation="nearest")
+    ax.set_xticks(range(len(rows)))
+    ax.set_xticklabels([r["label"] for r in rows], rotation=90, fontsize=6)
+    ax.set_ylabel("chromosome n")
+    ax.set_title("genetic map: macro (red) / micro (blue) chromosomes")
+    return save_figure(fig, path)
+
+
+def plot_map_summary(rows, path, n_max=10) -> "Path":
+    """Fig. 55: share of genomes in which chromosome n (1..n_max) is macro or micro."""
+    n = np.arange(1, n_max + 1)
+    macro = np.array([sum(1 for r in rows if k in r["macro"]) for k in n])
+    present = np.array([sum(1 for r in rows if k <= r["n_c"]) for k in n])
+    fig, ax = new_figure(figsize=(6.4, 3.6))
+    ax.bar(n, macro / np.maximum(present, 1), color=_MACRO, label="macro")
+    ax.bar(n, (present - macro) / np.maximum(present, 1), bottom=macro / np.maximum(present, 1),
+           color=_MICRO, label="micro")
+    ax.set_xlabel("chromosome n")
+    ax.set_ylabel("fraction of genomes")
+    ax.set_xticks(n)
+    ax.legend()
+    return save_figure(fig, path)
+
+
+def plot_database_curves(entries, targets, path) -> "Path":
+    """Fig. 57/67: K(p), A(p) of every database genome rescaled (Eq. 4.2) and the targets."""
+    p_max = targets[0].p_max
+    fig, axes = new_figure(1, 2, figsize=(11, 4))
+    for e in entries:
+        c = e.curve.to_target_range(p_max)
+        axes[0].plot(c.pressure, c.stiffness, color="0.7", lw=0.7)
+        axes[1].plot(c.pressure, c.area_fraction, color="0.7", lw=0.7)
+    colors = ("r", "k", "m")
+    for t, col in zip(targets, colors):
+        ax = axes[0] if t.quantity == "K" else axes[1]
+        ax.plot(t.pressure, t.values, "-", color=col, lw=2, label=t.name)
+    axes[0].set_xlabel("p (Pa)")
+    axes[0].set_ylabel("K (Pa/m)")
+    axes[1].set_xlabel("p (Pa)")
+    axes[1].set_ylabel("A = A_r/A_n")
+    for ax in axes:
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend()
+    return save_figure(fig, path)
+
+
+def plot_design_curves(results, path, title="") -> "Path":
+    """Figs. 60/64/68: K(p) and A(p) of the best design of each result vs the targets."""
+    results = list(results)
+    fig, axes = new_figure(1, 2, figsize=(11, 4))
+    for t in results[0].objective.targets:
+        ax = axes[0] if t.quantity == "K" else axes[1]
+        ax.plot(t.pressure, t.values, "r-", lw=2.5, label=f"target {t.name}")
+    for r, m in zip(results, ("o", "s", "^", "x")):
+        c = r.best.curve
+        s = float(np.prod(r.best.scores))
+        axes[0].plot(c.pressure, c.stiffness, "--" + m, ms=4, label=f"{r.method} s={s:.3f}")
+        axes[1].plot(c.pressure, c.area_fraction, "--" + m, ms=4, label=r.method)
+    axes[0].set_xlabel("p (Pa)")
+    axes[0].set_ylabel("K (Pa/m)")
+    axes[1].set_xlabel("p (Pa)")
+    axes[1].set_ylabel("A = A_r/A_n")
+    axes[0].legend(fontsize=8)
+    axes[1].legend(fontsize=8)
+    fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+def plot_stages(results, path, title="") -> "Path":
+    """Figs. 58/63: similarity of every candidate at GCMMA 0, 1, 2, per method."""
+    fig, ax = new_figure(figsize=(6.4, 4))
+    styles = {"sog": "k--", "gco": "r-", "cco": "b-.", "mcco": "m-"}
+    for r in results:
+        for k, (c, mk) in enumerate(zip(r.candidates, ("^", "o", "x"))):
+            ax.plot([0, 1, 2], c.stages, styles.get(r.method, "g-"), marker=mk,
+                    label=f"{r.method.upper()} ({k + 1})")
+    ax.set_xticks([0, 1, 2])
+    ax.set_xticklabels(["GCMMA 0", "GCMMA 1", "GCMMA 2"])
+    ax.set_ylabel("similarity score s")
+    ax.set_title(title)
+    ax.legend(fontsize=7, ncol=2)
+    return save_figure(fig, path)
+
+
+def plot_pbar_sensitivity(pbars, best, n_cross, n_above, path) -> "Path":
+    """Fig. 59: best s vs pbar per method (a) and |U3| with the part above 0.95 (b).
+
+    ``best``, ``n_cross``, ``n_above``: dict method -> list aligned with ``pbars``.
+    """
+    fig, axes = new_figure(1, 2, figsize=(11, 4))
+    pbars = np.asarray(pbars)
+    for m, st in (("gco", "ro-"), ("cco", "bs-.")):
+        if m in best:
+            axes[0].plot(pbars, best[m], st, label=m.upper())
+    axes[0].set_xlabel("pbar (Pa)")
+    axes[0].set_ylabel("best similarity s")
+    axes[0].legend()
+    w = 0.35 * (pbars[1] - pbars[0] if pbars.size > 1 else 1.0)
+    for k, (m, col) in enumerate((("gco", "r"), ("cco", "b"))):
+        if m in n_cross:
+            axes[1].bar(pbars + (k - 0.5) * w, n_cross[m], w, color=col, label=f"|U3| {m.upper()}")
+            axes[1].bar(pbars + (k - 0.5) * w, n_above[m], w, color="w", edgecolor=col)
+    axes[1].set_xlabel("pbar (Pa)")
+    axes[1].set_ylabel("cardinality of U3 (white: s > 0.95)")
+    axes[1].legend()
+    return save_figure(fig, path)
+
+
+def plot_profiles(named_surfaces, path, title="") -> "Path":
+    """Figs. 61/65/69: topographies of designed profiles (``name -> Surface``)."""
+    fig, ax = new_figure(figsize=(8, 3.6))
+    for name, s in named_surfaces.items():
+        x = s.metadata.get("x0", 0.0) + np.arange(s.shape[0]) * s.spacing[0]
+        ax.plot(x * 1e6, s.heights * 1e6, lw=1, label=name)
+    ax.set_xlabel("x (um)")
+    ax.set_ylabel("height (um)")
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    return save_figure(fig, path)
+
+
+def plot_psds(named, path, title="") -> "Path":
+    """Figs. 62/66/70: log10 PSD of each designed profile (FFT, line) and the discrete
+    spectrum of its chromosomes (markers: C = a_n^2 / (2 dq) at q_n).
+
+    ``named``: name -> (Surface, list of (q_n (rad/m), a_n (m))).
+    """
+    fig, axes = new_figure(1, len(named), figsize=(4.5 * len(named), 3.6), squeeze=False)
+    for ax, (name, (surf, lines)) in zip(axes[0], named.items()):
+        ps = power_spectrum(surf)
+        ax.loglog(ps.q, ps.C, "k-", lw=0.8, label="FFT (Hann)")
+        dq = 2 * np.pi / surf.size[0]
+        if lines:
+            q, a = np.asarray(lines, float).T
+            ax.loglog(q, a ** 2 / (2 * dq), "rs", ms=4, label="chromosomes")
+        ax.set_xlabel("q (rad/m)")
+        ax.set_ylabel("C (m^3)")
+        ax.set_title(name)
+        ax.legend(fontsize=7)
+    fig.suptitle(title)
+    return save_figure(fig, path)
