@@ -1,8 +1,19 @@
 """Finite-element cross-validation of the BEM (the only importer of dolfinx/petsc4py/gmsh).
 
+* :func:`mesh_profile` -> :class:`ProfileMesh` -- gmsh mesh of the plane-strain body below
+  a profile (formulation (a) ``"flat"`` or (b) ``"profile"``), tagged top/bottom/left/right.
+* :func:`fem_contact_sweep` -> :class:`FemSweepResult` of :class:`FemContactResult`
+  (field names of the BEM results) -- SNES VI or penalty contact with rollers.
+* :func:`mirrored_profile` -- the periodic profile whose BEM solution is the reference of
+  the FEM body with rollers.
+
 dolfinx, petsc4py, gmsh and ufl are imported inside the functions that need them, so
 ``import roughfe.fem`` works (and fails only on use) where dolfinx is not installed.
 """
+from .contact import (FemContactResult, FemSolverOptions, FemSweepResult, contact_edge,
+                      fem_contact_sweep, fem_solve_contact, p_wave_modulus)
 from .mesh import FACET_TAGS, ProfileMesh, mesh_profile, mirrored_profile
 
-__all__ = ["FACET_TAGS", "ProfileMesh", "mesh_profile", "mirrored_profile"]
+__all__ = ["FACET_TAGS", "ProfileMesh", "mesh_profile", "mirrored_profile",
+           "FemSolverOptions", "FemContactResult", "FemSweepResult", "fem_contact_sweep",
+           "fem_solve_contact", "contact_edge", "p_wave_modulus"]
