@@ -173,7 +173,9 @@ def plot_correlations(mech, path) -> Path:
         ax.set_xlabel("n (chromosome index; for TD/BU the last one added)")
         ax.set_title(name, fontsize=9)
     axes[0].set_ylabel("c_n")
-    axes[0].set_ylim(min(-0.2, np.nanmin(np.concatenate([mech.c_td["K"], mech.c_td["A"]]))), 1.05)
+    allc = np.concatenate([v for d in (mech.c_td, mech.c_bu, mech.c_chromosome) for v in d.values()])
+    low = np.nanmin(allc) if np.isfinite(allc).any() else 0.0
+    axes[0].set_ylim(min(0.8, low - 0.05), 1.01)
     axes[0].legend(fontsize=8, loc="lower right")
     fig.suptitle(f"correlation with the complete profile ({mech.kernel} kernel)", fontsize=10)
     return save_figure(fig, path)
