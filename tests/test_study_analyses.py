@@ -80,3 +80,19 @@ def test_tiny_leakage_study_keeps_the_seed_across_D(tmp_path):
     seeds = {(r["D"], r["replica"]): r["seed"] for r in rows}
     assert seeds[(2.3, 0)] == seeds[(2.7, 0)] != seeds[(2.3, 1)]
     assert all("free_volume_star" in r and "D_result" not in r for r in rows)
+
+
+def test_genome_db_study_fills_a_sqlite_database(tmp_path):
+    gdb = pytest.importorskip("roughfe.genomics.database")
+    from roughfe.study import genome_db_to_sqlite
+
+    study = {"study": {"analysis": "genome_db", "output": str(tmp_path / "g"), "seed": 1},
+             "grid": {"gamma": [1.5, 2.0], "replica": [0, 1]},
+             "fixed": {"hurst": 0.7, "n_nodes": 64, "n_steps": 3}}
+    assert run_study(spec_from_mapping(study), workers=2, progress=False).complete
+    db = tmp_path / "genomes.sqlite"
+    assert genome_db_to_sqlite(tmp_path / "g", db) == 4
+    assert genome_db_to_sqlite(tmp_path / "g", db) == 0  # idempotent
+    entries = gdb.load_entries(db)
+    assert len({e.label for e in entries}) == 4
+    assert gdb.read_settings(db).n_nodes == 64

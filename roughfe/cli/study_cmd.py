@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import sys
 
-from ..study import ANALYSES, EXECUTORS, collect, load_spec, run_study, study_status
+from ..study import (ANALYSES, EXECUTORS, collect, genome_db_to_sqlite, load_spec,
+                     run_study, study_status)
 
 
 def _log(message):
@@ -40,6 +41,9 @@ def _collect(args) -> int:
     print(f"{n_rows} rows")
     if note:
         print(note)
+    if args.genome_db:
+        n = genome_db_to_sqlite(args.outdir, args.genome_db)
+        print(f"inserted {n} new genome(s) into {args.genome_db}")
     if missing:
         print(f"warning: {missing} task(s) have no result yet and are not in the table",
               file=sys.stderr)
@@ -79,4 +83,7 @@ def register(sub):
     c = ssub.add_parser("collect", help="write OUTDIR/table.csv (and .parquet with pyarrow)")
     c.add_argument("outdir", metavar="OUTDIR", help="study results folder")
     c.add_argument("--no-parquet", action="store_true", help="write CSV only")
+    c.add_argument("--genome-db", metavar="DB.sqlite", default=None,
+                   help="genome_db studies: also insert the finished genomes into this SQLite "
+                        "genome database (created if missing; existing labels are skipped)")
     c.set_defaults(func=_collect)

@@ -17,12 +17,14 @@ Example
 """
 from .analyses import ANALYSES, Analysis, selftest_task
 from .executors import EXECUTORS, make_executor
+from .exports import genome_db_to_sqlite
 from .runner import StudySummary, execute_task, run_study
 from .spec import StudySpec, Task, derive_seed, load_spec, spec_from_mapping
 from .store import StudyStatus, collect, study_status, table_rows
 
 __all__ = [
     "ANALYSES", "Analysis", "EXECUTORS", "StudySpec", "StudyStatus", "StudySummary", "Task",
-    "collect", "derive_seed", "execute_task", "load_spec", "make_executor", "run_study",
+    "collect", "derive_seed", "execute_task", "genome_db_to_sqlite", "load_spec",
+    "make_executor", "run_study",
     "selftest_task", "spec_from_mapping", "study_status", "table_rows",
 ]

@@ -261,8 +261,8 @@ def collect(outdir, *, parquet=True):
 
             from ..writers import atomic_path
 
-            frame = pd.DataFrame([{c: _cell(r.get(c)) for c in columns} for r in rows],
-                                 columns=columns)
+            frame = pd.DataFrame([{c: None if r.get(c) is None else _cell(r[c]) for c in columns}
+                                  for r in rows], columns=columns)
             with atomic_path(outdir / "table.parquet") as tmp:
                 frame.to_parquet(tmp, index=False)
             paths.append(outdir / "table.parquet")
