@@ -217,6 +217,7 @@ def test_cli_run_status_collect(tmp_path, capsys):
     assert cli_main(["study", "collect", str(out)]) == 0
     text = capsys.readouterr().out
     assert "16/16 done, 0 failed, 0 missing" in text and "48 rows" in text
+    assert "CPU per task" in text
     assert ("pyarrow is not installed" in text) != (out / "table.parquet").exists()
 
 

@@ -32,9 +32,10 @@ def execute_task(analysis: str, params: dict, seed: int) -> dict:
     -------
     dict
         ``ok``; ``records`` (JSON-safe list of dicts) or ``error`` and ``traceback``;
-        ``elapsed_s``, ``host`` and ``pid`` of the worker.
+        ``elapsed_s`` (wall) and ``cpu_s`` (CPU time of the worker process: the cost on
+        an idle core, whatever else shares the machine), ``host`` and ``pid``.
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     out = {"host": socket.gethostname(), "pid": os.getpid()}
     try:
         func = resolve(analysis)
@@ -44,6 +45,7 @@ def execute_task(analysis: str, params: dict, seed: int) -> dict:
         out.update(ok=False, error=f"{type(exc).__name__}: {exc}",
                    traceback=traceback.format_exc())
     out["elapsed_s"] = time.perf_counter() - t0
+    out["cpu_s"] = time.process_time() - c0
     return out
 
 
@@ -217,8 +219,8 @@ def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached):
                     "analysis_version": ANALYSES[spec.analysis].version,
                     "code_version": __version__, "params": dict(task.params),
                     "seed": task.seed, "records": out["records"],
-                    "elapsed_s": out["elapsed_s"], "host": out["host"],
-                    "attempts": attempts[task.key]})
+                    "elapsed_s": out["elapsed_s"], "cpu_s": out["cpu_s"],
+                    "host": out["host"], "attempts": attempts[task.key]})
                 store.clear_failure(outdir, task.key)
                 counts["done"] += 1
                 counts["task_s"] += out["elapsed_s"]

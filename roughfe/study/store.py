@@ -150,6 +150,8 @@ class StudyStatus:
         (task index, parameters, last error line) of each failed task.
     cost_s : tuple of float
         Wall time in seconds of each finished task on its worker.
+    cpu_s : tuple of float
+        CPU time in seconds of each finished task (its cost on an idle core).
     """
 
     name: str
@@ -160,6 +162,7 @@ class StudyStatus:
     n_missing: int
     failures: tuple
     cost_s: tuple
+    cpu_s: tuple = ()
 
     def describe(self) -> str:
         """Human-readable multi-line summary."""
@@ -169,6 +172,10 @@ class StudyStatus:
             lines.append(f"cost per task: mean {statistics.fmean(self.cost_s):.3g} s, median "
                          f"{statistics.median(self.cost_s):.3g} s, max {max(self.cost_s):.3g} s "
                          f"(worker wall time, {len(self.cost_s)} tasks)")
+        if self.cpu_s:
+            lines.append(f"CPU per task: mean {statistics.fmean(self.cpu_s):.3g} s, median "
+                         f"{statistics.median(self.cpu_s):.3g} s, max {max(self.cpu_s):.3g} s, "
+                         f"total {sum(self.cpu_s):.4g} s (the cost on an idle core)")
         for index, params, error in self.failures:
             lines.append(f"  failed task {index} {canonical_json(params)}: {error}")
         return "\n".join(lines)
@@ -178,7 +185,7 @@ def study_status(outdir) -> StudyStatus:
     """Status of the study in ``outdir`` from its files."""
     data = read_study(outdir)
     done, failed = done_keys(outdir), failed_keys(outdir)
-    failures, costs = [], []
+    failures, costs, cpus = [], [], []
     n_done = n_failed = 0
     for t in data["tasks"]:
         if t["key"] in done:
@@ -186,6 +193,8 @@ def study_status(outdir) -> StudyStatus:
             result = read_result(outdir, t["key"])
             if result is not None and "elapsed_s" in result:
                 costs.append(float(result["elapsed_s"]))
+                if "cpu_s" in result:
+                    cpus.append(float(result["cpu_s"]))
         elif t["key"] in failed:
             n_failed += 1
             try:
@@ -198,7 +207,7 @@ def study_status(outdir) -> StudyStatus:
     return StudyStatus(name=spec["name"], analysis=spec["analysis"], n_tasks=len(data["tasks"]),
                        n_done=n_done, n_failed=n_failed,
                        n_missing=len(data["tasks"]) - n_done - n_failed,
-                       failures=tuple(failures), cost_s=tuple(costs))
+                       failures=tuple(failures), cost_s=tuple(costs), cpu_s=tuple(cpus))
 
 
 def _cell(value):
