@@ -1,0 +1,56 @@
+"""``roughfe db`` and ``roughfe design`` end to end on a tiny database."""
+import json
+
+import numpy as np
+import pytest
+
+from roughfe.cli import main
+from roughfe.genomics import database as db
+from roughfe.genomics import design as de
+from roughfe.genomics.similarity import Target
+
+
+def test_db_and_design_commands(tmp_path, capsys):
+    path = tmp_path / "db.sqlite"
+    assert main(["db", "build", str(path), "--nodes", "128", "--steps", "10", "--limit", "3",
+                 "--quiet"]) == 0
+    assert main(["db", "list", str(path), "--json"]) == 0
+    listing = json.loads(capsys.readouterr().out.split("\n", 1)[1])
+    assert len(listing["genomes"]) == 3 and listing["settings"]["n_nodes"] == 128
+    assert main(["db", "map", str(path), "-o", str(tmp_path / "map")]) == 0
+    assert (tmp_path / "map" / "genetic_map.png").stat().st_size > 1000
+    assert main(["design-targets", "--db", str(path), "-o", str(tmp_path / "t")]) == 0
+    out = tmp_path / "sog"
+    assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "y_t1.csv"),
+                 "--method", "sog", "--iterations", "1", "-o", str(out)]) == 0
+    for name in ("result.json", "design.json", "genome.json", "profile.npz", "curves.csv",
+                 "stages.csv", "curves.png", "stages.png", "profile.png", "psd.png"):
+        assert (out / name).is_file(), name
+    report = json.loads((out / "result.json").read_text())
+    settings = db.DatabaseSettings.from_dict(report["settings"])
+    target = Target.from_dict(report["targets"][0])
+    design = de.Design.from_dict(json.loads((out / "design.json").read_text()))
+    s = de.rescore(design, [target], settings)[0]
+    assert s == pytest.approx(report["candidates"][0]["score"], abs=1e-7)
+    # a single-genome design is a genome with the rescaled amplitude gene
+    genome = json.loads((out / "genome.json").read_text())
+    assert genome["format"] == "roughfe-genome"
+    assert genome["A"] == pytest.approx(design.parts[0].weight * design.scale)
+
+
+def test_design_command_reports_bad_input(tmp_path, capsys):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("pressure_Pa,value\n1.0,2.0\n2.0,-1\n")
+    path = tmp_path / "empty.sqlite"
+    db.connect(path, create=True).close()
+    assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",
+                 "-o", str(tmp_path / "o")]) == 2
+    assert "empty" in capsys.readouterr().err
+    with db.connect(path) as con:
+        con.execute("INSERT INTO meta VALUES ('settings', ?)",
+                    (json.dumps(db.DatabaseSettings(n_nodes=64).to_dict()),))
+    assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",
+                 "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "no genomes" in err or ">= 0" in err
+    np.testing.assert_equal((tmp_path / "o").exists(), False)

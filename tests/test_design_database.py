@@ -1,0 +1,103 @@
+"""Genome database: Sobol design, Alg. 2 records, resumable SQLite build, extend, errors."""
+import json
+import sqlite3
+
+import numpy as np
+import pytest
+
+from roughfe.errors import FileFormatError, InputError
+from roughfe.genomics import database as db
+from roughfe.genomics.genome import Genome, realize
+from roughfe.genomics.macro_micro import classify, correlation, profile_response
+from roughfe.genomics.similarity import ResponseCurve
+
+SMALL = db.DatabaseSettings(n_nodes=256)
+
+
+def test_sobol_design_is_the_thesis_design_and_reproducible():
+    d = db.SobolDesign()
+    pairs = d.pairs()
+    assert pairs.shape == (20, 2)
+    assert np.all((pairs[:, 0] >= 1.2) & (pairs[:, 0] <= 2.0))
+    assert np.all((pairs[:, 1] >= 0.5) & (pairs[:, 1] <= 1.5))
+    phases = d.phase_vectors()
+    assert phases.shape == (3, 64) and np.all((phases >= 0) & (phases < 2 * np.pi))
+    tasks = d.tasks()
+    assert len(tasks) == 60 and len({t[0] for t in tasks}) == 60
+    np.testing.assert_array_equal(db.SobolDesign().pairs(), pairs)        # recorded seed
+    assert not np.allclose(db.SobolDesign(seed=1).pairs(), pairs)
+    # "3 vectors of 30 phases taken sequentially": vector 2 continues vector 1
+    assert not np.allclose(phases[0, :30], phases[1, :30])
+
+
+def test_alg2_classification_maths():
+    p = np.linspace(1.0, 2.0, 20)
+    full = ResponseCurve(p, p ** 0.7, p / 4)
+    same_shape = full.rescaled(5.0)                   # a chromosome that is the profile, scaled
+    opposite = ResponseCurve(p, p[::-1], p / 4)       # K falling where the profile's rises
+    assert correlation(full, same_shape) == pytest.approx(1.0)
+    r = classify(full, [same_shape, opposite], [1, 2], threshold=0.95)
+    assert r.macro == (1,) and r.micro == (2,)
+    assert r.corr_k[1] == pytest.approx(-1.0, abs=0.05)
+
+
+def test_eq_4_2_scaling_law_with_the_bem():
+    """Heights x eta under displacement control: p x eta, K and A unchanged (linear elasticity)."""
+    g = db.make_genome(1.6, 0.8, 7, SMALL)
+    surf = realize(g, SMALL.length, SMALL.n_nodes)
+    kw = dict(youngs_modulus=SMALL.youngs_modulus, n_steps=10)
+    for kind in ("fd", "exact"):
+        c1 = profile_response(surf, stiffness=kind, **kw)
+        c3 = profile_response(surf.scaled(3.0), stiffness=kind, **kw)
+        np.testing.assert_allclose(c3.pressure, 3.0 * c1.pressure, rtol=1e-7)
+        np.testing.assert_allclose(c3.stiffness, c1.stiffness, rtol=1e-6)
+        np.testing.assert_array_equal(c3.area_fraction, c1.area_fraction)
+        np.testing.assert_allclose(c1.rescaled(3.0).pressure, c3.pressure, rtol=1e-7)
+
+
+def test_build_resumes_extends_and_refuses_mismatches(tmp_path):
+    path = tmp_path / "g.sqlite"
+    assert db.build_database(path, SMALL, progress=False, limit=2) == 2
+    # an interrupted build keeps finished genomes: a rerun computes only the rest
+    assert db.build_database(path, SMALL, progress=False, limit=4) == 2
+    assert db.build_database(path, SMALL, progress=False, limit=4) == 0
+    entries = db.load_entries(path)
+    assert [e.label for e in entries] == ["1-1", "1-2", "1-3", "2-1"]
+    e = entries[0]
+    g = Genome.from_dict(e.genome)
+    n_s, n_f = g.chromosome_range(SMALL.length, SMALL.n_nodes)
+    assert len(e.chromosome_curves) == len(e.corr_k) == n_f - n_s + 1
+    assert set(e.macro) | set(e.micro) == set(range(n_s, n_f + 1))
+    assert not set(e.macro) & set(e.micro)
+    assert np.all(np.asarray(e.corr_k)[[n - n_s for n in e.macro]] > SMALL.threshold)
+    assert e.p_max == pytest.approx(e.curve.p_max)
+    # the stored curve is the realisation's BEM curve
+    again = profile_response(realize(g, SMALL.length, SMALL.n_nodes),
+                             youngs_modulus=SMALL.youngs_modulus, n_steps=SMALL.n_steps)
+    np.testing.assert_allclose(again.stiffness, e.curve.stiffness, rtol=1e-9)
+    with pytest.raises(InputError, match="settings"):
+        db.build_database(path, db.DatabaseSettings(n_nodes=128), progress=False, limit=1)
+    with pytest.raises(InputError, match="Sobol design"):
+        db.build_database(path, SMALL, db.SobolDesign(seed=3), progress=False, limit=1)
+    new = db.make_genome(1.7, 0.9, 11, SMALL)
+    assert db.extend_database(path, [new], labels_=["seq-1"], progress=False) == 1
+    assert db.load_entries(path, labels_=["seq-1"])[0].source == "extend"
+    with pytest.raises(InputError, match="already"):
+        db.extend_database(path, [new], labels_=["seq-1"], progress=False)
+    con = sqlite3.connect(path)
+    assert json.loads(con.execute("SELECT value FROM meta WHERE key='schema_version'")
+                      .fetchone()[0]) == db.SCHEMA_VERSION
+    con.close()
+
+
+def test_empty_missing_and_foreign_databases(tmp_path):
+    empty = tmp_path / "empty.sqlite"
+    db.connect(empty, create=True).close()
+    with pytest.raises(InputError, match="no genomes"):
+        db.load_entries(empty)
+    with pytest.raises(InputError, match="does not exist"):
+        db.load_entries(tmp_path / "nope.sqlite")
+    junk = tmp_path / "junk.sqlite"
+    junk.write_text("not a database at all" * 100)
+    with pytest.raises(FileFormatError):
+        db.connect(junk)
