@@ -62,3 +62,13 @@ def test_json_round_trip_and_errors(tmp_path):
     bad = g.to_dict() | {"version": 99}
     with pytest.raises(FileFormatError, match="version"):
         Genome.from_dict(bad)
+
+
+def test_surface_realisation_with_ridges_along_x_repeats_the_profile():
+    from roughfe.genomics.genome import Genome, realize_surface
+    g = table1_genome(rng=5)
+    g2 = Genome(A=g.A, H=g.H, gamma=g.gamma, lambda1=g.lambda1, phases=g.phases, angles=np.zeros(8))
+    surf = realize_surface(g2, 1e-3, 64)
+    prof = realize(g2, length=1e-3, n_nodes=64).heights
+    np.testing.assert_allclose(surf.heights, np.repeat(prof[:, None], 64, axis=1),
+                               atol=1e-12 * np.abs(prof).max())

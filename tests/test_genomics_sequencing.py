@@ -107,3 +107,12 @@ def test_measured_profile_is_sequenced_with_an_honest_report(topographies_dir):
     assert res.sequencing.rms_errors.shape == (3,)
     assert np.all(np.isfinite(res.sequencing.rms_errors))
     assert res.success == bool(np.all(res.sequencing.rms_errors <= 0.05))
+
+
+def test_thesis_zd_fit_cannot_identify_M(table1):
+    from roughfe.genomics.sequencing import thesis_zd_fit
+    _, _, res = table1
+    fit = thesis_zd_fit(res, (2, 8, 20), seed=0, n_starts=1)
+    assert [n for n, _ in fit.chromosomes] == [1, 17, 18]       # Z_d = C_1 - C_17 - C_18 (Fig. 33)
+    assert np.all(fit.cost < 1e-16)                              # Eq. 3.15 fits exactly for any M
+    assert 0.8 < res.A0 < 1.3                                    # Eq. 3.13 variance estimate of A = 1

@@ -95,7 +95,7 @@ def plot_reconstruction(rec, path, max_steps=6) -> Path:
 
 def plot_validity(res, path) -> Path:
     """Monte Carlo of Eq. (3.10) (Fig. 29): valid fraction and how often arccos gives the right phase."""
-    fig, ax = new_figure(figsize=(7, 4))
+    fig, ax = new_figure(figsize=(10, 4))
     ax.bar(res.M - 0.2, 100 * res.valid_fraction, width=0.4, label="Eq. 3.10 satisfied")
     ax.bar(res.M + 0.2, 100 * res.arccos_fraction, width=0.4,
            label="theta = arccos(...) reproduces C_n (needs g2 >= 0)")
@@ -103,7 +103,8 @@ def plot_validity(res, path) -> Path:
     ax.set_xlabel("M (ridges)")
     ax.set_ylabel(f"% of {res.n_trials} random phase sets")
     ax.set_ylim(0, 105)
-    ax.legend(fontsize=8, loc="lower right")
+    ax.set_xticks(res.M)
+    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.0, 0.5))
     ax.set_title("Eq. 3.10 is an identity (|g1| <= |sum e^{i phi}|); the arccos phase is right half the time",
                  fontsize=9)
     return save_figure(fig, path)
