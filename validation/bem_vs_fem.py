@@ -105,7 +105,7 @@ def profile_case(name, surf, outdir: Path, n_steps=16):
     h = surf.heights
     mirrored = mirrored_profile(surf)
     top = float(h.max() - np.mean(mirrored.heights))
-    deltas_bem = top * np.geomspace(0.02, 0.6, n_steps)
+    deltas_bem = top * np.geomspace(0.02, 0.9, n_steps)
     t0 = time.perf_counter()
     bem = contact_sweep(mirrored, MATERIAL, deltas=deltas_bem, kernel="spectral")
     t_bem = time.perf_counter() - t0

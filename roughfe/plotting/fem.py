@@ -39,10 +39,12 @@ def plot_area_stiffness(curves, path, title="") -> Path:
                   label=c["label"])
         ax1.plot(p, c["area_fraction"], **kw)
         ax2.plot(p, np.asarray(c["stiffness"]) / 1e12, **kw)
-    ax1.set(xlabel="mean pressure p (MPa)", ylabel="A* = A_r / A_n", title="A*(p)")
-    ax2.set(xlabel="mean pressure p (MPa)", ylabel="K = dp/dDelta (MPa/um)", title="K(p)")
+    ax1.set(xlabel="mean pressure p (MPa)", ylabel="A* = A_r / A_n", title="A*(p)",
+            xscale="log", yscale="log")
+    ax2.set(xlabel="mean pressure p (MPa)", ylabel="K = dp/dDelta (MPa/um)", title="K(p)",
+            xscale="log", yscale="log")
     for ax in (ax1, ax2):
-        ax.grid(alpha=0.3)
+        ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
     if title:
         fig.suptitle(title)
@@ -63,8 +65,10 @@ def plot_pressures(x, series, path, title="") -> Path:
     fig, ax = new_figure(figsize=(10, 4))
     for s in series:
         kw = {"color": s.get("color"), "label": s["label"]}
-        if s.get("style", "line") == "points":
-            ax.plot(np.asarray(x) * 1e3, np.asarray(s["pressure"]) / 1e6, "o", ms=2.5, mfc="none", **kw)
+        if s.get("style", "line") == "points":           # only the loaded points
+            p = np.asarray(s["pressure"], float)
+            on = p > 0
+            ax.plot(np.asarray(x)[on] * 1e3, p[on] / 1e6, "o", ms=3, mfc="none", **kw)
         else:
             ax.plot(np.asarray(x) * 1e3, np.asarray(s["pressure"]) / 1e6, "-", lw=1, **kw)
     ax.set(xlabel="x (mm)", ylabel="pressure (MPa)", title=title)
