@@ -69,6 +69,8 @@ class StudySummary:
         Wall time of this run (seconds), executor start-up included.
     task_s : float
         Sum of the worker wall times of the tasks finished by this run.
+    task_cpu_s : float
+        Sum of their CPU times (the cost on idle cores).
     executor : str
         Executor description.
     """
@@ -81,16 +83,18 @@ class StudySummary:
     wall_s: float
     task_s: float
     executor: str
+    task_cpu_s: float = 0.0
 
     @property
     def complete(self) -> bool:
         return self.n_cached + self.n_done == self.n_tasks
 
     def describe(self) -> str:
-        mean = self.task_s / self.n_done if self.n_done else float("nan")
+        n = max(self.n_done, 1)
         return (f"{self.n_tasks} tasks: {self.n_cached} already done, {self.n_done} computed, "
-                f"{self.n_failed} failed ({self.n_retries} retries); wall {self.wall_s:.1f} s, "
-                f"mean cost {mean:.3g} s/task on the workers; {self.executor}")
+                f"{self.n_failed} failed ({self.n_retries} retries); wall {self.wall_s:.1f} s; "
+                f"per task {self.task_s / n:.3g} s wall, {self.task_cpu_s / n:.3g} s CPU on "
+                f"the workers; {self.executor}")
 
 
 class _Progress:
@@ -161,7 +165,7 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     summary = StudySummary(n_tasks=len(tasks), n_cached=n_cached, n_done=counts["done"],
                            n_failed=counts["failed"], n_retries=counts["retries"],
                            wall_s=time.perf_counter() - t_start, task_s=counts["task_s"],
-                           executor=description)
+                           task_cpu_s=counts["task_cpu_s"], executor=description)
     log(summary.describe())
     return summary
 
@@ -224,6 +228,7 @@ def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached):
                 store.clear_failure(outdir, task.key)
                 counts["done"] += 1
                 counts["task_s"] += out["elapsed_s"]
+                counts["task_cpu_s"] += out["cpu_s"]
                 bar.update(1, counts["done"] + n_cached, counts["failed"])
             else:
                 store.record_failure(outdir, task, {
