@@ -123,7 +123,8 @@ def test_mpi_two_ranks_gives_identical_table(reference, tmp_path):
          "--executor", "mpi", "--no-progress"],
         capture_output=True, text=True, timeout=60, cwd=tmp_path, env=dict(os.environ))
     if proc.returncode != 0 and "mpi executor" not in proc.stdout:
-        pytest.skip(f"mpirun does not work here (exit {proc.returncode}): {proc.stdout[-800:]} {proc.stderr[-800:]}")
+        pytest.skip(f"mpirun does not work here (exit {proc.returncode}): "
+                    f"{proc.stdout[-800:]} {proc.stderr[-800:]}")
     assert proc.returncode == 0, proc.stderr
     assert "mpi executor, 1 worker(s)" in proc.stdout
     assert _table(tmp_path / "mpi") == reference

@@ -153,7 +153,8 @@ class DaskExecutor(_Base):
             try:
                 self._client = distributed.Client(**where, timeout="30s")
             except (OSError, TimeoutError) as exc:
-                raise InputError(f"cannot reach the dask scheduler at {scheduler!r}: {exc}") from None
+                raise InputError(
+                    f"cannot reach the dask scheduler at {scheduler!r}: {exc}") from None
             self.n_workers = max(1, len(self._client.scheduler_info()["workers"]))
         else:
             self.n_workers = workers or available_cores()

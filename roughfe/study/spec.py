@@ -245,7 +245,8 @@ def spec_from_mapping(data: Mapping[str, Any], *, output=None) -> StudySpec:
                          "'analysis' and 'output'")
     extra = set(study) - STUDY_KEYS
     if extra:
-        raise InputError(f"unknown key(s) {sorted(extra)} in [study]; allowed: {sorted(STUDY_KEYS)}")
+        raise InputError(f"unknown key(s) {sorted(extra)} in [study]; "
+                         f"allowed: {sorted(STUDY_KEYS)}")
     for needed in ("analysis",):
         if needed not in study:
             raise InputError(f"[study] needs '{needed}'")
