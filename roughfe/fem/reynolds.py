@@ -125,6 +125,7 @@ class _GridSpace:
     velocity: object   # Constant vector: wall velocity (m/s)
     a: object          # compiled stiffness form
     L: object          # compiled Couette load form
+    K: object          # PETSc matrix with the sparsity of ``a`` (re-assembled per solve)
     dof_of_vertex: np.ndarray   # (nx+1)*(ny+1) structured vertex -> Q1 dof
     dof_of_cell: np.ndarray     # nx*ny structured cell -> DG0 dof
 
@@ -160,7 +161,9 @@ def _grid_space(nx: int, ny: int, lx: float, ly: float) -> _GridSpace:
     jc = np.floor(xc[:, 1] / dy).astype(np.int64)
     dof_of_cell = np.empty(nx * ny, dtype=np.int32)
     dof_of_cell[ic * ny + jc] = np.arange(xc.shape[0], dtype=np.int32)
-    return _GridSpace(msh, h, mu, velocity, a, L, dof_of_vertex, dof_of_cell)
+    import dolfinx.fem.petsc as fem_petsc
+    K = fem_petsc.create_matrix(a)
+    return _GridSpace(msh, h, mu, velocity, a, L, K, dof_of_vertex, dof_of_cell)
 
 
 def vertex_components(open_cells: np.ndarray, *, periodic_axis: Optional[int] = None):
@@ -270,7 +273,9 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     space.h.x.array[space.dof_of_cell] = h.ravel()
     space.mu.value = mu
     space.velocity.value = u
-    K = fem_petsc.assemble_matrix(space.a)
+    K = space.K                       # cached sparsity; values re-assembled here
+    K.zeroEntries()
+    fem_petsc.assemble_matrix(K, space.a)
     K.assemble()
     nv = (nx + 1) * (ny + 1)
     b_dof = np.zeros(nv)
@@ -359,7 +364,7 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     Kl.setArray(p_dof)
     K.mult(Kl, Klift)
     r_dof = Klift.array - b_dof
-    for obj in (Kl, Klift, K):
+    for obj in (Kl, Klift):
         obj.destroy()
 
     p = p_dof[dofs]                      # structured vertex order
