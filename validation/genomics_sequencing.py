@@ -132,7 +132,7 @@ def main(outdir: Path) -> bool:
 
     md = ["# Genome sequencing (thesis Sec. 3.3-3.4)", "",
           "## (i) Table 1 genome, sequenced from 10x/20x/100x (N = 512), per seed of the phases", "",
-          "| seed | gamma | lambda1 (mm) | H | A | M | H (PSD hull, thesis) | rms 10x / 20x / 100x | "
+          "| seed | gamma | lambda1 (mm) | H | A | M | H (PSD peak slope, thesis) | rms 10x / 20x / 100x | "
           "max dA, dK thesis | max dA, dK strip | time (s) |",
           "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:

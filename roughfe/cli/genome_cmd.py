@@ -62,7 +62,7 @@ def _print_sequencing(res):
     for k, (L, r, e) in enumerate(zip(res.lengths, res.ranges, res.rms_errors)):
         print(f"  acquisition {k + 1}: L = {L:.6g} m, n = {r[0]}..{r[1]}, relative rms error "
               f"{100 * e:.4g} %")
-    print(f"  PSD-only estimates (thesis): gamma = {res.gamma_psd:.5g}, H (hull slope) = {res.H_psd:.4g}")
+    print(f"  PSD-only estimates (thesis): gamma = {res.gamma_psd:.5g}, H (peak slope) = {res.H_psd:.4g}")
     print(f"  {'success' if res.success else 'FAILED quality check'}: {res.message}")
 
 

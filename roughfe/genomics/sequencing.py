@@ -481,8 +481,9 @@ class SequencingResult:
         sequenced counterpart (m); empty when they share no node.
     spectra : list of SpectrumPeaks
     gamma_psd, H_psd : float
-        gamma from the PSD peaks alone (comb, step 2) and H from the slope of the upper
-        hull peaks (log C ~ -2H log q, Eq. 3.11): the thesis's estimates, for comparison.
+        gamma from the PSD peaks alone (comb, step 2) and H from the slope of the PSD
+        peaks on the lattice (ln C ~ -2H ln q, Eq. 3.11): the thesis's estimates, for
+        comparison with the fit and the maximum-likelihood H.
     M_loglik : ndarray
         Log-likelihood of M = 2..20 (flat-ish: M is weakly identifiable).
     A0 : float
@@ -539,17 +540,27 @@ def _rel_rms(z, fit):
     return math.sqrt(float(np.mean((z - fit) ** 2))) / rz if rz > 0 else math.inf
 
 
-def _hull_slope_H(spectra):
-    """H from the upper-hull peaks: ln C = const - 2H ln q (Eq. 3.11), all acquisitions."""
-    lq, lc = [], []
-    for sp in spectra:
-        h = sp.hull[(sp.hull > 2) & (sp.hull < sp.q.size - 2)]
-        lq.append(np.log(sp.q[h]))
-        lc.append(np.log(sp.C[h]))
-    lq, lc = np.concatenate(lq), np.concatenate(lc)
-    if lq.size < 2:
+def _peak_slope_H(spectra, log_q1, log_gamma):
+    """H from the PSD peaks on the fitted lattice: ln C_peak = c_i - 2H ln q (Eq. 3.11).
+
+    The thesis's estimate (slope of the line through the retained peaks). A spectral line
+    of amplitude c gives a periodogram peak C ~ c^2 L_i whatever its q, so the peaks
+    fall as q_n^(-2H); one intercept per acquisition absorbs L_i. Peaks farther than 0.15
+    lattice steps from the lattice (aliases, leakage) are ignored.
+    """
+    lq, lc, which = [], [], []
+    for i, sp in enumerate(spectra):
+        k = (np.log(sp.peak_q) - log_q1) / log_gamma
+        on = np.abs(k - np.round(k)) < 0.15
+        lq.append(np.log(sp.peak_q[on]))
+        lc.append(np.log(sp.peak_C[on]))
+        which.append(np.full(int(on.sum()), i))
+    lq, lc, which = np.concatenate(lq), np.concatenate(lc), np.concatenate(which)
+    if lq.size < len(spectra) + 2:
         return float("nan")
-    return float(-np.polyfit(lq, lc, 1)[0] / 2)
+    design = np.column_stack([lq] + [(which == i).astype(float) for i in range(len(spectra))])
+    coef, *_ = np.linalg.lstsq(design, lc, rcond=None)
+    return float(-coef[0] / 2)
 
 
 def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restarts=3) -> SequencingResult:
@@ -681,7 +692,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         genome=genome, success=ok, message=message, nit=nit, n=n, amplitudes=amps, phases=thetas,
         ranges=ranges, lengths=np.array([a.length for a in acqs]), rms_errors=rms,
         x=[a.x for a in acqs], heights=[a.z for a in acqs], fitted=fitted, zd_x=zd_x, zd=zd,
-        zd_fit=zd_fit, spectra=spectra, gamma_psd=gamma_psd, H_psd=_hull_slope_H(spectra),
+        zd_fit=zd_fit, spectra=spectra, gamma_psd=gamma_psd, H_psd=_peak_slope_H(spectra, lq1, lg),
         M_loglik=loglik, A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1),
                                                gamma, lam1, H),
         seed=int(seed), elapsed=time.perf_counter() - t0)
