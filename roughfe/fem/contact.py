@@ -317,13 +317,16 @@ class _ContactProblem:
             F.array[self.top_dofs] += self.kappa * self.weights * pen
 
     def _jacobian(self, snes, x, J, P):
+        """VI: the constant stiffness K. Penalty: K + kappa w_i on the penetrating u_y."""
+        from petsc4py import PETSc
+
         if self.options.method == "penalty":
             self.K.copy(J, structure=J.Structure.SAME_NONZERO_PATTERN)
             active = (x.array_r[self.top_dofs] > self.bound).astype(float)
             d = J.createVecLeft()
             d.set(0.0)
             d.array[self.top_dofs] = self.kappa * self.weights * active
-            J.setDiagonal(d, addv=True)
+            J.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
             J.assemble()
 
     def _make_snes(self):
