@@ -34,7 +34,7 @@ class Analysis:
     version : str
         Part of every task key; change it when the results change.
     description : str
-        One line for ``--help`` and ``roughfe study run --list``.
+        One line for ``roughfe study run --help``.
     """
 
     target: str
