@@ -156,6 +156,8 @@ def study_figures(summary, outdir) -> list:
     def per_d(ax, x, y, logy=False, err=None):
         for D, rows in sorted(byD.items()):
             xs, ys = _series(rows, x, y)
+            if logy:
+                ys = np.where(ys > 0, ys, np.nan)      # zero volumes have no logarithm
             if err:
                 _, es = _series(rows, x, err)
                 ax.errorbar(xs, ys, yerr=es, marker="o", capsize=2, label=f"D={D:g}")
