@@ -40,10 +40,13 @@ lines; the same definitions are evaluated with array operations and a graph):
    virtual outlet node joined to every cross-section of the last row. The network
    percolates when inlet and outlet are in one connected component. "Open paths are
    obtained by iterating C recursively, excluding channels that present only one
-   connection": cross-sections with fewer than two connections are removed
-   repeatedly (dead ends, Fig. 11-12: the connection 6-7 is non-percolating). What
-   remains in the inlet-outlet component is ``U_p^a``. A dead-end *loop* hanging on a
-   single cross-section survives this recursion, as in the thesis.
+   connection" (dead ends, Fig. 11-12: the connection 6-7 is non-percolating). We keep
+   exactly the cross-sections that lie on some open (self-avoiding) path from the inlet
+   to the outlet: the *backbone*, i.e. the biconnected block that contains an extra edge
+   inlet-outlet (Tarjan's lowpoint search, linear in the graph size). This removes the
+   dead-end branches the thesis' recursion removes, and also two cases it leaves:
+   dead-end loops hanging on one cross-section, and pockets whose only openings are on
+   the inlet (or only on the outlet) side, in which the fluid stands still.
 6. **Union over directions.** ``U_p = U_p^x u U_p^y`` (Sec. 2.4.2), ``V_p = sum over U_p``
    (Eq. 2.15), ``V_np = V - V_p`` (Eq. 2.16), made dimensionless with ``L^2 sigma``
    (``L^2`` the nominal area, ``sigma`` the rms height of the undeformed surface).
@@ -87,8 +90,8 @@ class DirectionalNetwork:
         Channels that exist through a saddle point (diagonal-only contact, Fig. 13a).
     n_rejected_diagonals : int
         Diagonal-only contacts without a saddle point (Fig. 13b): no channel.
-    n_pruning_passes : int
-        Passes of the dead-end removal (the recursion depth of the thesis' step).
+    n_backbone_sections : int
+        Cross-sections on open inlet-outlet paths.
     """
 
     direction: str
@@ -99,7 +102,7 @@ class DirectionalNetwork:
     hydraulic_diameter: np.ndarray
     saddle: np.ndarray
     n_rejected_diagonals: int
-    n_pruning_passes: int
+    n_backbone_sections: int
 
     @property
     def n_sections(self) -> int:
@@ -193,6 +196,65 @@ def _diagonal_pairs(o, g, shift, periodic):
     return diag, saddle, d_zc
 
 
+def _backbone(n_nodes: int, edges: np.ndarray, source: int, target: int) -> np.ndarray:
+    """Nodes on some self-avoiding path from ``source`` to ``target`` (undirected graph).
+
+    They are the nodes of the biconnected block that contains the extra edge
+    ``(source, target)``. Iterative Tarjan lowpoint depth-first search from ``source``
+    that takes the extra edge first: the block is what lies on the edge stack above that
+    edge when its child ``target`` is finished. Linear in nodes + edges.
+    """
+    e = np.concatenate([np.array([[source, target]], dtype=np.int64), edges])
+    e = e[e[:, 0] != e[:, 1]]
+    m = len(e)
+    heads = np.concatenate([e[:, 0], e[:, 1]])
+    tails = np.concatenate([e[:, 1], e[:, 0]])
+    eid = np.concatenate([np.arange(m), np.arange(m)])
+    order = np.lexsort((eid, heads))           # per node, edge 0 (source-target) first
+    nbr, nbr_e = tails[order].tolist(), eid[order].tolist()
+    ptr = np.searchsorted(heads[order], np.arange(n_nodes + 1)).tolist()
+    disc = [-1] * n_nodes
+    low = [0] * n_nodes
+    nxt = ptr[:-1]                              # next neighbour to visit, per node
+    disc[source] = low[source] = 0
+    counter = 1
+    stack = [(source, -1)]                      # (node, edge id used to reach it)
+    edge_stack = []
+    while stack:
+        v, pe = stack[-1]
+        if nxt[v] < ptr[v + 1]:
+            k = nxt[v]
+            nxt[v] += 1
+            w, ew = nbr[k], nbr_e[k]
+            if ew == pe:
+                continue
+            if disc[w] < 0:
+                edge_stack.append(ew)
+                disc[w] = low[w] = counter
+                counter += 1
+                stack.append((w, ew))
+            elif disc[w] < disc[v]:
+                edge_stack.append(ew)
+                low[v] = min(low[v], disc[w])
+            continue
+        stack.pop()
+        if not stack:
+            break
+        u = stack[-1][0]
+        low[u] = min(low[u], low[v])
+        if low[v] >= disc[u]:
+            block = []
+            while True:
+                x = edge_stack.pop()
+                block.append(x)
+                if x == pe:
+                    break
+            if pe == 0:                         # the block of the source-target edge
+                nodes = np.unique(e[block].ravel())
+                return nodes
+    return np.array([source, target], dtype=np.int64)
+
+
 def directional_network(open_cells, gap, spacing, direction: str = "x", *,
                         periodic: bool = False,
                         min_hydraulic_diameter: float = 0.0) -> DirectionalNetwork:
@@ -275,20 +337,8 @@ def directional_network(open_cells, gap, spacing, direction: str = "x", *,
     percolates = bool(comp[inlet] == comp[outlet])
 
     alive = np.zeros(nn, dtype=bool)
-    passes = 0
     if percolates:
-        alive = comp == comp[inlet]
-        anchor = np.zeros(nn, dtype=bool)
-        anchor[[inlet, outlet]] = True
-        while True:
-            e_alive = alive[edges[:, 0]] & alive[edges[:, 1]]
-            deg = (np.bincount(edges[e_alive, 0], minlength=nn)
-                   + np.bincount(edges[e_alive, 1], minlength=nn))
-            dead_end = alive & ~anchor & (deg < 2)
-            if not dead_end.any():
-                break
-            alive &= ~dead_end
-            passes += 1
+        alive[_backbone(nn, edges, inlet, outlet)] = True
     perc = np.zeros_like(o)
     perc[o] = alive[sec[o]]
     if axis == 1:
@@ -296,7 +346,8 @@ def directional_network(open_cells, gap, spacing, direction: str = "x", *,
     return DirectionalNetwork(
         direction=direction, percolates=percolates, percolating=np.ascontiguousarray(perc),
         section=np.ascontiguousarray(sec), channels=channels, hydraulic_diameter=dh,
-        saddle=is_saddle, n_rejected_diagonals=n_rejected, n_pruning_passes=passes)
+        saddle=is_saddle, n_rejected_diagonals=n_rejected,
+        n_backbone_sections=int(alive[:nsec].sum()))
 
 
 def free_volume_network(gap, contact, spacing, *, directions: Sequence[str] = ("x", "y"),
