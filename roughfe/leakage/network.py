@@ -79,7 +79,7 @@ class DirectionalNetwork:
     percolates : bool
         Whether an open path joins the inlet side (index 0) to the outlet side.
     percolating : ndarray of bool, shape (nx, ny)
-        Cells of ``U_p^i`` (cross-sections left after removing dead ends).
+        Cells of ``U_p^i``: the cross-sections on open inlet-outlet paths (backbone).
     section : ndarray of int, shape (nx, ny)
         Cross-section label of each open cell, -1 elsewhere.
     channels : ndarray of int, shape (n_channels, 2)
