@@ -144,6 +144,16 @@ def _operator(shape, size, e_star, kernel) -> InfluenceOperator:
     return influence_operator(shape, size, e_star, kernel)
 
 
+@functools.lru_cache(maxsize=16)
+def _inverse_spectrum(op: InfluenceOperator) -> np.ndarray:
+    return op.inverse_spectrum()
+
+
+def _preconditioner(op: InfluenceOperator):
+    """The map g -> M g with M ~ H^-1 (exact stiffness E*|q|/2 when periodic)."""
+    return functools.partial(op.convolve_spectrum, spectrum=_inverse_spectrum(op))
+
+
 @functools.lru_cache(maxsize=4)
 def _dense(op: InfluenceOperator) -> np.ndarray:
     return op.dense()
@@ -223,16 +233,10 @@ def _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter):
     imposed gap). The primal form would have to find the mean pressure through a
     direction of zero curvature, which stalls the CG.
     """
-    import scipy.fft
-    from .solvers import polonsky_keer
-    shape = b.shape
-    inv = np.where(op.spectrum > 0, 1.0 / np.where(op.spectrum > 0, op.spectrum, 1.0), 0.0)
-
-    def stiff(v):
-        return scipy.fft.irfftn(scipy.fft.rfftn(v) * inv, s=shape)
-
+    stiff = _preconditioner(op)
     s = delta + b
     gbar = -float(s.mean())
+    compliance = functools.partial(op.convolve_spectrum, spectrum=op.spectrum)
     Ks = stiff(s)
     w0 = None
     if initial is not None and np.any(initial > 0):
@@ -242,13 +246,16 @@ def _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter):
             w0 = None
     pscale = float(np.ptp(Ks)) or 1.0
     o = polonsky_keer(stiff, -Ks, pscale, mean_pressure=gbar, initial=w0,
-                      diagonal=1.0 / op.diagonal, tol=tol, max_iter=max_iter)
+                      diagonal=float(stiff(np.eye(1, b.size).reshape(b.shape)).flat[0]),
+                      precond=compliance, tol=tol,
+                      max_iter=max_iter)
     w = o.pressure
     u = w + s
     p = np.maximum(stiff(u) - o.delta, 0.0)
     p[w > 0] = 0.0
-    res = kkt_residual(p, op.apply(p) - s, scale)
-    return SolverOutput(p, op.apply(p), delta, o.nit, max(res, o.residual), "pk")
+    u = op.apply(p)
+    res = kkt_residual(p, u - s, scale)
+    return SolverOutput(p, u, delta, o.nit, max(res, o.residual), "pk")
 
 
 def _stiffness(op, solver, p, w, scale):
@@ -351,7 +358,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
             out = _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter or 20000)
         elif solver == "pk":
             out = polonsky_keer(op.apply, b, scale, delta=delta, mean_pressure=mean_pressure,
-                                initial=initial, diagonal=op.diagonal, tol=tol,
+                                initial=initial, diagonal=op.diagonal,
+                                precond=_preconditioner(op), tol=tol,
                                 max_iter=max_iter or 20000)
         else:
             H = _dense(op)

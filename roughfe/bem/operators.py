@@ -56,7 +56,7 @@ from ..reference import uniform_rectangle_displacement, uniform_strip_displaceme
 from ..surfaces.stats import angular_wavevectors
 
 KERNELS = ("spectral", "strip", "thesis", "love")
-WORKERS = max(1, min(4, os.cpu_count() or 1))
+WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads per FFT
 
 _KERNEL_REFERENCES = {
     "spectral": ("Stanley H.M., Kato T. (1997) J. Tribol. 119:481-485",),
@@ -120,6 +120,30 @@ class InfluenceOperator:
         if self.periodic:
             return u
         return u[tuple(slice(0, n) for n in self.shape)]
+
+    def inverse_spectrum(self):
+        """Spectrum (Pa/m) of an approximate inverse of H on the ``shape`` grid.
+
+        Periodic: the exact stiffness E*|q|/2 (zero at q = 0). Non-periodic: the inverse
+        of Strang's circulant approximation of the Toeplitz operator (offsets up to
+        n/2 kept, floored at 1e-12 of its maximum). Used as the CG preconditioner.
+        """
+        if self.periodic:
+            spec = self.spectrum
+        else:
+            idx = np.ix_(*[np.where(np.arange(n) <= n // 2, np.arange(n), np.arange(n) - n)
+                           % m for n, m in zip(self.shape, self.fft_shape)])
+            spec = scipy.fft.rfftn(self.kernel[idx]).real
+            spec = np.maximum(spec, 1e-12 * spec.max())
+        with np.errstate(divide="ignore"):
+            return np.where(spec > 0, 1.0 / np.where(spec > 0, spec, 1.0), 0.0)
+
+    def convolve_spectrum(self, v, spectrum):
+        """Circular convolution of ``v`` (``shape``) with a multiplier on its rFFT."""
+        axes = tuple(range(v.ndim))
+        vh = scipy.fft.rfftn(v, axes=axes, workers=WORKERS)
+        vh *= spectrum
+        return scipy.fft.irfftn(vh, s=v.shape, axes=axes, workers=WORKERS)
 
     def dense(self, index=None):
         """The dense matrix H (m/Pa), rows and columns in C order of the grid.

@@ -182,64 +182,101 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
 
 # -- matrix-free: Polonsky & Keer constrained conjugate gradients ------------------------
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
-                  diagonal=1.0, tol=1e-10, max_iter=10000):
-    """Polonsky & Keer (1999) constrained CG with FFT products (two per iteration).
+                  diagonal=1.0, precond=None, tol=1e-10, max_iter=10000):
+    """Polonsky & Keer (1999) constrained CG with FFT operator products.
 
     Load control (``mean_pressure``): the gap is projected on zero mean over the
-    contact set and the pressure rescaled to the load after each step; Delta is the
-    mean of ``u - b`` over the contact set at convergence. Displacement control
-    (``delta``): the plain projected CG on Eq. 2.6 (as in Tamaas' PolonskyKeerRey with
-    an imposed gap). ``diagonal`` (m/Pa, H_ii) sets the first trial pressure.
+    contact set S and the pressure rescaled to the load after each step; Delta is the
+    mean of ``u - b`` over S at convergence. Displacement control (``delta``): the plain
+    projected CG on Eq. 2.6 (positive definite H only).
+
+    ``precond`` (a linear map, e.g. the stiffness operator E*|q|/2 = H^-1) turns the
+    CG on S into a preconditioned CG (search direction from z = P_S M P_S g instead of
+    g, Fletcher-Reeves beta = g.z / g_old.z_old, exact line search): on rough surfaces
+    it cuts the iterations 3-4 fold and makes them grow much more slowly with n.
+    ``diagonal`` (m/Pa, H_ii) scales the first trial pressure in displacement control
+    and the (Jacobi) step that gives pressure to penetrating points with a
+    preconditioner.
+
+    The displacement is updated without a transform (u <- a (u - tau H t)) whenever a
+    step changes neither the contact set by clipping nor the overlap set, and is
+    recomputed otherwise and every 50 iterations; convergence is always confirmed on
+    a recomputed u. Returns a :class:`SolverOutput`.
     """
     load = mean_pressure is not None
     if initial is not None:
-        p = np.array(initial, dtype=float).reshape(b.shape)
-        p = np.maximum(p, 0.0)
-        if load and p.mean() <= 0:
-            p[:] = mean_pressure
-        elif load:
-            p *= mean_pressure / p.mean()
+        p = np.maximum(np.array(initial, dtype=float).reshape(b.shape), 0.0)
+        if load:
+            pm = p.mean()
+            p = np.full(b.shape, float(mean_pressure)) if pm <= 0 else p * (mean_pressure / pm)
     elif load:
         p = np.full(b.shape, float(mean_pressure))
     else:
         p = np.maximum(-(delta + b), 0.0) / diagonal
     t = np.zeros_like(p)
-    g_old, conj = 1.0, False
+    gz_old, conj = 1.0, False
     res = np.inf
     d = float(delta) if not load else 0.0
+    u, exact = None, False
     for it in range(1, max_iter + 1):
-        u = apply(p)
+        if u is None or it % 50 == 0:
+            u, exact = apply(p), True
         g = u - b
         S = p > 0
+        nS = int(np.count_nonzero(S))
         if load:
-            d = float(g[S].mean()) if S.any() else float(g.min())
+            d = float(np.sum(g, where=S)) / nS if nS else float(g.min())
         g -= d
         res = kkt_residual(p, g, scale)
         if res <= tol:
-            return SolverOutput(p, u, d, it, res, "pk")
-        gS = g[S]
-        G = float(gS @ gS)
-        if conj:
-            t[S] = gS + (G / g_old) * t[S]
+            if exact:
+                return SolverOutput(p, u, d, it, res, "pk")
+            u = None          # confirm on a freshly computed displacement
+            continue
+        gm = g * S
+        if precond is not None:
+            z = precond(gm)
+            z *= S
+            if load and nS:
+                z -= float(z.sum()) / nS
+                z *= S
         else:
-            t[S] = gS
-        t[~S] = 0.0
-        g_old = G
+            z = gm
+        gz = float(np.vdot(gm, z))
+        if conj and gz_old > 0:
+            t *= S
+            t *= gz / gz_old
+            t += z
+        else:
+            t = z.copy()
+        gz_old = gz
         r = apply(t)
-        if load:
-            r -= r[S].mean()
-        den = float(r[S] @ t[S])
-        tau = float(gS @ t[S]) / den if den > 0 else 0.0
-        p[S] -= tau * t[S]
-        np.maximum(p, 0.0, out=p)
+        tr = float(np.vdot(r, t))
+        if load and nS:
+            tr -= float(np.sum(r, where=S)) / nS * float(t.sum())
+        tau = float(np.vdot(gm, t)) / tr if tr > 0 else 0.0
+        p -= tau * t
+        clipped = float(p.min()) < 0.0
+        if clipped:
+            np.maximum(p, 0.0, out=p)
         overlap = (p == 0.0) & (g < 0.0)
         conj = not overlap.any()
         if not conj:
-            step = tau if tau > 0 else 1.0 / diagonal
-            p[overlap] -= step * g[overlap]
+            # PK's step tau is in Pa/m only without preconditioner; else a Jacobi step
+            step = tau if (tau > 0 and precond is None) else 1.0 / diagonal
+            p -= step * (g * overlap)
+        alpha = 1.0
         if load:
-            pm = p.mean()
-            p *= (mean_pressure / pm) if pm > 0 else 1.0
+            pm = float(p.mean())
+            alpha = mean_pressure / pm if pm > 0 else 1.0
+            p *= alpha
+        if clipped or not conj:
+            u = apply(p)
+            exact = True
+        else:
+            u -= tau * r
+            u *= alpha
+            exact = False
     _fail("Polonsky-Keer CG", max_iter, res, tol, p, apply(p), d, "pk")
 
 
