@@ -16,6 +16,7 @@ from ..errors import InputError
 VALIDATIONS = {
     "fem": "bem_vs_fem",
     "sequencing": "genomics_sequencing",
+    "design": "design_study",
 }
 
 
