@@ -49,7 +49,7 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
 def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
     from roughfe.cli import main
     out = tmp_path / "study"
-    argv = ["leak-study", "--D", "2.3", "2.7", "--m", "3", "--surfaces", "2",
+    argv = ["leak-study", "--D", "2.3", "2.7", "--m", "3", "--surfaces", "2", "--no-reynolds",
             "--workers", "1", "--no-progress", "-o", str(out)]
     assert main(argv) == 0
     summary = json.loads((out / "summary.json").read_text())
