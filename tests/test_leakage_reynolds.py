@@ -10,6 +10,7 @@ import pytest
 
 from roughfe.errors import InputError
 from roughfe.leakage import analyse_leakage, hydraulic_aperture, reynolds_flow
+from roughfe.leakage.finite_volume import finite_volume_leak_rate
 
 MU = 1.0e-3          # Pa s (water)
 DP = 1.0e3           # Pa
@@ -152,34 +153,6 @@ def test_bad_input_is_named():
         reynolds_flow(np.ones((3, 3)), (DX, DY), pressure_drop=0.0)
 
 
-def _fv_leak_rate(g, spacing, dp):
-    """Independent cell-centred finite volumes (two-point flux, harmonic-mean
-    transmissibility), flow along x, no-flux side walls: the classical Reynolds scheme."""
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import spsolve
-    nx, ny = g.shape
-    dx, dy = spacing
-    k = g**3 / (12 * MU)
-    idx = np.arange(nx * ny).reshape(nx, ny)
-    rows, cols, vals = [], [], []
-    rhs = np.zeros(nx * ny)
-
-    def couple(a, b, t):
-        rows.extend([a, b, a, b]); cols.extend([a, b, b, a]); vals.extend([t, t, -t, -t])
-
-    tx = dy / dx * 2 * k[:-1] * k[1:] / (k[:-1] + k[1:])
-    ty = dx / dy * 2 * k[:, :-1] * k[:, 1:] / (k[:, :-1] + k[:, 1:])
-    couple(idx[:-1].ravel(), idx[1:].ravel(), tx.ravel())
-    couple(idx[:, :-1].ravel(), idx[:, 1:].ravel(), ty.ravel())
-    tin, tout = dy / (dx / 2) * k[0], dy / (dx / 2) * k[-1]
-    rows.extend([idx[0], idx[-1]]); cols.extend([idx[0], idx[-1]]); vals.extend([tin, tout])
-    rhs[idx[0]] += tin * dp
-    A = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                      shape=(nx * ny,) * 2)
-    p = spsolve(A.tocsc(), rhs).reshape(nx, ny)
-    return float(np.sum(tin * (dp - p[0])))
-
-
 def test_mesh_convergence_and_agreement_with_finite_volumes():
     # smooth 2D gap: Q1-FE and an independent finite-volume scheme converge (2nd order)
     # to the same leak rate
@@ -194,7 +167,7 @@ def test_mesh_convergence_and_agreement_with_finite_volumes():
     for n in (16, 32, 64):
         sp_ = (length / n, length / n)
         fe.append(reynolds_flow(gap(n), sp_, mu=MU, pressure_drop=DP).leak_rate)
-        fv.append(_fv_leak_rate(gap(n), sp_, DP))
+        fv.append(finite_volume_leak_rate(gap(n), sp_, mu=MU, pressure_drop=DP))
     fe, fv = np.array(fe), np.array(fv)
     order_fe = np.log2(abs(fe[1] - fe[0]) / abs(fe[2] - fe[1]))
     order_fv = np.log2(abs(fv[1] - fv[0]) / abs(fv[2] - fv[1]))
@@ -202,3 +175,15 @@ def test_mesh_convergence_and_agreement_with_finite_volumes():
     # Richardson-extrapolated limits agree far better than either scheme at n = 64
     lim_fe, lim_fv = (4 * fe[2] - fe[1]) / 3, (4 * fv[2] - fv[1]) / 3
     assert abs(lim_fe / lim_fv - 1) < 0.1 * abs(fe[2] / fv[2] - 1) + 1e-5
+
+
+def test_finite_volume_check_is_exact_on_plates_and_sees_no_corner_flow():
+    q = finite_volume_leak_rate(np.full((8, 5), H), (DX, DY), mu=MU, pressure_drop=DP)
+    assert q == pytest.approx(plates(H, 5 * DY, DP, 8 * DX), rel=1e-12)
+    qy = finite_volume_leak_rate(np.full((8, 5), H), (DX, DY), direction="y", mu=MU,
+                                 pressure_drop=DP)
+    assert qy == pytest.approx(plates(H, 8 * DX, DP, 5 * DY), rel=1e-12)
+    # two blocks touching at a corner: finite volumes see no path, Q1 conducts
+    g = np.array([[1, 1, 0, 0], [1, 1, 0, 0], [0, 0, 1, 1], [0, 0, 1, 1.]]) * H
+    assert finite_volume_leak_rate(g, (DX, DX), mu=MU, pressure_drop=DP) == 0.0
+    assert reynolds_flow(g, (DX, DX), mu=MU, pressure_drop=DP).leak_rate > 0

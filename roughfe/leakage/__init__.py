@@ -6,13 +6,17 @@
   (Eq. 2.10-2.12) solved with dolfinx (Q1 pressure, DG0 gap).
 * :func:`analyse_leakage` / :func:`leakage_of_contact` -> :class:`LeakageResult`: both on
   one gap field (for example a BEM ``ContactResult``).
+* :func:`finite_volume_leak_rate`: an independent two-point-flux finite-volume leak rate
+  (scipy only) to cross-check the finite elements.
 * :mod:`roughfe.leakage.study`: the percolation study of Sec. 2.4.2-2.4.5.
 """
 from .analysis import (LeakageResult, LeakageSweep, analyse_leakage, leakage_of_contact,
                        leakage_sweep)
 from .network import DirectionalNetwork, NetworkResult, directional_network, free_volume_network
+from .finite_volume import finite_volume_leak_rate
 from .reynolds import ReynoldsResult, hydraulic_aperture, reynolds_flow
 
 __all__ = ["free_volume_network", "directional_network", "NetworkResult", "DirectionalNetwork",
            "reynolds_flow", "ReynoldsResult", "hydraulic_aperture", "analyse_leakage",
-           "leakage_of_contact", "LeakageResult", "leakage_sweep", "LeakageSweep"]
+           "leakage_of_contact", "LeakageResult", "leakage_sweep", "LeakageSweep",
+           "finite_volume_leak_rate"]
