@@ -182,7 +182,40 @@ def spectrum_peaks(acq: Acquisition, min_bin=4, prominence=2.0) -> SpectrumPeaks
     ym, y0, yp = logc[cand - 1], logc[cand], logc[cand + 1]
     den = ym - 2 * y0 + yp
     shift = np.where(den < 0, 0.5 * (ym - yp) / np.where(den < 0, den, -1.0), 0.0)
-    return SpectrumPeaks(q, C, hull, q[cand] + np.clip(shift, -0.5, 0.5) * dq, C[cand])
+    q0 = q[cand] + np.clip(shift, -0.5, 0.5) * dq
+    return SpectrumPeaks(q, C, hull, refine_peaks(acq, q0, dq), C[cand])
+
+
+def refine_peaks(acq: Acquisition, q0, dq, n_iter=40):
+    """Wavenumbers maximising the Hann-windowed DTFT power |sum w z e^{-i q x}|^2 near q0.
+
+    A golden-section search within +-0.75 bin of each parabolic estimate: a line's
+    windowed spectrum peaks at its own wavenumber, up to the leakage of the other lines
+    (Hann sidelobes fall as 1/k^3, the neighbouring chromosomes are many bins away), so
+    the estimate is far finer than a bin. All peaks are refined at once (vectorised).
+    """
+    q0 = np.asarray(q0, dtype=float)
+    if q0.size == 0:
+        return q0
+    w = np.hanning(acq.z.size)
+    zw = (acq.z - acq.z.mean()) * w
+
+    def power(qs):
+        return np.abs(np.exp(-1j * np.multiply.outer(qs, acq.x)) @ zw) ** 2
+
+    a, b = q0 - 0.75 * dq, q0 + 0.75 * dq
+    r = (math.sqrt(5) - 1) / 2
+    c, d = b - r * (b - a), a + r * (b - a)
+    fc, fd = power(c), power(d)
+    for _ in range(n_iter):
+        left = fc > fd                         # maximum in [a, d]
+        b = np.where(left, d, b)
+        a = np.where(left, a, c)
+        c_new = b - r * (b - a)
+        d_new = a + r * (b - a)
+        c, d = c_new, d_new
+        fc, fd = power(c), power(d)
+    return 0.5 * (a + b)
 
 
 # -- step 2-3: the lattice -----------------------------------------------------------------
@@ -326,26 +359,14 @@ def _scan(p, cap, acqs, ranges, weights, rhs, span=(0.015, 0.03), shape=(31, 13)
     return best[1], shape[0] * shape[1]
 
 
-def _fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600):
-    """Variable projection with continuation in the highest chromosome index.
-
-    The continuation starts at the last chromosome with <= 30 periods in the coarsest
-    window (:func:`_first_cap`), where a grid search (:func:`_scan`) absorbs the error
-    of the PSD estimate -- starting lower lets the unresolved longest waves drag gamma
-    away, starting higher leaves the basin -- and then adds one chromosome per step
-    (each step shrinks the error enough for the next one).
-    """
-    ranges = _ranges(log_q1, log_gamma, acqs, n_nodes)
-    lo = min(r[0] for r in ranges)
-    hi = max(r[1] for r in ranges)
-    p = np.array([log_q1, log_gamma])
-    first = _first_cap(log_q1, log_gamma, lo, hi, acqs[0].length)
-    p, nit = _scan(p, first, acqs, ranges, weights, rhs)
+def _continuation(p, first, hi, acqs, ranges, weights, rhs, budget):
+    """Local least squares at caps first..hi, one chromosome added per step."""
     caps = list(range(first, hi + 1))
     if len(caps) > 16:                    # many chromosomes (gamma near 1): coarser continuation
         caps = sorted(set(np.linspace(caps[0], hi, 16).round().astype(int).tolist()))
+    nit = 0
     for cap in caps:
-        if nit >= budget + 403:
+        if nit >= budget:
             break
         res = least_squares(_vp_residual, p, args=(acqs, ranges, weights, rhs, cap),
                             x_scale=np.array([1e-3, 1e-3]), diff_step=1e-9,
@@ -354,6 +375,48 @@ def _fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600):
         if res.x[1] > 0:
             p = res.x
     return p, nit
+
+
+def _fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600):
+    """Variable projection with continuation in the highest chromosome index.
+
+    First a local fit of the full model from the PSD estimate (enough when the refined
+    peaks place every chromosome within the basin). Otherwise the continuation starts at
+    the last chromosome with <= 30 periods in the coarsest
+    window (:func:`_first_cap`) -- starting lower lets the unresolved longest waves drag
+    gamma away -- and adds one chromosome per step (each step shrinks the error enough
+    for the next one). It is run from the PSD estimate and, unless that already fits
+    to round-off, again from the best point of a grid search (:func:`_scan`) around it,
+    which absorbs a larger PSD error but can also pick a spurious minimum (the
+    unmodelled shorter waves still carry most of the misfit at the first cap); the
+    lower final residual wins.
+    """
+    ranges = _ranges(log_q1, log_gamma, acqs, n_nodes)
+    lo = min(r[0] for r in ranges)
+    hi = max(r[1] for r in ranges)
+    p0 = np.array([log_q1, log_gamma])
+    first = _first_cap(log_q1, log_gamma, lo, hi, acqs[0].length)
+    rr = float(rhs @ rhs)
+
+    def final_cost(p):
+        r = _vp_residual(p, acqs, ranges, weights, rhs, None)
+        return float(r @ r) / rr
+
+    res = least_squares(_vp_residual, p0, args=(acqs, ranges, weights, rhs, None),
+                        x_scale=np.array([1e-4, 1e-4]), diff_step=1e-10, max_nfev=40,
+                        xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    nit = res.nfev + 2 * (res.njev or 0)
+    if res.x[1] > 0 and final_cost(res.x) < 1e-20:
+        return res.x, nit                 # the refined PSD lattice is already in the basin
+    p_a, k = _continuation(p0, first, hi, acqs, ranges, weights, rhs, budget)
+    nit += k
+    cost_a = final_cost(p_a)
+    if cost_a < 1e-20:
+        return p_a, nit
+    p_s, k = _scan(p0, first, acqs, ranges, weights, rhs)
+    p_b, k2 = _continuation(p_s, first, hi, acqs, ranges, weights, rhs, budget)
+    nit += k + k2
+    return (p_a if cost_a <= final_cost(p_b) else p_b), nit
 
 
 # -- step 5: genes ---------------------------------------------------------------------------
@@ -617,15 +680,17 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         p, k = _fit_lattice(lq1, lg, acqs, n_nodes, weights, rhs)
         nit += k
         # lattice label compatible with n_s = 1 for the coarsest acquisition
+        if not (1.0 < math.exp(p[1]) <= 10.0):
+            continue
+        base = _label_q1(p[0], p[1], acqs[0].length)     # lambda1 in [L_1, gamma L_1)
         for shift in (0.0, -1.0, 1.0):
-            cand = np.array([p[0] + shift * p[1], p[1]])
+            cand = np.array([base + shift * p[1], p[1]])
             lam1 = 2 * math.pi / math.exp(cand[0])
-            if not (acqs[0].length * (1 - 1e-6) <= lam1 < math.exp(cand[1]) * acqs[0].length * (1 + 1e-6)):
-                continue
-            if not (1.0 < math.exp(cand[1]) <= 10.0):
+            if shift and not (acqs[0].length * (1 - 1e-6) <= lam1
+                              < math.exp(cand[1]) * acqs[0].length * (1 + 1e-6)):
                 continue
             ranges = _ranges(cand[0], cand[1], acqs, n_nodes)
-            if ranges[0][0] != 1:
+            if shift and ranges[0][0] != 1:
                 continue
             r = _vp_residual(cand, acqs, ranges, weights, rhs, None)
             n_par = 2 * (max(rr[1] for rr in ranges) - 1 + 1) + 2
