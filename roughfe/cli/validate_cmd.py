@@ -17,6 +17,7 @@ VALIDATIONS = {
     "fem": "bem_vs_fem",
     "sequencing": "genomics_sequencing",
     "design": "design_study",
+    "leakage": "leakage_flow",
 }
 
 
