@@ -49,6 +49,8 @@ from .genome import Genome, realize
 from .macro_micro import classify, profile_response
 from .similarity import ResponseCurve, Target, similarity, split_ranges
 
+#: genes other than the phases that CCO optimises ("all genes", Sec. 4.2.4)
+GENE_VARIABLES = ("H", "gamma", "lambda1", "weight")
 DESIGN_FORMAT = "roughfe-design"
 DESIGN_VERSION = 1
 METHODS = ("sog", "gco", "cco", "mcco")
@@ -119,19 +121,39 @@ class Design:
                     out.extend((k, m, int(n)) for m in range(part.genome.M))
         return out
 
+    def gene_keys(self) -> list:
+        """Gene variables ``(part, name)`` for name in H, gamma, lambda1 and the part weight
+        (its amplitude gene relative to the other parts)."""
+        return [(k, g) for k in range(len(self.parts)) for g in GENE_VARIABLES]
+
     def phase_values(self, keys) -> np.ndarray:
-        """Current phases (rad) of the variables ``keys``."""
-        return np.array([self.parts[k].genome.phases[m, n - self.parts[k].genome.n_first]
-                         for k, m, n in keys])
+        """Current values of the variables ``keys``: phases (rad) ``(part, m, n)`` and
+        genes ``(part, name)``."""
+        out = []
+        for key in keys:
+            part = self.parts[key[0]]
+            if len(key) == 2:
+                out.append(part.weight if key[1] == "weight" else getattr(part.genome, key[1]))
+            else:
+                _, m, n = key
+                out.append(part.genome.phases[m, n - part.genome.n_first])
+        return np.array(out, dtype=float)
 
     def with_phases(self, keys, values) -> "Design":
-        """A new design with the phases of ``keys`` set to ``values`` (rad)."""
+        """A new design with the variables ``keys`` (phases and genes) set to ``values``."""
         phases = [np.array(p.genome.phases) for p in self.parts]
-        for (k, m, n), v in zip(keys, np.asarray(values, dtype=float)):
-            phases[k][m, n - self.parts[k].genome.n_first] = v
-        parts = tuple(replace(p, genome=replace(p.genome, phases=ph))
-                      for p, ph in zip(self.parts, phases))
-        return replace(self, parts=parts)
+        genes = [{} for _ in self.parts]
+        for key, v in zip(keys, np.asarray(values, dtype=float)):
+            if len(key) == 2:
+                genes[key[0]][key[1]] = float(v)
+            else:
+                k, m, n = key
+                phases[k][m, n - self.parts[k].genome.n_first] = v
+        parts = []
+        for p, ph, g in zip(self.parts, phases, genes):
+            w = g.pop("weight", p.weight)
+            parts.append(replace(p, genome=replace(p.genome, phases=ph, **g), weight=w))
+        return replace(self, parts=tuple(parts))
 
     def rescaled(self, factor) -> "Design":
         return replace(self, scale=self.scale * float(factor))
@@ -474,7 +496,13 @@ class GcmmaOptions:
     ``n_it``: outer iterations per stage (thesis: SOG 5, GCO/CCO 3, stage 2: 1);
     ``fraction``/``bound``: phase box (see :func:`phase_bounds`); ``eps``: forward
     difference step in unit-box units; ``n_micro``: at most this many micro-scale
-    chromosomes per part (the longest wavelengths, largest amplitudes) enter stage 2.
+    chromosomes per part (the longest wavelengths, largest amplitudes) enter stage 2;
+    ``formulation``: ``"minimax"`` (:func:`gcmma_minimax`, Svanberg's min-max form with
+    the finite-difference Jacobian of every residual, same cost per iteration) or
+    ``"thesis"`` (minimise (1 - s)^2 with the finite-difference gradient of s);
+    ``cco_genes``: CCO's stage 1 optimises "all genes of the new genome" (Sec. 4.2.4):
+    besides the phases, H, gamma, lambda and the relative amplitude of each part, each
+    within +-fraction of its start (SOG and GCO keep H, gamma, lambda fixed, Sec. 4.2.2).
     """
 
     n_it_sog: int = 5
@@ -485,6 +513,7 @@ class GcmmaOptions:
     eps: float = 0.02
     n_micro: int = 6
     formulation: str = "minimax"
+    cco_genes: bool = True
 
 
 def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evaluator, n_it: int,
@@ -495,6 +524,9 @@ def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evalua
         return design, float(s), None
     phi0 = design.phase_values(keys)
     lo, hi = phase_bounds(phi0, options.fraction, options.bound)
+    is_gene = np.array([len(k) == 2 for k in keys])
+    if is_gene.any():                       # genes: always +-fraction of their start value
+        lo[is_gene], hi[is_gene] = phase_bounds(phi0[is_gene], options.fraction, "start")
     if options.formulation == "minimax":
         def score(r):
             k = [int(np.sum((t.pressure >= objective.p_range[0]) & (t.pressure <= objective.p_range[1])))
@@ -603,7 +635,7 @@ def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, ent
     for design, s0, curve0, origin in starts:
         macro, micro = _macro_micro_of(design, curve0, entries_by_label, threshold)
         if stage1 == "all":
-            keys1 = design.keys("all")
+            keys1 = design.keys("all") + (design.gene_keys() if options.cco_genes else [])
         else:
             keys1 = design.keys(macro)
         d1, s1, _ = optimise_phases(design, keys1, objective, evaluate, n_it1, options, f0=s0)
@@ -714,7 +746,8 @@ def cco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, eva
         options: GcmmaOptions = GcmmaOptions(), n_best: int = 3, max_set: Optional[int] = 8
         ) -> DesignResult:
     """Chromosomes Cross-Over (Alg. 6): as GCO with the macro-scale chromosomes only;
-    GCMMA on all their phases (stage 1); stage 2 repeats stage 1 (thesis Sec. 4.3.1)."""
+    GCMMA on all genes of the new genome (phases, and with ``options.cco_genes`` also H,
+    gamma, lambda and the part amplitudes; stage 1); stage 2 repeats stage 1 (Sec. 4.3.1)."""
     t0 = time.perf_counter()
     entries, by_label = _check_entries(entries)
     pbar = target.check_pbar(pbar)
