@@ -305,14 +305,13 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         master[:, -1] = master[:, 0]
     master = master.ravel()
     fixed = inlet | outlet
-    # pin the first vertex (master) of each floating component
-    floating = ~connected
-    first = np.full(live.size, -1, dtype=np.int64)
-    idx = np.flatnonzero(floating & (master == np.arange(nv)))
-    first[labels[idx[::-1]]] = idx[::-1]
-    pinned = np.zeros(nv, dtype=bool)
-    pinned[first[first >= 0]] = True
+    # pin one (master) vertex of each floating component: one constant null vector each
     is_master = master == np.arange(nv)
+    floating_masters = np.flatnonzero(~connected & is_master)
+    one_per_component = np.full(live.size, -1, dtype=np.int64)
+    one_per_component[labels[floating_masters]] = floating_masters
+    pinned = np.zeros(nv, dtype=bool)
+    pinned[one_per_component[one_per_component >= 0]] = True
     fixed_v = fixed | pinned[master]
     free_master = is_master & ~fixed_v
     n_red = int(free_master.sum())
