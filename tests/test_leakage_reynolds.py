@@ -187,3 +187,19 @@ def test_finite_volume_check_is_exact_on_plates_and_sees_no_corner_flow():
     g = np.array([[1, 1, 0, 0], [1, 1, 0, 0], [0, 0, 1, 1], [0, 0, 1, 1.]]) * H
     assert finite_volume_leak_rate(g, (DX, DX), mu=MU, pressure_drop=DP) == 0.0
     assert reynolds_flow(g, (DX, DX), mu=MU, pressure_drop=DP).leak_rate > 0
+
+
+def test_enclosed_pocket_changes_nothing_and_has_no_pressure():
+    # an open pocket ringed by contact is a floating component (pinned internally): it
+    # carries no flow, its pressure is undetermined (NaN) and the leak rate is the one of
+    # the same field with the pocket closed
+    g = np.full((12, 10), H)
+    g[3:8, 2:7] = 0.0                   # contact ring ...
+    g[4:7, 3:6] = 2 * H                 # ... around an open pocket
+    closed = g.copy()
+    closed[4:7, 3:6] = 0.0
+    r = reynolds_flow(g, (DX, DX), mu=MU, pressure_drop=DP)
+    rc = reynolds_flow(closed, (DX, DX), mu=MU, pressure_drop=DP)
+    assert r.leak_rate == pytest.approx(rc.leak_rate, rel=1e-9)
+    assert np.isnan(r.pressure[5, 5]) and np.all(np.isfinite(r.flux))
+    assert np.allclose(r.flux[4:7, 3:6], 0.0, atol=1e-12 * r.leak_rate / (10 * DX))
