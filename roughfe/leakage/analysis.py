@@ -8,7 +8,7 @@ example the fields of a :class:`roughfe.bem.ContactResult`, see
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Optional, Sequence
+from typing import Mapping, Optional
 
 import numpy as np
 
