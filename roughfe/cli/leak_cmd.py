@@ -18,8 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..plotting import leakage as figs  # first: loads vtk before dolfinx (see there)
-from ..bem import Material  # noqa: E402
+from ..bem import Material
 from ..errors import InputError
 from ..leakage import leakage_sweep
 from ..leakage.study import THESIS_D, THESIS_M, study_grid, summarise
@@ -57,6 +56,9 @@ def _save_fields(path, contact, leak):
 
 
 def _leak(args) -> int:
+    # imported before any solve: loads vtk before dolfinx (see roughfe.plotting.leakage)
+    from ..plotting import leakage as figs
+
     if (args.delta is None) == (args.pressure is None):
         raise InputError("give exactly one of --delta (approaches, m) or --pressure "
                          "(mean contact pressures, Pa)")
@@ -108,6 +110,7 @@ def _leak(args) -> int:
 
 
 def _leak_study(args) -> int:
+    from ..plotting import leakage as figs
     from ..study import run_study, spec_from_mapping, table_rows
 
     out = Path(args.output)
