@@ -6,7 +6,11 @@ matplotlib figures. Every file is written atomically (roughfe.plotting.common).
 """
 from __future__ import annotations
 
+import json
 import os
+import subprocess
+import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -15,12 +19,27 @@ from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
 
 # Load vtk before dolfinx can be loaded: with dolfinx 0.5.2 (Debian) loaded first, vtk
 # 9.7's label formatting (std::regex in vtk::is_printf_format, used by scalar bars and
-# axes) aborts the process with std::bad_alloc; loaded in this order it works.
+# axes) aborts the process with std::bad_alloc; loaded in this order it works. If this
+# process already loaded dolfinx (and not vtk), maps are rendered by a fresh interpreter.
+_RENDER_ELSEWHERE = "dolfinx" in sys.modules and "vtkmodules.vtkCommonCore" not in sys.modules
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
 import pyvista  # noqa: E402,F401
 
 UM = 1e6
+
+
+def _render_elsewhere(name, arrays, **kwargs) -> Path:
+    """Call ``roughfe.plotting.leakage.<name>(**arrays, **kwargs)`` in a fresh interpreter."""
+    with tempfile.TemporaryDirectory() as tmp:
+        npz = Path(tmp) / "arrays.npz"
+        np.savez(npz, **{k: np.asarray(v) for k, v in arrays.items()})
+        code = ("import sys, json, numpy as np; from roughfe.plotting import leakage as L; "
+                "a = dict(np.load(sys.argv[1])); "
+                f"L.{name}(**a, **json.loads(sys.argv[2]))")
+        subprocess.run([sys.executable, "-c", code, str(npz), json.dumps(kwargs)],
+                       check=True, capture_output=True)
+    return Path(kwargs["path"])
 
 
 def _image(shape, size):
@@ -62,6 +81,10 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
     path : path-like
         PNG file.
     """
+    if _RENDER_ELSEWHERE:
+        return _render_elsewhere("network_map", {"gap": gap, "percolating": percolating,
+                                                 "trapped": trapped},
+                                 size=list(size), path=str(path), title=title)
     g = np.asarray(gap, float)
     rgb = np.zeros(g.shape + (3,))
     gmax = g[percolating].max() if np.any(percolating) else 1.0
@@ -81,6 +104,9 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
 
 def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)"):
     """Q1 nodal pressure (NaN where undetermined: grey)."""
+    if _RENDER_ELSEWHERE:
+        return _render_elsewhere("pressure_map", {"pressure": pressure}, size=list(size),
+                                 path=str(path), title=title)
     p = np.asarray(pressure, float)
     img = _image((p.shape[0] - 1, p.shape[1] - 1), size)
     img.point_data["p (Pa)"] = p.ravel(order="F")
@@ -92,6 +118,9 @@ def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)"):
 
 def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
     """Cell flux magnitude on a log colour scale (cells without flow: black)."""
+    if _RENDER_ELSEWHERE:
+        return _render_elsewhere("flux_map", {"flux_magnitude": flux_magnitude},
+                                 size=list(size), path=str(path), title=title)
     q = np.asarray(flux_magnitude, float)
     pos = q[q > 0]
     floor = pos.max() * 1e-8 if pos.size else 1.0
