@@ -270,7 +270,7 @@ def _stiffness(op, solver, p, w, scale):
         idx = np.flatnonzero(c.ravel())
         x = solve_spd(_dense(op)[np.ix_(idx, idx)], np.ones(idx.size))
         return float(x.sum()) / n
-    x, _ = restricted_cg(op.apply, c, np.ones(p.shape))
+    x, _ = restricted_cg(op.apply, c, np.ones(p.shape), precond=_preconditioner(op))
     return float(x.sum()) / n
 
 

@@ -1,0 +1,66 @@
+"""Result files of a contact sweep, written atomically (roughfe.writers).
+
+* ``results.json``: ``{"inputs": {...}, "steps": [...]}``, one record per step with the
+  keys :data:`roughfe.bem.RECORD_KEYS` in SI units (see :meth:`SweepResult.to_records`),
+  plus the sweep-level dimensionless curves.
+* ``fields.h5``: datasets ``pressure`` (Pa) and ``gap`` (m) of shape
+  ``(frame, *grid)``, ``contact`` (bool) and ``delta`` (m) per frame, with the grid
+  size/spacing as attributes (the "frame" layout of Tamaas/ContactMechanics dumps).
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..writers import atomic_path, write_json
+from .sweep import SweepResult
+
+
+def sweep_document(sweep: SweepResult, inputs: dict) -> dict:
+    """The JSON document of a sweep: inputs, per-step records and derived curves."""
+    return {
+        "inputs": dict(inputs),
+        "steps": sweep.to_records(),
+        "derived": {
+            "rms_height": sweep.rms_height, "rms_slope": sweep.rms_slope,
+            "e_star": sweep.e_star,
+            "load_star": [float(x) for x in sweep.load_star],
+            "pressure_over_estar_rms_slope": [float(x) for x in sweep.pressure_star],
+            "separation_over_sigma": [float(x) for x in sweep.separation_star],
+            "units": {"delta": "m", "load": "N (surface) or N/m (profile)",
+                      "mean_pressure": "Pa", "stiffness": "Pa/m", "mean_gap": "m",
+                      "mean_plane_separation": "m",
+                      "free_volume": "m^3 (surface) or m^2 (profile)"},
+            "references": list(sweep.results[0].references),
+        },
+    }
+
+
+def write_results_json(path, sweep: SweepResult, inputs: dict):
+    """Write ``results.json`` atomically; returns the path."""
+    return write_json(path, sweep_document(sweep, inputs))
+
+
+def write_fields_h5(path, sweep: SweepResult, compression: str = "gzip"):
+    """Write pressure and gap of every step to HDF5 (``frame`` first axis), atomically."""
+    import h5py  # Debian's h5py; imported here so the package works without it
+
+    res = sweep.results
+    r0 = res[0]
+    with atomic_path(path, suffix=".h5") as tmp:
+        with h5py.File(tmp, "w") as f:
+            f.attrs["size_m"] = np.asarray(r0.size)
+            f.attrs["spacing_m"] = np.asarray(r0.spacing)
+            f.attrs["periodic"] = bool(r0.periodic)
+            f.attrs["kernel"] = r0.kernel
+            f.attrs["dimensions"] = json.dumps(["frame"] + ["x", "y"][: r0.pressure.ndim])
+            for name, unit in (("pressure", "Pa"), ("gap", "m"), ("contact", "1")):
+                data = np.stack([getattr(r, name) for r in res])
+                ds = f.create_dataset(name, data=data, compression=compression)
+                ds.attrs["unit"] = unit
+            ds = f.create_dataset("delta", data=np.array([r.delta for r in res]))
+            ds.attrs["unit"] = "m"
+            ds = f.create_dataset("mean_pressure", data=np.array([r.mean_pressure for r in res]))
+            ds.attrs["unit"] = "Pa"
+    return path

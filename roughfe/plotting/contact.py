@@ -1,0 +1,112 @@
+"""Figures of BEM contact results: A(p), K(p) curves and a 3D render of the deformed
+surface coloured by pressure. Reads results (``SweepResult``/``ContactResult`` or the
+step records of ``results.json``); never solves.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
+
+UM = 1e6
+MPA = 1e-6
+
+
+def _column(steps, key):
+    return np.array([np.nan if s[key] is None else s[key] for s in steps], float)
+
+
+def plot_area_stiffness(steps, path, title=None):
+    """A*(p) and K(p) (exact incremental and central finite differences), log-log.
+
+    Parameters
+    ----------
+    steps : list of dict
+        Step records (``SweepResult.to_records()`` or ``results.json["steps"]``).
+    path : str or Path
+        PNG to write.
+    """
+    p = _column(steps, "mean_pressure") * MPA
+    a = _column(steps, "area_fraction")
+    k = _column(steps, "stiffness") * MPA * 1e-6      # MPa/um
+    kfd = _column(steps, "stiffness_fd") * MPA * 1e-6
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
+    ok = p > 0
+    ax1.loglog(p[ok], a[ok], "o-", ms=4)
+    ax1.set_xlabel("mean pressure p (MPa)")
+    ax1.set_ylabel("A* = A_r / A_n")
+    ax1.set_title("contact area A(p)")
+    ax1.grid(True, which="both", alpha=0.3)
+    ok2 = ok & np.isfinite(k) & (k > 0)
+    ax2.loglog(p[ok2], k[ok2], "o-", ms=4, label="exact, H_cc x = 1")
+    ok3 = ok & np.isfinite(kfd) & (kfd > 0)
+    ax2.loglog(p[ok3], kfd[ok3], "x--", ms=5, label="central differences")
+    ax2.set_xlabel("mean pressure p (MPa)")
+    ax2.set_ylabel("K = dp/dDelta (MPa/um)")
+    ax2.set_title("contact stiffness K(p), Eq. 2.7")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend()
+    if title:
+        fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+def plot_profile_state(heights, result, path, title=None):
+    """Profile contact: rigid rough profile, deformed elastic flat and pressure."""
+    x = np.arange(result.pressure.size) * result.spacing[0] * UM
+    h = np.asarray(heights)
+    flat = (h.max() - result.delta + result.displacement)
+    fig, (ax1, ax2) = new_figure(2, 1, figsize=(9, 5), sharex=True)
+    ax1.plot(x, h * UM, lw=0.8, label="rough profile")
+    ax1.plot(x, flat * UM, lw=0.8, label="deformed elastic surface")
+    ax1.set_ylabel("height (um)")
+    ax1.legend(loc="lower right")
+    ax2.plot(x, result.pressure * MPA, lw=0.8)
+    ax2.set_xlabel("x (um)")
+    ax2.set_ylabel("pressure (MPa)")
+    if title:
+        ax1.set_title(title)
+    return save_figure(fig, path)
+
+
+def render_contact(heights, result, path, title=None, exaggeration=None,
+                   window_size=(1000, 800)):
+    """Off-screen render of the deformed rough surface z = h - u coloured by pressure.
+
+    The thesis treats the rough surface as the deformable body (Fig. 7b): z = h - u puts
+    every contact point on the flat at max h - Delta. Contact points are drawn in black
+    on top (a thin layer); the colour bar shows the pressure in MPa.
+    """
+    import pyvista as pv
+
+    h = np.asarray(heights)
+    if h.ndim != 2:
+        raise ValueError("render_contact needs a surface (2D heights)")
+    nx, ny = h.shape
+    dx, dy = result.spacing
+    z = (h - result.displacement) * UM
+    z -= z.mean()
+    ptp = float(np.ptp(h)) * UM or 1.0
+    if exaggeration is None:
+        exaggeration = 0.25 * max(nx * dx, ny * dy) * UM / ptp
+    xx, yy = np.meshgrid(np.arange(nx) * dx * UM, np.arange(ny) * dy * UM, indexing="ij")
+    grid = pv.StructuredGrid(xx, yy, z * exaggeration)
+    grid["pressure (MPa)"] = (result.pressure * MPA).ravel(order="F")
+    grid["contact"] = result.contact.astype(float).ravel(order="F")
+    plotter = offscreen_plotter(window_size=window_size)
+    plotter.add_mesh(grid, scalars="pressure (MPa)", cmap="inferno", smooth_shading=True,
+                     scalar_bar_args={"title": "pressure (MPa)", "vertical": True,
+                                      "position_x": 0.86, "position_y": 0.15,
+                                      "height": 0.7, "fmt": "%.3g"})
+    if result.contact.any():
+        pts = grid.threshold(0.5, scalars="contact", preference="point")
+        if pts.n_points:
+            plotter.add_mesh(pts, color="cyan", opacity=0.6, label="contact")
+    label = (title or "") + (f"\nDelta = {result.delta * UM:.3g} um, A* = "
+                             f"{result.area_fraction:.3f}, p = {result.mean_pressure * MPA:.3g} "
+                             f"MPa (contact in cyan), vertical x{exaggeration:.3g}")
+    plotter.add_text(label.strip(), position="upper_left", font_size=10)
+    plotter.set_background("white")
+    plotter.camera_position = "iso"
+    plotter.camera.zoom(1.3)
+    return save_screenshot(plotter, path)
