@@ -37,6 +37,10 @@ Discretisation
   ``Q = w . r`` (m^3/s), which is exact for the discrete problem; the inlet and outlet
   sums of ``r`` are returned too (they agree to the solver tolerance).
 
+Cells should be (nearly) square, as BEM grids are: for an aspect ratio above sqrt(2)
+the Q1 stiffness has positive off-diagonal entries, and the discrete pressure may then
+overshoot [p_out, p_in] slightly on rough gaps (measured: -3e-4 dp at aspect 1.5).
+
 Note: with Q1 pressure, two open cells that touch only at a corner share a pressure
 unknown and exchange flux through that vertex. The network analysis of
 :mod:`roughfe.leakage.network` uses the saddle-point rule instead (thesis Fig. 13);
