@@ -224,7 +224,8 @@ def comb_periods(log_q, weights=None, gamma_range=(1.05, 4.0), n_grid=6000, n_be
 
     Coherence S(T) = |sum w e^{2 pi i ln q / T}| / sum w is 1 for a perfect lattice of
     period T and also for T/2, T/3, ... ; the candidates are the local maxima of S with
-    S >= 0.75 max S, largest periods first (the fundamental), at most ``n_best``.
+    S >= 0.75 max S and the local maxima near their multiples 2T, 3T with S >= 0.5 max S,
+    largest periods first (the fundamental), at most ``n_best``.
     Returns (periods, coherences, reference ln q).
     """
     log_q = np.asarray(log_q, dtype=float)
@@ -236,6 +237,21 @@ def comb_periods(log_q, weights=None, gamma_range=(1.05, 4.0), n_grid=6000, n_be
     if loc.size == 0:
         loc = np.array([int(np.argmax(s))])
     keep = loc[s[loc] >= 0.75 * s[loc].max()]
+    # a lattice of period T is also one of T/2, T/3 (which can collect stray peaks --
+    # aliases, leakage -- and win on coherence): the multiples 2T, 3T of each candidate
+    # are candidates too when their coherence is fair (>= 0.5 max)
+    extra = []
+    for k in keep:
+        for mult in (2, 3):
+            j = int(np.argmin(np.abs(periods - mult * periods[k])))
+            if abs(periods[j] / (mult * periods[k]) - 1) > 0.01:
+                continue
+            near = loc[np.abs(periods[loc] / periods[j] - 1) < 0.03]
+            if near.size:
+                j = near[np.argmax(s[near])]
+                if s[j] >= 0.5 * s[loc].max():
+                    extra.append(j)
+    keep = np.unique(np.concatenate([keep, np.array(extra, dtype=int)]))
     keep = keep[np.argsort(-periods[keep])][:n_best]
     refs = []
     for k in keep:
