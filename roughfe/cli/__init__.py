@@ -16,6 +16,7 @@ from ..errors import RoughfeError
 # Explicit, ordered list (no import-time registration magic).
 _SUBCOMMAND_MODULES = (
     "surface_cmds",   # generate, info
+    "contact_cmd",    # contact
     "demo_cmd",       # demo
     "validate_cmd",   # validate
     "study_cmd",      # study run|status|collect

@@ -74,8 +74,8 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     """Off-screen render of the deformed rough surface z = h - u coloured by pressure.
 
     The thesis treats the rough surface as the deformable body (Fig. 7b): z = h - u puts
-    every contact point on the flat at max h - Delta. Contact points are drawn in black
-    on top (a thin layer); the colour bar shows the pressure in MPa.
+    every contact point on the flat at max h - Delta. Contact points are coloured by
+    their pressure (MPa), the free (non-contact) area is grey.
     """
     import pyvista as pv
 
@@ -91,20 +91,18 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
         exaggeration = 0.25 * max(nx * dx, ny * dy) * UM / ptp
     xx, yy = np.meshgrid(np.arange(nx) * dx * UM, np.arange(ny) * dy * UM, indexing="ij")
     grid = pv.StructuredGrid(xx, yy, z * exaggeration)
-    grid["pressure (MPa)"] = (result.pressure * MPA).ravel(order="F")
-    grid["contact"] = result.contact.astype(float).ravel(order="F")
+    # pressure on the contact points, grey (NaN) elsewhere: the grey is the free area
+    pressure = np.where(result.contact, result.pressure * MPA, np.nan)
+    grid["pressure (MPa)"] = pressure.ravel(order="F")
     plotter = offscreen_plotter(window_size=window_size)
-    plotter.add_mesh(grid, scalars="pressure (MPa)", cmap="inferno", smooth_shading=True,
+    plotter.add_mesh(grid, scalars="pressure (MPa)", cmap="plasma", smooth_shading=True,
+                     nan_color="lightgrey",
                      scalar_bar_args={"title": "pressure (MPa)", "vertical": True,
                                       "position_x": 0.86, "position_y": 0.15,
                                       "height": 0.7, "fmt": "%.3g"})
-    if result.contact.any():
-        pts = grid.threshold(0.5, scalars="contact", preference="point")
-        if pts.n_points:
-            plotter.add_mesh(pts, color="cyan", opacity=0.6, label="contact")
     label = (title or "") + (f"\nDelta = {result.delta * UM:.3g} um, A* = "
                              f"{result.area_fraction:.3f}, p = {result.mean_pressure * MPA:.3g} "
-                             f"MPa (contact in cyan), vertical x{exaggeration:.3g}")
+                             f"MPa (free area grey), vertical x{exaggeration:.3g}")
     plotter.add_text(label.strip(), position="upper_left", font_size=10)
     plotter.set_background("white")
     plotter.camera_position = "iso"

@@ -1,0 +1,61 @@
+"""`roughfe contact`: the files it writes and what they contain."""
+import json
+
+import numpy as np
+import pytest
+
+from roughfe.cli import main
+from roughfe.surfaces import Surface
+from roughfe.surfaces.io import save_surface
+
+
+def _bump(n=24, periodic=False):
+    x = (np.arange(n) - n // 2) * 1e-6
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    return Surface(-(X ** 2 + Y ** 2) / 2e-3 + 1e-8 * np.cos(X / 3e-6), n * 1e-6,
+                   periodic=periodic, metadata={"generator": "test bump"})
+
+
+def test_contact_cli_writes_results_fields_and_figures(tmp_path):
+    path = save_surface(_bump(), tmp_path / "bump.npz")
+    out = tmp_path / "out"
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0.3", "--steps", "4",
+                 "-o", str(out)]) == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert doc["inputs"]["kernel"] == "love" and doc["inputs"]["E_star"] == pytest.approx(
+        1e9 / 0.91)
+    steps = doc["steps"]
+    assert len(steps) == 4
+    assert set(steps[0]) == {"delta", "load", "mean_pressure", "area_fraction", "n_contact",
+                             "stiffness", "stiffness_fd", "mean_gap", "mean_plane_separation",
+                             "free_volume", "free_volume_star", "iterations", "residual"}
+    # the last approach is the peak-to-valley height, loads increase
+    assert steps[-1]["delta"] == pytest.approx(np.ptp(_bump().heights))
+    assert all(a["load"] < b["load"] for a, b in zip(steps, steps[1:]))
+    h5py = pytest.importorskip("h5py")
+    with h5py.File(out / "fields.h5", "r") as f:
+        assert f["pressure"].shape == (4, 24, 24) and f["gap"].shape == (4, 24, 24)
+        assert json.loads(f.attrs["dimensions"]) == ["frame", "x", "y"]
+        # the stored pressure integrates to the recorded load
+        assert f["pressure"][2].mean() * 24e-6 ** 2 == pytest.approx(steps[2]["load"], rel=1e-12)
+        assert np.all(f["gap"][...] >= 0)
+    assert (out / "contact_area_stiffness.png").stat().st_size > 0
+    assert (out / "contact_render.png").stat().st_size > 0
+
+
+def test_contact_cli_pressure_control_profile(tmp_path):
+    x = np.arange(256) * 1e-6
+    prof = Surface(1e-6 * np.cos(2 * np.pi * x / 256e-6), 256e-6, periodic=True)
+    path = save_surface(prof, tmp_path / "sine.npz")
+    out = tmp_path / "o"
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0", "--pressure", "1e6", "2e6",
+                 "-o", str(out), "--no-figures"]) == 0
+    steps = json.loads((out / "results.json").read_text())["steps"]
+    assert [s["mean_pressure"] for s in steps] == pytest.approx([1e6, 2e6], rel=1e-12)
+
+
+def test_contact_cli_bad_input_is_reported(tmp_path, capsys):
+    path = save_surface(_bump(), tmp_path / "bump.npz")
+    assert main(["contact", str(path), "--E", "-1", "--nu", "0.3", "-o",
+                 str(tmp_path / "x")]) == 2
+    assert "E (Young's modulus, Pa) must be finite and > 0" in capsys.readouterr().err
