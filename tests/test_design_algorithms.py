@@ -105,3 +105,28 @@ def test_bad_inputs_are_clear(entries, targets):
         de.phase_bounds([1.0], bound="wide")
     with pytest.raises(InputError):
         de.Design.from_dict({"format": "something-else"})
+
+
+def test_exact_sensitivities_equal_finite_differences_on_fixed_contact_sets():
+    """residual_jacobian (one sweep + H_cc solves) vs forward differences with a step small
+    enough to keep every contact set: K by differences and A, through Eq. 4.2 and the
+    interpolation at the target pressures."""
+    g = db.make_genome(1.6, 0.8, 7, SETTINGS)
+    d = de.Design((de.DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 2.0, "a"),), 1.3,
+                  SETTINGS.length, SETTINGS.n_nodes)
+    other = db.make_genome(1.5, 0.9, 8, SETTINGS)     # target pressures off the curve's nodes
+    c = de.Evaluator(SETTINGS)(de.Design((de.DesignPart(other, tuple(range(
+        other.n_first, other.n_last + 1))),), 1.0, SETTINGS.length, SETTINGS.n_nodes))
+    obj = de.Objective((Target(c.pressure, c.stiffness, "K"),
+                        Target(c.pressure[:-1], c.area_fraction[:-1], "A")))
+    keys = d.keys([[1, 2, 4]])
+    r, jac = de.residual_jacobian(d, keys, obj, SETTINGS)
+    ev = de.Evaluator(SETTINGS)
+    np.testing.assert_allclose(r, obj.residuals(ev(d)), atol=1e-12)
+    v = d.phase_values(keys)
+    for col in range(len(keys)):
+        w = v.copy()
+        w[col] += 1e-7
+        fd = (obj.residuals(ev(d.with_phases(keys, w))) - r) / 1e-7
+        np.testing.assert_allclose(jac[:, col], fd, atol=1e-5 * np.abs(jac).max())
+    assert np.abs(jac).max() > 1e-3
