@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ..bem import KERNELS, Material, contact_sweep
 from ..bem.contact import SOLVERS
 from ..bem.output import write_fields_h5, write_results_json
@@ -79,3 +81,89 @@ def _run(args) -> int:
               f"{k:12.4e} {s['mean_gap']:12.4e} {s['iterations']:5d}")
     print(f"wrote {out / 'results.json'}, {out / 'fields.h5'}")
     return 0
+
+
+# -- demo section (appended to roughfe.cli.demo_cmd.SECTIONS) ------------------------------
+THESIS_FIG7 = {"A_star": 0.25, "P_star": 0.56, "h_s": 6.72e-6}
+
+
+def section_contact(outdir: Path, context: dict) -> str:
+    """20-step BEM sweep of the demo RMD surface (thesis Fig. 7: D = 2.3, m = 7, L = 0.1
+    mm, non-periodic, Love kernel) up to Delta = h_s = peak-to-valley; A* and P* at
+    Delta = h_s against the thesis' 0.25 and 0.56."""
+    import time
+
+    from ..bem import solve_contact
+    from ..plotting.contact import plot_area_stiffness, render_contact
+
+    surface = context.get("surface")
+    if surface is None:
+        from ..surfaces.rmd import rmd_surface
+        surface = rmd_surface(m=7, fractal_dimension=2.3, length=1e-4, rng=0)
+    material = Material(210e6, 0.3)
+    t0 = time.perf_counter()
+    sweep = contact_sweep(surface, material, n_steps=20)
+    elapsed = time.perf_counter() - t0
+    sub = outdir / "contact"
+    inputs = {"surface": "demo RMD surface (rmd_surface.npz)", "E": material.E,
+              "nu": material.nu, "E_star": material.E_star, "kernel": sweep.results[0].kernel,
+              "solver": sweep.results[0].solver, "steps": 20, "metadata": dict(surface.metadata)}
+    write_results_json(sub / "results.json", sweep, inputs)
+    write_fields_h5(sub / "fields.h5", sweep)
+    fig = plot_area_stiffness(sweep.to_records(), sub / "contact_area_stiffness.png",
+                              title="RMD D = 2.3, m = 7: A(p) and K(p)")
+    last = sweep.results[-1]
+    render = render_contact(surface.heights, last, sub / "contact_render.png",
+                            title="RMD D = 2.3, m = 7 at Delta = h_s")
+    thesis_kernel = solve_contact(surface, material, delta=last.delta, kernel="thesis",
+                                  initial=last.pressure)
+    sigma, gbar, length = sweep.rms_height, sweep.rms_slope, surface.size[0]
+    p_star = sweep.load_star[-1]
+    p_star_t = thesis_kernel.mean_pressure * length / (material.E_star * sigma)
+    kappa = last.area_fraction / sweep.pressure_star[-1]
+    picks = sorted(set(range(0, len(sweep.results), 4)) | {len(sweep.results) - 1})
+    rows = "\n".join(
+        f"| {r.delta * 1e6:.3f} | {r.mean_pressure * 1e-6:.4g} | {r.area_fraction:.4f} | "
+        f"{sweep.load_star[i]:.3f} | {r.stiffness * 1e-12:.4g} | {r.mean_gap * 1e6:.4f} | "
+        f"{r.free_volume_star:.3f} | {r.nit} |"
+        for i, r in ((i, sweep.results[i]) for i in picks))
+    needed = THESIS_FIG7["P_star"] * kappa / THESIS_FIG7["A_star"]
+    # realisation scatter: the same generator, seeds 1-5, at Delta = h_s
+    from ..surfaces.rmd import rmd_surface
+    scatter = []
+    for seed in range(1, 6):
+        other = rmd_surface(m=7, fractal_dimension=2.3, length=1e-4, rng=seed)
+        r = solve_contact(other, material, delta=float(np.ptp(other.heights)),
+                          compute_stiffness=False)
+        scatter.append((r.area_fraction, r.mean_pressure * other.size[0]
+                        / (material.E_star * r.rms_height)))
+    a_lo, a_hi = min(a for a, _ in scatter), max(a for a, _ in scatter)
+    p_lo, p_hi = min(p for _, p in scatter), max(p for _, p in scatter)
+    return (
+        "## BEM contact sweep (thesis Sec. 2.2, Fig. 7)\n\n"
+        f"Rigid RMD surface on an elastic half-space, E = {material.E:.3g} Pa, nu = "
+        f"{material.nu}, E* = {material.E_star:.4g} Pa; non-periodic Love kernel "
+        f"(DC-FFT), {sweep.results[0].solver} solver, 20 approaches Delta up to h_s = "
+        f"peak-to-valley = {np.ptp(surface.heights) * 1e6:.3f} um; {elapsed:.1f} s for the "
+        f"sweep (shared 2-core machine). Files: `contact/results.json`, `contact/fields.h5`.\n\n"
+        "| Delta (um) | p (MPa) | A* | P* = pL/(E* sigma) | K (MPa/um) | mean gap (um) | V* "
+        "| iterations |\n|---|---|---|---|---|---|---|---|\n" + rows + "\n\n"
+        f"**At Delta = h_s:** A* = {last.area_fraction:.3f} (thesis 0.25), "
+        f"P* = {p_star:.2f} (thesis 0.56); with the thesis kernel Eq. 2.4 instead of Love's: "
+        f"A* = {thesis_kernel.area_fraction:.3f}, P* = {p_star_t:.2f}.\n\n"
+        f"Why they differ: A* agrees within the scatter between RMD realisations (seeds 1-5 "
+        f"give A* = {a_lo:.2f}-{a_hi:.2f} at Delta = h_s, as h_s/sigma varies between them; "
+        f"here h_s/sigma = {np.ptp(surface.heights) / sigma:.2f}, the thesis' own h_s = "
+        f"6.72 um belongs to another realisation and normalisation). P* is about "
+        f"{p_star / THESIS_FIG7['P_star']:.0f}x the thesis value, which neither the "
+        f"realisation (P* = {p_lo:.1f}-{p_hi:.1f} over seeds 1-5), nor E vs E* (10 %), nor the kernel "
+        f"(Love vs Eq. 2.4, above) explains. Our numbers obey the standard checks: with the "
+        f"rms slope gbar = {gbar:.3f}, A* / (p/(E* gbar)) = {kappa:.2f}, within the range "
+        f"1.6-2.5 of rough-contact theory and simulations (Persson; Hyun et al. 2004; "
+        f"Yastrebov et al. 2015). Since A* = kappa p/(E* gbar), P* = (A*/kappa) gbar L/sigma: "
+        f"the thesis pair (A* = 0.25, P* = 0.56) needs gbar L/sigma = {needed:.1f}, while this "
+        f"surface has gbar L/sigma = {gbar * length / sigma:.1f} (an RMD surface with m = 7 "
+        f"and D = 2.3 can not be that smooth). The thesis' P* is most likely normalised "
+        f"differently from what Sec. 2.2.2 states; we report pL/(E* sigma) as written.\n\n"
+        f"![A(p), K(p)]({fig.relative_to(outdir)})\n\n"
+        f"![deformed surface coloured by pressure]({render.relative_to(outdir)})\n")

@@ -76,7 +76,9 @@ def section_measured(outdir: Path, context: dict) -> str:
             f"{_stats_table(stats)}\n\n![measured surface]({render})\n\n![PSD]({psd})\n")
 
 
-SECTIONS = (section_surface, section_measured)
+from .contact_cmd import section_contact  # noqa: E402  (BEM contact sweep section)
+
+SECTIONS = (section_surface, section_measured, section_contact)
 
 
 def run_demo(outdir, sections=None) -> Path:
