@@ -260,25 +260,46 @@ def comb_periods(log_q, weights=None, gamma_range=(1.05, 4.0), n_grid=6000, n_be
     return periods[keep], s[keep], np.array(refs)
 
 
-def _lattice_from_period(log_q, period, ref, coarse_length, weights=None):
+def _lattice_from_period(log_q, period, ref, coarse_length, weights=None, groups=None, power=None):
     """Refine (ln q1, ln gamma) by weighted regression on the lattice indices; q1 so that n_s = 1.
 
-    Peaks farther than 0.15 period from the lattice (aliased lines, leakage) are dropped
-    iteratively; ``weights`` (the peak bin numbers: the relative precision of a peak
-    grows with its bin) weight the regression.
+    Each peak gets the nearest lattice index. Within one acquisition (``groups``) only the
+    strongest peak (``power``) per index is kept -- aliases of the sub-Nyquist chromosomes
+    can land next to a true line. Peaks farther than 0.15 period from the lattice are
+    dropped, then, iteratively, those farther than 4 robust standard deviations (MAD) of
+    the regression residual. ``weights`` (the peak bin numbers: the relative precision of
+    a peak grows with its bin) weight the regression.
     """
     w = np.ones_like(log_q) if weights is None else np.asarray(weights, dtype=float)
-    keep = np.ones(log_q.size, dtype=bool)
-    for _ in range(5):
+    grp = np.zeros(log_q.size, dtype=int) if groups is None else np.asarray(groups)
+    pw = np.ones_like(log_q) if power is None else np.asarray(power, dtype=float)
+    tol = None
+    for _ in range(8):
         k = np.round((log_q - ref) / period)
-        dev = np.abs(log_q - ref - k * period)
-        keep = dev < 0.15 * period
+        dev = log_q - ref - k * period
+        keep = np.abs(dev) < 0.15 * period
+        if tol is not None:
+            keep &= np.abs(dev) <= tol
+        order = np.lexsort((-pw, k, grp))           # strongest first within (group, index)
+        seen = set()
+        for idx in order:
+            key = (int(grp[idx]), int(k[idx]))
+            if keep[idx] and key in seen:
+                keep[idx] = False
+            elif keep[idx]:
+                seen.add(key)
         if np.unique(k[keep]).size < 2:
             break
         slope, icpt = np.polyfit(k[keep], log_q[keep], 1, w=np.sqrt(w[keep]))
         if not (0.5 * period < slope < 2 * period):
             break
         period, ref = slope, icpt
+        res = log_q[keep] - ref - np.round((log_q[keep] - ref) / period) * period
+        mad = float(np.median(np.abs(res - np.median(res)))) * 1.4826
+        new_tol = max(4 * mad, 1e-4 * period)
+        if tol is not None and abs(new_tol - tol) <= 1e-3 * tol:
+            break
+        tol = new_tol
     return _label_q1(ref, period, coarse_length), period
 
 
@@ -681,6 +702,9 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     else:
         periods, coh, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
     bins = np.concatenate([s.peak_q / (s.q[1] - s.q[0]) for s in spectra])
+    groups = np.concatenate([np.full(s.peak_q.size, i) for i, s in enumerate(spectra)])
+    power = np.concatenate([s.peak_C / max(float(s.peak_C.max()), 1e-300) if s.peak_C.size else s.peak_C
+                            for s in spectra])
     gamma_psd = float(math.exp(periods[0]))
 
     # 3-4. lattice fit with restarts
@@ -688,7 +712,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     nit = 0
     for period, ref in zip(periods, refs):
         if log_q.size >= 3:
-            lq1, lg = _lattice_from_period(log_q, period, ref, acqs[0].length, bins)
+            lq1, lg = _lattice_from_period(log_q, period, ref, acqs[0].length, bins, groups, power)
         else:
             lq1, lg = _label_q1(ref, period, acqs[0].length), period
         if not (math.log(1.0 + 1e-3) < lg < math.log(10.0)):
@@ -719,6 +743,14 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         raise InputError("sequencing found no admissible wavenumber lattice (gamma in (1, 10]) in the PSD "
                          "peaks; the acquisitions are not WM-like")
     _, (lq1, lg), ranges = best
+    # final polish of the full model with the final chromosome ranges
+    r0 = _vp_residual(np.array([lq1, lg]), acqs, ranges, weights, rhs, None)
+    pol = least_squares(_vp_residual, np.array([lq1, lg]), args=(acqs, ranges, weights, rhs, None),
+                        x_scale=np.array([1e-5, 1e-5]), diff_step=1e-11, max_nfev=100,
+                        xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    nit += pol.nfev + 2 * (pol.njev or 0)
+    if 2 * pol.cost < float(r0 @ r0) and _ranges(pol.x[0], pol.x[1], acqs, n_nodes) == ranges:
+        lq1, lg = pol.x
     gamma, lam1 = math.exp(lg), 2 * math.pi / math.exp(lq1)
     n, mat = _design(lq1, lg, acqs, ranges, weights)
     coef = _solve_linear(mat, rhs)
