@@ -82,6 +82,8 @@ class DatabaseSettings:
         BEM influence kernel passed to :func:`roughfe.bem.contact_sweep`.
     stiffness : {"fd", "exact"}
         How K(p) is taken from the sweep (see :func:`roughfe.genomics.macro_micro.profile_response`).
+    correlation : {"steps", "pressure"}
+        How c_n pairs the curves (see :mod:`roughfe.genomics.macro_micro`).
     """
 
     length: float = 849.42e-6
@@ -92,6 +94,7 @@ class DatabaseSettings:
     threshold: float = 0.95
     kernel: str = "auto"
     stiffness: str = "fd"
+    correlation: str = "steps"
 
     def __post_init__(self):
         for name in ("length", "youngs_modulus"):
@@ -102,6 +105,8 @@ class DatabaseSettings:
             raise InputError(f"n_nodes must be >= 16, got {self.n_nodes!r}")
         if int(self.n_steps) < 3:
             raise InputError(f"n_steps must be >= 3, got {self.n_steps!r}")
+        if self.correlation not in ("steps", "pressure"):
+            raise InputError(f"correlation must be 'steps' or 'pressure', got {self.correlation!r}")
         if self.stiffness not in ("fd", "exact"):
             raise InputError(f"stiffness must be 'fd' or 'exact', got {self.stiffness!r}")
         if not (0.0 < self.threshold < 1.0):
@@ -210,7 +215,7 @@ class DatabaseEntry:
 def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=1.0,
                       lambda1=None, length=849.42e-6, n_nodes=512, youngs_modulus=1.0e6,
                       poisson=0.0, n_steps=20, threshold=0.95, kernel="auto",
-                      stiffness="fd", genome_json=None) -> dict:
+                      stiffness="fd", correlation="steps", genome_json=None) -> dict:
     """Realise one genome, run Alg. 2 on it and return its database record (JSON-safe).
 
     Parameters
@@ -224,7 +229,8 @@ def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=
         Unique name of the genome in the database.
     amplitude, lambda1 : float
         Genes A (-) and lambda (m); ``lambda1=None`` means lambda = L (thesis).
-    length, n_nodes, youngs_modulus, poisson, n_steps, threshold, kernel, stiffness
+    length, n_nodes, youngs_modulus, poisson, n_steps, threshold, kernel, stiffness,
+    correlation
         :class:`DatabaseSettings` fields (keywords so a study runner can pass them).
     genome_json : dict, optional
         A complete Genome JSON (e.g. a sequenced genome for ``db extend``); then
@@ -239,7 +245,7 @@ def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=
     from .macro_micro import macro_micro
     from .genome import Genome
     settings = DatabaseSettings(length, n_nodes, youngs_modulus, poisson, n_steps, threshold,
-                                kernel, stiffness)
+                                kernel, stiffness, correlation)
     if genome_json is not None:
         genome = Genome.from_dict(genome_json)
     else:

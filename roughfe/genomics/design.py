@@ -728,7 +728,8 @@ class DesignResult:
         return self.candidates[0]
 
 
-def _macro_micro_of(design: Design, curve: ResponseCurve, entries_by_label, threshold):
+def _macro_micro_of(design: Design, curve: ResponseCurve, entries_by_label, threshold,
+                    axis="steps"):
     """Alg. 2 on a (cross-over) design from the parents' stored chromosome curves."""
     chroms, curves = [], []
     for k, part in enumerate(design.parts):
@@ -737,7 +738,7 @@ def _macro_micro_of(design: Design, curve: ResponseCurve, entries_by_label, thre
         for n in part.chromosomes:
             chroms.append((k, n))
             curves.append(e.chromosome_curves[n - n_s])
-    res = classify(curve, curves, np.arange(len(chroms)), threshold)
+    res = classify(curve, curves, np.arange(len(chroms)), threshold, axis)
     macro = [[] for _ in design.parts]
     micro = [[] for _ in design.parts]
     for j, c in enumerate(res.corr_k):
@@ -760,11 +761,12 @@ def _finish(design, s_stages, objective, evaluate, macro, micro, origin):
 
 
 def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, entries_by_label,
-                         threshold, stage1="macro"):
+                         settings, stage1="macro"):
     """GCMMA 1 and 2 for each start ``(design, s0, curve0, origin)``; best first."""
     out = []
     for design, s0, curve0, origin in starts:
-        macro, micro = _macro_micro_of(design, curve0, entries_by_label, threshold)
+        macro, micro = _macro_micro_of(design, curve0, entries_by_label, settings.threshold,
+                                       settings.correlation)
         if stage1 == "all":
             keys1 = design.keys("all") + (design.gene_keys() if options.cco_genes else [])
         else:
@@ -818,7 +820,7 @@ def sog(entries, target: Target, settings: DatabaseSettings, *, evaluate=None,
         d = entry_design(e, settings, weight=target.p_max / e.p_max)
         starts.append((d, float(s[i]), e.curve.rescaled(target.p_max / e.p_max), e.label))
     cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_sog,
-                                 options.n_it_micro, by_label, settings.threshold)
+                                 options.n_it_micro, by_label, settings)
     return _result("sog", cands, objective, None, {"s": s.tolist()}, 0, 0, True, evaluate, t0)
 
 
@@ -868,7 +870,7 @@ def gco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, eva
     starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
                                       every, n_best, max_set)
     cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
-                                 options.n_it_micro, by_label, settings.threshold)
+                                 options.n_it_micro, by_label, settings)
     return _result("gco", cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
                    n_cross, n_above, passed, evaluate, t0)
 
@@ -889,7 +891,7 @@ def cco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, eva
     starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
                                       macro, n_best, max_set)
     cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross, 0,
-                                 by_label, settings.threshold, stage1="all")
+                                 by_label, settings, stage1="all")
     return _result("cco", cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
                    n_cross, n_above, passed, evaluate, t0)
 
@@ -918,7 +920,7 @@ def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings
     starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate,
                                       (u1, u2), parts, n_best, max_set)
     cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
-                                 options.n_it_micro, by_label, settings.threshold)
+                                 options.n_it_micro, by_label, settings)
     return _result("mcco", cands, objective, None, {"s1": s1.tolist(), "s2": s2.tolist()},
                    n_cross, n_above, ok1 and ok2, evaluate, t0)
 
