@@ -204,3 +204,12 @@ def test_operator_symmetry_and_positivity():
     assert np.allclose(op.dense() @ p.ravel(), op.apply(p).ravel(), rtol=1e-12, atol=0)
     # a uniform pressure does not move a periodic surface (zero mean mode)
     assert np.allclose(op.apply(np.ones((16, 16))), 0.0, atol=1e-25)
+
+
+def test_non_convergence_is_an_error_that_says_what_was_reached():
+    from roughfe.errors import NoConvergenceError
+    surf = random_surface((64, 64), 1e-4, seed=4)
+    with pytest.raises(NoConvergenceError, match=r"residual .* after 3 iterations") as exc:
+        solve_contact(surf, MAT, mean_pressure=1e6, solver="pk", max_iter=3)
+    assert isinstance(exc.value, RuntimeError)
+    assert exc.value.result.pressure.shape == (64, 64)

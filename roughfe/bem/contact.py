@@ -30,7 +30,9 @@ from .solvers import (SolverOutput, dense_solve, kkt_residual, polonsky_keer,
 
 SOLVERS = ("auto", "dense", "nnls", "pk")
 #: largest number of grid points solved with the dense solvers by ``solver="auto"``
-DENSE_MAX_POINTS = 2048
+#: (measured: a 20-step sweep of a 512-point profile takes the same time with both, at
+#: 1024 points pk is 3x faster, at 2048 15x)
+DENSE_MAX_POINTS = 512
 
 REFERENCES = (
     "Bemporad A., Paggi M. (2015) Int. J. Solids Struct. 69-70:94-105 (NNLS BEM)",
