@@ -14,6 +14,7 @@ from ..errors import InputError
 
 # name on the command line -> script in validation/ (explicit, ordered)
 VALIDATIONS = {
+    "bem": "bem_contact",
     "fem": "bem_vs_fem",
     "sequencing": "genomics_sequencing",
     "design": "design_study",
