@@ -28,8 +28,8 @@ def test_genome_commands_end_to_end(tmp_path, capsys):
     for fig in ("profiles", "psd", "td", "bu"):
         assert (tmp_path / f"seq_{fig}.png").stat().st_size > 10_000
     mech = tmp_path / "mech"
-    assert main(["genome", "mechanics", str(out), "--nodes", "64", "--kernels", "strip",
-                 "--steps", "5", "--max-chromosomes", "2", "-o", str(mech)]) == 0
+    assert main(["genome", "mechanics", str(out), "--nodes", "32", "--kernels", "strip",
+                 "--steps", "5", "--max-chromosomes", "1", "-o", str(mech)]) == 0
     data = json.loads((mech / "mechanics_strip.json").read_text())
     assert np.isclose(data["c_td"]["K"][-1], 1.0)
     assert (mech / "correlations_strip.png").is_file()

@@ -133,14 +133,15 @@ class NaturalResult:
 
 def sequence_measured(surface: Surface, *, fractions=DEFAULT_FRACTIONS, n_nodes=DEFAULT_NODES,
                       seed=0, kernels=("thesis", "strip"), youngs_modulus=THESIS_YOUNGS_MODULUS,
-                      n_steps=20, rms_tolerance=0.05) -> NaturalResult:
+                      n_steps=20, rms_tolerance=0.05, n_restarts=3) -> NaturalResult:
     """Sequence a measured topography's central row and compare A(p), K(p) (Sec. 3.4.2).
 
     The measured and sequenced profiles of the coarsest acquisition are loaded with
     ``n_steps`` equal approaches each (E = 210 MPa as the thesis) for every kernel.
+    ``n_restarts`` is passed to :func:`~roughfe.genomics.sequencing.sequence_profiles`.
     """
     acq = nested_acquisitions(surface, fractions, n_nodes)
-    seq = sequence_profiles(acq, seed=seed, rms_tolerance=rms_tolerance)
+    seq = sequence_profiles(acq, seed=seed, rms_tolerance=rms_tolerance, n_restarts=n_restarts)
     full = acq[0]
     model = realize(seq.genome, length=full.metadata["length"], n_nodes=n_nodes)
     curves = {}
