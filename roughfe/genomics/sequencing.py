@@ -260,19 +260,18 @@ def comb_periods(log_q, weights=None, gamma_range=(1.05, 4.0), n_grid=6000, n_be
     return periods[keep], s[keep], np.array(refs)
 
 
-def _lattice_from_period(log_q, period, ref, coarse_length, weights=None, groups=None, power=None):
+def _lattice_from_period(log_q, period, ref, coarse_length, weights=None, groups=None):
     """Refine (ln q1, ln gamma) by weighted regression on the lattice indices; q1 so that n_s = 1.
 
     Each peak gets the nearest lattice index. Within one acquisition (``groups``) only the
-    strongest peak (``power``) per index is kept -- aliases of the sub-Nyquist chromosomes
-    can land next to a true line. Peaks farther than 0.15 period from the lattice are
+    peak closest to the lattice is kept per index -- aliases of the sub-Nyquist
+    chromosomes can land next to a true line, and be stronger. Peaks farther than 0.15 period from the lattice are
     dropped, then, iteratively, those farther than 4 robust standard deviations (MAD) of
     the regression residual. ``weights`` (the peak bin numbers: the relative precision of
     a peak grows with its bin) weight the regression.
     """
     w = np.ones_like(log_q) if weights is None else np.asarray(weights, dtype=float)
     grp = np.zeros(log_q.size, dtype=int) if groups is None else np.asarray(groups)
-    pw = np.ones_like(log_q) if power is None else np.asarray(power, dtype=float)
     tol = None
     for _ in range(8):
         k = np.round((log_q - ref) / period)
@@ -280,7 +279,7 @@ def _lattice_from_period(log_q, period, ref, coarse_length, weights=None, groups
         keep = np.abs(dev) < 0.15 * period
         if tol is not None:
             keep &= np.abs(dev) <= tol
-        order = np.lexsort((-pw, k, grp))           # strongest first within (group, index)
+        order = np.lexsort((np.abs(dev), k, grp))   # closest first within (group, index)
         seen = set()
         for idx in order:
             key = (int(grp[idx]), int(k[idx]))
@@ -703,8 +702,6 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         periods, coh, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
     bins = np.concatenate([s.peak_q / (s.q[1] - s.q[0]) for s in spectra])
     groups = np.concatenate([np.full(s.peak_q.size, i) for i, s in enumerate(spectra)])
-    power = np.concatenate([s.peak_C / max(float(s.peak_C.max()), 1e-300) if s.peak_C.size else s.peak_C
-                            for s in spectra])
     gamma_psd = float(math.exp(periods[0]))
 
     # 3-4. lattice fit with restarts
@@ -712,7 +709,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     nit = 0
     for period, ref in zip(periods, refs):
         if log_q.size >= 3:
-            lq1, lg = _lattice_from_period(log_q, period, ref, acqs[0].length, bins, groups, power)
+            lq1, lg = _lattice_from_period(log_q, period, ref, acqs[0].length, bins, groups)
         else:
             lq1, lg = _label_q1(ref, period, acqs[0].length), period
         if not (math.log(1.0 + 1e-3) < lg < math.log(10.0)):
@@ -734,10 +731,14 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
                 continue
             r = _vp_residual(cand, acqs, ranges, weights, rhs, None)
             n_par = 2 * (max(rr[1] for rr in ranges) - 1 + 1) + 2
-            cost = r.size * math.log(max(float(r @ r) / r.size, 1e-300)) + n_par * math.log(r.size)  # BIC
+            # BIC; the misfit is floored at round-off (1e-24 of the data energy) so that two
+            # exact fits tie and the lattice with fewer chromosomes wins (a lattice of ratio
+            # sqrt(gamma) contains the gamma lattice and fits WM data exactly too)
+            rss = max(float(r @ r), 1e-24 * float(rhs @ rhs))
+            cost = r.size * math.log(rss / r.size) + n_par * math.log(r.size)
             if best is None or cost < best[0]:
                 best = (cost, cand, ranges)
-        if best is not None and best[0] < r.size * math.log(1e-20):
+        if best is not None and best[0] < r.size * math.log(1e-20 * float(rhs @ rhs) / r.size) + 1e-9:
             break                              # exact fit (WM data): no restart needed
     if best is None:
         raise InputError("sequencing found no admissible wavenumber lattice (gamma in (1, 10]) in the PSD "
