@@ -14,6 +14,13 @@ the BEM call and c_n are :func:`~roughfe.genomics.macro_micro.profile_response` 
 :func:`~roughfe.genomics.macro_micro.correlation` (shared with roughness design): c_n is
 Pearson's coefficient on the complete profile's pressures after the Eq. (4.2) stretch.
 
+Amplitude. The genes of Table 1 read in SI (A = 1 m^0.25, lambda1 = 1 mm) give a 10x
+profile with rms height 0.73 mm and rms slope ~27: far outside the small-slope
+assumption of any half-space BEM, and pressures well above E. Because the contact problem
+is linear in the heights (Eq. 4.2 scaling, :mod:`roughfe.genomics.similarity`), A only
+stretches the pressure axis: A(p) and K(p) *shapes* and the c_n do not depend on it, and
+p scales with A. Use a smaller A for physically meaningful absolute pressures.
+
 Kernels: ``"thesis"`` is Eq. (2.4) (a line of 3D punch patches), ``"strip"`` the
 plane-strain half-plane of a profile; they give different pressures for the same
 profile (see :mod:`roughfe.bem.operators`), so both are offered and labelled.
