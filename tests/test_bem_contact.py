@@ -227,3 +227,17 @@ def test_non_convergence_is_an_error_that_says_what_was_reached():
         solve_contact(surf, MAT, mean_pressure=1e6, solver="pk", max_iter=3)
     assert isinstance(exc.value, RuntimeError)
     assert exc.value.result.pressure.shape == (64, 64)
+
+
+def test_periodic_sweep_ends_in_full_contact_and_stays_json_safe():
+    from roughfe.writers import to_json_text
+    sweep = contact_sweep(sinusoid(128), MAT, n_steps=5)
+    assert sweep.area_fraction[-1] == 1.0 and sweep.delta[-1] == pytest.approx(1e-6)
+    # full contact of the sinusoid at Delta = g needs exactly p* (Westergaard)
+    assert sweep.mean_pressure[-1] == pytest.approx(np.pi * MAT.E_star * 1e-6 / 1e-3, rel=1e-3)
+    recs = sweep.to_records()
+    assert recs[-1]["stiffness"] is None       # infinite: reported as null, not as an error
+    to_json_text(recs)
+    # repeated full-contact pressures: the finite difference is undefined, not an error
+    sw = contact_sweep(sinusoid(128), MAT, pressures=[1e5, 1e7, 1e8])
+    assert np.isnan(sw.stiffness_fd[-1]) and list(sw.area_fraction[1:]) == [1.0, 1.0]

@@ -260,19 +260,19 @@ def _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter):
     return SolverOutput(p, u, delta, o.nit, max(res, o.residual), "pk")
 
 
-def _stiffness(op, solver, p, w, scale):
+def _stiffness(op, solver, contact, w, scale):
     """Exact incremental stiffness dp/dDelta (Pa/m) from the contact set."""
-    c = p > 0
+    c = contact
     if not c.any():
-        c = w <= 1e-12 * scale
-    n = p.size
+        c = w <= 1e-12 * scale          # Delta = 0: the touching point(s)
+    n = c.size
     if op.periodic and c.all():
         return float("inf")
     if solver in ("dense", "nnls"):
         idx = np.flatnonzero(c.ravel())
         x = solve_spd(_dense(op)[np.ix_(idx, idx)], np.ones(idx.size))
         return float(x.sum()) / n
-    x, _ = restricted_cg(op.apply, c, np.ones(p.shape), precond=_preconditioner(op))
+    x, _ = restricted_cg(op.apply, c, np.ones(c.shape), precond=_preconditioner(op))
     return float(x.sum()) / n
 
 
@@ -393,7 +393,7 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness):
     sigma = rms_height(surface)
     A = surface.nominal_area
     mean_gap = float(gap.mean())
-    K = _stiffness(op, solver, p, w, scale) if compute_stiffness else float("nan")
+    K = _stiffness(op, solver, contact, w, scale) if compute_stiffness else float("nan")
     for arr in (p, u, gap, contact):
         arr.setflags(write=False)
     return ContactResult(

@@ -23,13 +23,19 @@ RECORD_KEYS = ("delta", "load", "mean_pressure", "area_fraction", "n_contact", "
 
 
 def central_differences(x, y):
-    """dy/dx at every point: central differences inside (non-uniform spacing, second
-    order), one-sided at the ends. NaN for fewer than 2 points."""
+    """dy/dx: (y[i+1] - y[i-1]) / (x[i+1] - x[i-1]) inside, one-sided at the ends; NaN
+    where the spacing is zero (e.g. repeated full-contact steps) or fewer than 2 points."""
     x = np.asarray(x, float)
     y = np.asarray(y, float)
+    out = np.full(x.shape, np.nan)
     if x.size < 2:
-        return np.full(x.shape, np.nan)
-    return np.gradient(y, x, edge_order=1)
+        return out
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out[1:-1] = (y[2:] - y[:-2]) / (x[2:] - x[:-2])
+        out[0] = (y[1] - y[0]) / (x[1] - x[0])
+        out[-1] = (y[-1] - y[-2]) / (x[-1] - x[-2])
+    out[~np.isfinite(out)] = np.nan
+    return out
 
 
 @dataclass(frozen=True, eq=False)
