@@ -20,7 +20,7 @@ from typing import Optional
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, NoConvergenceError
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from .material import Material
@@ -368,10 +368,13 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
             if initial is None:
                 # a rough matrix-free solve gives the contact set: pivoting then needs
                 # only a few exchanges (the answer is still the exact pivoting solution)
-                initial = solve_contact(surface, material, delta=delta,
-                                        mean_pressure=mean_pressure, kernel=kernel,
-                                        solver="pk", tol=1e-4, compute_stiffness=False,
-                                        max_iter=2000).pressure
+                try:
+                    initial = solve_contact(surface, material, delta=delta,
+                                            mean_pressure=mean_pressure, kernel=kernel,
+                                            solver="pk", tol=1e-4, compute_stiffness=False,
+                                            max_iter=2000).pressure
+                except NoConvergenceError as exc:
+                    initial = exc.result.pressure
             o = dense_solve(H, b.ravel(), scale, delta=delta, mean_pressure=mean_pressure,
                             initial=initial, method="nnls" if solver == "nnls" else "bpp",
                             tol=tol, max_iter=max_iter or 100)
