@@ -65,7 +65,8 @@ def _run(args) -> int:
     if not args.no_figures:
         from ..plotting.contact import plot_area_stiffness, plot_profile_state, render_contact
         plot_area_stiffness(sweep.to_records(), out / "contact_area_stiffness.png",
-                            title=f"{Path(args.surface).name}, E* = {material.E_star:.4g} Pa")
+                            title=f"{Path(args.surface).name}, E* = {material.E_star:.4g} Pa",
+                            rms_height=sweep.rms_height)
         last = sweep.results[-1]
         if surface.ndim == 2:
             render_contact(surface.heights, last, out / "contact_render.png",
@@ -111,7 +112,8 @@ def section_contact(outdir: Path, context: dict) -> str:
     write_results_json(sub / "results.json", sweep, inputs)
     write_fields_h5(sub / "fields.h5", sweep)
     fig = plot_area_stiffness(sweep.to_records(), sub / "contact_area_stiffness.png",
-                              title="RMD D = 2.3, m = 7: A(p) and K(p)")
+                              title="RMD D = 2.3, m = 7: A(p), K(p), V*(d/sigma)",
+                              rms_height=sweep.rms_height)
     last = sweep.results[-1]
     render = render_contact(surface.heights, last, sub / "contact_render.png",
                             title="RMD D = 2.3, m = 7 at Delta = h_s")

@@ -16,8 +16,9 @@ def _column(steps, key):
     return np.array([np.nan if s[key] is None else s[key] for s in steps], float)
 
 
-def plot_area_stiffness(steps, path, title=None):
-    """A*(p) and K(p) (exact incremental and central finite differences), log-log.
+def plot_area_stiffness(steps, path, title=None, rms_height=None):
+    """A*(p) and K(p) (exact incremental and central finite differences), log-log, and
+    with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8).
 
     Parameters
     ----------
@@ -25,12 +26,23 @@ def plot_area_stiffness(steps, path, title=None):
         Step records (``SweepResult.to_records()`` or ``results.json["steps"]``).
     path : str or Path
         PNG to write.
+    rms_height : float, optional
+        sigma (m) for the free-volume panel.
     """
     p = _column(steps, "mean_pressure") * MPA
     a = _column(steps, "area_fraction")
     k = _column(steps, "stiffness") * MPA * 1e-6      # MPa/um
     kfd = _column(steps, "stiffness_fd") * MPA * 1e-6
-    fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
+    ncol = 2 if rms_height is None else 3
+    fig, axes = new_figure(1, ncol, figsize=(5 * ncol, 4))
+    ax1, ax2 = axes[0], axes[1]
+    if rms_height is not None:
+        d = _column(steps, "mean_plane_separation") / rms_height
+        axes[2].plot(d, _column(steps, "free_volume_star"), "o-", ms=4)
+        axes[2].set_xlabel("d / sigma")
+        axes[2].set_ylabel("V* = V / (A_n sigma)")
+        axes[2].set_title("free volume V*(d/sigma), Eq. 2.8")
+        axes[2].grid(True, alpha=0.3)
     ok = p > 0
     ax1.loglog(p[ok], a[ok], "o-", ms=4)
     ax1.set_xlabel("mean pressure p (MPa)")
