@@ -431,6 +431,12 @@ class GcmmaResult:
     message: str
 
 
+def _inside(u):
+    """Keep a GCMMA iterate in the unit box (the subproblem can return round-off or, on a
+    degenerate subproblem, non-finite values outside it)."""
+    return np.clip(np.nan_to_num(u, nan=0.5, posinf=1.0, neginf=0.0), 0.0, 1.0)
+
+
 def gcmma_maximize(fun: Callable[[np.ndarray], float], x0, lower, upper, *, n_it: int = 5,
                    eps: float = 0.02, grad: Optional[Callable] = None, f0=None,
                    max_inner: int = 5) -> GcmmaResult:
@@ -486,6 +492,7 @@ def gcmma_maximize(fun: Callable[[np.ndarray], float], x0, lower, upper, *, n_it
                                     raa0eps, raaeps, df0dx, dfdx)
         xmma, *_, f0app, fapp = gcmmasub(m, n, it, epsimin, u, xmin, xmax, low, upp, raa0, raa,
                                          f0val, df0dx, fval, dfdx, a0, a, c, d)
+        xmma = _inside(xmma)
         s_new = s_of(xmma)
         f0new = np.array([[obj(s_new)]])
         conserv = concheck(m, epsimin, f0app, f0new, fapp, fval)
@@ -496,6 +503,7 @@ def gcmma_maximize(fun: Callable[[np.ndarray], float], x0, lower, upper, *, n_it
                                   raa, raa0eps, raaeps, epsimin)
             xmma, *_, f0app, fapp = gcmmasub(m, n, it, epsimin, u, xmin, xmax, low, upp, raa0,
                                              raa, f0val, df0dx, fval, dfdx, a0, a, c, d)
+            xmma = _inside(xmma)
             s_new = s_of(xmma)
             f0new = np.array([[obj(s_new)]])
             conserv = concheck(m, epsimin, f0app, f0new, fapp, fval)
@@ -569,6 +577,7 @@ def gcmma_minimax(residuals: Callable[[np.ndarray], np.ndarray], score: Callable
                                     raa0eps, raaeps, df0dx, dfdx)
         xmma, *_, f0app, fapp = gcmmasub(m, n, it, epsimin, u, xmin, xmax, low, upp, raa0, raa,
                                          f0val, df0dx, fval, dfdx, a0, a, c, d)
+        xmma = _inside(xmma)
         r_new = r_of(xmma)
         fnew = cons(r_new)
         conserv = concheck(m, epsimin, f0app, np.zeros((1, 1)), fapp, fnew)
@@ -579,6 +588,7 @@ def gcmma_minimax(residuals: Callable[[np.ndarray], np.ndarray], score: Callable
                                   fapp, raa0, raa, raa0eps, raaeps, epsimin)
             xmma, *_, f0app, fapp = gcmmasub(m, n, it, epsimin, u, xmin, xmax, low, upp, raa0,
                                              raa, f0val, df0dx, fval, dfdx, a0, a, c, d)
+            xmma = _inside(xmma)
             r_new = r_of(xmma)
             fnew = cons(r_new)
             conserv = concheck(m, epsimin, f0app, np.zeros((1, 1)), fapp, fnew)
