@@ -35,6 +35,7 @@ def _run(args) -> int:
     if args.method != "mcco" and args.second_target:
         raise InputError("--second-target is used by --method mcco only")
     options = GcmmaOptions(bound=args.bound, formulation=args.formulation, eps=args.eps,
+                           gradient=args.gradient,
                            **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
                               if args.iterations else {}))
     result = run_design(args.method, entries, targets, settings, pbar=args.pbar, options=options)
@@ -89,8 +90,10 @@ def register(sub):
                    help="phase box: +-10%% of the start value (thesis) or of 2 pi")
     g.add_argument("--formulation", choices=("minimax", "thesis"), default="minimax",
                    help="min-max form with residual Jacobian, or (1-s)^2 with its gradient")
+    g.add_argument("--gradient", choices=("exact", "fd"), default="exact",
+                   help="exact sensitivities on the fixed contact sets, or finite differences")
     g.add_argument("--eps", type=float, default=0.02,
-                   help="finite-difference step in units of the phase box")
+                   help="finite-difference step in units of the phase box (--gradient fd)")
     p.add_argument("-o", "--output", required=True, help="output folder")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.set_defaults(func=_run)
