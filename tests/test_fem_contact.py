@@ -38,8 +38,10 @@ def test_westergaard_width_and_mean_gap(westergaard_mesh):
     of Westergaard (measured 0.1-0.4 %), and the mean gap, which tests the finite-depth
     correction of Delta, within 2 % of g (1 - s + s ln s) (measured 0.1-0.5 %)."""
     pm = westergaard_mesh
-    sweep = fem_contact_sweep(pm, MAT, np.array([0.4, 1.0, 1.6]) * G)
+    targets = np.array([0.2, 0.5, 0.8]) * G          # half-plane approaches (full contact: G)
+    sweep = fem_contact_sweep(pm, MAT, targets)
     res = sweep.results
+    assert np.allclose(sweep.delta, targets, rtol=1e-8)
     for r in res:
         ref = westergaard(G, LAM, MAT.E_star, r.mean_pressure)
         a = contact_edge(r.x, r.gap, r.contact)
@@ -80,9 +82,10 @@ def test_vi_and_penalty_agree():
     pm = mesh_profile(random_profile(65, seed=4), growth=0.1)
     hr = np.ptp(pm.heights)
     deltas = np.array([0.1, 0.3, 0.5]) * hr
-    vi = fem_contact_sweep(pm, MAT, deltas, FemSolverOptions(method="vi")).results
-    pen = fem_contact_sweep(pm, MAT, deltas, FemSolverOptions(method="penalty",
-                                                              penalty_factor=1e4)).results
+    vi = fem_contact_sweep(pm, MAT, applied_deltas=deltas,
+                           options=FemSolverOptions(method="vi")).results
+    pen = fem_contact_sweep(pm, MAT, applied_deltas=deltas,
+                            options=FemSolverOptions(method="penalty", penalty_factor=1e4)).results
     for a, b in zip(vi, pen):
         assert b.mean_pressure == pytest.approx(a.mean_pressure, rel=1e-4)
         assert np.sum(a.contact != b.contact) <= 1
@@ -99,7 +102,7 @@ def test_uniform_layer_compliance_exact(formulation):
     flat = Surface(np.zeros(n), n * L / (n - 1))
     pm = mesh_profile(flat, depth=0.7e-3, growth=0.3, formulation=formulation)
     delta = 2e-6
-    r = fem_solve_contact(pm, MAT, delta, keep_fields=True)
+    r = fem_solve_contact(pm, MAT, applied_delta=delta, keep_fields=True)
     M = MAT.E * 0.7 / (1.3 * 0.4)
     assert p_wave_modulus(MAT) == pytest.approx(M, rel=1e-15)
     p = M * delta / 0.7e-3
@@ -143,7 +146,7 @@ def test_forced_non_convergence_names_the_snes_reason():
     pm = mesh_profile(random_profile(33, seed=2), growth=0.3)
     opts = FemSolverOptions(method="vi", max_it=1)
     with pytest.raises(NoConvergenceError, match="DIVERGED_MAX_IT"):
-        fem_contact_sweep(pm, MAT, [0.5 * np.ptp(pm.heights)], opts)
+        fem_contact_sweep(pm, MAT, applied_deltas=[0.5 * np.ptp(pm.heights)], options=opts)
 
 
 def test_mirrored_profile_and_bad_input():

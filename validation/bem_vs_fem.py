@@ -31,7 +31,7 @@ import numpy as np
 
 from roughfe.bem import Material, contact_sweep
 from roughfe.fem import mesh_profile, mirrored_profile
-from roughfe.fem.contact import FemSolverOptions, contact_edge, fem_contact_sweep, p_wave_modulus
+from roughfe.fem.contact import FemSolverOptions, contact_edge, fem_contact_sweep
 from roughfe.plotting import fem as fplot
 from roughfe.reference import westergaard
 from roughfe.surfaces import Surface
@@ -57,7 +57,7 @@ def westergaard_case(outdir: Path, n=513, wavelength=1e-3, amplitude=1e-6):
     t0 = time.perf_counter()
     pm = mesh_profile(surf, growth=GROWTH)
     t_mesh = time.perf_counter() - t0
-    deltas = amplitude * np.linspace(0.1, 1.8, 10)
+    deltas = amplitude * np.linspace(0.05, 0.95, 10)    # half-plane approach; full contact: g
     t0 = time.perf_counter()
     fem = fem_contact_sweep(pm, MATERIAL, deltas, keep_fields=(4,))
     t_fem = time.perf_counter() - t0
@@ -117,8 +117,6 @@ def profile_case(name, surf, outdir: Path, n_steps=16):
     pm = mesh_profile(surf, growth=GROWTH)
     pm_b = mesh_profile(surf, growth=GROWTH, formulation="profile")
     t_mesh = time.perf_counter() - t0
-    compliance = pm.depth / p_wave_modulus(MATERIAL)
-    applied = bem.delta + bem.mean_pressure * compliance      # aim at the BEM delta
     timings = {"bem": t_bem, "mesh (a)+(b)": t_mesh}
     sweeps = {}
     for label, mesh, opts in (("FEM-VI", pm, FemSolverOptions(method="vi")),
@@ -126,15 +124,15 @@ def profile_case(name, surf, outdir: Path, n_steps=16):
                                                                    penalty_factor=1e4)),
                               ("FEM-VI (b)", pm_b, FemSolverOptions(method="vi"))):
         t0 = time.perf_counter()
-        sweeps[label] = fem_contact_sweep(mesh, MATERIAL, applied,
+        sweeps[label] = fem_contact_sweep(mesh, MATERIAL, bem.delta,   # the BEM's approaches
                                           options=opts, keep_fields=(n_steps // 2,))
         timings[label] = time.perf_counter() - t0
     thesis = contact_sweep(surf, MATERIAL, pressures=bem.mean_pressure, kernel="thesis")
     vi, pen, vb = sweeps["FEM-VI"], sweeps["FEM-penalty"], sweeps["FEM-VI (b)"]
 
-    # Compare where >= MIN_CONTACT nodes touch in both. The FEM steps aim at the BEM
-    # deltas (equal to 0.3 %), so A* and K are compared step by step (equal Delta) and,
-    # for A(p), also with the BEM curve interpolated at the FEM pressure.
+    # Compare where >= MIN_CONTACT nodes touch in both. The FEM solves at the BEM's
+    # half-plane approaches (to 1e-9), so A* and K are compared step by step (equal
+    # Delta) and, for A(p), also with the BEM curve interpolated at the FEM pressure.
     n = h.size
     n_bem = np.array([int(r.contact[:n].sum()) for r in bem.results])   # profile nodes
     mask = (vi.n_contact >= MIN_CONTACT) & (n_bem >= MIN_CONTACT)
@@ -246,9 +244,7 @@ def resolution_study(surf: Surface, refinements=(1, 2, 4), fractions=(0.3, 0.6, 
         t0 = time.perf_counter()
         bem = contact_sweep(mirrored_profile(s_r), MATERIAL, deltas=top * np.asarray(fractions),
                             kernel="spectral")
-        pm = mesh_profile(s_r, growth=0.1)
-        applied = bem.delta + bem.mean_pressure * pm.depth / p_wave_modulus(MATERIAL)
-        fem = fem_contact_sweep(pm, MATERIAL, applied)
+        fem = fem_contact_sweep(mesh_profile(s_r, growth=0.1), MATERIAL, bem.delta)
         for k, f in enumerate(fractions):
             rb, rf = bem.results[k], fem.results[k]
             rows.append({"refinement": r, "fraction": f, "n_nodes": n,
@@ -274,7 +270,7 @@ n, lam, g = 129, 1e-3, 1e-6
 dx = lam / 2 / (n - 1)
 x = np.arange(n) * dx
 pm = mesh_profile(Surface(g * np.cos(2 * np.pi * x / lam), n * dx), growth=0.1)
-sw = fem_contact_sweep(pm, Material(E=210e9, nu=0.3), np.array([1.0, 2.0, 3.0]) * g)
+sw = fem_contact_sweep(pm, Material(E=210e9, nu=0.3), applied_deltas=np.array([1.0, 2.0, 3.0]) * g)
 if MPI.COMM_WORLD.rank == 0:
     print(json.dumps({"p": sw.mean_pressure.tolist(), "A": sw.area_fraction.tolist(),
                       "K": sw.stiffness.tolist(), "ranks": MPI.COMM_WORLD.size}))

@@ -307,6 +307,7 @@ class _ContactProblem:
         self.x.set(0.0)
         self.r = self.x.duplicate()
         self.kappa = options.penalty_factor * (n - 1)         # k E/delta in units E/W
+        self.last_pressure = 0.0
         self.snes = self._make_snes()
 
     # -- SNES ---------------------------------------------------------------------------
@@ -354,16 +355,37 @@ class _ContactProblem:
 
     # -- one load step ----------------------------------------------------------------
     def solve(self, delta: float, keep_fields: bool = False) -> FemContactResult:
-        """Solve for the approach ``delta`` (m), starting from the previous solution."""
+        """Solve for the imposed approach ``delta`` (m), from the previous solution."""
         self.bound = self.gap0 - float(delta) / self.u_ref
         if self.options.method == "vi":
             self.upper.array[self.top_dofs] = self.bound
             self.snes.setVariableBounds(self.lower, self.upper)
         self.snes.solve(None, self.x)
         what = (f"FEM contact ({self.options.method}, {self.pmesh.formulation}) at "
-                f"delta = {float(delta):.6g} m")
+                f"imposed delta = {float(delta):.6g} m")
         nit = check_snes(self.snes, what)
         return self._result(float(delta), nit, what, keep_fields)
+
+    def solve_half_plane(self, target: float, keep_fields: bool = False) -> FemContactResult:
+        """Solve for the half-plane approach ``target`` (m), the BEM's Delta.
+
+        Newton on the imposed approach: delta = applied - p H_d/M, so
+        d applied = d delta (1 + K H_d/M) with the exact stiffness K of the last solve.
+        Converges in 1-3 steps unless the contact set changes (then a few more).
+        """
+        compliance = self.pmesh.depth / p_wave_modulus(self.material)
+        applied = target + self.last_pressure * compliance
+        tol = 1e-9 * self.u_ref
+        for _ in range(12):
+            r = self.solve(applied, keep_fields)
+            err = target - r.delta
+            if abs(err) <= tol:
+                self.last_pressure = r.mean_pressure
+                return r
+            applied = max(applied + err * (1.0 + r.stiffness * compliance), 0.0)
+        raise NoConvergenceError(
+            f"FEM contact: the half-plane approach {target:.6g} m was not reached "
+            f"(last {r.delta:.6g} m, imposed {applied:.6g} m)", result=r)
 
     def _incremental_stiffness(self, contact_local):
         """Exact dp/d delta_applied (non-dimensional E/W units) with the contact set frozen.
@@ -501,9 +523,10 @@ def contact_edge(x, gap, contact):
     return float(np.clip(a, x[j], x[j + 1]))
 
 
-def fem_contact_sweep(pmesh: ProfileMesh, material: Material, applied_deltas,
-                      options: FemSolverOptions | None = None, keep_fields=()) -> FemSweepResult:
-    """Solve the FEM contact problem for increasing imposed approaches (load stepping).
+def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
+                      applied_deltas=None, options: FemSolverOptions | None = None,
+                      keep_fields=()) -> FemSweepResult:
+    """Solve the FEM contact problem for increasing approaches (load stepping).
 
     Each step starts from the previous solution.
 
@@ -512,9 +535,12 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, applied_deltas,
     pmesh : ProfileMesh
     material : roughfe.bem.Material
         E (Pa) and nu < 0.5 of the body (the obstacle is rigid).
-    applied_deltas : array_like
-        Strictly increasing approaches imposed on the layer, Delta >= 0 (m). To aim at a
-        half-plane approach delta with mean pressure p, impose delta + p H_d / M.
+    deltas : array_like, optional
+        Strictly increasing half-plane approaches Delta >= 0 (m), the BEM's Delta
+        (``result.delta``); each costs 2-4 solves (Newton on the imposed approach).
+    applied_deltas : array_like, optional
+        Or: strictly increasing approaches imposed on the layer (m), one solve each;
+        ``result.delta`` is then ``applied - p H_d / M``. Give exactly one of the two.
     options : FemSolverOptions, optional
     keep_fields : iterable of int
         Indices of the steps whose full fields (mesh, displacement, sigma_yy) are kept.
@@ -527,18 +553,23 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, applied_deltas,
     """
     material = _check_material(material)
     options = FemSolverOptions() if options is None else options
-    deltas = np.asarray(applied_deltas, dtype=float).ravel()
-    if deltas.size == 0 or not np.all(np.isfinite(deltas)) or np.any(deltas < 0):
-        raise InputError(f"applied_deltas must be a non-empty list of finite values >= 0 (m), "
-                         f"got {deltas!r}")
-    if np.any(np.diff(deltas) <= 0):
-        raise InputError("applied_deltas must be strictly increasing (load stepping)")
-    keep = {int(k) % deltas.size for k in keep_fields}
+    if (deltas is None) == (applied_deltas is None):
+        raise InputError("give exactly one of deltas (half-plane approaches, m) or "
+                         "applied_deltas (approaches imposed on the layer, m)")
+    name = "deltas" if applied_deltas is None else "applied_deltas"
+    values = np.asarray(deltas if applied_deltas is None else applied_deltas, dtype=float).ravel()
+    if values.size == 0 or not np.all(np.isfinite(values)) or np.any(values < 0):
+        raise InputError(f"{name} must be a non-empty list of finite values >= 0 (m), "
+                         f"got {values!r}")
+    if np.any(np.diff(values) <= 0):
+        raise InputError(f"{name} must be strictly increasing (load stepping)")
+    keep = {int(k) % values.size for k in keep_fields}
     problem = _ContactProblem(pmesh, material, options)
+    step = problem.solve if applied_deltas is not None else problem.solve_half_plane
     results = []
     try:
-        for k, d in enumerate(deltas):
-            results.append(problem.solve(d, keep_fields=k in keep))
+        for k, d in enumerate(values):
+            results.append(step(d, keep_fields=k in keep))
     except NoConvergenceError as exc:
         raise NoConvergenceError(str(exc), result=results) from None
     finally:
@@ -551,9 +582,12 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, applied_deltas,
                           n_contact=np.array([r.n_contact for r in results]), **arr)
 
 
-def fem_solve_contact(pmesh: ProfileMesh, material: Material, applied_delta: float,
-                      options: FemSolverOptions | None = None,
+def fem_solve_contact(pmesh: ProfileMesh, material: Material, delta=None, *,
+                      applied_delta=None, options: FemSolverOptions | None = None,
                       keep_fields: bool = False) -> FemContactResult:
-    """One FEM contact solve at the imposed approach ``applied_delta`` (m)."""
-    return fem_contact_sweep(pmesh, material, [applied_delta], options,
-                             keep_fields=(0,) if keep_fields else ()).results[0]
+    """One FEM contact solve at the half-plane approach ``delta`` or the imposed
+    ``applied_delta`` (m), see :func:`fem_contact_sweep`."""
+    return fem_contact_sweep(
+        pmesh, material, None if delta is None else [delta],
+        applied_deltas=None if applied_delta is None else [applied_delta], options=options,
+        keep_fields=(0,) if keep_fields else ()).results[0]
