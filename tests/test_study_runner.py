@@ -270,3 +270,11 @@ def test_worker_crash_charges_only_the_crashing_task(tmp_path):
     assert failure[1]["x"] == 2.5 and "worker lost" in failure[2]
     attempts = json.loads(next((out / "failures").glob("*.json")).read_text())["attempts"]
     assert len(attempts) == 2
+
+
+def test_non_finite_result_is_a_clear_task_error():
+    from roughfe.study import execute_task
+
+    out = execute_task("selftest", {"x": float("inf")}, 0)  # f = inf**2: not storable
+    assert not out["ok"] and "non-finite number" in out["error"]
+    assert execute_task("selftest", {"x": 2.0}, 0)["records"][0]["f"] == 4.0

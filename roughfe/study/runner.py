@@ -40,7 +40,13 @@ def execute_task(analysis: str, params: dict, seed: int) -> dict:
     try:
         func = resolve(analysis)
         records = as_records(func(**params, seed=seed), analysis)
-        out.update(ok=True, records=json.loads(to_json_text(records)))
+        try:
+            text = to_json_text(records)
+        except ValueError as exc:  # NaN or inf: a result file must hold finite numbers
+            raise ValueError(f"analysis {analysis!r} returned a non-finite number (NaN or "
+                             f"inf) in its records; return None for undefined values ({exc})"
+                             ) from None
+        out.update(ok=True, records=json.loads(text))
     except Exception as exc:  # a failing task is data for the driver, not a crash
         out.update(ok=False, error=f"{type(exc).__name__}: {exc}",
                    traceback=traceback.format_exc())
