@@ -245,14 +245,18 @@ def resolution_study(surf: Surface, refinements=(1, 2, 4), fractions=(0.3, 0.6, 
         bem = contact_sweep(mirrored_profile(s_r), MATERIAL, deltas=top * np.asarray(fractions),
                             kernel="spectral")
         fem = fem_contact_sweep(mesh_profile(s_r, growth=0.1), MATERIAL, bem.delta)
+        bem_p = contact_sweep(mirrored_profile(s_r), MATERIAL, pressures=fem.mean_pressure,
+                              kernel="spectral")
         for k, f in enumerate(fractions):
-            rb, rf = bem.results[k], fem.results[k]
+            rb, rf, rp = bem.results[k], fem.results[k], bem_p.results[k]
             rows.append({"refinement": r, "fraction": f, "n_nodes": n,
                          "n_contact_bem": int(rb.contact[:n].sum()),
                          "n_contact_fem": rf.n_contact,
                          "nodes_differing": int(np.sum(rb.contact[:n] != rf.contact)),
                          "area_bem": rb.area_fraction, "area_fem": rf.area_fraction,
                          "area_rel_diff": rf.area_fraction / rb.area_fraction - 1,
+                         "area_rel_diff_equal_p": rf.area_fraction / rp.area_fraction - 1,
+                         "nodes_differing_equal_p": int(np.sum(rp.contact[:n] != rf.contact)),
                          "p_rel_diff": rf.mean_pressure / rb.mean_pressure - 1,
                          "seconds": time.perf_counter() - t0})
     return rows
@@ -400,16 +404,19 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
                      f"{r[10]} / {r[11]} |")
         L.append("")
         L.append("Resolution study (the same piecewise-linear profile sampled r times "
-                 "finer, BEM and FEM-VI with growth 0.1, loads at 0.3/0.6/0.9 of max h - "
-                 "mean h):\n")
+                 "finer, BEM and FEM-VI with growth 0.1, half-plane approaches 0.3/0.6/0.9 of "
+                 "max h - mean h; the last column re-solves the BEM under load control at "
+                 "the FEM pressures):\n")
         L.append("| r | nodes | load | n_c BEM | n_c FEM | nodes differing | A* BEM | A* FEM | "
-                 "A* FEM/BEM - 1 | p FEM/BEM - 1 |")
-        L.append("|---|---|---|---|---|---|---|---|---|---|")
+                 "A* FEM/BEM - 1 | p FEM/BEM - 1 | at equal p: A* FEM/BEM - 1 (nodes) |")
+        L.append("|---|---|---|---|---|---|---|---|---|---|---|")
         for r in c["resolution_study"]:
             L.append(f"| {r['refinement']} | {r['n_nodes']} | {r['fraction']} | "
                      f"{r['n_contact_bem']} | {r['n_contact_fem']} | {r['nodes_differing']} | "
                      f"{r['area_bem']:.4f} | {r['area_fem']:.4f} | "
-                     f"{100 * r['area_rel_diff']:+.2f} % | {100 * r['p_rel_diff']:+.3f} % |")
+                     f"{100 * r['area_rel_diff']:+.2f} % | {100 * r['p_rel_diff']:+.3f} % | "
+                     f"{100 * r['area_rel_diff_equal_p']:+.2f} % "
+                     f"({r['nodes_differing_equal_p']}) |")
         L.append("")
         L.append(f"![curves](bem_vs_fem_{name}_curves.png)\n")
         L.append(f"![pressure](bem_vs_fem_{name}_pressure.png)\n")
@@ -434,11 +441,17 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
              "pressure) and the FEM (P1, nodal reactions) discretise the edge differently, "
              "and both only converge to the continuum edge under refinement. The load p(Delta) "
              "and the stiffness, which integrate over the contact, agree much more closely. "
-             "The resolution studies show it: on the same piecewise-linear profile sampled "
-             "2 and 4 times finer, the A* of BEM and FEM agree within the 2 % target. The "
-             "pass/fail status of this report therefore uses the resolved A*; the "
-             "native-sampling A* is reported above and is NOT within 2 % for these "
-             "sample-scale rough profiles.\n")
+             "The resolution studies show what the differences are: a handful of nodes "
+             "(1-8) at grazing contact edges, whose gap is 1e-5-1e-3 of the rms height, at "
+             "every resolution. Their number does not grow with the number of contact "
+             "nodes, so the relative A* difference falls as the contact grows, but it is "
+             "noisy (a grazing patch flips with a 0.1 % change of load), at equal Delta as "
+             "well as at equal p. The FEM (P1, displacement-based) is slightly stiffer than "
+             "the BEM: at equal Delta its mean pressure is 0.1-0.8 % higher, falling with "
+             "the resolution and with a gentler mesh growth (compare growth 0.03 in the "
+             "main tables with 0.1 in the study). The pass/fail status of this report uses "
+             "the A* of the resolved profiles (r = 2, 4); the native-sampling A* is "
+             "reported as well.\n")
     L.append("## The thesis kernel (Eq. 2.4)\n")
     L.append("Eq. 2.4, H_ij = 2/(pi E delta) arcsin(delta / (2 |x_i - x_j|)), is the "
              "displacement outside a rigid circular punch of diameter delta in 3D: it decays "
