@@ -173,8 +173,8 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
             gmsh.model.setPhysicalName(2, DOMAIN_TAG, "body")
             field = gmsh.model.mesh.field.add("MathEval")
             ytop = float(ys.max())
-            gmsh.model.mesh.field.setString(
-                field, "F", f"Min({d!r} + {float(growth)!r} * ({ytop!r} - y), {size_max / scale!r})")
+            size = f"Min({d!r} + {float(growth)!r} * ({ytop!r} - y), {size_max / scale!r})"
+            gmsh.model.mesh.field.setString(field, "F", size)
             gmsh.model.mesh.field.setAsBackgroundMesh(field)
             for opt in ("Mesh.CharacteristicLengthExtendFromBoundary",
                         "Mesh.CharacteristicLengthFromPoints",

@@ -92,7 +92,8 @@ def plot_westergaard(p_star_ratio, width_errors, x, pressure_pairs, path) -> Pat
     """
     fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
     for k, (label, err) in enumerate(width_errors.items()):
-        ax1.plot(p_star_ratio, 100 * np.asarray(err), marker="os^"[k % 3], ls=_STYLES[k], label=label)
+        ax1.plot(p_star_ratio, 100 * np.asarray(err), marker="os^"[k % 3], ls=_STYLES[k],
+                 label=label)
     ax1.axhspan(-0.5, 0.5, color="g", alpha=0.1, label="target +-0.5 %")
     ax1.set(xlabel="p / p*", ylabel="a / a_Westergaard - 1 (%)", title="contact half-width")
     for k, (label, num, ref) in enumerate(pressure_pairs):
