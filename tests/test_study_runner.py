@@ -278,3 +278,15 @@ def test_non_finite_result_is_a_clear_task_error():
     out = execute_task("selftest", {"x": float("inf")}, 0)  # f = inf**2: not storable
     assert not out["ok"] and "non-finite number" in out["error"]
     assert execute_task("selftest", {"x": 2.0}, 0)["records"][0]["f"] == 4.0
+
+
+def test_status_warns_when_results_come_from_several_commits(tmp_path):
+    out = tmp_path / "prov"
+    run_study(_spec(out), executor="local", workers=1, progress=False)
+    status = study_status(out)
+    assert "different code commits" not in status.describe()
+    first = next((out / "results").glob("*.json"))
+    record = json.loads(first.read_text())
+    record["code_commit"] = "0" * 40
+    first.write_text(json.dumps(record))
+    assert "warning: the results come from" in study_status(out).describe()

@@ -11,10 +11,12 @@ import collections
 import json
 import os
 import socket
+import subprocess
 import sys
 import time
 import traceback
 from dataclasses import dataclass
+from pathlib import Path
 
 from .. import __version__
 from ..writers import to_json_text, write_json
@@ -23,6 +25,27 @@ from .analyses import ANALYSES, as_records, check_parameters, resolve
 from .executors import make_executor
 
 INDEX_EVERY_S = 2.0
+
+
+def code_commit():
+    """Git commit of the roughfe checkout (``+dirty`` with local edits), or None.
+
+    Recorded in every result as provenance. It is not part of the task key: keys change
+    only with the roughfe and analysis versions, so a study survives unrelated commits;
+    ``roughfe study status`` warns when the results come from several commits.
+    """
+    root = Path(__file__).resolve().parents[2]
+    if not (root / ".git").exists():
+        return None
+    try:
+        head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
+                              text=True, timeout=10, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "--no-optional-locks", "-C", str(root), "status",
+                                "--porcelain", "--", "roughfe"],
+                               capture_output=True, text=True, timeout=10, check=True).stdout
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return head + ("+dirty" if dirty.strip() else "")
 
 
 def execute_task(analysis: str, params: dict, seed: int) -> dict:
@@ -166,7 +189,7 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
                 description = ex.describe()
                 log(description)
                 _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
-                       n_cached=n_cached)
+                       n_cached=n_cached, commit=code_commit())
         store.write_index(outdir, keys)
     summary = StudySummary(n_tasks=len(tasks), n_cached=n_cached, n_done=counts["done"],
                            n_failed=counts["failed"], n_retries=counts["retries"],
@@ -176,7 +199,7 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     return summary
 
 
-def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached):
+def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached, commit=None):
     """Submit ``todo`` through ``ex`` with a bounded window; retry; store results.
 
     A task that raises is charged one attempt and requeued until ``max_attempts``.
@@ -227,7 +250,8 @@ def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached):
                 write_json(store.result_path(outdir, task.key), {
                     "key": task.key, "index": task.index, "analysis": spec.analysis,
                     "analysis_version": ANALYSES[spec.analysis].version,
-                    "code_version": __version__, "params": dict(task.params),
+                    "code_version": __version__, "code_commit": commit,
+                    "params": dict(task.params),
                     "seed": task.seed, "records": out["records"],
                     "elapsed_s": out["elapsed_s"], "cpu_s": out["cpu_s"],
                     "host": out["host"], "attempts": attempts[task.key]})

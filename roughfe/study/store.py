@@ -152,6 +152,8 @@ class StudyStatus:
         Wall time in seconds of each finished task on its worker.
     cpu_s : tuple of float
         CPU time in seconds of each finished task (its cost on an idle core).
+    commits : tuple of str
+        The distinct code commits (provenance) of the finished results.
     """
 
     name: str
@@ -163,6 +165,7 @@ class StudyStatus:
     failures: tuple
     cost_s: tuple
     cpu_s: tuple = ()
+    commits: tuple = ()
 
     def describe(self) -> str:
         """Human-readable multi-line summary."""
@@ -176,6 +179,10 @@ class StudyStatus:
             lines.append(f"CPU per task: mean {statistics.fmean(self.cpu_s):.3g} s, median "
                          f"{statistics.median(self.cpu_s):.3g} s, max {max(self.cpu_s):.3g} s, "
                          f"total {sum(self.cpu_s):.4g} s (the cost on an idle core)")
+        if len(self.commits) > 1:
+            lines.append(f"warning: the results come from {len(self.commits)} different code "
+                         f"commits ({', '.join(c[:12] for c in self.commits)}); bump the "
+                         "analysis version or use a new output folder after a physics change")
         for index, params, error in self.failures:
             lines.append(f"  failed task {index} {canonical_json(params)}: {error}")
         return "\n".join(lines)
@@ -185,7 +192,7 @@ def study_status(outdir) -> StudyStatus:
     """Status of the study in ``outdir`` from its files."""
     data = read_study(outdir)
     done, failed = done_keys(outdir), failed_keys(outdir)
-    failures, costs, cpus = [], [], []
+    failures, costs, cpus, commits = [], [], [], set()
     n_done = n_failed = 0
     for t in data["tasks"]:
         if t["key"] in done:
@@ -195,6 +202,8 @@ def study_status(outdir) -> StudyStatus:
                 costs.append(float(result["elapsed_s"]))
                 if "cpu_s" in result:
                     cpus.append(float(result["cpu_s"]))
+                if result.get("code_commit"):
+                    commits.add(result["code_commit"])
         elif t["key"] in failed:
             n_failed += 1
             try:
@@ -207,7 +216,8 @@ def study_status(outdir) -> StudyStatus:
     return StudyStatus(name=spec["name"], analysis=spec["analysis"], n_tasks=len(data["tasks"]),
                        n_done=n_done, n_failed=n_failed,
                        n_missing=len(data["tasks"]) - n_done - n_failed,
-                       failures=tuple(failures), cost_s=tuple(costs), cpu_s=tuple(cpus))
+                       failures=tuple(failures), cost_s=tuple(costs), cpu_s=tuple(cpus),
+                       commits=tuple(sorted(commits)))
 
 
 def _cell(value):
