@@ -96,3 +96,22 @@ def test_genome_db_study_fills_a_sqlite_database(tmp_path):
     entries = gdb.load_entries(db)
     assert len({e.label for e in entries}) == 4
     assert gdb.read_settings(db).n_nodes == 64
+
+
+@pytest.mark.parametrize("name, n_tasks", [("selftest", 12), ("contact_sweep", 70),
+                                           ("leakage_thesis", 700), ("genome_db", 1000)])
+def test_example_specs_load_and_bind_to_their_analysis(name, n_tasks):
+    from pathlib import Path
+
+    from roughfe.study import load_spec
+
+    spec = load_spec(Path(__file__).resolve().parents[1] / "examples" / "studies" / f"{name}.toml")
+    assert spec.n_tasks == n_tasks
+    tasks = spec.tasks()
+    assert len({t.key for t in tasks}) == n_tasks
+    try:
+        check_parameters(spec.analysis, tasks[0].kwargs)
+    except InputError as exc:
+        if "cannot be imported" in str(exc):
+            pytest.skip(str(exc))
+        raise
