@@ -658,8 +658,9 @@ def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evalua
     phi0 = design.phase_values(keys)
     lo, hi = phase_bounds(phi0, options.fraction, options.bound)
     is_gene = np.array([len(k) == 2 for k in keys])
-    if is_gene.any():                       # genes: always +-fraction of their start value
-        lo[is_gene], hi[is_gene] = phase_bounds(phi0[is_gene], options.fraction, "start")
+    if is_gene.any():                       # genes (> 0): +-fraction of their start value
+        lo[is_gene] = phi0[is_gene] * (1.0 - options.fraction)
+        hi[is_gene] = phi0[is_gene] * (1.0 + options.fraction)
     if options.formulation == "minimax":
         def score(r):
             k = [int(np.sum((t.pressure >= objective.p_range[0]) & (t.pressure <= objective.p_range[1])))
