@@ -81,6 +81,8 @@ def test_bad_input_is_reported():
     a = realize(g, scale="10x")
     with pytest.raises(InputError, match="same number of nodes"):
         sequence_profiles([a, realize(g, scale="20x", n_nodes=256)])
+    with pytest.raises(InputError, match="flat"):
+        sequence_profiles([a, a.with_heights(np.zeros(512))])
     with pytest.raises(InputError, match="at least 2"):
         sequence_profiles([a])
     with pytest.raises(InputError, match="too few points"):

@@ -89,7 +89,7 @@ def acquisitions_from_surfaces(surfaces) -> list:
     """Check nested acquisitions and return them sorted from coarsest to finest.
 
     Raises InputError for: fewer than 2 profiles, 2D data, different N, fewer than
-    ``MIN_NODES`` nodes, equal lengths, windows that are not nested around x = 0, or
+    ``MIN_NODES`` nodes, a flat profile, equal lengths, windows that are not nested around x = 0, or
     scales that do not overlap (the finer window shorter than two coarse spacings).
     """
     surfaces = list(surfaces)
@@ -108,7 +108,10 @@ def acquisitions_from_surfaces(surfaces) -> list:
     if n < MIN_NODES:
         raise InputError(f"too few points: N = {n} nodes per acquisition, at least {MIN_NODES} are needed")
     acq = []
-    for s in surfaces:
+    for k, s in enumerate(surfaces):
+        if np.ptp(s.heights) == 0:
+            raise InputError(f"acquisition {k} is flat (all heights equal {float(s.heights[0])!r} m): "
+                             f"there is no roughness to sequence")
         x = observation_coordinates(s)
         acq.append(Acquisition(x, np.asarray(s.heights, dtype=float), float((n - 1) * s.spacing[0])))
     acq.sort(key=lambda a: -a.length)
