@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import InputError
 from ..genomics.chromosomes import reconstruction, validity_monte_carlo
 from ..genomics.genome import SCALES, load_genome, realize, save_genome, table1_genome
 from ..genomics.mechanics import THESIS_YOUNGS_MODULUS, chromosome_mechanics

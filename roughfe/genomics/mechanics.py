@@ -35,7 +35,7 @@ import numpy as np
 from ..errors import InputError
 from ..surfaces.surface import Surface
 from .chromosomes import reconstruction
-from .genome import DEFAULT_NODES, Genome, realize
+from .genome import DEFAULT_NODES, Genome
 from .macro_micro import correlation, profile_response
 from .similarity import ResponseCurve
 

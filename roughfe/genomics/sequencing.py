@@ -318,12 +318,6 @@ def _ranges(log_q1, log_gamma, acqs, n_nodes):
     return [chromosome_range(math.exp(log_gamma), lam1, a.length, n_nodes) for a in acqs]
 
 
-@dataclass(frozen=True, eq=False)
-class _Design:
-    n: np.ndarray             # union of chromosome indices
-    rows: list                # (matrix, weighted heights) per acquisition
-
-
 def _design(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
     lo = min(r[0] for r in ranges)
     hi = max(r[1] for r in ranges) if n_cap is None else min(n_cap, max(r[1] for r in ranges))
@@ -701,9 +695,9 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     messages = []
     if log_q.size < 3:
         messages.append(f"only {log_q.size} PSD peaks found: the spectrum is not a discrete WM spectrum")
-        periods, coh, refs = np.array([math.log(1.5)]), np.array([0.0]), np.array([math.log(2 * math.pi / acqs[0].length)])
+        periods, refs = np.array([math.log(1.5)]), np.array([math.log(2 * math.pi / acqs[0].length)])
     else:
-        periods, coh, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
+        periods, _, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
     bins = np.concatenate([s.peak_q / (s.q[1] - s.q[0]) for s in spectra])
     groups = np.concatenate([np.full(s.peak_q.size, i) for i, s in enumerate(spectra)])
     gamma_psd = float(math.exp(periods[0]))
