@@ -188,7 +188,11 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     The CG runs on the free set F = {p > 0} + {p = 0, g < 0} (points in contact and
     penetrating points: the latter are PK's "overlap" points, here they enter the
     search direction directly). After each exact line search the pressure is clipped
-    at zero; conjugacy restarts whenever F changes or a clip happens.
+    at zero. The conjugation uses the Polak-Ribiere+ beta, max(0, g.(z - z_old)) /
+    g_old.z_old, on the direction masked to F: it restarts itself when the free set or
+    the gradient changes much, instead of a forced restart at every clip (Fletcher-
+    Reeves with forced restarts took 83 -> 131 -> 264 iterations at 512^2 -> 2048^2,
+    A* = 10 %; PR+ 50 -> 63 at 512^2 -> 1024^2).
 
     Load control (``mean_pressure``): the gap and the search direction are projected on
     zero mean over F and the pressure is rescaled to the load after each step; Delta
@@ -216,8 +220,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     else:
         p = np.maximum(-(delta + b), 0.0) / diagonal
     t = np.zeros_like(p)
-    gz_old, F_old = 1.0, None
-    restart = True
+    gz_old, F_old, z_old = 1.0, None, None
     res = np.inf
     d = float(delta) if not load else 0.0
     u, exact = None, False
@@ -251,25 +254,28 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         else:
             z = gm
         gz = float(np.vdot(gm, z))
-        if not restart and gz_old > 0 and np.array_equal(F, F_old):
-            t *= gz / gz_old
+        if F_old is not None and gz_old > 0:
+            # Polak-Ribiere+ (restarts itself when the set or the gradient changes)
+            beta = max(0.0, (gz - float(np.vdot(gm, z_old))) / gz_old)
+            t *= F
+            t *= beta
             t += z
         else:
             t = z.copy()
-        gz_old, F_old = gz, F
+        gz_old, F_old, z_old = gz, F, z
         r = apply(t)
         tr = float(np.vdot(r, t))
         tau = float(np.vdot(gm, t)) / tr if tr > 0 else 0.0
         p -= tau * t
-        restart = float(p.min()) < 0.0
-        if restart:
+        clipped = float(p.min()) < 0.0
+        if clipped:
             np.maximum(p, 0.0, out=p)
         alpha = 1.0
         if load:
             pm = float(p.mean())
             alpha = mean_pressure / pm if pm > 0 else 1.0
             p *= alpha
-        if restart:
+        if clipped:
             u = apply(p)
             exact = True
         else:
