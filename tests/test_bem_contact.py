@@ -3,7 +3,6 @@ import numpy as np
 import pytest
 
 from roughfe.bem import Material, composite, contact_sweep, influence_operator, solve_contact
-from roughfe.errors import InputError
 from roughfe.reference import hertz_cylinder, hertz_sphere, westergaard
 from roughfe.surfaces import Surface
 
