@@ -179,6 +179,10 @@ def _choose_solver(n_points: int, op: InfluenceOperator, solver: str) -> str:
         raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
     if solver == "auto":
         return "dense" if n_points <= DENSE_MAX_POINTS else "pk"
+    if solver in ("dense", "nnls") and n_points > 8192:
+        raise InputError(f"solver {solver!r} would build a dense {n_points} x {n_points} "
+                         f"matrix ({8 * n_points ** 2 / 1e9:.1f} GB); use solver='pk' above "
+                         f"8192 points")
     if solver == "nnls" and op.periodic:
         raise InputError("solver 'nnls' (Cholesky + Lawson-Hanson) needs a positive definite "
                          "operator: not the periodic one (its mean mode is free); use 'dense'")
