@@ -240,3 +240,15 @@ def test_periodic_sweep_ends_in_full_contact_and_stays_json_safe():
     # repeated full-contact pressures: the finite difference is undefined, not an error
     sw = contact_sweep(sinusoid(128), MAT, pressures=[1e5, 1e7, 1e8])
     assert np.isnan(sw.stiffness_fd[-1]) and list(sw.area_fraction[1:]) == [1.0, 1.0]
+
+
+def test_preconditioned_cg_iterations_grow_slowly_with_resolution():
+    from roughfe.surfaces.spectral import spectral_surface
+    nits = []
+    for n in (64, 256):
+        surf = spectral_surface(n, 1.0, 0.8, rms_slope=1.0, rng=1)
+        r = solve_contact(surf, Material(1.0, 0.0), mean_pressure=0.05, solver="pk",
+                          compute_stiffness=False)
+        nits.append(r.nit)
+    # measured 23 -> 41 (unpreconditioned PK: 16x more unknowns cost about 4x the iterations)
+    assert nits[1] < 2.5 * nits[0]
