@@ -250,5 +250,5 @@ def test_preconditioned_cg_iterations_grow_slowly_with_resolution():
         r = solve_contact(surf, Material(1.0, 0.0), mean_pressure=0.05, solver="pk",
                           compute_stiffness=False)
         nits.append(r.nit)
-    # measured 23 -> 41 (unpreconditioned PK: 16x more unknowns cost about 4x the iterations)
+    # measured 23 -> 41 iterations for 16x more unknowns (Tamaas: 124 at 256^2 alone)
     assert nits[1] < 2.5 * nits[0]
