@@ -165,7 +165,9 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"Yastrebov et al. 2015). Since A* = kappa p/(E* gbar), P* = (A*/kappa) gbar L/sigma: "
         f"the thesis pair (A* = 0.25, P* = 0.56) needs gbar L/sigma = {needed:.1f}, while this "
         f"surface has gbar L/sigma = {gbar * length / sigma:.1f}; even a single sinusoid of "
-        f"wavelength L has 2 pi = 6.3. The thesis' P* is most likely normalised "
-        f"differently from what Sec. 2.2.2 states; we report pL/(E* sigma) as written.\n\n"
+        f"wavelength L has 2 pi = 6.3. The thesis' P* is therefore most likely normalised "
+        f"differently from what Sec. 2.2.2 states: with the maximum height h_s in place of "
+        f"sigma, pL/(E* h_s) = {p_star * sigma / np.ptp(surface.heights):.2f} here, close to "
+        f"0.56. We report pL/(E* sigma) as written.\n\n"
         f"![A(p), K(p)]({fig.relative_to(outdir)})\n\n"
         f"![deformed surface coloured by pressure]({render.relative_to(outdir)})\n")
