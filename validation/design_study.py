@@ -79,12 +79,14 @@ def _run(name, method, entries, targets, settings, out, options, pbar=None):
 
 
 def _stage_table(results):
-    rows = ["| method | candidate | origin | GCMMA 0 | GCMMA 1 | GCMMA 2 | BEM sweeps | time (s) |",
-            "|---|---|---|---|---|---|---|---|"]
+    rows = ["| method | candidate | origin | GCMMA 0 | GCMMA 1 | GCMMA 2 | GCMMA 3 (refined) | "
+            "BEM sweeps | time (s) |",
+            "|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         for k, c in enumerate(r.candidates, 1):
+            st = list(c.stages) + ([float("nan")] if len(c.stages) == 3 else [])
             rows.append(f"| {r.method.upper()} | {k} | {c.origin} | " +
-                        " | ".join(f"{s:.4f}" for s in c.stages) +
+                        " | ".join(f"{s:.4f}" for s in st) +
                         (f" | {r.nit} | {r.elapsed:.1f} |" if k == 1 else " | | |"))
     return rows
 
@@ -142,7 +144,19 @@ def main(outdir: Path) -> bool:
         r, err = _run(f"yt1_{m}", m, entries, [t1], settings, out, opts, pbar1)
         res1.append(r)
         reproducible.append(err)
-    dplot.plot_stages(res1, out / "stages_yt1.png", title="y_t1, thesis GCMMA stages")
+    print("== y_t1, refinement stage (beyond the thesis)", flush=True)
+    ref1 = []
+    for r in res1:
+        rr = de.refine(r, settings)
+        de.write_design_result(rr, settings, out / f"yt1_{r.method}_refined")
+        err = float(np.max(np.abs(np.asarray(de.rescore(rr.best.design, [t1], settings))
+                                  - np.asarray(rr.best.scores))))
+        reproducible.append(err)
+        print(f"  {rr.message} [{rr.nit} sweeps, {rr.elapsed:.1f} s, rescore error {err:.1e}]",
+              flush=True)
+        ref1.append(rr)
+    res1 = ref1
+    dplot.plot_stages(res1, out / "stages_yt1.png", title="y_t1: GCMMA stages 0-2 (thesis) and 3 (refined)")
     dplot.plot_design_curves(res1, out / "curves_yt1.png", title="best designs for y_t1")
     dplot.plot_profiles({r.method: r.best.design.surface() for r in res1}, out / "profiles_yt1.png")
     dplot.plot_psds({r.method: (r.best.design.surface(), r.best.design.spectrum_lines())
@@ -150,7 +164,10 @@ def main(outdir: Path) -> bool:
     lines += [f"## Single target y_t1 (Sec. 4.3.1, Figs. 58, 60-62), pbar = {pbar1:.4g} Pa", "",
               "GCMMA settings of the thesis: phases within +-10 % of their start, n_it = 5 "
               "(SOG) / 3 (GCO, CCO) in stage 1 and 1 in stage 2; min-max form with exact "
-              "sensitivities on the fixed contact sets (CCO: all genes).", ""]
+              "sensitivities on the fixed contact sets (CCO: all genes). GCMMA 3 is an extra "
+              "stage beyond the thesis (`roughfe.genomics.design.refine`): 3 rounds x 15 "
+              "iterations on all phases, box +-10 % of 2 pi re-centred each round, so phases "
+              "may drift beyond +-10 % of their database values.", ""]
     lines += _stage_table(res1) + ["", "![](design/stages_yt1.png) ![](design/curves_yt1.png)", "",
                                    "![](design/profiles_yt1.png)", "", "![](design/psd_yt1.png)", ""]
 
@@ -173,7 +190,9 @@ def main(outdir: Path) -> bool:
             best_variant[(label, m)] = r
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
     lines.append("")
-    best_t1 = max([float(np.prod(r.best.scores)) for r in res1] +
+    thesis_t1 = max([c.stages[2] for r in ref1 for c in r.candidates] +
+                    [float(np.prod(r.best.scores)) for r in best_variant.values()])
+    best_t1 = max([float(np.prod(r.best.scores)) for r in ref1] +
                   [float(np.prod(r.best.scores)) for r in best_variant.values()])
 
     print("== y_t2", flush=True)
@@ -183,6 +202,11 @@ def main(outdir: Path) -> bool:
         r, err = _run(f"yt2_{m}", m, entries, [t2], settings, out, opts, pbar2)
         res2.append(r)
         reproducible.append(err)
+    res2 = [de.refine(r, settings) for r in res2]
+    for r in res2:
+        de.write_design_result(r, settings, out / f"yt2_{r.method}_refined")
+        reproducible.append(float(np.max(np.abs(np.asarray(de.rescore(r.best.design, [t2], settings))
+                                                - np.asarray(r.best.scores)))))
     dplot.plot_stages(res2, out / "stages_yt2.png", title="y_t2")
     dplot.plot_design_curves(res2, out / "curves_yt2.png", title="best designs for y_t2")
     dplot.plot_profiles({r.method: r.best.design.surface() for r in res2}, out / "profiles_yt2.png")
@@ -194,8 +218,11 @@ def main(outdir: Path) -> bool:
     print("== multi-target", flush=True)
     rm, err = _run("mcco", "mcco", entries, [t1, t3], settings, out, opts)
     reproducible.append(err)
-    rm2, err = _run("mcco_period", "mcco", entries, [t1, t3], settings, out,
-                    replace(opts, bound="period", n_it_cross=6, n_it_micro=2))
+    rm2 = de.refine(rm, settings)
+    de.write_design_result(rm2, settings, out / "mcco_refined")
+    err = float(np.max(np.abs(np.asarray(de.rescore(rm2.best.design, [t1, t3], settings))
+                              - np.asarray(rm2.best.scores))))
+    print(f"  {rm2.message} [rescore error {err:.1e}]", flush=True)
     reproducible.append(err)
     dplot.plot_design_curves([rm, rm2], out / "curves_mcco.png", title="M-CCO, (y_t1, y_t3)")
     dplot.plot_profiles({f"y{k}": c.design.surface() for k, c in enumerate(rm.candidates, 1)},
@@ -205,7 +232,7 @@ def main(outdir: Path) -> bool:
     lines += ["## Multi-target (y_t1 for K, y_t3 for A): M-CCO (Sec. 4.4, Table 4, Figs. 68-70)", "",
               "| run | genome | f | s(y_t1, K) | s(y_t3, A) | macro + micro from | GCMMA 0/1/2 |",
               "|---|---|---|---|---|---|---|"]
-    for label, r in (("thesis settings", rm), ("+-10 % of 2 pi, 6+2 it.", rm2)):
+    for label, r in (("thesis stages", rm), ("with GCMMA 3 (refined)", rm2)):
         for k, c in enumerate(r.candidates, 1):
             lines.append(f"| {label} | y_{k} | {np.prod(c.scores):.3f} | {c.scores[0]:.3f} | "
                          f"{c.scores[1]:.3f} | {c.origin} | " +
@@ -239,7 +266,9 @@ def main(outdir: Path) -> bool:
     ok = {"s_yt1": best_t1 >= GOALS["s_yt1"], "f_multi": best_f >= GOALS["f_multi"],
           "reproducible": rep <= GOALS["reproducible"]}
     lines += ["## Goals", "",
-              f"* best s for y_t1: {best_t1:.4f} (goal >= {GOALS['s_yt1']}): "
+              f"* best s for y_t1 with the thesis stages only (GCMMA 0-2, any variant): "
+              f"{thesis_t1:.4f}",
+              f"* best s for y_t1 including GCMMA 3 (refined): {best_t1:.4f} (goal >= {GOALS['s_yt1']}): "
               f"{'met' if ok['s_yt1'] else 'NOT met'}",
               f"* best f for (y_t1, y_t3): {best_f:.4f} (goal >= {GOALS['f_multi']}): "
               f"{'met' if ok['f_multi'] else 'NOT met'}",
@@ -249,7 +278,7 @@ def main(outdir: Path) -> bool:
               f"* total wall time {time.perf_counter() - t_start:.0f} s", ""]
     write_text(outdir / "design_study.md", "\n".join(lines) + "\n")
     write_json(outdir / "design_study.json",
-               {"best_s_yt1": best_t1, "best_f_multi": best_f, "max_rescore_error": rep,
+               {"best_s_yt1": best_t1, "best_s_yt1_thesis_stages": thesis_t1, "best_f_multi": best_f, "max_rescore_error": rep,
                 "goals": GOALS, "met": ok,
                 "pbar_sweep": {"pbar": pbars.tolist(), "best": best, "n_cross": n_cross,
                                "n_above": n_above}})

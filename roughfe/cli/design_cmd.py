@@ -22,7 +22,7 @@ def _target(spec, quantity, settings, cache):
 def _run(args) -> int:
     from ..errors import InputError
     from ..genomics.database import load_entries, read_settings
-    from ..genomics.design import GcmmaOptions, run_design, write_design_result
+    from ..genomics.design import GcmmaOptions, refine, run_design, write_design_result
     from ..plotting.design import plot_design_curves, plot_profiles, plot_psds, plot_stages
     settings = read_settings(args.db)
     entries = load_entries(args.db)
@@ -39,6 +39,8 @@ def _run(args) -> int:
                            **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
                               if args.iterations else {}))
     result = run_design(args.method, entries, targets, settings, pbar=args.pbar, options=options)
+    if args.refine:
+        result = refine(result, settings, rounds=args.refine)
     out = Path(args.output)
     paths = write_design_result(result, settings, out)
     if not args.no_figures:
@@ -49,7 +51,8 @@ def _run(args) -> int:
         plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
     print(result.message)
     for k, c in enumerate(result.candidates, 1):
-        print(f"  ({k}) {c.origin:>16}  GCMMA 0/1/2: " + " ".join(f"{s:.4f}" for s in c.stages)
+        print(f"  ({k}) {c.origin:>16}  GCMMA 0/1/2{'/3' if len(c.stages) > 3 else ''}: "
+              + " ".join(f"{s:.4f}" for s in c.stages)
               + "  per target: " + " ".join(f"{s:.4f}" for s in c.scores))
     print(f"{result.nit} BEM sweeps in {result.elapsed:.1f} s; wrote {paths['design'].parent}/")
     return 0
@@ -94,6 +97,9 @@ def register(sub):
                    help="exact sensitivities on the fixed contact sets, or finite differences")
     g.add_argument("--eps", type=float, default=0.02,
                    help="finite-difference step in units of the phase box (--gradient fd)")
+    g.add_argument("--refine", type=int, default=0, metavar="ROUNDS",
+                   help="extra stage beyond the thesis: ROUNDS x 15 GCMMA iterations on all "
+                        "phases, box (+-10%% of 2 pi) re-centred each round (default 0: off)")
     p.add_argument("-o", "--output", required=True, help="output folder")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.set_defaults(func=_run)

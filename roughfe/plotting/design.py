@@ -130,15 +130,17 @@ def plot_design_curves(results, path, title="") -> "Path":
 
 
 def plot_stages(results, path, title="") -> "Path":
-    """Figs. 58/63: similarity of every candidate at GCMMA 0, 1, 2, per method."""
+    """Figs. 58/63: similarity of every candidate at GCMMA 0, 1, 2 (and the optional
+    refinement stage 3), per method."""
     fig, ax = new_figure(figsize=(6.4, 4))
     styles = {"sog": "k--", "gco": "r-", "cco": "b-.", "mcco": "m-"}
     for r in results:
         for k, (c, mk) in enumerate(zip(r.candidates, ("^", "o", "x"))):
-            ax.plot([0, 1, 2], c.stages, styles.get(r.method, "g-"), marker=mk,
+            ax.plot(range(len(c.stages)), c.stages, styles.get(r.method, "g-"), marker=mk,
                     label=f"{r.method.upper()} ({k + 1})")
-    ax.set_xticks([0, 1, 2])
-    ax.set_xticklabels(["GCMMA 0", "GCMMA 1", "GCMMA 2"])
+    n = max(len(c.stages) for r in results for c in r.candidates)
+    ax.set_xticks(range(n))
+    ax.set_xticklabels(["GCMMA 0", "GCMMA 1", "GCMMA 2", "GCMMA 3\n(refined)"][:n])
     ax.set_ylabel("similarity score s")
     ax.set_title(title)
     ax.legend(fontsize=7, ncol=2)
