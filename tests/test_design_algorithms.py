@@ -130,3 +130,13 @@ def test_exact_sensitivities_equal_finite_differences_on_fixed_contact_sets():
         fd = (obj.residuals(ev(d.with_phases(keys, w))) - r) / 1e-7
         np.testing.assert_allclose(jac[:, col], fd, atol=1e-5 * np.abs(jac).max())
     assert np.abs(jac).max() > 1e-3
+
+
+def test_refinement_stage_appends_a_reproducible_fourth_score(entries, targets):
+    t1 = targets[0]
+    r = de.run_design("sog", entries, [t1], SETTINGS, options=FAST, n_best=1)
+    rr = de.refine(r, SETTINGS, rounds=1, n_it=2)
+    c0, c1 = r.best, rr.best
+    assert c1.stages[:3] == c0.stages and len(c1.stages) == 4
+    assert c1.stages[3] >= c0.stages[2] - 1e-12
+    assert de.rescore(c1.design, [t1], SETTINGS)[0] == pytest.approx(c1.stages[3], abs=1e-7)
