@@ -106,11 +106,12 @@ def lcp_bpp(H, s, passive=None, *, tol=1e-12, max_iter=None):
 
 def lcp_nnls(H, s):
     """Bemporad & Paggi (2015): Cholesky H = C'C, then Lawson-Hanson NNLS on
-    || C p - C^-T s ||  (scipy.optimize.nnls). Needs H positive definite."""
+    || C p - C^-T s ||  (scipy.optimize.nnls). Needs H positive definite. scipy does not
+    report its iterations: ``nit`` counts NNLS calls (1)."""
     C = scipy.linalg.cholesky(H, lower=False, check_finite=False)
     d = scipy.linalg.solve_triangular(C, s, trans="T", check_finite=False)
     p, _ = scipy.optimize.nnls(C, d, maxiter=50 * s.size)
-    return p, 0
+    return p, 1
 
 
 def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, method="bpp",
