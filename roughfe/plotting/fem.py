@@ -179,7 +179,8 @@ def _render(fields, path, magnification, top_fraction, window_size) -> Path:
     name = "sigma_yy (MPa)"
     grid.cell_data[name] = np.asarray(fields["stress_yy"])[keep] / 1e6
     lo = float(np.percentile(grid.cell_data[name], 1))
-    plotter.add_mesh(grid, scalars=name, cmap="viridis", clim=(lo, 0.0), show_edges=True,
+    plotter.add_mesh(grid, scalars=name, cmap="viridis", clim=(lo, 0.0),
+                     show_edges=cells.shape[0] < 6000,                # edges hide fine meshes
                      edge_color="grey", line_width=0.2, scalar_bar_args={"title": name})
     plotter.add_text(f"deformed mesh, displacements x{magnification:.3g}; coordinates / W",
                      font_size=10)
