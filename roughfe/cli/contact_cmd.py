@@ -23,6 +23,9 @@ def register(subparsers) -> None:
                     "half-space (thesis Sec. 2.2). Writes OUTDIR/results.json, "
                     "OUTDIR/fields.h5 and figures. SI units.")
     add_surface_options(p)
+    p.add_argument("--detrend", choices=("none", "mean", "plane"), default="none",
+                   help="remove the mean or the least-squares plane of the heights first "
+                        "(measured topographies usually need 'plane'); default none")
     mat = p.add_argument_group("material")
     mat.add_argument("--E", type=float, required=True, help="Young's modulus (Pa)")
     mat.add_argument("--nu", type=float, required=True, help="Poisson's ratio, in (-1, 0.5]")
@@ -48,6 +51,8 @@ def register(subparsers) -> None:
 
 def _run(args) -> int:
     surface = surface_from_args(args)
+    if args.detrend != "none":
+        surface = surface.detrended(args.detrend)
     material = Material(args.E, args.nu)
     sweep = contact_sweep(surface, material, n_steps=args.steps or 20, deltas=args.delta,
                           pressures=args.pressure, kernel=args.kernel, solver=args.solver,
@@ -59,6 +64,7 @@ def _run(args) -> int:
               "E": material.E, "nu": material.nu, "E_star": material.E_star,
               "kernel": r0.kernel, "solver": r0.solver, "tol": args.tol,
               "control": "pressure" if args.pressure else "delta",
+              "detrend": args.detrend,
               "metadata": dict(surface.metadata)}
     write_results_json(out / "results.json", sweep, inputs)
     write_fields_h5(out / "fields.h5", sweep)
