@@ -252,3 +252,13 @@ def test_preconditioned_cg_iterations_grow_slowly_with_resolution():
         nits.append(r.nit)
     # measured 23 -> 41 iterations for 16x more unknowns (Tamaas: 124 at 256^2 alone)
     assert nits[1] < 2.5 * nits[0]
+
+
+def test_thesis_kernel_is_a_boussinesq_line_of_punches():
+    n, L, E = 256, 1e-3, 2e9
+    op = influence_operator((n,), (L,), E, "thesis")
+    dx = L / n
+    assert op.diagonal == pytest.approx(dx / E, rel=1e-14)   # punch: F/(E* delta), F = p dx^2
+    r = np.arange(50, 200) * dx
+    # far field: the 3D point load u = F / (pi E* r), not the 2D logarithm
+    assert np.allclose(op.kernel[50:200] * np.pi * E * r / dx ** 2, 1.0, rtol=2e-5)
