@@ -9,6 +9,9 @@ Public API (stable):
   (A(p), K(p), V*(d/sigma)); ``SweepResult.to_records()`` for results.json.
 * :func:`influence_operator` -- the operators u = H p (``"spectral"``, ``"strip"``,
   ``"thesis"``, ``"love"``).
+
+Result files: :mod:`roughfe.bem.output` (results.json, fields.h5). Analytic references
+(Westergaard, Hertz, Love, strip) live in :mod:`roughfe.reference`.
 """
 from .contact import ContactResult, solve_contact
 from .material import Material, composite
