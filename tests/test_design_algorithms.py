@@ -54,8 +54,8 @@ def test_methods_improve_and_scores_reproduce_from_the_saved_design(entries, tar
     assert r.success and len(r.candidates) == 2
     for c in r.candidates:
         assert c.stages[0] <= c.stages[1] + 1e-12 <= c.stages[2] + 2e-12   # best kept per stage
-        assert float(np.prod(c.scores)) == pytest.approx(c.stages[2], abs=1e-9)
-    assert np.prod(r.best.scores) >= np.prod(r.candidates[1].scores)
+        assert de.combined_score(c.scores) == pytest.approx(c.stages[2], abs=1e-9)
+    assert de.combined_score(r.best.scores) >= de.combined_score(r.candidates[1].scores)
     # independent check: write, reload the design JSON, fresh BEM run without rescaling
     paths = de.write_design_result(r, SETTINGS, tmp_path)
     d = de.Design.from_dict(json.loads(paths["design"].read_text()))

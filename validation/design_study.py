@@ -186,14 +186,14 @@ def main(outdir: Path) -> bool:
         for m in ("sog", "gco", "cco"):
             r, err = _run(f"yt1_{m}_v{k}", m, entries, [t1], settings, out, o, pbar1)
             reproducible.append(err)
-            cells.append(f"{np.prod(r.best.scores):.4f} ({r.nit})")
+            cells.append(f"{de.combined_score(r.best.scores):.4f} ({r.nit})")
             best_variant[(label, m)] = r
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
     lines.append("")
     thesis_t1 = max([c.stages[2] for r in ref1 for c in r.candidates] +
-                    [float(np.prod(r.best.scores)) for r in best_variant.values()])
-    best_t1 = max([float(np.prod(r.best.scores)) for r in ref1] +
-                  [float(np.prod(r.best.scores)) for r in best_variant.values()])
+                    [de.combined_score(r.best.scores) for r in best_variant.values()])
+    best_t1 = max([de.combined_score(r.best.scores) for r in ref1] +
+                  [de.combined_score(r.best.scores) for r in best_variant.values()])
 
     print("== y_t2", flush=True)
     pbar2 = t2.metadata["pbar"]
@@ -234,10 +234,10 @@ def main(outdir: Path) -> bool:
               "|---|---|---|---|---|---|---|"]
     for label, r in (("thesis stages", rm), ("with GCMMA 3 (refined)", rm2)):
         for k, c in enumerate(r.candidates, 1):
-            lines.append(f"| {label} | y_{k} | {np.prod(c.scores):.3f} | {c.scores[0]:.3f} | "
+            lines.append(f"| {label} | y_{k} | {de.combined_score(c.scores):.3f} | {c.scores[0]:.3f} | "
                          f"{c.scores[1]:.3f} | {c.origin} | " +
                          " / ".join(f"{s:.3f}" for s in c.stages) + " |")
-    best_f = max(float(np.prod(rm.best.scores)), float(np.prod(rm2.best.scores)))
+    best_f = max(de.combined_score(rm.best.scores), de.combined_score(rm2.best.scores))
     lines += ["", "![](design/curves_mcco.png)", "", "![](design/profiles_mcco.png)", ""]
 
     print("== pbar sensitivity", flush=True)
@@ -248,7 +248,7 @@ def main(outdir: Path) -> bool:
     for pb in pbars:
         for m, fn in (("gco", de.gco), ("cco", de.cco)):
             r = fn(entries, t1, pb, settings, options=opts)
-            best[m].append(float(np.prod(r.best.scores)))
+            best[m].append(de.combined_score(r.best.scores))
             n_cross[m].append(r.n_cross)
             n_above[m].append(r.n_cross_above)
         print(f"  pbar {pb:.4g}: GCO {best['gco'][-1]:.4f}, CCO {best['cco'][-1]:.4f}", flush=True)

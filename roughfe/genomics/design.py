@@ -269,7 +269,9 @@ class Objective:
         return tuple(similarity(t, c, self.p_range, rescale=False) for t in self.targets)
 
     def __call__(self, curve: ResponseCurve) -> float:
-        return float(np.prod(self.scores(curve)))
+        """s (one target) or f = s_1 s_2 (Alg. 7); with a negative score f is the smallest
+        score instead, since a product of two negative scores would look good."""
+        return combined_score(self.scores(curve))
 
     def residuals(self, curve: ResponseCurve) -> np.ndarray:
         """Relative errors (y_t - y_i)/y_t at every target point in ``p_range`` (all
@@ -281,6 +283,13 @@ class Objective:
             yi = np.interp(t.pressure[sel], c.pressure, c.values(t.quantity))
             out.append((t.values[sel] - yi) / t.values[sel])
         return np.concatenate(out)
+
+
+def combined_score(scores) -> float:
+    """Product of the similarity scores (Alg. 7 Step 10) when all are >= 0, else the
+    smallest (negative) one."""
+    scores = np.asarray(scores, dtype=float)
+    return float(np.prod(scores)) if np.all(scores >= 0) else float(scores.min())
 
 
 class Evaluator:
@@ -666,7 +675,7 @@ def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evalua
             k = [int(np.sum((t.pressure >= objective.p_range[0]) & (t.pressure <= objective.p_range[1])))
                  for t in objective.targets]
             parts = np.split(np.abs(r), np.cumsum(k)[:-1])
-            return float(np.prod([1.0 - p.max() for p in parts]))
+            return combined_score([1.0 - p.max() for p in parts])
         jacobian = None
         if options.gradient == "exact":
             def jacobian(x):
@@ -793,13 +802,13 @@ def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, ent
             if s2 < s1:
                 d2, s2 = d1, s1
         out.append(_finish(d2, (s0, s1, s2), objective, evaluate, macro, micro, origin))
-    out.sort(key=lambda c: -float(np.prod(c.scores)))
+    out.sort(key=lambda c: -combined_score(c.scores))
     return tuple(out)
 
 
 def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evaluate, t0):
     best = cands[0]
-    msg = (f"{method}: best {best.origin} s = {np.prod(best.scores):.4f} "
+    msg = (f"{method}: best {best.origin} s = {combined_score(best.scores):.4f} "
            f"(stages {', '.join(f'{s:.4f}' for s in best.stages)})"
            + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used"))
     return DesignResult(method, cands, objective, pbar, dbs, n_cross, n_above, passed, True, msg,
@@ -951,7 +960,7 @@ def refine(result: DesignResult, settings: DatabaseSettings, *, rounds: int = 3,
     objective = result.objective
     out = []
     for c in result.candidates:
-        d, sc = c.design, float(np.prod(c.scores))
+        d, sc = c.design, combined_score(c.scores)
         for _ in range(int(rounds)):
             d_new, s_new, _ = optimise_phases(d, d.keys("all"), objective, evaluate, n_it, options,
                                               f0=sc)
@@ -960,11 +969,11 @@ def refine(result: DesignResult, settings: DatabaseSettings, *, rounds: int = 3,
             d, sc = d_new, s_new
         new = _finish(d, (*c.stages[:3], sc), objective, evaluate, c.macro, c.micro, c.origin)
         out.append(new)
-    out.sort(key=lambda c: -float(np.prod(c.scores)))
+    out.sort(key=lambda c: -combined_score(c.scores))
     return replace(result, candidates=tuple(out), nit=result.nit + evaluate.n_sweeps,
                    elapsed=result.elapsed + time.perf_counter() - t0,
                    message=result.message + f"; refined (GCMMA 3, {rounds} x {n_it} it., all "
-                   f"phases): s = {np.prod(out[0].scores):.4f}")
+                   f"phases): s = {combined_score(out[0].scores):.4f}")
 
 
 def run_design(method: str, entries, targets, settings: DatabaseSettings, *, pbar=None,
@@ -1052,7 +1061,7 @@ def result_to_dict(result: DesignResult, settings: DatabaseSettings) -> dict:
         "targets": [t.to_dict() for t in result.objective.targets],
         "settings": settings.to_dict(), "database_scores": result.database_scores,
         "candidates": [{"origin": c.origin, "stages": list(c.stages), "scores": list(c.scores),
-                        "score": float(np.prod(c.scores)), "macro": [list(m) for m in c.macro],
+                        "score": combined_score(c.scores), "macro": [list(m) for m in c.macro],
                         "micro": [list(m) for m in c.micro], "curve": c.curve.to_dict(),
                         "design": c.design.to_dict()} for c in result.candidates],
         "references": list(result.references)}
@@ -1091,7 +1100,7 @@ def write_design_result(result: DesignResult, settings: DatabaseSettings, outdir
     rows += [f"{result.method},{k + 1},{cand.origin},{cand.stages[0]:.6f},{cand.stages[1]:.6f},"
              f"{cand.stages[2]:.6f},"
              f"{cand.stages[3] if len(cand.stages) > 3 else float('nan'):.6f},"
-             f"{float(np.prod(cand.scores)):.6f}"
+             f"{combined_score(cand.scores):.6f}"
              for k, cand in enumerate(result.candidates)]
     paths["stages"] = write_text(out / "stages.csv", "\n".join(rows) + "\n")
     return paths

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..genomics.design import combined_score
 from ..surfaces.stats import power_spectrum
 from .common import new_figure, save_figure
 
@@ -116,7 +117,7 @@ def plot_design_curves(results, path, title="") -> "Path":
         ax.plot(t.pressure, t.values, "r-", lw=2.5, label=f"target {t.name}")
     for r, m in zip(results, ("o", "s", "^", "x")):
         c = r.best.curve
-        s = float(np.prod(r.best.scores))
+        s = combined_score(r.best.scores)
         axes[0].plot(c.pressure, c.stiffness, "--" + m, ms=4, label=f"{r.method} s={s:.3f}")
         axes[1].plot(c.pressure, c.area_fraction, "--" + m, ms=4, label=r.method)
     axes[0].set_xlabel("p (Pa)")
