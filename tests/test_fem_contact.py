@@ -97,7 +97,7 @@ def test_vi_and_penalty_agree():
 @pytest.mark.parametrize("formulation", ["flat", "profile"])
 def test_uniform_layer_compliance_exact(formulation):
     """A flat punch on a roller-supported layer is uniaxial strain: p = M Delta / H_d
-    exactly, so delta_corrected = 0, uniform pressure and sigma_yy = -p in every cell."""
+    exactly, so the half-plane delta = 0, uniform pressure and sigma_yy = -p in every cell."""
     n, L = 17, 1e-3
     flat = Surface(np.zeros(n), n * L / (n - 1))
     pm = mesh_profile(flat, depth=0.7e-3, growth=0.3, formulation=formulation)

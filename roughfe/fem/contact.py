@@ -41,7 +41,7 @@ vertices give A* = sum(w_i in contact) / W. Delta is corrected for the finite de
 uniform pressure p on a roller-supported layer of depth H_d shortens it by exactly
 p H_d / M, M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) (the P-wave/oedometric modulus), and by
 Betti's theorem the mean top displacement under any pressure distribution is
--p_mean H_d / M. So ``delta_corrected = Delta - p_mean H_d / M`` is the approach with
+-p_mean H_d / M. So ``delta = delta_applied - p_mean H_d / M`` is the approach with
 zero mean elastic displacement: the convention of the periodic half-plane BEM. The
 stiffness K = dp/dDelta_corrected (thesis Eq. 2.7) is computed exactly for the converged
 contact set (and by central differences over a sweep, ``stiffness_fd``).
