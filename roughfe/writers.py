@@ -69,3 +69,19 @@ def write_text(path, text):
     with atomic_path(path) as tmp:
         tmp.write_text(text)
     return Path(path)
+
+
+def json_scalars(obj, keys) -> dict:
+    """``{key: getattr(obj, key)}`` as JSON-safe numbers: ints stay ints, floats become
+    Python floats and non-finite values become ``None`` (JSON has no NaN/inf)."""
+    out = {}
+    for key in keys:
+        v = getattr(obj, key)
+        if isinstance(v, (bool, np.bool_)):
+            out[key] = bool(v)
+        elif isinstance(v, (int, np.integer)):
+            out[key] = int(v)
+        else:
+            v = float(v)
+            out[key] = v if np.isfinite(v) else None
+    return out

@@ -21,6 +21,7 @@ from typing import Optional
 import numpy as np
 
 from ..errors import InputError, NoConvergenceError
+from ..writers import json_scalars
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from .material import Material
@@ -130,14 +131,10 @@ class ContactResult:
 
     def scalars(self) -> dict:
         """The scalar fields as a JSON-safe dict (non-finite values -> None)."""
-        out = {}
-        for key in ("delta", "load", "mean_pressure", "area_fraction", "contact_area",
-                    "n_contact", "mean_gap", "mean_plane_separation", "free_volume",
-                    "free_volume_star", "stiffness", "nit", "residual"):
-            v = getattr(self, key)
-            out[key] = (int(v) if isinstance(v, (int, np.integer))
-                        else (float(v) if np.isfinite(v) else None))
-        return out
+        return json_scalars(self, (
+            "delta", "load", "mean_pressure", "area_fraction", "contact_area", "n_contact",
+            "mean_gap", "mean_plane_separation", "free_volume", "free_volume_star",
+            "stiffness", "nit", "residual"))
 
 
 # -- cached operators ---------------------------------------------------------------------

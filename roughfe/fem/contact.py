@@ -54,6 +54,7 @@ from typing import Literal, Mapping
 import numpy as np
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..writers import json_scalars
 from ..bem import Material
 from ..bem.sweep import central_differences
 from .mesh import FACET_TAGS, ProfileMesh
@@ -213,14 +214,10 @@ class FemContactResult:
 
     def scalars(self) -> dict:
         """The scalar fields as a JSON-safe dict (non-finite values -> None)."""
-        out = {}
-        for key in ("delta", "delta_applied", "layer_compliance", "load", "mean_pressure",
-                    "area_fraction", "contact_area", "n_contact", "mean_gap",
-                    "mean_plane_separation", "stiffness", "nit", "residual"):
-            v = getattr(self, key)
-            out[key] = (int(v) if isinstance(v, (int, np.integer))
-                        else (float(v) if np.isfinite(v) else None))
-        return out
+        return json_scalars(self, (
+            "delta", "delta_applied", "layer_compliance", "load", "mean_pressure",
+            "area_fraction", "contact_area", "n_contact", "mean_gap", "mean_plane_separation",
+            "stiffness", "nit", "residual"))
 
 
 @dataclass(frozen=True, eq=False)
