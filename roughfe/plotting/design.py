@@ -187,7 +187,8 @@ def plot_profiles(named_surfaces, path, title="") -> "Path":
 
 def plot_psds(named, path, title="") -> "Path":
     """Figs. 62/66/70: log10 PSD of each designed profile (FFT, line) and the discrete
-    spectrum of its chromosomes (markers: C = a_n^2 / (2 dq) at q_n).
+    spectrum of its chromosomes (markers at q_n: C = a_n^2 / (4 dq), the value whose
+    weight 2 dq (:func:`power_spectrum`) gives the mean square a_n^2/2 of one cosine).
 
     ``named``: name -> (Surface, list of (q_n (rad/m), a_n (m))).
     """
@@ -198,7 +199,7 @@ def plot_psds(named, path, title="") -> "Path":
         dq = 2 * np.pi / surf.size[0]
         if lines:
             q, a = np.asarray(lines, float).T
-            ax.loglog(q, a ** 2 / (2 * dq), "rs", ms=4, label="chromosomes")
+            ax.loglog(q, a ** 2 / (4 * dq), "rs", ms=4, label="chromosomes")
         ax.set_xlabel("q (rad/m)")
         ax.set_ylabel("C (m^3)")
         ax.set_title(name)
