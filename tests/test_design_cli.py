@@ -13,9 +13,12 @@ from roughfe.genomics.similarity import Target
 def test_db_and_design_commands(tmp_path, capsys):
     path = tmp_path / "db.sqlite"
     assert main(["db", "build", str(path), "--nodes", "128", "--steps", "10", "--limit", "3",
-                 "--quiet"]) == 0
+                 "--quiet", "--workers", "1"]) == 0
+    # the genomes were computed by the study runner, in the study folder beside the file
+    assert main(["study", "status", str(path) + ".study"]) == 0
+    capsys.readouterr()
     assert main(["db", "list", str(path), "--json"]) == 0
-    listing = json.loads(capsys.readouterr().out.split("\n", 1)[1])
+    listing = json.loads(capsys.readouterr().out)
     assert len(listing["genomes"]) == 3 and listing["settings"]["n_nodes"] == 128
     assert main(["db", "map", str(path), "-o", str(tmp_path / "map")]) == 0
     assert (tmp_path / "map" / "genetic_map.png").stat().st_size > 1000

@@ -55,15 +55,59 @@ def test_eq_4_2_scaling_law_with_the_bem():
         np.testing.assert_allclose(c1.rescaled(3.0).pressure, c3.pressure, rtol=1e-7)
 
 
-def test_build_resumes_extends_and_refuses_mismatches(tmp_path):
+def test_build_through_the_runner_equals_the_task_and_resumes(tmp_path):
+    """db build = genome_entry_task run by the study runner, then imported into SQLite."""
+    from roughfe.study import build_genome_db, extend_genome_db
+
+    tiny = db.DatabaseSettings(n_nodes=128, n_steps=8)
     path = tmp_path / "g.sqlite"
-    assert db.build_database(path, SMALL, progress=False, limit=2) == 2
-    # an interrupted build keeps finished genomes: a rerun computes only the rest
-    assert db.build_database(path, SMALL, progress=False, limit=4) == 2
-    assert db.build_database(path, SMALL, progress=False, limit=4) == 0
-    entries = db.load_entries(path)
-    assert [e.label for e in entries] == ["1-1", "1-2", "1-3", "2-1"]
-    e = entries[0]
+    run = build_genome_db(path, tiny, limit=2, workers=1, progress=False)
+    assert (run.summary.n_done, run.n_inserted, run.n_genomes) == (2, 2, 2)
+    assert run.study_dir == tmp_path / "g.sqlite.study"
+    # the stored entry is exactly what a direct genome_entry_task call gives
+    e = db.load_entries(path, labels_=["1-2"])[0]
+    direct = db.genome_entry_task(**db.sobol_tasks(db.SobolDesign(), 2)[1], **tiny.to_dict())
+    assert e.genome == direct["genome"] and e.curve.to_dict() == direct["curve"]
+    assert [c.to_dict() for c in e.chromosome_curves] == direct["chromosome_curves"]
+    assert list(e.corr_k) == direct["corr_k"] and list(e.macro) == direct["macro"]
+    # interrupted after the tasks, before the import (here: the SQLite file is lost):
+    # the finished genomes come from the study folder, only the new one is computed
+    path.unlink()
+    run = build_genome_db(path, tiny, limit=3, workers=1, progress=False)
+    assert (run.summary.n_cached, run.summary.n_done, run.n_inserted) == (2, 1, 3)
+    assert [x.label for x in db.load_entries(path)] == ["1-1", "1-2", "1-3"]
+    assert db.load_entries(path, labels_=["1-2"])[0].curve.to_dict() == direct["curve"]
+    # genomes already in the file are kept and not run again
+    assert build_genome_db(path, tiny, limit=3, progress=False).summary.n_tasks == 0
+    with pytest.raises(InputError, match="settings"):
+        build_genome_db(path, db.DatabaseSettings(n_nodes=256), limit=1, progress=False)
+    with pytest.raises(InputError, match="Sobol design"):
+        build_genome_db(path, tiny, db.SobolDesign(seed=3), limit=1, progress=False)
+    with pytest.raises(InputError, match="limit"):
+        build_genome_db(path, tiny, limit=0, progress=False)
+    new = db.make_genome(1.7, 0.9, 11, tiny)
+    run = extend_genome_db(path, [new], labels=["seq-1"], workers=1, progress=False)
+    assert run.n_inserted == 1 and run.n_genomes == 4
+    assert db.load_entries(path, labels_=["seq-1"])[0].source == "extend"
+    with pytest.raises(InputError, match="already"):
+        extend_genome_db(path, [new], labels=["seq-1"], progress=False)
+    empty = tmp_path / "empty.sqlite"
+    db.connect(empty, create=True).close()
+    with pytest.raises(InputError, match="empty"):
+        extend_genome_db(empty, [new], progress=False)
+    con = sqlite3.connect(path)
+    assert json.loads(con.execute("SELECT value FROM meta WHERE key='schema_version'")
+                      .fetchone()[0]) == db.SCHEMA_VERSION
+    con.close()
+
+
+def test_build_database_library_shortcut_and_record_checks(tmp_path):
+    """build_database (one machine, no study folder) stores the realisation's BEM curve;
+    insert_records refuses a record with other settings and inserts nothing."""
+    path = tmp_path / "g.sqlite"
+    assert db.build_database(path, SMALL, progress=False, limit=1) == 1
+    assert db.build_database(path, SMALL, progress=False, limit=1) == 0
+    e = db.load_entries(path)[0]
     g = Genome.from_dict(e.genome)
     n_s, n_f = g.chromosome_range(SMALL.length, SMALL.n_nodes)
     assert len(e.chromosome_curves) == len(e.corr_k) == n_f - n_s + 1
@@ -71,23 +115,17 @@ def test_build_resumes_extends_and_refuses_mismatches(tmp_path):
     assert not set(e.macro) & set(e.micro)
     assert np.all(np.asarray(e.corr_k)[[n - n_s for n in e.macro]] > SMALL.threshold)
     assert e.p_max == pytest.approx(e.curve.p_max)
-    # the stored curve is the realisation's BEM curve
     again = profile_response(realize(g, SMALL.length, SMALL.n_nodes),
                              youngs_modulus=SMALL.youngs_modulus, n_steps=SMALL.n_steps)
     np.testing.assert_allclose(again.stiffness, e.curve.stiffness, rtol=1e-9)
-    with pytest.raises(InputError, match="settings"):
-        db.build_database(path, db.DatabaseSettings(n_nodes=128), progress=False, limit=1)
-    with pytest.raises(InputError, match="Sobol design"):
-        db.build_database(path, SMALL, db.SobolDesign(seed=3), progress=False, limit=1)
-    new = db.make_genome(1.7, 0.9, 11, SMALL)
-    assert db.extend_database(path, [new], labels_=["seq-1"], progress=False) == 1
-    assert db.load_entries(path, labels_=["seq-1"])[0].source == "extend"
-    with pytest.raises(InputError, match="already"):
-        db.extend_database(path, [new], labels_=["seq-1"], progress=False)
-    con = sqlite3.connect(path)
-    assert json.loads(con.execute("SELECT value FROM meta WHERE key='schema_version'")
-                      .fetchone()[0]) == db.SCHEMA_VERSION
-    con.close()
+    record = {"label": "other", "settings": db.DatabaseSettings(n_nodes=128).to_dict()}
+    con = db.connect(path)
+    try:
+        with pytest.raises(InputError, match="settings"):
+            db.insert_records(con, [record])
+        assert db.labels(con) == ["1-1"]
+    finally:
+        con.close()
 
 
 def test_empty_missing_and_foreign_databases(tmp_path):

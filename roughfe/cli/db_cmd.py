@@ -1,7 +1,16 @@
-"""``roughfe db build|extend|list|map``: the genome database of thesis Sec. 4.1.2."""
+"""``roughfe db build|extend|list|map``: the genome database of thesis Sec. 4.1.2.
+
+``build`` and ``extend`` compute the genomes through the study runner
+(:func:`roughfe.study.build_genome_db`): local process pool, dask or MPI, with a study
+folder beside the database (``DB.study``) so that an interrupted build resumes from its
+finished genomes (rerun the same command). Under MPI run::
+
+    mpirun -n K python -m mpi4py.futures $(which roughfe) db build DB --executor mpi
+"""
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 
@@ -12,23 +21,52 @@ def _settings(args):
                             stiffness=args.stiffness)
 
 
-def _build(args) -> int:
-    from ..genomics.database import SobolDesign, build_database
-    design = SobolDesign(seed=args.seed, scramble=not args.no_scramble)
-    n = build_database(args.database, _settings(args), design, workers=args.workers,
-                       progress=not args.quiet, limit=args.limit)
-    print(f"{args.database}: {n} genome(s) computed (finished genomes are kept; rerun to resume)")
+def _runner(args) -> dict:
+    return dict(executor=args.executor, workers=args.workers, scheduler=args.scheduler,
+                study_dir=args.study_dir, progress=not args.quiet,
+                log=lambda message: print(message, file=sys.stderr))
+
+
+def _report(args, run) -> int:
+    print(f"{args.database}: {run.describe()}")
+    if not run.complete:
+        print(f"some genomes failed; `roughfe study status {run.study_dir}` shows why; rerun "
+              "the same command to retry them (finished genomes are kept)", file=sys.stderr)
+        return 1
     return 0
+
+
+def _build(args) -> int:
+    from ..genomics.database import SobolDesign
+    from ..study import build_genome_db
+    design = SobolDesign(seed=args.seed, scramble=not args.no_scramble)
+    run = build_genome_db(args.database, _settings(args), design, limit=args.limit,
+                          **_runner(args))
+    return _report(args, run)
 
 
 def _extend(args) -> int:
-    from ..genomics.database import extend_database
     from ..genomics.genome import load_genome
+    from ..study import extend_genome_db
     genomes = [load_genome(p) for p in args.genomes]
-    n = extend_database(args.database, genomes, labels_=args.label or None,
-                        workers=args.workers, progress=not args.quiet)
-    print(f"{args.database}: {n} genome(s) added")
-    return 0
+    run = extend_genome_db(args.database, genomes, labels=args.label or None, **_runner(args))
+    return _report(args, run)
+
+
+def _add_runner_options(p):
+    from ..study import EXECUTORS
+    r = p.add_argument_group("study runner (as `roughfe study run`)")
+    r.add_argument("--executor", choices=EXECUTORS, default="local",
+                   help="local: process pool on this machine (default); dask: dask.distributed "
+                        "(LocalCluster, or --scheduler); mpi: mpi4py.futures under mpirun")
+    r.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="a running dask scheduler: address or scheduler file (dask only)")
+    r.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="worker processes for local and a dask LocalCluster (default: cores)")
+    r.add_argument("--study-dir", default=None, metavar="DIR",
+                   help="study folder of the tasks (default: DATABASE.study); keep it to "
+                        "resume an interrupted run")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def _list(args) -> int:
@@ -67,7 +105,8 @@ def register(sub):
     dsub.required = True
 
     b = dsub.add_parser("build", help="build or resume the Sobol genome database (Sec. 4.1.2)")
-    b.add_argument("database", help="SQLite file (created if missing; an interrupted build resumes)")
+    b.add_argument("database", help="SQLite file (created if missing; genomes there are kept, "
+                                    "an interrupted build resumes)")
     g = b.add_argument_group("realisation and contact settings (stored in the database)")
     g.add_argument("--length", type=float, default=849.42e-6, help="observation length L = lambda (m)")
     g.add_argument("--nodes", type=int, default=512, help="nodes N per profile")
@@ -81,16 +120,14 @@ def register(sub):
     s.add_argument("--seed", type=int, default=20240, help="Sobol scrambling seed (recorded)")
     s.add_argument("--no-scramble", action="store_true", help="unscrambled Sobol sequences")
     s.add_argument("--limit", type=int, default=None, help="build only the first K genomes")
-    b.add_argument("--workers", type=int, default=1, help="worker processes")
-    b.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_runner_options(b)
     b.set_defaults(func=_build)
 
     e = dsub.add_parser("extend", help="add genome JSON files (e.g. sequenced genomes)")
     e.add_argument("database", help="existing SQLite genome database")
     e.add_argument("genomes", nargs="+", help="roughfe-genome JSON files")
     e.add_argument("--label", action="append", help="label per genome (repeat); default x-<k>")
-    e.add_argument("--workers", type=int, default=1, help="worker processes")
-    e.add_argument("--quiet", action="store_true", help="no progress bar")
+    _add_runner_options(e)
     e.set_defaults(func=_extend)
 
     li = dsub.add_parser("list", help="list the genomes with genes, p_max and macro chromosomes")

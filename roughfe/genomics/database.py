@@ -15,10 +15,12 @@ Layout (schema version :data:`SCHEMA_VERSION`, stdlib :mod:`sqlite3`)
     ``corr_k_json`` / ``corr_a_json`` (c_n of Alg. 2, in the order n = n_s..n_f),
     ``macro_json`` (chromosome indices n with c_n > threshold) and ``created_utc``.
 
-Every finished genome is inserted in its own transaction (``with connection:``), so an
-interrupted build keeps all finished rows and :func:`build_database` resumes by
-skipping the labels already present. Only the parent process writes; workers return
-JSON-safe records from :func:`genome_entry_task`.
+The genomes are computed by the study runner (``roughfe db build|extend`` call
+:func:`roughfe.study.build_genome_db`: any executor, a study folder beside the file, so an
+interrupted build resumes from its finished genomes) or, for library callers on one
+machine, by :func:`build_database`. Either way workers only return JSON-safe records of
+:func:`genome_entry_task`; :func:`insert_records` adds them in one transaction, keeping
+the genomes already present, after checking their settings against the stored ones.
 """
 from __future__ import annotations
 
@@ -212,17 +214,17 @@ class DatabaseEntry:
 # ---------------------------------------------------------------------------------------
 # per-genome task (pure; runs in a worker process or in the study runner)
 # ---------------------------------------------------------------------------------------
-def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=1.0,
-                      lambda1=None, length=849.42e-6, n_nodes=512, youngs_modulus=1.0e6,
+def genome_entry_task(gamma=None, hurst=None, phases=None, *, label, source="sobol",
+                      amplitude=1.0, lambda1=None, length=849.42e-6, n_nodes=512, youngs_modulus=1.0e6,
                       poisson=0.0, n_steps=20, threshold=0.95, kernel="auto",
                       stiffness="fd", correlation="steps", genome_json=None) -> dict:
     """Realise one genome, run Alg. 2 on it and return its database record (JSON-safe).
 
     Parameters
     ----------
-    gamma, hurst : float
+    gamma, hurst : float, optional
         Genes gamma (-) and H (-) of Eq. (3.1).
-    phases : int or array_like
+    phases : int or array_like, optional
         A phase vector phi_{1,n} (rad; the first n_c entries are used, M = 1) or an
         int seed that draws uniform phases with ``numpy.random.default_rng(seed)``.
     label : str
@@ -234,7 +236,7 @@ def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=
         :class:`DatabaseSettings` fields (keywords so a study runner can pass them).
     genome_json : dict, optional
         A complete Genome JSON (e.g. a sequenced genome for ``db extend``); then
-        gamma/hurst/phases are ignored.
+        gamma/hurst/phases are not needed.
 
     Returns
     -------
@@ -248,6 +250,8 @@ def genome_entry_task(gamma, hurst, phases, *, label, source="sobol", amplitude=
                                 kernel, stiffness, correlation)
     if genome_json is not None:
         genome = Genome.from_dict(genome_json)
+    elif gamma is None or hurst is None or phases is None:
+        raise InputError("genome_entry_task needs gamma, hurst and phases, or genome_json")
     else:
         genome = make_genome(gamma, hurst, phases, settings, amplitude=amplitude,
                              lambda1=lambda1)
@@ -323,7 +327,14 @@ def _get_meta(con, key):
     return None if row is None else json.loads(row[0])
 
 
-def _set_settings(con, settings: DatabaseSettings):
+def write_settings(con, settings: DatabaseSettings):
+    """Store ``settings`` in a new database, or check them against the stored ones.
+
+    Raises
+    ------
+    InputError
+        When the database holds other settings (all genomes share L, N, material, n_t).
+    """
     stored = _get_meta(con, "settings")
     if stored is None:
         with con:
@@ -331,6 +342,17 @@ def _set_settings(con, settings: DatabaseSettings):
     elif DatabaseSettings.from_dict(stored) != settings:
         raise InputError(f"the database was built with settings {stored}; got {settings.to_dict()}. "
                          f"All genomes of one database share L, N, material and n_t.")
+
+
+def write_design(con, design: SobolDesign):
+    """Store the Sobol design of a new database, or check it against the stored one."""
+    stored = _get_meta(con, "sobol")
+    if stored is None:
+        with con:
+            con.execute("INSERT INTO meta VALUES ('sobol', ?)", (json.dumps(design.to_dict()),))
+    elif SobolDesign.from_dict(stored) != design:
+        raise InputError(f"the database was built with the Sobol design {stored}; got "
+                         f"{design.to_dict()}")
 
 
 def read_settings(path_or_con) -> DatabaseSettings:
@@ -341,57 +363,93 @@ def read_settings(path_or_con) -> DatabaseSettings:
     return DatabaseSettings.from_dict(stored)
 
 
-def insert_record(con, record: dict):
-    """Insert one :func:`genome_entry_task` record in its own transaction."""
+def _insert_row(con, record: dict):
     g = record["genome"]
     row = (record["label"], record["source"], float(g["gamma"]), float(g["H"]), float(g["A"]),
            float(g["lambda1"]), int(g["M"]), len(record["corr_k"]), json.dumps(g),
            float(record["p_max"]), json.dumps(record["curve"]),
            json.dumps(record["chromosome_curves"]), json.dumps(record["corr_k"]),
            json.dumps(record["corr_a"]), json.dumps(record["macro"]), _now())
+    con.execute("INSERT INTO genomes (label, source, gamma, hurst, amplitude, lambda1, "
+                "n_ridges, n_chromosomes, genome_json, p_max, curve_json, "
+                "chromosome_curves_json, corr_k_json, corr_a_json, macro_json, created_utc) "
+                "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)", row)
+
+
+def insert_records(con, records) -> int:
+    """Insert :func:`genome_entry_task` records in one transaction; return how many.
+
+    Records whose label is already in the database are skipped (the genomes there are
+    kept), so importing the same results again adds nothing. Every record must carry the
+    database's settings (write them first with :func:`write_settings`); otherwise nothing
+    is inserted and InputError names the record.
+    """
+    settings = read_settings(con)
+    present = set(labels(con))
+    new = []
+    for record in records:
+        if DatabaseSettings.from_dict(record["settings"]) != settings:
+            raise InputError(f"genome {record['label']!r} was computed with the settings "
+                             f"{record['settings']}, the database holds {settings.to_dict()}")
+        if record["label"] not in present:
+            present.add(record["label"])
+            new.append(record)
     with con:
-        con.execute("INSERT INTO genomes (label, source, gamma, hurst, amplitude, lambda1, "
-                    "n_ridges, n_chromosomes, genome_json, p_max, curve_json, "
-                    "chromosome_curves_json, corr_k_json, corr_a_json, macro_json, created_utc) "
-                    "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)", row)
+        for record in new:
+            _insert_row(con, record)
+    return len(new)
 
 
 def labels(con) -> list:
     return [r[0] for r in con.execute("SELECT label FROM genomes ORDER BY id")]
 
 
-def _run_tasks(con, tasks, settings, workers, progress, desc):
-    """Run ``genome_entry_task`` over ``tasks`` (dicts of arguments); insert as they finish."""
-    kw = settings.to_dict()
-    done = set(labels(con))
-    todo = [t for t in tasks if t["label"] not in done]
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(tasks), initial=len(tasks) - len(todo), desc=desc, unit="genome")
-    try:
-        if workers <= 1 or len(todo) <= 1:
-            for t in todo:
-                insert_record(con, genome_entry_task(**t, **kw))
-                if bar is not None:
-                    bar.update()
-        else:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
-                futures = [pool.submit(genome_entry_task, **t, **kw) for t in todo]
-                for fut in as_completed(futures):
-                    insert_record(con, fut.result())
-                    if bar is not None:
-                        bar.update()
-    finally:
-        if bar is not None:
-            bar.close()
-    return len(todo)
+def sobol_tasks(design: SobolDesign, limit=None) -> list:
+    """:func:`genome_entry_task` arguments (label, source, gamma, hurst, phases) per genome.
+
+    ``limit`` keeps the first genomes of the design (a reduced database); it must be >= 1.
+    """
+    tasks = [{"label": lab, "source": "sobol", "gamma": g, "hurst": h,
+              "phases": [float(v) for v in phi]} for lab, g, h, phi in design.tasks()]
+    if limit is not None:
+        if int(limit) < 1:
+            raise InputError(f"limit must be >= 1 genome, got {limit!r}")
+        tasks = tasks[: int(limit)]
+    return tasks
+
+
+def extend_tasks(con, genomes, labels_=None) -> list:
+    """:func:`genome_entry_task` arguments (label, source, genome_json) to add ``genomes``.
+
+    ``genomes`` are Genome objects or Genome JSON dicts (e.g. sequenced ones); labels
+    default to ``"x-<k>"``. The database must hold settings already (an empty database
+    is an error: build it first); a label already present is an error.
+    """
+    read_settings(con)
+    dicts = [g if isinstance(g, dict) else g.to_dict() for g in genomes]
+    if not dicts:
+        raise InputError("no genomes given to add to the database")
+    have = set(labels(con))
+    if labels_ is None:
+        start = len(have) + 1
+        labels_ = [f"x-{start + k}" for k in range(len(dicts))]
+    if len(labels_) != len(dicts):
+        raise InputError(f"{len(labels_)} label(s) for {len(dicts)} genome(s)")
+    clash = sorted(set(labels_) & have)
+    if clash:
+        raise InputError(f"labels already in the database: {clash}")
+    return [{"label": lab, "source": "extend", "genome_json": d}
+            for lab, d in zip(labels_, dicts)]
 
 
 def build_database(path, settings: DatabaseSettings = DatabaseSettings(),
                    design: SobolDesign = SobolDesign(), *, workers: int = 1,
                    progress: bool = True, limit=None) -> int:
-    """Build (or resume building) the Sobol genome database of Sec. 4.1.2.
+    """Build (or resume building) the Sobol genome database of Sec. 4.1.2 on this machine.
+
+    A library shortcut without a study folder; ``roughfe db build`` runs the same tasks
+    through the study runner instead (:func:`roughfe.study.build_genome_db`: dask or MPI
+    too, resumable from its study folder).
 
     Parameters
     ----------
@@ -413,48 +471,36 @@ def build_database(path, settings: DatabaseSettings = DatabaseSettings(),
     """
     con = connect(path, create=True)
     try:
-        _set_settings(con, settings)
-        stored = _get_meta(con, "sobol")
-        if stored is None:
-            with con:
-                con.execute("INSERT INTO meta VALUES ('sobol', ?)", (json.dumps(design.to_dict()),))
-        elif SobolDesign.from_dict(stored) != design:
-            raise InputError(f"the database was built with the Sobol design {stored}; got "
-                             f"{design.to_dict()}")
-        tasks = [{"gamma": g, "hurst": h, "phases": list(phi), "label": lab, "source": "sobol"}
-                 for lab, g, h, phi in design.tasks()]
-        if limit is not None:
-            tasks = tasks[: int(limit)]
-        return _run_tasks(con, tasks, settings, workers, progress, "db build")
-    finally:
-        con.close()
+        write_settings(con, settings)
+        write_design(con, design)
+        tasks = sobol_tasks(design, limit)
+        done = set(labels(con))
+        todo = [t for t in tasks if t["label"] not in done]
+        kw = settings.to_dict()
+        bar = None
+        if progress:
+            from tqdm import tqdm
+            bar = tqdm(total=len(tasks), initial=len(tasks) - len(todo), desc="db build",
+                       unit="genome")
 
+        def add(record):            # each genome in its own transaction, as it finishes
+            insert_records(con, [record])
+            if bar is not None:
+                bar.update()
 
-def extend_database(path, genomes, *, labels_=None, settings: DatabaseSettings = None,
-                    workers: int = 1, progress: bool = True) -> int:
-    """Add genomes (Genome objects or Genome JSON dicts, e.g. sequenced ones) to a database.
-
-    The database's own settings are used (``settings`` only for a new, empty file).
-    Labels default to ``"x-<k>"``; an existing label is an error.
-    """
-    con = connect(path, create=settings is not None)
-    try:
-        if settings is not None:
-            _set_settings(con, settings)
-        settings = read_settings(con)
-        dicts = [g if isinstance(g, dict) else g.to_dict() for g in genomes]
-        if not dicts:
-            raise InputError("no genomes given to add to the database")
-        have = set(labels(con))
-        if labels_ is None:
-            start = len(have) + 1
-            labels_ = [f"x-{start + k}" for k in range(len(dicts))]
-        clash = sorted(set(labels_) & have)
-        if clash:
-            raise InputError(f"labels already in the database: {clash}")
-        tasks = [{"gamma": d["gamma"], "hurst": d["H"], "phases": None, "label": lab,
-                  "source": "extend", "genome_json": d} for lab, d in zip(labels_, dicts)]
-        return _run_tasks(con, tasks, settings, workers, progress, "db extend")
+        try:
+            if workers <= 1 or len(todo) <= 1:
+                for t in todo:
+                    add(genome_entry_task(**t, **kw))
+            else:
+                with ProcessPoolExecutor(max_workers=workers) as pool:
+                    futures = [pool.submit(genome_entry_task, **t, **kw) for t in todo]
+                    for future in as_completed(futures):
+                        add(future.result())
+        finally:
+            if bar is not None:
+                bar.close()
+        return len(todo)
     finally:
         con.close()
 

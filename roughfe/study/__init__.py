@@ -5,7 +5,8 @@ the explicit registry :data:`ANALYSES`, a parameter grid (cartesian product) and
 parameters, and an output folder. :func:`run_study` runs the missing tasks on an
 executor (``local``, ``dask`` or ``mpi``), storing each result atomically under a
 content key, so that an interrupted study resumes to the same table; :func:`study_status`
-reports progress and failures; :func:`collect` writes one tidy table.
+reports progress and failures; :func:`collect` writes one tidy table;
+:func:`build_genome_db` and :func:`extend_genome_db` fill a SQLite genome database.
 
 Example
 -------
@@ -18,13 +19,15 @@ Example
 from .analyses import ANALYSES, Analysis, selftest_task
 from .executors import EXECUTORS, make_executor
 from .exports import genome_db_to_sqlite
+from .genome_db import GenomeDbRun, build_genome_db, extend_genome_db
 from .runner import StudySummary, execute_task, run_study
 from .spec import StudySpec, Task, derive_seed, load_spec, spec_from_mapping
 from .store import StudyStatus, collect, study_status, table_rows
 
 __all__ = [
-    "ANALYSES", "Analysis", "EXECUTORS", "StudySpec", "StudyStatus", "StudySummary", "Task",
-    "collect", "derive_seed", "execute_task", "genome_db_to_sqlite", "load_spec",
+    "ANALYSES", "Analysis", "EXECUTORS", "GenomeDbRun", "StudySpec", "StudyStatus",
+    "StudySummary", "Task", "build_genome_db", "collect", "derive_seed", "execute_task",
+    "extend_genome_db", "genome_db_to_sqlite", "load_spec",
     "make_executor", "run_study",
     "selftest_task", "spec_from_mapping", "study_status", "table_rows",
 ]

@@ -56,6 +56,10 @@ ANALYSES = {
         "roughfe.study.analyses:genome_db_task", "1",
         "one entry of the genome database: WM genome, Alg. 2 macro/micro, BEM sweep "
         "(roughfe.genomics.database.genome_entry_task)"),
+    "genome_entry": Analysis(
+        "roughfe.study.analyses:genome_entry_study_task", "1",
+        "one given genome (Sobol design or a genome JSON) of a genome database: Alg. 2, BEM "
+        "sweep; what `roughfe db build|extend` run"),
 }
 
 
@@ -213,3 +217,33 @@ def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=Non
         source="study", amplitude=amplitude, lambda1=lambda1, length=length, n_nodes=n_nodes,
         youngs_modulus=youngs_modulus, poisson=poisson, n_steps=n_steps, threshold=threshold,
         kernel=kernel)
+
+
+def genome_entry_study_task(*, entry, seed, length=849.42e-6, n_nodes=512,
+                            youngs_modulus=1.0e6, poisson=0.0, n_steps=20, threshold=0.95,
+                            kernel="auto", stiffness="fd", correlation="steps"):
+    """One genome-database entry of a given genome (``roughfe db build|extend``).
+
+    Parameters
+    ----------
+    entry : dict
+        Keyword arguments of :func:`roughfe.genomics.database.genome_entry_task` for one
+        genome: ``label``, ``source`` and ``gamma``, ``hurst``, ``phases`` (a Sobol
+        genome, :func:`~roughfe.genomics.database.sobol_tasks`) or ``genome_json``
+        (:func:`~roughfe.genomics.database.extend_tasks`).
+    seed : int
+        Not used: the genome is given (the runner records it).
+    length, n_nodes, youngs_modulus, poisson, n_steps, threshold, kernel, stiffness, correlation
+        The :class:`~roughfe.genomics.database.DatabaseSettings` of the database.
+
+    Returns
+    -------
+    dict
+        The database record of ``genome_entry_task``.
+    """
+    from ..genomics.database import genome_entry_task
+
+    return genome_entry_task(**entry, length=length, n_nodes=n_nodes,
+                             youngs_modulus=youngs_modulus, poisson=poisson, n_steps=n_steps,
+                             threshold=threshold, kernel=kernel, stiffness=stiffness,
+                             correlation=correlation)
