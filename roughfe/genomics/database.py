@@ -215,9 +215,10 @@ class DatabaseEntry:
 # per-genome task (pure; runs in a worker process or in the study runner)
 # ---------------------------------------------------------------------------------------
 def genome_entry_task(gamma=None, hurst=None, phases=None, *, label, source="sobol",
-                      amplitude=1.0, lambda1=None, length=849.42e-6, n_nodes=512, youngs_modulus=1.0e6,
-                      poisson=0.0, n_steps=20, threshold=0.95, kernel="auto",
-                      stiffness="fd", correlation="steps", genome_json=None) -> dict:
+                      amplitude=1.0, lambda1=None, length=849.42e-6, n_nodes=512,
+                      youngs_modulus=1.0e6, poisson=0.0, n_steps=20, threshold=0.95,
+                      kernel="auto", stiffness="fd", correlation="steps",
+                      genome_json=None) -> dict:
     """Realise one genome, run Alg. 2 on it and return its database record (JSON-safe).
 
     Parameters
