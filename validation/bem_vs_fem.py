@@ -16,6 +16,12 @@ the thesis Table 1 genome (Eq. 3.1, 512 nodes, phases from seed 0), (iii) an RMD
 (D = 1.5, 513 nodes, seed 1). Methods: BEM, FEM-VI (SNES vinewtonrsls), FEM-penalty
 (k = 1e4), FEM-VI on formulation (b) (the profile as the real top boundary), and the
 thesis kernel (Eq. 2.4) on the same profile for comparison.
+
+A* is compared two ways: by counting contact nodes (tributary lengths; edges quantised to
+dx) and, as the primary metric, by the contact length with each edge located inside its
+element from the edge pressure and gap (``roughfe.fem.contact_length``). A resolution
+study (profile resolved 2x, 4x; BEM at 16x as the converged reference) separates the
+counting artefact from the grid-scale discretisation difference of the two methods.
 """
 from __future__ import annotations
 
@@ -31,7 +37,8 @@ import numpy as np
 
 from roughfe.bem import Material, contact_sweep
 from roughfe.fem import mesh_profile, mirrored_profile
-from roughfe.fem.contact import FemSolverOptions, contact_edge, fem_contact_sweep
+from roughfe.fem.contact import (FemSolverOptions, contact_edge, contact_length,
+                                 fem_contact_sweep, p_wave_modulus)
 from roughfe.plotting import fem as fplot
 from roughfe.reference import westergaard
 from roughfe.surfaces import Surface
@@ -40,11 +47,56 @@ from roughfe.writers import write_json, write_text
 MATERIAL = Material(E=210e9, nu=0.3)
 GROWTH = 0.03                 # element-size growth with depth (<= 0.14 % on Westergaard)
 MIN_CONTACT = 5               # compare A and K only where >= 5 nodes touch (issue 4)
+R_CONVERGED = 16              # BEM on the profile resolved 16x: the converged A* reference
 TARGETS = {"westergaard_width": 0.005, "area": 0.02, "stiffness": 0.03, "vi_penalty": 0.005}
 
 
 def _rel(a, b):
     return np.abs(np.asarray(a, float) / np.asarray(b, float) - 1.0)
+
+
+def subcell_area(result, n):
+    """A* from the contact length with sub-element edges (:func:`contact_length`) of the
+    first n samples (the profile; for the mirrored BEM the first half period)."""
+    x = np.arange(n) * result.spacing[0]
+    return contact_length(x, result.pressure[:n], result.gap[:n], result.contact[:n],
+                          MATERIAL.E_star) / x[-1]
+
+
+def applied_for(surface_m, targets, pmesh):
+    """Approaches to impose on the FEM layer so that its half-plane approach is close to
+    ``targets``: target + p_BEM(target) H_d / M. One FEM solve per load (instead of a
+    Newton loop); the BEM is then solved at the FEM's own half-plane approach, so the two
+    are compared at exactly equal Delta."""
+    est = contact_sweep(surface_m, MATERIAL, deltas=targets, kernel="spectral",
+                        compute_stiffness=False)
+    return np.asarray(targets) + est.mean_pressure * pmesh.depth / p_wave_modulus(MATERIAL)
+
+
+def patch_stats(contact):
+    """Number of contact patches (runs of contact vertices) and their mean size (vertices)."""
+    step = np.diff(np.concatenate([[0], np.asarray(contact, np.int8), [0]]))
+    sizes = np.flatnonzero(step == -1) - np.flatnonzero(step == 1)
+    return int(sizes.size), (float(sizes.mean()) if sizes.size else 0.0), int(np.sum(sizes == 1))
+
+
+def neighbour_gap_difference(rb, rf, n):
+    """Median |g_FEM / g_BEM - 1| at vertices open in both, (a) next to a vertex in contact
+    in both, (b) at least 3 vertices from any contact: how differently the two
+    discretisations move the neighbours of a loaded vertex."""
+    cb, cf = rb.contact[:n], rf.contact
+    both = cb & cf
+    open_ = ~cb & ~cf & (rb.gap[:n] > 0)
+    near = np.zeros(n, bool)
+    near[1:] |= both[:-1]
+    near[:-1] |= both[1:]
+    far = np.ones(n, bool)
+    for k in range(-3, 4):
+        far &= ~np.roll(cb | cf, k)
+    ratio = np.abs(rf.gap / np.where(open_, rb.gap[:n], 1.0) - 1.0)
+    a, b = ratio[open_ & near], ratio[open_ & far]
+    return (float(np.median(a)) if a.size else float("nan"),
+            float(np.median(b)) if b.size else float("nan"))
 
 
 # -- (i) Westergaard ----------------------------------------------------------------------
@@ -59,10 +111,11 @@ def westergaard_case(outdir: Path, n=513, wavelength=1e-3, amplitude=1e-6):
     t_mesh = time.perf_counter() - t0
     deltas = amplitude * np.linspace(0.05, 0.95, 10)    # half-plane approach; full contact: g
     t0 = time.perf_counter()
-    fem = fem_contact_sweep(pm, MATERIAL, deltas, keep_fields=(4,))
+    fem = fem_contact_sweep(pm, MATERIAL, applied_deltas=applied_for(
+        mirrored_profile(surf), deltas, pm), keep_fields=(4,))
     t_fem = time.perf_counter() - t0
     bem = contact_sweep(mirrored_profile(surf), MATERIAL, deltas=fem.delta, kernel="spectral")
-    rows, err_fem, err_bem, ratio = [], [], [], []
+    rows, err_fem, err_bem, ratio, err_sub = [], [], [], [], []
     pairs = []
     for k, (rf, rb) in enumerate(zip(fem.results, bem.results)):
         ref_f = westergaard(amplitude, wavelength, MATERIAL.E_star, rf.mean_pressure)
@@ -71,6 +124,8 @@ def westergaard_case(outdir: Path, n=513, wavelength=1e-3, amplitude=1e-6):
         a_b = contact_edge(x, rb.gap[:n], rb.contact[:n])
         err_fem.append(a_f / ref_f.half_width - 1)
         err_bem.append(a_b / ref_b.half_width - 1)
+        err_sub.append((subcell_area(rf, n) * x[-1] / ref_f.half_width - 1,
+                        subcell_area(rb, n) * x[-1] / ref_b.half_width - 1))
         ratio.append(rf.mean_pressure / ref_f.full_contact_pressure)
         s_ref = ratio[-1]                                    # K = d p / d(g - gbar)
         k_ref = -ref_f.full_contact_pressure / (amplitude * np.log(s_ref)) if s_ref < 1 else np.nan
@@ -85,6 +140,8 @@ def westergaard_case(outdir: Path, n=513, wavelength=1e-3, amplitude=1e-6):
     max_err = float(np.max(np.abs(err_fem)))
     return {"rows": rows, "max_width_error_fem": max_err,
             "max_width_error_bem": float(np.max(np.abs(err_bem))),
+            "max_length_error_subcell": [float(np.max(np.abs(np.array(err_sub)[:, k])))
+                                         for k in (0, 1)],
             "n_cells": pm.n_cells, "n_nodes": n, "time_mesh": t_mesh, "time_fem": t_fem,
             "ok": max_err <= TARGETS["westergaard_width"]}
 
@@ -105,73 +162,118 @@ def rmd_profile_case():
     return rmd_profile(9, 1.5, 1e-3, rng=1, rms_height=1e-6)
 
 
-def profile_case(name, surf, outdir: Path, n_steps=16):
+def profile_case(name, surf, outdir: Path, n_steps=12):
     h = surf.heights
+    n = h.size
     mirrored = mirrored_profile(surf)
     top = float(h.max() - np.mean(mirrored.heights))
-    deltas_bem = top * np.geomspace(0.02, 0.9, n_steps)
-    t0 = time.perf_counter()
-    bem = contact_sweep(mirrored, MATERIAL, deltas=deltas_bem, kernel="spectral")
-    t_bem = time.perf_counter() - t0
     t0 = time.perf_counter()
     pm = mesh_profile(surf, growth=GROWTH)
     pm_b = mesh_profile(surf, growth=GROWTH, formulation="profile")
-    t_mesh = time.perf_counter() - t0
-    timings = {"bem": t_bem, "mesh (a)+(b)": t_mesh}
+    timings = {"mesh (a)+(b)": time.perf_counter() - t0}
+    applied = applied_for(mirrored, top * np.geomspace(0.05, 0.9, n_steps), pm)
+    keep = (3 * n_steps // 4,)
     sweeps = {}
     for label, mesh, opts in (("FEM-VI", pm, FemSolverOptions(method="vi")),
                               ("FEM-penalty", pm, FemSolverOptions(method="penalty",
-                                                                   penalty_factor=1e4)),
-                              ("FEM-VI (b)", pm_b, FemSolverOptions(method="vi"))):
+                                                                   penalty_factor=1e4))):
         t0 = time.perf_counter()
-        sweeps[label] = fem_contact_sweep(mesh, MATERIAL, bem.delta,   # the BEM's approaches
-                                          options=opts, keep_fields=(3 * n_steps // 4,))
+        sweeps[label] = fem_contact_sweep(mesh, MATERIAL, applied_deltas=applied,
+                                          options=opts, keep_fields=keep)
         timings[label] = time.perf_counter() - t0
+    vi, pen = sweeps["FEM-VI"], sweeps["FEM-penalty"]
+    t0 = time.perf_counter()
+    bem = contact_sweep(mirrored, MATERIAL, deltas=vi.delta, kernel="spectral")  # equal Delta
+    timings["bem"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    sweeps["FEM-VI (b)"] = vb = fem_contact_sweep(pm_b, MATERIAL, vi.delta,   # equal Delta
+                                                  options=FemSolverOptions(method="vi"))
+    timings["FEM-VI (b)"] = time.perf_counter() - t0
     thesis = contact_sweep(surf, MATERIAL, pressures=bem.mean_pressure, kernel="thesis")
-    vi, pen, vb = sweeps["FEM-VI"], sweeps["FEM-penalty"], sweeps["FEM-VI (b)"]
 
-    # Compare where >= MIN_CONTACT nodes touch in both. The FEM solves at the BEM's
-    # half-plane approaches (to 1e-9), so A* and K are compared step by step (equal
-    # Delta) and, for A(p), also with the BEM curve interpolated at the FEM pressure.
-    n = h.size
+    # Compare where >= MIN_CONTACT nodes touch in both, at exactly equal half-plane Delta
+    # (the BEM is solved at the FEM's Delta) and, for A(p), also with the BEM curve
+    # interpolated at the FEM pressure.
     n_bem = np.array([int(r.contact[:n].sum()) for r in bem.results])   # profile nodes
     mask = (vi.n_contact >= MIN_CONTACT) & (n_bem >= MIN_CONTACT)
     inner = mask.copy()
     inner[[0, -1]] = False                 # one-sided differences at the ends: no K there
     node_flips = np.array([int(np.sum(rb.contact[:n] != rf.contact))
                            for rb, rf in zip(bem.results, vi.results)])
+    sub_bem = np.array([subcell_area(r, n) for r in bem.results])
+    sub_vi = np.array([subcell_area(r, n) for r in vi.results])
+    sub_pen = np.array([subcell_area(r, n) for r in pen.results])
+    # checks of the comparison itself: same Delta, same samples and weights, no tolerance
+    hr = float(np.std(h))
+    checks = {
+        "max |Delta_BEM / Delta_FEM - 1|": float(np.max(_rel(bem.delta, vi.delta))),
+        "max |A*_BEM(mirrored) - A*_BEM(first half, trapezoid weights)|": float(max(
+            abs(r.area_fraction - (np.sum(r.contact[1:n - 1]) + 0.5 * (r.contact[0] + r.contact[n - 1]))
+                / (n - 1)) for r in bem.results)),
+        "vertices within 1e-6 rms of touching, open or unloaded (BEM + FEM)": int(sum(
+            np.sum(~r.contact[:n] & (r.gap[:n] < 1e-6 * hr))
+            + np.sum(r.contact[:n] & (r.pressure[:n] < 1e-6 * r.mean_pressure))
+            for r in (*bem.results, *vi.results))),
+    }
+    flipped = [(float(rf.pressure[i] / rf.mean_pressure), float(rb.gap[i] / hr))
+               for rb, rf in zip(bem.results, vi.results) for i in
+               np.flatnonzero(rb.contact[:n] != rf.contact) if rf.contact[i]]
+    checks["differing vertices: FEM p / p_mean (range)"] = (
+        [min(f[0] for f in flipped), max(f[0] for f in flipped)] if flipped else [])
+    checks["differing vertices: BEM gap / rms height (range)"] = (
+        [min(f[1] for f in flipped), max(f[1] for f in flipped)] if flipped else [])
+    checks["differing vertices open in the FEM, in contact in the BEM"] = int(sum(
+        np.sum(rb.contact[:n] & ~rf.contact) for rb, rf in zip(bem.results, vi.results)))
+    stats = [patch_stats(r.contact[:n]) for r, m in zip(bem.results, mask) if m]
+    near_far = [neighbour_gap_difference(rb, rf, n)
+                for rb, rf, m in zip(bem.results, vi.results, mask) if m]
+    grid = {"mean_patch_size": [s[1] for s in stats],
+            "single_node_fraction": [s[2] / s[0] for s in stats if s[0]],
+            "gap_diff_next_to_contact": float(np.nanmedian([g[0] for g in near_far]))
+            if near_far else float("nan"),
+            "gap_diff_far_from_contact": float(np.nanmedian([g[1] for g in near_far]))
+            if near_far else float("nan")}
+    area_sub = "A* sub-element contact edges, equal delta: FEM-VI vs BEM"
+    area_cnt = "A* node count, equal delta: FEM-VI vs BEM"
+    k_key = "K(p) at equal delta: FEM-VI vs BEM, exact incremental (frozen contact set)"
     diffs = {
-        "p(delta): FEM-VI vs BEM": _rel(vi.mean_pressure,
-                                        np.interp(vi.delta, bem.delta, bem.mean_pressure))[mask],
-        "A* at equal delta: FEM-VI vs BEM": _rel(vi.area_fraction, bem.area_fraction)[mask],
-        "A(p), BEM interpolated at the FEM p": _rel(
+        "p(delta): FEM-VI vs BEM": _rel(vi.mean_pressure, bem.mean_pressure)[mask],
+        area_sub: _rel(sub_vi, sub_bem)[mask],
+        area_cnt: _rel(vi.area_fraction, bem.area_fraction)[mask],
+        "A(p) node count, BEM interpolated at the FEM p": _rel(
             vi.area_fraction, np.interp(vi.mean_pressure, bem.mean_pressure,
                                         bem.area_fraction))[mask],
-        "K(p) at equal delta: FEM-VI vs BEM, exact incremental (frozen contact set)": _rel(
-            vi.stiffness, bem.stiffness)[mask],
+        k_key: _rel(vi.stiffness, bem.stiffness)[mask],
         "K(p) at equal delta: FEM-VI vs BEM, central differences": _rel(
             vi.stiffness_fd, bem.stiffness_fd)[inner],
-        "p: FEM-penalty vs FEM-VI": _rel(pen.mean_pressure, vi.mean_pressure)[mask],
-        "A: FEM-penalty vs FEM-VI": _rel(pen.area_fraction, vi.area_fraction)[mask],
+        "p: FEM-penalty vs FEM-VI (equal imposed approach)": _rel(
+            pen.mean_pressure, vi.mean_pressure)[mask],
+        "A* node count: FEM-penalty vs FEM-VI": _rel(pen.area_fraction, vi.area_fraction)[mask],
+        "A* sub-element: FEM-penalty vs FEM-VI": _rel(sub_pen, sub_vi)[mask],
         "K: FEM-penalty vs FEM-VI": _rel(pen.stiffness, vi.stiffness)[mask],
         "p: formulation (b) vs (a)": _rel(vb.mean_pressure, vi.mean_pressure)[mask],
-        "A* at equal delta: formulation (b) vs (a)": _rel(vb.area_fraction,
-                                                         vi.area_fraction)[mask],
+        "A* node count at equal delta: formulation (b) vs (a)": _rel(vb.area_fraction,
+                                                                     vi.area_fraction)[mask],
         "A(p): thesis kernel Eq. 2.4 vs plane-strain BEM": _rel(
             thesis.area_fraction, bem.area_fraction)[mask],
     }
     diffs = {k: (float(v.max()) if v.size else float("nan")) for k, v in diffs.items()}
+    t0 = time.perf_counter()
     study = resolution_study(surf)
+    timings["resolution study"] = time.perf_counter() - t0
     resolved = [r for r in study if r["refinement"] >= 2 and r["n_contact_bem"] >= MIN_CONTACT]
-    diffs["A* at equal delta, profile resolved by r = 2, 4 elements per sample"] = (
-        max(abs(r["area_rel_diff"]) for r in resolved) if resolved else float("nan"))
-    area_key = "A* at equal delta, profile resolved by r = 2, 4 elements per sample"
-    k_key = "K(p) at equal delta: FEM-VI vs BEM, exact incremental (frozen contact set)"
-    ok = {"area (native sampling)": diffs["A* at equal delta: FEM-VI vs BEM"] <= TARGETS["area"],
-          "area (resolved, r >= 2)": diffs[area_key] <= TARGETS["area"],
+    area_sub_r = "A* sub-element edges, profile resolved r = 2, 4: FEM-VI vs BEM"
+    area_cnt_r = "A* node count, profile resolved r = 2, 4: FEM-VI vs BEM"
+    diffs[area_sub_r] = (max(abs(r["area_sub_rel_diff"]) for r in resolved)
+                         if resolved else float("nan"))
+    diffs[area_cnt_r] = (max(abs(r["area_rel_diff"]) for r in resolved)
+                         if resolved else float("nan"))
+    ok = {"area, sub-element edges (native sampling)": diffs[area_sub] <= TARGETS["area"],
+          "area, sub-element edges (resolved, r = 2, 4)": diffs[area_sub_r] <= TARGETS["area"],
           "stiffness": diffs[k_key] <= TARGETS["stiffness"],
-          "vi_penalty": max(diffs["p: FEM-penalty vs FEM-VI"],
-                            diffs["A: FEM-penalty vs FEM-VI"]) <= TARGETS["vi_penalty"]}
+          "vi_penalty": max(diffs["p: FEM-penalty vs FEM-VI (equal imposed approach)"],
+                            diffs["A* node count: FEM-penalty vs FEM-VI"])
+          <= TARGETS["vi_penalty"]}
 
     curves = [{"label": "BEM plane strain (mirrored, spectral)", "marker": "s",
                "mean_pressure": bem.mean_pressure, "area_fraction": bem.area_fraction,
@@ -193,22 +295,21 @@ def profile_case(name, surf, outdir: Path, n_steps=16):
                        "color": c, "style": "points"})
     fplot.plot_pressures(vi.results[0].x, series, outdir / f"bem_vs_fem_{name}_pressure.png",
                          title=f"{name}: pressure at three loads")
-    fplot.render_deformed_mesh(vi.results[3 * n_steps // 4].fields,
-                               outdir / f"bem_vs_fem_{name}_mesh.png")
+    fplot.render_deformed_mesh(vi.results[keep[0]].fields, outdir / f"bem_vs_fem_{name}_mesh.png")
     table = [(float(bem.mean_pressure[k]), int(n_bem[k]), int(vi.n_contact[k]),
               int(node_flips[k]), float(bem.area_fraction[k]), float(vi.area_fraction[k]),
-              float(pen.area_fraction[k]), float(vb.area_fraction[k]), float(bem.stiffness[k]),
-              float(vi.stiffness[k]), int(vi.results[k].nit), int(pen.results[k].nit))
+              float(sub_bem[k]), float(sub_vi[k]), float(pen.area_fraction[k]),
+              float(vb.area_fraction[k]), float(bem.stiffness[k]), float(vi.stiffness[k]),
+              int(vi.results[k].nit), int(pen.results[k].nit))
              for k in range(n_steps)]
-    # Pass rule: every target except the native-sampling A*, which is a documented
-    # grid-scale effect (see the report: it vanishes once the profile is resolved).
-    passed = all(v for k, v in ok.items() if k != "area (native sampling)")
     ratio_a = thesis.area_fraction[mask] / bem.area_fraction[mask]
     ratio_k = thesis.stiffness[mask] / bem.stiffness[mask]
     thesis_ratio = {"area": [float(ratio_a.min()), float(ratio_a.max())] if mask.any() else [],
                     "stiffness": [float(ratio_k.min()), float(ratio_k.max())] if mask.any() else []}
-    return {"diffs": diffs, "ok": bool(passed), "ok_by_target": ok, "table": table,
-            "thesis_ratio": thesis_ratio,
+    return {"diffs": diffs, "ok": bool(all(ok.values())), "ok_by_target": ok, "table": table,
+            "keys": {"area_sub": area_sub, "area_cnt": area_cnt, "area_sub_resolved": area_sub_r,
+                     "area_cnt_resolved": area_cnt_r, "stiffness": k_key},
+            "checks": checks, "grid": grid, "thesis_ratio": thesis_ratio,
             "resolution_study": study,
             "max_node_flips": int(node_flips[mask].max()) if mask.any() else 0,
             "timings": timings,
@@ -229,36 +330,44 @@ def upsampled(surf: Surface, r: int) -> Surface:
 
 
 def resolution_study(surf: Surface, refinements=(1, 2, 4), fractions=(0.3, 0.6, 0.9)):
-    """BEM and FEM-VI on the same piecewise-linear profile sampled 1, 2, 4 times finer.
+    """BEM and FEM-VI on the same piecewise-linear profile sampled 1, 2, 4 times finer,
+    and the BEM at 16x as the converged reference (same Delta).
 
     Both discretisations converge to the continuum contact of the piecewise-linear
-    profile, so their A* difference should shrink with the sample spacing if it is a
-    grid-scale (contact-edge) effect.
+    profile, so their A* difference shrinks with the sample spacing if it is a
+    grid-scale (contact-edge) effect; the 16x BEM shows each method's own error.
     """
     base = mirrored_profile(surf)
     top = float(surf.heights.max() - base.heights.mean())
+    s_c = mirrored_profile(upsampled(surf, R_CONVERGED))
+    n_c = s_c.shape[0] // 2 + 1
     rows = []
     for r in refinements:
         s_r = upsampled(surf, r)
         n = s_r.shape[0]
         t0 = time.perf_counter()
-        bem = contact_sweep(mirrored_profile(s_r), MATERIAL, deltas=top * np.asarray(fractions),
-                            kernel="spectral")
-        fem = fem_contact_sweep(mesh_profile(s_r, growth=0.1), MATERIAL, bem.delta)
-        bem_p = contact_sweep(mirrored_profile(s_r), MATERIAL, pressures=fem.mean_pressure,
-                              kernel="spectral")
+        pm = mesh_profile(s_r, growth=0.1)
+        fem = fem_contact_sweep(pm, MATERIAL, applied_deltas=applied_for(
+            mirrored_profile(s_r), top * np.asarray(fractions), pm))
+        bem = contact_sweep(mirrored_profile(s_r), MATERIAL, deltas=fem.delta,
+                            kernel="spectral", compute_stiffness=False)
+        ref = contact_sweep(s_c, MATERIAL, deltas=fem.delta, kernel="spectral",
+                            compute_stiffness=False)
         for k, f in enumerate(fractions):
-            rb, rf, rp = bem.results[k], fem.results[k], bem_p.results[k]
-            rows.append({"refinement": r, "fraction": f, "n_nodes": n,
-                         "n_contact_bem": int(rb.contact[:n].sum()),
-                         "n_contact_fem": rf.n_contact,
-                         "nodes_differing": int(np.sum(rb.contact[:n] != rf.contact)),
-                         "area_bem": rb.area_fraction, "area_fem": rf.area_fraction,
-                         "area_rel_diff": rf.area_fraction / rb.area_fraction - 1,
-                         "area_rel_diff_equal_p": rf.area_fraction / rp.area_fraction - 1,
-                         "nodes_differing_equal_p": int(np.sum(rp.contact[:n] != rf.contact)),
-                         "p_rel_diff": rf.mean_pressure / rb.mean_pressure - 1,
-                         "seconds": time.perf_counter() - t0})
+            rb, rf = bem.results[k], fem.results[k]
+            row = {"refinement": r, "fraction": f, "n_nodes": n, "delta": float(fem.delta[k]),
+                   "n_contact_bem": int(rb.contact[:n].sum()), "n_contact_fem": rf.n_contact,
+                   "nodes_differing": int(np.sum(rb.contact[:n] != rf.contact)),
+                   "area_bem": rb.area_fraction, "area_fem": rf.area_fraction,
+                   "area_rel_diff": rf.area_fraction / rb.area_fraction - 1,
+                   "area_sub_bem": subcell_area(rb, n), "area_sub_fem": subcell_area(rf, n),
+                   "area_converged": subcell_area(ref.results[k], n_c),
+                   "p_rel_diff": rf.mean_pressure / rb.mean_pressure - 1,
+                   "seconds": time.perf_counter() - t0}
+            row["area_sub_rel_diff"] = row["area_sub_fem"] / row["area_sub_bem"] - 1
+            for key in ("area_bem", "area_fem", "area_sub_bem", "area_sub_fem"):
+                row[key + "_error"] = row[key] / row["area_converged"] - 1
+            rows.append(row)
     return rows
 
 
@@ -343,23 +452,29 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
     L.append(f"| Westergaard contact width within 0.5 % | FEM {_fmt(west['max_width_error_fem'])}, "
              f"BEM {_fmt(west['max_width_error_bem'])} | {'met' if west['ok'] else 'NOT met'} |")
     for name, c in cases.items():
-        d = c["diffs"]
-        for label, key, limit in (
-                ("A* within 2 % (native sampling)", "A* at equal delta: FEM-VI vs BEM", 0.02),
-                ("A* within 2 % (resolved, r = 2, 4)",
-                 "A* at equal delta, profile resolved by r = 2, 4 elements per sample", 0.02),
-                ("K within 3 % (exact incremental)",
-                 "K(p) at equal delta: FEM-VI vs BEM, exact incremental (frozen contact set)",
-                 0.03),
-                ("VI vs penalty within 0.5 % (p)", "p: FEM-penalty vs FEM-VI", 0.005),
-                ("VI vs penalty within 0.5 % (A*)", "A: FEM-penalty vs FEM-VI", 0.005)):
-            status = "met" if d[key] <= limit else "NOT met"
-            L.append(f"| {name}: {label} | {_fmt(d[key])} | {status} |")
+        d, key = c["diffs"], c["keys"]
+        for label, k, limit in (
+                ("A* within 2 %, sub-element contact edges (native sampling)", "area_sub", 0.02),
+                ("A* within 2 %, sub-element contact edges (resolved, r = 2, 4)",
+                 "area_sub_resolved", 0.02),
+                ("A* node count, native sampling (info)", "area_cnt", None),
+                ("A* node count, resolved r = 2, 4 (info)", "area_cnt_resolved", None),
+                ("K within 3 % (exact incremental)", "stiffness", 0.03),
+                ("VI vs penalty within 0.5 % (p)", "p: FEM-penalty vs FEM-VI (equal imposed "
+                 "approach)", 0.005),
+                ("VI vs penalty within 0.5 % (A*)", "A* node count: FEM-penalty vs FEM-VI", 0.005)):
+            v = d[key.get(k, k)]
+            status = "info" if limit is None else ("met" if v <= limit else "NOT met")
+            L.append(f"| {name}: {label} | {_fmt(v)} | {status} |")
     L.append("")
     L.append("## (i) Westergaard cosine\n")
     L.append(f"{west['n_nodes']} nodes on a half wavelength, {west['n_cells']} triangles; mesh "
              f"{west['time_mesh']:.1f} s, 10 FEM-VI steps {west['time_fem']:.1f} s (2 shared "
-             "cores, timings inflated). Half-width from the gap (x - a)^(3/2) law.\n")
+             "cores, timings inflated). Half-width from the gap (x - a)^(3/2) law (the "
+             "sub-element contact length of the rough-profile tables, from the edge pressure "
+             "and gap, has max errors FEM "
+             f"{_fmt(west['max_length_error_subcell'][0])}, BEM "
+             f"{_fmt(west['max_length_error_subcell'][1])}).\n")
     L.append("Stiffness reference: the half-plane approach is delta = g - gbar(p) with "
              "Westergaard's mean gap gbar = g (1 - s + s ln s), s = p/p*, so "
              "K = dp/d delta = -p* / (g ln s).\n")
@@ -381,45 +496,68 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
         L.append(f"## {titles.get(name, name)}\n")
         L.append(f"{c['n_nodes']} nodes, {c['n_cells']} triangles; metadata {c['metadata']}. "
                  f"Compared at {c['n_compared']} of the loads (those with >= {MIN_CONTACT} "
-                 "nodes in contact in both). Timings (s): "
+                 "nodes in contact in both), at exactly equal half-plane Delta: the FEM is "
+                 "solved at imposed approaches, the BEM at the FEM's Delta. Timings (s): "
                  + ", ".join(f"{k} {v:.1f}" for k, v in c["timings"].items()) + ".\n")
         L.append("| quantity | max relative difference | target |")
         L.append("|---|---|---|")
-        tgt = {"A* at equal delta: FEM-VI vs BEM": "2 %",
-               "A* at equal delta, profile resolved by r = 2, 4 elements per sample": "2 %",
-               "K(p) at equal delta: FEM-VI vs BEM, exact incremental (frozen contact set)":
-               "3 %",
-               "p: FEM-penalty vs FEM-VI": "0.5 %", "A: FEM-penalty vs FEM-VI": "0.5 %"}
+        key = c["keys"]
+        tgt = {key["area_sub"]: "2 %", key["area_sub_resolved"]: "2 %", key["stiffness"]: "3 %",
+               "p: FEM-penalty vs FEM-VI (equal imposed approach)": "0.5 %",
+               "A* node count: FEM-penalty vs FEM-VI": "0.5 %"}
         for k, v in c["diffs"].items():
             L.append(f"| {k} | {_fmt(v)} | {tgt.get(k, 'info')} |")
         L.append("\nTargets: " + ", ".join(f"{k} **{'met' if v else 'NOT met'}**"
                                           for k, v in c["ok_by_target"].items())
                  + f". Largest number of profile nodes whose contact state differs between "
                  f"BEM and FEM-VI at a compared load: {c['max_node_flips']}. n_c counts "
-                 "profile nodes (the first half of the mirrored BEM profile).\n")
-        L.append("| p (MPa) | n_c BEM | n_c FEM | nodes differing | A* BEM | "
-                 "A* FEM-VI | A* penalty | A* (b) | K BEM (MPa/um) | K FEM (MPa/um) | "
-                 "SNES its VI / penalty |")
-        L.append("|---|---|---|---|---|---|---|---|---|---|---|")
+                 "profile nodes (the first half of the mirrored BEM profile). 'A* count' "
+                 "is the tributary length of the contact nodes / W (BEM: contact cells of the "
+                 "mirrored period / 2(n-1), the same thing); 'A* sub' the contact length with "
+                 "the edges located inside the element (`roughfe.fem.contact_length`).\n")
+        ch = c["checks"]
+        L.append("Checks of the comparison itself: "
+                 + "; ".join(f"{k}: {v if not isinstance(v, float) else f'{v:.1e}'}"
+                             for k, v in ch.items() if not isinstance(v, list))
+                 + "; at the differing nodes the FEM pressure is "
+                 + (f"{ch['differing vertices: FEM p / p_mean (range)'][0]:.2g}-"
+                    f"{ch['differing vertices: FEM p / p_mean (range)'][1]:.2g} p_mean and the "
+                    f"BEM gap {ch['differing vertices: BEM gap / rms height (range)'][0]:.1e}-"
+                    f"{ch['differing vertices: BEM gap / rms height (range)'][1]:.1e} rms height"
+                    if ch["differing vertices: FEM p / p_mean (range)"] else "n/a")
+                 + ".\n")
+        g = c["grid"]
+        if g["mean_patch_size"]:
+            L.append(f"Contact at the compared loads (BEM): mean patch size "
+                     f"{min(g['mean_patch_size']):.1f}-{max(g['mean_patch_size']):.1f} nodes, "
+                     f"single-node patches {100 * min(g['single_node_fraction']):.0f}-"
+                     f"{100 * max(g['single_node_fraction']):.0f} %. Median |g_FEM/g_BEM - 1| at "
+                     f"open nodes next to a contact node {_fmt(g['gap_diff_next_to_contact'])}, "
+                     f">= 3 nodes from any contact {_fmt(g['gap_diff_far_from_contact'])}.\n")
+        L.append("| p (MPa) | n_c BEM | n_c FEM | nodes differing | A* count BEM | "
+                 "A* count FEM-VI | A* sub BEM | A* sub FEM-VI | A* penalty | A* (b) | "
+                 "K BEM (MPa/um) | K FEM (MPa/um) | SNES its VI / penalty |")
+        L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for r in c["table"]:
             L.append(f"| {r[0] / 1e6:.4g} | {r[1]} | {r[2]} | {r[3]} | {r[4]:.4f} | {r[5]:.4f} | "
-                     f"{r[6]:.4f} | {r[7]:.4f} | {r[8] / 1e12:.4g} | {r[9] / 1e12:.4g} | "
-                     f"{r[10]} / {r[11]} |")
+                     f"{r[6]:.4f} | {r[7]:.4f} | {r[8]:.4f} | {r[9]:.4f} | "
+                     f"{r[10] / 1e12:.4g} | {r[11] / 1e12:.4g} | {r[12]} / {r[13]} |")
         L.append("")
-        L.append("Resolution study (the same piecewise-linear profile sampled r times "
-                 "finer, BEM and FEM-VI with growth 0.1, half-plane approaches 0.3/0.6/0.9 of "
-                 "max h - mean h; the last column re-solves the BEM under load control at "
-                 "the FEM pressures):\n")
-        L.append("| r | nodes | load | n_c BEM | n_c FEM | nodes differing | A* BEM | A* FEM | "
-                 "A* FEM/BEM - 1 | p FEM/BEM - 1 | at equal p: A* FEM/BEM - 1 (nodes) |")
+        L.append("Resolution study: the same piecewise-linear profile sampled r times finer, "
+                 "BEM and FEM-VI (growth 0.1) at equal Delta near 0.3/0.6/0.9 of "
+                 f"max h - mean h; 'converged' is the sub-element A* of the BEM at r = "
+                 f"{R_CONVERGED} at the same Delta, and the error columns are relative to it.\n")
+        L.append("| r | nodes | load | n_c BEM / FEM | nodes differing | A* count FEM/BEM - 1 | "
+                 "A* sub FEM/BEM - 1 | A* converged | error count BEM / FEM | "
+                 "error sub BEM / FEM | p FEM/BEM - 1 |")
         L.append("|---|---|---|---|---|---|---|---|---|---|---|")
         for r in c["resolution_study"]:
             L.append(f"| {r['refinement']} | {r['n_nodes']} | {r['fraction']} | "
-                     f"{r['n_contact_bem']} | {r['n_contact_fem']} | {r['nodes_differing']} | "
-                     f"{r['area_bem']:.4f} | {r['area_fem']:.4f} | "
-                     f"{100 * r['area_rel_diff']:+.2f} % | {100 * r['p_rel_diff']:+.3f} % | "
-                     f"{100 * r['area_rel_diff_equal_p']:+.2f} % "
-                     f"({r['nodes_differing_equal_p']}) |")
+                     f"{r['n_contact_bem']} / {r['n_contact_fem']} | {r['nodes_differing']} | "
+                     f"{100 * r['area_rel_diff']:+.2f} % | {100 * r['area_sub_rel_diff']:+.2f} % | "
+                     f"{r['area_converged']:.4f} | {100 * r['area_bem_error']:+.1f} % / "
+                     f"{100 * r['area_fem_error']:+.1f} % | {100 * r['area_sub_bem_error']:+.1f} % / "
+                     f"{100 * r['area_sub_fem_error']:+.1f} % | {100 * r['p_rel_diff']:+.3f} % |")
         L.append("")
         L.append(f"![curves](bem_vs_fem_{name}_curves.png)\n")
         L.append(f"![pressure](bem_vs_fem_{name}_pressure.png)\n")
@@ -434,27 +572,46 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
                  f"{mpi.get('max_rel_diff', float('nan')):.1e} "
                  f"(**{'equal' if mpi['ok'] else 'DIFFERENT'}**). {mpi.get('note', '')}\n")
     L.append("## Reading the A* differences\n")
-    L.append("A* counts nodes: one profile node that changes its state changes the FEM A* by "
-             "dx/W and the mirrored BEM A* by 2 nodes of 2(n-1). With N_c nodes in contact a "
-             "single flip is a relative change 1/N_c, so the 2 % target on A* can only be met "
-             "once about 50 nodes per differing node are in contact; below that the "
-             "comparison is reported as the number of nodes whose state differs. The nodes "
-             "that differ sit at the edges of contact patches, where the gap is a tiny "
-             "fraction of the rms height: the BEM (collocation with piecewise-constant "
-             "pressure) and the FEM (P1, nodal reactions) discretise the edge differently, "
-             "and both only converge to the continuum edge under refinement. The load p(Delta) "
-             "and the stiffness, which integrate over the contact, agree much more closely. "
-             "The resolution studies show what the differences are: a handful of nodes "
-             "(1-8) at grazing contact edges, whose gap is 1e-5-1e-3 of the rms height, at "
-             "every resolution. Their number does not grow with the number of contact "
-             "nodes, so the relative A* difference falls as the contact grows, but it is "
-             "noisy (a grazing patch flips with a 0.1 % change of load), at equal Delta as "
-             "well as at equal p. The FEM (P1, displacement-based) is slightly stiffer than "
-             "the BEM: at equal Delta its mean pressure is 0.1-0.8 % higher, falling with "
-             "the resolution and with a gentler mesh growth (compare growth 0.03 in the "
-             "main tables with 0.1 in the study). The pass/fail status of this report uses "
-             "the A* of the resolved profiles (r = 2, 4); the native-sampling A* is "
-             "reported as well.\n")
+    L.append("Question: is the A* difference between BEM and FEM a real disagreement or a "
+             "difference in how the two methods define or count the contact area? Measured "
+             "(see the 'Checks' lines above):\n")
+    L.append("1. *Same Delta, same samples, same weights.* The BEM is solved at the FEM's own "
+             "half-plane Delta (difference at round-off). The mirrored BEM has 2(n-1) "
+             "samples; its A* (contact samples / 2(n-1)) equals the A* of its first half with "
+             "the FEM's trapezoid weights (end nodes dx/2) to round-off at every load, so the "
+             "counts are per node and consistent, end nodes included.")
+    L.append("2. *No tolerance effect.* BEM contact is p > 0 on a cell, FEM-VI contact is "
+             "'gap <= 1e-8 of the height range and nodal reaction > 0'. No node at any load "
+             "lies within 1e-6 rms height of touching while open or carries < 1e-6 p_mean "
+             "while closed, in either method (count above). The differing nodes are closed with "
+             "a positive reaction in the FEM and open with a positive gap in the BEM (ranges "
+             "above): the two discrete solutions really differ there.")
+    L.append("3. *Sub-element contact edges.* Counting nodes moves each patch edge in jumps of "
+             "dx. Locating every edge inside its element from the edge pressure and the "
+             "neighbouring gap (square-root law, continuous when a node changes state; "
+             "Westergaard errors in section (i)) is the physically right measure of the "
+             "contact length and is the primary A* metric above. With it the Table 1 "
+             "genome profile agrees to the numbers in the summary; the rough RMD profile "
+             "does not.")
+    L.append("4. *Why the RMD profile still differs at native sampling.* Its contact is "
+             "not resolved by the grid: at the compared loads the patches are 1-2 nodes wide "
+             "and most are single nodes (see 'Contact at the compared loads'), so every "
+             "contact node carries two edges whose position is set by grid-scale "
+             "elasticity. There the two discretisations differ: a BEM cell pressure acts on "
+             "a top hat of width dx, a P1 nodal reaction on the two adjacent elements, so "
+             "the FEM pulls the neighbours of a loaded node further down (the gap at open "
+             "nodes next to contact differs by the median quoted above, far from contact by "
+             "far less). The resolution study shows that neither method's native A* is "
+             "converged (errors against the 16x BEM in the last columns, tens of per cent "
+             "for node counts on the RMD profile) and that the FEM-BEM difference falls once "
+             "the profile is resolved.")
+    L.append("\nConclusion: the node-count A* mixed a counting artefact (edges quantised to "
+             "dx) with a real grid-scale discretisation difference. The first is removed by "
+             "the sub-element edges. The second remains where the contact patches are "
+             "single nodes (RMD at native sampling); it is a resolution limit of both "
+             "methods, not a disagreement about the continuum problem: p(Delta) and K agree "
+             "to the numbers above, and A* converges as the profile is resolved. The 2 % "
+             "target is reported as NOT met wherever it is not met.\n")
     L.append("## The thesis kernel (Eq. 2.4)\n")
     L.append("Eq. 2.4, H_ij = 2/(pi E delta) arcsin(delta / (2 |x_i - x_j|)), is the "
              "displacement outside a rigid circular punch of diameter delta in 3D: it decays "
