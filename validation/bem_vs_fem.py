@@ -81,7 +81,7 @@ def patch_stats(contact):
 
 
 def neighbour_gap_difference(rb, rf, n):
-    """Median |g_FEM / g_BEM - 1| at vertices open in both, (a) next to a vertex in contact
+    """Median of g_FEM / g_BEM - 1 (signed) at vertices open in both, (a) next to a vertex in contact
     in both, (b) at least 3 vertices from any contact: how differently the two
     discretisations move the neighbours of a loaded vertex."""
     cb, cf = rb.contact[:n], rf.contact
@@ -93,7 +93,7 @@ def neighbour_gap_difference(rb, rf, n):
     far = np.ones(n, bool)
     for k in range(-3, 4):
         far &= ~np.roll(cb | cf, k)
-    ratio = np.abs(rf.gap / np.where(open_, rb.gap[:n], 1.0) - 1.0)
+    ratio = rf.gap / np.where(open_, rb.gap[:n], 1.0) - 1.0
     a, b = ratio[open_ & near], ratio[open_ & far]
     return (float(np.median(a)) if a.size else float("nan"),
             float(np.median(b)) if b.size else float("nan"))
@@ -261,15 +261,23 @@ def profile_case(name, surf, outdir: Path, n_steps=12):
     t0 = time.perf_counter()
     study = resolution_study(surf)
     timings["resolution study"] = time.perf_counter() - t0
-    resolved = [r for r in study if r["refinement"] >= 2 and r["n_contact_bem"] >= MIN_CONTACT]
-    area_sub_r = "A* sub-element edges, profile resolved r = 2, 4: FEM-VI vs BEM"
+    area_sub_r = {r: f"A* sub-element edges, profile resolved r = {r}: FEM-VI vs BEM"
+                  for r in (2, 4)}
     area_cnt_r = "A* node count, profile resolved r = 2, 4: FEM-VI vs BEM"
-    diffs[area_sub_r] = (max(abs(r["area_sub_rel_diff"]) for r in resolved)
-                         if resolved else float("nan"))
+    for r_, key_ in area_sub_r.items():
+        rows_ = [r for r in study if r["refinement"] == r_ and r["n_contact_bem"] >= MIN_CONTACT]
+        diffs[key_] = (max(abs(r["area_sub_rel_diff"]) for r in rows_)
+                       if rows_ else float("nan"))
+    resolved = [r for r in study if r["refinement"] >= 2 and r["n_contact_bem"] >= MIN_CONTACT]
     diffs[area_cnt_r] = (max(abs(r["area_rel_diff"]) for r in resolved)
                          if resolved else float("nan"))
+    native = [r for r in study if r["refinement"] == 1 and r["n_contact_bem"] >= MIN_CONTACT]
+    converged = {k: ([min(r[k] for r in native), max(r[k] for r in native)] if native else [])
+                 for k in ("area_bem_error", "area_fem_error", "area_sub_bem_error",
+                           "area_sub_fem_error")}
     ok = {"area, sub-element edges (native sampling)": diffs[area_sub] <= TARGETS["area"],
-          "area, sub-element edges (resolved, r = 2, 4)": diffs[area_sub_r] <= TARGETS["area"],
+          "area, sub-element edges (resolved, r = 2)": diffs[area_sub_r[2]] <= TARGETS["area"],
+          "area, sub-element edges (resolved, r = 4)": diffs[area_sub_r[4]] <= TARGETS["area"],
           "stiffness": diffs[k_key] <= TARGETS["stiffness"],
           "vi_penalty": max(diffs["p: FEM-penalty vs FEM-VI (equal imposed approach)"],
                             diffs["A* node count: FEM-penalty vs FEM-VI"])
@@ -307,8 +315,10 @@ def profile_case(name, surf, outdir: Path, n_steps=12):
     thesis_ratio = {"area": [float(ratio_a.min()), float(ratio_a.max())] if mask.any() else [],
                     "stiffness": [float(ratio_k.min()), float(ratio_k.max())] if mask.any() else []}
     return {"diffs": diffs, "ok": bool(all(ok.values())), "ok_by_target": ok, "table": table,
-            "keys": {"area_sub": area_sub, "area_cnt": area_cnt, "area_sub_resolved": area_sub_r,
-                     "area_cnt_resolved": area_cnt_r, "stiffness": k_key},
+            "keys": {"area_sub": area_sub, "area_cnt": area_cnt, "area_sub_r2": area_sub_r[2],
+                     "area_sub_r4": area_sub_r[4], "area_cnt_resolved": area_cnt_r,
+                     "stiffness": k_key},
+            "native_error_vs_converged": converged,
             "checks": checks, "grid": grid, "thesis_ratio": thesis_ratio,
             "resolution_study": study,
             "max_node_flips": int(node_flips[mask].max()) if mask.any() else 0,
@@ -455,8 +465,10 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
         d, key = c["diffs"], c["keys"]
         for label, k, limit in (
                 ("A* within 2 %, sub-element contact edges (native sampling)", "area_sub", 0.02),
-                ("A* within 2 %, sub-element contact edges (resolved, r = 2, 4)",
-                 "area_sub_resolved", 0.02),
+                ("A* within 2 %, sub-element contact edges (profile resolved r = 2)",
+                 "area_sub_r2", 0.02),
+                ("A* within 2 %, sub-element contact edges (profile resolved r = 4)",
+                 "area_sub_r4", 0.02),
                 ("A* node count, native sampling (info)", "area_cnt", None),
                 ("A* node count, resolved r = 2, 4 (info)", "area_cnt_resolved", None),
                 ("K within 3 % (exact incremental)", "stiffness", 0.03),
@@ -502,7 +514,8 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
         L.append("| quantity | max relative difference | target |")
         L.append("|---|---|---|")
         key = c["keys"]
-        tgt = {key["area_sub"]: "2 %", key["area_sub_resolved"]: "2 %", key["stiffness"]: "3 %",
+        tgt = {key["area_sub"]: "2 %", key["area_sub_r2"]: "2 %", key["area_sub_r4"]: "2 %",
+               key["stiffness"]: "3 %",
                "p: FEM-penalty vs FEM-VI (equal imposed approach)": "0.5 %",
                "A* node count: FEM-penalty vs FEM-VI": "0.5 %"}
         for k, v in c["diffs"].items():
@@ -531,9 +544,10 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
             L.append(f"Contact at the compared loads (BEM): mean patch size "
                      f"{min(g['mean_patch_size']):.1f}-{max(g['mean_patch_size']):.1f} nodes, "
                      f"single-node patches {100 * min(g['single_node_fraction']):.0f}-"
-                     f"{100 * max(g['single_node_fraction']):.0f} %. Median |g_FEM/g_BEM - 1| at "
-                     f"open nodes next to a contact node {_fmt(g['gap_diff_next_to_contact'])}, "
-                     f">= 3 nodes from any contact {_fmt(g['gap_diff_far_from_contact'])}.\n")
+                     f"{100 * max(g['single_node_fraction']):.0f} %. Median of g_FEM/g_BEM - 1 at "
+                     f"open nodes next to a contact node {100 * g['gap_diff_next_to_contact']:+.2f} %, "
+                     f">= 3 nodes from any contact {100 * g['gap_diff_far_from_contact']:+.2f} %"
+                     " (median over the compared loads).\n")
         L.append("| p (MPa) | n_c BEM | n_c FEM | nodes differing | A* count BEM | "
                  "A* count FEM-VI | A* sub BEM | A* sub FEM-VI | A* penalty | A* (b) | "
                  "K BEM (MPa/um) | K FEM (MPa/um) | SNES its VI / penalty |")
@@ -547,6 +561,16 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
                  "BEM and FEM-VI (growth 0.1) at equal Delta near 0.3/0.6/0.9 of "
                  f"max h - mean h; 'converged' is the sub-element A* of the BEM at r = "
                  f"{R_CONVERGED} at the same Delta, and the error columns are relative to it.\n")
+        cv = c["native_error_vs_converged"]
+        if cv["area_bem_error"]:
+            L.append("At native sampling (r = 1, >= 5 nodes) the A* of each method against the "
+                     "converged A*: node count BEM "
+                     + " / FEM ".join(f"{100 * cv[k][0]:+.0f} to {100 * cv[k][1]:+.0f} %"
+                                      for k in ("area_bem_error", "area_fem_error"))
+                     + "; sub-element BEM "
+                     + " / FEM ".join(f"{100 * cv[k][0]:+.1f} to {100 * cv[k][1]:+.1f} %"
+                                      for k in ("area_sub_bem_error", "area_sub_fem_error"))
+                     + ".\n")
         L.append("| r | nodes | load | n_c BEM / FEM | nodes differing | A* count FEM/BEM - 1 | "
                  "A* sub FEM/BEM - 1 | A* converged | error count BEM / FEM | "
                  "error sub BEM / FEM | p FEM/BEM - 1 |")
@@ -597,11 +621,13 @@ def write_report(outdir: Path, west, cases, extra) -> Path:
              "not resolved by the grid: at the compared loads the patches are 1-2 nodes wide "
              "and most are single nodes (see 'Contact at the compared loads'), so every "
              "contact node carries two edges whose position is set by grid-scale "
-             "elasticity. There the two discretisations differ: a BEM cell pressure acts on "
-             "a top hat of width dx, a P1 nodal reaction on the two adjacent elements, so "
-             "the FEM pulls the neighbours of a loaded node further down (the gap at open "
-             "nodes next to contact differs by the median quoted above, far from contact by "
-             "far less). The resolution study shows that neither method's native A* is "
+             "elasticity. There the two discretisations differ: the BEM spreads a node's "
+             "pressure uniformly over its cell (top hat of width dx), the P1 FEM applies a "
+             "nodal reaction work-conjugate to the hat function over two elements. On the "
+             "RMD profile the FEM leaves the open neighbours of a loaded node closer to the "
+             "obstacle (median gap difference next to contact quoted above, against a few "
+             "hundredths of a per cent far from contact), so it closes more of them: every "
+             "differing node is closed in the FEM and open in the BEM. The resolution study shows that neither method's native A* is "
              "converged (errors against the 16x BEM in the last columns, tens of per cent "
              "for node counts on the RMD profile) and that the FEM-BEM difference falls once "
              "the profile is resolved.")
