@@ -140,3 +140,30 @@ def test_refinement_stage_appends_a_reproducible_fourth_score(entries, targets):
     assert c1.stages[:3] == c0.stages and len(c1.stages) == 4
     assert c1.stages[3] >= c0.stages[2] - 1e-12
     assert de.rescore(c1.design, [t1], SETTINGS)[0] == pytest.approx(c1.stages[3], abs=1e-7)
+
+
+def test_target_pressure_rescore_gives_one_for_the_target_genome(targets):
+    """Load-controlled steps at the target pressures reproduce y_t1 and y_t3 exactly:
+    same pressures, exact node counts, the same central-difference stencil for K."""
+    t1, _, t3, _ = targets
+    g = de.target_genome_t1(SETTINGS)
+    d = de.Design((de.DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "y_t1"),), 0.37,
+                  SETTINGS.length, SETTINGS.n_nodes)              # any amplitude: Eq. (4.2)
+    np.testing.assert_allclose(de.rescore_at_target_pressures(d, [t1, t3], SETTINGS), [1.0, 1.0],
+                               atol=1e-6)
+
+
+def test_mcco_wider_pool_crosses_every_ordered_pair_and_weight(entries, targets):
+    t1, _, t3, _ = targets
+    weights = (0.5, 2.0)
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, pool=2, swap=True,
+                weights=weights)
+    s1, s2 = (np.asarray(r.database_scores[k]) for k in ("s1", "s2"))
+    u1 = set(np.argsort(-s1, kind="stable")[:3].tolist())     # no genome passes 0.95 here
+    u2 = set(np.argsort(-s2, kind="stable")[:3].tolist())
+    pairs = {(a, b) for a in u1 for b in u2} | {(b, a) for a in u1 for b in u2}
+    assert r.n_cross == len(weights) * sum(1 for a, b in pairs if a != b)
+    assert "micro x" in r.best.origin
+    assert de.rescore(r.best.design, [t1, t3], SETTINGS) == pytest.approx(r.best.scores, abs=1e-7)
+    with pytest.raises(InputError, match="weights"):
+        de.mcco(entries, t1, t3, SETTINGS, options=FAST, weights=(0.0,))

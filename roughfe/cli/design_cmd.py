@@ -22,7 +22,8 @@ def _target(spec, quantity, settings, cache):
 def _run(args) -> int:
     from ..errors import InputError
     from ..genomics.database import load_entries, read_settings
-    from ..genomics.design import GcmmaOptions, refine, run_design, write_design_result
+    from ..genomics.design import (GcmmaOptions, refine, rescore_at_target_pressures,
+                                   run_design, write_design_result)
     from ..plotting.design import plot_design_curves, plot_profiles, plot_psds, plot_stages
     settings = read_settings(args.db)
     entries = load_entries(args.db)
@@ -38,7 +39,11 @@ def _run(args) -> int:
                            gradient=args.gradient,
                            **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
                               if args.iterations else {}))
-    result = run_design(args.method, entries, targets, settings, pbar=args.pbar, options=options)
+    if args.pool and args.method != "mcco":
+        raise InputError("--pool is used by --method mcco only")
+    extra = ({"pool": args.pool, "swap": True, "weights": (0.5, 1.0, 2.0)} if args.pool else {})
+    result = run_design(args.method, entries, targets, settings, pbar=args.pbar, options=options,
+                        **extra)
     if args.refine:
         result = refine(result, settings, rounds=args.refine)
     out = Path(args.output)
@@ -54,6 +59,9 @@ def _run(args) -> int:
         print(f"  ({k}) {c.origin:>16}  GCMMA 0/1/2{'/3' if len(c.stages) > 3 else ''}: "
               + " ".join(f"{s:.4f}" for s in c.stages)
               + "  per target: " + " ".join(f"{s:.4f}" for s in c.scores))
+    strict = rescore_at_target_pressures(result.best.design, targets, settings)
+    print("best design solved at the target pressures (no interpolation): "
+          + " ".join(f"{s:.4f}" for s in strict))
     print(f"{result.nit} BEM sweeps in {result.elapsed:.1f} s; wrote {paths['design'].parent}/")
     return 0
 
@@ -100,6 +108,10 @@ def register(sub):
     g.add_argument("--refine", type=int, default=0, metavar="ROUNDS",
                    help="extra stage beyond the thesis: ROUNDS x 15 GCMMA iterations on all "
                         "phases, box (+-10%% of 2 pi) re-centred each round (default 0: off)")
+    p.add_argument("--pool", type=int, default=0, metavar="K",
+                   help="mcco, beyond the thesis: start pool of the K best genomes of each "
+                        "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "
+                        "(default 0: the thesis sets)")
     p.add_argument("-o", "--output", required=True, help="output folder")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.set_defaults(func=_run)

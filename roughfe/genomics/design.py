@@ -918,13 +918,21 @@ def cco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, eva
 
 def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings, *,
          evaluate=None, options: GcmmaOptions = GcmmaOptions(), n_best: int = 3,
-         max_set: Optional[int] = 8) -> DesignResult:
+         max_set: Optional[int] = 8, pool: int = 0, swap: bool = False,
+         weights: Sequence[float] = (1.0,)) -> DesignResult:
     """Mixed Chromosomes Cross-Over (Alg. 7) for a K(p) target and an A(p) target.
 
     U1: macro chromosomes of genomes with s(y_t1, K) > 0.95; U2: micro chromosomes of
     genomes with s(y_t3, A) > 0.95 (the 3 best if none passes); every pair summed,
     rescaled, scored with f = s_K * s_A; the ``n_best`` best get GCMMA on their macro
     phases, then on their micro phases, objective f.
+
+    Wider start pool (beyond the thesis; the defaults are the thesis'): ``pool = k``
+    puts the k best genomes of each Alg. 3 ranking in U1/U2 (besides those > 0.95, at
+    most ``max_set``); ``swap`` also crosses the macro chromosomes of the A-ranked
+    genomes with the micro chromosomes of the K-ranked ones; ``weights`` multiplies the
+    micro part's Eq. (4.2) amplitude by each factor before the pair is rescaled, so
+    the macro/micro amplitude ratio is scanned too. Every start is one BEM sweep.
     """
     t0 = time.perf_counter()
     if target_k.quantity != "K" or target_a.quantity != "A":
@@ -934,15 +942,38 @@ def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings
     evaluate = evaluate or Evaluator(settings)
     objective = Objective((target_k, target_a))
     s1, s2 = score_database(entries, target_k), score_database(entries, target_a)
-    u1, ok1 = _select(s1, 0.95, 3)
-    u2, ok2 = _select(s2, 0.95, 3)
-    parts = (lambda e: e.macro or e.micro[:1], lambda e: e.micro or e.macro[-1:])
-    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate,
-                                      (u1, u2), parts, n_best, max_set)
+    fallback = max(3, int(pool))
+    u1, ok1 = _select(s1, 0.95, fallback)
+    u2, ok2 = _select(s2, 0.95, fallback)
+    if pool:
+        u1 = list(dict.fromkeys(u1 + [int(i) for i in np.argsort(-s1, kind="stable")[:pool]]))
+        u2 = list(dict.fromkeys(u2 + [int(i) for i in np.argsort(-s2, kind="stable")[:pool]]))
+    u1, u2 = (u[:max_set] if max_set else u for u in (u1, u2))
+    pairs = [(i1, i2) for i1 in u1 for i2 in u2]
+    if swap:
+        pairs += [(i2, i1) for i2 in u2 for i1 in u1 if (i2, i1) not in pairs]
+    ws = tuple(float(w) for w in weights)
+    if not ws or any(not (np.isfinite(w) and w > 0) for w in ws):
+        raise InputError(f"weights must be finite and > 0, got {weights!r}")
+    found = []
+    for i1, i2 in pairs:
+        if i1 == i2:
+            continue
+        e1, e2 = entries[i1], entries[i2]
+        d1 = entry_design(e1, settings, objective.p_max / e1.p_max, e1.macro or e1.micro[:1])
+        for w in ws:
+            d2 = entry_design(e2, settings, w * objective.p_max / e2.p_max,
+                              e2.micro or e2.macro[-1:])
+            d = combine(d1, d2)
+            curve = evaluate(d)
+            tag = f"{e1.label}+{e2.label}" + ("" if w == 1.0 else f" (micro x{w:g})")
+            found.append((objective(curve), d, curve, tag))
+    found.sort(key=lambda t: -t[0])
+    starts = [(d, s, c, o) for s, d, c, o in found[:n_best]]
     cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
                                  options.n_it_micro, by_label, settings)
     return _result("mcco", cands, objective, None, {"s1": s1.tolist(), "s2": s2.tolist()},
-                   n_cross, n_above, ok1 and ok2, evaluate, t0)
+                   len(found), sum(1 for t in found if t[0] > 0.95), ok1 and ok2, evaluate, t0)
 
 
 def refine(result: DesignResult, settings: DatabaseSettings, *, rounds: int = 3, n_it: int = 15,
@@ -1005,6 +1036,36 @@ def rescore(design: Design, targets, settings: DatabaseSettings, response=None) 
     rescaling and return the similarity per target (must equal the reported scores)."""
     evaluate = Evaluator(settings, response)
     curve = evaluate(design)
+    return tuple(similarity(t, curve, rescale=False) for t in targets)
+
+
+def rescore_at_target_pressures(design: Design, targets, settings: DatabaseSettings) -> tuple:
+    """Stricter independent check: Eq. (4.1) with the design solved *at the target's
+    pressures* (load-controlled BEM steps), so nothing is interpolated.
+
+    :func:`rescore` (and every optimiser) samples the design at its own n_t equal
+    approaches and interpolates linearly at the target pressures. A(p) of a profile is
+    a count of contact nodes (a staircase in p), so the interpolated value can be a
+    fraction of a node that the design never has at that pressure. Here one
+    displacement solve at Delta = peak-valley gives p_max (Eq. 4.2 factor
+    ``eta = p_max^t / p_max``); then the design is solved at the pressures ``p_j / eta``
+    of all targets; A is the exact node fraction there and K = dp/dDelta by the same
+    central differences over those steps as the target's K over its own steps. An
+    independent BEM run of the target genome itself scores 1 to round-off.
+    """
+    from ..bem import Material, contact_sweep
+    from ..bem.sweep import central_differences
+    targets = list(targets)
+    surf = design.surface()
+    mat = Material(settings.youngs_modulus, settings.poisson)
+    top = contact_sweep(surf, mat, deltas=[float(np.ptp(surf.heights))], kernel=settings.kernel,
+                        compute_stiffness=False)
+    eta = targets[0].p_max / float(top.mean_pressure[-1])
+    p = np.unique(np.concatenate([t.pressure for t in targets]))
+    sw = contact_sweep(surf, mat, pressures=p / eta, kernel=settings.kernel,
+                       compute_stiffness=False)
+    k = central_differences(sw.delta, sw.mean_pressure)
+    curve = ResponseCurve(np.asarray(sw.mean_pressure) * eta, k, sw.area_fraction)
     return tuple(similarity(t, curve, rescale=False) for t in targets)
 
 
