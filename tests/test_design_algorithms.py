@@ -12,6 +12,7 @@ from roughfe.genomics import design as de
 from roughfe.genomics.genome import Genome, realize
 from roughfe.genomics.macro_micro import profile_response
 from roughfe.genomics.similarity import Target
+from roughfe.study import build_genome_db
 
 SETTINGS = db.DatabaseSettings(n_nodes=128, n_steps=12)
 FAST = de.GcmmaOptions(n_it_sog=1, n_it_cross=1, n_it_micro=1, n_micro=2)
@@ -20,7 +21,7 @@ FAST = de.GcmmaOptions(n_it_sog=1, n_it_cross=1, n_it_micro=1, n_micro=2)
 @pytest.fixture(scope="module")
 def entries(tmp_path_factory):
     path = tmp_path_factory.mktemp("design") / "db.sqlite"
-    db.build_database(path, SETTINGS, progress=False, limit=6)
+    build_genome_db(path, SETTINGS, limit=6, workers=1, progress=False)
     return db.load_entries(path)
 
 

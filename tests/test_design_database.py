@@ -101,12 +101,13 @@ def test_build_through_the_runner_equals_the_task_and_resumes(tmp_path):
     con.close()
 
 
-def test_build_database_library_shortcut_and_record_checks(tmp_path):
-    """build_database (one machine, no study folder) stores the realisation's BEM curve;
+def test_built_entry_matches_its_bem_curve_and_record_checks(tmp_path):
+    """A built genome stores the realisation's BEM curve and a consistent macro/micro split;
     insert_records refuses a record with other settings and inserts nothing."""
+    from roughfe.study import build_genome_db
     path = tmp_path / "g.sqlite"
-    assert db.build_database(path, SMALL, progress=False, limit=1) == 1
-    assert db.build_database(path, SMALL, progress=False, limit=1) == 0
+    assert build_genome_db(path, SMALL, limit=1, workers=1, progress=False).n_inserted == 1
+    assert build_genome_db(path, SMALL, limit=1, workers=1, progress=False).n_inserted == 0
     e = db.load_entries(path)[0]
     g = Genome.from_dict(e.genome)
     n_s, n_f = g.chromosome_range(SMALL.length, SMALL.n_nodes)

@@ -24,6 +24,7 @@ from roughfe.genomics.genome import realize, table1_genome
 from roughfe.genomics.macro_micro import macro_micro
 from roughfe.genomics.similarity import write_target_csv
 from roughfe.plotting import design as dplot
+from roughfe.study import build_genome_db
 from roughfe.writers import write_json, write_text
 
 GOALS = {"s_yt1": 0.98, "f_multi": 0.9, "reproducible": 1e-6}
@@ -107,7 +108,7 @@ def main(outdir: Path) -> bool:
     settings = db.DatabaseSettings()
     path = out / "genomes.sqlite"
     t0 = time.perf_counter()
-    n_new = db.build_database(path, settings, workers=2, progress=False)
+    n_new = build_genome_db(path, settings, workers=2, progress=False).n_inserted
     t_db = time.perf_counter() - t0
     entries = db.load_entries(path)
     rows = db.summary_table(path)

@@ -17,8 +17,7 @@ Layout (schema version :data:`SCHEMA_VERSION`, stdlib :mod:`sqlite3`)
 
 The genomes are computed by the study runner (``roughfe db build|extend`` call
 :func:`roughfe.study.build_genome_db`: any executor, a study folder beside the file, so an
-interrupted build resumes from its finished genomes) or, for library callers on one
-machine, by :func:`build_database`. Either way workers only return JSON-safe records of
+interrupted build resumes from its finished genomes). Workers only return JSON-safe records of
 :func:`genome_entry_task`; :func:`insert_records` adds them in one transaction, keeping
 the genomes already present, after checking their settings against the stored ones.
 """
@@ -27,7 +26,6 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import sqlite3
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -441,69 +439,6 @@ def extend_tasks(con, genomes, labels_=None) -> list:
         raise InputError(f"labels already in the database: {clash}")
     return [{"label": lab, "source": "extend", "genome_json": d}
             for lab, d in zip(labels_, dicts)]
-
-
-def build_database(path, settings: DatabaseSettings = DatabaseSettings(),
-                   design: SobolDesign = SobolDesign(), *, workers: int = 1,
-                   progress: bool = True, limit=None) -> int:
-    """Build (or resume building) the Sobol genome database of Sec. 4.1.2 on this machine.
-
-    A library shortcut without a study folder; ``roughfe db build`` runs the same tasks
-    through the study runner instead (:func:`roughfe.study.build_genome_db`: dask or MPI
-    too, resumable from its study folder).
-
-    Parameters
-    ----------
-    path : path-like
-        SQLite file; created when missing. Finished genomes are kept across interruptions.
-    settings, design : DatabaseSettings, SobolDesign
-        Must match what an existing file stores.
-    workers : int
-        Processes (1 = in this process).
-    progress : bool
-        Show a tqdm progress bar.
-    limit : int, optional
-        Build only the first ``limit`` genomes of the design (a reduced database).
-
-    Returns
-    -------
-    int
-        Number of genomes computed in this call.
-    """
-    con = connect(path, create=True)
-    try:
-        write_settings(con, settings)
-        write_design(con, design)
-        tasks = sobol_tasks(design, limit)
-        done = set(labels(con))
-        todo = [t for t in tasks if t["label"] not in done]
-        kw = settings.to_dict()
-        bar = None
-        if progress:
-            from tqdm import tqdm
-            bar = tqdm(total=len(tasks), initial=len(tasks) - len(todo), desc="db build",
-                       unit="genome")
-
-        def add(record):            # each genome in its own transaction, as it finishes
-            insert_records(con, [record])
-            if bar is not None:
-                bar.update()
-
-        try:
-            if workers <= 1 or len(todo) <= 1:
-                for t in todo:
-                    add(genome_entry_task(**t, **kw))
-            else:
-                with ProcessPoolExecutor(max_workers=workers) as pool:
-                    futures = [pool.submit(genome_entry_task, **t, **kw) for t in todo]
-                    for future in as_completed(futures):
-                        add(future.result())
-        finally:
-            if bar is not None:
-                bar.close()
-        return len(todo)
-    finally:
-        con.close()
 
 
 def _entry(row) -> DatabaseEntry:
