@@ -122,7 +122,7 @@ def _leak_study(args) -> int:
                   "seed": args.seed, "seed_from": ["replica"]},
         "grid": study_grid(args.D, args.m, args.surfaces), "fixed": fixed})
     summary = run_study(spec, executor=args.executor, workers=args.workers,
-                        progress=not args.no_progress,
+                        scheduler=args.scheduler, progress=not args.no_progress,
                         log=lambda msg: print(msg, file=sys.stderr))
     _, rows, missing = table_rows(out)
     if not rows:
@@ -171,6 +171,8 @@ def register(sub):
     _add_fluid_material(s)
     s.add_argument("--executor", choices=("local", "dask", "mpi"), default="local",
                    help="where tasks run (default: local process pool)")
+    s.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="a running dask scheduler (tcp://host:8786 or a scheduler file); dask only")
     s.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
