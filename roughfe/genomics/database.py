@@ -334,24 +334,25 @@ def write_settings(con, settings: DatabaseSettings):
     InputError
         When the database holds other settings (all genomes share L, N, material, n_t).
     """
-    stored = _get_meta(con, "settings")
-    if stored is None:
-        with con:
-            con.execute("INSERT INTO meta VALUES ('settings', ?)", (json.dumps(settings.to_dict()),))
-    elif DatabaseSettings.from_dict(stored) != settings:
-        raise InputError(f"the database was built with settings {stored}; got {settings.to_dict()}. "
-                         f"All genomes of one database share L, N, material and n_t.")
+    _store_or_check(con, "settings", settings, "settings",
+                    " All genomes of one database share L, N, material and n_t.")
 
 
 def write_design(con, design: SobolDesign):
     """Store the Sobol design of a new database, or check it against the stored one."""
-    stored = _get_meta(con, "sobol")
+    _store_or_check(con, "sobol", design, "the Sobol design", "")
+
+
+def _store_or_check(con, key, value, what, hint):
+    """Store ``value`` (a dataclass with to_dict/from_dict) under ``key`` in the meta table
+    of a new database, or raise InputError naming ``what`` when the stored one differs."""
+    stored = _get_meta(con, key)
     if stored is None:
         with con:
-            con.execute("INSERT INTO meta VALUES ('sobol', ?)", (json.dumps(design.to_dict()),))
-    elif SobolDesign.from_dict(stored) != design:
-        raise InputError(f"the database was built with the Sobol design {stored}; got "
-                         f"{design.to_dict()}")
+            con.execute("INSERT INTO meta VALUES (?, ?)", (key, json.dumps(value.to_dict())))
+    elif type(value).from_dict(stored) != value:
+        raise InputError(f"the database was built with {what} {stored}; got "
+                         f"{value.to_dict()}.{hint}")
 
 
 def read_settings(path_or_con) -> DatabaseSettings:
