@@ -1,6 +1,6 @@
 """The one-way data flow of STYLE.md (a): packages import only leftward.
 
-surfaces -> bem -> fem -> leakage -> genomics -> study -> plotting -> cli
+surfaces -> theory -> bem -> fem -> leakage -> genomics -> study -> plotting -> cli
 (errors, writers and reference are the base layer, importable from anywhere.)
 dolfinx, petsc4py, mpi4py.futures aside, gmsh and ufl are imported only inside roughfe/fem.
 """
@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "roughfe"
-ORDER = ["errors", "writers", "reference", "surfaces", "bem", "fem", "leakage",
+ORDER = ["errors", "writers", "reference", "surfaces", "theory", "bem", "fem", "leakage",
          "genomics", "study", "plotting", "cli"]
 BASE = {"errors", "writers", "reference", "__init__"}
 FEM_ONLY = {"dolfinx", "petsc4py", "gmsh", "ufl", "basix", "ffcx"}

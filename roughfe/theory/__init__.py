@@ -1,0 +1,15 @@
+"""Analytic theories of rough contact evaluated from the PSD of a surface.
+
+* :func:`persson` -> :class:`PerssonResult`: Persson's A*(p) and mean separation u(p).
+* :func:`critical_junction` -> :class:`CriticalJunction`: Lorenz & Persson's leak rate.
+
+Layer: after :mod:`roughfe.surfaces` (it needs only the PSD), before the solvers and
+their consumers, which draw the theory beside their results.
+"""
+from .persson import (GAMMA_DEFAULT, KAPPA_PERSSON, PERCOLATION_THRESHOLD, CriticalJunction,
+                      PerssonResult, area_fraction, critical_junction, mean_separation,
+                      persson)
+
+__all__ = ["persson", "PerssonResult", "critical_junction", "CriticalJunction",
+           "area_fraction", "mean_separation", "KAPPA_PERSSON", "GAMMA_DEFAULT",
+           "PERCOLATION_THRESHOLD"]

@@ -1,0 +1,414 @@
+"""Persson's contact theory from the PSD of a surface: A(p), u(p) and the critical junction.
+
+All quantities are SI: pressures and E* in Pa, lengths in m, the PSD in the
+normalisation of :mod:`roughfe.surfaces.stats` (``<h^2> = sum C * weight``).
+
+Area of real contact (Persson 2001)
+-----------------------------------
+At magnification zeta (all roughness with ``|q| <= q = zeta q0`` resolved) the
+probability density of the contact stress obeys a diffusion equation whose solution with
+``P(sigma = 0) = 0`` gives
+
+    A(q, p) / A0 = erf( 1 / (2 sqrt(G(q))) ),    G(q) = <sigma^2>_q / (2 p^2),
+
+where ``<sigma^2>_q = (E*/2)^2 m(q)`` is the variance of the stress needed to flatten the
+roughness up to ``q`` and ``m(q) = sum_{|q'| <= q} |q'|^2 |h~(q')|^2`` its mean-square
+gradient. For an isotropic surface ``m(q) = 2 pi int_q0^q q'^3 C dq'``, so
+``G = (pi/4)(E*/p)^2 int q'^3 C dq'`` as in Persson (2001); for a profile on an elastic
+half-plane in plane strain (same E* and the same kernel ``2/(E*|q|)``) ``m(q) = int q'^2
+C dq'`` over both signs of q' (the derivation is identical, only the sum over the
+wavevectors is one-dimensional). The result at full magnification is therefore the same
+formula in 1D and 2D,
+
+    A*(p) = erf( sqrt(2) p / (E* gbar) ),        gbar^2 = m(q1) = <|grad h|^2>,      (1)
+
+with gbar the rms gradient (2D) or rms slope (1D). At small load
+``A* -> kappa p / (E* gbar)`` with ``kappa = sqrt(8/pi) = 1.596`` in both dimensions.
+
+Small-A* correction: BEM simulations of self-affine surfaces (Hyun et al. 2004; Campana &
+Muser 2007; Prodanov, Dapp & Muser 2014) find kappa ~ 1.9-2.1 for surfaces and an
+A*(p) that is not linear for profiles; the P(sigma = 0) = 0 boundary condition
+underestimates the area at small A*. Persson's later work (Persson 2007; Yang & Persson
+2008) corrects the *elastic energy* at small A* with ``S(q) = gamma + (1 - gamma) P(q)^2``
+(it enters u(p) below) and leaves Eq. (1) as is. :func:`area_fraction` accepts
+``kappa`` to use the measured small-load slope instead of sqrt(8/pi) (Eq. (1) with
+``sqrt(2)`` replaced by ``kappa sqrt(pi) / 2``: the same erf, still -> 1 at large p); the
+default is Persson's sqrt(8/pi).
+
+Mean interfacial separation (Persson 2007; Yang & Persson 2008)
+---------------------------------------------------------------
+With the elastic energy ``U/A0 = (E*/4) sum_q |q| |h~(q)|^2 P(q, p) S(q, p)`` and
+``p A0 = -dU/du``:
+
+    u(p) = (1/4) sum_k |q_k| C_k weight_k w_k J(w_k p / E*),                          (2)
+    w_k  = sqrt(2 / m(q_k)),
+    J(y) = (2/sqrt(pi)) int_y^inf exp(-x^2) [gamma + 3 (1 - gamma) erf(x)^2] dx / x,
+
+which for an isotropic surface is Yang & Persson's
+``u = sqrt(pi) int dq q^2 C w int_p^inf dp'/p' [gamma + 3(1-gamma)P^2] exp(-(w p'/E*)^2)``
+with ``w = (pi int_q0^q q'^3 C)^(-1/2)``. u is the separation of the mean planes, which
+equals the BEM ``mean_gap`` (mean of the gap field). gamma ~ 0.4-0.5 (Persson 2007 uses
+0.4, Yang & Persson 0.45); the default here is **gamma = 0.45**. At intermediate
+pressures ``u = u0 ln(p_ref / p)``, i.e. ``p ~ exp(-u / u0)``, with
+
+    u0 = -du/dln p (p -> 0) = (1 / (2 sqrt(pi))) gamma sum_k |q_k| C_k weight_k w_k,   (3)
+
+(:attr:`PerssonResult.u0`). Persson (2007) writes ``u0 ~ gamma h_rms``; that is an
+order-of-magnitude statement (the ratio u0 / (gamma h_rms) depends on the spectrum, see
+docs/theory/adhesion-persson.md); Eq. (3) is what the theory gives.
+
+Critical junction (Lorenz & Persson 2009)
+-----------------------------------------
+Increasing the magnification, A(q, p) falls from 1; the contact area stops percolating
+at ``A(q_c, p) = A_c``. Lorenz & Persson take the site-percolation threshold A_c ~ 0.42
+(used here, changeable). The fluid then flows through the critical junction, whose
+surface separation is the mean separation of the roughness *below* the critical scale
+pressed by the local pressure on the contact patches at that scale:
+
+    u_c = u(p_c; |q| > q_c),     p_c = p / A(q_c, p)                                   (4)
+
+(Eq. (2) with the PSD restricted to ``|q| > q_c`` and ``m`` summed from ``q_c``; Lorenz
+& Persson add a small term ``u1`` for the deformation of the junction, omitted here).
+Each square of the nominal contact holds one critical junction; a seal of length Lx (the
+direction of the pressure drop) and width Ly holds Ly/Lx such squares in parallel, each
+a narrow gap of height u_c, so
+
+    Q = (Ly / Lx) * (Delta P / eta) * u_c^3 / 12          (m^3/s)                     (5)
+
+(Delta P in Pa, eta in Pa s, u_c in m). For a profile (1D) every contact point seals,
+so no critical junction exists; :func:`critical_junction` accepts surfaces only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import scipy.special
+
+from ..errors import InputError, check_finite_positive, check_in_open_interval
+from ..surfaces.stats import PowerSpectrum, power_spectrum
+from ..surfaces.surface import Surface
+
+KAPPA_PERSSON = float(np.sqrt(8.0 / np.pi))
+GAMMA_DEFAULT = 0.45
+PERCOLATION_THRESHOLD = 0.42
+
+REFERENCES = (
+    "Persson B.N.J. (2001) J. Chem. Phys. 115:3840-3861 (A(p), Eq. (1))",
+    "Persson B.N.J. (2007) Phys. Rev. Lett. 99:125502 (u(p), gamma)",
+    "Yang C., Persson B.N.J. (2008) J. Phys.: Condens. Matter 20:215214 (u(p), Eq. (2))",
+    "Lorenz B., Persson B.N.J. (2009) Eur. Phys. J. E 31:159-167 (critical junction)",
+)
+
+
+# -- inputs ---------------------------------------------------------------------------------
+def _spectrum(source) -> PowerSpectrum:
+    if isinstance(source, PowerSpectrum):
+        return source
+    if isinstance(source, Surface):
+        return power_spectrum(source)
+    raise InputError(f"expected a roughfe Surface or PowerSpectrum, got {type(source).__name__}")
+
+
+def _pressures(mean_pressure):
+    try:
+        p = np.atleast_1d(np.asarray(mean_pressure, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(f"mean_pressure must be numbers (Pa), got {mean_pressure!r}") from None
+    bad = ~(np.isfinite(p) & (p > 0))
+    if p.ndim != 1 or p.size == 0 or bad.any():
+        raise InputError(f"mean_pressure must be finite and > 0 (Pa), got {mean_pressure!r}")
+    return p
+
+
+def _arrays(psd: PowerSpectrum):
+    q = np.asarray(psd.q, float)
+    power = np.asarray(psd.C, float) * np.asarray(psd.weight, float)     # |h~|^2 per value
+    keep = power > 0
+    if not keep.any():
+        raise InputError("the PSD is zero everywhere: a flat surface has no Persson theory")
+    return q[keep], power[keep]
+
+
+def _cumulative_gradient(q, power):
+    """m(q_k): mean-square gradient of the roughness up to q_k (midpoint in the bin)."""
+    term = q ** 2 * power
+    return np.cumsum(term) - 0.5 * term
+
+
+# -- the universal function J(y) of Eq. (2) -------------------------------------------------
+_X_MAX = 7.0
+
+
+@lru_cache(maxsize=None)
+def _erf2_table():
+    """``K(y) = int_y^inf exp(-x^2) erf(x)^2 / x dx`` tabulated on [0, 7] (trapezoid,
+    dx = 3.5e-4, error < 1e-8; the integrand is smooth and 0 at x = 0)."""
+    x = np.linspace(0.0, _X_MAX, 20001)
+    f = np.zeros_like(x)
+    f[1:] = np.exp(-x[1:] ** 2) * scipy.special.erf(x[1:]) ** 2 / x[1:]
+    seg = 0.5 * (f[1:] + f[:-1]) * np.diff(x)
+    k = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]])
+    return x, k
+
+
+def j_function(y, gamma=GAMMA_DEFAULT):
+    """``J(y)`` of Eq. (2) (dimensionless), y > 0.
+
+    ``J = (2/sqrt(pi)) [gamma E1(y^2)/2 + 3 (1 - gamma) K(y)]`` with the exponential
+    integral E1 and the tabulated ``K`` (:func:`_erf2_table`).
+    """
+    y = np.asarray(y, float)
+    x, k = _erf2_table()
+    kk = np.interp(y, x, k, right=0.0)
+    return (2 / np.sqrt(np.pi)) * (0.5 * gamma * scipy.special.exp1(y ** 2)
+                                   + 3 * (1 - gamma) * kk)
+
+
+# -- pure functions on arrays ---------------------------------------------------------------
+def area_fraction(rms_gradient, e_star, mean_pressure, kappa=KAPPA_PERSSON):
+    """Persson's A*(p) = erf(kappa sqrt(pi)/2 * p / (E* gbar)), Eq. (1) (dimensionless).
+
+    Parameters
+    ----------
+    rms_gradient : float
+        gbar: rms gradient of a surface / rms slope of a profile (-).
+    e_star : float
+        Composite modulus E* (Pa).
+    mean_pressure : float or array
+        Nominal mean pressure p (Pa), > 0.
+    kappa : float
+        Small-load slope, default Persson's sqrt(8/pi) (then the argument is
+        ``sqrt(2) p / (E* gbar)``).
+    """
+    g = check_finite_positive("rms_gradient", rms_gradient)
+    e = check_finite_positive("e_star (Pa)", e_star)
+    k = check_finite_positive("kappa", kappa)
+    p = _pressures(mean_pressure)
+    return scipy.special.erf(0.5 * k * np.sqrt(np.pi) * p / (e * g))
+
+
+def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=0.0):
+    """Persson's mean separation u(p) (m), Eq. (2), from the roughness with |q| > q_min.
+
+    Parameters
+    ----------
+    q : array
+        Wavenumbers |q| of the PSD values (rad/m), increasing.
+    power : array
+        ``C * weight`` per value: the mean-square height each carries (m^2).
+    e_star : float
+        E* (Pa).
+    mean_pressure : float or array
+        Pressure(s) p > 0 (Pa).
+    gamma : float
+        Persson's elastic-energy factor, in (0, 1].
+    q_min : float
+        Only the roughness at |q| > q_min counts (Eq. (4) of the critical junction).
+
+    Returns
+    -------
+    ndarray
+        u(p) for each pressure (m).
+    """
+    e = check_finite_positive("e_star (Pa)", e_star)
+    gamma = check_in_open_interval("gamma", gamma, 0.0, 1.0 + 1e-12)
+    p = _pressures(mean_pressure)
+    sel = np.asarray(q) > q_min
+    q, power = np.asarray(q, float)[sel], np.asarray(power, float)[sel]
+    if q.size == 0:
+        return np.zeros(p.shape)
+    w = np.sqrt(2.0 / _cumulative_gradient(q, power))
+    weight = 0.25 * q * power * w                                   # m per unit J
+    return j_function(np.outer(p, w / e), gamma) @ weight
+
+
+# -- results ---------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class PerssonResult:
+    """Persson's theory for one surface at a set of mean pressures (SI).
+
+    Attributes
+    ----------
+    mean_pressure : ndarray
+        p (Pa).
+    area_fraction : ndarray
+        A*(p), Eq. (1).
+    mean_gap : ndarray
+        u(p), Eq. (2) (m): separation of the mean planes, comparable with the BEM mean gap.
+    rms_gradient : float
+        gbar from the PSD (-).
+    rms_height : float
+        From the PSD (m).
+    u0 : float
+        Decay length of p ~ exp(-u/u0) at intermediate p, Eq. (3) (m).
+    e_star, gamma, kappa : float
+        Inputs (Pa, -, -).
+    ndim : int
+        1 (profile) or 2 (surface).
+    references : tuple of str
+    """
+
+    mean_pressure: np.ndarray
+    area_fraction: np.ndarray
+    mean_gap: np.ndarray
+    rms_gradient: float
+    rms_height: float
+    u0: float
+    e_star: float
+    gamma: float
+    kappa: float
+    ndim: int
+    references: tuple = REFERENCES
+
+    def records(self) -> list:
+        """One JSON-safe dict per pressure (keys as in results.json)."""
+        return [{"mean_pressure": float(p), "persson_area_fraction": float(a),
+                 "persson_mean_gap": float(u)}
+                for p, a, u in zip(self.mean_pressure, self.area_fraction, self.mean_gap)]
+
+
+def persson(source, e_star, mean_pressure, *, gamma=GAMMA_DEFAULT,
+            kappa=KAPPA_PERSSON) -> PerssonResult:
+    """Persson's A*(p) and u(p) for a surface or profile (or its PSD), Eqs. (1)-(3).
+
+    Parameters
+    ----------
+    source : Surface or PowerSpectrum
+        A surface's PSD is taken with :func:`roughfe.surfaces.stats.power_spectrum`
+        (radial average for surfaces; Hann window for non-periodic data).
+    e_star : float
+        E* (Pa).
+    mean_pressure : float or array
+        Nominal pressures p > 0 (Pa).
+    gamma : float
+        Elastic-energy factor of u(p), default 0.45.
+    kappa : float
+        Small-load slope of A*, default sqrt(8/pi).
+
+    Returns
+    -------
+    PerssonResult
+    """
+    psd = _spectrum(source)
+    q, power = _arrays(psd)
+    p = _pressures(mean_pressure)
+    gbar = float(np.sqrt(np.sum(q ** 2 * power)))
+    u = mean_separation(q, power, e_star, p, gamma)
+    w = np.sqrt(2.0 / _cumulative_gradient(q, power))
+    u0 = float(gamma / (2 * np.sqrt(np.pi)) * np.sum(q * power * w))
+    return PerssonResult(mean_pressure=p, area_fraction=area_fraction(gbar, e_star, p, kappa),
+                         mean_gap=u, rms_gradient=gbar, rms_height=float(np.sqrt(power.sum())),
+                         u0=u0, e_star=float(e_star), gamma=float(gamma), kappa=float(kappa),
+                         ndim=psd.ndim)
+
+
+@dataclass(frozen=True, eq=False)
+class CriticalJunction:
+    """Lorenz & Persson's critical-junction leak estimate at one pressure, Eqs. (4)-(5).
+
+    Attributes
+    ----------
+    mean_pressure : float
+        p (Pa).
+    q_c : float
+        Wavenumber at which A(q, p) falls to the percolation threshold (rad/m); NaN when
+        the contact still percolates at full magnification (sealed: u_c = Q = 0).
+    area_fraction_c : float
+        A(q_c, p) (-).
+    pressure_c : float
+        Local pressure p / A(q_c, p) on the junction (Pa).
+    u_c : float
+        Surface separation at the critical junction (m).
+    leak_rate : float
+        Q, Eq. (5) (m^3/s).
+    geometry_factor : float
+        Ly/Lx (-).
+    pressure_drop, viscosity : float
+        Delta P (Pa), eta (Pa s).
+    threshold : float
+        A_c used (-).
+    sealed : bool
+        True when the real contact percolates (A(q1, p) >= A_c).
+    """
+
+    mean_pressure: float
+    q_c: float
+    area_fraction_c: float
+    pressure_c: float
+    u_c: float
+    leak_rate: float
+    geometry_factor: float
+    pressure_drop: float
+    viscosity: float
+    threshold: float
+    sealed: bool
+    references: tuple = REFERENCES
+
+
+def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *,
+                      geometry_factor=None, threshold=PERCOLATION_THRESHOLD,
+                      gamma=GAMMA_DEFAULT) -> CriticalJunction:
+    """Critical-junction leak rate of Lorenz & Persson (2009), Eqs. (4)-(5).
+
+    Parameters
+    ----------
+    source : Surface or PowerSpectrum
+        A 2D surface (a profile has no leak path once in contact).
+    e_star : float
+        E* (Pa).
+    mean_pressure : float
+        Nominal contact pressure p > 0 (Pa).
+    pressure_drop : float
+        Fluid pressure drop Delta P > 0 across the seal (Pa).
+    viscosity : float
+        Dynamic viscosity eta > 0 (Pa s).
+    geometry_factor : float, optional
+        Ly/Lx, width over length along the pressure drop; default from the surface size
+        (flow along x = axis 0: ``size[1] / size[0]``), 1 for a bare PSD.
+    threshold : float
+        Percolation threshold A_c of the contact area, default 0.42.
+    gamma : float
+        As in :func:`persson`.
+
+    Returns
+    -------
+    CriticalJunction
+    """
+    psd = _spectrum(source)
+    if psd.ndim != 2:
+        raise InputError("critical_junction needs a surface (2D): on a profile any contact "
+                         "point seals the flow")
+    if geometry_factor is None:
+        geometry_factor = (source.size[1] / source.size[0]) if isinstance(source, Surface) else 1.0
+    geometry_factor = check_finite_positive("geometry_factor Ly/Lx", geometry_factor)
+    threshold = check_in_open_interval("threshold A_c", threshold, 0.0, 1.0)
+    dp = check_finite_positive("pressure_drop (Pa)", pressure_drop)
+    eta = check_finite_positive("viscosity (Pa s)", viscosity)
+    if np.ndim(mean_pressure) != 0:
+        raise InputError(f"mean_pressure must be one number (Pa), got {mean_pressure!r}")
+    p = float(_pressures(mean_pressure)[0])
+    e = check_finite_positive("e_star (Pa)", e_star)
+    q, power = _arrays(psd)
+    m = np.cumsum(q ** 2 * power)                    # m(q) with the bin fully resolved
+    a = scipy.special.erf(np.sqrt(2.0) * p / (e * np.sqrt(m)))
+    below = np.flatnonzero(a < threshold)
+    common = dict(mean_pressure=p, geometry_factor=geometry_factor, pressure_drop=dp,
+                  viscosity=eta, threshold=threshold)
+    if below.size == 0:
+        return CriticalJunction(q_c=float("nan"), area_fraction_c=float(a[-1]),
+                                pressure_c=p / float(a[-1]), u_c=0.0, leak_rate=0.0,
+                                sealed=True, **common)
+    k = int(below[0])
+    if k == 0:
+        q_c, a_c = float(q[0]), float(a[0])
+    else:   # log-linear interpolation of A(q) between the bracketing wavenumbers
+        t = (a[k - 1] - threshold) / (a[k - 1] - a[k])
+        q_c = float(np.exp(np.log(q[k - 1]) + t * (np.log(q[k]) - np.log(q[k - 1]))))
+        a_c = threshold
+    p_c = p / a_c
+    u_c = float(mean_separation(q, power, e, p_c, gamma, q_min=q_c)[0])
+    leak = geometry_factor * dp / eta * u_c ** 3 / 12.0
+    return CriticalJunction(q_c=q_c, area_fraction_c=a_c, pressure_c=p_c, u_c=u_c,
+                            leak_rate=leak, sealed=False, **common)

@@ -1,0 +1,180 @@
+"""Persson's theory from the PSD (roughfe.theory.persson): limits, closed forms, an
+independent quadrature, dimensional analysis and the critical junction."""
+import numpy as np
+import pytest
+import scipy.integrate
+import scipy.special
+
+from roughfe.errors import InputError
+from roughfe.surfaces import stats
+from roughfe.surfaces.spectral import spectral_profile, spectral_surface
+from roughfe.surfaces.stats import PowerSpectrum
+from roughfe.surfaces.surface import Surface
+from roughfe.theory import KAPPA_PERSSON, area_fraction, critical_junction, persson
+
+E_STAR = 1e9
+
+
+@pytest.fixture(scope="module")
+def surface():
+    return spectral_surface(128, 1e-3, 0.8, rms_height=1e-6, rng=3)
+
+
+def power_law(h=0.8, q0=1e4, q1=1e6, c0=1e-30, n=4000):
+    """A pure power-law PSD C = c0 q^-2(1+H) on q0..q1 in fine log bins (2D, isotropic)."""
+    edges = np.geomspace(q0, q1, n + 1)
+    q = np.sqrt(edges[1:] * edges[:-1])
+    weight = np.pi * (edges[1:] ** 2 - edges[:-1] ** 2)        # annulus area 2 pi q dq
+    return PowerSpectrum(q=q, C=c0 * q ** (-2 * (1 + h)), weight=weight, ndim=2, window="none")
+
+
+def test_small_load_slope_is_sqrt_8_over_pi_in_2d(surface):
+    # A* -> kappa p / (E* gbar), kappa = sqrt(8/pi), with gbar the surface's rms gradient
+    # by Parseval (stats.rms_slope). Tolerance 1e-2: the PSD is radially binned and each
+    # annulus carries its mean |q|, so sum q^2 C w differs from <|grad h|^2> by < 1 %.
+    gbar = stats.rms_slope(surface)
+    p = 1e-5 * E_STAR * gbar
+    r = persson(surface, E_STAR, p)
+    assert r.area_fraction[0] / 1e-5 == pytest.approx(np.sqrt(8 / np.pi), rel=1e-2)
+    assert r.rms_gradient == pytest.approx(gbar, rel=1e-2)
+    assert KAPPA_PERSSON == pytest.approx(1.5957691, rel=1e-7)
+
+
+def test_small_load_slope_1d_is_the_same_with_the_rms_slope():
+    # 1D analogue (derived in the module docstring): <sigma^2> = (E*/2)^2 <h'^2>, hence
+    # A* = erf(sqrt(2) p/(E* h'_rms)) and kappa = sqrt(8/pi) with the rms *slope*. The
+    # profile PSD is not binned: the identity holds to round-off.
+    prof = spectral_profile(2048, 1e-3, 0.7, rms_height=1e-6, rng=5)
+    gbar = stats.rms_slope(prof)
+    r = persson(prof, E_STAR, 1e-6 * E_STAR * gbar)
+    assert r.ndim == 1
+    assert r.area_fraction[0] / 1e-6 == pytest.approx(np.sqrt(8 / np.pi), rel=1e-6)
+
+
+def test_area_is_monotone_to_full_contact_and_gap_decreases(surface):
+    gbar = stats.rms_slope(surface)
+    p = np.geomspace(1e-4, 10, 50) * E_STAR * gbar
+    r = persson(surface, E_STAR, p)
+    a = r.area_fraction
+    assert np.all(np.diff(a) >= 0) and np.all(np.diff(a)[a[1:] < 0.999] > 0)
+    assert r.area_fraction[-1] == pytest.approx(1.0, abs=1e-12)
+    assert np.all(np.diff(r.mean_gap) <= 0) and np.all(r.mean_gap >= 0)
+    assert r.mean_gap[0] > r.rms_height          # light load: the planes stand apart
+    assert r.mean_gap[-1] < 1e-6 * r.rms_height  # full contact closes the gap
+
+
+def test_power_law_area_has_the_erf_closed_form():
+    h, q0, q1, c0 = 0.8, 1e4, 1e6, 1e-30
+    psd = power_law(h, q0, q1, c0)
+    gbar = np.sqrt(2 * np.pi * c0 * (q1 ** (2 - 2 * h) - q0 ** (2 - 2 * h)) / (2 - 2 * h))
+    p = np.geomspace(1e-3, 3, 20) * E_STAR * gbar
+    r = persson(psd, E_STAR, p)
+    exact = scipy.special.erf(np.sqrt(2) * p / (E_STAR * gbar))
+    # the log-bin midpoint rule for int q^3 C dq: relative error ~ (dlnq)^2/24 ~ 6e-7
+    np.testing.assert_allclose(r.area_fraction, exact, rtol=1e-5)
+    np.testing.assert_allclose(area_fraction(gbar, E_STAR, p), exact, rtol=1e-12)
+
+
+def test_mean_gap_matches_a_direct_quadrature_of_yang_persson():
+    # Independent evaluation of u(p) = sqrt(pi) int dq q^2 C w int_p^inf dp'/p'
+    # [g + 3(1-g) P^2] exp(-(w p'/E*)^2), w = (pi int_q0^q q'^3 C)^-1/2, by nested
+    # adaptive quadrature in q and ln p' (no tabulated J, no bins).
+    h, q0, q1, c0, gamma = 0.8, 1e4, 1e6, 1e-30, 0.45
+    psd = power_law(h, q0, q1, c0, n=6000)
+    a = 2 - 2 * h
+
+    def w(q):
+        return (np.pi * c0 * (q ** a - q0 ** a) / a) ** -0.5
+
+    def u_quad(p):
+        def inner(q):
+            wq = w(q)
+            top = np.log(8 * E_STAR / wq)
+            if top <= np.log(p):
+                return 0.0
+            f = lambda lp: ((gamma + 3 * (1 - gamma) * scipy.special.erf(wq * np.exp(lp) / E_STAR) ** 2)
+                            * np.exp(-(wq * np.exp(lp) / E_STAR) ** 2))
+            return scipy.integrate.quad(f, np.log(p), top, limit=200)[0]
+        g = lambda lq: np.exp(lq) ** 3 * c0 * np.exp(lq) ** (-2 * (1 + h)) * w(np.exp(lq)) * inner(np.exp(lq))
+        return np.sqrt(np.pi) * scipy.integrate.quad(g, np.log(q0), np.log(q1), limit=200,
+                                                     epsrel=1e-7)[0]
+
+    gbar = np.sqrt(2 * np.pi * c0 * (q1 ** a - q0 ** a) / a)
+    for x in (1e-3, 0.1, 0.5):
+        p = x * E_STAR * gbar
+        ours = persson(psd, E_STAR, p, gamma=gamma).mean_gap[0]
+        # 2e-3: the 1/sqrt(q - q0) singularity of w at q0 in the first of 6000 log bins
+        assert ours == pytest.approx(u_quad(p), rel=2e-3)
+
+
+def test_log_law_at_intermediate_pressures(surface):
+    # p ~ exp(-u/u0): -du/dln p -> u0 (Eq. 3) as p -> 0, within 1e-3 at p = 1e-6 E* gbar
+    gbar = stats.rms_slope(surface)
+    p = np.array([1e-6, 1.1e-6]) * E_STAR * gbar
+    r = persson(surface, E_STAR, p)
+    slope = -np.diff(r.mean_gap)[0] / np.log(1.1)
+    assert slope == pytest.approx(r.u0, rel=1e-3)
+    assert 0.2 < r.u0 / (r.gamma * r.rms_height) < 2     # Persson's "u0 ~ gamma h_rms"
+
+
+def test_dimensional_analysis(surface):
+    gbar = stats.rms_slope(surface)
+    p = np.array([0.01, 0.1, 0.5]) * E_STAR * gbar
+    r = persson(surface, E_STAR, p)
+    # heights x 3 at pressures x 3: slopes x 3, so A unchanged and u x 3
+    s3 = Surface(3 * surface.heights, surface.size, periodic=True)
+    r3 = persson(s3, E_STAR, 3 * p)
+    np.testing.assert_allclose(r3.area_fraction, r.area_fraction, rtol=1e-12)
+    np.testing.assert_allclose(r3.mean_gap, 3 * r.mean_gap, rtol=1e-10)
+    # all lengths x 7 (heights and size): slopes unchanged, u x 7; E* and p x 2: same
+    s7 = Surface(7 * surface.heights, tuple(7 * s for s in surface.size), periodic=True)
+    r7 = persson(s7, 2 * E_STAR, 2 * p)
+    np.testing.assert_allclose(r7.area_fraction, r.area_fraction, rtol=1e-12)
+    np.testing.assert_allclose(r7.mean_gap, 7 * r.mean_gap, rtol=1e-10)
+
+
+def test_critical_junction(surface):
+    gbar = stats.rms_slope(surface)
+    dp, eta = 1e5, 1e-3
+    light = critical_junction(surface, E_STAR, 0.05 * E_STAR * gbar, dp, eta)
+    assert not light.sealed
+    # Eq. (5), units m^3/s, exactly linear in Delta P / eta
+    assert light.leak_rate == pytest.approx(dp / eta * light.u_c ** 3 / 12, rel=1e-12)
+    twice = critical_junction(surface, E_STAR, 0.05 * E_STAR * gbar, 2 * dp, 0.5 * eta)
+    assert twice.leak_rate == pytest.approx(4 * light.leak_rate, rel=1e-12)
+    # the junction is narrower than the mean gap, and the leak falls with the load
+    assert 0 < light.u_c < persson(surface, E_STAR, 0.05 * E_STAR * gbar).mean_gap[0]
+    heavier = critical_junction(surface, E_STAR, 0.15 * E_STAR * gbar, dp, eta)
+    assert heavier.leak_rate < light.leak_rate
+    # A(q1, p) above the threshold: the contact percolates and seals
+    sealed = critical_junction(surface, E_STAR, 1.0 * E_STAR * gbar, dp, eta)
+    assert sealed.sealed and sealed.leak_rate == 0.0
+    # aspect ratio Ly/Lx from the surface size
+    wide = Surface(surface.heights, (1e-3, 2e-3), periodic=True)
+    assert critical_junction(wide, E_STAR, 0.05 * E_STAR * gbar, dp, eta).geometry_factor == 2.0
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(mean_pressure=-1.0), "mean_pressure"),
+    (dict(mean_pressure=np.nan), "mean_pressure"),
+    (dict(e_star=0.0), "e_star"),
+    (dict(gamma=1.5), "gamma"),
+])
+def test_bad_input_is_a_clear_error(surface, kwargs, match):
+    args = dict(e_star=E_STAR, mean_pressure=1e6)
+    args.update(kwargs)
+    gamma = args.pop("gamma", 0.45)
+    with pytest.raises(InputError, match=match):
+        persson(surface, args["e_star"], args["mean_pressure"], gamma=gamma)
+
+
+def test_bad_input_critical_junction(surface):
+    prof = spectral_profile(64, 1e-3, 0.7, rms_height=1e-6, rng=1)
+    with pytest.raises(InputError, match="2D"):
+        critical_junction(prof, E_STAR, 1e6, 1e5, 1e-3)
+    with pytest.raises(InputError, match="viscosity"):
+        critical_junction(surface, E_STAR, 1e6, 1e5, 0.0)
+    with pytest.raises(InputError, match="flat"):
+        persson(Surface(np.zeros((8, 8)), 1e-3, periodic=True), E_STAR, 1e6)
+    with pytest.raises(InputError, match="Surface or PowerSpectrum"):
+        persson([1, 2], E_STAR, 1e6)
