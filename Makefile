@@ -1,6 +1,7 @@
 # roughfe: two commands do all set-up on a fresh Debian 12 machine.
 #   make demo   installs what is missing, runs the default case, writes demo-output/
 #   make test   installs what is missing, runs the test suite
+#   make docs   builds the documentation (docs/_build/html)
 VENV   := .venv
 PY     := $(VENV)/bin/python
 # vtk renders off-screen through EGL; this silences its X11 warning.
@@ -9,7 +10,7 @@ export PYVISTA_OFF_SCREEN := true
 export MPLBACKEND := Agg
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 
-.PHONY: env test demo validate bench clean
+.PHONY: env test demo validate bench docs clean
 
 env:
 	@bash tools/bootstrap.sh
@@ -27,5 +28,11 @@ bench: env
 	@bash tools/bootstrap.sh io,design,study,test,bench
 	$(PY) benchmarks/run_all.py
 
+# HTML documentation in docs/_build/html (warnings are errors).
+docs: env
+	@bash tools/bootstrap.sh io,design,study,test,docs
+	rm -rf docs/api/generated
+	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+
 clean:
-	rm -rf demo-output validation/output benchmarks/output .pytest_cache
+	rm -rf demo-output validation/output benchmarks/output .pytest_cache docs/_build docs/api/generated

@@ -1,0 +1,144 @@
+"""Sphinx configuration of the roughfe documentation (``make docs``).
+
+Pages are Markdown (MyST) or reStructuredText. ``index.rst`` collects every page of
+``theory/``, ``tutorials/``, ``validation/``, ``benchmarks/`` and ``api/`` by glob, so a new
+page needs no edit of the index. The validation and benchmark pages are written by
+``docs/generate.py`` from the JSON of ``make validate`` / ``make bench`` before the build.
+The API reference imports roughfe (dolfinx included): build with the project's venv python.
+"""
+import os
+import sys
+from pathlib import Path
+
+DOCS = Path(__file__).resolve().parent
+sys.path.insert(0, str(DOCS.parent))
+
+# Headless rendering, and vtk loaded before dolfinx (see tests/conftest.py): autodoc
+# imports roughfe.plotting and roughfe.fem in one process.
+os.environ.setdefault("MPLBACKEND", "Agg")
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+try:
+    import pyvista  # noqa: F401,E402
+except ImportError:  # pragma: no cover - pyvista is a core dependency
+    pass
+
+import roughfe  # noqa: E402
+
+project = "roughfe"
+author = "the roughfe developers"
+copyright = "roughfe developers, MIT licence"
+release = roughfe.__version__
+version = release
+
+extensions = [
+    "myst_parser",
+    "numpydoc",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.viewcode",
+    "sphinx.ext.intersphinx",
+]
+
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+exclude_patterns = ["_build", "**/.ipynb_checkpoints", "README.md", "api/generated/*.md"]
+templates_path = ["_templates"]
+
+# MyST: $...$ and $$...$$ math, ::: fences, definition lists, heading anchors.
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist", "attrs_inline"]
+myst_heading_anchors = 3
+
+# API reference: autosummary writes one page per module into api/generated/.
+autosummary_generate = True
+autosummary_imported_members = False
+autodoc_default_options = {"members": True, "show-inheritance": True}
+autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types and units
+autodoc_member_order = "bysource"
+numpydoc_show_class_members = False
+numpydoc_class_members_toctree = False
+numpydoc_xref_param_type = False
+numpydoc_validation_checks = set()
+
+intersphinx_mapping = {
+    "python": ("https://docs.python.org/3", None),
+    "numpy": ("https://numpy.org/doc/stable/", None),
+    "scipy": ("https://docs.scipy.org/doc/scipy/", None),
+}
+# The build must work offline: intersphinx inventories are fetched only when asked.
+if os.environ.get("ROUGHFE_DOCS_OFFLINE", "1") == "1":
+    intersphinx_mapping = {}
+
+html_theme = "pydata_sphinx_theme"
+html_title = f"roughfe {release}"
+html_static_path = ["_static"]
+html_theme_options = {
+    "navigation_depth": 3,
+    "show_toc_level": 2,
+    "header_links_before_dropdown": 6,
+    "secondary_sidebar_items": ["page-toc"],
+}
+html_sidebars = {"**": ["sidebar-nav-bs"]}
+html_show_sourcelink = False
+
+highlight_language = "none"  # plain-text formula blocks of the docstrings
+nitpicky = False
+suppress_warnings = ["myst.header"]
+
+
+# --- Docstrings are plain-text numpydoc; make them valid reStructuredText -----------------
+# roughfe docstrings write formulas as text (|q|, |x - s|), put indented formula blocks
+# after a colon and underline module-docstring headings by eye. These are rewritten here
+# (the source stays readable in a terminal) instead of littering the code with escapes.
+import re  # noqa: E402
+import warnings  # noqa: E402
+
+# numpydoc re-reads class docstrings for member lists and warns on "Fields" (handled below)
+warnings.filterwarnings("ignore", message="Unknown section", category=UserWarning)
+
+_LITERAL_OR_ROLE = re.compile(r"(``.+?``|:[a-z:]+:`[^`]+`|`[^`]+`_?)")
+_UNDERLINE = re.compile(r"^(\s*)([-=~^\"'])\2{2,}\s*$")
+_LIST_ITEM = re.compile(r"^\s*([-*+]|\d+\.|\(?[a-z0-9]\))\s")
+_SECTION_ALIASES = {"Fields": "Attributes"}
+
+
+def _escape_bars(line):
+    """Escape ``|`` outside literals and roles (never a substitution in roughfe); keep a
+    ". " inside a literal from ending autosummary's first sentence (U+2024, a one-dot leader)."""
+    parts = _LITERAL_OR_ROLE.split(line)
+    return "".join(p.replace(". ", "\u2024 ") if i % 2 else p.replace("|", r"\|")
+                   for i, p in enumerate(parts))
+
+
+def _rst_docstring(lines):
+    out = []
+    for i, line in enumerate(lines):
+        line = _escape_bars(line)
+        m = _UNDERLINE.match(line)
+        if m and out and out[-1].strip():
+            title = out[-1]
+            if title.strip() in _SECTION_ALIASES:
+                out[-1] = title.replace(title.strip(), _SECTION_ALIASES[title.strip()])
+                title = out[-1]
+            line = m.group(1) + m.group(2) * len(title.strip())
+        out.append(line)
+    # a paragraph ending in ":" followed by a blank line and a deeper-indented block
+    # is a formula or a code block: make it a literal block.
+    for i in range(len(out) - 2):
+        cur, blank, nxt = out[i], out[i + 1], out[i + 2]
+        if (cur.rstrip().endswith(":") and not cur.rstrip().endswith("::")
+                and not blank.strip() and nxt.strip()
+                and len(nxt) - len(nxt.lstrip()) > len(cur) - len(cur.lstrip())
+                and not _LIST_ITEM.match(nxt)
+                and not cur.lstrip().startswith((".. ", ":"))):
+            out[i] = cur.rstrip() + ":"
+    return out
+
+
+def _process_docstring(app, what, name, obj, options, lines):
+    lines[:] = _rst_docstring(lines)
+
+
+def setup(app):
+    # priority < 500: runs before numpydoc parses the sections
+    app.connect("autodoc-process-docstring", _process_docstring, priority=100)
