@@ -1,7 +1,8 @@
 """The one-way data flow of STYLE.md (a): packages import only leftward.
 
-surfaces -> theory -> bem -> fem -> leakage -> genomics -> study -> plotting -> cli
-(errors, writers and reference are the base layer, importable from anywhere.)
+surfaces -> model -> theory -> bem -> fem -> response -> leakage -> genomics -> study -> plotting -> cli
+(errors, writers and reference are the base layer, importable from anywhere; model.py
+holds the contract types shared by bem and fem, response.py the one dispatch to them.)
 dolfinx, petsc4py, mpi4py.futures aside, gmsh and ufl are imported only inside roughfe/fem.
 """
 import ast
@@ -10,8 +11,8 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "roughfe"
-ORDER = ["errors", "writers", "reference", "surfaces", "theory", "bem", "fem", "leakage",
-         "genomics", "study", "plotting", "cli"]
+ORDER = ["errors", "writers", "reference", "surfaces", "model", "theory", "bem", "fem",
+         "response", "leakage", "genomics", "study", "plotting", "cli"]
 BASE = {"errors", "writers", "reference", "__init__"}
 FEM_ONLY = {"dolfinx", "petsc4py", "gmsh", "ufl", "basix", "ffcx"}
 

@@ -2,7 +2,9 @@
 
 Public API (stable):
 
-* :class:`Material` and :func:`composite` -- elastic constants, E* (Pa).
+* :class:`Material` and :func:`composite` -- elastic constants, E* (Pa); defined in
+  :mod:`roughfe.model` with :class:`ContactResult` and :class:`SweepResult`, the result
+  types shared with the FEM (re-exported here).
 * :func:`solve_contact` -> :class:`ContactResult` -- one contact problem under an
   imposed approach ``delta`` (m) or ``mean_pressure`` (Pa).
 * :func:`contact_sweep` -> :class:`SweepResult` -- warm-started loading sweeps
@@ -14,7 +16,7 @@ Result files: :mod:`roughfe.bem.output` (results.json, fields.h5). Analytic refe
 (Westergaard, Hertz, Love, strip) live in :mod:`roughfe.reference`.
 """
 from .contact import ContactResult, solve_contact
-from .material import Material, composite
+from ..model import Material, composite
 from .operators import KERNELS, InfluenceOperator, influence_operator
 from .sweep import RECORD_KEYS, SweepResult, contact_sweep
 

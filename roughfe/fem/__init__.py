@@ -2,8 +2,9 @@
 
 * :func:`mesh_profile` -> :class:`ProfileMesh` -- gmsh mesh of the plane-strain body below
   a profile (formulation (a) ``"flat"`` or (b) ``"profile"``), tagged top/bottom/left/right.
-* :func:`fem_contact_sweep` -> :class:`FemSweepResult` of :class:`FemContactResult`
-  (field names of the BEM results) -- SNES VI or penalty contact with rollers.
+* :func:`fem_contact_sweep` -> :class:`roughfe.model.SweepResult` of
+  :class:`roughfe.model.ContactResult` (the BEM's result types; ``FemSweepResult`` and
+  ``FemContactResult`` are aliases of them) -- SNES VI or penalty contact with rollers.
 * :func:`mirrored_profile` -- the periodic profile whose BEM solution is the reference of
   the FEM body with rollers.
 

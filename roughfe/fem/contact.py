@@ -34,7 +34,7 @@ Everything is solved in non-dimensional units (coordinates / W, displacements / 
 range, E = 1): the SNES VI active-set test uses absolute tolerances, and displacements of
 1e-7 m made most steps fail. Results are converted back to SI.
 
-Outputs per load step (:class:`FemContactResult`, same field names as the BEM result):
+Outputs per load step (:class:`roughfe.model.ContactResult`, the BEM's result type):
 the nodal contact forces are the reaction ``-(K u)_y`` on the top vertical DOFs (N/m);
 the load is their sum, the mean pressure load / W; ``pressure = force / w_i``; contact
 vertices give A* = sum(w_i in contact) / W. Delta is corrected for the finite depth: a
@@ -48,16 +48,16 @@ contact set (and by central differences over a sweep, ``stiffness_fd``).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal, Mapping
 
 import numpy as np
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
-from ..writers import json_scalars
-from ..bem import Material
-from ..bem.sweep import central_differences
-from .mesh import FACET_TAGS, ProfileMesh
+from ..model import ContactResult, Material, SweepResult
+from ..surfaces import Surface
+from ..surfaces.stats import rms_height, rms_slope
+from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
 from .petsc_tools import LU_MUMPS, apply_options, check_snes, unique_prefix
 
 Method = Literal["vi", "penalty"]
@@ -119,131 +119,10 @@ class FemSolverOptions:
             raise InputError(f"max_it must be >= 1, got {self.max_it!r}")
 
 
-@dataclass(frozen=True, eq=False)
-class FemContactResult:
-    """One FEM contact solution. Fields shared with :class:`roughfe.bem.ContactResult`
-    have the same names, units, signs and conventions.
-
-    Attributes
-    ----------
-    x : ndarray (n,)
-        Positions of the top vertices (m), ``x[i] = i dx``.
-    pressure : ndarray (n,)
-        Contact pressure (Pa): nodal reaction / tributary length (dx; dx/2 at the ends).
-    displacement : ndarray (n,)
-        Normal displacement of the body surface in the BEM convention (m): positive into
-        the body, zero mean: ``-u_y - mean_pressure * layer_compliance``.
-    gap : ndarray (n,)
-        ``displacement + max h - h - delta`` (m), >= 0 (penalty: >= -penetration).
-    contact : ndarray (n,) of bool
-        Vertices in contact.
-    delta : float
-        Half-plane approach (m): the imposed ``delta_applied`` minus the uniform layer
-        shortening ``mean_pressure * layer_compliance`` (the BEM's Delta).
-    delta_applied : float
-        Approach imposed on the finite layer (m), from first touch of the highest sample.
-    layer_compliance : float
-        H_d / M (m/Pa), see :func:`p_wave_modulus`.
-    load : float
-        Total contact force per unit depth (N/m), the sum of the nodal reactions.
-    mean_pressure : float
-        load / W (Pa), W = (n-1) dx.
-    area_fraction : float
-        A* = contact_area / W.
-    contact_area : float
-        Contact length per unit depth (m): tributary lengths of the contact vertices.
-    n_contact : int
-        Number of top vertices in contact.
-    mean_gap : float
-        Trapezoidal mean of the gap over W (m) (= the mean over the mirrored period).
-    mean_plane_separation : float
-        d = max h - mean h - delta (m), mean h trapezoidal; equals mean_gap (Betti).
-    stiffness : float
-        Exact incremental stiffness K = dp/d delta (Pa/m, Eq. 2.7) with the contact set
-        frozen (as the BEM's): one extra linear solve, then corrected for the layer,
-        1/K = 1/K_applied - H_d/M. For the penalty solver the penetrating vertices are
-        treated as bonded (differs from the penalty tangent by O(1/k)).
-    success, message, nit, residual
-        As in scipy's OptimizeResult: nit SNES iterations, residual the final SNES
-        residual norm (non-dimensional).
-    solver : str
-        ``"fem-vi"`` or ``"fem-penalty"``.
-    formulation : str
-        ``"flat"`` (a) or ``"profile"`` (b).
-    e_star : float
-        E / (1 - nu^2) (Pa).
-    size, spacing : tuple
-        ``(W,)`` and ``(dx,)`` (m).
-    periodic : bool
-        False: the FEM body has rollers (it equals the periodic mirrored problem).
-    fields : dict or None
-        Full fields for pictures (``keep_fields``, serial only): ``points`` (m, (N, 2),
-        undeformed), ``cells`` ((C, 3)), ``displacement`` (m, (N, 2), u_x and u_y),
-        ``stress_yy`` (Pa, per cell), ``formulation``.
-    references : tuple of str
-    """
-
-    x: np.ndarray
-    pressure: np.ndarray
-    displacement: np.ndarray
-    gap: np.ndarray
-    contact: np.ndarray
-    delta: float
-    delta_applied: float
-    layer_compliance: float
-    load: float
-    mean_pressure: float
-    area_fraction: float
-    contact_area: float
-    n_contact: int
-    mean_gap: float
-    mean_plane_separation: float
-    stiffness: float
-    success: bool
-    message: str
-    nit: int
-    residual: float
-    solver: str
-    formulation: str
-    e_star: float
-    size: tuple
-    spacing: tuple
-    periodic: bool = False
-    fields: dict | None = None
-    references: tuple = field(default=REFERENCES)
-
-    def scalars(self) -> dict:
-        """The scalar fields as a JSON-safe dict (non-finite values -> None)."""
-        return json_scalars(self, (
-            "delta", "delta_applied", "layer_compliance", "load", "mean_pressure",
-            "area_fraction", "contact_area", "n_contact", "mean_gap", "mean_plane_separation",
-            "stiffness", "nit", "residual"))
-
-
-@dataclass(frozen=True, eq=False)
-class FemSweepResult:
-    """A FEM loading sweep; array names follow :class:`roughfe.bem.SweepResult`.
-
-    Attributes
-    ----------
-    results : tuple of FemContactResult
-    delta, delta_applied, mean_pressure, load, area_fraction, stiffness, mean_gap : ndarray
-        Step values (see :class:`FemContactResult`).
-    stiffness_fd : ndarray
-        dp/d delta by central differences over the sweep (Pa/m), as the BEM's.
-    n_contact : ndarray of int
-    """
-
-    results: tuple
-    delta: np.ndarray
-    delta_applied: np.ndarray
-    mean_pressure: np.ndarray
-    load: np.ndarray
-    area_fraction: np.ndarray
-    stiffness: np.ndarray
-    stiffness_fd: np.ndarray
-    mean_gap: np.ndarray
-    n_contact: np.ndarray
+#: The FEM returns the one result types of :mod:`roughfe.model`; these names are aliases
+#: kept for the code written against round 1.
+FemContactResult = ContactResult
+FemSweepResult = SweepResult
 
 
 class _ContactProblem:
@@ -300,6 +179,10 @@ class _ContactProblem:
         w[[0, -1]] *= 0.5
         self.weights = w[idx]
         self.gap0 = (h.max() - h[idx]) / self.u_ref
+        # sigma and rms slope of the evenly mirrored (periodic) profile: the problem the
+        # body with rollers solves (trapezoidal rms over W)
+        mirror = mirrored_profile(Surface(h, h.size * pmesh.element_size))
+        self.rms_height, self.rms_slope = rms_height(mirror), rms_slope(mirror)
         self.x, self.y = self.K.createVecs()
         self.x.set(0.0)
         self.r = self.x.duplicate()
@@ -336,6 +219,7 @@ class _ContactProblem:
         snes.setFunction(self._residual, self.r)
         snes.setJacobian(self._jacobian, J, J)
         snes.setTolerances(rtol=opt.rtol, atol=opt.atol, max_it=int(opt.max_it))
+        snes.setConvergenceHistory(reset=True)       # |F(x_0)| of each solve: the tolerance
         defaults = {"snes_type": "vinewtonrsls" if opt.method == "vi" else "newtonls",
                     "snes_linesearch_type": "basic", **LU_MUMPS}
         ksp_keys = {"ksp_type", "pc_type", "pc_factor_mat_solver_type"}
@@ -351,7 +235,7 @@ class _ContactProblem:
         return snes
 
     # -- one load step ----------------------------------------------------------------
-    def solve(self, delta: float, keep_fields: bool = False) -> FemContactResult:
+    def solve(self, delta: float, keep_fields: bool = False) -> ContactResult:
         """Solve for the imposed approach ``delta`` (m), from the previous solution."""
         self.bound = self.gap0 - float(delta) / self.u_ref
         if self.options.method == "vi":
@@ -363,7 +247,7 @@ class _ContactProblem:
         nit = check_snes(self.snes, what)
         return self._result(float(delta), nit, what, keep_fields)
 
-    def solve_half_plane(self, target: float, keep_fields: bool = False) -> FemContactResult:
+    def solve_half_plane(self, target: float, keep_fields: bool = False) -> ContactResult:
         """Solve for the half-plane approach ``target`` (m), the BEM's Delta.
 
         Newton on the imposed approach: delta = applied - p H_d/M, so
@@ -452,18 +336,30 @@ class _ContactProblem:
             contact = gap < 0.0
         area = float(w[contact].sum())
         mean_h = float(np.sum(w * h)) / W
+        mean_gap = float(np.sum(w * gap)) / W
+        sigma = self.rms_height
         k_applied = self._incremental_stiffness(contact[self.sample]) * mat.E / W
         stiffness = 1.0 / (1.0 / k_applied - compliance) if k_applied > 0 else 0.0
-        return FemContactResult(
+        return ContactResult(
             x=pm.x.copy(), pressure=np.maximum(force, 0.0) / w, displacement=disp, gap=gap,
             contact=contact, delta=delta, delta_applied=delta_applied,
             layer_compliance=compliance, load=load, mean_pressure=mean_p,
             area_fraction=area / W, contact_area=area, n_contact=int(contact.sum()),
-            mean_gap=float(np.sum(w * gap)) / W, mean_plane_separation=h.max() - mean_h - delta,
-            stiffness=stiffness, success=True, message=f"{what}: converged", nit=nit,
-            residual=float(self.snes.getFunctionNorm()), solver=f"fem-{self.options.method}",
-            formulation=pm.formulation, e_star=mat.E_star, size=(W,), spacing=(pm.element_size,),
+            mean_gap=mean_gap, mean_plane_separation=h.max() - mean_h - delta,
+            free_volume=float(np.sum(w * np.maximum(gap, 0.0))),
+            free_volume_star=mean_gap / sigma if sigma > 0 else float("nan"),
+            stiffness=stiffness, message=f"{what}: converged", nit=nit,
+            residual=float(self.snes.getFunctionNorm()), tolerance=self._tolerance(),
+            kernel=None, solver=f"fem-{self.options.method}", formulation=pm.formulation,
+            e_star=mat.E_star, rms_height=sigma, size=(W,), spacing=(pm.element_size,),
+            periodic=False, references=REFERENCES, method="fem",
             fields=self._fields() if keep_fields else None)
+
+    def _tolerance(self) -> float:
+        """The SNES residual test of the last solve: max(atol, rtol * |F(x_0)|)."""
+        norms = self.snes.getConvergenceHistory()[0]
+        f0 = float(norms[0]) if len(norms) else float(self.snes.getFunctionNorm())
+        return max(self.options.atol, self.options.rtol * f0)
 
     def _fields(self):
         """Vertices, triangles, displacement (m) and cell-wise sigma_yy (Pa), serial."""
@@ -585,7 +481,7 @@ def contact_length(x, pressure, gap, contact, e_star) -> float:
 
 def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
                       applied_deltas=None, options: FemSolverOptions | None = None,
-                      keep_fields=()) -> FemSweepResult:
+                      keep_fields=()) -> SweepResult:
     """Solve the FEM contact problem for increasing approaches (load stepping).
 
     Each step starts from the previous solution.
@@ -634,17 +530,12 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
         raise NoConvergenceError(str(exc), result=results) from None
     finally:
         problem.snes.destroy()
-    arr = {k: np.array([getattr(r, k) for r in results], float)
-           for k in ("delta", "delta_applied", "mean_pressure", "load", "area_fraction",
-                     "mean_gap", "stiffness")}
-    return FemSweepResult(results=tuple(results),
-                          stiffness_fd=central_differences(arr["delta"], arr["mean_pressure"]),
-                          n_contact=np.array([r.n_contact for r in results]), **arr)
+    return SweepResult.from_results(results, rms_slope=problem.rms_slope, length=pmesh.width)
 
 
 def fem_solve_contact(pmesh: ProfileMesh, material: Material, delta=None, *,
                       applied_delta=None, options: FemSolverOptions | None = None,
-                      keep_fields: bool = False) -> FemContactResult:
+                      keep_fields: bool = False) -> ContactResult:
     """One FEM contact solve at the half-plane approach ``delta`` or the imposed
     ``applied_delta`` (m), see :func:`fem_contact_sweep`."""
     return fem_contact_sweep(

@@ -1,0 +1,110 @@
+"""The one way to ask for "a sweep of this surface": :func:`response`.
+
+``response(surface, material, loading, method="bem"|"fem", **solver_options)`` returns a
+:class:`roughfe.model.SweepResult` from either method, so genomics, design, studies and
+the CLI never call a solver directly and a faster solver or a new physics option reaches
+them all at once. It sits above :mod:`roughfe.bem` and :mod:`roughfe.fem` in the layer
+order (tests/test_architecture.py); the types it returns live in :mod:`roughfe.model`.
+"""
+from __future__ import annotations
+
+from typing import Literal, Optional
+
+from .errors import InputError
+from .model import Loading, Material, SweepResult
+from .surfaces import Surface
+
+Method = Literal["bem", "fem"]
+METHODS = ("bem", "fem")
+
+#: keyword options of each method (everything else is refused with the list below)
+BEM_OPTIONS = ("kernel", "solver", "tol", "max_iter", "compute_stiffness")
+FEM_MESH_OPTIONS = ("depth", "growth", "formulation", "size_max")
+FEM_SOLVER_OPTIONS = ("solver", "penalty_factor", "rtol", "atol", "max_it", "petsc_options")
+FEM_OPTIONS = FEM_MESH_OPTIONS + FEM_SOLVER_OPTIONS + ("keep_fields",)
+
+
+def _check_options(method, options, allowed):
+    unknown = sorted(set(options) - set(allowed))
+    if unknown:
+        raise InputError(f"unknown option(s) {unknown} for method={method!r}; allowed: "
+                         f"{list(allowed)}")
+
+
+def response(surface: Surface, material: Material, loading: Optional[Loading] = None,
+             method: Method = "bem", **solver_options) -> SweepResult:
+    """Contact response of a rough surface on an elastic body (thesis Sec. 2.2).
+
+    Parameters
+    ----------
+    surface : Surface
+        Heights (m). The FEM needs a 1D profile (plane strain).
+    material : Material
+        E (Pa) and nu of the elastic body (the rough surface is rigid).
+    loading : Loading, optional
+        What to impose; default ``Loading()``: 20 equispaced approaches (Eq. 2.5). A
+        single ``delta`` / ``mean_pressure`` is a one-step sweep.
+    method : {"bem", "fem"}
+        ``"bem"``: :func:`roughfe.bem.contact_sweep` (the production solver).
+        ``"fem"``: :func:`roughfe.fem.fem_contact_sweep` on a gmsh body below the profile,
+        approaches only (``n_steps`` / ``delta`` / ``deltas``, strictly increasing):
+        Delta is the half-plane approach, the BEM's; ``n_steps`` gives the BEM's default
+        approaches of the evenly mirrored profile, which the body with rollers solves
+        (:func:`roughfe.fem.mirrored_profile`), up to full contact.
+    **solver_options
+        BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness`` (see
+        :func:`roughfe.bem.solve_contact`). FEM: mesh ``depth``, ``growth``,
+        ``formulation``, ``size_max`` (:func:`roughfe.fem.mesh_profile`); ``solver``
+        (``"vi"`` or ``"penalty"``), ``penalty_factor``, ``rtol``, ``atol``, ``max_it``,
+        ``petsc_options`` (:class:`roughfe.fem.FemSolverOptions`); ``keep_fields``.
+
+    Returns
+    -------
+    SweepResult
+        One :class:`roughfe.model.ContactResult` per step, the same fields from both
+        methods.
+
+    Raises
+    ------
+    InputError
+        Unknown method or option, a loading the method can not impose, bad input.
+    NoConvergenceError
+        A step did not converge.
+    """
+    loading = Loading() if loading is None else loading
+    if not isinstance(loading, Loading):
+        raise InputError(f"loading must be a roughfe.model.Loading, got {loading!r}")
+    if not isinstance(material, Material):
+        raise InputError(f"material must be a roughfe.model.Material, got {material!r}")
+    if not isinstance(surface, Surface):
+        raise InputError(f"surface must be a roughfe Surface, got {type(surface).__name__}")
+    if method == "bem":
+        from .bem import contact_sweep
+
+        _check_options(method, solver_options, BEM_OPTIONS)
+        return contact_sweep(surface, material, **loading.sweep_arguments(), **solver_options)
+    if method == "fem":
+        return _fem_response(surface, material, loading, solver_options)
+    raise InputError(f"method must be one of {METHODS}, got {method!r}")
+
+
+def _fem_response(surface, material, loading, options) -> SweepResult:
+    from .bem.sweep import default_deltas
+    from .fem import FemSolverOptions, fem_contact_sweep, mesh_profile, mirrored_profile
+
+    _check_options("fem", options, FEM_OPTIONS)
+    if surface.ndim != 1:
+        raise InputError(f"method='fem' needs a 1D profile (plane strain), got a surface of "
+                         f"shape {surface.shape}")
+    if loading.controls_pressure:
+        raise InputError(f"method='fem' imposes approaches (delta, deltas, n_steps); got "
+                         f"{loading.kind}: use method='bem' for load control")
+    if loading.kind == "n_steps":
+        deltas = default_deltas(mirrored_profile(surface), loading.n_steps, periodic=True)
+    else:
+        deltas = loading.sweep_arguments()["deltas"]
+    mesh = mesh_profile(surface, **{k: options[k] for k in FEM_MESH_OPTIONS if k in options})
+    solver = {("method" if k == "solver" else k): options[k]
+              for k in FEM_SOLVER_OPTIONS if k in options}
+    return fem_contact_sweep(mesh, material, deltas, options=FemSolverOptions(**solver),
+                             keep_fields=options.get("keep_fields", ()))

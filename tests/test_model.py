@@ -1,0 +1,209 @@
+"""The contract layer (roughfe.model, roughfe.response): one ContactResult / SweepResult
+from the BEM and the FEM, the Loading description, and the one response function."""
+import dataclasses
+from types import MappingProxyType
+from typing import Optional
+
+import numpy as np
+import pytest
+
+from roughfe import bem
+from roughfe.errors import InputError
+from roughfe.model import (RECORD_KEYS, ContactResult, Loading, Material, SweepResult,
+                           composite)
+from roughfe.reference import westergaard
+from roughfe.response import response
+from roughfe.surfaces import Surface
+
+LAM, G = 1e-3, 1e-6                       # Westergaard wavelength and amplitude (m)
+MAT = Material(E=1e9, nu=0.3)
+
+
+def cosine_half_period(n):
+    """g cos(2 pi x / lambda) on [0, lambda/2], n samples: mirrored, Westergaard's cosine."""
+    dx = (LAM / 2) / (n - 1)
+    return Surface(G * np.cos(2 * np.pi * np.arange(n) * dx / LAM), n * dx)
+
+
+def test_old_names_are_the_one_class():
+    assert bem.Material is Material and bem.composite is composite
+    assert bem.ContactResult is ContactResult and bem.SweepResult is SweepResult
+    assert bem.RECORD_KEYS == RECORD_KEYS
+
+
+@pytest.fixture(scope="module")
+def bem_and_fem():
+    """Westergaard, 4 approaches: the FEM body (rollers, 65 top vertices) and the
+    periodic BEM on the mirrored profile (128 cells), both through response()."""
+    pytest.importorskip("dolfinx")
+    from roughfe.fem import mirrored_profile
+
+    prof = cosine_half_period(65)
+    loading = Loading(deltas=np.array([0.2, 0.4, 0.6, 0.8]) * G)
+    fem = response(prof, MAT, loading, method="fem", growth=0.1)
+    ref = response(mirrored_profile(prof), MAT, loading, method="bem")
+    return fem, ref
+
+
+@pytest.mark.fem
+def test_bem_and_fem_return_one_type_with_one_field_set(bem_and_fem):
+    fem, ref = bem_and_fem
+    assert type(fem) is type(ref) is SweepResult
+    assert all(type(r) is ContactResult for r in fem.results + ref.results)
+    assert fem.method == "fem" and ref.method == "bem"
+    assert fem.success and ref.success
+    # FEM extras are set for the FEM only, the BEM kernel for the BEM only
+    f, b = fem.results[0], ref.results[0]
+    assert f.kernel is None and b.kernel == "spectral"
+    assert f.delta_applied > f.delta and b.delta_applied is None
+    assert fem.delta_applied is not None and ref.delta_applied is None
+    # one results.json record schema: the BEM keys, then the FEM's optional numbers
+    rf, rb = fem.to_records()[0], ref.to_records()[0]
+    assert tuple(rb) == RECORD_KEYS
+    assert tuple(rf) == RECORD_KEYS + ("delta_applied", "layer_compliance")
+
+
+@pytest.mark.fem
+def test_every_array_is_read_only(bem_and_fem):
+    for sweep in bem_and_fem:
+        arrays = [getattr(sweep, f.name) for f in dataclasses.fields(sweep)]
+        for r in sweep.results:
+            arrays += [getattr(r, f.name) for f in dataclasses.fields(r)]
+        arrays = [a for a in arrays if isinstance(a, np.ndarray)]
+        assert len(arrays) > 20
+        for a in arrays:
+            with pytest.raises(ValueError):
+                a[...] = 0
+
+
+@pytest.mark.fem
+def test_bem_and_fem_agree_within_discretisation_error(bem_and_fem):
+    """Same Delta (the half-plane approach), same scalars: the mean pressure within 2 %
+    (measured 0.5-0.7 %, coarse FEM mesh dx = lambda/128), the stiffness within 2 %
+    (measured 0.5-0.7 %), A* within one FEM element (the BEM counts 128 cells, the FEM
+    64 elements), and the mean gap, d and V* exactly (both equal max h - mean h - Delta
+    by Betti / the zero-mean kernel). Both sit on Westergaard's A(p) within 2 cells."""
+    fem, ref = bem_and_fem
+    np.testing.assert_allclose(fem.delta, ref.delta, rtol=1e-8)
+    np.testing.assert_allclose(fem.mean_pressure, ref.mean_pressure, rtol=0.02)
+    np.testing.assert_allclose(fem.stiffness, ref.stiffness, rtol=0.02)
+    np.testing.assert_allclose(fem.area_fraction, ref.area_fraction, atol=1.0 / 64)
+    for k in ("mean_gap", "mean_plane_separation", "free_volume_star", "separation_star"):
+        np.testing.assert_allclose(getattr(fem, k), getattr(ref, k), rtol=1e-6, atol=1e-12)
+    assert fem.rms_height == pytest.approx(ref.rms_height, rel=1e-12)   # G / sqrt(2)
+    assert fem.rms_height == pytest.approx(G / np.sqrt(2), rel=1e-12)
+    # P* = load / (E* sigma): the FEM body carries half the load of the mirrored period
+    np.testing.assert_allclose(2 * fem.load_star, ref.load_star, rtol=0.02)
+    for sweep, cell in ((fem, 1.0 / 64), (ref, 1.0 / 128)):
+        for r in sweep.results:
+            exact = westergaard(G, LAM, MAT.E_star, r.mean_pressure).area_fraction
+            assert abs(r.area_fraction - exact) <= 2 * cell
+
+
+def test_response_bem_is_contact_sweep():
+    rng = np.random.default_rng(1)
+    surf = Surface(rng.normal(size=(16, 16)) * 1e-6, 1e-3, periodic=True)
+    for loading, kwargs in ((Loading(n_steps=4), {"n_steps": 4}),
+                            (Loading(pressures=[1e5, 1e6]), {"pressures": [1e5, 1e6]}),
+                            (Loading(delta=5e-7), {"deltas": [5e-7]})):
+        a = response(surf, MAT, loading, solver="pk")
+        b = bem.contact_sweep(surf, MAT, solver="pk", **kwargs)
+        for f in dataclasses.fields(SweepResult):
+            if f.name != "results":
+                np.testing.assert_array_equal(getattr(a, f.name), getattr(b, f.name))
+        for ra, rb in zip(a.results, b.results):
+            np.testing.assert_array_equal(ra.pressure, rb.pressure)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"delta": -1e-6}, "delta"), ({"delta": float("nan")}, "delta"),
+    ({"delta": "1e-6"}, "delta"), ({"mean_pressure": 0.0}, "mean_pressure"),
+    ({"mean_pressure": True}, "mean_pressure"), ({"n_steps": 0}, "n_steps"),
+    ({"n_steps": 8.5}, "n_steps"), ({"n_steps": True}, "n_steps"),
+    ({"deltas": []}, "deltas"), ({"deltas": [1e-6, -1e-6]}, r"deltas\[1\]"),
+    ({"deltas": [[1e-6]]}, "deltas"), ({"pressures": [1e5, float("inf")]}, "pressures"),
+    ({"deltas": 1e-6}, "deltas"),
+    ({"delta": 1e-6, "mean_pressure": 1e5}, "ONE of"),
+])
+def test_loading_rejects_bad_input(kwargs, match):
+    with pytest.raises(InputError, match=match):
+        Loading(**kwargs)
+
+
+def test_loading_is_frozen_and_describes_itself():
+    assert Loading().n_steps == 20 and Loading().kind == "n_steps"
+    ld = Loading(deltas=np.array([1e-6, 2e-6]))
+    assert ld.deltas == (1e-6, 2e-6) and hash(ld) == hash(Loading(deltas=[1e-6, 2e-6]))
+    assert ld.describe() == {"deltas": [1e-6, 2e-6]}
+    assert Loading(mean_pressure=1e5).sweep_arguments() == {"pressures": (1e5,)}
+    assert Loading(n_steps=3.0).n_steps == 3
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        ld.deltas = (1.0,)
+
+
+def test_response_rejects_what_a_method_can_not_do():
+    surf = Surface(np.cos(np.linspace(0, 2 * np.pi, 32, endpoint=False)) * 1e-6, 1e-3,
+                   periodic=True)
+    with pytest.raises(InputError, match="unknown option"):
+        response(surf, MAT, Loading(n_steps=2), tolerance=1e-8)
+    with pytest.raises(InputError, match="method must be"):
+        response(surf, MAT, method="xfem")
+    with pytest.raises(InputError, match="loading must be"):
+        response(surf, MAT, {"delta": 1e-7})
+    with pytest.raises(InputError, match="load control"):
+        response(surf, MAT, Loading(mean_pressure=1e5), method="fem")
+    with pytest.raises(InputError, match="1D profile"):
+        response(Surface(np.ones((4, 4)), 1.0), MAT, method="fem")
+
+
+def _bem_result():
+    surf = Surface(np.cos(np.linspace(0, 2 * np.pi, 64, endpoint=False)) * 1e-6, 1e-3,
+                   periodic=True)
+    return bem.solve_contact(surf, MAT, delta=4e-7), surf
+
+
+def test_success_is_computed_from_residual_and_tolerance():
+    r, _ = _bem_result()
+    assert r.success and r.residual <= r.tolerance
+    init = {f.name: getattr(r, f.name) for f in dataclasses.fields(r) if f.init}
+    with pytest.raises(TypeError):
+        ContactResult(**init, success=True)
+    worse = ContactResult(**{**init, "residual": 2 * r.tolerance, "pressure": r.pressure.copy()})
+    assert not worse.success
+
+
+def test_optional_field_is_one_line():
+    """The mechanism the module docstring promises: one optional field line in the result
+    classes, and it reaches scalars(), the sweep arrays and the results.json records."""
+    @dataclasses.dataclass(frozen=True, eq=False)
+    class Result(ContactResult):
+        plastic_area_fraction: Optional[float] = None
+
+    @dataclasses.dataclass(frozen=True, eq=False)
+    class Sweep(SweepResult):
+        plastic_area_fraction: Optional[np.ndarray] = None
+
+    r, surf = _bem_result()
+    init = {f.name: getattr(r, f.name) for f in dataclasses.fields(r) if f.init}
+    steps = [Result(**init, plastic_area_fraction=v) for v in (0.1, 0.2)]
+    sweep = Sweep.from_results(steps, rms_slope=1.0, length=1e-3)
+    np.testing.assert_array_equal(sweep.plastic_area_fraction, [0.1, 0.2])
+    assert not sweep.plastic_area_fraction.flags.writeable
+    assert steps[0].scalars()["plastic_area_fraction"] == 0.1
+    assert sweep.to_records()[1]["plastic_area_fraction"] == 0.2
+    # a step without the value: no array, and the records of the BEM stay as they were
+    mixed = Sweep.from_results([steps[0], Result(**init)], rms_slope=1.0, length=1e-3)
+    assert mixed.plastic_area_fraction is None
+    assert tuple(mixed.to_records()[1]) == RECORD_KEYS
+
+
+@pytest.mark.fem
+def test_fem_fields_are_an_immutable_mapping():
+    pytest.importorskip("dolfinx")
+    prof = cosine_half_period(17)
+    r = response(prof, MAT, Loading(delta=0.5 * G), method="fem", keep_fields=(0,),
+                 growth=0.5).results[0]
+    assert isinstance(r.fields, MappingProxyType)
+    with pytest.raises(TypeError):
+        r.fields["points"] = None
+    assert not r.fields["stress_yy"].flags.writeable
