@@ -1,6 +1,7 @@
 """The one-way data flow of STYLE.md (a): packages import only leftward.
 
-surfaces -> model -> theory -> bem -> fem -> response -> leakage -> genomics -> study -> plotting -> cli
+surfaces -> model -> theory -> bem -> fem -> response -> leakage -> genomics -> study
+-> plotting -> cli
 (errors, writers and reference are the base layer, importable from anywhere; model.py
 holds the contract types shared by bem and fem, response.py the one dispatch to them.)
 dolfinx, petsc4py, mpi4py.futures aside, gmsh and ufl are imported only inside roughfe/fem.
