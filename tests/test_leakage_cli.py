@@ -38,7 +38,7 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
     assert steps[1]["free_volume_star"] < steps[0]["free_volume_star"]
     assert steps[1]["leak_rate"] < steps[0]["leak_rate"]
     with np.load(out / "fields" / "step_000.npz") as f:
-        assert f["gap"].shape == s.shape and f["fluid_pressure_x"].shape == (18, 18)
+        assert f["gap"].shape == s.shape and f["fluid_pressure_x"].shape == s.shape
         assert f["flux_x"].shape == s.shape + (2,) and "flux_y" not in f
         assert not (f["percolating"] & f["trapped"]).any()
     for name in ("step_000_network.png", "step_001_pressure_x.png", "step_000_flux_x.png",

@@ -66,7 +66,8 @@ def convergence(ns=(32, 64, 128, 256)):
     fe, fv = [], []
     for n in ns:
         sp = (L / n, L / n)
-        fe.append(reynolds_flow(smooth_gap(n), sp, mu=MU, pressure_drop=DP).leak_rate)
+        fe.append(reynolds_flow(smooth_gap(n), sp, mu=MU, pressure_drop=DP,
+                                scheme="fe").leak_rate)
         fv.append(finite_volume_leak_rate(smooth_gap(n), sp, mu=MU, pressure_drop=DP))
     fe, fv = np.array(fe), np.array(fv)
     order = lambda q: float(np.log2(abs(q[-2] - q[-3]) / abs(q[-1] - q[-2])))  # noqa: E731
@@ -87,7 +88,8 @@ def rough_cases(m=7, seeds=(1, 2, 3), fractions=(1 / 6, 2 / 6, 3 / 6)):
             net = free_volume_network(gap, c.contact, s.spacing, sigma=c.rms_height)
             for d in ("x", "y"):
                 t0 = time.perf_counter()
-                r = reynolds_flow(gap, s.spacing, direction=d, mu=MU, pressure_drop=DP)
+                r = reynolds_flow(gap, s.spacing, direction=d, mu=MU, pressure_drop=DP,
+                                  scheme="fe")
                 t_fe = time.perf_counter() - t0
                 q_fv = finite_volume_leak_rate(gap, s.spacing, direction=d, mu=MU,
                                                pressure_drop=DP)

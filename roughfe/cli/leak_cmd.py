@@ -7,7 +7,7 @@ per step), ``fields/step_NNN.npz`` and figures.
 
 ``leak-study`` runs the study of Sec. 2.4.2-2.4.5 (RMD surfaces, D x m x replicas) on
 the resumable study runner (``roughfe study``), then writes ``summary.json`` (means,
-standard deviations, Eq. 2.17 fits, Q1-vs-saddle percolation disagreements) and the
+standard deviations, Eq. 2.17 fits, network-vs-Reynolds percolation disagreements) and the
 figures.
 """
 from __future__ import annotations
@@ -90,7 +90,7 @@ def _leak(args) -> int:
         for d, flow in lk.flows.items():
             written.append(figs.pressure_map(
                 flow.pressure, surface.size, out / "figures" / f"step_{k:03d}_pressure_{d}.png",
-                title=f"Reynolds pressure (Pa), flow along {d}\n{tag}"))
+                title=f"Reynolds pressure (Pa), flow along {d}\n{tag}", at=flow.pressure_at))
             written.append(figs.flux_map(
                 flow.flux_magnitude, surface.size, out / "figures" / f"step_{k:03d}_flux_{d}.png",
                 title=f"flux magnitude (m^2/s), flow along {d}\nleak rate Q = {flow.leak_rate:.3e} m^3/s"))
@@ -132,7 +132,7 @@ def _leak_study(args) -> int:
     paths = [] if args.no_figures else figs.study_figures(result, out / "figures")
     perc = result["percolation"]
     print(f"{len(rows)} step records from {spec.n_tasks - missing} surfaces; "
-          f"Q1 vs saddle-rule percolation disagree in {perc['n_disagree']}/{perc['n_compared']}")
+          f"network and Reynolds percolation disagree in {perc['n_disagree']}/{perc['n_compared']}")
     for f in result["fits"]:
         g = "-" if f["g"] is None else f"{f['g']:.3f}"
         b = "-" if f["beta"] is None else f"{f['beta']:.3f}"

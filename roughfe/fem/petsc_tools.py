@@ -14,6 +14,8 @@ import tempfile
 from pathlib import Path
 from typing import Mapping
 
+import numpy as np
+
 from ..errors import NoConvergenceError
 
 _COUNTER = itertools.count()
@@ -89,3 +91,62 @@ def check_snes(snes, what: str, result=None) -> int:
             f"{what}: PETSc SNES did not converge: reason {name} ({reason}) after {nit} "
             f"iterations, residual norm {snes.getFunctionNorm():.3e}", result=result)
     return nit
+
+
+#: CG + BoomerAMG (hypre): the default for the symmetric positive definite Reynolds
+#: systems (FE and FV). rtol 1e-10 relative to the right-hand side.
+CG_AMG = {"ksp_type": "cg", "pc_type": "hypre", "pc_hypre_type": "boomeramg",
+          "ksp_rtol": 1e-10, "ksp_atol": 0.0, "ksp_max_it": 2000}
+
+
+def petsc_aij(matrix):
+    """A scipy sparse matrix as a sequential PETSc AIJ matrix (values copied)."""
+    from petsc4py import PETSc
+
+    m = matrix.tocsr()
+    m.sort_indices()
+    return PETSc.Mat().createAIJ(
+        size=m.shape, csr=(m.indptr.astype(PETSc.IntType), m.indices.astype(PETSc.IntType),
+                           m.data.astype(PETSc.ScalarType)), comm=PETSc.COMM_SELF)
+
+
+def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None):
+    """Solve ``A x = b`` with a PETSc KSP; options under a unique prefix.
+
+    Parameters
+    ----------
+    matrix : petsc4py.PETSc.Mat or scipy.sparse matrix
+        The operator (a scipy matrix is copied into PETSc AIJ and destroyed afterwards).
+    rhs : ndarray
+        Right-hand side.
+    name : str
+        Options prefix stem and the name in messages.
+    options : mapping, optional
+        PETSc options overriding :data:`CG_AMG`.
+
+    Returns
+    -------
+    (ndarray, int, bool, str)
+        Solution, iterations, converged flag and a one-line report (KSP/PC type, PETSc
+        converged reason, iterations, residual norm).
+    """
+    from petsc4py import PETSc
+
+    own = not isinstance(matrix, PETSc.Mat)
+    A = petsc_aij(matrix) if own else matrix
+    b = A.createVecLeft()
+    b.setArray(np.asarray(rhs, dtype=PETSc.ScalarType))
+    x = A.createVecRight()
+    ksp = PETSc.KSP().create(PETSc.COMM_SELF)
+    ksp.setOperators(A)
+    apply_options(ksp, unique_prefix(name), {**CG_AMG, **dict(options or {})})
+    ksp.solve(b, x)
+    reason = ksp.getConvergedReason()
+    nit = int(ksp.getIterationNumber())
+    message = (f"KSP {ksp.getType()}/{ksp.getPC().getType()} "
+               f"{reason_name(PETSc.KSP.ConvergedReason, reason)} in {nit} iterations, "
+               f"residual norm {ksp.getResidualNorm():.3e}")
+    out = x.array.copy()
+    for obj in (ksp, x, b) + ((A,) if own else ()):
+        obj.destroy()
+    return out, nit, reason > 0, message

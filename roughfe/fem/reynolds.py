@@ -61,16 +61,9 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
-from .petsc_tools import apply_options, reason_name, unique_prefix
+from .petsc_tools import CG_AMG, ksp_solve, petsc_aij
 
-DEFAULT_PETSC_OPTIONS = {
-    "ksp_type": "cg",
-    "pc_type": "hypre",
-    "pc_hypre_type": "boomeramg",
-    "ksp_rtol": 1e-10,
-    "ksp_atol": 0.0,
-    "ksp_max_it": 2000,
-}
+DEFAULT_PETSC_OPTIONS = CG_AMG
 
 
 @dataclass(frozen=True, eq=False)
@@ -206,15 +199,6 @@ def vertex_components(open_cells: np.ndarray, *, periodic_axis: Optional[int] = 
     return labels.reshape(nx + 1, ny + 1)
 
 
-def _petsc_aij(matrix: sp.csr_matrix):
-    from petsc4py import PETSc
-    m = matrix.tocsr()
-    m.sort_indices()
-    return PETSc.Mat().createAIJ(
-        size=m.shape, csr=(m.indptr.astype(PETSc.IntType), m.indices.astype(PETSc.IntType),
-                           m.data.astype(PETSc.ScalarType)), comm=PETSc.COMM_SELF)
-
-
 def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
                       p_in: float = 1.0, p_out: float = 0.0, periodic: bool = False,
                       wall_velocity=(0.0, 0.0), h_min: float = 0.0,
@@ -344,24 +328,12 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     p_dof = lift.copy()
     nit, success, message = 0, True, "nothing to solve: every pressure unknown is fixed"
     if n_red > 0:
-        Pm = _petsc_aij(P)
+        Pm = petsc_aij(P)
         Kr = K.PtAP(Pm)
-        rhs = Kr.createVecLeft()
-        rhs.setArray(P.T @ rhs_full)
-        x = Kr.createVecRight()
-        ksp = PETSc.KSP().create(PETSc.COMM_SELF)
-        ksp.setOperators(Kr)
-        apply_options(ksp, unique_prefix("reynolds"),
-                      {**DEFAULT_PETSC_OPTIONS, **dict(petsc_options or {})})
-        ksp.solve(rhs, x)
-        reason = ksp.getConvergedReason()
-        nit = int(ksp.getIterationNumber())
-        success = reason > 0
-        message = (f"KSP {ksp.getType()}/{ksp.getPC().getType()} "
-                   f"{reason_name(PETSc.KSP.ConvergedReason, reason)} in {nit} iterations, "
-                   f"residual norm {ksp.getResidualNorm():.3e}")
-        p_dof = lift + P @ x.array
-        for obj in (ksp, x, rhs, Kr, Pm):
+        x, nit, success, message = ksp_solve(Kr, P.T @ rhs_full, name="reynolds",
+                                             options=petsc_options)
+        p_dof = lift + P @ x
+        for obj in (Kr, Pm):
             obj.destroy()
     # full residual r = K p - b (flux into the domain at inlet/outlet vertices)
     Kl.setArray(p_dof)

@@ -75,7 +75,7 @@ def leakage_task(D: float, m: int, seed: int, n_steps: int = 6, L: float = 1.0e-
         mean_pressure, area_fraction, mean_plane_separation, separation_star (d/sigma),
         m0_star, m2_star`` and the fields of :meth:`LeakageResult.record`
         (``free_volume_star``, ``percolating_volume_star``, ``trapped_volume_star``,
-        ``percolates_x/y``, ``percolates_q1_x/y``, ``leak_rate``, ...).
+        ``percolates_x/y``, ``percolates_reynolds_x/y``, ``leak_rate``, ...).
     """
     n_steps = int(n_steps)
     if n_steps < 1:
@@ -144,8 +144,9 @@ def summarise(records: Iterable[dict]) -> dict:
         ``beta`` of ``V_np* = (V*)^beta`` (Eq. 2.17, Fig. 24; the thesis writes the
         dimensional ``V_np``, which cannot be a power of a dimensionless number: we use
         ``V_np*``) with the thesis' approximation ``1 - beta/10`` beside ``g``;
-        ``percolation`` -- how often the network (saddle rule) and the Q1 finite
-        elements (corner conduction) disagree on "percolates".
+        ``percolation`` -- how often the network (its corner rule) and the Reynolds
+        scheme disagree on "percolates" (never with the defaults: FV and
+        ``corner_rule="closed"``).
     """
     records = list(records)
     if not records:
@@ -174,7 +175,7 @@ def summarise(records: Iterable[dict]) -> dict:
     disagreements = []
     for r in records:
         for d in ("x", "y"):
-            a, b = r.get(f"percolates_{d}"), r.get(f"percolates_q1_{d}")
+            a, b = r.get(f"percolates_{d}"), r.get(f"percolates_reynolds_{d}")
             if a is None or b is None:
                 continue
             n_cmp += 1
@@ -182,7 +183,7 @@ def summarise(records: Iterable[dict]) -> dict:
                 n_dis += 1
                 disagreements.append({"D": r["D"], "m": r["m"], "seed": r.get("seed"),
                                       "step": r["step"], "direction": d,
-                                      "network": bool(a), "q1": bool(b)})
+                                      "network": bool(a), "reynolds": bool(b)})
     return {"n_records": len(records), "curves": curves, "fits": fits,
             "percolation": {"n_compared": n_cmp, "n_disagree": n_dis,
                             "fraction_disagree": (n_dis / n_cmp) if n_cmp else None,

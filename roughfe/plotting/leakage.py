@@ -102,14 +102,19 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
                        f"red: trapped ({n_t})", path, size)
 
 
-def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)"):
-    """Q1 nodal pressure (NaN where undetermined: grey)."""
+def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="cells"):
+    """Fluid pressure per cell (``at="cells"``, FV) or at the cell corners (``"nodes"``,
+    Q1 FE); NaN where undetermined is grey."""
     if _RENDER_ELSEWHERE:
         return _render_elsewhere("pressure_map", {"pressure": pressure}, size=list(size),
-                                 path=str(path), title=title)
+                                 path=str(path), title=title, at=at)
     p = np.asarray(pressure, float)
-    img = _image((p.shape[0] - 1, p.shape[1] - 1), size)
-    img.point_data["p (Pa)"] = p.ravel(order="F")
+    if at == "cells":
+        img = _image(p.shape, size)
+        img.cell_data["p (Pa)"] = _cells(p)
+    else:
+        img = _image((p.shape[0] - 1, p.shape[1] - 1), size)
+        img.point_data["p (Pa)"] = p.ravel(order="F")
     pl = offscreen_plotter(window_size=(900, 900))
     pl.add_mesh(img, scalars="p (Pa)", cmap="viridis", nan_color="grey", lighting=False,
                 scalar_bar_args={"vertical": True, "title": "p (Pa)"})
