@@ -37,6 +37,11 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
     assert steps[1]["area_fraction"] > steps[0]["area_fraction"]
     assert steps[1]["free_volume_star"] < steps[0]["free_volume_star"]
     assert steps[1]["leak_rate"] < steps[0]["leak_rate"]
+    # Persson's theory beside every step (A*, mean gap, critical-junction leak rate)
+    for st in steps:
+        assert 0 < st["persson_area_fraction"] <= 1 and st["persson_mean_gap"] > 0
+        assert st["persson_leak_rate"] >= 0
+    assert res["persson"]["percolation_threshold"] == 0.42
     with np.load(out / "fields" / "step_000.npz") as f:
         assert f["gap"].shape == s.shape and f["fluid_pressure_x"].shape == s.shape
         assert f["flux_x"].shape == s.shape + (2,) and "flux_y" not in f

@@ -10,7 +10,7 @@ from roughfe.surfaces import stats
 from roughfe.surfaces.spectral import spectral_profile, spectral_surface
 from roughfe.surfaces.stats import PowerSpectrum
 from roughfe.surfaces.surface import Surface
-from roughfe.theory import KAPPA_PERSSON, area_fraction, critical_junction, persson
+from roughfe.theory import KAPPA_PERSSON, area_fraction, beside, critical_junction, persson
 
 E_STAR = 1e9
 
@@ -178,3 +178,18 @@ def test_bad_input_critical_junction(surface):
         persson(Surface(np.zeros((8, 8)), 1e-3, periodic=True), E_STAR, 1e6)
     with pytest.raises(InputError, match="Surface or PowerSpectrum"):
         persson([1, 2], E_STAR, 1e6)
+
+
+def test_beside_adds_the_theory_to_step_records(surface):
+    gbar = stats.rms_slope(surface)
+    steps = [{"mean_pressure": 0.0, "x": 1}, {"mean_pressure": 0.05 * E_STAR * gbar, "x": 2}]
+    doc = beside(surface, E_STAR, steps, pressure_drop=1e5, viscosity=1e-3)
+    first, second = doc["steps"]
+    assert first["persson_area_fraction"] is None and first["persson_leak_rate"] is None
+    assert first["x"] == 1 and "persson_mean_gap" not in steps[0]     # copies, inputs intact
+    r = persson(surface, E_STAR, steps[1]["mean_pressure"])
+    assert second["persson_area_fraction"] == r.area_fraction[0]
+    assert second["persson_mean_gap"] == r.mean_gap[0]
+    cj = critical_junction(surface, E_STAR, steps[1]["mean_pressure"], 1e5, 1e-3)
+    assert second["persson_leak_rate"] == pytest.approx(cj.leak_rate, rel=1e-12)
+    assert doc["persson"]["u0"] == pytest.approx(r.u0)

@@ -1,8 +1,10 @@
 """``roughfe contact SURFACE --E .. --nu .. (--steps N | --pressure P .. | --delta D ..) -o DIR``
 
 Runs one warm-started BEM contact sweep (:func:`roughfe.bem.contact_sweep`) and writes
-``results.json``, ``fields.h5`` and the figures (A(p), K(p); a 3D render of the last
-step for surfaces, a profile plot for profiles).
+``results.json``, ``fields.h5`` and the figures (A(p), K(p), mean gap, with Persson's
+theory beside the BEM curves; a 3D render of the last step for surfaces, a profile plot
+for profiles). Each step record carries ``persson_area_fraction`` and
+``persson_mean_gap`` (:func:`roughfe.theory.beside`).
 """
 from __future__ import annotations
 
@@ -12,7 +14,9 @@ import numpy as np
 
 from ..bem import KERNELS, Material, contact_sweep
 from ..bem.contact import SOLVERS
-from ..bem.output import write_fields_h5, write_results_json
+from ..bem.output import sweep_document, write_fields_h5, write_results_json
+from ..theory import beside
+from ..writers import write_json
 from .common import add_surface_options, surface_from_args
 
 
@@ -66,11 +70,14 @@ def _run(args) -> int:
               "control": "pressure" if args.pressure else "delta",
               "detrend": args.detrend,
               "metadata": dict(surface.metadata)}
-    write_results_json(out / "results.json", sweep, inputs)
+    doc = sweep_document(sweep, inputs)
+    theory = beside(surface, material.E_star, doc["steps"])
+    doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
+    write_json(out / "results.json", doc)
     write_fields_h5(out / "fields.h5", sweep)
     if not args.no_figures:
         from ..plotting.contact import plot_area_stiffness, plot_profile_state, render_contact
-        plot_area_stiffness(sweep.to_records(), out / "contact_area_stiffness.png",
+        plot_area_stiffness(doc["steps"], out / "contact_area_stiffness.png",
                             title=f"{Path(args.surface).name}, E* = {material.E_star:.4g} Pa",
                             rms_height=sweep.rms_height)
         last = sweep.results[-1]

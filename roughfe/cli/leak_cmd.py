@@ -22,6 +22,7 @@ from ..bem import Material
 from ..errors import InputError
 from ..leakage import leakage_sweep
 from ..leakage.study import THESIS_D, THESIS_M, study_grid, summarise
+from ..theory import beside
 from ..writers import atomic_path, write_json
 from .common import add_surface_options, surface_from_args
 
@@ -68,7 +69,9 @@ def _leak(args) -> int:
                           direction=args.direction, mu=args.mu,
                           pressure_drop=args.pressure_drop, reynolds=not args.no_reynolds)
     out = Path(args.output)
-    steps = sweep.records()
+    theory = beside(surface, material.E_star, sweep.records(), pressure_drop=args.pressure_drop,
+                    viscosity=args.mu)
+    steps = theory["steps"]
     inputs = {"surface": str(args.surface), "shape": list(surface.shape),
               "size": list(surface.size), "periodic": surface.periodic,
               "surface_metadata": dict(surface.metadata),
@@ -77,7 +80,8 @@ def _leak(args) -> int:
               "delta": args.delta, "pressure": args.pressure,
               "units": "SI (m, Pa, Pa s, m^3/s)",
               "references": list(sweep.leakages[0].references)}
-    write_json(out / "results.json", {"inputs": inputs, "steps": steps})
+    write_json(out / "results.json", {"inputs": inputs, "steps": steps,
+                                      "persson": theory["persson"]})
     written = [out / "results.json"]
     for k, (c, lk) in enumerate(zip(sweep.contacts, sweep.leakages)):
         written.append(_save_fields(out / "fields" / f"step_{k:03d}.npz", c, lk))

@@ -16,9 +16,18 @@ def _column(steps, key):
     return np.array([np.nan if s[key] is None else s[key] for s in steps], float)
 
 
+def _theory(steps, key):
+    """The Persson column ``key`` when the records carry it (else None)."""
+    if not any(s.get(key) is not None for s in steps):
+        return None
+    return np.array([np.nan if s.get(key) is None else s[key] for s in steps], float)
+
+
 def plot_area_stiffness(steps, path, title=None, rms_height=None):
-    """A*(p) and K(p) (exact incremental and central finite differences), log-log, and
-    with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8).
+    """A*(p), K(p) (exact incremental and central finite differences) and the mean gap
+    u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8). Records
+    with ``persson_area_fraction`` / ``persson_mean_gap`` (:func:`roughfe.theory.beside`)
+    get Persson's curves drawn beside the BEM points.
 
     Parameters
     ----------
@@ -33,18 +42,33 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None):
     a = _column(steps, "area_fraction")
     k = _column(steps, "stiffness") * MPA * 1e-6      # MPa/um
     kfd = _column(steps, "stiffness_fd") * MPA * 1e-6
-    ncol = 2 if rms_height is None else 3
+    ncol = 3 if rms_height is None else 4
     fig, axes = new_figure(1, ncol, figsize=(5 * ncol, 4))
-    ax1, ax2 = axes[0], axes[1]
+    ax1, ax2, ax3 = axes[0], axes[1], axes[2]
     if rms_height is not None:
         d = _column(steps, "mean_plane_separation") / rms_height
-        axes[2].plot(d, _column(steps, "free_volume_star"), "o-", ms=4)
-        axes[2].set_xlabel("d / sigma")
-        axes[2].set_ylabel("V* = V / (A_n sigma)")
-        axes[2].set_title("free volume V*(d/sigma), Eq. 2.8")
-        axes[2].grid(True, alpha=0.3)
+        axes[3].plot(d, _column(steps, "free_volume_star"), "o-", ms=4)
+        axes[3].set_xlabel("d / sigma")
+        axes[3].set_ylabel("V* = V / (A_n sigma)")
+        axes[3].set_title("free volume V*(d/sigma), Eq. 2.8")
+        axes[3].grid(True, alpha=0.3)
     ok = p > 0
-    ax1.loglog(p[ok], a[ok], "o-", ms=4)
+    ax1.loglog(p[ok], a[ok], "o", ms=4, label="BEM")
+    a_th = _theory(steps, "persson_area_fraction")
+    if a_th is not None:
+        ax1.loglog(p[ok], a_th[ok], "-", label="Persson (2001)")
+        ax1.legend()
+    gap = _column(steps, "mean_gap") * UM
+    okg = ok & (gap > 0)
+    ax3.semilogx(p[okg], gap[okg], "o", ms=4, label="BEM")
+    u_th = _theory(steps, "persson_mean_gap")
+    if u_th is not None:
+        ax3.semilogx(p[ok], u_th[ok] * UM, "-", label="Persson (2007)")
+        ax3.legend()
+    ax3.set_xlabel("mean pressure p (MPa)")
+    ax3.set_ylabel("mean gap (um)")
+    ax3.set_title("mean interfacial separation u(p)")
+    ax3.grid(True, which="both", alpha=0.3)
     ax1.set_xlabel("mean pressure p (MPa)")
     ax1.set_ylabel("A* = A_r / A_n")
     ax1.set_title("contact area A(p)")

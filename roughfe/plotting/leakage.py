@@ -138,13 +138,16 @@ def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
 
 
 def steps_figure(steps, path):
-    """Leak rate and volumes over the load steps of ``roughfe leak`` (results.json steps)."""
+    """Leak rate and volumes over the load steps of ``roughfe leak`` (results.json steps);
+    with ``persson_leak_rate`` in the records also Lorenz & Persson's critical-junction
+    estimate beside the Reynolds leak rates."""
     a = np.array([s["area_fraction"] for s in steps], float)
     fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
-    for d, mk in (("x", "o-"), ("y", "s--")):
-        q = [s.get(f"leak_rate_{d}") for s in steps]
+    for key, mk, label in (("leak_rate_x", "o-", "x"), ("leak_rate_y", "s--", "y"),
+                           ("persson_leak_rate", "k:", "critical junction (Persson)")):
+        q = [s.get(key) for s in steps]
         if any(v is not None for v in q):
-            ax1.semilogy(a, [np.nan if v is None or v <= 0 else v for v in q], mk, label=d)
+            ax1.semilogy(a, [np.nan if v is None or v <= 0 else v for v in q], mk, label=label)
     ax1.set_xlabel("A* = A_r / A_n")
     ax1.set_ylabel("leak rate Q (m$^3$/s)")
     ax1.legend(title="flow")

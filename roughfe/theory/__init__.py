@@ -2,14 +2,15 @@
 
 * :func:`persson` -> :class:`PerssonResult`: Persson's A*(p) and mean separation u(p).
 * :func:`critical_junction` -> :class:`CriticalJunction`: Lorenz & Persson's leak rate.
+* :func:`beside`: the theory added to the step records of a simulation (results.json).
 
 Layer: after :mod:`roughfe.surfaces` (it needs only the PSD), before the solvers and
 their consumers, which draw the theory beside their results.
 """
 from .persson import (GAMMA_DEFAULT, KAPPA_PERSSON, PERCOLATION_THRESHOLD, CriticalJunction,
-                      PerssonResult, area_fraction, critical_junction, mean_separation,
-                      persson)
+                      PerssonResult, area_fraction, beside, critical_junction,
+                      mean_separation, persson)
 
-__all__ = ["persson", "PerssonResult", "critical_junction", "CriticalJunction",
+__all__ = ["persson", "beside", "PerssonResult", "critical_junction", "CriticalJunction",
            "area_fraction", "mean_separation", "KAPPA_PERSSON", "GAMMA_DEFAULT",
            "PERCOLATION_THRESHOLD"]

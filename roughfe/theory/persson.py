@@ -347,6 +347,13 @@ class CriticalJunction:
     references: tuple = REFERENCES
 
 
+def _geometry_factor(source) -> float:
+    """Ly/Lx of a surface (flow along x = axis 0); 1 for a bare PSD."""
+    if isinstance(source, Surface) and source.ndim == 2:
+        return source.size[1] / source.size[0]
+    return 1.0
+
+
 def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *,
                       geometry_factor=None, threshold=PERCOLATION_THRESHOLD,
                       gamma=GAMMA_DEFAULT) -> CriticalJunction:
@@ -381,7 +388,7 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
         raise InputError("critical_junction needs a surface (2D): on a profile any contact "
                          "point seals the flow")
     if geometry_factor is None:
-        geometry_factor = (source.size[1] / source.size[0]) if isinstance(source, Surface) else 1.0
+        geometry_factor = _geometry_factor(source)
     geometry_factor = check_finite_positive("geometry_factor Ly/Lx", geometry_factor)
     threshold = check_in_open_interval("threshold A_c", threshold, 0.0, 1.0)
     dp = check_finite_positive("pressure_drop (Pa)", pressure_drop)
@@ -412,3 +419,53 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
     leak = geometry_factor * dp / eta * u_c ** 3 / 12.0
     return CriticalJunction(q_c=q_c, area_fraction_c=a_c, pressure_c=p_c, u_c=u_c,
                             leak_rate=leak, sealed=False, **common)
+
+
+def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None,
+           gamma=GAMMA_DEFAULT) -> dict:
+    """Persson's theory at the mean pressure of each simulation step (results.json).
+
+    Parameters
+    ----------
+    source : Surface or PowerSpectrum
+    e_star : float
+        E* (Pa).
+    steps : list of dict
+        Step records with ``mean_pressure`` (Pa).
+    pressure_drop, viscosity : float, optional
+        Delta P (Pa) and eta (Pa s): add the critical-junction leak rate (surfaces).
+    gamma : float
+        As in :func:`persson`.
+
+    Returns
+    -------
+    dict
+        ``"steps"``: copies of ``steps`` with ``persson_area_fraction`` (-),
+        ``persson_mean_gap`` (m) and, with ``pressure_drop``, ``persson_leak_rate``
+        (m^3/s) added; steps with no positive finite pressure get None (no theory at zero
+        load). ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
+        percolation threshold, units, references).
+    """
+    psd = _spectrum(source)
+    pressures = [s.get("mean_pressure") for s in steps]
+    ok = [p is not None and np.isfinite(p) and p > 0 for p in pressures]
+    theory = persson(psd, e_star, [p for p, k in zip(pressures, ok) if k] or [1.0],
+                     gamma=gamma)
+    out, j = [], 0
+    for step, p, k in zip(steps, pressures, ok):
+        rec = dict(step)
+        rec["persson_area_fraction"] = float(theory.area_fraction[j]) if k else None
+        rec["persson_mean_gap"] = float(theory.mean_gap[j]) if k else None
+        if pressure_drop is not None:
+            rec["persson_leak_rate"] = (critical_junction(
+                psd, e_star, float(p), pressure_drop, viscosity, gamma=gamma,
+                geometry_factor=_geometry_factor(source)).leak_rate if k else None)
+        j += k
+        out.append(rec)
+    info = {"gamma": theory.gamma, "kappa": theory.kappa, "rms_gradient": theory.rms_gradient,
+            "u0": theory.u0, "units": {"persson_mean_gap": "m", "u0": "m",
+                                       "persson_leak_rate": "m^3/s"},
+            "references": list(REFERENCES)}
+    if pressure_drop is not None:
+        info["percolation_threshold"] = PERCOLATION_THRESHOLD
+    return {"steps": out, "persson": info}
