@@ -19,6 +19,7 @@ from typing import Optional
 
 import numpy as np
 
+from ..caching import MB, bytes_bounded_cache
 from ..errors import InputError, NoConvergenceError
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
@@ -41,14 +42,35 @@ REFERENCES = (
 
 
 # -- cached operators ---------------------------------------------------------------------
-@functools.lru_cache(maxsize=16)
+#: Memory budgets of the operator caches (bytes of the arrays kept). A sweep reuses one
+#: operator, its preconditioner and (dense solvers) its matrix: the budgets keep a few
+#: of them; larger ones (a 2048^2 surface's operator, a dense matrix of more than ~5800
+#: points) are rebuilt per solve instead of being pinned for the life of the process.
+OPERATOR_CACHE_BYTES = 256 * MB
+DENSE_CACHE_BYTES = 256 * MB
+
+
+def _operator_key(op: InfluenceOperator) -> tuple:
+    return op.name, op.shape, op.spacing, op.e_star
+
+
+def _read_only(*arrays):
+    for a in arrays:
+        a.setflags(write=False)
+
+
+@bytes_bounded_cache(OPERATOR_CACHE_BYTES)
 def _operator(shape, size, e_star, kernel) -> InfluenceOperator:
-    return influence_operator(shape, size, e_star, kernel)
+    op = influence_operator(shape, size, e_star, kernel)
+    _read_only(op.kernel, op.spectrum)
+    return op
 
 
-@functools.lru_cache(maxsize=16)
+@bytes_bounded_cache(OPERATOR_CACHE_BYTES, key=_operator_key)
 def _inverse_spectrum(op: InfluenceOperator) -> np.ndarray:
-    return op.inverse_spectrum()
+    spec = op.inverse_spectrum()
+    _read_only(spec)
+    return spec
 
 
 def _preconditioner(op: InfluenceOperator):
@@ -56,9 +78,11 @@ def _preconditioner(op: InfluenceOperator):
     return functools.partial(op.convolve_spectrum, spectrum=_inverse_spectrum(op))
 
 
-@functools.lru_cache(maxsize=4)
+@bytes_bounded_cache(DENSE_CACHE_BYTES, key=_operator_key)
 def _dense(op: InfluenceOperator) -> np.ndarray:
-    return op.dense()
+    H = op.dense()
+    _read_only(H)
+    return H
 
 
 def _choose_kernel(surface: Surface, kernel: str) -> str:

@@ -234,6 +234,11 @@ class _ContactProblem:
         self.upper.set(PETSc.INFINITY)
         return snes
 
+    def destroy(self):
+        """Free the PETSc objects (nothing of this problem outlives its sweep)."""
+        for obj in (self.snes, self.K, self.x, self.y, self.r, self.lower, self.upper):
+            obj.destroy()
+
     # -- one load step ----------------------------------------------------------------
     def solve(self, delta: float, keep_fields: bool = False) -> ContactResult:
         """Solve for the imposed approach ``delta`` (m), from the previous solution."""
@@ -529,7 +534,7 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     except NoConvergenceError as exc:
         raise NoConvergenceError(str(exc), result=results) from None
     finally:
-        problem.snes.destroy()
+        problem.destroy()
     return SweepResult.from_results(results, rms_slope=problem.rms_slope, length=pmesh.width)
 
 
