@@ -46,6 +46,10 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
         assert f["gap"].shape == s.shape and f["fluid_pressure_x"].shape == s.shape
         assert f["flux_x"].shape == s.shape + (2,) and "flux_y" not in f
         assert not (f["percolating"] & f["trapped"]).any()
+        # the widest path runs inlet -> outlet through cells no narrower than u_c
+        path = f["widest_path_x"]
+        assert path[0, 0] == 0 and path[-1, 0] == s.shape[0] - 1
+        assert f["gap"][path[:, 0], path[:, 1]].min() == pytest.approx(steps[0]["critical_gap"])
     for name in ("step_000_network.png", "step_001_pressure_x.png", "step_000_flux_x.png",
                  "steps.png"):
         assert (out / "figures" / name).stat().st_size > 5000

@@ -50,6 +50,9 @@ def _save_fields(path, contact, leak):
     for d, flow in leak.flows.items():
         arrays[f"fluid_pressure_{d}"] = flow.pressure
         arrays[f"flux_{d}"] = flow.flux
+    for d, con in leak.constrictions.items():
+        arrays[f"widest_path_{d}"] = con.path          # (n, 2) cell indices
+        arrays[f"parent_channel_{d}"] = con.channel
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
             np.savez_compressed(fh, **arrays)
@@ -88,9 +91,14 @@ def _leak(args) -> int:
         if args.no_figures:
             continue
         tag = f"step {k}: A*={c.area_fraction:.3f}, p={c.mean_pressure:.3g} Pa"
-        written.append(figs.network_map(c.gap, lk.network.percolating, lk.network.trapped,
-                                        surface.size, out / "figures" / f"step_{k:03d}_network.png",
-                                        title=f"free-volume network, {tag}"))
+        widest = np.zeros(c.gap.shape, bool)
+        for con in lk.constrictions.values():
+            widest[con.path[:, 0], con.path[:, 1]] = True
+        written.append(figs.network_map(
+            c.gap, lk.network.percolating, lk.network.trapped, surface.size,
+            out / "figures" / f"step_{k:03d}_network.png", title=f"free-volume network, {tag}",
+            widest_path=widest, junctions=[con.position for con in lk.constrictions.values()
+                                           if con.position is not None]))
         for d, flow in lk.flows.items():
             written.append(figs.pressure_map(
                 flow.pressure, surface.size, out / "figures" / f"step_{k:03d}_pressure_{d}.png",

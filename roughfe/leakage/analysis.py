@@ -13,6 +13,7 @@ from typing import Mapping, Optional
 import numpy as np
 
 from ..errors import InputError
+from .junction import CriticalConstriction, critical_constriction
 from .network import NetworkResult, free_volume_network
 from .reynolds import ReynoldsResult, reynolds_flow
 
@@ -47,12 +48,23 @@ class LeakageResult:
         :class:`ReynoldsResult` per flow direction (empty when Reynolds was skipped).
     directions : tuple of str
         Analysed flow directions.
+    constrictions : dict
+        :class:`~roughfe.leakage.junction.CriticalConstriction` per flow direction (the
+        critical gap, junction, width and parent channel; empty when not computed).
+    mu, pressure_drop : float
+        Viscosity (Pa s) and ``p_in - p_out`` (Pa) of the flow problem.
+    size : (float, float)
+        Domain size (m).
     references : tuple of str
     """
 
     network: NetworkResult
     flows: Mapping[str, ReynoldsResult]
     directions: tuple
+    constrictions: Mapping[str, CriticalConstriction]
+    mu: float
+    pressure_drop: float
+    size: tuple
     references: tuple = REFERENCES
 
     @property
@@ -105,6 +117,20 @@ class LeakageResult:
                 else abs(flow.inlet_flow - flow.outlet_flow)
                 / max(abs(flow.inlet_flow), abs(flow.outlet_flow), 1e-300))
             rec[f"reynolds_nit_{d}"] = None if flow is None else flow.nit
+            con = self.constrictions.get(d)
+            for key, val in (con.record() if con is not None else
+                             dict.fromkeys(("critical_gap", "critical_position",
+                                            "critical_width", "parent_channel_length"))).items():
+                rec[f"{key}_{d}"] = val
+            rec[f"leak_rate_critical_junction_{d}"] = (
+                None if con is None else con.leak_rate_junction(
+                    mu=self.mu, pressure_drop=self.pressure_drop,
+                    length=self.size[0 if d == "x" else 1], width=self.size[1 if d == "x" else 0]))
+        # the first analysed direction's constriction, unsuffixed (results.json contract)
+        first = self.directions[0]
+        for key in ("critical_gap", "critical_position", "critical_width",
+                    "parent_channel_length", "leak_rate_critical_junction"):
+            rec[key] = rec[f"{key}_{first}"]
         return rec
 
 
@@ -112,7 +138,7 @@ def analyse_leakage(gap, contact, spacing, *, direction="both", periodic: bool =
                     sigma: Optional[float] = None, mu: float = 1e-3,
                     pressure_drop: float = 1.0, reynolds: bool = True,
                     wall_velocity=(0.0, 0.0), gap_tol: float = 0.0, scheme: str = "fv",
-                    corner_rule: str = "closed",
+                    corner_rule: str = "closed", junction: bool = True,
                     petsc_options: Optional[Mapping] = None) -> LeakageResult:
     """Network (Alg. 1) and Reynolds (Eq. 2.12) analysis of a gap field.
 
@@ -145,6 +171,9 @@ def analyse_leakage(gap, contact, spacing, *, direction="both", periodic: bool =
         Diagonal-only contacts in the network: ``"closed"`` (default) is the connectivity
         of the FV scheme, so network and Reynolds agree on percolation; ``"saddle"`` is
         the thesis' rule (Fig. 13).
+    junction : bool
+        Find the critical constriction per direction
+        (:func:`roughfe.leakage.junction.critical_constriction`).
     petsc_options : mapping, optional
         PETSc options for the Reynolds solve.
     """
@@ -153,12 +182,16 @@ def analyse_leakage(gap, contact, spacing, *, direction="both", periodic: bool =
     net = free_volume_network(g, contact, spacing, directions=dirs, periodic=periodic,
                               sigma=sigma, gap_tol=gap_tol, corner_rule=corner_rule)
     flows = {}
+    h = np.where(net.open, g, 0.0)
     if reynolds:
-        h = np.where(net.open, g, 0.0)
         flows = {d: reynolds_flow(h, spacing, direction=d, mu=mu, pressure_drop=pressure_drop,
                                   periodic=periodic, wall_velocity=wall_velocity,
                                   scheme=scheme, petsc_options=petsc_options) for d in dirs}
-    return LeakageResult(network=net, flows=flows, directions=dirs)
+    cons = ({d: critical_constriction(h, spacing, direction=d, periodic=periodic) for d in dirs}
+            if junction else {})
+    size = (g.shape[0] * float(spacing[0]), g.shape[1] * float(spacing[1]))
+    return LeakageResult(network=net, flows=flows, directions=dirs, constrictions=cons,
+                         mu=float(mu), pressure_drop=float(pressure_drop), size=size)
 
 
 def leakage_of_contact(contact_result, **kwargs) -> LeakageResult:

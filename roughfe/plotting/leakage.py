@@ -66,9 +66,11 @@ def _finish(plotter, title, path, size):
     return save_screenshot(plotter, path)
 
 
-def network_map(gap, percolating, trapped, size, path, *, title="free-volume network"):
+def network_map(gap, percolating, trapped, size, path, *, title="free-volume network",
+                widest_path=None, junctions=None):
     """Gap map with contact black, percolating cells white to blue (by gap) and trapped
-    cells red, like thesis Fig. 16-17.
+    cells red, like thesis Fig. 16-17; optionally the widest path (orange) and the
+    critical junctions (yellow discs).
 
     Parameters
     ----------
@@ -80,11 +82,19 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
         Physical size in m.
     path : path-like
         PNG file.
+    widest_path : ndarray of bool, optional
+        Cells of the widest inlet-outlet path(s) (:mod:`roughfe.leakage.junction`).
+    junctions : sequence of (x, y), optional
+        Junction centres in m.
     """
     if _RENDER_ELSEWHERE:
-        return _render_elsewhere("network_map", {"gap": gap, "percolating": percolating,
-                                                 "trapped": trapped},
-                                 size=list(size), path=str(path), title=title)
+        arrays = {"gap": gap, "percolating": percolating, "trapped": trapped}
+        if widest_path is not None:
+            arrays["widest_path"] = widest_path
+        return _render_elsewhere("network_map", arrays, size=list(size), path=str(path),
+                                 title=title,
+                                 junctions=None if junctions is None else
+                                 [list(map(float, j)) for j in junctions])
     g = np.asarray(gap, float)
     rgb = np.zeros(g.shape + (3,))
     gmax = g[percolating].max() if np.any(percolating) else 1.0
@@ -92,14 +102,22 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
     blue = np.stack([1.0 - 0.85 * t, 1.0 - 0.6 * t, np.ones_like(t)], axis=-1)
     rgb[percolating] = blue[percolating]
     rgb[trapped] = (0.85, 0.1, 0.1)
+    legend = ""
+    if widest_path is not None and np.any(widest_path):
+        rgb[np.asarray(widest_path, bool)] = (1.0, 0.55, 0.0)
+        legend = "\norange: widest path"
     img = _image(g.shape, size)
     img.cell_data["colour"] = (_cells(rgb) * 255).astype(np.uint8)
     pl = offscreen_plotter(window_size=(900, 900))
     pl.add_mesh(img, scalars="colour", rgb=True, show_scalar_bar=False, lighting=False)
+    if junctions:
+        pts = np.array([[x * UM, y * UM, 0.5] for x, y in junctions])
+        pl.add_points(pts, color="yellow", point_size=22, render_points_as_spheres=True)
+        legend += ("  " if legend else "\n") + "yellow: critical junction"
     n_p, n_t, n_c = int(np.sum(percolating)), int(np.sum(trapped)), int(
         g.size - np.sum(percolating) - np.sum(trapped))
     return _finish(pl, f"{title}\nblack: contact ({n_c})  white-blue: percolating ({n_p})  "
-                       f"red: trapped ({n_t})", path, size)
+                       f"red: trapped ({n_t}){legend}", path, size)
 
 
 def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="cells"):

@@ -1,0 +1,99 @@
+"""The critical constriction (thesis Ch. 5): bottleneck gap, junction, width, parent channel.
+
+Checked against brute force (every threshold), against its defining property (the
+junction is a cut cell of {gap >= u_c}), on hand-built channels with known sizes, and
+against the Reynolds solve: the leak rate of a field dominated by one narrow channel is
+the junction formula's.
+"""
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.leakage import analyse_leakage, critical_constriction, reynolds_flow
+from roughfe.leakage.finite_volume import components_reaching
+
+UM = 1e-6
+
+
+def _perc(open_cells, periodic=False):
+    _, a, b = components_reaching(open_cells, periodic=periodic)
+    return bool((a & b).any())
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_critical_gap_is_the_brute_force_bottleneck(periodic):
+    rng = np.random.default_rng(5)
+    n_perc = 0
+    for _ in range(25):
+        g = np.maximum(rng.standard_normal((10, 8)) + 0.3, 0.0) * UM
+        for d, gf in (("x", g), ("y", g.T)):
+            c = critical_constriction(g, (UM, UM), direction=d, periodic=periodic)
+            vals = np.unique(gf[gf > 0])
+            ok = [u for u in vals if _perc(gf >= u, periodic)]
+            assert c.percolates is bool(ok)
+            if not ok:
+                continue
+            n_perc += 1
+            assert c.critical_gap == max(ok)
+            # the junction is a cut cell: without it {gap >= u_c} no longer percolates
+            i, j = c.junction
+            assert g[i, j] == c.critical_gap
+            cut = g.copy()
+            cut[i, j] = 0.0
+            cf = cut if d == "x" else cut.T
+            assert not _perc(cf >= c.critical_gap, periodic)
+            # the path is face-connected, inlet to outlet, its minimum gap is u_c
+            p = c.path
+            axis = 0 if d == "x" else 1
+            assert p[0, axis] == 0 and p[-1, axis] == g.shape[axis] - 1
+            steps = np.abs(np.diff(p, axis=0))
+            if periodic:
+                steps[:, 1 - axis] = np.minimum(steps[:, 1 - axis],
+                                                g.shape[1 - axis] - steps[:, 1 - axis])
+            assert np.all(steps.sum(axis=1) == 1)
+            assert g[p[:, 0], p[:, 1]].min() == c.critical_gap
+    assert n_perc > 15
+
+
+def test_channel_sizes_and_junction_leak_rate():
+    # wide open inlet and outlet reservoirs (gap 10 um) joined by one straight channel
+    # 3 cells wide, 6 cells long, gap 1 um, with a 0.6 um throat in its middle
+    nx, ny = 20, 15
+    g = np.zeros((nx, ny))
+    g[:7], g[13:] = 10 * UM, 10 * UM
+    g[7:13, 6:9] = 1 * UM
+    g[10, 6:9] = 0.6 * UM
+    c = critical_constriction(g, (UM, 2 * UM))
+    assert c.critical_gap == 0.6 * UM and c.junction[0] == 10
+    assert c.width == pytest.approx(3 * 2 * UM)                 # 3 cells of dy = 2 um
+    assert c.parent_channel_length == pytest.approx(6 * UM)     # 6 cells of dx = 1 um
+    assert c.position[0] == pytest.approx(10.5 * UM)
+    # the same in y (transposed field)
+    cy = critical_constriction(g.T, (2 * UM, UM), direction="y")
+    assert cy.junction == c.junction[::-1] and cy.width == pytest.approx(c.width)
+    assert cy.parent_channel_length == pytest.approx(c.parent_channel_length)
+    # the channel carries all the flow; its resistance is the throat row plus five 1 um
+    # rows (strips in series, 3 cells wide): Reynolds equals that up to the spreading
+    # resistance of the reservoirs (< 1 %), and the junction formula with the channel's
+    # own aspect (width/length) bounds it from above (it ignores the 1 um rows)
+    q = reynolds_flow(g, (UM, 2 * UM), mu=1e-3, pressure_drop=1e3).leak_rate
+    w = 3 * 2 * UM
+    q_series = w * 1e3 / (12e-3) / (UM / (0.6 * UM) ** 3 + 5 * UM / UM ** 3)
+    assert q == pytest.approx(q_series, rel=0.05) and q < q_series
+    q_j = c.leak_rate_junction(mu=1e-3, pressure_drop=1e3, length=UM, width=w)
+    assert q_j > q
+
+
+def test_sealed_field_and_record():
+    g = np.full((6, 6), UM)
+    g[3] = 0.0
+    c = critical_constriction(g, (UM, UM))
+    assert not c.percolates and c.critical_gap is None and c.path.shape == (0, 2)
+    assert c.leak_rate_junction(mu=1e-3, pressure_drop=1.0, length=1, width=1) == 0.0
+    res = analyse_leakage(g, None, (UM, UM), direction="both", mu=1e-3, pressure_drop=1.0)
+    rec = res.record()
+    assert rec["critical_gap_x"] is None and rec["critical_gap_y"] == UM
+    assert rec["critical_gap"] is None                    # first direction: x
+    assert rec["leak_rate_critical_junction_y"] == pytest.approx(UM ** 3 / 12e-3)
+    with pytest.raises(InputError, match="channel_factor"):
+        critical_constriction(g, (UM, UM), channel_factor=0.5)
