@@ -28,11 +28,13 @@ bench: env
 	@bash tools/bootstrap.sh io,design,study,test,bench
 	$(PY) benchmarks/run_all.py
 
-# HTML documentation in docs/_build/html (warnings are errors).
+# HTML documentation in docs/_build/html (warnings are errors); the API, validation and
+# benchmark pages are generated first from the sources and the JSON of validate/bench.
 docs: env
 	@bash tools/bootstrap.sh io,design,study,test,docs
-	rm -rf docs/api/generated
+	$(PY) docs/generate.py
 	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	@echo "open docs/_build/html/index.html"
 
 clean:
-	rm -rf demo-output validation/output benchmarks/output .pytest_cache docs/_build docs/api/generated
+	rm -rf demo-output validation/output benchmarks/output .pytest_cache docs/_build docs/api/generated docs/validation/generated docs/benchmarks/generated

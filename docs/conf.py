@@ -49,10 +49,10 @@ templates_path = ["_templates"]
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist", "attrs_inline"]
 myst_heading_anchors = 3
 
-# API reference: autosummary writes one page per module into api/generated/.
-autosummary_generate = True
+# API reference: docs/generate.py writes one page per module into api/generated/.
+autosummary_generate = False  # docs/generate.py writes the module pages
 autosummary_imported_members = False
-autodoc_default_options = {"members": True, "show-inheritance": True}
+autodoc_default_options = {}  # module pages ask for :members:; package pages do not
 autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types and units
 autodoc_member_order = "bysource"
 numpydoc_show_class_members = False
@@ -102,36 +102,70 @@ _LIST_ITEM = re.compile(r"^\s*([-*+]|\d+\.|\(?[a-z0-9]\))\s")
 _SECTION_ALIASES = {"Fields": "Attributes"}
 
 
-def _escape_bars(line):
-    """Escape ``|`` outside literals and roles (never a substitution in roughfe); keep a
-    ". " inside a literal from ending autosummary's first sentence (U+2024, a one-dot leader)."""
+_EMPHASIS = re.compile(r"(?<![\w*\\])(\*\*?)(?=[^\s*])([^*]*?[^\s*\\])\1(?![\w*])")
+_BULLET = re.compile(r"^(\s*)\* ")
+
+
+def _escape_markup(text):
+    """Escape ``|`` (never a substitution in roughfe) and every ``*`` that is not part of
+    ``*emphasis*``/``**strong**`` (``A*``, ``E*|q|``, ``(n, *shape)`` are plain text)."""
+    parts = _EMPHASIS.split(text)
+    out = []
+    for i in range(0, len(parts), 3):
+        out.append(parts[i].replace("|", r"\|").replace("*", r"\*"))
+        if i + 2 < len(parts):
+            out.append(parts[i + 1] + parts[i + 2].replace("|", r"\|") + parts[i + 1])
+    return "".join(out)
+
+
+def _escape_line(line):
+    """Plain-text markup outside literals and roles; a ". " inside a literal must not end
+    autosummary's first sentence (U+2024, a one-dot leader, looks the same)."""
+    bullet = _BULLET.match(line)
+    head, line = (line[:bullet.end()], line[bullet.end():]) if bullet else ("", line)
     parts = _LITERAL_OR_ROLE.split(line)
-    return "".join(p.replace(". ", "\u2024 ") if i % 2 else p.replace("|", r"\|")
-                   for i, p in enumerate(parts))
+    return head + "".join(p.replace(". ", "\u2024 ") if i % 2 else _escape_markup(p)
+                          for i, p in enumerate(parts))
+
+
+def _indent(line):
+    return len(line) - len(line.lstrip())
 
 
 def _rst_docstring(lines):
-    out = []
-    for i, line in enumerate(lines):
-        line = _escape_bars(line)
-        m = _UNDERLINE.match(line)
-        if m and out and out[-1].strip():
-            title = out[-1]
-            if title.strip() in _SECTION_ALIASES:
-                out[-1] = title.replace(title.strip(), _SECTION_ALIASES[title.strip()])
-                title = out[-1]
-            line = m.group(1) + m.group(2) * len(title.strip())
-        out.append(line)
+    """The docstring lines as valid reStructuredText (see the comment above)."""
+    lines = list(lines)
     # a paragraph ending in ":" followed by a blank line and a deeper-indented block
-    # is a formula or a code block: make it a literal block.
-    for i in range(len(out) - 2):
-        cur, blank, nxt = out[i], out[i + 1], out[i + 2]
+    # (not a list) is a formula or a code block: make it a literal block.
+    for i in range(len(lines) - 2):
+        cur, blank, nxt = lines[i], lines[i + 1], lines[i + 2]
         if (cur.rstrip().endswith(":") and not cur.rstrip().endswith("::")
-                and not blank.strip() and nxt.strip()
-                and len(nxt) - len(nxt.lstrip()) > len(cur) - len(cur.lstrip())
+                and not blank.strip() and nxt.strip() and _indent(nxt) > _indent(cur)
                 and not _LIST_ITEM.match(nxt)
                 and not cur.lstrip().startswith((".. ", ":"))):
-            out[i] = cur.rstrip() + ":"
+            lines[i] = cur.rstrip() + ":"
+    out, literal_indent, doctest = [], None, False
+    for line in lines:
+        if literal_indent is not None:       # inside a literal block: leave verbatim
+            if not line.strip() or _indent(line) > literal_indent:
+                out.append(line)
+                continue
+            literal_indent = None
+        if doctest or line.lstrip().startswith(">>>"):
+            doctest = bool(line.strip())
+            out.append(line)
+            continue
+        m = _UNDERLINE.match(line)
+        if m and out and out[-1].strip():
+            title = out[-1].strip()
+            if title in _SECTION_ALIASES:
+                out[-1] = out[-1].replace(title, _SECTION_ALIASES[title])
+            line = m.group(1) + m.group(2) * len(out[-1].strip())
+        else:
+            line = _escape_line(line)
+        if line.rstrip().endswith("::"):
+            literal_indent = _indent(line)
+        out.append(line)
     return out
 
 

@@ -1,0 +1,78 @@
+"""docs/generate.py: result pages carry the JSON's numbers and verdicts, never invented ones."""
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def gen():
+    spec = importlib.util.spec_from_file_location("docs_generate", ROOT / "docs" / "generate.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _pages(gen, tmp_path, payloads):
+    """Write fake scripts + JSON, run the generator, return {stem: page text}."""
+    scripts, output, pages = tmp_path / "validation", tmp_path / "output", tmp_path / "pages"
+    scripts.mkdir()
+    output.mkdir()
+    for stem, data in payloads.items():
+        (scripts / f"{stem}.py").write_text("")
+        if data is not None:
+            (output / f"{stem}.json").write_text(json.dumps(data))
+    report = gen.write_results(sorted(scripts.glob("*.py")), output, pages, "Validation",
+                               {"alpha": "roughfe validate alpha"})
+    assert len(report) == len(payloads)
+    return {p.stem: p.read_text() for p in pages.glob("*.md")}
+
+
+def test_targets_records_give_values_and_verdicts(gen, tmp_path):
+    data = {"title": "Alpha check", "elapsed_s": 12.5,
+            "targets": [{"name": "width error", "value": 0.0012, "target": 0.005, "met": True,
+                         "unit": "relative"},
+                        {"name": "area error", "value": 0.0912, "target": 0.02, "met": False}],
+            "cases": {"rmd": [{"r": 1, "A": 0.123456789}, {"r": 2, "A": None}]}}
+    page = _pages(gen, tmp_path, {"alpha": data})["alpha"]
+    assert "# Validation: Alpha check" in page
+    assert "1 of 2 met." in page
+    assert "| width error | 0.0012 | 0.005 | relative | met |" in page
+    assert "| area error | 0.0912 | 0.02 | n/a | **NOT met** |" in page
+    assert "| elapsed_s | 12.5 |" in page            # top-level scalar summary
+    assert "## cases / rmd" in page and "| 1 | 0.1235 |" in page and "| 2 | n/a |" in page
+    assert "roughfe validate alpha" in page
+
+
+def test_legacy_flag_maps_are_found_at_any_depth(gen, tmp_path):
+    data = {"checks": {"hertz": True, "line": False},
+            "cases": {"rmd": {"ok_by_target": {"area": False}}},
+            "targets": {"hertz": 0.02}}
+    page = _pages(gen, tmp_path, {"beta": data})["beta"]
+    assert "1 of 3 met." in page
+    assert "| hertz | 0.02 | met |" in page
+    assert "| line | n/a | **NOT met** |" in page
+    assert "| cases.rmd: area | n/a | **NOT met** |" in page
+
+
+def test_missing_json_says_so_and_shows_no_numbers(gen, tmp_path):
+    page = _pages(gen, tmp_path, {"gamma": None})["gamma"]
+    assert "Not run yet" in page and "gamma.json" in page
+    assert "| " not in page and "met" not in page.replace("make docs", "")
+
+
+def test_api_pages_cover_every_public_module(gen, tmp_path):
+    n = gen.write_api(tmp_path)
+    modules = [p for p in (ROOT / "roughfe").rglob("*.py")
+               if not any(part.startswith(("_", ".")) for part in p.relative_to(ROOT).parts)
+               or p.name == "__init__.py"]
+    expected = {".".join(p.relative_to(ROOT).with_suffix("").parts).removesuffix(".__init__")
+                for p in modules
+                if not any(part.startswith(("_", ".")) for part in p.relative_to(ROOT).parts[:-1])}
+    written = {p.stem for p in tmp_path.glob("*.rst")}
+    assert written == expected and n == len(expected)
+    page = (tmp_path / "roughfe.bem.rst").read_text()
+    assert ".. automodule:: roughfe.bem\n" in page and ":members:" not in page  # no re-exports
