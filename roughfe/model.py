@@ -351,6 +351,13 @@ class ContactResult:
         ``"flat"`` or ``"profile"``.
     fields : mapping, FEM
         Full fields for pictures (read-only), see :mod:`roughfe.fem.contact`.
+    plastic_area_fraction : float, BEM with a hardness
+        Fraction of the nominal area at p = H_p (perfectly plastic flow).
+    plastic_displacement : ndarray, BEM with a hardness
+        Permanent displacement u_pl >= 0 (m) of the elastic surface after this step
+        (read-only); kept by the next steps of a sweep.
+    unloading : bool, BEM sweeps with a hardness or ``unload``
+        The branch of the step: False on loading, True on unloading.
     """
 
     pressure: np.ndarray
@@ -388,6 +395,9 @@ class ContactResult:
     layer_compliance: Optional[float] = None
     formulation: Optional[str] = None
     fields: Optional[Mapping[str, Any]] = None
+    plastic_area_fraction: Optional[float] = None
+    plastic_displacement: Optional[np.ndarray] = None
+    unloading: Optional[bool] = None
 
     def __post_init__(self):
         _freeze_fields(self)
@@ -465,6 +475,10 @@ class SweepResult:
     -----------------------------------------------------------
     delta_applied : ndarray, FEM
         Approaches imposed on the finite layer (m).
+    plastic_area_fraction : ndarray, BEM with a hardness
+        Plastic area fraction per step.
+    unloading : ndarray, BEM sweeps with a branch
+        1.0 on the unloading branch, 0.0 on loading.
 
     All arrays are read-only.
     """
@@ -488,6 +502,8 @@ class SweepResult:
     e_star: float
     # -- optional per-step arrays: the ContactResult field of the same name per step --
     delta_applied: Optional[np.ndarray] = None
+    plastic_area_fraction: Optional[np.ndarray] = None
+    unloading: Optional[np.ndarray] = None
 
     def __post_init__(self):
         _freeze_fields(self)

@@ -177,23 +177,23 @@ def test_optional_field_is_one_line():
     classes, and it reaches scalars(), the sweep arrays and the results.json records."""
     @dataclasses.dataclass(frozen=True, eq=False)
     class Result(ContactResult):
-        plastic_area_fraction: Optional[float] = None
+        example_quantity: Optional[float] = None
 
     @dataclasses.dataclass(frozen=True, eq=False)
     class Sweep(SweepResult):
-        plastic_area_fraction: Optional[np.ndarray] = None
+        example_quantity: Optional[np.ndarray] = None
 
     r, surf = _bem_result()
     init = {f.name: getattr(r, f.name) for f in dataclasses.fields(r) if f.init}
-    steps = [Result(**init, plastic_area_fraction=v) for v in (0.1, 0.2)]
+    steps = [Result(**init, example_quantity=v) for v in (0.1, 0.2)]
     sweep = Sweep.from_results(steps, rms_slope=1.0, length=1e-3)
-    np.testing.assert_array_equal(sweep.plastic_area_fraction, [0.1, 0.2])
-    assert not sweep.plastic_area_fraction.flags.writeable
-    assert steps[0].scalars()["plastic_area_fraction"] == 0.1
-    assert sweep.to_records()[1]["plastic_area_fraction"] == 0.2
+    np.testing.assert_array_equal(sweep.example_quantity, [0.1, 0.2])
+    assert not sweep.example_quantity.flags.writeable
+    assert steps[0].scalars()["example_quantity"] == 0.1
+    assert sweep.to_records()[1]["example_quantity"] == 0.2
     # a step without the value: no array, and the records of the BEM stay as they were
     mixed = Sweep.from_results([steps[0], Result(**init)], rms_slope=1.0, length=1e-3)
-    assert mixed.plastic_area_fraction is None
+    assert mixed.example_quantity is None
     assert tuple(mixed.to_records()[1]) == RECORD_KEYS
 
 

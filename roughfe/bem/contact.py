@@ -20,7 +20,7 @@ from typing import Optional
 import numpy as np
 
 from ..caching import MB, bytes_bounded_cache
-from ..errors import InputError, NoConvergenceError
+from ..errors import InputError, NoConvergenceError, check_finite_positive
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
@@ -98,11 +98,18 @@ def _choose_kernel(surface: Surface, kernel: str) -> str:
     return kernel
 
 
-def _choose_solver(n_points: int, op: InfluenceOperator, solver: str) -> str:
+def _choose_solver(n_points: int, op: InfluenceOperator, solver: str,
+                   bounded: bool = False) -> str:
     if solver not in SOLVERS:
         raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
     if solver == "auto":
+        if bounded:   # the dense bounded path is BVLS, which needs a definite operator
+            return "nnls" if n_points <= DENSE_MAX_POINTS and not op.periodic else "pk"
         return "dense" if n_points <= DENSE_MAX_POINTS else "pk"
+    if bounded and solver == "dense":
+        raise InputError("solver 'dense' (block principal pivoting) has no hardness bound; "
+                         "use solver='nnls' (bounded least squares, non-periodic kernels) or "
+                         "'pk'")
     if solver in ("dense", "nnls") and n_points > 8192:
         raise InputError(f"solver {solver!r} would build a dense {n_points} x {n_points} "
                          f"matrix ({8 * n_points ** 2 / 1e9:.1f} GB); use solver='pk' above "
@@ -141,6 +148,30 @@ def _check_target(delta, mean_pressure):
     if not (np.isfinite(pm) and pm > 0):
         raise InputError(f"mean_pressure (Pa) must be finite and > 0, got {mean_pressure!r}")
     return None, pm
+
+
+def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
+    """Validate the hardness (Pa) and a prior plastic displacement (m)."""
+    if hardness is None:
+        if plastic_displacement is not None:
+            raise InputError("plastic_displacement needs a hardness (it is the permanent "
+                             "deformation of a perfectly plastic interface)")
+        return None, None
+    if isinstance(hardness, bool):
+        raise InputError(f"hardness must be a number of Pa > 0, got {hardness!r}")
+    hp = check_finite_positive("hardness (Pa, the pressure cap of the perfectly plastic "
+                               "interface)", hardness)
+    if mean_pressure is not None and not mean_pressure < hp:
+        raise InputError(f"mean_pressure = {mean_pressure:.6g} Pa must be below the hardness "
+                         f"{hp:.6g} Pa (at p = hardness every point is plastic)")
+    if plastic_displacement is not None:
+        up = np.asarray(plastic_displacement, dtype=float)
+        if up.shape != shape:
+            raise InputError(f"plastic_displacement has shape {up.shape}, expected {shape}")
+        if not np.all(np.isfinite(up)) or float(up.min()) < 0:
+            raise InputError("plastic_displacement (m) must be finite and >= 0")
+        plastic_displacement = up
+    return hp, plastic_displacement
 
 
 def _periodic_full_contact(op, h):
@@ -208,10 +239,14 @@ def _stiffness(op, solver, contact, w, scale):
 def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pressure=None,
                   kernel: str = "auto", solver: str = "auto", tol: float = 1e-10,
                   max_iter: Optional[int] = None, initial=None,
-                  compute_stiffness: bool = True) -> ContactResult:
+                  compute_stiffness: bool = True, hardness=None,
+                  plastic_displacement=None) -> ContactResult:
     """Solve the frictionless contact of a rigid rough surface on an elastic half-space.
 
-    Displacement control (``delta``) or load control (``mean_pressure``), Eq. 2.5-2.6.
+    Displacement control (``delta``) or load control (``mean_pressure``), Eq. 2.5-2.6;
+    with a ``hardness`` the interface is perfectly plastic: 0 <= p <= H_p (box
+    constraint; the thesis has no plasticity, this is the Kato-type saturated model of
+    e.g. Almqvist et al. 2007 and Tamaas' ``KatoSaturated``).
 
     Parameters
     ----------
@@ -243,6 +278,16 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         Initial pressure (Pa), e.g. the previous step of a sweep.
     compute_stiffness : bool
         Compute the exact incremental stiffness (one extra solve on the contact set).
+    hardness : float, optional
+        Indentation hardness H_p (Pa), finite and > 0: the pressure cap of a perfectly
+        plastic interface. Points at p = H_p flow: there the rigid surface
+        interpenetrates the elastic one by the plastic (permanent) displacement. With a
+        periodic surface only load control is available; the dense path is bounded
+        least squares (``solver="nnls"``, non-periodic kernels).
+    plastic_displacement : ndarray, optional
+        Permanent displacement (m, >= 0, grid shape) left by an earlier loading, e.g. on
+        the unloading branch of a cycle: the elastic body's surface is recessed by it,
+        so the gap is u + u_pl + max h - h - Delta.
 
     Raises
     ------
@@ -255,13 +300,19 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     if not isinstance(material, Material):
         raise InputError(f"material must be a roughfe.bem.Material, got {material!r}")
     delta, mean_pressure = _check_target(delta, mean_pressure)
+    hardness, plastic = _check_hardness(hardness, mean_pressure, plastic_displacement,
+                                        surface.shape)
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
-    solver = _choose_solver(surface.heights.size, op, solver)
+    solver = _choose_solver(surface.heights.size, op, solver, hardness is not None)
+    if hardness is not None and op.periodic and delta is not None:
+        raise InputError("with a hardness, a periodic surface is solved in load control: "
+                         "give mean_pressure (Pa) instead of delta")
     h = surface.heights
     hmax = float(h.max())
-    b = h - hmax
-    scale = float(np.ptp(h))
+    if plastic is not None:
+        h = h - plastic   # the recessed elastic surface acts as lowered rigid heights
+    scale = float(np.ptp(surface.heights))
     if initial is not None:
         initial = np.asarray(initial, dtype=float)
         if initial.shape != h.shape:
@@ -281,19 +332,22 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 or mean_pressure is not None:
             p0 = _periodic_full_contact(op, h)
             p_full = -float(p0.min())
-            if delta is not None or mean_pressure >= p_full:
+            capped = hardness is not None and float(p0.max()) + max(p_full, mean_pressure
+                                                                    or 0.0) > hardness
+            if (delta is not None or mean_pressure >= p_full) and not capped:
                 level = p_full if delta is not None else mean_pressure
                 p = p0 + level
                 p[p < 0] = 0.0
                 out = SolverOutput(p, h - h.mean(), delta_full, 0, 0.0, "closed form")
     if out is None:
         if solver == "pk" and op.periodic and delta is not None:
-            out = _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter or 20000)
+            out = _periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
+                                        max_iter or 20000)
         elif solver == "pk":
-            out = polonsky_keer(op.apply, b, scale, delta=delta, mean_pressure=mean_pressure,
+            out = polonsky_keer(op.apply, h, scale, delta=delta, mean_pressure=mean_pressure,
                                 initial=initial, diagonal=op.diagonal,
                                 precond=_preconditioner(op), tol=tol,
-                                max_iter=max_iter or 20000)
+                                max_iter=max_iter or 20000, offset=-hmax, hardness=hardness)
         else:
             H = _dense(op)
             if initial is None:
@@ -303,31 +357,52 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                     initial = solve_contact(surface, material, delta=delta,
                                             mean_pressure=mean_pressure, kernel=kernel,
                                             solver="pk", tol=1e-4, compute_stiffness=False,
-                                            max_iter=2000).pressure
+                                            max_iter=2000, hardness=hardness,
+                                            plastic_displacement=plastic).pressure
                 except NoConvergenceError as exc:
                     initial = exc.result.pressure
-            o = dense_solve(H, b.ravel(), scale, delta=delta, mean_pressure=mean_pressure,
-                            initial=initial, method="nnls" if solver == "nnls" else "bpp",
-                            tol=tol, max_iter=max_iter or 100)
+            o = dense_solve(H, (h - hmax).ravel(), scale, delta=delta,
+                            mean_pressure=mean_pressure, initial=initial,
+                            method="nnls" if solver == "nnls" else "bpp", tol=tol,
+                            max_iter=max_iter or 100,
+                            upper=np.inf if hardness is None else hardness)
             out = SolverOutput(o.pressure.reshape(h.shape), o.displacement.reshape(h.shape),
                                o.delta, o.nit, o.residual, solver)
-    return _result(surface, material, op, solver, out, scale, compute_stiffness, tolerance)
+    return _result(surface, material, op, solver, out, scale, compute_stiffness, tolerance,
+                   hardness, plastic)
 
 
-def _result(surface, material, op, solver, out, scale, compute_stiffness, tolerance):
+def _result(surface, material, op, solver, out, scale, compute_stiffness, tolerance,
+            hardness=None, plastic=None):
     h = surface.heights
     p, u, d = out.pressure, out.displacement, out.delta
     w = u + h.max() - h - d
+    if plastic is not None:
+        w += plastic
     # closed-form full contact at the least pressure: one point has p = 0 and g = 0
     contact = p > 0 if out.solver != "closed form" else np.ones(p.shape, bool)
     gap = np.where(contact, 0.0, np.maximum(w, 0.0))
+    plastic_fraction = None
+    if hardness is not None:
+        flowing = p >= hardness
+        plastic_fraction = float(np.count_nonzero(flowing)) / p.size
+        new = np.where(flowing, np.maximum(-w, 0.0), 0.0)
+        plastic = new if plastic is None else plastic + new
+        plastic.setflags(write=False)
+        # the stiffness: saturated points carry a fixed pressure and do not respond
+        stiff_set = contact & ~flowing
+    else:
+        stiff_set = contact
     n = p.size
     nc = int(contact.sum())
     pm = float(p.mean())
     sigma = rms_height(surface)
     A = surface.nominal_area
     mean_gap = float(gap.mean())
-    K = _stiffness(op, solver, contact, w, scale) if compute_stiffness else float("nan")
+    K = float("nan")
+    if compute_stiffness:
+        K = 0.0 if contact.any() and not stiff_set.any() else _stiffness(op, solver, stiff_set,
+                                                                         w, scale)
     return ContactResult(
         pressure=p, displacement=u, gap=gap, contact=contact, delta=float(d),
         load=pm * A, mean_pressure=pm, area_fraction=nc / n,
@@ -340,4 +415,5 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
         kernel=op.name,
         solver=out.solver, e_star=material.E_star, rms_height=sigma,
         size=tuple(surface.size), spacing=tuple(surface.spacing),
-        periodic=op.periodic, references=REFERENCES + op.references, method="bem")
+        periodic=op.periodic, references=REFERENCES + op.references, method="bem",
+        plastic_area_fraction=plastic_fraction, plastic_displacement=plastic)

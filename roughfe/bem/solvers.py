@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 import scipy.optimize
+from scipy.linalg.blas import daxpy
 
 from ..errors import NoConvergenceError
 
@@ -38,14 +39,26 @@ class SolverOutput:
     nit: int
     residual: float
     solver: str
+    n_products: int = 0
 
 
-def kkt_residual(p, w, scale):
-    """Relative KKT residual (see the module docstring); ``scale`` in m."""
+def kkt_residual(p, w, scale, upper=np.inf):
+    """Relative KKT residual (see the module docstring); ``scale`` in m.
+
+    With a finite ``upper`` bound of the pressure (the hardness, Pa) the points at the
+    bound may interpenetrate (w <= 0): there only w > 0 violates complementarity, and
+    the feasibility term counts only points below the bound.
+    """
     sp = float(np.sum(p))
-    comp = float(np.sum(p * np.abs(w))) / (sp * scale) if sp > 0 else 0.0
-    feas = max(0.0, -float(np.min(w))) / scale
-    return max(comp, feas)
+    if not np.isfinite(upper):
+        comp = float(np.sum(p * np.abs(w)))
+        feas = max(0.0, -float(np.min(w)))
+    else:
+        sat = p >= upper
+        comp = float(np.sum(p * np.where(sat, np.maximum(w, 0.0), np.abs(w))))
+        feas = max(0.0, -float(np.min(w, initial=np.inf, where=~sat)))
+    comp = comp / (sp * scale) if sp > 0 else 0.0
+    return max(comp, feas / scale)
 
 
 def _fail(name, nit, res, tol, p, u, delta, solver):
@@ -104,23 +117,38 @@ def lcp_bpp(H, s, passive=None, *, tol=1e-12, max_iter=None):
                              f"{max_iter} exchanges")
 
 
-def lcp_nnls(H, s):
+def lcp_nnls(H, s, upper=np.inf):
     """Bemporad & Paggi (2015): Cholesky H = C'C, then Lawson-Hanson NNLS on
     || C p - C^-T s ||  (scipy.optimize.nnls). Needs H positive definite. scipy does not
-    report its iterations: ``nit`` counts NNLS calls (1)."""
+    report its iterations: ``nit`` counts NNLS calls (1).
+
+    A finite ``upper`` (hardness, Pa) bounds 0 <= p <= upper: the same least-squares
+    problem by Stark & Parker's bounded-variable least squares (BVLS, the bounded
+    Lawson-Hanson active set, ``scipy.optimize.lsq_linear(method="bvls")``).
+    """
     C = scipy.linalg.cholesky(H, lower=False, check_finite=False)
     d = scipy.linalg.solve_triangular(C, s, trans="T", check_finite=False)
+    if np.isfinite(upper):
+        sol = scipy.optimize.lsq_linear(C, d, bounds=(0.0, upper), method="bvls",
+                                        lsq_solver="exact", tol=1e-15,
+                                        max_iter=50 * s.size)
+        p = np.clip(sol.x, 0.0, upper)
+        p[sol.active_mask < 0] = 0.0       # exactly on the bounds BVLS left active
+        p[sol.active_mask > 0] = upper
+        return p, 1
     p, _ = scipy.optimize.nnls(C, d, maxiter=50 * s.size)
     return p, 1
 
 
 def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, method="bpp",
-                tol=1e-10, max_iter=100):
+                tol=1e-10, max_iter=100, upper=np.inf):
     """Dense solve in displacement (``delta``) or load (``mean_pressure``) control.
 
     Load control: the mean pressure P(Delta) is convex and piecewise linear in Delta
     with slope the exact stiffness K(Delta), so Newton's method on Delta (warm-started
-    pivoting at each step) ends in finitely many steps at the exact state.
+    pivoting at each step) ends in finitely many steps at the exact state. With a finite
+    ``upper`` (hardness, Pa; ``method="nnls"`` only) the slope comes from the points
+    strictly between the bounds (the saturated ones no longer respond).
     """
     n = b.size
     passive = None if initial is None else np.asarray(initial).ravel() > 0
@@ -128,7 +156,7 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
     def at(d):
         s = d + b
         if method == "nnls":
-            p, it = lcp_nnls(H, s)
+            p, it = lcp_nnls(H, s, upper)
         else:
             p, it = lcp_bpp(H, s, passive)
         return p, it
@@ -136,7 +164,7 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
     if delta is not None:
         p, nit = at(float(delta))
         u = H @ p
-        res = kkt_residual(p, u - b - delta, scale)
+        res = kkt_residual(p, u - b - delta, scale, upper)
         if res > tol:
             _fail(f"dense {method}", nit, res, tol, p, u, delta, method)
         return SolverOutput(p, u, float(delta), nit, res, method)
@@ -150,7 +178,7 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
     nit = 0
     for k in range(max_iter):
         p, it = at(d)
-        passive = p > 0
+        passive = (p > 0) & (p < upper)
         nit += it
         pm = float(p.mean())
         if abs(pm - target) <= tol * target:
@@ -172,118 +200,255 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
         u = H @ p
         _fail(f"dense {method} (load control)", nit, abs(pm - target) / target, tol, p, u, d,
               method)
-    p = p * (target / pm) if pm > 0 else p
+    if pm > 0:
+        _rescale_to_load(p, target * n, upper)
     u = H @ p
     w = u - b - d
-    res = kkt_residual(p, w, scale)
+    res = kkt_residual(p, w, scale, upper)
     if res > tol:
         _fail(f"dense {method} (load control)", nit, res, tol, p, u, d, method)
     return SolverOutput(p, u, d, nit, res, method)
 
 
 # -- matrix-free: Polonsky & Keer constrained conjugate gradients ------------------------
-def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
-                  diagonal=1.0, precond=None, tol=1e-10, max_iter=10000):
-    """Polonsky & Keer (1999) constrained CG with FFT operator products.
+def _rescale_to_load(p, target_sum, upper):
+    """Scale ``p`` (>= 0, in place) by alpha > 0 so that sum(min(alpha p, upper)) equals
+    ``target_sum``; entries reaching ``upper`` saturate there. Returns ``(alpha,
+    saturated)``. The sum is concave and piecewise linear in alpha: Newton's method from
+    alpha = target / sum(p) (below the root) increases monotonically and ends after at
+    most as many steps as saturating entries."""
+    s = float(p.sum())
+    if s <= 0.0:
+        return 1.0, False
+    alpha = target_sum / s
+    if not np.isfinite(upper) or alpha * float(p.max()) <= upper:
+        p *= alpha
+        return alpha, False
+    for _ in range(p.size + 1):
+        free = alpha * p < upper
+        slope = float(p.sum(where=free))
+        f = alpha * slope + upper * (p.size - int(np.count_nonzero(free))) - target_sum
+        if f >= -1e-15 * target_sum or slope <= 0.0:
+            break
+        alpha -= f / slope
+    p *= alpha
+    np.minimum(p, upper, out=p)
+    return alpha, True
 
-    The CG runs on the free set F = {p > 0} + {p = 0, g < 0} (points in contact and
-    penetrating points: the latter are PK's "overlap" points, here they enter the
-    search direction directly). After each exact line search the pressure is clipped
-    at zero. The conjugation uses the Polak-Ribiere+ beta, max(0, g.(z - z_old)) /
-    g_old.z_old, on the direction masked to F: it restarts itself when the free set or
-    the gradient changes much, instead of a forced restart at every clip (Fletcher-
-    Reeves with forced restarts took 83 -> 131 -> 264 iterations at 512^2 -> 2048^2,
-    A* = 10 %; PR+ 50 -> 63 at 512^2 -> 1024^2).
+
+def _shift_to_load(x, target_sum, upper):
+    """Euclidean projection of ``x`` (in place) on {0 <= x <= upper, sum(x) = target_sum}:
+    x <- clip(x + lam, 0, upper) with the shift lam found by safeguarded Newton steps on
+    the monotone, piecewise linear sum (bisection when a step leaves the bracket).
+    Returns False (x unchanged) when even x = upper everywhere is below the target."""
+    if x.size * upper < target_sum:
+        return False
+    lo, hi = -float(x.max()), upper - float(x.min())
+    lam = 0.0
+    y = np.empty_like(x)
+    for _ in range(200):
+        np.add(x, lam, out=y)
+        np.clip(y, 0.0, upper, out=y)
+        f = float(y.sum()) - target_sum
+        if abs(f) <= 1e-15 * target_sum or hi - lo <= 1e-16 * max(abs(lo), abs(hi)):
+            break
+        if f < 0:
+            lo = lam
+        else:
+            hi = lam
+        slope = int(np.count_nonzero((y > 0.0) & (y < upper)))
+        step = lam - f / slope if slope else np.nan
+        lam = step if lo < step < hi else 0.5 * (lo + hi)
+    x[...] = y
+    return True
+
+
+def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
+                  diagonal=1.0, precond=None, tol=1e-10, max_iter=10000, offset=0.0,
+                  hardness=None):
+    """Polonsky & Keer (1999) constrained CG with FFT operator products, bounded form.
+
+    Solves Eq. 2.5-2.6 for ``0 <= p <= hardness`` with the gap ``w = H p - b - offset -
+    Delta`` (``b`` in m; ``offset`` a scalar shift of it, so that a caller can pass the
+    heights themselves and save a full-grid copy). Without ``hardness`` (``None`` or
+    ``inf``) it is the elastic problem; with it, points at ``p = hardness`` are the
+    perfectly plastic interface of Kato-type saturated solvers: there ``w <= 0`` (the
+    interpenetration is the plastic displacement ``-w``).
+
+    The CG runs on the free set F = {0 < p < hardness} + {p = 0, w < 0} + {p = hardness,
+    w > 0} (points whose pressure may move: PK's "overlap" points enter the search
+    direction directly). After each exact line search the pressure is projected on
+    [0, hardness] (box projection). The conjugation uses the Polak-Ribiere+ beta,
+    max(0, z.(g - g_old)) / g_old.z_old, on the direction masked to F: it restarts itself
+    when the free set or the gradient changes much, instead of a forced restart at every
+    clip (Fletcher-Reeves with forced restarts took 83 -> 131 -> 264 iterations at 512^2
+    -> 2048^2, A* = 10 %; PR+ 50 -> 63 at 512^2 -> 1024^2).
 
     Load control (``mean_pressure``): the gap and the search direction are projected on
-    zero mean over F and the pressure is rescaled to the load after each step; Delta
-    is the mean of ``u - b`` over the contact set at convergence. Displacement control
-    (``delta``): the plain projected CG on Eq. 2.6 (needs a positive definite H).
+    zero mean over F and the pressure is rescaled to the load after each step
+    (saturating at the hardness); Delta is the mean of ``u - b`` over the points with
+    0 < p < hardness. Displacement control (``delta``): the plain projected CG on
+    Eq. 2.6 (needs a positive definite H).
 
     ``precond`` (a linear map M ~ H^-1, e.g. the stiffness operator E*|q|/2) makes it a
-    preconditioned CG (direction from z = P_F M P_F g, beta = g.z / g_old.z_old): on
-    rough surfaces it cuts the iterations 3-4 fold and they grow much more slowly with
-    n. ``diagonal`` (m/Pa, H_ii) scales the first trial pressure in displacement
-    control.
+    preconditioned CG (direction from z = P_F M P_F g): on rough surfaces it cuts the
+    iterations 3-4 fold and they grow much more slowly with n. ``diagonal`` (m/Pa, H_ii)
+    scales the first trial pressure in displacement control.
 
-    The displacement is updated without a transform (u <- a (u - tau H t)) when no clip
-    happened, recomputed otherwise and every 50 iterations; convergence is always
-    confirmed on a recomputed u. Returns a :class:`SolverOutput`.
+    Cost and memory: one product with H and one with M per iteration, plus a third with
+    H after an iteration whose projection clipped (u = H p is then recomputed; without a
+    clip u <- alpha (u - tau H t), kept with a lazy scale factor, one BLAS axpy). All CG
+    vectors live on the free set F (gathered by index); the full-grid fields are p, u,
+    the direction t and the previous masked gradient (the preconditioner's input buffer),
+    plus the transients of one FFT product. ``nit`` counts iterations, ``n_products``
+    the operator products (H and M).
+
+    Returns a :class:`SolverOutput`.
     """
     load = mean_pressure is not None
+    upper = np.inf if hardness is None else float(hardness)
+    bounded = np.isfinite(upper)
+    shape = b.shape
+    n = b.size
+    bf = b.reshape(-1)
+    products = 0
+
+    def H(x):
+        nonlocal products
+        products += 1
+        return np.ascontiguousarray(apply(x.reshape(shape))).reshape(-1)
+
+    def M(x):
+        nonlocal products
+        products += 1
+        return np.ascontiguousarray(precond(x.reshape(shape))).reshape(-1)
+
     if initial is not None:
-        p = np.maximum(np.array(initial, dtype=float).reshape(b.shape), 0.0)
-        if load:
-            pm = p.mean()
-            p = np.full(b.shape, float(mean_pressure)) if pm <= 0 else p * (mean_pressure / pm)
+        p = np.array(initial, dtype=float).reshape(-1)
+        np.clip(p, 0.0, upper, out=p)
+        if load and not p.any():
+            p[:] = mean_pressure
     elif load:
-        p = np.full(b.shape, float(mean_pressure))
+        p = np.full(n, float(mean_pressure))
     else:
-        p = np.maximum(-(delta + b), 0.0) / diagonal
-    t = np.zeros_like(p)
-    gz_old, F_old, z_old = 1.0, None, None
+        p = -(delta + offset + bf)
+        p /= diagonal
+        np.clip(p, 0.0, upper, out=p)
+    target = float(mean_pressure) * n if load else 0.0
+    if load:
+        _rescale_to_load(p, target, upper)
+        if bounded and float(p.sum()) < target * (1 - 1e-12):
+            _shift_to_load(p, target, upper)    # too few points to carry it below the cap
+    t = np.zeros(n)              # search direction, zero off F
+    gbuf = np.zeros(n)           # masked gradient of the last iteration, zero off F
+    mask = np.empty(n, bool)
+    F = np.empty(0, np.intp)
+    S = np.flatnonzero(p)
+    gz_old = 0.0
     res = np.inf
-    d = float(delta) if not load else 0.0
-    u, exact = None, False
+    d = 0.0 if load else float(delta)
+    u, us, exact = None, 1.0, False
     for it in range(1, max_iter + 1):
         if u is None or it % 50 == 0:
-            u, exact = apply(p), True
-        g = u - b
-        S = p > 0
+            u = None
+            u, us, exact = H(p), 1.0, True
+        g = np.multiply(u, us) if us != 1.0 else u.copy()
+        g -= bf
+        g -= offset
+        gS = g[S]
+        pS = p[S]
+        free_c = pS < upper if bounded else None
         if load:
-            nS = int(np.count_nonzero(S))
-            d = float(np.sum(g, where=S)) / nS if nS else float(g.min())
-        g -= d
-        res = kkt_residual(p, g, scale)
+            gE = gS[free_c] if bounded else gS
+            d = float(gE.mean()) if gE.size else float(g.min())
+        # KKT residual (module docstring), bounded form: at p = hardness only w > 0
+        # violates complementarity
+        wS = gS - d
+        if bounded:
+            comp = float(np.dot(pS[free_c], np.abs(wS[free_c])))
+            comp += float(np.dot(pS[~free_c], np.maximum(wS[~free_c], 0.0)))
+        else:
+            comp = float(np.dot(pS, np.abs(wS)))
+        np.less(g, d, out=mask)
+        pen = np.flatnonzero(mask)
+        gpen = g[pen]
+        if bounded:
+            gpen = gpen[p[pen] < upper]
+        feas = max(0.0, d - float(gpen.min())) if gpen.size else 0.0
+        sp = float(pS.sum())
+        res = max(comp / (sp * scale) if sp > 0 else 0.0, feas / scale)
         if res <= tol:
             if exact:
-                return SolverOutput(p, u, d, it, res, "pk")
+                return SolverOutput(p.reshape(shape), (u * us).reshape(shape), d, it, res,
+                                    "pk", products)
             u = None          # confirm on a freshly computed displacement
             continue
-        F = S | (g < 0)
-        nF = int(np.count_nonzero(F))
-        gm = g * F
+        mask[S] = True
+        if bounded:           # saturated points pushed further in stay at the bound
+            fixed = S[~free_c & (wS <= 0.0)]
+            mask[fixed] = False
+        F_old, F = F, np.flatnonzero(mask)
+        gF = g[F]
+        del g
+        gF -= d
         if load:
-            gm -= float(gm.sum()) / nF
-            gm *= F
+            gF -= gF.mean()
+        g_old = gbuf[F]       # previous masked gradient on the new free set
+        gbuf[F_old] = 0.0
+        gbuf[F] = gF
         if precond is not None:
-            z = precond(gm)
-            z *= F
+            zF = M(gbuf)[F]
             if load:
-                z -= float(z.sum()) / nF
-                z *= F
+                zF -= zF.mean()
         else:
-            z = gm
-        gz = float(np.vdot(gm, z))
-        if F_old is not None and gz_old > 0:
-            # Polak-Ribiere+ (restarts itself when the set or the gradient changes)
-            beta = max(0.0, (gz - float(np.vdot(gm, z_old))) / gz_old)
-            t *= F
-            t *= beta
-            t += z
-        else:
-            t = z.copy()
-        gz_old, F_old, z_old = gz, F, z
-        r = apply(t)
-        tr = float(np.vdot(r, t))
-        tau = float(np.vdot(gm, t)) / tr if tr > 0 else 0.0
-        p -= tau * t
-        clipped = float(p.min()) < 0.0
+            zF = gF.copy()
+        gz = float(np.dot(gF, zF))
+        beta = max(0.0, (gz - float(np.dot(zF, g_old))) / gz_old) if gz_old > 0 else 0.0
+        gz_old = gz
+        tF = t[F]
+        tF *= beta
+        tF += zF
+        t[F_old] = 0.0
+        t[F] = tF
+        r = H(t)
+        tr = float(np.dot(tF, r[F]))
+        tau = float(np.dot(gF, tF)) / tr if tr > 0 else 0.0
+        pF = p[F]
+        pF -= tau * tF
+        lo, hi = float(pF.min()), float(pF.max())
+        clipped = lo < 0.0 or hi > upper
         if clipped:
-            np.maximum(p, 0.0, out=p)
+            np.clip(pF, 0.0, upper, out=pF)
         alpha = 1.0
         if load:
-            pm = float(p.mean())
-            alpha = mean_pressure / pm if pm > 0 else 1.0
-            p *= alpha
+            # back to the load: scale F (PK's rescaling; the fixed saturated points carry
+            # fixed.size * upper); if that would cross the cap, project F on the load
+            # instead (Euclidean: a shift, clipped to the box), or the whole grid when F
+            # cannot carry it
+            carried = target - fixed.size * upper if bounded else target
+            sF = float(pF.sum())
+            alpha = carried / sF if sF > 0 else 0.0
+            if sF > 0 and alpha * float(pF.max()) <= upper:
+                pF *= alpha
+            else:
+                alpha, clipped = 1.0, True
+                if not bounded:       # every pressure was clipped: spread the load on F
+                    pF[:] = carried / pF.size
+                elif not _shift_to_load(pF, carried, upper):
+                    p[F] = pF
+                    _shift_to_load(p, target, upper)
+                    pF = p[F]
+        p[F] = pF
+        S = np.flatnonzero(p) if bounded else F[pF > 0]
         if clipped:
-            u = apply(p)
-            exact = True
+            u = None          # the projection moved p off the line: recompute u = H p
         else:
-            u -= tau * r
-            u *= alpha
+            daxpy(r, u, a=-tau / us)
+            us *= alpha
             exact = False
-    _fail("Polonsky-Keer CG", max_iter, res, tol, p, apply(p), d, "pk")
+        del r
+    u = H(p)
+    _fail("Polonsky-Keer CG", max_iter, res, tol, p.reshape(shape), u.reshape(shape), d, "pk")
 
 
 def restricted_cg(apply, mask, rhs, *, precond=None, tol=1e-8, max_iter=2000):

@@ -9,6 +9,8 @@ pressures, each step starting from the previous pressure. The result type is the
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..errors import InputError
@@ -30,9 +32,15 @@ def default_deltas(surface: Surface, n_steps: int, periodic: bool) -> np.ndarray
 
 def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, deltas=None,
                   pressures=None, kernel: str = "auto", solver: str = "auto",
-                  tol: float = 1e-10, max_iter=None,
-                  compute_stiffness: bool = True) -> SweepResult:
+                  tol: float = 1e-10, max_iter=None, compute_stiffness: bool = True,
+                  hardness=None, unload: bool = False) -> SweepResult:
     """Warm-started sequence of contact solutions.
+
+    Each step starts from the previous pressure (measured at 512^2, p/E* = 0.005-0.1,
+    see ``benchmarks/bench_bem.py``). With a ``hardness`` the plastic displacement is
+    carried from step to step (it is permanent); ``unload`` appends the unloading
+    branch: the same steps in reverse order, below the highest one, with the plastic
+    displacement of the loading branch (its steps have ``unloading=True``).
 
     Parameters
     ----------
@@ -45,6 +53,10 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
         Approaches Delta >= 0 (m), solved in the order given.
     pressures : sequence of float, optional
         Mean pressures > 0 (Pa), solved in the order given.
+    hardness : float, optional
+        H_p (Pa) of a perfectly plastic interface (see :func:`roughfe.bem.solve_contact`).
+    unload : bool
+        Append the unloading branch.
     """
     if deltas is not None and pressures is not None:
         raise InputError("give at most one of deltas (m) or pressures (Pa)")
@@ -58,13 +70,21 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     else:
         deltas = getattr(loading, loading.kind)
     key = "mean_pressure" if loading.controls_pressure else "delta"
+    steps = [(float(v), False) for v in deltas]
+    if unload:
+        steps += [(float(v), True) for v in deltas[-2::-1]]
+    branch = unload or hardness is not None
     results = []
-    prev = None
-    for v in deltas:
-        r = solve_contact(surface, material, **{key: float(v)}, kernel=kernel, solver=solver,
+    prev = plastic = None
+    for v, unloading in steps:
+        r = solve_contact(surface, material, **{key: v}, kernel=kernel, solver=solver,
                           tol=tol, max_iter=max_iter, initial=prev,
-                          compute_stiffness=compute_stiffness)
+                          compute_stiffness=compute_stiffness, hardness=hardness,
+                          plastic_displacement=plastic)
+        if branch:
+            r = dataclasses.replace(r, unloading=unloading)
         results.append(r)
         prev = r.pressure if r.n_contact else None
+        plastic = r.plastic_displacement
     return SweepResult.from_results(results, rms_slope=rms_slope(surface),
                                     length=surface.size[0])

@@ -1,0 +1,178 @@
+"""Hardness-limited (perfectly plastic interface) BEM contact, 0 <= p <= H_p: the elastic
+limit, the fully plastic limit, Westergaard and Hertz below the onset of flow, agreement
+of the matrix-free and the bounded least-squares solvers, a load-unload cycle."""
+import numpy as np
+import pytest
+
+from roughfe.bem import Material, solve_contact
+from roughfe.reference import hertz_sphere, westergaard
+from roughfe.surfaces import Surface
+from roughfe.surfaces.spectral import spectral_surface
+
+MAT = Material(1.0e9, 0.3)
+UNIT = Material(1.0, 0.0)
+
+
+def rough(n=64, seed=1):
+    """Periodic self-affine surface, unit rms slope, L = 1 m; with E* = 1 Pa the mean
+    pressure is p / (E* gbar)."""
+    return spectral_surface(n, 1.0, 0.8, rms_slope=1.0, rng=seed)
+
+
+def test_infinite_hardness_is_the_elastic_solution():
+    surf = rough(128)
+    a = solve_contact(surf, UNIT, mean_pressure=0.05, solver="pk")
+    # a cap far above every pressure never binds: the same iterates up to round-off
+    b = solve_contact(surf, UNIT, mean_pressure=0.05, solver="pk",
+                      hardness=1e6 * a.pressure.max())
+    assert a.plastic_area_fraction is None and b.plastic_area_fraction == 0.0
+    assert np.array_equal(a.contact, b.contact)
+    assert np.max(np.abs(a.pressure - b.pressure)) <= 1e-12 * a.pressure.max()
+    assert b.mean_gap == pytest.approx(a.mean_gap, rel=1e-12)
+    assert b.stiffness == pytest.approx(a.stiffness, rel=1e-9)
+    assert not b.plastic_displacement.any()
+
+
+def test_fully_plastic_limit_area_is_load_over_hardness():
+    # H_p far below the elastic pressures E* gbar: the contact points flow and
+    # A* -> p / H_p (rigid-plastic junctions), approached as H_p / (E* gbar) -> 0
+    surf, pm = rough(64), 0.01
+    excess = []
+    for hp in (0.1, 0.05, 0.02):
+        r = solve_contact(surf, UNIT, mean_pressure=pm, hardness=hp)
+        assert r.pressure.max() == hp and r.mean_pressure == pytest.approx(pm, rel=1e-12)
+        assert r.residual <= 1e-10
+        excess.append(r.area_fraction * hp / pm - 1)
+        plastic = r.pressure >= hp
+        assert r.plastic_area_fraction == pytest.approx(plastic.mean(), abs=0)
+        # the plastic displacement is the interpenetration at the flowing points only
+        assert np.all(r.plastic_displacement[~plastic] == 0)
+        assert np.all(r.plastic_displacement[plastic] >= 0)
+    # measured 6.0 %, 1.4 %, 0.34 %: the elastic rims shrink with H_p
+    assert excess[0] > excess[1] > excess[2] > 0 and excess[2] < 5e-3
+    assert r.plastic_area_fraction > 0.99 * r.area_fraction
+
+
+def test_westergaard_sinusoid_below_and_beyond_the_onset_of_flow():
+    n, lam, g = 1024, 1e-3, 1e-6
+    x = np.arange(n) * lam / n
+    surf = Surface(g * np.cos(2 * np.pi * x / lam), lam, periodic=True)
+    pm = 0.2 * np.pi * MAT.E_star * g / lam            # 0.2 p*: partial contact
+    ref = westergaard(g, lam, MAT.E_star, pm)
+    peak = float(ref.pressure(0.0))                      # 2 p / sin(pi a / lambda)
+    el = solve_contact(surf, MAT, mean_pressure=pm)
+    # just above the analytic peak nothing flows: the elastic (Westergaard) state
+    a = solve_contact(surf, MAT, mean_pressure=pm, hardness=1.02 * peak)
+    assert a.plastic_area_fraction == 0.0
+    assert np.max(np.abs(a.pressure - el.pressure)) <= 1e-9 * peak
+    assert a.area_fraction == pytest.approx(ref.area_fraction, abs=2.0 / n)
+    # below it the crest flows: a plateau at H_p, a wider contact carrying the same load
+    b = solve_contact(surf, MAT, mean_pressure=pm, hardness=0.7 * peak)
+    assert b.pressure.max() == 0.7 * peak and b.plastic_area_fraction > 0
+    assert b.area_fraction > a.area_fraction
+    assert np.all(np.diff(b.pressure[: n // 4]) <= 1e-9 * peak)   # still decreasing
+    # fully plastic limit: H_p << p*: A* -> p / H_p
+    c = solve_contact(surf, MAT, mean_pressure=pm, hardness=1.25 * pm)
+    assert c.area_fraction == pytest.approx(pm / (1.25 * pm), abs=0.01)
+
+
+def test_hertz_sphere_below_and_beyond_the_onset_of_flow():
+    n, L, R = 96, 1e-3, 1e-2
+    x = (np.arange(n) - n // 2) * L / n
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    surf = Surface(-(X ** 2 + Y ** 2) / (2 * R), L, periodic=False)
+    pm = 1e5
+    ref = hertz_sphere(R, MAT.E_star, load=pm * L * L)
+    el = solve_contact(surf, MAT, mean_pressure=pm, solver="pk")
+    assert el.pressure.max() == pytest.approx(ref.peak_pressure, rel=2e-2)
+    a = solve_contact(surf, MAT, mean_pressure=pm, solver="pk", hardness=1.01 * el.pressure.max())
+    assert a.plastic_area_fraction == 0.0 and np.array_equal(a.contact, el.contact)
+    assert np.max(np.abs(a.pressure - el.pressure)) <= 1e-8 * ref.peak_pressure
+    # H_p = p0 / 2: a central plastic disc, the contact widens, the load is kept
+    b = solve_contact(surf, MAT, mean_pressure=pm, solver="pk", hardness=0.5 * ref.peak_pressure)
+    assert b.plastic_area_fraction > 0 and b.contact_area > a.contact_area
+    assert b.load == pytest.approx(ref.load, rel=1e-10)
+    centre = b.plastic_displacement[n // 2, n // 2]
+    assert centre == b.plastic_displacement.max() > 0       # deepest at the apex
+    # rigid-plastic limit H_p << p0: contact area -> P / H_p
+    c = solve_contact(surf, MAT, mean_pressure=pm, solver="pk", hardness=0.05 * ref.peak_pressure)
+    assert c.contact_area == pytest.approx(ref.load / (0.05 * ref.peak_pressure), rel=0.03)
+
+
+@pytest.mark.parametrize("control", ["delta", "mean_pressure"])
+def test_bounded_least_squares_and_matrix_free_agree(control):
+    rng = np.random.default_rng(5)
+    h = np.cumsum(rng.standard_normal(200)) * 1e-8
+    surf = Surface(h - h.mean(), 1e-4, periodic=False)
+    el = solve_contact(surf, MAT, delta=0.5 * np.ptp(h), solver="pk")
+    hp = 0.3 * el.pressure.max()
+    kw = {"delta": 0.5 * np.ptp(h)} if control == "delta" else {"mean_pressure":
+                                                                el.mean_pressure / 3}
+    a = solve_contact(surf, MAT, solver="nnls", hardness=hp, tol=1e-12, **kw)
+    b = solve_contact(surf, MAT, solver="pk", hardness=hp, tol=1e-12, **kw)
+    assert a.solver == "nnls" and b.solver == "pk"
+    assert 0 < a.plastic_area_fraction < a.area_fraction
+    assert np.array_equal(a.pressure >= hp, b.pressure >= hp)
+    assert np.max(np.abs(a.pressure - b.pressure)) <= 1e-7 * hp
+    assert np.max(np.abs(a.plastic_displacement - b.plastic_displacement)) <= \
+        1e-6 * a.plastic_displacement.max()
+    assert b.stiffness == pytest.approx(a.stiffness, rel=1e-6)
+
+
+def test_load_unload_cycle_keeps_the_plastic_displacement():
+    surf, hp = rough(64), 0.1
+    top = solve_contact(surf, UNIT, mean_pressure=0.03, hardness=hp)
+    up = top.plastic_displacement
+    assert top.plastic_area_fraction > 0
+    # unloading: nothing flows any more, the permanent displacement stays as it was
+    low = solve_contact(surf, UNIT, mean_pressure=0.01, hardness=hp, plastic_displacement=up)
+    assert low.plastic_area_fraction == 0.0
+    assert np.array_equal(low.plastic_displacement, up)
+    # hysteresis: the flattened asperities carry the lower load on a larger area and a
+    # smaller mean gap than on the loading branch
+    virgin = solve_contact(surf, UNIT, mean_pressure=0.01, hardness=hp)
+    assert low.area_fraction > virgin.area_fraction and low.mean_gap < virgin.mean_gap
+    # reloading to the same peak load is elastic (shakedown): the same pressure as at the
+    # end of the first loading, and no further plastic displacement
+    again = solve_contact(surf, UNIT, mean_pressure=0.03, hardness=hp, plastic_displacement=up)
+    assert np.max(np.abs(again.pressure - top.pressure)) <= 1e-6 * hp
+    assert np.max(np.abs(again.plastic_displacement - up)) <= 1e-8 * up.max()
+
+
+@pytest.mark.parametrize("hardness", [0.0, -1.0, np.inf, np.nan, "soft", True])
+def test_bad_hardness_is_an_input_error(hardness):
+    with pytest.raises(ValueError, match="hardness"):
+        solve_contact(rough(16), UNIT, mean_pressure=0.01, hardness=hardness)
+
+
+def test_hardness_inconsistent_requests_are_input_errors():
+    surf = rough(16)
+    with pytest.raises(ValueError, match="below the hardness"):
+        solve_contact(surf, UNIT, mean_pressure=0.2, hardness=0.1)
+    with pytest.raises(ValueError, match="load control"):
+        solve_contact(surf, UNIT, delta=0.1, hardness=0.1)
+    with pytest.raises(ValueError, match="'dense'"):
+        solve_contact(surf, UNIT, mean_pressure=0.01, hardness=0.1, solver="dense")
+    with pytest.raises(ValueError, match="needs a hardness"):
+        solve_contact(surf, UNIT, mean_pressure=0.01, plastic_displacement=np.zeros((16, 16)))
+    with pytest.raises(ValueError, match="shape"):
+        solve_contact(surf, UNIT, mean_pressure=0.01, hardness=0.1,
+                      plastic_displacement=np.zeros(3))
+
+
+def test_sweep_with_hardness_carries_the_plastic_displacement_and_unloads():
+    from roughfe.bem import contact_sweep
+    surf = rough(32)
+    sw = contact_sweep(surf, UNIT, pressures=[0.01, 0.02, 0.03], hardness=0.1, unload=True)
+    assert list(sw.mean_pressure) == pytest.approx([0.01, 0.02, 0.03, 0.02, 0.01], rel=1e-12)
+    assert list(sw.unloading) == [0, 0, 0, 1, 1]
+    recs = sw.to_records()
+    assert recs[3]["unloading"] is True and recs[0]["plastic_area_fraction"] >= 0
+    ups = [r.plastic_displacement for r in sw.results]
+    # permanent: never decreases along the path, unchanged on unloading
+    for a, b in zip(ups, ups[1:]):
+        assert np.all(b >= a - 1e-15 * ups[2].max())
+    assert np.array_equal(ups[-1], ups[2]) and sw.plastic_area_fraction[-1] == 0.0
+    # hysteresis: more contact on the way down than on the way up at the same load
+    assert sw.area_fraction[3] > sw.area_fraction[1]
+    assert sw.area_fraction[4] > sw.area_fraction[0]
