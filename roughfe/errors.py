@@ -49,3 +49,31 @@ def check_in_open_interval(name, value, low, high):
     if not (low < v < high):
         raise InputError(f"{name} must lie in the open interval ({low}, {high}), got {value!r}")
     return v
+
+
+def available_memory() -> int:
+    """Bytes of memory this process may still use: ``MemAvailable`` on Linux, else the
+    physical memory."""
+    import os
+
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
+def check_memory(what: str, n_bytes: float) -> None:
+    """Raise :class:`InputError` when ``what`` needs more than the available memory.
+
+    The message gives both in GiB, e.g. "a 100000 x 100000 grid needs 74.5 GiB of
+    memory, 21.3 GiB are available".
+    """
+    free = available_memory()
+    if n_bytes > free:
+        gib = 2.0 ** 30
+        raise InputError(f"{what} needs {n_bytes / gib:.1f} GiB of memory, "
+                         f"{free / gib:.1f} GiB are available")

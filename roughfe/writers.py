@@ -1,18 +1,50 @@
-"""Atomic file output shared by every module that writes results.
+"""Every file roughfe writes goes through here: atomic, umask-honouring, JSON-safe.
 
-An interrupted run must never leave a half-written file: everything is written to a
-temporary file in the destination folder and then renamed over the target
-(``os.replace`` is atomic on POSIX within one file system).
+* :func:`atomic_path` -- write to a temporary file beside the target, then rename it
+  (``os.replace`` is atomic on POSIX within one file system): an interrupted run never
+  leaves a half-written file. The file gets the mode a plain ``open()`` would give
+  (``0o666 & ~umask``: 0644 under umask 022), not ``mkstemp``'s private 0600.
+* :func:`to_jsonable` -- the ONE JSON rule of the package: numpy scalars and arrays
+  become numbers and lists, paths strings, and non-finite floats (NaN, +-inf) ``null``.
+  :func:`write_json` and :func:`to_json_text` apply it.
+* :class:`OutputFolder` -- the ownership contract of a command that writes a folder
+  (checked before the work, lock, ``UNFINISHED`` marker, no files of two runs mixed);
+  :func:`output_file` the same check for a command that writes one file.
 """
 from __future__ import annotations
 
 import contextlib
+import dataclasses
+import datetime as _dt
 import json
+import math
 import os
+import shutil
 import tempfile
+import time
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
+
+from .errors import InputError
+
+#: Prefix of every temporary file (``.roughfe-XXXXXXXX.tmp<suffix>``): short, so that a
+#: target name of any legal length (255 bytes) still has a legal temporary name.
+TMP_PREFIX = ".roughfe-"
+_MAX_TMP_SUFFIX = 16
+
+
+def current_umask() -> int:
+    """The process umask, read without changing it where Linux allows (``/proc``)."""
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    old = os.umask(0o022)  # pragma: no cover - non-Linux fallback
+    os.umask(old)
+    return old
 
 
 @contextlib.contextmanager
@@ -21,15 +53,32 @@ def atomic_path(path, suffix=None):
 
     Use it for writers that want a file name (``np.savez``, ``h5py.File``, matplotlib
     ``savefig``, pyvista ``screenshot``). On an exception the temporary file is removed
-    and ``path`` is left untouched.
+    and ``path`` is left untouched. The final file has mode ``0o666 & ~umask``.
+
+    Parameters
+    ----------
+    path : path-like
+        The target file; its folder is created if missing.
+    suffix : str, optional
+        Suffix of the temporary name (writers that infer the format from it); default
+        the target's suffix (dropped if longer than 16 characters).
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"cannot create folder {path.parent}: {exc.strerror}") from None
     suffix = path.suffix if suffix is None else suffix
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".tmp{suffix}", dir=path.parent)
+    if len(suffix) > _MAX_TMP_SUFFIX:
+        suffix = ""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=TMP_PREFIX, suffix=f".tmp{suffix}", dir=path.parent)
+    except OSError as exc:
+        raise InputError(f"cannot write in {path.parent}: {exc.strerror}") from None
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~current_umask())
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
@@ -37,27 +86,60 @@ def atomic_path(path, suffix=None):
         raise
 
 
-def _json_default(obj):
-    if isinstance(obj, np.generic):
-        return obj.item()
+# -- the one JSON rule -----------------------------------------------------------------
+def to_jsonable(obj):
+    """A JSON-ready copy of ``obj``: THE rule of every roughfe JSON file.
+
+    ``None``, ``bool``, ``int`` and ``str`` pass; floats pass when finite and become
+    ``None`` (JSON ``null``) when NaN or infinite (JSON has no NaN/inf, and a reader must
+    not mistake an undefined value for a number); numpy scalars and arrays become Python
+    numbers and (nested) lists by the same rule; mappings become dicts with ``str`` keys;
+    tuples, lists and sets lists; paths strings; dates ISO strings; objects with a
+    ``to_dict()`` method and dataclasses their dict. Anything else (complex numbers,
+    arbitrary objects) raises ``TypeError``: it has no faithful JSON form.
+    """
+    if obj is None or isinstance(obj, (bool, str)):
+        return obj
+    if isinstance(obj, int):
+        return int(obj)
+    if isinstance(obj, float):
+        return float(obj) if math.isfinite(obj) else None
     if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, Path):
-        return str(obj)
+        if np.iscomplexobj(obj):
+            raise TypeError(f"a complex array {obj.shape} has no JSON form")
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return to_jsonable(obj.item())
+    if isinstance(obj, Mapping):
+        return {str(to_jsonable(k)) if not isinstance(k, str) else k: to_jsonable(v)
+                for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, (set, frozenset)):
+        return [to_jsonable(v) for v in sorted(obj, key=repr)]
+    if isinstance(obj, os.PathLike):
+        return os.fspath(obj)
+    if isinstance(obj, (_dt.datetime, _dt.date)):
+        return obj.isoformat()
+    if callable(getattr(obj, "to_dict", None)):
+        return to_jsonable(obj.to_dict())
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return to_jsonable({f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)})
     raise TypeError(f"object of type {type(obj).__name__} is not JSON serialisable")
 
 
-def to_json_text(data) -> str:
-    """JSON text of ``data``; numpy scalars and arrays become plain numbers and lists.
+def to_json_text(data, indent=2) -> str:
+    """JSON text of :func:`to_jsonable` of ``data`` (non-finite floats are ``null``)."""
+    return json.dumps(to_jsonable(data), indent=indent, allow_nan=False)
 
-    Non-finite floats are written as ``null`` is *not* done silently: ``allow_nan`` is
-    False so that a NaN in a result is caught here rather than written.
-    """
-    return json.dumps(data, indent=2, default=_json_default, allow_nan=False)
+
+def json_scalars(obj, keys) -> dict:
+    """``{key: to_jsonable(getattr(obj, key))}`` for the named attributes of ``obj``."""
+    return {key: to_jsonable(getattr(obj, key)) for key in keys}
 
 
 def write_json(path, data):
-    """Write ``data`` as indented JSON, atomically. Returns the path."""
+    """Write ``data`` as indented JSON (:func:`to_jsonable`), atomically. Returns the path."""
     text = to_json_text(data)
     with atomic_path(path) as tmp:
         tmp.write_text(text + "\n")
@@ -71,17 +153,205 @@ def write_text(path, text):
     return Path(path)
 
 
-def json_scalars(obj, keys) -> dict:
-    """``{key: getattr(obj, key)}`` as JSON-safe numbers: ints stay ints, floats become
-    Python floats and non-finite values become ``None`` (JSON has no NaN/inf)."""
-    out = {}
-    for key in keys:
-        v = getattr(obj, key)
-        if isinstance(v, (bool, np.bool_)):
-            out[key] = bool(v)
-        elif isinstance(v, (int, np.integer)):
-            out[key] = int(v)
+# -- output ownership ------------------------------------------------------------------
+#: The record of the run that owns an output folder (command, status, times).
+OWNER_FILE = ".roughfe-output.json"
+#: Present (and visible) while a run is writing the folder or after it failed/was killed.
+UNFINISHED_FILE = "UNFINISHED"
+#: flock-ed by the run writing the folder (released by the OS if the process dies).
+LOCK_FILE = ".lock"
+
+
+@contextlib.contextmanager
+def folder_lock(folder, holder: str):
+    """Hold an exclusive ``flock`` on ``folder/.lock`` or raise :class:`InputError`.
+
+    The OS releases the lock when the process dies, so a killed run never blocks the
+    next one. ``holder`` names the command in the error message.
+    """
+    import fcntl
+
+    folder = Path(folder)
+    lock = folder / LOCK_FILE
+    with open(lock, "w") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise InputError(f"another {holder} is writing to {folder} (it holds {lock}); "
+                             "wait for it or choose another output folder") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def _read_owner(folder: Path):
+    with contextlib.suppress(OSError, ValueError):
+        data = json.loads((folder / OWNER_FILE).read_text())
+        if isinstance(data, dict):
+            return data
+    return None
+
+
+def _refuse_to_clear(folder: Path):
+    """Folders ``--overwrite`` must never empty: /, home, the working directory (or an
+    ancestor of it) and a version-controlled checkout."""
+    real = folder.resolve()
+    cwd = Path.cwd().resolve()
+    if real == Path(real.anchor) or real == Path.home().resolve() or real == cwd \
+            or real in cwd.parents or (real / ".git").exists():
+        raise InputError(f"refusing to clear {folder}: it is the file-system root, the home "
+                         "folder, the working directory (or above it) or a git checkout; "
+                         "choose a dedicated output folder")
+
+
+def _clear(folder: Path):
+    for entry in folder.iterdir():
+        if entry.name == LOCK_FILE:
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.rmtree(entry)
         else:
-            v = float(v)
-            out[key] = v if np.isfinite(v) else None
-    return out
+            entry.unlink()
+
+
+class OutputFolder:
+    """The ownership contract of a command that writes a folder (docs/usage/cli.md).
+
+    ``OutputFolder(folder, command, overwrite=...)`` checks, writing nothing, that the
+    folder can be taken: not an existing file, creatable and writable, not locked by
+    another run, and empty, or written by an earlier run of the same ``command``, or any
+    other content with ``overwrite`` (never /, home, the working directory or a git
+    checkout). Create it before a long computation, so bad output arguments fail at once.
+
+    ``with OutputFolder(...) as out:`` then takes the folder for the writes:
+
+    * it is locked (:func:`folder_lock`) until the block ends;
+    * its old content is removed (no file of two runs ever sits side by side; stale
+      temporary files of a killed run go with it);
+    * ``UNFINISHED`` exists and ``.roughfe-output.json`` says ``"status": "running"``
+      until the block returns normally; then ``UNFINISHED`` is removed and the status
+      is ``"complete"``. A killed run never leaves a folder that looks complete. When
+      the block raises, a folder this run created is removed again (nothing written);
+      an older folder keeps ``UNFINISHED`` and ``"status": "failed"`` with the error.
+    """
+
+    def __init__(self, folder, command: str, *, overwrite: bool = False):
+        self.path = Path(folder)
+        self.command = command
+        self.overwrite = overwrite
+        self._check(self.path)
+
+    def _check(self, folder: Path):
+        if folder.exists() and not folder.is_dir():
+            raise InputError(f"output {folder} is an existing file; -o takes a folder here "
+                             "(the command writes several files)")
+        if not folder.is_dir():
+            _probe_writable(folder)
+            return
+        if (folder / LOCK_FILE).exists():
+            with folder_lock(folder, f"`roughfe {self.command}` (or another roughfe run)"):
+                pass  # free now; taken for the writes by __enter__
+        entries = [e.name for e in folder.iterdir() if e.name != LOCK_FILE]
+        owner = _read_owner(folder) if entries else None
+        if entries and (owner is None or owner.get("command") != self.command):
+            if not self.overwrite:
+                what = (f"the output of `roughfe {owner.get('command')}`" if owner
+                        else "not a roughfe output folder")
+                raise InputError(
+                    f"output folder {folder} is not empty and is {what} ({len(entries)} "
+                    f"entries, e.g. {sorted(entries)[0]!r}); choose a new or empty folder, "
+                    "or pass --overwrite to replace its contents")
+            _refuse_to_clear(folder)
+        _probe_writable(folder)
+
+    def __enter__(self) -> Path:
+        folder = self.path
+        self._check(folder)
+        self._created = not folder.exists()
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"cannot create output folder {folder}: {exc.strerror}") from None
+        self._lock = contextlib.ExitStack()
+        self._lock.enter_context(folder_lock(folder, f"`roughfe {self.command}`"))
+        _clear(folder)
+        self._record = {"command": self.command, "status": "running", "pid": os.getpid(),
+                        "started": _now()}
+        self._t0 = time.perf_counter()
+        write_text(folder / UNFINISHED_FILE,
+                   f"`roughfe {self.command}` started {self._record['started']} and has not "
+                   "finished: the files here are incomplete. Rerun the command to replace "
+                   "them.\n")
+        write_json(folder / OWNER_FILE, self._record)
+        return folder
+
+    def __exit__(self, kind, exc, tb):
+        folder = self.path
+        try:
+            if kind is None:
+                write_json(folder / OWNER_FILE, {
+                    **self._record, "status": "complete", "finished": _now(),
+                    "elapsed_s": time.perf_counter() - self._t0})
+                (folder / UNFINISHED_FILE).unlink()
+            elif self._created:
+                shutil.rmtree(folder, ignore_errors=True)
+            else:
+                with contextlib.suppress(Exception):
+                    write_json(folder / OWNER_FILE, {**self._record, "status": "failed",
+                                                     "error": f"{kind.__name__}: {exc}"})
+        finally:
+            self._lock.close()  # releases the flock (after a removed folder: harmless)
+        return False
+
+
+def _probe_writable(folder: Path) -> None:
+    """Raise :class:`InputError` unless ``folder`` is a writable folder or can be created.
+
+    A missing folder is probed by creating and removing a temporary folder in its nearest
+    existing parent (permission bits alone do not tell, e.g. for root); an existing one
+    by its permissions and mount flags (no probe entry: nothing in it is touched)."""
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    if existing is None or not existing.is_dir():
+        raise InputError(f"cannot create output folder {folder}: {existing} is not a folder")
+    if existing == folder:  # no probe entry (it would touch the folder's mtime)
+        if not os.access(folder, os.W_OK | os.X_OK) or \
+                os.statvfs(folder).f_flag & os.ST_RDONLY:
+            raise InputError(f"cannot write in output folder {folder} (permission denied or "
+                             "read-only file system)")
+        return
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=TMP_PREFIX, dir=existing))
+    except OSError as exc:
+        raise InputError(f"cannot create or write output folder {folder}: {exc.strerror} "
+                         f"(in {existing})") from None
+
+
+def _now() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def output_folder(folder, command: str, *, overwrite: bool = False) -> OutputFolder:
+    """:class:`OutputFolder` (checked now; ``with`` it to write)."""
+    return OutputFolder(folder, command, overwrite=overwrite)
+
+
+def output_file(path, *, overwrite: bool = False, suffixes=None) -> Path:
+    """Check ``path`` as the output FILE of a command; return it as a ``Path``.
+
+    Refuses a folder, a parent folder that cannot be created or written, an existing
+    file unless ``overwrite``, a name longer than 255 bytes, and (with ``suffixes``,
+    lower case with the dot) another extension. Nothing is written.
+    """
+    path = Path(path)
+    if len(path.name.encode()) > 255:
+        raise InputError(f"output file name is {len(path.name.encode())} bytes long; file "
+                         "systems allow at most 255")
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise InputError(f"-o/--output must name a {' or '.join(suffixes)} file, got {str(path)!r}")
+    if path.is_dir():
+        raise InputError(f"output {path} is a folder; -o takes a file name here")
+    if path.exists() and not overwrite:
+        raise InputError(f"output file {path} exists; pass --overwrite to replace it")
+    _probe_writable(path.parent)
+    return path

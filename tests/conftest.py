@@ -1,22 +1,13 @@
 """Shared test set-up: headless rendering and the location of the shared test data."""
-import os
 from pathlib import Path
 
 import pytest
 
-# Headless figures in every test process (the Makefile sets the same).
-os.environ.setdefault("MPLBACKEND", "Agg")
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+# Headless figures in every test process, and vtk loaded before any test module imports
+# dolfinx (in the other order the first off-screen render aborts): roughfe._runtime.
+from roughfe._runtime import load_render_backend  # noqa: E402
 
-# Load order matters: with Debian's dolfinx and the vtk wheel in one process, vtk must be
-# loaded first, otherwise the first off-screen render aborts (measured: import dolfinx, then
-# render a pyvista scene with a scalar bar -> SIGABRT). Test modules import dolfinx at
-# collection, so vtk is loaded here, before any of them.
-try:
-    import pyvista  # noqa: F401,E402
-except ImportError:  # pragma: no cover - pyvista is a core dependency
-    pass
+load_render_backend()
 
 REPO = Path(__file__).resolve().parents[1]
 TOPOGRAPHIES = REPO.parent / "shared" / "data" / "topographies"

@@ -24,7 +24,7 @@ def _nonblank(png):
 ])
 def test_generate_writes_a_loadable_npz(tmp_path, model, extra):
     out = tmp_path / f"{model}.npz"
-    assert main(["generate", model, *extra, "--seed", "11", "--no-png", "-o", str(out)]) == 0
+    assert main(["generate", model, *extra, "--seed", "11", "--no-figures", "-o", str(out)]) == 0
     s = load_surface(out)
     assert s.metadata["seed"] == 11 and rms_height(s) > 0
     if model == "mwm":
@@ -32,7 +32,7 @@ def test_generate_writes_a_loadable_npz(tmp_path, model, extra):
     if model == "rmd" and "--profile" not in extra:
         assert s.shape == (33, 33)
     again = tmp_path / "again.npz"
-    main(["generate", model, *extra, "--seed", "11", "--no-png", "-o", str(again)])
+    main(["generate", model, *extra, "--seed", "11", "--no-figures", "-o", str(again)])
     np.testing.assert_array_equal(load_surface(again).heights, s.heights)   # reproducible
 
 

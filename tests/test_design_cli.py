@@ -49,7 +49,7 @@ def test_design_command_reports_bad_input(tmp_path, capsys):
     assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",
                  "-o", str(tmp_path / "o")]) == 2
     assert "empty" in capsys.readouterr().err
-    with db.connect(path) as con:
+    with db.connect(path, create=True) as con:
         con.execute("INSERT INTO meta VALUES ('settings', ?)",
                     (json.dumps(db.DatabaseSettings(n_nodes=64).to_dict()),))
     assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",

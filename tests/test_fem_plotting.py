@@ -14,8 +14,8 @@ pytestmark = pytest.mark.fem
 
 
 def test_deformed_mesh_picture_after_a_dolfinx_solve(tmp_path):
-    """dolfinx is loaded here, so vtk renders in a fresh interpreter (in-process it
-    aborts); the stresses handed to it are compressive under the contact."""
+    """After a dolfinx solve the picture renders (in-process: conftest loaded vtk first
+    through roughfe._runtime); the stresses handed to it are compressive under the contact."""
     n = 17
     x = np.arange(n) * 1e-3 / (n - 1)
     surf = Surface(1e-6 * np.cos(np.pi * x / 1e-3), n * 1e-3 / (n - 1))

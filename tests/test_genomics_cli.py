@@ -16,17 +16,18 @@ def test_genome_commands_end_to_end(tmp_path, capsys):
                      "-o", str(tmp_path / f"{s}.npz")]) == 0
     z = load_surface(tmp_path / "10x.npz")
     assert z.shape == (128,) and z.heights[64] == 0.0
-    out = tmp_path / "seq.json"
+    seqdir = tmp_path / "seq"
     assert main(["genome", "sequence", str(tmp_path / "20x.npz"), str(tmp_path / "10x.npz"),
-                 "-o", str(out)]) == 0
+                 "-o", str(seqdir)]) == 0
     text = capsys.readouterr().out
     assert "gamma = 1.5" in text and "relative rms error" in text
+    out = seqdir / "genome.json"
     seq = load_genome(out)
     assert abs(seq.gamma - 1.5) < 1e-9
-    rep = json.loads((tmp_path / "seq_report.json").read_text())
+    rep = json.loads((seqdir / "report.json").read_text())
     assert rep["success"] and max(rep["rms_errors"]) < 1e-9
     for fig in ("profiles", "psd", "td", "bu"):
-        assert (tmp_path / f"seq_{fig}.png").stat().st_size > 10_000
+        assert (seqdir / f"{fig}.png").stat().st_size > 10_000
     mech = tmp_path / "mech"
     assert main(["genome", "mechanics", str(out), "--nodes", "32", "--kernels", "strip",
                  "--steps", "5", "--max-chromosomes", "1", "-o", str(mech)]) == 0
@@ -42,5 +43,5 @@ def test_genome_cli_reports_bad_input(tmp_path, capsys):
     main(["genome", "realize", str(g), "--scale", "10x", "--nodes", "128", "-o", str(tmp_path / "a.npz")])
     main(["genome", "realize", str(g), "--scale", "20x", "--nodes", "64", "-o", str(tmp_path / "b.npz")])
     assert main(["genome", "sequence", str(tmp_path / "a.npz"), str(tmp_path / "b.npz"),
-                 "-o", str(tmp_path / "s.json")]) == 2
+                 "-o", str(tmp_path / "s")]) == 2
     assert "same number of nodes" in capsys.readouterr().err

@@ -20,7 +20,7 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
     path = save_surface(s, tmp_path / "s.npz")
     out = tmp_path / "out"
     deltas = [0.2 * np.ptp(s.heights), 0.6 * np.ptp(s.heights)]
-    # a fresh process: pyvista must be loaded before dolfinx (see roughfe.plotting.leakage)
+    # a fresh process, as a user runs it (the CLI loads vtk before dolfinx: roughfe._runtime)
     env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": "vtkEGLRenderWindow",
            "PYVISTA_OFF_SCREEN": "true", "MPLBACKEND": "Agg"}
     proc = subprocess.run(
@@ -59,7 +59,7 @@ def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
     from roughfe.cli import main
     out = tmp_path / "study"
     argv = ["leak-study", "--D", "2.3", "2.7", "--m", "3", "--surfaces", "2", "--no-reynolds",
-            "--workers", "1", "--no-progress", "-o", str(out)]
+            "--workers", "1", "--quiet", "-o", str(out)]
     assert main(argv) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["n_records"] == 2 * 2 * 6

@@ -17,51 +17,54 @@ from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5, write_results_json
 from ..theory import beside
 from ..writers import write_json
-from .common import add_surface_options, surface_from_args
+from .options import (add_detrend_option, add_material_options, add_output_folder,
+                      add_run_options, add_surface_options, check_small_strain,
+                      material_from_args, output_folder_of, positive_float, positive_int,
+                      surface_from_args)
+
+DEFAULT_STEPS = 20
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "contact", help="BEM contact sweep of a rough surface: A(p), K(p), gap, free volume",
         description="Frictionless normal contact of a rigid rough surface on an elastic "
-                    "half-space (thesis Sec. 2.2). Writes OUTDIR/results.json, "
-                    "OUTDIR/fields.h5 and figures. SI units.")
+                    "half-space (thesis Sec. 2.2), warm-started from load to load. Writes "
+                    "OUTDIR/fields.h5 (pressure, gap, contact per step), the figures and, "
+                    "last, OUTDIR/results.json (inputs and one record per step). SI units.")
     add_surface_options(p)
-    p.add_argument("--detrend", choices=("none", "mean", "plane"), default="none",
-                   help="remove the mean or the least-squares plane of the heights first "
-                        "(measured topographies usually need 'plane'); default none")
-    mat = p.add_argument_group("material")
-    mat.add_argument("--E", type=float, required=True, help="Young's modulus (Pa)")
-    mat.add_argument("--nu", type=float, required=True, help="Poisson's ratio, in (-1, 0.5]")
-    load = p.add_argument_group("loading (one of)").add_mutually_exclusive_group()
-    load.add_argument("--steps", type=int, default=None,
-                      help="N equispaced approaches up to the peak-to-valley height (up to "
-                           "full contact for periodic surfaces); default 20")
-    load.add_argument("--pressure", type=float, nargs="+", metavar="P",
+    add_detrend_option(p)
+    add_material_options(p)
+    load = p.add_argument_group("loading (one of; default --steps 20)").add_mutually_exclusive_group()
+    load.add_argument("--steps", type=positive_int, default=None, metavar="N",
+                      help=f"N equispaced approaches up to the peak-to-valley height (up to "
+                           f"full contact for periodic surfaces); {DEFAULT_STEPS} if no "
+                           "loading is given")
+    load.add_argument("--pressure", type=positive_float, nargs="+", metavar="P",
                       help="mean pressures (Pa), solved in the order given")
     load.add_argument("--delta", type=float, nargs="+", metavar="D",
                       help="approaches from first contact (m), solved in the order given")
     num = p.add_argument_group("numerics")
     num.add_argument("--kernel", default="auto", choices=("auto",) + KERNELS,
-                     help="influence operator (default: spectral if periodic, else strip "
-                          "for profiles and love for surfaces; 'thesis' = Eq. 2.4)")
+                     help="influence operator: auto = spectral if periodic, else strip for "
+                          "profiles and love for surfaces; 'thesis' = Eq. 2.4")
     num.add_argument("--solver", default="auto", choices=SOLVERS,
                      help="dense pivoting, scipy NNLS, or matrix-free Polonsky-Keer PCG")
-    num.add_argument("--tol", type=float, default=1e-10, help="relative KKT residual")
-    p.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="output folder")
-    p.add_argument("--no-figures", action="store_true", help="skip the figures")
+    num.add_argument("--tol", type=positive_float, default=1e-10,
+                     help="relative KKT residual at which a load step is converged")
+    add_output_folder(p)
+    add_run_options(p)
     p.set_defaults(func=_run)
 
 
 def _run(args) -> int:
     surface = surface_from_args(args)
-    if args.detrend != "none":
-        surface = surface.detrended(args.detrend)
-    material = Material(args.E, args.nu)
-    sweep = contact_sweep(surface, material, n_steps=args.steps or 20, deltas=args.delta,
-                          pressures=args.pressure, kernel=args.kernel, solver=args.solver,
-                          tol=args.tol)
-    out = Path(args.output)
+    material = material_from_args(args)
+    folder = output_folder_of(args, "contact")  # checked now, taken when writing
+    sweep = contact_sweep(surface, material, n_steps=args.steps or DEFAULT_STEPS,
+                          deltas=args.delta, pressures=args.pressure, kernel=args.kernel,
+                          solver=args.solver, tol=args.tol)
+    check_small_strain(args, surface, sweep.delta, material, sweep.mean_pressure)
     r0 = sweep.results[0]
     inputs = {"surface": str(args.surface), "shape": list(surface.shape),
               "size": list(surface.size), "periodic": surface.periodic,
@@ -73,20 +76,22 @@ def _run(args) -> int:
     doc = sweep_document(sweep, inputs)
     theory = beside(surface, material.E_star, doc["steps"])
     doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
-    write_json(out / "results.json", doc)
-    write_fields_h5(out / "fields.h5", sweep)
-    if not args.no_figures:
-        from ..plotting.contact import plot_area_stiffness, plot_profile_state, render_contact
-        plot_area_stiffness(doc["steps"], out / "contact_area_stiffness.png",
-                            title=f"{Path(args.surface).name}, E* = {material.E_star:.4g} Pa",
-                            rms_height=sweep.rms_height)
-        last = sweep.results[-1]
-        if surface.ndim == 2:
-            render_contact(surface.heights, last, out / "contact_render.png",
-                           title=Path(args.surface).name)
-        else:
-            plot_profile_state(surface.heights, last, out / "contact_profile.png",
+    with folder as out:
+        write_fields_h5(out / "fields.h5", sweep)
+        if not args.no_figures:
+            from ..plotting.contact import (plot_area_stiffness, plot_profile_state,
+                                            render_contact)
+            plot_area_stiffness(doc["steps"], out / "contact_area_stiffness.png",
+                                title=f"{Path(args.surface).name}, E* = {material.E_star:.4g} Pa",
+                                rms_height=sweep.rms_height)
+            last = sweep.results[-1]
+            if surface.ndim == 2:
+                render_contact(surface.heights, last, out / "contact_render.png",
                                title=Path(args.surface).name)
+            else:
+                plot_profile_state(surface.heights, last, out / "contact_profile.png",
+                                   title=Path(args.surface).name)
+        write_json(out / "results.json", doc)  # last: the run is complete
     print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} {'K (Pa/m)':>12s} {'gap (m)':>12s} "
           f"{'nit':>5s}")
     for s in sweep.to_records():

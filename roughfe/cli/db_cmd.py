@@ -9,9 +9,23 @@ finished genomes (rerun the same command). Under MPI run::
 """
 from __future__ import annotations
 
-import json
 import sys
-from pathlib import Path
+
+DESCRIPTION = """\
+The genome database of thesis Sec. 4.1.2 (an SQLite file): each row is a genome with its
+A(p), K(p) curves, chromosome correlations and macro chromosomes, computed with the
+realisation and contact settings stored in the file.
+
+build computes the genomes of a Sobol design; extend adds genome JSON files; both run on
+the study runner (local process pool, dask or MPI) with a study folder beside the
+database (DATABASE.study), so an interrupted run resumes when you rerun the same command.
+list prints the genomes (read-only); map draws the genetic map. Under MPI run:
+
+    mpirun -n K python -m mpi4py.futures $(which roughfe) db build DB --executor mpi
+"""
+
+from .options import (add_material_options, add_output_folder, add_run_options,
+                      add_runner_options, output_folder_of, positive_float, positive_int)
 
 
 def _settings(args):
@@ -54,27 +68,19 @@ def _extend(args) -> int:
 
 
 def _add_runner_options(p):
-    from ..study import EXECUTORS
-    r = p.add_argument_group("study runner (as `roughfe study run`)")
-    r.add_argument("--executor", choices=EXECUTORS, default="local",
-                   help="local: process pool on this machine (default); dask: dask.distributed "
-                        "(LocalCluster, or --scheduler); mpi: mpi4py.futures under mpirun")
-    r.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                   help="a running dask scheduler: address or scheduler file (dask only)")
-    r.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="worker processes for local and a dask LocalCluster (default: cores)")
-    r.add_argument("--study-dir", default=None, metavar="DIR",
+    add_runner_options(p)
+    p.add_argument("--study-dir", default=None, metavar="DIR",
                    help="study folder of the tasks (default: DATABASE.study); keep it to "
                         "resume an interrupted run")
-    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_run_options(p, figures=False)
 
 
 def _list(args) -> int:
     from ..genomics.database import read_settings, summary_table
     rows = summary_table(args.database)
     if args.json:
-        print(json.dumps({"settings": read_settings(args.database).to_dict(), "genomes": rows},
-                         indent=2))
+        from ..writers import to_json_text
+        print(to_json_text({"settings": read_settings(args.database).to_dict(), "genomes": rows}))
         return 0
     print(f"{'label':>7} {'source':>7} {'gamma':>7} {'H':>6} {'n_c':>4} {'p_max (Pa)':>12}  macro n")
     for r in rows:
@@ -91,16 +97,16 @@ def _map(args) -> int:
     if not rows:
         from ..errors import InputError
         raise InputError(f"the genome database {args.database} holds no genomes")
-    out = Path(args.output)
-    a = plot_genetic_map(rows, out / "genetic_map.png")
-    b = plot_map_summary(rows, out / "genetic_map_summary.png")
+    with output_folder_of(args, "db map") as out:
+        a = plot_genetic_map(rows, out / "genetic_map.png")
+        b = plot_map_summary(rows, out / "genetic_map_summary.png")
     print(f"wrote {a} and {b}")
     return 0
 
 
 def register(sub):
     p = sub.add_parser("db", help="genome database: build (Sobol design), extend, list, map",
-                       description=__doc__)
+                       description=DESCRIPTION)
     dsub = p.add_subparsers(dest="db_command", metavar="ACTION")
     dsub.required = True
 
@@ -108,18 +114,20 @@ def register(sub):
     b.add_argument("database", help="SQLite file (created if missing; genomes there are kept, "
                                     "an interrupted build resumes)")
     g = b.add_argument_group("realisation and contact settings (stored in the database)")
-    g.add_argument("--length", type=float, default=849.42e-6, help="observation length L = lambda (m)")
-    g.add_argument("--nodes", type=int, default=512, help="nodes N per profile")
-    g.add_argument("--E", type=float, default=1.0e6, help="Young's modulus (Pa)")
-    g.add_argument("--nu", type=float, default=0.0, help="Poisson's ratio")
-    g.add_argument("--steps", type=int, default=20, help="n_t approaches to the peak-valley height")
-    g.add_argument("--threshold", type=float, default=0.95, help="c_n threshold of Alg. 2")
+    g.add_argument("--length", type=positive_float, default=849.42e-6,
+                   help="observation length L = lambda (m)")
+    g.add_argument("--nodes", type=positive_int, default=512, help="nodes N per profile")
+    g.add_argument("--steps", type=positive_int, default=20,
+                   help="n_t approaches to the peak-valley height")
+    g.add_argument("--threshold", type=positive_float, default=0.95, help="c_n threshold of Alg. 2")
     g.add_argument("--stiffness", choices=("fd", "exact"), default="fd",
                    help="K(p) by differences over the steps (thesis) or exact per step")
+    add_material_options(b, "material (stored in the database; the thesis used E = 1 MPa: "
+                            "pressures scale with E*)")
     s = b.add_argument_group("Sobol design")
     s.add_argument("--seed", type=int, default=20240, help="Sobol scrambling seed (recorded)")
     s.add_argument("--no-scramble", action="store_true", help="unscrambled Sobol sequences")
-    s.add_argument("--limit", type=int, default=None, help="build only the first K genomes")
+    s.add_argument("--limit", type=positive_int, default=None, help="build only the first K genomes")
     _add_runner_options(b)
     b.set_defaults(func=_build)
 
@@ -137,5 +145,5 @@ def register(sub):
 
     m = dsub.add_parser("map", help="genetic map (Fig. 54) and its summary (Fig. 55)")
     m.add_argument("database", help="SQLite genome database")
-    m.add_argument("-o", "--output", default="db-map", help="output folder for the figures")
+    add_output_folder(m, "output folder for the figures", required=False, default="db-map")
     m.set_defaults(func=_map)

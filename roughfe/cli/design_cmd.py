@@ -5,6 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .options import (add_output_folder, add_run_options, nonnegative_int, output_folder_of,
+                      positive_float, positive_int)
+
 BUILTIN = ("y_t1", "y_t2", "y_t3")
 
 
@@ -24,7 +27,6 @@ def _run(args) -> int:
     from ..genomics.database import load_entries, read_settings
     from ..genomics.design import (GcmmaOptions, refine, rescore_at_target_pressures,
                                    run_design, write_design_result)
-    from ..plotting.design import plot_design_curves, plot_profiles, plot_psds, plot_stages
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}
@@ -42,18 +44,20 @@ def _run(args) -> int:
     if args.pool and args.method != "mcco":
         raise InputError("--pool is used by --method mcco only")
     extra = ({"pool": args.pool, "swap": True, "weights": (0.5, 1.0, 2.0)} if args.pool else {})
-    result = run_design(args.method, entries, targets, settings, pbar=args.pbar, options=options,
-                        **extra)
-    if args.refine:
-        result = refine(result, settings, rounds=args.refine)
-    out = Path(args.output)
-    paths = write_design_result(result, settings, out)
-    if not args.no_figures:
-        best = result.best.design
-        plot_design_curves([result], out / "curves.png", title=result.message)
-        plot_stages([result], out / "stages.png")
-        plot_profiles({result.method: best.surface()}, out / "profile.png")
-        plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
+    with output_folder_of(args, "design") as out:
+        result = run_design(args.method, entries, targets, settings, pbar=args.pbar,
+                            options=options, **extra)
+        if args.refine:
+            result = refine(result, settings, rounds=args.refine)
+        if not args.no_figures:
+            from ..plotting.design import (plot_design_curves, plot_profiles, plot_psds,
+                                           plot_stages)
+            best = result.best.design
+            plot_design_curves([result], out / "curves.png", title=result.message)
+            plot_stages([result], out / "stages.png")
+            plot_profiles({result.method: best.surface()}, out / "profile.png")
+            plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
+        paths = write_design_result(result, settings, out)
     print(result.message)
     for k, c in enumerate(result.candidates, 1):
         print(f"  ({k}) {c.origin:>16}  GCMMA 0/1/2{'/3' if len(c.stages) > 3 else ''}: "
@@ -71,16 +75,21 @@ def _targets(args) -> int:
     from ..genomics.design import thesis_targets
     from ..genomics.similarity import write_target_csv
     t1, t2, t3, _ = thesis_targets(read_settings(args.db))
-    out = Path(args.output)
-    for t in (t1, t2, t3):
-        print(write_target_csv(out / f"{t.name}.csv", t))
+    with output_folder_of(args, "design-targets") as out:
+        for t in (t1, t2, t3):
+            print(write_target_csv(out / f"{t.name}.csv", t))
     print(f"pbar of y_t2: {t2.metadata['pbar']:.6g} Pa; p_max^t = {t1.p_max:.6g} Pa")
     return 0
 
 
 def register(sub):
     p = sub.add_parser("design", help="design roughness for a target K(p)/A(p) (SOG/GCO/CCO/M-CCO)",
-                       description=__doc__)
+                       description="Design a rough profile whose K(p) and/or A(p) hit a "
+                                   "target (thesis Sec. 4.2-4.4) from a genome database. "
+                                   "Writes OUTDIR/result.json (scores, stages), design.json, "
+                                   "genome.json (a roughfe-genome for 'genome realize'; for a "
+                                   "design of several genomes one genome_partK.json per part), "
+                                   "profile.npz, curves.csv, stages.csv and the figures.")
     p.add_argument("--db", required=True, help="SQLite genome database ('roughfe db build')")
     p.add_argument("--target", required=True,
                    help="CSV 'pressure_Pa,value' or a thesis target y_t1|y_t2|y_t3")
@@ -92,10 +101,10 @@ def register(sub):
                    help="what the second target CSV holds")
     p.add_argument("--method", choices=("sog", "gco", "cco", "mcco"), required=True,
                    help="Alg. 4 (sog), 5 (gco), 6 (cco) or 7 (mcco)")
-    p.add_argument("--pbar", type=float, default=None,
+    p.add_argument("--pbar", type=positive_float, default=None,
                    help="threshold pressure (Pa) splitting [0, pbar] and [pbar, p_max] (gco, cco)")
     g = p.add_argument_group("GCMMA options")
-    g.add_argument("--iterations", type=int, default=None,
+    g.add_argument("--iterations", type=positive_int, default=None,
                    help="outer GCMMA iterations of stage 1 (default: thesis, 5 sog / 3 others)")
     g.add_argument("--bound", choices=("start", "period"), default="start",
                    help="phase box: +-10%% of the start value (thesis) or of 2 pi")
@@ -103,20 +112,21 @@ def register(sub):
                    help="min-max form with residual Jacobian, or (1-s)^2 with its gradient")
     g.add_argument("--gradient", choices=("exact", "fd"), default="exact",
                    help="exact sensitivities on the fixed contact sets, or finite differences")
-    g.add_argument("--eps", type=float, default=0.02,
+    g.add_argument("--eps", type=positive_float, default=0.02,
                    help="finite-difference step in units of the phase box (--gradient fd)")
-    g.add_argument("--refine", type=int, default=0, metavar="ROUNDS",
+    g.add_argument("--refine", type=nonnegative_int, default=0, metavar="ROUNDS",
                    help="extra stage beyond the thesis: ROUNDS x 15 GCMMA iterations on all "
-                        "phases, box (+-10%% of 2 pi) re-centred each round (default 0: off)")
-    p.add_argument("--pool", type=int, default=0, metavar="K",
+                        "phases, box (+-10%% of 2 pi) re-centred each round (0: off)")
+    p.add_argument("--pool", type=nonnegative_int, default=0, metavar="K",
                    help="mcco, beyond the thesis: start pool of the K best genomes of each "
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "
-                        "(default 0: the thesis sets)")
-    p.add_argument("-o", "--output", required=True, help="output folder")
-    p.add_argument("--no-figures", action="store_true", help="skip the figures")
+                        "(0: the thesis sets)")
+    add_output_folder(p)
+    add_run_options(p)
     p.set_defaults(func=_run)
 
     t = sub.add_parser("design-targets", help="write the thesis targets y_t1, y_t2, y_t3 as CSV")
     t.add_argument("--db", required=True, help="SQLite genome database (for L, N, E, n_t)")
-    t.add_argument("-o", "--output", required=True, help="output folder")
+    add_output_folder(t)
+    add_run_options(t, figures=False)
     t.set_defaults(func=_targets)

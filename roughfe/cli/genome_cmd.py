@@ -8,14 +8,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..genomics.chromosomes import reconstruction, validity_monte_carlo
-from ..genomics.genome import SCALES, load_genome, realize, save_genome, table1_genome
-from ..genomics.mechanics import THESIS_YOUNGS_MODULUS, chromosome_mechanics
-from ..genomics.natural import DEFAULT_FRACTIONS, sequence_measured
-from ..genomics.sequencing import sequence_profiles
-from ..surfaces.io import load_surface, save_surface
-from ..writers import write_json
-from .common import add_surface_options, surface_from_args
+from .options import (add_material_options, add_output_file, add_output_folder,
+                      add_run_options, add_surface_options, material_from_args,
+                      output_file_of, output_folder_of, positive_float, positive_int,
+                      surface_from_args, add_detrend_option)
+
+from ..genomics.genome import SCALES
+from ..genomics.natural import DEFAULT_FRACTIONS
 
 
 def _print_genome(g, prefix="  "):
@@ -24,34 +23,39 @@ def _print_genome(g, prefix="  "):
 
 
 def _example(args) -> int:
+    from ..genomics.genome import save_genome, table1_genome
+    out = output_file_of(args, suffixes=(".json",))
     g = table1_genome(rng=args.seed, n_max=args.n_max)
-    save_genome(g, args.output)
-    print(f"Table 1 genome (phases from seed {args.seed}) -> {args.output}")
+    save_genome(g, out)
+    print(f"Table 1 genome (phases from seed {args.seed}) -> {out}")
     _print_genome(g)
     return 0
 
 
 def _realize(args) -> int:
+    from ..genomics.genome import load_genome, realize
+    from ..surfaces.io import save_surface
     g = load_genome(args.genome)
+    out = output_file_of(args, suffixes=(".npz",))
     s = realize(g, length=args.length, scale=args.scale, n_nodes=args.nodes,
                 chromosomes=args.chromosomes)
-    save_surface(s, args.output)
+    save_surface(s, out)
     m = s.metadata
     print(f"realised L = {m['length']:.6g} m, N = {m['n_nodes']}, chromosomes "
           f"{m['chromosomes'][0]}..{m['chromosomes'][-1]} (Eq. 3.5: n_s = {m['n_s']}, n_f = {m['n_f']}) "
-          f"-> {args.output}")
+          f"-> {out}")
     return 0
 
 
 def _sequence_figures(res, outdir: Path, stem: str):
+    from ..genomics.chromosomes import reconstruction
     from ..plotting import genomics as gp
-    outdir.mkdir(parents=True, exist_ok=True)
-    paths = [gp.plot_sequenced_profiles(res, outdir / f"{stem}_profiles.png"),
-             gp.plot_spectra(res, outdir / f"{stem}_psd.png")]
+    paths = [gp.plot_sequenced_profiles(res, outdir / f"{stem}profiles.png"),
+             gp.plot_spectra(res, outdir / f"{stem}psd.png")]
     g = res.genome
     for order in ("td", "bu"):
         rec = reconstruction(g, float(res.lengths[0]), len(res.x[0]), order=order)
-        paths.append(gp.plot_reconstruction(rec, outdir / f"{stem}_{order}.png"))
+        paths.append(gp.plot_reconstruction(rec, outdir / f"{stem}{order}.png"))
     return paths
 
 
@@ -66,148 +70,202 @@ def _print_sequencing(res):
 
 
 def _sequence(args) -> int:
+    from ..genomics.genome import save_genome
+    from ..genomics.sequencing import sequence_profiles
+    from ..surfaces.io import load_surface
+    from ..writers import write_json
     surfaces = [load_surface(p) for p in args.profiles]
+    folder = output_folder_of(args, "genome sequence")
     res = sequence_profiles(surfaces, seed=args.seed, M=args.ridges, rms_tolerance=args.tolerance)
-    out = Path(args.output)
-    save_genome(res.genome, out)
-    write_json(out.with_name(out.stem + "_report.json"), res.report())
+    with folder as out:
+        if not args.no_figures:
+            for p in _sequence_figures(res, out, ""):
+                print(f"  figure {p}")
+        write_json(out / "report.json", res.report())
+        save_genome(res.genome, out / "genome.json")
     _print_sequencing(res)
-    if not args.no_figures:
-        figdir = Path(args.figures) if args.figures else out.parent
-        for p in _sequence_figures(res, figdir, out.stem):
-            print(f"  figure {p}")
-    print(f"genome -> {out}")
+    print(f"genome -> {out / 'genome.json'}")
     return 0 if res.success or not args.strict else 1
 
 
 def _mechanics(args) -> int:
-    from ..plotting import genomics as gp
+    from ..genomics.genome import load_genome
+    from ..genomics.mechanics import chromosome_mechanics
+    from ..writers import write_json
     g = load_genome(args.genome)
-    out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
+    material = material_from_args(args)
     length = args.length if args.length is not None else g.length_of(args.scale)
-    for kernel in args.kernels:
-        mech = chromosome_mechanics(g, length=length, n_nodes=args.nodes,
-                                    youngs_modulus=args.youngs_modulus, poisson=args.poisson,
-                                    kernel=kernel, n_steps=args.steps,
-                                    max_chromosomes=args.max_chromosomes)
-        write_json(out / f"mechanics_{kernel}.json", mech.to_dict())
-        gp.plot_chromosome_curves(mech, out / f"chromosomes_{kernel}.png")
-        gp.plot_td_bu(mech, out / f"td_bu_A_{kernel}.png", "A")
-        gp.plot_td_bu(mech, out / f"td_bu_K_{kernel}.png", "K")
-        gp.plot_correlations(mech, out / f"correlations_{kernel}.png")
-        print(f"{kernel} kernel: {mech.message}, {mech.elapsed:.1f} s")
-        print("  c_n TD (K): " + " ".join(f"{v:.3f}" for v in mech.c_td["K"]))
-        print("  c_n BU (K): " + " ".join(f"{v:.3f}" for v in mech.c_bu["K"]))
+    with output_folder_of(args, "genome mechanics") as out:
+        for kernel in args.kernels:
+            mech = chromosome_mechanics(g, length=length, n_nodes=args.nodes,
+                                        youngs_modulus=material.E, poisson=material.nu,
+                                        kernel=kernel, n_steps=args.steps,
+                                        max_chromosomes=args.max_chromosomes)
+            if not args.no_figures:
+                from ..plotting import genomics as gp
+                gp.plot_chromosome_curves(mech, out / f"chromosomes_{kernel}.png")
+                gp.plot_td_bu(mech, out / f"td_bu_A_{kernel}.png", "A")
+                gp.plot_td_bu(mech, out / f"td_bu_K_{kernel}.png", "K")
+                gp.plot_correlations(mech, out / f"correlations_{kernel}.png")
+            write_json(out / f"mechanics_{kernel}.json", mech.to_dict())
+            print(f"{kernel} kernel: {mech.message}, {mech.elapsed:.1f} s")
+            print("  c_n TD (K): " + " ".join(f"{v:.3f}" for v in mech.c_td["K"]))
+            print("  c_n BU (K): " + " ".join(f"{v:.3f}" for v in mech.c_bu["K"]))
     print(f"curves, c_n and figures -> {out}")
     return 0
 
 
 def _natural(args) -> int:
-    from ..plotting import genomics as gp
+    from ..genomics.genome import save_genome
+    from ..genomics.natural import sequence_measured
+    from ..surfaces.io import save_surface
+    from ..writers import write_json
     surface = surface_from_args(args)
-    out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
-    res = sequence_measured(surface, fractions=args.fractions, n_nodes=args.nodes, seed=args.seed,
-                            kernels=args.kernels, n_steps=args.steps,
-                            rms_tolerance=args.tolerance)
-    stem = Path(args.surface).stem
-    for k, a in enumerate(res.acquisitions):
-        save_surface(a, out / f"{stem}_acq{k + 1}.npz")
-    save_genome(res.sequencing.genome, out / f"{stem}_genome.json")
-    write_json(out / f"{stem}_report.json", res.report())
+    material = material_from_args(args)
+    folder = output_folder_of(args, "genome natural")
+    res = sequence_measured(surface, fractions=args.fractions, n_nodes=args.nodes,
+                            seed=args.seed, kernels=args.kernels, n_steps=args.steps,
+                            rms_tolerance=args.tolerance, youngs_modulus=material.E_star)
+    with folder as out:
+        stem = Path(args.surface).stem
+        for k, a in enumerate(res.acquisitions):
+            save_surface(a, out / f"{stem}_acq{k + 1}.npz")
+        if not args.no_figures:
+            from ..plotting import genomics as gp
+            _sequence_figures(res.sequencing, out, f"{stem}_")
+            if res.curves:
+                gp.plot_measured_vs_sequenced(res.curves, out / f"{stem}_curves.png",
+                                              title=f"{stem}: measured vs sequenced")
+        save_genome(res.sequencing.genome, out / f"{stem}_genome.json")
+        write_json(out / f"{stem}_report.json", res.report())
     _print_sequencing(res.sequencing)
     print("  measured samples per acquisition: "
           + ", ".join(str(a.metadata["measured_points"]) for a in res.acquisitions))
     for k, v in res.curves.items():
         d = v["difference"]
         print(f"  {k} kernel: A(p) differs by up to {100 * d['A']:.3g} %, K(p) by {100 * d['K']:.3g} %")
-    _sequence_figures(res.sequencing, out, stem)
-    if res.curves:
-        gp.plot_measured_vs_sequenced(res.curves, out / f"{stem}_curves.png",
-                                      title=f"{stem}: measured vs sequenced")
     print(f"outputs -> {out}")
     return 0
 
 
 def _validity(args) -> int:
+    from ..genomics.chromosomes import validity_monte_carlo
     from ..plotting import genomics as gp
-    res = validity_monte_carlo(range(2, 21), args.trials, rng=args.seed)
-    gp.plot_validity(res, args.output)
+    out = output_file_of(args, suffixes=(".png",))
+    res = validity_monte_carlo(range(2, args.max_ridges + 1), args.trials, rng=args.seed)
+    gp.plot_validity(res, out)
     print("M      : " + " ".join(f"{m:5d}" for m in res.M))
     print("Eq 3.10: " + " ".join(f"{100 * v:5.1f}" for v in res.valid_fraction))
     print("arccos : " + " ".join(f"{100 * v:5.1f}" for v in res.arccos_fraction))
-    print(f"figure -> {args.output}")
+    print(f"figure -> {out}")
     return 0
 
 
-def _length_or_scale(p):
-    g = p.add_mutually_exclusive_group(required=True)
-    g.add_argument("--scale", choices=sorted(SCALES), help="named scale: L = lambda1, lambda1/2, lambda1/10")
-    g.add_argument("--length", type=float, help="observation length L (m)")
+def _length_or_scale(p, required=True, default=None):
+    g = p.add_mutually_exclusive_group(required=required)
+    g.add_argument("--scale", choices=sorted(SCALES), default=default,
+                   help="named observation scale: L = lambda1 (10x), lambda1/2 (20x), "
+                        "lambda1/10 (100x)")
+    g.add_argument("--length", type=positive_float, help="observation length L (m)")
 
 
 def register(sub):
     top = sub.add_parser("genome", help="surface roughness genomics: realise, sequence, chromosome mechanics",
-                         description=__doc__)
+                         description="Surface roughness genomics (thesis Ch. 3): write the "
+                                     "Table 1 genome, realise a genome as a profile, sequence "
+                                     "a genome from nested acquisitions or a measured "
+                                     "topography, and the contact mechanics of its "
+                                     "chromosomes. Genomes are roughfe-genome JSON files.")
     gs = top.add_subparsers(dest="genome_command", metavar="ACTION")
     gs.required = True
 
-    p = gs.add_parser("example", help="write the Table 1 genome (A=1, H=0.75, gamma=1.5, M=8, lambda1=1 mm)")
-    p.add_argument("-o", "--output", required=True, help="genome JSON file")
+    p = gs.add_parser("example", help="write the Table 1 genome (A=1, H=0.75, gamma=1.5, M=8, lambda1=1 mm)",
+                      description="Write the genome of thesis Table 1 (A = 1, H = 0.75, "
+                                  "gamma = 1.5, M = 8, lambda1 = 1 mm) with seeded phases "
+                                  "(the thesis does not publish its phases).")
+    add_output_file(p, "genome JSON file to write")
     p.add_argument("--seed", type=int, default=0, help="seed of the (unpublished) phases")
-    p.add_argument("--n-max", type=int, default=22, help="last chromosome with a phase (22 covers 100x)")
+    p.add_argument("--n-max", type=positive_int, default=22,
+                   help="last chromosome with a phase (22 covers the 100x scale)")
     p.set_defaults(func=_example)
 
-    p = gs.add_parser("realize", help="realise a genome as a profile (Eq. 3.1, 3.5)")
-    p.add_argument("genome", metavar="GENOME.json")
+    p = gs.add_parser("realize", help="realise a genome as a profile (Eq. 3.1, 3.5)",
+                      description="Realise a roughfe-genome JSON as a profile of N nodes over "
+                                  "L (Eq. 3.1 with the chromosomes of Eq. 3.5) and save it as "
+                                  "a roughfe .npz surface.")
+    p.add_argument("genome", metavar="GENOME.json", help="roughfe-genome JSON file")
     _length_or_scale(p)
-    p.add_argument("--nodes", type=int, default=512, help="number of nodes N (delta = L/(N-1))")
-    p.add_argument("--chromosomes", type=int, nargs="+", help="sum only these chromosome indices")
-    p.add_argument("-o", "--output", required=True, help="profile .npz (roughfe surface format)")
+    p.add_argument("--nodes", type=positive_int, default=512,
+                   help="number of nodes N (spacing L/(N-1))")
+    p.add_argument("--chromosomes", type=positive_int, nargs="+",
+                   help="sum only these chromosome indices (default: those of Eq. 3.5)")
+    add_output_file(p, "profile .npz to write (roughfe surface format)")
     p.set_defaults(func=_realize)
 
-    p = gs.add_parser("sequence", help="sequence a genome from 2-3 nested acquisitions (Sec. 3.3.1)")
+    p = gs.add_parser("sequence", help="sequence a genome from 2-3 nested acquisitions (Sec. 3.3.1)",
+                      description="Sequence a genome (Sec. 3.3.1) from 2-3 acquisitions of "
+                                  "one profile at nested lengths. Writes OUTDIR/genome.json, "
+                                  "OUTDIR/report.json and the figures (profiles, psd, td, bu).")
     p.add_argument("profiles", nargs="+", metavar="PROFILE.npz",
                    help="acquisitions of the same profile (same N, nested windows centred on x = 0)")
-    p.add_argument("-o", "--output", required=True, help="sequenced genome JSON (+ _report.json)")
     p.add_argument("--seed", type=int, default=0, help="seed of the M likelihood and the phase draws")
-    p.add_argument("--ridges", type=int, default=None, help="impose M (default: maximum likelihood)")
-    p.add_argument("--tolerance", type=float, default=0.05, help="relative rms error of a WM-like profile")
-    p.add_argument("--figures", default=None, help="figure folder (default: next to the genome)")
-    p.add_argument("--no-figures", action="store_true", help="skip the figures")
+    p.add_argument("--ridges", type=positive_int, default=None,
+                   help="impose M (default: maximum likelihood)")
+    p.add_argument("--tolerance", type=positive_float, default=0.05,
+                   help="relative rms error below which a profile counts as WM-like")
     p.add_argument("--strict", action="store_true", help="exit 1 when the quality check fails")
+    add_output_folder(p)
+    add_run_options(p)
     p.set_defaults(func=_sequence)
 
-    p = gs.add_parser("mechanics", help="A(p), K(p) of a realisation, its chromosomes and TD/BU sums (Fig. 36-39)")
-    p.add_argument("genome", metavar="GENOME.json")
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--scale", choices=sorted(SCALES), default="10x", help="named scale (default 10x)")
-    g.add_argument("--length", type=float, help="observation length L (m)")
-    p.add_argument("--nodes", type=int, default=512, help="number of nodes N")
-    p.add_argument("--kernels", nargs="+", default=["thesis", "strip"],
+    p = gs.add_parser("mechanics", help="A(p), K(p) of a realisation, its chromosomes and TD/BU sums (Fig. 36-39)",
+                      description="BEM A(p), K(p) of a genome's realisation, of its single "
+                                  "chromosomes and of the top-down/bottom-up sums (thesis "
+                                  "Sec. 3.4.1, Fig. 36-39). Writes OUTDIR/mechanics_KERNEL.json "
+                                  "and the figures.")
+    p.add_argument("genome", metavar="GENOME.json", help="roughfe-genome JSON file")
+    _length_or_scale(p, required=False, default="10x")
+    p.add_argument("--nodes", type=positive_int, default=512, help="number of nodes N")
+    p.add_argument("--kernels", nargs="+", choices=("thesis", "strip"), default=["thesis", "strip"],
                    help="BEM kernels: thesis (Eq. 2.4) and/or strip (plane strain)")
-    p.add_argument("--youngs-modulus", type=float, default=THESIS_YOUNGS_MODULUS, help="E (Pa), thesis 210 MPa")
-    p.add_argument("--poisson", type=float, default=0.0, help="Poisson ratio")
-    p.add_argument("--steps", type=int, default=20, help="equal approaches up to the peak-valley amplitude")
-    p.add_argument("--max-chromosomes", type=int, default=10, help="single-chromosome curves (thesis: 10)")
-    p.add_argument("-o", "--output", required=True, help="output folder")
+    add_material_options(p)
+    p.add_argument("--steps", type=positive_int, default=20,
+                   help="equal approaches up to the peak-valley amplitude")
+    p.add_argument("--max-chromosomes", type=positive_int, default=10,
+                   help="single-chromosome curves (thesis: 10)")
+    add_output_folder(p)
+    add_run_options(p)
     p.set_defaults(func=_mechanics)
 
-    p = gs.add_parser("natural", help="sequence the central row of a measured topography (Sec. 3.4.2)")
+    p = gs.add_parser("natural", help="sequence the central row of a measured topography (Sec. 3.4.2)",
+                      description="Sequence the central row of a measured topography (thesis "
+                                  "Sec. 3.4.2): nested acquisitions, their genome and report, "
+                                  "and the measured vs sequenced A(p), K(p).")
     add_surface_options(p)
-    p.add_argument("--fractions", type=float, nargs="+", default=list(DEFAULT_FRACTIONS),
-                   help="nested window lengths as fractions of the row (default 1 0.5 0.2)")
-    p.add_argument("--nodes", type=int, default=512, help="nodes per acquisition")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--kernels", nargs="*", default=["thesis", "strip"], help="BEM kernels for A(p), K(p)")
-    p.add_argument("--steps", type=int, default=20)
-    p.add_argument("--tolerance", type=float, default=0.05)
-    p.add_argument("-o", "--output", required=True, help="output folder")
+    add_detrend_option(p)
+    p.add_argument("--fractions", type=positive_float, nargs="+", default=list(DEFAULT_FRACTIONS),
+                   help="nested window lengths as fractions of the row")
+    p.add_argument("--nodes", type=positive_int, default=512, help="nodes per acquisition")
+    p.add_argument("--seed", type=int, default=0, help="seed of the M likelihood and phase draws")
+    p.add_argument("--kernels", nargs="*", choices=("thesis", "strip"), default=["thesis", "strip"],
+                   help="BEM kernels for A(p), K(p) (none: sequencing only)")
+    add_material_options(p)
+    p.add_argument("--steps", type=positive_int, default=20,
+                   help="equal approaches up to the peak-valley amplitude")
+    p.add_argument("--tolerance", type=positive_float, default=0.05,
+                   help="relative rms error below which a profile counts as WM-like")
+    add_output_folder(p)
+    add_run_options(p)
     p.set_defaults(func=_natural)
 
-    p = gs.add_parser("validity", help="Monte Carlo of Eq. 3.10 (Fig. 29)")
-    p.add_argument("--trials", type=int, default=1000)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("-o", "--output", required=True, help="figure (.png)")
+    p = gs.add_parser("validity", help="Monte Carlo of Eq. 3.10 (Fig. 29)",
+                      description="Monte Carlo check of the validity condition Eq. 3.10 (thesis "
+                                  "Fig. 29): for M = 2..MAX ridges, the fraction of random phase "
+                                  "draws for which Eq. 3.10 holds, beside the arccos form.")
+    p.add_argument("--trials", type=positive_int, default=1000,
+                   help="random phase draws per number of ridges M")
+    p.add_argument("--max-ridges", type=positive_int, default=20,
+                   help="largest number of ridges M (from 2)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random phases")
+    add_output_file(p, "figure (.png) to write")
     p.set_defaults(func=_validity)

@@ -12,32 +12,30 @@ figures.
 """
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from ..bem import Material
 from ..errors import InputError
-from ..leakage import leakage_sweep
-from ..leakage.study import THESIS_D, THESIS_M, study_grid, summarise
-from ..theory import beside
+from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
-from .common import add_surface_options, surface_from_args
+from .options import (add_detrend_option, add_material_options, add_output_folder,
+                      add_run_options, add_runner_options, add_surface_options,
+                      check_small_strain,
+                      material_from_args, output_folder_of, positive_float, positive_int,
+                      surface_from_args)
 
 
 def _add_fluid_material(p):
-    mat = p.add_argument_group("material (elastic body against the rigid surface)")
-    mat.add_argument("--E", type=float, default=1.0e9, help="Young's modulus in Pa (default 1e9)")
-    mat.add_argument("--nu", type=float, default=0.3, help="Poisson ratio (default 0.3)")
+    add_material_options(p, "material (elastic body against the rigid surface)")
     fl = p.add_argument_group("fluid")
-    fl.add_argument("--mu", type=float, default=1.0e-3,
-                    help="dynamic viscosity in Pa s (default 1e-3, water)")
-    fl.add_argument("--pressure-drop", type=float, default=1.0,
-                    help="fluid pressure drop p_in - p_out in Pa (default 1; Q is linear in it)")
+    fl.add_argument("--mu", type=positive_float, default=1.0e-3,
+                    help="dynamic viscosity in Pa s (1e-3: water)")
+    fl.add_argument("--pressure-drop", type=positive_float, default=1.0,
+                    help="fluid pressure drop p_in - p_out in Pa (Q is linear in it)")
     fl.add_argument("--direction", choices=("x", "y", "both"), default="both",
-                    help="flow direction(s); percolating volume is the union (default both)")
+                    help="flow direction(s); the percolating volume is their union")
     fl.add_argument("--no-reynolds", action="store_true",
                     help="network analysis only (skip the Reynolds FE solve)")
 
@@ -60,18 +58,34 @@ def _save_fields(path, contact, leak):
 
 
 def _leak(args) -> int:
-    # imported before any solve: loads vtk before dolfinx (see roughfe.plotting.leakage)
-    from ..plotting import leakage as figs
-
-    if (args.delta is None) == (args.pressure is None):
-        raise InputError("give exactly one of --delta (approaches, m) or --pressure "
-                         "(mean contact pressures, Pa)")
     surface = surface_from_args(args)
-    material = Material(args.E, args.nu)
+    material = material_from_args(args)
+    with output_folder_of(args, "leak") as out:
+        sweep, steps, written = _leak_run(args, surface, material, out)
+    print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>7} {'Vp*':>9} {'Vnp*':>9} "
+          f"{'perc x/y':>8} {'Q (m^3/s)':>11}")
+    for s in steps:
+        q = s["leak_rate"]
+        print(f"{s['step']:>4} {s['delta']:>11.4e} {s['mean_pressure']:>10.4g} "
+              f"{s['area_fraction']:>7.4f} {s['percolating_volume_star'] or 0:>9.3e} "
+              f"{s['trapped_volume_star'] or 0:>9.3e} "
+              f"{str(s['percolates_x'])[0]}/{str(s['percolates_y'])[0]:>6} "
+              f"{'-' if q is None else format(q, '.4e'):>11}")
+    print(f"wrote {len(written)} files in {out}")
+    return 0 if sweep.success else 1
+
+
+def _leak_run(args, surface, material, out):
+    """Solve and write every file of ``roughfe leak`` into ``out``; results.json last."""
+    from ..leakage import leakage_sweep
+    from ..plotting import leakage as figs
+    from ..theory import beside
+
     sweep = leakage_sweep(surface, material, deltas=args.delta, pressures=args.pressure,
                           direction=args.direction, mu=args.mu,
                           pressure_drop=args.pressure_drop, reynolds=not args.no_reynolds)
-    out = Path(args.output)
+    check_small_strain(args, surface, [c.delta for c in sweep.contacts], material,
+                       [c.mean_pressure for c in sweep.contacts])
     theory = beside(surface, material.E_star, sweep.records(), pressure_drop=args.pressure_drop,
                     viscosity=args.mu)
     steps = theory["steps"]
@@ -80,12 +94,10 @@ def _leak(args) -> int:
               "surface_metadata": dict(surface.metadata),
               "E": args.E, "nu": args.nu, "mu": args.mu, "pressure_drop": args.pressure_drop,
               "direction": args.direction, "reynolds": not args.no_reynolds,
-              "delta": args.delta, "pressure": args.pressure,
+              "delta": args.delta, "pressure": args.pressure, "detrend": args.detrend,
               "units": "SI (m, Pa, Pa s, m^3/s)",
               "references": list(sweep.leakages[0].references)}
-    write_json(out / "results.json", {"inputs": inputs, "steps": steps,
-                                      "persson": theory["persson"]})
-    written = [out / "results.json"]
+    written = []
     for k, (c, lk) in enumerate(zip(sweep.contacts, sweep.leakages)):
         written.append(_save_fields(out / "fields" / f"step_{k:03d}.npz", c, lk))
         if args.no_figures:
@@ -108,20 +120,13 @@ def _leak(args) -> int:
                 title=f"flux magnitude (m^2/s), flow along {d}\nleak rate Q = {flow.leak_rate:.3e} m^3/s"))
     if not args.no_figures:
         written.append(figs.steps_figure(steps, out / "figures" / "steps.png"))
-    print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>7} {'Vp*':>9} {'Vnp*':>9} "
-          f"{'perc x/y':>8} {'Q (m^3/s)':>11}")
-    for s in steps:
-        q = s["leak_rate"]
-        print(f"{s['step']:>4} {s['delta']:>11.4e} {s['mean_pressure']:>10.4g} "
-              f"{s['area_fraction']:>7.4f} {s['percolating_volume_star'] or 0:>9.3e} "
-              f"{s['trapped_volume_star'] or 0:>9.3e} "
-              f"{str(s['percolates_x'])[0]}/{str(s['percolates_y'])[0]:>6} "
-              f"{'-' if q is None else format(q, '.4e'):>11}")
-    print(f"wrote {len(written)} files in {out}")
-    return 0 if sweep.success else 1
+    written.append(write_json(out / "results.json", {"inputs": inputs, "steps": steps,
+                                                      "persson": theory["persson"]}))
+    return sweep, steps, written
 
 
 def _leak_study(args) -> int:
+    from ..leakage.study import study_grid, summarise
     from ..plotting import leakage as figs
     from ..study import run_study, spec_from_mapping, table_rows
 
@@ -134,7 +139,7 @@ def _leak_study(args) -> int:
                   "seed": args.seed, "seed_from": ["replica"]},
         "grid": study_grid(args.D, args.m, args.surfaces), "fixed": fixed})
     summary = run_study(spec, executor=args.executor, workers=args.workers,
-                        scheduler=args.scheduler, progress=not args.no_progress,
+                        scheduler=args.scheduler, progress=not args.quiet,
                         log=lambda msg: print(msg, file=sys.stderr))
     _, rows, missing = table_rows(out)
     if not rows:
@@ -156,37 +161,44 @@ def _leak_study(args) -> int:
 def register(sub):
     p = sub.add_parser(
         "leak", help="leakage through a rough contact: BEM -> free-volume network -> Reynolds",
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+        description="Leakage through a rough contact (thesis Sec. 2.3): at each approach "
+                    "or mean pressure, the BEM contact, the percolating and trapped free "
+                    "volume (Alg. 1) and the Reynolds flow through the gap. Writes "
+                    "OUTDIR/fields/step_NNN.npz (gap, contact, pressures, fluxes), the "
+                    "figures in OUTDIR/figures and, last, OUTDIR/results.json (inputs and one "
+                    "record per step). SI units (m, Pa, Pa s, m^3/s).")
     add_surface_options(p)
-    load = p.add_argument_group("loading (one of)")
+    add_detrend_option(p)
+    load = p.add_argument_group("loading (exactly one)").add_mutually_exclusive_group(required=True)
     load.add_argument("--delta", type=float, nargs="+", metavar="M",
                       help="approaches Delta from first contact, in m (one step each)")
-    load.add_argument("--pressure", type=float, nargs="+", metavar="PA",
+    load.add_argument("--pressure", type=positive_float, nargs="+", metavar="PA",
                       help="mean contact pressures in Pa (one step each)")
     _add_fluid_material(p)
-    p.add_argument("-o", "--output", required=True, help="output folder")
-    p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
-    p.set_defaults(func=_leak)
+    add_output_folder(p)
+    add_run_options(p)
+    p.set_defaults(func=_leak, renders_with_dolfinx=True)
 
     s = sub.add_parser(
         "leak-study", help="the percolation/leakage study of thesis Sec. 2.4 (resumable)",
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+        description="The percolation/leakage study of thesis Sec. 2.4.2-2.4.5: RMD "
+                    "surfaces for every fractal dimension D and resolution m, several "
+                    "replicas each, loaded in steps up to h_s. Runs on the resumable study "
+                    "runner (rerun the same command after an interruption), then writes "
+                    "OUTDIR/summary.json (means, standard deviations, Eq. 2.17 fits, "
+                    "percolation-rule disagreements) and the figures.")
     s.add_argument("--D", type=float, nargs="+", default=list(THESIS_D),
-                   help=f"fractal dimensions (default {' '.join(map(str, THESIS_D))})")
-    s.add_argument("--m", type=int, nargs="+", default=list(THESIS_M),
-                   help=f"RMD resolutions, 2**m+1 points (default {' '.join(map(str, THESIS_M))})")
-    s.add_argument("--surfaces", type=int, default=2,
+                   help="fractal dimensions of the RMD surfaces, in (2, 3)")
+    s.add_argument("--m", type=positive_int, nargs="+", default=list(THESIS_M),
+                   help="RMD resolutions, 2**m+1 points per side")
+    s.add_argument("--surfaces", type=positive_int, default=2,
                    help="surfaces per (D, m) set; the same seeds across D and m (thesis: 20)")
-    s.add_argument("--steps", type=int, default=6, help="approach steps up to h_s (default 6)")
-    s.add_argument("--length", type=float, default=1.0e-4, help="lateral size L in m (default 1e-4)")
+    s.add_argument("--steps", type=positive_int, default=6, help="approach steps up to h_s")
+    s.add_argument("--length", type=positive_float, default=1.0e-4, help="lateral size L in m")
     s.add_argument("--seed", type=int, default=2016, help="base seed of the study")
     _add_fluid_material(s)
-    s.add_argument("--executor", choices=("local", "dask", "mpi"), default="local",
-                   help="where tasks run (default: local process pool)")
-    s.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                   help="a running dask scheduler (tcp://host:8786 or a scheduler file); dask only")
-    s.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
-    s.add_argument("--no-progress", action="store_true", help="no progress bar")
-    s.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
-    s.add_argument("-o", "--output", required=True, help="study folder (rerun to resume)")
+    add_runner_options(s)
+    s.add_argument("-o", "--output", required=True, metavar="OUTDIR",
+                   help="study folder (rerun the same command to resume)")
+    add_run_options(s)
     s.set_defaults(func=_leak_study)

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import sys
 
-from ..study import (ANALYSES, EXECUTORS, collect, genome_db_to_sqlite, load_spec,
-                     run_study, study_status)
+from ..study import (ANALYSES, collect, genome_db_to_sqlite, load_spec, run_study,
+                     study_status)
+from .options import add_run_options, add_runner_options
 
 
 def _log(message):
@@ -21,7 +22,7 @@ def _log(message):
 def _run(args) -> int:
     spec = load_spec(args.spec, output=args.output)
     summary = run_study(spec, executor=args.executor, workers=args.workers,
-                        scheduler=args.scheduler, progress=not args.no_progress, log=_log)
+                        scheduler=args.scheduler, progress=not args.quiet, log=_log)
     print(summary.describe())
     print(f"results in {spec.output}; `roughfe study status {spec.output}` lists failures, "
           f"`roughfe study collect {spec.output}` writes the table")
@@ -53,7 +54,13 @@ def _collect(args) -> int:
 
 def register(sub):
     p = sub.add_parser("study", help="run parameter studies (local, dask or MPI), resumable",
-                       description=__doc__)
+                       description="Parameter studies over a grid written in a TOML "
+                                   "spec: `run` computes the missing tasks (resumable: rerun "
+                                   "after an interruption), `status` lists what is done or "
+                                   "failed, `collect` writes the tidy table. Runs on a local "
+                                   "process pool, dask or MPI (mpirun -n K python -m "
+                                   "mpi4py.futures $(which roughfe) study run SPEC.toml "
+                                   "--executor mpi).")
     ssub = p.add_subparsers(dest="study_command", metavar="ACTION")
     ssub.required = True
 
@@ -63,17 +70,10 @@ def register(sub):
         description="Run every task of SPEC whose result is missing. Safe to rerun after an "
                     f"interruption. Analyses: {analyses}.")
     r.add_argument("spec", metavar="SPEC.toml", help="study spec ([study], [grid], [fixed])")
-    r.add_argument("--executor", choices=EXECUTORS, default="local",
-                   help="local: process pool on this machine (default); dask: dask.distributed "
-                        "(LocalCluster, or --scheduler); mpi: mpi4py.futures under mpirun")
-    r.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                   help="a running dask scheduler: address (tcp://head:8786) or scheduler "
-                        "file (*.json, from `dask scheduler --scheduler-file`); dask only")
-    r.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="worker processes for local and a dask LocalCluster (default: cores)")
+    add_runner_options(r)
     r.add_argument("-o", "--output", default=None, metavar="OUTDIR",
                    help="results folder (overrides [study] output)")
-    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_run_options(r, figures=False)
     r.set_defaults(func=_run)
 
     s = ssub.add_parser("status", help="tasks done, failed (with errors) and missing; cost")

@@ -1,16 +1,12 @@
 """``roughfe generate`` (rmd | wm | mwm | spectral) and ``roughfe info FILE``."""
 from __future__ import annotations
 
-import json
-from pathlib import Path
+import numpy as np
 
-from ..errors import InputError
-from ..surfaces.io import save_surface
-from ..surfaces.rmd import rmd_profile, rmd_surface
-from ..surfaces.spectral import spectral_profile, spectral_surface
-from ..surfaces.stats import rms_height, surface_statistics
-from ..surfaces.wm import mwm_surface, wm_profile
-from .common import add_surface_options, surface_from_args
+from ..errors import check_memory
+from .options import (add_detrend_option, add_output_file, add_run_options,
+                      add_surface_options, output_file_of, positive_float, positive_int,
+                      surface_from_args)
 
 # (key, label, unit, scale) rows of the info table
 _TABLE = (
@@ -57,13 +53,13 @@ def format_table(stats: dict) -> str:
 
 
 def _info(args) -> int:
+    from ..surfaces.stats import surface_statistics
+    from ..writers import to_json_text
     surface = surface_from_args(args)
-    if args.detrend != "none":
-        surface = surface.detrended(args.detrend)
     stats = surface_statistics(surface).as_dict()
     if args.json:
-        print(json.dumps({"file": str(args.surface), "statistics": stats,
-                          "metadata": dict(surface.metadata)}, indent=2))
+        print(to_json_text({"file": str(args.surface), "statistics": stats,
+                            "metadata": dict(surface.metadata)}))
     else:
         print(f"{args.surface}: {surface!r}")
         print(format_table(stats))
@@ -72,18 +68,21 @@ def _info(args) -> int:
 
 # -- generate --------------------------------------------------------------------------
 def _make_rmd(a):
+    from ..surfaces.rmd import rmd_profile, rmd_surface
     if a.profile:
         return rmd_profile(a.m, a.D, a.length, rng=a.seed, rms_height=a.rms_height)
     return rmd_surface(a.m, a.D, a.length, rng=a.seed, rms_height=a.rms_height)
 
 
 def _make_wm(a):
+    from ..surfaces.wm import wm_profile
     k_range = None if a.k_range is None else tuple(a.k_range)
     return wm_profile(a.n, a.length, a.hurst, gamma=a.gamma, amplitude=a.amplitude,
                       k_range=k_range, rng=a.seed)
 
 
 def _make_mwm(a):
+    from ..surfaces.wm import mwm_surface
     n_range = None if a.n_range is None else tuple(a.n_range)
     return mwm_surface(a.n, a.length, a.hurst, gamma=a.gamma, wavelength=a.wavelength,
                        n_range=n_range, ridges=a.ridges, amplitude=a.amplitude,
@@ -92,6 +91,7 @@ def _make_mwm(a):
 
 
 def _make_spectral(a):
+    from ..surfaces.spectral import spectral_profile, spectral_surface
     make = spectral_profile if a.profile else spectral_surface
     rms_h = a.rms_height if (a.rms_height is not None or a.rms_slope is not None) else 1e-6
     return make(a.n, a.length, a.hurst, rms_height=rms_h,
@@ -99,17 +99,27 @@ def _make_spectral(a):
                 amplitudes="fixed" if a.fixed_amplitudes else "gaussian", rng=a.seed)
 
 
+def _grid_points(a) -> tuple:
+    """Points per axis of the requested grid (for the memory check before generating)."""
+    if a.model == "rmd":
+        n = 2 ** a.m + 1
+        return (n,) if a.profile else (n, n)
+    return (a.n,) if a.model == "wm" or getattr(a, "profile", False) else (a.n, a.n)
+
+
 def _generate(args) -> int:
+    from ..surfaces.io import save_surface
+    from ..surfaces.stats import rms_height
+    out = output_file_of(args, suffixes=(".npz",))
+    shape = _grid_points(args)
+    check_memory(f"a {' x '.join(map(str, shape))} grid", 8.0 * float(np.prod(shape)))
     surface = args.make(args)
     if args.rms_height is not None and args.model in ("wm", "mwm"):
         surface = surface.scaled(args.rms_height / rms_height(surface))
-    out = Path(args.output)
-    if out.suffix.lower() != ".npz":
-        raise InputError(f"-o/--output must name a .npz file, got {str(out)!r}")
     save_surface(surface, out)
     print(f"wrote {out}: {surface!r}, rms height {rms_height(surface) * 1e6:.4g} um, "
           f"seed {surface.metadata.get('seed')}")
-    if not args.no_png:
+    if not args.no_figures:
         from ..plotting.surfaces import plot_profile, render_surface
         png = out.with_suffix(".png")
         kind = "surface" if surface.ndim == 2 else "profile"
@@ -128,27 +138,27 @@ def _register_generate(sub):
 
     def common(q, help_, make):
         m = models.add_parser(q, help=help_, description=help_)
-        m.add_argument("-o", "--output", required=True, help="output .npz file")
+        add_output_file(m, "output .npz file (the figure goes beside it, FILE.png)")
         m.add_argument("--seed", type=int, default=None,
                        help="random seed (default: fresh, recorded in the file)")
-        m.add_argument("--rms-height", type=float, default=None,
+        m.add_argument("--rms-height", type=positive_float, default=None,
                        help="rescale to this rms height (m)")
-        m.add_argument("--no-png", action="store_true", help="do not write the PNG")
+        add_run_options(m)
         m.set_defaults(func=_generate, make=make)
         return m
 
     m = common("rmd", "Random Midpoint Displacement surface (thesis Sec. 2.1.1), (2^m+1)^2 grid",
                _make_rmd)
-    m.add_argument("--m", type=int, default=7, help="refinement levels (default 7)")
+    m.add_argument("--m", type=positive_int, default=7, help="refinement levels: (2^m+1)^2 points")
     m.add_argument("--D", type=float, default=2.3,
-                   help="fractal dimension, (2,3) surface / (1,2) profile (default 2.3)")
-    m.add_argument("--length", type=float, default=1e-4,
-                   help="thesis L end to end (m), default 1e-4; size = (2^m+1) L / 2^m")
+                   help="fractal dimension, in (2, 3) for a surface, (1, 2) for a profile")
+    m.add_argument("--length", type=positive_float, default=1e-4,
+                   help="thesis L end to end (m); size = (2^m+1) L / 2^m")
     m.add_argument("--profile", action="store_true", help="a 1D profile instead of a surface")
 
     m = common("wm", "Weierstrass-Mandelbrot profile (thesis Eq. 2.1)", _make_wm)
-    m.add_argument("--n", type=int, default=2048, help="number of points (default 2048)")
-    m.add_argument("--length", type=float, default=1e-3, help="profile length (m), default 1e-3")
+    m.add_argument("--n", type=positive_int, default=2048, help="number of points")
+    m.add_argument("--length", type=positive_float, default=1e-3, help="profile length (m)")
     m.add_argument("--hurst", type=float, default=0.7, help="Hurst exponent in (0,1)")
     m.add_argument("--gamma", type=float, default=1.5, help="frequency density > 1")
     m.add_argument("--amplitude", type=float, default=1e-7, help="A (m)")
@@ -156,14 +166,14 @@ def _register_generate(sub):
                    help="truncation k1 k2 (default: profile length to Nyquist)")
 
     m = common("mwm", "multivariate WM surface (thesis Eq. 2.2 / 3.17)", _make_mwm)
-    m.add_argument("--n", type=int, default=256, help="grid points per side (default 256)")
-    m.add_argument("--length", type=float, default=1e-4, help="side (m), default 1e-4")
+    m.add_argument("--n", type=positive_int, default=256, help="grid points per side")
+    m.add_argument("--length", type=positive_float, default=1e-4, help="side (m)")
     m.add_argument("--hurst", type=float, default=0.7, help="Hurst exponent in (0,1)")
     m.add_argument("--gamma", type=float, default=1.5, help="frequency density > 1")
     m.add_argument("--wavelength", type=float, default=None, help="lambda (m), default L")
     m.add_argument("--n-range", type=int, nargs=2, metavar=("NS", "NF"), default=None,
                    help="frequency indices n_s n_f (default: 1 to Nyquist)")
-    m.add_argument("--ridges", type=int, default=10, help="number of ridges M")
+    m.add_argument("--ridges", type=positive_int, default=10, help="number of ridges M")
     m.add_argument("--amplitude", type=float, default=1e-6, help="A of Eq. 3.17 (m^(1-H))")
     m.add_argument("--anisotropy", type=float, nargs="+", default=None,
                    help="M factors a_m (default all 1)")
@@ -171,8 +181,8 @@ def _register_generate(sub):
                    help="random ridge angles (default pi m / M)")
 
     m = common("spectral", "periodic self-affine surface by Fourier filtering", _make_spectral)
-    m.add_argument("--n", type=int, default=256, help="grid points per side (default 256)")
-    m.add_argument("--length", type=float, default=1e-4, help="period (m), default 1e-4")
+    m.add_argument("--n", type=positive_int, default=256, help="grid points per side")
+    m.add_argument("--length", type=positive_float, default=1e-4, help="period (m)")
     m.add_argument("--hurst", type=float, default=0.8, help="Hurst exponent in (0,1)")
     m.add_argument("--rms-slope", type=float, default=None,
                    help="target rms slope instead of rms height (1 um if neither)")
@@ -190,7 +200,6 @@ def register(sub):
                        description="Statistics of a profile or surface: rms height/slope/"
                                    "curvature, spectral moments, Nayak alpha, Hurst exponent.")
     add_surface_options(p)
-    p.add_argument("--detrend", choices=("none", "mean", "plane"), default="mean",
-                   help="remove the mean (default) or the best plane before the statistics")
+    add_detrend_option(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(func=_info)

@@ -42,6 +42,16 @@ def run_validation(name: str, outdir: Path) -> bool:
     return bool(module.main(Path(outdir)))
 
 
+def _script_doc(name: str) -> str:
+    """The docstring of ``validation/<script>.py`` (read with ast: nothing is imported)."""
+    import ast
+    try:
+        path = _validation_dir() / f"{VALIDATIONS[name]}.py"
+        return ast.get_docstring(ast.parse(path.read_text())) or ""
+    except (InputError, OSError, SyntaxError):
+        return "(validation script not found: run from a roughfe checkout)"
+
+
 def _run(args) -> int:
     names = list(VALIDATIONS) if args.name == "all" else [args.name]
     failed = []
@@ -56,7 +66,17 @@ def _run(args) -> int:
 def register(sub):
     p = sub.add_parser(
         "validate", help="run a validation study (analytic, FEM, literature) and write its report",
-        description=__doc__)
-    p.add_argument("name", choices=[*VALIDATIONS, "all"], help="which validation to run")
-    p.add_argument("-o", "--output", default="validation/output", help="report folder")
-    p.set_defaults(func=_run)
+        description="Run a validation study of validation/ and write its Markdown report, JSON "
+                    "and figures into OUTDIR. Each prints its checks and exits 1 when a target "
+                    "is missed. Studies take minutes (fem, design: tens of minutes); "
+                    "`roughfe validate NAME --help` describes one.")
+    names = p.add_subparsers(dest="name", metavar="NAME")
+    names.required = True
+    for name in [*VALIDATIONS, "all"]:
+        doc = ("every validation in turn: " + ", ".join(VALIDATIONS) if name == "all"
+               else _script_doc(name))
+        v = names.add_parser(name, help=doc.splitlines()[0] if doc else name, description=doc)
+        v.add_argument("-o", "--output", default="validation/output", metavar="OUTDIR",
+                       help="report folder (each study writes its own <script>.md/.json and "
+                            "figures there; other files are kept)")
+        v.set_defaults(func=_run, renders_with_dolfinx=True)

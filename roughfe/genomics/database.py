@@ -300,10 +300,18 @@ def _now():
 
 
 def connect(path, *, create=False) -> sqlite3.Connection:
-    """Open (or with ``create=True`` create) a genome database and check its schema version."""
+    """Open (or with ``create=True`` create) a genome database and check its schema version.
+
+    Without ``create`` the file is opened read-only and must already hold roughfe's
+    tables: a foreign or empty SQLite file is reported (FileFormatError), never written.
+    """
     path = Path(path)
-    if not create and not path.is_file():
-        raise InputError(f"genome database {path} does not exist (build it with 'roughfe db build')")
+    if not create:
+        if not path.is_file():
+            raise InputError(f"genome database {path} does not exist"
+                             + (" (it is a folder)" if path.is_dir() else
+                                " (build it with 'roughfe db build')"))
+        return _connect_read_only(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     con = sqlite3.connect(str(path), timeout=30.0)
     try:
@@ -318,6 +326,29 @@ def connect(path, *, create=False) -> sqlite3.Connection:
     except sqlite3.DatabaseError as exc:
         con.close()
         raise FileFormatError(f"{path} is not a roughfe genome database: {exc}") from None
+    return con
+
+
+def _connect_read_only(path: Path) -> sqlite3.Connection:
+    from urllib.parse import quote
+
+    con = sqlite3.connect(f"file:{quote(str(path.resolve()))}?mode=ro", uri=True, timeout=30.0)
+    try:
+        tables = {r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+        if not {"meta", "genomes"} <= tables:
+            raise FileFormatError(f"{path} is not a roughfe genome database (no 'meta' and "
+                                  "'genomes' tables); build one with 'roughfe db build'")
+        row = con.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()
+        if row is None or int(row[0]) != SCHEMA_VERSION:
+            raise FileFormatError(f"{path}: genome database schema version "
+                                  f"{None if row is None else row[0]}, this roughfe reads "
+                                  f"version {SCHEMA_VERSION}")
+    except sqlite3.DatabaseError as exc:
+        con.close()
+        raise FileFormatError(f"{path} is not a roughfe genome database: {exc}") from None
+    except BaseException:
+        con.close()
+        raise
     return con
 
 

@@ -45,7 +45,7 @@ import numpy as np
 from ..errors import InputError
 from ..surfaces.surface import Surface
 from .database import DatabaseEntry, DatabaseSettings
-from .genome import Genome, realize
+from .genome import Genome, realize, save_genome
 from .macro_micro import classify, profile_response
 from .similarity import ResponseCurve, Target, similarity, split_ranges
 
@@ -190,15 +190,18 @@ class Design:
                 out.append((float(p.genome.wavenumber(n)), a))
         return sorted(out)
 
-    def as_genome(self) -> Optional[Genome]:
-        """The single genome equal to this design when it has one part, else None."""
-        if len(self.parts) != 1:
-            return None
-        p = self.parts[0]
+    def part_genome(self, k) -> Genome:
+        """Part ``k`` as a genome: its weight and the overall scale folded into the
+        amplitude gene A; the part's chromosomes (realise only those) in metadata."""
+        p = self.parts[k]
         g = p.genome
         return replace(g, A=g.A * p.weight * self.scale,
-                       metadata={**g.metadata, "design": self.name,
+                       metadata={**g.metadata, "design": self.name, "part": k + 1,
                                  "chromosomes": list(p.chromosomes)})
+
+    def as_genome(self) -> Optional[Genome]:
+        """The single genome equal to this design when it has one part, else None."""
+        return self.part_genome(0) if len(self.parts) == 1 else None
 
     # -- JSON --------------------------------------------------------------------------
     def to_dict(self) -> dict:
@@ -1133,7 +1136,8 @@ def write_design_result(result: DesignResult, settings: DatabaseSettings, outdir
 
     Files: ``result.json`` (:func:`result_to_dict`), ``design.json`` (the best design,
     reloadable with :meth:`Design.from_dict`), ``genome.json`` (the roughfe-genome when
-    the design is one genome, else the design JSON again), ``profile.npz`` (native
+    the design is one genome; for several, ``genome_partK.json``: part K as a genome with
+    its weight and the overall scale in A), ``profile.npz`` (native
     surface file of the designed profile), ``curves.csv`` (p, targets, K, A) and
     ``stages.csv`` (similarity per candidate and GCMMA stage).
     """
@@ -1146,8 +1150,12 @@ def write_design_result(result: DesignResult, settings: DatabaseSettings, outdir
     paths = {"result": write_json(out / "result.json", result_to_dict(result, settings)),
              "design": write_json(out / "design.json", best.design.to_dict())}
     g = best.design.as_genome()
-    paths["genome"] = write_json(out / "genome.json", g.to_dict() if g is not None
-                                 else best.design.to_dict())
+    if g is not None:  # one genome: realisable with 'roughfe genome realize'
+        paths["genome"] = save_genome(g, out / "genome.json")
+    else:  # several genomes cannot be one genome: each part is one (its chromosomes in metadata)
+        for k in range(len(best.design.parts)):
+            paths[f"genome_part{k + 1}"] = save_genome(best.design.part_genome(k),
+                                                       out / f"genome_part{k + 1}.json")
     paths["profile"] = save_surface(best.design.surface(), out / "profile.npz")
     c = best.curve
     cols = ["pressure_Pa", "K_Pa_per_m", "A"]

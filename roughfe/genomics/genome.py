@@ -226,11 +226,19 @@ class Genome:
         missing = [k for k in ("A", "H", "gamma", "lambda1", "phases") if k not in data]
         if missing:
             raise FileFormatError(f"{GENOME_FORMAT} object lacks the genes {missing}")
+        for key in ("A", "H", "gamma", "lambda1"):
+            _json_number(key, data[key])
+        for key in ("M", "n_first"):
+            if key in data:
+                _json_number(key, data[key], integer=True)
+        for key in ("phases", "angles", "anisotropy"):
+            if data.get(key) is not None:
+                _json_numbers(key, data[key])
         genome = cls(A=data["A"], H=data["H"], gamma=data["gamma"], lambda1=data["lambda1"],
                      phases=data["phases"], n_first=data.get("n_first", 1),
                      angles=data.get("angles"), anisotropy=data.get("anisotropy"),
                      metadata=data.get("metadata", {}))
-        if "M" in data and int(data["M"]) != genome.M:
+        if "M" in data and data["M"] != genome.M:
             raise FileFormatError(f"M = {data['M']} disagrees with the {genome.M} rows of phases")
         return genome
 
@@ -251,6 +259,29 @@ class Genome:
                 f"lambda1={self.lambda1:.6g} m, M={self.M}, n={self.n_first}..{self.n_last})")
 
 
+def _json_number(key, value, integer=False):
+    """A gene read from JSON must be a JSON number (an integer where ``integer``):
+    ``"0.75"``, ``true`` or ``8.5`` for M are format errors, not silent conversions."""
+    ok = isinstance(value, int) if integer else isinstance(value, (int, float))
+    if isinstance(value, bool) or not ok:
+        kind = "an integer" if integer else "a number"
+        raise FileFormatError(f"{key} must be {kind} in a {GENOME_FORMAT} file, got "
+                              f"{json.dumps(value)} ({type(value).__name__})")
+    return value
+
+
+def _json_numbers(key, value):
+    """``value`` must be a (nested) list of JSON numbers."""
+    if isinstance(value, list):
+        for v in value:
+            _json_numbers(key, v)
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise FileFormatError(f"{key} must hold numbers only in a {GENOME_FORMAT} file, got "
+                              f"{json.dumps(value)} ({type(value).__name__})")
+    return value
+
+
 def save_genome(genome: Genome, path) -> Path:
     """Write ``genome`` as versioned JSON, atomically (``roughfe.writers.write_json``)."""
     return write_json(path, genome.to_dict())
@@ -259,10 +290,18 @@ def save_genome(genome: Genome, path) -> Path:
 def load_genome(path) -> Genome:
     """Read a genome JSON file written by :func:`save_genome`."""
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{path} is a folder, not a genome JSON file")
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(f"genome file {path} does not exist") from None
     except OSError as exc:
-        raise FileFormatError(f"{path}: cannot read genome file ({exc})") from None
+        raise FileFormatError(f"{path}: cannot read genome file ({exc.strerror})") from None
+    except UnicodeDecodeError:
+        raise FileFormatError(f"{path} is not a genome JSON file (binary content"
+                              + (", a roughfe surface .npz?" if path.suffix == ".npz" else "")
+                              + ")") from None
     try:
         return Genome.from_json(text)
     except FileFormatError as exc:

@@ -6,7 +6,6 @@ written atomically through :func:`roughfe.writers.atomic_path`.
 """
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import matplotlib
@@ -14,6 +13,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from .._runtime import headless_environment  # noqa: E402
 from ..writers import atomic_path  # noqa: E402
 
 
@@ -37,11 +37,10 @@ def save_figure(fig, path, dpi=150) -> Path:
 def offscreen_plotter(window_size=(1000, 800), **kwargs):
     """A ``pyvista.Plotter`` that renders off-screen (no display needed).
 
-    Sets ``VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow`` and ``PYVISTA_OFF_SCREEN=true``
-    when they are unset, before pyvista is imported.
+    Sets the headless defaults (:func:`roughfe._runtime.headless_environment`) before
+    pyvista is imported.
     """
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+    headless_environment()
     import pyvista as pv
     pv.OFF_SCREEN = True
     return pv.Plotter(off_screen=True, window_size=list(window_size), **kwargs)

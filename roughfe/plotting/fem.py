@@ -8,14 +8,11 @@
 """
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from .._runtime import load_render_backend, render_in_fresh_process
 from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
 
 _STYLES = ("-", "--", ":", "-.", (0, (5, 1)), (0, (1, 3)))
@@ -126,33 +123,23 @@ def render_deformed_mesh(fields, path, *, magnification=None, top_fraction=0.35,
         Only cells within ``top_fraction * W`` of the top are shown (the stresses of a
         rough contact are confined near the surface).
 
-    Debian's dolfinx and the vtk wheel cannot render in one process once dolfinx is
-    loaded (vtk aborts in its std::regex): when ``dolfinx`` is imported, the picture is
-    rendered by a fresh interpreter from a temporary ``.npz`` of the fields.
+    Debian's dolfinx and the vtk wheel cannot render in one process when dolfinx was
+    loaded first (vtk aborts in its std::regex): then the picture is rendered by a fresh
+    interpreter (:mod:`roughfe._runtime`).
     """
     path = Path(path)
     arrays = {k: np.asarray(fields[k]) for k in ("points", "cells", "displacement", "stress_yy")}
-    if "dolfinx" not in sys.modules:
+    if load_render_backend():
         return _render(arrays, path, magnification, top_fraction, window_size)
-    with tempfile.TemporaryDirectory() as tmp:
-        npz = Path(tmp) / "fields.npz"
-        np.savez(npz, **arrays)
-        code = ("import sys, numpy as np; from roughfe.plotting.fem import _render; "
-                "from pathlib import Path; a = dict(np.load(sys.argv[1])); "
-                "m = None if sys.argv[3] == 'None' else float(sys.argv[3]); "
-                "_render(a, Path(sys.argv[2]), m, float(sys.argv[4]), "
-                "(int(sys.argv[5]), int(sys.argv[6])))")
-        env = dict(os.environ)
-        root = str(Path(__file__).resolve().parents[2])
-        env["PYTHONPATH"] = os.pathsep.join([root, env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-        env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-        env.setdefault("PYVISTA_OFF_SCREEN", "true")
-        proc = subprocess.run([sys.executable, "-c", code, str(npz), str(path), str(magnification),
-                               str(top_fraction), *map(str, window_size)],
-                              env=env, capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise RuntimeError(f"rendering {path} failed: {proc.stderr[-2000:]}")
+    render_in_fresh_process(__name__, "_render_arrays", arrays, path=str(path),
+                            magnification=magnification, top_fraction=top_fraction,
+                            window_size=list(window_size))
     return path
+
+
+def _render_arrays(*, path, magnification, top_fraction, window_size, **fields) -> Path:
+    """:func:`_render` with the fields as keyword arrays (the fresh-process entry point)."""
+    return _render(fields, Path(path), magnification, top_fraction, tuple(window_size))
 
 
 def _render(fields, path, magnification, top_fraction, window_size) -> Path:

@@ -6,39 +6,20 @@ matplotlib figures. Every file is written atomically (roughfe.plotting.common).
 """
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from .._runtime import load_render_backend, render_in_fresh_process
 from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
-
-# Load vtk before dolfinx can be loaded: with dolfinx 0.5.2 (Debian) loaded first, vtk
-# 9.7's label formatting (std::regex in vtk::is_printf_format, used by scalar bars and
-# axes) aborts the process with std::bad_alloc; loaded in this order it works. If this
-# process already loaded dolfinx (and not vtk), maps are rendered by a fresh interpreter.
-_RENDER_ELSEWHERE = "dolfinx" in sys.modules and "vtkmodules.vtkCommonCore" not in sys.modules
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
-import pyvista  # noqa: E402,F401
 
 UM = 1e6
 
 
 def _render_elsewhere(name, arrays, **kwargs) -> Path:
-    """Call ``roughfe.plotting.leakage.<name>(**arrays, **kwargs)`` in a fresh interpreter."""
-    with tempfile.TemporaryDirectory() as tmp:
-        npz = Path(tmp) / "arrays.npz"
-        np.savez(npz, **{k: np.asarray(v) for k, v in arrays.items()})
-        code = ("import sys, json, numpy as np; from roughfe.plotting import leakage as L; "
-                "a = dict(np.load(sys.argv[1])); "
-                f"L.{name}(**a, **json.loads(sys.argv[2]))")
-        subprocess.run([sys.executable, "-c", code, str(npz), json.dumps(kwargs)],
-                       check=True, capture_output=True)
+    """Call ``roughfe.plotting.leakage.<name>(**arrays, **kwargs)`` in a fresh interpreter
+    (this process loaded dolfinx before vtk: see :mod:`roughfe._runtime`)."""
+    render_in_fresh_process(__name__, name, arrays, **kwargs)
     return Path(kwargs["path"])
 
 
@@ -87,7 +68,7 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
     junctions : sequence of (x, y), optional
         Junction centres in m.
     """
-    if _RENDER_ELSEWHERE:
+    if not load_render_backend():
         arrays = {"gap": gap, "percolating": percolating, "trapped": trapped}
         if widest_path is not None:
             arrays["widest_path"] = widest_path
@@ -123,7 +104,7 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
 def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="cells"):
     """Fluid pressure per cell (``at="cells"``, FV) or at the cell corners (``"nodes"``,
     Q1 FE); NaN where undetermined is grey."""
-    if _RENDER_ELSEWHERE:
+    if not load_render_backend():
         return _render_elsewhere("pressure_map", {"pressure": pressure}, size=list(size),
                                  path=str(path), title=title, at=at)
     p = np.asarray(pressure, float)
@@ -141,7 +122,7 @@ def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="ce
 
 def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
     """Cell flux magnitude on a log colour scale (cells without flow: black)."""
-    if _RENDER_ELSEWHERE:
+    if not load_render_backend():
         return _render_elsewhere("flux_map", {"flux_magnitude": flux_magnitude},
                                  size=list(size), path=str(path), title=title)
     q = np.asarray(flux_magnitude, float)

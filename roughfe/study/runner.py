@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import __version__
-from ..writers import to_json_text, write_json
+from ..writers import to_jsonable, write_json
 from . import store
 from .analyses import ANALYSES, as_records, check_parameters, resolve
 from .executors import make_executor
@@ -63,13 +63,7 @@ def execute_task(analysis: str, params: dict, seed: int) -> dict:
     try:
         func = resolve(analysis)
         records = as_records(func(**params, seed=seed), analysis)
-        try:
-            text = to_json_text(records)
-        except ValueError as exc:  # NaN or inf: a result file must hold finite numbers
-            raise ValueError(f"analysis {analysis!r} returned a non-finite number (NaN or "
-                             f"inf) in its records; return None for undefined values ({exc})"
-                             ) from None
-        out.update(ok=True, records=json.loads(text))
+        out.update(ok=True, records=to_jsonable(records))  # NaN/inf -> null, as every file
     except Exception as exc:  # a failing task is data for the driver, not a crash
         out.update(ok=False, error=f"{type(exc).__name__}: {exc}",
                    traceback=traceback.format_exc())

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import FileFormatError, InputError
-from ..writers import write_json, write_text
+from ..writers import folder_lock, write_json, write_text
 from .spec import canonical_json, spec_from_mapping
 
 
@@ -45,20 +45,10 @@ def failure_path(outdir, key) -> Path:
 @contextlib.contextmanager
 def study_lock(outdir):
     """Hold an exclusive lock on ``OUTDIR/.lock`` (released by the OS if the driver dies)."""
-    import fcntl
-
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
-    with open(outdir / ".lock", "w") as fh:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise InputError(f"another `roughfe study run` is using {outdir} (it holds "
-                             f"{outdir / '.lock'}); wait for it or use another output") from None
-        try:
-            yield
-        finally:
-            fcntl.flock(fh, fcntl.LOCK_UN)
+    with folder_lock(outdir, "`roughfe study run`"):
+        yield
 
 
 def write_study(outdir, spec, tasks, code_version):

@@ -28,12 +28,14 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import FileFormatError, InputError
-from ..writers import atomic_path
+from ..writers import atomic_path, to_jsonable
 from .surface import Surface
 
 NATIVE_FORMAT = "roughfe-surface"
@@ -44,8 +46,10 @@ NATIVE_VERSION = 1
 def json_safe(value, depth=0):
     """Return a JSON-serialisable copy of ``value`` (dicts, lists, numbers, strings).
 
-    Dates become ISO strings, numpy scalars/arrays plain numbers/lists, non-finite
-    floats and unknown objects their ``str``. Nesting deeper than 8 levels is cut.
+    For foreign (instrument) metadata: numbers follow the one JSON rule of
+    :func:`roughfe.writers.to_jsonable` (non-finite -> None), dates become ISO strings,
+    arrays of more than 64 values a shape summary, unknown objects their ``str``, and
+    nesting deeper than 8 levels is cut.
     """
     if depth > 8:
         return str(value)
@@ -54,8 +58,7 @@ def json_safe(value, depth=0):
     if isinstance(value, (int, np.integer)):
         return int(value)
     if isinstance(value, (float, np.floating)):
-        v = float(value)
-        return v if np.isfinite(v) else str(v)
+        return to_jsonable(float(value))
     if isinstance(value, (_dt.datetime, _dt.date)):
         return value.isoformat()
     if isinstance(value, np.ndarray):
@@ -68,7 +71,14 @@ def json_safe(value, depth=0):
 
 
 # -- native npz --------------------------------------------------------------------------
+def _single_channel(path, channel, what):
+    if channel is not None:
+        raise InputError(f"--channel/channel={channel!r} selects a channel of a multi-channel "
+                         f"instrument file; {path} is {what} with one height field")
+
+
 def _read_native(path, size, periodic, channel):
+    _single_channel(path, channel, "a roughfe .npz surface")
     try:
         with np.load(path, allow_pickle=False) as data:
             keys = set(data.files)
@@ -82,14 +92,16 @@ def _read_native(path, size, periodic, channel):
                 raise FileFormatError(
                     f"{path}: format {fmt!r} version {version} is not readable by this roughfe "
                     f"(reads {NATIVE_FORMAT!r} up to version {NATIVE_VERSION})")
-            heights = np.array(data["heights"], dtype=float)
+            heights = np.array(data["heights"])
             file_size = tuple(float(s) for s in np.atleast_1d(data["size"]))
             file_periodic = bool(data["periodic"])
             metadata = json.loads(str(data["metadata"]))
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, zlib.error) as exc:
         if isinstance(exc, FileFormatError):
             raise
-        raise FileFormatError(f"{path}: cannot read as .npz ({exc})") from None
+        reason = ("truncated or not a zip archive" if isinstance(exc, (zipfile.BadZipFile,
+                                                                       EOFError)) else exc)
+        raise FileFormatError(f"{path}: cannot read as a roughfe .npz ({reason})") from None
     return Surface(heights, file_size if size is None else size,
                    file_periodic if periodic is None else periodic, metadata)
 
@@ -133,14 +145,23 @@ def _plain_surface(heights, path, size, periodic):
 
 
 def _read_npy(path, size, periodic, channel):
+    _single_channel(path, channel, "a plain .npy matrix")
+    with open(path, "rb") as fh:
+        magic = fh.read(6)
+    if magic != b"\x93NUMPY":
+        raise FileFormatError(f"{path}: not a .npy file ("
+                              + ("the file is empty" if not magic else "no .npy header") + ")")
     try:
         heights = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise FileFormatError(f"{path}: cannot read as .npy ({exc})") from None
+    except (OSError, ValueError, EOFError) as exc:
+        reason = ("an object array (pickled data is never loaded)" if "pickle" in str(exc)
+                  else exc)
+        raise FileFormatError(f"{path}: cannot read as .npy ({reason})") from None
     return _plain_surface(heights, path, size, periodic)
 
 
 def _read_text(path, size, periodic, channel):
+    _single_channel(path, channel, "a plain text matrix")
     delimiter = "," if Path(path).suffix.lower() == ".csv" else None
     try:
         heights = np.loadtxt(path, delimiter=delimiter, ndmin=2)
@@ -258,8 +279,12 @@ def load_surface(path, size=None, periodic=None, channel=None) -> Surface:
         The file cannot be parsed.
     """
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"surface file {str(path)!r} is a folder, not a file")
     if not path.is_file():
         raise InputError(f"surface file {str(path)!r} does not exist")
+    if path.stat().st_size == 0:
+        raise FileFormatError(f"{path}: the file is empty")
     suffix = path.suffix.lower()
     for suffixes, reader, _ in READERS:
         if suffixes is None or suffix in suffixes:

@@ -338,14 +338,9 @@ class SurfaceStatistics:
     hurst_success: bool
 
     def as_dict(self) -> dict:
-        """JSON-safe dict (NaN becomes None)."""
-        out = asdict(self)
-        for k, v in out.items():
-            if isinstance(v, float) and not np.isfinite(v):
-                out[k] = None
-            elif isinstance(v, tuple):
-                out[k] = list(v)
-        return out
+        """JSON-safe dict (NaN becomes None: :func:`roughfe.writers.to_jsonable`)."""
+        from ..writers import to_jsonable
+        return to_jsonable(asdict(self))
 
 
 def surface_statistics(surface: Surface, q_range=None) -> SurfaceStatistics:

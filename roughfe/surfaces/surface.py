@@ -64,6 +64,8 @@ class Surface:
     metadata: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self):
+        if np.iscomplexobj(self.heights):  # np.array(..., float) would drop the imaginary part
+            raise InputError("heights must be real numbers (m), got a complex array")
         try:
             h = np.array(self.heights, dtype=float, copy=True)
         except (TypeError, ValueError):

@@ -1,0 +1,85 @@
+"""The one render-backend set-up of a roughfe process: headless, and vtk before dolfinx.
+
+With Debian's dolfinx 0.5.2 and the vtk wheel in one process, vtk must be loaded
+*before* dolfinx: in the other order vtk's label formatting (``std::regex`` in
+``vtk::is_printf_format``, used by scalar bars and axes) aborts the process (SIGABRT /
+``std::bad_alloc``) at the first off-screen render. Loading vtk costs about 0.7 s, so it
+is loaded only by a process that will render:
+
+* :func:`load_render_backend` -- call it before the first dolfinx import in any process
+  that may also render (``roughfe leak``, ``roughfe validate``, the test session). It
+  imports pyvista (hence vtk) unless dolfinx is already loaded.
+* :func:`can_render_here` -- True when pyvista may render in this process: vtk already
+  loaded, or dolfinx not loaded (then importing pyvista now is safe).
+* :func:`render_in_fresh_process` -- the fallback when it is not: call a plotting
+  function in a fresh interpreter that never loads dolfinx.
+
+Nothing here imports matplotlib, pyvista or dolfinx at import time.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+_VTK_CORE = "vtkmodules.vtkCommonCore"
+
+
+def headless_environment() -> None:
+    """Headless defaults (unless the user set them): matplotlib Agg, vtk EGL off-screen."""
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+
+
+def can_render_here() -> bool:
+    """True when pyvista can render in this process (vtk loaded first, or no dolfinx)."""
+    return _VTK_CORE in sys.modules or "dolfinx" not in sys.modules
+
+
+def load_render_backend() -> bool:
+    """Load pyvista/vtk now, before dolfinx; return :func:`can_render_here`.
+
+    Idempotent and cheap after the first call. When dolfinx is already loaded (and vtk
+    is not), vtk is *not* loaded (it would abort at the first render); renders then go
+    through :func:`render_in_fresh_process`.
+    """
+    headless_environment()
+    if can_render_here() and _VTK_CORE not in sys.modules:
+        try:
+            import pyvista  # noqa: F401  (loads vtk)
+        except ImportError:  # pragma: no cover - pyvista is a core dependency
+            return False
+    return can_render_here()
+
+
+def render_in_fresh_process(module: str, function: str, arrays: dict, **kwargs) -> None:
+    """Call ``module.function(**arrays, **kwargs)`` in a fresh interpreter.
+
+    ``arrays`` go through a temporary ``.npz``, ``kwargs`` through JSON (plain values
+    only). The child sees this process's ``sys.path`` first, so it imports the same
+    roughfe. Raises ``RuntimeError`` with the child's stderr tail on failure.
+    """
+    import numpy as np
+
+    with tempfile.TemporaryDirectory() as tmp:
+        npz = Path(tmp) / "arrays.npz"
+        np.savez(npz, **{k: np.asarray(v) for k, v in arrays.items()})
+        code = ("import sys, json, importlib, numpy as np; "
+                "a = dict(np.load(sys.argv[1])); "
+                f"getattr(importlib.import_module({module!r}), {function!r})"
+                "(**a, **json.loads(sys.argv[2]))")
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
+        for key, value in (("MPLBACKEND", "Agg"),
+                           ("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow"),
+                           ("PYVISTA_OFF_SCREEN", "true")):
+            env.setdefault(key, value)
+        proc = subprocess.run([sys.executable, "-c", code, str(npz), json.dumps(kwargs)],
+                              env=env, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"rendering in a fresh process ({module}.{function}) failed: "
+                               f"{proc.stderr[-2000:]}")

@@ -1,0 +1,290 @@
+"""The one option vocabulary of the ``roughfe`` command (docs/usage/cli.md).
+
+Every subcommand builds its options from these helpers, so a name means the same thing
+everywhere:
+
+* :func:`add_surface_options` -- ``SURFACE``, ``--size LX [LY]``, ``--periodic`` |
+  ``--non-periodic`` (exclusive), ``--channel``; :func:`surface_from_args` reads it.
+* :func:`add_detrend_option` -- ``--detrend none|mean|plane``, default ``mean``.
+* :func:`add_material_options` -- ``--E`` (Pa) and ``--nu`` (-), default the thesis'
+  E* = 210 MPa (E = 210 MPa, nu = 0); :func:`material_from_args`.
+* :func:`add_output_folder` -- ``-o/--output OUTDIR`` (a FOLDER whenever a command writes
+  several files) and ``--overwrite``; :func:`output_folder_of` applies the ownership
+  contract of :func:`roughfe.writers.output_folder`. :func:`add_output_file` for
+  commands that write one file.
+* :func:`add_run_options` -- ``--no-figures`` and ``--quiet`` (no progress bar, no
+  summary on stdout; errors still go to stderr).
+* :func:`positive_int`, :func:`positive_float`, :func:`nonnegative_int` -- argparse
+  types that reject 0/negative values at parse time (exit 2, one line).
+
+:class:`RoughfeParser` shows every default in ``--help``, accepts negative numbers as
+option values (``--E -1e9`` reaches the validator: "E must be > 0") and prints parse
+errors on one line.
+"""
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+import textwrap
+
+#: The one default material of every command: the thesis' E* = 210 MPa (Sec. 3.4,
+#: "E = 210 MPa", nu = 0 so that E* = E). Pressures scale linearly with E* in elastic
+#: contact, so A(p/E*) does not depend on it.
+DEFAULT_E = 210.0e6
+DEFAULT_NU = 0.0
+#: Default of --detrend in info, contact, leak and genome natural.
+DEFAULT_DETREND = "mean"
+DETRENDS = ("none", "mean", "plane")
+
+# a number, also negative and in exponent form: -1, -1.5, -.5, -1e9, -1.5E-3, -inf, -nan
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """Wrapped paragraphs (indented blocks kept as written); ``(default: X)`` after every
+    option that takes a value and has a default (not after flags, not for ``None``)."""
+
+    def _fill_text(self, text, width, indent):
+        out = []
+        for block in textwrap.dedent(text).strip().split("\n\n"):
+            if block.startswith((" ", "\t")) or "::" in block.splitlines()[-1][-3:]:
+                out.append(textwrap.indent(block, indent))
+            else:
+                out.append(textwrap.fill(" ".join(block.split()), width,
+                                         initial_indent=indent, subsequent_indent=indent))
+        return "\n\n".join(out)
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        default = action.default
+        if ("%(default)" in text or action.nargs == 0 or default is None
+                or default is argparse.SUPPRESS):
+            return text
+        if action.option_strings or action.nargs in (argparse.OPTIONAL, argparse.ZERO_OR_MORE):
+            values = default if isinstance(default, (list, tuple)) else [default]
+            shown = " ".join(format(v, "g") if isinstance(v, float) else str(v) for v in values)
+            return f"{text} (default: {shown.replace('%', '%%')})"
+        return text
+
+
+class RoughfeParser(argparse.ArgumentParser):
+    """``ArgumentParser`` with roughfe's conventions (see the module docstring)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
+
+    def error(self, message):
+        """One line on stderr, exit code 2 (argparse prints usage + error)."""
+        self.exit(2, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
+
+
+def _check(kind, test, what):
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
+        if not test(value):
+            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}")
+        return value
+    parse.__name__ = what
+    return parse
+
+
+positive_int = _check(int, lambda v: v >= 1, "an integer >= 1")
+nonnegative_int = _check(int, lambda v: v >= 0, "an integer >= 0")
+positive_float = _check(float, lambda v: 0.0 < v < float("inf"), "a finite number > 0")
+
+
+# -- surfaces ------------------------------------------------------------------------------
+def add_surface_options(parser, positional: bool = True) -> None:
+    """Add ``SURFACE``, ``--size LX [LY]``, ``--periodic``/``--non-periodic``, ``--channel``."""
+    if positional:
+        parser.add_argument(
+            "surface", metavar="SURFACE",
+            help="surface file: roughfe .npz, plain .npy/.txt/.csv matrix (heights in m, "
+                 "needs --size) or an instrument file (.x3p .sur .opd .plu .di .datx ...)")
+    group = parser.add_argument_group("surface file options")
+    group.add_argument(
+        "--size", nargs="+", type=positive_float, metavar=("LX", "LY"),
+        help="physical size in metres (n * spacing per axis); required for plain matrices, "
+             "overrides the file's size otherwise; one value = square")
+    periodic = group.add_mutually_exclusive_group()
+    periodic.add_argument(
+        "--periodic", dest="periodic", action="store_true", default=None,
+        help="treat the heights as periodic (default: the file's flag; plain matrices: no)")
+    periodic.add_argument(
+        "--non-periodic", dest="periodic", action="store_false",
+        help="treat the heights as non-periodic")
+    group.add_argument(
+        "--channel", default=None,
+        help="channel index or name of a multi-channel instrument file (default: the first)")
+
+
+def surface_from_args(args):
+    """The :class:`~roughfe.surfaces.surface.Surface` named by ``args.surface`` with
+    ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
+    command has that option."""
+    from ..errors import InputError
+    from ..surfaces.io import load_surface
+
+    size = args.size
+    if size is not None and len(size) > 2:
+        raise InputError(f"--size takes one or two lengths in metres, got {size}")
+    if size is not None and len(size) == 1:
+        size = size[0]
+    surface = load_surface(args.surface, size=size, periodic=args.periodic, channel=args.channel)
+    detrend = getattr(args, "detrend", "none")
+    return surface if detrend == "none" else surface.detrended(detrend)
+
+
+def add_detrend_option(parser) -> None:
+    """``--detrend none|mean|plane`` with the one default (``mean``)."""
+    parser.add_argument(
+        "--detrend", choices=DETRENDS, default=DEFAULT_DETREND,
+        help="remove nothing, the mean height, or the least-squares plane before the "
+             "analysis (measured topographies usually need 'plane'; a plane fit breaks "
+             "the periodicity of a periodic surface)")
+
+
+# -- material ------------------------------------------------------------------------------
+class _Deprecated(argparse.Action):
+    """An old option name: stores into the new ``dest`` and warns once."""
+
+    def __init__(self, *args, new=None, **kwargs):
+        self.new = new
+        super().__init__(*args, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"{parser.prog}: warning: {option_string} is deprecated, use {self.new}",
+              file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
+def add_material_options(parser, title: str = "material (elastic half-space)") -> None:
+    """``--E`` (Pa) and ``--nu`` (-) with the one default (thesis E* = 210 MPa).
+
+    The old spellings ``--youngs-modulus``/``--poisson`` are accepted with a warning.
+    """
+    group = parser.add_argument_group(title)
+    group.add_argument("--E", type=float, default=DEFAULT_E, metavar="PA",
+                       help="Young's modulus E in Pa")
+    group.add_argument("--nu", type=float, default=DEFAULT_NU, metavar="NU",
+                       help="Poisson's ratio nu, in (-1, 0.5]; E* = E / (1 - nu^2)")
+    group.add_argument("--youngs-modulus", dest="E", type=float, action=_Deprecated,
+                       new="--E", help=argparse.SUPPRESS)
+    group.add_argument("--poisson", dest="nu", type=float, action=_Deprecated, new="--nu",
+                       help=argparse.SUPPRESS)
+
+
+def material_from_args(args):
+    """``Material(args.E, args.nu)`` (validated: E > 0, -1 < nu <= 0.5)."""
+    from ..bem import Material
+    return Material(args.E, args.nu)
+
+
+# -- outputs and runs ----------------------------------------------------------------------
+def add_output_folder(parser, help: str = "output folder", required: bool = True,
+                      default=None) -> None:
+    """``-o/--output OUTDIR`` (a folder) and ``--overwrite``."""
+    parser.add_argument("-o", "--output", required=required, default=default,
+                        metavar="OUTDIR",
+                        help=f"{help}; created if missing, refused if it holds files that are "
+                             "not an earlier output of this command (see --overwrite)")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="empty a non-empty output folder/file of any origin first")
+
+
+def add_output_file(parser, help: str, required: bool = True) -> None:
+    """``-o/--output FILE`` and ``--overwrite`` (an existing file is refused without it)."""
+    parser.add_argument("-o", "--output", required=required, metavar="FILE", help=help)
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing file")
+
+
+def output_folder_of(args, command: str):
+    """:func:`roughfe.writers.output_folder` for ``args.output`` (context manager)."""
+    from ..writers import output_folder
+    return output_folder(args.output, command, overwrite=getattr(args, "overwrite", False))
+
+
+def output_file_of(args, suffixes=None):
+    """:func:`roughfe.writers.output_file` for ``args.output``; nothing is written."""
+    from ..writers import output_file
+    return output_file(args.output, overwrite=getattr(args, "overwrite", False),
+                       suffixes=suffixes)
+
+
+def add_run_options(parser, figures: bool = True) -> None:
+    """``--no-figures`` (when the command draws) and ``--quiet``."""
+    if figures:
+        parser.add_argument("--no-figures", action="store_true",
+                            help="skip the figures (they are drawn by default)")
+    parser.add_argument("--quiet", action="store_true",
+                        help="no progress bar and no summary on stdout (errors still on stderr)")
+
+
+def progress(args, total: int, desc: str):
+    """A tqdm bar on stderr when it is a terminal and ``--quiet`` is not given, else a
+    do-nothing object with the same ``update``/``close`` methods."""
+    if getattr(args, "quiet", False) or not sys.stderr.isatty():
+        return _NoBar()
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is a core dependency
+        return _NoBar()
+    return tqdm(total=total, desc=desc, file=sys.stderr, leave=False)
+
+
+class _NoBar:
+    def update(self, n=1):
+        pass
+
+    def close(self):
+        pass
+
+
+def warn(args, message: str) -> None:
+    """One warning line on stderr (``roughfe CMD: warning: ...``), even with --quiet."""
+    print(f"roughfe {args.command}: warning: {message}", file=sys.stderr)
+
+
+#: Largest approach Delta / lateral size L before :func:`check_small_strain` warns.
+SMALL_STRAIN_LIMIT = 0.1
+
+
+def check_small_strain(args, surface, deltas, material, pressures) -> None:
+    """Warn when the largest approach exceeds 10 % of the smallest lateral size.
+
+    The half-space solution is linear elasticity: it assumes strains ~ Delta / L << 1.
+    A non-periodic patch of 100 um pressed to p = 1e12 Pa needs Delta ~ 8 cm, a strain
+    of 800 -- a number the solver returns but no material follows.
+    """
+    deltas = [float(d) for d in deltas]
+    if not deltas:
+        return
+    d_max, length = max(deltas), min(surface.size)
+    if d_max > SMALL_STRAIN_LIMIT * length:
+        p_max = max(float(p) for p in pressures)
+        warn(args, f"approach Delta = {d_max:.3g} m is {d_max / length:.3g} x the lateral size "
+                   f"{length:.3g} m (p = {p_max:.3g} Pa = {p_max / material.E_star:.3g} E*): "
+                   "far beyond the small strains of the elastic half-space; the result is not "
+                   "physical")
+
+
+def add_runner_options(parser) -> None:
+    """``--executor``, ``--scheduler``, ``--workers``: the study runner (as `study run`)."""
+    from ..study import EXECUTORS
+
+    group = parser.add_argument_group("study runner (as `roughfe study run`)")
+    group.add_argument("--executor", choices=EXECUTORS, default="local",
+                       help="local: process pool on this machine; dask: dask.distributed "
+                            "(LocalCluster, or --scheduler); mpi: mpi4py.futures under mpirun")
+    group.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                       help="a running dask scheduler: address (tcp://head:8786) or scheduler "
+                            "file (*.json, from `dask scheduler --scheduler-file`); dask only")
+    group.add_argument("--workers", type=positive_int, default=None, metavar="N",
+                       help="worker processes for local and a dask LocalCluster (default: "
+                            "the cores)")

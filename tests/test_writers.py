@@ -1,0 +1,149 @@
+"""roughfe.writers: file modes, the one JSON rule, temporary names, output-folder ownership."""
+import json
+import os
+import stat
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.writers import (OWNER_FILE, UNFINISHED_FILE, OutputFolder, atomic_path,
+                             output_file, to_json_text, to_jsonable, write_json, write_text)
+
+
+@pytest.fixture
+def umask022():
+    old = os.umask(0o022)
+    yield
+    os.umask(old)
+
+
+def test_files_honour_the_umask(tmp_path, umask022):
+    p = write_text(tmp_path / "a.txt", "x")
+    assert stat.S_IMODE(p.stat().st_mode) == 0o644         # not mkstemp's private 0600
+    os.umask(0o077)
+    q = write_json(tmp_path / "b.json", {"a": 1})
+    assert stat.S_IMODE(q.stat().st_mode) == 0o600
+
+
+def test_to_jsonable_is_the_one_rule():
+    data = {"nan": float("nan"), "inf": -np.inf, "f32": np.float32(0.5), "i": np.int64(3),
+            "b": np.bool_(True), "arr": np.array([1.0, np.nan, np.inf]), "path": Path("x/y"),
+            "t": (1, 2), 7: "int key", "nested": [{"v": np.float64("nan")}]}
+    out = to_jsonable(data)
+    assert out == {"nan": None, "inf": None, "f32": 0.5, "i": 3, "b": True,
+                   "arr": [1.0, None, None], "path": "x/y", "t": [1, 2], "7": "int key",
+                   "nested": [{"v": None}]}
+    assert type(out["i"]) is int and type(out["b"]) is bool
+    json.loads(to_json_text(data))                          # strict JSON (no NaN tokens)
+    with pytest.raises(TypeError, match="complex"):
+        to_jsonable(np.array([1j]))
+    with pytest.raises(TypeError):
+        to_jsonable(object())
+
+
+def test_a_legal_249_character_name_is_written_and_no_temporary_is_left(tmp_path):
+    name = "a" * 245 + ".npz"                                 # 249 bytes: legal (<= 255)
+    with atomic_path(tmp_path / name) as tmp:
+        assert len(tmp.name) < 60
+        tmp.write_bytes(b"x")
+    assert (tmp_path / name).read_bytes() == b"x" and os.listdir(tmp_path) == [name]
+    with pytest.raises(InputError, match="255"):
+        output_file(tmp_path / ("b" * 256 + ".npz"))
+
+
+def test_a_failed_write_leaves_the_old_file(tmp_path):
+    p = write_text(tmp_path / "r.json", "old")
+    with pytest.raises(RuntimeError):
+        with atomic_path(p) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("killed")
+    assert p.read_text() == "old" and os.listdir(tmp_path) == ["r.json"]
+
+
+def _files(folder):
+    return sorted(str(p.relative_to(folder)) for p in Path(folder).rglob("*"))
+
+
+def test_output_folder_contract(tmp_path):
+    out = tmp_path / "run"
+    with OutputFolder(out, "contact") as d:
+        assert (d / UNFINISHED_FILE).is_file()                # marked while writing
+        assert json.loads((d / OWNER_FILE).read_text())["status"] == "running"
+        write_text(d / "fields" / "step_001.npz", "1")
+        write_text(d / "results.json", "{}")
+    assert not (out / UNFINISHED_FILE).exists()
+    assert json.loads((out / OWNER_FILE).read_text())["status"] == "complete"
+    # a re-run of the same command replaces the previous run's files: none are mixed
+    with OutputFolder(out, "contact") as d:
+        write_text(d / "results.json", "{}")
+    assert "fields/step_001.npz" not in _files(out) and "results.json" in _files(out)
+    # another command's output, or foreign files, are refused unless --overwrite
+    with pytest.raises(InputError, match=r"output of `roughfe contact`.*--overwrite"):
+        OutputFolder(out, "leak")
+    foreign = tmp_path / "mine"
+    write_text(foreign / "thesis.tex", "precious")
+    with pytest.raises(InputError, match="not a roughfe output folder"):
+        OutputFolder(foreign, "contact")
+    assert (foreign / "thesis.tex").read_text() == "precious"
+    with OutputFolder(foreign, "contact", overwrite=True) as d:
+        write_text(d / "results.json", "{}")
+    assert not (foreign / "thesis.tex").exists()
+    with pytest.raises(InputError, match="existing file"):
+        OutputFolder(foreign / "results.json", "contact")
+
+
+def test_a_failed_run_never_looks_complete_and_a_fresh_folder_is_removed(tmp_path):
+    out = tmp_path / "new"
+    with pytest.raises(ValueError):
+        with OutputFolder(out, "contact"):
+            raise ValueError("solver blew up")
+    assert not out.exists()                                   # nothing written
+    with OutputFolder(out, "contact") as d:
+        write_text(d / "results.json", "{}")
+    with pytest.raises(ValueError):
+        with OutputFolder(out, "contact") as d:
+            write_text(d / "fields.h5", "partial")
+            raise ValueError("killed")
+    assert (out / UNFINISHED_FILE).exists()
+    assert json.loads((out / OWNER_FILE).read_text())["status"] == "failed"
+
+
+def test_a_killed_run_leaves_unfinished_and_the_next_run_cleans_its_temporaries(tmp_path):
+    out = tmp_path / "k"
+    code = ("import os, sys; from roughfe.writers import OutputFolder, atomic_path; "
+            "f = OutputFolder(sys.argv[1], 'contact').__enter__(); "
+            "c = atomic_path(f / 'results.json'); t = c.__enter__(); t.write_text('{'); "
+            "os._exit(9)")
+    subprocess.run([sys.executable, "-c", code, str(out)], check=False)
+    names = os.listdir(out)
+    assert UNFINISHED_FILE in names and any(n.startswith(".roughfe-") for n in names)
+    assert "results.json" not in names                        # never looks complete
+    with OutputFolder(out, "contact") as d:                   # the lock died with the process
+        write_text(d / "results.json", "{}")
+    assert _files(out) == [".lock", OWNER_FILE, "results.json"]
+
+
+def test_a_folder_being_written_is_locked(tmp_path):
+    out = tmp_path / "busy"
+    with OutputFolder(out, "contact"):
+        with pytest.raises(InputError, match="writing to"):
+            OutputFolder(out, "contact")
+
+
+def test_overwrite_never_empties_the_working_directory(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    write_text(tmp_path / "notes.txt", "x")
+    with pytest.raises(InputError, match="refusing to clear"):
+        OutputFolder(".", "contact", overwrite=True)
+    assert (tmp_path / "notes.txt").exists()
+
+
+def test_study_lock_uses_the_same_lock(tmp_path):
+    from roughfe.study.store import study_lock
+    with study_lock(tmp_path / "s"):
+        with pytest.raises(InputError, match="is writing to"):
+            OutputFolder(tmp_path / "s", "study")
