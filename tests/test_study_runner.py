@@ -120,7 +120,7 @@ def test_mpi_two_ranks_gives_identical_table(reference, tmp_path):
         + "\n")
     proc = subprocess.run(
         [*mpirun, PY, "-m", "mpi4py.futures", script, "study", "run", str(spec_path),
-         "--executor", "mpi", "--quiet"],
+         "--executor", "mpi"],
         capture_output=True, text=True, timeout=300, cwd=tmp_path, env=dict(os.environ))
     if proc.returncode != 0 and "mpi executor" not in proc.stdout:
         pytest.skip(f"mpirun does not work here (exit {proc.returncode}): "

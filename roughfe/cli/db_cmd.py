@@ -25,7 +25,8 @@ list prints the genomes (read-only); map draws the genetic map. Under MPI run:
 """
 
 from .options import (add_material_options, add_output_folder, add_run_options,
-                      add_runner_options, output_folder_of, positive_float, positive_int)
+                      add_runner_options, output_folder_of, positive_float, positive_int,
+                      show_progress)
 
 
 def _settings(args):
@@ -37,7 +38,7 @@ def _settings(args):
 
 def _runner(args) -> dict:
     return dict(executor=args.executor, workers=args.workers, scheduler=args.scheduler,
-                study_dir=args.study_dir, progress=not args.quiet,
+                study_dir=args.study_dir, progress=show_progress(args),
                 log=lambda message: print(message, file=sys.stderr))
 
 

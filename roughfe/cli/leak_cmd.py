@@ -22,9 +22,8 @@ from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
 from .options import (add_detrend_option, add_material_options, add_output_folder,
                       add_run_options, add_runner_options, add_surface_options,
-                      check_small_strain,
-                      material_from_args, output_folder_of, positive_float, positive_int,
-                      surface_from_args)
+                      check_small_strain, material_from_args, output_folder_of, positive_float,
+                      positive_int, show_progress, surface_from_args)
 
 
 def _add_fluid_material(p):
@@ -139,7 +138,7 @@ def _leak_study(args) -> int:
                   "seed": args.seed, "seed_from": ["replica"]},
         "grid": study_grid(args.D, args.m, args.surfaces), "fixed": fixed})
     summary = run_study(spec, executor=args.executor, workers=args.workers,
-                        scheduler=args.scheduler, progress=not args.quiet,
+                        scheduler=args.scheduler, progress=show_progress(args),
                         log=lambda msg: print(msg, file=sys.stderr))
     _, rows, missing = table_rows(out)
     if not rows:

@@ -226,24 +226,9 @@ def add_run_options(parser, figures: bool = True) -> None:
                         help="no progress bar and no summary on stdout (errors still on stderr)")
 
 
-def progress(args, total: int, desc: str):
-    """A tqdm bar on stderr when it is a terminal and ``--quiet`` is not given, else a
-    do-nothing object with the same ``update``/``close`` methods."""
-    if getattr(args, "quiet", False) or not sys.stderr.isatty():
-        return _NoBar()
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is a core dependency
-        return _NoBar()
-    return tqdm(total=total, desc=desc, file=sys.stderr, leave=False)
-
-
-class _NoBar:
-    def update(self, n=1):
-        pass
-
-    def close(self):
-        pass
+def show_progress(args) -> bool:
+    """True when a progress bar should be drawn: stderr is a terminal and no ``--quiet``."""
+    return not getattr(args, "quiet", False) and sys.stderr.isatty()
 
 
 def warn(args, message: str) -> None:

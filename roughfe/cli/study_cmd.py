@@ -12,7 +12,7 @@ import sys
 
 from ..study import (ANALYSES, collect, genome_db_to_sqlite, load_spec, run_study,
                      study_status)
-from .options import add_run_options, add_runner_options
+from .options import (add_run_options, add_runner_options, show_progress)
 
 
 def _log(message):
@@ -22,7 +22,7 @@ def _log(message):
 def _run(args) -> int:
     spec = load_spec(args.spec, output=args.output)
     summary = run_study(spec, executor=args.executor, workers=args.workers,
-                        scheduler=args.scheduler, progress=not args.quiet, log=_log)
+                        scheduler=args.scheduler, progress=show_progress(args), log=_log)
     print(summary.describe())
     print(f"results in {spec.output}; `roughfe study status {spec.output}` lists failures, "
           f"`roughfe study collect {spec.output}` writes the table")
