@@ -257,3 +257,66 @@ def uniform_rectangle_displacement(x, y, half_a, half_b, e_star, pressure=1.0):
     s = (_love_primitive(x + half_a, y + half_b) - _love_primitive(x + half_a, y - half_b)
          - _love_primitive(x - half_a, y + half_b) + _love_primitive(x - half_a, y - half_b))
     return pressure / (np.pi * e_star) * s
+
+
+# -- Maugis-Dugdale: adhesive sphere ------------------------------------------------------
+REFERENCES_MAUGIS = ("Maugis D. (1992) J. Colloid Interface Sci. 150:243-269",
+                     "Johnson K.L., Greenwood J.A. (1997) J. Colloid Interface Sci. 192:326-333")
+
+
+def maugis_parameter(radius, e_star, work, max_traction):
+    """Maugis' transition parameter ``lambda = 2 sigma0 (R / (pi w K^2))^(1/3)``,
+    ``K = 4 E* / 3`` (dimensionless; lambda ~ 1.16 x Tabor's mu). R in m, E* and
+    sigma0 in Pa, w in J/m^2. lambda -> 0: DMT, lambda -> infinity: JKR."""
+    r = check_finite_positive("radius (m)", radius)
+    k = 4.0 / 3.0 * check_finite_positive("e_star (Pa)", e_star)
+    w = check_finite_positive("work of adhesion (J/m^2)", work)
+    s0 = check_finite_positive("max_traction (Pa)", max_traction)
+    return 2.0 * s0 * (r / (np.pi * w * k ** 2)) ** (1.0 / 3.0)
+
+
+def _maugis_m(lam, a_bar):
+    """Solve Maugis' Eq. (i) for m = c/a > 1 at the reduced contact radius ``a_bar``."""
+    import scipy.optimize
+
+    def lhs(m):
+        s = np.sqrt(m * m - 1.0)
+        t = np.arctan(s)
+        return (lam * a_bar ** 2 / 2 * (s + (m * m - 2) * t)
+                + 4 * lam ** 2 * a_bar / 3 * (s * t - m + 1) - 1.0)
+
+    hi = 2.0
+    while lhs(hi) < 0:
+        hi *= 2.0
+    return scipy.optimize.brentq(lhs, 1.0 + 1e-15, hi, xtol=1e-14, rtol=1e-14)
+
+
+def maugis_load(lam, a_bar):
+    """Maugis-Dugdale sphere: reduced load ``P/(pi w R)`` and approach
+    ``delta (K^2/(pi^2 w^2 R))^(1/3)`` at the reduced contact radius
+    ``a_bar = a (K/(pi w R^2))^(1/3)`` (Maugis 1992, Eqs. as in Johnson & Greenwood 1997).
+    Returns ``(P_bar, delta_bar, m)`` with ``m = c/a`` the edge of the cohesive zone."""
+    lam = check_finite_positive("lambda", lam)
+    a_bar = check_finite_positive("a_bar", a_bar)
+    m = _maugis_m(lam, a_bar)
+    s = np.sqrt(m * m - 1.0)
+    t = np.arctan(s)
+    p_bar = a_bar ** 3 - lam * a_bar ** 2 * (s + m * m * t)
+    d_bar = a_bar ** 2 - 4.0 / 3.0 * lam * a_bar * s
+    return float(p_bar), float(d_bar), float(m)
+
+
+def maugis_pull_off(lam):
+    """Pull-off force of the Maugis-Dugdale sphere under load control, ``P_c / (pi w R)``
+    (negative: tensile): -2 at lambda -> 0 (DMT), -1.5 at lambda -> infinity (JKR).
+    The minimum over the contact radius of :func:`maugis_load`."""
+    import scipy.optimize
+
+    lam = check_finite_positive("lambda", lam)
+    grid = np.geomspace(1e-3, 10.0, 200)
+    vals = [maugis_load(lam, a)[0] for a in grid]
+    k = int(np.argmin(vals))
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    res = scipy.optimize.minimize_scalar(lambda a: maugis_load(lam, a)[0], bounds=(lo, hi),
+                                         method="bounded", options={"xatol": 1e-10})
+    return float(min(res.fun, vals[k]))
