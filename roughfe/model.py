@@ -349,15 +349,21 @@ class ContactResult:
         H_d / M (m/Pa), the uniform compliance of the finite layer.
     formulation : str, FEM
         ``"flat"`` or ``"profile"``.
-    fields : mapping, FEM
-        Full fields for pictures (read-only), see :mod:`roughfe.fem.contact`.
+    fields : mapping, FEM; BEM adhesion
+        Full fields for pictures (read-only), see :mod:`roughfe.fem.contact`; the
+        non-periodic adhesive BEM keeps ``padded_displacement`` (its warm start).
     plastic_area_fraction : float, BEM with a hardness
         Fraction of the nominal area at p = H_p (perfectly plastic flow).
     plastic_displacement : ndarray, BEM with a hardness
         Permanent displacement u_pl >= 0 (m) of the elastic surface after this step
         (read-only); kept by the next steps of a sweep.
-    unloading : bool, BEM sweeps with a hardness or ``unload``
+    unloading : bool, BEM sweeps with a hardness or ``unload``; BEM adhesion
         The branch of the step: False on loading, True on unloading.
+    adhesive_area_fraction : float, BEM adhesion
+        Fraction of the nominal area under tensile (adhesive) traction.
+
+    With adhesion (:mod:`roughfe.bem.adhesion`) ``pressure`` is the total interface
+    traction and is negative (tensile) in the interaction zone; ``contact`` marks g = 0.
     """
 
     pressure: np.ndarray
@@ -398,6 +404,7 @@ class ContactResult:
     plastic_area_fraction: Optional[float] = None
     plastic_displacement: Optional[np.ndarray] = None
     unloading: Optional[bool] = None
+    adhesive_area_fraction: Optional[float] = None
 
     def __post_init__(self):
         _freeze_fields(self)

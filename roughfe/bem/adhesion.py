@@ -1,0 +1,441 @@
+"""Adhesive frictionless contact by the BEM: Maugis-Dugdale and exponential interface
+laws in the gap-based formulation, loading and unloading branches, pull-off force.
+
+Problem (SI; geometry and signs of :mod:`roughfe.bem.contact`)
+--------------------------------------------------------------
+The rigid rough surface h and the elastic half-space (profile: half-plane in plane
+strain) interact through a potential phi(g) per unit area of the gap g >= 0,
+``phi(0) = -w`` (w the work of adhesion, J/m^2), ``phi(inf) = 0``:
+
+* Maugis-Dugdale (``"md"``): a constant attraction sigma0 up to the range h0,
+  ``w = sigma0 h0``; ``phi = -w + sigma0 g`` for g < h0, 0 beyond (Maugis 1992). The
+  kink at h0 is smoothed by a linear ramp of the traction from sigma0 to 0 over
+  ``[h0 (1 - s/2), h0 (1 + s/2)]`` (s = ``smoothing``, default 0.05), symmetric about h0
+  so that ``int phi' dg = sigma0 h0 = w`` is kept exactly: a quasi-Newton method cannot
+  converge on a traction that jumps; the effect on the pull-off force is O(s^2).
+* exponential (``"exp"``): ``phi = -w exp(-g / rho)``, traction ``(w/rho) exp(-g/rho)``,
+  range rho, peak traction sigma0 = w/rho.
+
+With the gap g (m), the elastic displacement u = g - c, ``c = max h - h - Delta``, and
+the stiffness operator K = H^-1 (Pa/m) the total energy per nominal area is
+
+    Pi(g) = (1/A) [ 1/2 u' K u + sum phi(g) ] dA,   g >= 0,                       (1)
+
+whose stationary points are the equilibria: ``p = K u = -phi'(g)`` where g > 0 (tensile
+where attractive), ``p = -phi'(0) + lambda``, ``lambda >= 0`` in contact (g = 0). The
+total traction p (Pa, compressive > 0) is ``ContactResult.pressure``: unlike the
+non-adhesive solver it is negative in the interaction zone.
+
+Pi is not convex (phi is concave where the attraction decays), so an equilibrium depends
+on the path: loading and unloading branches differ (hysteresis), and the pull-off force
+is the most tensile load of the unloading branch.
+
+Solver and continuation
+-----------------------
+Eq. (1) is minimised by L-BFGS-B (scipy; Byrd, Lu, Nocedal & Zhu 1995) in the gap
+variable, scaled by the range (x = g / range) and the gradient by the traction scale
+S = max(sigma0, E* gbar / 2) (gbar the rms slope: the elastic pressure scale of the
+roughness), so that the stopping measure is the largest projected traction residual over
+S (the
+``residual``; default tolerance 1e-6). The energy and its gradient cost two FFTs:
+
+* periodic (``"spectral"``): K is the exact spectral stiffness E*|q|/2. An imposed
+  Delta fixes the mean gap (mean u = 0, see :mod:`roughfe.bem.operators`); it is
+  imposed through a stiff "machine" spring on the mean gap, ``k0/2 (mean g - gbar)^2``
+  with ``k0`` = 10x the stiffest elastic mode, whose force is the mean pressure
+  ``pbar = k0 (mean g - gbar)``. Every reported state is an exact equilibrium at the
+  Delta it reports (``delta`` = max h - mean h - mean g, within pbar/k0 of the target).
+* non-periodic (``"strip"``, ``"love"``, ``"thesis"``): the DC-FFT operator lives on the
+  zero-padded grid, where it is a positive definite circulant (all eigenvalues > 0,
+  checked), so K is its exact inverse there. The unknowns are the gap on the grid and
+  the displacement of the padding; stationarity makes the pressure vanish on the
+  padding, so the solution is that of the isolated body.
+
+The continuation in the approach (:func:`adhesive_sweep`) starts each step from the
+previous gap shifted by the change of Delta: L-BFGS-B then descends to the nearest
+local minimum, which follows the stable branch until it disappears (jump-in on loading,
+jump-out on unloading), as a displacement-controlled experiment does. A solve that does
+not reach the tolerance raises :class:`~roughfe.errors.NoConvergenceError` with the
+residual.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.optimize
+
+from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..model import ContactResult, Material, SweepResult
+from ..surfaces.stats import rms_height, rms_slope
+from ..surfaces.surface import Surface
+from .contact import _choose_kernel, _operator
+
+LAWS = ("md", "exp")
+
+REFERENCES = (
+    "Maugis D. (1992) J. Colloid Interface Sci. 150:243-269 (Maugis-Dugdale law)",
+    "Rey V., Anciaux G., Molinari J.-F. (2017) Comput. Mech. 60:69-81 (gap-based "
+    "adhesive BEM)",
+    "Byrd R.H., Lu P., Nocedal J., Zhu C. (1995) SIAM J. Sci. Comput. 16:1190-1208 "
+    "(L-BFGS-B)",
+)
+
+
+@dataclass(frozen=True)
+class AdhesionLaw:
+    """Interface law of adhesion (SI).
+
+    Parameters
+    ----------
+    kind : {"md", "exp"}
+        Maugis-Dugdale or exponential (module docstring).
+    work : float
+        Work of adhesion w > 0 (J/m^2).
+    range : float
+        h0 (md) or rho (exp) > 0 (m).
+    smoothing : float
+        md only: relative width s of the traction ramp about h0, 0 <= s < 1.
+    """
+
+    kind: str
+    work: float
+    range: float
+    smoothing: float = 0.05
+
+    def __post_init__(self):
+        if self.kind not in LAWS:
+            raise InputError(f"adhesion law must be one of {LAWS}, got {self.kind!r}")
+        object.__setattr__(self, "work", check_finite_positive(
+            "work of adhesion w (J/m^2)", self.work))
+        object.__setattr__(self, "range", check_finite_positive(
+            "range of adhesion (m)", self.range))
+        s = float(self.smoothing)
+        if not 0.0 <= s < 1.0:
+            raise InputError(f"smoothing must be in [0, 1), got {self.smoothing!r}")
+
+    @property
+    def max_traction(self) -> float:
+        """sigma0 = w / range (Pa): the Dugdale stress or the peak exponential traction."""
+        return self.work / self.range
+
+    def _ramp(self):
+        half = 0.5 * self.smoothing * self.range
+        return self.range - half, self.range + half
+
+    def potential(self, g):
+        """phi(g) (J/m^2), -w at contact, 0 far away."""
+        g = np.asarray(g, float)
+        w, s0 = self.work, self.max_traction
+        if self.kind == "exp":
+            return -w * np.exp(-g / self.range)
+        g1, g2 = self._ramp()
+        if g2 <= g1:
+            return np.where(g < self.range, -w + s0 * g, 0.0)
+        t = np.clip(g - g1, 0.0, g2 - g1)
+        return np.where(g < g1, -w + s0 * g,
+                        np.where(g < g2, -w + s0 * g1 + s0 * (t - t * t / (2 * (g2 - g1))),
+                                 0.0))
+
+    def traction(self, g):
+        """phi'(g) (Pa) >= 0: the magnitude of the attractive traction at gap g."""
+        g = np.asarray(g, float)
+        s0 = self.max_traction
+        if self.kind == "exp":
+            return s0 * np.exp(-g / self.range)
+        g1, g2 = self._ramp()
+        if g2 <= g1:
+            return np.where(g < self.range, s0, 0.0)
+        return s0 * np.clip((g2 - g) / (g2 - g1), 0.0, 1.0)
+
+    def describe(self) -> dict:
+        """JSON-safe parameters (SI)."""
+        return {"law": self.kind, "work_of_adhesion": self.work, "range": self.range,
+                "max_traction": self.max_traction,
+                "smoothing": self.smoothing if self.kind == "md" else None}
+
+
+class _Energy:
+    """Eq. (1) on one grid: value and gradient in the scaled gap variable x = g / range."""
+
+    def __init__(self, op, law, c, spring, traction_scale):
+        self.op, self.law, self.c = op, law, c
+        self.ell, self.s0 = law.range, traction_scale
+        self.n = c.size
+        if op.periodic:
+            self.kspec = op.inverse_spectrum()
+            self.k0 = spring if spring is not None else 10.0 * float(self.kspec.max())
+            self.gbar = float(c.mean())
+            self.shape = c.shape
+        else:
+            self.kspec = 1.0 / op.spectrum.real
+            self.shape = op.fft_shape
+            self.phys = tuple(slice(0, m) for m in op.shape)
+            self.inside = np.zeros(self.shape, bool)
+            self.inside[self.phys] = True
+
+    def bounds(self):
+        lb = np.where(self.inside, 0.0, -np.inf).ravel() if not self.op.periodic \
+            else np.zeros(self.n)
+        return scipy.optimize.Bounds(lb, np.full(lb.size, np.inf))
+
+    def split(self, x):
+        """Gap g on the grid and the displacement field on ``shape`` (m)."""
+        v = x.reshape(self.shape) * self.ell
+        if self.op.periodic:
+            return v, v - self.c
+        u = v.copy()
+        g = v[self.phys]
+        u[self.phys] = g - self.c
+        return g, u
+
+    def pressure(self, x):
+        """Total traction p (Pa) on the grid and the mean pressure pbar of the spring."""
+        g, u = self.split(x)
+        ku = self.op.convolve_spectrum(u, self.kspec)
+        if self.op.periodic:
+            pbar = self.k0 * (float(g.mean()) - self.gbar)
+            return ku + pbar, pbar, g, u, ku
+        return ku[self.phys], 0.0, g, u, ku
+
+    def __call__(self, x):
+        p, pbar, g, u, ku = self.pressure(x)
+        scale = self.n / (self.s0 * self.ell)               # Pi*A per (S range) per cell
+        value = 0.5 * float(np.vdot(u, ku)) + float(self.law.potential(g).sum())
+        grad = ku.copy()
+        if self.op.periodic:
+            value += 0.5 * self.k0 * self.n * (float(g.mean()) - self.gbar) ** 2
+            grad += pbar
+            grad += self.law.traction(g)
+        else:
+            grad[self.phys] += self.law.traction(g)
+        return value * scale / self.n, (grad / self.s0).ravel()
+
+    def residual(self, x):
+        """Largest projected gradient (traction residual / traction scale S)."""
+        _, grad = self(x)
+        lb = self.bounds().lb
+        pg = np.where((x <= lb) & (grad > 0), 0.0, grad)
+        return float(np.max(np.abs(pg)))
+
+
+def _check(surface, material, law, delta):
+    if not isinstance(surface, Surface):
+        raise InputError(f"surface must be a roughfe Surface, got {type(surface).__name__}")
+    if not isinstance(material, Material):
+        raise InputError(f"material must be a roughfe Material, got {material!r}")
+    if not isinstance(law, AdhesionLaw):
+        raise InputError(f"law must be an AdhesionLaw, got {law!r}")
+    try:
+        d = float(delta)
+    except (TypeError, ValueError):
+        raise InputError(f"delta must be a number of metres, got {delta!r}") from None
+    if not np.isfinite(d):
+        raise InputError(f"delta (approach, m; negative = apart) must be finite, got {delta!r}")
+    return d
+
+
+def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, delta,
+                   kernel: str = "auto", initial=None, tol: float = 1e-5,
+                   max_iter: int = 20000, spring=None, unloading: bool = False
+                   ) -> ContactResult:
+    """Equilibrium of the adhesive contact at the approach ``delta`` (Eq. (1)).
+
+    Parameters
+    ----------
+    surface : Surface
+        Profile (plane strain) or surface; heights in m.
+    material : Material
+        Elastic body (E* in Pa).
+    law : AdhesionLaw
+        Interface law.
+    delta : float
+        Approach from first contact of the highest point (m); negative: apart.
+    kernel : str
+        As in :func:`roughfe.bem.solve_contact`.
+    initial : ContactResult, optional
+        A previous adhesive state (its gap, shifted by the change of delta, starts the
+        descent: the continuation of :func:`adhesive_sweep`).
+    tol : float
+        Largest projected traction residual, relative to S = max(sigma0, E* gbar / 2).
+    max_iter : int
+        L-BFGS-B iterations.
+    spring : float, optional
+        Periodic only: stiffness k0 (Pa/m) of the spring imposing the mean gap.
+    unloading : bool
+        The branch stored in the result (``ContactResult.unloading``).
+
+    Returns
+    -------
+    ContactResult
+        ``pressure`` is the total traction (Pa, < 0 where tensile), ``contact`` the
+        points at g = 0, ``adhesive_area_fraction`` the fraction with tensile traction,
+        ``unloading`` the branch; ``stiffness`` is not computed (NaN).
+
+    Raises
+    ------
+    InputError
+        Bad input.
+    NoConvergenceError
+        The residual stayed above ``tol``; ``result`` holds the last state.
+    """
+    d = _check(surface, material, law, delta)
+    kernel = _choose_kernel(surface, kernel)
+    op = _operator(surface.shape, surface.size, material.E_star, kernel)
+    h = surface.heights
+    c = float(h.max()) - h - d
+    scale = max(law.max_traction, 0.5 * material.E_star * rms_slope(surface))
+    energy = _Energy(op, law, c, spring, scale)
+    x0 = np.zeros(energy.shape)
+    if initial is not None:
+        g_prev = np.asarray(initial.gap, float) + (initial.delta - d)
+        if g_prev.shape != h.shape:
+            raise InputError(f"initial state has shape {g_prev.shape}, expected {h.shape}")
+        if op.periodic:
+            x0 = g_prev
+        else:
+            x0 = np.asarray(initial.fields["padded_displacement"], float).copy() \
+                if initial.fields is not None else x0
+            x0[energy.phys] = g_prev
+    else:
+        if op.periodic:
+            x0 = np.maximum(c, 0.0)
+        else:
+            x0[energy.phys] = np.maximum(c, 0.0)
+    x0 = np.maximum(x0 / law.range, energy.bounds().lb.reshape(x0.shape)).ravel()
+    nit, x = 0, x0
+    for _ in range(4):       # restarts with a fresh quasi-Newton memory (round-off stalls)
+        res = scipy.optimize.minimize(energy, x, jac=True, method="L-BFGS-B",
+                                      bounds=energy.bounds(),
+                                      options={"maxiter": int(max_iter) - nit, "maxcor": 20,
+                                               "ftol": 0.0, "gtol": tol,
+                                               "maxfun": 2 * int(max_iter)})
+        x, nit = res.x, nit + int(res.nit)
+        r = energy.residual(x)
+        if r <= tol or nit >= max_iter:
+            break
+    out = _adhesive_result(surface, material, op, law, energy, x, d, r, tol, nit,
+                           bool(unloading))
+    if r > tol:
+        raise NoConvergenceError(
+            f"adhesive L-BFGS-B did not converge: traction residual {r:.3e} (relative to "
+            f"{scale:.3e} Pa) after {nit} iterations ({res.message}), tolerance {tol:.1e}",
+            result=out)
+    return out
+
+
+def _adhesive_result(surface, material, op, law, energy, x, delta, resid, tol, nit,
+                     unloading):
+    p, pbar, g, u, _ = energy.pressure(x)
+    h = surface.heights
+    g = np.maximum(g, 0.0)
+    contact = g <= 0.0
+    n = g.size
+    nc = int(contact.sum())
+    pm = float(p.mean())
+    if op.periodic:   # the approach this equilibrium belongs to (mean u = 0)
+        delta = float(h.max() - h.mean() - g.mean())
+        disp = u - u.mean()
+        fields = None
+    else:
+        disp = u[energy.phys]
+        fields = {"padded_displacement": x.reshape(energy.shape).copy()}
+    sigma = rms_height(surface)
+    mean_gap = float(g.mean())
+    return ContactResult(
+        pressure=p, displacement=disp, gap=g, contact=contact, delta=delta,
+        load=pm * surface.nominal_area, mean_pressure=pm, area_fraction=nc / n,
+        contact_area=nc * surface.cell_area, n_contact=nc, mean_gap=mean_gap,
+        mean_plane_separation=float(h.max() - h.mean() - delta),
+        free_volume=float(g.sum()) * surface.cell_area,
+        free_volume_star=mean_gap / sigma if sigma > 0 else float("nan"),
+        stiffness=float("nan"),
+        message=f"{'unloading' if unloading else 'loading'} ({law.kind}, L-BFGS-B)", nit=nit,
+        residual=float(resid), tolerance=float(tol), kernel=op.name,
+        solver=f"adhesive-lbfgsb-{law.kind}", e_star=material.E_star, rms_height=sigma,
+        size=tuple(surface.size), spacing=tuple(surface.spacing), periodic=op.periodic,
+        references=REFERENCES + op.references, method="bem", unloading=unloading,
+        adhesive_area_fraction=float(np.count_nonzero(p < 0)) / n, fields=fields)
+
+
+@dataclass(frozen=True, eq=False)
+class AdhesiveSweep:
+    """Loading (and unloading) branches of an adhesive contact (SI).
+
+    Attributes
+    ----------
+    sweep : SweepResult
+        Every step in order (loading, then unloading); each ContactResult has
+        ``unloading`` (and ``sweep.unloading`` the per-step branch, 1.0 on unloading).
+    pull_off_force : float
+        Most tensile load of the unloading branch (N for surfaces, N/m for profiles;
+        negative), NaN without unloading.
+    pull_off_pressure : float
+        The same as a mean pressure (Pa).
+    detached : bool
+        The unloading reached separation (no contact, load back above 1e-3 of the
+        pull-off load); if False the pull-off force is a bound (the branch was cut).
+    law : AdhesionLaw
+    """
+
+    sweep: SweepResult
+    pull_off_force: float
+    pull_off_pressure: float
+    detached: bool
+    law: AdhesionLaw
+
+    def records(self) -> list:
+        """Per-step records (``sweep.to_records()``: with ``unloading`` and
+        ``adhesive_area_fraction``)."""
+        return self.sweep.to_records()
+
+
+def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, deltas, *,
+                   unload: bool = False, max_unload_steps=None, kernel: str = "auto",
+                   tol: float = 1e-5, max_iter: int = 20000) -> AdhesiveSweep:
+    """Continuation in the approach: loading through ``deltas`` and, with ``unload``,
+    back down past them until the surfaces separate (see the module docstring).
+
+    Parameters
+    ----------
+    deltas : sequence of float
+        Increasing approaches (m) of the loading branch.
+    unload : bool
+        Also trace the unloading branch: the loading approaches in reverse, then further
+        apart with the last loading step size until separation (at most
+        ``max_unload_steps``, default 4 x the loading steps, beyond the loading range).
+    Other parameters as in :func:`solve_adhesive`.
+    """
+    deltas = np.atleast_1d(np.asarray(deltas, float))
+    if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)):
+        raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "
+                         f"got {deltas!r}")
+    results = []
+    prev = None
+    for d in deltas:
+        prev = solve_adhesive(surface, material, law, delta=d, kernel=kernel, initial=prev,
+                              tol=tol, max_iter=max_iter, unloading=False)
+        results.append(prev)
+    pull, detached = float("nan"), False
+    if unload:
+        step = float(deltas[-1] - deltas[-2]) if deltas.size > 1 else float(abs(deltas[0]))
+        step = step if step > 0 else law.range
+        extra = int(max_unload_steps or 4 * deltas.size)
+        path = list(deltas[-2::-1]) + [deltas[0] - step * (k + 1) for k in range(extra)]
+        loads = []
+        for k, d in enumerate(path):
+            prev = solve_adhesive(surface, material, law, delta=d, kernel=kernel, initial=prev,
+                                  tol=tol, max_iter=max_iter, unloading=True)
+            results.append(prev)
+            loads.append(prev.load)
+            low = min(loads)
+            if k >= deltas.size - 1 and prev.n_contact == 0 and low < 0 \
+                    and prev.load > 1e-3 * low:
+                detached = True
+                break
+        pull = float(min(loads))
+    sweep = SweepResult.from_results(results, rms_slope=rms_slope(surface),
+                                     length=surface.size[0])
+    return AdhesiveSweep(sweep=sweep, pull_off_force=pull,
+                         pull_off_pressure=pull / surface.nominal_area, detached=detached,
+                         law=law)

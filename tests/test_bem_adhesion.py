@@ -1,0 +1,145 @@
+"""Adhesive BEM (roughfe.bem.adhesion): interface laws, the non-adhesive limit, sphere
+pull-off against Maugis-Dugdale (DMT and JKR sides), hysteresis, failure reporting."""
+import numpy as np
+import pytest
+
+from roughfe.bem import solve_contact
+from roughfe.bem.adhesion import AdhesionLaw, adhesive_sweep, solve_adhesive
+from roughfe.errors import InputError, NoConvergenceError
+from roughfe.model import Material
+from roughfe.reference import maugis_parameter, maugis_pull_off
+from roughfe.surfaces.spectral import spectral_surface
+from roughfe.surfaces.surface import Surface
+
+# a sphere of radius R = 1 m on E* = 1 Pa with w = 2.83e-4 J/m^2: JKR pull-off contact
+# radius (9 pi w R^2 / 8 E*)^(1/3) = 0.1 m; lengths scale out of every ratio tested
+R, E_STAR, W = 1.0, 1.0, 2.83e-4
+MAT = Material(E_STAR * 0.91, 0.3)
+K = 4.0 / 3.0 * E_STAR
+D_SCALE = (np.pi ** 2 * W ** 2 * R / K ** 2) ** (1 / 3)       # Maugis' approach unit (m)
+
+
+def sphere(n, length):
+    x = (np.arange(n) - n / 2 + 0.5) * length / n
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    return Surface(-(X ** 2 + Y ** 2) / (2 * R), length, periodic=False)
+
+
+def md_law(lam):
+    """Maugis-Dugdale law with Maugis' parameter lambda for this sphere."""
+    sigma0 = lam / (2 * (R / (np.pi * W * K ** 2)) ** (1 / 3))
+    return AdhesionLaw("md", W, W / sigma0)
+
+
+@pytest.fixture(scope="module")
+def jkr_side():
+    # lambda = 2 (Maugis: -1.535 pi w R, 2.3 % from the JKR limit). dx = 3.3e-3 m puts 4
+    # cells in the Dugdale zone c - a = 1.3e-2 m at pull-off; the domain (0.21 m) holds the
+    # contact (a <= 0.1 m) of every step.
+    law = md_law(2.0)
+    return adhesive_sweep(sphere(64, 0.21), MAT, law, np.array([-0.2, 0.0, 0.2]) * D_SCALE,
+                          unload=True, max_unload_steps=8)
+
+
+@pytest.mark.parametrize("kind", ["md", "exp"])
+def test_laws_store_the_work_of_adhesion(kind):
+    law = AdhesionLaw(kind, 0.05, 1e-9)
+    g = np.linspace(0, 30e-9, 300001)
+    t = law.traction(g)
+    # phi(0) = -w, phi(inf) = 0, phi' = traction, int traction dg = w (the md ramp is
+    # symmetric about h0, so w = sigma0 h0 holds exactly)
+    assert law.potential(0.0) == pytest.approx(-0.05, rel=1e-12)
+    assert law.potential(30e-9) == pytest.approx(0.0, abs=1e-12 * 0.05)
+    assert np.sum(0.5 * (t[1:] + t[:-1]) * np.diff(g)) == pytest.approx(0.05, rel=1e-6)
+    dphi = np.gradient(law.potential(g), g)
+    inner = slice(10, -10)
+    np.testing.assert_allclose(dphi[inner], t[inner], atol=1e-3 * law.max_traction)
+    assert law.max_traction == pytest.approx(0.05 / 1e-9)
+
+
+def test_weak_adhesion_recovers_the_elastic_bem_periodic_and_not():
+    # w -> 0: the adhesive equilibrium is the non-adhesive one (independent solver: PK).
+    # Tolerance 2e-3: the traction residual 1e-5 sigma0 on a tiny sigma0, plus the
+    # remaining adhesive traction w/rho ~ 1e-6 of the mean pressure.
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-7, rng=4)
+    mat = Material(1e9, 0.3)
+    delta = 0.5 * float(s.heights.max() - s.heights.mean())
+    law = AdhesionLaw("exp", 1e-12, 1e-9)
+    adh = solve_adhesive(s, mat, law, delta=delta)
+    ref = solve_contact(s, mat, delta=delta)
+    assert adh.mean_pressure == pytest.approx(ref.mean_pressure, rel=2e-3)
+    assert adh.delta == pytest.approx(delta, rel=1e-3)       # the machine spring holds Delta
+    assert adh.n_contact == pytest.approx(ref.n_contact, rel=0.05)
+    # non-periodic profile (strip kernel on the padded grid): a parabolic bump
+    x = (np.arange(128) - 64) * 1e-6
+    bump = Surface(-x ** 2 / 2e-3, 128e-6, periodic=False)
+    d = 2e-8
+    adh = solve_adhesive(bump, mat, law, delta=d)
+    ref = solve_contact(bump, mat, delta=d)
+    assert adh.kernel == "strip" and adh.mean_pressure == pytest.approx(ref.mean_pressure,
+                                                                         rel=2e-3)
+
+
+def test_dmt_limit_sphere_pull_off():
+    # lambda = 0.1: Maugis -1.9506 pi w R, DMT -2. The attraction reaches r ~ sqrt(2 R h0)
+    # = 0.31 m: the domain (0.8 m) holds it; the contact is a few cells, and in this
+    # limit the pull-off is the integral of the Dugdale traction over the rigid sphere,
+    # which the cells sample accurately. Measured -1.9503 (n = 64).
+    law = md_law(0.1)
+    assert maugis_parameter(R, MAT.E_star, W, law.max_traction) == pytest.approx(0.1)
+    sw = adhesive_sweep(sphere(48, 0.8), MAT, law, np.array([-0.1, 0.2]) * D_SCALE,
+                        unload=True, max_unload_steps=3)
+    ratio = sw.pull_off_force / (np.pi * W * R)
+    assert ratio == pytest.approx(maugis_pull_off(0.1), rel=1e-2)
+    assert ratio == pytest.approx(-2.0, rel=3e-2)
+
+
+def test_jkr_side_sphere_pull_off(jkr_side):
+    # lambda = 2: Maugis -1.535 pi w R. Measured -1.595: +4 %, the contact edge pinned by
+    # the grid (lattice trapping) at 4 cells per Dugdale zone; tolerance 6 %. It is far
+    # from the DMT value 2 and within 7 % of the JKR limit 1.5 (the Maugis curve and the
+    # refinement study are in validation/adhesion_maugis.py).
+    ratio = jkr_side.pull_off_force / (np.pi * W * R)
+    assert jkr_side.detached
+    assert ratio == pytest.approx(maugis_pull_off(2.0), rel=6e-2)
+    assert ratio == pytest.approx(-1.5, rel=7e-2)
+
+
+def test_loading_and_unloading_branches_differ(jkr_side):
+    recs = jkr_side.records()
+    assert [r["unloading"] for r in recs[:3]] == [False] * 3
+    assert all(r["unloading"] for r in recs[3:])
+    load = {round(r["delta"] / D_SCALE, 6): r for r in recs if not r["unloading"]}
+    unload = {round(r["delta"] / D_SCALE, 6): r for r in recs if r["unloading"]}
+    # at the same approach the unloading branch holds more contact and more tension
+    back = unload[-0.2]
+    assert back["n_contact"] > load[-0.2]["n_contact"]
+    assert back["load"] < load[-0.2]["load"]
+    # the sweep ends detached: no contact, load back near zero
+    assert recs[-1]["n_contact"] == 0 and abs(recs[-1]["load"]) < 1e-2 * abs(
+        jkr_side.pull_off_force)
+    # the traction is tensile in the interaction zone of every contact state
+    assert all(r.adhesive_area_fraction > 0 for r in jkr_side.sweep.results if r.n_contact)
+
+
+def test_non_converged_adhesive_solve_raises_with_the_residual():
+    with pytest.raises(NoConvergenceError, match="residual") as info:
+        solve_adhesive(sphere(32, 0.21), MAT, md_law(2.0), delta=0.1 * D_SCALE, max_iter=2)
+    assert info.value.result.residual > 1e-5
+
+
+@pytest.mark.parametrize("args, match", [
+    (("md", 0.0, 1e-9), "work of adhesion"),
+    (("exp", -1.0, 1e-9), "work of adhesion"),
+    (("md", 0.05, float("nan")), "range"),
+    (("md", 0.05, float("inf")), "range"),
+    (("lj", 0.05, 1e-9), "adhesion law"),
+])
+def test_bad_adhesion_parameters(args, match):
+    with pytest.raises(InputError, match=match):
+        AdhesionLaw(*args)
+
+
+def test_bad_approach():
+    with pytest.raises(InputError, match="delta"):
+        solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=float("nan"))
