@@ -417,3 +417,23 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
         size=tuple(surface.size), spacing=tuple(surface.spacing),
         periodic=op.periodic, references=REFERENCES + op.references, method="bem",
         plastic_area_fraction=plastic_fraction, plastic_displacement=plastic)
+
+
+def surface_displacement(surface: Surface, material: Material, traction,
+                         kernel: str = "auto") -> np.ndarray:
+    """Displacement ``u = H t`` (m) of the elastic body under a known normal traction (Pa).
+
+    The operator and the kernel choice are those of :func:`solve_contact` (for a periodic
+    surface the uniform part of ``t`` gives no displacement: zero mean displacement). A
+    known traction ``t`` acting with the contact pressure ``p`` is the dry contact of the
+    heights ``h - H t`` (used by the fluid-structure coupling of
+    :mod:`roughfe.leakage.fsi`).
+    """
+    _check_surface(surface)
+    t = np.asarray(traction, dtype=float)
+    if t.shape != surface.heights.shape or not np.all(np.isfinite(t)):
+        raise InputError(f"traction must be finite with the surface's shape "
+                         f"{surface.heights.shape} (Pa), got shape {t.shape}")
+    op = _operator(surface.shape, surface.size, material.E_star,
+                   _choose_kernel(surface, kernel))
+    return np.asarray(op.apply(t)).reshape(t.shape)

@@ -262,7 +262,6 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     -------
     ReynoldsFESolution
     """
-    from petsc4py import PETSc
     import dolfinx.fem.petsc as fem_petsc
 
     gap = np.asarray(gap, dtype=float)
