@@ -274,8 +274,8 @@ RECORD_KEYS = ("delta", "load", "mean_pressure", "area_fraction", "n_contact", "
 class ContactResult:
     """Solution of one contact problem, the same type from the BEM and the FEM (SI).
 
-    Fields
-    ------
+    Attributes
+    ----------
     pressure : ndarray
         Contact pressure p (Pa), >= 0 (compressive), grid shape (BEM: cell values; FEM:
         nodal reaction / tributary length at the top vertices).
@@ -337,11 +337,9 @@ class ContactResult:
     references : tuple of str
     method : str
         ``"bem"`` or ``"fem"``.
-
-    Optional fields (None where a method does not compute them)
-    ------------------------------------------------------------
-    x : ndarray, FEM
-        Positions of the top vertices (m).
+    x : ndarray or None
+        Optional (None where a method does not compute it; the same for the fields
+        below). FEM: positions of the top vertices (m).
     delta_applied : float, FEM
         Approach imposed on the finite layer (m); ``delta`` is it minus the layer
         shortening ``mean_pressure * layer_compliance``.
@@ -477,15 +475,13 @@ class SweepResult:
         d / sigma.
     rms_height, rms_slope, e_star : float
         sigma (m), gbar, E* (Pa).
-
-    Optional attributes (None unless every step has the value)
-    -----------------------------------------------------------
-    delta_applied : ndarray, FEM
-        Approaches imposed on the finite layer (m).
-    plastic_area_fraction : ndarray, BEM with a hardness
-        Plastic area fraction per step.
-    unloading : ndarray, BEM sweeps with a branch
-        1.0 on the unloading branch, 0.0 on loading.
+    delta_applied : ndarray or None
+        Optional (None unless every step has the value; the same below). FEM:
+        approaches imposed on the finite layer (m).
+    plastic_area_fraction : ndarray or None
+        BEM with a hardness: plastic area fraction per step.
+    unloading : ndarray or None
+        BEM sweeps with a branch: 1.0 on the unloading branch, 0.0 on loading.
 
     All arrays are read-only.
     """

@@ -207,3 +207,26 @@ def test_fem_fields_are_an_immutable_mapping():
     with pytest.raises(TypeError):
         r.fields["points"] = None
     assert not r.fields["stress_yy"].flags.writeable
+
+
+@pytest.mark.fem
+def test_one_results_file_schema_for_bem_and_fem(bem_and_fem, tmp_path):
+    import json
+
+    h5py = pytest.importorskip("h5py")
+    from roughfe.bem.output import write_fields_h5, write_results_json
+
+    docs = {}
+    for sweep in bem_and_fem:
+        write_results_json(tmp_path / f"{sweep.method}.json", sweep, {"case": "westergaard"})
+        write_fields_h5(tmp_path / f"{sweep.method}.h5", sweep)
+        docs[sweep.method] = json.loads((tmp_path / f"{sweep.method}.json").read_text())
+        with h5py.File(tmp_path / f"{sweep.method}.h5") as f:
+            assert f["pressure"].shape[0] == len(sweep.results) == f["delta"].shape[0]
+            assert f.attrs["method"] == sweep.method
+    fem, ref = docs["fem"], docs["bem"]
+    assert fem.keys() == ref.keys() and fem["derived"].keys() == ref["derived"].keys()
+    assert fem["derived"]["method"] == "fem" and fem["derived"]["success"] is True
+    assert set(ref["steps"][0]) < set(fem["steps"][0])
+    assert set(fem["steps"][0]) - set(ref["steps"][0]) == {"delta_applied",
+                                                           "layer_compliance"}

@@ -15,10 +15,12 @@ Public API (stable):
 Result files: :mod:`roughfe.bem.output` (results.json, fields.h5). Analytic references
 (Westergaard, Hertz, Love, strip) live in :mod:`roughfe.reference`.
 """
-from .contact import ContactResult, solve_contact
-from ..model import Material, composite
+from .contact import ContactResult, solve_contact  # noqa: F401 (re-export)
+from ..model import Material, composite  # noqa: F401 (re-export)
 from .operators import KERNELS, InfluenceOperator, influence_operator
-from .sweep import RECORD_KEYS, SweepResult, contact_sweep
+from .sweep import RECORD_KEYS, SweepResult, contact_sweep  # noqa: F401 (re-export)
 
-__all__ = ["Material", "composite", "solve_contact", "ContactResult", "contact_sweep",
-           "SweepResult", "RECORD_KEYS", "influence_operator", "InfluenceOperator", "KERNELS"]
+# Material, composite, ContactResult, SweepResult and RECORD_KEYS are roughfe.model's,
+# re-exported for round-1 code; __all__ lists what this package defines.
+__all__ = ["solve_contact", "contact_sweep", "influence_operator", "InfluenceOperator",
+           "KERNELS"]

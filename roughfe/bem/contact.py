@@ -298,7 +298,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     """
     _check_surface(surface)
     if not isinstance(material, Material):
-        raise InputError(f"material must be a roughfe.bem.Material, got {material!r}")
+        raise InputError(f"material must be a roughfe.model.Material, got {material!r}")
     delta, mean_pressure = _check_target(delta, mean_pressure)
     hardness, plastic = _check_hardness(hardness, mean_pressure, plastic_displacement,
                                         surface.shape)

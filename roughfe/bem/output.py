@@ -1,8 +1,13 @@
 """Result files of a contact sweep, written atomically (roughfe.writers).
 
-* ``results.json``: ``{"inputs": {...}, "steps": [...]}``, one record per step with the
-  keys :data:`roughfe.bem.RECORD_KEYS` in SI units (see :meth:`SweepResult.to_records`),
-  plus the sweep-level dimensionless curves.
+One schema for every method: the sweep is a :class:`roughfe.model.SweepResult` from the
+BEM or the FEM (:func:`roughfe.response.response`).
+
+* ``results.json``: ``{"inputs": {...}, "steps": [...], "derived": {...}}``, one record
+  per step with the keys :data:`roughfe.model.RECORD_KEYS` in SI units, followed by the
+  optional numbers a method sets (FEM: ``delta_applied``, ``layer_compliance``), see
+  :meth:`SweepResult.to_records`; ``derived`` holds the method, the sweep-level
+  dimensionless curves, the units and the references.
 * ``fields.h5``: datasets ``pressure`` (Pa) and ``gap`` (m) of shape
   ``(frame, *grid)``, ``contact`` (bool) and ``delta`` (m) per frame, with the grid
   size/spacing as attributes (the "frame" layout of Tamaas/ContactMechanics dumps).
@@ -14,7 +19,13 @@ import json
 import numpy as np
 
 from ..writers import atomic_path, write_json
-from .sweep import SweepResult
+from ..model import SweepResult
+
+#: Units of the step records (dimensionless keys are absent).
+UNITS = {"delta": "m", "load": "N (surface) or N/m (profile)", "mean_pressure": "Pa",
+         "stiffness": "Pa/m", "stiffness_fd": "Pa/m", "mean_gap": "m",
+         "mean_plane_separation": "m", "free_volume": "m^3 (surface) or m^2 (profile)",
+         "delta_applied": "m", "layer_compliance": "m/Pa"}
 
 
 def sweep_document(sweep: SweepResult, inputs: dict) -> dict:
@@ -23,15 +34,13 @@ def sweep_document(sweep: SweepResult, inputs: dict) -> dict:
         "inputs": dict(inputs),
         "steps": sweep.to_records(),
         "derived": {
+            "method": sweep.method, "success": sweep.success,
             "rms_height": sweep.rms_height, "rms_slope": sweep.rms_slope,
             "e_star": sweep.e_star,
             "load_star": [float(x) for x in sweep.load_star],
             "pressure_over_estar_rms_slope": [float(x) for x in sweep.pressure_star],
             "separation_over_sigma": [float(x) for x in sweep.separation_star],
-            "units": {"delta": "m", "load": "N (surface) or N/m (profile)",
-                      "mean_pressure": "Pa", "stiffness": "Pa/m", "mean_gap": "m",
-                      "mean_plane_separation": "m",
-                      "free_volume": "m^3 (surface) or m^2 (profile)"},
+            "units": dict(UNITS),
             "references": list(sweep.results[0].references),
         },
     }
@@ -43,7 +52,8 @@ def write_results_json(path, sweep: SweepResult, inputs: dict):
 
 
 def write_fields_h5(path, sweep: SweepResult, compression: str = "gzip"):
-    """Write pressure and gap of every step to HDF5 (``frame`` first axis), atomically."""
+    """Write pressure and gap of every step to HDF5 (``frame`` first axis), atomically
+    (FEM: the values at the top vertices)."""
     import h5py  # Debian's h5py; imported here so the package works without it
 
     res = sweep.results
@@ -53,7 +63,8 @@ def write_fields_h5(path, sweep: SweepResult, compression: str = "gzip"):
             f.attrs["size_m"] = np.asarray(r0.size)
             f.attrs["spacing_m"] = np.asarray(r0.spacing)
             f.attrs["periodic"] = bool(r0.periodic)
-            f.attrs["kernel"] = r0.kernel
+            f.attrs["method"] = r0.method
+            f.attrs["kernel"] = r0.kernel or ""          # none for the FEM
             f.attrs["dimensions"] = json.dumps(["frame"] + ["x", "y"][: r0.pressure.ndim])
             for name, unit in (("pressure", "Pa"), ("gap", "m"), ("contact", "1")):
                 data = np.stack([getattr(r, name) for r in res])

@@ -1,6 +1,6 @@
 """``roughfe contact SURFACE --E .. --nu .. (--steps N | --pressure P .. | --delta D ..) -o DIR``
 
-Runs one warm-started BEM contact sweep (:func:`roughfe.bem.contact_sweep`) and writes
+Runs one warm-started BEM contact sweep (:func:`roughfe.response.response`) and writes
 ``results.json``, ``fields.h5`` and the figures (A(p), K(p), mean gap, with Persson's
 theory beside the BEM curves; a 3D render of the last step for surfaces, a profile plot
 for profiles). Each step record carries ``persson_area_fraction`` and
@@ -12,7 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bem import KERNELS, Material, contact_sweep
+from ..bem import KERNELS
+from ..model import Loading, Material
+from ..response import response
 from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5, write_results_json
 from ..theory import beside
@@ -61,9 +63,11 @@ def _run(args) -> int:
     surface = surface_from_args(args)
     material = material_from_args(args)
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
-    sweep = contact_sweep(surface, material, n_steps=args.steps or DEFAULT_STEPS,
-                          deltas=args.delta, pressures=args.pressure, kernel=args.kernel,
-                          solver=args.solver, tol=args.tol)
+    loading = (Loading(pressures=args.pressure) if args.pressure else
+               Loading(deltas=args.delta) if args.delta else
+               Loading(n_steps=args.steps or DEFAULT_STEPS))
+    sweep = response(surface, material, loading, kernel=args.kernel, solver=args.solver,
+                     tol=args.tol)
     check_small_strain(args, surface, sweep.delta, material, sweep.mean_pressure)
     r0 = sweep.results[0]
     inputs = {"surface": str(args.surface), "shape": list(surface.shape),
@@ -121,7 +125,7 @@ def section_contact(outdir: Path, context: dict) -> str:
         surface = rmd_surface(m=7, fractal_dimension=2.3, length=1e-4, rng=0)
     material = Material(210e6, 0.3)
     t0 = time.perf_counter()
-    sweep = contact_sweep(surface, material, n_steps=20)
+    sweep = response(surface, material, Loading(n_steps=20))
     elapsed = time.perf_counter() - t0
     sub = outdir / "contact"
     inputs = {"surface": "demo RMD surface (rmd_surface.npz)", "E": material.E,

@@ -11,11 +11,12 @@
 dolfinx, petsc4py, gmsh and ufl are imported inside the functions that need them, so
 ``import roughfe.fem`` works (and fails only on use) where dolfinx is not installed.
 """
-from .contact import (FemContactResult, FemSolverOptions, FemSweepResult, contact_edge,
-                      contact_length, fem_contact_sweep, fem_solve_contact, p_wave_modulus)
+from .contact import FemContactResult, FemSweepResult  # noqa: F401 (aliases, round 1)
+from .contact import (FemSolverOptions, contact_edge, contact_length, fem_contact_sweep,
+                      fem_solve_contact, p_wave_modulus)
 from .mesh import FACET_TAGS, ProfileMesh, mesh_profile, mirrored_profile
 
 __all__ = ["FACET_TAGS", "ProfileMesh", "mesh_profile", "mirrored_profile",
-           "FemSolverOptions", "FemContactResult", "FemSweepResult", "fem_contact_sweep",
+           "FemSolverOptions", "fem_contact_sweep",
            "fem_solve_contact", "contact_edge", "contact_length",
            "p_wave_modulus"]

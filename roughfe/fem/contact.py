@@ -78,7 +78,7 @@ def p_wave_modulus(material: Material) -> float:
 
 def _check_material(material) -> Material:
     if not isinstance(material, Material):
-        raise InputError(f"material must be a roughfe.bem.Material, got {type(material).__name__}")
+        raise InputError(f"material must be a roughfe.model.Material, got {type(material).__name__}")
     if material.nu >= 0.5:
         raise InputError(f"the P1 displacement FEM needs nu < 0.5 (it locks when incompressible), "
                          f"got nu = {material.nu!r}")
@@ -494,7 +494,7 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     Parameters
     ----------
     pmesh : ProfileMesh
-    material : roughfe.bem.Material
+    material : roughfe.model.Material
         E (Pa) and nu < 0.5 of the body (the obstacle is rigid).
     deltas : array_like, optional
         Strictly increasing half-plane approaches Delta >= 0 (m), the BEM's Delta

@@ -1,7 +1,7 @@
 """Leakage of one contact state: free-volume network (Alg. 1) plus Reynolds flow (Eq. 2.12).
 
 :func:`analyse_leakage` takes a gap field, its contact mask and the grid spacing (for
-example the fields of a :class:`roughfe.bem.ContactResult`, see
+example the fields of a :class:`roughfe.model.ContactResult`, see
 :func:`leakage_of_contact`) and returns a frozen :class:`LeakageResult`; its
 :meth:`LeakageResult.record` is the JSON-safe summary written per load step.
 """
@@ -195,7 +195,7 @@ def analyse_leakage(gap, contact, spacing, *, direction="both", periodic: bool =
 
 
 def leakage_of_contact(contact_result, **kwargs) -> LeakageResult:
-    """:func:`analyse_leakage` on a :class:`roughfe.bem.ContactResult` (surfaces only).
+    """:func:`analyse_leakage` on a :class:`roughfe.model.ContactResult` (surfaces only).
 
     Uses its ``gap``, ``contact``, ``spacing``, ``periodic`` and ``rms_height`` (sigma);
     keyword arguments are passed on (``direction``, ``mu``, ``pressure_drop``, ...).
@@ -214,7 +214,7 @@ class LeakageSweep:
 
     Attributes
     ----------
-    contacts : tuple of roughfe.bem.ContactResult
+    contacts : tuple of roughfe.model.ContactResult
     leakages : tuple of LeakageResult
     """
 
@@ -245,7 +245,7 @@ def leakage_sweep(surface, material, *, deltas=None, pressures=None, kernel: str
     ----------
     surface : roughfe.surfaces.Surface
         2D surface (heights in m).
-    material : roughfe.bem.Material
+    material : roughfe.model.Material
         Elastic body (Pa).
     deltas, pressures : sequence of float
         Approaches Delta (m) or mean contact pressures (Pa); exactly one.
@@ -255,13 +255,14 @@ def leakage_sweep(surface, material, *, deltas=None, pressures=None, kernel: str
         Passed to :func:`analyse_leakage` (``direction``, ``mu``, ``pressure_drop``,
         ``reynolds``, ``sigma``, ...).
     """
-    from ..bem import contact_sweep
+    from ..model import Loading
+    from ..response import response
 
     if surface.ndim != 2:
         raise InputError(f"leakage needs a 2D surface, got {surface!r}")
     if (deltas is None) == (pressures is None):
         raise InputError("give exactly one of deltas (m) or pressures (Pa)")
-    sweep = contact_sweep(surface, material, deltas=deltas, pressures=pressures, kernel=kernel,
-                          compute_stiffness=False)
+    loading = Loading(deltas=deltas) if deltas is not None else Loading(pressures=pressures)
+    sweep = response(surface, material, loading, kernel=kernel, compute_stiffness=False)
     leaks = tuple(leakage_of_contact(c, **leak_kwargs) for c in sweep.results)
     return LeakageSweep(contacts=tuple(sweep.results), leakages=leaks)

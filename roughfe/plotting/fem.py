@@ -4,7 +4,7 @@
 * :func:`plot_pressures` -- pressure along the profile at a few loads, BEM vs FEM.
 * :func:`plot_westergaard` -- contact half-width error and pressure vs Westergaard.
 * :func:`render_deformed_mesh` -- pyvista off-screen picture of the deformed FEM mesh
-  coloured by sigma_yy (from ``FemContactResult.fields``).
+  coloured by sigma_yy (from the FEM ``ContactResult.fields``).
 """
 from __future__ import annotations
 
@@ -111,8 +111,8 @@ def render_deformed_mesh(fields, path, *, magnification=None, top_fraction=0.35,
 
     Parameters
     ----------
-    fields : dict
-        ``FemContactResult.fields``: ``points`` (m), ``cells``, ``displacement`` (m),
+    fields : mapping
+        ``ContactResult.fields`` (FEM): ``points`` (m), ``cells``, ``displacement`` (m),
         ``stress_yy`` (Pa, per cell).
     path : path
         PNG file.

@@ -48,7 +48,7 @@ ANALYSES = {
         "analytic function of x, y (cheap; options to sleep and to fail) for testing the runner"),
     "contact_sweep": Analysis(
         "roughfe.study.analyses:contact_sweep_task", "1",
-        "generate a random surface, run the BEM load sweep (roughfe.bem.contact_sweep)"),
+        "generate a random surface, run the BEM load sweep (roughfe.response.response)"),
     "leakage": Analysis(
         "roughfe.leakage.study:leakage_task", "1",
         "leakage of one surface over approach steps (thesis Sec. 2.4)"),
@@ -173,14 +173,15 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
     youngs_modulus, poisson : float
         Elastic solid against a rigid surface (Pa, -).
     n_steps, kernel, solver, tol
-        As in :func:`roughfe.bem.contact_sweep`.
+        As in :func:`roughfe.bem.contact_sweep` (run through :func:`roughfe.response.response`).
 
     Returns
     -------
     list of dict
         One record per approach step: ``step`` and :data:`roughfe.bem.RECORD_KEYS` (SI).
     """
-    from ..bem import Material, contact_sweep
+    from ..model import Loading, Material
+    from ..response import response
     from ..surfaces import rmd_surface, spectral_surface
 
     if generator == "rmd":
@@ -190,8 +191,8 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
                                    rms_height=rms_height, rng=seed)
     else:
         raise InputError(f"generator must be 'rmd' or 'spectral', got {generator!r}")
-    sweep = contact_sweep(surface, Material(youngs_modulus, poisson), n_steps=n_steps,
-                          kernel=kernel, solver=solver, tol=tol)
+    sweep = response(surface, Material(youngs_modulus, poisson), Loading(n_steps=n_steps),
+                     kernel=kernel, solver=solver, tol=tol)
     return [{"step": k, **record} for k, record in enumerate(sweep.to_records())]
 
 
