@@ -95,6 +95,7 @@ import warnings  # noqa: E402
 
 # numpydoc re-reads class docstrings for member lists and warns on "Fields" (handled below)
 warnings.filterwarnings("ignore", message="Unknown section", category=UserWarning)
+warnings.filterwarnings("ignore", message="potentially wrong underline", category=UserWarning)
 
 _LITERAL_OR_ROLE = re.compile(r"(``.+?``|:[a-z:]+:`[^`]+`|`[^`]+`_?)")
 _UNDERLINE = re.compile(r"^(\s*)([-=~^\"'])\2{2,}\s*$")
