@@ -17,8 +17,8 @@ Conventions (SI, signs fixed once): pressure p >= 0 is compressive; gap g >= 0; 
 approach Delta >= 0 is counted from first contact of the highest point; ``area_fraction``
 is the dimensionless A* = A_r / A_n, ``contact_area`` is A_r in m^2 (m per unit depth for
 profiles). Every array in a result is read-only, every container immutable (tuples,
-:class:`types.MappingProxyType`), and ``success`` is computed from ``residual <=
-tolerance``: nobody sets it.
+:class:`roughfe.frozen.FrozenMapping`), also after unpickling, and ``success`` is
+computed from ``residual <= tolerance``: nobody sets it.
 
 Adding an optional field
 ------------------------
@@ -40,12 +40,12 @@ import dataclasses
 import math
 import numbers
 from dataclasses import dataclass, field
-from types import MappingProxyType
 from typing import Any, Mapping, Optional
 
 import numpy as np
 
 from .errors import InputError, check_finite_positive
+from .frozen import Frozen, freeze_fields
 from .writers import json_scalars
 
 __all__ = ["Material", "composite", "Loading", "ContactResult", "SweepResult",
@@ -236,24 +236,6 @@ class Loading:
 
 
 # -- results ------------------------------------------------------------------------------
-def _freeze(value):
-    """Read-only arrays and immutable containers (recursively for mappings/lists)."""
-    if isinstance(value, np.ndarray):
-        value.setflags(write=False)
-        return value
-    if isinstance(value, Mapping):
-        return MappingProxyType({k: _freeze(v) for k, v in value.items()})
-    if isinstance(value, (list, tuple)):
-        return tuple(_freeze(v) for v in value)
-    return value
-
-
-def _freeze_fields(obj):
-    for f in dataclasses.fields(obj):
-        if f.init:
-            object.__setattr__(obj, f.name, _freeze(getattr(obj, f.name)))
-
-
 def _is_number(v) -> bool:
     return isinstance(v, (numbers.Number, np.number, np.bool_)) and not isinstance(v, complex)
 
@@ -271,7 +253,7 @@ RECORD_KEYS = ("delta", "load", "mean_pressure", "area_fraction", "n_contact", "
 
 
 @dataclass(frozen=True, eq=False)
-class ContactResult:
+class ContactResult(Frozen):
     """Solution of one contact problem, the same type from the BEM and the FEM (SI).
 
     Attributes
@@ -405,7 +387,7 @@ class ContactResult:
     adhesive_area_fraction: Optional[float] = None
 
     def __post_init__(self):
-        _freeze_fields(self)
+        freeze_fields(self)
         object.__setattr__(self, "success", bool(self.residual <= self.tolerance))
 
     @property
@@ -451,7 +433,7 @@ _SWEEP_SERIES = ("delta", "mean_pressure", "load", "area_fraction", "stiffness",
 
 
 @dataclass(frozen=True, eq=False)
-class SweepResult:
+class SweepResult(Frozen):
     """A loading sweep (SI units), the same type from the BEM and the FEM.
 
     Attributes
@@ -507,9 +489,6 @@ class SweepResult:
     delta_applied: Optional[np.ndarray] = None
     plastic_area_fraction: Optional[np.ndarray] = None
     unloading: Optional[np.ndarray] = None
-
-    def __post_init__(self):
-        _freeze_fields(self)
 
     @classmethod
     def from_results(cls, results, *, rms_slope: float, length: float) -> "SweepResult":

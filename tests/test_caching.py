@@ -57,3 +57,19 @@ def test_cached_operator_arrays_are_read_only():
                 bem_contact._dense(op)):
         with pytest.raises(ValueError):
             arr[...] = 0
+
+
+def test_frozen_mapping_is_read_only_and_picklable():
+    import pickle
+
+    from roughfe.frozen import FrozenMapping, freeze
+
+    m = freeze({"a": [1, 2], "b": {"c": np.zeros(2)}})
+    assert isinstance(m, FrozenMapping) and m["a"] == (1, 2)
+    with pytest.raises(TypeError):
+        m["a"] = 0
+    with pytest.raises(AttributeError):
+        m._data = {}
+    assert not m["b"]["c"].flags.writeable
+    back = pickle.loads(pickle.dumps(m))
+    assert dict(back)["a"] == (1, 2) and isinstance(back["b"], FrozenMapping)

@@ -1,7 +1,7 @@
 """The contract layer (roughfe.model, roughfe.response): one ContactResult / SweepResult
 from the BEM and the FEM, the Loading description, and the one response function."""
 import dataclasses
-from types import MappingProxyType
+import pickle
 from typing import Optional
 
 import numpy as np
@@ -9,6 +9,7 @@ import pytest
 
 from roughfe import bem
 from roughfe.errors import InputError
+from roughfe.frozen import FrozenMapping
 from roughfe.model import (RECORD_KEYS, ContactResult, Loading, Material, SweepResult,
                            composite)
 from roughfe.reference import westergaard
@@ -162,6 +163,16 @@ def _bem_result():
     return bem.solve_contact(surf, MAT, delta=4e-7), surf
 
 
+def test_results_stay_read_only_after_pickling():
+    r, surf = _bem_result()
+    sweep = SweepResult.from_results([r], rms_slope=1.0, length=1e-3)
+    back = pickle.loads(pickle.dumps(sweep))
+    np.testing.assert_array_equal(back.results[0].pressure, r.pressure)
+    for a in (back.delta, back.results[0].pressure, back.results[0].contact):
+        with pytest.raises(ValueError):
+            a[...] = 0
+
+
 def test_success_is_computed_from_residual_and_tolerance():
     r, _ = _bem_result()
     assert r.success and r.residual <= r.tolerance
@@ -203,10 +214,12 @@ def test_fem_fields_are_an_immutable_mapping():
     prof = cosine_half_period(17)
     r = response(prof, MAT, Loading(delta=0.5 * G), method="fem", keep_fields=(0,),
                  growth=0.5).results[0]
-    assert isinstance(r.fields, MappingProxyType)
-    with pytest.raises(TypeError):
-        r.fields["points"] = None
-    assert not r.fields["stress_yy"].flags.writeable
+    for res in (r, pickle.loads(pickle.dumps(r))):     # results travel between processes
+        assert isinstance(res.fields, FrozenMapping)
+        with pytest.raises(TypeError):
+            res.fields["points"] = None
+        assert not res.fields["stress_yy"].flags.writeable
+        assert not res.pressure.flags.writeable and res.success
 
 
 @pytest.mark.fem

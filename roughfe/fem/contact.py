@@ -54,6 +54,7 @@ from typing import Literal, Mapping
 import numpy as np
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
@@ -117,6 +118,8 @@ class FemSolverOptions:
         check_finite_positive("penalty_factor", self.penalty_factor)
         if int(self.max_it) < 1:
             raise InputError(f"max_it must be >= 1, got {self.max_it!r}")
+        if self.petsc_options is not None:
+            object.__setattr__(self, "petsc_options", FrozenMapping(self.petsc_options))
 
 
 #: The FEM returns the one result types of :mod:`roughfe.model`; these names are aliases

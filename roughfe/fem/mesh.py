@@ -24,12 +24,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, Mapping
 
 import numpy as np
 
 from ..errors import InputError, check_finite_positive
 from ..surfaces import Surface
+from ..frozen import FrozenMapping
 from ..writers import atomic_path
 from .petsc_tools import ensure_jit_cache
 
@@ -65,7 +66,7 @@ class ProfileMesh:
         ``"flat"`` or ``"profile"`` (see module docstring).
     n_cells : int
         Number of triangles.
-    files : dict
+    files : mapping
         Paths of the written ``.msh`` / ``.xdmf`` files (empty unless requested).
     """
 
@@ -81,7 +82,7 @@ class ProfileMesh:
     length_scale: float
     formulation: str
     n_cells: int
-    files: dict
+    files: Mapping[str, Any]
 
 
 def _check_profile(surface):
@@ -193,7 +194,8 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
     h_ro.setflags(write=False)
     x.setflags(write=False)
     return ProfileMesh(mesh, cell_tags, facet_tags, h_ro, x, float(width), float(depth),
-                       float(dx), float(growth), float(scale), formulation, int(n_cells), files)
+                       float(dx), float(growth), float(scale), formulation, int(n_cells),
+                       FrozenMapping(files))
 
 
 def _write_mesh_files(folder: Path, name: str, scale: float) -> dict:

@@ -13,6 +13,7 @@ from typing import Mapping, Optional
 import numpy as np
 
 from ..errors import InputError
+from ..frozen import FrozenMapping
 from .junction import CriticalConstriction, critical_constriction
 from .network import NetworkResult, free_volume_network
 from .reynolds import ReynoldsResult, reynolds_flow
@@ -66,6 +67,10 @@ class LeakageResult:
     pressure_drop: float
     size: tuple
     references: tuple = REFERENCES
+
+    def __post_init__(self):
+        for name in ("flows", "constrictions"):
+            object.__setattr__(self, name, FrozenMapping(getattr(self, name)))
 
     @property
     def leak_rate(self) -> Optional[float]:

@@ -63,13 +63,14 @@ never periodic (inlet and outlet are distinct sides).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional, Sequence
+from typing import Mapping, Optional, Sequence
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, check_finite_positive
+from ..frozen import FrozenMapping
 
 _AXES = {"x": 0, "y": 1}
 CORNER_RULES = ("saddle", "closed")
@@ -149,7 +150,10 @@ class NetworkResult:
     free_volume_star: Optional[float]
     percolating_volume_star: Optional[float]
     trapped_volume_star: Optional[float]
-    directions: dict
+    directions: Mapping[str, DirectionalNetwork]
+
+    def __post_init__(self):
+        object.__setattr__(self, "directions", FrozenMapping(self.directions))
 
     def percolates(self, direction: str) -> Optional[bool]:
         """Whether the network percolates along ``direction`` (None: not analysed)."""
