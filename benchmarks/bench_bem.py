@@ -1,30 +1,86 @@
-"""Speed of the BEM contact solver, against Tamaas' PolonskyKeerRey when importable.
+"""Speed and memory of the BEM contact solver (issue 16 §1-2, issue 13 §1), against Tamaas.
 
-Periodic self-affine surfaces (H = 0.8, unit rms slope, seed 1, L = 1 m, E* = 1 Pa:
-everything is dimensionless) at mean pressures p/E* giving A* of about 1 %, 10 %, 20 %,
-solved by roughfe (``solver="pk"``: preconditioned Polonsky-Keer CG) and by Tamaas at
-the same tolerance on the same heights. Prints the wall time of each, their ratio, the
-iteration counts and the relative differences in A* and mean gap; also times a 20-step
-sweep of a 512-point profile. The machine's load inflates every time (both codes alike).
+Periodic self-affine surfaces (H = 0.8, unit rms slope, seed 1, L = 1 m, E* = 1 Pa: all
+dimensionless), cold solves (no initial guess) at mean pressures p/E* (default 0.005,
+0.01, 0.05, 0.1), tol 1e-10, ``solver="pk"``. Every case runs in its own subprocess so
+that its peak RSS (``resource.getrusage(RUSAGE_SELF).ru_maxrss``) is its own.
 
-    .venv/bin/python benchmarks/bench_bem.py [--sizes 256 512 1024 2048]
-        [--pressures 0.005 0.05 0.1] [--tamaas-max 1024] [--tol 1e-10]
+Time is reported as process CPU seconds and as *convolution-equivalents*: the CPU time
+divided by the median CPU time of one ``rfftn`` + ``irfftn`` pair of the same size in
+the same process (same FFT threads). That unit is stable on a shared machine where
+wall times are not (the load average is printed and stored).
+
+Cases
+-----
+elastic   n = --sizes: cold solves of every load; the 4-load sum in convolutions is the
+          issue-16 target (<= 500 at 2048^2); a warm-started sweep over the same loads
+          (each from the previous pressure) measures the warm-start saving; Tamaas 2.8.1
+          (``PolonskyKeerRey``, when importable) for n <= --tamaas-max.
+hardness  n = --hardness-size: H_p = --hardness E*: the hardness-limited solve against
+          the elastic one (target: <= 3x its time) and against Tamaas' ``KatoSaturated``
+          (target: the same A* and plastic area fraction to 2e-3).
+large     n = --large (e.g. 4096 8192): one load p/E* = 0.05: time, iterations and the
+          peak RSS of generation + solve (targets 4096^2 <= 1.2 GB, 8192^2 <= 4.5 GB and
+          <= 240 s).
+
+Writes ``benchmarks/output/bench_bem.json`` (targets with met / NOT met, the tables) and
+prints the tables. Usage::
+
+    .venv/bin/python benchmarks/bench_bem.py [--sizes 512 1024 2048] [--tamaas-max 512]
+        [--hardness-size 512] [--large 4096] [--quick]
 """
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import resource
+import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
-from roughfe.bem import Material, contact_sweep, solve_contact
-from roughfe.surfaces.spectral import spectral_profile, spectral_surface
+HERE = Path(__file__).resolve().parent
+LOADS = (0.005, 0.01, 0.05, 0.1)
+TOL = 1e-10
 
 
-def _tamaas(heights, pressure, tol):
+# -- measurement helpers (run in the child) ------------------------------------------------
+def _peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0   # KiB on Linux
+
+
+def _convolution_cpu(n: int) -> float:
+    """Median process CPU seconds of one rfftn + irfftn pair of an n x n grid."""
+    import scipy.fft
+    from roughfe.bem.operators import WORKERS
+    x = np.random.default_rng(0).standard_normal((n, n))
+    times = []
+    for _ in range(7 if n <= 2048 else 3):
+        c0 = time.process_time()
+        y = scipy.fft.irfftn(scipy.fft.rfftn(x, workers=WORKERS), s=x.shape, workers=WORKERS)
+        times.append(time.process_time() - c0)
+        del y
+    return float(np.median(times))
+
+
+def _surface(n):
+    from roughfe.surfaces.spectral import spectral_surface
+    return spectral_surface(n, 1.0, 0.8, rms_slope=1.0, rng=1)
+
+
+def _timed(fn):
+    c0, w0 = time.process_time(), time.perf_counter()
+    out = fn()
+    return out, time.process_time() - c0, time.perf_counter() - w0
+
+
+def _tamaas(heights, pressure, hardness=None):
+    """Tamaas' PolonskyKeerRey (or KatoSaturated with ``hardness``): (cpu s, pressure,
+    iterations) or None when tamaas is not importable."""
     try:
         import tamaas as tm
     except ImportError:
@@ -32,65 +88,221 @@ def _tamaas(heights, pressure, tol):
     n = heights.shape[0]
     model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [n, n])
     model.E, model.nu = 1.0, 0.0
-    solver = tm.PolonskyKeerRey(model, np.array(heights, order="C"), tol)
-    # Tamaas logs its iterations on stderr: catch fd 2 to count them
+    h = np.array(heights, order="C")
+    solver = (tm.PolonskyKeerRey(model, h, TOL) if hardness is None
+              else tm.KatoSaturated(model, h, TOL, hardness))
     sys.stderr.flush()
-    saved = os.dup(2)
+    saved = os.dup(2)      # Tamaas logs its iterations on fd 2: count them there
     with tempfile.TemporaryFile(mode="w+") as log:
         os.dup2(log.fileno(), 2)
         try:
-            t0 = time.perf_counter()
-            solver.solve(pressure)
-            elapsed = time.perf_counter() - t0
+            _, cpu, _ = _timed(lambda: solver.solve(pressure))
         finally:
             sys.stderr.flush()
             os.dup2(saved, 2)
             os.close(saved)
         log.seek(0)
-        rows = [ln.split() for ln in log.read().splitlines()]
-    its = [int(r[0]) for r in rows if r and r[0].isdigit()]
-    nit = its[-1] if its else None
+        its = [int(r.split()[0]) for r in log.read().splitlines()
+               if r.split() and r.split()[0].isdigit()]
     p = np.array(model.traction, copy=True).reshape(heights.shape)
-    gap = np.array(model["gap"], copy=True).reshape(heights.shape) if "gap" in model else None
-    return elapsed, float((p > 0).mean()), (float(gap.mean()) if gap is not None else np.nan), nit
+    return cpu, p, (its[-1] if its else None)
+
+
+def case_elastic(n, loads, tamaas, sweep):
+    from roughfe.bem import Material, contact_sweep, solve_contact
+    mat = Material(1.0, 0.0)
+    surf = _surface(n)
+    conv = _convolution_cpu(n)
+    rows = []
+    for pm in loads:
+        r, cpu, wall = _timed(lambda: solve_contact(surf, mat, mean_pressure=pm, solver="pk",
+                                                    tol=TOL, compute_stiffness=False))
+        row = {"n": n, "p/E*": pm, "A*": r.area_fraction, "nit": r.nit, "cpu_s": cpu,
+               "wall_s": wall, "convolutions": cpu / conv}
+        tm = _tamaas(surf.heights, pm) if tamaas else None
+        if tm is not None:
+            t_cpu, p, t_nit = tm
+            row.update({"tamaas_cpu_s": t_cpu, "tamaas_nit": t_nit,
+                        "tamaas_A*": float((p > 0).mean()), "tamaas/roughfe": t_cpu / cpu,
+                        "max|dp|/max p": float(np.abs(p - r.pressure).max() / p.max())})
+        rows.append(row)
+    out = {"n": n, "convolution_cpu_s": conv, "rows": rows,
+           "cold_convolutions": sum(r["convolutions"] for r in rows),
+           "cold_nit": sum(r["nit"] for r in rows)}
+    if sweep:
+        sw, cpu, wall = _timed(lambda: contact_sweep(surf, mat, pressures=list(loads),
+                                                     solver="pk", tol=TOL,
+                                                     compute_stiffness=False))
+        out.update({"warm_convolutions": cpu / conv, "warm_nit": sw.nit,
+                    "warm_A*": [float(a) for a in sw.area_fraction]})
+    out["peak_rss_mb"] = _peak_rss_mb()
+    return out
+
+
+def case_hardness(n, loads, hardness, tamaas):
+    from roughfe.bem import Material, solve_contact
+    mat = Material(1.0, 0.0)
+    surf = _surface(n)
+    conv = _convolution_cpu(n)
+    rows = []
+    for pm in loads:
+        e, cpu_e, _ = _timed(lambda: solve_contact(surf, mat, mean_pressure=pm, solver="pk",
+                                                   tol=TOL, compute_stiffness=False))
+        r, cpu, _ = _timed(lambda: solve_contact(surf, mat, mean_pressure=pm, solver="pk",
+                                                 tol=TOL, compute_stiffness=False,
+                                                 hardness=hardness))
+        row = {"n": n, "p/E*": pm, "H_p/E*": hardness, "A*": r.area_fraction,
+               "plastic": r.plastic_area_fraction, "nit": r.nit, "elastic_nit": e.nit,
+               "convolutions": cpu / conv, "elastic_convolutions": cpu_e / conv,
+               "hardness/elastic": cpu / cpu_e}
+        tm = _tamaas(surf.heights, pm, hardness) if tamaas else None
+        if tm is not None:
+            t_cpu, p, t_nit = tm
+            a_t = float((p > 0).mean())
+            pl_t = float((p >= hardness * (1 - 1e-9)).mean())
+            row.update({"tamaas_cpu_s": t_cpu, "tamaas_nit": t_nit, "tamaas_A*": a_t,
+                        "tamaas_plastic": pl_t, "|dA*|": abs(r.area_fraction - a_t),
+                        "|dplastic|": abs(r.plastic_area_fraction - pl_t)})
+        rows.append(row)
+    return {"n": n, "rows": rows, "peak_rss_mb": _peak_rss_mb()}
+
+
+def case_large(n, pm):
+    from roughfe.bem import Material, solve_contact
+    surf, cpu_g, wall_g = _timed(lambda: _surface(n))
+    rss_gen = _peak_rss_mb()
+    r, cpu, wall = _timed(lambda: solve_contact(surf, Material(1.0, 0.0), mean_pressure=pm,
+                                                solver="pk", tol=TOL,
+                                                compute_stiffness=False))
+    return {"n": n, "p/E*": pm, "A*": r.area_fraction, "nit": r.nit,
+            "generation_wall_s": wall_g, "generation_rss_mb": rss_gen,
+            "solve_cpu_s": cpu, "solve_wall_s": wall, "peak_rss_mb": _peak_rss_mb(),
+            "bytes_per_point": _peak_rss_mb() * 2 ** 20 / n ** 2,
+            "load_average": os.getloadavg()[0]}
+
+
+CASES = {"elastic": case_elastic, "hardness": case_hardness, "large": case_large}
+
+
+# -- driver ----------------------------------------------------------------------------------
+def run_case(kind, **kw):
+    """Run one case in a fresh interpreter; returns its JSON dict."""
+    spec = json.dumps({"kind": kind, **kw})
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--child", spec]
+    res = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if res.returncode != 0:
+        raise RuntimeError(f"benchmark case {spec} failed:\n{res.stderr[-2000:]}")
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def _table(rows, cols):
+    head = " ".join(f"{c:>14s}" for c in cols)
+    lines = [head]
+    for r in rows:
+        cells = []
+        for c in cols:
+            v = r.get(c)
+            cells.append(f"{'-':>14s}" if v is None else f"{v:14.4g}" if isinstance(v, float)
+                         else f"{v!s:>14s}")
+        lines.append(" ".join(cells))
+    return "\n".join(lines)
+
+
+def _target(name, value, target, met, unit=""):
+    return {"name": name, "value": value, "target": target, "met": bool(met), "unit": unit}
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", type=int, nargs="+", default=[256, 512, 1024, 2048])
-    ap.add_argument("--pressures", type=float, nargs="+", default=[0.005, 0.05, 0.1])
-    ap.add_argument("--tamaas-max", type=int, default=1024,
-                    help="largest n for which Tamaas is run too (it is slow at 2048^2)")
-    ap.add_argument("--tol", type=float, default=1e-10)
+    ap.add_argument("--sizes", type=int, nargs="+", default=[512, 1024, 2048])
+    ap.add_argument("--loads", type=float, nargs="+", default=list(LOADS))
+    ap.add_argument("--tamaas-max", type=int, default=512,
+                    help="largest n also solved by Tamaas (it takes ~20 min at 2048^2)")
+    ap.add_argument("--hardness", type=float, default=0.5, help="H_p / E* (gbar = 1)")
+    ap.add_argument("--hardness-size", type=int, default=512)
+    ap.add_argument("--large", type=int, nargs="*", default=[4096],
+                    help="sizes of the single-load memory case (8192 takes minutes and "
+                         "~4 GB: run it alone)")
+    ap.add_argument("--quick", action="store_true", help="256 and 512 only, no large case")
+    ap.add_argument("--output", type=Path, default=HERE / "output" / "bench_bem.json")
+    ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    mat = Material(1.0, 0.0)
-    print(f"{'n':>5s} {'p/E*':>7s} {'A*':>7s} {'roughfe s':>10s} {'nit':>5s} "
-          f"{'tamaas s':>9s} {'t-nit':>5s} {'ratio':>6s} {'dA*/A*':>9s} {'dgap/gap':>9s}",
-          flush=True)
+    if args.child:
+        spec = json.loads(args.child)
+        print(json.dumps(CASES[spec.pop("kind")](**spec)))
+        return 0
+    if args.quick:
+        args.sizes, args.large, args.hardness_size = [256, 512], [], 256
+    from roughfe.writers import write_json
+
+    load0 = os.getloadavg()[0]
+    print(f"load average {load0:.1f} on {os.cpu_count()} cores", flush=True)
+    elastic = []
     for n in args.sizes:
-        surf = spectral_surface(n, 1.0, 0.8, rms_slope=1.0, rng=1)
-        for pm in args.pressures:
-            t0 = time.perf_counter()
-            r = solve_contact(surf, mat, mean_pressure=pm, solver="pk", tol=args.tol,
-                              compute_stiffness=False)
-            t_r = time.perf_counter() - t0
-            tm = _tamaas(surf.heights, pm, args.tol) if n <= args.tamaas_max else None
-            if tm is None:
-                print(f"{n:5d} {pm:7.3f} {r.area_fraction:7.4f} {t_r:10.2f} {r.nit:5d}",
-                      flush=True)
-                continue
-            t_t, a_t, g_t, nit_t = tm
-            print(f"{n:5d} {pm:7.3f} {r.area_fraction:7.4f} {t_r:10.2f} {r.nit:5d} "
-                  f"{t_t:9.2f} {nit_t if nit_t is not None else -1:5d} {t_r / t_t:6.2f} {abs(r.area_fraction / a_t - 1):9.1e} "
-                  f"{abs(r.mean_gap / g_t - 1):9.1e}", flush=True)
-    prof = spectral_profile(512, 1e-3, 0.8, rms_height=1e-6, rng=3)
-    best = np.inf
-    for _ in range(3):
-        t0 = time.perf_counter()
-        sw = contact_sweep(prof, Material(1e9, 0.3), n_steps=20)
-        best = min(best, time.perf_counter() - t0)
-    print(f"512-point periodic profile, 20-step sweep with exact stiffness: {best:.3f} s "
-          f"(best of 3, solver {sw.results[0].solver}, {sw.nit} pivoting steps)")
+        elastic.append(run_case("elastic", n=n, loads=args.loads,
+                                tamaas=n <= args.tamaas_max, sweep=True))
+        e = elastic[-1]
+        print(_table(e["rows"], ["n", "p/E*", "A*", "nit", "cpu_s", "convolutions",
+                                 "tamaas_cpu_s", "tamaas_nit", "tamaas_A*", "tamaas/roughfe",
+                                 "max|dp|/max p"]), flush=True)
+        print(f"n = {n}: cold {e['cold_nit']} iterations, {e['cold_convolutions']:.0f} "
+              f"convolutions; warm sweep {e['warm_nit']} iterations, "
+              f"{e['warm_convolutions']:.0f} convolutions; peak RSS {e['peak_rss_mb']:.0f} MB",
+              flush=True)
+    hard = run_case("hardness", n=args.hardness_size, loads=args.loads[:3],
+                    hardness=args.hardness, tamaas=args.hardness_size <= args.tamaas_max)
+    print(_table(hard["rows"], ["n", "p/E*", "A*", "plastic", "nit", "elastic_nit",
+                                "hardness/elastic", "tamaas_A*", "tamaas_plastic", "|dA*|",
+                                "|dplastic|"]), flush=True)
+    large = []
+    for n in args.large:
+        large.append(run_case("large", n=n, pm=0.05))
+        print(_table([large[-1]], ["n", "nit", "generation_wall_s", "solve_cpu_s",
+                                   "solve_wall_s", "peak_rss_mb", "bytes_per_point",
+                                   "load_average"]), flush=True)
+
+    targets = []
+    by_n = {e["n"]: e for e in elastic}
+    if 2048 in by_n:
+        c = by_n[2048]["cold_convolutions"]
+        targets.append(_target("4 loads at 2048^2, cold (convolution-equivalents)", c, 500,
+                               c <= 500))
+    ns = sorted(by_n)
+    for a, b in zip(ns, ns[1:]):
+        if b == 2 * a:
+            g = by_n[b]["cold_nit"] / by_n[a]["cold_nit"]
+            targets.append(_target(f"iteration growth {a}^2 -> {b}^2", g, 1.15, g <= 1.15))
+    for e in elastic:
+        diffs = [abs(r["A*"] - r["tamaas_A*"]) for r in e["rows"] if "tamaas_A*" in r]
+        if diffs:
+            targets.append(_target(f"|A* - A*_Tamaas| at {e['n']}^2", max(diffs), 0.0,
+                                   max(diffs) == 0.0))
+    for r in hard["rows"]:
+        targets.append(_target(f"hardness/elastic time, p/E* = {r['p/E*']}",
+                               r["hardness/elastic"], 3.0, r["hardness/elastic"] <= 3.0))
+        if "|dA*|" in r:
+            d = max(r["|dA*|"], r["|dplastic|"])
+            targets.append(_target(f"A*, plastic fraction vs Tamaas KatoSaturated, p/E* = "
+                                   f"{r['p/E*']}", d, 2e-3, d <= 2e-3))
+    limits = {4096: 1.2e3, 8192: 4.5e3}
+    for r in large:
+        if r["n"] in limits:
+            targets.append(_target(f"peak RSS {r['n']}^2 (MB)", r["peak_rss_mb"],
+                                   limits[r["n"]], r["peak_rss_mb"] <= limits[r["n"]], "MB"))
+        if r["n"] == 8192:
+            targets.append(_target("8192^2 solve (s)", r["solve_wall_s"], 240.0,
+                                   r["solve_wall_s"] <= 240.0, "s"))
+    result = {"load_average_start": load0, "load_average_end": os.getloadavg()[0],
+              "cpus": os.cpu_count(), "tol": TOL, "targets": targets,
+              "elastic": [{k: v for k, v in e.items() if k != "rows"} for e in elastic],
+              "cold_solves": [r for e in elastic for r in e["rows"]],
+              "hardness": hard["rows"], "large": large}
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    write_json(args.output, result)
+    for t in targets:
+        print(f"{'met' if t['met'] else 'NOT met':>8s}  {t['name']}: {t['value']:.4g} "
+              f"(target {t['target']:.4g})")
+    print(f"wrote {args.output}")
     return 0
 
 

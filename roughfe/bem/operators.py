@@ -45,8 +45,10 @@ Kernels (``kernel=`` in :func:`roughfe.bem.solve_contact`):
 """
 from __future__ import annotations
 
+import functools
 import os
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 import scipy.fft
@@ -84,10 +86,12 @@ class InfluenceOperator:
         True for the circulant (spectral) operator; its q = 0 mode is zero.
     e_star : float
         E* (Pa).
-    kernel : ndarray
-        Real-space kernel on ``fft_shape`` (m/Pa).
     spectrum : ndarray
         ``rfftn(kernel)``: the multiplier of ``rfftn(p)`` (m/Pa).
+    padded_kernel : ndarray or None
+        The real-space kernel of a non-periodic operator on its zero-padded grid (m/Pa);
+        None for the periodic one, whose real-space kernel (:attr:`kernel`) is made from
+        the spectrum only when asked for (it would be one more full grid in memory).
     """
 
     name: str
@@ -95,17 +99,35 @@ class InfluenceOperator:
     spacing: tuple
     periodic: bool
     e_star: float
-    kernel: np.ndarray
     spectrum: np.ndarray
+    padded_kernel: Optional[np.ndarray] = None
+
+    @functools.cached_property
+    def kernel(self) -> np.ndarray:
+        """Real-space kernel on ``fft_shape`` (m/Pa), read-only."""
+        if self.padded_kernel is not None:
+            return self.padded_kernel
+        kern = scipy.fft.irfftn(self.spectrum, s=self.shape)
+        kern.setflags(write=False)
+        return kern
 
     @property
     def fft_shape(self) -> tuple:
-        return self.kernel.shape
+        return self.shape if self.padded_kernel is None else self.padded_kernel.shape
 
     @property
     def diagonal(self) -> float:
-        """Self-influence H_ii (m/Pa)."""
-        return float(self.kernel.flat[0])
+        """Self-influence H_ii (m/Pa): the kernel at zero offset, for the periodic
+        operator the mean of the full spectrum (from the rfft half: interior columns
+        stand for two modes)."""
+        if self.padded_kernel is not None:
+            return float(self.padded_kernel.flat[0])
+        m = self.shape[-1]
+        spec = self.spectrum
+        total = 2.0 * float(spec.sum()) - float(spec[..., 0].sum())
+        if m % 2 == 0:
+            total -= float(spec[..., -1].sum())
+        return total / float(np.prod(self.shape))
 
     @property
     def references(self) -> tuple:
@@ -116,7 +138,8 @@ class InfluenceOperator:
         axes = tuple(range(p.ndim))
         ph = scipy.fft.rfftn(p, s=self.fft_shape, axes=axes, workers=WORKERS)
         ph *= self.spectrum
-        u = scipy.fft.irfftn(ph, s=self.fft_shape, axes=axes, workers=WORKERS)
+        u = scipy.fft.irfftn(ph, s=self.fft_shape, axes=axes, workers=WORKERS,
+                             overwrite_x=True)
         if self.periodic:
             return u
         return u[tuple(slice(0, n) for n in self.shape)]
@@ -139,11 +162,18 @@ class InfluenceOperator:
             return np.where(spec > 0, 1.0 / np.where(spec > 0, spec, 1.0), 0.0)
 
     def convolve_spectrum(self, v, spectrum):
-        """Circular convolution of ``v`` (``shape``) with a multiplier on its rFFT."""
+        """Circular convolution of ``v`` (``shape``) with a multiplier on its rFFT.
+
+        A ``float32`` multiplier makes it a single-precision product (``v`` is rounded
+        to float32, the result is float32): half the FFT work, for preconditioners,
+        whose rounding only perturbs the search direction, never the residual.
+        """
         axes = tuple(range(v.ndim))
+        if spectrum.dtype == np.float32:
+            v = v.astype(np.float32)
         vh = scipy.fft.rfftn(v, axes=axes, workers=WORKERS)
         vh *= spectrum
-        return scipy.fft.irfftn(vh, s=v.shape, axes=axes, workers=WORKERS)
+        return scipy.fft.irfftn(vh, s=v.shape, axes=axes, workers=WORKERS, overwrite_x=True)
 
     def dense(self, index=None):
         """The dense matrix H (m/Pa), rows and columns in C order of the grid.
@@ -191,8 +221,7 @@ def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOpera
         qmod = np.sqrt(sum(q ** 2 for q in qs))
         with np.errstate(divide="ignore"):
             spec = np.where(qmod > 0, 2.0 / (e_star * qmod), 0.0)
-        kern = scipy.fft.irfftn(spec, s=shape)
-        return InfluenceOperator(kernel, shape, spacing, True, e_star, kern, spec)
+        return InfluenceOperator(kernel, shape, spacing, True, e_star, spec)
     if kernel == "strip":
         if ndim != 1:
             raise InputError("kernel 'strip' is for profiles (1D); use 'love' or 'spectral' "
@@ -214,4 +243,4 @@ def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOpera
                            indexing="ij")
         kern = uniform_rectangle_displacement(x, y, spacing[0] / 2, spacing[1] / 2, e_star)
     spec = scipy.fft.rfftn(kern)
-    return InfluenceOperator(kernel, shape, spacing, False, e_star, kern, spec)
+    return InfluenceOperator(kernel, shape, spacing, False, e_star, spec, kern)

@@ -212,28 +212,36 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
 
 # -- matrix-free: Polonsky & Keer constrained conjugate gradients ------------------------
 def _rescale_to_load(p, target_sum, upper):
-    """Scale ``p`` (>= 0, in place) by alpha > 0 so that sum(min(alpha p, upper)) equals
-    ``target_sum``; entries reaching ``upper`` saturate there. Returns ``(alpha,
-    saturated)``. The sum is concave and piecewise linear in alpha: Newton's method from
-    alpha = target / sum(p) (below the root) increases monotonically and ends after at
-    most as many steps as saturating entries."""
-    s = float(p.sum())
+    """Scale the entries of ``p`` (>= 0, in place) below ``upper`` by alpha > 0 so that
+    the sum, with the entries at ``upper`` kept there, equals ``target_sum``; scaled
+    entries reaching ``upper`` saturate. Returns ``(alpha, saturated)``. The sum is
+    concave and piecewise linear in alpha: Newton's method from the unsaturated alpha
+    (below the root) increases monotonically and ends after at most as many steps as
+    saturating entries."""
+    if np.isfinite(upper):
+        below = p < upper
+        target_sum -= upper * float(p.size - np.count_nonzero(below))
+        q = p[below]
+    else:
+        below, q = None, p
+    s = float(q.sum())
     if s <= 0.0:
         return 1.0, False
     alpha = target_sum / s
-    if not np.isfinite(upper) or alpha * float(p.max()) <= upper:
-        p *= alpha
-        return alpha, False
-    for _ in range(p.size + 1):
-        free = alpha * p < upper
-        slope = float(p.sum(where=free))
-        f = alpha * slope + upper * (p.size - int(np.count_nonzero(free))) - target_sum
+    saturated = alpha * float(q.max()) > upper
+    for _ in range(q.size + 1 if saturated else 0):
+        free = alpha * q < upper
+        slope = float(q.sum(where=free))
+        f = alpha * slope + upper * (q.size - int(np.count_nonzero(free))) - target_sum
         if f >= -1e-15 * target_sum or slope <= 0.0:
             break
         alpha -= f / slope
-    p *= alpha
-    np.minimum(p, upper, out=p)
-    return alpha, True
+    q *= alpha
+    if saturated:
+        np.minimum(q, upper, out=q)
+    if below is not None:
+        p[below] = q
+    return alpha, saturated
 
 
 def _shift_to_load(x, target_sum, upper):
