@@ -18,7 +18,7 @@ Method = Literal["bem", "fem"]
 METHODS = ("bem", "fem")
 
 #: keyword options of each method (everything else is refused with the list below)
-BEM_OPTIONS = ("kernel", "solver", "tol", "max_iter", "compute_stiffness")
+BEM_OPTIONS = ("kernel", "solver", "tol", "max_iter", "compute_stiffness", "unload")
 FEM_MESH_OPTIONS = ("depth", "growth", "formulation", "size_max")
 FEM_SOLVER_OPTIONS = ("solver", "penalty_factor", "rtol", "atol", "max_it", "petsc_options")
 FEM_OPTIONS = FEM_MESH_OPTIONS + FEM_SOLVER_OPTIONS + ("keep_fields",)
@@ -52,7 +52,7 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         approaches of the evenly mirrored profile, which the body with rollers solves
         (:func:`roughfe.fem.mirrored_profile`), up to full contact.
     **solver_options
-        BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness`` (see
+        BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness``, ``unload`` (see
         :func:`roughfe.bem.solve_contact`). FEM: mesh ``depth``, ``growth``,
         ``formulation``, ``size_max`` (:func:`roughfe.fem.mesh_profile`); ``solver``
         (``"vi"`` or ``"penalty"``), ``penalty_factor``, ``rtol``, ``atol``, ``max_it``,

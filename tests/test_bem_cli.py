@@ -86,3 +86,55 @@ def test_contact_cli_bad_input_is_reported(tmp_path, capsys):
     assert main(["contact", str(path), "--E", "-1", "--nu", "0.3", "-o",
                  str(tmp_path / "x")]) == 2
     assert "E (Young's modulus, Pa) must be finite and > 0" in capsys.readouterr().err
+
+
+def _sphere_file(tmp_path, n=40, length=0.8):
+    x = (np.arange(n) - n / 2 + 0.5) * length / n
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    return save_surface(Surface(-(X ** 2 + Y ** 2) / 2.0, length, periodic=False),
+                        tmp_path / "sphere.npz")
+
+
+def test_contact_cli_adhesion_unload_pull_off(tmp_path):
+    # R = 1 m sphere on E* = 1 Pa, Maugis-Dugdale w = 2.83e-4 J/m^2, h0 = 0.0486 m
+    # (lambda = 0.1: Maugis' pull-off -1.95 pi w R, 2.5 % from DMT's -2 pi w R)
+    path = _sphere_file(tmp_path)
+    out = tmp_path / "adh"
+    w = 2.83e-4
+    assert main(["contact", str(path), "--E", "0.91", "--nu", "0.3", "--adhesion", "md",
+                 "--work-of-adhesion", str(w), "--range", "0.0486", "--delta", "-0.002",
+                 "0.004", "--unload", "-o", str(out)]) == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert doc["inputs"]["adhesion"]["law"] == "md"
+    assert doc["inputs"]["tol"] == 1e-5
+    steps = doc["steps"]
+    assert [s["unloading"] for s in steps[:2]] == [False, False]
+    assert all(s["unloading"] for s in steps[2:])
+    pull = doc["derived"]["pull_off_force"]
+    assert pull == min(s["load"] for s in steps if s["unloading"])
+    # a coarse 40^2 grid with 0.006 m steps: within 5 % of Maugis / DMT
+    assert pull / (np.pi * w) == pytest.approx(-1.95, rel=5e-2)
+    assert doc["derived"]["detached"] is True
+    assert all("adhesive_area_fraction" in s for s in steps)
+    assert (out / "adhesion_load_approach.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--adhesion", "md"], "needs --work-of-adhesion"),
+    (["--work-of-adhesion", "0.1"], "need --adhesion"),
+    (["--adhesion", "exp", "--work-of-adhesion", "0.1", "--range", "1e-9", "--pressure",
+      "1e3"], "displacement control"),
+])
+def test_contact_cli_adhesion_bad_input(tmp_path, capsys, extra, message):
+    path = _sphere_file(tmp_path, n=8)
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0.3", *extra,
+                 "-o", str(tmp_path / "x")]) == 2
+    assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "inf"])
+def test_contact_cli_adhesion_parameters_must_be_positive_and_finite(tmp_path, capsys, value):
+    path = _sphere_file(tmp_path, n=8)
+    assert main(["contact", str(path), "--adhesion", "md", "--work-of-adhesion", value,
+                 "--range", "1e-9", "-o", str(tmp_path / "x")]) == 2
+    assert "--work-of-adhesion" in capsys.readouterr().err

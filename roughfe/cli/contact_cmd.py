@@ -19,10 +19,10 @@ from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5, write_results_json
 from ..theory import beside
 from ..writers import write_json
-from .options import (add_detrend_option, add_material_options, add_output_folder,
-                      add_run_options, add_surface_options, check_small_strain,
-                      material_from_args, output_folder_of, positive_float, positive_int,
-                      surface_from_args)
+from .options import (add_adhesion_options, add_detrend_option, add_material_options,
+                      add_output_folder, add_run_options, add_surface_options,
+                      adhesion_from_args, check_small_strain, material_from_args,
+                      output_folder_of, positive_float, positive_int, surface_from_args)
 
 DEFAULT_STEPS = 20
 
@@ -46,14 +46,19 @@ def register(subparsers) -> None:
                       help="mean pressures (Pa), solved in the order given")
     load.add_argument("--delta", type=float, nargs="+", metavar="D",
                       help="approaches from first contact (m), solved in the order given")
+    p.add_argument("--unload", action="store_true",
+                   help="after loading, trace the unloading branch (with --adhesion: until "
+                        "the surfaces separate, giving the pull-off force)")
+    add_adhesion_options(p)
     num = p.add_argument_group("numerics")
     num.add_argument("--kernel", default="auto", choices=("auto",) + KERNELS,
                      help="influence operator: auto = spectral if periodic, else strip for "
                           "profiles and love for surfaces; 'thesis' = Eq. 2.4")
     num.add_argument("--solver", default="auto", choices=SOLVERS,
                      help="dense pivoting, scipy NNLS, or matrix-free Polonsky-Keer PCG")
-    num.add_argument("--tol", type=positive_float, default=1e-10,
-                     help="relative KKT residual at which a load step is converged")
+    num.add_argument("--tol", type=positive_float, default=None,
+                     help="relative KKT residual at which a load step is converged (default "
+                          "1e-10); with --adhesion the traction residual (default 1e-5)")
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_run)
@@ -62,22 +67,35 @@ def register(subparsers) -> None:
 def _run(args) -> int:
     surface = surface_from_args(args)
     material = material_from_args(args)
+    law = adhesion_from_args(args)
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
-    loading = (Loading(pressures=args.pressure) if args.pressure else
-               Loading(deltas=args.delta) if args.delta else
-               Loading(n_steps=args.steps or DEFAULT_STEPS))
-    sweep = response(surface, material, loading, kernel=args.kernel, solver=args.solver,
-                     tol=args.tol)
+    adhesive = None
+    tol = args.tol if args.tol is not None else (1e-10 if law is None else 1e-5)
+    if law is None:
+        loading = (Loading(pressures=args.pressure) if args.pressure else
+                   Loading(deltas=args.delta) if args.delta else
+                   Loading(n_steps=args.steps or DEFAULT_STEPS))
+        sweep = response(surface, material, loading, kernel=args.kernel, solver=args.solver,
+                         tol=tol, unload=args.unload)
+    else:
+        adhesive = _adhesive_sweep(args, surface, material, law, tol)
+        sweep = adhesive.sweep
     check_small_strain(args, surface, sweep.delta, material, sweep.mean_pressure)
     r0 = sweep.results[0]
     inputs = {"surface": str(args.surface), "shape": list(surface.shape),
               "size": list(surface.size), "periodic": surface.periodic,
               "E": material.E, "nu": material.nu, "E_star": material.E_star,
-              "kernel": r0.kernel, "solver": r0.solver, "tol": args.tol,
+              "kernel": r0.kernel, "solver": r0.solver, "tol": tol,
               "control": "pressure" if args.pressure else "delta",
               "detrend": args.detrend,
               "metadata": dict(surface.metadata)}
     doc = sweep_document(sweep, inputs)
+    if adhesive is not None:
+        doc["inputs"]["adhesion"] = law.describe()
+        doc["derived"]["pull_off_force"] = adhesive.pull_off_force
+        doc["derived"]["pull_off_pressure"] = adhesive.pull_off_pressure
+        doc["derived"]["detached"] = adhesive.detached
+        doc["derived"]["units"]["pull_off_force"] = "N (surface) or N/m (profile)"
     theory = beside(surface, material.E_star, doc["steps"])
     doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
     with folder as out:
@@ -88,7 +106,15 @@ def _run(args) -> int:
             plot_area_stiffness(doc["steps"], out / "contact_area_stiffness.png",
                                 title=f"{Path(args.surface).name}, E* = {material.E_star:.4g} Pa",
                                 rms_height=sweep.rms_height)
-            last = sweep.results[-1]
+            if adhesive is not None:
+                from ..plotting.contact import plot_adhesion
+                plot_adhesion(doc["steps"], out / "adhesion_load_approach.png",
+                              pull_off_force=adhesive.pull_off_force,
+                              title=f"{Path(args.surface).name}, {law.kind}: w = {law.work:.3g} "
+                                    f"J/m^2, range {law.range:.3g} m")
+            # the state of largest contact (the last of a loading sweep; not the
+            # detached end of an unloading branch)
+            last = sweep.results[len(sweep.results) - 1 - int(np.argmax(sweep.area_fraction[::-1]))]
             if surface.ndim == 2:
                 render_contact(surface.heights, last, out / "contact_render.png",
                                title=Path(args.surface).name)
@@ -102,8 +128,29 @@ def _run(args) -> int:
         k = s["stiffness"] if s["stiffness"] is not None else float("inf")
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.4f} "
               f"{k:12.4e} {s['mean_gap']:12.4e} {s['iterations']:5d}")
+    if adhesive is not None:
+        print(f"pull-off force {adhesive.pull_off_force:.4e} "
+              f"({'detached' if adhesive.detached else 'NOT detached: a bound'})")
     print(f"wrote {out / 'results.json'}, {out / 'fields.h5'}")
     return 0
+
+
+def _adhesive_sweep(args, surface, material, law, tol):
+    """The adhesive continuation in the approach (``--delta`` or ``--steps``)."""
+    from ..bem.adhesion import adhesive_sweep
+    from ..bem.sweep import default_deltas
+    from ..errors import InputError
+    if args.pressure is not None:
+        raise InputError("--adhesion runs in displacement control (the load-approach curve "
+                         "has unstable parts): give --delta or --steps, not --pressure")
+    if args.solver != "auto":
+        raise InputError("--solver does not apply with --adhesion (L-BFGS-B on the gap)")
+    deltas = args.delta
+    if deltas is None:
+        periodic = surface.periodic and args.kernel in ("auto", "spectral")
+        deltas = default_deltas(surface, args.steps or DEFAULT_STEPS, periodic)
+    return adhesive_sweep(surface, material, law, deltas, unload=args.unload,
+                          kernel=args.kernel, tol=tol)
 
 
 # -- demo section (appended to roughfe.cli.demo_cmd.SECTIONS) ------------------------------

@@ -186,6 +186,34 @@ def material_from_args(args):
     return Material(args.E, args.nu)
 
 
+# -- adhesion --------------------------------------------------------------------------------
+def add_adhesion_options(parser) -> None:
+    """``--adhesion md|exp``, ``--work-of-adhesion W`` (J/m^2), ``--range R`` (m)."""
+    group = parser.add_argument_group("adhesion (roughfe.bem.adhesion; displacement control)")
+    group.add_argument("--adhesion", choices=("md", "exp"), default=None,
+                       help="interface law: Maugis-Dugdale (constant attraction w/R up to the "
+                            "gap R) or exponential (w/R exp(-g/R)); default: no adhesion")
+    group.add_argument("--work-of-adhesion", type=positive_float, default=None, metavar="W",
+                       help="work of adhesion w in J/m^2 (with --adhesion)")
+    group.add_argument("--range", type=positive_float, default=None, metavar="R",
+                       help="range of the attraction in m: h0 (md) or rho (exp)")
+
+
+def adhesion_from_args(args):
+    """The :class:`roughfe.bem.adhesion.AdhesionLaw` of the options, or None without them."""
+    from ..bem.adhesion import AdhesionLaw
+    from ..errors import InputError
+    given = [args.work_of_adhesion is not None, args.range is not None]
+    if args.adhesion is None:
+        if any(given):
+            raise InputError("--work-of-adhesion and --range need --adhesion md|exp")
+        return None
+    if not all(given):
+        raise InputError(f"--adhesion {args.adhesion} needs --work-of-adhesion W (J/m^2) and "
+                         "--range R (m), both finite and > 0")
+    return AdhesionLaw(args.adhesion, args.work_of_adhesion, args.range)
+
+
 # -- outputs and runs ----------------------------------------------------------------------
 def add_output_folder(parser, help: str = "output folder", required: bool = True,
                       default=None) -> None:

@@ -87,6 +87,47 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None):
     return save_figure(fig, path)
 
 
+def plot_adhesion(steps, path, pull_off_force=None, title=None):
+    """Adhesive contact: load and contact area against the approach, loading and
+    unloading branches (the hysteresis loop), the pull-off force marked.
+
+    Parameters
+    ----------
+    steps : list of dict
+        Step records with ``delta`` (m), ``load``, ``area_fraction`` and ``unloading``.
+    path : str or Path
+        PNG to write.
+    pull_off_force : float, optional
+        Most tensile load of the unloading branch (same unit as ``load``).
+    """
+    d = _column(steps, "delta") * UM
+    f = _column(steps, "load")
+    a = _column(steps, "area_fraction")
+    back = np.array([bool(s.get("unloading")) for s in steps])
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
+    for mask, style, label in ((~back, "o-", "loading"), (back, "s--", "unloading")):
+        if mask.any():
+            ax1.plot(d[mask], f[mask], style, ms=4, label=label)
+            ax2.plot(d[mask], a[mask], style, ms=4, label=label)
+    if pull_off_force is not None and np.isfinite(pull_off_force):
+        ax1.axhline(pull_off_force, color="k", lw=0.8, ls=":",
+                    label=f"pull-off {pull_off_force:.3g}")
+    ax1.axhline(0.0, color="0.5", lw=0.5)
+    ax1.set_xlabel("approach Delta (um)")
+    ax1.set_ylabel("load (N, or N/m for profiles)")
+    ax1.set_title("load-approach, adhesive")
+    ax1.legend()
+    ax2.set_xlabel("approach Delta (um)")
+    ax2.set_ylabel("A* (points at zero gap)")
+    ax2.set_title("contact area")
+    ax2.legend()
+    for ax in (ax1, ax2):
+        ax.grid(True, alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    return save_figure(fig, path)
+
+
 def plot_profile_state(heights, result, path, title=None):
     """Profile contact: rigid rough profile, deformed elastic flat and pressure."""
     x = np.arange(result.pressure.size) * result.spacing[0] * UM
