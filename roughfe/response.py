@@ -52,8 +52,9 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         approaches of the evenly mirrored profile, which the body with rollers solves
         (:func:`roughfe.fem.mirrored_profile`), up to full contact.
     **solver_options
-        BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness``, ``unload`` (see
-        :func:`roughfe.bem.solve_contact`). FEM: mesh ``depth``, ``growth``,
+        BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness`` (see
+        :func:`roughfe.bem.solve_contact`), ``unload`` (:func:`roughfe.bem.contact_sweep`).
+        FEM: mesh ``depth``, ``growth``,
         ``formulation``, ``size_max`` (:func:`roughfe.fem.mesh_profile`); ``solver``
         (``"vi"`` or ``"penalty"``), ``penalty_factor``, ``rtol``, ``atol``, ``max_it``,
         ``petsc_options`` (:class:`roughfe.fem.FemSolverOptions`); ``keep_fields``.
