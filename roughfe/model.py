@@ -46,7 +46,7 @@ import numpy as np
 
 from .errors import InputError, check_finite_positive
 from .frozen import Frozen, freeze_fields
-from .writers import json_scalars
+from .writers import json_scalars, to_jsonable
 
 __all__ = ["Material", "composite", "Loading", "ContactResult", "SweepResult",
            "RECORD_KEYS", "central_differences"]
@@ -556,7 +556,7 @@ class SweepResult(Frozen):
         recs = []
         for r, kfd in zip(self.results, self.stiffness_fd):
             s = r.scalars()
-            s["stiffness_fd"] = float(kfd) if np.isfinite(kfd) else None
+            s["stiffness_fd"] = to_jsonable(kfd)
             s["iterations"] = int(r.nit)
             recs.append({k: s[k] for k in RECORD_KEYS + r.optional_scalars()})
         return recs

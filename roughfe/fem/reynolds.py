@@ -145,7 +145,7 @@ class _GridSpace:
         return self.grid.dof_of_cell
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=2)
 def _grid(nx: int, ny: int, lx: float, ly: float) -> _Grid:
     """Mesh, spaces and index maps of an nx x ny grid (no PETSc object, nothing a solve
     mutates; the index maps are O(nx ny) integers)."""
