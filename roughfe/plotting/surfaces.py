@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
+from .common import (block_centres, block_means, decimation_note, new_figure,
+                     offscreen_plotter, render_blocks, save_figure, save_screenshot)
 
 UM = 1e6   # metres -> micrometres
 
@@ -26,7 +27,8 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
         Text in the upper-left corner.
     exaggeration : float, optional
         Vertical exaggeration of the heights; default: peak-to-valley shown as 25 % of
-        the larger lateral size. The colour bar always shows true heights in um.
+        the larger lateral size. The colour bar always shows true heights in um (block
+        means when the grid has more than ``MAX_RENDER_POINTS`` points per side).
 
     Returns
     -------
@@ -36,12 +38,13 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
 
     if surface.ndim != 2:
         raise ValueError(f"render_surface needs a 2D surface, got a profile {surface.shape}")
-    x, y = (c * UM for c in surface.coordinates())
-    h = (surface.heights - surface.heights.mean()) * UM
-    ptp = float(np.ptp(h)) or 1.0
+    blocks = render_blocks(surface.shape)
+    h = block_means(surface.heights - surface.heights.mean(), blocks) * UM
+    ptp = float(np.ptp(surface.heights)) * UM or 1.0
     if exaggeration is None:
         exaggeration = 0.25 * max(surface.size) * UM / ptp
-    xx, yy = np.meshgrid(x, y, indexing="ij")
+    spacing = [d * UM for d in surface.spacing]
+    xx, yy = np.meshgrid(*block_centres(blocks, surface.shape, spacing), indexing="ij")
     grid = pv.StructuredGrid(xx, yy, h * exaggeration)
     grid["height (um)"] = h.ravel(order="F")
     plotter = offscreen_plotter(window_size=window_size)
@@ -51,7 +54,7 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
                                       "height": 0.7, "fmt": "%.3g"})
     label = title or ""
     label += (f"\n{surface.size[0] * UM:.4g} um x {surface.size[1] * UM:.4g} um, "
-              f"vertical exaggeration x{exaggeration:.3g}")
+              f"vertical exaggeration x{exaggeration:.3g}" + decimation_note(surface.shape, h.shape))
     plotter.add_text(label.strip(), position="upper_left", font_size=11)
     plotter.set_background("white")
     plotter.camera_position = "iso"

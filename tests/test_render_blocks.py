@@ -1,0 +1,41 @@
+"""Display decimation of large renders (issue 16 sec. 3): block means that conserve sums
+and are exact on linear fields at the block centres; a 520^2 contact render is drawn
+from 260^2 blocks."""
+import numpy as np
+import pytest
+
+from roughfe.plotting.common import (MAX_RENDER_POINTS, block_centres, block_means, block_sums,
+                                     render_blocks)
+
+
+@pytest.mark.parametrize("shape", [(2048, 2048), (1030, 700), (300, 5000), (17, 9)])
+def test_blocks_conserve_sums_and_are_exact_on_planes(shape):
+    rng = np.random.default_rng(0)
+    a = rng.normal(size=shape)
+    blocks = render_blocks(shape)
+    assert all(len(b) <= MAX_RENDER_POINTS for b in blocks)
+    assert block_sums(a, blocks).sum() == pytest.approx(a.sum(), rel=1e-12, abs=1e-9)
+    # a linear field's block mean is its value at the block centre (also for the shorter
+    # last block of a non-divisible axis)
+    dx, dy = 0.5e-6, 2e-6
+    x, y = np.arange(shape[0]) * dx, np.arange(shape[1]) * dy
+    plane = 3.0 + 2.0 * x[:, None] - 5.0 * y[None, :]
+    cx, cy = block_centres(blocks, shape, (dx, dy))
+    np.testing.assert_allclose(block_means(plane, blocks), 3.0 + 2.0 * cx[:, None] - 5.0 * cy[None, :],
+                               rtol=1e-12, atol=1e-12)
+    if max(shape) <= MAX_RENDER_POINTS:           # small grids are drawn point by point
+        np.testing.assert_array_equal(block_means(a, blocks), a)
+
+
+def test_a_large_contact_render_is_drawn_from_blocks(tmp_path):
+    from roughfe.bem import Material, solve_contact
+    from roughfe.plotting.contact import render_contact
+    from roughfe.surfaces import Surface
+
+    n = 520                                        # > MAX_RENDER_POINTS: blocks of 2 x 2
+    x = np.arange(n) / n
+    h = 1e-6 * np.cos(2 * np.pi * x)[:, None] * np.cos(2 * np.pi * x)[None, :]
+    s = Surface(h, 1e-4, periodic=True)
+    r = solve_contact(s, Material(1e9, 0.0), mean_pressure=2e6, tol=1e-4)
+    path = render_contact(s.heights, r, tmp_path / "r.png", title="t", window_size=(400, 300))
+    assert path.stat().st_size > 5000
