@@ -116,3 +116,20 @@ def test_example_specs_load_and_bind_to_their_analysis(name, n_tasks):
         if "cannot be imported" in str(exc):
             pytest.skip(str(exc))
         raise
+
+
+def test_study_specs_speak_the_cli_vocabulary(tmp_path):
+    """E/nu as on the command line; the old youngs_modulus/poisson are renamed with a
+    FutureWarning (same task key as the new spelling), both at once is an error."""
+    base = {"study": {"analysis": "contact_sweep", "output": str(tmp_path / "v")},
+            "grid": {"m": [3]}}
+    new = spec_from_mapping({**base, "fixed": {"E": 2e9, "nu": 0.25}})
+    with pytest.warns(FutureWarning, match="youngs_modulus is deprecated: write E"):
+        old = spec_from_mapping({**base, "fixed": {"youngs_modulus": 2e9, "poisson": 0.25}})
+    assert old.fixed == new.fixed == {"E": 2e9, "nu": 0.25}
+    assert [t.key for t in old.tasks()] == [t.key for t in new.tasks()]
+    with pytest.raises(InputError, match="both 'poisson' and 'nu'"):
+        spec_from_mapping({**base, "fixed": {"poisson": 0.2, "nu": 0.3}})
+    check_parameters("contact_sweep", {"E": 1e9, "nu": 0.3})
+    with pytest.raises(InputError, match="does not accept"):
+        check_parameters("contact_sweep", {"youngs_modulus": 1e9})

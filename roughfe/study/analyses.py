@@ -150,7 +150,7 @@ def selftest_task(*, x, seed, y=0.0, n_records=3, sleep=0.0, fail_x=(), crash_x=
 
 
 def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, length=1.0e-3,
-                       rms_height=1.0e-6, youngs_modulus=1.0e9, poisson=0.3, n_steps=10,
+                       rms_height=1.0e-6, E=1.0e9, nu=0.3, n_steps=10,
                        kernel="auto", solver="auto", tol=1e-10):
     """Generate one random surface and run the BEM loading sweep on it.
 
@@ -170,8 +170,10 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
         Lateral size (m).
     rms_height : float
         Rms height the surface is scaled to (m).
-    youngs_modulus, poisson : float
-        Elastic solid against a rigid surface (Pa, -).
+    E, nu : float
+        Young's modulus (Pa) and Poisson's ratio (-) of the elastic solid against the
+        rigid surface (the spellings ``youngs_modulus``/``poisson`` of older specs are
+        renamed with a warning by :func:`roughfe.study.spec.spec_from_mapping`).
     n_steps, kernel, solver, tol
         As in :func:`roughfe.bem.contact_sweep` (run through :func:`roughfe.response.response`).
 
@@ -191,18 +193,19 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
                                    rms_height=rms_height, rng=seed)
     else:
         raise InputError(f"generator must be 'rmd' or 'spectral', got {generator!r}")
-    sweep = response(surface, Material(youngs_modulus, poisson), Loading(n_steps=n_steps),
+    sweep = response(surface, Material(E, nu), Loading(n_steps=n_steps),
                      kernel=kernel, solver=solver, tol=tol)
     return [{"step": k, **record} for k, record in enumerate(sweep.to_records())]
 
 
 def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=None,
-                   length=849.42e-6, n_nodes=512, youngs_modulus=1.0e6, poisson=0.0,
+                   length=849.42e-6, n_nodes=512, E=1.0e6, nu=0.0,
                    n_steps=20, threshold=0.95, kernel="auto"):
     """One genome-database entry: the study seed draws the WM phases.
 
     Calls :func:`roughfe.genomics.database.genome_entry_task` with ``phases=seed`` and
-    ``label`` (default ``"genome-<seed>"``). The full entry (genome, curves,
+    ``label`` (default ``"genome-<seed>"``); ``E`` (Pa) and ``nu`` (-) are the material
+    (thesis: E = 1 MPa, nu = 0). The full entry (genome, curves,
     chromosome curves, correlations) is stored in the task's result file; the table
     shows its scalars and the macro/micro chromosome lists as JSON text.
 
@@ -216,8 +219,7 @@ def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=Non
     return genome_entry_task(
         gamma, hurst, seed, label=label if label is not None else f"genome-{seed}",
         source="study", amplitude=amplitude, lambda1=lambda1, length=length, n_nodes=n_nodes,
-        youngs_modulus=youngs_modulus, poisson=poisson, n_steps=n_steps, threshold=threshold,
-        kernel=kernel)
+        youngs_modulus=E, poisson=nu, n_steps=n_steps, threshold=threshold, kernel=kernel)
 
 
 def genome_entry_study_task(*, entry, seed, length=849.42e-6, n_nodes=512,

@@ -33,10 +33,12 @@ gets the same key, on any machine and with any executor.
 from __future__ import annotations
 
 import hashlib
+import inspect
 import itertools
 import json
 import math
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -228,6 +230,34 @@ class StudySpec:
         return out
 
 
+#: Old parameter names of study specs -> the names of the CLI vocabulary (``--E``, ``--nu``).
+RENAMED_PARAMETERS = {"youngs_modulus": "E", "poisson": "nu"}
+
+
+def _current_names(analysis: str, section: str, table: Mapping) -> dict:
+    """``table`` with old parameter names (:data:`RENAMED_PARAMETERS`) renamed, with a
+    ``FutureWarning``, where the analysis takes the new name and not the old one."""
+    table = dict(table)
+    old = [k for k in table if k in RENAMED_PARAMETERS]
+    if not old:
+        return table
+    from .analyses import ANALYSES, resolve
+
+    if analysis not in ANALYSES:
+        return table  # StudySpec reports the unknown analysis
+    accepted = inspect.signature(resolve(analysis)).parameters
+    for key in old:
+        new = RENAMED_PARAMETERS[key]
+        if key in accepted or new not in accepted:
+            continue
+        if new in table:
+            raise InputError(f"[{section}] gives both {key!r} and {new!r}; write {new!r} only")
+        warnings.warn(f"study spec [{section}] {key} is deprecated: write {new} (the "
+                      f"vocabulary of the command line)", FutureWarning, stacklevel=3)
+        table[new] = table.pop(key)
+    return table
+
+
 def spec_from_mapping(data: Mapping[str, Any], *, output=None) -> StudySpec:
     """Build a :class:`StudySpec` from the TOML layout (``[study]``, ``[grid]``, ``[fixed]``).
 
@@ -255,12 +285,14 @@ def spec_from_mapping(data: Mapping[str, Any], *, output=None) -> StudySpec:
     for section in ("grid", "fixed"):
         if section in data and not isinstance(data[section], Mapping):
             raise InputError(f"[{section}] must be a table, got {data[section]!r}")
+    grid, fixed = (_current_names(study["analysis"], section, data.get(section, {}))
+                   for section in ("grid", "fixed"))
     return StudySpec(
         name=study.get("name", study["analysis"]),
         analysis=study["analysis"],
         output=Path(output if output is not None else study["output"]),
-        grid=dict(data.get("grid", {})),
-        fixed=dict(data.get("fixed", {})),
+        grid=grid,
+        fixed=fixed,
         seed=study.get("seed", 0),
         seed_from=study.get("seed_from"),
         max_attempts=study.get("max_attempts", 2),
