@@ -2,8 +2,8 @@
 
 surfaces -> model -> theory -> bem -> fem -> response -> leakage -> genomics -> study
 -> plotting -> cli
-(errors, writers, reference, caching, frozen and _runtime are the base layer, importable
-from anywhere; model.py holds the contract types shared by bem and fem, response.py the one
+(errors, writers, reference, caching, frozen, _runtime and progress are the base layer,
+importable from anywhere; model.py holds the contract types shared by bem and fem, response.py the one
 dispatch to them.)
 dolfinx, petsc4py, mpi4py.futures aside, gmsh and ufl are imported only inside roughfe/fem.
 """
@@ -15,7 +15,7 @@ import pytest
 PKG = Path(__file__).resolve().parents[1] / "roughfe"
 ORDER = ["errors", "writers", "reference", "surfaces", "model", "theory", "bem", "fem",
          "response", "leakage", "genomics", "study", "plotting", "cli"]
-BASE = {"errors", "writers", "reference", "caching", "frozen", "_runtime", "__init__"}
+BASE = {"errors", "writers", "reference", "caching", "frozen", "_runtime", "progress", "__init__"}
 FEM_ONLY = {"dolfinx", "petsc4py", "gmsh", "ufl", "basix", "ffcx"}
 
 

@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 
+from .. import progress
 from ..errors import InputError
 from ..model import RECORD_KEYS, Loading, Material, SweepResult, central_differences
 from ..surfaces.stats import rms_slope
@@ -76,7 +77,7 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     branch = unload or hardness is not None
     results = []
     prev = plastic = None
-    for v, unloading in steps:
+    for v, unloading in progress.iterate(steps, "BEM load steps"):
         r = solve_contact(surface, material, **{key: v}, kernel=kernel, solver=solver,
                           tol=tol, max_iter=max_iter, initial=prev,
                           compute_stiffness=compute_stiffness, hardness=hardness,

@@ -18,8 +18,9 @@ import importlib
 import os
 import sys
 
+from .. import progress
 from ..errors import RoughfeError
-from .options import RoughfeParser
+from .options import ProgressBars, RoughfeParser, show_progress
 
 # module -> the commands it registers (explicit and ordered; no import-time magic)
 SUBCOMMANDS = {
@@ -74,8 +75,14 @@ def main(argv=None) -> int:
     name = " ".join(str(getattr(args, k)) for k in ("command", "genome_command", "db_command",
                                                      "study_command") if getattr(args, k, None))
     quiet = open(os.devnull, "w") if getattr(args, "quiet", False) else None
+    bars = ProgressBars() if show_progress(args) else None
     try:
-        with contextlib.redirect_stdout(quiet) if quiet else contextlib.nullcontext():
+        with contextlib.ExitStack() as stack:
+            if quiet:
+                stack.enter_context(contextlib.redirect_stdout(quiet))
+            if bars:
+                stack.enter_context(progress.listening(bars))
+                stack.callback(bars.close)
             return int(args.func(args) or 0)
     except RoughfeError as exc:
         message = str(exc)

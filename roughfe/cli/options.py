@@ -259,6 +259,36 @@ def show_progress(args) -> bool:
     return not getattr(args, "quiet", False) and sys.stderr.isatty()
 
 
+class ProgressBars:
+    """A :mod:`roughfe.progress` listener: one tqdm bar on stderr per running loop
+    (nested loops, e.g. the BEM load steps of each design candidate, stack)."""
+
+    def __init__(self):
+        self.bars = {}
+
+    def __call__(self, description, done, total):
+        from tqdm import tqdm
+
+        bar = self.bars.get(description)
+        if done == 0:
+            if bar is not None:
+                bar.close()
+            self.bars[description] = tqdm(total=total, desc=description, file=sys.stderr,
+                                          leave=False, dynamic_ncols=True,
+                                          position=len(self.bars))
+            return
+        if bar is not None:
+            bar.update(done - bar.n)
+            if total is not None and done >= total:
+                bar.close()
+                del self.bars[description]
+
+    def close(self):
+        for bar in self.bars.values():
+            bar.close()
+        self.bars.clear()
+
+
 def warn(args, message: str) -> None:
     """One warning line on stderr (``roughfe CMD: warning: ...``), even with --quiet."""
     print(f"roughfe {args.command}: warning: {message}", file=sys.stderr)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
+from .. import progress
 from ..errors import InputError
 
 # name on the command line -> script in validation/ (explicit, ordered)
@@ -55,7 +56,7 @@ def _script_doc(name: str) -> str:
 def _run(args) -> int:
     names = list(VALIDATIONS) if args.name == "all" else [args.name]
     failed = []
-    for name in names:
+    for name in progress.iterate(names, "validations"):
         print(f"== validation {name}")
         if not run_validation(name, Path(args.output)):
             failed.append(name)

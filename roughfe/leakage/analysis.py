@@ -12,6 +12,7 @@ from typing import Mapping, Optional
 
 import numpy as np
 
+from .. import progress
 from ..errors import InputError
 from ..frozen import FrozenMapping
 from .junction import CriticalConstriction, critical_constriction
@@ -269,5 +270,6 @@ def leakage_sweep(surface, material, *, deltas=None, pressures=None, kernel: str
         raise InputError("give exactly one of deltas (m) or pressures (Pa)")
     loading = Loading(deltas=deltas) if deltas is not None else Loading(pressures=pressures)
     sweep = response(surface, material, loading, kernel=kernel, compute_stiffness=False)
-    leaks = tuple(leakage_of_contact(c, **leak_kwargs) for c in sweep.results)
+    leaks = tuple(leakage_of_contact(c, **leak_kwargs)
+                  for c in progress.iterate(sweep.results, "leakage steps"))
     return LeakageSweep(contacts=tuple(sweep.results), leakages=leaks)

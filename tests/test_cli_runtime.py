@@ -1,0 +1,64 @@
+"""The light command (issue 16 sec. 3) and the one render-backend set-up (roughfe._runtime):
+what a command imports, progress reporting, rendering after dolfinx was loaded first."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from roughfe import progress
+
+_PROBE = """
+import os, sys, json
+import roughfe.cli.contact_cmd as C
+seen = {}
+def stop(*a, **k):
+    seen.update({m: m in sys.modules for m in ("pyvista", "vtkmodules", "matplotlib",
+                                                "dolfinx", "roughfe.genomics", "roughfe.study")})
+    print(json.dumps(seen), flush=True)
+    os._exit(0)
+C.response = stop  # the solve: roughfe.response.response
+from roughfe.cli import main
+main(sys.argv[1:])
+"""
+
+
+def test_contact_reaches_its_solve_without_render_or_fem_modules(tmp_path):
+    from roughfe.surfaces import Surface
+    from roughfe.surfaces.io import save_surface
+    path = save_surface(Surface(np.outer(np.hanning(8), np.hanning(8)) * 1e-6, 1e-4,
+                                periodic=True), tmp_path / "s.npz")
+    proc = subprocess.run([sys.executable, "-c", _PROBE, "contact", str(path),
+                           "-o", str(tmp_path / "o")], capture_output=True, text=True,
+                          timeout=120)
+    seen = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert len(seen) == 6 and not any(seen.values()), seen          # vtk/matplotlib/dolfinx only when drawn/used
+
+
+def test_sweeps_report_progress_to_the_listener_only():
+    from roughfe.bem import Material, contact_sweep
+    from roughfe.surfaces import Surface
+    x = np.arange(64) / 64
+    s = Surface(1e-6 * np.cos(2 * np.pi * x), 1e-4, periodic=True)
+    calls = []
+    with progress.listening(lambda d, k, n: calls.append((d, k, n))):
+        contact_sweep(s, Material(1e9, 0.0), n_steps=3)
+    assert calls == [("BEM load steps", k, 3) for k in range(4)]
+    contact_sweep(s, Material(1e9, 0.0), n_steps=2)       # no listener: nothing reported
+    assert len(calls) == 4
+    assert list(progress.iterate(iter("ab"), "no len")) == ["a", "b"]
+
+
+@pytest.mark.fem
+def test_a_picture_after_dolfinx_was_loaded_first_renders_in_a_fresh_process(tmp_path):
+    pytest.importorskip("dolfinx")
+    code = ("import sys, dolfinx, numpy as np; from roughfe import _runtime; "
+            "assert not _runtime.can_render_here() and not _runtime.load_render_backend(); "
+            "from roughfe.plotting.leakage import pressure_map; "
+            "pressure_map(np.outer(np.arange(8.), np.ones(8)), (1e-4, 1e-4), sys.argv[1]); "
+            "assert 'vtkmodules.vtkCommonCore' not in sys.modules")
+    proc = subprocess.run([sys.executable, "-c", code, str(tmp_path / "p.png")],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert (tmp_path / "p.png").stat().st_size > 5000
