@@ -69,3 +69,48 @@ def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
     assert main(argv) == 0
     assert json.loads((out / "summary.json").read_text()) == summary
     assert "4 already done" in capsys.readouterr().err
+
+
+FSI_KEYS = {"fluid_load_fraction", "coupled_iterations", "critical_gap", "critical_position",
+            "leak_rate_critical_junction", "pocket_pressures", "trapped_volume",
+            "trapped_load_fraction", "leak_rate_one_way", "fsi_state", "external_pressure"}
+
+
+def test_leak_fsi_writes_coupled_steps(tmp_path, capsys):
+    from roughfe.cli import main
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=4)
+    path = save_surface(s, tmp_path / "s.npz")
+    out = tmp_path / "fsi"
+    argv = ["leak", str(path), "--pressure", "1e6", "3e6", "--fsi", "--direction", "x",
+            "--inlet-pressure", "1e6", "--outlet-pressure", "0", "--E", "2.1e8",
+            "--no-figures", "--quiet", "-o", str(out)]
+    assert main(argv) == 0
+    steps = json.loads((out / "results.json").read_text())["steps"]
+    assert len(steps) == 2 and FSI_KEYS <= set(steps[0])
+    for st in steps:
+        assert st["fsi_state"] == "contact" and st["coupled_residual"] <= 1e-8
+        # the fluid opens the contact: the coupled leak rate exceeds the one-way one
+        assert st["leak_rate"] > st["leak_rate_one_way"] > 0
+        assert 0 < st["fluid_load_fraction"] < 1
+        # external load = solid (effective) + fluid share
+        assert st["mean_pressure"] == pytest.approx(
+            st["external_pressure"] * (1 - st["fluid_load_fraction"]), rel=1e-8)
+    with np.load(out / "fields" / "step_000.npz") as f:
+        assert f["fluid_pressure"].shape == s.shape and f["fluid_pressure"].max() <= 1e6 * (1 + 1e-9)
+    # bad input: one line each, exit code 2
+    bad = [["--delta", "1e-7"], ["--direction", "both"], ["--inlet-pressure", "1e6"],
+           ["--pressure-drop", "1", "--inlet-pressure", "1", "--outlet-pressure", "0"]]
+    base = ["leak", str(path), "--fsi", "--no-figures", "--quiet", "--overwrite", "-o", str(out)]
+    for extra in bad:
+        args = list(base) + extra
+        if "--delta" not in extra:
+            args += ["--pressure", "1e6"]
+        if "--direction" not in extra:
+            args += ["--direction", "x"]
+        assert main(args) == 2, extra
+    # without --fsi a reversed pressure pair is refused (with --fsi it is solved)
+    assert main(["leak", str(path), "--pressure", "1e6", "--inlet-pressure", "0",
+                 "--outlet-pressure", "1e6", "--no-figures", "--quiet", "--overwrite",
+                 "-o", str(out)]) == 2
+    assert "reversed flow" in capsys.readouterr().err

@@ -106,6 +106,8 @@ def test_bad_input_is_named(surface):
         coupled_leakage(surface, MAT, -1.0, p_in=1.0, p_out=0.0)
     with pytest.raises(InputError, match="inlet pressure"):
         coupled_leakage(surface, MAT, P_EXT, p_in=float("nan"), p_out=0.0)
+    film = coupled_sweep(surface, MAT, [1e7, 2e7, 3e7, 6e7], p_in=5e6, p_out=0.0)
+    assert all(r.residual <= 1e-8 for r in film)
     with pytest.raises(InputError, match="trapped"):
         coupled_leakage(surface, MAT, P_EXT, p_in=1.0, p_out=0.0, trapped="volume")
 
@@ -113,7 +115,7 @@ def test_bad_input_is_named(surface):
 
 
 def test_sweep_trapped_pockets_keep_their_pressure_at_closure(surface):
-    rs = coupled_sweep(surface, MAT, [1e7, 2e7, 3e7], p_in=5e6, p_out=0.0)
+    rs = coupled_sweep(surface, MAT, [1e7, 2e7, 3e7], p_in=5e6, p_out=0.0, trapped="pressure")
     assert [r.state for r in rs] == ["contact"] * 3
     for r in rs:
         assert r.residual <= 1e-8

@@ -1,9 +1,11 @@
 """``roughfe leak`` and ``roughfe leak-study``: leakage through a rough contact (Sec. 2.3-2.4).
 
 ``leak`` loads a surface, solves the BEM contact at each requested approach or mean
-pressure, finds the percolating and trapped free volume (Alg. 1) and solves the Reynolds
-equation (dolfinx) for the leak rate; it writes ``results.json`` (inputs and one record
-per step), ``fields/step_NNN.npz`` and figures.
+pressure, finds the percolating and trapped free volume (Alg. 1), the critical
+constriction and the Reynolds leak rate (cell-centred finite volumes); with ``--fsi`` the
+fluid pressure acts back on the body (two-way coupling, :mod:`roughfe.leakage.fsi`) and
+``--pressure`` is the external pressure. It writes ``results.json`` (inputs and one
+record per step), ``fields/step_NNN.npz`` and figures.
 
 ``leak-study`` runs the study of Sec. 2.4.2-2.4.5 (RMD surfaces, D x m x replicas) on
 the resumable study runner (``roughfe study``), then writes ``summary.json`` (means,
@@ -31,12 +33,50 @@ def _add_fluid_material(p):
     fl = p.add_argument_group("fluid")
     fl.add_argument("--mu", type=positive_float, default=1.0e-3,
                     help="dynamic viscosity in Pa s (1e-3: water)")
-    fl.add_argument("--pressure-drop", type=positive_float, default=1.0,
-                    help="fluid pressure drop p_in - p_out in Pa (Q is linear in it)")
+    fl.add_argument("--pressure-drop", type=positive_float, default=None,
+                    help="fluid pressure drop p_in - p_out in Pa (Q is linear in it; "
+                         "default 1; with --fsi: p_in = DP, p_out = 0)")
     fl.add_argument("--direction", choices=("x", "y", "both"), default="both",
                     help="flow direction(s); the percolating volume is their union")
     fl.add_argument("--no-reynolds", action="store_true",
-                    help="network analysis only (skip the Reynolds FE solve)")
+                    help="network analysis only (skip the Reynolds solve)")
+
+
+def _add_coupling_options(p):
+    fs = p.add_argument_group("fluid-structure coupling")
+    fs.add_argument("--fsi", action="store_true",
+                    help="two-way coupling: the fluid pressure loads the body; --pressure is "
+                         "the external pressure (contact + fluid); one flow direction")
+    fs.add_argument("--inlet-pressure", type=float, default=None, metavar="PI",
+                    help="absolute inlet pressure in Pa (with --outlet-pressure; instead of "
+                         "--pressure-drop; PI < PO reverses the flow with --fsi)")
+    fs.add_argument("--outlet-pressure", type=float, default=None, metavar="PO",
+                    help="absolute outlet pressure in Pa")
+    fs.add_argument("--trapped-fluid", choices=("film", "pressure"), default="film",
+                    help="trapped pockets: 'film' take the pressure of their surroundings "
+                         "(drained), 'pressure' keep their pressure at closure (the volume "
+                         "model is not implemented)")
+
+
+def _fluid_pressures(args):
+    """(p_in, p_out) from --inlet/--outlet-pressure or --pressure-drop (one-line errors)."""
+    given = (args.inlet_pressure is not None, args.outlet_pressure is not None)
+    if any(given) and args.pressure_drop is not None:
+        raise InputError("give either --pressure-drop or --inlet-pressure and "
+                         "--outlet-pressure, not both")
+    if any(given) and not all(given):
+        raise InputError("--inlet-pressure and --outlet-pressure go together (absolute Pa)")
+    if all(given):
+        p_in, p_out = float(args.inlet_pressure), float(args.outlet_pressure)
+        for name, v in (("--inlet-pressure", p_in), ("--outlet-pressure", p_out)):
+            if not (np.isfinite(v) and v >= 0):
+                raise InputError(f"{name} must be an absolute pressure >= 0 in Pa, got {v!r}")
+        if not args.fsi and p_in <= p_out:
+            raise InputError(f"--inlet-pressure {p_in:g} Pa must exceed --outlet-pressure "
+                             f"{p_out:g} Pa (reversed flow is solved with --fsi only)")
+        return p_in, p_out
+    dp = 1.0 if args.pressure_drop is None else float(args.pressure_drop)
+    return dp, 0.0
 
 
 def _save_fields(path, contact, leak):
@@ -61,6 +101,18 @@ def _leak(args) -> int:
     material = material_from_args(args)
     with output_folder_of(args, "leak") as out:
         sweep, steps, written = _leak_run(args, surface, material, out)
+    if args.fsi:
+        print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>7} {'fluid':>6} {'iter':>5} "
+              f"{'Q (m^3/s)':>11} {'Q one-way':>11} {'u_c (m)':>10}")
+        for s in steps:
+            fmt = lambda v, f: "-" if v is None else format(v, f)  # noqa: E731
+            print(f"{s['step']:>4} {s['external_pressure']:>11.4g} {s['fsi_state']:>8} "
+                  f"{fmt(s.get('area_fraction'), '.4f'):>7} {s['fluid_load_fraction']:>6.3f} "
+                  f"{s['coupled_iterations']:>5} {fmt(s['leak_rate'], '.4e'):>11} "
+                  f"{fmt(s['leak_rate_one_way'], '.4e'):>11} "
+                  f"{fmt(s.get('critical_gap'), '.3e'):>10}")
+        print(f"wrote {len(written)} files in {out}")
+        return 0 if sweep.success else 1
     print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>7} {'Vp*':>9} {'Vnp*':>9} "
           f"{'perc x/y':>8} {'Q (m^3/s)':>11}")
     for s in steps:
@@ -74,27 +126,87 @@ def _leak(args) -> int:
     return 0 if sweep.success else 1
 
 
+def _leak_fsi(args, surface, material, out, p_in, p_out):
+    """``roughfe leak --fsi``: the coupled sweep, its fields and figures; results.json last."""
+    from ..leakage.fsi import coupled_leakage_sweep
+    from ..plotting import leakage as figs
+
+    if args.pressure is None:
+        raise InputError("--fsi needs --pressure (external pressures, Pa), not --delta")
+    if args.direction == "both":
+        raise InputError("--fsi solves one flow direction: give --direction x or --direction y")
+    if args.no_reynolds:
+        raise InputError("--fsi needs the Reynolds solve; drop --no-reynolds")
+    sweep = coupled_leakage_sweep(surface, material, args.pressure, direction=args.direction,
+                                  p_in=p_in, p_out=p_out, mu=args.mu,
+                                  trapped=args.trapped_fluid)
+    steps = sweep.records()
+    written = []
+    for k, (r, lk) in enumerate(zip(sweep.results, sweep.leakages)):
+        arrays = {"fluid_pressure": r.fluid_pressure}
+        if r.contact is not None:
+            arrays.update(gap=r.contact.gap, contact=r.contact.contact,
+                          pressure_contact=r.contact.pressure, flux=r.flow.flux,
+                          percolating=lk.network.percolating, trapped=lk.network.trapped)
+            for d, con in lk.constrictions.items():
+                arrays[f"widest_path_{d}"] = con.path
+        path = out / "fields" / f"step_{k:03d}.npz"
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as fh:
+                np.savez_compressed(fh, **arrays)
+        written.append(path)
+        if args.no_figures or r.contact is None:
+            continue
+        tag = (f"step {k}: p_ext={r.external_pressure:.3g} Pa, A*={r.contact.area_fraction:.3f}, "
+               f"fluid load {r.fluid_load_fraction:.3f}")
+        widest = np.zeros(r.contact.gap.shape, bool)
+        for con in lk.constrictions.values():
+            widest[con.path[:, 0], con.path[:, 1]] = True
+        written.append(figs.network_map(
+            r.contact.gap, lk.network.percolating, lk.network.trapped, surface.size,
+            out / "figures" / f"step_{k:03d}_network.png",
+            title=f"coupled free-volume network, {tag}", widest_path=widest,
+            junctions=[con.position for con in lk.constrictions.values()
+                       if con.position is not None]))
+        written.append(figs.pressure_map(
+            r.fluid_pressure, surface.size, out / "figures" / f"step_{k:03d}_fluid_pressure.png",
+            title=f"fluid pressure (Pa), two-way coupled\n{tag}", at="cells"))
+    if not args.no_figures:
+        written.append(figs.steps_figure([s for s in steps if s.get("area_fraction") is not None],
+                                         out / "figures" / "steps.png"))
+    return sweep, steps, written
+
+
 def _leak_run(args, surface, material, out):
     """Solve and write every file of ``roughfe leak`` into ``out``; results.json last."""
     from ..leakage import leakage_sweep
     from ..plotting import leakage as figs
     from ..theory import beside
 
+    p_in, p_out = _fluid_pressures(args)
+    base = {"surface": str(args.surface), "shape": list(surface.shape),
+            "size": list(surface.size), "periodic": surface.periodic,
+            "surface_metadata": dict(surface.metadata), "E": args.E, "nu": args.nu,
+            "mu": args.mu, "inlet_pressure": p_in, "outlet_pressure": p_out,
+            "pressure_drop": p_in - p_out, "direction": args.direction, "fsi": args.fsi,
+            "trapped_fluid": args.trapped_fluid, "delta": args.delta,
+            "pressure": args.pressure, "detrend": args.detrend,
+            "units": "SI (m, Pa, Pa s, m^3/s)"}
+    if args.fsi:
+        sweep, steps, written = _leak_fsi(args, surface, material, out, p_in, p_out)
+        base["references"] = list(sweep.results[0].references)
+        written.append(write_json(out / "results.json", {"inputs": base, "steps": steps}))
+        return sweep, steps, written
+    dp = p_in - p_out
     sweep = leakage_sweep(surface, material, deltas=args.delta, pressures=args.pressure,
-                          direction=args.direction, mu=args.mu,
-                          pressure_drop=args.pressure_drop, reynolds=not args.no_reynolds)
+                          direction=args.direction, mu=args.mu, pressure_drop=dp,
+                          reynolds=not args.no_reynolds)
     check_small_strain(args, surface, [c.delta for c in sweep.contacts], material,
                        [c.mean_pressure for c in sweep.contacts])
-    theory = beside(surface, material.E_star, sweep.records(), pressure_drop=args.pressure_drop,
+    theory = beside(surface, material.E_star, sweep.records(), pressure_drop=dp,
                     viscosity=args.mu)
     steps = theory["steps"]
-    inputs = {"surface": str(args.surface), "shape": list(surface.shape),
-              "size": list(surface.size), "periodic": surface.periodic,
-              "surface_metadata": dict(surface.metadata),
-              "E": args.E, "nu": args.nu, "mu": args.mu, "pressure_drop": args.pressure_drop,
-              "direction": args.direction, "reynolds": not args.no_reynolds,
-              "delta": args.delta, "pressure": args.pressure, "detrend": args.detrend,
-              "units": "SI (m, Pa, Pa s, m^3/s)",
+    inputs = {**base, "reynolds": not args.no_reynolds,
               "references": list(sweep.leakages[0].references)}
     written = []
     for k, (c, lk) in enumerate(zip(sweep.contacts, sweep.leakages)):
@@ -131,7 +243,8 @@ def _leak_study(args) -> int:
 
     out = Path(args.output)
     fixed = {"n_steps": args.steps, "L": args.length, "E": args.E, "nu": args.nu,
-             "mu": args.mu, "pressure_drop": args.pressure_drop,
+             "mu": args.mu,
+             "pressure_drop": 1.0 if args.pressure_drop is None else args.pressure_drop,
              "reynolds": not args.no_reynolds, "direction": args.direction}
     spec = spec_from_mapping({
         "study": {"name": "leakage-sec2.4", "analysis": "leakage", "output": str(out),
@@ -174,6 +287,7 @@ def register(sub):
     load.add_argument("--pressure", type=positive_float, nargs="+", metavar="PA",
                       help="mean contact pressures in Pa (one step each)")
     _add_fluid_material(p)
+    _add_coupling_options(p)
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_leak, renders_with_dolfinx=True)

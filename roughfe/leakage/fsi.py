@@ -55,7 +55,13 @@ naming the residual reached.
 
 Trapped fluid
 -------------
-Pockets are open cells whose face-connected component reaches neither inlet nor outlet.
+Pockets are open cells whose face-connected component reaches neither inlet nor outlet
+(cells open by less than ``h_reg`` count as closed here).
+
+* ``trapped="film"`` (default): a pocket's pressure is the regularised film's, the limit
+  of its surroundings (a drained pocket); the fluid load is then a continuous function of
+  the gap and the fixed point converges robustly (load sweeps on 32^2-64^2 surfaces in
+  5-17 iterations).
 Their fluid was trapped when they closed; the **reference state** (``history``) holds the
 per-cell fluid pressure and fluid volume of the previous load step (for the first step:
 the first-contact state, gap ``max h - h``, with its Reynolds pressure). Per pocket:
@@ -85,7 +91,7 @@ from ..errors import InputError, NoConvergenceError, check_finite_positive
 from ..surfaces import Surface
 from .finite_volume import FVSolution, components_reaching, solve_reynolds_fv
 
-TRAPPED_MODELS = ("pressure",)
+TRAPPED_MODELS = ("film", "pressure")
 REFERENCES = (
     "Anderson acceleration: Walker & Ni, SIAM J. Numer. Anal. 49 (2011) 1715",
     "Critical junction: Lorenz & Persson, EPL 86 (2009) 44006",
@@ -204,7 +210,7 @@ def first_contact_state(surface: Surface, *, direction: str = "x", mu: float = 1
 
 def coupled_leakage(surface: Surface, material, external_pressure: float, *,
                     p_in: float, p_out: float, mu: float = 1e-3, direction: str = "x",
-                    trapped: str = "pressure",
+                    trapped: str = "film",
                     history: Optional[FluidState] = None, tol: float = 1e-8,
                     max_iter: int = 60, anderson: int = 5, relaxation: float = 1.0,
                     kernel: str = "auto", contact_tol: float = 1e-11,
@@ -225,8 +231,10 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         Viscosity (Pa s).
     direction : {"x", "y"}
         Flow axis.
-    trapped : {"pressure"}
-        Trapped-pocket model (pressure at closure).
+    trapped : {"film", "pressure"}
+        Trapped pockets: ``"film"`` (default) take the regularised film's pressure (the
+        limit of their surroundings: drained pockets); ``"pressure"`` keep their pressure
+        at closure (may not converge in load sweeps: pockets that open and close jump).
     history : FluidState, optional
         Reference state (previous load step); default :func:`first_contact_state`.
     tol : float
@@ -300,12 +308,16 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         film = solve_reynolds_fv(np.maximum(gap, h_reg), spacing, direction=direction, mu=mu,
                                  p_in=p_in, p_out=p_out, periodic=surface.periodic)
         y = film.pressure
-        lab_all, t_in, t_out = components_reaching(gap > 0 if axis == 0 else (gap > 0).T,
+        # cells open by less than the film count as closed for the pocket topology (else a
+        # cell flickering between contact and a sub-film gap splits and merges pockets)
+        wet = gap > h_reg
+        lab_all, t_in, t_out = components_reaching(wet if axis == 0 else wet.T,
                                                    periodic=surface.periodic)
         lab_all = lab_all if axis == 0 else lab_all.T
-        connected = (lab_all >= 0) & (t_in | t_out)[np.maximum(lab_all, 0)]
-        lab, n = _pockets(gap > 0, connected, surface.periodic, axis)
-        if n:
+        connected = np.zeros(gap.shape, bool)
+        connected[lab_all >= 0] = (t_in | t_out)[lab_all[lab_all >= 0]]
+        lab, n = _pockets(wet, connected, surface.periodic, axis)
+        if n and trapped == "pressure":
             inp = lab >= 0
             vol = np.bincount(lab[inp], gap[inp], n)
             # pressure at closure: the pocket cells' pressure in the incoming iterate (the
@@ -410,3 +422,60 @@ def coupled_sweep(surface: Surface, material, external_pressures, **kwargs) -> t
             break
         history = r.fluid_state
     return tuple(out)
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledSweep:
+    """Coupled results over a load sweep and the network/junction analysis of each
+    coupled gap (:func:`roughfe.leakage.analyse_leakage`, Reynolds not re-solved)."""
+
+    surface: Surface
+    results: tuple
+    leakages: tuple
+
+    @property
+    def success(self) -> bool:
+        return all(r.state in ("contact", "lift-off") for r in self.results)
+
+    def records(self) -> list:
+        """One JSON-safe dict per step: contact scalars (``mean_pressure`` is the solid's
+        effective pressure), the coupled scalars (:meth:`CoupledResult.record`), the network
+        and critical constriction of the coupled gap; ``leak_rate`` is the coupled one."""
+        out = []
+        sigma = float(np.std(self.surface.heights))
+        for k, (r, lk) in enumerate(zip(self.results, self.leakages)):
+            rec = {"step": k}
+            if r.contact is not None:
+                rec.update(r.contact.scalars())
+                rec["separation_star"] = float(r.contact.mean_plane_separation / sigma)
+            if lk is not None:
+                rec.update(lk.record())
+            rec.update(r.record())
+            rec["leak_rate"] = r.leak_rate
+            if lk is not None:
+                rec[f"leak_rate_{lk.directions[0]}"] = r.leak_rate
+            out.append(rec)
+        return out
+
+
+def coupled_leakage_sweep(surface: Surface, material, external_pressures, *,
+                          direction: str = "x", **kwargs) -> CoupledSweep:
+    """:func:`coupled_sweep`, then the free-volume network and critical constriction of
+    each coupled gap (``corner_rule="closed"``, as the FV scheme).
+
+    ``kwargs`` go to :func:`coupled_leakage` (``p_in``, ``p_out``, ``mu``, ``trapped``, ...).
+    """
+    from .analysis import analyse_leakage
+
+    results = coupled_sweep(surface, material, external_pressures, direction=direction,
+                            **kwargs)
+    leaks = []
+    for r in results:
+        if r.contact is None:
+            leaks.append(None)
+            continue
+        leaks.append(analyse_leakage(
+            r.contact.gap, r.contact.contact, surface.spacing, direction=direction,
+            periodic=surface.periodic, sigma=float(np.std(surface.heights)), mu=r.mu,
+            pressure_drop=abs(r.inlet_pressure - r.outlet_pressure), reynolds=False))
+    return CoupledSweep(surface=surface, results=results, leakages=tuple(leaks))
