@@ -3,6 +3,7 @@
 * ``docs/api/generated/``: one page per module of :mod:`roughfe` (found by walking the
   source tree, so a new module is documented without an edit here); a package page shows
   its docstring and its submodules, a module page its members.
+* ``docs/api/cli_reference.md``: ``roughfe ... --help`` of every command and subcommand.
 * ``docs/validation/generated/<script>.md``: one page per ``validation/<script>.py``,
   from ``validation/output/<script>.json`` (and ``<script>*.json``): its targets as a
   table with a met / NOT met column, its scalars and every table of records in it.
@@ -91,6 +92,35 @@ def write_api(outdir: Path) -> int:
     for filename, text in pages.items():
         _write(outdir / filename, text)
     return len(pages)
+
+
+# -- command-line reference -------------------------------------------------------------
+def _subcommands(parser, path):
+    """(command path, parser) of ``parser`` and of every subcommand below it, in order."""
+    import argparse
+    yield path, parser
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                yield from _subcommands(sub, path + [name])
+
+
+def write_cli_reference(path: Path) -> int:
+    """``roughfe ... --help`` of every command and subcommand as one Markdown page."""
+    import os
+    os.environ["COLUMNS"] = "92"                 # argparse wraps the help at this width
+    from roughfe.cli import build_parser
+    lines = [GENERATED_MARK.format(source="roughfe.cli.build_parser()"), "",
+             "# Command-line reference", "",
+             "The help of every `roughfe` command, as `roughfe COMMAND --help` prints it "
+             "(defaults included). SI units: metres, pascals, seconds.", ""]
+    count = 0
+    for words, parser in _subcommands(build_parser(), ["roughfe"]):
+        lines += [f"## `{' '.join(words)}`", "", "```text", parser.format_help().rstrip(),
+                  "```", ""]
+        count += 1
+    _write(path, "\n".join(lines))
+    return count
 
 
 # -- validation and benchmark results ----------------------------------------------------
@@ -273,6 +303,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     n_api = write_api(DOCS / "api" / "generated")
     print(f"[docs] API reference: {n_api} module pages")
+    n_cli = write_cli_reference(DOCS / "api" / "cli_reference.md")
+    print(f"[docs] command-line reference: {n_cli} commands")
     scripts = sorted(p for p in (ROOT / "validation").glob("*.py") if not p.name.startswith("_"))
     report = write_results(scripts, args.validation, DOCS / "validation" / "generated",
                            "Validation", _validation_commands())

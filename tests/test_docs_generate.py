@@ -76,3 +76,14 @@ def test_api_pages_cover_every_public_module(gen, tmp_path):
     assert written == expected and n == len(expected)
     page = (tmp_path / "roughfe.bem.rst").read_text()
     assert ".. automodule:: roughfe.bem\n" in page and ":members:" not in page  # no re-exports
+
+
+def test_cli_reference_has_every_command(gen, tmp_path):
+    from roughfe.cli import SUBCOMMANDS
+    page = tmp_path / "cli.md"
+    n = gen.write_cli_reference(page)
+    text = page.read_text()
+    for command in (c for cs in SUBCOMMANDS.values() for c in cs):
+        assert f"## `roughfe {command}`" in text
+    assert n == text.count("\n## `roughfe") and "## `roughfe genome sequence`" in text
+    assert "--E" in text and "(default:" in text
