@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..surfaces.surface import Surface
+from ..writers import to_jsonable
 from .bands import BandChromosomes
 from .macro_micro import MacroMicroResult, classify, correlation, profile_response
 from .similarity import ResponseCurve
@@ -74,12 +75,10 @@ class BandMechanics:
         def curves(cs):
             return [None if c is None else c.to_dict() for c in cs]
 
-        def coeffs(d):
-            return {k: [float(v) if np.isfinite(v) else None for v in d[k]] for k in d}
         return {"indices": [int(n) for n in self.indices], "complete": self.complete.to_dict(),
                 "chromosomes": curves(self.chromosome_curves), "td": curves(self.td_curves),
-                "bu": curves(self.bu_curves), "c_chromosome": coeffs(self.c_chromosome),
-                "c_td": coeffs(self.c_td), "c_bu": coeffs(self.c_bu),
+                "bu": curves(self.bu_curves), "c_chromosome": to_jsonable(self.c_chromosome),
+                "c_td": to_jsonable(self.c_td), "c_bu": to_jsonable(self.c_bu),
                 "youngs_modulus": self.youngs_modulus, "poisson": self.poisson,
                 "n_steps": self.n_steps, "nit": self.nit, "elapsed_s": self.elapsed,
                 "success": self.success, "message": self.message}

@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..surfaces.surface import Surface
+from ..writers import to_jsonable
 from .chromosomes import reconstruction
 from .genome import DEFAULT_NODES, Genome
 from .macro_micro import correlation, profile_response
@@ -116,14 +117,12 @@ class ChromosomeMechanics:
         def curves(cs):
             return [None if c is None else c.to_dict() for c in cs]
 
-        def coeffs(d):
-            return {k: [None if not np.isfinite(v) else float(v) for v in d[k]] for k in d}
         return {"length": self.length, "kernel": self.kernel, "youngs_modulus": self.youngs_modulus,
                 "poisson": self.poisson, "indices": self.indices.tolist(),
                 "complete": self.complete.to_dict(), "chromosomes": curves(self.chromosome_curves),
                 "td": curves(self.td_curves), "bu": curves(self.bu_curves),
-                "c_chromosome": coeffs(self.c_chromosome), "c_td": coeffs(self.c_td),
-                "c_bu": coeffs(self.c_bu), "success": self.success, "message": self.message,
+                "c_chromosome": to_jsonable(self.c_chromosome), "c_td": to_jsonable(self.c_td),
+                "c_bu": to_jsonable(self.c_bu), "success": self.success, "message": self.message,
                 "nit": self.nit, "elapsed_s": self.elapsed}
 
 

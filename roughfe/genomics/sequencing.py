@@ -70,6 +70,7 @@ from scipy.spatial import ConvexHull, QhullError
 from ..errors import InputError
 from ..surfaces.stats import power_spectrum
 from ..surfaces.surface import Surface
+from ..writers import to_jsonable
 from .genome import Genome, chromosome_range, observation_coordinates, profile_heights
 
 MIN_NODES = 32
@@ -628,7 +629,7 @@ class SequencingResult:
                                        / max(np.sqrt(np.mean(self.zd ** 2)), 1e-300))
                                  if self.zd.size else None),
                 "gamma_psd": self.gamma_psd, "H_psd": self.H_psd, "A0_variance": self.A0,
-                "M_loglik": [None if not np.isfinite(v) else float(v) for v in self.M_loglik],
+                "M_loglik": to_jsonable(self.M_loglik),
                 "seed": self.seed, "elapsed_s": self.elapsed}
 
 
