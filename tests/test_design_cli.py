@@ -39,6 +39,22 @@ def test_db_and_design_commands(tmp_path, capsys):
     genome = json.loads((out / "genome.json").read_text())
     assert genome["format"] == "roughfe-genome"
     assert genome["A"] == pytest.approx(design.parts[0].weight * design.scale)
+    # ... that `genome realize` accepts and realises as the designed profile
+    part = design.parts[0]
+    assert main(["genome", "realize", str(out / "genome.json"), "--length", str(design.length),
+                 "--nodes", str(design.n_nodes), "--chromosomes", *map(str, part.chromosomes),
+                 "-o", str(tmp_path / "again.npz")]) == 0
+    from roughfe.surfaces.io import load_surface
+    np.testing.assert_allclose(load_surface(tmp_path / "again.npz").heights,
+                               design.surface().heights, rtol=1e-12, atol=1e-18)
+    # a design of two genomes is two genomes: their realisations sum to the profile
+    from dataclasses import replace
+    two = replace(design, parts=(part, replace(part, weight=0.5 * part.weight, label="b")))
+    assert two.as_genome() is None
+    from roughfe.genomics.genome import realize
+    total = sum(realize(two.part_genome(k), two.length, two.n_nodes,
+                        chromosomes=two.parts[k].chromosomes).heights for k in range(2))
+    np.testing.assert_allclose(total, two.surface().heights, rtol=1e-12, atol=1e-18)
 
 
 def test_design_command_reports_bad_input(tmp_path, capsys):
