@@ -1,10 +1,12 @@
 """The one-way data flow of STYLE.md (a): packages import only leftward.
 
-surfaces -> model -> theory -> bem -> fem -> response -> leakage -> genomics -> study
+optim -> surfaces -> model -> theory -> bem -> fem -> response -> leakage -> genomics -> study
 -> plotting -> cli
 (errors, writers, reference, caching, frozen, _runtime and progress are the base layer,
 importable from anywhere; model.py holds the contract types shared by bem and fem, response.py the one
 dispatch to them.)
+optim holds generic optimisers without physics (the one GCMMA driver).
+No library module is over MAX_LINES lines unless ``LONG_MODULES`` states why.
 dolfinx, petsc4py, mpi4py.futures aside, gmsh and ufl are imported only inside roughfe/fem.
 """
 import ast
@@ -13,10 +15,16 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "roughfe"
-ORDER = ["errors", "writers", "reference", "surfaces", "model", "theory", "bem", "fem",
+ORDER = ["errors", "writers", "reference", "optim", "surfaces", "model", "theory", "bem", "fem",
          "response", "leakage", "genomics", "study", "plotting", "cli"]
 BASE = {"errors", "writers", "reference", "caching", "frozen", "_runtime", "progress", "__init__"}
 FEM_ONLY = {"dolfinx", "petsc4py", "gmsh", "ufl", "basix", "ffcx"}
+MAX_LINES = 500
+#: modules allowed beyond MAX_LINES, each with its reason
+LONG_MODULES = {
+    "fem/contact.py": "the dolfinx contact solver (mesh, forms, SNES-VI, results) predates "
+                      "the limit; its split is open (issue 11)",
+}
 
 
 def _layer(parts):
@@ -71,3 +79,10 @@ def test_imports_flow_one_way():
             if other > me:
                 bad.append(f"{path.relative_to(PKG.parent)}:{lineno} imports {mod} (rightward)")
     assert not bad, "backward imports:\n" + "\n".join(bad)
+
+
+def test_no_module_is_over_the_line_limit():
+    long = {str(p.relative_to(PKG)): len(p.read_text().splitlines())
+            for p in sorted(PKG.rglob("*.py"))}
+    over = {k: n for k, n in long.items() if n > MAX_LINES and k not in LONG_MODULES}
+    assert not over, f"modules over {MAX_LINES} lines (split them by idea): {over}"

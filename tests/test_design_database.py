@@ -1,6 +1,7 @@
 """Genome database: Sobol design, Alg. 2 records, resumable SQLite build, extend, errors."""
 import json
 import sqlite3
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -140,3 +141,27 @@ def test_empty_missing_and_foreign_databases(tmp_path):
     junk.write_text("not a database at all" * 100)
     with pytest.raises(FileFormatError):
         db.connect(junk)
+
+
+def test_genome_entry_task_rows_are_byte_identical_to_the_recorded_ones(tmp_path):
+    """The database task (Alg. 2 on one genome, BEM sweeps of 64-node profiles) gives
+    the record of the code before the split of issue 11, byte for byte, and the SQLite
+    row stores exactly that JSON. A deliberate change of the rows (a new solver or
+    physics option) must regenerate tests/data/genomics_refactor_reference.json and say
+    so: databases built before and after would otherwise mix."""
+    raw = json.loads((Path(__file__).parent / "data" / "genomics_refactor_reference.json")
+                     .read_text())["genome_entry_task_json"]
+    rec = db.genome_entry_task(1.7, 0.9, 11, label="r-1", n_nodes=64, n_steps=6)
+    assert json.dumps(rec) == raw
+    ref = json.loads(raw)
+    con = db.connect(tmp_path / "g.sqlite", create=True)
+    db.write_settings(con, db.DatabaseSettings.from_dict(rec["settings"]))
+    assert db.insert_records(con, [rec]) == 1
+    row = con.execute("SELECT genome_json, curve_json, chromosome_curves_json, corr_k_json, "
+                      "corr_a_json, macro_json, p_max FROM genomes").fetchone()
+    con.close()
+    assert row[:6] == tuple(json.dumps(ref[k]) for k in
+                            ("genome", "curve", "chromosome_curves", "corr_k", "corr_a", "macro"))
+    assert row[6] == ref["p_max"]
+    with pytest.raises(InputError, match="unknown database setting"):
+        db.genome_entry_task(1.7, 0.9, 11, label="r-2", n_node=64)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..genomics.database.settings import THESIS_SETTINGS as _THESIS
 
 
 @dataclass(frozen=True)
@@ -199,8 +200,9 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
 
 
 def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=None,
-                   length=849.42e-6, n_nodes=512, E=1.0e6, nu=0.0,
-                   n_steps=20, threshold=0.95, kernel="auto"):
+                   length=_THESIS.length, n_nodes=_THESIS.n_nodes, E=_THESIS.youngs_modulus,
+                   nu=_THESIS.poisson, n_steps=_THESIS.n_steps, threshold=_THESIS.threshold,
+                   kernel=_THESIS.kernel):
     """One genome-database entry: the study seed draws the WM phases.
 
     Calls :func:`roughfe.genomics.database.genome_entry_task` with ``phases=seed`` and
@@ -222,9 +224,11 @@ def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=Non
         youngs_modulus=E, poisson=nu, n_steps=n_steps, threshold=threshold, kernel=kernel)
 
 
-def genome_entry_study_task(*, entry, seed, length=849.42e-6, n_nodes=512,
-                            youngs_modulus=1.0e6, poisson=0.0, n_steps=20, threshold=0.95,
-                            kernel="auto", stiffness="fd", correlation="steps"):
+def genome_entry_study_task(*, entry, seed, length=_THESIS.length, n_nodes=_THESIS.n_nodes,
+                            youngs_modulus=_THESIS.youngs_modulus, poisson=_THESIS.poisson,
+                            n_steps=_THESIS.n_steps, threshold=_THESIS.threshold,
+                            kernel=_THESIS.kernel, stiffness=_THESIS.stiffness,
+                            correlation=_THESIS.correlation):
     """One genome-database entry of a given genome (``roughfe db build|extend``).
 
     Parameters

@@ -1,0 +1,87 @@
+"""Realisation and contact settings of a genome database, and the thesis values
+(Sec. 4.1.2) in ONE constant, :data:`THESIS_SETTINGS`."""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields, replace
+
+import numpy as np
+
+from ...errors import InputError
+
+
+@dataclass(frozen=True)
+class DatabaseSettings:
+    """Realisation and contact settings shared by every genome of a database (Sec. 4.1.2).
+
+    Parameters
+    ----------
+    length : float
+        Observation length L (m); thesis 849.42 um (= lambda).
+    n_nodes : int
+        Nodes N of each realisation; thesis 512.
+    youngs_modulus : float
+        E (Pa) of the deformable body against a rigid profile; thesis 1 MPa.
+    poisson : float
+        nu; the thesis gives none, 0 makes E* = E.
+    n_steps : int
+        n_t far-field displacements up to the peak-valley amplitude; thesis 20.
+    threshold : float
+        c_n above which a chromosome is macro-scale (Alg. 2); thesis 0.95.
+    kernel : str
+        BEM influence kernel passed to :func:`roughfe.bem.contact_sweep`.
+    stiffness : {"fd", "exact"}
+        How K(p) is taken from the sweep (see :func:`roughfe.genomics.macro_micro.profile_response`).
+    correlation : {"steps", "pressure"}
+        How c_n pairs the curves (see :mod:`roughfe.genomics.macro_micro`).
+    """
+
+    length: float = 849.42e-6
+    n_nodes: int = 512
+    youngs_modulus: float = 1.0e6
+    poisson: float = 0.0
+    n_steps: int = 20
+    threshold: float = 0.95
+    kernel: str = "auto"
+    stiffness: str = "fd"
+    correlation: str = "steps"
+
+    def __post_init__(self):
+        for name in ("length", "youngs_modulus"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise InputError(f"{name} must be finite and > 0, got {v!r}")
+        if int(self.n_nodes) < 16:
+            raise InputError(f"n_nodes must be >= 16, got {self.n_nodes!r}")
+        if int(self.n_steps) < 3:
+            raise InputError(f"n_steps must be >= 3, got {self.n_steps!r}")
+        if self.correlation not in ("steps", "pressure"):
+            raise InputError(f"correlation must be 'steps' or 'pressure', got {self.correlation!r}")
+        if self.stiffness not in ("fd", "exact"):
+            raise InputError(f"stiffness must be 'fd' or 'exact', got {self.stiffness!r}")
+        if not (0.0 < self.threshold < 1.0):
+            raise InputError(f"threshold must lie in (0, 1), got {self.threshold!r}")
+        object.__setattr__(self, "n_nodes", int(self.n_nodes))
+        object.__setattr__(self, "n_steps", int(self.n_steps))
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d) -> "DatabaseSettings":
+        return cls(**d)
+
+
+#: the thesis database settings (Sec. 4.1.2): L = 849.42 um, N = 512, E = 1 MPa, nu = 0,
+#: n_t = 20, threshold 0.95 -- every default elsewhere (task keywords, study analyses,
+#: CLI options, designs) is read from here
+THESIS_SETTINGS = DatabaseSettings()
+
+
+def settings_from(values) -> DatabaseSettings:
+    """:class:`DatabaseSettings` from a mapping of field values, :data:`THESIS_SETTINGS`
+    for the missing ones (InputError naming an unknown field)."""
+    allowed = [f.name for f in fields(DatabaseSettings)]
+    unknown = sorted(set(values) - set(allowed))
+    if unknown:
+        raise InputError(f"unknown database setting(s) {unknown}; the settings are {allowed}")
+    return replace(THESIS_SETTINGS, **values)

@@ -1,0 +1,38 @@
+"""Roughness design for a target K(p)/A(p) (thesis Sec. 4.2-4.4, Algs. 3-7).
+
+Modules, by idea (see ``docs/theory/genomics-layout.md``):
+
+* :mod:`.model` -- :class:`Design`/:class:`DesignPart` (a sum of chromosome sets of
+  genomes, Eq. 3.2, with the Eq. 4.2 factors) and their JSON;
+* :mod:`.objective` -- :class:`Objective` (Eq. 4.1 after Eq. 4.2; f = s_1 s_2 of
+  Alg. 7), :func:`combined_score` and the counted BEM :class:`Evaluator`;
+* :mod:`.sensitivities` -- exact residual derivatives on the fixed contact sets;
+* :mod:`.stages` -- one GCMMA stage (Sec. 4.3.1) through the one driver
+  :func:`roughfe.optim.gcmma.gcmma`, its options and the phase box;
+* :mod:`.algorithms` -- Alg. 3 (:func:`score_database`), SOG/GCO/CCO/M-CCO (Algs. 4-7),
+  :func:`refine` (beyond the thesis) and :func:`run_design`;
+* :mod:`.targets` -- the thesis targets y_t1, y_t2, y_t3 and independent re-scoring;
+* :mod:`.io` -- the result files.
+
+Every public name is importable from ``roughfe.genomics.design``.
+"""
+from ...optim.gcmma import GcmmaResult, gcmma_maximize, gcmma_minimax
+from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, mcco, refine,
+                         run_design, score_database, sog)
+from .io import result_to_dict, write_design_result
+from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
+                    entry_design)
+from .objective import Evaluator, Objective, combined_score
+from .sensitivities import residual_jacobian
+from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
+from .targets import (Y_T1_GENES, rescore, rescore_at_target_pressures, target_genome_t1,
+                      thesis_targets)
+
+__all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
+           "run_design", "score_database", "sog", "result_to_dict", "write_design_result",
+           "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",
+           "combine", "entry_design", "Evaluator", "Objective", "combined_score",
+           "residual_jacobian", "FORMULATIONS", "GcmmaOptions", "optimise_phases",
+           "phase_bounds", "Y_T1_GENES", "rescore", "rescore_at_target_pressures",
+           "target_genome_t1", "thesis_targets", "GcmmaResult", "gcmma_maximize",
+           "gcmma_minimax"]

@@ -1,0 +1,370 @@
+"""Algs. 3-7 of the thesis (Sec. 4.2-4.4): database scoring and the four design methods.
+
+* :func:`score_database` -- Alg. 3. The database curves are stored at A = 1; Eq. (4.2)
+  rescales a curve exactly by stretching its pressure axis (see
+  :mod:`roughfe.genomics.similarity`), so scoring needs no new BEM solution.
+* :func:`sog` (Alg. 4), :func:`gco` (Alg. 5), :func:`cco` (Alg. 6), :func:`mcco` (Alg. 7),
+  each with the stages of Sec. 4.3.1: "GCMMA 0" (selection/cross-over), "GCMMA 1"
+  (GCMMA on the macro-scale phases; all phases for CCO) and "GCMMA 2" (GCMMA on the
+  micro-scale phases; CCO repeats stage 1); :func:`refine` is an optional "GCMMA 3"
+  beyond the thesis.
+* Alg. 2 on a cross-over (Alg. 5 Step 13) needs the K_n(p) of every chromosome of the
+  new genome: a chromosome of a part is the parent's chromosome times a positive factor,
+  whose curve is the parent's stretched in p (Eq. 4.2), and c_n rescales it anyway, so
+  the stored chromosome curves of the parents are reused with the new complete curve.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from typing import Optional, Sequence
+
+import numpy as np
+
+from ...errors import InputError
+from ..database import DatabaseEntry, DatabaseSettings
+from ..macro_micro import classify
+from ..similarity import ResponseCurve, Target, similarity, split_ranges
+from .model import Design, combine, entry_design
+from .objective import Evaluator, Objective, combined_score
+from .stages import GcmmaOptions, optimise_phases
+
+METHODS = ("sog", "gco", "cco", "mcco")
+#: similarity above which a database genome (Algs. 5-7 Step 2-3) or a cross-over counts
+#: as a match (thesis: 0.95)
+SELECTION = 0.95
+REFERENCES = ("Borri C. (2019) Surface roughness genomics, PhD thesis, IMT Lucca, Ch. 4",
+              "Svanberg K. (2002) SIAM J. Optim. 12(2):555-573 (GCMMA)")
+
+
+def score_database(entries: Sequence[DatabaseEntry], target: Target, p_range=(0.0, math.inf)
+                   ) -> np.ndarray:
+    """Alg. 3: s_i of every database genome after Eq. (4.2), in ``p_range`` (Pa)."""
+    if not entries:
+        raise InputError("the genome database is empty: build it first ('roughfe db build')")
+    return np.array([similarity(target, e.curve, p_range) for e in entries])
+
+
+def _select(scores, threshold, fallback):
+    """Indices with score > threshold, best first; the ``fallback`` best if none pass."""
+    order = np.argsort(-scores, kind="stable")
+    chosen = [int(i) for i in order if scores[i] > threshold]
+    return (chosen if chosen else [int(i) for i in order[:fallback]]), bool(chosen)
+
+
+@dataclass(frozen=True, eq=False)
+class Candidate:
+    """One of the (up to three) final designs of a method, with its score per stage."""
+
+    design: Design
+    stages: tuple           # scores at GCMMA 0, 1, 2 (and 3 after :func:`refine`)
+    scores: tuple           # final similarity per target
+    curve: ResponseCurve    # final response on the target range (Eq. 4.2 applied)
+    macro: tuple            # variables of stage 1, per part
+    micro: tuple            # variables of stage 2, per part
+    origin: str
+
+
+@dataclass(frozen=True, eq=False)
+class DesignResult:
+    """Output of SOG / GCO / CCO / M-CCO (scipy-like: success, message, nit = BEM sweeps)."""
+
+    method: str
+    candidates: tuple
+    objective: Objective
+    pbar: Optional[float]
+    database_scores: dict
+    n_cross: int
+    n_cross_above: int
+    selection_passed: bool
+    success: bool
+    message: str
+    nit: int
+    elapsed: float
+    references: tuple = REFERENCES
+
+    @property
+    def best(self) -> Candidate:
+        return self.candidates[0]
+
+
+def _macro_micro_of(design: Design, curve: ResponseCurve, entries_by_label, threshold,
+                    axis="steps"):
+    """Alg. 2 on a (cross-over) design from the parents' stored chromosome curves."""
+    chroms, curves = [], []
+    for k, part in enumerate(design.parts):
+        e = entries_by_label[part.label]
+        n_s = int(e.genome.get("n_first", 1))
+        for n in part.chromosomes:
+            chroms.append((k, n))
+            curves.append(e.chromosome_curves[n - n_s])
+    res = classify(curve, curves, np.arange(len(chroms)), threshold, axis)
+    macro = [[] for _ in design.parts]
+    micro = [[] for _ in design.parts]
+    for j, c in enumerate(res.corr_k):
+        k, n = chroms[j]
+        (macro if c > threshold else micro)[k].append(n)
+    return tuple(tuple(x) for x in macro), tuple(tuple(x) for x in micro)
+
+
+def _limit_micro(micro, n_micro):
+    return tuple(tuple(sorted(m)[:n_micro]) for m in micro)
+
+
+def _finish(design, s_stages, objective, evaluate, macro, micro, origin):
+    curve = evaluate(design)
+    eta = objective.p_max / curve.p_max
+    design = design.rescaled(eta)
+    curve = curve.rescaled(eta)
+    return Candidate(design, tuple(float(s) for s in s_stages), objective.scores(curve), curve,
+                     macro, micro, origin)
+
+
+def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, entries_by_label,
+                         settings, stage1="macro"):
+    """GCMMA 1 and 2 for each start ``(design, s0, curve0, origin)``; best first."""
+    out = []
+    for design, s0, curve0, origin in starts:
+        macro, micro = _macro_micro_of(design, curve0, entries_by_label, settings.threshold,
+                                       settings.correlation)
+        if stage1 == "all":
+            keys1 = design.keys("all") + (design.gene_keys() if options.cco_genes else [])
+        else:
+            keys1 = design.keys(macro)
+        d1, s1, _ = optimise_phases(design, keys1, objective, evaluate, n_it1, options, f0=s0)
+        if s1 < s0:
+            d1, s1 = design, s0
+        if stage1 == "all" or n_it2 <= 0:
+            d2, s2 = d1, s1
+        else:
+            keys2 = d1.keys(_limit_micro(micro, options.n_micro))
+            d2, s2, _ = optimise_phases(d1, keys2, objective, evaluate, n_it2, options, f0=s1)
+            if s2 < s1:
+                d2, s2 = d1, s1
+        out.append(_finish(d2, (s0, s1, s2), objective, evaluate, macro, micro, origin))
+    out.sort(key=lambda c: -combined_score(c.scores))
+    return tuple(out)
+
+
+def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evaluate, t0):
+    best = cands[0]
+    msg = (f"{method}: best {best.origin} s = {combined_score(best.scores):.4f} "
+           f"(stages {', '.join(f'{s:.4f}' for s in best.stages)})"
+           + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used"))
+    return DesignResult(method, cands, objective, pbar, dbs, n_cross, n_above, passed, True, msg,
+                        evaluate.n_sweeps, time.perf_counter() - t0)
+
+
+def _check_entries(entries):
+    if not entries:
+        raise InputError("the genome database is empty: build it first ('roughfe db build')")
+    return list(entries), {e.label: e for e in entries}
+
+
+def sog(entries, target: Target, settings: DatabaseSettings, *, evaluate=None,
+        options: GcmmaOptions = GcmmaOptions(), n_best: int = 3) -> DesignResult:
+    """Simple Optimisation of Genes (Alg. 4).
+
+    The ``n_best`` genomes with the largest s (Alg. 3) are optimised with GCMMA on the
+    phases of their macro-scale chromosomes (Alg. 2, stored in the database; stage 1,
+    ``n_it_sog`` iterations), then on their micro-scale phases (stage 2).
+    """
+    t0 = time.perf_counter()
+    entries, by_label = _check_entries(entries)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target,))
+    s = score_database(entries, target)
+    starts = []
+    for i in np.argsort(-s, kind="stable")[:n_best]:
+        e = entries[int(i)]
+        d = entry_design(e, settings, weight=target.p_max / e.p_max)
+        starts.append((d, float(s[i]), e.curve.rescaled(target.p_max / e.p_max), e.label))
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_sog,
+                                 options.n_it_micro, by_label, settings)
+    return _result("sog", cands, objective, None, {"s": s.tolist()}, 0, 0, True, evaluate, t0)
+
+
+def _cross(entries, by_label, objective, settings, evaluate, sets, parts_of, n_best, max_set):
+    """Steps 5-12 of Algs. 5-7: every pair of U1 x U2, rescaled (Eq. 4.2), scored."""
+    u1, u2 = (s[:max_set] if max_set else s for s in sets)
+    pool = []
+    for i1 in u1:
+        for i2 in u2:
+            e1, e2 = entries[i1], entries[i2]
+            d1 = entry_design(e1, settings, objective.p_max / e1.p_max, parts_of[0](e1))
+            d2 = entry_design(e2, settings, objective.p_max / e2.p_max, parts_of[1](e2))
+            d = combine(d1, d2)
+            curve = evaluate(d)
+            pool.append((objective(curve), d, curve, f"{e1.label}+{e2.label}"))
+    pool.sort(key=lambda t: -t[0])
+    starts = [(d, s, c, o) for s, d, c, o in pool[:n_best]]
+    return starts, len(pool), sum(1 for t in pool if t[0] > SELECTION)
+
+
+def _two_range_sets(entries, target, pbar, threshold=SELECTION, fallback=3):
+    r1, r2 = split_ranges(target, pbar)
+    s1, s2 = score_database(entries, target, r1), score_database(entries, target, r2)
+    u1, ok1 = _select(s1, threshold, fallback)
+    u2, ok2 = _select(s2, threshold, fallback)
+    return (s1, s2), (u1, u2), ok1 and ok2
+
+
+def gco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, evaluate=None,
+        options: GcmmaOptions = GcmmaOptions(), n_best: int = 3, max_set: Optional[int] = 8
+        ) -> DesignResult:
+    """Genome Cross-Over (Alg. 5).
+
+    U1/U2: genomes with s > 0.95 on [0, pbar] / [pbar, p_max^t] (the 3 best of a range
+    if none passes; at most ``max_set`` per set, None = all as in the thesis); every
+    pair U1 x U2 is summed (each at its Eq. 4.2 amplitude), rescaled and scored; the
+    ``n_best`` best go through GCMMA on their macro phases (Alg. 2 on the new genome),
+    then their micro phases.
+    """
+    t0 = time.perf_counter()
+    entries, by_label = _check_entries(entries)
+    pbar = target.check_pbar(pbar)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target,))
+    (s1, s2), sets, passed = _two_range_sets(entries, target, pbar)
+    every = (lambda e: None, lambda e: None)
+    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
+                                      every, n_best, max_set)
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
+                                 options.n_it_micro, by_label, settings)
+    return _result("gco", cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
+                   n_cross, n_above, passed, evaluate, t0)
+
+
+def cco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, evaluate=None,
+        options: GcmmaOptions = GcmmaOptions(), n_best: int = 3, max_set: Optional[int] = 8
+        ) -> DesignResult:
+    """Chromosomes Cross-Over (Alg. 6): as GCO with the macro-scale chromosomes only;
+    GCMMA on all genes of the new genome (phases, and with ``options.cco_genes`` also H,
+    gamma, lambda and the part amplitudes; stage 1); stage 2 repeats stage 1 (Sec. 4.3.1)."""
+    t0 = time.perf_counter()
+    entries, by_label = _check_entries(entries)
+    pbar = target.check_pbar(pbar)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target,))
+    (s1, s2), sets, passed = _two_range_sets(entries, target, pbar)
+    macro = (lambda e: e.macro or e.micro[:1], lambda e: e.macro or e.micro[:1])
+    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
+                                      macro, n_best, max_set)
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross, 0,
+                                 by_label, settings, stage1="all")
+    return _result("cco", cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
+                   n_cross, n_above, passed, evaluate, t0)
+
+
+def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings, *,
+         evaluate=None, options: GcmmaOptions = GcmmaOptions(), n_best: int = 3,
+         max_set: Optional[int] = 8, pool: int = 0, swap: bool = False,
+         weights: Sequence[float] = (1.0,)) -> DesignResult:
+    """Mixed Chromosomes Cross-Over (Alg. 7) for a K(p) target and an A(p) target.
+
+    U1: macro chromosomes of genomes with s(y_t1, K) > 0.95; U2: micro chromosomes of
+    genomes with s(y_t3, A) > 0.95 (the 3 best if none passes); every pair summed,
+    rescaled, scored with f = s_K * s_A; the ``n_best`` best get GCMMA on their macro
+    phases, then on their micro phases, objective f.
+
+    Wider start pool (beyond the thesis; the defaults are the thesis'): ``pool = k``
+    puts the k best genomes of each Alg. 3 ranking in U1/U2 (besides those > 0.95, at
+    most ``max_set``); ``swap`` also crosses the macro chromosomes of the A-ranked
+    genomes with the micro chromosomes of the K-ranked ones; ``weights`` multiplies the
+    micro part's Eq. (4.2) amplitude by each factor before the pair is rescaled, so
+    the macro/micro amplitude ratio is scanned too. Every start is one BEM sweep.
+    """
+    t0 = time.perf_counter()
+    if target_k.quantity != "K" or target_a.quantity != "A":
+        raise InputError(f"M-CCO needs a K(p) target and an A(p) target, got "
+                         f"{target_k.quantity!r} and {target_a.quantity!r}")
+    entries, by_label = _check_entries(entries)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target_k, target_a))
+    s1, s2 = score_database(entries, target_k), score_database(entries, target_a)
+    fallback = max(3, int(pool))
+    u1, ok1 = _select(s1, SELECTION, fallback)
+    u2, ok2 = _select(s2, SELECTION, fallback)
+    if pool:
+        u1 = list(dict.fromkeys(u1 + [int(i) for i in np.argsort(-s1, kind="stable")[:pool]]))
+        u2 = list(dict.fromkeys(u2 + [int(i) for i in np.argsort(-s2, kind="stable")[:pool]]))
+    u1, u2 = (u[:max_set] if max_set else u for u in (u1, u2))
+    pairs = [(i1, i2) for i1 in u1 for i2 in u2]
+    if swap:
+        pairs += [(i2, i1) for i2 in u2 for i1 in u1 if (i2, i1) not in pairs]
+    ws = tuple(float(w) for w in weights)
+    if not ws or any(not (np.isfinite(w) and w > 0) for w in ws):
+        raise InputError(f"weights must be finite and > 0, got {weights!r}")
+    found = []
+    for i1, i2 in pairs:
+        if i1 == i2:
+            continue
+        e1, e2 = entries[i1], entries[i2]
+        d1 = entry_design(e1, settings, objective.p_max / e1.p_max, e1.macro or e1.micro[:1])
+        for w in ws:
+            d2 = entry_design(e2, settings, w * objective.p_max / e2.p_max,
+                              e2.micro or e2.macro[-1:])
+            d = combine(d1, d2)
+            curve = evaluate(d)
+            tag = f"{e1.label}+{e2.label}" + ("" if w == 1.0 else f" (micro x{w:g})")
+            found.append((objective(curve), d, curve, tag))
+    found.sort(key=lambda t: -t[0])
+    starts = [(d, s, c, o) for s, d, c, o in found[:n_best]]
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
+                                 options.n_it_micro, by_label, settings)
+    return _result("mcco", cands, objective, None, {"s1": s1.tolist(), "s2": s2.tolist()},
+                   len(found), sum(1 for t in found if t[0] > SELECTION), ok1 and ok2, evaluate, t0)
+
+
+def refine(result: DesignResult, settings: DatabaseSettings, *, rounds: int = 3, n_it: int = 15,
+           options: GcmmaOptions = GcmmaOptions(bound="period"), evaluate=None) -> DesignResult:
+    """An optional stage beyond the thesis ("GCMMA 3"): GCMMA on *all* phases of every
+    candidate (macro and micro together), ``rounds`` times ``n_it`` iterations, the
+    +-``options.fraction`` box re-centred on the current phases at every round.
+
+    Re-centring lets the phases drift beyond +-10 % of their database values, which the
+    thesis stages do not allow; the result keeps the thesis stages and appends the
+    refined score as a fourth stage, so both are reported. Candidates are re-sorted.
+    """
+    t0 = time.perf_counter()
+    evaluate = evaluate or Evaluator(settings)
+    objective = result.objective
+    out = []
+    for c in result.candidates:
+        d, sc = c.design, combined_score(c.scores)
+        for _ in range(int(rounds)):
+            d_new, s_new, _ = optimise_phases(d, d.keys("all"), objective, evaluate, n_it, options,
+                                              f0=sc)
+            if s_new <= sc + 1e-12:
+                break
+            d, sc = d_new, s_new
+        new = _finish(d, (*c.stages[:3], sc), objective, evaluate, c.macro, c.micro, c.origin)
+        out.append(new)
+    out.sort(key=lambda c: -combined_score(c.scores))
+    return replace(result, candidates=tuple(out), nit=result.nit + evaluate.n_sweeps,
+                   elapsed=result.elapsed + time.perf_counter() - t0,
+                   message=result.message + f"; refined (GCMMA 3, {rounds} x {n_it} it., all "
+                   f"phases): s = {combined_score(out[0].scores):.4f}")
+
+
+def run_design(method: str, entries, targets, settings: DatabaseSettings, *, pbar=None,
+               evaluate=None, options: GcmmaOptions = GcmmaOptions(), **kw) -> DesignResult:
+    """Dispatch to :func:`sog`, :func:`gco`, :func:`cco` or :func:`mcco` (the CLI entry)."""
+    targets = list(targets)
+    if method not in METHODS:
+        raise InputError(f"method must be one of {METHODS}, got {method!r}")
+    if method == "mcco":
+        if len(targets) != 2:
+            raise InputError("mcco needs two targets: K(p) (--target) and A(p) (--second-target)")
+        return mcco(entries, targets[0], targets[1], settings, evaluate=evaluate,
+                    options=options, **kw)
+    if len(targets) != 1:
+        raise InputError(f"{method} takes one target, got {len(targets)}")
+    if method == "sog":
+        return sog(entries, targets[0], settings, evaluate=evaluate, options=options, **kw)
+    if pbar is None:
+        raise InputError(f"{method} needs the threshold pressure pbar (Pa)")
+    fn = gco if method == "gco" else cco
+    return fn(entries, targets[0], pbar, settings, evaluate=evaluate, options=options, **kw)
+

@@ -1,0 +1,204 @@
+"""Designed profiles and their JSON (thesis Sec. 4.2).
+
+A designed profile is a :class:`Design`: a sum of *parts*, each a set of chromosomes
+(Eq. 3.2) of one genome, realised at the database length L with N nodes, multiplied by
+the part's Eq. (4.2) factor (the amplitude that put its genome on the target pressure
+range in Alg. 3) and by one overall factor ``scale`` (Eq. 4.2 applied to the sum).
+A single-part design is an ordinary genome with amplitude gene ``scale*weight*A``
+(:meth:`Design.as_genome`); cross-overs of genomes with different (gamma, H) are not one
+MWM genome, so the design JSON stores every part's versioned genome JSON.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Optional
+
+import numpy as np
+
+from ...errors import InputError
+from ...surfaces.surface import Surface
+from ..database import THESIS_SETTINGS, DatabaseEntry, DatabaseSettings
+from ..genome import Genome, realize
+
+#: genes other than the phases that CCO optimises ("all genes", Sec. 4.2.4)
+GENE_VARIABLES = ("H", "gamma", "lambda1", "weight")
+DESIGN_FORMAT = "roughfe-design"
+DESIGN_VERSION = 1
+
+
+@dataclass(frozen=True, eq=False)
+class DesignPart:
+    """Chromosomes ``chromosomes`` (indices n) of ``genome`` times ``weight`` (-)."""
+
+    genome: Genome
+    chromosomes: tuple
+    weight: float = 1.0
+    label: str = ""
+
+    def __post_init__(self):
+        ch = tuple(sorted({int(n) for n in self.chromosomes}))
+        if not ch:
+            raise InputError(f"design part {self.label!r} has no chromosomes")
+        object.__setattr__(self, "chromosomes", ch)
+        if not (np.isfinite(self.weight) and self.weight > 0):
+            raise InputError(f"part weight must be finite and > 0, got {self.weight!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class Design:
+    """A designed rough profile: ``scale * sum_parts weight * sum_{n in part} C_n(x)``.
+
+    Parameters
+    ----------
+    parts : tuple of DesignPart
+    scale : float
+        Overall Eq. (4.2) factor (-).
+    length : float
+        Observation length L (m).
+    n_nodes : int
+        Nodes N (spacing L/(N-1), the genome node convention).
+    name : str
+        Provenance, e.g. ``"5-1+2-2"``.
+    """
+
+    parts: tuple
+    scale: float = 1.0
+    length: float = THESIS_SETTINGS.length
+    n_nodes: int = THESIS_SETTINGS.n_nodes
+    name: str = ""
+
+    def __post_init__(self):
+        object.__setattr__(self, "parts", tuple(self.parts))
+        if not self.parts:
+            raise InputError("a design needs at least one part")
+        if not (np.isfinite(self.scale) and self.scale > 0):
+            raise InputError(f"design scale must be finite and > 0, got {self.scale!r}")
+
+    # -- geometry ----------------------------------------------------------------------
+    def keys(self, which="all") -> list:
+        """Phase variables ``(part, row m, chromosome n)``; ``which`` = "all" or a per-part
+        list of chromosome sets."""
+        out = []
+        for k, part in enumerate(self.parts):
+            chosen = part.chromosomes if which == "all" else tuple(which[k])
+            for n in chosen:
+                if n in part.chromosomes:
+                    out.extend((k, m, int(n)) for m in range(part.genome.M))
+        return out
+
+    def gene_keys(self) -> list:
+        """Gene variables ``(part, name)`` for name in H, gamma, lambda1 and the part weight
+        (its amplitude gene relative to the other parts)."""
+        return [(k, g) for k in range(len(self.parts)) for g in GENE_VARIABLES]
+
+    def phase_values(self, keys) -> np.ndarray:
+        """Current values of the variables ``keys``: phases (rad) ``(part, m, n)`` and
+        genes ``(part, name)``."""
+        out = []
+        for key in keys:
+            part = self.parts[key[0]]
+            if len(key) == 2:
+                out.append(part.weight if key[1] == "weight" else getattr(part.genome, key[1]))
+            else:
+                _, m, n = key
+                out.append(part.genome.phases[m, n - part.genome.n_first])
+        return np.array(out, dtype=float)
+
+    def with_phases(self, keys, values) -> "Design":
+        """A new design with the variables ``keys`` (phases and genes) set to ``values``."""
+        phases = [np.array(p.genome.phases) for p in self.parts]
+        genes = [{} for _ in self.parts]
+        for key, v in zip(keys, np.asarray(values, dtype=float)):
+            if len(key) == 2:
+                genes[key[0]][key[1]] = float(v)
+            else:
+                k, m, n = key
+                phases[k][m, n - self.parts[k].genome.n_first] = v
+        parts = []
+        for p, ph, g in zip(self.parts, phases, genes):
+            w = g.pop("weight", p.weight)
+            parts.append(replace(p, genome=replace(p.genome, phases=ph, **g), weight=w))
+        return replace(self, parts=tuple(parts))
+
+    def rescaled(self, factor) -> "Design":
+        return replace(self, scale=self.scale * float(factor))
+
+    def part_surface(self, k) -> Surface:
+        """Part ``k`` alone (with its weight and the overall scale)."""
+        part = self.parts[k]
+        s = realize(part.genome, self.length, self.n_nodes, chromosomes=part.chromosomes)
+        return s.scaled(self.scale * part.weight)
+
+    def chromosome_surface(self, k, n) -> Surface:
+        part = self.parts[k]
+        s = realize(part.genome, self.length, self.n_nodes, chromosomes=[n])
+        return s.scaled(self.scale * part.weight)
+
+    def surface(self) -> Surface:
+        """The designed profile (heights in m) on the genome nodes."""
+        surfs = [self.part_surface(k) for k in range(len(self.parts))]
+        h = np.sum([s.heights for s in surfs], axis=0)
+        meta = {"generator": "roughfe.design", "name": self.name, "length": self.length,
+                "n_nodes": self.n_nodes, "x0": surfs[0].metadata["x0"],
+                "parts": [{"label": p.label, "chromosomes": list(p.chromosomes)}
+                          for p in self.parts]}
+        return Surface(h, surfs[0].size, periodic=False, metadata=meta)
+
+    def spectrum_lines(self) -> list:
+        """Discrete spectrum ``(q_n (rad/m), a_n (m))`` of every chromosome of every part:
+        a_n = scale * weight * G gamma^((1-n)H) * sqrt(M) (the rms-equivalent amplitude of
+        the M ridges' waves)."""
+        out = []
+        for p in self.parts:
+            for n in p.chromosomes:
+                a = self.scale * p.weight * float(p.genome.wave_amplitude(n)) * math.sqrt(p.genome.M)
+                out.append((float(p.genome.wavenumber(n)), a))
+        return sorted(out)
+
+    def part_genome(self, k) -> Genome:
+        """Part ``k`` as a genome: its weight and the overall scale folded into the
+        amplitude gene A; the part's chromosomes (realise only those) in metadata."""
+        p = self.parts[k]
+        g = p.genome
+        return replace(g, A=g.A * p.weight * self.scale,
+                       metadata={**g.metadata, "design": self.name, "part": k + 1,
+                                 "chromosomes": list(p.chromosomes)})
+
+    def as_genome(self) -> Optional[Genome]:
+        """The single genome equal to this design when it has one part, else None."""
+        return self.part_genome(0) if len(self.parts) == 1 else None
+
+    # -- JSON --------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        return {"format": DESIGN_FORMAT, "version": DESIGN_VERSION, "name": self.name,
+                "scale": self.scale, "length": self.length, "n_nodes": self.n_nodes,
+                "parts": [{"label": p.label, "weight": p.weight,
+                           "chromosomes": list(p.chromosomes), "genome": p.genome.to_dict()}
+                          for p in self.parts]}
+
+    @classmethod
+    def from_dict(cls, d) -> "Design":
+        if d.get("format") != DESIGN_FORMAT or int(d.get("version", 0)) > DESIGN_VERSION:
+            raise InputError(f"not a readable {DESIGN_FORMAT} object (format={d.get('format')!r}, "
+                             f"version={d.get('version')!r})")
+        parts = tuple(DesignPart(Genome.from_dict(p["genome"]), tuple(p["chromosomes"]),
+                                 float(p["weight"]), p.get("label", "")) for p in d["parts"])
+        return cls(parts, float(d["scale"]), float(d["length"]), int(d["n_nodes"]),
+                   d.get("name", ""))
+
+
+def entry_design(entry: DatabaseEntry, settings: DatabaseSettings, weight=1.0,
+                 chromosomes=None) -> Design:
+    """A database genome (or some of its chromosomes) as a one-part design."""
+    g = Genome.from_dict(entry.genome)
+    ch = tuple(chromosomes) if chromosomes is not None else tuple(entry.macro) + tuple(entry.micro)
+    return Design((DesignPart(g, ch, float(weight), entry.label),), 1.0, settings.length,
+                  settings.n_nodes, entry.label)
+
+
+def combine(a: Design, b: Design) -> Design:
+    """Cross-over: the sum of two designs (Algs. 5-7 Step 6); scales folded into weights."""
+    parts = tuple(replace(p, weight=p.weight * d.scale) for d in (a, b) for p in d.parts)
+    return Design(parts, 1.0, a.length, a.n_nodes, f"{a.name}+{b.name}")
+

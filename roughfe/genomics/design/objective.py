@@ -1,0 +1,85 @@
+"""What a design is scored against: Eq. (4.1) after Eq. (4.2), one or two targets
+(Alg. 7 Step 10), and the counted BEM evaluation of designs."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import InputError
+from ..database import DatabaseSettings
+from ..macro_micro import profile_response
+from ..similarity import ResponseCurve, similarity
+from .model import Design
+
+
+@dataclass(frozen=True, eq=False)
+class Objective:
+    """What a design is scored against.
+
+    ``targets[0]`` sets p_max^t (Eq. 4.2). With two targets (M-CCO) the score is the
+    product f = s(y_t1, .) * s(y_t3, .) (Alg. 7 Step 10); the second target is read on
+    the same rescaled curve, so it must not extend beyond p_max^t of the first.
+    """
+
+    targets: tuple
+    p_range: tuple = (0.0, math.inf)
+
+    def __post_init__(self):
+        t = tuple(self.targets)
+        if not 1 <= len(t) <= 2:
+            raise InputError(f"one or two targets, got {len(t)}")
+        if len(t) == 2 and t[1].p_max > t[0].p_max * (1 + 1e-6):
+            raise InputError(f"the second target reaches p = {t[1].p_max:.6g} Pa beyond the "
+                             f"first target's p_max = {t[0].p_max:.6g} Pa (Eq. 4.2 matches one "
+                             f"p_max)")
+        object.__setattr__(self, "targets", t)
+
+    @property
+    def p_max(self) -> float:
+        return self.targets[0].p_max
+
+    def scores(self, curve: ResponseCurve) -> tuple:
+        """Similarity per target (Eq. 4.1) after Eq. (4.2)."""
+        c = curve.to_target_range(self.p_max)
+        return tuple(similarity(t, c, self.p_range, rescale=False) for t in self.targets)
+
+    def __call__(self, curve: ResponseCurve) -> float:
+        """s (one target) or f = s_1 s_2 (Alg. 7); with a negative score f is the smallest
+        score instead, since a product of two negative scores would look good."""
+        return combined_score(self.scores(curve))
+
+    def residuals(self, curve: ResponseCurve) -> np.ndarray:
+        """Relative errors (y_t - y_i)/y_t at every target point in ``p_range`` (all
+        targets stacked); ``s = 1 - max |r|`` for one target (Eq. 4.1)."""
+        c = curve.to_target_range(self.p_max)
+        out = []
+        for t in self.targets:
+            sel = (t.pressure >= self.p_range[0]) & (t.pressure <= self.p_range[1])
+            yi = np.interp(t.pressure[sel], c.pressure, c.values(t.quantity))
+            out.append((t.values[sel] - yi) / t.values[sel])
+        return np.concatenate(out)
+
+
+def combined_score(scores) -> float:
+    """Product of the similarity scores (Alg. 7 Step 10) when all are >= 0, else the
+    smallest (negative) one."""
+    scores = np.asarray(scores, dtype=float)
+    return float(np.prod(scores)) if np.all(scores >= 0) else float(scores.min())
+
+
+class Evaluator:
+    """Counts and runs the BEM response of designs (``Surface -> ResponseCurve``)."""
+
+    def __init__(self, settings: DatabaseSettings, response=None):
+        self.settings = settings
+        self.response = response or (lambda s: profile_response(
+            s, youngs_modulus=settings.youngs_modulus, poisson=settings.poisson,
+            n_steps=settings.n_steps, kernel=settings.kernel, stiffness=settings.stiffness))
+        self.n_sweeps = 0
+
+    def __call__(self, design: Design) -> ResponseCurve:
+        self.n_sweeps += 1
+        return self.response(design.surface())
+

@@ -1,0 +1,125 @@
+"""Exact sensitivities of the design residuals on the fixed contact sets (Sec. 4.3.1,
+beyond the thesis' finite differences)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ...bem import Material, contact_sweep, influence_operator
+from ...errors import InputError
+from ..database import DatabaseSettings
+from ..genome import node_coordinates
+from ..macro_micro import profile_response
+from ..similarity import ResponseCurve
+from .model import Design
+from .objective import Objective
+
+
+def residual_jacobian(design: Design, keys, objective: Objective, settings: DatabaseSettings):
+    """Residuals r = (y_t - y)/y_t (as :meth:`Objective.residuals`) and their exact
+    derivatives with respect to the phase variables ``keys`` on the fixed contact sets.
+
+    At step j the contact set c_j is fixed and ``H_cc p_c = h_c - max h + Delta_j``
+    (gap definition of :mod:`roughfe.bem.contact`), so with ``H_cc x_j = 1`` (H is
+    symmetric) the mean pressure varies as
+
+        d p_j = (1/N) [x_j . dh_c + sum(x_j) (dDelta_j - d max h)],
+        Delta_j = (j/n_t) (max h - min h).
+
+    The heights vary with a phase phi_{m,n} of a part as
+    ``dh/dphi = scale * weight * a_{m,n} (sin(q_n x + phi) - sin(phi))`` (Eq. 3.2).
+    K by differences over the steps (``stiffness="fd"``) is ``D p / delta`` with a fixed
+    difference matrix D and ``delta = (max h - min h)/n_t``; the exact per-step K and
+    A(p) depend only on the contact sets, so their derivatives vanish. The chain then
+    goes through the Eq. (4.2) rescaling ``eta = p_max^t / p_n`` and the linear
+    interpolation at the target pressures. Gene variables (``(part, name)`` keys) get
+    forward differences. One BEM sweep plus n_t solves with H_cc replace the n + 1
+    sweeps of finite differences; the derivative ignores contact-set changes, as any
+    derivative of this piecewise-smooth map must (measured in
+    ``validation/design_study.py``: GCMMA reaches the same scores as with finite
+    differences).
+
+    Returns
+    -------
+    (r, J) : ndarray (n_r,), ndarray (n_r, len(keys))
+    """
+    surf = design.surface()
+    h = surf.heights
+    n_nodes = h.size
+    sweep = contact_sweep(surf, Material(settings.youngs_modulus, settings.poisson),
+                          n_steps=settings.n_steps, kernel=settings.kernel,
+                          compute_stiffness=settings.stiffness == "exact")
+    p = np.asarray(sweep.mean_pressure, float)
+    if np.any(p <= 0):
+        raise InputError("a loading step without contact: no sensitivities (use finite differences)")
+    k_vals = np.asarray(sweep.stiffness if settings.stiffness == "exact" else sweep.stiffness_fd)
+    curve = ResponseCurve(p, k_vals, sweep.area_fraction)
+    op = influence_operator(surf.shape, surf.size, sweep.e_star, sweep.results[0].kernel)
+    hmat = op.dense()
+    i_max, i_min = int(np.argmax(h)), int(np.argmin(h))
+    n_t = p.size
+    frac = np.arange(1, n_t + 1) / n_t
+    # dh/dvariable, shape (N, n_var): phases exactly, genes by differences below
+    x = node_coordinates(design.length, design.n_nodes)
+    dh = np.zeros((n_nodes, len(keys)))
+    gene_cols = []
+    for col, key in enumerate(keys):
+        if len(key) == 2:
+            gene_cols.append(col)
+            continue
+        k, m, n = key
+        part = design.parts[k]
+        g = part.genome
+        a = float(g.wave_amplitude(n)) * (1.0 if g.anisotropy is None else g.anisotropy[m])
+        phi = g.phases[m, n - g.n_first]
+        dh[:, col] = design.scale * part.weight * a * (np.sin(g.wavenumber(n) * x + phi) - np.sin(phi))
+    d_ptp = dh[i_max] - dh[i_min]
+    dp = np.empty((n_t, len(keys)))
+    for j, res in enumerate(sweep.results):
+        c = np.flatnonzero(res.contact.ravel())
+        xj = np.linalg.solve(hmat[np.ix_(c, c)], np.ones(c.size))
+        dp[j] = (xj @ dh[c] + xj.sum() * (frac[j] * d_ptp - dh[i_max])) / n_nodes
+    if settings.stiffness == "exact":
+        dk = np.zeros_like(dp)
+    else:
+        delta = float(np.ptp(h)) / n_t
+        d1 = np.gradient(np.eye(n_t), axis=0, edge_order=1)       # K = d1 @ p / delta
+        dk = d1 @ dp / delta - np.outer(k_vals, d_ptp / n_t / delta)
+    eta = objective.p_max / p[-1]
+    pr = eta * p
+    dpr = eta * (dp - np.outer(p, dp[-1] / p[-1]))
+    r_out, j_out = [], []
+    for t in objective.targets:
+        sel = (t.pressure >= objective.p_range[0]) & (t.pressure <= objective.p_range[1])
+        pt, yt = t.pressure[sel], t.values[sel]
+        yv = curve.values(t.quantity)
+        dyv = dk if t.quantity == "K" else np.zeros_like(dp)
+        y = np.interp(pt, pr, yv)
+        dy = np.empty((pt.size, len(keys)))
+        b = np.clip(np.searchsorted(pr, pt), 1, n_t - 1)
+        a_ = b - 1
+        for i, (ia, ib, q) in enumerate(zip(a_, b, pt)):
+            if q <= pr[0]:
+                dy[i] = dyv[0]
+            elif q >= pr[-1]:
+                dy[i] = dyv[-1]
+            else:
+                span = pr[ib] - pr[ia]
+                w = (q - pr[ia]) / span
+                dw = (-dpr[ia] * span - (q - pr[ia]) * (dpr[ib] - dpr[ia])) / span ** 2
+                dy[i] = (1 - w) * dyv[ia] + w * dyv[ib] + (yv[ib] - yv[ia]) * dw
+        r_out.append((yt - y) / yt)
+        j_out.append(-dy / yt[:, None])
+    r, jac = np.concatenate(r_out), np.vstack(j_out)
+    if gene_cols:
+        vals = design.phase_values(keys)
+        for col in gene_cols:
+            step = 1e-6 * max(abs(vals[col]), 1e-12)
+            v = vals.copy()
+            v[col] += step
+            c2 = profile_response(design.with_phases(keys, v).surface(),
+                                  youngs_modulus=settings.youngs_modulus, poisson=settings.poisson,
+                                  n_steps=settings.n_steps, kernel=settings.kernel,
+                                  stiffness=settings.stiffness)
+            jac[:, col] = (objective.residuals(c2) - r) / step
+    return r, jac
+

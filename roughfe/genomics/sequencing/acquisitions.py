@@ -1,0 +1,69 @@
+"""Nested acquisitions of a profile and their checks (thesis Sec. 3.2-3.3.1)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import InputError
+from ...surfaces.surface import Surface
+from ..genome import observation_coordinates
+
+MIN_NODES = 32
+
+
+# -- data checks -------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class Acquisition:
+    """One acquisition: node abscissae x (m), heights z (m), observation length L = (N-1) dx."""
+
+    x: np.ndarray
+    z: np.ndarray
+    length: float
+
+
+def acquisitions_from_surfaces(surfaces) -> list:
+    """Check nested acquisitions and return them sorted from coarsest to finest.
+
+    Raises InputError for: fewer than 2 profiles, 2D data, different N, fewer than
+    ``MIN_NODES`` nodes, a flat profile, equal lengths, windows that are not nested around x = 0, or
+    scales that do not overlap (the finer window shorter than two coarse spacings).
+    """
+    surfaces = list(surfaces)
+    if len(surfaces) < 2:
+        raise InputError(f"sequencing needs at least 2 nested acquisitions, got {len(surfaces)}")
+    for k, s in enumerate(surfaces):
+        if not isinstance(s, Surface):
+            raise InputError(f"acquisition {k} must be a roughfe Surface, got {type(s).__name__}")
+        if s.ndim != 1:
+            raise InputError(f"acquisition {k} must be a profile (1D heights), got shape {s.shape}")
+    sizes = {s.shape[0] for s in surfaces}
+    if len(sizes) != 1:
+        raise InputError(f"all acquisitions must have the same number of nodes N (Sec. 3.2: N = 512 "
+                         f"at every scale), got N = {[s.shape[0] for s in surfaces]}")
+    n = sizes.pop()
+    if n < MIN_NODES:
+        raise InputError(f"too few points: N = {n} nodes per acquisition, at least {MIN_NODES} are needed")
+    acq = []
+    for k, s in enumerate(surfaces):
+        if np.ptp(s.heights) == 0:
+            raise InputError(f"acquisition {k} is flat (all heights equal {float(s.heights[0])!r} m): "
+                             f"there is no roughness to sequence")
+        x = observation_coordinates(s)
+        acq.append(Acquisition(x, np.asarray(s.heights, dtype=float), float((n - 1) * s.spacing[0])))
+    acq.sort(key=lambda a: -a.length)
+    for a, b in zip(acq, acq[1:]):
+        if not b.length < a.length * (1 - 1e-9):
+            raise InputError(f"acquisitions must have different observation lengths, got two of "
+                             f"{a.length:.6g} m")
+        tol = 1e-6 * a.length
+        if b.x[0] < a.x[0] - tol or b.x[-1] > a.x[-1] + tol:
+            raise InputError(f"acquisition of length {b.length:.6g} m ([{b.x[0]:.4g}, {b.x[-1]:.4g}] m) is "
+                             f"not nested inside the one of length {a.length:.6g} m "
+                             f"([{a.x[0]:.4g}, {a.x[-1]:.4g}] m)")
+        dx = a.length / (n - 1)
+        if b.length <= 2 * dx:
+            raise InputError(f"non-overlapping scales: the finer window {b.length:.4g} m is not longer than "
+                             f"two spacings {2 * dx:.4g} m of the coarser acquisition, so they share no "
+                             f"wavelength")
+    return acq

@@ -1,0 +1,174 @@
+"""Sequencing of a profile from nested acquisitions: the driver of steps 1-5
+(thesis Sec. 3.3.1, see :mod:`roughfe.genomics.sequencing`)."""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ...errors import InputError
+from ..genome import Genome, profile_heights
+from .acquisitions import acquisitions_from_surfaces
+from .genes import (amplitude_genes, peak_slope_H, phases_with_sums, ridge_likelihood,
+                    variance_amplitude)
+from .lattice import (comb_periods, design_matrix, fit_lattice, label_q1, lattice_from_period,
+                      lattice_ranges, solve_linear, vp_residual)
+from .peaks import spectrum_peaks
+from .result import SequencingResult
+
+
+def _rel_rms(z, fit):
+    rz = math.sqrt(float(np.mean(z ** 2)))
+    return math.sqrt(float(np.mean((z - fit) ** 2))) / rz if rz > 0 else math.inf
+
+
+def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restarts=3) -> SequencingResult:
+    """Sequence the genome of a profile from nested acquisitions (Sec. 3.3.1).
+
+    Parameters
+    ----------
+    surfaces : sequence of Surface
+        Two or more profiles of the same N nodes at observation lengths L_1 > L_2 > ...,
+        centred on x = 0 (see :func:`acquisitions_from_surfaces` for the checks).
+    seed : int
+        Seeds the M likelihood and the phase draws (the fit itself is deterministic).
+    M : int, optional
+        Number of ridges of the sequenced genome. Default: maximum likelihood over 2..20
+        (weakly identifiable, see the module notes).
+    rms_tolerance : float
+        Relative rms error above which the result is flagged ``success = False``.
+    n_restarts : int
+        Number of comb periods (gamma candidates) tried; the lowest residual wins.
+
+    Returns
+    -------
+    SequencingResult
+    """
+    t0 = time.perf_counter()
+    acqs = acquisitions_from_surfaces(surfaces)
+    n_nodes = acqs[0].z.size
+    rng = np.random.default_rng(seed)
+    weights = [1.0 / max(math.sqrt(float(np.mean(a.z ** 2))), 1e-300) for a in acqs]
+    rhs = np.concatenate([a.z * w for a, w in zip(acqs, weights)])
+
+    # 1-2. spectra, peaks and the comb
+    spectra = [spectrum_peaks(a) for a in acqs]
+    log_q = np.concatenate([np.log(s.peak_q) for s in spectra])
+    messages = []
+    if log_q.size < 3:
+        messages.append(f"only {log_q.size} PSD peaks found: the spectrum is not a discrete WM spectrum")
+        periods, refs = np.array([math.log(1.5)]), np.array([math.log(2 * math.pi / acqs[0].length)])
+    else:
+        periods, _, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
+    bins = np.concatenate([s.peak_q / (s.q[1] - s.q[0]) for s in spectra])
+    groups = np.concatenate([np.full(s.peak_q.size, i) for i, s in enumerate(spectra)])
+    gamma_psd = float(math.exp(periods[0]))
+
+    # 3-4. lattice fit with restarts
+    best = None
+    nit = 0
+    for period, ref in zip(periods, refs):
+        if log_q.size >= 3:
+            lq1, lg = lattice_from_period(log_q, period, ref, acqs[0].length, bins, groups)
+        else:
+            lq1, lg = label_q1(ref, period, acqs[0].length), period
+        if not (math.log(1.0 + 1e-3) < lg < math.log(10.0)):
+            continue
+        p, k = fit_lattice(lq1, lg, acqs, n_nodes, weights, rhs)
+        nit += k
+        # lattice label compatible with n_s = 1 for the coarsest acquisition
+        if not (1.0 < math.exp(p[1]) <= 10.0):
+            continue
+        base = label_q1(p[0], p[1], acqs[0].length)     # lambda1 in [L_1, gamma L_1)
+        for shift in (0.0, -1.0, 1.0):
+            cand = np.array([base + shift * p[1], p[1]])
+            lam1 = 2 * math.pi / math.exp(cand[0])
+            if shift and not (acqs[0].length * (1 - 1e-6) <= lam1
+                              < math.exp(cand[1]) * acqs[0].length * (1 + 1e-6)):
+                continue
+            ranges = lattice_ranges(cand[0], cand[1], acqs, n_nodes)
+            if shift and ranges[0][0] != 1:
+                continue
+            r = vp_residual(cand, acqs, ranges, weights, rhs, None)
+            n_par = 2 * (max(rr[1] for rr in ranges) - 1 + 1) + 2
+            # BIC; the misfit is floored at round-off (1e-24 of the data energy) so that two
+            # exact fits tie and the lattice with fewer chromosomes wins (a lattice of ratio
+            # sqrt(gamma) contains the gamma lattice and fits WM data exactly too)
+            rss = max(float(r @ r), 1e-24 * float(rhs @ rhs))
+            cost = r.size * math.log(rss / r.size) + n_par * math.log(r.size)
+            if best is None or cost < best[0]:
+                best = (cost, cand, ranges)
+        if best is not None and best[0] < r.size * math.log(1e-20 * float(rhs @ rhs) / r.size) + 1e-9:
+            break                              # exact fit (WM data): no restart needed
+    if best is None:
+        raise InputError("sequencing found no admissible wavenumber lattice (gamma in (1, 10]) in the PSD "
+                         "peaks; the acquisitions are not WM-like")
+    _, (lq1, lg), ranges = best
+    # final polish of the full model with the final chromosome ranges
+    r0 = vp_residual(np.array([lq1, lg]), acqs, ranges, weights, rhs, None)
+    pol = least_squares(vp_residual, np.array([lq1, lg]), args=(acqs, ranges, weights, rhs, None),
+                        x_scale=np.array([1e-5, 1e-5]), diff_step=1e-11, max_nfev=100,
+                        xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    nit += pol.nfev + 2 * (pol.njev or 0)
+    if 2 * pol.cost < float(r0 @ r0) and lattice_ranges(pol.x[0], pol.x[1], acqs, n_nodes) == ranges:
+        lq1, lg = pol.x
+    gamma, lam1 = math.exp(lg), 2 * math.pi / math.exp(lq1)
+    n, mat = design_matrix(lq1, lg, acqs, ranges, weights)
+    coef = solve_linear(mat, rhs)
+    cvec = coef[0::2] + 1j * coef[1::2]
+    amps, thetas = np.abs(cvec), np.angle(cvec)
+
+    # 5. genes
+    A, H = amplitude_genes(n, amps, gamma, lam1)
+    m_values = tuple(range(2, 21))
+    g1 = Genome(A=A, H=H, gamma=gamma, lambda1=lam1, phases=np.zeros((1, n.size)), n_first=int(n[0]))
+    unit = g1.prefactor * gamma ** ((1.0 - n) * H)       # G(M=1) gamma^((1-n)H)
+    u = amps / unit                                     # = |sum_m e^{i phi}| / sqrt(M)
+    loglik = ridge_likelihood(u, m_values, rng=rng)
+    if M is None:
+        M = m_values[int(np.argmax(loglik))] if np.isfinite(loglik).any() else \
+            max(2, int(math.ceil(float(np.max(u)) ** 2)))
+    M = int(M)
+    if M < 1:
+        raise InputError(f"M must be >= 1, got {M}")
+    target = u * math.sqrt(M) * np.exp(1j * thetas)
+    over = np.abs(target) > M
+    if over.any():
+        messages.append(f"{int(over.sum())} chromosome amplitude(s) exceed what M = {M} ridges can carry "
+                        f"with A = {A:.4g}; they were clipped (the realisation is not exact)")
+        target = np.where(over, target / np.abs(target) * M, target)
+    phases = phases_with_sums(target, M, rng=rng)
+    genome = Genome(A=A, H=H, gamma=gamma, lambda1=lam1, phases=phases, n_first=int(n[0]),
+                    metadata={"generator": "sequence_profiles", "seed": int(seed),
+                              "lengths": [a.length for a in acqs], "n_nodes": n_nodes})
+
+    # quality
+    fitted = [profile_heights(genome, a.x, np.arange(r[0], r[1] + 1)) for a, r in zip(acqs, ranges)]
+    rms = np.array([_rel_rms(a.z, f) for a, f in zip(acqs, fitted)])
+    d = acqs[1].x[1] - acqs[1].x[0]
+    k0 = np.round(acqs[0].x / d)
+    k1 = np.round(acqs[1].x / d)
+    on0 = np.isin(k0, k1) & (np.abs(acqs[0].x / d - k0) < 1e-6)
+    on1 = np.isin(k1, k0[on0])
+    zd_x = acqs[0].x[on0]
+    zd = acqs[0].z[on0] - acqs[1].z[on1]
+    zd_fit = fitted[0][on0] - fitted[1][on1]
+    ok = bool(np.all(rms <= rms_tolerance))
+    if not ok:
+        messages.insert(0, "not WM-like: relative rms error " +
+                        ", ".join(f"{e:.3g}" for e in rms) + f" exceeds {rms_tolerance:g}")
+    message = "; ".join(messages) if messages else \
+        "sequenced: relative rms errors " + ", ".join(f"{e:.2e}" for e in rms)
+    meta_report = {"rms_errors": rms.tolist(), "success": ok}
+    genome = Genome(A=A, H=H, gamma=gamma, lambda1=lam1, phases=phases, n_first=int(n[0]),
+                    metadata={**genome.metadata, "sequencing": meta_report})
+    return SequencingResult(
+        genome=genome, success=ok, message=message, nit=nit, n=n, amplitudes=amps, phases=thetas,
+        ranges=ranges, lengths=np.array([a.length for a in acqs]), rms_errors=rms,
+        x=[a.x for a in acqs], heights=[a.z for a in acqs], fitted=fitted, zd_x=zd_x, zd=zd,
+        zd_fit=zd_fit, spectra=spectra, gamma_psd=gamma_psd, H_psd=peak_slope_H(spectra, lq1, lg),
+        M_loglik=loglik, A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1),
+                                               gamma, lam1, H),
+        seed=int(seed), elapsed=time.perf_counter() - t0)

@@ -1,0 +1,94 @@
+"""The result of sequencing (scipy OptimizeResult-like)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+from ...writers import to_jsonable
+from ..genome import Genome
+
+
+@dataclass(frozen=True, eq=False)
+class SequencingResult:
+    """Sequenced genome and its quality report (scipy OptimizeResult-like).
+
+    Attributes
+    ----------
+    genome : Genome
+        Sequenced genome (phases: one set consistent with the fitted chromosome sums).
+    success : bool
+        True when every acquisition is reproduced within ``rms_tolerance``.
+    message : str
+    nit : int
+        Residual evaluations of the nonlinear (lattice) fit.
+    n : ndarray of int
+        Chromosome indices fitted (union over acquisitions).
+    amplitudes, phases : ndarray
+        c_n (m) and theta_n (rad) of the reduced chromosomes (Eq. 3.7-3.8).
+    ranges : list of (int, int)
+        (n_s, n_f) per acquisition, coarsest first (Eq. 3.5).
+    lengths : ndarray
+        Observation lengths (m), coarsest first.
+    rms_errors : ndarray
+        rms(Z_i - Z_i^seq) / rms(Z_i) per acquisition (relative, -).
+    x, heights, fitted : list of ndarray
+        Nodes (m), measured and sequenced heights (m) per acquisition.
+    zd_x, zd, zd_fit : ndarray
+        Z_d = Z_1 - Z_2 at the common nodes of the two coarsest acquisitions and its
+        sequenced counterpart (m); empty when they share no node.
+    spectra : list of SpectrumPeaks
+    gamma_psd, H_psd : float
+        gamma from the PSD peaks alone (comb, step 2) and H from the slope of the PSD
+        peaks on the lattice (ln C ~ -2H ln q, Eq. 3.11): the thesis's estimates, for
+        comparison with the fit and the maximum-likelihood H.
+    M_loglik : ndarray
+        Log-likelihood of M = 2..20 (flat-ish: M is weakly identifiable).
+    A0 : float
+        Amplitude from the height variance of the coarsest acquisition (Eq. 3.13), for
+        comparison with the maximum-likelihood A.
+    seed : int or None
+    elapsed : float
+        Wall time (s).
+    """
+
+    genome: Genome
+    success: bool
+    message: str
+    nit: int
+    n: np.ndarray
+    amplitudes: np.ndarray
+    phases: np.ndarray
+    ranges: list
+    lengths: np.ndarray
+    rms_errors: np.ndarray
+    x: list
+    heights: list
+    fitted: list
+    zd_x: np.ndarray
+    zd: np.ndarray
+    zd_fit: np.ndarray
+    spectra: list
+    gamma_psd: float
+    H_psd: float
+    M_loglik: np.ndarray
+    A0: float = float("nan")
+    seed: Optional[int] = None
+    elapsed: float = 0.0
+    references: tuple = field(default=("thesis Sec. 3.3.1, Eq. 3.5-3.16",))
+
+    def report(self) -> dict:
+        """JSON-safe summary (genes, rms errors, ranges, diagnostics)."""
+        g = self.genome
+        return {"success": bool(self.success), "message": self.message, "nit": int(self.nit),
+                "genes": {"A": g.A, "H": g.H, "gamma": g.gamma, "lambda1": g.lambda1, "M": g.M},
+                "lengths": self.lengths.tolist(), "ranges": [list(r) for r in self.ranges],
+                "rms_errors": self.rms_errors.tolist(),
+                "zd_rms": float(np.sqrt(np.mean(self.zd ** 2))) if self.zd.size else None,
+                "zd_rms_error": (float(np.sqrt(np.mean((self.zd - self.zd_fit) ** 2))
+                                       / max(np.sqrt(np.mean(self.zd ** 2)), 1e-300))
+                                 if self.zd.size else None),
+                "gamma_psd": self.gamma_psd, "H_psd": self.H_psd, "A0_variance": self.A0,
+                "M_loglik": to_jsonable(self.M_loglik),
+                "seed": self.seed, "elapsed_s": self.elapsed}
