@@ -1,6 +1,6 @@
 """Design algorithms (Algs. 3-7) on a reduced database: exact recovery of a database
 genome, stage monotonicity, reproducibility of every reported score by an independent
-BEM run of the saved design, GCMMA on an analytic problem, and bad input."""
+BEM run of the saved design, and bad input (GCMMA on an analytic problem: tests/test_optim_gcmma.py)."""
 import json
 
 import numpy as np
@@ -63,31 +63,6 @@ def test_methods_improve_and_scores_reproduce_from_the_saved_design(entries, tar
     again = de.rescore(d, tg, SETTINGS)
     np.testing.assert_allclose(again, r.best.scores, atol=1e-7)
     assert d.surface().shape == (SETTINGS.n_nodes,)
-
-
-def test_gcmma_formulations_improve_an_analytic_minimax_problem():
-    """s(x) = 1 - max_j |A_j x - b_j| / b_j with the optimum inside the box."""
-    rng = np.random.default_rng(4)
-    a = rng.uniform(0.5, 1.5, (8, 3))
-    x_star = np.array([1.0, 2.0, 3.0])
-    b = a @ x_star
-
-    def resid(x):
-        return (b - a @ x) / b
-
-    def score(x):
-        return 1.0 - np.max(np.abs(resid(x)))
-
-    x0 = x_star * np.array([0.92, 1.08, 0.95])
-    lo, hi = x_star * 0.85, x_star * 1.15
-    thesis = de.gcmma_maximize(score, x0, lo, hi, n_it=8, eps=1e-4)
-    minimax = de.gcmma_minimax(resid, lambda r: 1 - np.max(np.abs(r)), x0, lo, hi, n_it=8,
-                               eps=1e-4)
-    s0 = score(x0)
-    assert thesis.fun0 == pytest.approx(s0) and minimax.fun0 == pytest.approx(s0)
-    assert thesis.fun > s0 + 0.5 * (1 - s0)
-    assert minimax.fun > 0.99
-    assert np.all(minimax.x >= lo - 1e-12) and np.all(minimax.x <= hi + 1e-12)
 
 
 def test_bad_inputs_are_clear(entries, targets):

@@ -210,6 +210,24 @@ def _two_range_sets(entries, target, pbar, threshold=SELECTION, fallback=3):
     return (s1, s2), (u1, u2), ok1 and ok2
 
 
+def _two_range_cross_over(method, entries, target, pbar, settings, evaluate, options, n_best,
+                          max_set, chromosomes, n_it_micro, stage1):
+    """Algs. 5 and 6: U1/U2 on the two pressure ranges, the crossed pairs of
+    ``chromosomes(entry)`` (None = all), then GCMMA stages 1 and 2."""
+    t0 = time.perf_counter()
+    entries, by_label = _check_entries(entries)
+    pbar = target.check_pbar(pbar)
+    evaluate = evaluate or Evaluator(settings)
+    objective = Objective((target,))
+    (s1, s2), sets, passed = _two_range_sets(entries, target, pbar)
+    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
+                                      (chromosomes, chromosomes), n_best, max_set)
+    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
+                                 n_it_micro, by_label, settings, stage1=stage1)
+    return _result(method, cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
+                   n_cross, n_above, passed, evaluate, t0)
+
+
 def gco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, evaluate=None,
         options: GcmmaOptions = GcmmaOptions(), n_best: int = 3, max_set: Optional[int] = 8
         ) -> DesignResult:
@@ -221,19 +239,8 @@ def gco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, eva
     ``n_best`` best go through GCMMA on their macro phases (Alg. 2 on the new genome),
     then their micro phases.
     """
-    t0 = time.perf_counter()
-    entries, by_label = _check_entries(entries)
-    pbar = target.check_pbar(pbar)
-    evaluate = evaluate or Evaluator(settings)
-    objective = Objective((target,))
-    (s1, s2), sets, passed = _two_range_sets(entries, target, pbar)
-    every = (lambda e: None, lambda e: None)
-    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
-                                      every, n_best, max_set)
-    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
-                                 options.n_it_micro, by_label, settings)
-    return _result("gco", cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
-                   n_cross, n_above, passed, evaluate, t0)
+    return _two_range_cross_over("gco", entries, target, pbar, settings, evaluate, options,
+                                 n_best, max_set, lambda e: None, options.n_it_micro, "macro")
 
 
 def cco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, evaluate=None,
@@ -242,19 +249,8 @@ def cco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, eva
     """Chromosomes Cross-Over (Alg. 6): as GCO with the macro-scale chromosomes only;
     GCMMA on all genes of the new genome (phases, and with ``options.cco_genes`` also H,
     gamma, lambda and the part amplitudes; stage 1); stage 2 repeats stage 1 (Sec. 4.3.1)."""
-    t0 = time.perf_counter()
-    entries, by_label = _check_entries(entries)
-    pbar = target.check_pbar(pbar)
-    evaluate = evaluate or Evaluator(settings)
-    objective = Objective((target,))
-    (s1, s2), sets, passed = _two_range_sets(entries, target, pbar)
-    macro = (lambda e: e.macro or e.micro[:1], lambda e: e.macro or e.micro[:1])
-    starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
-                                      macro, n_best, max_set)
-    cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross, 0,
-                                 by_label, settings, stage1="all")
-    return _result("cco", cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
-                   n_cross, n_above, passed, evaluate, t0)
+    return _two_range_cross_over("cco", entries, target, pbar, settings, evaluate, options,
+                                 n_best, max_set, lambda e: e.macro or e.micro[:1], 0, "all")
 
 
 def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings, *,
@@ -314,7 +310,8 @@ def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings
     cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
                                  options.n_it_micro, by_label, settings)
     return _result("mcco", cands, objective, None, {"s1": s1.tolist(), "s2": s2.tolist()},
-                   len(found), sum(1 for t in found if t[0] > SELECTION), ok1 and ok2, evaluate, t0)
+                   len(found), sum(1 for t in found if t[0] > SELECTION), ok1 and ok2, evaluate,
+                   t0)
 
 
 def refine(result: DesignResult, settings: DatabaseSettings, *, rounds: int = 3, n_it: int = 15,
