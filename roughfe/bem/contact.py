@@ -276,20 +276,57 @@ def _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter):
     return out
 
 
+def _pressure_rate(op, solver, contact):
+    """x = dp/dDelta (Pa/m) at every point for the FIXED contact set c: H_cc x_c = 1, x = 0
+    outside c (Eq. 2.5 differentiated with the set frozen). Returns (x, x_c)."""
+    if solver in ("dense", "nnls"):
+        idx = np.flatnonzero(contact.ravel())
+        xc = solve_spd(_dense(op)[np.ix_(idx, idx)], np.ones(idx.size))
+        x = np.zeros(contact.size)
+        x[idx] = xc
+        return x.reshape(contact.shape), xc
+    x, _ = restricted_cg(op.apply, contact, np.ones(contact.shape),
+                         precond=_cg_preconditioner(op))
+    return x, x
+
+
+def contact_set_pressure_rate(result: ContactResult) -> np.ndarray:
+    """dp/dDelta (Pa/m) at every point of a BEM solution with its contact set held fixed.
+
+    The solution x of ``H_cc x_c = 1`` on the contact set c of ``result`` (zero outside):
+    the pressure increment per unit approach while no point enters or leaves contact.
+    Its mean is the exact incremental stiffness K of Eq. (2.7) (``result.stiffness``);
+    with x the derivative of the mean pressure with respect to the heights on c is
+    ``x_c / N`` (H is symmetric), which gives exact design sensitivities
+    (:mod:`roughfe.genomics.design.sensitivities`).
+
+    Raises
+    ------
+    InputError
+        A FEM result (no influence operator), plastic points (hardness), no contact, or
+        full contact of a periodic surface (the mean displacement is free: no finite rate).
+    """
+    if result.kernel is None:
+        raise InputError("contact_set_pressure_rate needs a BEM result (an influence kernel)")
+    if result.plastic_area_fraction:
+        raise InputError("contact_set_pressure_rate is for elastic contact: this solution has "
+                         f"plastic points (plastic area fraction {result.plastic_area_fraction})")
+    c = np.asarray(result.contact, bool)
+    op = _operator(c.shape, tuple(result.size), result.e_star, result.kernel)
+    if not c.any() or (op.periodic and c.all()):
+        raise InputError(f"no finite pressure rate with {int(c.sum())} of {c.size} points in "
+                         f"contact")
+    return _pressure_rate(op, result.solver, c)[0]
+
+
 def _stiffness(op, solver, contact, w, scale):
     """Exact incremental stiffness dp/dDelta (Pa/m) from the contact set."""
     c = contact
     if not c.any():
         c = w <= 1e-12 * scale          # Delta = 0: the touching point(s)
-    n = c.size
     if op.periodic and c.all():
         return float("inf")
-    if solver in ("dense", "nnls"):
-        idx = np.flatnonzero(c.ravel())
-        x = solve_spd(_dense(op)[np.ix_(idx, idx)], np.ones(idx.size))
-        return float(x.sum()) / n
-    x, _ = restricted_cg(op.apply, c, np.ones(c.shape), precond=_cg_preconditioner(op))
-    return float(x.sum()) / n
+    return float(_pressure_rate(op, solver, c)[1].sum()) / c.size
 
 
 def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pressure=None,

@@ -27,11 +27,35 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError
+from ..model import Loading, Material, SweepResult
+from ..response import response as contact_response
 from ..surfaces.surface import Surface
 from .similarity import ResponseCurve
 
 
 STIFFNESS_KINDS = ("fd", "exact")
+
+
+def profile_sweep(surface: Surface, *, youngs_modulus: float, poisson: float = 0.0,
+                  n_steps: int = 20, kernel: str = "auto", stiffness: str = "fd") -> SweepResult:
+    """The BEM sweep behind :func:`profile_response`: ``n_steps`` equal approaches
+    ``Delta_j = j/n_t * (max h - min h)`` through :func:`roughfe.response.response` (the
+    one response function), with the exact per-step stiffness only when ``stiffness``
+    is ``"exact"``. Parameters as :func:`profile_response`."""
+    if stiffness not in STIFFNESS_KINDS:
+        raise InputError(f"stiffness must be one of {STIFFNESS_KINDS}, got {stiffness!r}")
+    return contact_response(surface, Material(youngs_modulus, poisson),
+                            Loading(n_steps=int(n_steps)), kernel=kernel,
+                            compute_stiffness=stiffness == "exact")
+
+
+def sweep_curve(sweep: SweepResult, stiffness: str = "fd") -> ResponseCurve:
+    """K(p) (Pa/m) and A(p) of a sweep at its steps with p > 0: K = dp/dDelta by central
+    differences over the steps (``"fd"``) or exact per step (``"exact"``)."""
+    p = np.asarray(sweep.mean_pressure, dtype=float)
+    k = np.asarray(sweep.stiffness if stiffness == "exact" else sweep.stiffness_fd, dtype=float)
+    keep = p > 0
+    return ResponseCurve(p[keep], k[keep], np.asarray(sweep.area_fraction, dtype=float)[keep])
 
 
 def profile_response(surface: Surface, *, youngs_modulus: float, poisson: float = 0.0,
@@ -63,15 +87,9 @@ def profile_response(surface: Surface, *, youngs_modulus: float, poisson: float 
     ResponseCurve
         Mean pressure (Pa), stiffness K (Pa/m) and area fraction at the steps with p > 0.
     """
-    from ..bem import Material, contact_sweep
-    if stiffness not in STIFFNESS_KINDS:
-        raise InputError(f"stiffness must be one of {STIFFNESS_KINDS}, got {stiffness!r}")
-    sweep = contact_sweep(surface, Material(youngs_modulus, poisson), n_steps=int(n_steps),
-                          kernel=kernel, compute_stiffness=stiffness == "exact")
-    p = np.asarray(sweep.mean_pressure, dtype=float)
-    k = np.asarray(sweep.stiffness if stiffness == "exact" else sweep.stiffness_fd, dtype=float)
-    keep = p > 0
-    return ResponseCurve(p[keep], k[keep], np.asarray(sweep.area_fraction, dtype=float)[keep])
+    sweep = profile_sweep(surface, youngs_modulus=youngs_modulus, poisson=poisson,
+                          n_steps=n_steps, kernel=kernel, stiffness=stiffness)
+    return sweep_curve(sweep, stiffness)
 
 
 CORRELATION_AXES = ("steps", "pressure")
@@ -174,9 +192,7 @@ def macro_micro(genome, settings, *, response=None) -> MacroMicroResult:
     from .genome import realize
     if response is None:
         def response(s):
-            return profile_response(s, youngs_modulus=settings.youngs_modulus,
-                                    poisson=settings.poisson, n_steps=settings.n_steps,
-                                    kernel=settings.kernel, stiffness=settings.stiffness)
+            return profile_response(s, **settings.response_options())
     total = realize(genome, settings.length, settings.n_nodes)
     n_s, n_f = total.metadata["n_s"], total.metadata["n_f"]
     ns = np.arange(n_s, n_f + 1)

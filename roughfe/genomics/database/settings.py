@@ -66,6 +66,12 @@ class DatabaseSettings:
     def to_dict(self) -> dict:
         return asdict(self)
 
+    def response_options(self) -> dict:
+        """Keywords of :func:`roughfe.genomics.macro_micro.profile_response` (and
+        ``profile_sweep``): E, nu, n_t, kernel and the K kind of these settings."""
+        return {"youngs_modulus": self.youngs_modulus, "poisson": self.poisson,
+                "n_steps": self.n_steps, "kernel": self.kernel, "stiffness": self.stiffness}
+
     @classmethod
     def from_dict(cls, d) -> "DatabaseSettings":
         return cls(**d)

@@ -75,8 +75,7 @@ class Evaluator:
     def __init__(self, settings: DatabaseSettings, response=None):
         self.settings = settings
         self.response = response or (lambda s: profile_response(
-            s, youngs_modulus=settings.youngs_modulus, poisson=settings.poisson,
-            n_steps=settings.n_steps, kernel=settings.kernel, stiffness=settings.stiffness))
+            s, **settings.response_options()))
         self.n_sweeps = 0
 
     def __call__(self, design: Design) -> ResponseCurve:

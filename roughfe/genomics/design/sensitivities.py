@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...bem import Material, contact_sweep, influence_operator
+from ...bem import contact_set_pressure_rate
 from ...errors import InputError
 from ..database import DatabaseSettings
 from ..genome import node_coordinates
-from ..macro_micro import profile_response
-from ..similarity import ResponseCurve
+from ..macro_micro import profile_response, profile_sweep, sweep_curve
 from .model import Design
 from .objective import Objective
 
@@ -20,7 +19,8 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
 
     At step j the contact set c_j is fixed and ``H_cc p_c = h_c - max h + Delta_j``
     (gap definition of :mod:`roughfe.bem.contact`), so with ``H_cc x_j = 1`` (H is
-    symmetric) the mean pressure varies as
+    symmetric; x_j from :func:`roughfe.bem.contact_set_pressure_rate`, the solve behind
+    the exact stiffness K) the mean pressure varies as
 
         d p_j = (1/N) [x_j . dh_c + sum(x_j) (dDelta_j - d max h)],
         Delta_j = (j/n_t) (max h - min h).
@@ -45,16 +45,13 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     surf = design.surface()
     h = surf.heights
     n_nodes = h.size
-    sweep = contact_sweep(surf, Material(settings.youngs_modulus, settings.poisson),
-                          n_steps=settings.n_steps, kernel=settings.kernel,
-                          compute_stiffness=settings.stiffness == "exact")
+    sweep = profile_sweep(surf, **settings.response_options())
     p = np.asarray(sweep.mean_pressure, float)
     if np.any(p <= 0):
-        raise InputError("a loading step without contact: no sensitivities (use finite differences)")
-    k_vals = np.asarray(sweep.stiffness if settings.stiffness == "exact" else sweep.stiffness_fd)
-    curve = ResponseCurve(p, k_vals, sweep.area_fraction)
-    op = influence_operator(surf.shape, surf.size, sweep.e_star, sweep.results[0].kernel)
-    hmat = op.dense()
+        raise InputError("a loading step without contact: no sensitivities (use finite "
+                         "differences)")
+    curve = sweep_curve(sweep, settings.stiffness)
+    k_vals = curve.stiffness
     i_max, i_min = int(np.argmax(h)), int(np.argmin(h))
     n_t = p.size
     frac = np.arange(1, n_t + 1) / n_t
@@ -75,9 +72,8 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     d_ptp = dh[i_max] - dh[i_min]
     dp = np.empty((n_t, len(keys)))
     for j, res in enumerate(sweep.results):
-        c = np.flatnonzero(res.contact.ravel())
-        xj = np.linalg.solve(hmat[np.ix_(c, c)], np.ones(c.size))
-        dp[j] = (xj @ dh[c] + xj.sum() * (frac[j] * d_ptp - dh[i_max])) / n_nodes
+        xj = contact_set_pressure_rate(res).ravel()
+        dp[j] = (xj @ dh + xj.sum() * (frac[j] * d_ptp - dh[i_max])) / n_nodes
     if settings.stiffness == "exact":
         dk = np.zeros_like(dp)
     else:
@@ -117,9 +113,7 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
             v = vals.copy()
             v[col] += step
             c2 = profile_response(design.with_phases(keys, v).surface(),
-                                  youngs_modulus=settings.youngs_modulus, poisson=settings.poisson,
-                                  n_steps=settings.n_steps, kernel=settings.kernel,
-                                  stiffness=settings.stiffness)
+                                  **settings.response_options())
             jac[:, col] = (objective.residuals(c2) - r) / step
     return r, jac
 

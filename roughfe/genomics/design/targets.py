@@ -5,8 +5,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...bem import Material, contact_sweep
-from ...bem.sweep import central_differences
+from ...model import Loading, Material, central_differences
+from ...response import response
 from ..database import DatabaseSettings, make_genome
 from ..genome import Genome
 from ..similarity import ResponseCurve, Target, linear_then_flat_target, similarity
@@ -39,12 +39,12 @@ def rescore_at_target_pressures(design: Design, targets, settings: DatabaseSetti
     targets = list(targets)
     surf = design.surface()
     mat = Material(settings.youngs_modulus, settings.poisson)
-    top = contact_sweep(surf, mat, deltas=[float(np.ptp(surf.heights))], kernel=settings.kernel,
-                        compute_stiffness=False)
+    top = response(surf, mat, Loading(delta=float(np.ptp(surf.heights))),
+                   kernel=settings.kernel, compute_stiffness=False)
     eta = targets[0].p_max / float(top.mean_pressure[-1])
     p = np.unique(np.concatenate([t.pressure for t in targets]))
-    sw = contact_sweep(surf, mat, pressures=p / eta, kernel=settings.kernel,
-                       compute_stiffness=False)
+    sw = response(surf, mat, Loading(pressures=tuple(p / eta)), kernel=settings.kernel,
+                  compute_stiffness=False)
     k = central_differences(sw.delta, sw.mean_pressure)
     curve = ResponseCurve(np.asarray(sw.mean_pressure) * eta, k, sw.area_fraction)
     return tuple(similarity(t, curve, rescale=False) for t in targets)
