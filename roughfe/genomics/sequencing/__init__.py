@@ -61,7 +61,7 @@ Modules: :mod:`.acquisitions` (checks), :mod:`.peaks` (step 1), :mod:`.lattice` 
 from .acquisitions import MIN_NODES, Acquisition, acquisitions_from_surfaces
 from .genes import (amplitude_genes, peak_slope_H, phases_with_sums, ridge_likelihood,
                     variance_amplitude)
-from .lattice import comb_periods
+from .lattice import comb_periods, label_q1, lattice_from_period
 from .peaks import SpectrumPeaks, refine_peaks, spectrum_peaks, upper_hull
 from .profile import sequence_profiles
 from .result import SequencingResult
@@ -69,5 +69,6 @@ from .zd import ZdRidgeFit, thesis_zd_fit
 
 __all__ = ["MIN_NODES", "Acquisition", "acquisitions_from_surfaces", "amplitude_genes",
            "peak_slope_H", "phases_with_sums", "ridge_likelihood", "variance_amplitude",
-           "comb_periods", "SpectrumPeaks", "refine_peaks", "spectrum_peaks", "upper_hull",
+           "comb_periods", "label_q1", "lattice_from_period", "SpectrumPeaks", "refine_peaks",
+           "spectrum_peaks", "upper_hull",
            "sequence_profiles", "SequencingResult", "ZdRidgeFit", "thesis_zd_fit"]
