@@ -39,3 +39,13 @@ def test_no_contact_or_full_periodic_contact_is_refused():
     assert r.area_fraction == 1.0
     with pytest.raises(InputError, match="no finite pressure rate"):
         contact_set_pressure_rate(r)
+
+
+def test_plastic_points_are_refused():
+    """With a hardness the saturated points do not respond to the approach: the fixed-set
+    rate of the elastic contact set does not apply."""
+    s, mat = _profile(), Material(1e6, 0.3)
+    r = solve_contact(s, mat, delta=0.5 * float(np.ptp(s.heights)), hardness=1e3)
+    assert r.plastic_area_fraction > 0
+    with pytest.raises(InputError, match="elastic contact"):
+        contact_set_pressure_rate(r)
