@@ -17,9 +17,10 @@ Public API (stable):
 Result files: :mod:`roughfe.bem.output` (results.json, fields.h5). Analytic references
 (Westergaard, Hertz, Love, strip) live in :mod:`roughfe.reference`.
 """
-from .contact import ContactResult, contact_set_pressure_rate, solve_contact  # noqa: F401
+from .contact import ContactResult, solve_contact  # noqa: F401 (re-export)
 from ..model import Material, composite  # noqa: F401 (re-export)
 from .operators import KERNELS, InfluenceOperator, influence_operator
+from .stiffness import contact_set_pressure_rate
 from .sweep import RECORD_KEYS, SweepResult, contact_sweep  # noqa: F401 (re-export)
 
 # Material, composite, ContactResult, SweepResult and RECORD_KEYS are roughfe.model's,

@@ -26,8 +26,8 @@ from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
 from .operators import KERNELS, WORKERS, InfluenceOperator, influence_operator
-from .solvers import (SolverOutput, dense_solve, kkt_residual, polonsky_keer,
-                      restricted_cg, solve_spd)
+from .solvers import SolverOutput, dense_solve, kkt_residual, polonsky_keer
+from .stiffness import exact_stiffness
 
 SOLVERS = ("auto", "dense", "nnls", "pk")
 #: largest number of grid points solved with the dense solvers by ``solver="auto"``
@@ -276,59 +276,6 @@ def _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter):
     return out
 
 
-def _pressure_rate(op, solver, contact):
-    """x = dp/dDelta (Pa/m) at every point for the FIXED contact set c: H_cc x_c = 1, x = 0
-    outside c (Eq. 2.5 differentiated with the set frozen). Returns (x, x_c)."""
-    if solver in ("dense", "nnls"):
-        idx = np.flatnonzero(contact.ravel())
-        xc = solve_spd(_dense(op)[np.ix_(idx, idx)], np.ones(idx.size))
-        x = np.zeros(contact.size)
-        x[idx] = xc
-        return x.reshape(contact.shape), xc
-    x, _ = restricted_cg(op.apply, contact, np.ones(contact.shape),
-                         precond=_cg_preconditioner(op))
-    return x, x
-
-
-def contact_set_pressure_rate(result: ContactResult) -> np.ndarray:
-    """dp/dDelta (Pa/m) at every point of a BEM solution with its contact set held fixed.
-
-    The solution x of ``H_cc x_c = 1`` on the contact set c of ``result`` (zero outside):
-    the pressure increment per unit approach while no point enters or leaves contact.
-    Its mean is the exact incremental stiffness K of Eq. (2.7) (``result.stiffness``);
-    with x the derivative of the mean pressure with respect to the heights on c is
-    ``x_c / N`` (H is symmetric), which gives exact design sensitivities
-    (:mod:`roughfe.genomics.design.sensitivities`).
-
-    Raises
-    ------
-    InputError
-        A FEM result (no influence operator), plastic points (hardness), no contact, or
-        full contact of a periodic surface (the mean displacement is free: no finite rate).
-    """
-    if result.kernel is None:
-        raise InputError("contact_set_pressure_rate needs a BEM result (an influence kernel)")
-    if result.plastic_area_fraction:
-        raise InputError("contact_set_pressure_rate is for elastic contact: this solution has "
-                         f"plastic points (plastic area fraction {result.plastic_area_fraction})")
-    c = np.asarray(result.contact, bool)
-    op = _operator(c.shape, tuple(result.size), result.e_star, result.kernel)
-    if not c.any() or (op.periodic and c.all()):
-        raise InputError(f"no finite pressure rate with {int(c.sum())} of {c.size} points in "
-                         f"contact")
-    return _pressure_rate(op, result.solver, c)[0]
-
-
-def _stiffness(op, solver, contact, w, scale):
-    """Exact incremental stiffness dp/dDelta (Pa/m) from the contact set."""
-    c = contact
-    if not c.any():
-        c = w <= 1e-12 * scale          # Delta = 0: the touching point(s)
-    if op.periodic and c.all():
-        return float("inf")
-    return float(_pressure_rate(op, solver, c)[1].sum()) / c.size
-
-
 def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pressure=None,
                   kernel: str = "auto", solver: str = "auto", tol: float = 1e-10,
                   max_iter: Optional[int] = None, initial=None,
@@ -496,8 +443,8 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
     mean_gap = float(gap.mean())
     K = float("nan")
     if compute_stiffness:
-        K = 0.0 if contact.any() and not stiff_set.any() else _stiffness(op, solver, stiff_set,
-                                                                         w, scale)
+        K = 0.0 if contact.any() and not stiff_set.any() else \
+            exact_stiffness(op, solver, stiff_set, w, scale)
     return ContactResult(
         pressure=p, displacement=u, gap=gap, contact=contact, delta=float(d),
         load=pm * A, mean_pressure=pm, area_fraction=nc / n,

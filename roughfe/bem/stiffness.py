@@ -1,0 +1,76 @@
+"""The one fixed-contact-set solve of the BEM: H_cc x = 1 (thesis Eq. 2.5 and 2.7).
+
+With the contact set c of a solution held fixed, Eq. (2.5) is linear in the approach:
+``H_cc p_c = h_c - max h + Delta``. Its derivative ``x = dp/dDelta`` solves
+``H_cc x_c = 1`` (zero outside c). The mean of x is the exact incremental stiffness K of
+Eq. (2.7) (:func:`exact_stiffness`, used by :func:`roughfe.bem.solve_contact`); x itself
+gives the derivative of the mean pressure with respect to the heights on c, ``x_c / N``
+(H is symmetric), behind the exact design sensitivities
+(:mod:`roughfe.genomics.design.sensitivities`) through :func:`contact_set_pressure_rate`.
+The dense and matrix-free paths reuse the solver's cached operator, matrix and
+preconditioner (:mod:`roughfe.bem.contact`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from ..model import ContactResult
+from .solvers import restricted_cg, solve_spd
+
+
+def pressure_rate(op, solver, contact):
+    """x = dp/dDelta (Pa/m) at every point for the FIXED contact set ``contact``:
+    ``H_cc x_c = 1``, x = 0 outside. Cholesky on the cached dense matrix for the dense
+    solvers, restricted preconditioned CG otherwise. Returns ``(x, x_c)``."""
+    from .contact import _cg_preconditioner, _dense   # the solver's caches (contact imports us)
+
+    if solver in ("dense", "nnls"):
+        idx = np.flatnonzero(contact.ravel())
+        xc = solve_spd(_dense(op)[np.ix_(idx, idx)], np.ones(idx.size))
+        x = np.zeros(contact.size)
+        x[idx] = xc
+        return x.reshape(contact.shape), xc
+    x, _ = restricted_cg(op.apply, contact, np.ones(contact.shape),
+                         precond=_cg_preconditioner(op))
+    return x, x
+
+
+def exact_stiffness(op, solver, contact, w, scale) -> float:
+    """Exact incremental stiffness K = dp/dDelta (Pa/m, Eq. 2.7) of the contact set: the
+    mean of :func:`pressure_rate`; at Delta = 0 the touching point(s) (gap w <= 1e-12
+    scale); ``inf`` at full contact of a periodic surface."""
+    c = contact
+    if not c.any():
+        c = w <= 1e-12 * scale          # Delta = 0: the touching point(s)
+    if op.periodic and c.all():
+        return float("inf")
+    return float(pressure_rate(op, solver, c)[1].sum()) / c.size
+
+
+def contact_set_pressure_rate(result: ContactResult) -> np.ndarray:
+    """dp/dDelta (Pa/m) at every point of a BEM solution with its contact set held fixed.
+
+    The solution x of ``H_cc x_c = 1`` on the contact set c of ``result`` (zero outside):
+    the pressure increment per unit approach while no point enters or leaves contact.
+    Its mean is the exact stiffness K (``result.stiffness``).
+
+    Raises
+    ------
+    InputError
+        A FEM result (no influence operator), plastic points (hardness), no contact, or
+        full contact of a periodic surface (the mean displacement is free: no finite rate).
+    """
+    from .contact import _operator
+
+    if result.kernel is None:
+        raise InputError("contact_set_pressure_rate needs a BEM result (an influence kernel)")
+    if result.plastic_area_fraction:
+        raise InputError("contact_set_pressure_rate is for elastic contact: this solution has "
+                         f"plastic points (plastic area fraction {result.plastic_area_fraction})")
+    c = np.asarray(result.contact, bool)
+    op = _operator(c.shape, tuple(result.size), result.e_star, result.kernel)
+    if not c.any() or (op.periodic and c.all()):
+        raise InputError(f"no finite pressure rate with {int(c.sum())} of {c.size} points in "
+                         f"contact")
+    return pressure_rate(op, result.solver, c)[0]
