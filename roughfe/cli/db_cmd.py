@@ -24,6 +24,7 @@ list prints the genomes (read-only); map draws the genetic map. Under MPI run:
     mpirun -n K python -m mpi4py.futures $(which roughfe) db build DB --executor mpi
 """
 
+from ..genomics.database.settings import THESIS_SETTINGS as THESIS
 from .options import (add_material_options, add_output_folder, add_run_options,
                       add_runner_options, output_folder_of, positive_float, positive_int,
                       show_progress)
@@ -115,13 +116,15 @@ def register(sub):
     b.add_argument("database", help="SQLite file (created if missing; genomes there are kept, "
                                     "an interrupted build resumes)")
     g = b.add_argument_group("realisation and contact settings (stored in the database)")
-    g.add_argument("--length", type=positive_float, default=849.42e-6,
+    g.add_argument("--length", type=positive_float, default=THESIS.length,
                    help="observation length L = lambda (m)")
-    g.add_argument("--nodes", type=positive_int, default=512, help="nodes N per profile")
-    g.add_argument("--steps", type=positive_int, default=20,
+    g.add_argument("--nodes", type=positive_int, default=THESIS.n_nodes,
+                   help="nodes N per profile")
+    g.add_argument("--steps", type=positive_int, default=THESIS.n_steps,
                    help="n_t approaches to the peak-valley height")
-    g.add_argument("--threshold", type=positive_float, default=0.95, help="c_n threshold of Alg. 2")
-    g.add_argument("--stiffness", choices=("fd", "exact"), default="fd",
+    g.add_argument("--threshold", type=positive_float, default=THESIS.threshold,
+                   help="c_n threshold of Alg. 2")
+    g.add_argument("--stiffness", choices=("fd", "exact"), default=THESIS.stiffness,
                    help="K(p) by differences over the steps (thesis) or exact per step")
     add_material_options(b, "material (stored in the database; the thesis used E = 1 MPa: "
                             "pressures scale with E*)")
