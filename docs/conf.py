@@ -13,15 +13,11 @@ from pathlib import Path
 DOCS = Path(__file__).resolve().parent
 sys.path.insert(0, str(DOCS.parent))
 
-# Headless rendering, and vtk loaded before dolfinx (see tests/conftest.py): autodoc
-# imports roughfe.plotting and roughfe.fem in one process.
-os.environ.setdefault("MPLBACKEND", "Agg")
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
-try:
-    import pyvista  # noqa: F401,E402
-except ImportError:  # pragma: no cover - pyvista is a core dependency
-    pass
+# Headless rendering, and vtk loaded before dolfinx: autodoc imports roughfe.plotting and
+# roughfe.fem in one process (the one set-up: roughfe._runtime).
+from roughfe._runtime import load_render_backend  # noqa: E402
+
+load_render_backend()
 
 import roughfe  # noqa: E402
 

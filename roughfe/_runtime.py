@@ -26,13 +26,17 @@ import tempfile
 from pathlib import Path
 
 _VTK_CORE = "vtkmodules.vtkCommonCore"
+#: Headless defaults: matplotlib Agg, vtk EGL off-screen (a user's own setting wins).
+HEADLESS = {"MPLBACKEND": "Agg", "VTK_DEFAULT_OPENGL_WINDOW": "vtkEGLRenderWindow",
+            "PYVISTA_OFF_SCREEN": "true"}
 
 
-def headless_environment() -> None:
-    """Headless defaults (unless the user set them): matplotlib Agg, vtk EGL off-screen."""
-    os.environ.setdefault("MPLBACKEND", "Agg")
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+def headless_environment(env=None) -> dict:
+    """Put the :data:`HEADLESS` defaults into ``env`` (default ``os.environ``) unless set."""
+    env = os.environ if env is None else env
+    for key, value in HEADLESS.items():
+        env.setdefault(key, value)
+    return env
 
 
 def can_render_here() -> bool:
@@ -72,12 +76,8 @@ def render_in_fresh_process(module: str, function: str, arrays: dict, **kwargs) 
                 "a = dict(np.load(sys.argv[1])); "
                 f"getattr(importlib.import_module({module!r}), {function!r})"
                 "(**a, **json.loads(sys.argv[2]))")
-        env = dict(os.environ)
+        env = headless_environment(dict(os.environ))
         env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
-        for key, value in (("MPLBACKEND", "Agg"),
-                           ("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow"),
-                           ("PYVISTA_OFF_SCREEN", "true")):
-            env.setdefault(key, value)
         proc = subprocess.run([sys.executable, "-c", code, str(npz), json.dumps(kwargs)],
                               env=env, capture_output=True, text=True)
         if proc.returncode != 0:

@@ -24,7 +24,7 @@ FENCE = re.compile(r"^(<!-- not-run -->\n)?```(\w+)[^\n]*\n(.*?)^```", re.M | re
 
 DRIVER = r"""
 import json, sys, traceback
-import pyvista  # vtk before dolfinx, as the roughfe command does (tests/conftest.py)
+from roughfe._runtime import load_render_backend; load_render_backend()  # vtk before dolfinx
 steps = json.load(sys.stdin)
 namespace = {"__name__": "__main__"}
 for i, (kind, payload) in enumerate(steps):

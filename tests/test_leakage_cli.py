@@ -7,6 +7,7 @@ import sys
 import numpy as np
 import pytest
 
+from roughfe._runtime import headless_environment
 from roughfe.surfaces.io import save_surface
 from roughfe.surfaces.rmd import rmd_surface
 
@@ -21,8 +22,7 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
     out = tmp_path / "out"
     deltas = [0.2 * np.ptp(s.heights), 0.6 * np.ptp(s.heights)]
     # a fresh process, as a user runs it (the CLI loads vtk before dolfinx: roughfe._runtime)
-    env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": "vtkEGLRenderWindow",
-           "PYVISTA_OFF_SCREEN": "true", "MPLBACKEND": "Agg"}
+    env = headless_environment(dict(os.environ))
     proc = subprocess.run(
         [sys.executable, "-m", "roughfe.cli", "leak", str(path), "--delta", *map(str, deltas),
          "--direction", "x", "--mu", "1e-3", "-o", str(out)],
