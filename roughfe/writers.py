@@ -193,6 +193,20 @@ def _read_owner(folder: Path):
     return None
 
 
+def _relative_files(folder: Path) -> list:
+    """Every file below ``folder`` (relative, sorted) but the lock and the owner record."""
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*")
+                  if not p.is_dir() and p.name not in (LOCK_FILE, OWNER_FILE))
+
+
+def _added_files(folder: Path, owner) -> list:
+    """Files in a completed output folder that its run did not write (a user's own files:
+    never removed without --overwrite). Empty for a run that did not complete."""
+    if not owner or owner.get("status") != "complete" or "files" not in owner:
+        return []
+    return sorted(set(_relative_files(folder)) - set(owner["files"]))
+
+
 def _refuse_to_clear(folder: Path):
     """Folders ``--overwrite`` must never empty: /, home, the working directory (or an
     ancestor of it) and a version-controlled checkout."""
@@ -216,11 +230,12 @@ def _clear(folder: Path):
 
 
 class OutputFolder:
-    """The ownership contract of a command that writes a folder (docs/usage/cli.md).
+    """The ownership contract of a command that writes a folder (docs/guide/02_command_line.md).
 
     ``OutputFolder(folder, command, overwrite=...)`` checks, writing nothing, that the
     folder can be taken: not an existing file, creatable and writable, not locked by
-    another run, and empty, or written by an earlier run of the same ``command``, or any
+    another run, and empty, or written by an earlier run of the same ``command`` (with
+    no file added since, when that run completed: its file list is recorded), or any
     other content with ``overwrite`` (never /, home, the working directory or a git
     checkout). Create it before a long computation, so bad output arguments fail at once.
 
@@ -254,10 +269,14 @@ class OutputFolder:
                 pass  # free now; taken for the writes by __enter__
         entries = [e.name for e in folder.iterdir() if e.name != LOCK_FILE]
         owner = _read_owner(folder) if entries else None
-        if entries and (owner is None or owner.get("command") != self.command):
+        added = _added_files(folder, owner)
+        if entries and (owner is None or owner.get("command") != self.command or added):
             if not self.overwrite:
-                what = (f"the output of `roughfe {owner.get('command')}`" if owner
-                        else "not a roughfe output folder")
+                what = ("not a roughfe output folder" if owner is None else
+                        f"the output of `roughfe {owner.get('command')}`"
+                        if owner.get("command") != self.command else
+                        f"an output of `roughfe {self.command}` with files it did not write "
+                        f"({', '.join(added[:3])})")
                 raise InputError(
                     f"output folder {folder} is not empty and is {what} ({len(entries)} "
                     f"entries, e.g. {sorted(entries)[0]!r}); choose a new or empty folder, "
@@ -290,10 +309,11 @@ class OutputFolder:
         folder = self.path
         try:
             if kind is None:
+                (folder / UNFINISHED_FILE).unlink()
                 write_json(folder / OWNER_FILE, {
                     **self._record, "status": "complete", "finished": _now(),
-                    "elapsed_s": time.perf_counter() - self._t0})
-                (folder / UNFINISHED_FILE).unlink()
+                    "elapsed_s": time.perf_counter() - self._t0,
+                    "files": _relative_files(folder)})
             elif self._created:
                 shutil.rmtree(folder, ignore_errors=True)
             else:

@@ -81,6 +81,12 @@ def test_output_folder_contract(tmp_path):
     with OutputFolder(out, "contact") as d:
         write_text(d / "results.json", "{}")
     assert "fields/step_001.npz" not in _files(out) and "results.json" in _files(out)
+    # a file the user put into the output folder is not silently removed by a re-run
+    write_text(out / "my_notes.txt", "mine")
+    with pytest.raises(InputError, match="files it did not write .my_notes.txt"):
+        OutputFolder(out, "contact")
+    assert (out / "my_notes.txt").exists()
+    (out / "my_notes.txt").unlink()
     # another command's output, or foreign files, are refused unless --overwrite
     with pytest.raises(InputError, match=r"output of `roughfe contact`.*--overwrite"):
         OutputFolder(out, "leak")
