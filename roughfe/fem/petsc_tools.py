@@ -106,8 +106,9 @@ def petsc_aij(matrix):
     m = matrix.tocsr()
     m.sort_indices()
     return PETSc.Mat().createAIJ(
-        size=m.shape, csr=(m.indptr.astype(PETSc.IntType), m.indices.astype(PETSc.IntType),
-                           m.data.astype(PETSc.ScalarType)), comm=PETSc.COMM_SELF)
+        size=m.shape, csr=(m.indptr.astype(PETSc.IntType, copy=False),
+                           m.indices.astype(PETSc.IntType, copy=False),
+                           m.data.astype(PETSc.ScalarType, copy=False)), comm=PETSc.COMM_SELF)
 
 
 def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None):

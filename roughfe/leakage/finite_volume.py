@@ -42,7 +42,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
-from ..fem.petsc_tools import ksp_solve
+from ..fem.petsc_tools import ksp_solve, petsc_aij
 
 
 @dataclass(frozen=True, eq=False)
@@ -182,60 +182,69 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     live[ok] = (t_in_lab | t_out_lab)[lab[ok]]
     percolates = bool((t_in_lab & t_out_lab).any())
 
-    # face transmissibilities (m^3/(Pa s)) and Couette face flows (m^3/s, along +axis)
-    both_l = is_open[:-1] & is_open[1:]
-    T_l = dt / dl * _harmonic(k[:-1], k[1:])
-    C_l = np.where(both_l, 0.25 * (g[:-1] + g[1:]) * ul * dt, 0.0)
-    gt_a, gt_b = (g, np.roll(g, -1, axis=1)) if wrap else (g[:, :-1], g[:, 1:])
-    kt_a, kt_b = (k, np.roll(k, -1, axis=1)) if wrap else (k[:, :-1], k[:, 1:])
-    T_t = dl / dt * _harmonic(kt_a, kt_b)
-    C_t = np.where((gt_a > 0) & (gt_b > 0), 0.25 * (gt_a + gt_b) * ut * dl, 0.0)
-    T_in = dt / (0.5 * dl) * k[0]
-    T_out = dt / (0.5 * dl) * k[-1]
-    C_in = 0.5 * g[0] * ul * dt
-    C_out = 0.5 * g[-1] * ul * dt
+    # face transmissibilities (m^3/(Pa s)) and Couette face flows (m^3/s, along +axis);
+    # faces outside the live components carry nothing
+    T_l = dt / dl * _harmonic(k[:-1], k[1:]) * live[:-1]
+    C_l = np.where(is_open[:-1] & is_open[1:] & live[:-1],
+                   0.25 * (g[:-1] + g[1:]) * ul * dt, 0.0)
+    gt_b = np.roll(g, -1, axis=1) if wrap else g[:, 1:]
+    gt_a = g if wrap else g[:, :-1]
+    lt_a = live if wrap else live[:, :-1]
+    T_t = dl / dt * _harmonic(k if wrap else k[:, :-1],
+                              np.roll(k, -1, axis=1) if wrap else k[:, 1:]) * lt_a
+    C_t = np.where((gt_a > 0) & (gt_b > 0) & lt_a, 0.25 * (gt_a + gt_b) * ut * dl, 0.0)
+    if wrap and nt == 2:                       # the wrap face joins the same two cells
+        T_t, C_t, wrap = T_t[:, :1] + T_t[:, 1:], C_t[:, :1] - C_t[:, 1:], False
+    T_in = dt / (0.5 * dl) * k[0] * live[0]
+    T_out = dt / (0.5 * dl) * k[-1] * live[-1]
+    C_in = 0.5 * g[0] * ul * dt * live[0]
+    C_out = 0.5 * g[-1] * ul * dt * live[-1]
 
-    idx = np.arange(n).reshape(nl, nt)
-    ia_c = np.concatenate([idx[:-1].ravel(), idx[:, :T_t.shape[1]].ravel()])
-    ib_c = np.concatenate([idx[1:].ravel(),
-                           (np.roll(idx, -1, axis=1) if wrap else idx[:, 1:]).ravel()])
-    T = np.concatenate([T_l.ravel(), T_t.ravel()])
-    C = np.concatenate([C_l.ravel(), C_t.ravel()])
+    # weights to the four neighbours per cell (up = i-1, down = i+1, left = j-1, right = j+1)
+    zr = np.zeros((1, nt))
+    w_up = np.concatenate([zr, T_l])
+    w_dn = np.concatenate([T_l, zr])
+    if wrap:
+        w_lf, w_rt = np.roll(T_t, 1, axis=1), T_t
+    else:
+        zc = np.zeros((nl, 1))
+        w_lf = np.concatenate([zc, T_t], axis=1)
+        w_rt = np.concatenate([T_t, zc], axis=1)
+    diag = w_up + w_dn + w_lf + w_rt
+    diag[0] += T_in
+    diag[-1] += T_out
+    # right-hand side: boundary pressures and the net Couette inflow of each cell
+    rhs = np.zeros((nl, nt))
+    rhs[:-1] -= C_l
+    rhs[1:] += C_l
+    if wrap:
+        rhs -= C_t
+        rhs += np.roll(C_t, 1, axis=1)
+    else:
+        rhs[:, :-1] -= C_t
+        rhs[:, 1:] += C_t
+    rhs[0] += T_in * p_in + C_in
+    rhs[-1] += T_out * p_out - C_out
+    diag[~live] = 1.0
+    rhs[~live] = 0.0
     lv = live.ravel()
-    C = np.where(lv[ia_c], C, 0.0)            # C != 0 only inside one open component
-    keep = (T > 0) & lv[ia_c]                 # faces inside a live component
-    ia, ib, T = ia_c[keep], ib_c[keep], T[keep]
-
-    # (float: bincount of an empty weight array is integer)
-    diag = np.bincount(ia, T, n) + np.bincount(ib, T, n) + 0.0
-    diag[idx[0]] += T_in
-    diag[idx[-1]] += T_out
-    rhs = np.bincount(ib_c, C, n) - np.bincount(ia_c, C, n) + 0.0
-    rhs[idx[0]] += T_in * p_in + C_in
-    rhs[idx[-1]] += T_out * p_out - C_out
-    dead = ~lv
-    diag[dead] = 1.0
-    rhs[dead] = 0.0
 
     p = np.zeros(n)
     nit, success, message = 0, True, "nothing to solve: no open cell reaches inlet or outlet"
     if lv.any():
-        A = sp.csr_matrix((np.concatenate([diag, -T, -T]),
-                           (np.concatenate([np.arange(n), ia, ib]),
-                            np.concatenate([np.arange(n), ib, ia]))), shape=(n, n))
-        p, nit, success, message = ksp_solve(A, rhs, name="reynolds_fv", options=petsc_options)
-        del A
+        M = petsc_aij(_five_point(-w_up, -w_lf, diag, -w_rt, -w_dn, wrap))
+        del w_up, w_dn, w_lf, w_rt
+        p, nit, success, message = ksp_solve(M, rhs.ravel(), name="reynolds_fv",
+                                             options=petsc_options)
+        M.destroy()
     p = np.where(lv, p, 0.0).reshape(nl, nt)
     if not success:
         raise NoConvergenceError(f"Reynolds finite-volume solve: {message}")
 
     # face flows (m^3/s, along +axis) and the inlet/outlet balance
     F_l = T_l * (p[:-1] - p[1:]) + C_l
-    F_l = np.where(live[:-1] & live[1:], F_l, 0.0)
     pt_b = np.roll(p, -1, axis=1) if wrap else p[:, 1:]
-    F_t = T_t * (p[:, :T_t.shape[1]] - pt_b) + C_t
-    lt_b = np.roll(live, -1, axis=1) if wrap else live[:, 1:]
-    F_t = np.where(live[:, :T_t.shape[1]] & lt_b, F_t, 0.0)
+    F_t = T_t * ((p if wrap else p[:, :-1]) - pt_b) + C_t
     F_in = np.where(live[0], T_in * (p_in - p[0]) + C_in, 0.0)
     F_out = np.where(live[-1], T_out * (p[-1] - p_out) + C_out, 0.0)
     q_in, q_out = float(F_in.sum()), float(F_out.sum())
@@ -247,8 +256,7 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     fl = np.concatenate([F_in[None], F_l, F_out[None]], axis=0)
     q_l = 0.5 * (fl[:-1] + fl[1:]) / dt
     if wrap:
-        ft = np.concatenate([np.roll(F_t, 1, axis=1)[:, :, None], F_t[:, :, None]], axis=2)
-        q_t = 0.5 * ft.sum(axis=2) / dl
+        q_t = 0.5 * (np.roll(F_t, 1, axis=1) + F_t) / dl
     else:
         z = np.zeros((nl, 1))
         ft = np.concatenate([z, F_t, z], axis=1)
@@ -262,6 +270,39 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
                       connected=np.ascontiguousarray(live), inlet_flow=q_in,
                       outlet_flow=q_out, leak_rate=float(leak), percolates=percolates,
                       success=bool(success), message=message, nit=int(nit))
+
+
+def _five_point(up, left, diag, right, down, wrap):
+    """CSR matrix of a 5-point stencil on an (nl, nt) grid, built row by row in column order
+    (no COO intermediate: 4096^2 grids fit in memory). Entries on missing neighbours
+    (domain edges) are left out; ``wrap`` joins column 0 and column nt-1 (nt >= 3)."""
+    nl, nt = diag.shape
+    n = nl * nt
+    idx = np.arange(n, dtype=np.int32).reshape(nl, nt)
+    c_up, c_dn = idx - nt, idx + nt
+    c_lf = np.roll(idx, 1, axis=1) if wrap else idx - 1
+    c_rt = np.roll(idx, -1, axis=1) if wrap else idx + 1
+    vals = np.stack([up, left, diag, right, down], axis=-1).reshape(n, 5)
+    cols = np.stack([c_up, c_lf, idx, c_rt, c_dn], axis=-1).reshape(n, 5)
+    del c_up, c_dn, c_lf, c_rt
+    valid = np.ones((nl, nt, 5), bool)
+    valid[0, :, 0] = False
+    valid[-1, :, 4] = False
+    if not wrap:
+        valid[:, 0, 1] = False
+        valid[:, -1, 3] = False
+    valid = valid.reshape(n, 5)
+    if wrap:                                   # the wrapped columns break the order
+        rows = np.concatenate([idx[:, 0], idx[:, -1]])
+        order = np.argsort(cols[rows], axis=1, kind="stable")
+        cols[rows] = np.take_along_axis(cols[rows], order, axis=1)
+        vals[rows] = np.take_along_axis(vals[rows], order, axis=1)
+        valid[rows] = np.take_along_axis(valid[rows], order, axis=1)
+    indptr = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(valid.sum(axis=1), out=indptr[1:])
+    m = sp.csr_matrix((vals[valid], cols[valid], indptr), shape=(n, n))
+    m.has_sorted_indices = True
+    return m
 
 
 def finite_volume_leak_rate(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
