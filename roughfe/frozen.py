@@ -16,31 +16,24 @@ from collections.abc import Mapping
 import numpy as np
 
 
-class FrozenMapping(Mapping):
-    """A read-only, picklable mapping (``types.MappingProxyType`` can not be pickled)."""
+def _read_only(self, *args, **kwargs):
+    raise TypeError("a FrozenMapping is read-only (copy it with dict(...) to change it)")
 
-    __slots__ = ("_data",)
 
-    def __init__(self, data=()):
-        object.__setattr__(self, "_data", dict(data))
+class FrozenMapping(dict):
+    """A read-only dict: picklable and JSON-serialisable as a dict (which
+    ``types.MappingProxyType`` is not); every mutating method raises ``TypeError``.
+    ``dict(m)`` or ``{**m, ...}`` give a mutable copy."""
 
-    def __getitem__(self, key):
-        return self._data[key]
-
-    def __iter__(self):
-        return iter(self._data)
-
-    def __len__(self):
-        return len(self._data)
-
-    def __setattr__(self, name, value):
-        raise AttributeError("FrozenMapping is read-only")
+    __slots__ = ()
+    __setitem__ = __delitem__ = __ior__ = _read_only
+    clear = pop = popitem = setdefault = update = _read_only
 
     def __reduce__(self):
-        return FrozenMapping, (self._data,)
+        return FrozenMapping, (dict(self),)
 
     def __repr__(self):
-        return f"FrozenMapping({self._data!r})"
+        return f"FrozenMapping({dict.__repr__(self)})"
 
 
 def freeze(value):

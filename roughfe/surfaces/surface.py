@@ -24,6 +24,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..errors import InputError
+from ..frozen import FrozenMapping
 
 
 def _as_size(size, ndim):
@@ -53,7 +54,8 @@ class Surface:
     periodic : bool
         Whether the heights are periodic with period ``size``.
     metadata : mapping, optional
-        JSON-safe information (generator, parameters, seed, source file, ...).
+        JSON-safe information (generator, parameters, seed, source file, ...); kept as
+        a read-only mapping.
 
     The heights are copied into a read-only array: a ``Surface`` never changes.
     """
@@ -85,7 +87,8 @@ class Surface:
         object.__setattr__(self, "heights", h)
         object.__setattr__(self, "size", _as_size(self.size, h.ndim))
         object.__setattr__(self, "periodic", bool(self.periodic))
-        object.__setattr__(self, "metadata", dict(self.metadata or {}))
+        # read-only (FrozenMapping, picklable): a Surface never changes, nor do its facts
+        object.__setattr__(self, "metadata", FrozenMapping(self.metadata or {}))
 
     # -- geometry -------------------------------------------------------------------
     @property
