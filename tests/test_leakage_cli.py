@@ -72,7 +72,7 @@ def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
 
 
 FSI_KEYS = {"fluid_load_fraction", "coupled_iterations", "critical_gap", "critical_position",
-            "leak_rate_critical_junction", "pocket_pressures", "trapped_volume",
+            "leak_rate_critical_junction", "pocket_pressures", "trapped_volume", "persson_leak_rate",
             "trapped_load_fraction", "leak_rate_one_way", "fsi_state", "external_pressure"}
 
 

@@ -195,7 +195,12 @@ def _leak_run(args, surface, material, out):
     if args.fsi:
         sweep, steps, written = _leak_fsi(args, surface, material, out, p_in, p_out)
         base["references"] = list(sweep.results[0].references)
-        written.append(write_json(out / "results.json", {"inputs": base, "steps": steps}))
+        # Persson's theory at the solid's (effective) mean pressure of each coupled step
+        theory = beside(surface, material.E_star, steps,
+                        pressure_drop=abs(p_in - p_out) or None, viscosity=args.mu)
+        steps = theory["steps"]
+        written.append(write_json(out / "results.json", {"inputs": base, "steps": steps,
+                                                          "persson": theory["persson"]}))
         return sweep, steps, written
     dp = p_in - p_out
     sweep = leakage_sweep(surface, material, deltas=args.delta, pressures=args.pressure,
