@@ -50,7 +50,10 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         approaches only (``n_steps`` / ``delta`` / ``deltas``, strictly increasing):
         Delta is the half-plane approach, the BEM's; ``n_steps`` gives the BEM's default
         approaches of the evenly mirrored profile, which the body with rollers solves
-        (:func:`roughfe.fem.mirrored_profile`), up to full contact.
+        (:func:`roughfe.fem.mirrored_profile`), up to full contact. The FEM solves that
+        mirrored problem also for a periodic profile: compare it with
+        ``response(mirrored_profile(surface), ...)``, not with the periodic BEM of
+        ``surface`` itself.
     **solver_options
         BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness`` (see
         :func:`roughfe.bem.solve_contact`), ``unload`` (:func:`roughfe.bem.contact_sweep`).
