@@ -141,8 +141,19 @@ def _rst_docstring(lines):
                 and not _LIST_ITEM.match(nxt)
                 and not cur.lstrip().startswith((".. ", ":"))):
             lines[i] = cur.rstrip() + ":"
-    out, literal_indent, doctest = [], None, False
+    out, literal_indent, doctest, item_indent = [], None, False, None
     for line in lines:
+        # a list item must end with a blank line before less-indented text
+        if line.strip() and literal_indent is None and not doctest:
+            item = _LIST_ITEM.match(line)
+            if (item_indent is not None and _indent(line) < item_indent and not item
+                    and out and out[-1].strip()):
+                out.append("")
+            item_indent = (item.end() if item else
+                           item_indent if item_indent is not None
+                           and _indent(line) >= item_indent else None)
+        elif not line.strip():
+            item_indent = None
         if literal_indent is not None:       # inside a literal block: leave verbatim
             if not line.strip() or _indent(line) > literal_indent:
                 out.append(line)

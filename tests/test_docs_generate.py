@@ -87,3 +87,19 @@ def test_cli_reference_has_every_command(gen, tmp_path):
         assert f"## `roughfe {command}`" in text
     assert n == text.count("\n## `roughfe") and "## `roughfe genome sequence`" in text
     assert "--E" in text and "(default:" in text
+
+
+def test_plain_text_docstrings_become_valid_rst():
+    """docs/conf.py rewrites the plain-text habits of roughfe docstrings for Sphinx."""
+    spec = importlib.util.spec_from_file_location("docs_conf", ROOT / "docs" / "conf.py")
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+    lines = ["Solve Eq. (2.12):", "", "    q = -h^3/(12 mu) grad p,   |q| in m^2/s", "",
+             "A* = 2 p/(E* gbar) and *emphasis*, ``literal |x|. ok``", "",
+             "* item", "  more", "Glued paragraph", "", "Title (long)", "-----", "x"]
+    out = conf._rst_docstring(lines)
+    assert out[0] == "Solve Eq. (2.12)::"                         # formula block -> literal
+    assert out[2] == "    q = -h^3/(12 mu) grad p,   |q| in m^2/s"  # untouched inside it
+    assert out[4] == r"A\* = 2 p/(E\* gbar) and *emphasis*, ``literal |x|" + "\u2024 ok``"
+    assert out[6:10] == ["* item", "  more", "", "Glued paragraph"]
+    assert out[-2] == "-" * len("Title (long)")
