@@ -8,6 +8,7 @@ from roughfe.bem.adhesion import AdhesionLaw, adhesive_sweep, solve_adhesive
 from roughfe.errors import InputError, NoConvergenceError
 from roughfe.model import Material
 from roughfe.reference import maugis_parameter, maugis_pull_off
+from roughfe.surfaces.shapes import sphere_cap
 from roughfe.surfaces.spectral import spectral_surface
 from roughfe.surfaces.surface import Surface
 
@@ -20,9 +21,7 @@ D_SCALE = (np.pi ** 2 * W ** 2 * R / K ** 2) ** (1 / 3)       # Maugis' approach
 
 
 def sphere(n, length):
-    x = (np.arange(n) - n / 2 + 0.5) * length / n
-    X, Y = np.meshgrid(x, x, indexing="ij")
-    return Surface(-(X ** 2 + Y ** 2) / (2 * R), length, periodic=False)
+    return sphere_cap(n, length, R)
 
 
 def md_law(lam):

@@ -89,10 +89,8 @@ def test_contact_cli_bad_input_is_reported(tmp_path, capsys):
 
 
 def _sphere_file(tmp_path, n=40, length=0.8):
-    x = (np.arange(n) - n / 2 + 0.5) * length / n
-    X, Y = np.meshgrid(x, x, indexing="ij")
-    return save_surface(Surface(-(X ** 2 + Y ** 2) / 2.0, length, periodic=False),
-                        tmp_path / "sphere.npz")
+    from roughfe.surfaces.shapes import sphere_cap
+    return save_surface(sphere_cap(n, length, 1.0), tmp_path / "sphere.npz")
 
 
 def test_contact_cli_adhesion_unload_pull_off(tmp_path):

@@ -123,30 +123,29 @@ class AdhesionLaw:
         half = 0.5 * self.smoothing * self.range
         return self.range - half, self.range + half
 
-    def potential(self, g):
-        """phi(g) (J/m^2), -w at contact, 0 far away."""
+    def evaluate(self, g):
+        """``(phi(g), phi'(g))``: the potential (J/m^2; -w at contact, 0 far away) and
+        the magnitude of the attractive traction (Pa, >= 0), in one pass."""
         g = np.asarray(g, float)
         w, s0 = self.work, self.max_traction
         if self.kind == "exp":
-            return -w * np.exp(-g / self.range)
+            e = np.exp(-g / self.range)
+            return -w * e, s0 * e
         g1, g2 = self._ramp()
         if g2 <= g1:
-            return np.where(g < self.range, -w + s0 * g, 0.0)
+            near = g < self.range
+            return np.where(near, s0 * g - w, 0.0), np.where(near, s0, 0.0)
         t = np.clip(g - g1, 0.0, g2 - g1)
-        return np.where(g < g1, -w + s0 * g,
-                        np.where(g < g2, -w + s0 * g1 + s0 * (t - t * t / (2 * (g2 - g1))),
-                                 0.0))
+        phi = s0 * (np.minimum(g, g1) + t - t * t / (2 * (g2 - g1))) - w
+        return phi, s0 * (1.0 - t / (g2 - g1))
+
+    def potential(self, g):
+        """phi(g) (J/m^2), -w at contact, 0 far away."""
+        return self.evaluate(g)[0]
 
     def traction(self, g):
         """phi'(g) (Pa) >= 0: the magnitude of the attractive traction at gap g."""
-        g = np.asarray(g, float)
-        s0 = self.max_traction
-        if self.kind == "exp":
-            return s0 * np.exp(-g / self.range)
-        g1, g2 = self._ramp()
-        if g2 <= g1:
-            return np.where(g < self.range, s0, 0.0)
-        return s0 * np.clip((g2 - g) / (g2 - g1), 0.0, 1.0)
+        return self.evaluate(g)[1]
 
     def describe(self) -> dict:
         """JSON-safe parameters (SI)."""
@@ -200,16 +199,17 @@ class _Energy:
 
     def __call__(self, x):
         p, pbar, g, u, ku = self.pressure(x)
-        scale = self.n / (self.s0 * self.ell)               # Pi*A per (S range) per cell
-        value = 0.5 * float(np.vdot(u, ku)) + float(self.law.potential(g).sum())
-        grad = ku.copy()
+        phi, traction = self.law.evaluate(g)
+        value = 0.5 * float(np.vdot(u, ku)) + float(phi.sum())
+        grad = ku
         if self.op.periodic:
             value += 0.5 * self.k0 * self.n * (float(g.mean()) - self.gbar) ** 2
             grad += pbar
-            grad += self.law.traction(g)
+            grad += traction
         else:
-            grad[self.phys] += self.law.traction(g)
-        return value * scale / self.n, (grad / self.s0).ravel()
+            grad[self.phys] += traction
+        # Pi*A per (S range) and the traction residual per S: both O(1) per cell
+        return value / (self.s0 * self.ell), (grad / self.s0).ravel()
 
     def residual(self, x):
         """Largest projected gradient (traction residual / traction scale S)."""
@@ -307,7 +307,7 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     for _ in range(4):       # restarts with a fresh quasi-Newton memory (round-off stalls)
         res = scipy.optimize.minimize(energy, x, jac=True, method="L-BFGS-B",
                                       bounds=energy.bounds(),
-                                      options={"maxiter": int(max_iter) - nit, "maxcor": 20,
+                                      options={"maxiter": int(max_iter) - nit, "maxcor": 10,
                                                "ftol": 0.0, "gtol": tol,
                                                "maxfun": 2 * int(max_iter)})
         x, nit = res.x, nit + int(res.nit)

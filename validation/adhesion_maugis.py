@@ -1,0 +1,122 @@
+"""Adhesive BEM against Maugis-Dugdale: the pull-off transition curve from DMT to JKR.
+
+A rigid sphere (R = 1 m, parabolic) on an elastic half-space (E* = 1 Pa; every length
+and force is reported in Maugis' units, so the scale drops out), work of adhesion
+w = 2.83e-4 J/m^2, Maugis-Dugdale law with h0 set by Maugis' parameter
+lambda = 2 sigma0 (R / (pi w K^2))^(1/3), K = 4 E*/3. Non-periodic Love kernel on a grid
+that holds the attraction zone and puts >= 8 cells in the Dugdale zone c - a at pull-off
+(capped at 160^2); continuation in the approach (steps of 0.1 in Maugis' approach unit),
+loading to delta_bar = 0.2, then unloading until the sphere separates. The pull-off is
+the most tensile load of the unloading branch; Maugis' is the minimum of his load over
+the contact radius (roughfe.reference.maugis_pull_off), the load-control pull-off, which
+the displacement-controlled branch passes through.
+
+Also a refinement study at lambda = 2 (4 and 8 cells in c - a) and a rough adhesive
+contact (periodic self-affine surface, exponential law): loading and unloading branches,
+pull-off pressure, whether the surface is sticky.
+
+Target: |F_BEM / F_Maugis - 1| <= 2 % for lambda in {0.1, 0.3, 1, 2}.
+Writes validation/output/adhesion_maugis.json. Run:
+``.venv/bin/python validation/adhesion_maugis.py`` (a few CPU minutes).
+"""
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import scipy.optimize
+
+from roughfe.bem.adhesion import AdhesionLaw, adhesive_sweep
+from roughfe.model import Material
+from roughfe.reference import maugis_load, maugis_pull_off
+from roughfe.surfaces.shapes import sphere_cap
+from roughfe.surfaces.spectral import spectral_surface
+from roughfe.surfaces.stats import rms_slope
+from roughfe.theory import persson
+from roughfe.writers import write_json
+
+OUT = Path(__file__).resolve().parent / "output" / "adhesion_maugis.json"
+R, E_STAR, W = 1.0, 1.0, 2.83e-4
+K = 4.0 / 3.0 * E_STAR
+MAT = Material(E_STAR * 0.91, 0.3)
+A_UNIT = (np.pi * W * R ** 2 / K) ** (1 / 3)                 # Maugis' radius unit (m)
+D_UNIT = (np.pi ** 2 * W ** 2 * R / K ** 2) ** (1 / 3)       # Maugis' approach unit (m)
+
+
+def maugis_zone(lam):
+    """Contact radius a and Dugdale-zone width c - a (m) at Maugis' pull-off."""
+    res = scipy.optimize.minimize_scalar(lambda a: maugis_load(lam, a)[0], bounds=(1e-3, 5),
+                                         method="bounded")
+    _, _, m = maugis_load(lam, res.x)
+    return res.x * A_UNIT, (m - 1) * res.x * A_UNIT
+
+
+def run_sphere(lam, cells_in_zone=8, n_max=160):
+    sigma0 = lam / (2 * (R / (np.pi * W * K ** 2)) ** (1 / 3))
+    law = AdhesionLaw("md", W, W / sigma0)
+    a, zone = maugis_zone(lam)
+    length = max(0.21, 2.4 * np.sqrt(2 * R * law.range), 2.4 * a)
+    dx = min(zone / cells_in_zone, a / 15)
+    n = int(min(n_max, 2 * np.ceil(length / dx / 2)))
+    t0 = time.process_time()
+    sw = adhesive_sweep(sphere_cap(n, length, R), MAT, law, np.linspace(-0.2, 0.2, 5) * D_UNIT,
+                        unload=True, max_unload_steps=40)
+    cpu = time.process_time() - t0
+    bem = sw.pull_off_force / (np.pi * W * R)
+    theory = maugis_pull_off(lam)
+    return {"lambda": lam, "n": n, "length_m": length, "cells_in_dugdale_zone": zone / (length / n),
+            "pull_off_bem": bem, "pull_off_maugis": theory, "relative_error": bem / theory - 1,
+            "detached": sw.detached, "steps": len(sw.sweep.results), "iterations": sw.sweep.nit,
+            "cpu_s": cpu}
+
+
+def rough_adhesive():
+    s = spectral_surface(128, 1e-5, 0.8, rms_height=1e-8, q_roll=2 * 2 * np.pi / 1e-5,
+                         q_short=32 * 2 * np.pi / 1e-5, rng=3)
+    mat = Material(1e6, 0.5)            # a soft elastomer: adhesion competes with elasticity
+    law = AdhesionLaw("exp", 0.02, 2e-9)
+    h = s.heights
+    top = float(h.max() - h.mean())
+    t0 = time.process_time()
+    sw = adhesive_sweep(s, mat, law, np.linspace(0.1, 0.6, 6) * top, unload=True,
+                        max_unload_steps=30)
+    cpu = time.process_time() - t0
+    recs = sw.records()
+    gbar = rms_slope(s)
+    p_load = [r["mean_pressure"] for r in recs if not r["unloading"]]
+    theory = persson(s, mat.E_star, [p for p in p_load if p > 0] or [1.0])
+    return {"surface": "periodic self-affine, H = 0.8, rms height 10 nm, L = 10 um, 128^2",
+            "E_star": mat.E_star, "law": law.describe(), "rms_slope": gbar,
+            "pull_off_pressure": sw.pull_off_pressure, "detached": sw.detached,
+            "sticky": bool(sw.pull_off_pressure < 0), "cpu_s": cpu,
+            "steps": [{k: r[k] for k in ("delta", "mean_pressure", "area_fraction",
+                                         "adhesive_area_fraction", "unloading")} for r in recs],
+            "persson_area_fraction_nonadhesive": [float(a) for a in theory.area_fraction]}
+
+
+def main():
+    rows = []
+    for lam in (0.1, 0.3, 1.0, 2.0):
+        r = run_sphere(lam)
+        rows.append(r)
+        print(f"lambda {lam:4.1f}: n = {r['n']:4d}, {r['cells_in_dugdale_zone']:5.1f} cells in "
+              f"c - a, pull-off BEM {r['pull_off_bem']:.4f} vs Maugis {r['pull_off_maugis']:.4f} "
+              f"({100 * r['relative_error']:+.2f} %), {r['cpu_s']:.0f} s CPU", flush=True)
+    refinement = [run_sphere(2.0, cells_in_zone=c) for c in (2, 4)] + [rows[-1]]
+    for r in refinement:
+        print(f"lambda 2 refinement: {r['cells_in_dugdale_zone']:.1f} cells in c - a, n = "
+              f"{r['n']}: {100 * r['relative_error']:+.2f} %", flush=True)
+    rough = rough_adhesive()
+    print(f"rough adhesive contact: pull-off pressure {rough['pull_off_pressure']:.4g} Pa, "
+          f"sticky {rough['sticky']}, detached {rough['detached']}, {rough['cpu_s']:.0f} s CPU")
+    targets = [{"name": f"sphere pull-off vs Maugis, lambda = {r['lambda']}",
+                "value": r["relative_error"], "target": "|error| <= 0.02",
+                "met": bool(abs(r["relative_error"]) <= 0.02)} for r in rows]
+    write_json(OUT, {"validation": "adhesion_maugis", "targets": targets, "maugis": rows,
+                     "refinement_lambda_2": refinement, "rough": rough,
+                     "units": {"pull_off": "P / (pi w R)", "length_m": "m", "cpu_s": "s"}})
+    return 0 if all(t["met"] for t in targets) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
