@@ -331,7 +331,8 @@ class ContactResult(Frozen):
         ``"flat"`` or ``"profile"``.
     fields : mapping, FEM; BEM adhesion
         Full fields for pictures (read-only), see :mod:`roughfe.fem.contact`; the
-        non-periodic adhesive BEM keeps ``padded_displacement`` (its warm start).
+        non-periodic adhesive BEM keeps ``padded_displacement`` (m: the gap on the grid,
+        the displacement on the zero padding; its warm start).
     plastic_area_fraction : float, BEM with a hardness
         Fraction of the nominal area at p = H_p (perfectly plastic flow).
     plastic_displacement : ndarray, BEM with a hardness

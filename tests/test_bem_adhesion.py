@@ -34,9 +34,10 @@ def md_law(lam):
 def jkr_side():
     # lambda = 2 (Maugis: -1.535 pi w R, 2.3 % from the JKR limit). dx = 3.3e-3 m puts 4
     # cells in the Dugdale zone c - a = 1.3e-2 m at pull-off; the domain (0.21 m) holds the
-    # contact (a <= 0.1 m) of every step.
+    # contact (a <= 0.1 m) of every step. Loading starts out of range (the apex gap
+    # 0.6 D_SCALE = 4.6e-3 m exceeds h0 = 2.4e-3 m) and jumps into contact by -0.4.
     law = md_law(2.0)
-    return adhesive_sweep(sphere(64, 0.21), MAT, law, np.array([-0.2, 0.0, 0.2]) * D_SCALE,
+    return adhesive_sweep(sphere(64, 0.21), MAT, law, np.linspace(-0.6, 0.2, 5) * D_SCALE,
                           unload=True, max_unload_steps=8)
 
 
@@ -94,10 +95,11 @@ def test_dmt_limit_sphere_pull_off():
 
 
 def test_jkr_side_sphere_pull_off(jkr_side):
-    # lambda = 2: Maugis -1.535 pi w R. Measured -1.595: +4 %, the contact edge pinned by
-    # the grid (lattice trapping) at 4 cells per Dugdale zone; tolerance 6 %. It is far
-    # from the DMT value 2 and within 7 % of the JKR limit 1.5 (the Maugis curve and the
-    # refinement study are in validation/adhesion_maugis.py).
+    # lambda = 2: Maugis -1.535 pi w R. Measured -1.511 (-1.6 %); with 4 cells per
+    # Dugdale zone the contact edge is pinned by the grid (lattice trapping) and the
+    # pinned state depends on the step path (seen: -1.6 % to +4 % for other starts);
+    # tolerance 6 %. Far from the DMT value 2 and within 7 % of the JKR limit 1.5 (the
+    # Maugis curve and the refinement are in validation/adhesion_maugis.py).
     ratio = jkr_side.pull_off_force / (np.pi * W * R)
     assert jkr_side.detached
     assert ratio == pytest.approx(maugis_pull_off(2.0), rel=6e-2)
@@ -106,14 +108,15 @@ def test_jkr_side_sphere_pull_off(jkr_side):
 
 def test_loading_and_unloading_branches_differ(jkr_side):
     recs = jkr_side.records()
-    assert [r["unloading"] for r in recs[:3]] == [False] * 3
-    assert all(r["unloading"] for r in recs[3:])
+    assert [r["unloading"] for r in recs[:5]] == [False] * 5
+    assert all(r["unloading"] for r in recs[5:])
     load = {round(r["delta"] / D_SCALE, 6): r for r in recs if not r["unloading"]}
     unload = {round(r["delta"] / D_SCALE, 6): r for r in recs if r["unloading"]}
-    # at the same approach the unloading branch holds more contact and more tension
-    back = unload[-0.2]
-    assert back["n_contact"] > load[-0.2]["n_contact"]
-    assert back["load"] < load[-0.2]["load"]
+    # hysteresis: at Delta = -0.6 the loading branch is out of range (no contact, no
+    # force: the Dugdale attraction ends at h0), the unloading branch still adheres
+    assert load[-0.6]["n_contact"] == 0 and abs(load[-0.6]["load"]) < 1e-12 * np.pi * W * R
+    assert unload[-0.6]["n_contact"] > 0
+    assert unload[-0.6]["load"] < -0.9 * np.pi * W * R
     # the sweep ends detached: no contact, load back near zero
     assert recs[-1]["n_contact"] == 0 and abs(recs[-1]["load"]) < 1e-2 * abs(
         jkr_side.pull_off_force)

@@ -235,6 +235,30 @@ def _check(surface, material, law, delta):
     return d
 
 
+def _elastic_start(surface, material, op, delta, c, energy):
+    """Start of a cold solve (m, on the unknowns' grid): the non-adhesive equilibrium at
+    the same approach (Polonsky-Keer, preconditioned: cheap), or the rigid gap when
+    there is none (Delta <= 0, or full periodic contact)."""
+    from .contact import solve_contact
+
+    h = surface.heights
+    rigid = np.maximum(c, 0.0)
+    if delta <= 0 or (op.periodic and delta >= float(h.max() - h.mean())):
+        if op.periodic:
+            return rigid
+        x0 = np.zeros(energy.shape)
+        x0[energy.phys] = rigid
+        return x0
+    r = solve_contact(surface, material, delta=delta, kernel=op.name, solver="pk", tol=1e-6,
+                      compute_stiffness=False)
+    if op.periodic:
+        return np.array(r.gap, float)
+    x0 = op.convolve_spectrum(np.pad(r.pressure, [(0, m - n) for n, m in
+                                                  zip(op.shape, op.fft_shape)]), op.spectrum)
+    x0[energy.phys] = r.gap
+    return x0
+
+
 def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, delta,
                    kernel: str = "auto", initial=None, tol: float = 1e-5,
                    max_iter: int = 20000, spring=None, unloading: bool = False
@@ -255,7 +279,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
         As in :func:`roughfe.bem.solve_contact`.
     initial : ContactResult, optional
         A previous adhesive state (its gap, shifted by the change of delta, starts the
-        descent: the continuation of :func:`adhesive_sweep`).
+        descent: the continuation of :func:`adhesive_sweep`). Without it the descent
+        starts from the non-adhesive equilibrium at ``delta`` (Polonsky-Keer).
     tol : float
         Largest projected traction residual, relative to S = max(sigma0, E* gbar / 2).
     max_iter : int
@@ -286,22 +311,18 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     c = float(h.max()) - h - d
     scale = max(law.max_traction, 0.5 * material.E_star * rms_slope(surface))
     energy = _Energy(op, law, c, spring, scale)
-    x0 = np.zeros(energy.shape)
     if initial is not None:
         g_prev = np.asarray(initial.gap, float) + (initial.delta - d)
         if g_prev.shape != h.shape:
             raise InputError(f"initial state has shape {g_prev.shape}, expected {h.shape}")
-        if op.periodic:
-            x0 = g_prev
-        else:
-            x0 = np.asarray(initial.fields["padded_displacement"], float).copy() \
-                if initial.fields is not None else x0
+        x0 = g_prev
+        if not op.periodic:
+            x0 = np.zeros(energy.shape)
+            if initial.fields is not None:
+                x0 = np.array(initial.fields["padded_displacement"], float)
             x0[energy.phys] = g_prev
     else:
-        if op.periodic:
-            x0 = np.maximum(c, 0.0)
-        else:
-            x0[energy.phys] = np.maximum(c, 0.0)
+        x0 = _elastic_start(surface, material, op, d, c, energy)
     x0 = np.maximum(x0 / law.range, energy.bounds().lb.reshape(x0.shape)).ravel()
     nit, x = 0, x0
     for _ in range(4):       # restarts with a fresh quasi-Newton memory (round-off stalls)
@@ -339,7 +360,7 @@ def _adhesive_result(surface, material, op, law, energy, x, delta, resid, tol, n
         fields = None
     else:
         disp = u[energy.phys]
-        fields = {"padded_displacement": x.reshape(energy.shape).copy()}
+        fields = {"padded_displacement": x.reshape(energy.shape) * law.range}
     sigma = rms_height(surface)
     mean_gap = float(g.mean())
     return ContactResult(
