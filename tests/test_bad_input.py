@@ -118,6 +118,11 @@ def _channel_on_npz(t):
     return ["info", str(_surface(t)), "--channel", "1"], "--channel"
 
 
+def _damaged_instrument_file(t):
+    (t / "scan.x3p").write_text("garbage\n")            # content ST would read as a .hgt grid
+    return ["info", str(t / "scan.x3p")], "is not a readable .x3p file"
+
+
 def _tol_zero(t):
     return ["contact", str(_surface(t)), "--tol", "0", "-o", str(t / "o")], "number > 0"
 
@@ -152,12 +157,12 @@ def _leak_delta_and_pressure(t):
 
 
 CASES = [_truncated_npz, _output_is_a_file, _output_not_writable, _output_foreign_folder,
-         _generate_existing_file, _genome_example_existing_file, _huge_grid,
-         _genome_h_string, _genome_m_fraction, _genome_h_bool, _npz_as_genome, _steps_zero,
+         _generate_existing_file, _genome_example_existing_file, _huge_grid, _genome_h_string,
+         _genome_m_fraction, _genome_h_bool, _npz_as_genome, _steps_zero,
          _periodic_and_non_periodic, _complex_heights, _db_list_foreign_sqlite,
-         _db_list_empty_sqlite, _channel_on_npz, _tol_zero, _empty_npy, _directory_as_input,
-         _db_build_workers_zero, _negative_young_modulus, _negative_poisson_exponent,
-         _leak_delta_and_pressure]
+         _db_list_empty_sqlite, _channel_on_npz, _damaged_instrument_file, _tol_zero,
+         _empty_npy, _directory_as_input, _db_build_workers_zero, _negative_young_modulus,
+         _negative_poisson_exponent, _leak_delta_and_pressure]
 
 
 def _snapshot(root):

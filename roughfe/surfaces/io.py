@@ -188,6 +188,19 @@ def _choose_channel(reader, channel, path):
     return channels[index]
 
 
+def _check_reader_matches_suffix(path, reader):
+    """SurfaceTopography picks its reader by content: a damaged ``.x3p`` can be taken for
+    another format (8 bytes of text read as a 2 x 2 SRTM ``.hgt`` grid). When the suffix
+    names a format SurfaceTopography knows, the reader must be that format's."""
+    from SurfaceTopography.IO import readers
+
+    suffix = path.suffix.lower().lstrip(".")
+    fmt = reader.format()
+    if suffix != fmt and suffix in {r.format() for r in readers}:
+        raise FileFormatError(f"{path} is not a readable .{suffix} file (its content matches "
+                              f"SurfaceTopography's {fmt!r} reader instead)")
+
+
 def _read_instrument(path, size, periodic, channel):
     try:
         from SurfaceTopography import open_topography
@@ -199,6 +212,7 @@ def _read_instrument(path, size, periodic, channel):
         reader = open_topography(str(path))
     except Exception as exc:      # ST raises many types for unknown formats
         raise FileFormatError(f"{path}: no reader recognises this file ({exc})") from None
+    _check_reader_matches_suffix(path, reader)
     ch = _choose_channel(reader, channel, path)
     if ch.dim not in (1, 2):
         raise FileFormatError(f"{path}: channel {ch.name!r} has dimension {ch.dim}, not 1 or 2")
