@@ -123,6 +123,14 @@ def _damaged_instrument_file(t):
     return ["info", str(t / "scan.x3p")], "is not a readable .x3p file"
 
 
+def _study_into_a_foreign_folder(t):
+    (t / "o").mkdir()
+    (t / "o" / "results.json").write_text("{}")
+    spec = t / "s.toml"
+    spec.write_text('[study]\nanalysis = "selftest"\noutput = "o"\n[grid]\nx = [1.0]\n')
+    return ["study", "run", str(spec), "-o", str(t / "o")], "not a study folder"
+
+
 def _tol_zero(t):
     return ["contact", str(_surface(t)), "--tol", "0", "-o", str(t / "o")], "number > 0"
 
@@ -160,7 +168,8 @@ CASES = [_truncated_npz, _output_is_a_file, _output_not_writable, _output_foreig
          _generate_existing_file, _genome_example_existing_file, _huge_grid, _genome_h_string,
          _genome_m_fraction, _genome_h_bool, _npz_as_genome, _steps_zero,
          _periodic_and_non_periodic, _complex_heights, _db_list_foreign_sqlite,
-         _db_list_empty_sqlite, _channel_on_npz, _damaged_instrument_file, _tol_zero,
+         _db_list_empty_sqlite, _channel_on_npz, _damaged_instrument_file,
+         _study_into_a_foreign_folder, _tol_zero,
          _empty_npy, _directory_as_input, _db_build_workers_zero, _negative_young_modulus,
          _negative_poisson_exponent, _leak_delta_and_pressure]
 

@@ -44,8 +44,19 @@ def failure_path(outdir, key) -> Path:
 
 @contextlib.contextmanager
 def study_lock(outdir):
-    """Hold an exclusive lock on ``OUTDIR/.lock`` (released by the OS if the driver dies)."""
+    """Hold an exclusive lock on ``OUTDIR/.lock`` (released by the OS if the driver dies).
+
+    A folder that holds files but no ``study.json`` is not a study folder: it is refused
+    (InputError), so a study never mixes its files into another command's output.
+    """
     outdir = Path(outdir)
+    if outdir.exists() and not outdir.is_dir():
+        raise InputError(f"study output {outdir} is an existing file; give a folder")
+    if outdir.is_dir() and not study_file(outdir).exists():
+        other = sorted(e.name for e in outdir.iterdir() if e.name != ".lock")
+        if other:
+            raise InputError(f"study output {outdir} holds files but is not a study folder (no "
+                             f"study.json; e.g. {other[0]!r}); choose a new or empty folder")
     outdir.mkdir(parents=True, exist_ok=True)
     with folder_lock(outdir, "`roughfe study run`"):
         yield
