@@ -169,6 +169,15 @@ def _length_or_scale(p, required=True, default=None):
     g.add_argument("--length", type=positive_float, help="observation length L (m)")
 
 
+def _add_response_options(p, nargs, kernels_help):
+    """``--kernels``, ``--E``/``--nu`` and ``--steps`` of the A(p), K(p) sweeps."""
+    p.add_argument("--kernels", nargs=nargs, choices=("thesis", "strip"),
+                   default=["thesis", "strip"], help=kernels_help)
+    add_material_options(p)
+    p.add_argument("--steps", type=positive_int, default=20,
+                   help="equal approaches up to the peak-valley amplitude")
+
+
 def register(sub):
     top = sub.add_parser("genome", help="surface roughness genomics: realise, sequence, chromosome mechanics",
                          description="Surface roughness genomics (thesis Ch. 3): write the "
@@ -226,11 +235,7 @@ def register(sub):
     p.add_argument("genome", metavar="GENOME.json", help="roughfe-genome JSON file")
     _length_or_scale(p, required=False, default="10x")
     p.add_argument("--nodes", type=positive_int, default=512, help="number of nodes N")
-    p.add_argument("--kernels", nargs="+", choices=("thesis", "strip"), default=["thesis", "strip"],
-                   help="BEM kernels: thesis (Eq. 2.4) and/or strip (plane strain)")
-    add_material_options(p)
-    p.add_argument("--steps", type=positive_int, default=20,
-                   help="equal approaches up to the peak-valley amplitude")
+    _add_response_options(p, "+", "BEM kernels: thesis (Eq. 2.4) and/or strip (plane strain)")
     p.add_argument("--max-chromosomes", type=positive_int, default=10,
                    help="single-chromosome curves (thesis: 10)")
     add_output_folder(p)
@@ -247,11 +252,7 @@ def register(sub):
                    help="nested window lengths as fractions of the row")
     p.add_argument("--nodes", type=positive_int, default=512, help="nodes per acquisition")
     p.add_argument("--seed", type=int, default=0, help="seed of the M likelihood and phase draws")
-    p.add_argument("--kernels", nargs="*", choices=("thesis", "strip"), default=["thesis", "strip"],
-                   help="BEM kernels for A(p), K(p) (none: sequencing only)")
-    add_material_options(p)
-    p.add_argument("--steps", type=positive_int, default=20,
-                   help="equal approaches up to the peak-valley amplitude")
+    _add_response_options(p, "*", "BEM kernels for A(p), K(p) (none: sequencing only)")
     p.add_argument("--tolerance", type=positive_float, default=0.05,
                    help="relative rms error below which a profile counts as WM-like")
     add_output_folder(p)
