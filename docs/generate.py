@@ -161,7 +161,7 @@ def _flat_rows(value) -> bool:
 
 def _table(rows, columns=None) -> list:
     columns = columns or list(dict.fromkeys(k for r in rows for k in r))
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines = ["| " + " | ".join(_fmt(c) for c in columns) + " |", "|" + "---|" * len(columns)]
     lines += ["| " + " | ".join(_fmt(r.get(c)) for c in columns) + " |" for r in rows[:MAX_ROWS]]
     if len(rows) > MAX_ROWS:
         lines.append(f"\n({len(rows) - MAX_ROWS} more rows in the JSON)")
@@ -229,6 +229,8 @@ def result_page(title: str, source: Path, data, command: str) -> str:
 
     def walk(node, path, depth):
         heading = f"## {' / '.join(path) or 'Results'}"
+        if path == ["targets"] and targets:
+            return                                  # shown above with its verdicts
         if _flat_rows(node):
             lines.extend([heading, ""] + _table(node) + [""])
         elif (depth > 0 and isinstance(node, dict) and node and path[-1] not in FLAG_KEYS

@@ -36,15 +36,18 @@ def test_targets_records_give_values_and_verdicts(gen, tmp_path):
             "targets": [{"name": "width error", "value": 0.0012, "target": 0.005, "met": True,
                          "unit": "relative"},
                         {"name": "area error", "value": 0.0912, "target": 0.02, "met": False}],
-            "cases": {"rmd": [{"r": 1, "A": 0.123456789}, {"r": 2, "A": None}]}}
+            "cases": {"rmd": [{"r": 1, "A": 0.123456789}, {"r": 2, "A": None}]},
+            "diffs": [{"max|dp|/max p": 1e-10}]}
     page = _pages(gen, tmp_path, {"alpha": data})["alpha"]
     assert "# Validation: Alpha check" in page
     assert "1 of 2 met." in page
     assert "| width error | 0.0012 | 0.005 | relative | met |" in page
     assert "| area error | 0.0912 | 0.02 | n/a | **NOT met** |" in page
     assert "| elapsed_s | 12.5 |" in page            # top-level scalar summary
+    assert "| max\\|dp\\|/max p |" in page                 # a pipe in a header is escaped
     assert "## cases / rmd" in page and "| 1 | 0.1235 |" in page and "| 2 | n/a |" in page
     assert "roughfe validate alpha" in page
+    assert page.count("width error") == 1                  # the targets are listed once
 
 
 def test_legacy_flag_maps_are_found_at_any_depth(gen, tmp_path):
