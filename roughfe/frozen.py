@@ -17,7 +17,7 @@ import numpy as np
 
 
 def _read_only(self, *args, **kwargs):
-    raise TypeError("a FrozenMapping is read-only (copy it with dict(...) to change it)")
+    raise TypeError(f"a {type(self).__name__} is read-only (copy it to change it)")
 
 
 class FrozenMapping(dict):
@@ -34,6 +34,21 @@ class FrozenMapping(dict):
 
     def __repr__(self):
         return f"FrozenMapping({dict.__repr__(self)})"
+
+
+class FrozenList(list):
+    """A read-only list: equal to the list it holds, picklable and JSON-serialisable as
+    a list; every mutating method raises ``TypeError``. ``list(x)`` gives a mutable copy."""
+
+    __slots__ = ()
+    __setitem__ = __delitem__ = __iadd__ = __imul__ = _read_only
+    append = extend = insert = pop = remove = clear = sort = reverse = _read_only
+
+    def __reduce__(self):
+        return FrozenList, (list(self),)
+
+    def __repr__(self):
+        return f"FrozenList({list.__repr__(self)})"
 
 
 def freeze(value):
@@ -54,6 +69,19 @@ def freeze_fields(obj) -> None:
     for f in dataclasses.fields(obj):
         if f.init:
             object.__setattr__(obj, f.name, freeze(getattr(obj, f.name)))
+
+
+def freeze_containers(obj) -> None:
+    """Make the dict and list fields of the dataclass instance ``obj`` immutable (one
+    level: a dict becomes a :class:`FrozenMapping`, a list a :class:`FrozenList`, both
+    still equal to what they were); arrays are left as they are. For frozen results
+    whose arrays their producer shares."""
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if isinstance(value, dict) and not isinstance(value, FrozenMapping):
+            object.__setattr__(obj, f.name, FrozenMapping(value))
+        elif isinstance(value, list) and not isinstance(value, FrozenList):
+            object.__setattr__(obj, f.name, FrozenList(value))
 
 
 class Frozen:

@@ -75,3 +75,17 @@ def test_frozen_mapping_is_read_only_and_picklable():
     assert not m["b"]["c"].flags.writeable
     back = pickle.loads(pickle.dumps(m))
     assert dict(back)["a"] == (1, 2) and isinstance(back["b"], FrozenMapping)
+
+
+def test_frozen_list_equals_its_list_and_refuses_changes():
+    import json
+    import pickle
+
+    from roughfe.frozen import FrozenList
+
+    x = FrozenList([1, (2, 3)])
+    assert x == [1, (2, 3)] and json.dumps(x) == "[1, [2, 3]]"
+    for change in (lambda: x.append(4), lambda: x.__setitem__(0, 5), lambda: x.sort()):
+        with pytest.raises(TypeError):
+            change()
+    assert pickle.loads(pickle.dumps(x)) == x and x == [1, (2, 3)]

@@ -22,6 +22,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from ..errors import InputError
+from ..frozen import freeze_containers
 from ..surfaces.surface import Surface
 from ..writers import to_jsonable
 from .bands import BandChromosomes
@@ -69,6 +70,9 @@ class BandMechanics:
     elapsed: float
     success: bool = True
     message: str = ""
+
+    def __post_init__(self):
+        freeze_containers(self)
 
     def to_dict(self) -> dict:
         """JSON-ready curves and coefficients (NaN -> None)."""

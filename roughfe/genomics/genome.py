@@ -54,6 +54,7 @@ from typing import Any, Mapping, Optional
 import numpy as np
 
 from ..errors import FileFormatError, InputError, check_finite_positive
+from ..frozen import FrozenMapping
 from ..surfaces.surface import Surface
 from ..surfaces.wm import wm_series
 from ..writers import write_json
@@ -155,7 +156,7 @@ class Genome:
         if aniso is not None and not np.all(aniso > 0):
             raise InputError(f"anisotropy factors must be > 0, got {aniso.tolist()}")
         set_(self, "anisotropy", aniso)
-        set_(self, "metadata", dict(self.metadata or {}))
+        set_(self, "metadata", FrozenMapping(self.metadata or {}))
 
     # -- derived genes --------------------------------------------------------------
     @property

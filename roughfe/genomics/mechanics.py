@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..frozen import freeze_containers
 from ..surfaces.surface import Surface
 from ..writers import to_jsonable
 from .chromosomes import reconstruction
@@ -111,6 +112,9 @@ class ChromosomeMechanics:
     nit: int
     elapsed: float = 0.0
     references: tuple = field(default=("thesis Sec. 3.4.1, Fig. 36-39",))
+
+    def __post_init__(self):
+        freeze_containers(self)
 
     def to_dict(self) -> dict:
         """JSON-safe curves and coefficients."""

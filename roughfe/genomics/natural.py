@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..frozen import freeze_containers
 from ..surfaces.surface import Surface
 from .genome import DEFAULT_NODES, node_coordinates, realize
 from .mechanics import THESIS_YOUNGS_MODULUS, curve_difference, response
@@ -123,6 +124,9 @@ class NaturalResult:
     message: str
     nit: int
     references: tuple = field(default=("thesis Sec. 3.4.2, Table 3, Fig. 41-46",))
+
+    def __post_init__(self):
+        freeze_containers(self)
 
     def report(self) -> dict:
         out = {"sequencing": self.sequencing.report(),

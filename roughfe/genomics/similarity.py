@@ -33,6 +33,7 @@ from typing import Literal
 import numpy as np
 
 from ..errors import FileFormatError, InputError
+from ..frozen import FrozenMapping
 
 Quantity = Literal["K", "A"]
 QUANTITIES = ("K", "A")
@@ -193,7 +194,7 @@ class Target:
             raise InputError("target pressures must be distinct")
         object.__setattr__(self, "pressure", _readonly(p))
         object.__setattr__(self, "values", _readonly(y))
-        object.__setattr__(self, "metadata", dict(self.metadata or {}))
+        object.__setattr__(self, "metadata", FrozenMapping(self.metadata or {}))
 
     @property
     def p_max(self) -> float:

@@ -45,6 +45,7 @@ from typing import Any, Mapping
 
 from .. import __version__
 from ..errors import InputError
+from ..frozen import freeze_containers
 
 SECTIONS = {"study", "grid", "fixed"}
 RUNNER_ONLY = ("replica",)  # parameters that select seeds but are not passed to the analysis
@@ -120,6 +121,9 @@ class Task:
     params: Mapping[str, Any]
     seed: int
     key: str
+
+    def __post_init__(self):
+        freeze_containers(self)
 
     @property
     def kwargs(self) -> dict:

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import FileFormatError, InputError
+from ...frozen import freeze_containers
 from ..similarity import ResponseCurve
 from .settings import DatabaseSettings
 from .sobol import SobolDesign
@@ -63,6 +64,8 @@ class DatabaseEntry:
     gamma: float = field(default=np.nan)
     hurst: float = field(default=np.nan)
 
+    def __post_init__(self):
+        freeze_containers(self)
 
 def _now():
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")

@@ -23,6 +23,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from ...errors import InputError
+from ...frozen import freeze_containers
 from ..database import DatabaseEntry, DatabaseSettings
 from ..macro_micro import classify
 from ..similarity import ResponseCurve, Target, similarity, split_ranges
@@ -83,6 +84,9 @@ class DesignResult:
     nit: int
     elapsed: float
     references: tuple = REFERENCES
+
+    def __post_init__(self):
+        freeze_containers(self)
 
     @property
     def best(self) -> Candidate:

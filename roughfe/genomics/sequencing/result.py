@@ -7,6 +7,7 @@ from typing import Optional
 import numpy as np
 
 from ...writers import to_jsonable
+from ...frozen import freeze_containers
 from ..genome import Genome
 
 
@@ -77,6 +78,9 @@ class SequencingResult:
     seed: Optional[int] = None
     elapsed: float = 0.0
     references: tuple = field(default=("thesis Sec. 3.3.1, Eq. 3.5-3.16",))
+
+    def __post_init__(self):
+        freeze_containers(self)
 
     def report(self) -> dict:
         """JSON-safe summary (genes, rms errors, ranges, diagnostics)."""
