@@ -145,3 +145,12 @@ def test_bad_adhesion_parameters(args, match):
 def test_bad_approach():
     with pytest.raises(InputError, match="delta"):
         solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=float("nan"))
+
+
+def test_periodic_full_contact_approach_is_refused():
+    # mean u = 0: Delta = max h - mean h closes every gap; the adhesive state is then not
+    # set by the approach (the solver would return the machine spring's force)
+    s = spectral_surface(16, 1e-4, 0.8, rms_height=1e-7, rng=1)
+    top = float(s.heights.max() - s.heights.mean())
+    with pytest.raises(InputError, match="full contact"):
+        solve_adhesive(s, Material(1e9, 0.3), AdhesionLaw("exp", 0.01, 1e-9), delta=top)

@@ -5,13 +5,15 @@ and force is reported in Maugis' units, so the scale drops out), work of adhesio
 w = 2.83e-4 J/m^2, Maugis-Dugdale law with h0 set by Maugis' parameter
 lambda = 2 sigma0 (R / (pi w K^2))^(1/3), K = 4 E*/3. Non-periodic Love kernel on a grid
 that holds the attraction zone and puts >= 8 cells in the Dugdale zone c - a at pull-off
-(capped at 160^2); continuation in the approach (steps of 0.1 in Maugis' approach unit),
+(capped at 128^2); continuation in the approach (steps of 0.1 in Maugis' approach unit),
 loading to delta_bar = 0.2, then unloading until the sphere separates. The pull-off is
 the most tensile load of the unloading branch; Maugis' is the minimum of his load over
 the contact radius (roughfe.reference.maugis_pull_off), the load-control pull-off, which
 the displacement-controlled branch passes through.
 
-Also a refinement study at lambda = 2 (4 and 8 cells in c - a) and a rough adhesive
+Also a refinement study at lambda = 2 (2, 4 and 8 cells in c - a), Johnson's (1995)
+adhesive sinusoid (JKR-type closed form against the Maugis-Dugdale BEM near the JKR
+limit, two grids) and a rough adhesive
 contact (periodic self-affine surface, exponential law): loading and unloading branches,
 pull-off pressure, whether the surface is sticky.
 
@@ -32,6 +34,7 @@ from roughfe.reference import maugis_load, maugis_pull_off
 from roughfe.surfaces.shapes import sphere_cap
 from roughfe.surfaces.spectral import spectral_surface
 from roughfe.surfaces.stats import rms_slope
+from roughfe.surfaces.surface import Surface
 from roughfe.theory import persson
 from roughfe.writers import write_json
 
@@ -51,7 +54,7 @@ def maugis_zone(lam):
     return res.x * A_UNIT, (m - 1) * res.x * A_UNIT
 
 
-def run_sphere(lam, cells_in_zone=8, n_max=160):
+def run_sphere(lam, cells_in_zone=8, n_max=128):
     sigma0 = lam / (2 * (R / (np.pi * W * K ** 2)) ** (1 / 3))
     law = AdhesionLaw("md", W, W / sigma0)
     a, zone = maugis_zone(lam)
@@ -94,6 +97,31 @@ def rough_adhesive():
             "persson_area_fraction_nonadhesive": [float(a) for a in theory.area_fraction]}
 
 
+def johnson_sinusoid():
+    """Johnson (1995): periodic profile h = D cos(2 pi x / l), plane strain, JKR-type
+    adhesion: p = p* sin^2(psi) - sqrt(2 w E* tan(psi) / l), psi = pi a / l,
+    p* = pi E* D / l. Maugis-Dugdale law with a Dugdale zone ~2 % of a (near the JKR
+    limit); loading steps; the contact half-width a from the contact points. Two grids."""
+    l, amp = 1.0, 0.01
+    alpha = 0.5                      # Johnson's alpha = sqrt(2 l w / (pi^2 E* D^2))
+    w = alpha ** 2 * np.pi ** 2 * amp ** 2 / (2 * l)
+    law = AdhesionLaw("md", w, w / 0.137)
+    pstar = np.pi * E_STAR * amp / l
+    out = []
+    for n in (4096, 8192):
+        x = np.arange(n) * l / n
+        s = Surface(amp * np.cos(2 * np.pi * x / l), l, periodic=True)
+        sw = adhesive_sweep(s, MAT, law, np.linspace(0.002, 0.008, 4))
+        for r in sw.sweep.results:
+            psi = np.pi * r.n_contact * (l / n) / 2 / l
+            theory = pstar * np.sin(psi) ** 2 - np.sqrt(2 * w * E_STAR * np.tan(psi) / l)
+            out.append({"n": n, "delta": r.delta, "a_over_l": psi / np.pi,
+                        "p_over_pstar_bem": r.mean_pressure / pstar,
+                        "p_over_pstar_johnson": theory / pstar,
+                        "difference_over_pstar": (r.mean_pressure - theory) / pstar})
+    return out
+
+
 def main():
     rows = []
     for lam in (0.1, 0.3, 1.0, 2.0):
@@ -106,6 +134,10 @@ def main():
     for r in refinement:
         print(f"lambda 2 refinement: {r['cells_in_dugdale_zone']:.1f} cells in c - a, n = "
               f"{r['n']}: {100 * r['relative_error']:+.2f} %", flush=True)
+    johnson = johnson_sinusoid()
+    for r in johnson:
+        print(f"Johnson sinusoid n = {r['n']}: a/l = {r['a_over_l']:.4f}, p/p* BEM "
+              f"{r['p_over_pstar_bem']:.4f} vs {r['p_over_pstar_johnson']:.4f}", flush=True)
     rough = rough_adhesive()
     print(f"rough adhesive contact: pull-off pressure {rough['pull_off_pressure']:.4g} Pa, "
           f"sticky {rough['sticky']}, detached {rough['detached']}, {rough['cpu_s']:.0f} s CPU")
@@ -113,7 +145,8 @@ def main():
                 "value": r["relative_error"], "target": "|error| <= 0.02",
                 "met": bool(abs(r["relative_error"]) <= 0.02)} for r in rows]
     write_json(OUT, {"validation": "adhesion_maugis", "targets": targets, "maugis": rows,
-                     "refinement_lambda_2": refinement, "rough": rough,
+                     "refinement_lambda_2": refinement, "johnson_sinusoid": johnson,
+                     "rough": rough,
                      "units": {"pull_off": "P / (pi w R)", "length_m": "m", "cpu_s": "s"}})
     return 0 if all(t["met"] for t in targets) else 1
 

@@ -308,6 +308,11 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
     h = surface.heights
+    if op.periodic and d >= float(h.max() - h.mean()):
+        raise InputError(f"delta = {d:.6g} m reaches max h - mean h = "
+                         f"{float(h.max() - h.mean()):.6g} m: on a periodic surface (zero mean "
+                         f"displacement) that is full contact, where the adhesive state is "
+                         f"not defined by the approach; stay below it")
     c = float(h.max()) - h - d
     scale = max(law.max_traction, 0.5 * material.E_star * rms_slope(surface))
     energy = _Energy(op, law, c, spring, scale)
