@@ -225,3 +225,35 @@ def test_contact_length_westergaard_bem():
         ref = westergaard(G, LAM, MAT.E_star, r.mean_pressure)
         length = contact_length(x, r.pressure[:n], r.gap[:n], r.contact[:n], MAT.E_star)
         assert length == pytest.approx(ref.half_width, rel=0.005)
+
+
+def test_load_control_reaches_the_pressure_and_equals_displacement_control(westergaard_mesh):
+    """fem_contact_sweep(pressures=...): each step reaches its mean pressure to LOAD_RTOL,
+    is the solution of the displacement-controlled problem at its own imposed approach
+    (same p, A*, K to 1e-9), and its half-width matches Westergaard at that load (1 %)."""
+    from roughfe.fem.contact import LOAD_RTOL
+    p_star = np.pi * MAT.E_star * G / LAM
+    targets = np.array([0.15, 0.4, 0.7]) * p_star
+    sweep = fem_contact_sweep(westergaard_mesh, MAT, pressures=targets)
+    assert np.all(np.abs(sweep.mean_pressure / targets - 1) <= LOAD_RTOL)
+    again = fem_contact_sweep(westergaard_mesh, MAT, applied_deltas=sweep.delta_applied)
+    for key in ("mean_pressure", "area_fraction", "stiffness", "mean_gap"):
+        assert np.allclose(getattr(again, key), getattr(sweep, key), rtol=1e-9, atol=0), key
+    for r in sweep.results:
+        ref = westergaard(G, LAM, MAT.E_star, r.mean_pressure)
+        assert abs(contact_edge(r.x, r.gap, r.contact) / ref.half_width - 1) < 0.01
+    with pytest.raises(InputError, match="exactly one of"):
+        fem_contact_sweep(westergaard_mesh, MAT, [1e-7], pressures=targets)
+    with pytest.raises(InputError, match="pressures must be > 0"):
+        fem_contact_sweep(westergaard_mesh, MAT, pressures=[0.0, 1.0])
+
+
+def test_iterative_inner_solver_gives_the_direct_solution(westergaard_mesh):
+    """CG + hypre for the SNES-VI inner solves and the stiffness solve (petsc_options
+    ksp_*/pc_*) reproduces the MUMPS solution (p, A*, K to 1e-6)."""
+    applied = np.array([0.5]) * G
+    direct = fem_contact_sweep(westergaard_mesh, MAT, applied_deltas=applied)
+    cg = fem_contact_sweep(westergaard_mesh, MAT, applied_deltas=applied, options=FemSolverOptions(
+        petsc_options={"ksp_type": "cg", "pc_type": "hypre", "ksp_rtol": 1e-13}))
+    for key in ("mean_pressure", "area_fraction", "stiffness"):
+        assert np.allclose(getattr(cg, key), getattr(direct, key), rtol=1e-6, atol=0), key

@@ -32,6 +32,7 @@ from roughfe.genomics.natural import sequence_measured
 from roughfe.genomics.sequencing import sequence_profiles, thesis_zd_fit
 from roughfe.plotting import genomics as gp
 from roughfe.surfaces.io import load_surface
+from roughfe.validation import within
 from roughfe.writers import write_json, write_text
 
 SEEDS = tuple(range(20))
@@ -40,9 +41,9 @@ TOPOGRAPHIES = Path(__file__).resolve().parents[2] / "shared" / "data" / "topogr
 TARGETS = {"gamma": 0.01, "rms": 0.02, "curves": 0.02, "H_mean": 0.02}
 
 
-def table1_case(outdir: Path, rows_zd: dict):
+def table1_case(outdir: Path, rows_zd: dict, seeds=SEEDS):
     rows = []
-    for seed in SEEDS:
+    for seed in seeds:
         g = table1_genome(rng=seed)
         acq = [realize(g, scale=s) for s in ("10x", "20x", "100x")]
         t0 = time.perf_counter()
@@ -58,7 +59,7 @@ def table1_case(outdir: Path, rows_zd: dict):
                      "M": G.M, "H_psd": res.H_psd, "gamma_psd": res.gamma_psd,
                      "rms_errors": res.rms_errors.tolist(), "ranges": [list(r) for r in res.ranges],
                      "curves": curves, "time_s": dt, "success": res.success})
-        if seed == SEEDS[0]:
+        if seed == seeds[0]:
             zfit = thesis_zd_fit(res, seed=seed)
             rows_zd.update({"M": zfit.M.tolist(), "cost": zfit.cost.tolist(), "P": zfit.P.tolist(),
                             "A_from_alpha": (zfit.alpha * zfit.A0).tolist(), "A0": zfit.A0,
@@ -110,15 +111,17 @@ def _fmt(v, f=".3g"):
     return "n/a" if v is None else format(v, f)
 
 
-def main(outdir: Path) -> bool:
+def main(outdir: Path, quick: bool = False) -> bool:
+    """All cases; ``quick``: the Table 1 genome on the first 3 seeds only (no measured rows,
+    no chromosome mechanics)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     zd = {}
-    rows = table1_case(outdir, zd)
+    rows = table1_case(outdir, zd, SEEDS[:3] if quick else SEEDS)
     val = validity_monte_carlo(range(2, 21), 1000, rng=0)
     gp.plot_validity(val, outdir / "eq3_10_validity.png")
-    natural = natural_case(outdir)
-    mech = mechanics_case(outdir)
+    natural = {} if quick else natural_case(outdir)
+    mech = {} if quick else mechanics_case(outdir)
 
     g_err = max(abs(r["gamma"] / 1.5 - 1) for r in rows)
     rms = max(max(r["rms_errors"]) for r in rows)
@@ -126,8 +129,17 @@ def main(outdir: Path) -> bool:
     h_vals = np.array([r["H"] for r in rows])
     a_vals = np.array([r["A"] for r in rows])
     h_mean_err = abs(h_vals.mean() / 0.75 - 1)
-    checks = {"gamma": g_err <= TARGETS["gamma"], "rms": rms <= TARGETS["rms"],
-              "curves": curv <= TARGETS["curves"], "H_mean": h_mean_err <= TARGETS["H_mean"]}
+    n_seeds = f"{len(rows)} seeds"
+    targets = [
+        within("Table 1: gamma", g_err, TARGETS["gamma"], f"worst of {n_seeds}"),
+        within("Table 1: relative rms error of every acquisition", rms, TARGETS["rms"],
+               f"worst of {n_seeds} x 10x/20x/100x"),
+        within("Table 1: A(p), K(p) sequenced vs true", curv, TARGETS["curves"],
+               f"worst of {n_seeds} x both kernels"),
+        within("Table 1: mean H over the seeds (no bias)", h_mean_err, TARGETS["H_mean"],
+               f"{n_seeds}; H per seed is a statistical estimate (sd "
+               f"{h_vals.std(ddof=1) if h_vals.size > 1 else float('nan'):.3f})")]
+    checks = {k: t.met for k, t in zip(("gamma", "rms", "curves", "H_mean"), targets)}
     ok = all(checks.values())
 
     md = ["# Genome sequencing (thesis Sec. 3.3-3.4)", "",
@@ -210,7 +222,9 @@ def main(outdir: Path) -> bool:
     write_json(outdir / "genomics_sequencing.json",
                {"table1": rows, "zd_ridge_fit": zd, "validity": {"M": val.M.tolist(), "valid": val.valid_fraction.tolist(),
                                              "arccos": val.arccos_fraction.tolist()},
-                "natural": natural, "mechanics": mech, "checks": checks, "targets": TARGETS})
+                "natural": natural, "mechanics": mech, "checks": checks, "tolerances": TARGETS,
+                "name": "genomics_sequencing", "quick": quick,
+                "targets": [t.to_dict() for t in targets]})
     return ok
 
 

@@ -1,26 +1,37 @@
 """``roughfe validate NAME``: run a validation script of ``validation/`` and write its report.
 
-Each script ``validation/<script>.py`` defines ``main(outdir: pathlib.Path) -> bool``
-(True when every target is met) and writes ``<outdir>/<script>.md`` with its figures.
-They are readable physics scripts that compare roughfe with analytic solutions, FEM and
-the literature; they need the repository checkout (they are not installed modules).
+Each script ``validation/<script>.py`` defines ``main(outdir: pathlib.Path, quick=False)
+-> bool`` (True when every target is met) and writes ``<outdir>/<script>.md`` with its
+figures and ``<outdir>/<script>.json`` whose ``"targets"`` rows follow the schema of
+:mod:`roughfe.validation`; ``roughfe validate`` collects them in ``<outdir>/summary.json``.
+``--quick`` runs the reduced cases of every script (``make validate-quick``, CI): same
+targets, smaller problems. They are readable physics scripts that compare roughfe with
+analytic solutions, FEM and the literature; they need the repository checkout (they are
+not installed modules).
 """
 from __future__ import annotations
 
 import importlib.util
+import inspect
+import json
+import time
 from pathlib import Path
 
 from .. import progress
 from ..errors import InputError
+from ..validation import Target
+from ..writers import write_json
 
-# name on the command line -> script in validation/ (explicit, ordered)
+# name on the command line -> scripts in validation/ (explicit, ordered)
 VALIDATIONS = {
-    "bem": "bem_contact",
-    "fem": "bem_vs_fem",
-    "sequencing": "genomics_sequencing",
-    "design": "design_study",
-    "leakage": "leakage_flow",
+    "bem": ("bem_contact",),
+    "fem": ("bem_vs_fem", "fem_convergence"),
+    "sequencing": ("genomics_sequencing",),
+    "design": ("design_study",),
+    "leakage": ("leakage_flow",),
 }
+#: scripts without a reduced case, left out of ``--quick``
+NOT_QUICK = {"fem_convergence"}
 
 
 def _validation_dir() -> Path:
@@ -30,36 +41,72 @@ def _validation_dir() -> Path:
     return here
 
 
-def run_validation(name: str, outdir: Path) -> bool:
-    """Import ``validation/<script>.py`` and run its ``main(outdir)``."""
-    if name not in VALIDATIONS:
-        raise InputError(f"unknown validation {name!r}; choose from {sorted(VALIDATIONS)} or 'all'")
-    path = _validation_dir() / f"{VALIDATIONS[name]}.py"
+def _load(script: str):
+    path = _validation_dir() / f"{script}.py"
     if not path.is_file():
         raise InputError(f"validation script {path} is missing")
-    spec = importlib.util.spec_from_file_location(f"roughfe_validation_{VALIDATIONS[name]}", path)
+    spec = importlib.util.spec_from_file_location(f"roughfe_validation_{script}", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    return bool(module.main(Path(outdir)))
+    return module
+
+
+def _targets(outdir: Path, script: str, ok: bool) -> list:
+    """The script's target rows from its JSON; one summary row if it wrote none."""
+    path = Path(outdir) / f"{script}.json"
+    try:
+        rows = json.loads(path.read_text()).get("targets")
+    except (OSError, ValueError, AttributeError):
+        rows = None
+    if isinstance(rows, list) and rows and all(isinstance(r, dict) for r in rows):
+        return rows
+    return [Target(f"{script}: all targets", "every target of the script",
+                   "met" if ok else "NOT met", ok,
+                   f"the script wrote no target rows in {path.name}").to_dict()]
+
+
+def run_validation(name: str, outdir: Path, quick: bool = False) -> dict:
+    """Run the scripts of validation ``name``; ``{"met": bool, "targets": [rows], ...}``."""
+    if name not in VALIDATIONS:
+        raise InputError(f"unknown validation {name!r}; choose from {sorted(VALIDATIONS)} or 'all'")
+    out = {"met": True, "targets": [], "seconds": {}}
+    for script in VALIDATIONS[name]:
+        if quick and script in NOT_QUICK:
+            continue
+        module = _load(script)
+        takes_quick = "quick" in inspect.signature(module.main).parameters
+        t0 = time.perf_counter()
+        ok = bool(module.main(Path(outdir), **({"quick": True} if quick and takes_quick else {})))
+        out["seconds"][script] = time.perf_counter() - t0
+        out["met"] &= ok
+        out["targets"] += _targets(outdir, script, ok)
+    return out
 
 
 def _script_doc(name: str) -> str:
     """The docstring of ``validation/<script>.py`` (read with ast: nothing is imported)."""
     import ast
     try:
-        path = _validation_dir() / f"{VALIDATIONS[name]}.py"
-        return ast.get_docstring(ast.parse(path.read_text())) or ""
+        return "\n\n".join(
+            ast.get_docstring(ast.parse((_validation_dir() / f"{script}.py").read_text())) or ""
+            for script in VALIDATIONS[name])
     except (InputError, OSError, SyntaxError):
         return "(validation script not found: run from a roughfe checkout)"
 
 
 def _run(args) -> int:
     names = list(VALIDATIONS) if args.name == "all" else [args.name]
-    failed = []
+    outdir = Path(args.output)
+    summary = {}
     for name in progress.iterate(names, "validations"):
-        print(f"== validation {name}")
-        if not run_validation(name, Path(args.output)):
-            failed.append(name)
+        print(f"== validation {name}{' (quick)' if args.quick else ''}", flush=True)
+        summary[name] = run_validation(name, outdir, quick=args.quick)
+        for t in summary[name]["targets"]:
+            if not t["met"]:
+                print(f"   NOT met: {t['name']}: {t['measured']} (target {t['target']})")
+    failed = [n for n, v in summary.items() if not v["met"]]
+    write_json(outdir / "summary.json", {"validations": summary, "quick": bool(args.quick),
+                                         "all_met": not failed})
     print("all validation targets met" if not failed else f"targets missed in: {', '.join(failed)}")
     return 1 if failed else 0
 
@@ -80,4 +127,6 @@ def register(sub):
         v.add_argument("-o", "--output", default="validation/output", metavar="OUTDIR",
                        help="report folder (each study writes its own <script>.md/.json and "
                             "figures there; other files are kept)")
+        v.add_argument("--quick", action="store_true",
+                       help="reduced cases of every script, same targets (make validate-quick)")
         v.set_defaults(func=_run, renders_with_dolfinx=True)

@@ -63,6 +63,9 @@ from .petsc_tools import LU_MUMPS, apply_options, check_snes, unique_prefix
 
 Method = Literal["vi", "penalty"]
 METHODS = ("vi", "penalty")
+_KSP_PREFIXES = ("ksp_", "pc_", "mat_mumps_")
+#: Load control: relative tolerance on the mean pressure of a step.
+LOAD_RTOL = 1e-6
 REFERENCES = ("Benson S.J., Munson T.S. (2006) Optim. Methods Softw. 21:155-168 (SNES VI)",
               "Wriggers P. (2006) Computational Contact Mechanics, Springer (penalty)",
               "Johnson K.L. (1985) Contact Mechanics, Sec. 13.2 (Westergaard)")
@@ -102,7 +105,10 @@ class FemSolverOptions:
         SNES iteration limit per load step.
     petsc_options : mapping, optional
         Extra PETSc options (without prefix) overriding the defaults, e.g.
-        ``{"snes_linesearch_type": "bt"}``.
+        ``{"snes_linesearch_type": "bt"}``. The linear-solver keys (``ksp_*``, ``pc_*``,
+        ``mat_mumps_*``; default MUMPS LU) apply to the SNES's inner solves and to the
+        incremental-stiffness solve, e.g. ``{"ksp_type": "cg", "pc_type": "hypre",
+        "ksp_rtol": 1e-12}`` (see ``benchmarks/bench_fem.py`` for their cost).
     """
 
     method: Method = "vi"
@@ -225,12 +231,15 @@ class _ContactProblem:
         snes.setConvergenceHistory(reset=True)       # |F(x_0)| of each solve: the tolerance
         defaults = {"snes_type": "vinewtonrsls" if opt.method == "vi" else "newtonls",
                     "snes_linesearch_type": "basic", **LU_MUMPS}
-        ksp_keys = {"ksp_type", "pc_type", "pc_factor_mat_solver_type"}
         petsc = {**defaults, **dict(opt.petsc_options or {})}
+        # the linear-solver options (ksp_*, pc_*) serve the SNES's inner solves and the
+        # incremental-stiffness solve alike (MUMPS LU by default; e.g. CG + hypre)
+        self.ksp_options = {k: v for k, v in petsc.items() if k.startswith(_KSP_PREFIXES)}
         prefix = unique_prefix(opt.method)
-        apply_options(snes, prefix, {k: v for k, v in petsc.items() if k not in ksp_keys})
+        apply_options(snes, prefix, {k: v for k, v in petsc.items()
+                                     if k not in self.ksp_options})
         ksp = snes.getKSP()
-        apply_options(ksp, prefix, {k: v for k, v in petsc.items() if k in ksp_keys})
+        apply_options(ksp, prefix, self.ksp_options)
         self.lower = self.x.duplicate()
         self.upper = self.x.duplicate()
         self.lower.set(-PETSc.INFINITY)
@@ -276,6 +285,30 @@ class _ContactProblem:
             f"FEM contact: the half-plane approach {target:.6g} m was not reached "
             f"(last {r.delta:.6g} m, imposed {applied:.6g} m)", result=r)
 
+    def solve_mean_pressure(self, target: float, guess: float,
+                            keep_fields: bool = False) -> FemContactResult:
+        """Solve for the mean pressure ``target`` (Pa) (load control), starting from the
+        imposed approach ``guess`` (m).
+
+        Newton on the imposed approach with the exact stiffness of the last solve,
+        d applied = d p (1/K + H_d/M), until |p / target - 1| <= :data:`LOAD_RTOL`;
+        2-3 solves from a guess within a few per cent (e.g. the BEM's Delta(p)).
+        """
+        compliance = self.pmesh.depth / p_wave_modulus(self.material)
+        applied = float(guess)
+        for _ in range(12):
+            r = self.solve(applied, keep_fields)
+            err = target - r.mean_pressure
+            if abs(err) <= LOAD_RTOL * target:
+                return r
+            if r.stiffness > 0:
+                applied = max(applied + err * (1.0 / r.stiffness + compliance), 0.0)
+            else:                                  # not touching yet: move half-way up
+                applied = applied + 0.5 * self.u_ref
+        raise NoConvergenceError(
+            f"FEM contact: the mean pressure {target:.6g} Pa was not reached "
+            f"(last {r.mean_pressure:.6g} Pa at imposed approach {applied:.6g} m)", result=r)
+
     def _incremental_stiffness(self, contact_local):
         """Exact dp/d delta_applied (non-dimensional E/W units) with the contact set frozen.
 
@@ -298,7 +331,7 @@ class _ContactProblem:
         J.zeroRowsColumns((rows + rstart).astype(PETSc.IntType), diag=1.0, x=du, b=b)
         ksp = PETSc.KSP().create(comm)
         ksp.setOperators(J)
-        apply_options(ksp, unique_prefix("stiffness"), LU_MUMPS)
+        apply_options(ksp, unique_prefix("stiffness"), self.ksp_options)
         ksp.solve(b, du)
         reason = ksp.getConvergedReason()
         ksp.destroy()
@@ -488,9 +521,10 @@ def contact_length(x, pressure, gap, contact, e_star) -> float:
 
 
 def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
-                      applied_deltas=None, options: FemSolverOptions | None = None,
+                      applied_deltas=None, pressures=None, guesses=None,
+                      options: FemSolverOptions | None = None,
                       keep_fields=()) -> SweepResult:
-    """Solve the FEM contact problem for increasing approaches (load stepping).
+    """Solve the FEM contact problem for increasing approaches or loads (load stepping).
 
     Each step starts from the previous solution.
 
@@ -504,7 +538,14 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
         (``result.delta``); each costs 2-4 solves (Newton on the imposed approach).
     applied_deltas : array_like, optional
         Or: strictly increasing approaches imposed on the layer (m), one solve each;
-        ``result.delta`` is then ``applied - p H_d / M``. Give exactly one of the two.
+        ``result.delta`` is then ``applied - p H_d / M``.
+    pressures : array_like, optional
+        Or: strictly increasing mean pressures > 0 (Pa), load control to a relative
+        :data:`LOAD_RTOL`; each costs 2-3 solves (Newton on the imposed approach from the
+        periodic BEM's Delta(p) of the mirrored profile). Give exactly one of the three.
+    guesses : array_like, optional
+        With ``pressures``: imposed approaches (m) to start each step's Newton from
+        instead of the BEM's, e.g. ``delta_applied`` of a coarser mesh of the same body.
     options : FemSolverOptions, optional
     keep_fields : iterable of int
         Indices of the steps whose full fields (mesh, displacement, sigma_yy) are kept.
@@ -517,28 +558,59 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     """
     material = _check_material(material)
     options = FemSolverOptions() if options is None else options
-    if (deltas is None) == (applied_deltas is None):
-        raise InputError("give exactly one of deltas (half-plane approaches, m) or "
-                         "applied_deltas (approaches imposed on the layer, m)")
-    name = "deltas" if applied_deltas is None else "applied_deltas"
-    values = np.asarray(deltas if applied_deltas is None else applied_deltas, dtype=float).ravel()
+    given = {k: v for k, v in (("deltas", deltas), ("applied_deltas", applied_deltas),
+                               ("pressures", pressures)) if v is not None}
+    if len(given) != 1:
+        raise InputError("give exactly one of deltas (half-plane approaches, m), "
+                         "applied_deltas (approaches imposed on the layer, m) or pressures "
+                         f"(mean pressures, Pa); got {sorted(given) or 'none'}")
+    (name, values), = given.items()
+    values = np.asarray(values, dtype=float).ravel()
     if values.size == 0 or not np.all(np.isfinite(values)) or np.any(values < 0):
-        raise InputError(f"{name} must be a non-empty list of finite values >= 0 (m), "
+        raise InputError(f"{name} must be a non-empty list of finite values >= 0, "
                          f"got {values!r}")
+    if name == "pressures" and np.any(values <= 0):
+        raise InputError(f"pressures must be > 0 (Pa), got {values!r}")
     if np.any(np.diff(values) <= 0):
         raise InputError(f"{name} must be strictly increasing (load stepping)")
     keep = {int(k) % values.size for k in keep_fields}
     problem = _ContactProblem(pmesh, material, options)
-    step = problem.solve if applied_deltas is not None else problem.solve_half_plane
+    if name == "pressures" and guesses is None:
+        guesses = _applied_guesses(pmesh, material, values)
+    elif guesses is not None:
+        guesses = np.asarray(guesses, dtype=float).ravel()
+        if name != "pressures" or guesses.shape != values.shape:
+            raise InputError(f"guesses (m) go with pressures, one per load; got {guesses!r}")
+
+    def step(k):
+        if name == "pressures":
+            return problem.solve_mean_pressure(values[k], guesses[k], k in keep)
+        if name == "applied_deltas":
+            return problem.solve(values[k], k in keep)
+        return problem.solve_half_plane(values[k], k in keep)
+
     results = []
     try:
-        for k, d in enumerate(values):
-            results.append(step(d, keep_fields=k in keep))
+        for k in range(values.size):
+            results.append(step(k))
     except NoConvergenceError as exc:
         raise NoConvergenceError(str(exc), result=results) from None
     finally:
         problem.destroy()
     return SweepResult.from_results(results, rms_slope=problem.rms_slope, length=pmesh.width)
+
+
+def _applied_guesses(pmesh: ProfileMesh, material: Material, pressures) -> np.ndarray:
+    """Imposed approaches (m) expected to give ``pressures``: the periodic BEM's Delta(p) of
+    the mirrored profile (the FEM body's reference problem) plus the layer shortening."""
+    from ..bem import contact_sweep
+    from ..surfaces import Surface
+    from .mesh import mirrored_profile
+
+    profile = Surface(np.asarray(pmesh.heights), pmesh.heights.size * pmesh.element_size)
+    bem = contact_sweep(mirrored_profile(profile), material, pressures=pressures,
+                        kernel="spectral", solver="pk", compute_stiffness=False)
+    return bem.delta + np.asarray(pressures) * pmesh.depth / p_wave_modulus(material)
 
 
 def fem_solve_contact(pmesh: ProfileMesh, material: Material, delta=None, *,

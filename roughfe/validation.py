@@ -1,0 +1,183 @@
+"""Tools of the validation studies: target rows (the JSON schema of ``validation/output``)
+and Richardson extrapolation of a refinement sequence.
+
+Target rows
+-----------
+Every validation script (``roughfe validate NAME``) writes ``<outdir>/<script>.json`` with a
+top-level key ``"targets"``: a list of rows
+
+    {"name": str,        what is compared, e.g. "RMD: A* limits FEM vs BEM"
+     "target": str,      the criterion as text, e.g. "<= 1 %"
+     "measured": str,    the measured value as text, e.g. "0.42 %"
+     "value": float|null the measured value as a number (SI or a fraction), if any
+     "met": bool,
+     "reason": str}      why it is (not) met, or what it measures; "" when obvious
+
+and ``roughfe validate`` writes ``<outdir>/summary.json``: ``{"validations": {name: {"met":
+bool, "targets": [rows]}}, "all_met": bool}``. The documentation pages are generated from
+these files; no number is typed by hand.
+
+Richardson extrapolation
+------------------------
+For a quantity Q_h computed on a sequence of discretisations refined by a constant ratio
+rho (h, h/rho, h/rho^2, ...), Q_h = Q + C h^p + o(h^p). Three consecutive levels give the
+observed order p = ln((Q_1 - Q_0) / (Q_2 - Q_1)) / ln(rho) and the extrapolated limit
+Q = Q_2 + (Q_2 - Q_1) / (rho^p - 1) (Roache 1998, Verification and Validation in
+Computational Science and Engineering, Ch. 5).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+#: Orders outside this range are taken as "not in the asymptotic range".
+ORDER_RANGE = (0.5, 4.0)
+#: Roache's safety factors of the grid convergence index: 1.25 with an observed order from
+#: three grids, 3 when the order is not observed (fallback).
+SAFETY_OBSERVED, SAFETY_FALLBACK = 1.25, 3.0
+
+
+@dataclass(frozen=True)
+class Target:
+    """One validation target: the row of the JSON schema (see the module docstring)."""
+
+    name: str
+    target: str
+    measured: str
+    met: bool
+    reason: str = ""
+    value: float | None = None
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["met"] = bool(self.met)
+        if d["value"] is not None:
+            d["value"] = float(d["value"]) if math.isfinite(d["value"]) else None
+        return d
+
+
+def percent(value: float, digits: int = 2) -> str:
+    """``0.0123 -> "1.23 %"``; non-finite -> ``"n/a"``."""
+    return f"{100 * value:.{digits}f} %" if np.isfinite(value) else "n/a"
+
+
+def within(name: str, value: float, limit: float, reason: str = "") -> Target:
+    """A target ``|value| <= limit`` for a relative quantity (fractions, shown in %)."""
+    v = float(value)
+    return Target(name=name, target=f"<= {percent(limit, 3).replace('.000', '')}",
+                  measured=percent(v, 3), met=bool(np.isfinite(v) and abs(v) <= limit),
+                  reason=reason, value=v)
+
+
+def targets_markdown(rows) -> str:
+    """The rows as a Markdown table (target | criterion | measured | status | reason)."""
+    lines = ["| target | criterion | measured | status | reason |", "|---|---|---|---|---|"]
+    for t in rows:
+        lines.append(f"| {t.name} | {t.target} | {t.measured} | "
+                     f"{'met' if t.met else '**NOT met**'} | {t.reason} |")
+    return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True)
+class Richardson:
+    """Richardson extrapolation of a refinement sequence (see the module docstring).
+
+    Attributes
+    ----------
+    values : tuple of float
+        Q at the levels, coarsest first.
+    ratio : float
+        Refinement ratio rho between consecutive levels.
+    orders : tuple of float
+        Observed order of every consecutive triple of levels (NaN where the two
+        differences change sign or one is zero).
+    order : float
+        Order used: that of the finest triple if it is observed and within
+        :data:`ORDER_RANGE`, else NaN (fallback).
+    asymptotic : bool
+        True when ``order`` is observed (the finest triple converges monotonically at an
+        order within :data:`ORDER_RANGE`).
+    limit : float
+        Extrapolated value; in the fallback the finest value (no extrapolation).
+    uncertainty : float
+        Estimated error of ``limit``: asymptotic, (F_s - 1) |Q_fine - limit| with
+        F_s = 1.25, i.e. a quarter of the extrapolation step; fallback, F_s |Q_fine -
+        Q_previous| with F_s = 3 (Roache's grid convergence index for an unobserved
+        order, assuming first order).
+    errors : tuple of float
+        Estimated discretisation error of every level: ``|Q_level - limit| +
+        uncertainty``.
+    method : str
+        How the limit was obtained, in words.
+    """
+
+    values: tuple
+    ratio: float
+    orders: tuple
+    order: float
+    asymptotic: bool
+    limit: float
+    uncertainty: float
+    errors: tuple
+    method: str
+
+    def to_dict(self) -> dict:
+        def clean(v):
+            return float(v) if np.isfinite(v) else None
+        return {"values": [clean(v) for v in self.values], "ratio": self.ratio,
+                "orders": [clean(v) for v in self.orders], "order": clean(self.order),
+                "asymptotic": self.asymptotic, "limit": clean(self.limit),
+                "uncertainty": clean(self.uncertainty),
+                "errors": [clean(v) for v in self.errors], "method": self.method}
+
+
+def observed_orders(values, ratio: float = 2.0) -> np.ndarray:
+    """Observed order of each consecutive triple of ``values`` (NaN if not monotone)."""
+    q = np.asarray(values, dtype=float)
+    d = np.diff(q)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        quotient = d[:-1] / d[1:]
+        return np.where(quotient > 0, np.log(np.abs(quotient)) / math.log(ratio), np.nan)
+
+
+def richardson(values, ratio: float = 2.0) -> Richardson:
+    """Richardson-extrapolate ``values`` (coarsest first, refined by ``ratio`` each).
+
+    Uses the finest three levels. If their differences have one sign and the observed
+    order lies in :data:`ORDER_RANGE`, the limit is extrapolated with that order;
+    otherwise the sequence is not in its asymptotic range and the fallback keeps the
+    finest value as the limit with the wider uncertainty (see :class:`Richardson`).
+
+    Raises
+    ------
+    InputError
+        Fewer than 3 finite values, or ``ratio <= 1``.
+    """
+    q = np.asarray(values, dtype=float).ravel()
+    if q.size < 3 or not np.all(np.isfinite(q)):
+        raise InputError(f"Richardson extrapolation needs >= 3 finite values, got {q.tolist()}")
+    if not ratio > 1:
+        raise InputError(f"the refinement ratio must be > 1, got {ratio!r}")
+    orders = observed_orders(q, ratio)
+    p = float(orders[-1])
+    step = q[-1] - q[-2]
+    if np.isfinite(p) and ORDER_RANGE[0] <= p <= ORDER_RANGE[1]:
+        limit = float(q[-1] + step / (ratio ** p - 1.0))
+        unc = (SAFETY_OBSERVED - 1.0) * abs(q[-1] - limit)
+        method = f"extrapolated with the observed order {p:.2f} of the finest three levels"
+        asymptotic = True
+    else:
+        why = ("the last two differences change sign" if not np.isfinite(p)
+               else f"observed order {p:.2f} outside {ORDER_RANGE}")
+        limit, unc, asymptotic = float(q[-1]), SAFETY_FALLBACK * abs(step), False
+        method = (f"not in the asymptotic range ({why}): limit = finest value, "
+                  f"uncertainty {SAFETY_FALLBACK:g} x the last difference")
+        p = float("nan")
+    errors = tuple(float(abs(v - limit) + unc) for v in q)
+    return Richardson(values=tuple(float(v) for v in q), ratio=float(ratio),
+                      orders=tuple(float(o) for o in orders), order=p, asymptotic=asymptotic,
+                      limit=limit, uncertainty=float(unc), errors=errors, method=method)
