@@ -1,0 +1,124 @@
+"""Cost of one FEM contact load step (SNES VI) against the number of dofs: MUMPS LU vs
+iterative inner solvers, and the largest profile solvable in < 30 s per step (issue 16 §4).
+
+Case: RMD profiles (D = 1.5, rms height 1 um, L = 1 mm, seed 1) of n = 2^m + 1 nodes, the
+production mesh of ``roughfe validate fem`` (top elements dx, growth 0.1 with depth, depth
+2 W), E = 210 GPa, nu = 0.3. One load step = one SNES ``vinewtonrsls`` solve at the imposed
+approach 0.6 (max h - mean h) starting from the converged solution at 0.4 (the typical
+step of a sweep), including the incremental-stiffness solve; mesh generation and assembly
+are reported apart. Solvers of the inner linear systems (``FemSolverOptions.petsc_options``):
+
+* ``mumps``: LU (the default);
+* ``cg-hypre``: CG + BoomerAMG, rtol 1e-10;
+* ``cg-gamg``: CG + PETSc GAMG, rtol 1e-10.
+
+Timings are process CPU seconds (the machine is shared; wall time is printed beside it);
+the iterative solvers are stopped at the first size whose step exceeds ``ITERATIVE_CAP``
+CPU seconds. The largest profile solvable in < 30 s per step is read from the measured
+MUMPS rows and extrapolated with the fitted power law t = a dofs^b.
+Run: ``.venv/bin/python benchmarks/bench_fem.py [M ...]`` (default m = 8..12); writes
+``benchmarks/output/bench_fem.json``.
+"""
+from __future__ import annotations
+
+import os
+import resource
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from roughfe.bem import Material
+from roughfe.fem import mesh_profile
+from roughfe.fem.contact import FemSolverOptions, _ContactProblem
+from roughfe.surfaces.rmd import rmd_profile
+from roughfe.writers import write_json
+
+MATERIAL = Material(E=210e9, nu=0.3)
+SOLVERS = {"mumps": {},
+           "cg-hypre": {"ksp_type": "cg", "pc_type": "hypre", "ksp_rtol": 1e-10},
+           "cg-gamg": {"ksp_type": "cg", "pc_type": "gamg", "ksp_rtol": 1e-10}}
+ITERATIVE_CAP = 60.0          # CPU s per step beyond which an iterative solver is not grown
+STEP_LIMIT = 30.0             # issue 16: the largest profile solvable in < 30 s per VI step
+OUT = Path(__file__).resolve().parent / "output" / "bench_fem.json"
+
+
+def one_size(m: int, solvers) -> list:
+    surf = rmd_profile(m, 1.5, 1e-3, rng=1, rms_height=1e-6)
+    top = float(surf.heights.max() - surf.heights.mean())
+    c0, t0 = time.process_time(), time.perf_counter()
+    pm = mesh_profile(surf, growth=0.1)
+    mesh_cpu, mesh_wall = time.process_time() - c0, time.perf_counter() - t0
+    rows = []
+    for name in solvers:
+        row = {"m": m, "nodes": surf.shape[0], "cells": pm.n_cells, "solver": name,
+               "mesh_cpu_s": mesh_cpu, "mesh_wall_s": mesh_wall}
+        try:
+            c0 = time.process_time()
+            problem = _ContactProblem(pm, MATERIAL, FemSolverOptions(petsc_options=SOLVERS[name]))
+            row["dofs"] = int(problem.K.getSize()[0])
+            row["assembly_cpu_s"] = time.process_time() - c0
+            problem.solve(0.4 * top)
+            ksp0 = problem.snes.getLinearSolveIterations()
+            c0, t0 = time.process_time(), time.perf_counter()
+            r = problem.solve(0.6 * top)
+            row.update(step_cpu_s=time.process_time() - c0, step_wall_s=time.perf_counter() - t0,
+                       snes_iterations=int(r.nit),
+                       ksp_iterations=int(problem.snes.getLinearSolveIterations() - ksp0),
+                       area_fraction=float(r.area_fraction), mean_pressure=float(r.mean_pressure),
+                       ok=True)
+            problem.destroy()
+        except Exception as exc:          # PETSc errors and non-convergence are reported
+            row.update(ok=False, error=f"{type(exc).__name__}: {str(exc).splitlines()[0][:200]}")
+        row["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+        rows.append(row)
+        print(f"{m:>3} {row['nodes']:>6} {row.get('dofs', 0):>8} {name:>9} "
+              + (f"{row['step_cpu_s']:>8.2f} {row['step_wall_s']:>8.2f} {row['snes_iterations']:>4} "
+                 f"{row['ksp_iterations']:>6} {row['area_fraction']:>7.4f}" if row["ok"]
+                 else f"failed: {row['error']}"), flush=True)
+    return rows
+
+
+def largest_within(rows, limit=STEP_LIMIT) -> dict:
+    """Largest measured MUMPS profile with a step < limit, and the power-law estimate."""
+    ok = [r for r in rows if r["solver"] == "mumps" and r["ok"]]
+    if len(ok) < 2:
+        return {}
+    dofs = np.array([r["dofs"] for r in ok], float)
+    cpu = np.array([r["step_cpu_s"] for r in ok])
+    nodes = np.array([r["nodes"] for r in ok], float)
+    b, log_a = np.polyfit(np.log(dofs[-3:]), np.log(cpu[-3:]), 1)
+    dofs_at = float(np.exp((np.log(limit) - log_a) / b))
+    nodes_per_dof = np.polyfit(np.log(dofs), np.log(nodes), 1)
+    within = [r for r in ok if r["step_cpu_s"] < limit]
+    return {"limit_s": limit, "exponent": float(b),
+            "largest_measured_nodes": max((r["nodes"] for r in within), default=None),
+            "extrapolated_dofs": dofs_at,
+            "extrapolated_nodes": float(np.exp(np.polyval(nodes_per_dof, np.log(dofs_at))))}
+
+
+def main(ms) -> int:
+    print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    print(f"{'m':>3} {'nodes':>6} {'dofs':>8} {'solver':>9} {'cpu s':>8} {'wall s':>8} "
+          f"{'its':>4} {'ksp':>6} {'A*':>7}")
+    rows, active = [], list(SOLVERS)
+    for m in ms:
+        new = one_size(m, active)
+        rows += new
+        active = [s for s in active if s == "mumps" or any(
+            r["solver"] == s and r["ok"] and r["step_cpu_s"] < ITERATIVE_CAP for r in new)]
+    big = largest_within(rows)
+    if big:
+        print(f"MUMPS: step CPU ~ dofs^{big['exponent']:.2f}; largest measured profile with a "
+              f"step < {STEP_LIMIT:.0f} s CPU: {big['largest_measured_nodes']} nodes; "
+              f"extrapolated: {big['extrapolated_nodes']:.0f} nodes "
+              f"({big['extrapolated_dofs']:.3g} dofs)")
+    OUT.parent.mkdir(parents=True, exist_ok=True)
+    write_json(OUT, {"name": "bench_fem", "rows": rows, "largest_within_30s": big,
+                     "load_average": os.getloadavg()[0], "solvers": SOLVERS})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main([int(a) for a in sys.argv[1:]] or list(range(8, 13))))
