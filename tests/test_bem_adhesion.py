@@ -94,6 +94,7 @@ def test_dmt_limit_sphere_pull_off():
     assert ratio == pytest.approx(-2.0, rel=3e-2)
 
 
+@pytest.mark.slow
 def test_jkr_side_sphere_pull_off(jkr_side):
     # lambda = 2: Maugis -1.535 pi w R. Measured -1.511 (-1.6 %); with 4 cells per
     # Dugdale zone the contact edge is pinned by the grid (lattice trapping) and the

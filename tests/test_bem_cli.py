@@ -16,6 +16,7 @@ def _bump(n=24, periodic=False):
                    periodic=periodic, metadata={"generator": "test bump"})
 
 
+@pytest.mark.slow
 def test_contact_cli_writes_results_fields_and_figures(tmp_path):
     path = save_surface(_bump(), tmp_path / "bump.npz")
     out = tmp_path / "out"
@@ -93,6 +94,7 @@ def _sphere_file(tmp_path, n=40, length=0.8):
     return save_surface(sphere_cap(n, length, 1.0), tmp_path / "sphere.npz")
 
 
+@pytest.mark.slow
 def test_contact_cli_adhesion_unload_pull_off(tmp_path):
     # R = 1 m sphere on E* = 1 Pa, Maugis-Dugdale w = 2.83e-4 J/m^2, h0 = 0.0486 m
     # (lambda = 0.1: Maugis' pull-off -1.95 pi w R, 2.5 % from DMT's -2 pi w R)

@@ -10,6 +10,7 @@ from roughfe.genomics import design as de
 from roughfe.genomics.similarity import Target
 
 
+@pytest.mark.slow
 def test_db_and_design_commands(tmp_path, capsys):
     path = tmp_path / "db.sqlite"
     assert main(["db", "build", str(path), "--nodes", "128", "--steps", "10", "--limit", "3",

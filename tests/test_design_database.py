@@ -56,6 +56,7 @@ def test_eq_4_2_scaling_law_with_the_bem():
         np.testing.assert_allclose(c1.rescaled(3.0).pressure, c3.pressure, rtol=1e-7)
 
 
+@pytest.mark.slow
 def test_build_through_the_runner_equals_the_task_and_resumes(tmp_path):
     """db build = genome_entry_task run by the study runner, then imported into SQLite."""
     from roughfe.study import build_genome_db, extend_genome_db

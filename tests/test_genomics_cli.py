@@ -2,12 +2,14 @@
 import json
 
 import numpy as np
+import pytest
 
 from roughfe.cli import main
 from roughfe.genomics.genome import load_genome
 from roughfe.surfaces.io import load_surface
 
 
+@pytest.mark.slow
 def test_genome_commands_end_to_end(tmp_path, capsys):
     g = tmp_path / "g.json"
     assert main(["genome", "example", "-o", str(g), "--seed", "3"]) == 0

@@ -16,6 +16,7 @@ STEP_KEYS = {"delta", "mean_pressure", "area_fraction", "leak_rate", "hydraulic_
              "trapped_volume_star"}
 
 
+@pytest.mark.slow
 def test_leak_command_writes_results_fields_and_figures(tmp_path):
     s = rmd_surface(4, 2.3, 1e-4, rng=5)
     path = save_surface(s, tmp_path / "s.npz")
@@ -55,6 +56,7 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
         assert (out / "figures" / name).stat().st_size > 5000
 
 
+@pytest.mark.slow
 def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
     from roughfe.cli import main
     out = tmp_path / "study"

@@ -23,6 +23,7 @@ def test_missing_analysis_module_is_a_clear_error(monkeypatch):
         resolve("ghost")
 
 
+@pytest.mark.slow
 def test_tiny_contact_sweep_study_runs_and_is_reproducible(tmp_path):
     pytest.importorskip("roughfe.bem")
     study = {"study": {"analysis": "contact_sweep", "output": str(tmp_path / "a"), "seed": 3,

@@ -90,6 +90,7 @@ def test_seed_is_a_stable_hash():
     assert derive_seed(2026, "selftest", {"x": 1.0}) != derive_seed(2027, "selftest", {"x": 1.0})
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_gives_identical_table(reference, tmp_path):
     pytest.importorskip("distributed")
     out = tmp_path / "dask"
@@ -150,6 +151,7 @@ def _alive(pid):
     return state != "Z"
 
 
+@pytest.mark.slow
 def test_kill_9_then_resume_gives_identical_table(tmp_path):
     out = tmp_path / "killed"
     spec_path = _write_toml(tmp_path / "spec.toml", out, sleep=0.25)
