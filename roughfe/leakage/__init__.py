@@ -10,16 +10,20 @@
   (scipy only) to cross-check the finite elements.
 * :func:`critical_constriction` -> :class:`CriticalConstriction`: the critical gap
   (widest-path bottleneck), its junction, width and parent channel (thesis Ch. 5).
+* :func:`coupled_leakage` / :func:`coupled_leakage_sweep` -> :class:`CoupledResult`: two-way
+  fluid-structure coupling (the Reynolds pressure loads the elastic body; trapped fluid).
 * :mod:`roughfe.leakage.study`: the percolation study of Sec. 2.4.2-2.4.5.
 """
 from .analysis import (LeakageResult, LeakageSweep, analyse_leakage, leakage_of_contact,
                        leakage_sweep)
 from .network import DirectionalNetwork, NetworkResult, directional_network, free_volume_network
 from .finite_volume import finite_volume_leak_rate
+from .fsi import CoupledResult, coupled_leakage, coupled_leakage_sweep
 from .junction import CriticalConstriction, critical_constriction
 from .reynolds import ReynoldsResult, hydraulic_aperture, reynolds_flow
 
 __all__ = ["free_volume_network", "directional_network", "NetworkResult", "DirectionalNetwork",
            "reynolds_flow", "ReynoldsResult", "hydraulic_aperture", "analyse_leakage",
            "leakage_of_contact", "LeakageResult", "leakage_sweep", "LeakageSweep",
-           "finite_volume_leak_rate", "critical_constriction", "CriticalConstriction"]
+           "finite_volume_leak_rate", "critical_constriction", "CriticalConstriction",
+           "coupled_leakage", "coupled_leakage_sweep", "CoupledResult"]
