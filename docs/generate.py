@@ -260,19 +260,27 @@ def _validation_commands():
     except Exception:  # the page still says how to run the script
         return {}
     return {script: f"roughfe validate {name} -o validation/output"
-            for name, script in VALIDATIONS.items()}
+            for name, scripts in VALIDATIONS.items()
+            for script in ((scripts,) if isinstance(scripts, str) else scripts)}
 
 
-def write_results(scripts, output: Path, outdir: Path, kind: str, commands) -> list:
+def write_results(scripts, output: Path, outdir: Path, kind: str, commands,
+                  fallback: Path | None = None) -> list:
     """One page per script (``<stem>.md``) from ``output/<stem>.json`` or any
-    ``output/<stem>*.json``; returns ``(stem, status)`` pairs."""
+    ``output/<stem>*.json`` (else from ``fallback``, e.g. the quick validation run, which
+    the page then says); returns ``(stem, status)`` pairs."""
     outdir.mkdir(parents=True, exist_ok=True)
     pages, report = {}, []
     for script in scripts:
         stem = script.stem
         command = commands.get(stem, f"python {_rel(script)}")
-        found = sorted(output.glob(f"{stem}.json")) + sorted(
-            p for p in output.glob(f"{stem}*.json") if p.name != f"{stem}.json")
+        for folder in (output, fallback):
+            found = [] if folder is None else sorted(folder.glob(f"{stem}.json")) + sorted(
+                p for p in folder.glob(f"{stem}*.json") if p.name != f"{stem}.json")
+            if found:
+                break
+        if found and folder is fallback:
+            command += f" --quick (reduced cases; found in {_rel(fallback)})"
         if not found:
             pages[f"{stem}.md"] = missing_page(f"{kind}: {stem}", output / f"{stem}.json", command)
             report.append((stem, "missing"))
@@ -300,6 +308,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--validation", type=Path, default=ROOT / "validation" / "output",
                         help="folder of the validation JSON (make validate)")
+    parser.add_argument("--quick", type=Path, default=ROOT / "validation" / "output-quick",
+                        help="folder of the quick validation JSON (make validate-quick), "
+                             "used for a validation whose full run is missing")
     parser.add_argument("--benchmarks", type=Path, default=ROOT / "benchmarks" / "output",
                         help="folder of the benchmark JSON (make bench)")
     args = parser.parse_args(argv)
@@ -309,7 +320,7 @@ def main(argv=None) -> int:
     print(f"[docs] command-line reference: {n_cli} commands")
     scripts = sorted(p for p in (ROOT / "validation").glob("*.py") if not p.name.startswith("_"))
     report = write_results(scripts, args.validation, DOCS / "validation" / "generated",
-                           "Validation", _validation_commands())
+                           "Validation", _validation_commands(), fallback=args.quick)
     print("[docs] validation pages: " + ", ".join(f"{s} ({r})" for s, r in report))
     benches = sorted((ROOT / "benchmarks").glob("bench_*.py"))
     report = write_results(benches, args.benchmarks, DOCS / "benchmarks" / "generated",

@@ -61,6 +61,21 @@ def test_legacy_flag_maps_are_found_at_any_depth(gen, tmp_path):
     assert "| cases.rmd: area | n/a | **NOT met** |" in page
 
 
+def test_quick_run_is_used_and_named_when_the_full_run_is_missing(gen, tmp_path):
+    scripts, full, quick, pages = (tmp_path / d for d in ("v", "full", "quick", "pages"))
+    for d in (scripts, full, quick):
+        d.mkdir()
+    (scripts / "alpha.py").write_text("")
+    (quick / "alpha.json").write_text(json.dumps(
+        {"targets": [{"name": "w", "target": "<= 1 %", "measured": "0.2 %", "value": 0.002,
+                      "met": True, "reason": ""}]}))
+    gen.write_results([scripts / "alpha.py"], full, pages, "Validation",
+                      {"alpha": "roughfe validate alpha"}, fallback=quick)
+    page = (pages / "alpha.md").read_text()
+    assert "roughfe validate alpha --quick" in page and "1 of 1 met." in page
+    assert "| w | 0.002 | <= 1 % | 0.2 % |" in page
+
+
 def test_missing_json_says_so_and_shows_no_numbers(gen, tmp_path):
     page = _pages(gen, tmp_path, {"gamma": None})["gamma"]
     assert "Not run yet" in page and "gamma.json" in page
