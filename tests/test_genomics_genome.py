@@ -4,7 +4,8 @@ import pytest
 
 from roughfe.errors import FileFormatError, InputError
 from roughfe.genomics.genome import (Genome, chromosome_heights, chromosome_range, load_genome,
-                                     node_coordinates, realize, save_genome, table1_genome)
+                                     node_coordinates, observation_coordinates, profile_heights,
+                                     realize, save_genome, table1_genome)
 
 
 def test_table1_index_ranges_from_eq_3_5():
@@ -57,8 +58,16 @@ def test_json_round_trip_and_errors(tmp_path):
         Genome(A=1, H=0.7, gamma=1.0, lambda1=1e-3, phases=np.zeros((2, 3)))
     with pytest.raises(InputError, match="H"):
         Genome(A=1, H=-0.1, gamma=1.5, lambda1=1e-3, phases=np.zeros((2, 3)))
-    with pytest.raises(InputError, match="phases"):
-        realize(g, length=1e-5)          # needs chromosomes beyond n = 22
+    # a band-limited genome (issue 15): a window that shows chromosomes beyond the phase
+    # matrix (n = 1..22) sums those it holds and invents none; a window that shows none
+    # of them is an error
+    fine = realize(g, length=1e-5)
+    assert fine.metadata["chromosomes"][-1] == 22 < fine.metadata["n_f"]
+    np.testing.assert_allclose(
+        fine.heights, profile_heights(g, observation_coordinates(fine),
+                                      np.arange(fine.metadata["n_s"], 23)))
+    with pytest.raises(InputError, match="holds only"):
+        realize(g, length=1e-9)
     bad = g.to_dict() | {"version": 99}
     with pytest.raises(FileFormatError, match="version"):
         Genome.from_dict(bad)

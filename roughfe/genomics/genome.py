@@ -195,6 +195,20 @@ class Genome:
         """(n_s, n_f) at observation length ``length`` (m) with ``n_nodes`` nodes, Eq. (3.5)."""
         return chromosome_range(self.gamma, self.lambda1, length, n_nodes)
 
+    def held_range(self, length, n_nodes=DEFAULT_NODES):
+        """The chromosomes of Eq. (3.5) at this window that the genome holds (band-limited
+        genome): ``(max(n_s, n_first), min(n_f, n_last))``. A genome carries chromosomes
+        only over a finite band (a sequenced genome holds exactly those present in the
+        data); a realisation sums those and never invents the ones beyond its phases.
+        InputError when the window shows none of them."""
+        n_s, n_f = self.chromosome_range(length, n_nodes)
+        lo, hi = max(n_s, self.n_first), min(n_f, self.n_last)
+        if lo > hi:
+            raise InputError(f"a window of L = {length:g} m with {n_nodes} nodes shows chromosomes "
+                             f"{n_s}..{n_f} (Eq. 3.5), but the genome holds only "
+                             f"{self.n_first}..{self.n_last}")
+        return lo, hi
+
     def length_of(self, scale) -> float:
         """Observation length (m) of a named scale ("10x", "20x", "100x"): fraction of lambda1."""
         if scale not in SCALES:
@@ -446,7 +460,8 @@ def realize(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, scale=None,
         Named scale: L = lambda1, lambda1/2, lambda1/10 (Table 1 convention).
     chromosomes : sequence of int, optional
         Sum only these chromosome indices (a single chromosome, a top-down or bottom-up
-        partial sum, Sec. 3.2.2). Default: all of n_s..n_f (Eq. 3.5).
+        partial sum, Sec. 3.2.2). Default: the chromosomes n_s..n_f of Eq. (3.5) that
+        the genome holds (:meth:`Genome.held_range`: none beyond its phase matrix).
 
     Returns
     -------
@@ -462,7 +477,7 @@ def realize(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, scale=None,
     n_nodes = _check_nodes(n_nodes)
     n_s, n_f = genome.chromosome_range(length, n_nodes)
     if chromosomes is None:
-        idx = np.arange(n_s, n_f + 1)
+        idx = np.arange(*np.add(genome.held_range(length, n_nodes), (0, 1)))
     else:
         idx = np.unique(np.atleast_1d(np.asarray(chromosomes, dtype=int)))
         if idx.size == 0:
@@ -494,7 +509,7 @@ def realize_surface(genome: Genome, length, n_nodes=DEFAULT_NODES) -> Surface:
         raise InputError("realize_surface needs a genome with ridge angles (one per row of phases)")
     n_nodes = _check_nodes(n_nodes)
     n_s, n_f = genome.chromosome_range(length, n_nodes)
-    n = np.arange(n_s, n_f + 1)
+    n = np.arange(*np.add(genome.held_range(length, n_nodes), (0, 1)))
     phases = genome.phase_columns(n)
     amps = np.broadcast_to(genome.wave_amplitude(n), phases.shape)
     if genome.anisotropy is not None:
@@ -503,7 +518,7 @@ def realize_surface(genome: Genome, length, n_nodes=DEFAULT_NODES) -> Surface:
     z = wm_series((x[:, None], x[None, :]), amps, genome.wavenumber(n), phases, genome.angles)
     delta = length / (n_nodes - 1)
     meta = {"generator": "genome", "length": float(length), "n_nodes": n_nodes,
-            "x0": float(x[0]), "n_s": n_s, "n_f": n_f}
+            "x0": float(x[0]), "n_s": n_s, "n_f": n_f, "chromosomes": [int(i) for i in n]}
     return Surface(z, n_nodes * delta, periodic=False, metadata=meta)
 
 

@@ -57,6 +57,8 @@ Steps (:func:`sequence_profiles`)
 Modules: :mod:`.acquisitions` (checks), :mod:`.peaks` (step 1), :mod:`.lattice` (steps
 2-4), :mod:`.genes` (step 5), :mod:`.result`, :mod:`.profile` (the driver,
 :func:`sequence_profiles`) and :mod:`.zd` (the thesis's Z_d fit, for the record).
+Surfaces (2D MWM, issue 15): :mod:`.surface_data` (acquisitions, peaks, ridge directions)
+and :mod:`.surface` (:func:`sequence_surfaces`).
 """
 from .acquisitions import MIN_NODES, Acquisition, acquisitions_from_surfaces
 from .genes import (amplitude_genes, peak_slope_H, phases_with_sums, ridge_likelihood,
@@ -65,10 +67,14 @@ from .lattice import comb_periods, label_q1, lattice_from_period
 from .peaks import SpectrumPeaks, refine_peaks, spectrum_peaks, upper_hull
 from .profile import sequence_profiles
 from .result import SequencingResult
+from .surface import SurfaceSequencingResult, sequence_surfaces
+from .surface_data import SurfaceAcquisition, SurfacePeaks, surface_acquisitions, surface_peaks
 from .zd import ZdRidgeFit, thesis_zd_fit
 
 __all__ = ["MIN_NODES", "Acquisition", "acquisitions_from_surfaces", "amplitude_genes",
            "peak_slope_H", "phases_with_sums", "ridge_likelihood", "variance_amplitude",
            "comb_periods", "label_q1", "lattice_from_period", "SpectrumPeaks", "refine_peaks",
            "spectrum_peaks", "upper_hull",
-           "sequence_profiles", "SequencingResult", "ZdRidgeFit", "thesis_zd_fit"]
+           "sequence_profiles", "SequencingResult", "ZdRidgeFit", "thesis_zd_fit",
+           "sequence_surfaces", "SurfaceSequencingResult", "SurfaceAcquisition", "SurfacePeaks",
+           "surface_acquisitions", "surface_peaks"]

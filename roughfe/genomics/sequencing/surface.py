@@ -1,0 +1,478 @@
+"""Genome sequencing of 2D MWM surfaces (issue 15 §1; thesis Sec. 3.3.2 and Eq. 3.17).
+
+Model (Eq. 3.17 in the projected plane-wave form of :func:`roughfe.surfaces.wm.wm_series`
+and :func:`roughfe.genomics.genome.realize_surface`): ridge m is a plane wave along the
+in-plane direction theta_m,
+
+    Z(x, y) = sum_n sum_m G gamma^((1-n)H) alpha_m [cos(phi_mn) - cos(q_n (x cos theta_m
+              + y sin theta_m) + phi_mn)],      q_n = (2 pi / lambda1) gamma^(n-1).
+
+What a surface can tell (unlike a profile)
+------------------------------------------
+On a profile all M ridges of chromosome n share the wavenumber q_n and only their phasor
+sum is seen (:mod:`roughfe.genomics.sequencing`). On a surface every ridge of every
+chromosome is its own wavevector q_n (cos theta_m, sin theta_m), so M, the angles Theta,
+the amplitude factors alpha and every phase phi_mn are identifiable, and so are A and H
+(the amplitudes b_mn = G gamma^((1-n)H) alpha_m are then known one by one, and
+ln b_mn is linear in (ln G, H, ln alpha_m)).
+
+Conventions
+-----------
+* Angles are defined modulo pi: the ridge at theta + pi is the same wave with phase -phi
+  (cos(-q x.e + phi) = cos(q x.e - phi)). Sequenced angles lie in [0, pi); a ridge found
+  at theta >= pi is reported at theta - pi with its phases negated.
+* A and alpha share one scale: the anisotropy factors are normalised to a geometric mean
+  of 1 (prod alpha_m = 1), and A carries the scale.
+* lambda1 is labelled as for profiles (Eq. 3.5): lambda1 in [L_1, gamma L_1) for the
+  coarsest acquisition L_1, so that its first chromosome is n = 1. (Any lambda1 gamma^k
+  with the indices shifted by k and A rescaled describes the same heights.)
+* The genome is band-limited: its phase matrix spans exactly the chromosomes present in
+  the data (n_first..n_last, Eq. 3.5 over all acquisitions); the sequencer never invents
+  chromosomes above the data's band.
+
+Steps (:func:`sequence_surfaces`)
+---------------------------------
+1. Windowed (Blackman-Harris, ~92 dB side lobes), zero-padded 2D periodogram of each
+   acquisition; peaks = local maxima above the noise floor, located to sub-bin precision.
+   Only peaks below 0.9 Nyquist on both axes are used (Eq. 3.5 keeps chromosomes with
+   wavelengths between one and two node spacings, which alias on the grid).
+2. Angles: the peak directions (mod pi) clustered; clusters of >= 2 peaks are ridges.
+3. Lattice (gamma, q1): the comb fit of the profile sequencer on ln |q| of the peaks.
+4. Variable projection: the heights are linear in the cos/sin coefficients of every
+   (m, n) wave plus a plane per acquisition (which absorbs a removed mean plane);
+   (ln q1, ln gamma, theta_1..theta_M) are refined by Levenberg-Marquardt with the
+   Kaufman Jacobian, in continuation over the highest chromosome fitted.
+5. Genes: b_mn, phi_mn from the coefficients; (ln G, H, ln alpha) by least squares on
+   ln b_mn weighted by b_mn^2; A from G (Eq. 3.1).
+Undefined points (NaN) of a measured acquisition are left out of every step.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+import scipy.linalg
+from scipy.optimize import least_squares
+
+from ..genome import Genome, chromosome_range
+from .lattice import comb_periods, label_q1, lattice_from_period
+from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, surface_acquisitions,
+                           surface_peaks)
+
+
+# -- step 4: variable projection ----------------------------------------------------------------
+class _Model:
+    """Design of the MWM surface model over all acquisitions (rows: valid nodes)."""
+
+    def __init__(self, acqs, n_nodes):
+        self.acqs = acqs
+        self.n_nodes = n_nodes
+        xs, ys, zs, blocks = [], [], [], []
+        for k, a in enumerate(acqs):
+            ok = a.valid
+            xx, yy = np.meshgrid(a.x, a.y, indexing="ij")
+            xs.append(xx[ok])
+            ys.append(yy[ok])
+            zs.append(a.z[ok])
+            blocks.append(np.full(int(ok.sum()), k))
+        self.x, self.y = np.concatenate(xs), np.concatenate(ys)
+        self.z = np.concatenate(zs)
+        self.block = np.concatenate(blocks)
+        self.scale = float(np.sqrt(np.mean(self.z ** 2)))
+
+    def ranges(self, log_q1, log_gamma):
+        lam1 = 2 * math.pi / math.exp(log_q1)
+        return [chromosome_range(math.exp(log_gamma), lam1, a.length, self.n_nodes)
+                for a in self.acqs]
+
+    def waves(self, p, ranges, cap=None):
+        """Wave list (n, m) active in the model and the phase arguments (rows x waves)."""
+        lo = min(r[0] for r in ranges)
+        hi = max(r[1] for r in ranges) if cap is None else min(cap, max(r[1] for r in ranges))
+        n = np.arange(lo, hi + 1)
+        theta = np.asarray(p[2:])
+        nn, mm = np.meshgrid(n, np.arange(theta.size), indexing="ij")
+        nn, mm = nn.ravel(), mm.ravel()
+        q = np.exp(p[0] + (nn - 1) * p[1])
+        proj = np.multiply.outer(self.x, np.cos(theta)) + np.multiply.outer(self.y, np.sin(theta))
+        arg = proj[:, mm] * q
+        on = np.ones(arg.shape, bool)
+        for k, (ns, nf) in enumerate(ranges):
+            rows = self.block == k
+            on[rows] = ((nn >= ns) & (nn <= nf))[None, :]
+        return nn, mm, q, arg, on, proj
+
+    def design(self, arg, on):
+        n_acq = len(self.acqs)
+        cols = [np.where(on, np.cos(arg), 0.0), np.where(on, np.sin(arg), 0.0)]
+        plane = np.zeros((self.z.size, 3 * n_acq))
+        for k in range(n_acq):
+            rows = self.block == k
+            plane[rows, 3 * k] = 1.0
+            plane[rows, 3 * k + 1] = self.x[rows] / self.acqs[k].length
+            plane[rows, 3 * k + 2] = self.y[rows] / self.acqs[k].length
+        return np.hstack(cols + [plane])
+
+    def solve(self, p, ranges, cap=None, exact=False):
+        """Linear least squares for the wave and plane coefficients at the lattice ``p``.
+
+        Normal equations with a Cholesky factor of the column-scaled Gram matrix: the
+        columns (plane waves of distinct wavevectors) are nearly orthogonal, so the Gram
+        matrix is well conditioned, and one BLAS-3 product is several times cheaper than
+        a QR; a ridge duplicated by the fit makes it singular (LinAlgError).
+        """
+        nn, mm, q, arg, on, proj = self.waves(p, ranges, cap)
+        a = self.design(arg, on)
+        norm = np.linalg.norm(a, axis=0)
+        norm[norm == 0] = 1.0
+        a /= norm
+        gram = a.T @ a
+        gram[np.diag_indices_from(gram)] += 1e-13 * gram.shape[0]   # two ridges merging
+        chol = scipy.linalg.cho_factor(gram)
+        if exact:     # final coefficients: pivoted QR, no squared condition number
+            coef = scipy.linalg.lstsq(a, self.z, lapack_driver="gelsy", check_finite=False)[0]
+        else:
+            coef = scipy.linalg.cho_solve(chol, a.T @ self.z)
+        resid = self.z - a @ coef
+        return dict(nn=nn, mm=mm, q=q, arg=arg, on=on, proj=proj, coef=coef / norm,
+                    resid=resid, a=a, chol=chol)
+
+    def jacobian(self, p, sol):
+        """Kaufman's variable-projection Jacobian d(resid)/d(p) ~ -(I - P) (dA/dp) c."""
+        w = sol["nn"].size
+        u, v = sol["coef"][:w], sol["coef"][w:2 * w]
+        arg, on = sol["arg"], sol["on"]
+        s = np.where(on, -u * np.sin(arg) + v * np.cos(arg), 0.0)
+        theta = np.asarray(p[2:])
+        cols = [np.sum(s * arg, axis=1), np.sum(s * arg * (sol["nn"] - 1), axis=1)]
+        dproj = (-np.multiply.outer(self.x, np.sin(theta))
+                 + np.multiply.outer(self.y, np.cos(theta)))
+        for m in range(theta.size):
+            sel = sol["mm"] == m
+            cols.append(np.sum(s[:, sel] * sol["q"][sel], axis=1) * dproj[:, m])
+        d = np.column_stack(cols)
+        a = sol["a"]
+        return -(d - a @ scipy.linalg.cho_solve(sol["chol"], a.T @ d))
+
+
+def _fit(model, p0, budget=60, continuation=True):
+    """Levenberg-Marquardt on (ln q1, ln gamma, theta), with continuation in the cap.
+
+    A direct fit of the whole model comes first (enough when the peaks put every wave in
+    the basin); when it does not reproduce the data to round-off, the fit is redone from
+    ``p0`` adding the chromosomes a few at a time (the basin in ln gamma shrinks like 1/n).
+    """
+    if continuation:
+        p, ranges, nit = _fit(model, p0, budget=budget // 2, continuation=False)
+        sol = model.solve(p, ranges)
+        if float(sol["resid"] @ sol["resid"]) <= 1e-24 * float(model.z @ model.z):
+            return p, ranges, nit
+    else:
+        nit = 0
+    ranges = model.ranges(p0[0], p0[1])
+    lo = min(r[0] for r in ranges)
+    hi = max(r[1] for r in ranges)
+    caps = list(range(min(lo + 3, hi), hi + 1)) if continuation else [hi]
+    if len(caps) > 5:
+        caps = sorted(set(np.linspace(caps[0], hi, 5).round().astype(int).tolist()))
+    p = np.asarray(p0, float)
+    for cap in caps:
+        cache = {}
+
+        def sol(x):
+            key = x.tobytes()
+            if key not in cache:
+                cache.clear()
+                cache[key] = model.solve(x, ranges, cap)
+            return cache[key]
+
+        res = least_squares(lambda x: sol(x)["resid"] / model.scale, p,
+                            jac=lambda x: model.jacobian(x, sol(x)) / model.scale,
+                            method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                            max_nfev=budget if cap == caps[-1] else 10)
+        nit += res.nfev
+        p = res.x
+        if p[1] <= 0:
+            raise ValueError("gamma <= 1")
+        p[0] = label_q1(p[0], p[1], model.acqs[0].length)    # n_s = 1 for L_1 (Eq. 3.5)
+        new = model.ranges(p[0], p[1])
+        if new != ranges:            # the lattice moved across an Eq. 3.5 boundary
+            ranges = new
+    return p, ranges, nit
+
+
+def _merge_duplicate_ridges(p, tol=ANGLE_TOL / 10):
+    """Drop ridges whose angle (mod pi) lies within ``tol`` of an earlier ridge's."""
+    theta = np.mod(p[2:], np.pi)
+    keep = []
+    for k, t in enumerate(theta):
+        if all(abs(np.angle(np.exp(2j * (t - theta[j])))) / 2 > tol for j in keep):
+            keep.append(k)
+    return np.concatenate([p[:2], p[2:][keep]])
+
+
+def _weak_ridges(sol, n_ridges, ratio=0.01):
+    """Ridges whose waves are all below ``ratio`` times the strongest wave of the same
+    chromosome (median over n): spurious directions (side lobes, aliases, noise)."""
+    w = sol["nn"].size
+    b = np.hypot(sol["coef"][:w], sol["coef"][w:2 * w])
+    n = np.unique(sol["nn"])
+    amp = np.zeros((n_ridges, n.size))
+    amp[sol["mm"], sol["nn"] - n[0]] = b
+    rel = amp / np.maximum(amp.max(axis=0, keepdims=True), 1e-300)
+    return np.flatnonzero(np.median(rel, axis=1) < ratio)
+
+
+def _residual_acquisitions(model, resid):
+    """The fit residual laid back on each acquisition's grid (NaN where undefined)."""
+    out = []
+    for k, a in enumerate(model.acqs):
+        z = np.full(a.z.shape, np.nan)
+        z[a.valid] = resid[model.block == k]
+        out.append(SurfaceAcquisition(a.x, a.y, z, a.length))
+    return out
+
+
+def _add_missing_ridges(model, p, ranges, sol, max_new=8):
+    """Greedy completion: a direction that holds the strongest peaks of the residual's
+    periodogram becomes a new ridge when the refit halves the residual (ridges with one
+    detected peak, or close to a stronger one, are missed by the first clustering)."""
+    nit = 0
+    cost = float(sol["resid"] @ sol["resid"])
+    for _ in range(max_new):
+        if cost <= 1e-24 * float(model.z @ model.z):
+            break
+        peaks = [surface_peaks(a) for a in _residual_acquisitions(model, sol["resid"])]
+        ang = np.concatenate([pk.angle for pk in peaks])
+        pw = np.concatenate([pk.power for pk in peaks])
+        if ang.size == 0:
+            break
+        centres, labels, _ = cluster_angles(ang, pw)
+        strength = np.bincount(labels, weights=pw)
+        new = centres[int(np.argmax(strength))]
+        try:
+            p_new, r_new, k = _fit(model, np.append(p, new), continuation=False)
+            s_new = model.solve(p_new, r_new)
+        except (np.linalg.LinAlgError, ValueError):
+            break
+        nit += k
+        c_new = float(s_new["resid"] @ s_new["resid"])
+        if not c_new < 0.5 * cost:
+            break
+        p, ranges, sol, cost = p_new, r_new, s_new, c_new
+    return p, ranges, sol, nit
+
+
+# -- step 5: genes --------------------------------------------------------------------------------
+def _genes(p, sol, ranges):
+    """Genome genes from the fitted coefficients (see the module notes)."""
+    nn, mm = sol["nn"], sol["mm"]
+    w = nn.size
+    u, v = sol["coef"][:w], sol["coef"][w:2 * w]
+    theta = np.asarray(p[2:], float)
+    flip = np.floor(theta / np.pi).astype(int) % 2 == 1     # theta in [pi, 2 pi) mod 2 pi
+    theta = np.mod(theta, np.pi)
+    v = np.where(flip[mm], -v, v)
+    order = np.argsort(theta)                     # ridges listed by angle in [0, pi)
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    theta, mm = theta[order], rank[mm]
+    b = np.hypot(u, v)
+    phi = np.arctan2(v, -u)
+    n = np.unique(nn)
+    M = theta.size
+    phases = np.zeros((M, n.size))
+    phases[mm, nn - n[0]] = phi
+    amp = np.zeros((M, n.size))
+    amp[mm, nn - n[0]] = b
+    gamma = math.exp(p[1])
+    lam1 = 2 * math.pi / math.exp(p[0])
+    # ln b = ln G + (1 - n) H ln gamma + ln alpha_m, sum ln alpha_m = 0, weights b^2
+    good = b > 0
+    rows = np.flatnonzero(good)
+    mat = np.zeros((rows.size, 2 + M))
+    mat[:, 0] = 1.0
+    mat[:, 1] = (1.0 - nn[rows]) * math.log(gamma)
+    mat[np.arange(rows.size), 2 + mm[rows]] = 1.0
+    rhs = np.log(b[rows])
+    wts = b[rows] / b[rows].max()
+    # gauge: replace ln alpha_M by -sum of the others
+    red = mat[:, :2 + M - 1].copy()
+    red[:, 2:] -= mat[:, [2 + M - 1]]
+    sol_g, *_ = np.linalg.lstsq(red * wts[:, None], rhs * wts, rcond=None)
+    ln_g, hurst = sol_g[0], sol_g[1]
+    ln_alpha = np.append(sol_g[2:], -np.sum(sol_g[2:]))
+    prefactor = math.exp(ln_g)
+    a_gene = prefactor / (math.sqrt(math.log(gamma) / M) * (2 * math.pi / lam1) ** (-hurst))
+    return dict(A=a_gene, H=float(hurst), gamma=gamma, lambda1=lam1, phases=phases,
+                n_first=int(n[0]), angles=theta, anisotropy=np.exp(ln_alpha), amplitudes=amp)
+
+
+@dataclass(frozen=True, eq=False)
+class SurfaceSequencingResult:
+    """Sequenced surface genome and its quality report (OptimizeResult-like).
+
+    Attributes
+    ----------
+    genome : Genome or None
+        The band-limited genome (None when no WM lattice was found).
+    success : bool
+        True when every acquisition is reproduced within ``rms_tolerance``.
+    message : str
+    nit : int
+        Residual evaluations of the nonlinear fit.
+    ranges : list of (int, int)
+        Eq. 3.5 chromosome range per acquisition, coarsest first.
+    lengths, rms_errors : ndarray
+        Observation lengths (m) and relative rms misfits per acquisition.
+    amplitudes : ndarray (M, n_c)
+        Fitted wave amplitudes b_mn (m).
+    peaks : list of SurfacePeaks
+    elapsed : float
+    """
+
+    genome: Optional[Genome]
+    success: bool
+    message: str
+    nit: int
+    ranges: list
+    lengths: np.ndarray
+    rms_errors: np.ndarray
+    amplitudes: np.ndarray
+    peaks: list
+    elapsed: float = 0.0
+    references: tuple = field(default=("thesis Sec. 3.3.2, Eq. 3.17 (projected form)",))
+
+    def report(self) -> dict:
+        g = self.genome
+        genes = None if g is None else {
+            "A": g.A, "H": g.H, "gamma": g.gamma, "lambda1": g.lambda1, "M": g.M,
+            "angles_deg": np.degrees(g.angles).tolist(), "anisotropy": g.anisotropy.tolist(),
+            "n_first": g.n_first, "n_last": g.n_last}
+        return {"success": bool(self.success), "message": self.message, "nit": int(self.nit),
+                "genes": genes, "lengths": self.lengths.tolist(),
+                "ranges": [list(r) for r in self.ranges],
+                "rms_errors": [float(e) for e in self.rms_errors],
+                "elapsed_s": self.elapsed}
+
+
+def _failure(message, acqs, peaks, t0):
+    return SurfaceSequencingResult(
+        genome=None, success=False, message=message, nit=0, ranges=[],
+        lengths=np.array([a.length for a in acqs]), rms_errors=np.full(len(acqs), np.inf),
+        amplitudes=np.zeros((0, 0)), peaks=peaks, elapsed=time.perf_counter() - t0)
+
+
+def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
+                      n_restarts=3) -> SurfaceSequencingResult:
+    """Sequence the genome of a 2D MWM surface from one or more nested acquisitions.
+
+    Parameters
+    ----------
+    surfaces : sequence of Surface
+        N x N acquisitions with the genome node convention on both axes (node (N//2, N//2)
+        at the origin, spacing L/(N-1); ``metadata["x0"]`` (and ``"y0"``) when given), at
+        observation lengths L_1 > L_2 > ...; non-periodic windows.
+    valid : sequence of bool ndarray, optional
+        Per acquisition, True where the height is defined (undefined points are left out).
+    rms_tolerance : float
+        Relative rms misfit above which ``success`` is False (not WM-like, or noisy).
+    n_restarts : int
+        Number of comb periods (gamma candidates) tried; the lowest residual wins.
+    """
+    t0 = time.perf_counter()
+    acqs = surface_acquisitions(surfaces, valid)
+    n_nodes = acqs[0].z.shape[0]
+    peaks = [surface_peaks(a) for a in acqs]
+    q = np.concatenate([pk.magnitude for pk in peaks])
+    ang = np.concatenate([pk.angle for pk in peaks])
+    if q.size < 4:
+        return _failure(f"only {q.size} spectral peaks: the spectrum is not a discrete WM "
+                        f"spectrum", acqs, peaks, t0)
+    centres, labels, sizes = cluster_angles(ang, q ** 2)
+    ridges = np.flatnonzero(sizes >= 2)
+    if ridges.size == 0:
+        return _failure("no direction holds two or more spectral peaks: no MWM ridges found",
+                        acqs, peaks, t0)
+    in_ridge = np.isin(labels, ridges)
+    log_q = np.log(q[in_ridge])
+    groups = np.concatenate([np.full(pk.qx.size, k) for k, pk in enumerate(peaks)])[in_ridge]
+    groups = groups * 1000 + labels[in_ridge]           # one peak per (acquisition, ridge, n)
+    periods, _, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
+    model = _Model(acqs, n_nodes)
+    tiny = 1e-24 * float(model.z @ model.z)
+
+    def attempt(p0, continuation):
+        """Fit from p0 and drop merged or empty ridges: (cost, p, ranges, sol, nit)."""
+        p, ranges, nit = _fit(model, p0, continuation=continuation)
+        sol = model.solve(p, ranges)
+        p = _merge_duplicate_ridges(p)
+        weak = _weak_ridges(sol, p.size - 2) if p.size == sol["mm"].max() + 3 else []
+        if len(weak) and len(weak) < p.size - 2 or p.size != sol["mm"].max() + 3:
+            # a direction with no lattice waves, or two ridges fitted onto one
+            p, ranges, k = _fit(model, np.delete(p, 2 + np.asarray(weak, int)),
+                                continuation=False)
+            nit += k
+            sol = model.solve(p, ranges)
+        return float(sol["resid"] @ sol["resid"]), p, ranges, sol, nit
+
+    def complete(out):
+        """Add the ridges the first clustering missed (best lattice only)."""
+        p, ranges, sol, k = _add_missing_ridges(model, out[1], out[2], out[3])
+        return float(sol["resid"] @ sol["resid"]), p, ranges, sol, out[4] + k
+
+    starts = []
+    for period, ref in zip(periods, refs):
+        log_q1, log_gamma = lattice_from_period(log_q, period, ref, acqs[0].length,
+                                                 weights=q[in_ridge], groups=groups)
+        if log_gamma > 0:
+            starts.append(np.concatenate([[log_q1, log_gamma], centres[ridges]]))
+    best, nit = None, 0
+    # direct fits from every gamma candidate; the best is completed with missed ridges;
+    # only when that does not reproduce the data to round-off (noise, measured data) is
+    # the continuation tried from every candidate as well, and the lowest cost wins
+    for continuation in (False, True):
+        outs = []
+        for p0 in starts:
+            try:
+                outs.append(attempt(p0, continuation))
+            except (np.linalg.LinAlgError, ValueError):
+                continue
+        nit += sum(o[4] for o in outs)
+        if not outs:
+            continue
+        top = complete(min(outs, key=lambda o: o[0]))
+        nit += top[4] - min(outs, key=lambda o: o[0])[4]
+        if best is None or top[0] < best[0]:
+            best = top
+        if best[0] <= tiny:
+            break
+    if best is None:
+        return _failure("no gamma candidate gave a lattice fit", acqs, peaks, t0)
+    _, p, ranges, _, _ = best
+    sol = model.solve(p, ranges, exact=True)
+    g = _genes(p, sol, ranges)
+    genome = Genome(A=g["A"], H=g["H"], gamma=g["gamma"], lambda1=g["lambda1"],
+                    phases=g["phases"], n_first=g["n_first"], angles=g["angles"],
+                    anisotropy=g["anisotropy"], metadata={"source": "sequence_surfaces"})
+    errs = []
+    fitted = model.z - sol["resid"]
+    for k in range(len(acqs)):
+        rows = model.block == k
+        zk = model.z[rows] - model.z[rows].mean()
+        errs.append(float(np.sqrt(np.mean((model.z[rows] - fitted[rows]) ** 2)
+                                  / np.mean(zk ** 2))))
+    errs = np.array(errs)
+    ok = bool(np.all(errs <= rms_tolerance))
+    msg = (f"M = {genome.M} ridges, gamma = {genome.gamma:.6g}, chromosomes "
+           f"{genome.n_first}..{genome.n_last}; relative rms misfit "
+           f"{', '.join(f'{e:.3g}' for e in errs)}")
+    if not ok:
+        msg += f" > {rms_tolerance:g}: not reproduced (the surface is not WM-like or noisy)"
+    return SurfaceSequencingResult(
+        genome=genome, success=ok, message=msg, nit=nit, ranges=[tuple(r) for r in ranges],
+        lengths=np.array([a.length for a in acqs]), rms_errors=errs,
+        amplitudes=g["amplitudes"], peaks=peaks, elapsed=time.perf_counter() - t0)

@@ -1,0 +1,213 @@
+"""Acquisitions, periodogram peaks and ridge directions of 2D MWM sequencing (steps 1-2).
+
+See :mod:`roughfe.genomics.sequencing.surface` for the model and the conventions.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.fft
+from scipy.ndimage import maximum_filter
+from scipy.signal.windows import blackmanharris
+
+from ...errors import InputError
+from ...surfaces.surface import Surface
+from .acquisitions import MIN_NODES
+
+#: zero-padding factor of the periodogram
+PAD = 4
+#: peaks are used below this fraction of the Nyquist wavenumber on both axes
+NYQUIST_FRACTION = 0.9
+#: single-linkage tolerance of the angle clustering (rad)
+ANGLE_TOL = math.radians(1.5)
+
+
+@dataclass(frozen=True, eq=False)
+class SurfaceAcquisition:
+    """One 2D acquisition: node coordinates x, y (m), heights z (m; NaN = undefined)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    length: float
+
+    @property
+    def valid(self) -> np.ndarray:
+        return np.isfinite(self.z)
+
+
+def _node_coordinates(surface: Surface, axis: int) -> np.ndarray:
+    n = surface.shape[axis]
+    d = surface.spacing[axis]
+    x0 = surface.metadata.get("y0" if axis == 1 else "x0")
+    if axis == 1 and x0 is None:
+        x0 = surface.metadata.get("x0")
+    x0 = -(n // 2) * d if x0 is None else float(x0)
+    return x0 + np.arange(n) * d
+
+
+def surface_acquisitions(surfaces, valid=None) -> list:
+    """Check nested 2D acquisitions; return them sorted coarsest first.
+
+    ``valid`` (optional, one boolean N x N mask per surface, True = defined) marks the
+    undefined points of measured acquisitions (a :class:`Surface` holds finite heights
+    only: readers fill undefined points, ``metadata["filled_points"]``); they are left out.
+
+    Raises InputError (one message naming the mismatch) for: a profile among them (mixing
+    1D and 2D), different N, non-square grids or unequal spacings, fewer than
+    ``MIN_NODES`` nodes, a flat or all-undefined acquisition, equal lengths, or windows that
+    are not nested around the origin.
+    """
+    surfaces = list(surfaces)
+    if not surfaces:
+        raise InputError("sequencing needs at least one acquisition")
+    for k, s in enumerate(surfaces):
+        if not isinstance(s, Surface):
+            raise InputError(f"acquisition {k} must be a roughfe Surface, got {type(s).__name__}")
+    dims = sorted({s.ndim for s in surfaces})
+    if dims != [2]:
+        raise InputError(f"surface sequencing needs 2D acquisitions only; got dimensions "
+                         f"{[s.ndim for s in surfaces]} (profiles: roughfe.genomics.sequencing)")
+    shapes = {s.shape for s in surfaces}
+    if len(shapes) != 1:
+        raise InputError(f"all acquisitions must have the same N x N nodes, got "
+                         f"{[s.shape for s in surfaces]}")
+    n, n2 = shapes.pop()
+    if n != n2:
+        raise InputError(f"acquisitions must be square (N x N nodes), got {n} x {n2}")
+    if n < MIN_NODES:
+        raise InputError(f"too few points: {n} x {n} nodes, at least {MIN_NODES} per axis")
+    if valid is None:
+        valid = [None] * len(surfaces)
+    valid = list(valid)
+    if len(valid) != len(surfaces):
+        raise InputError(f"valid must give one mask per acquisition: {len(valid)} masks for "
+                         f"{len(surfaces)} acquisitions")
+    acq = []
+    for k, (s, mask) in enumerate(zip(surfaces, valid)):
+        dx, dy = s.spacing
+        if abs(dx / dy - 1) > 1e-9:
+            raise InputError(f"acquisition {k} has spacings {dx:g} m and {dy:g} m: the node "
+                             f"convention needs equal spacings on both axes")
+        z = np.array(s.heights, dtype=float)
+        if mask is not None:
+            mask = np.asarray(mask)
+            if mask.shape != z.shape or mask.dtype != bool:
+                raise InputError(f"valid mask {k} must be a boolean array of shape {z.shape}, "
+                                 f"got {mask.dtype} {mask.shape}")
+            z[~mask] = np.nan
+        ok = np.isfinite(z)
+        if ok.sum() < 0.5 * z.size:
+            raise InputError(f"acquisition {k} has {z.size - ok.sum()} undefined points of "
+                             f"{z.size}: at least half must be defined")
+        if np.ptp(z[ok]) == 0:
+            raise InputError(f"acquisition {k} is flat: there is no roughness to sequence")
+        x, y = _node_coordinates(s, 0), _node_coordinates(s, 1)
+        acq.append(SurfaceAcquisition(x, y, z, float((n - 1) * dx)))
+    acq.sort(key=lambda a: -a.length)
+    for a, b in zip(acq, acq[1:]):
+        if not b.length < a.length * (1 - 1e-9):
+            raise InputError(f"acquisitions must have different observation lengths, got two of "
+                             f"{a.length:g} m")
+    for k, a in enumerate(acq):
+        for c in (a.x, a.y):
+            if not (c[0] <= 1e-9 * a.length and c[-1] >= -1e-9 * a.length):
+                raise InputError(f"acquisition {k} (L = {a.length:g} m) does not contain the "
+                                 f"origin: windows must be nested around x = y = 0")
+    return acq
+
+
+# -- steps 1-3: peaks, ridges, lattice --------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class SurfacePeaks:
+    """Periodogram peaks of one acquisition: wavevectors (rad/m) and power (m^2 arbitrary)."""
+
+    qx: np.ndarray
+    qy: np.ndarray
+    power: np.ndarray
+
+    @property
+    def magnitude(self):
+        return np.hypot(self.qx, self.qy)
+
+    @property
+    def angle(self):
+        """Direction mod pi in [0, pi)."""
+        return np.mod(np.arctan2(self.qy, self.qx), np.pi)
+
+
+def _parabola_offset(lm, l0, lp):
+    den = lm - 2 * l0 + lp
+    return np.where(den < 0, 0.5 * (lm - lp) / np.where(den < 0, den, -1.0), 0.0)
+
+
+def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
+    """Peaks of the Blackman-Harris windowed, zero-padded periodogram (half plane q_y >= 0).
+
+    A peak is a local maximum over +-3 original bins whose power exceeds both
+    ``dynamic_range`` times the largest peak and 30 times the median power (the noise
+    floor); sub-bin positions by a parabola in log power along each axis.
+    """
+    n = acq.z.shape[0]
+    d = acq.x[1] - acq.x[0]
+    ok = acq.valid
+    z = np.where(ok, acq.z - acq.z[ok].mean(), 0.0)
+    w1 = blackmanharris(n)
+    spec = scipy.fft.rfft2(z * np.outer(w1, w1), s=(PAD * n, PAD * n))
+    power = np.abs(spec) ** 2
+    size = 2 * 3 * PAD + 1
+    is_max = power == maximum_filter(power, size=size, mode="wrap")
+    floor = 30.0 * float(np.median(power))
+    top = float(power.max())
+    cand = np.argwhere(is_max & (power > max(floor, dynamic_range * top)))
+    m_pad = PAD * n
+    kx = np.where(cand[:, 0] <= m_pad // 2, cand[:, 0], cand[:, 0] - m_pad).astype(float)
+    ky = cand[:, 1].astype(float)
+    keep = ~((ky == 0) & (kx < 0))            # q and -q are one wave on the q_y = 0 row
+    cand, kx, ky = cand[keep], kx[keep], ky[keep]
+    lp = np.log(power + 1e-300 * top)
+    i, j = cand[:, 0], cand[:, 1]
+    dx = _parabola_offset(lp[(i - 1) % m_pad, j], lp[i, j], lp[(i + 1) % m_pad, j])
+    jm, jp = np.abs(j - 1), np.minimum(j + 1, lp.shape[1] - 1)
+    dy = _parabola_offset(lp[i, jm], lp[i, j], lp[i, jp])
+    dq = 2 * np.pi / (m_pad * d)
+    qx, qy = (kx + dx) * dq, (ky + dy) * dq
+    nyq = NYQUIST_FRACTION * np.pi / d
+    inside = (np.abs(qx) < nyq) & (np.abs(qy) < nyq) & (np.hypot(qx, qy) > 0)
+    return SurfacePeaks(qx[inside], qy[inside], power[i, j][inside])
+
+
+def cluster_angles(angles, weights, tol=ANGLE_TOL):
+    """Single-linkage clusters of directions mod pi; returns (centres, labels, sizes).
+
+    Centres are weighted circular means (period pi); clusters are ordered by centre.
+    """
+    a = np.mod(np.asarray(angles, float), np.pi)
+    if a.size == 0:
+        return np.array([]), np.array([], int), np.array([], int)
+    order = np.argsort(a)
+    s = a[order]
+    gaps = np.diff(np.concatenate([s, [s[0] + np.pi]]))
+    cuts = set(np.flatnonzero(gaps > tol).tolist())     # gap after sorted position i
+    labels_sorted = np.zeros(a.size, int)
+    if cuts:
+        start = (min(cuts) + 1) % a.size                 # a cluster may wrap around pi
+        lab = 0
+        for k in range(a.size):
+            idx = (start + k) % a.size
+            labels_sorted[idx] = lab
+            if idx in cuts:
+                lab += 1
+    labels = np.empty(a.size, int)
+    labels[order] = labels_sorted
+    w = np.asarray(weights, float)
+    n_cl = labels.max() + 1
+    centres = np.array([np.mod(np.angle(np.sum(w[labels == c] * np.exp(2j * a[labels == c])))
+                               / 2, np.pi) for c in range(n_cl)])
+    sizes = np.bincount(labels, minlength=n_cl)
+    rank = np.argsort(centres)
+    relabel = np.empty(n_cl, int)
+    relabel[rank] = np.arange(n_cl)
+    return centres[rank], relabel[labels], sizes[rank]
