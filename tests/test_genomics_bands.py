@@ -2,6 +2,7 @@
 import numpy as np
 import pytest
 
+from roughfe import progress
 from roughfe.errors import InputError
 from roughfe.genomics.band_mechanics import band_macro_micro, band_mechanics
 from roughfe.genomics.bands import band_chromosomes, band_leakage, genome_q1
@@ -125,7 +126,8 @@ def test_band_mechanics_of_a_periodic_surface():
     s = spectral_surface(32, 1e-3, 0.8, rms_height=1e-6, rng=2)
     b = band_chromosomes(s, 2.0, detrend="mean")
     calls = []
-    m = band_mechanics(b, youngs_modulus=1e9, n_steps=6, progress=lambda d, t: calls.append((d, t)))
+    with progress.listening(lambda desc, d, t: calls.append((d, t)) if desc == "band sweeps" else None):
+        m = band_mechanics(b, youngs_modulus=1e9, n_steps=6)
     n_c = b.n_chromosomes
     assert len(m.td_curves) == len(m.bu_curves) == len(m.chromosome_curves) == n_c
     assert m.td_curves[-1] is m.complete and m.bu_curves[-1] is m.complete
@@ -138,3 +140,31 @@ def test_band_mechanics_of_a_periodic_surface():
     assert sorted(mm.macro + mm.micro) == list(b.indices)
     d = m.to_dict()
     assert len(d["td"]) == n_c and d["complete"]["pressure"]
+
+
+def test_genome_chromosomes_command(tmp_path, capsys):
+    """`roughfe genome chromosomes`: the documented files, bands summing to the surface,
+    TD/BU curves ending on the complete one, figures; a bad gamma is a one-line error."""
+    import json
+
+    from roughfe.cli import main
+    from roughfe.surfaces.io import save_surface
+    s = spectral_surface(32, 1e-3, 0.8, rms_height=1e-6, rng=4)
+    path = save_surface(s, tmp_path / "s.npz")
+    out = tmp_path / "out"
+    assert main(["genome", "chromosomes", str(path), "--gamma", "2", "--steps", "4",
+                 "--E", "1e9", "-o", str(out)]) == 0
+    data = np.load(out / "chromosomes.npz")
+    assert np.allclose(data["chromosomes"].sum(0), data["surface"], atol=1e-12 * 1e-6)
+    assert data["q_bounds"].size == data["chromosomes"].shape[0] + 1
+    mech = json.loads((out / "mechanics.json").read_text())
+    assert mech["td"][-1] == mech["complete"] == mech["bu"][-1]
+    mm = json.loads((out / "macro_micro.json").read_text())
+    assert sorted(mm["macro"] + mm["micro"]) == mech["indices"]
+    for fig in ("td", "bu", "chromosomes", "energy", "curves", "correlations"):
+        assert (out / f"{fig}.png").stat().st_size > 5_000
+    assert "band chromosomes" in capsys.readouterr().out
+    assert main(["genome", "chromosomes", str(path), "--gamma", "20", "-o",
+                 str(tmp_path / "bad")]) == 2
+    assert "gamma" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()

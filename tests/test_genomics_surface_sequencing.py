@@ -120,3 +120,22 @@ def test_bad_acquisitions_name_the_mismatch():
         sequence_surfaces([a1, a1])
     with pytest.raises(InputError, match="one mask per acquisition"):
         sequence_surfaces([a1, a2], valid=[None])
+
+
+def test_genome_sequence_command_on_surfaces(tmp_path, capsys):
+    """`roughfe genome sequence` takes 2D acquisitions (angles and anisotropy in the genome
+    JSON) and refuses a mix of profiles and surfaces in one line."""
+    from roughfe.cli import main
+    from roughfe.genomics.genome import load_genome
+    from roughfe.surfaces.io import save_surface
+    g, (a1, a2), _ = _genome(7)
+    p1, p2 = save_surface(a1, tmp_path / "a1.npz"), save_surface(a2, tmp_path / "a2.npz")
+    assert main(["genome", "sequence", str(p2), str(p1), "--no-figures",
+                 "-o", str(tmp_path / "seq")]) == 0
+    s = load_genome(tmp_path / "seq" / "genome.json")
+    np.testing.assert_allclose(s.angles, g.angles, atol=1e-8)
+    np.testing.assert_allclose(s.anisotropy, g.anisotropy, rtol=1e-7)
+    assert "ridge angles" in capsys.readouterr().out
+    prof = save_surface(realize(g, length=L1, n_nodes=N), tmp_path / "p.npz")
+    assert main(["genome", "sequence", str(p1), str(prof), "-o", str(tmp_path / "mix")]) == 2
+    assert "mix profiles (1D) and surfaces (2D)" in capsys.readouterr().err

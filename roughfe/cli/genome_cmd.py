@@ -10,7 +10,8 @@ from pathlib import Path
 
 from .options import (add_material_options, add_output_file, add_output_folder,
                       add_run_options, add_surface_options, material_from_args,
-                      output_file_of, output_folder_of, positive_float, positive_int,
+                      nonnegative_int, output_file_of, output_folder_of, positive_float,
+                      positive_int,
                       surface_from_args, add_detrend_option)
 
 from ..genomics.genome import SCALES
@@ -70,11 +71,48 @@ def _print_sequencing(res):
 
 
 def _sequence(args) -> int:
+    from ..errors import InputError
+    from ..surfaces.io import load_surface
+    surfaces = [load_surface(p) for p in args.profiles]
+    dims = sorted({s.ndim for s in surfaces})
+    if dims == [2]:
+        return _sequence_surfaces(args, surfaces)
+    if dims != [1]:
+        raise InputError("acquisitions mix profiles (1D) and surfaces (2D): "
+                         + ", ".join(f"{p} is {s.ndim}D" for p, s in zip(args.profiles, surfaces)))
+    return _sequence_profiles(args, surfaces)
+
+
+def _sequence_surfaces(args, surfaces) -> int:
+    """2D MWM acquisitions: angles, anisotropy and every phase (issue 15)."""
+    from ..genomics.genome import save_genome
+    from ..genomics.sequencing import sequence_surfaces
+    from ..writers import write_json
+    folder = output_folder_of(args, "genome sequence")
+    res = sequence_surfaces(surfaces, rms_tolerance=args.tolerance)
+    with folder as out:
+        write_json(out / "report.json", res.report())
+        if res.genome is not None:
+            save_genome(res.genome, out / "genome.json")
+            if not args.no_figures:
+                from ..plotting.genomics import plot_sequenced_surfaces
+                print(f"  figure {plot_sequenced_surfaces(res, surfaces, out / 'surfaces.png')}")
+    if res.genome is not None:
+        print("sequenced surface genome:")
+        _print_genome(res.genome)
+        print("  ridge angles (deg): " + " ".join(f"{a:.4f}" for a in res.genome.angles * 57.29577951308232))
+        print("  anisotropy        : " + " ".join(f"{a:.4f}" for a in res.genome.anisotropy))
+    for k, (L, e) in enumerate(zip(res.lengths, res.rms_errors)):
+        print(f"  acquisition {k + 1}: L = {L:.6g} m, relative rms error {100 * e:.4g} %")
+    print(f"  {'success' if res.success else 'FAILED quality check'}: {res.message}")
+    print(f"report -> {out / 'report.json'}")
+    return 0 if res.success or not args.strict else 1
+
+
+def _sequence_profiles(args, surfaces) -> int:
     from ..genomics.genome import save_genome
     from ..genomics.sequencing import sequence_profiles
-    from ..surfaces.io import load_surface
     from ..writers import write_json
-    surfaces = [load_surface(p) for p in args.profiles]
     folder = output_folder_of(args, "genome sequence")
     res = sequence_profiles(surfaces, seed=args.seed, M=args.ridges, rms_tolerance=args.tolerance)
     with folder as out:
@@ -148,6 +186,59 @@ def _natural(args) -> int:
     return 0
 
 
+def _chromosomes(args) -> int:
+    """Band chromosomes of any surface, their mechanics and Alg. 2 (issue 15 §2)."""
+    import numpy as np
+
+    from ..genomics.band_mechanics import band_macro_micro, band_mechanics
+    from ..genomics.bands import band_chromosomes
+    from ..writers import atomic_path, write_json
+    surface = surface_from_args(args)
+    material = material_from_args(args)
+    bands = band_chromosomes(surface, args.gamma, detrend=args.detrend)
+    folder = output_folder_of(args, "genome chromosomes")
+    mech = None
+    if args.steps:
+        mech = band_mechanics(bands, youngs_modulus=material.E, poisson=material.nu,
+                              n_steps=args.steps)
+        split = band_macro_micro(mech, threshold=args.threshold)
+    with folder as out:
+        with atomic_path(out / "chromosomes.npz") as tmp:
+            np.savez_compressed(tmp, chromosomes=bands.chromosomes,
+                                surface=bands.surface.heights, q_bounds=bands.q_bounds,
+                                indices=bands.indices, energy=bands.energy,
+                                size=np.asarray(bands.surface.size), gamma=bands.gamma,
+                                transform=bands.transform, detrend=bands.detrend)
+        if mech is not None:
+            write_json(out / "mechanics.json", mech.to_dict())
+            write_json(out / "macro_micro.json", {
+                "threshold": split.threshold, "macro": list(split.macro),
+                "micro": list(split.micro), "c_n_K": split.corr_k, "c_n_A": split.corr_a,
+                "chromosomes": split.chromosomes, "message": split.message})
+        if not args.no_figures:
+            from ..plotting import bands as bp
+            paths = [bp.render_band_sums(bands, out / "td.png", "td"),
+                     bp.render_band_sums(bands, out / "bu.png", "bu"),
+                     bp.render_band_sums(bands, out / "chromosomes.png", "chromosomes"),
+                     bp.plot_band_energy(bands, out / "energy.png")]
+            if mech is not None:
+                paths += [bp.plot_band_curves(mech, out / "curves.png"),
+                          bp.plot_band_correlations(mech, out / "correlations.png", split)]
+            if not args.quiet:
+                for p in paths:
+                    print(f"  figure {p}")
+    if not args.quiet:
+        print(f"{bands.n_chromosomes} band chromosomes (gamma = {bands.gamma:.4g}, "
+              f"{bands.transform.upper()}, detrend {bands.detrend}); wavelengths "
+              f"{bands.wavelengths()[0]:.4g} .. {bands.wavelengths()[-1]:.4g} m")
+        print("  share of <h^2> (%): " + " ".join(f"{100 * e / bands.energy.sum():.2f}"
+                                                for e in bands.energy))
+        if mech is not None:
+            print(f"  {mech.message}; macro bands {list(split.macro)}, micro {list(split.micro)}")
+        print(f"outputs -> {out}")
+    return 0
+
+
 def _validity(args) -> int:
     from ..genomics.chromosomes import validity_monte_carlo
     from ..plotting import genomics as gp
@@ -211,12 +302,15 @@ def register(sub):
     add_output_file(p, "profile .npz to write (roughfe surface format)")
     p.set_defaults(func=_realize)
 
-    p = gs.add_parser("sequence", help="sequence a genome from 2-3 nested acquisitions (Sec. 3.3.1)",
-                      description="Sequence a genome (Sec. 3.3.1) from 2-3 acquisitions of "
-                                  "one profile at nested lengths. Writes OUTDIR/genome.json, "
-                                  "OUTDIR/report.json and the figures (profiles, psd, td, bu).")
-    p.add_argument("profiles", nargs="+", metavar="PROFILE.npz",
-                   help="acquisitions of the same profile (same N, nested windows centred on x = 0)")
+    p = gs.add_parser("sequence", help="sequence a genome from nested acquisitions (profiles or 2D surfaces)",
+                      description="Sequence a genome from acquisitions at nested lengths: "
+                                  "2-3 profiles (Sec. 3.3.1: gamma, lambda1, the chromosome "
+                                  "sums, statistical A, H, M) or one or more 2D MWM surfaces "
+                                  "(every gene: M, ridge angles, anisotropy and phases). "
+                                  "Writes OUTDIR/genome.json, OUTDIR/report.json and figures.")
+    p.add_argument("profiles", nargs="+", metavar="ACQUISITION.npz",
+                   help="acquisitions of one profile or surface (same N, nested windows "
+                        "centred on the origin)")
     p.add_argument("--seed", type=int, default=0, help="seed of the M likelihood and the phase draws")
     p.add_argument("--ridges", type=positive_int, default=None,
                    help="impose M (default: maximum likelihood)")
@@ -258,6 +352,29 @@ def register(sub):
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_natural)
+
+    p = gs.add_parser("chromosomes", help="band chromosomes of any surface, their A(p), K(p) and Alg. 2",
+                      description="Split any surface or profile (measured files included) "
+                                  "into band chromosomes: the parts of its Fourier (periodic) "
+                                  "or cosine (window) transform in the annuli [q_n, gamma q_n). "
+                                  "They sum exactly to the detrended surface. Then the BEM "
+                                  "A(p), K(p) of every chromosome and top-down/bottom-up sum, "
+                                  "their correlation with the whole surface and the macro/micro "
+                                  "split of Alg. 2. Writes OUTDIR/chromosomes.npz "
+                                  "(chromosomes, surface, q_bounds, ...), mechanics.json, "
+                                  "macro_micro.json and figures.")
+    add_surface_options(p)
+    add_detrend_option(p)
+    p.add_argument("--gamma", type=positive_float, default=2 ** 0.5,
+                   help="band ratio q_{n+1}/q_n (the genome's gamma when known)")
+    add_material_options(p)
+    p.add_argument("--steps", type=nonnegative_int, default=20,
+                   help="equal approaches per A(p), K(p) curve (0: decomposition only)")
+    p.add_argument("--threshold", type=positive_float, default=0.95,
+                   help="Alg. 2: c_n of K(p) above which a band is macro-scale roughness")
+    add_output_folder(p)
+    add_run_options(p)
+    p.set_defaults(func=_chromosomes)
 
     p = gs.add_parser("validity", help="Monte Carlo of Eq. 3.10 (Fig. 29)",
                       description="Monte Carlo check of the validity condition Eq. 3.10 (thesis "

@@ -21,6 +21,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from .. import progress
 from ..errors import InputError
 from ..frozen import freeze_containers
 from ..surfaces.surface import Surface
@@ -99,8 +100,8 @@ def _coeffs(complete, curves):
 
 def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: float = 0.0,
                    n_steps: int = 20, kernel: str = "auto",
-                   response: Optional[Callable[[Surface], ResponseCurve]] = None,
-                   progress: Optional[Callable[[int, int], None]] = None) -> BandMechanics:
+                   response: Optional[Callable[[Surface], ResponseCurve]] = None
+                   ) -> BandMechanics:
     """BEM curves of every band chromosome and TD/BU partial sum (see the module notes).
 
     Parameters
@@ -116,8 +117,8 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
     response : callable, optional
         ``Surface -> ResponseCurve``; default the BEM sweep of
         :func:`~roughfe.genomics.macro_micro.profile_response` with the above.
-    progress : callable, optional
-        Called as ``progress(done, total)`` after each sweep.
+
+    Progress is reported through :func:`roughfe.progress.iterate` ("band sweeps").
     """
     if int(n_steps) < 2:
         raise InputError(f"n_steps must be >= 2 (a curve needs two points), got {n_steps!r}")
@@ -135,17 +136,11 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
     jobs.update({("c", k): chrom[k] for k in range(n_c)})
     jobs.update({("td", k): td[k] for k in range(1, n_c - 1)})
     jobs.update({("bu", k): bu[k] for k in range(1, n_c - 1)})
-    curves = {}
-    total = sum(not _is_flat(z) for z in jobs.values())
-    done = 0
-    for key, z in jobs.items():
-        if _is_flat(z):
-            curves[key] = None
-            continue
-        curves[key] = response(bands.as_surface(z))
-        done += 1
-        if progress is not None:
-            progress(done, total)
+    curves = {key: None for key, z in jobs.items() if _is_flat(z)}
+    todo = [key for key in jobs if key not in curves]
+    for key in progress.iterate(todo, "band sweeps"):
+        curves[key] = response(bands.as_surface(jobs[key]))
+    done = len(todo)
     complete = curves["complete"]
     if complete is None:
         raise InputError("the surface is flat: no contact curve")
