@@ -130,14 +130,21 @@ class ChromosomeMechanics:
                 "nit": self.nit, "elapsed_s": self.elapsed}
 
 
+def is_flat(z) -> bool:
+    """True when heights are constant to round-off: such a field has no contact curve."""
+    return bool(np.ptp(z) <= 1e-12 * max(float(np.max(np.abs(z))), 1e-300))
+
+
 def _curve_or_none(x0, z, length, n_nodes, **kw):
-    if np.ptp(z) <= 1e-12 * max(np.max(np.abs(z)), 1e-300):
+    if is_flat(z):
         return None
     surf = Surface(z, n_nodes * length / (n_nodes - 1), metadata={"x0": float(x0), "length": length})
     return response(surf, **kw)
 
 
-def _coeffs(complete, curves):
+def correlations(complete, curves):
+    """``{"K": c_n, "A": c_n}``: Pearson c_n of each curve with the complete one (Alg. 2,
+    paired by loading step); NaN where a curve is None."""
     out = {}
     for q in ("K", "A"):
         out[q] = np.array([np.nan if c is None else correlation(complete, c, q) for c in curves])
@@ -193,7 +200,7 @@ def chromosome_mechanics(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, 
         length=float(length), kernel=kernel, youngs_modulus=float(youngs_modulus),
         poisson=float(poisson), indices=td.indices.copy(), complete=complete,
         chromosome_curves=chrom, td_curves=td_c, bu_curves=bu_c,
-        c_chromosome=_coeffs(complete, chrom), c_td=_coeffs(complete, td_c),
-        c_bu=_coeffs(complete, bu_c), success=True,
+        c_chromosome=correlations(complete, chrom), c_td=correlations(complete, td_c),
+        c_bu=correlations(complete, bu_c), success=True,
         message=f"{nit} BEM sweeps ({kernel} kernel, {n_steps} steps each)", nit=nit,
         elapsed=time.perf_counter() - t0)
