@@ -45,6 +45,7 @@ def test_contact_cli_writes_results_fields_and_figures(tmp_path):
     assert (out / "contact_render.png").stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_contact_cli_draws_persson_beside_the_bem(tmp_path):
     # a self-affine periodic surface: BEM and Persson's theory side by side in results.json
     from roughfe.surfaces.spectral import spectral_surface

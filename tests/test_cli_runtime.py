@@ -50,6 +50,7 @@ def test_sweeps_report_progress_to_the_listener_only():
     assert list(progress.iterate(iter("ab"), "no len")) == ["a", "b"]
 
 
+@pytest.mark.slow
 @pytest.mark.fem
 def test_a_picture_after_dolfinx_was_loaded_first_renders_in_a_fresh_process(tmp_path):
     pytest.importorskip("dolfinx")

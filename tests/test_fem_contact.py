@@ -248,6 +248,7 @@ def test_load_control_reaches_the_pressure_and_equals_displacement_control(weste
         fem_contact_sweep(westergaard_mesh, MAT, pressures=[0.0, 1.0])
 
 
+@pytest.mark.slow
 def test_iterative_inner_solver_gives_the_direct_solution(westergaard_mesh):
     """CG + hypre for the SNES-VI inner solves and the stiffness solve (petsc_options
     ksp_*/pc_*) reproduces the MUMPS solution (p, A*, K to 1e-6)."""
