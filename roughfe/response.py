@@ -18,7 +18,8 @@ Method = Literal["bem", "fem"]
 METHODS = ("bem", "fem")
 
 #: keyword options of each method (everything else is refused with the list below)
-BEM_OPTIONS = ("kernel", "solver", "tol", "max_iter", "compute_stiffness", "unload")
+BEM_OPTIONS = ("kernel", "solver", "tol", "max_iter", "compute_stiffness", "hardness",
+               "unload")
 FEM_MESH_OPTIONS = ("depth", "growth", "formulation", "size_max")
 FEM_SOLVER_OPTIONS = ("solver", "penalty_factor", "rtol", "atol", "max_it", "petsc_options")
 FEM_OPTIONS = FEM_MESH_OPTIONS + FEM_SOLVER_OPTIONS + ("keep_fields",)
@@ -55,9 +56,9 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         ``response(mirrored_profile(surface), ...)``, not with the periodic BEM of
         ``surface`` itself.
     **solver_options
-        BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness`` (see
-        :func:`roughfe.bem.solve_contact`), ``unload`` (:func:`roughfe.bem.contact_sweep`).
-        FEM: mesh ``depth``, ``growth``,
+        BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness``,
+        ``hardness`` (see :func:`roughfe.bem.solve_contact`), ``unload``
+        (:func:`roughfe.bem.contact_sweep`). FEM: mesh ``depth``, ``growth``,
         ``formulation``, ``size_max`` (:func:`roughfe.fem.mesh_profile`); ``solver``
         (``"vi"`` or ``"penalty"``), ``penalty_factor``, ``rtol``, ``atol``, ``max_it``,
         ``petsc_options`` (:class:`roughfe.fem.FemSolverOptions`); ``keep_fields``.

@@ -139,3 +139,35 @@ def test_contact_cli_adhesion_parameters_must_be_positive_and_finite(tmp_path, c
     assert main(["contact", str(path), "--adhesion", "md", "--work-of-adhesion", value,
                  "--range", "1e-9", "-o", str(tmp_path / "x")]) == 2
     assert "--work-of-adhesion" in capsys.readouterr().err
+def test_contact_cli_hardness_load_unload_cycle(tmp_path, capsys):
+    # a Westergaard sinusoid whose crest flows: p* = pi E* g / lambda = 12.3 MPa, the
+    # elastic peak at 3 MPa mean is ~10.8 MPa > H_p = 8 MPa
+    x = np.arange(256) * 1e-6
+    prof = Surface(1e-6 * np.cos(2 * np.pi * x / 256e-6), 256e-6, periodic=True)
+    path = save_surface(prof, tmp_path / "sine.npz")
+    out = tmp_path / "o"
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0", "--pressure", "1e6", "3e6",
+                 "--hardness", "8e6", "--unload", "-o", str(out), "--no-figures"]) == 0
+    doc = json.loads((out / "results.json").read_text())
+    steps = doc["steps"]
+    assert doc["inputs"]["hardness"] == 8e6 and doc["inputs"]["unload"] is True
+    assert [s["unloading"] for s in steps] == [False, False, True]
+    assert steps[0]["plastic_area_fraction"] == 0.0 < steps[1]["plastic_area_fraction"]
+    # back at 1 MPa the flattened crest carries the load on a wider contact
+    assert steps[2]["area_fraction"] > steps[0]["area_fraction"]
+    h5py = pytest.importorskip("h5py")
+    with h5py.File(out / "fields.h5", "r") as f:
+        up = f["plastic_displacement"][:]
+        assert f["plastic_displacement"].attrs["unit"] == "m"
+        assert not up[0].any() and up[1].max() > 0 and np.array_equal(up[1], up[2])
+    # a hardness below the load, and a non-positive one, are one-line input errors
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0", "--pressure", "1e6",
+                 "--hardness", "5e5", "-o", str(tmp_path / "x")]) == 2
+    assert "below the hardness" in capsys.readouterr().err
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0", "--pressure", "1e6",
+                 "--hardness", "0", "-o", str(tmp_path / "y")]) == 2
+    capsys.readouterr()
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0", "--hardness", "1e7",
+                 "--adhesion", "md", "--work-of-adhesion", "0.1", "--range", "1e-7",
+                 "-o", str(tmp_path / "z")]) == 2
+    assert "not supported" in capsys.readouterr().err

@@ -384,12 +384,14 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
             out = _periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
                                         max_iter or 20000)
         elif solver == "pk":
-            if initial is None and mean_pressure is not None and plastic is None:
+            own = initial is None and mean_pressure is not None and plastic is None
+            if own:
                 initial = _coarse_start(surface, material, mean_pressure, hardness)
             out = polonsky_keer(op.apply, h, scale, delta=delta, mean_pressure=mean_pressure,
                                 initial=initial, diagonal=op.diagonal,
                                 precond=_cg_preconditioner(op), tol=tol,
-                                max_iter=max_iter or 20000, offset=-hmax, hardness=hardness)
+                                max_iter=max_iter or 20000, offset=-hmax, hardness=hardness,
+                                overwrite_initial=own)
         else:
             H = _dense(op)
             if initial is None:

@@ -55,7 +55,7 @@ import scipy.fft
 
 from ..errors import InputError
 from ..reference import uniform_rectangle_displacement, uniform_strip_displacement
-from ..surfaces.stats import angular_wavevectors
+from ..surfaces.stats import angular_wavevectors, rfft_full_sum
 
 KERNELS = ("spectral", "strip", "thesis", "love")
 WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads per FFT
@@ -122,12 +122,7 @@ class InfluenceOperator:
         stand for two modes)."""
         if self.padded_kernel is not None:
             return float(self.padded_kernel.flat[0])
-        m = self.shape[-1]
-        spec = self.spectrum
-        total = 2.0 * float(spec.sum()) - float(spec[..., 0].sum())
-        if m % 2 == 0:
-            total -= float(spec[..., -1].sum())
-        return total / float(np.prod(self.shape))
+        return rfft_full_sum(self.spectrum, self.shape[-1]) / float(np.prod(self.shape))
 
     @property
     def references(self) -> tuple:
@@ -170,7 +165,7 @@ class InfluenceOperator:
         """
         axes = tuple(range(v.ndim))
         if spectrum.dtype == np.float32:
-            v = v.astype(np.float32)
+            v = v.astype(np.float32, copy=False)
         vh = scipy.fft.rfftn(v, axes=axes, workers=WORKERS)
         vh *= spectrum
         return scipy.fft.irfftn(vh, s=v.shape, axes=axes, workers=WORKERS, overwrite_x=True)

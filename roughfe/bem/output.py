@@ -66,7 +66,10 @@ def write_fields_h5(path, sweep: SweepResult, compression: str = "gzip"):
             f.attrs["method"] = r0.method
             f.attrs["kernel"] = r0.kernel or ""          # none for the FEM
             f.attrs["dimensions"] = json.dumps(["frame"] + ["x", "y"][: r0.pressure.ndim])
-            for name, unit in (("pressure", "Pa"), ("gap", "m"), ("contact", "1")):
+            names = [("pressure", "Pa"), ("gap", "m"), ("contact", "1")]
+            if all(r.plastic_displacement is not None for r in res):
+                names.append(("plastic_displacement", "m"))      # BEM with a hardness
+            for name, unit in names:
                 data = np.stack([getattr(r, name) for r in res])
                 ds = f.create_dataset(name, data=data, compression=compression)
                 ds.attrs["unit"] = unit

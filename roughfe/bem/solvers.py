@@ -273,7 +273,7 @@ def _shift_to_load(x, target_sum, upper):
 
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
                   diagonal=1.0, precond=None, tol=1e-10, max_iter=10000, offset=0.0,
-                  hardness=None):
+                  hardness=None, overwrite_initial=False):
     """Polonsky & Keer (1999) constrained CG with FFT operator products, bounded form.
 
     Solves Eq. 2.5-2.6 for ``0 <= p <= hardness`` with the gap ``w = H p - b - offset -
@@ -307,9 +307,11 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     H after an iteration whose projection clipped (u = H p is then recomputed; without a
     clip u <- alpha (u - tau H t), kept with a lazy scale factor, one BLAS axpy). All CG
     vectors live on the free set F (gathered by index); the full-grid fields are p, u,
-    the direction t and the previous masked gradient (the preconditioner's input buffer),
-    plus the transients of one FFT product. ``nit`` counts iterations, ``n_products``
-    the operator products (H and M).
+    the direction t (float64) and the previous masked gradient (float32: the
+    preconditioner's input and PR's g_old), plus the transients of one FFT product.
+    ``overwrite_initial`` lets the solver use ``initial`` as its pressure array (no
+    copy; the caller gives it up). ``nit`` counts iterations, ``n_products`` the
+    operator products (H and M).
 
     Returns a :class:`SolverOutput`.
     """
@@ -332,7 +334,10 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         return np.ascontiguousarray(precond(x.reshape(shape))).reshape(-1)
 
     if initial is not None:
-        p = np.array(initial, dtype=float).reshape(-1)
+        own = (overwrite_initial and isinstance(initial, np.ndarray)
+               and initial.dtype == np.float64 and initial.flags.c_contiguous
+               and initial.flags.writeable)
+        p = initial.reshape(-1) if own else np.array(initial, dtype=float).reshape(-1)
         np.clip(p, 0.0, upper, out=p)
         if load and not p.any():
             p[:] = mean_pressure
@@ -348,7 +353,9 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         if bounded and float(p.sum()) < target * (1 - 1e-12):
             _shift_to_load(p, target, upper)    # too few points to carry it below the cap
     t = np.zeros(n)              # search direction, zero off F
-    gbuf = np.zeros(n)           # masked gradient of the last iteration, zero off F
+    # masked gradient of the last iteration, zero off F: the preconditioner's input and
+    # the g_old of the Polak-Ribiere beta, both only needed to single precision
+    gbuf = np.zeros(n, np.float32)
     mask = np.empty(n, bool)
     F = np.empty(0, np.intp)
     S = np.flatnonzero(p)

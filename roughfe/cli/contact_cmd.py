@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..bem import KERNELS
+from ..errors import InputError
 from ..model import Loading, Material
 from ..response import response
 from ..bem.contact import SOLVERS
@@ -48,8 +49,14 @@ def register(subparsers) -> None:
                       help="approaches from first contact (m), solved in the order given")
     p.add_argument("--unload", action="store_true",
                    help="after loading, trace the unloading branch (with --adhesion: until "
-                        "the surfaces separate, giving the pull-off force)")
+                        "the surfaces separate, giving the pull-off force; with --hardness "
+                        "keeping the plastic displacement)")
     add_adhesion_options(p)
+    p.add_argument("--hardness", type=positive_float, default=None, metavar="H",
+                   help="indentation hardness H_p (Pa) of a perfectly plastic interface: "
+                        "0 <= p <= H_p; results get plastic_area_fraction per step and "
+                        "fields.h5 the plastic displacement (periodic surfaces: use "
+                        "--pressure)")
     num = p.add_argument_group("numerics")
     num.add_argument("--kernel", default="auto", choices=("auto",) + KERNELS,
                      help="influence operator: auto = spectral if periodic, else strip for "
@@ -68,6 +75,9 @@ def _run(args) -> int:
     surface = surface_from_args(args)
     material = material_from_args(args)
     law = adhesion_from_args(args)
+    if law is not None and args.hardness is not None:
+        raise InputError("--hardness and --adhesion together are not supported (the adhesive "
+                         "solver has no pressure cap); give one of them")
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
     adhesive = None
     tol = args.tol if args.tol is not None else (1e-10 if law is None else 1e-5)
@@ -76,7 +86,7 @@ def _run(args) -> int:
                    Loading(deltas=args.delta) if args.delta else
                    Loading(n_steps=args.steps or DEFAULT_STEPS))
         sweep = response(surface, material, loading, kernel=args.kernel, solver=args.solver,
-                         tol=tol, unload=args.unload)
+                         tol=tol, unload=args.unload, hardness=args.hardness)
     else:
         adhesive = _adhesive_sweep(args, surface, material, law, tol)
         sweep = adhesive.sweep
@@ -87,6 +97,7 @@ def _run(args) -> int:
               "E": material.E, "nu": material.nu, "E_star": material.E_star,
               "kernel": r0.kernel, "solver": r0.solver, "tol": tol,
               "control": "pressure" if args.pressure else "delta",
+              "hardness": args.hardness, "unload": args.unload,
               "detrend": args.detrend,
               "metadata": dict(surface.metadata)}
     doc = sweep_document(sweep, inputs)
@@ -139,7 +150,7 @@ def _adhesive_sweep(args, surface, material, law, tol):
     """The adhesive continuation in the approach (``--delta`` or ``--steps``)."""
     from ..bem.adhesion import adhesive_sweep
     from ..bem.sweep import default_deltas
-    from ..errors import InputError
+
     if args.pressure is not None:
         raise InputError("--adhesion runs in displacement control (the load-approach curve "
                          "has unstable parts): give --delta or --steps, not --pressure")

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, check_finite_positive, check_in_open_interval
-from .stats import angular_wavevectors, rms_height as _rms_height, rms_slope as _rms_slope
+from .stats import angular_wavevectors, periodic_moment
 from .surface import Surface
 from .wm import resolve_rng
 
@@ -37,8 +37,11 @@ def self_affine_psd(q, hurst, q_roll, q_short, q_long=0.0, ndim=2):
     Exponent ``-(ndim + 2 H)``: ``ndim = 2`` surface, ``ndim = 1`` profile.
     """
     q = np.asarray(q, dtype=float)
-    c = np.where(q < q_roll, 1.0, (np.maximum(q, q_roll) / q_roll) ** (-(ndim + 2.0 * hurst)))
-    return np.where((q >= q_long) & (q <= q_short) & (q > 0), c, 0.0)
+    c = np.maximum(q, q_roll)          # in place from here: one array of q's size
+    c /= q_roll                         # 1 below the roll-off
+    c **= -(ndim + 2.0 * hurst)
+    c[(q < q_long) | (q > q_short) | (q <= 0)] = 0.0
+    return c
 
 
 def _shape_and_size(n, size, ndim):
@@ -69,14 +72,21 @@ def _synthesise(ndim, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_s
         raise InputError(f"wavenumbers must satisfy 0 <= q_long <= q_roll < q_short (rad/m), got "
                          f"q_long={q_long!r}, q_roll={q_roll!r}, q_short={q_short!r}")
     gen, seed = resolve_rng(rng)
-    noise = np.fft.rfftn(gen.standard_normal(shape)) / np.sqrt(np.prod(shape))   # E|xi|^2 = 1
+    # memory: one complex half-spectrum and two real half-grids at most (in-place passes)
+    noise = np.fft.rfftn(gen.standard_normal(shape))
+    noise /= np.sqrt(np.prod(shape))                     # E|xi|^2 = 1
     if amplitudes == "fixed":
         noise = np.exp(1j * np.angle(noise))
     qs = list(angular_wavevectors(shape, size))
     qs[-1] = qs[-1][..., : shape[-1] // 2 + 1]          # rfft keeps q_last >= 0
     qs[-1] = np.abs(qs[-1])
-    qabs = np.sqrt(sum(q ** 2 for q in qs))
-    filt = np.sqrt(self_affine_psd(qabs, hurst, q_roll, q_short, q_long, ndim))
+    qabs = np.zeros(noise.shape)
+    for q in qs:
+        qabs += q ** 2
+    np.sqrt(qabs, out=qabs)
+    filt = self_affine_psd(qabs, hurst, q_roll, q_short, q_long, ndim)
+    del qabs
+    np.sqrt(filt, out=filt)
     for axis, nn in enumerate(shape):                    # drop Nyquist modes of even axes
         if nn % 2 == 0:
             idx = [slice(None)] * ndim
@@ -85,13 +95,18 @@ def _synthesise(ndim, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_s
     if not np.any(filt > 0):
         raise InputError(f"no Fourier mode lies in [q_long, q_short] = [{q_long}, {q_short}] rad/m "
                          f"on this grid")
-    h = np.fft.irfftn(noise * filt, s=shape, axes=tuple(range(ndim)))
+    noise *= filt
+    del filt
+    h = np.fft.irfftn(noise, s=shape, axes=tuple(range(ndim)))
+    del noise
     meta = {"generator": "spectral", "hurst": hurst, "q_long": q_long, "q_roll": q_roll,
             "q_short": q_short, "amplitudes": amplitudes, "rms_height_target": rms_height,
             "rms_slope_target": rms_slope, "seed": seed}
-    unit = Surface(h, size, periodic=True)
-    achieved = _rms_height(unit) if rms_slope is None else _rms_slope(unit)
-    return Surface(h * (target / achieved), size, periodic=True, metadata=meta)
+    # the statistics of :mod:`.stats` on the raw array (no Surface copy of it)
+    achieved = (float(np.std(h)) if rms_slope is None else
+                float(np.sqrt(periodic_moment(h, size, 1))))
+    h *= target / achieved
+    return Surface(h, size, periodic=True, metadata=meta)
 
 
 def spectral_surface(n, size, hurst, rms_height=None, rms_slope=None, q_long=None, q_roll=None,

@@ -82,6 +82,41 @@ def _fourier_power(surface: Surface, window):
     return power, angular_wavevectors(h.shape, surface.size)
 
 
+def rfft_full_sum(values, n_last: int) -> float:
+    """Sum over all modes of a quantity given on the ``rfftn`` half-spectrum of a real
+    grid whose last axis has ``n_last`` points: the interior columns stand for two modes
+    (q and -q), column 0 and, for even ``n_last``, the Nyquist column for one."""
+    total = 2.0 * float(values.sum()) - float(values[..., 0].sum())
+    if n_last % 2 == 0:
+        total -= float(values[..., -1].sum())
+    return total
+
+
+def periodic_moment(heights, size, order: int) -> float:
+    """``sum |q|^(2 order) |h~(q)|^2`` over all q of periodic ``heights`` (m) of physical
+    ``size`` (m) (order >= 1), from the real FFT (half the modes; the interior columns of
+    the last axis stand for two), with in-place passes: one complex half-spectrum and
+    one real half-grid in memory (a 8192^2 surface needs 1 GB here instead of ~4 GB
+    through the full FFT)."""
+    h = heights
+    spec = np.fft.rfftn(h)
+    power = np.abs(spec)
+    del spec
+    power *= power
+    power /= float(h.size) ** 2
+    qs = list(angular_wavevectors(h.shape, size))
+    m = h.shape[-1]
+    qs[-1] = qs[-1][..., : m // 2 + 1]
+    q2 = np.zeros(power.shape)
+    for q in qs:
+        q2 += q ** 2
+    if order > 1:
+        q2 **= order
+    power *= q2
+    del q2
+    return rfft_full_sum(power, m)
+
+
 def _default_window(surface, window):
     if window == "auto":
         return None if surface.periodic else "hann"
@@ -187,8 +222,7 @@ def spectral_moments(surface: Surface):
 
 def rms_height(surface: Surface) -> float:
     """Root-mean-square height about the mean, Rq/Sq (m)."""
-    h = surface.heights
-    return float(np.sqrt(np.mean((h - h.mean()) ** 2)))
+    return float(np.std(surface.heights))
 
 
 def rms_slope(surface: Surface) -> float:
@@ -199,8 +233,7 @@ def rms_slope(surface: Surface) -> float:
     spectral derivative would see the jump at the edge).
     """
     if surface.periodic:
-        power, qs = _fourier_power(surface, None)
-        return float(np.sqrt(np.sum(sum(q ** 2 for q in qs) * power)))
+        return float(np.sqrt(periodic_moment(surface.heights, surface.size, 1)))
     h = surface.heights
     return float(np.sqrt(sum(np.mean((np.diff(h, axis=a) / d) ** 2)
                              for a, d in enumerate(surface.spacing))))
@@ -214,9 +247,7 @@ def rms_curvature(surface: Surface) -> float:
     """
     factor = 1.0 if surface.ndim == 1 else 0.5
     if surface.periodic:
-        power, qs = _fourier_power(surface, None)
-        q2 = sum(q ** 2 for q in qs)
-        return factor * float(np.sqrt(np.sum(q2 ** 2 * power)))
+        return factor * float(np.sqrt(periodic_moment(surface.heights, surface.size, 2)))
     h = surface.heights
     inner = tuple(slice(1, -1) for _ in range(h.ndim))
     lap = np.zeros_like(h[inner])
