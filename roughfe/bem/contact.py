@@ -215,7 +215,7 @@ def _coarse_start(surface, material, mean_pressure, hardness):
     same load, recursively down to ``COARSE_START_MIN`` points per axis) to
     ``COARSE_START_TOL`` and its pressure injected on 2 x 2 blocks. Each level costs a
     quarter of the next; measured (H = 0.8, p/E* = 0.005-0.1, 4 loads) it saves 15-20 %
-    of the fine-grid iterations at 512^2-1024^2 (see docs/theory/bem-performance.md).
+    of the fine-grid iterations at 512^2-1024^2 (see docs/theory/02b_bem_performance.md).
     """
     shape = surface.shape
     if (not surface.periodic or surface.ndim != 2 or min(shape) < COARSE_START_MIN
