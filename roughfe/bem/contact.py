@@ -26,7 +26,8 @@ from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
 from .operators import KERNELS, WORKERS, InfluenceOperator, influence_operator
-from .solvers import SolverOutput, dense_solve, kkt_residual, polonsky_keer
+from .pk import polonsky_keer
+from .solvers import SolverOutput, dense_solve, kkt_residual
 from .stiffness import exact_stiffness
 
 SOLVERS = ("auto", "dense", "nnls", "pk")
