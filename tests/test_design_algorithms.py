@@ -143,3 +143,49 @@ def test_mcco_wider_pool_crosses_every_ordered_pair_and_weight(entries, targets)
     assert de.rescore(r.best.design, [t1, t3], SETTINGS) == pytest.approx(r.best.scores, abs=1e-7)
     with pytest.raises(InputError, match="weights"):
         de.mcco(entries, t1, t3, SETTINGS, options=FAST, weights=(0.0,))
+
+
+def _strict_scores_by_hand(design, targets):
+    """Independent of design.rescore_at_target_pressures: bem.contact_sweep directly, A as
+    the contact-node count, K by central differences written out, Eq. (4.1) written out."""
+    from roughfe.bem import contact_sweep
+    from roughfe.model import Material
+
+    surf = design.surface()
+    mat = Material(SETTINGS.youngs_modulus, SETTINGS.poisson)
+    top = contact_sweep(surf, mat, deltas=(float(np.ptp(surf.heights)),), compute_stiffness=False)
+    eta = targets[0].p_max / top.results[-1].mean_pressure
+    p_t = targets[0].pressure
+    sw = contact_sweep(surf, mat, pressures=tuple(p_t / eta), compute_stiffness=False)
+    p = np.array([r.mean_pressure for r in sw.results]) * eta
+    dl = np.array([r.delta for r in sw.results])
+    k = np.empty_like(p)
+    k[1:-1] = (p[2:] - p[:-2]) / (dl[2:] - dl[:-2])
+    k[0], k[-1] = (p[1] - p[0]) / (dl[1] - dl[0]), (p[-1] - p[-2]) / (dl[-1] - dl[-2])
+    a = np.array([np.count_nonzero(r.contact) for r in sw.results]) / surf.heights.size
+    np.testing.assert_allclose(p, p_t, rtol=1e-6)
+    return [1.0 - np.max(np.abs((t.values - (k if t.quantity == "K" else a)) / t.values))
+            for t in targets]
+
+
+def test_search_at_target_pressures_raises_the_strict_score_reproducibly(entries, targets,
+                                                                        tmp_path):
+    """The stage beyond the thesis: the M-CCO best design's f solved at the target
+    pressures rises, and the saved design's strict scores equal an independent BEM run
+    (the interpolated scores still equal de.rescore)."""
+    t1, _, t3, _ = targets
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    f0 = de.combined_score(de.rescore_at_target_pressures(r.best.design, [t1, t3], SETTINGS))
+    rs = de.search_at_target_pressures(r, SETTINGS, n_eval=40, seed=1)
+    c = rs.best
+    assert c.stages == r.best.stages and len(c.at_targets) == 2
+    assert de.combined_score(c.at_targets) > f0 + 0.01
+    assert rs.nit > r.nit + 40
+    paths = de.write_design_result(rs, SETTINGS, tmp_path)
+    saved = json.loads(paths["result"].read_text())["candidates"][0]
+    d = de.Design.from_dict(json.loads(paths["design"].read_text()))
+    np.testing.assert_allclose(_strict_scores_by_hand(d, [t1, t3]),
+                               saved["scores_at_target_pressures"], atol=1e-7)
+    np.testing.assert_allclose(de.rescore(d, [t1, t3], SETTINGS), c.scores, atol=1e-7)
+    with pytest.raises(InputError, match="n_eval"):
+        de.search_at_target_pressures(r, SETTINGS, n_eval=0)

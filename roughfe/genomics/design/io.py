@@ -24,7 +24,9 @@ def result_to_dict(result: DesignResult, settings: DatabaseSettings) -> dict:
         "targets": [t.to_dict() for t in result.objective.targets],
         "settings": settings.to_dict(), "database_scores": result.database_scores,
         "candidates": [{"origin": c.origin, "stages": list(c.stages), "scores": list(c.scores),
-                        "score": combined_score(c.scores), "macro": [list(m) for m in c.macro],
+                        "score": combined_score(c.scores),
+                        "scores_at_target_pressures": list(c.at_targets),
+                        "macro": [list(m) for m in c.macro],
                         "micro": [list(m) for m in c.micro], "curve": c.curve.to_dict(),
                         "design": c.design.to_dict()} for c in result.candidates],
         "references": list(result.references)}
