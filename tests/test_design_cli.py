@@ -26,7 +26,7 @@ def test_db_and_design_commands(tmp_path, capsys):
     assert main(["design-targets", "--db", str(path), "-o", str(tmp_path / "t")]) == 0
     out = tmp_path / "sog"
     assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "y_t1.csv"),
-                 "--method", "sog", "--iterations", "1", "-o", str(out)]) == 0
+                 "--method", "sog", "--iterations", "1", "--search", "3", "-o", str(out)]) == 0
     for name in ("result.json", "design.json", "genome.json", "profile.npz", "curves.csv",
                  "stages.csv", "curves.png", "stages.png", "profile.png", "psd.png"):
         assert (out / name).is_file(), name
@@ -36,6 +36,8 @@ def test_db_and_design_commands(tmp_path, capsys):
     design = de.Design.from_dict(json.loads((out / "design.json").read_text()))
     s = de.rescore(design, [target], settings)[0]
     assert s == pytest.approx(report["candidates"][0]["score"], abs=1e-7)
+    assert de.rescore_at_target_pressures(design, [target], settings) == pytest.approx(
+        report["candidates"][0]["scores_at_target_pressures"], abs=1e-7)
     # a single-genome design is a genome with the rescaled amplitude gene
     genome = json.loads((out / "genome.json").read_text())
     assert genome["format"] == "roughfe-genome"

@@ -35,7 +35,7 @@ PBAR_SWEEP = np.linspace(0.5, 1.1, 7) / 1.6
 MCCO_POOL = {"pool": 8, "swap": True, "weights": (0.5, 1.0, 2.0)}
 #: the stage beyond the thesis that searches on f at the target pressures
 #: (``design.search_at_target_pressures``): BEM sweeps per candidate
-SEARCH_EVAL = 600
+SEARCH_EVAL = 400
 
 
 def _table1(out, lines):

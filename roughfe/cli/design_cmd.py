@@ -26,7 +26,8 @@ def _run(args) -> int:
     from ..errors import InputError
     from ..genomics.database import load_entries, read_settings
     from ..genomics.design import (GcmmaOptions, refine, rescore_at_target_pressures,
-                                   run_design, write_design_result)
+                                   run_design, search_at_target_pressures,
+                                   write_design_result)
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}
@@ -49,6 +50,8 @@ def _run(args) -> int:
                             options=options, **extra)
         if args.refine:
             result = refine(result, settings, rounds=args.refine)
+        if args.search:
+            result = search_at_target_pressures(result, settings, n_eval=args.search)
         if not args.no_figures:
             from ..plotting.design import (plot_design_curves, plot_profiles, plot_psds,
                                            plot_stages)
@@ -117,6 +120,10 @@ def register(sub):
     g.add_argument("--refine", type=nonnegative_int, default=0, metavar="ROUNDS",
                    help="extra stage beyond the thesis: ROUNDS x 15 GCMMA iterations on all "
                         "phases, box (+-10%% of 2 pi) re-centred each round (0: off)")
+    g.add_argument("--search", type=nonnegative_int, default=0, metavar="SWEEPS",
+                   help="extra stage beyond the thesis, after --refine: a (1+1) evolution "
+                        "strategy on all phases and part weights maximising the score solved "
+                        "at the target pressures, SWEEPS BEM sweeps per candidate (0: off)")
     p.add_argument("--pool", type=nonnegative_int, default=0, metavar="K",
                    help="mcco, beyond the thesis: start pool of the K best genomes of each "
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "

@@ -360,7 +360,7 @@ def _at_targets(design, objective, settings, evaluate):
 
 def search_at_target_pressures(result: DesignResult, settings: DatabaseSettings, *,
                                n_eval: int = 400, width: float = math.pi,
-                               weight_fraction: float = 0.3, sigma: float = 0.1, seed: int = 0,
+                               weight_fraction: float = 0.3, sigma: float = 0.3, seed: int = 0,
                                evaluate=None) -> DesignResult:
     """An optional stage beyond the thesis: a derivative-free search of every phase and
     part weight on the score solved *at the target's own pressures*.
@@ -416,7 +416,7 @@ def search_at_target_pressures(result: DesignResult, settings: DatabaseSettings,
                 d_best = d_v
             else:
                 step *= 1.5 ** -0.25
-            step = min(max(step, 1e-3), 0.5)
+            step = float(sigma) if step < 2e-3 else min(step, 0.5)   # restart when collapsed
         new = _finish(d_best if f > f_start else d0, c.stages, objective, evaluate, c.macro,
                       c.micro, c.origin)
         out.append(replace(new, at_targets=_at_targets(new.design, objective, settings,
