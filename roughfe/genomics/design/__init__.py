@@ -10,8 +10,8 @@ Modules, by idea (see ``docs/theory/genomics-layout.md``):
 * :mod:`.stages` -- one GCMMA stage (Sec. 4.3.1) through the one driver
   :func:`roughfe.optim.gcmma.gcmma`, its options and the phase box;
 * :mod:`.algorithms` -- Alg. 3 (:func:`score_database`), SOG/GCO/CCO/M-CCO (Algs. 4-7),
-  :func:`refine` and
-  :func:`search_at_target_pressures` (beyond the thesis) and :func:`run_design`;
+  :func:`refine` and :func:`search_at_target_pressures` (beyond the thesis) and
+  :func:`run_design`;
 * :mod:`.targets` -- the thesis targets y_t1, y_t2, y_t3 and independent re-scoring;
 * :mod:`.io` -- the result files.
 
@@ -19,8 +19,7 @@ Every public name is importable from ``roughfe.genomics.design``.
 """
 from ...optim.gcmma import GcmmaResult, gcmma_maximize, gcmma_minimax
 from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, mcco, refine,
-                         run_design, score_database, search_at_target_pressures,
-                         sog)
+                         run_design, score_database, search_at_target_pressures, sog)
 from .io import result_to_dict, write_design_result
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
@@ -31,7 +30,8 @@ from .targets import (Y_T1_GENES, rescore, rescore_at_target_pressures, target_g
                       thesis_targets)
 
 __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
-           "run_design", "score_database", "search_at_target_pressures", "sog", "result_to_dict", "write_design_result",
+           "run_design", "score_database", "search_at_target_pressures", "sog",
+           "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",
            "combine", "entry_design", "Evaluator", "Objective", "combined_score",
            "residual_jacobian", "FORMULATIONS", "GcmmaOptions", "optimise_phases",
