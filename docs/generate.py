@@ -13,17 +13,16 @@
 A page whose JSON is missing says so and shows the command that writes it; no number on
 these pages is typed by hand. Generated files are listed in ``.gitignore``.
 
-Usage: ``python docs/generate.py [--validation DIR] [--benchmarks DIR]``.
+Usage: ``python docs/generate.py [--validation DIR] [--quick DIR] [--benchmarks DIR]``.
 """
 from __future__ import annotations
 
 import argparse
 import ast
-import io
 import json
 import math
+import os
 import sys
-from contextlib import redirect_stdout
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
@@ -97,7 +96,6 @@ def write_api(outdir: Path) -> int:
 # -- command-line reference -------------------------------------------------------------
 def _subcommands(parser, path):
     """(command path, parser) of ``parser`` and of every subcommand below it, in order."""
-    import argparse
     yield path, parser
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
@@ -107,7 +105,6 @@ def _subcommands(parser, path):
 
 def write_cli_reference(path: Path) -> int:
     """``roughfe ... --help`` of every command and subcommand as one Markdown page."""
-    import os
     os.environ["COLUMNS"] = "92"                 # argparse wraps the help at this width
     from roughfe.cli import build_parser
     lines = [GENERATED_MARK.format(source="roughfe.cli.build_parser()"), "",
