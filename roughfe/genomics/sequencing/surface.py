@@ -63,16 +63,30 @@ from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, surfac
                            surface_peaks)
 
 
+#: nodes (over all acquisitions) used by the nonlinear fit; the final solve uses every node
+FIT_ROWS = 16384
+
+
 # -- step 4: variable projection ----------------------------------------------------------------
 class _Model:
-    """Design of the MWM surface model over all acquisitions (rows: valid nodes)."""
+    """Design of the MWM surface model over all acquisitions (rows: valid nodes).
 
-    def __init__(self, acqs, n_nodes):
+    ``max_rows`` keeps a fixed pseudo-random subset of the valid nodes (the same share of
+    each acquisition): the nonlinear fit needs a few rows per unknown, not every node, and
+    its cost is linear in the rows; the final coefficients use every node.
+    """
+
+    def __init__(self, acqs, n_nodes, max_rows=None):
         self.acqs = acqs
         self.n_nodes = n_nodes
+        total = sum(int(a.valid.sum()) for a in acqs)
+        share = 1.0 if max_rows is None else min(1.0, max_rows / total)
+        rng = np.random.default_rng(0)
         xs, ys, zs, blocks = [], [], [], []
         for k, a in enumerate(acqs):
             ok = a.valid
+            if share < 1.0:
+                ok = ok & (rng.random(ok.shape) < share)
             xx, yy = np.meshgrid(a.x, a.y, indexing="ij")
             xs.append(xx[ok])
             ys.append(yy[ok])
@@ -226,17 +240,19 @@ def _weak_ridges(sol, n_ridges, ratio=0.01):
     return np.flatnonzero(np.median(rel, axis=1) < ratio)
 
 
-def _residual_acquisitions(model, resid):
-    """The fit residual laid back on each acquisition's grid (NaN where undefined)."""
+def _residual_acquisitions(full, p, ranges):
+    """The residual of the fit at ``p`` on every node of each acquisition (``full`` is the
+    model of all nodes; NaN where undefined)."""
+    resid = full.solve(p, ranges)["resid"]
     out = []
-    for k, a in enumerate(model.acqs):
+    for k, a in enumerate(full.acqs):
         z = np.full(a.z.shape, np.nan)
-        z[a.valid] = resid[model.block == k]
+        z[a.valid] = resid[full.block == k]
         out.append(SurfaceAcquisition(a.x, a.y, z, a.length))
     return out
 
 
-def _add_missing_ridges(model, p, ranges, sol, max_new=8):
+def _add_missing_ridges(model, full, p, ranges, sol, max_new=8):
     """Greedy completion: a direction that holds the strongest peaks of the residual's
     periodogram becomes a new ridge when the refit halves the residual (ridges with one
     detected peak, or close to a stronger one, are missed by the first clustering)."""
@@ -245,7 +261,7 @@ def _add_missing_ridges(model, p, ranges, sol, max_new=8):
     for _ in range(max_new):
         if cost <= 1e-24 * float(model.z @ model.z):
             break
-        peaks = [surface_peaks(a) for a in _residual_acquisitions(model, sol["resid"])]
+        peaks = [surface_peaks(a) for a in _residual_acquisitions(full, p, ranges)]
         ang = np.concatenate([pk.angle for pk in peaks])
         pw = np.concatenate([pk.power for pk in peaks])
         if ang.size == 0:
@@ -402,7 +418,8 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     groups = np.concatenate([np.full(pk.qx.size, k) for k, pk in enumerate(peaks)])[in_ridge]
     groups = groups * 1000 + labels[in_ridge]           # one peak per (acquisition, ridge, n)
     periods, _, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
-    model = _Model(acqs, n_nodes)
+    model = _Model(acqs, n_nodes, max_rows=FIT_ROWS)     # the nonlinear fit
+    full = _Model(acqs, n_nodes)                          # the final coefficients
     tiny = 1e-24 * float(model.z @ model.z)
 
     def attempt(p0, continuation):
@@ -421,7 +438,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
 
     def complete(out):
         """Add the ridges the first clustering missed (best lattice only)."""
-        p, ranges, sol, k = _add_missing_ridges(model, out[1], out[2], out[3])
+        p, ranges, sol, k = _add_missing_ridges(model, full, out[1], out[2], out[3])
         return float(sol["resid"] @ sol["resid"]), p, ranges, sol, out[4] + k
 
     starts = []
@@ -453,17 +470,17 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     if best is None:
         return _failure("no gamma candidate gave a lattice fit", acqs, peaks, t0)
     _, p, ranges, _, _ = best
-    sol = model.solve(p, ranges, exact=True)
+    sol = full.solve(p, ranges, exact=True)
     g = _genes(p, sol, ranges)
     genome = Genome(A=g["A"], H=g["H"], gamma=g["gamma"], lambda1=g["lambda1"],
                     phases=g["phases"], n_first=g["n_first"], angles=g["angles"],
                     anisotropy=g["anisotropy"], metadata={"source": "sequence_surfaces"})
     errs = []
-    fitted = model.z - sol["resid"]
+    fitted = full.z - sol["resid"]
     for k in range(len(acqs)):
-        rows = model.block == k
-        zk = model.z[rows] - model.z[rows].mean()
-        errs.append(float(np.sqrt(np.mean((model.z[rows] - fitted[rows]) ** 2)
+        rows = full.block == k
+        zk = full.z[rows] - full.z[rows].mean()
+        errs.append(float(np.sqrt(np.mean((full.z[rows] - fitted[rows]) ** 2)
                                   / np.mean(zk ** 2))))
     errs = np.array(errs)
     ok = bool(np.all(errs <= rms_tolerance))
