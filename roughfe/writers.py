@@ -29,8 +29,8 @@ import numpy as np
 
 from .errors import InputError
 
-#: Prefix of every temporary file (``.roughfe-<8 random characters>.tmp<suffix>``): short, so that a
-#: target name of any legal length (255 bytes) still has a legal temporary name.
+#: Prefix of every temporary file (``.roughfe-<8 random characters>.tmp<suffix>``): short,
+#: so that a target name of any legal length (255 bytes) still has a legal temporary name.
 TMP_PREFIX = ".roughfe-"
 _MAX_TMP_SUFFIX = 16
 
