@@ -77,3 +77,11 @@ def check_memory(what: str, n_bytes: float) -> None:
         gib = 2.0 ** 30
         raise InputError(f"{what} needs {n_bytes / gib:.1f} GiB of memory, "
                          f"{free / gib:.1f} GiB are available")
+
+
+def check_instance(name, value, cls, what):
+    """Return ``value`` or raise :class:`InputError` (``"NAME must be WHAT, got TYPE"``)
+    unless it is an instance of ``cls``."""
+    if not isinstance(value, cls):
+        raise InputError(f"{name} must be {what}, got {type(value).__name__}")
+    return value

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Literal, Optional
 
-from .errors import InputError
+from .errors import InputError, check_instance
 from .model import Loading, Material, SweepResult
 from .surfaces import Surface
 
@@ -77,12 +77,9 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         A step did not converge.
     """
     loading = Loading() if loading is None else loading
-    if not isinstance(loading, Loading):
-        raise InputError(f"loading must be a roughfe.model.Loading, got {loading!r}")
-    if not isinstance(material, Material):
-        raise InputError(f"material must be a roughfe.model.Material, got {material!r}")
-    if not isinstance(surface, Surface):
-        raise InputError(f"surface must be a roughfe Surface, got {type(surface).__name__}")
+    check_instance("loading", loading, Loading, "a roughfe.model.Loading")
+    check_instance("material", material, Material, "a roughfe.model.Material")
+    check_instance("surface", surface, Surface, "a roughfe Surface")
     if method == "bem":
         from .bem import contact_sweep
 

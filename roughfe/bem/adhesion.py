@@ -65,7 +65,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..errors import InputError, NoConvergenceError, check_finite_positive, check_instance
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
@@ -220,12 +220,9 @@ class _Energy:
 
 
 def _check(surface, material, law, delta):
-    if not isinstance(surface, Surface):
-        raise InputError(f"surface must be a roughfe Surface, got {type(surface).__name__}")
-    if not isinstance(material, Material):
-        raise InputError(f"material must be a roughfe Material, got {material!r}")
-    if not isinstance(law, AdhesionLaw):
-        raise InputError(f"law must be an AdhesionLaw, got {law!r}")
+    check_instance("surface", surface, Surface, "a roughfe Surface")
+    check_instance("material", material, Material, "a roughfe.model.Material")
+    check_instance("law", law, AdhesionLaw, "an AdhesionLaw")
     try:
         d = float(delta)
     except (TypeError, ValueError):

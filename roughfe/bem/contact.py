@@ -21,7 +21,7 @@ import numpy as np
 import scipy.fft
 
 from ..caching import MB, bytes_bounded_cache
-from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..errors import InputError, NoConvergenceError, check_finite_positive, check_instance
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
@@ -138,8 +138,7 @@ def _choose_solver(n_points: int, op: InfluenceOperator, solver: str,
 
 
 def _check_surface(surface):
-    if not isinstance(surface, Surface):
-        raise InputError(f"surface must be a roughfe Surface, got {type(surface).__name__}")
+    check_instance("surface", surface, Surface, "a roughfe Surface")
     if np.ptp(surface.heights) == 0.0:
         raise InputError("the surface is flat (constant heights): contact of a flat on a "
                          "flat is uniform and has no rough-contact solution")
@@ -344,8 +343,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         The tolerance was not reached; its ``result`` holds the last iterate.
     """
     _check_surface(surface)
-    if not isinstance(material, Material):
-        raise InputError(f"material must be a roughfe.model.Material, got {material!r}")
+    check_instance("material", material, Material, "a roughfe.model.Material")
     delta, mean_pressure = _check_target(delta, mean_pressure)
     hardness, plastic = _check_hardness(hardness, mean_pressure, plastic_displacement,
                                         surface.shape)

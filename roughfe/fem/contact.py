@@ -53,7 +53,7 @@ from typing import Literal, Mapping
 
 import numpy as np
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..errors import InputError, NoConvergenceError, check_finite_positive, check_instance
 from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
@@ -81,8 +81,7 @@ def p_wave_modulus(material: Material) -> float:
 
 
 def _check_material(material) -> Material:
-    if not isinstance(material, Material):
-        raise InputError(f"material must be a roughfe.model.Material, got {type(material).__name__}")
+    check_instance("material", material, Material, "a roughfe.model.Material")
     if material.nu >= 0.5:
         raise InputError(f"the P1 displacement FEM needs nu < 0.5 (it locks when incompressible), "
                          f"got nu = {material.nu!r}")

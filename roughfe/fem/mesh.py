@@ -28,7 +28,7 @@ from typing import Any, Literal, Mapping
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive
+from ..errors import InputError, check_finite_positive, check_instance
 from ..surfaces import Surface
 from ..frozen import FrozenMapping
 from ..writers import atomic_path
@@ -86,8 +86,7 @@ class ProfileMesh:
 
 
 def _check_profile(surface):
-    if not isinstance(surface, Surface):
-        raise InputError(f"surface must be a roughfe Surface, got {type(surface).__name__}")
+    check_instance("surface", surface, Surface, "a roughfe Surface")
     if surface.ndim != 1:
         raise InputError(f"the FEM body needs a 1D profile, got a surface of shape {surface.shape}")
     if surface.shape[0] < 3:

@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
-from ..errors import InputError, check_finite_positive
+from ..errors import InputError, check_finite_positive, check_instance
 from ..surfaces.stats import angular_wavevectors
 from ..surfaces.surface import Surface
 
@@ -222,8 +222,7 @@ def band_chromosomes(surface: Surface, gamma: float = DEFAULT_GAMMA, *, q1=None,
     -------
     BandChromosomes
     """
-    if not isinstance(surface, Surface):
-        raise InputError(f"surface must be a roughfe Surface, got {type(surface).__name__}")
+    check_instance("surface", surface, Surface, "a roughfe Surface")
     gamma = _check_gamma(gamma)
     if transform not in TRANSFORMS:
         raise InputError(f"transform must be one of {TRANSFORMS}, got {transform!r}")

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_instance
 from ...surfaces.surface import Surface
 from ..genome import observation_coordinates
 
@@ -33,8 +33,7 @@ def acquisitions_from_surfaces(surfaces) -> list:
     if len(surfaces) < 2:
         raise InputError(f"sequencing needs at least 2 nested acquisitions, got {len(surfaces)}")
     for k, s in enumerate(surfaces):
-        if not isinstance(s, Surface):
-            raise InputError(f"acquisition {k} must be a roughfe Surface, got {type(s).__name__}")
+        check_instance(f"acquisition {k}", s, Surface, "a roughfe Surface")
         if s.ndim != 1:
             raise InputError(f"acquisition {k} must be a profile (1D heights), got shape {s.shape}")
     sizes = {s.shape[0] for s in surfaces}

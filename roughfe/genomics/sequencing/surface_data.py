@@ -12,7 +12,7 @@ import scipy.fft
 from scipy.ndimage import maximum_filter
 from scipy.signal.windows import blackmanharris
 
-from ...errors import InputError
+from ...errors import InputError, check_instance
 from ...surfaces.surface import Surface
 from .acquisitions import MIN_NODES
 
@@ -64,8 +64,7 @@ def surface_acquisitions(surfaces, valid=None) -> list:
     if not surfaces:
         raise InputError("sequencing needs at least one acquisition")
     for k, s in enumerate(surfaces):
-        if not isinstance(s, Surface):
-            raise InputError(f"acquisition {k} must be a roughfe Surface, got {type(s).__name__}")
+        check_instance(f"acquisition {k}", s, Surface, "a roughfe Surface")
     dims = sorted({s.ndim for s in surfaces})
     if dims != [2]:
         raise InputError(f"surface sequencing needs 2D acquisitions only; got dimensions "
