@@ -63,3 +63,22 @@ def test_a_picture_after_dolfinx_was_loaded_first_renders_in_a_fresh_process(tmp
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert (tmp_path / "p.png").stat().st_size > 5000
+
+
+
+def test_public_render_backend_call_orders_vtk_before_dolfinx():
+    """roughfe.load_render_backend (the notebook entry point) loads vtk in a fresh process
+    before dolfinx, after which an off-screen render with a scalar bar (the label
+    formatting that aborts in the other order) works."""
+    import os
+
+    from roughfe._runtime import headless_environment
+    code = ("import sys, roughfe; assert roughfe.load_render_backend(); "
+            "assert 'vtkmodules.vtkCommonCore' in sys.modules; "
+            "import dolfinx, pyvista; p = pyvista.Plotter(off_screen=True); "
+            "m = pyvista.Sphere(); m['z'] = m.points[:, 2]; p.add_mesh(m, scalars='z'); "
+            "img = p.screenshot(return_img=True); assert img.ndim == 3; print('rendered')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=headless_environment(dict(os.environ)), timeout=180)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "rendered" in out.stdout
