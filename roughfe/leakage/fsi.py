@@ -88,6 +88,7 @@ from typing import Optional
 import numpy as np
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..optim.anderson import RejectedIterate, anderson_fixed_point
 from ..surfaces import Surface
 from .finite_volume import FVSolution, components_reaching, solve_reynolds_fv
 
@@ -180,8 +181,8 @@ class CoupledResult:
                 "coupled_residual": self.residual}
 
 
-class _LiftOff(Exception):
-    pass
+class _LiftOff(RejectedIterate):
+    """The fluid alone would carry the external load."""
 
 
 def _pockets(open_cells, connected, periodic, axis):
@@ -335,42 +336,17 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     x = np.zeros(h.shape)
     gx = G(x, first=True)
     one_way = _flow(last["gap"]).leak_rate
-    hist_x, hist_r, residuals = [], [], []
-    it = 0
-    state = "contact"
-    while True:
-        r = gx - x
-        res = float(np.linalg.norm(r) / max(np.linalg.norm(gx), 1e-300))
-        residuals.append(res)
-        if res <= tol:
-            break
-        if it >= max_iter:
-            last["flow"] = _flow(last["gap"])
-            partial = _result("contact", last, gx, p_ext, p_in, p_out, mu, one_way, it, res,
-                              residuals, cell)
-            raise NoConvergenceError(
-                f"fluid-structure coupling: relative residual {res:.3e} after {it} iterations "
-                f"(tolerance {tol:.1e}, Anderson memory {anderson})", result=partial)
-        hist_x.append(x.ravel())
-        hist_r.append(r.ravel())
-        del hist_x[:-(anderson + 1)], hist_r[:-(anderson + 1)]
-        x_new = x + relaxation * r
-        if len(hist_r) > 1:
-            dR = np.diff(np.array(hist_r), axis=0).T
-            dX = np.diff(np.array(hist_x), axis=0).T
-            gamma, *_ = np.linalg.lstsq(dR, r.ravel(), rcond=None)
-            x_new = x_new - ((dX + relaxation * dR) @ gamma).reshape(h.shape)
-        it += 1
-        try:
-            x, gx = x_new, G(x_new)
-        except _LiftOff:
-            hist_x.clear()
-            hist_r.clear()
-            try:
-                x, gx = gx, G(gx)
-            except _LiftOff:
-                state = "lift-off"
-                break
+    fp = anderson_fixed_point(G, x, gx, tol=tol, max_iter=int(max_iter),
+                              memory=int(anderson), relaxation=relaxation)
+    it, gx, residuals = fp.iterations, fp.gx, list(fp.residuals)
+    if fp.status == "max_iter":
+        last["flow"] = _flow(last["gap"])
+        partial = _result("contact", last, gx, p_ext, p_in, p_out, mu, one_way, it,
+                          fp.residual, residuals, cell)
+        raise NoConvergenceError(
+            f"fluid-structure coupling: relative residual {fp.residual:.3e} after {it} "
+            f"iterations (tolerance {tol:.1e}, Anderson memory {anderson})", result=partial)
+    state = "lift-off" if fp.status == "rejected" else "contact"
     if state == "contact":
         last["flow"] = _flow(last["gap"])
     return _result(state, last, gx, p_ext, p_in, p_out, mu, one_way, it,

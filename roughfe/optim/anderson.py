@@ -1,0 +1,127 @@
+"""Anderson-accelerated fixed-point iteration ``x = G(x)`` (no physics here).
+
+Type II Anderson acceleration with memory ``m`` and mixing ``beta`` (Walker & Ni 2011):
+with the residuals ``r_k = G(x_k) - x_k`` and the differences ``dR``, ``dX`` of the last
+``m + 1`` iterates and residuals, ``gamma = argmin ||r_k - dR gamma||`` and
+
+    x_{k+1} = x_k + beta r_k - (dX + beta dR) gamma.
+
+``m = 0`` is the relaxed Picard iteration ``x + beta r``. The residual is
+``||G(x) - x|| / ||G(x)||`` (2-norms). ``G`` may refuse an iterate by raising
+:class:`RejectedIterate` (e.g. an extrapolated fluid pressure that would lift the body
+off): the plain iterate ``G(x_k)`` is taken instead and the memory cleared; if ``G``
+refuses that too, the iteration stops with ``status = "rejected"``.
+
+Used by the fluid-structure couplings of :mod:`roughfe.leakage.fsi` (surfaces) and
+:mod:`roughfe.leakage.profile_fsi` (profiles, BEM and FEM bodies): one loop for all.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import numpy as np
+
+REFERENCES = ("Walker H.F., Ni P. (2011) SIAM J. Numer. Anal. 49:1715-1735 (Anderson)",)
+
+
+class RejectedIterate(Exception):
+    """Raised by ``G`` when it cannot be evaluated at an iterate."""
+
+
+@dataclass(frozen=True, eq=False)
+class FixedPoint:
+    """Outcome of :func:`anderson_fixed_point`.
+
+    Attributes
+    ----------
+    x, gx : ndarray
+        Last iterate and ``G(x)``.
+    status : {"converged", "max_iter", "rejected"}
+        Residual <= tol; iteration limit reached; ``G`` refused the plain iterate.
+    iterations : int
+        Evaluations of ``G`` after the first.
+    residual : float
+        Last relative residual.
+    residuals : tuple of float
+        Residual history (one per evaluated iterate).
+    """
+
+    x: np.ndarray
+    gx: np.ndarray
+    status: str
+    iterations: int
+    residual: float
+    residuals: tuple
+
+    @property
+    def converged(self) -> bool:
+        return self.status == "converged"
+
+
+def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
+                         tol: float = 1e-8, max_iter: int = 60, memory: int = 5,
+                         relaxation: float = 1.0) -> FixedPoint:
+    """Solve ``x = G(x)`` from ``x0`` (module docstring).
+
+    Parameters
+    ----------
+    G : callable
+        ndarray -> ndarray of the same shape; may raise :class:`RejectedIterate`.
+    x0 : ndarray
+        Starting iterate.
+    gx0 : ndarray, optional
+        ``G(x0)`` when the caller has it already (not evaluated again).
+    tol : float
+        Relative residual to reach.
+    max_iter : int
+        Evaluations of ``G`` allowed after the first.
+    memory : int
+        Anderson memory ``m`` (0: relaxed Picard).
+    relaxation : float
+        Mixing ``beta`` in (0, 1].
+
+    Returns
+    -------
+    FixedPoint
+        Never raises on non-convergence: the caller reads ``status`` and raises its own
+        :class:`~roughfe.errors.NoConvergenceError` with its partial result.
+    """
+    x = np.asarray(x0, dtype=float)
+    gx = G(x) if gx0 is None else np.asarray(gx0, dtype=float)
+    hist_x: list = []
+    hist_r: list = []
+    residuals: list = []
+    it = 0
+    status: Optional[str] = None
+    while status is None:
+        r = gx - x
+        res = float(np.linalg.norm(r) / max(np.linalg.norm(gx), 1e-300))
+        residuals.append(res)
+        if res <= tol:
+            status = "converged"
+            break
+        if it >= max_iter:
+            status = "max_iter"
+            break
+        hist_x.append(x.ravel())
+        hist_r.append(r.ravel())
+        del hist_x[:-(memory + 1)], hist_r[:-(memory + 1)]
+        x_new = x + relaxation * r
+        if len(hist_r) > 1:
+            dR = np.diff(np.array(hist_r), axis=0).T
+            dX = np.diff(np.array(hist_x), axis=0).T
+            gamma, *_ = np.linalg.lstsq(dR, r.ravel(), rcond=None)
+            x_new = x_new - ((dX + relaxation * dR) @ gamma).reshape(x.shape)
+        it += 1
+        try:
+            x, gx = x_new, G(x_new)
+        except RejectedIterate:
+            hist_x.clear()
+            hist_r.clear()
+            try:
+                x, gx = gx, G(gx)
+            except RejectedIterate:
+                status = "rejected"
+    return FixedPoint(x=x, gx=gx, status=status, iterations=it, residual=residuals[-1],
+                      residuals=tuple(residuals))
