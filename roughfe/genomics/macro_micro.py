@@ -36,17 +36,37 @@ from .similarity import ResponseCurve
 STIFFNESS_KINDS = ("fd", "exact")
 
 
+def top_approach(surface: Surface, kernel: str = "auto", top_fraction: float = 1.0) -> float:
+    """The last approach of :func:`profile_sweep` (m): ``top_fraction`` times the
+    peak-valley height, or times max h - mean h (full contact) with a periodic kernel."""
+    h = surface.heights
+    full = h.max() - h.mean() if periodic_approach(surface, kernel) else np.ptp(h)
+    return float(top_fraction) * float(full)
+
+
+def periodic_approach(surface: Surface, kernel: str = "auto") -> bool:
+    """True when the BEM solves ``surface`` with the periodic kernel (approaches measured
+    up to full contact, max h - mean h)."""
+    return bool(surface.periodic and kernel in ("auto", "spectral"))
+
+
 def profile_sweep(surface: Surface, *, youngs_modulus: float, poisson: float = 0.0,
-                  n_steps: int = 20, kernel: str = "auto", stiffness: str = "fd") -> SweepResult:
+                  n_steps: int = 20, kernel: str = "auto", stiffness: str = "fd",
+                  top_fraction: float = 1.0) -> SweepResult:
     """The BEM sweep behind :func:`profile_response`: ``n_steps`` equal approaches
-    ``Delta_j = j/n_t * (max h - min h)`` through :func:`roughfe.response.response` (the
-    one response function), with the exact per-step stiffness only when ``stiffness``
-    is ``"exact"``. Parameters as :func:`profile_response`."""
+    ``Delta_j = j/n_t * top`` (:func:`top_approach`: ``max h - min h`` for a profile, the
+    thesis) through :func:`roughfe.response.response` (the one response function), with
+    the exact per-step stiffness only when ``stiffness`` is ``"exact"``. Parameters as
+    :func:`profile_response`."""
     if stiffness not in STIFFNESS_KINDS:
         raise InputError(f"stiffness must be one of {STIFFNESS_KINDS}, got {stiffness!r}")
-    return contact_response(surface, Material(youngs_modulus, poisson),
-                            Loading(n_steps=int(n_steps)), kernel=kernel,
-                            compute_stiffness=stiffness == "exact")
+    if top_fraction == 1.0:
+        loading = Loading(n_steps=int(n_steps))
+    else:
+        top = top_approach(surface, kernel, top_fraction)
+        loading = Loading(deltas=tuple(top * np.arange(1, int(n_steps) + 1) / int(n_steps)))
+    return contact_response(surface, Material(youngs_modulus, poisson), loading,
+                            kernel=kernel, compute_stiffness=stiffness == "exact")
 
 
 def sweep_curve(sweep: SweepResult, stiffness: str = "fd") -> ResponseCurve:
@@ -59,8 +79,8 @@ def sweep_curve(sweep: SweepResult, stiffness: str = "fd") -> ResponseCurve:
 
 
 def profile_response(surface: Surface, *, youngs_modulus: float, poisson: float = 0.0,
-                     n_steps: int = 20, kernel: str = "auto", stiffness: str = "fd"
-                     ) -> ResponseCurve:
+                     n_steps: int = 20, kernel: str = "auto", stiffness: str = "fd",
+                     top_fraction: float = 1.0) -> ResponseCurve:
     """K(p) and A(p) of a profile by the BEM at ``n_steps`` equal approaches (Sec. 4.2.1).
 
     Parameters
@@ -81,6 +101,9 @@ def profile_response(surface: Surface, *, youngs_modulus: float, poisson: float 
         step averages those jumps. Measured on the Sobol database: the best Alg. 3 score
         for y_t1 is 0.89 with "fd" and 0.83 with "exact". Both are invariant under the
         Eq. (4.2) rescaling.
+    top_fraction : float
+        The last approach is ``top_fraction`` times the default one (:func:`top_approach`);
+        surface databases stop before the full contact of a periodic surface.
 
     Returns
     -------
@@ -88,7 +111,8 @@ def profile_response(surface: Surface, *, youngs_modulus: float, poisson: float 
         Mean pressure (Pa), stiffness K (Pa/m) and area fraction at the steps with p > 0.
     """
     sweep = profile_sweep(surface, youngs_modulus=youngs_modulus, poisson=poisson,
-                          n_steps=n_steps, kernel=kernel, stiffness=stiffness)
+                          n_steps=n_steps, kernel=kernel, stiffness=stiffness,
+                          top_fraction=top_fraction)
     return sweep_curve(sweep, stiffness)
 
 
@@ -185,16 +209,17 @@ def macro_micro(genome, settings, *, response=None) -> MacroMicroResult:
     ----------
     genome : roughfe.genomics.genome.Genome
     settings : roughfe.genomics.database.DatabaseSettings
-        Length L (m), nodes N, E (Pa), nu, n_t, threshold, kernel.
+        Length L (m), nodes N, dim (profile or periodic surface,
+        :func:`roughfe.genomics.periodic.realization`), E (Pa), nu, n_t, threshold, kernel.
     response : callable, optional
         ``Surface -> ResponseCurve``; default :func:`profile_response` with ``settings``.
     """
-    from .genome import realize
+    from .periodic import realization
     if response is None:
         def response(s):
             return profile_response(s, **settings.response_options())
-    total = realize(genome, settings.length, settings.n_nodes)
-    n_s, n_f = total.metadata["n_s"], total.metadata["n_f"]
-    ns = np.arange(n_s, n_f + 1)
-    parts = [realize(genome, settings.length, settings.n_nodes, chromosomes=[n]) for n in ns]
+    total = realization(genome, settings.length, settings.n_nodes, settings.dim)
+    ns = np.asarray(total.metadata["chromosomes"], dtype=int)
+    parts = [realization(genome, settings.length, settings.n_nodes, settings.dim, [n])
+             for n in ns]
     return classify_profiles(total, parts, ns, response, settings.threshold, settings.correlation)

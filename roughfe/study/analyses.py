@@ -228,7 +228,8 @@ def genome_entry_study_task(*, entry, seed, length=_THESIS.length, n_nodes=_THES
                             youngs_modulus=_THESIS.youngs_modulus, poisson=_THESIS.poisson,
                             n_steps=_THESIS.n_steps, threshold=_THESIS.threshold,
                             kernel=_THESIS.kernel, stiffness=_THESIS.stiffness,
-                            correlation=_THESIS.correlation):
+                            correlation=_THESIS.correlation, dim=_THESIS.dim,
+                            top_fraction=_THESIS.top_fraction):
     """One genome-database entry of a given genome (``roughfe db build|extend``).
 
     Parameters
@@ -240,8 +241,9 @@ def genome_entry_study_task(*, entry, seed, length=_THESIS.length, n_nodes=_THES
         (:func:`~roughfe.genomics.database.extend_tasks`).
     seed : int
         Not used: the genome is given (the runner records it).
-    length, n_nodes, youngs_modulus, poisson, n_steps, threshold, kernel, stiffness, correlation
-        The :class:`~roughfe.genomics.database.DatabaseSettings` of the database.
+    length, n_nodes, youngs_modulus, poisson, n_steps, threshold, kernel, stiffness, correlation, dim, top_fraction
+        The :class:`~roughfe.genomics.database.DatabaseSettings` of the database
+        (``dim = 2``: a periodic surface database, issue 15).
 
     Returns
     -------
@@ -253,4 +255,4 @@ def genome_entry_study_task(*, entry, seed, length=_THESIS.length, n_nodes=_THES
     return genome_entry_task(**entry, length=length, n_nodes=n_nodes,
                              youngs_modulus=youngs_modulus, poisson=poisson, n_steps=n_steps,
                              threshold=threshold, kernel=kernel, stiffness=stiffness,
-                             correlation=correlation)
+                             correlation=correlation, dim=dim, top_fraction=top_fraction)

@@ -33,6 +33,16 @@ class DatabaseSettings:
         How K(p) is taken from the sweep (see :func:`roughfe.genomics.macro_micro.profile_response`).
     correlation : {"steps", "pressure"}
         How c_n pairs the curves (see :mod:`roughfe.genomics.macro_micro`).
+    dim : {1, 2}
+        1: profiles (Eq. 3.1, nodes spanning L, non-periodic BEM; the thesis). 2: periodic
+        N x N surfaces of period L with M ridges (Eq. 3.17 on the torus,
+        :mod:`roughfe.genomics.periodic`), periodic spectral BEM.
+    top_fraction : float
+        The n_t approaches end at ``top_fraction`` times the default top approach
+        (peak-valley for profiles; max h - mean h, i.e. full contact, for periodic
+        surfaces). 1 for profiles (thesis). A periodic surface's K(p) diverges at full
+        contact (the mean displacement is free), so surface databases stop before it
+        (``roughfe db build --dim 2``: 0.8, where A* is about 0.3-0.4).
     """
 
     length: float = 849.42e-6
@@ -44,6 +54,8 @@ class DatabaseSettings:
     kernel: str = "auto"
     stiffness: str = "fd"
     correlation: str = "steps"
+    dim: int = 1
+    top_fraction: float = 1.0
 
     def __post_init__(self):
         for name in ("length", "youngs_modulus"):
@@ -60,17 +72,30 @@ class DatabaseSettings:
             raise InputError(f"stiffness must be 'fd' or 'exact', got {self.stiffness!r}")
         if not (0.0 < self.threshold < 1.0):
             raise InputError(f"threshold must lie in (0, 1), got {self.threshold!r}")
+        if self.dim not in (1, 2):
+            raise InputError(f"dim must be 1 (profiles) or 2 (periodic surfaces), got {self.dim!r}")
+        if not (np.isfinite(self.top_fraction) and 0.0 < self.top_fraction <= 1.0):
+            raise InputError(f"top_fraction must lie in (0, 1], got {self.top_fraction!r}")
         object.__setattr__(self, "n_nodes", int(self.n_nodes))
+        object.__setattr__(self, "dim", int(self.dim))
+        object.__setattr__(self, "top_fraction", float(self.top_fraction))
         object.__setattr__(self, "n_steps", int(self.n_steps))
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """The fields as a dict; a thesis profile database (dim 1, top_fraction 1) omits
+        ``dim`` and ``top_fraction``, so its records stay byte-identical to those of
+        databases built before surfaces existed (an absent ``dim`` reads as 1)."""
+        d = asdict(self)
+        if self.dim == 1 and self.top_fraction == 1.0:
+            del d["dim"], d["top_fraction"]
+        return d
 
     def response_options(self) -> dict:
         """Keywords of :func:`roughfe.genomics.macro_micro.profile_response` (and
-        ``profile_sweep``): E, nu, n_t, kernel and the K kind of these settings."""
+        ``profile_sweep``): E, nu, n_t, kernel, the K kind and the top approach."""
         return {"youngs_modulus": self.youngs_modulus, "poisson": self.poisson,
-                "n_steps": self.n_steps, "kernel": self.kernel, "stiffness": self.stiffness}
+                "n_steps": self.n_steps, "kernel": self.kernel, "stiffness": self.stiffness,
+                "top_fraction": self.top_fraction}
 
     @classmethod
     def from_dict(cls, d) -> "DatabaseSettings":

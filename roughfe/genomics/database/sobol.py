@@ -21,6 +21,15 @@ class SobolDesign:
     larger number of phases for smaller gamma". Both sequences use
     ``scipy.stats.qmc.Sobol(scramble=scramble, seed=seed)`` (pairs: ``seed``, phases:
     ``seed + 1``); the design is stored in the database.
+
+    Surface databases (``dim = 2``, issue 15 Sec. 3): each genome has ``n_ridges`` ridges;
+    the genes come from one Sobol point of dimension 2 + 2M (same ``seed``): gamma, H,
+    the M ridge angles theta_m in [0, pi) (a ridge at theta + pi is the same wave with
+    another phase) and the M anisotropy factors alpha_m, log-uniform in
+    ``anisotropy_range``; so each of the ``n_pairs`` points carries its own angles and
+    anisotropy. A phase "vector" is then an (M, n_phases + n_extra) matrix taken
+    sequentially from the 1-D phase sequence (row by row). ``dim = 1`` is the thesis
+    design above, unchanged.
     """
 
     n_pairs: int = 20
@@ -31,6 +40,40 @@ class SobolDesign:
     hurst_range: tuple = (0.5, 1.5)
     seed: int = 20240
     scramble: bool = True
+    dim: int = 1
+    n_ridges: int = 3
+    anisotropy_range: tuple = (0.5, 2.0)
+
+    def __post_init__(self):
+        if self.dim not in (1, 2):
+            raise InputError(f"dim must be 1 (profiles) or 2 (surfaces), got {self.dim!r}")
+        if int(self.n_ridges) < 1 or int(self.n_ridges) > 100:
+            raise InputError(f"n_ridges must lie in 1..100, got {self.n_ridges!r}")
+        lo, hi = self.anisotropy_range
+        if not (0 < lo <= hi and np.isfinite(hi)):
+            raise InputError(f"anisotropy_range must be 0 < low <= high, got "
+                             f"{self.anisotropy_range!r}")
+
+    @property
+    def rows(self) -> int:
+        """Ridges per genome: 1 for profiles, ``n_ridges`` for surfaces."""
+        return 1 if self.dim == 1 else int(self.n_ridges)
+
+    def genes(self) -> np.ndarray:
+        """Surfaces: (gamma, H, theta_1..theta_M, alpha_1..alpha_M) per point, shape
+        (n_pairs, 2 + 2M)."""
+        from scipy.stats import qmc
+        m = self.rows
+        e = int(np.ceil(np.log2(max(self.n_pairs, 2))))
+        u = qmc.Sobol(d=2 + 2 * m, scramble=self.scramble, seed=self.seed).random_base2(e)
+        u = u[: self.n_pairs]
+        out = np.empty_like(u)
+        out[:, 0] = self.gamma_range[0] + u[:, 0] * (self.gamma_range[1] - self.gamma_range[0])
+        out[:, 1] = self.hurst_range[0] + u[:, 1] * (self.hurst_range[1] - self.hurst_range[0])
+        out[:, 2:2 + m] = np.pi * u[:, 2:2 + m]
+        lo, hi = np.log(self.anisotropy_range[0]), np.log(self.anisotropy_range[1])
+        out[:, 2 + m:] = np.exp(lo + u[:, 2 + m:] * (hi - lo))
+        return out
 
     def pairs(self) -> np.ndarray:
         """The (gamma, H) pairs, shape (n_pairs, 2)."""
@@ -41,34 +84,49 @@ class SobolDesign:
                          [self.gamma_range[1], self.hurst_range[1]])
 
     def phase_vectors(self) -> np.ndarray:
-        """Phase vectors (rad), shape (n_vectors, n_phases + n_extra)."""
+        """Phase vectors (rad), shape (n_vectors, n_phases + n_extra); for surfaces
+        (n_vectors, M, n_phases + n_extra), the M rows of vector k taken one after the
+        other (each row as a profile vector is)."""
         from scipy.stats import qmc
-        base = self.n_vectors * self.n_phases
-        total = base + self.n_vectors * self.n_extra
+        per, extra = self.n_phases * self.rows, self.n_extra * self.rows
+        base = self.n_vectors * per
+        total = base + self.n_vectors * extra
         m = int(np.ceil(np.log2(total)))
         seq = 2 * np.pi * qmc.Sobol(d=1, scramble=self.scramble,
                                     seed=self.seed + 1).random_base2(m)[:total, 0]
-        out = np.empty((self.n_vectors, self.n_phases + self.n_extra))
+        out = np.empty((self.n_vectors, self.rows, self.n_phases + self.n_extra))
         for k in range(self.n_vectors):
-            out[k, : self.n_phases] = seq[k * self.n_phases:(k + 1) * self.n_phases]
-            out[k, self.n_phases:] = seq[base + k * self.n_extra: base + (k + 1) * self.n_extra]
-        return out
+            out[k, :, : self.n_phases] = seq[k * per:(k + 1) * per].reshape(self.rows, -1)
+            out[k, :, self.n_phases:] = seq[base + k * extra:
+                                            base + (k + 1) * extra].reshape(self.rows, -1)
+        return out[:, 0, :] if self.dim == 1 else out
 
     def tasks(self):
-        """``(label, gamma, H, phases)`` for every genome, labels ``"i-k"`` (1-based)."""
-        pairs, phases = self.pairs(), self.phase_vectors()
-        return [(f"{i + 1}-{k + 1}", float(g), float(h), phases[k])
-                for i, (g, h) in enumerate(pairs) for k in range(self.n_vectors)]
+        """``(label, gamma, H, phases)`` for every genome (surfaces: ``(label, gamma, H,
+        phases, angles, anisotropy)``), labels ``"i-k"`` (1-based)."""
+        phases = self.phase_vectors()
+        if self.dim == 1:
+            return [(f"{i + 1}-{k + 1}", float(g), float(h), phases[k])
+                    for i, (g, h) in enumerate(self.pairs()) for k in range(self.n_vectors)]
+        m = self.rows
+        return [(f"{i + 1}-{k + 1}", float(r[0]), float(r[1]), phases[k], r[2:2 + m], r[2 + m:])
+                for i, r in enumerate(self.genes()) for k in range(self.n_vectors)]
 
     def to_dict(self) -> dict:
         d = asdict(self)
-        d["gamma_range"], d["hurst_range"] = list(self.gamma_range), list(self.hurst_range)
+        for key in ("gamma_range", "hurst_range", "anisotropy_range"):
+            d[key] = list(getattr(self, key))
+        if self.dim == 1:       # the thesis design: stored as before the surface fields
+            for key in ("dim", "n_ridges", "anisotropy_range"):
+                d.pop(key)
         return d
 
     @classmethod
     def from_dict(cls, d) -> "SobolDesign":
         d = dict(d)
-        d["gamma_range"], d["hurst_range"] = tuple(d["gamma_range"]), tuple(d["hurst_range"])
+        for key in ("gamma_range", "hurst_range", "anisotropy_range"):
+            if key in d:
+                d[key] = tuple(d[key])
         return cls(**d)
 
 
@@ -77,8 +135,15 @@ def sobol_tasks(design: SobolDesign, limit=None) -> list:
 
     ``limit`` keeps the first genomes of the design (a reduced database); it must be >= 1.
     """
-    tasks = [{"label": lab, "source": "sobol", "gamma": g, "hurst": h,
-              "phases": [float(v) for v in phi]} for lab, g, h, phi in design.tasks()]
+    tasks = []
+    for row in design.tasks():
+        lab, g, h, phi = row[:4]
+        task = {"label": lab, "source": "sobol", "gamma": g, "hurst": h,
+                "phases": np.asarray(phi, dtype=float).tolist()}
+        if design.dim == 2:
+            task["angles"] = [float(v) for v in row[4]]
+            task["anisotropy"] = [float(v) for v in row[5]]
+        tasks.append(task)
     if limit is not None:
         if int(limit) < 1:
             raise InputError(f"limit must be >= 1 genome, got {limit!r}")

@@ -6,11 +6,13 @@ import numpy as np
 from ...errors import InputError
 from ..genome import Genome, chromosome_range
 from ..macro_micro import macro_micro
+from ..periodic import periodic_chromosome_range
 from .settings import DatabaseSettings, settings_from
 
 
 def genome_entry_task(gamma=None, hurst=None, phases=None, *, label, source="sobol",
-                      amplitude=1.0, lambda1=None, genome_json=None, **settings) -> dict:
+                      amplitude=1.0, lambda1=None, genome_json=None, angles=None,
+                      anisotropy=None, **settings) -> dict:
     """Realise one genome, run Alg. 2 on it and return its database record (JSON-safe).
 
     Parameters
@@ -18,8 +20,12 @@ def genome_entry_task(gamma=None, hurst=None, phases=None, *, label, source="sob
     gamma, hurst : float, optional
         Genes gamma (-) and H (-) of Eq. (3.1).
     phases : int or array_like, optional
-        A phase vector phi_{1,n} (rad; the first n_c entries are used, M = 1) or an
-        int seed that draws uniform phases with ``numpy.random.default_rng(seed)``.
+        A phase vector phi_{1,n} (rad; the first n_c entries are used, M = 1), for a
+        surface database (``dim = 2``) a phase matrix (M rows), or an int seed that draws
+        uniform phases with ``numpy.random.default_rng(seed)``.
+    angles, anisotropy : sequence of float, optional
+        Surface databases: ridge angles theta_m (rad) and amplitude factors alpha_m
+        (Eq. 3.17), one per ridge.
     label : str
         Unique name of the genome in the database.
     amplitude, lambda1 : float
@@ -45,7 +51,7 @@ def genome_entry_task(gamma=None, hurst=None, phases=None, *, label, source="sob
         raise InputError("genome_entry_task needs gamma, hurst and phases, or genome_json")
     else:
         genome = make_genome(gamma, hurst, phases, settings, amplitude=amplitude,
-                             lambda1=lambda1)
+                             lambda1=lambda1, angles=angles, anisotropy=anisotropy)
     mm = macro_micro(genome, settings)
     genome = _with_metadata(genome, label=str(label), source=str(source))
     return {"label": str(label), "source": str(source), "genome": genome.to_dict(),
@@ -62,21 +68,34 @@ def _with_metadata(genome, **facts):
 
 
 def make_genome(gamma, hurst, phases, settings: DatabaseSettings, *, amplitude=1.0,
-                lambda1=None):
-    """A one-ridge (M = 1) genome with the chromosomes realised at ``settings`` (Eq. 3.5).
+                lambda1=None, angles=None, anisotropy=None):
+    """A genome with exactly the chromosomes realised at ``settings``.
 
-    ``phases`` is a vector (its first n_c entries are used) or an int seed.
+    Profiles (``settings.dim == 1``): one ridge (M = 1), the chromosomes of Eq. (3.5).
+    Surfaces (``dim == 2``): one ridge per entry of ``angles`` (rad) with the amplitude
+    factors ``anisotropy`` (default 1), the chromosomes of the periodic range
+    (:func:`roughfe.genomics.periodic.periodic_chromosome_range`). ``phases`` is a
+    vector (M = 1) or a matrix with M rows (their first n_c entries are used), or an int
+    seed (uniform phases in [0, 2 pi) from ``numpy.random.default_rng(seed)``).
     """
     lam = settings.length if lambda1 is None else float(lambda1)
-    n_s, n_f = chromosome_range(float(gamma), lam, settings.length, settings.n_nodes)
+    if settings.dim == 2:
+        if angles is None:
+            raise InputError("a surface database genome (dim 2) needs ridge angles")
+        n_s, n_f = periodic_chromosome_range(float(gamma), lam, settings.length,
+                                             settings.n_nodes)
+        m = len(np.atleast_1d(angles))
+    else:
+        n_s, n_f = chromosome_range(float(gamma), lam, settings.length, settings.n_nodes)
+        m = 1
     n_c = n_f - n_s + 1
     if np.isscalar(phases) and float(phases) == int(phases):
-        phi = np.random.default_rng(int(phases)).uniform(0, 2 * np.pi, n_c)
+        phi = np.random.default_rng(int(phases)).uniform(0, 2 * np.pi, (m, n_c))
     else:
-        phi = np.asarray(phases, dtype=float).ravel()
-        if phi.size < n_c:
-            raise InputError(f"gamma = {gamma:.4g} needs {n_c} phases at N = {settings.n_nodes}, "
-                             f"got a phase vector of {phi.size}")
-        phi = phi[:n_c]
+        phi = np.atleast_2d(np.asarray(phases, dtype=float))
+        if phi.shape[0] != m or phi.shape[1] < n_c:
+            raise InputError(f"gamma = {gamma:.4g} needs {m} x {n_c} phases at "
+                             f"N = {settings.n_nodes}, got a phase array of shape {phi.shape}")
+        phi = phi[:, :n_c]
     return Genome(A=float(amplitude), H=float(hurst), gamma=float(gamma), lambda1=lam,
-                  phases=phi[None, :], n_first=n_s)
+                  phases=phi, n_first=n_s, angles=angles, anisotropy=anisotropy)

@@ -1,4 +1,4 @@
-"""Designed profiles and their JSON (thesis Sec. 4.2).
+"""Designed profiles and surfaces and their JSON (thesis Sec. 4.2; surfaces: issue 15).
 
 A designed profile is a :class:`Design`: a sum of *parts*, each a set of chromosomes
 (Eq. 3.2) of one genome, realised at the database length L with N nodes, multiplied by
@@ -19,7 +19,8 @@ import numpy as np
 from ...errors import InputError
 from ...surfaces.surface import Surface
 from ..database import THESIS_SETTINGS, DatabaseEntry, DatabaseSettings
-from ..genome import Genome, realize
+from ..genome import Genome, node_coordinates
+from ..periodic import check_dim, periodic_heights, realization
 
 #: genes other than the phases that CCO optimises ("all genes", Sec. 4.2.4)
 GENE_VARIABLES = ("H", "gamma", "lambda1", "weight")
@@ -57,9 +58,13 @@ class Design:
     length : float
         Observation length L (m).
     n_nodes : int
-        Nodes N (spacing L/(N-1), the genome node convention).
+        Nodes N (spacing L/(N-1), the genome node convention; dim 2: N x N nodes of
+        spacing L/N on the torus of period L).
     name : str
         Provenance, e.g. ``"5-1+2-2"``.
+    dim : {1, 2}
+        1: a profile (thesis); 2: a periodic surface, every part realised by
+        :func:`roughfe.genomics.periodic.realize_periodic_surface` (surface database).
     """
 
     parts: tuple
@@ -67,6 +72,7 @@ class Design:
     length: float = THESIS_SETTINGS.length
     n_nodes: int = THESIS_SETTINGS.n_nodes
     name: str = ""
+    dim: int = 1
 
     def __post_init__(self):
         object.__setattr__(self, "parts", tuple(self.parts))
@@ -74,6 +80,7 @@ class Design:
             raise InputError("a design needs at least one part")
         if not (np.isfinite(self.scale) and self.scale > 0):
             raise InputError(f"design scale must be finite and > 0, got {self.scale!r}")
+        object.__setattr__(self, "dim", check_dim(self.dim))
 
     # -- geometry ----------------------------------------------------------------------
     def keys(self, which="all") -> list:
@@ -127,23 +134,37 @@ class Design:
     def part_surface(self, k) -> Surface:
         """Part ``k`` alone (with its weight and the overall scale)."""
         part = self.parts[k]
-        s = realize(part.genome, self.length, self.n_nodes, chromosomes=part.chromosomes)
+        s = realization(part.genome, self.length, self.n_nodes, self.dim, part.chromosomes)
         return s.scaled(self.scale * part.weight)
 
     def chromosome_surface(self, k, n) -> Surface:
         part = self.parts[k]
-        s = realize(part.genome, self.length, self.n_nodes, chromosomes=[n])
+        s = realization(part.genome, self.length, self.n_nodes, self.dim, [n])
         return s.scaled(self.scale * part.weight)
 
+    def phase_derivative(self, k, m, n) -> np.ndarray:
+        """d heights / d phi_{m,n} of part ``k`` (m/rad): the wave (m, n) with its phase
+        shifted by pi/2, times scale and weight (a[-sin phi + sin(q.x + phi)], Eq. 3.2)."""
+        part = self.parts[k]
+        g = part.genome
+        factor = self.scale * part.weight
+        if self.dim == 2:
+            return factor * periodic_heights(g, self.length, self.n_nodes, [n], rows=[m],
+                                             phase_shift=np.pi / 2)
+        x = node_coordinates(self.length, self.n_nodes)
+        a = float(g.wave_amplitude(n)) * (1.0 if g.anisotropy is None else g.anisotropy[m])
+        phi = g.phases[m, n - g.n_first]
+        return factor * a * (np.sin(g.wavenumber(n) * x + phi) - np.sin(phi))
+
     def surface(self) -> Surface:
-        """The designed profile (heights in m) on the genome nodes."""
+        """The designed profile or periodic surface (heights in m) on the nodes."""
         surfs = [self.part_surface(k) for k in range(len(self.parts))]
         h = np.sum([s.heights for s in surfs], axis=0)
         meta = {"generator": "roughfe.design", "name": self.name, "length": self.length,
                 "n_nodes": self.n_nodes, "x0": surfs[0].metadata["x0"],
                 "parts": [{"label": p.label, "chromosomes": list(p.chromosomes)}
                           for p in self.parts]}
-        return Surface(h, surfs[0].size, periodic=False, metadata=meta)
+        return Surface(h, surfs[0].size, periodic=self.dim == 2, metadata=meta)
 
     def spectrum_lines(self) -> list:
         """Discrete spectrum ``(q_n (rad/m), a_n (m))`` of every chromosome of every part:
@@ -173,6 +194,7 @@ class Design:
     def to_dict(self) -> dict:
         return {"format": DESIGN_FORMAT, "version": DESIGN_VERSION, "name": self.name,
                 "scale": self.scale, "length": self.length, "n_nodes": self.n_nodes,
+                "dim": self.dim,
                 "parts": [{"label": p.label, "weight": p.weight,
                            "chromosomes": list(p.chromosomes), "genome": p.genome.to_dict()}
                           for p in self.parts]}
@@ -185,7 +207,7 @@ class Design:
         parts = tuple(DesignPart(Genome.from_dict(p["genome"]), tuple(p["chromosomes"]),
                                  float(p["weight"]), p.get("label", "")) for p in d["parts"])
         return cls(parts, float(d["scale"]), float(d["length"]), int(d["n_nodes"]),
-                   d.get("name", ""))
+                   d.get("name", ""), int(d.get("dim", 1)))
 
 
 def entry_design(entry: DatabaseEntry, settings: DatabaseSettings, weight=1.0,
@@ -194,11 +216,13 @@ def entry_design(entry: DatabaseEntry, settings: DatabaseSettings, weight=1.0,
     g = Genome.from_dict(entry.genome)
     ch = tuple(chromosomes) if chromosomes is not None else tuple(entry.macro) + tuple(entry.micro)
     return Design((DesignPart(g, ch, float(weight), entry.label),), 1.0, settings.length,
-                  settings.n_nodes, entry.label)
+                  settings.n_nodes, entry.label, settings.dim)
 
 
 def combine(a: Design, b: Design) -> Design:
     """Cross-over: the sum of two designs (Algs. 5-7 Step 6); scales folded into weights."""
     parts = tuple(replace(p, weight=p.weight * d.scale) for d in (a, b) for p in d.parts)
-    return Design(parts, 1.0, a.length, a.n_nodes, f"{a.name}+{b.name}")
+    if a.dim != b.dim:
+        raise InputError(f"cannot cross a dim-{a.dim} design with a dim-{b.dim} design")
+    return Design(parts, 1.0, a.length, a.n_nodes, f"{a.name}+{b.name}", a.dim)
 

@@ -7,8 +7,8 @@ import numpy as np
 from ...bem import contact_set_pressure_rate
 from ...errors import InputError
 from ..database import DatabaseSettings
-from ..genome import node_coordinates
-from ..macro_micro import profile_response, profile_sweep, sweep_curve
+from ..macro_micro import (periodic_approach, profile_response, profile_sweep, sweep_curve,
+                           top_approach)
 from .model import Design
 from .objective import Objective
 
@@ -23,10 +23,14 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     the exact stiffness K) the mean pressure varies as
 
         d p_j = (1/N) [x_j . dh_c + sum(x_j) (dDelta_j - d max h)],
-        Delta_j = (j/n_t) (max h - min h).
+        Delta_j = (j/n_t) f (max h - min h)
+
+    (f = ``top_fraction``; a periodic surface, dim 2: ``f (max h - mean h)``,
+    :func:`~roughfe.genomics.macro_micro.top_approach`).
 
     The heights vary with a phase phi_{m,n} of a part as
-    ``dh/dphi = scale * weight * a_{m,n} (sin(q_n x + phi) - sin(phi))`` (Eq. 3.2).
+    ``dh/dphi = scale * weight * a_{m,n} (sin(q_n x + phi) - sin(phi))`` (Eq. 3.2;
+    :meth:`Design.phase_derivative`, on a surface with the lattice wavevector).
     K by differences over the steps (``stiffness="fd"``) is ``D p / delta`` with a fixed
     difference matrix D and ``delta = (max h - min h)/n_t``; the exact per-step K and
     A(p) depend only on the contact sets, so their derivatives vanish. The chain then
@@ -43,9 +47,10 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     (r, J) : ndarray (n_r,), ndarray (n_r, len(keys))
     """
     surf = design.surface()
-    h = surf.heights
+    h = surf.heights.ravel()
     n_nodes = h.size
-    sweep = profile_sweep(surf, **settings.response_options())
+    opts = settings.response_options()
+    sweep = profile_sweep(surf, **opts)
     p = np.asarray(sweep.mean_pressure, float)
     if np.any(p <= 0):
         raise InputError("a loading step without contact: no sensitivities (use finite "
@@ -56,20 +61,17 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     n_t = p.size
     frac = np.arange(1, n_t + 1) / n_t
     # dh/dvariable, shape (N, n_var): phases exactly, genes by differences below
-    x = node_coordinates(design.length, design.n_nodes)
     dh = np.zeros((n_nodes, len(keys)))
     gene_cols = []
     for col, key in enumerate(keys):
         if len(key) == 2:
             gene_cols.append(col)
             continue
-        k, m, n = key
-        part = design.parts[k]
-        g = part.genome
-        a = float(g.wave_amplitude(n)) * (1.0 if g.anisotropy is None else g.anisotropy[m])
-        phi = g.phases[m, n - g.n_first]
-        dh[:, col] = design.scale * part.weight * a * (np.sin(g.wavenumber(n) * x + phi) - np.sin(phi))
-    d_ptp = dh[i_max] - dh[i_min]
+        dh[:, col] = design.phase_derivative(*key).ravel()
+    # the top approach (profile_sweep): fraction * (max h - min h), periodic: max h - mean h
+    top = top_approach(surf, opts["kernel"], opts["top_fraction"])
+    d_low = dh.mean(axis=0) if periodic_approach(surf, opts["kernel"]) else dh[i_min]
+    d_ptp = opts["top_fraction"] * (dh[i_max] - d_low)
     dp = np.empty((n_t, len(keys)))
     for j, res in enumerate(sweep.results):
         xj = contact_set_pressure_rate(res).ravel()
@@ -77,7 +79,7 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     if settings.stiffness == "exact":
         dk = np.zeros_like(dp)
     else:
-        delta = float(np.ptp(h)) / n_t
+        delta = top / n_t
         d1 = np.gradient(np.eye(n_t), axis=0, edge_order=1)       # K = d1 @ p / delta
         dk = d1 @ dp / delta - np.outer(k_vals, d_ptp / n_t / delta)
     eta = objective.p_max / p[-1]

@@ -9,6 +9,7 @@ from ...model import Loading, Material, central_differences
 from ...response import response
 from ..database import DatabaseSettings, make_genome
 from ..genome import Genome
+from ..macro_micro import top_approach
 from ..similarity import ResponseCurve, Target, linear_then_flat_target, similarity
 from .model import Design, DesignPart
 from .objective import Evaluator
@@ -30,7 +31,8 @@ def rescore_at_target_pressures(design: Design, targets, settings: DatabaseSetti
     approaches and interpolates linearly at the target pressures. A(p) of a profile is
     a count of contact nodes (a staircase in p), so the interpolated value can be a
     fraction of a node that the design never has at that pressure. Here one
-    displacement solve at Delta = peak-valley gives p_max (Eq. 4.2 factor
+    displacement solve at the last approach of the sweep (Delta = peak-valley for a
+    profile, :func:`~roughfe.genomics.macro_micro.top_approach`) gives p_max (Eq. 4.2 factor
     ``eta = p_max^t / p_max``); then the design is solved at the pressures ``p_j / eta``
     of all targets; A is the exact node fraction there and K = dp/dDelta by the same
     central differences over those steps as the target's K over its own steps. An
@@ -39,8 +41,9 @@ def rescore_at_target_pressures(design: Design, targets, settings: DatabaseSetti
     targets = list(targets)
     surf = design.surface()
     mat = Material(settings.youngs_modulus, settings.poisson)
-    top = response(surf, mat, Loading(delta=float(np.ptp(surf.heights))),
-                   kernel=settings.kernel, compute_stiffness=False)
+    delta = top_approach(surf, settings.kernel, settings.top_fraction)
+    top = response(surf, mat, Loading(delta=delta), kernel=settings.kernel,
+                   compute_stiffness=False)
     eta = targets[0].p_max / float(top.mean_pressure[-1])
     p = np.unique(np.concatenate([t.pressure for t in targets]))
     sw = response(surf, mat, Loading(pressures=tuple(p / eta)), kernel=settings.kernel,

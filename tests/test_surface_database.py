@@ -1,0 +1,182 @@
+"""Surface genome database and surface design (issue 15 Sec. 3): periodic realisation of a
+surface genome, 2D database rows, design on a 2D database, bad input."""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.genomics import database as db
+from roughfe.genomics.design import (Design, DesignPart, Evaluator, Objective, rescore,
+                                     rescore_at_target_pressures, run_design)
+from roughfe.genomics.design.sensitivities import residual_jacobian
+from roughfe.genomics.genome import Genome, random_genome
+from roughfe.genomics.periodic import (lattice_wavevectors, periodic_chromosome_range,
+                                       periodic_heights, realize_periodic_surface)
+from roughfe.genomics.similarity import Target
+
+L = 1e-4
+SETTINGS = db.DatabaseSettings(length=L, n_nodes=32, dim=2, top_fraction=0.8,
+                               youngs_modulus=1e6, n_steps=8)
+
+
+def _genome():
+    return random_genome(1.0, 0.8, 1.5, L, 3, 12, rng=1, angles=[0.3, 1.2, 2.5],
+                         anisotropy=[1.0, 0.7, 1.3])
+
+
+def test_periodic_realisation_is_the_lattice_plane_wave_sum():
+    """Eq. 3.17 on the torus: the FFT build equals the brute-force sum of the rounded
+    plane waves to round-off, Z(0) = 0, and every wavevector moved by <= (2 pi/L)/sqrt 2."""
+    g, n = _genome(), 32
+    s = realize_periodic_surface(g, L, n)
+    idx = np.array(s.metadata["chromosomes"])
+    assert (idx[0], idx[-1]) == periodic_chromosome_range(g.gamma, g.lambda1, L, n)
+    k, l_ = lattice_wavevectors(g, idx, L)
+    x = np.arange(n) * L / n
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    a = g.wave_amplitude(idx)[None, :] * g.anisotropy[:, None]
+    phi = g.phase_columns(idx)
+    z = sum(a[m, j] * (np.cos(phi[m, j]) - np.cos(2 * np.pi * (k[m, j] * X + l_[m, j] * Y) / L
+                                                   + phi[m, j]))
+            for m in range(g.M) for j in range(idx.size))
+    assert np.max(np.abs(s.heights - z)) <= 1e-12 * np.max(np.abs(z))
+    assert s.heights[0, 0] == pytest.approx(0.0, abs=1e-12 * np.max(np.abs(z)))
+    q = g.wavenumber(idx) * L / (2 * np.pi)
+    moved = np.hypot(k - q * np.cos(g.angles)[:, None], l_ - q * np.sin(g.angles)[:, None])
+    assert moved.max() <= 2 ** -0.5 + 1e-12
+    assert s.periodic and s.size == (L, L)
+
+
+def test_phase_shift_translates_the_periodic_surface():
+    """Translating by one node along x equals adding 2 pi k / N to every phase (the
+    phases carry position: the symmetry the design variables rely on)."""
+    g, n = _genome(), 32
+    idx = np.arange(*np.add(periodic_chromosome_range(g.gamma, g.lambda1, L, n), (0, 1)))
+    k, _ = lattice_wavevectors(g, idx, L)
+    ph = np.array(g.phases)
+    ph[:, idx - g.n_first] += 2 * np.pi * k / n
+    z0 = periodic_heights(g, L, n)
+    z1 = periodic_heights(replace(g, phases=ph), L, n)
+    # Z has the offset sum a cos(phi) that makes Z(0) = 0: compare without the mean
+    assert np.allclose(z1 - z1.mean(), np.roll(z0, -1, axis=0) - z0.mean(), atol=1e-12 * np.ptp(z0))
+
+
+def test_phase_derivative_matches_differences():
+    g = _genome()
+    d = Design((DesignPart(g, (3, 4, 5), 2.0, "g"),), 1.5, L, 32, "g", 2)
+    dz = d.phase_derivative(0, 1, 4)
+    eps = 1e-6
+    d2 = d.with_phases([(0, 1, 4)], [g.phases[1, 3] + eps])
+    fd = (d2.surface().heights - d.surface().heights) / eps
+    assert np.max(np.abs(fd - dz)) <= 1e-5 * np.max(np.abs(dz))
+
+
+def test_sobol_surface_design_has_angles_and_anisotropy():
+    sd = db.SobolDesign(dim=2, n_pairs=4, n_vectors=2, n_ridges=3, anisotropy_range=(0.5, 2.0))
+    tasks = db.sobol_tasks(sd)
+    assert len(tasks) == 8
+    for t in tasks:
+        assert len(t["angles"]) == 3 and all(0 <= a < np.pi for a in t["angles"])
+        assert all(0.5 <= a <= 2.0 for a in t["anisotropy"])
+        assert np.shape(t["phases"]) == (3, sd.n_phases + sd.n_extra)
+    # profile design unchanged: no surface keys in its stored JSON
+    assert "dim" not in db.SobolDesign().to_dict()
+    assert db.SobolDesign.from_dict(sd.to_dict()) == sd
+
+
+@pytest.fixture(scope="module")
+def surface_db(tmp_path_factory):
+    sd = db.SobolDesign(dim=2, n_pairs=4, n_vectors=1, n_ridges=2)
+    records = [db.genome_entry_task(**t, **SETTINGS.to_dict()) for t in db.sobol_tasks(sd)]
+    path = tmp_path_factory.mktemp("sdb") / "db.sqlite"
+    con = db.connect(path, create=True)
+    db.write_settings(con, SETTINGS)
+    db.write_design(con, sd)
+    db.insert_records(con, records)
+    con.close()
+    return path, records
+
+
+def test_surface_db_rows(surface_db):
+    """Each row: M ridges with angles, one chromosome curve per chromosome of the periodic
+    range, the realisation loaded to 0.8 of full contact (A* < 1); the settings record
+    dim = 2; p scales with the amplitude gene (Eq. 4.2) while K(p/A), A*(p/A) do not change."""
+    path, records = surface_db
+    assert db.read_settings(path).dim == 2
+    entries = db.load_entries(path)
+    for e in entries:
+        g = Genome.from_dict(e.genome)
+        n_s, n_f = periodic_chromosome_range(g.gamma, g.lambda1, L, 32)
+        assert g.M == 2 and g.angles is not None
+        assert (g.n_first, g.n_last) == (n_s, n_f)
+        assert len(e.chromosome_curves) == n_f - n_s + 1
+        assert 0 < e.curve.area_fraction[-1] < 1
+    t = db.sobol_tasks(db.SobolDesign(dim=2, n_pairs=4, n_vectors=1, n_ridges=2))[0]
+    twice = db.genome_entry_task(**{**t, "label": "x"}, amplitude=2.0, **SETTINGS.to_dict())
+    assert twice["p_max"] == pytest.approx(2 * records[0]["p_max"], rel=1e-7)
+    assert np.allclose(twice["curve"]["stiffness"], records[0]["curve"]["stiffness"], rtol=1e-6)
+
+
+def test_exact_sensitivities_of_a_surface_design_agree_with_differences(surface_db):
+    """The fixed-contact-set Jacobian (periodic approach: f (max h - mean h)) against
+    forward differences of the K residuals: the same derivative within 15 % of its scale
+    (contact-set changes between steps are what the exact derivative ignores)."""
+    path, _ = surface_db
+    e = db.load_entries(path)[1]
+    d = Design((DesignPart(Genome.from_dict(e.genome), e.macro + e.micro, 1e-6, e.label),),
+               1.0, L, 32, e.label, 2)
+    c = Evaluator(SETTINGS)(d)
+    obj = Objective((Target(c.pressure * 1.001, c.stiffness * 1.01, "K", "t", {}),))
+    keys = d.keys("all")[:4]
+    r, jac = residual_jacobian(d, keys, obj, SETTINGS)
+    x0 = d.phase_values(keys)
+    ev = Evaluator(SETTINGS)
+    for i in range(len(keys)):
+        x = x0.copy()
+        x[i] += 1e-7
+        fd = (obj.residuals(ev(d.with_phases(keys, x))) - r) / 1e-7
+        assert np.max(np.abs(fd - jac[:, i])) <= 0.15 * np.max(np.abs(jac))
+
+
+def test_sog_recovers_a_surface_genome_near_the_database(surface_db):
+    """Target: a database genome with every phase moved by N(0, 0.3 rad) and amplitude x3
+    (a genome outside the database). SOG picks its parent and GCMMA raises s on K(p) to
+    >= 0.95; a fresh BEM run of the saved design reproduces the reported score."""
+    path, _ = surface_db
+    entries = db.load_entries(path)
+    g = Genome.from_dict(entries[1].genome)
+    g = replace(g, A=3.0, phases=g.phases + np.random.default_rng(5).normal(0, 0.3, g.phases.shape))
+    target = Design((DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "t"),), 1.0, L,
+                    32, "t", 2)
+    c = Evaluator(SETTINGS)(target)
+    tk = Target(c.pressure, c.stiffness, "K", "tK", {})
+    res = run_design("sog", entries, [tk], SETTINGS)
+    best = res.best
+    assert best.origin == entries[1].label
+    assert best.stages[1] > best.stages[0] and best.scores[0] >= 0.95
+    assert rescore(best.design, [tk], SETTINGS)[0] == pytest.approx(best.scores[0], abs=1e-9)
+    assert best.design.surface().periodic
+    # the design JSON keeps dim
+    assert Design.from_dict(best.design.to_dict()).dim == 2
+    strict = rescore_at_target_pressures(best.design, [tk], SETTINGS)[0]
+    assert abs(strict - best.scores[0]) < 0.05
+
+
+def test_surface_database_bad_input():
+    with pytest.raises(InputError, match="dim"):
+        db.DatabaseSettings(dim=3)
+    with pytest.raises(InputError, match="top_fraction"):
+        db.DatabaseSettings(dim=2, top_fraction=1.5)
+    with pytest.raises(InputError, match="angles"):
+        db.make_genome(1.5, 0.8, 1, SETTINGS)
+    with pytest.raises(InputError, match="2 x"):
+        db.make_genome(1.5, 0.8, np.zeros((1, 40)), SETTINGS, angles=[0.1, 0.2])
+    with pytest.raises(InputError, match="n_ridges"):
+        db.SobolDesign(dim=2, n_ridges=0)
+    g = _genome()
+    one = Design((DesignPart(g, (3,), 1.0, "a"),), 1.0, L, 32, "a", 1)
+    two = Design((DesignPart(g, (3,), 1.0, "b"),), 1.0, L, 32, "b", 2)
+    from roughfe.genomics.design import combine
+    with pytest.raises(InputError, match="dim"):
+        combine(one, two)
