@@ -414,7 +414,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                             mean_pressure=mean_pressure, initial=initial,
                             method="nnls" if solver == "nnls" else "bpp", tol=tol,
                             max_iter=max_iter or 100,
-                            upper=np.inf if hardness is None else hardness)
+                            upper=np.inf if hardness is None else hardness,
+                            delta_max=hmax - float(h.mean()) if op.periodic else np.inf)
             out = SolverOutput(o.pressure.reshape(h.shape), o.displacement.reshape(h.shape),
                                o.delta, o.nit, o.residual, solver)
     return _result(surface, material, op, solver, out, scale, compute_stiffness, tolerance,

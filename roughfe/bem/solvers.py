@@ -140,7 +140,7 @@ def lcp_nnls(H, s, upper=np.inf):
 
 
 def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, method="bpp",
-                tol=1e-10, max_iter=100, upper=np.inf):
+                tol=1e-10, max_iter=100, upper=np.inf, delta_max=np.inf):
     """Dense solve in displacement (``delta``) or load (``mean_pressure``) control.
 
     Load control: the mean pressure P(Delta) is convex and piecewise linear in Delta
@@ -148,6 +148,14 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
     pivoting at each step) ends in finitely many steps at the exact state. With a finite
     ``upper`` (hardness, Pa; ``method="nnls"`` only) the slope comes from the points
     strictly between the bounds (the saturated ones no longer respond).
+
+    ``delta_max`` (m) bounds the Newton bracket from above: a periodic operator is
+    singular (a uniform pressure leaves the zero-mean displacement unchanged), so at its
+    full-contact approach max h - mean h the contact matrix of every point is singular
+    and beyond it pivoting returns meaningless pressures. Newton on the convex P(Delta)
+    overshoots the root from below (a warm start from a much lower load), and without
+    the bound it could land there and stall (relative load error 9 after 102 steps,
+    measured on a mirrored cosine); a step to or beyond ``delta_max`` is a bisection.
     """
     n = b.size
     passive = None if initial is None else np.asarray(initial).ravel() > 0
@@ -173,7 +181,9 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
     if initial is not None and np.any(passive):
         c = passive
         d = float(np.mean((H[np.ix_(c, c)] @ np.asarray(initial).ravel()[c]) - b[c]))
-    lo, hi = 0.0, np.inf
+    lo, hi = 0.0, float(delta_max)
+    if not d < hi:
+        d = 0.5 * hi
     nit = 0
     for k in range(max_iter):
         p, it = at(d)
@@ -194,7 +204,7 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
         else:
             slope = 0.0
         d_new = d + (target - pm) / slope if slope > 0 else np.nan
-        if not (lo <= d_new <= hi) or not np.isfinite(d_new):
+        if not (lo <= d_new < hi) or not np.isfinite(d_new):
             d_new = 2 * lo + scale if not np.isfinite(hi) else 0.5 * (lo + hi)
         d = d_new
     else:
