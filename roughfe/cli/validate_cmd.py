@@ -8,6 +8,13 @@ figures and ``<outdir>/<script>.json`` whose ``"targets"`` rows follow the schem
 targets, smaller problems. They are readable physics scripts that compare roughfe with
 analytic solutions, FEM and the literature; they need the repository checkout (they are
 not installed modules).
+
+``OUTDIR`` is owned like every output folder (:class:`roughfe.writers.OutputFolder`):
+locked, ``UNFINISHED`` while the studies run, refused when it holds files that are not an
+earlier output of the same ``roughfe validate NAME`` (``--overwrite`` to replace them),
+the previous run's files removed first. A study that raises is reported as a failed
+target row (with the error) and the others still run, so a crash late in ``make
+validate`` does not lose the reports already written.
 """
 from __future__ import annotations
 
@@ -21,6 +28,7 @@ from .. import progress
 from ..errors import InputError
 from ..validation import Target
 from ..writers import write_json
+from .options import add_output_folder, output_folder_of
 
 # name on the command line -> scripts in validation/ (explicit, ordered)
 VALIDATIONS = {
@@ -70,18 +78,36 @@ def run_validation(name: str, outdir: Path, quick: bool = False) -> dict:
     """Run the scripts of validation ``name``; ``{"met": bool, "targets": [rows], ...}``."""
     if name not in VALIDATIONS:
         raise InputError(f"unknown validation {name!r}; choose from {sorted(VALIDATIONS)} or 'all'")
-    out = {"met": True, "targets": [], "seconds": {}}
+    out = {"met": True, "targets": [], "seconds": {}, "cpu_seconds": {}}
     for script in VALIDATIONS[name]:
         if quick and script in NOT_QUICK:
             continue
         module = _load(script)
         takes_quick = "quick" in inspect.signature(module.main).parameters
-        t0 = time.perf_counter()
-        ok = bool(module.main(Path(outdir), **({"quick": True} if quick and takes_quick else {})))
+        t0, c0 = time.perf_counter(), _cpu_seconds()
+        try:
+            ok = bool(module.main(Path(outdir),
+                                  **({"quick": True} if quick and takes_quick else {})))
+            rows = _targets(outdir, script, ok)
+        except Exception as exc:   # noqa: BLE001 -- reported as a failed row, others still run
+            ok = False
+            rows = [Target(f"{script}: ran to the end", "no error",
+                           f"{type(exc).__name__}: {exc}".splitlines()[0][:300], False,
+                           "the study raised; its report is missing or partial").to_dict()]
+            print(f"   {script} raised {type(exc).__name__}: {exc}", flush=True)
         out["seconds"][script] = time.perf_counter() - t0
+        out["cpu_seconds"][script] = _cpu_seconds() - c0
         out["met"] = out["met"] and ok
-        out["targets"] += _targets(outdir, script, ok)
+        out["targets"] += rows
     return out
+
+
+def _cpu_seconds() -> float:
+    """CPU seconds of this process and its finished children (MPI, render, workers)."""
+    import resource
+    own, kids = (resource.getrusage(w) for w in (resource.RUSAGE_SELF,
+                                                  resource.RUSAGE_CHILDREN))
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def _script_doc(name: str) -> str:
@@ -97,18 +123,23 @@ def _script_doc(name: str) -> str:
 
 def _run(args) -> int:
     names = list(VALIDATIONS) if args.name == "all" else [args.name]
-    outdir = Path(args.output)
     summary = {}
-    for name in progress.iterate(names, "validations"):
-        print(f"== validation {name}{' (quick)' if args.quick else ''}", flush=True)
-        summary[name] = run_validation(name, outdir, quick=args.quick)
-        for t in summary[name]["targets"]:
-            if not t["met"]:
-                print(f"   NOT met: {t.get('name')}: {t.get('measured', t.get('value'))} "
-                      f"(target {t.get('target')})")
-    failed = [n for n, v in summary.items() if not v["met"]]
-    write_json(outdir / "summary.json", {"validations": summary, "quick": bool(args.quick),
-                                         "all_met": not failed})
+    with output_folder_of(args, f"validate {args.name}") as outdir:
+        for name in progress.iterate(names, "validations"):
+            print(f"== validation {name}{' (quick)' if args.quick else ''}", flush=True)
+            summary[name] = run_validation(name, outdir, quick=args.quick)
+            for script in summary[name]["seconds"]:
+                print(f"   {script}: {summary[name]['seconds'][script]:.0f} s wall, "
+                      f"{summary[name]['cpu_seconds'][script]:.0f} s CPU", flush=True)
+            for t in summary[name]["targets"]:
+                if not t["met"]:
+                    print(f"   NOT met: {t.get('name')}: {t.get('measured', t.get('value'))} "
+                          f"(target {t.get('target')})")
+            failed = [n for n, v in summary.items() if not v["met"]]
+            # after every study, so that a killed run still has the finished ones
+            write_json(outdir / "summary.json", {"validations": summary,
+                                                 "quick": bool(args.quick),
+                                                 "all_met": not failed})
     print("all validation targets met" if not failed else f"targets missed in: {', '.join(failed)}")
     return 1 if failed else 0
 
@@ -126,9 +157,9 @@ def register(sub):
         doc = ("every validation in turn: " + ", ".join(VALIDATIONS) if name == "all"
                else _script_doc(name))
         v = names.add_parser(name, help=doc.splitlines()[0] if doc else name, description=doc)
-        v.add_argument("-o", "--output", default="validation/output", metavar="OUTDIR",
-                       help="report folder (each study writes its own <script>.md/.json and "
-                            "figures there; other files are kept)")
+        add_output_folder(v, "report folder (every study writes its <script>.md/.json and "
+                             "figures there, and summary.json)", required=False,
+                          default="validation/output")
         v.add_argument("--quick", action="store_true",
                        help="reduced cases of every script, same targets (make validate-quick)")
         v.set_defaults(func=_run, renders_with_dolfinx=True)
