@@ -54,6 +54,7 @@ def test_methods_improve_and_scores_reproduce_from_the_saved_design(entries, tar
                       n_best=2, max_set=2)
     assert r.success and len(r.candidates) == 2
     for c in r.candidates:
+        assert c.rescore_error <= 1e-9                                      # Eq. 4.2 exact
         assert c.stages[0] <= c.stages[1] + 1e-12 <= c.stages[2] + 2e-12   # best kept per stage
         assert de.combined_score(c.scores) == pytest.approx(c.stages[2], abs=1e-9)
     assert de.combined_score(r.best.scores) >= de.combined_score(r.candidates[1].scores)
@@ -63,6 +64,26 @@ def test_methods_improve_and_scores_reproduce_from_the_saved_design(entries, tar
     again = de.rescore(d, tg, SETTINGS)
     np.testing.assert_allclose(again, r.best.scores, atol=1e-7)
     assert d.surface().shape == (SETTINGS.n_nodes,)
+
+
+def test_success_fails_when_eq42_rescaling_is_not_exact(entries, targets):
+    """success is a criterion: with an elastic-plastic response (hardness H_p) a profile's
+    curve does not stretch exactly with its amplitude (Eq. 4.2 assumes linearity), so the
+    fresh sweep of the saved, rescaled design differs from the reported score."""
+    from roughfe.genomics.macro_micro import sweep_curve
+    from roughfe.model import Loading, Material
+    from roughfe.response import response
+
+    def plastic(surf):
+        return sweep_curve(response(surf, Material(SETTINGS.youngs_modulus, 0.0),
+                                    Loading(n_steps=SETTINGS.n_steps), hardness=2e6))
+    t1 = targets[0]
+    r = de.sog(entries, t1, SETTINGS, options=FAST, n_best=1,
+               evaluate=de.Evaluator(SETTINGS, plastic))
+    assert not r.success and "NOT a success" in r.message
+    assert r.best.rescore_error > 1e-6
+    elastic = de.sog(entries, t1, SETTINGS, options=FAST, n_best=1)
+    assert elastic.success and elastic.best.rescore_error <= 1e-9
 
 
 def test_bad_inputs_are_clear(entries, targets):

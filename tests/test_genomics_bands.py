@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from roughfe import progress
-from roughfe.errors import InputError
+from roughfe.errors import InputError, NoConvergenceError
+from roughfe.genomics.macro_micro import profile_response
 from roughfe.genomics.band_mechanics import band_macro_micro, band_mechanics
 from roughfe.genomics.bands import band_chromosomes, band_leakage, genome_q1
 from roughfe.genomics.genome import node_coordinates, random_genome, realize_surface
@@ -140,6 +141,15 @@ def test_band_mechanics_of_a_periodic_surface():
     assert sorted(mm.macro + mm.micro) == list(b.indices)
     d = m.to_dict()
     assert len(d["td"]) == n_c and d["complete"]["pressure"]
+    assert m.success and "NOT" not in m.message
+    # a band sweep that does not converge: no curve, c_n NaN, success False, named
+    def flaky(surf):
+        if np.array_equal(surf.heights, b.chromosomes[1]):
+            raise NoConvergenceError("KKT residual 1e-3 > tol")
+        return profile_response(surf, youngs_modulus=1e9, n_steps=6)
+    bad = band_mechanics(b, youngs_modulus=1e9, n_steps=6, response=flaky)
+    assert not bad.success and f"c {int(b.indices[1])}" in bad.message
+    assert bad.chromosome_curves[1] is None and np.isnan(bad.c_chromosome["K"][1])
 
 
 def test_genome_chromosomes_command(tmp_path, capsys):

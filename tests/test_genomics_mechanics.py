@@ -3,6 +3,8 @@ sequenced genome has the A(p), K(p) of the true one (goal: within 2 %)."""
 import numpy as np
 import pytest
 
+from roughfe.errors import NoConvergenceError
+
 from roughfe.genomics.genome import realize, table1_genome
 from roughfe.genomics.mechanics import chromosome_mechanics, curve_difference, response
 from roughfe.genomics.sequencing import sequence_profiles
@@ -28,6 +30,30 @@ def test_partial_sums_end_at_the_complete_profile(genome):
     c1 = mech.chromosome_curves[0]
     assert np.all(np.diff(c1.area_fraction) >= 0) and np.all(np.diff(c1.pressure) > 0)
     assert mech.nit == 1 + 2 + 2 * 12
+
+
+def test_a_sweep_that_does_not_converge_is_reported_not_hidden(genome):
+    """success is a criterion: a chromosome whose BEM sweep raises NoConvergenceError has
+    no curve, c_n NaN, success False and is named; a failure of the complete profile
+    re-raises (nothing can be compared without it)."""
+    def flaky(surf):
+        if np.ptp(surf.heights) < 0.5 * np.ptp(complete.heights):   # chromosomes, short sums
+            raise NoConvergenceError("KKT residual 3e-2 > tol after 10 iterations")
+        return response(surf, kernel="thesis", n_steps=6)
+    complete = realize(genome, scale="10x", n_nodes=N)
+    mech = chromosome_mechanics(genome, scale="10x", n_nodes=N, n_steps=6, max_chromosomes=3,
+                                partial_sums=False, response=flaky)
+    assert not mech.success
+    assert "did NOT converge" in mech.message and "c 3" in mech.message
+    assert mech.chromosome_curves[2] is None and np.isnan(mech.c_chromosome["K"][2])
+    ok = chromosome_mechanics(genome, scale="10x", n_nodes=N, n_steps=6, max_chromosomes=3,
+                              partial_sums=False, kernel="thesis")
+    assert ok.success and ok.nit == 4 and "NOT" not in ok.message
+
+    def broken(surf):
+        raise NoConvergenceError("no")
+    with pytest.raises(NoConvergenceError):
+        chromosome_mechanics(genome, scale="10x", n_nodes=N, n_steps=6, response=broken)
 
 
 def test_sequenced_genome_has_the_true_contact_curves(genome):

@@ -20,12 +20,11 @@ from __future__ import annotations
 import time
 from typing import Callable, Optional
 
-from .. import progress
 from ..errors import InputError
 from ..surfaces.surface import Surface
 from .bands import REFERENCES as BAND_REFERENCES, BandChromosomes
 from .macro_micro import MacroMicroResult, classify, profile_response
-from .mechanics import ChromosomeMechanics, correlations, is_flat
+from .mechanics import ChromosomeMechanics, correlations, sweep_fields, sweep_report
 from .similarity import ResponseCurve
 
 REFERENCES = BAND_REFERENCES + ("thesis Sec. 3.4.1, Fig. 36-39 and Alg. 2, on band chromosomes",)
@@ -69,11 +68,7 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
     jobs.update({("c", k): chrom[k] for k in range(n_c)})
     jobs.update({("td", k): td[k] for k in range(1, n_c - 1)})
     jobs.update({("bu", k): bu[k] for k in range(1, n_c - 1)})
-    curves = {key: None for key, z in jobs.items() if is_flat(z)}
-    todo = [key for key in jobs if key not in curves]
-    for key in progress.iterate(todo, "band sweeps"):
-        curves[key] = response(bands.as_surface(jobs[key]))
-    done = len(todo)
+    curves, failed, done = sweep_fields(jobs, bands.as_surface, response, "band sweeps")
     complete = curves["complete"]
     if complete is None:
         raise InputError("the surface is flat: no contact curve")
@@ -82,6 +77,8 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
     def sums(kind, first_key):
         out = [curves[first_key]] + [curves[(kind, k)] for k in range(1, n_c - 1)]
         return tuple(out + [complete]) if n_c > 1 else (complete,)
+    ok, why = sweep_report(failed, lambda key: key if isinstance(key, str)
+                           else f"{key[0]} {int(bands.indices[key[1]])}")
     td_curves = sums("td", ("c", 0))
     bu_curves = sums("bu", ("c", n_c - 1))
     return ChromosomeMechanics(
@@ -90,7 +87,7 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
         complete=complete, chromosome_curves=c_curves, td_curves=td_curves,
         bu_curves=bu_curves, c_chromosome=correlations(complete, c_curves),
         c_td=correlations(complete, td_curves), c_bu=correlations(complete, bu_curves),
-        success=True, message=f"{done} BEM sweeps of {n_steps} steps ({n_c} bands)", nit=done,
+        success=ok, message=f"{done} BEM sweeps of {n_steps} steps ({n_c} bands){why}", nit=done,
         elapsed=time.perf_counter() - t0, references=REFERENCES)
 
 

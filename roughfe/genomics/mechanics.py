@@ -29,10 +29,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
-from ..errors import InputError
+from .. import progress
+from ..errors import InputError, NoConvergenceError
 from ..frozen import freeze_containers
 from ..surfaces.surface import Surface
 from ..writers import to_jsonable
@@ -90,7 +92,10 @@ class ChromosomeMechanics:
         the profile is flat (no contact curve).
     c_chromosome, c_td, c_bu : dict
         ``{"K": ndarray, "A": ndarray}`` correlation coefficients c_n (NaN where None).
-    success, message, nit : scipy-like report; nit = number of BEM sweeps.
+    success, message, nit : scipy-like report; nit = number of BEM sweeps. ``success``
+        is True only when every BEM sweep converged (:func:`sweep_fields`); a chromosome
+        or partial sum whose sweep raised :class:`~roughfe.errors.NoConvergenceError`
+        has curve None and c_n NaN, and the message names it.
     elapsed : float
         Wall time (s).
     """
@@ -135,11 +140,54 @@ def is_flat(z) -> bool:
     return bool(np.ptp(z) <= 1e-12 * max(float(np.max(np.abs(z))), 1e-300))
 
 
-def _curve_or_none(x0, z, length, n_nodes, **kw):
-    if is_flat(z):
-        return None
-    surf = Surface(z, n_nodes * length / (n_nodes - 1), metadata={"x0": float(x0), "length": length})
-    return response(surf, **kw)
+def sweep_fields(fields: dict, surface_of, response, label=None):
+    """BEM curves of several height fields, one sweep each; the first field is the
+    reference (the complete surface): its failure re-raises, since nothing compares
+    without it.
+
+    Parameters
+    ----------
+    fields : dict
+        ``{key: heights}``.
+    surface_of : callable
+        ``heights -> Surface``.
+    response : callable
+        ``Surface -> ResponseCurve`` (a BEM sweep).
+    label : str, optional
+        Progress label (:func:`roughfe.progress.iterate`).
+
+    Returns
+    -------
+    curves : dict
+        ``{key: ResponseCurve or None}``: None for a flat field (no contact curve) and for
+        a field whose sweep raised :class:`~roughfe.errors.NoConvergenceError`.
+    failed : dict
+        ``{key: message}`` of the sweeps that did not converge.
+    n_sweeps : int
+        Sweeps run (flat fields are not run).
+    """
+    curves = {key: None for key, z in fields.items() if is_flat(z)}
+    todo = [key for key in fields if key not in curves]
+    first = next(iter(fields), None)
+    failed = {}
+    for key in (progress.iterate(todo, label) if label else todo):
+        try:
+            curves[key] = response(surface_of(fields[key]))
+        except NoConvergenceError as exc:
+            if key == first:
+                raise
+            curves[key], failed[key] = None, str(exc)
+    return curves, failed, len(todo)
+
+
+def sweep_report(failed: dict, names) -> tuple:
+    """``(success, message suffix)`` of :func:`sweep_fields`: success only when no sweep
+    failed; ``names(key)`` labels a failed field."""
+    if not failed:
+        return True, ""
+    labels = ", ".join(names(k) for k in failed)
+    first = next(iter(failed.values()))
+    return False, f"; {len(failed)} BEM sweep(s) did NOT converge ({labels}): {first}"
 
 
 def correlations(complete, curves):
@@ -153,7 +201,8 @@ def correlations(complete, curves):
 
 def chromosome_mechanics(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, scale=None,
                          youngs_modulus=THESIS_YOUNGS_MODULUS, poisson=0.0, kernel="thesis",
-                         n_steps=20, max_chromosomes=None, partial_sums=True) -> ChromosomeMechanics:
+                         n_steps=20, max_chromosomes=None, partial_sums=True,
+                         response=None) -> ChromosomeMechanics:
     """A(p), K(p) of a realisation, of each chromosome and of each TD and BU partial sum.
 
     Parameters
@@ -173,34 +222,47 @@ def chromosome_mechanics(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, 
         Only the first ``max_chromosomes`` single-chromosome curves (the thesis shows 10).
     partial_sums : bool
         Also compute every TD and BU partial sum (2 n_c sweeps).
+    response : callable, optional
+        ``Surface -> ResponseCurve``; default :func:`response` with the above. A sweep
+        that raises :class:`~roughfe.errors.NoConvergenceError` is reported (curve None,
+        ``success`` False); one of the complete profile re-raises.
     """
     t0 = time.perf_counter()
     if (length is None) == (scale is None):
         raise InputError("give exactly one of length (m) or scale ('10x', '20x', '100x')")
     if scale is not None:
         length = genome.length_of(scale)
-    kw = dict(youngs_modulus=youngs_modulus, poisson=poisson, kernel=kernel, n_steps=n_steps)
+    if response is None:
+        response = partial(profile_response, youngs_modulus=youngs_modulus, poisson=poisson,
+                           n_steps=n_steps, kernel=kernel)
     td = reconstruction(genome, length, n_nodes, order="td")
     x0 = float(td.x[0])
-    complete = _curve_or_none(x0, td.complete, length, n_nodes, **kw)
-    if complete is None:
-        raise InputError("the realisation is flat: no contact curve")
-    nit = 1
-    k = len(td.indices) if max_chromosomes is None else max(1, min(int(max_chromosomes), len(td.indices)))
-    chrom = tuple(_curve_or_none(x0, td.chromosomes[j], length, n_nodes, **kw) for j in range(k))
-    nit += k
+    n_td = len(td.indices)
+    k = n_td if max_chromosomes is None else max(1, min(int(max_chromosomes), n_td))
+    fields = {"complete": td.complete}
+    fields.update({("c", j): td.chromosomes[j] for j in range(k)})
     if partial_sums:
         bu = reconstruction(genome, length, n_nodes, order="bu")
-        td_c = tuple(_curve_or_none(x0, z, length, n_nodes, **kw) for z in td.partial_sums)
-        bu_c = tuple(_curve_or_none(x0, z, length, n_nodes, **kw) for z in bu.partial_sums)
-        nit += 2 * len(td.indices)
-    else:
-        td_c = bu_c = ()
+        fields.update({("td", j): z for j, z in enumerate(td.partial_sums)})
+        fields.update({("bu", j): z for j, z in enumerate(bu.partial_sums)})
+
+    def surface_of(z):
+        return Surface(z, n_nodes * length / (n_nodes - 1),
+                       metadata={"x0": x0, "length": float(length)})
+    curves, failed, nit = sweep_fields(fields, surface_of, response)
+    complete = curves["complete"]
+    if complete is None:
+        raise InputError("the realisation is flat: no contact curve")
+    chrom = tuple(curves[("c", j)] for j in range(k))
+    td_c = tuple(curves[("td", j)] for j in range(n_td)) if partial_sums else ()
+    bu_c = tuple(curves[("bu", j)] for j in range(n_td)) if partial_sums else ()
+    ok, why = sweep_report(failed, lambda key: f"{key[0]} {int(td.indices[0]) + key[1]}"
+                           if key[0] != "bu" else f"bu {int(td.indices[-1]) - key[1]}")
     return ChromosomeMechanics(
         length=float(length), kernel=kernel, youngs_modulus=float(youngs_modulus),
         poisson=float(poisson), indices=td.indices.copy(), complete=complete,
         chromosome_curves=chrom, td_curves=td_c, bu_curves=bu_c,
         c_chromosome=correlations(complete, chrom), c_td=correlations(complete, td_c),
-        c_bu=correlations(complete, bu_c), success=True,
-        message=f"{nit} BEM sweeps ({kernel} kernel, {n_steps} steps each)", nit=nit,
+        c_bu=correlations(complete, bu_c), success=ok,
+        message=f"{nit} BEM sweeps ({kernel} kernel, {n_steps} steps each){why}", nit=nit,
         elapsed=time.perf_counter() - t0)

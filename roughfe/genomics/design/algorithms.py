@@ -36,6 +36,9 @@ METHODS = ("sog", "gco", "cco", "mcco")
 #: similarity above which a database genome (Algs. 5-7 Step 2-3) or a cross-over counts
 #: as a match (thesis: 0.95)
 SELECTION = 0.95
+#: largest difference allowed between a candidate's reported scores (its curve stretched
+#: by Eq. 4.2) and a fresh BEM sweep of the saved, rescaled design: the success criterion
+RESCORE_TOL = 1e-6
 REFERENCES = ("Borri C. (2019) Surface roughness genomics, PhD thesis, IMT Lucca, Ch. 4",
               "Svanberg K. (2002) SIAM J. Optim. 12(2):555-573 (GCMMA)")
 
@@ -68,11 +71,20 @@ class Candidate:
     origin: str
     at_targets: tuple = ()  # similarity per target solved at the target pressures
                             # (:func:`search_at_target_pressures`; empty if not run)
+    rescore_error: float = 0.0  # max |scores - scores of a fresh sweep of the saved design|
 
 
 @dataclass(frozen=True, eq=False)
 class DesignResult:
-    """Output of SOG / GCO / CCO / M-CCO (scipy-like: success, message, nit = BEM sweeps)."""
+    """Output of SOG / GCO / CCO / M-CCO (scipy-like: success, message, nit = BEM sweeps).
+
+    ``success`` is a criterion, not a flag: every candidate's scores (and strict scores,
+    when searched) are finite, and a fresh BEM sweep of each saved (Eq. 4.2-rescaled)
+    design gives its reported scores within :data:`RESCORE_TOL`. The second fails when
+    the response is not linear in the heights (e.g. an elastic-plastic evaluator): Eq.
+    (4.2) then no longer rescales a curve exactly, and the reported design would not
+    have the reported score.
+    """
 
     method: str
     candidates: tuple
@@ -120,12 +132,31 @@ def _limit_micro(micro, n_micro):
 
 
 def _finish(design, s_stages, objective, evaluate, macro, micro, origin):
+    """The final candidate: Eq. (4.2) applied to the design, its scores from the stretched
+    curve, checked against a fresh sweep of the rescaled design (one more BEM sweep)."""
     curve = evaluate(design)
     eta = objective.p_max / curve.p_max
     design = design.rescaled(eta)
     curve = curve.rescaled(eta)
-    return Candidate(design, tuple(float(s) for s in s_stages), objective.scores(curve), curve,
-                     macro, micro, origin)
+    scores = objective.scores(curve)
+    err = float(np.max(np.abs(np.subtract(objective.scores(evaluate(design)), scores))))
+    return Candidate(design, tuple(float(s) for s in s_stages), scores, curve, macro, micro,
+                     origin, rescore_error=err)
+
+
+def _success(cands) -> tuple:
+    """``(success, message suffix)`` of the criterion of :class:`DesignResult`."""
+    bad = [c.origin for c in cands
+           if not np.all(np.isfinite(np.concatenate([c.scores, c.at_targets])))]
+    if bad:
+        return False, f"; NOT a success: non-finite score of {', '.join(bad)}"
+    worst = max(cands, key=lambda c: c.rescore_error)
+    if not worst.rescore_error <= RESCORE_TOL:
+        return False, (f"; NOT a success: a fresh BEM sweep of the saved design {worst.origin} "
+                       f"differs from its reported score by {worst.rescore_error:.2e} > "
+                       f"{RESCORE_TOL:g} (the response is not linear in the heights, so the "
+                       f"Eq. 4.2 rescaling is not exact)")
+    return True, ""
 
 
 def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, entries_by_label,
@@ -156,10 +187,12 @@ def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, ent
 
 def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evaluate, t0):
     best = cands[0]
+    ok, why = _success(cands)
     msg = (f"{method}: best {best.origin} s = {combined_score(best.scores):.4f} "
            f"(stages {', '.join(f'{s:.4f}' for s in best.stages)})"
-           + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used"))
-    return DesignResult(method, cands, objective, pbar, dbs, n_cross, n_above, passed, True, msg,
+           + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used")
+           + why)
+    return DesignResult(method, cands, objective, pbar, dbs, n_cross, n_above, passed, ok, msg,
                         evaluate.n_sweeps, time.perf_counter() - t0)
 
 
@@ -346,10 +379,17 @@ def refine(result: DesignResult, settings: DatabaseSettings, *, rounds: int = 3,
         new = _finish(d, (*c.stages[:3], sc), objective, evaluate, c.macro, c.micro, c.origin)
         out.append(new)
     out.sort(key=lambda c: -combined_score(c.scores))
+    return _extended(result, out, evaluate, t0, f"; refined (GCMMA 3, {rounds} x {n_it} it., "
+                     f"all phases): s = {combined_score(out[0].scores):.4f}")
+
+
+def _extended(result, out, evaluate, t0, note):
+    """``result`` with the candidates ``out`` of an extra stage, its sweeps and time added
+    and the success criterion re-applied to the new candidates."""
+    ok, why = _success(out)
     return replace(result, candidates=tuple(out), nit=result.nit + evaluate.n_sweeps,
                    elapsed=result.elapsed + time.perf_counter() - t0,
-                   message=result.message + f"; refined (GCMMA 3, {rounds} x {n_it} it., all "
-                   f"phases): s = {combined_score(out[0].scores):.4f}")
+                   success=result.success and ok, message=result.message + note + why)
 
 
 def _at_targets(design, objective, settings, evaluate):
@@ -423,11 +463,9 @@ def search_at_target_pressures(result: DesignResult, settings: DatabaseSettings,
                                                        evaluate)))
     out.sort(key=lambda c: -combined_score(c.at_targets))
     f = combined_score(out[0].at_targets)
-    return replace(result, candidates=tuple(out), nit=result.nit + evaluate.n_sweeps,
-                   elapsed=result.elapsed + time.perf_counter() - t0,
-                   message=result.message + f"; search at the target pressures ((1+1)-ES, all "
-                   f"phases +-{width:.3g} rad, weights +-{weight_fraction:.0%}, {n_eval} "
-                   f"sweeps per candidate): f at p_t = {f:.4f}")
+    return _extended(result, out, evaluate, t0, f"; search at the target pressures ((1+1)-ES, "
+                     f"all phases +-{width:.3g} rad, weights +-{weight_fraction:.0%}, {n_eval} "
+                     f"sweeps per candidate): f at p_t = {f:.4f}")
 
 
 def run_design(method: str, entries, targets, settings: DatabaseSettings, *, pbar=None,

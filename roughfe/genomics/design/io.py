@@ -26,6 +26,7 @@ def result_to_dict(result: DesignResult, settings: DatabaseSettings) -> dict:
         "candidates": [{"origin": c.origin, "stages": list(c.stages), "scores": list(c.scores),
                         "score": combined_score(c.scores),
                         "scores_at_target_pressures": list(c.at_targets),
+                        "rescore_error": c.rescore_error,
                         "macro": [list(m) for m in c.macro],
                         "micro": [list(m) for m in c.micro], "curve": c.curve.to_dict(),
                         "design": c.design.to_dict()} for c in result.candidates],
