@@ -37,6 +37,7 @@ VALIDATIONS = {
     "sequencing": ("genomics_sequencing",),
     "design": ("design_study",),
     "leakage": ("leakage_flow",),
+    "fsi": ("fsi_fem",),
     "adhesion": ("adhesion_maugis",),
 }
 #: scripts without a reduced case, left out of ``--quick``

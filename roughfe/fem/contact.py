@@ -170,6 +170,7 @@ class _ContactProblem:
             bcs.append(fem.dirichletbc(PETSc.ScalarType(0), dofs, V.sub(comp)))
         self.K = assemble_matrix(a, bcs=bcs)
         self.K.assemble()
+        self.bcs = bcs
 
         # owned top vertices -> profile sample index
         bs = V.dofmap.index_map_bs
@@ -196,11 +197,24 @@ class _ContactProblem:
         self.r = self.x.duplicate()
         self.kappa = options.penalty_factor * (n - 1)         # k E/delta in units E/W
         self.last_pressure = 0.0
+        # a known traction on the body (the fluid pressure of roughfe.fem.fluid): its load
+        # vector in the non-dimensional units of K (None: none) and its load (N/m)
+        self.traction, self.traction_load = None, 0.0
         self.snes = self._make_snes()
 
     # -- SNES ---------------------------------------------------------------------------
+    def set_traction(self, vector, load: float):
+        """Load the body by a known traction as well: ``vector`` is its load vector in the
+        units of K (PETSc Vec, zero on the Dirichlet DOFs, owned by the caller), ``load``
+        its resultant compressive load on the top (N/m), which enters the layer
+        compliance correction of ``delta`` (Betti: the mean top displacement is
+        -(total mean pressure) H_d / M). ``None``, 0 removes it."""
+        self.traction, self.traction_load = vector, float(load)
+
     def _residual(self, snes, x, F):
         self.K.mult(x, F)
+        if self.traction is not None:
+            F.axpy(-1.0, self.traction)
         if self.options.method == "penalty":
             pen = np.maximum(x.array_r[self.top_dofs] - self.bound, 0.0)
             F.array[self.top_dofs] += self.kappa * self.weights * pen
@@ -271,7 +285,8 @@ class _ContactProblem:
         Converges in 1-3 steps unless the contact set changes (then a few more).
         """
         compliance = self.pmesh.depth / p_wave_modulus(self.material)
-        applied = target + self.last_pressure * compliance
+        applied = target + (self.last_pressure + self.traction_load / self.pmesh.width) \
+            * compliance
         tol = 1e-9 * self.u_ref
         for _ in range(12):
             r = self.solve(applied, keep_fields)
@@ -279,7 +294,9 @@ class _ContactProblem:
             if abs(err) <= tol:
                 self.last_pressure = r.mean_pressure
                 return r
-            applied = max(applied + err * (1.0 + r.stiffness * compliance), 0.0)
+            applied = applied + err * (1.0 + r.stiffness * compliance)
+            if self.traction is None:          # dry: never above first contact
+                applied = max(applied, 0.0)
         raise NoConvergenceError(
             f"FEM contact: the half-plane approach {target:.6g} m was not reached "
             f"(last {r.delta:.6g} m, imposed {applied:.6g} m)", result=r)
@@ -353,6 +370,8 @@ class _ContactProblem:
         pm, mat = self.pmesh, self.material
         W, h = pm.width, pm.heights
         self.K.mult(self.x, self.y)
+        if self.traction is not None:
+            self.y.axpy(-1.0, self.traction)           # the contact reaction K u - f
         uy_hat = self.x.array_r[self.top_dofs]
         if self.options.method == "vi":
             force_hat = -self.y.array_r[self.top_dofs]
@@ -365,8 +384,9 @@ class _ContactProblem:
         load = float(force.sum())
         mean_p = load / W
         compliance = pm.depth / p_wave_modulus(mat)
-        delta = delta_applied - mean_p * compliance
-        disp = -uy - mean_p * compliance
+        mean_total = mean_p + self.traction_load / W              # contact + known traction
+        delta = delta_applied - mean_total * compliance
+        disp = -uy - mean_total * compliance
         gap = disp + h.max() - h - delta
         # as in the BEM, a vertex is in contact when it carries a positive pressure; for the
         # VI that means closed (to round-off) and pushed, for the penalty penetrating
