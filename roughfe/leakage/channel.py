@@ -85,6 +85,15 @@ def trapezoid_mean(values) -> float:
     return float((v.sum() - 0.5 * (v[0] + v[-1])) / (v.size - 1))
 
 
+def check_absolute_pressures(p_in, p_out) -> tuple:
+    """``(p_in, p_out)`` as floats if both are finite absolute pressures >= 0 (Pa), the
+    inputs of the coupled solvers; else InputError naming the bad one."""
+    for name, v in (("inlet pressure", p_in), ("outlet pressure", p_out)):
+        if not (np.isfinite(v) and v >= 0):
+            raise InputError(f"{name} must be a finite absolute pressure >= 0 (Pa), got {v!r}")
+    return float(p_in), float(p_out)
+
+
 def channel_flow(gap, spacing: float, *, p_in: float, p_out: float,
                  mu: float = 1e-3) -> ChannelFlow:
     """Exact 1D Reynolds flow on a piecewise-linear gap (module docstring).

@@ -88,8 +88,9 @@ from typing import Optional
 import numpy as np
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
-from ..optim.anderson import RejectedIterate, anderson_fixed_point
+from ..optim.anderson import RejectedIterate, anderson_fixed_point, check_options
 from ..surfaces import Surface
+from .channel import check_absolute_pressures
 from .finite_volume import FVSolution, components_reaching, solve_reynolds_fv
 
 TRAPPED_MODELS = ("film", "pressure")
@@ -271,19 +272,13 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     if not isinstance(surface, Surface) or surface.ndim != 2:
         raise InputError(f"coupled leakage needs a 2D Surface, got {surface!r}")
     p_ext = check_finite_positive("external pressure", external_pressure)
-    for name, v in (("inlet pressure", p_in), ("outlet pressure", p_out)):
-        if not (np.isfinite(v) and v >= 0):
-            raise InputError(f"{name} must be a finite absolute pressure >= 0 (Pa), got {v!r}")
+    p_in, p_out = check_absolute_pressures(p_in, p_out)
     if trapped not in TRAPPED_MODELS:
         raise InputError(f"trapped must be one of {TRAPPED_MODELS}, got {trapped!r}")
     if direction not in ("x", "y"):
         raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
     mu = check_finite_positive("mu", mu)
-    tol = check_finite_positive("tol", tol)
-    if not (0 < relaxation <= 1):
-        raise InputError(f"relaxation must be in (0, 1], got {relaxation!r}")
-    if int(max_iter) < 1 or int(anderson) < 0:
-        raise InputError(f"max_iter must be >= 1 and anderson >= 0, got {max_iter!r}, {anderson!r}")
+    tol, max_iter, anderson, relaxation = check_options(tol, max_iter, anderson, relaxation)
     axis = 0 if direction == "x" else 1
     spacing = surface.spacing
     cell = float(np.prod(spacing))
@@ -336,8 +331,8 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     x = np.zeros(h.shape)
     gx = G(x, first=True)
     one_way = _flow(last["gap"]).leak_rate
-    fp = anderson_fixed_point(G, x, gx, tol=tol, max_iter=int(max_iter),
-                              memory=int(anderson), relaxation=relaxation)
+    fp = anderson_fixed_point(G, x, gx, tol=tol, max_iter=max_iter, memory=anderson,
+                              relaxation=relaxation)
     it, gx, residuals = fp.iterations, fp.gx, list(fp.residuals)
     if fp.status == "max_iter":
         last["flow"] = _flow(last["gap"])

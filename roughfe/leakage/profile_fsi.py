@@ -49,6 +49,7 @@ throat (minimum) gap and the displacement field test the elasticity.
 """
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -57,9 +58,9 @@ import numpy as np
 from ..errors import InputError, NoConvergenceError, check_finite_positive, check_instance
 from ..model import Material
 from ..optim.anderson import REFERENCES as ANDERSON_REFERENCES
-from ..optim.anderson import RejectedIterate, anderson_fixed_point
+from ..optim.anderson import RejectedIterate, anderson_fixed_point, check_options
 from ..surfaces import Surface
-from .channel import ChannelFlow, channel_flow, trapezoid_mean
+from .channel import ChannelFlow, channel_flow, check_absolute_pressures, trapezoid_mean
 
 METHODS = ("bem", "fem")
 REFERENCES = ANDERSON_REFERENCES + (
@@ -146,7 +147,8 @@ class _Closed(RejectedIterate):
 
 class MirroredHalfPlane:
     """The BEM body of the channel: the periodic half-plane below the evenly mirrored
-    profile (module docstring). Same interface as :class:`roughfe.fem.fluid.FluidLoadedBody`.
+    profile (module docstring). Same ``solve``/``close`` as
+    :class:`roughfe.fem.fluid.FluidLoadedBody`.
     """
 
     def __init__(self, profile: Surface, material: Material):
@@ -155,12 +157,6 @@ class MirroredHalfPlane:
         self.profile, self.material = profile, material
         self.mirror = mirrored_profile(profile)
         self.n = profile.heights.size
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
     def close(self):
         """Nothing to free (the operators are cached by :mod:`roughfe.bem.contact`)."""
@@ -251,16 +247,9 @@ def coupled_channel(profile: Surface, material: Material, approach: float, *,
         raise InputError(f"method must be one of {METHODS}, got {method!r}")
     if not np.isfinite(approach):
         raise InputError(f"approach must be finite (m), got {approach!r}")
-    for name, v in (("inlet pressure", p_in), ("outlet pressure", p_out)):
-        if not (np.isfinite(v) and v >= 0):
-            raise InputError(f"{name} must be a finite absolute pressure >= 0 (Pa), got {v!r}")
+    p_in, p_out = check_absolute_pressures(p_in, p_out)
     mu = check_finite_positive("mu", mu)
-    tol = check_finite_positive("tol", tol)
-    if not (0 < relaxation <= 1):
-        raise InputError(f"relaxation must be in (0, 1], got {relaxation!r}")
-    if int(max_iter) < 1 or int(anderson) < 0:
-        raise InputError(f"max_iter must be >= 1 and anderson >= 0, got {max_iter!r}, "
-                         f"{anderson!r}")
+    tol, max_iter, anderson, relaxation = check_options(tol, max_iter, anderson, relaxation)
     n = profile.heights.size
     dx = profile.spacing[0]
     if method == "bem":
@@ -282,15 +271,15 @@ def coupled_channel(profile: Surface, material: Material, approach: float, *,
             raise _Closed()
         return flow.pressure
 
-    with body:
+    with contextlib.closing(body):
         x = np.zeros(n)
         try:
             gx = G(x)
         except _Closed:
             return _result(method, "closed", last, approach, mu, 0.0, 0, float("nan"), ())
         one_way = last["flow"].leak_rate
-        fp = anderson_fixed_point(G, x, gx, tol=tol, max_iter=int(max_iter),
-                                  memory=int(anderson), relaxation=relaxation)
+        fp = anderson_fixed_point(G, x, gx, tol=tol, max_iter=max_iter, memory=anderson,
+                                  relaxation=relaxation)
         if fp.status == "rejected":
             return _result(method, "closed", last, approach, mu, one_way, fp.iterations,
                            fp.residual, fp.residuals)

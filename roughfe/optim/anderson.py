@@ -22,6 +22,8 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from ..errors import InputError, check_finite_positive
+
 REFERENCES = ("Walker H.F., Ni P. (2011) SIAM J. Numer. Anal. 49:1715-1735 (Anderson)",)
 
 
@@ -57,6 +59,19 @@ class FixedPoint:
     @property
     def converged(self) -> bool:
         return self.status == "converged"
+
+
+def check_options(tol, max_iter, memory, relaxation) -> tuple:
+    """The options of :func:`anderson_fixed_point`, checked before any work is done:
+    ``(tol, max_iter, memory, relaxation)`` as (float, int, int, float); InputError naming
+    the bad one."""
+    tol = check_finite_positive("tol", tol)
+    if not (0 < relaxation <= 1):
+        raise InputError(f"relaxation must be in (0, 1], got {relaxation!r}")
+    if int(max_iter) < 1 or int(memory) < 0:
+        raise InputError(f"max_iter must be >= 1 and the Anderson memory >= 0, got "
+                         f"{max_iter!r}, {memory!r}")
+    return tol, int(max_iter), int(memory), float(relaxation)
 
 
 def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
