@@ -48,7 +48,15 @@ from .errors import InputError, check_finite_positive
 from .frozen import Frozen, freeze_fields
 from .writers import json_scalars, to_jsonable
 
-__all__ = ["Material", "composite", "Loading", "ContactResult", "SweepResult",
+#: The one default material of every command and study analysis: the thesis' E* = 210 MPa
+#: (Sec. 3.4, "E = 210 MPa", nu = 0 so that E* = E). Pressures scale linearly with E* in
+#: elastic contact, so A(p/E*) does not depend on it. ``roughfe.cli.options`` (``--E``,
+#: ``--nu``) and ``roughfe.study.analyses`` read it from here.
+DEFAULT_E = 210.0e6
+DEFAULT_NU = 0.0
+
+__all__ = ["DEFAULT_E", "DEFAULT_NU", "Material", "composite", "Loading", "ContactResult",
+           "SweepResult",
            "RECORD_KEYS", "central_differences"]
 
 

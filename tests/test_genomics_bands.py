@@ -150,6 +150,19 @@ def test_band_mechanics_of_a_periodic_surface():
     bad = band_mechanics(b, youngs_modulus=1e9, n_steps=6, response=flaky)
     assert not bad.success and f"c {int(b.indices[1])}" in bad.message
     assert bad.chromosome_curves[1] is None and np.isnan(bad.c_chromosome["K"][1])
+    # the material under the one vocabulary E/nu; files with the old keys still read
+    assert (d["E"], d["nu"]) == (1e9, 0.0) and "youngs_modulus" not in d
+    import json
+    from roughfe.genomics.mechanics import ChromosomeMechanics
+    old = json.loads(json.dumps(d))
+    old["youngs_modulus"], old["poisson"] = old.pop("E"), old.pop("nu")
+    for data in (d, old):
+        back = ChromosomeMechanics.from_dict(json.loads(json.dumps(data)))
+        assert back.youngs_modulus == 1e9 and back.to_dict()["complete"] == d["complete"]
+        np.testing.assert_array_equal(back.c_td["K"], m.c_td["K"])
+    from roughfe.errors import FileFormatError
+    with pytest.raises(FileFormatError, match="E"):
+        ChromosomeMechanics.from_dict({k: v for k, v in d.items() if k != "E"})
 
 
 def test_genome_chromosomes_command(tmp_path, capsys):

@@ -28,11 +28,10 @@ import re
 import sys
 import textwrap
 
-#: The one default material of every command: the thesis' E* = 210 MPa (Sec. 3.4,
-#: "E = 210 MPa", nu = 0 so that E* = E). Pressures scale linearly with E* in elastic
-#: contact, so A(p/E*) does not depend on it.
-DEFAULT_E = 210.0e6
-DEFAULT_NU = 0.0
+from ..model import DEFAULT_E, DEFAULT_NU
+
+#: DEFAULT_E, DEFAULT_NU: the one default material, defined in :mod:`roughfe.model` (shared
+#: with the study analyses) and imported above.
 #: Default of --detrend in info, contact, leak and genome natural.
 DEFAULT_DETREND = "mean"
 DETRENDS = ("none", "mean", "plane")

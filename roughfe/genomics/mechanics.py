@@ -34,7 +34,7 @@ from functools import partial
 import numpy as np
 
 from .. import progress
-from ..errors import InputError, NoConvergenceError
+from ..errors import FileFormatError, InputError, NoConvergenceError
 from ..frozen import freeze_containers
 from ..surfaces.surface import Surface
 from ..writers import to_jsonable
@@ -122,17 +122,46 @@ class ChromosomeMechanics:
         freeze_containers(self)
 
     def to_dict(self) -> dict:
-        """JSON-safe curves and coefficients."""
+        """JSON-safe curves and coefficients; the material under the one vocabulary of the
+        package, ``E`` (Pa) and ``nu`` (-) (files before issue 15 wrote ``youngs_modulus``
+        and ``poisson``: :meth:`from_dict` reads both)."""
         def curves(cs):
             return [None if c is None else c.to_dict() for c in cs]
 
-        return {"length": self.length, "kernel": self.kernel, "youngs_modulus": self.youngs_modulus,
-                "poisson": self.poisson, "indices": self.indices.tolist(),
+        return {"length": self.length, "kernel": self.kernel, "E": self.youngs_modulus,
+                "nu": self.poisson, "indices": self.indices.tolist(),
                 "complete": self.complete.to_dict(), "chromosomes": curves(self.chromosome_curves),
                 "td": curves(self.td_curves), "bu": curves(self.bu_curves),
                 "c_chromosome": to_jsonable(self.c_chromosome), "c_td": to_jsonable(self.c_td),
                 "c_bu": to_jsonable(self.c_bu), "success": self.success, "message": self.message,
                 "nit": self.nit, "elapsed_s": self.elapsed}
+
+    @classmethod
+    def from_dict(cls, d) -> "ChromosomeMechanics":
+        """Inverse of :meth:`to_dict` (a ``mechanics.json``); the old material keys
+        ``youngs_modulus``/``poisson`` are accepted (files written before the rename)."""
+        def curves(cs):
+            return tuple(None if c is None else ResponseCurve.from_dict(c) for c in cs)
+
+        def coefficients(c):
+            return {q: np.array([np.nan if v is None else v for v in c[q]], float) for q in c}
+
+        missing = [k for k in ("length", "kernel", "indices", "complete") if k not in d]
+        material = [k for k in (("E", "youngs_modulus"), ("nu", "poisson"))
+                    if not any(name in d for name in k)]
+        if missing or material:
+            raise FileFormatError(f"not a chromosome mechanics JSON: lacks {missing + material}")
+        return cls(length=float(d["length"]), kernel=d["kernel"],
+                   youngs_modulus=float(d["E"] if "E" in d else d["youngs_modulus"]),
+                   poisson=float(d["nu"] if "nu" in d else d["poisson"]),
+                   indices=np.asarray(d["indices"], int),
+                   complete=ResponseCurve.from_dict(d["complete"]),
+                   chromosome_curves=curves(d.get("chromosomes", ())),
+                   td_curves=curves(d.get("td", ())), bu_curves=curves(d.get("bu", ())),
+                   c_chromosome=coefficients(d.get("c_chromosome", {})),
+                   c_td=coefficients(d.get("c_td", {})), c_bu=coefficients(d.get("c_bu", {})),
+                   success=bool(d.get("success", True)), message=d.get("message", ""),
+                   nit=int(d.get("nit", 0)), elapsed=float(d.get("elapsed_s", 0.0)))
 
 
 def is_flat(z) -> bool:

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..genomics.database.settings import THESIS_SETTINGS as _THESIS
+from ..model import DEFAULT_E, DEFAULT_NU
 
 
 @dataclass(frozen=True)
@@ -151,7 +152,7 @@ def selftest_task(*, x, seed, y=0.0, n_records=3, sleep=0.0, fail_x=(), crash_x=
 
 
 def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, length=1.0e-3,
-                       rms_height=1.0e-6, E=1.0e9, nu=0.3, n_steps=10,
+                       rms_height=1.0e-6, E=DEFAULT_E, nu=DEFAULT_NU, n_steps=10,
                        kernel="auto", solver="auto", tol=1e-10):
     """Generate one random surface and run the BEM loading sweep on it.
 
@@ -173,7 +174,8 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
         Rms height the surface is scaled to (m).
     E, nu : float
         Young's modulus (Pa) and Poisson's ratio (-) of the elastic solid against the
-        rigid surface (the spellings ``youngs_modulus``/``poisson`` of older specs are
+        rigid surface (default: the one CLI default, :data:`roughfe.model.DEFAULT_E`; the
+        spellings ``youngs_modulus``/``poisson`` of older specs are
         renamed with a warning by :func:`roughfe.study.spec.spec_from_mapping`).
     n_steps, kernel, solver, tol
         As in :func:`roughfe.bem.contact_sweep` (run through :func:`roughfe.response.response`).
@@ -200,14 +202,15 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
 
 
 def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=None,
-                   length=_THESIS.length, n_nodes=_THESIS.n_nodes, E=_THESIS.youngs_modulus,
-                   nu=_THESIS.poisson, n_steps=_THESIS.n_steps, threshold=_THESIS.threshold,
+                   length=_THESIS.length, n_nodes=_THESIS.n_nodes, E=DEFAULT_E,
+                   nu=DEFAULT_NU, n_steps=_THESIS.n_steps, threshold=_THESIS.threshold,
                    kernel=_THESIS.kernel):
     """One genome-database entry: the study seed draws the WM phases.
 
     Calls :func:`roughfe.genomics.database.genome_entry_task` with ``phases=seed`` and
     ``label`` (default ``"genome-<seed>"``); ``E`` (Pa) and ``nu`` (-) are the material
-    (thesis: E = 1 MPa, nu = 0). The full entry (genome, curves,
+    (default: the one CLI default :data:`roughfe.model.DEFAULT_E`, 210 MPa, nu = 0; the
+    thesis database used E = 1 MPa: give ``E = 1e6``). The full entry (genome, curves,
     chromosome curves, correlations) is stored in the task's result file; the table
     shows its scalars and the macro/micro chromosome lists as JSON text.
 
