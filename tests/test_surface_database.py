@@ -180,3 +180,42 @@ def test_surface_database_bad_input():
     from roughfe.genomics.design import combine
     with pytest.raises(InputError, match="dim"):
         combine(one, two)
+
+
+def test_surface_db_and_design_commands(tmp_path, capsys):
+    """db build --dim 2 through the study runner, design-targets of a surface file (its own
+    BEM sweep), design on the surface database; the saved periodic heights re-scored by a
+    fresh BEM run give the reported scores."""
+    import json
+
+    from roughfe.cli import main
+    from roughfe.surfaces import Surface
+    from roughfe.surfaces.io import load_surface, save_surface
+
+    path = tmp_path / "s.sqlite"
+    assert main(["db", "build", str(path), "--dim", "2", "--nodes", "16", "--steps", "5",
+                 "--ridges", "2", "--limit", "2", "--length", "1e-4", "--quiet",
+                 "--workers", "1"]) == 0
+    settings = db.read_settings(path)
+    assert (settings.dim, settings.n_nodes, settings.top_fraction) == (2, 16, 0.8)
+    g = Genome.from_dict(db.load_entries(path)[0].genome)
+    tsurf = realize_periodic_surface(replace(g, A=2e-6, phases=g.phases + 0.2), 1e-4, 16)
+    save_surface(Surface(tsurf.heights, tsurf.size, periodic=True), tmp_path / "t.npz")
+    assert main(["design-targets", "--db", str(path), "--surface", str(tmp_path / "t.npz"),
+                 "--detrend", "mean", "-o", str(tmp_path / "t")]) == 0
+    out = tmp_path / "d"
+    assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "t_K.csv"),
+                 "--second-target", str(tmp_path / "t" / "t_A.csv"), "--method", "mcco",
+                 "--iterations", "1", "--search", "3", "--no-figures", "-o", str(out)]) == 0
+    report = json.loads((out / "result.json").read_text())
+    design = Design.from_dict(json.loads((out / "design.json").read_text()))
+    assert design.dim == 2
+    heights = load_surface(out / "profile.npz")
+    assert heights.periodic and heights.shape == (16, 16)
+    np.testing.assert_allclose(heights.heights, design.surface().heights, rtol=1e-12)
+    targets = [Target.from_dict(t) for t in report["targets"]]
+    assert rescore_at_target_pressures(design, targets, settings) == pytest.approx(
+        report["candidates"][0]["scores_at_target_pressures"], abs=1e-7)
+    assert main(["db", "build", str(tmp_path / "x.sqlite"), "--dim", "2",
+                 "--top-fraction", "1.5"]) == 2
+    assert "top_fraction" in capsys.readouterr().err

@@ -1,6 +1,8 @@
-"""``roughfe design``: design a rough profile whose K(p) and/or A(p) hit a target
-(thesis Sec. 4.2-4.4: SOG, GCO, CCO, M-CCO), and ``roughfe design-targets``: write the
-thesis targets y_t1, y_t2, y_t3 as CSV for a database's settings."""
+"""``roughfe design``: design a rough profile (or, on a surface database built with
+``db build --dim 2``, a periodic surface) whose K(p) and/or A(p) hit a target (thesis Sec.
+4.2-4.4: SOG, GCO, CCO, M-CCO), and ``roughfe design-targets``: write the thesis targets
+y_t1, y_t2, y_t3, or the K(p), A(p) of a given (measured) surface, as CSV for a database's
+settings."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -58,7 +60,7 @@ def _run(args) -> int:
             best = result.best.design
             plot_design_curves([result], out / "curves.png", title=result.message)
             plot_stages([result], out / "stages.png")
-            plot_profiles({result.method: best.surface()}, out / "profile.png")
+            plot_profiles({result.method: best.surface()}, out / "profile.png")  # 2D: a map
             plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
         paths = write_design_result(result, settings, out)
     print(result.message)
@@ -75,9 +77,21 @@ def _run(args) -> int:
 
 def _targets(args) -> int:
     from ..genomics.database import read_settings
-    from ..genomics.design import thesis_targets
+    from ..genomics.design import surface_targets, thesis_targets
     from ..genomics.similarity import write_target_csv
-    t1, t2, t3, _ = thesis_targets(read_settings(args.db))
+    settings = read_settings(args.db)
+    if args.surface:
+        from ..surfaces.io import load_surface
+        surface = load_surface(args.surface)
+        name = Path(args.surface).stem.replace(" ", "_")
+        tk, ta, curve = surface_targets(surface, settings, name=name, detrend=args.detrend)
+        with output_folder_of(args, "design-targets") as out:
+            for t in (tk, ta):
+                print(write_target_csv(out / f"{t.name}.csv", t))
+        print(f"{args.surface}: p_max^t = {curve.p_max:.6g} Pa, A* at p_max = "
+              f"{curve.area_fraction[-1]:.4f} ({len(curve.pressure)} BEM steps)")
+        return 0
+    t1, t2, t3, _ = thesis_targets(settings)
     with output_folder_of(args, "design-targets") as out:
         for t in (t1, t2, t3):
             print(write_target_csv(out / f"{t.name}.csv", t))
@@ -132,8 +146,16 @@ def register(sub):
     add_run_options(p)
     p.set_defaults(func=_run)
 
-    t = sub.add_parser("design-targets", help="write the thesis targets y_t1, y_t2, y_t3 as CSV")
+    t = sub.add_parser("design-targets", help="write the thesis targets y_t1, y_t2, y_t3 (or the "
+                                              "K(p), A(p) of a given surface) as CSV")
     t.add_argument("--db", required=True, help="SQLite genome database (for L, N, E, n_t)")
+    t.add_argument("--surface", default=None, metavar="FILE",
+                   help="instead of the thesis targets: K(p) and A(p) of this surface (any "
+                        "file 'roughfe info' reads, e.g. a measured topography) from its own "
+                        "BEM sweep with the database's E, nu and steps; writes NAME_K.csv "
+                        "and NAME_A.csv")
+    t.add_argument("--detrend", choices=("none", "mean", "plane"), default="plane",
+                   help="detrending of --surface before the BEM")
     add_output_folder(t)
     add_run_options(t, figures=False)
     t.set_defaults(func=_targets)

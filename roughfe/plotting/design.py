@@ -173,7 +173,20 @@ def plot_pbar_sensitivity(pbars, best, n_cross, n_above, path) -> "Path":
 
 
 def plot_profiles(named_surfaces, path, title="") -> "Path":
-    """Figs. 61/65/69: topographies of designed profiles (``name -> Surface``)."""
+    """Figs. 61/65/69: topographies of designed profiles (``name -> Surface``); designed
+    surfaces (2D) as height maps, one panel each."""
+    if any(s.ndim == 2 for s in named_surfaces.values()):
+        fig, axes = new_figure(1, len(named_surfaces), figsize=(4.5 * len(named_surfaces), 4),
+                               squeeze=False)
+        for ax, (name, s) in zip(axes[0], named_surfaces.items()):
+            im = ax.imshow(s.heights.T * 1e6, origin="lower", cmap="viridis",
+                           extent=(0, s.size[0] * 1e6, 0, s.size[1] * 1e6))
+            fig.colorbar(im, ax=ax, label="height (um)")
+            ax.set_xlabel("x (um)")
+            ax.set_ylabel("y (um)")
+            ax.set_title(name)
+        fig.suptitle(title)
+        return save_figure(fig, path)
     fig, ax = new_figure(figsize=(8, 3.6))
     for name, s in named_surfaces.items():
         x = s.metadata.get("x0", 0.0) + np.arange(s.shape[0]) * s.spacing[0]

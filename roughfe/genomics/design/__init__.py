@@ -26,8 +26,8 @@ from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, Desig
 from .objective import Evaluator, Objective, combined_score
 from .sensitivities import residual_jacobian
 from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
-from .targets import (Y_T1_GENES, rescore, rescore_at_target_pressures, target_genome_t1,
-                      thesis_targets)
+from .targets import (Y_T1_GENES, Y_T1_SURFACE_GENES, rescore, rescore_at_target_pressures,
+                      surface_targets, target_genome_t1, thesis_targets)
 
 __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
            "run_design", "score_database", "search_at_target_pressures", "sog",
@@ -35,6 +35,7 @@ __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",
            "combine", "entry_design", "Evaluator", "Objective", "combined_score",
            "residual_jacobian", "FORMULATIONS", "GcmmaOptions", "optimise_phases",
-           "phase_bounds", "Y_T1_GENES", "rescore", "rescore_at_target_pressures",
+           "phase_bounds", "Y_T1_GENES", "Y_T1_SURFACE_GENES", "rescore",
+           "rescore_at_target_pressures", "surface_targets",
            "target_genome_t1", "thesis_targets", "GcmmaResult", "gcmma_maximize",
            "gcmma_minimax"]

@@ -9,7 +9,7 @@ from ...model import Loading, Material, central_differences
 from ...response import response
 from ..database import DatabaseSettings, make_genome
 from ..genome import Genome
-from ..macro_micro import top_approach
+from ..macro_micro import profile_response, top_approach
 from ..similarity import ResponseCurve, Target, linear_then_flat_target, similarity
 from .model import Design, DesignPart
 from .objective import Evaluator
@@ -58,11 +58,44 @@ def rescore_at_target_pressures(design: Design, targets, settings: DatabaseSetti
 Y_T1_GENES = {"gamma": 1.55, "H": 0.8, "A": 1.0, "phase_seed": 20190}
 
 
+#: surface databases (dim 2): y_t1 has M = 3 ridges at angles
+#: ``default_rng(angle_seed).uniform(0, pi, 3)`` and unit anisotropy (beside Y_T1_GENES)
+Y_T1_SURFACE_GENES = {"M": 3, "angle_seed": 20191}
+
+
 def target_genome_t1(settings: DatabaseSettings) -> Genome:
-    """Genome of y_t1: M = 1, lambda = L, phases ``default_rng(20190).uniform(0, 2 pi)``."""
+    """Genome of y_t1: M = 1, lambda = L, phases ``default_rng(20190).uniform(0, 2 pi)``;
+    for a surface database (dim 2) M = 3 ridges (:data:`Y_T1_SURFACE_GENES`) with the
+    phases drawn as an (M, n_c) matrix from the same seed."""
+    facts = dict(Y_T1_GENES)
+    kw = {}
+    if settings.dim == 2:
+        m = Y_T1_SURFACE_GENES["M"]
+        kw["angles"] = np.random.default_rng(Y_T1_SURFACE_GENES["angle_seed"]).uniform(
+            0, np.pi, m)
+        kw["anisotropy"] = np.ones(m)
+        facts.update(Y_T1_SURFACE_GENES)
     g = make_genome(Y_T1_GENES["gamma"], Y_T1_GENES["H"], Y_T1_GENES["phase_seed"], settings,
-                    amplitude=Y_T1_GENES["A"])
-    return replace(g, metadata={"role": "target y_t1", **Y_T1_GENES})
+                    amplitude=Y_T1_GENES["A"], **kw)
+    return replace(g, metadata={"role": "target y_t1", **facts})
+
+
+def surface_targets(surface, settings: DatabaseSettings, *, name="measured", detrend="plane"):
+    """Targets K(p) and A(p) of a given (e.g. measured) surface: its own BEM sweep.
+
+    The surface is detrended (``"plane"`` by default: instruments leave a tilt) and
+    loaded exactly as the database loads its genomes (:func:`profile_response` with the
+    database's E, nu, n_t, K kind and ``top_fraction``; a non-periodic measured window is
+    solved with the non-periodic kernel, its approaches end at ``top_fraction`` times its
+    peak-valley height). The targets are that sweep's points: the design is then scored
+    at these pressures (Eq. 4.1 after Eq. 4.2). Returns ``(t_K, t_A, curve)``.
+    """
+    surf = surface.detrended(detrend) if detrend != "none" else surface
+    curve = profile_response(surf, **settings.response_options())
+    meta = {"surface": dict(surface.metadata), "shape": list(surface.shape),
+            "size_m": list(surface.size), "detrend": detrend, "settings": settings.to_dict()}
+    return (Target(curve.pressure, curve.stiffness, "K", f"{name}_K", meta),
+            Target(curve.pressure, curve.area_fraction, "A", f"{name}_A", meta), curve)
 
 
 def thesis_targets(settings: DatabaseSettings, response=None, *, pbar2_fraction=0.53 / 1.6):
@@ -78,7 +111,7 @@ def thesis_targets(settings: DatabaseSettings, response=None, *, pbar2_fraction=
     evaluate = Evaluator(settings, response)
     g = target_genome_t1(settings)
     d = Design((DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "y_t1"),), 1.0,
-               settings.length, settings.n_nodes, "y_t1")
+               settings.length, settings.n_nodes, "y_t1", settings.dim)
     curve = evaluate(d)
     meta = {"genome": g.to_dict(), "settings": settings.to_dict()}
     t1 = Target(curve.pressure, curve.stiffness, "K", "y_t1", meta)
