@@ -5,15 +5,25 @@ Layout (schema version :data:`SCHEMA_VERSION`, stdlib :mod:`sqlite3`)
 --------------------------------------------------------------------
 ``meta(key, value)``
     ``schema_version``; ``settings`` (JSON of :class:`DatabaseSettings`: the one
-    realisation length L, node count N, material and BEM steps shared by every row);
-    ``sobol`` (JSON of the :class:`SobolDesign` that made the ``sobol`` rows).
+    realisation length L, node count N, material and BEM steps shared by every row;
+    a surface database records ``"dim": 2`` and its ``top_fraction``, a profile
+    database written by any roughfe omits both, read as dim 1 and 1);
+    ``sobol`` (JSON of the :class:`SobolDesign` that made the ``sobol`` rows; for
+    surfaces with ``dim``, ``n_ridges`` and ``anisotropy_range``).
 ``genomes``
     one row per genome: ``label`` (unique; ``"i-k"`` = Sobol pair i, phase vector k),
-    ``source`` (``sobol`` or ``extend``), the scalar genes, ``genome_json`` (the
+    ``source`` (``sobol`` or ``extend``), the scalar genes (``n_ridges`` = M: 1 for
+    profiles, the ridges of a surface genome, whose angles and anisotropy are in its
+    ``genome_json``), ``genome_json`` (the
     versioned Genome JSON of :mod:`roughfe.genomics.genome`), ``p_max`` (Pa, at A as
     stored), ``curve_json`` (K(p), A(p) of the realisation), ``chromosome_curves_json``,
     ``corr_k_json`` / ``corr_a_json`` (c_n of Alg. 2, in the order n = n_s..n_f),
     ``macro_json`` (chromosome indices n with c_n > threshold) and ``created_utc``.
+
+Profiles (dim 1) are the thesis realisations (N nodes spanning L, non-periodic BEM);
+surfaces (dim 2, issue 15) are periodic N x N realisations of period L
+(:mod:`roughfe.genomics.periodic`) solved with the periodic spectral BEM, and their
+chromosome curves are those of the periodic range. The same tables hold both.
 
 The genomes are computed by the study runner (``roughfe db build|extend`` call
 :func:`roughfe.study.build_genome_db`: any executor, a study folder beside the file, so an

@@ -27,7 +27,8 @@ from .objective import Evaluator, Objective, combined_score
 from .sensitivities import residual_jacobian
 from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
 from .targets import (Y_T1_GENES, Y_T1_SURFACE_GENES, rescore, rescore_at_target_pressures,
-                      surface_targets, target_genome_t1, thesis_targets)
+                      score_at_target_pressures, surface_targets, target_genome_t1,
+                      thesis_targets)
 
 __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
            "run_design", "score_database", "search_at_target_pressures", "sog",
@@ -36,6 +37,6 @@ __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "
            "combine", "entry_design", "Evaluator", "Objective", "combined_score",
            "residual_jacobian", "FORMULATIONS", "GcmmaOptions", "optimise_phases",
            "phase_bounds", "Y_T1_GENES", "Y_T1_SURFACE_GENES", "rescore",
-           "rescore_at_target_pressures", "surface_targets",
+           "rescore_at_target_pressures", "score_at_target_pressures", "surface_targets",
            "target_genome_t1", "thesis_targets", "GcmmaResult", "gcmma_maximize",
            "gcmma_minimax"]

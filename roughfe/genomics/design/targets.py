@@ -25,28 +25,37 @@ def rescore(design: Design, targets, settings: DatabaseSettings, response=None) 
 
 def rescore_at_target_pressures(design: Design, targets, settings: DatabaseSettings) -> tuple:
     """Stricter independent check: Eq. (4.1) with the design solved *at the target's
-    pressures* (load-controlled BEM steps), so nothing is interpolated.
+    pressures* (load-controlled BEM steps), so nothing is interpolated; the design's
+    heights go through :func:`score_at_target_pressures`.
 
     :func:`rescore` (and every optimiser) samples the design at its own n_t equal
     approaches and interpolates linearly at the target pressures. A(p) of a profile is
     a count of contact nodes (a staircase in p), so the interpolated value can be a
-    fraction of a node that the design never has at that pressure. Here one
-    displacement solve at the last approach of the sweep (Delta = peak-valley for a
-    profile, :func:`~roughfe.genomics.macro_micro.top_approach`) gives p_max (Eq. 4.2 factor
-    ``eta = p_max^t / p_max``); then the design is solved at the pressures ``p_j / eta``
+    fraction of a node that the design never has at that pressure. An independent BEM
+    run of the target genome itself scores 1 to round-off.
+    """
+    return score_at_target_pressures(design.surface(), targets, settings)
+
+
+def score_at_target_pressures(surface, targets, settings: DatabaseSettings) -> tuple:
+    """Eq. (4.1) of a surface (e.g. a saved design's heights) solved at the targets' own
+    pressures, with the database's material and approach rule.
+
+    One displacement solve at the last approach of the database sweep (Delta =
+    peak-valley for a profile; ``top_fraction`` of full contact for a periodic surface,
+    :func:`~roughfe.genomics.macro_micro.top_approach`) gives p_max (Eq. 4.2 factor
+    ``eta = p_max^t / p_max``); then the surface is solved at the pressures ``p_j / eta``
     of all targets; A is the exact node fraction there and K = dp/dDelta by the same
-    central differences over those steps as the target's K over its own steps. An
-    independent BEM run of the target genome itself scores 1 to round-off.
+    central differences over those steps as the target's K over its own steps.
     """
     targets = list(targets)
-    surf = design.surface()
     mat = Material(settings.youngs_modulus, settings.poisson)
-    delta = top_approach(surf, settings.kernel, settings.top_fraction)
-    top = response(surf, mat, Loading(delta=delta), kernel=settings.kernel,
+    delta = top_approach(surface, settings.kernel, settings.top_fraction)
+    top = response(surface, mat, Loading(delta=delta), kernel=settings.kernel,
                    compute_stiffness=False)
     eta = targets[0].p_max / float(top.mean_pressure[-1])
     p = np.unique(np.concatenate([t.pressure for t in targets]))
-    sw = response(surf, mat, Loading(pressures=tuple(p / eta)), kernel=settings.kernel,
+    sw = response(surface, mat, Loading(pressures=tuple(p / eta)), kernel=settings.kernel,
                   compute_stiffness=False)
     k = central_differences(sw.delta, sw.mean_pressure)
     curve = ResponseCurve(np.asarray(sw.mean_pressure) * eta, k, sw.area_fraction)
