@@ -3,9 +3,10 @@ import numpy as np
 import pytest
 
 from roughfe.errors import InputError
-from roughfe.genomics.genome import random_genome, realize, realize_surface
+from roughfe.genomics.genome import realize, realize_surface
 from roughfe.genomics.sequencing import sequence_surfaces
-from roughfe.genomics.sequencing.surface_data import cluster_angles
+from roughfe.genomics.sequencing.surface_data import (cluster_angles,
+                                                      resolvable_surface_genome)
 from roughfe.surfaces.spectral import spectral_surface
 from roughfe.surfaces.surface import Surface
 
@@ -16,13 +17,8 @@ L1 = 1e-3
 def _genome(seed, M=3, gamma=1.8, H=0.8):
     """A genome in the sequencer's gauge: lambda1 in [L1, gamma L1) (n_s = 1 at L1),
     anisotropy of geometric mean 1, ridges at least 0.4 pi / M apart (resolvable)."""
-    rng = np.random.default_rng(seed)
-    lam1 = L1 * rng.uniform(1.0, gamma)
-    angles = np.sort((np.arange(M) + rng.uniform(0.2, 0.8, M)) * np.pi / M)
-    aniso = np.exp(rng.normal(0.0, 0.3, M))
-    aniso /= np.exp(np.mean(np.log(aniso)))
-    g = random_genome(1e-3, H, gamma, lam1, M, 30, rng=rng, angles=angles, anisotropy=aniso)
-    return g, [realize_surface(g, L1, N), realize_surface(g, L1 / 2.5, N)], rng
+    return resolvable_surface_genome(seed, length=L1, n_nodes=N, n_ridges=M, gamma=gamma,
+                                     hurst=H)
 
 
 def _wrapped(a):

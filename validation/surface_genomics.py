@@ -41,8 +41,8 @@ from roughfe.genomics.bands import band_chromosomes
 from roughfe.genomics.design import (Design, GcmmaOptions, combined_score, run_design,
                                      score_at_target_pressures, search_at_target_pressures,
                                      surface_targets, thesis_targets)
-from roughfe.genomics.genome import random_genome, realize_surface
 from roughfe.genomics.sequencing import sequence_surfaces
+from roughfe.genomics.sequencing.surface_data import resolvable_surface_genome
 from roughfe.model import DEFAULT_E
 from roughfe.surfaces import Surface
 from roughfe.surfaces.io import load_surface, save_surface
@@ -63,16 +63,8 @@ def _cpu():
     return r.ru_utime + r.ru_stime
 
 
-def _genome(seed, M=3, gamma=1.8, H=0.8):
-    """A surface genome in the sequencer's gauge (lambda1 in [L1, gamma L1), anisotropy of
-    geometric mean 1, ridges >= 0.4 pi / M apart so they are resolvable at N = 48)."""
-    rng = np.random.default_rng(seed)
-    lam1 = L1 * rng.uniform(1.0, gamma)
-    angles = np.sort((np.arange(M) + rng.uniform(0.2, 0.8, M)) * np.pi / M)
-    aniso = np.exp(rng.normal(0.0, 0.3, M))
-    aniso /= np.exp(np.mean(np.log(aniso)))
-    g = random_genome(1e-3, H, gamma, lam1, M, 30, rng=rng, angles=angles, anisotropy=aniso)
-    return g, [realize_surface(g, L1, N_SEQ), realize_surface(g, L1 / 2.5, N_SEQ)], rng
+def _genome(seed):
+    return resolvable_surface_genome(seed, length=L1, n_nodes=N_SEQ)
 
 
 def _wrapped(a):

@@ -210,3 +210,31 @@ def cluster_angles(angles, weights, tol=ANGLE_TOL):
     relabel = np.empty(n_cl, int)
     relabel[rank] = np.arange(n_cl)
     return centres[rank], relabel[labels], sizes[rank]
+
+
+def resolvable_surface_genome(seed, *, length, n_nodes, n_ridges=3, gamma=1.8, hurst=0.8,
+                              ratio=2.5):
+    """A random 2D MWM genome the sequencer can resolve, and its two nested acquisitions.
+
+    The genome is in the sequencer's gauge: lambda1 uniform in [L, gamma L) (so n_s = 1 at
+    L), anisotropy factors log-normal (sigma 0.3) with geometric mean 1, ridge angles at
+    least 0.4 pi / M apart (resolvable at N >= 48), phases uniform; A = 1e-3. The
+    acquisitions are :func:`~roughfe.genomics.genome.realize_surface` at L and L / ratio
+    with ``n_nodes`` nodes. Used by the sequencing tests and ``roughfe validate
+    surface-genomics`` (recovery over seeds, noise table).
+
+    Returns
+    -------
+    (Genome, [Surface, Surface], numpy.random.Generator)
+        The generator continues the seeded stream (e.g. for noise).
+    """
+    from ..genome import random_genome, realize_surface
+
+    rng = np.random.default_rng(seed)
+    lam1 = length * rng.uniform(1.0, gamma)
+    angles = np.sort((np.arange(n_ridges) + rng.uniform(0.2, 0.8, n_ridges)) * np.pi / n_ridges)
+    aniso = np.exp(rng.normal(0.0, 0.3, n_ridges))
+    aniso /= np.exp(np.mean(np.log(aniso)))
+    g = random_genome(1e-3, hurst, gamma, lam1, n_ridges, 30, rng=rng, angles=angles,
+                      anisotropy=aniso)
+    return g, [realize_surface(g, length, n_nodes), realize_surface(g, length / ratio, n_nodes)], rng
