@@ -42,10 +42,23 @@ follow. An iterate whose gap closes is refused (the plain iterate is tried); if 
 closes too the result has ``state = "closed"``, ``leak_rate = 0`` and the last body
 solution, without a converged fluid pressure.
 
-Mean gap. With ``Delta`` imposed and zero mean elastic displacement, the (trapezoidal)
-mean gap of an open channel is ``max h - mean h - Delta`` for both bodies: a check of the
-mean-level convention (exact to round-off), not of the elasticity. The leak rate, the
-throat (minimum) gap and the displacement field test the elasticity.
+Two controls
+------------
+* ``approach=Delta`` (position control). With zero mean elastic displacement the
+  (trapezoidal) mean gap of an open channel is then ``max h - mean h - Delta`` for both
+  bodies: a check of the mean-level convention (exact to round-off), not of the
+  elasticity. The leak rate, the throat (minimum) gap and the displacement field test it.
+* ``external_pressure=p_ext`` (load control, issue 12: total load / nominal length, carried
+  by contact and fluid together). Before closure the contact carries nothing, so the fluid
+  alone balances the load: ``mean(p_f) = p_ext`` (a hydrostatic film). With the contact
+  inactive the gap is ``s - Delta`` with the shape ``s = max h - h + u[p_f]``; every
+  evaluation of ``G`` solves the scalar balance for ``Delta`` exactly (Brent's method on the
+  open range ``Delta < min s``) before the Reynolds solve, so the mean gap is an output.
+  The mean fluid pressure of an open channel lies between ``(p_in + p_out)/2`` (wide open:
+  linear pressure) and its value at closure (the pressure on the throat's far side); a
+  ``p_ext`` above that range needs contact: ``state = "closed"``; below it the fluid lifts
+  the body off: ``state = "lift-off"`` (no equilibrium: ``leak_rate`` and the gaps None).
+  If the mean pressure is not monotone in ``Delta`` the balance takes one of its roots.
 """
 from __future__ import annotations
 
@@ -62,6 +75,8 @@ from ..optim.anderson import RejectedIterate, anderson_fixed_point, check_option
 from ..surfaces import Surface
 from .channel import ChannelFlow, channel_flow, check_absolute_pressures, trapezoid_mean
 
+STATES = ("open", "closed", "lift-off")
+
 METHODS = ("bem", "fem")
 REFERENCES = ANDERSON_REFERENCES + (
     "Reynolds flow in a 1D channel: Hamrock B.J. et al. (2004) Fundamentals of Fluid Film "
@@ -75,7 +90,7 @@ class ChannelCoupledResult:
     Attributes
     ----------
     method : {"bem", "fem"}
-    state : {"open", "closed"}
+    state : {"open", "closed", "lift-off"}
     x : ndarray (n,)
         Sample positions (m).
     gap : ndarray (n,)
@@ -88,14 +103,17 @@ class ChannelCoupledResult:
     flow : ChannelFlow
         Reynolds solution on the coupled gap.
     approach : float
-        Half-plane approach Delta (m; negative: clearance).
+        Half-plane approach Delta (m; negative: clearance); solved for under load control.
+    external_pressure : float or None
+        ``p_ext`` (Pa) under load control, None under position control.
     inlet_pressure, outlet_pressure, mu : float
-    leak_rate : float
-        Coupled flux per unit width (m^2/s); 0 when closed.
-    one_way_leak_rate : float
-        Flux of the one-way state (no fluid load on the body).
-    mean_gap, min_gap : float
-        Trapezoidal mean and minimum of the gap (m).
+    leak_rate : float or None
+        Coupled flux per unit width (m^2/s); 0 when closed, None at lift-off.
+    one_way_leak_rate : float or None
+        Flux of the one-way state (no fluid load on the body; under load control the rigid
+        channel balanced by its own fluid pressure).
+    mean_gap, min_gap : float or None
+        Trapezoidal mean and minimum of the gap (m); None at lift-off.
     mean_fluid_pressure : float
         Trapezoidal mean fluid pressure (Pa).
     iterations : int
@@ -117,13 +135,14 @@ class ChannelCoupledResult:
     fluid_pressure: np.ndarray
     flow: ChannelFlow
     approach: float
+    external_pressure: Optional[float]
     inlet_pressure: float
     outlet_pressure: float
     mu: float
-    leak_rate: float
-    one_way_leak_rate: float
-    mean_gap: float
-    min_gap: float
+    leak_rate: Optional[float]
+    one_way_leak_rate: Optional[float]
+    mean_gap: Optional[float]
+    min_gap: Optional[float]
     mean_fluid_pressure: float
     iterations: int
     residual: float
@@ -134,6 +153,7 @@ class ChannelCoupledResult:
     def record(self) -> dict:
         """JSON-safe scalars."""
         return {"method": self.method, "state": self.state, "approach": self.approach,
+                "external_pressure": self.external_pressure,
                 "inlet_pressure": self.inlet_pressure, "outlet_pressure": self.outlet_pressure,
                 "leak_rate": self.leak_rate, "leak_rate_one_way": self.one_way_leak_rate,
                 "mean_gap": self.mean_gap, "min_gap": self.min_gap,
@@ -143,6 +163,31 @@ class ChannelCoupledResult:
 
 class _Closed(RejectedIterate):
     """The gap of an iterate closes the channel."""
+
+
+class _LiftOff(RejectedIterate):
+    """The fluid of an open channel carries more than the external load."""
+
+
+def _balance(shape, dx, p_ext, **flow) -> float:
+    """The approach Delta (m) at which the open channel ``shape - Delta`` carries
+    ``p_ext`` by its mean fluid pressure (module docstring); _Closed / _LiftOff outside the
+    open range."""
+    from scipy.optimize import brentq
+
+    top = float(shape.min())
+    scale = float(np.ptp(shape)) or abs(top) or 1.0
+
+    def excess(d):
+        return channel_flow(shape - d, dx, **flow).mean_pressure - p_ext
+
+    hi, lo = top - 1e-9 * scale, top - 1e3 * scale
+    e_hi, e_lo = excess(hi), excess(lo)
+    if e_hi > 0 and e_lo > 0:
+        raise _LiftOff()
+    if e_hi < 0 and e_lo < 0:
+        raise _Closed()
+    return float(brentq(excess, lo, hi, xtol=1e-15 * scale, maxiter=200))
 
 
 class MirroredHalfPlane:
@@ -198,7 +243,8 @@ class HalfPlaneState:
     contact_result: object
 
 
-def coupled_channel(profile: Surface, material: Material, approach: float, *,
+def coupled_channel(profile: Surface, material: Material, approach: Optional[float] = None,
+                    *, external_pressure: Optional[float] = None,
                     p_in: float, p_out: float, mu: float = 1e-3, method: str = "bem",
                     growth: float = 0.05, depth: Optional[float] = None, fem_options=None,
                     tol: float = 1e-8, max_iter: int = 60, anderson: int = 5,
@@ -211,8 +257,11 @@ def coupled_channel(profile: Surface, material: Material, approach: float, *,
         1D profile, heights (m), sampled at ``x_i = i dx`` (its ``spacing``).
     material : roughfe.model.Material
         Elastic body (Pa); the profile is rigid.
-    approach : float
+    approach : float, optional
         Half-plane approach Delta (m) from first contact; negative: clearance.
+    external_pressure : float, optional
+        Or: the external mean pressure p_ext (Pa), carried by the fluid before closure
+        (module docstring). Give exactly one of the two.
     p_in, p_out : float
         Absolute fluid pressures at ``x = 0`` and ``x = W`` (Pa, >= 0).
     mu : float
@@ -245,8 +294,13 @@ def coupled_channel(profile: Surface, material: Material, approach: float, *,
                          f"surface of shape {profile.shape}")
     if method not in METHODS:
         raise InputError(f"method must be one of {METHODS}, got {method!r}")
-    if not np.isfinite(approach):
+    if (approach is None) == (external_pressure is None):
+        raise InputError("give exactly one of approach (the half-plane approach Delta, m) or "
+                         "external_pressure (the external mean pressure, Pa)")
+    if approach is not None and not np.isfinite(approach):
         raise InputError(f"approach must be finite (m), got {approach!r}")
+    p_ext = None if external_pressure is None else check_finite_positive(
+        "external pressure", external_pressure)
     p_in, p_out = check_absolute_pressures(p_in, p_out)
     mu = check_finite_positive("mu", mu)
     tol, max_iter, anderson, relaxation = check_options(tol, max_iter, anderson, relaxation)
@@ -260,13 +314,34 @@ def coupled_channel(profile: Surface, material: Material, approach: float, *,
 
         pmesh = mesh_profile(profile, growth=growth, depth=depth)
         body = FluidLoadedBody(pmesh, material, fem_options)
-    last = {}
+    flow_args = {"p_in": p_in, "p_out": p_out, "mu": mu}
+    # the body is solved at the imposed approach, or (load control: the contact is inactive
+    # before closure, so the shape of the gap does not depend on it) with a clearance of the
+    # height range below the last balanced approach
+    clearance = 0.0 if p_ext is None else float(np.ptp(profile.heights)) or 1e-6
+    last = {"approach": 0.0 if approach is None else float(approach)}
 
     def G(x):
-        c = body.solve(x, approach)
-        gap = np.where(c.contact[:n], 0.0, np.maximum(c.gap[:n], 0.0))
-        flow = channel_flow(gap, dx, p_in=p_in, p_out=p_out, mu=mu)
-        last.update(body=c, gap=gap, flow=flow)
+        trial = last["approach"] - clearance
+        c = body.solve(x, trial)
+        contact = np.asarray(c.contact[:n])
+        gap = np.where(contact, 0.0, np.maximum(c.gap[:n], 0.0))
+        if p_ext is not None and not contact.any():
+            shape = np.asarray(c.gap[:n]) + trial
+            try:
+                last["approach"] = _balance(shape, dx, p_ext, **flow_args)
+            except RejectedIterate as exc:
+                # no open balance: report the channel at closure (touching at its throat;
+                # the contact that would carry the rest of the load is not solved) or, at
+                # lift-off, the trial channel (no equilibrium)
+                lifted = isinstance(exc, _LiftOff)
+                gap = gap if lifted else shape - shape.min()
+                last.update(body=c, gap=gap, flow=channel_flow(gap, dx, **flow_args),
+                            state="lift-off" if lifted else "closed")
+                raise
+            gap = shape - last["approach"]
+        flow = channel_flow(gap, dx, **flow_args)
+        last.update(body=c, gap=gap, flow=flow, state="closed" if flow.closed else "open")
         if flow.closed:
             raise _Closed()
         return flow.pressure
@@ -275,16 +350,14 @@ def coupled_channel(profile: Surface, material: Material, approach: float, *,
         x = np.zeros(n)
         try:
             gx = G(x)
-        except _Closed:
-            return _result(method, "closed", last, approach, mu, 0.0, 0, float("nan"), ())
+        except RejectedIterate:
+            one_way = None if last["state"] == "lift-off" else last["flow"].leak_rate
+            return _result(method, last, p_ext, mu, one_way, 0, float("nan"), ())
         one_way = last["flow"].leak_rate
         fp = anderson_fixed_point(G, x, gx, tol=tol, max_iter=max_iter, memory=anderson,
                                   relaxation=relaxation)
-        if fp.status == "rejected":
-            return _result(method, "closed", last, approach, mu, one_way, fp.iterations,
-                           fp.residual, fp.residuals)
-        out = _result(method, "open", last, approach, mu, one_way, fp.iterations,
-                      fp.residual, fp.residuals)
+        out = _result(method, last, p_ext, mu, one_way, fp.iterations, fp.residual,
+                      fp.residuals)
     if fp.status == "max_iter":
         raise NoConvergenceError(
             f"channel fluid-structure coupling ({method}): relative residual "
@@ -293,14 +366,18 @@ def coupled_channel(profile: Surface, material: Material, approach: float, *,
     return out
 
 
-def _result(method, state, last, approach, mu, one_way, it, res, residuals):
-    flow, gap, c = last["flow"], last["gap"], last["body"]
+def _result(method, last, p_ext, mu, one_way, it, res, residuals):
+    """The result of the last evaluated iterate (the converged one when open)."""
+    state, gap, c, flow = last["state"], last["gap"], last["body"], last["flow"]
     n = gap.size
+    lifted = state == "lift-off"
     return ChannelCoupledResult(
         method=method, state=state, x=flow.x, gap=gap,
         displacement=np.asarray(c.displacement)[:n].copy(), fluid_pressure=flow.pressure,
-        flow=flow, approach=float(approach), inlet_pressure=flow.inlet_pressure,
-        outlet_pressure=flow.outlet_pressure, mu=mu, leak_rate=flow.leak_rate,
-        one_way_leak_rate=one_way, mean_gap=trapezoid_mean(gap), min_gap=float(gap.min()),
+        flow=flow, approach=float(last["approach"]), external_pressure=p_ext,
+        inlet_pressure=flow.inlet_pressure, outlet_pressure=flow.outlet_pressure, mu=mu,
+        leak_rate=None if lifted else flow.leak_rate, one_way_leak_rate=one_way,
+        mean_gap=None if lifted else trapezoid_mean(gap),
+        min_gap=None if lifted else float(gap.min()),
         mean_fluid_pressure=flow.mean_pressure, iterations=int(it), residual=float(res),
         residual_history=tuple(residuals), contact=c)
