@@ -256,7 +256,7 @@ def _validation_commands():
         from roughfe.cli.validate_cmd import VALIDATIONS
     except Exception:  # the page still says how to run the script
         return {}
-    return {script: f"roughfe validate {name} -o validation/output"
+    return {script: f"roughfe validate {name} -o OUTDIR"
             for name, scripts in VALIDATIONS.items()
             for script in ((scripts,) if isinstance(scripts, str) else scripts)}
 

@@ -20,10 +20,28 @@ the geometry is fixed, only its discretisation is refined):
 * FEM: every element size divided by r: top elements dx / r, growth with depth
   ``GROWTH_1 / r`` (size(d) = (dx + GROWTH_1 d) / r), depth H_d = 2 W unchanged.
 
-Both are load-controlled at the same three mean pressures (those of the native BEM at
-Delta = 0.5, 0.7, 0.9 of max h - mean h), so A*, K = dp/dDelta (Eq. 2.7, exact incremental,
-frozen contact set) and the mean gap (Eq. 2.8) are compared at equal load. A* is the
-contact length with sub-element edges (``roughfe.fem.contact_length``) / W.
+Both are load-controlled at the same three mean pressures p (those of the native BEM at
+Delta = 0.5, 0.7, 0.9 of max h - mean h) and at p (1 -+ K_WINDOW), so A*, K and the mean
+gap (Eq. 2.8) are compared at equal load. A* is the contact length with sub-element
+edges (``roughfe.fem.contact_length``) / W.
+
+K is the window stiffness K = -(p+ - p-) / (g(p+) - g(p-)) over p+- = p (1 -+ 5 %), the
+tangent dp/dDelta (Eq. 2.7) averaged over that load window (Delta = const - mean gap in
+load control). The tangent itself (exact incremental, frozen contact set) is reported but
+not gated, because at few contact patches it is not a converged quantity of the
+continuum problem at an arbitrary load. Measured on the Table 1 profile (BEM, periodic
+plane strain, r up to 64): the lowest study load (161.6 MPa) lies within 1 % of the load
+at which one more asperity (a polyline vertex at x = 612.5 um) touches; across that 1 %
+the tangent K jumps by 3 % (7.54 -> 7.77e14 Pa/m at r = 64; 10 % at another onset 4 %
+lower). In plane strain a patch of width a adds a stiffness ~ 1 / ln(L / a), which
+vanishes only logarithmically as a -> 0, so a one-node patch (a = dx / r) at an onset
+carries a stiffness the continuum patch (a << dx / r) does not have, and the tangent
+converges like 1 / ln r: BEM 7.458 / 7.838 / 7.787 / 7.777 / 7.767e14 at r = 4 / 8 / 16 /
+32 / 64 (the vertex enters contact at r = 8, the FEM's not yet at r = 8: FEM/BEM - 1 =
+-2.74 % there). A one-sided 1 % perturbation of the load (or of the discretisation) moves
+the tangent by more than the 1 % target, in both methods. The window stiffness at the same
+load converges: BEM 7.557 / 7.596 / 7.610 / 7.612 / 7.613e14 (r = 4 ... 64), and it is
+the same tangent averaged over a load range where a measurement would take it.
 
 For every method, quantity and load: observed orders and the Richardson limit of the
 finest three levels (``roughfe.validation.richardson``; fallback when not asymptotic: the
@@ -31,12 +49,15 @@ finest value with 3x the last difference as its uncertainty), and the estimated
 discretisation error of every level, |Q_r - Q_lim| + uncertainty.
 
 Targets (met / NOT met): per profile, the FEM and BEM limits agree within 1 % (A*) and
-1 % (K) at every load; at every r the FEM-BEM difference of A*, K and mean gap is within
-the sum of the two estimated discretisation errors.
+1 % (window K) at every load; at every r the FEM-BEM difference of A*, window K and mean
+gap is within the sum of the two estimated discretisation errors. The tangent K rows of
+the report are information.
 """
 from __future__ import annotations
 
 import json
+import os
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -57,9 +78,14 @@ from roughfe.writers import write_json, write_text  # noqa: E402
 LEVELS = (1, 2, 4, 8)
 GROWTH_1 = 0.2                 # element-size growth with depth at r = 1 (divided by r)
 FRACTIONS = (0.5, 0.7, 0.9)    # loads: native-BEM mean pressure at these Delta / (max h - mean h)
-QUANTITIES = {"area": "A* (sub-element edges)", "stiffness": "K = dp/dDelta",
-              "mean_gap": "mean gap"}
+K_WINDOW = 0.05                # K: secant over the mean pressures p (1 -+ K_WINDOW)
+QUANTITIES = {"area": "A* (sub-element edges)",
+              "stiffness": "K = -dp/d(mean gap) over p (1 -+ 5 %)",
+              "mean_gap": "mean gap",
+              "stiffness_tangent": "tangent K = dp/dDelta (information)"}
 LIMIT_TARGETS = {"area": 0.01, "stiffness": 0.01}
+#: gated at every level (the tangent K is reported, not gated: see the module docstring)
+LEVEL_TARGETS = ("area", "stiffness", "mean_gap")
 
 
 def refined(surface: Surface, r: int) -> Surface:
@@ -80,29 +106,52 @@ def study_pressures(surface: Surface) -> np.ndarray:
     return bem.mean_pressure
 
 
-def level(surface: Surface, r: int, pressures, guesses=None) -> dict:
-    """BEM and FEM at refinement r and the given mean pressures: A*, K, mean gap.
+def load_window(pressures) -> np.ndarray:
+    """The solved mean pressures (Pa): every compared p and p (1 -+ K_WINDOW), increasing."""
+    p = np.asarray(pressures, float)
+    return np.sort(np.concatenate([p * (1 - K_WINDOW), p, p * (1 + K_WINDOW)]))
 
-    ``guesses``: imposed FEM approaches of a coarser level to start the load control from.
+
+def window_quantities(sweep, n: int) -> dict:
+    """A*, K (window secant and tangent) and mean gap at the compared loads of a sweep
+    solved at :func:`load_window`: the middle load of every consecutive triple.
+
+    The window stiffness is K = -(p+ - p-) / (g+ - g-) with the mean gaps g (Eq. 2.8) at
+    the window's ends p+- = p (1 +- K_WINDOW): the tangent dp/dDelta (Eq. 2.7) averaged
+    over the window (in load control Delta = const - mean gap in both methods).
+    """
+    p = sweep.mean_pressure.reshape(-1, 3)
+    g = sweep.mean_gap.reshape(-1, 3)
+    mid = slice(1, None, 3)
+    return {"area": [subcell_area(x, n) for x in sweep.results[mid]],
+            "area_count": sweep.area_fraction[mid].tolist(),
+            "stiffness": ((p[:, 2] - p[:, 0]) / (g[:, 0] - g[:, 2])).tolist(),
+            "stiffness_tangent": sweep.stiffness[mid].tolist(),
+            "mean_gap": g[:, 1].tolist(), "mean_pressure": p[:, 1].tolist(),
+            "window_mean_pressure": sweep.mean_pressure.tolist(),
+            "window_mean_gap": sweep.mean_gap.tolist(),
+            "window_stiffness_tangent": sweep.stiffness.tolist()}
+
+
+def level(surface: Surface, r: int, pressures, guesses=None) -> dict:
+    """BEM and FEM at refinement r, solved at :func:`load_window` of ``pressures``: A*,
+    K (window secant and tangent), mean gap at ``pressures``.
+
+    ``guesses``: imposed FEM approaches of a coarser level (one per window load) to start
+    the load control from.
     """
     s = refined(surface, r)
     n = s.shape[0]
+    loads = load_window(pressures)
     out = {"r": r, "n_nodes": n}
     c0, t0 = time.process_time(), time.perf_counter()
-    bem = contact_sweep(mirrored_profile(s), MATERIAL, pressures=pressures, kernel="spectral")
-    out["bem"] = {"area": [subcell_area(x, n) for x in bem.results],
-                  "area_count": bem.area_fraction.tolist(),
-                  "stiffness": bem.stiffness.tolist(), "mean_gap": bem.mean_gap.tolist(),
-                  "mean_pressure": bem.mean_pressure.tolist(), "cpu_seconds": time.process_time() - c0}
+    bem = contact_sweep(mirrored_profile(s), MATERIAL, pressures=loads, kernel="spectral")
+    out["bem"] = {**window_quantities(bem, n), "cpu_seconds": time.process_time() - c0}
     c0 = time.process_time()
     pm = mesh_profile(s, growth=GROWTH_1 / r)
     c_mesh = time.process_time() - c0
-    fem = fem_contact_sweep(pm, MATERIAL, pressures=pressures, guesses=guesses)
-    out["fem"] = {"area": [subcell_area(x, n) for x in fem.results],
-                  "delta_applied": fem.delta_applied.tolist(),
-                  "area_count": fem.area_fraction.tolist(),
-                  "stiffness": fem.stiffness.tolist(), "mean_gap": fem.mean_gap.tolist(),
-                  "mean_pressure": fem.mean_pressure.tolist(),
+    fem = fem_contact_sweep(pm, MATERIAL, pressures=loads, guesses=guesses)
+    out["fem"] = {**window_quantities(fem, n), "delta_applied": fem.delta_applied.tolist(),
                   "snes_iterations": [int(x.nit) for x in fem.results],
                   "n_cells": pm.n_cells, "growth": GROWTH_1 / r, "cpu_seconds_mesh": c_mesh,
                   "cpu_seconds": time.process_time() - c0}
@@ -147,7 +196,7 @@ def profile_targets(name: str, analysis: dict, levels: list) -> list:
         rows.append(Target(f"{name}: {QUANTITIES[q]} limits FEM vs BEM",
                            f"<= {percent(limit, 0)}", percent(worst, 3),
                            bool(abs(worst) <= limit), reason, worst))
-    for q in QUANTITIES:
+    for q in LEVEL_TARGETS:
         bad = [(levels[i]["r"], k) for k, a in enumerate(analysis[q])
                for i, ok in enumerate(a["level_within"]) if not ok]
         ratio = max(d / a if a > 0 else np.inf for x in analysis[q]
@@ -219,7 +268,8 @@ PROFILES = {"table1_10x": table1_profile, "rmd": rmd_profile_case}
 
 
 def _settings(name: str, r: int, pressures) -> dict:
-    return {"profile": name, "r": r, "growth_r1": GROWTH_1, "pressures": list(map(float, pressures))}
+    return {"profile": name, "r": r, "growth_r1": GROWTH_1, "k_window": K_WINDOW,
+            "pressures": list(map(float, pressures))}
 
 
 def run(outdir: Path, levels=LEVELS, profiles=None, resume: bool = False) -> tuple[bool, list]:
@@ -254,12 +304,43 @@ def run(outdir: Path, levels=LEVELS, profiles=None, resume: bool = False) -> tup
     write_json(outdir / "fem_convergence.json",
                {"name": "fem_convergence", "targets": [t.to_dict() for t in rows],
                 "levels": list(levels), "growth_r1": GROWTH_1, "fractions": list(FRACTIONS),
+                "k_window": K_WINDOW,
                 "cases": cases})
     write_report(outdir, cases, rows)
     return ok, rows
 
 
+def run_parallel(outdir: Path, profiles, resume: bool = False) -> None:
+    """Run every profile as its own process (this script with ``--profile``; each writes
+    its level files), at most ``os.cpu_count()`` at a time. Raises when one fails
+    (exit status other than 0 = met / 1 = NOT met)."""
+    import roughfe
+    env = dict(os.environ)
+    root = str(Path(roughfe.__file__).resolve().parents[1])   # the same roughfe in the children
+    env["PYTHONPATH"] = os.pathsep.join(x for x in (root, env.get("PYTHONPATH")) if x)
+    todo, running = list(profiles), []
+    while todo or running:
+        while todo and len(running) < max(1, os.cpu_count() or 1):
+            name = todo.pop(0)
+            cmd = [sys.executable, str(Path(__file__).resolve()), str(outdir), "--profile", name]
+            running.append((name, subprocess.Popen(cmd + (["--resume"] if resume else []),
+                                                   env=env)))
+        name, proc = running.pop(0)
+        if proc.wait() not in (0, 1):
+            for _, other in running:
+                other.kill()
+            raise RuntimeError(f"fem_convergence --profile {name} failed with exit status "
+                               f"{proc.returncode} (its output is above)")
+
+
 def main(outdir, resume: bool = False) -> bool:
+    """The study (``roughfe validate fem``). With more than one CPU the profiles run as
+    parallel processes (:func:`run_parallel`); this process then assembles their levels."""
+    outdir = Path(outdir)
+    if len(PROFILES) > 1 and (os.cpu_count() or 1) > 1:
+        (outdir / "fem_convergence_levels").mkdir(parents=True, exist_ok=True)
+        run_parallel(outdir, list(PROFILES), resume)
+        resume = True
     return run(outdir, resume=resume)[0]
 
 
