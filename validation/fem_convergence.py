@@ -310,10 +310,10 @@ def run(outdir: Path, levels=LEVELS, profiles=None, resume: bool = False) -> tup
     return ok, rows
 
 
-def run_parallel(outdir: Path, profiles, resume: bool = False) -> None:
+def run_parallel(outdir: Path, profiles, resume: bool = False, levels=LEVELS) -> None:
     """Run every profile as its own process (this script with ``--profile``; each writes
     its level files), at most ``os.cpu_count()`` at a time. Raises when one fails
-    (exit status other than 0 = met / 1 = NOT met)."""
+    (exit status other than 0 = met / 1 = NOT met, e.g. 3 = raised)."""
     import roughfe
     env = dict(os.environ)
     root = str(Path(roughfe.__file__).resolve().parents[1])   # the same roughfe in the children
@@ -322,7 +322,8 @@ def run_parallel(outdir: Path, profiles, resume: bool = False) -> None:
     while todo or running:
         while todo and len(running) < max(1, os.cpu_count() or 1):
             name = todo.pop(0)
-            cmd = [sys.executable, str(Path(__file__).resolve()), str(outdir), "--profile", name]
+            cmd = [sys.executable, str(Path(__file__).resolve()), str(outdir), "--profile", name,
+                   "--levels", *map(str, levels)]
             running.append((name, subprocess.Popen(cmd + (["--resume"] if resume else []),
                                                    env=env)))
         name, proc = running.pop(0)
@@ -352,4 +353,10 @@ if __name__ == "__main__":
     parser.add_argument("--levels", type=int, nargs="+", default=list(LEVELS))
     parser.add_argument("--resume", action="store_true")
     a = parser.parse_args()
-    sys.exit(0 if run(Path(a.outdir), tuple(a.levels), a.profile, a.resume)[0] else 1)
+    try:
+        met = run(Path(a.outdir), tuple(a.levels), a.profile, a.resume)[0]
+    except Exception:   # noqa: BLE001 -- exit 3, told apart from 1 = a target NOT met
+        import traceback
+        traceback.print_exc()
+        sys.exit(3)
+    sys.exit(0 if met else 1)
