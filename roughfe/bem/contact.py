@@ -396,7 +396,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                                 initial=initial, diagonal=op.diagonal,
                                 precond=_cg_preconditioner(op), tol=tol,
                                 max_iter=max_iter or 20000, offset=-hmax, hardness=hardness,
-                                overwrite_initial=own)
+                                overwrite_initial=own,
+                                apply_single=functools.partial(op.apply, single=True))
         else:
             H = _dense(op)
             if initial is None:

@@ -6,9 +6,13 @@ and memory are measured in ``docs/theory/02b_bem_performance.md``.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.blas import daxpy
+from scipy.linalg.blas import daxpy, saxpy
 
 from .solvers import SolverOutput, _fail, _rescale_to_load
+
+#: relative KKT residual above which the products with H may be taken in single precision
+#: (``apply_single``): a hundred times the float32 rounding of u = H p (~1e-7 of max |u|)
+SINGLE_PRECISION_RESIDUAL = 1e-5
 
 
 def _shift_to_load(x, target_sum, upper):
@@ -40,7 +44,7 @@ def _shift_to_load(x, target_sum, upper):
 
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
                   diagonal=1.0, precond=None, tol=1e-10, max_iter=10000, offset=0.0,
-                  hardness=None, overwrite_initial=False):
+                  hardness=None, overwrite_initial=False, apply_single=None):
     """Polonsky & Keer (1999) constrained CG with FFT operator products, bounded form.
 
     Solves Eq. 2.5-2.6 for ``0 <= p <= hardness`` with the gap ``w = H p - b - offset -
@@ -80,6 +84,14 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     copy; the caller gives it up). ``nit`` counts iterations, ``n_products`` the
     operator products (H and M).
 
+    ``apply_single`` (H in single precision: float32 in and out) makes the iterations
+    with a residual above ``SINGLE_PRECISION_RESIDUAL`` mixed precision: u and H t are
+    float32 (half the FFT work and half the memory of u in the first iterations, where
+    the free set is large and most steps clip), the gradient, the CG vectors and p stay
+    float64. Below that residual u is recomputed in double precision and every later
+    product is float64, so the converged residual is the float64 one (a solution is
+    only returned after a double-precision u confirmed it).
+
     Returns a :class:`SolverOutput`.
     """
     load = mean_pressure is not None
@@ -94,6 +106,11 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         nonlocal products
         products += 1
         return np.ascontiguousarray(apply(x.reshape(shape))).reshape(-1)
+
+    def H_single(x):
+        nonlocal products
+        products += 1
+        return np.ascontiguousarray(apply_single(x.reshape(shape))).reshape(-1)
 
     def M(x):
         nonlocal products
@@ -128,15 +145,26 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     S = np.flatnonzero(p)
     gz_old = 0.0
     res = np.inf
-    d = 0.0 if load else float(delta)
+    # d is Delta + offset: the gap is g - d with g = u - b (offset folded into d: one
+    # full-grid pass less per iteration); Delta = d - offset is what is returned
+    d = 0.0 if load else float(delta) + offset
     u, us, exact = None, 1.0, False
+    low = confirm = False     # u (and H t) in single precision; a final check pending
     for it in range(1, max_iter + 1):
+        if low and res <= SINGLE_PRECISION_RESIDUAL:
+            u = None          # near the solution: double precision from here on
         if u is None or it % 50 == 0:
             u = None
-            u, us, exact = H(p), 1.0, True
-        g = np.multiply(u, us) if us != 1.0 else u.copy()
-        g -= bf
-        g -= offset
+            low = (apply_single is not None and not confirm
+                   and res > SINGLE_PRECISION_RESIDUAL)
+            u, us, exact = (H_single(p) if low else H(p)), 1.0, True
+            confirm = False
+        g = np.empty(n)
+        if us != 1.0:
+            np.multiply(u, us, out=g)
+            g -= bf
+        else:
+            np.subtract(u, bf, out=g)
         gS = g[S]
         pS = p[S]
         free_c = pS < upper if bounded else None
@@ -157,19 +185,22 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             comp = float(np.dot(pS, wS))
         del gS, wS, pS        # the first iterations of a cold start have S = every point
         np.less(g, d, out=mask)
-        pen = np.flatnonzero(mask)
-        gpen = g[pen]
-        if bounded:
+        if bounded:           # points at the bound may interpenetrate
+            pen = np.flatnonzero(mask)
+            gpen = g[pen]
             gpen = gpen[p[pen] < upper]
-        del pen
-        feas = max(0.0, d - float(gpen.min())) if gpen.size else 0.0
-        del gpen
+            del pen
+            feas = max(0.0, d - float(gpen.min())) if gpen.size else 0.0
+            del gpen
+        else:                 # the largest penetration, anywhere
+            feas = max(0.0, d - float(g.min()))
         res = max(comp / (sp * scale) if sp > 0 else 0.0, feas / scale)
         if res <= tol:
-            if exact:
-                return SolverOutput(p.reshape(shape), (u * us).reshape(shape), d, it, res,
-                                    "pk", products)
-            u = None          # confirm on a freshly computed displacement
+            if exact and not low:
+                return SolverOutput(p.reshape(shape), (u * us).reshape(shape), d - offset,
+                                    it, res, "pk", products)
+            u = None          # confirm on a freshly computed double-precision displacement
+            confirm = True
             continue
         mask[S] = True
         del S
@@ -203,7 +234,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         t[F] = tF
         gt = float(np.dot(gF, tF))
         del gF
-        r = H(t)
+        r = H_single(t) if low else H(t)
         tr = float(np.dot(tF, r[F]))
         tau = gt / tr if tr > 0 else 0.0
         pF = p[F]
@@ -238,9 +269,10 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         if clipped:
             u = None          # the projection moved p off the line: recompute u = H p
         else:
-            daxpy(r, u, a=-tau / us)
+            (saxpy if low else daxpy)(r, u, a=-tau / us)
             us *= alpha
             exact = False
         del r
     u = H(p)
-    _fail("Polonsky-Keer CG", max_iter, res, tol, p.reshape(shape), u.reshape(shape), d, "pk")
+    _fail("Polonsky-Keer CG", max_iter, res, tol, p.reshape(shape), u.reshape(shape),
+          d - offset, "pk")
