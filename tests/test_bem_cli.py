@@ -118,6 +118,13 @@ def test_contact_cli_adhesion_unload_pull_off(tmp_path):
     assert doc["derived"]["detached"] is True
     assert all("adhesive_area_fraction" in s for s in steps)
     assert (out / "adhesion_load_approach.png").stat().st_size > 0
+    # the Pastewka-Robbins criterion of the surface and law (roughfe.theory.stickiness)
+    from roughfe.surfaces.io import load_surface
+    from roughfe.theory import pastewka_robbins
+    st = doc["derived"]["stickiness"]
+    ref = pastewka_robbins(load_surface(path), 1.0, w, 0.0486)
+    assert st["stickiness"] == pytest.approx(ref.stickiness, rel=1e-12)
+    assert st["sticky"] is ref.sticky and st["references"]
 
 
 @pytest.mark.parametrize("extra, message", [

@@ -15,7 +15,9 @@ Also a refinement study at lambda = 2 (2, 4 and 8 cells in c - a), Johnson's (19
 adhesive sinusoid (JKR-type closed form against the Maugis-Dugdale BEM near the JKR
 limit, two grids) and a rough adhesive
 contact (periodic self-affine surface, exponential law): loading and unloading branches,
-pull-off pressure, whether the surface is sticky.
+pull-off pressure, whether the surface is sticky; and the Pastewka-Robbins criterion
+(roughfe.theory.stickiness) against the BEM's attractive load at A* = 2 % on four works
+of adhesion (its sticky verdict against the BEM's, a target row each).
 
 Target: |F_BEM / F_Maugis - 1| <= 2 % for lambda in {0.1, 0.3, 1, 2}.
 Writes validation/output/adhesion_maugis.json. Run:
@@ -28,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import scipy.optimize
 
+from roughfe.bem import solve_contact
 from roughfe.bem.adhesion import AdhesionLaw, adhesive_sweep
 from roughfe.model import Material
 from roughfe.reference import maugis_load, maugis_pull_off
@@ -36,6 +39,7 @@ from roughfe.surfaces.spectral import spectral_surface
 from roughfe.surfaces.stats import rms_slope
 from roughfe.surfaces.surface import Surface
 from roughfe.theory import persson
+from roughfe.theory.stickiness import pastewka_robbins
 from roughfe.writers import write_json
 
 OUT = Path(__file__).resolve().parent / "output" / "adhesion_maugis.json"
@@ -97,6 +101,61 @@ def rough_adhesive():
             "persson_area_fraction_nonadhesive": [float(a) for a in theory.area_fraction]}
 
 
+STICKY_AREA = 0.02     # A* at which the secant of A*(p) is read (Pastewka & Robbins' test)
+
+
+def _pressure_at_area(results, area):
+    """Mean pressure (Pa) at the area fraction ``area``, interpolated along a loading
+    branch (states with contact, sorted by area); when the branch jumped into contact
+    beyond ``area`` the pressure of its smallest contact state (the secant's sign is
+    what is read)."""
+    pts = sorted((r.area_fraction, r.mean_pressure) for r in results if r.n_contact)
+    a, p = np.array(pts).T
+    return float(np.interp(area, a, p))
+
+
+def stickiness_cases(works=(1e-5, 3e-5, 1e-4, 3e-4)):
+    """Pastewka-Robbins criterion against the adhesive BEM on one rough surface.
+
+    Periodic self-affine surface (H = 0.8, 10 nm rms, L = 10 um, 128^2, roll-off 2 q0,
+    cut-off 32 q0), E* = 1.33 MPa, Maugis-Dugdale law with range 5 nm and works of
+    adhesion ``works``. The criterion predicts S = N_att / N_rep at a given repulsive
+    area (Eq. (2) of roughfe.theory.stickiness); the BEM measures it directly as
+    ``S_BEM = 1 - p_adh(A*) / p_el(A*)`` at A* = 2 % (loading branch against the
+    non-adhesive sweep of the same surface); sticky (BEM) when p_adh <= 0 there (the
+    secant of A*(p) has changed sign: Pastewka & Robbins' test). The pull-off pressure
+    of the unloading branch is reported beside it."""
+    s = spectral_surface(128, 1e-5, 0.8, rms_height=1e-8, q_roll=2 * 2 * np.pi / 1e-5,
+                         q_short=32 * 2 * np.pi / 1e-5, rng=3)
+    mat = Material(1e6, 0.5)
+    top = float(s.heights.max() - s.heights.mean())
+    elastic = [solve_contact(s, mat, delta=d, compute_stiffness=False)
+               for d in np.linspace(0.05, 0.8, 16) * top]
+    p_el = _pressure_at_area(elastic, STICKY_AREA)
+    out = []
+    for w in works:
+        law = AdhesionLaw("md", w, 5e-9)
+        pr = pastewka_robbins(s, mat.E_star, w, law.range)
+        t0 = time.process_time()
+        sw = adhesive_sweep(s, mat, law, np.linspace(0.1, 0.6, 6) * top, unload=True,
+                            max_unload_steps=30)
+        p_adh = _pressure_at_area([r for r in sw.sweep.results if not r.unloading],
+                                  STICKY_AREA)
+        s_bem = 1.0 - p_adh / p_el
+        out.append({"work_of_adhesion": w, "range": law.range,
+                    "stickiness_pastewka_robbins": pr.stickiness,
+                    "ring_over_half_width": pr.ring_over_half_width,
+                    "sticky_pastewka_robbins": pr.sticky,
+                    "pressure_elastic_at_area": p_el, "pressure_adhesive_at_area": p_adh,
+                    "stickiness_bem": s_bem, "sticky_bem": bool(p_adh <= 0),
+                    "agree": bool(pr.sticky == (p_adh <= 0)),
+                    "pull_off_pressure": sw.pull_off_pressure, "detached": sw.detached,
+                    "cpu_s": time.process_time() - t0})
+    return {"surface": "periodic self-affine, H = 0.8, rms height 10 nm, L = 10 um, 128^2, "
+                       "cut-off 32 q0", "E_star": mat.E_star, "area_fraction": STICKY_AREA,
+            "rms_slope": rms_slope(s), "cases": out}
+
+
 def johnson_sinusoid():
     """Johnson (1995): periodic profile h = D cos(2 pi x / l), plane strain, JKR-type
     adhesion: p = p* sin^2(psi) - sqrt(2 w E* tan(psi) / l), psi = pi a / l,
@@ -142,14 +201,25 @@ def main(outdir=None) -> bool:
         print(f"Johnson sinusoid n = {r['n']}: a/l = {r['a_over_l']:.4f}, p/p* BEM "
               f"{r['p_over_pstar_bem']:.4f} vs {r['p_over_pstar_johnson']:.4f}", flush=True)
     rough = rough_adhesive()
+    sticky = stickiness_cases()
+    for c in sticky["cases"]:
+        print(f"stickiness w = {c['work_of_adhesion']:.0e}: S Pastewka-Robbins "
+              f"{c['stickiness_pastewka_robbins']:.3f}, S BEM {c['stickiness_bem']:.3f}, sticky "
+              f"PR {c['sticky_pastewka_robbins']} / BEM {c['sticky_bem']}, pull-off "
+              f"{c['pull_off_pressure']:.4g} Pa", flush=True)
     print(f"rough adhesive contact: pull-off pressure {rough['pull_off_pressure']:.4g} Pa, "
           f"sticky {rough['sticky']}, detached {rough['detached']}, {rough['cpu_s']:.0f} s CPU")
     targets = [{"name": f"sphere pull-off vs Maugis, lambda = {r['lambda']}",
                 "value": r["relative_error"], "target": "|error| <= 0.02",
                 "met": bool(abs(r["relative_error"]) <= 0.02)} for r in rows]
+    targets += [{"name": f"Pastewka-Robbins sticky verdict = BEM (p at A* = 2 % <= 0), "
+                         f"w = {c['work_of_adhesion']:g} J/m^2",
+                 "value": c["stickiness_bem"], "target": f"same verdict as S_PR = "
+                                                        f"{c['stickiness_pastewka_robbins']:.3g}",
+                 "met": c["agree"]} for c in sticky["cases"]]
     write_json(out_json, {"validation": "adhesion_maugis", "targets": targets, "maugis": rows,
                      "refinement_lambda_2": refinement, "johnson_sinusoid": johnson,
-                     "rough": rough,
+                     "rough": rough, "stickiness": sticky,
                      "units": {"pull_off": "P / (pi w R)", "length_m": "m", "cpu_s": "s"}})
     return all(t["met"] for t in targets)
 

@@ -18,7 +18,7 @@ from ..model import Loading, Material
 from ..response import response
 from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5, write_results_json
-from ..theory import beside
+from ..theory import beside, pastewka_robbins
 from ..writers import write_json
 from .options import (add_adhesion_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_surface_options,
@@ -107,6 +107,8 @@ def _run(args) -> int:
         doc["derived"]["pull_off_pressure"] = adhesive.pull_off_pressure
         doc["derived"]["detached"] = adhesive.detached
         doc["derived"]["units"]["pull_off_force"] = "N (surface) or N/m (profile)"
+        doc["derived"]["stickiness"] = pastewka_robbins(surface, material.E_star, law.work,
+                                                        law.range).describe()
     theory = beside(surface, material.E_star, doc["steps"])
     doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
     with folder as out:
@@ -140,8 +142,11 @@ def _run(args) -> int:
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.4f} "
               f"{k:12.4e} {s['mean_gap']:12.4e} {s['iterations']:5d}")
     if adhesive is not None:
+        st = doc["derived"]["stickiness"]
         print(f"pull-off force {adhesive.pull_off_force:.4e} "
-              f"({'detached' if adhesive.detached else 'NOT detached: a bound'})")
+              f"({'detached' if adhesive.detached else 'NOT detached: a bound'}); "
+              f"Pastewka-Robbins S = {st['stickiness']:.3g} "
+              f"({'sticky' if st['sticky'] else 'not sticky'})")
     print(f"wrote {out / 'results.json'}, {out / 'fields.h5'}")
     return 0
 

@@ -2,6 +2,8 @@
 
 * :func:`persson` -> :class:`PerssonResult`: Persson's A*(p) and mean separation u(p).
 * :func:`critical_junction` -> :class:`CriticalJunction`: Lorenz & Persson's leak rate.
+* :func:`pastewka_robbins` -> :class:`Stickiness`: the stickiness criterion of a rough
+  adhesive contact (Pastewka & Robbins 2014).
 * :func:`beside`: the theory added to the step records of a simulation (results.json).
 
 Layer: after :mod:`roughfe.surfaces` (it needs only the PSD), before the solvers and
@@ -10,7 +12,8 @@ their consumers, which draw the theory beside their results.
 from .persson import (GAMMA_DEFAULT, KAPPA_PERSSON, PERCOLATION_THRESHOLD, CriticalJunction,
                       PerssonResult, area_fraction, beside, critical_junction,
                       mean_separation, persson)
+from .stickiness import Stickiness, pastewka_robbins
 
 __all__ = ["persson", "beside", "PerssonResult", "critical_junction", "CriticalJunction",
            "area_fraction", "mean_separation", "KAPPA_PERSSON", "GAMMA_DEFAULT",
-           "PERCOLATION_THRESHOLD"]
+           "PERCOLATION_THRESHOLD", "pastewka_robbins", "Stickiness"]
