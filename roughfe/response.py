@@ -19,7 +19,7 @@ METHODS = ("bem", "fem")
 
 #: keyword options of each method (everything else is refused with the list below)
 BEM_OPTIONS = ("kernel", "solver", "tol", "max_iter", "compute_stiffness", "hardness",
-               "unload")
+               "unload", "adhesion")
 FEM_MESH_OPTIONS = ("depth", "growth", "formulation", "size_max")
 FEM_SOLVER_OPTIONS = ("solver", "penalty_factor", "rtol", "atol", "max_it", "petsc_options")
 FEM_OPTIONS = FEM_MESH_OPTIONS + FEM_SOLVER_OPTIONS + ("keep_fields",)
@@ -58,7 +58,11 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
     **solver_options
         BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness``,
         ``hardness`` (see :func:`roughfe.bem.solve_contact`), ``unload``
-        (:func:`roughfe.bem.contact_sweep`). FEM: mesh ``depth``, ``growth``,
+        (:func:`roughfe.bem.contact_sweep`), ``adhesion`` (an
+        :class:`roughfe.bem.adhesion.AdhesionLaw`: the adhesive continuation
+        :func:`roughfe.bem.adhesion.adhesive_sweep` in the approaches, with ``unload``
+        until the surfaces separate; ``kernel``, ``tol``, ``max_iter`` apply, the
+        default tolerance is its traction residual 1e-5). FEM: mesh ``depth``, ``growth``,
         ``formulation``, ``size_max`` (:func:`roughfe.fem.mesh_profile`); ``solver``
         (``"vi"`` or ``"penalty"``), ``penalty_factor``, ``rtol``, ``atol``, ``max_it``,
         ``petsc_options`` (:class:`roughfe.fem.FemSolverOptions`); ``keep_fields``.
@@ -84,10 +88,39 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         from .bem import contact_sweep
 
         _check_options(method, solver_options, BEM_OPTIONS)
+        if solver_options.get("adhesion") is not None:
+            return _adhesive_response(surface, material, loading, solver_options)
+        solver_options.pop("adhesion", None)
         return contact_sweep(surface, material, **loading.sweep_arguments(), **solver_options)
     if method == "fem":
         return _fem_response(surface, material, loading, solver_options)
     raise InputError(f"method must be one of {METHODS}, got {method!r}")
+
+
+def _adhesive_response(surface, material, loading, options) -> SweepResult:
+    """``response(..., adhesion=law)``: the adhesive continuation in the approach."""
+    from .bem.adhesion import adhesive_sweep
+    from .bem.sweep import default_deltas
+
+    law = options.pop("adhesion")
+    if options.get("hardness") is not None:
+        raise InputError("hardness and adhesion together are not supported (the adhesive "
+                         "solver has no pressure cap); give one of them")
+    if options.get("solver", "auto") != "auto":
+        raise InputError("solver does not apply with adhesion (L-BFGS-B on the gap)")
+    if loading.controls_pressure:
+        raise InputError("adhesion runs in displacement control (the load-approach curve "
+                         "has unstable parts): give approaches (delta, deltas, n_steps), "
+                         "not mean pressures")
+    args = loading.sweep_arguments()
+    kernel = options.get("kernel", "auto")
+    deltas = args.get("deltas")
+    if deltas is None:
+        deltas = default_deltas(surface, args["n_steps"], surface.periodic and kernel in
+                                ("auto", "spectral"))
+    extra = {k: options[k] for k in ("tol", "max_iter") if options.get(k) is not None}
+    return adhesive_sweep(surface, material, law, deltas, unload=bool(options.get("unload")),
+                          kernel=kernel, **extra).sweep
 
 
 def _fem_response(surface, material, loading, options) -> SweepResult:

@@ -116,3 +116,59 @@ def test_leak_fsi_writes_coupled_steps(tmp_path, capsys):
                  "--outlet-pressure", "1e6", "--no-figures", "--quiet", "--overwrite",
                  "-o", str(out)]) == 2
     assert "reversed flow" in capsys.readouterr().err
+
+
+def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
+    # roughfe leak accepts --adhesion/--hardness/--unload of roughfe contact (one option
+    # vocabulary): at the same approaches adhesion pulls the body onto the surface and a
+    # pressure cap lets the peaks flow, so both close more of the gap than the elastic
+    # contact: more contact, a smaller leak rate; unloading keeps the plastic set
+    from roughfe.cli import main
+
+    s = rmd_surface(4, 2.3, 1e-4, rng=5)
+    path = save_surface(s, tmp_path / "s.npz")
+    deltas = [str(f * np.ptp(s.heights)) for f in (0.3, 0.5)]
+    base = ["leak", str(path), "--delta", *deltas, "--direction", "x", "--no-figures",
+            "--quiet"]
+
+    def run(name, *extra):
+        assert main(base + ["-o", str(tmp_path / name), *extra]) == 0
+        return json.loads((tmp_path / name / "results.json").read_text())
+
+    el = run("elastic")
+    rng = str(0.05 * np.ptp(s.heights))
+    adh = run("adhesive", "--adhesion", "md", "--work-of-adhesion", "5", "--range", rng)
+    hp = 0.3 * max(st["mean_pressure"] for st in el["steps"]) / el["steps"][-1]["area_fraction"]
+    hard = run("hardness", "--hardness", str(hp), "--unload")
+    assert adh["inputs"]["adhesion"]["law"] == "md" and hard["inputs"]["hardness"] == hp
+    for other in (adh, hard):
+        for e, o in zip(el["steps"], other["steps"]):
+            assert o["delta"] == pytest.approx(e["delta"], rel=1e-6)
+            assert o["area_fraction"] >= e["area_fraction"]
+            assert o["leak_rate"] <= e["leak_rate"]
+            assert o["mean_pressure"] < e["mean_pressure"]
+    assert any(st["adhesive_area_fraction"] > 0 for st in adh["steps"])
+    assert max(st["plastic_area_fraction"] for st in hard["steps"]) > 0
+    # --unload: the loading steps in reverse; the plastic set keeps the gap smaller than
+    # on loading at the same approach
+    unl = [st for st in hard["steps"] if st["unloading"]]
+    assert len(unl) == 1 and unl[0]["delta"] == pytest.approx(hard["steps"][0]["delta"])
+    assert unl[0]["mean_gap"] < hard["steps"][0]["mean_gap"]
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--adhesion", "md", "--work-of-adhesion", "1", "--range", "1e-7", "--pressure", "1e6"],
+     "displacement control"),
+    (["--hardness", "1e6", "--adhesion", "exp", "--work-of-adhesion", "1", "--range", "1e-7",
+      "--delta", "1e-7"], "not supported"),
+    (["--fsi", "--direction", "x", "--hardness", "1e6", "--pressure", "1e6"], "--fsi"),
+])
+def test_leak_contact_physics_bad_input(tmp_path, capsys, extra, message):
+    from roughfe.cli import main
+
+    path = save_surface(rmd_surface(3, 2.3, 1e-4, rng=5), tmp_path / "s.npz")
+    out = tmp_path / "o"
+    assert main(["leak", str(path), "--quiet", "-o", str(out), *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+    assert not out.exists()

@@ -20,9 +20,9 @@ from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5, write_results_json
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
-from .options import (add_adhesion_options, add_detrend_option, add_material_options,
+from .options import (add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_surface_options,
-                      adhesion_from_args, check_small_strain, material_from_args,
+                      check_small_strain, contact_physics_from_args, material_from_args,
                       output_folder_of, positive_float, positive_int, surface_from_args)
 
 DEFAULT_STEPS = 20
@@ -47,16 +47,7 @@ def register(subparsers) -> None:
                       help="mean pressures (Pa), solved in the order given")
     load.add_argument("--delta", type=float, nargs="+", metavar="D",
                       help="approaches from first contact (m), solved in the order given")
-    p.add_argument("--unload", action="store_true",
-                   help="after loading, trace the unloading branch (with --adhesion: until "
-                        "the surfaces separate, giving the pull-off force; with --hardness "
-                        "keeping the plastic displacement)")
-    add_adhesion_options(p)
-    p.add_argument("--hardness", type=positive_float, default=None, metavar="H",
-                   help="indentation hardness H_p (Pa) of a perfectly plastic interface: "
-                        "0 <= p <= H_p; results get plastic_area_fraction per step and "
-                        "fields.h5 the plastic displacement (periodic surfaces: use "
-                        "--pressure)")
+    add_contact_physics_options(p)
     num = p.add_argument_group("numerics")
     num.add_argument("--kernel", default="auto", choices=("auto",) + KERNELS,
                      help="influence operator: auto = spectral if periodic, else strip for "
@@ -74,10 +65,7 @@ def register(subparsers) -> None:
 def _run(args) -> int:
     surface = surface_from_args(args)
     material = material_from_args(args)
-    law = adhesion_from_args(args)
-    if law is not None and args.hardness is not None:
-        raise InputError("--hardness and --adhesion together are not supported (the adhesive "
-                         "solver has no pressure cap); give one of them")
+    law = contact_physics_from_args(args)["adhesion"]
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
     adhesive = None
     tol = args.tol if args.tol is not None else (1e-10 if law is None else 1e-5)

@@ -22,10 +22,11 @@ import numpy as np
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
-from .options import (add_detrend_option, add_material_options, add_output_folder,
-                      add_run_options, add_runner_options, add_surface_options,
-                      check_small_strain, material_from_args, output_folder_of, positive_float,
-                      positive_int, show_progress, surface_from_args)
+from .options import (add_contact_physics_options, add_detrend_option, add_material_options,
+                      add_output_folder, add_run_options, add_runner_options,
+                      add_surface_options, check_small_strain, contact_physics_from_args,
+                      material_from_args, output_folder_of, positive_float, positive_int,
+                      show_progress, surface_from_args)
 
 
 def _add_fluid_material(p):
@@ -184,6 +185,7 @@ def _leak_run(args, surface, material, out):
     from ..theory import beside
 
     p_in, p_out = _fluid_pressures(args)
+    physics = contact_physics_from_args(args)
     base = {"surface": str(args.surface), "shape": list(surface.shape),
             "size": list(surface.size), "periodic": surface.periodic,
             "surface_metadata": dict(surface.metadata), "E": args.E, "nu": args.nu,
@@ -191,8 +193,14 @@ def _leak_run(args, surface, material, out):
             "pressure_drop": p_in - p_out, "direction": args.direction, "fsi": args.fsi,
             "trapped_fluid": args.trapped_fluid, "delta": args.delta,
             "pressure": args.pressure, "detrend": args.detrend,
+            "hardness": physics["hardness"], "unload": physics["unload"],
+            "adhesion": physics["adhesion"] and physics["adhesion"].describe(),
             "units": "SI (m, Pa, Pa s, m^3/s)"}
     if args.fsi:
+        if physics["adhesion"] is not None or physics["hardness"] is not None \
+                or physics["unload"]:
+            raise InputError("--fsi couples the elastic, non-adhesive contact: --adhesion, "
+                             "--hardness and --unload apply without --fsi")
         sweep, steps, written = _leak_fsi(args, surface, material, out, p_in, p_out)
         base["references"] = list(sweep.results[0].references)
         # Persson's theory at the solid's (effective) mean pressure of each coupled step
@@ -205,7 +213,7 @@ def _leak_run(args, surface, material, out):
     dp = p_in - p_out
     sweep = leakage_sweep(surface, material, deltas=args.delta, pressures=args.pressure,
                           direction=args.direction, mu=args.mu, pressure_drop=dp,
-                          reynolds=not args.no_reynolds)
+                          reynolds=not args.no_reynolds, contact_options=physics)
     check_small_strain(args, surface, [c.delta for c in sweep.contacts], material,
                        [c.mean_pressure for c in sweep.contacts])
     theory = beside(surface, material.E_star, sweep.records(), pressure_drop=dp,
@@ -292,6 +300,10 @@ def register(sub):
     load.add_argument("--pressure", type=positive_float, nargs="+", metavar="PA",
                       help="mean contact pressures in Pa (one step each)")
     _add_fluid_material(p)
+    add_contact_physics_options(p, unload_help=(
+        "after loading, the same approaches/pressures in reverse (with --hardness the "
+        "plastic displacement stays; with --adhesion until the surfaces separate); the "
+        "leakage of every step"))
     _add_coupling_options(p)
     add_output_folder(p)
     add_run_options(p)

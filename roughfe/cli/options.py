@@ -12,6 +12,9 @@ everywhere:
   several files) and ``--overwrite``; :func:`output_folder_of` applies the ownership
   contract of :func:`roughfe.writers.output_folder`. :func:`add_output_file` for
   commands that write one file.
+* :func:`add_contact_physics_options` -- ``--unload``, ``--adhesion md|exp``
+  ``--work-of-adhesion W --range R``, ``--hardness H``; :func:`contact_physics_from_args`
+  (``contact`` and ``leak``).
 * :func:`add_run_options` -- ``--no-figures`` and ``--quiet`` (no progress bar, no
   summary on stdout; errors still go to stderr).
 * :func:`positive_int`, :func:`positive_float`, :func:`nonnegative_int` -- argparse
@@ -211,6 +214,33 @@ def adhesion_from_args(args):
         raise InputError(f"--adhesion {args.adhesion} needs --work-of-adhesion W (J/m^2) and "
                          "--range R (m), both finite and > 0")
     return AdhesionLaw(args.adhesion, args.work_of_adhesion, args.range)
+
+
+# -- contact physics: adhesion, hardness, unloading ----------------------------------------
+def add_contact_physics_options(parser, unload_help: str = None) -> None:
+    """``--unload``, ``--adhesion md|exp --work-of-adhesion W --range R`` and
+    ``--hardness H`` (Pa): the interface physics of ``contact`` and ``leak``."""
+    parser.add_argument("--unload", action="store_true", help=unload_help or (
+        "after loading, trace the unloading branch (with --adhesion: until the surfaces "
+        "separate, giving the pull-off force; with --hardness keeping the plastic "
+        "displacement)"))
+    add_adhesion_options(parser)
+    parser.add_argument("--hardness", type=positive_float, default=None, metavar="H",
+                        help="indentation hardness H_p (Pa) of a perfectly plastic "
+                             "interface: 0 <= p <= H_p; results get plastic_area_fraction "
+                             "per step and the fields the plastic displacement")
+
+
+def contact_physics_from_args(args) -> dict:
+    """``{"adhesion": AdhesionLaw or None, "hardness": float or None, "unload": bool}``
+    of :func:`add_contact_physics_options` (the keyword options of
+    :func:`roughfe.response.response`); --hardness with --adhesion is one clear error."""
+    from ..errors import InputError
+    law = adhesion_from_args(args)
+    if law is not None and args.hardness is not None:
+        raise InputError("--hardness and --adhesion together are not supported (the adhesive "
+                         "solver has no pressure cap); give one of them")
+    return {"adhesion": law, "hardness": args.hardness, "unload": bool(args.unload)}
 
 
 # -- outputs and runs ----------------------------------------------------------------------

@@ -244,7 +244,7 @@ class LeakageSweep:
 
 
 def leakage_sweep(surface, material, *, deltas=None, pressures=None, kernel: str = "auto",
-                  **leak_kwargs) -> LeakageSweep:
+                  contact_options=None, **leak_kwargs) -> LeakageSweep:
     """BEM contact at each approach or mean pressure, then :func:`leakage_of_contact`.
 
     Parameters
@@ -257,6 +257,10 @@ def leakage_sweep(surface, material, *, deltas=None, pressures=None, kernel: str
         Approaches Delta (m) or mean contact pressures (Pa); exactly one.
     kernel : str
         BEM influence operator (:func:`roughfe.bem.solve_contact`).
+    contact_options : dict, optional
+        Interface physics of the contact solve, passed to :func:`roughfe.response.response`:
+        ``hardness`` (Pa), ``adhesion`` (an AdhesionLaw; approaches only), ``unload``
+        (the unloading steps follow the loading ones).
     **leak_kwargs
         Passed to :func:`analyse_leakage` (``direction``, ``mu``, ``pressure_drop``,
         ``reynolds``, ``sigma``, ...).
@@ -269,7 +273,8 @@ def leakage_sweep(surface, material, *, deltas=None, pressures=None, kernel: str
     if (deltas is None) == (pressures is None):
         raise InputError("give exactly one of deltas (m) or pressures (Pa)")
     loading = Loading(deltas=deltas) if deltas is not None else Loading(pressures=pressures)
-    sweep = response(surface, material, loading, kernel=kernel, compute_stiffness=False)
+    sweep = response(surface, material, loading, kernel=kernel, compute_stiffness=False,
+                     **(contact_options or {}))
     leaks = tuple(leakage_of_contact(c, **leak_kwargs)
                   for c in progress.iterate(sweep.results, "leakage steps"))
     return LeakageSweep(contacts=tuple(sweep.results), leakages=leaks)
