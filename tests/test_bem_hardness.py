@@ -154,8 +154,6 @@ def test_hardness_inconsistent_requests_are_input_errors():
     surf = rough(16)
     with pytest.raises(ValueError, match="below the hardness"):
         solve_contact(surf, UNIT, mean_pressure=0.2, hardness=0.1)
-    with pytest.raises(ValueError, match="load control"):
-        solve_contact(surf, UNIT, delta=0.1, hardness=0.1)
     with pytest.raises(ValueError, match="'dense'"):
         solve_contact(surf, UNIT, mean_pressure=0.01, hardness=0.1, solver="dense")
     with pytest.raises(ValueError, match="needs a hardness"):
@@ -181,3 +179,47 @@ def test_sweep_with_hardness_carries_the_plastic_displacement_and_unloads():
     # hysteresis: more contact on the way down than on the way up at the same load
     assert sw.area_fraction[3] > sw.area_fraction[1]
     assert sw.area_fraction[4] > sw.area_fraction[0]
+
+
+def test_periodic_displacement_control_with_a_hardness():
+    # the box 0 <= p <= H_p makes the periodic displacement-controlled problem well posed
+    # (bounded PK on the pressure): its state at Delta is the load-controlled state at the
+    # mean pressure it returns (an independent path: load control imposes the mean)
+    surf = rough(64)
+    h = surf.heights
+    top = float(h.max() - h.mean())
+    for frac, hp in ((0.3, 0.1), (0.6, 0.3), (0.8, 10.0)):     # the last one elastic
+        d = frac * top
+        r = solve_contact(surf, UNIT, delta=d, hardness=hp)
+        assert r.delta == d and r.residual <= 1e-10
+        ref = solve_contact(surf, UNIT, mean_pressure=r.mean_pressure, hardness=hp)
+        assert ref.delta == pytest.approx(d, rel=1e-7)
+        assert np.max(np.abs(r.pressure - ref.pressure)) <= 1e-6 * hp
+        assert r.plastic_area_fraction == ref.plastic_area_fraction
+        np.testing.assert_allclose(r.plastic_displacement, ref.plastic_displacement,
+                                   atol=1e-6 * top)
+    assert r.plastic_area_fraction == 0.0
+    # beyond max h - mean h (elastic full contact) the peaks flow: the mean gap minus the
+    # mean plastic displacement is max h - mean h - Delta < 0 (mean u = 0: volume balance)
+    for d in (1.2 * top, 1.5 * top):
+        r = solve_contact(surf, UNIT, delta=d, hardness=0.1)
+        assert 0 < r.mean_pressure < 0.1 and r.plastic_area_fraction > 0.5
+        assert r.mean_gap - r.plastic_displacement.mean() == pytest.approx(top - d, rel=1e-8)
+    # Delta >= max h - min h: every point flows, p = H_p
+    r = solve_contact(surf, UNIT, delta=1.01 * float(np.ptp(h)), hardness=0.1)
+    assert r.area_fraction == 1.0 and np.all(r.pressure == 0.1)
+
+
+def test_periodic_displacement_sweep_with_hardness_unloads():
+    from roughfe.bem import contact_sweep
+    surf = rough(32)
+    top = float(surf.heights.max() - surf.heights.mean())
+    sw = contact_sweep(surf, UNIT, deltas=[0.3 * top, 0.6 * top], hardness=0.1, unload=True)
+    assert list(sw.unloading) == [0, 0, 1]
+    # back at 0.3 top the flattened peaks carry less load, and the volume they lost opens
+    # the gap: mean gap = max h - mean h - Delta + mean plastic displacement (mean u = 0;
+    # nothing flows on unloading)
+    back = sw.results[2]
+    assert sw.mean_pressure[2] < sw.mean_pressure[0] and back.plastic_area_fraction == 0
+    assert back.mean_gap == pytest.approx(top - 0.3 * top + back.plastic_displacement.mean(),
+                                          rel=1e-8)

@@ -241,6 +241,25 @@ def _periodic_full_contact(op, h):
     return _preconditioner(op)(h - h.mean())
 
 
+def _periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol, max_iter,
+                                   hardness):
+    """Periodic displacement control with a hardness (bounded PK on the pressure).
+
+    The elastic state comes first (gap-variable CG, :func:`_periodic_gap_control`, for
+    Delta below max h - mean h): if no pressure exceeds H_p it is the answer. Otherwise
+    the bounded CG starts from it clipped to [0, H_p]; the points at the cap fix the
+    mean pressure, the direction of zero curvature of the periodic operator that stalls
+    the unbounded primal CG."""
+    if initial is None and delta < hmax - float(h.mean()):
+        elastic = _periodic_gap_control(op, h - hmax, scale, delta, None, tol, max_iter)
+        if float(elastic.pressure.max()) <= hardness:
+            return elastic
+        initial = elastic.pressure
+    return polonsky_keer(op.apply, h, scale, delta=delta, initial=initial,
+                         diagonal=op.diagonal, precond=_cg_preconditioner(op), tol=tol,
+                         max_iter=max_iter, offset=-hmax, hardness=hardness)
+
+
 def _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter):
     """Displacement control on the periodic operator, in the gap variable.
 
@@ -304,7 +323,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         Approach from first contact Delta >= 0 (m). For a periodic surface Delta can not
         exceed max h - mean h (full contact; the mean displacement is zero there, see
         :mod:`roughfe.bem.operators`); at that value the smallest full-contact
-        pressure is returned.
+        pressure is returned. With a ``hardness`` any Delta >= 0 is allowed.
     mean_pressure : float, optional
         Imposed mean pressure p > 0 over the nominal area (Pa). Above the full-contact
         pressure of a periodic surface the state is full contact (A* = 1).
@@ -327,9 +346,14 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     hardness : float, optional
         Indentation hardness H_p (Pa), finite and > 0: the pressure cap of a perfectly
         plastic interface. Points at p = H_p flow: there the rigid surface
-        interpenetrates the elastic one by the plastic (permanent) displacement. With a
-        periodic surface only load control is available; the dense path is bounded
-        least squares (``solver="nnls"``, non-periodic kernels).
+        interpenetrates the elastic one by the plastic (permanent) displacement. The
+        dense path is bounded least squares (``solver="nnls"``, non-periodic kernels).
+        A periodic surface in displacement control is solved by the bounded
+        Polonsky-Keer CG on ``0 <= p <= H_p`` directly: the box makes that problem well
+        posed (the minimum of 1/2 p.Hp - p.(b + Delta) over a compact set; the mean
+        pressure, which the periodic H does not see, is fixed by the points at the
+        bounds), and Delta may exceed max h - mean h (the mean gap then becomes
+        negative: plastic flow; Delta >= max h - min h flows everywhere, p = H_p).
     plastic_displacement : ndarray, optional
         Permanent displacement (m, >= 0, grid shape) left by an earlier loading, e.g. on
         the unloading branch of a cycle: the elastic body's surface is recessed by it,
@@ -350,9 +374,6 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
     solver = _choose_solver(surface.heights.size, op, solver, hardness is not None)
-    if hardness is not None and op.periodic and delta is not None:
-        raise InputError("with a hardness, a periodic surface is solved in load control: "
-                         "give mean_pressure (Pa) instead of delta")
     h = surface.heights
     hmax = float(h.max())
     if plastic is not None:
@@ -365,8 +386,10 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
 
     out = None
     # the gap-variable CG accepts a primal residual of 10 tol (its dual reaches tol)
-    tolerance = 10 * tol if (solver == "pk" and op.periodic and delta is not None) else tol
-    if op.periodic:
+    periodic_delta = solver == "pk" and op.periodic and delta is not None
+    gap_control = periodic_delta and hardness is None
+    tolerance = 10 * tol if periodic_delta else tol
+    if op.periodic and not (hardness is not None and delta is not None):
         delta_full = hmax - float(h.mean())
         if delta is not None and delta > delta_full * (1 + 1e-12):
             raise InputError(
@@ -385,9 +408,12 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 p[p < 0] = 0.0
                 out = SolverOutput(p, h - h.mean(), delta_full, 0, 0.0, "closed form")
     if out is None:
-        if solver == "pk" and op.periodic and delta is not None:
+        if gap_control:
             out = _periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
                                         max_iter or 20000)
+        elif periodic_delta:
+            out = _periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol,
+                                                 max_iter or 20000, hardness)
         elif solver == "pk":
             own = initial is None and mean_pressure is not None and plastic is None
             if own:
