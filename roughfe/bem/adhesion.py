@@ -7,14 +7,8 @@ The rigid rough surface h and the elastic half-space (profile: half-plane in pla
 strain) interact through a potential phi(g) per unit area of the gap g >= 0,
 ``phi(0) = -w`` (w the work of adhesion, J/m^2), ``phi(inf) = 0``:
 
-* Maugis-Dugdale (``"md"``): a constant attraction sigma0 up to the range h0,
-  ``w = sigma0 h0``; ``phi = -w + sigma0 g`` for g < h0, 0 beyond (Maugis 1992). The
-  kink at h0 is smoothed by a linear ramp of the traction from sigma0 to 0 over
-  ``[h0 (1 - s/2), h0 (1 + s/2)]`` (s = ``smoothing``, default 0.05), symmetric about h0
-  so that ``int phi' dg = sigma0 h0 = w`` is kept exactly: a quasi-Newton method cannot
-  converge on a traction that jumps; the effect on the pull-off force is O(s^2).
-* exponential (``"exp"``): ``phi = -w exp(-g / rho)``, traction ``(w/rho) exp(-g/rho)``,
-  range rho, peak traction sigma0 = w/rho.
+* Maugis-Dugdale (``"md"``) and exponential (``"exp"``) laws and their cell average:
+  :mod:`roughfe.bem.interface_law` (:class:`AdhesionLaw`, re-exported here).
 
 With the gap g (m), the elastic displacement u = g - c, ``c = max h - h - Delta``, and
 the stiffness operator K = H^-1 (Pa/m) the total energy per nominal area is
@@ -65,13 +59,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive, check_instance
+from ..errors import InputError, NoConvergenceError, check_instance
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
+from .interface_law import LAWS, AdhesionLaw
 
-LAWS = ("md", "exp")
+__all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "solve_adhesive"]
 
 REFERENCES = (
     "Maugis D. (1992) J. Colloid Interface Sci. 150:243-269 (Maugis-Dugdale law)",
@@ -82,83 +77,12 @@ REFERENCES = (
 )
 
 
-@dataclass(frozen=True)
-class AdhesionLaw:
-    """Interface law of adhesion (SI).
-
-    Parameters
-    ----------
-    kind : {"md", "exp"}
-        Maugis-Dugdale or exponential (module docstring).
-    work : float
-        Work of adhesion w > 0 (J/m^2).
-    range : float
-        h0 (md) or rho (exp) > 0 (m).
-    smoothing : float
-        md only: relative width s of the traction ramp about h0, 0 <= s < 1.
-    """
-
-    kind: str
-    work: float
-    range: float
-    smoothing: float = 0.05
-
-    def __post_init__(self):
-        if self.kind not in LAWS:
-            raise InputError(f"adhesion law must be one of {LAWS}, got {self.kind!r}")
-        object.__setattr__(self, "work", check_finite_positive(
-            "work of adhesion w (J/m^2)", self.work))
-        object.__setattr__(self, "range", check_finite_positive(
-            "range of adhesion (m)", self.range))
-        s = float(self.smoothing)
-        if not 0.0 <= s < 1.0:
-            raise InputError(f"smoothing must be in [0, 1), got {self.smoothing!r}")
-
-    @property
-    def max_traction(self) -> float:
-        """sigma0 = w / range (Pa): the Dugdale stress or the peak exponential traction."""
-        return self.work / self.range
-
-    def _ramp(self):
-        half = 0.5 * self.smoothing * self.range
-        return self.range - half, self.range + half
-
-    def evaluate(self, g):
-        """``(phi(g), phi'(g))``: the potential (J/m^2; -w at contact, 0 far away) and
-        the magnitude of the attractive traction (Pa, >= 0), in one pass."""
-        g = np.asarray(g, float)
-        w, s0 = self.work, self.max_traction
-        if self.kind == "exp":
-            e = np.exp(-g / self.range)
-            return -w * e, s0 * e
-        g1, g2 = self._ramp()
-        if g2 <= g1:
-            near = g < self.range
-            return np.where(near, s0 * g - w, 0.0), np.where(near, s0, 0.0)
-        t = np.clip(g - g1, 0.0, g2 - g1)
-        phi = s0 * (np.minimum(g, g1) + t - t * t / (2 * (g2 - g1))) - w
-        return phi, s0 * (1.0 - t / (g2 - g1))
-
-    def potential(self, g):
-        """phi(g) (J/m^2), -w at contact, 0 far away."""
-        return self.evaluate(g)[0]
-
-    def traction(self, g):
-        """phi'(g) (Pa) >= 0: the magnitude of the attractive traction at gap g."""
-        return self.evaluate(g)[1]
-
-    def describe(self) -> dict:
-        """JSON-safe parameters (SI)."""
-        return {"law": self.kind, "work_of_adhesion": self.work, "range": self.range,
-                "max_traction": self.max_traction,
-                "smoothing": self.smoothing if self.kind == "md" else None}
-
-
 class _Energy:
     """Eq. (1) on one grid: value and gradient in the scaled gap variable x = g / range."""
 
     def __init__(self, op, law, c, spring, traction_scale):
         self.op, self.law, self.c = op, law, c
+        self.spread = None
         self.ell, self.s0 = law.range, traction_scale
         self.n = c.size
         if op.periodic:
@@ -199,7 +123,7 @@ class _Energy:
 
     def __call__(self, x):
         p, pbar, g, u, ku = self.pressure(x)
-        phi, traction = self.law.evaluate(g)
+        phi, traction = self.law.evaluate(g, self.spread)
         value = 0.5 * float(np.vdot(u, ku)) + float(phi.sum())
         grad = ku
         if self.op.periodic:
@@ -210,6 +134,20 @@ class _Energy:
             grad[self.phys] += traction
         # Pi*A per (S range) and the traction residual per S: both O(1) per cell
         return value / (self.s0 * self.ell), (grad / self.s0).ravel()
+
+    def cell_spread(self, x):
+        """Half-range of the gap across each cell (m), ``|grad g| dx / 2`` by central
+        differences (one-sided at a non-periodic edge): the uniform spread of a linear
+        gap over a cell in 1D, and the one with the same variance in 2D."""
+        g = self.split(x)[0]
+        grad2 = np.zeros(g.shape)
+        for axis in range(g.ndim):
+            if self.op.periodic:
+                d = 0.5 * (np.roll(g, -1, axis) - np.roll(g, 1, axis))
+            else:
+                d = np.gradient(g, axis=axis)
+            grad2 += d * d
+        return 0.5 * np.sqrt(grad2)
 
     def residual(self, x):
         """Largest projected gradient (traction residual / traction scale S)."""
@@ -258,8 +196,8 @@ def _elastic_start(surface, material, op, delta, c, energy):
 
 def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, delta,
                    kernel: str = "auto", initial=None, tol: float = 1e-5,
-                   max_iter: int = 20000, spring=None, unloading: bool = False
-                   ) -> ContactResult:
+                   max_iter: int = 20000, spring=None, unloading: bool = False,
+                   cell_average: bool = True) -> ContactResult:
     """Equilibrium of the adhesive contact at the approach ``delta`` (Eq. (1)).
 
     Parameters
@@ -286,6 +224,9 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
         Periodic only: stiffness k0 (Pa/m) of the spring imposing the mean gap.
     unloading : bool
         The branch stored in the result (``ContactResult.unloading``).
+    cell_average : bool
+        Maugis-Dugdale: evaluate the law averaged over each cell (module docstring,
+        "Cell-averaged law"); False samples it at the cell centres.
 
     Returns
     -------
@@ -326,16 +267,22 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     else:
         x0 = _elastic_start(surface, material, op, d, c, energy)
     x0 = np.maximum(x0 / law.range, energy.bounds().lb.reshape(x0.shape)).ravel()
+    averaged = bool(cell_average) and law.kind == "md"
+    if averaged:
+        energy.spread = energy.cell_spread(x0)
     nit, x = 0, x0
-    for _ in range(4):       # restarts with a fresh quasi-Newton memory (round-off stalls)
-        res = scipy.optimize.minimize(energy, x, jac=True, method="L-BFGS-B",
-                                      bounds=energy.bounds(),
-                                      options={"maxiter": int(max_iter) - nit, "maxcor": 10,
-                                               "ftol": 0.0, "gtol": tol,
-                                               "maxfun": 2 * int(max_iter)})
-        x, nit = res.x, nit + int(res.nit)
-        r = energy.residual(x)
-        if r <= tol or nit >= max_iter:
+    for _ in range(MAX_SPREAD_PASSES):
+        for _ in range(4):   # restarts with a fresh quasi-Newton memory (round-off stalls)
+            res = scipy.optimize.minimize(energy, x, jac=True, method="L-BFGS-B",
+                                          bounds=energy.bounds(),
+                                          options={"maxiter": int(max_iter) - nit,
+                                                   "maxcor": 10, "ftol": 0.0, "gtol": tol,
+                                                   "maxfun": 2 * int(max_iter)})
+            x, nit = res.x, nit + int(res.nit)
+            r = energy.residual(x)
+            if r <= tol or nit >= max_iter:
+                break
+        if not averaged or r > tol or not _update_spread(energy, x, law):
             break
     out = _adhesive_result(surface, material, op, law, energy, x, d, r, tol, nit,
                            bool(unloading))
@@ -345,6 +292,26 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
             f"{scale:.3e} Pa) after {nit} iterations ({res.message}), tolerance {tol:.1e}",
             result=out)
     return out
+
+
+#: At most this many solves with the cell spread of the previous one (cell-averaged law).
+MAX_SPREAD_PASSES = 3
+
+
+def _update_spread(energy, x, law) -> bool:
+    """Set the cell spread of the solution ``x``; True when it moved by more than 10 %
+    of the ramp half-width on a cell whose gap lies in the ramp (the solve must then be
+    repeated with it)."""
+    new = energy.cell_spread(x)
+    old = energy.spread
+    g = energy.split(x)[0]
+    floor = 0.5 * law.smoothing * law.range
+    half = np.clip(np.maximum(new, old), floor, law.range)
+    ramp = np.abs(g - law.range) <= half
+    energy.spread = new
+    if not ramp.any():
+        return False
+    return bool(np.max(np.abs(new - old)[ramp]) > 0.1 * max(float(half[ramp].min()), floor))
 
 
 def _adhesive_result(surface, material, op, law, energy, x, delta, resid, tol, nit,

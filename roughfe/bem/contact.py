@@ -26,8 +26,9 @@ from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
 from .operators import KERNELS, WORKERS, InfluenceOperator, influence_operator
+from .periodic import periodic_bounded_displacement, periodic_gap_control
 from .pk import polonsky_keer
-from .solvers import SolverOutput, dense_solve, kkt_residual
+from .solvers import SolverOutput, dense_solve
 from .stiffness import exact_stiffness
 
 SOLVERS = ("auto", "dense", "nnls", "pk")
@@ -241,66 +242,6 @@ def _periodic_full_contact(op, h):
     return _preconditioner(op)(h - h.mean())
 
 
-def _periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol, max_iter,
-                                   hardness):
-    """Periodic displacement control with a hardness (bounded PK on the pressure).
-
-    The elastic state comes first (gap-variable CG, :func:`_periodic_gap_control`, for
-    Delta below max h - mean h): if no pressure exceeds H_p it is the answer. Otherwise
-    the bounded CG starts from it clipped to [0, H_p]; the points at the cap fix the
-    mean pressure, the direction of zero curvature of the periodic operator that stalls
-    the unbounded primal CG."""
-    if initial is None and delta < hmax - float(h.mean()):
-        elastic = _periodic_gap_control(op, h - hmax, scale, delta, None, tol, max_iter)
-        if float(elastic.pressure.max()) <= hardness:
-            return elastic
-        initial = elastic.pressure
-    return polonsky_keer(op.apply, h, scale, delta=delta, initial=initial,
-                         diagonal=op.diagonal, precond=_cg_preconditioner(op), tol=tol,
-                         max_iter=max_iter, offset=-hmax, hardness=hardness)
-
-
-def _periodic_gap_control(op, b, scale, delta, initial, tol, max_iter):
-    """Displacement control on the periodic operator, in the gap variable.
-
-    With mean(u) = 0 an imposed Delta is an imposed mean gap gbar = max h - mean h -
-    Delta. The problem min 1/2 u'Ku s.t. gap w = u - s >= 0, mean(w) = gbar (K = H^-1
-    the stiffness operator, E*|q|/2, s = Delta + b) has the structure of the
-    load-controlled problem with (pressure, compliance) -> (gap, stiffness), and the
-    pressure p = K u + pbar is the multiplier (as Tamaas' PolonskyKeerRey does for an
-    imposed gap). The primal form would have to find the mean pressure through a
-    direction of zero curvature, which stalls the CG.
-    """
-    stiff = _preconditioner(op)
-    s = delta + b
-    gbar = -float(s.mean())
-    compliance = functools.partial(op.convolve_spectrum, spectrum=op.spectrum)
-    Ks = stiff(s)
-    w0 = None
-    if initial is not None and np.any(initial > 0):
-        w0 = np.maximum(op.apply(initial) - s, 0.0)
-        w0[initial > 0] = 0.0
-        if w0.mean() <= 0:
-            w0 = None
-    pscale = float(np.ptp(Ks)) or 1.0
-    o = polonsky_keer(stiff, -Ks, pscale, mean_pressure=gbar, initial=w0,
-                      diagonal=float(stiff(np.eye(1, b.size).reshape(b.shape)).flat[0]),
-                      precond=compliance, tol=tol,
-                      max_iter=max_iter)
-    w = o.pressure
-    u = w + s
-    p = np.maximum(stiff(u) - o.delta, 0.0)
-    p[w > 0] = 0.0
-    u = op.apply(p)
-    res = kkt_residual(p, u - s, scale)      # the primal residual of Eq. 2.5
-    out = SolverOutput(p, u, delta, o.nit, res, "pk")
-    if res > 10 * tol:   # the dual converged; the primal must follow closely
-        raise NoConvergenceError(f"Polonsky-Keer CG (gap variable): primal KKT residual "
-                                 f"{res:.3e} after {o.nit} iterations, tolerance {tol:.1e}",
-                                 result=out)
-    return out
-
-
 def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pressure=None,
                   kernel: str = "auto", solver: str = "auto", tol: float = 1e-10,
                   max_iter: Optional[int] = None, initial=None,
@@ -409,11 +350,12 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 out = SolverOutput(p, h - h.mean(), delta_full, 0, 0.0, "closed form")
     if out is None:
         if gap_control:
-            out = _periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
-                                        max_iter or 20000)
+            out = periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
+                                       max_iter or 20000, _preconditioner(op))
         elif periodic_delta:
-            out = _periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol,
-                                                 max_iter or 20000, hardness)
+            out = periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol,
+                                                max_iter or 20000, hardness,
+                                                _preconditioner(op), _cg_preconditioner(op))
         elif solver == "pk":
             own = initial is None and mean_pressure is not None and plastic is None
             if own:
