@@ -138,6 +138,8 @@ def test_a_channel_that_closes_is_reported_closed():
     r = coupled_channel(wavy(65), MAT, -2e-6, p_in=0.0, p_out=2e6, mu=MU)
     assert r.state == "closed" and r.leak_rate == 0.0 and r.min_gap == 0.0
     assert r.flow.closed
+    # the half-plane's contact solve put the throat in contact under the fluid load
+    assert r.contact.contact_result is not None and r.contact.contact[0]
 
 
 def test_load_control_balances_the_fluid_and_agrees_with_position_control():
@@ -206,6 +208,11 @@ def test_fem_coupling_matches_the_bem_on_a_wavy_channel(bem65):
     assert fem_l.state == "open" and fem_l.residual <= 1e-8
     assert fem_l.mean_gap == pytest.approx(bem_l.mean_gap, rel=1e-2)
     assert fem_l.leak_rate == pytest.approx(bem_l.leak_rate, rel=3e-2)    # measured 2.0 %
+    # closure: the VI puts the throat in contact (the BEM's solve_contact likewise)
+    shut = coupled_channel(wavy(65), MAT, -2e-6, p_in=0.0, p_out=2e6, mu=MU, method="fem",
+                           growth=0.2)
+    assert shut.state == "closed" and shut.leak_rate == 0.0
+    assert shut.contact.n_contact >= 1 and shut.contact.mean_pressure > 0
     # a uniform fluid pressure: the layer compliance removes the uniform shortening
     none = coupled_channel(wavy(17), MAT, -2e-6, p_in=3e6, p_out=3e6, mu=MU, method="fem",
                            growth=0.2)
