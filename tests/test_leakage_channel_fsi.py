@@ -153,6 +153,14 @@ def test_load_control_balances_the_fluid_and_agrees_with_position_control():
     assert np.allclose(same.gap, r.gap, rtol=0, atol=1e-7 * r.min_gap)
 
 
+def test_load_control_of_a_body_that_deforms_more_than_the_roughness():
+    prof = wavy(65)
+    soft = Material(E=5e6, nu=0.3)
+    r = coupled_channel(prof, soft, external_pressure=1.8e6, p_in=0.0, p_out=2e6, mu=MU)
+    assert r.state == "open" and r.mean_fluid_pressure == pytest.approx(1.8e6, rel=1e-12)
+    assert np.ptp(r.displacement) > 5 * np.ptp(prof.heights)      # measured 11x
+
+
 def test_load_control_without_flow_has_no_open_balance():
     # a uniform fluid pressure p_f carries p_ext = p_f at any gap: more needs contact,
     # less lifts the body off

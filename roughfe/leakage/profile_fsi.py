@@ -201,7 +201,6 @@ class MirroredHalfPlane:
 
         self.profile, self.material = profile, material
         self.mirror = mirrored_profile(profile)
-        self.n = profile.heights.size
 
     def close(self):
         """Nothing to free (the operators are cached by :mod:`roughfe.bem.contact`)."""
@@ -211,8 +210,8 @@ class MirroredHalfPlane:
 
     def solve(self, pressure, approach: float):
         """Contact of the half-plane under the fluid ``pressure`` (Pa, nodal) at the
-        approach ``approach`` (m); a :class:`~roughfe.model.ContactResult` of the mirrored
-        profile (its first ``n`` samples are the channel's)."""
+        approach ``approach`` (m): a :class:`HalfPlaneState` of the mirrored profile (its
+        first ``n`` samples are the channel's)."""
         from ..bem import solve_contact
         from ..bem.contact import surface_displacement
 
@@ -316,15 +315,19 @@ def coupled_channel(profile: Surface, material: Material, approach: Optional[flo
         body = FluidLoadedBody(pmesh, material, fem_options)
     flow_args = {"p_in": p_in, "p_out": p_out, "mu": mu}
     # the body is solved at the imposed approach, or (load control: the contact is inactive
-    # before closure, so the shape of the gap does not depend on it) with a clearance of the
-    # height range below the last balanced approach
-    clearance = 0.0 if p_ext is None else float(np.ptp(profile.heights)) or 1e-6
-    last = {"approach": 0.0 if approach is None else float(approach)}
+    # before closure, so the shape of the gap does not depend on it) with a clearance below
+    # the last balanced approach: the height range, doubled while the body still touches
+    last = {"approach": 0.0 if approach is None else float(approach),
+            "clearance": 0.0 if p_ext is None else float(np.ptp(profile.heights)) or 1e-6}
 
     def G(x):
-        trial = last["approach"] - clearance
-        c = body.solve(x, trial)
-        contact = np.asarray(c.contact[:n])
+        for _ in range(30):
+            trial = last["approach"] - last["clearance"]
+            c = body.solve(x, trial)
+            contact = np.asarray(c.contact[:n])
+            if p_ext is None or not contact.any():
+                break
+            last["clearance"] *= 2.0
         gap = np.where(contact, 0.0, np.maximum(c.gap[:n], 0.0))
         if p_ext is not None and not contact.any():
             shape = np.asarray(c.gap[:n]) + trial
