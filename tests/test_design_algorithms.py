@@ -1,7 +1,9 @@
 """Design algorithms (Algs. 3-7) on a reduced database: exact recovery of a database
 genome, stage monotonicity, reproducibility of every reported score by an independent
 BEM run of the saved design, and bad input (GCMMA on an analytic problem: tests/test_optim_gcmma.py)."""
+import importlib.util
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -166,27 +168,17 @@ def test_mcco_wider_pool_crosses_every_ordered_pair_and_weight(entries, targets)
         de.mcco(entries, t1, t3, SETTINGS, options=FAST, weights=(0.0,))
 
 
-def _strict_scores_by_hand(design, targets):
-    """Independent of design.rescore_at_target_pressures: bem.contact_sweep directly, A as
-    the contact-node count, K by central differences written out, Eq. (4.1) written out."""
-    from roughfe.bem import contact_sweep
-    from roughfe.model import Material
-
-    surf = design.surface()
-    mat = Material(SETTINGS.youngs_modulus, SETTINGS.poisson)
-    top = contact_sweep(surf, mat, deltas=(float(np.ptp(surf.heights)),), compute_stiffness=False)
-    eta = targets[0].p_max / top.results[-1].mean_pressure
-    p_t = targets[0].pressure
-    sw = contact_sweep(surf, mat, pressures=tuple(p_t / eta), compute_stiffness=False)
-    p = np.array([r.mean_pressure for r in sw.results]) * eta
-    dl = np.array([r.delta for r in sw.results])
-    k = np.empty_like(p)
-    k[1:-1] = (p[2:] - p[:-2]) / (dl[2:] - dl[:-2])
-    k[0], k[-1] = (p[1] - p[0]) / (dl[1] - dl[0]), (p[-1] - p[-2]) / (dl[-1] - dl[-2])
-    a = np.array([np.count_nonzero(r.contact) for r in sw.results]) / surf.heights.size
-    np.testing.assert_allclose(p, p_t, rtol=1e-6)
-    return [1.0 - np.max(np.abs((t.values - (k if t.quantity == "K" else a)) / t.values))
-            for t in targets]
+def _strict_scores_by_hand(design, targets, tmp_path):
+    """Independent of design.rescore_at_target_pressures: the validation's check
+    (validation/design_study.py: design.json reloaded, bem.contact_sweep directly, A as
+    the contact-node count, K by central differences and Eq. 4.1 written out)."""
+    path = tmp_path / "by_hand_design.json"
+    path.write_text(json.dumps(design.to_dict()))
+    spec = importlib.util.spec_from_file_location(
+        "design_study", Path(__file__).resolve().parents[1] / "validation" / "design_study.py")
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    return study.strict_scores_from_file(path, targets, SETTINGS)
 
 
 def test_search_at_target_pressures_raises_the_strict_score_reproducibly(entries, targets,
@@ -205,8 +197,36 @@ def test_search_at_target_pressures_raises_the_strict_score_reproducibly(entries
     paths = de.write_design_result(rs, SETTINGS, tmp_path)
     saved = json.loads(paths["result"].read_text())["candidates"][0]
     d = de.Design.from_dict(json.loads(paths["design"].read_text()))
-    np.testing.assert_allclose(_strict_scores_by_hand(d, [t1, t3]),
+    np.testing.assert_allclose(_strict_scores_by_hand(d, [t1, t3], tmp_path),
                                saved["scores_at_target_pressures"], atol=1e-7)
     np.testing.assert_allclose(de.rescore(d, [t1, t3], SETTINGS), c.scores, atol=1e-7)
     with pytest.raises(InputError, match="n_eval"):
         de.search_at_target_pressures(r, SETTINGS, n_eval=0)
+    with pytest.raises(InputError, match="starts"):
+        de.search_at_target_pressures(r, SETTINGS, starts=0)
+
+
+def test_multi_start_and_chromosome_amplitudes(entries, targets, tmp_path):
+    """split_chromosomes realises the same heights; a 2-start search contains the 1-start
+    run (the same generator, drawn on in order), so its best strict f is not lower; with
+    chromosome amplitudes every chromosome is its own part and the strict scores of the
+    saved design are reproduced by an independent load-controlled BEM run."""
+    t1, _, t3, _ = targets
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    d = r.best.design
+    split = d.split_chromosomes()
+    assert len(split.parts) == sum(len(p.chromosomes) for p in d.parts) > len(d.parts)
+    np.testing.assert_allclose(split.surface().heights, d.surface().heights, rtol=0,
+                               atol=1e-12 * np.ptp(d.surface().heights))
+    one = de.search_at_target_pressures(r, SETTINGS, n_eval=15, seed=4)
+    two = de.search_at_target_pressures(r, SETTINGS, n_eval=15, seed=4, starts=2)
+    f1, f2 = (de.combined_score(x.best.at_targets) for x in (one, two))
+    assert f2 >= f1 and two.nit - one.nit == 15                  # one more run of 15 sweeps
+    amp = de.search_at_target_pressures(r, SETTINGS, n_eval=15, seed=4, amplitudes=True)
+    c = amp.best
+    assert amp.success and "chromosome weights" in amp.message
+    if de.combined_score(c.at_targets) > de.combined_score(
+            de.rescore_at_target_pressures(d, [t1, t3], SETTINGS)):
+        assert len(c.design.parts) == len(split.parts)
+    np.testing.assert_allclose(_strict_scores_by_hand(c.design, [t1, t3], tmp_path), c.at_targets,
+                               atol=1e-7)

@@ -75,4 +75,7 @@ def test_design_command_reports_bad_input(tmp_path, capsys):
                  "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "no genomes" in err or ">= 0" in err
+    assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",
+                 "--search", "5", "--search-starts", "0", "-o", str(tmp_path / "o")]) == 2
+    assert "--search-starts" in capsys.readouterr().err
     np.testing.assert_equal((tmp_path / "o").exists(), False)

@@ -53,7 +53,9 @@ def _run(args) -> int:
         if args.refine:
             result = refine(result, settings, rounds=args.refine)
         if args.search:
-            result = search_at_target_pressures(result, settings, n_eval=args.search)
+            result = search_at_target_pressures(result, settings, n_eval=args.search,
+                                                starts=args.search_starts,
+                                                amplitudes=args.search_amplitudes)
         if not args.no_figures:
             from ..plotting.design import (plot_design_curves, plot_profiles, plot_psds,
                                            plot_stages)
@@ -138,6 +140,11 @@ def register(sub):
                    help="extra stage beyond the thesis, after --refine: a (1+1) evolution "
                         "strategy on all phases and part weights maximising the score solved "
                         "at the target pressures, SWEEPS BEM sweeps per candidate (0: off)")
+    g.add_argument("--search-starts", type=positive_int, default=1, metavar="K",
+                   help="--search: K independent runs per candidate (deterministic seeds), "
+                        "the best kept")
+    g.add_argument("--search-amplitudes", action="store_true",
+                   help="--search: every chromosome's amplitude a variable too (+-30%%)")
     p.add_argument("--pool", type=nonnegative_int, default=0, metavar="K",
                    help="mcco, beyond the thesis: start pool of the K best genomes of each "
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "

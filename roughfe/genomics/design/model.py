@@ -128,6 +128,14 @@ class Design:
             parts.append(replace(p, genome=replace(p.genome, phases=ph, **g), weight=w))
         return replace(self, parts=tuple(parts))
 
+    def split_chromosomes(self) -> "Design":
+        """The same design with one part per chromosome (weights and the overall scale
+        folded into each part's weight), so each chromosome's amplitude is a variable
+        ``(part, "weight")`` of its own; the realised heights are unchanged."""
+        parts = tuple(replace(p, chromosomes=(n,), weight=p.weight * self.scale)
+                      for p in self.parts for n in p.chromosomes)
+        return replace(self, parts=parts, scale=1.0)
+
     def rescaled(self, factor) -> "Design":
         return replace(self, scale=self.scale * float(factor))
 
