@@ -193,3 +193,28 @@ def test_beside_adds_the_theory_to_step_records(surface):
     cj = critical_junction(surface, E_STAR, steps[1]["mean_pressure"], 1e5, 1e-3)
     assert second["persson_leak_rate"] == pytest.approx(cj.leak_rate, rel=1e-12)
     assert doc["persson"]["u0"] == pytest.approx(r.u0)
+
+
+def test_beside_direction_uses_the_geometry_factor_of_that_direction():
+    # transpose symmetry: flow along y on Z is flow along x on Z.T (the radially averaged
+    # PSD is the same; only width/length along the pressure drop changes: Lx/Ly for y)
+    z = spectral_surface(64, 1e-3, 0.8, rms_height=1e-6, rng=3).heights[:, :32]
+    s = Surface(z, (1e-3, 0.5e-3), periodic=False)
+    st = Surface(z.T.copy(), (0.5e-3, 1e-3), periodic=False)
+    steps = [{"mean_pressure": 2e6}]
+    kw = dict(pressure_drop=1e5, viscosity=1e-3)
+    along_y = beside(s, E_STAR, steps, direction="y", **kw)["steps"][0]
+    along_x_t = beside(st, E_STAR, steps, direction="x", **kw)["steps"][0]
+    along_x = beside(s, E_STAR, steps, direction="x", **kw)["steps"][0]
+    assert along_y["persson_leak_rate"] > 0
+    assert along_y["persson_leak_rate"] == pytest.approx(along_x_t["persson_leak_rate"],
+                                                         rel=1e-10)
+    # same surface, the other direction: Q scales with width/length, (Lx/Ly) / (Ly/Lx) = 4
+    assert along_y["persson_leak_rate"] == pytest.approx(4 * along_x["persson_leak_rate"],
+                                                         rel=1e-12)
+    both = beside(s, E_STAR, steps, direction="both", **kw)["steps"][0]
+    assert both["persson_leak_rate_y"] == along_y["persson_leak_rate"]
+    assert both["persson_leak_rate"] == pytest.approx(
+        0.5 * (along_x["persson_leak_rate"] + along_y["persson_leak_rate"]), rel=1e-12)
+    with pytest.raises(InputError, match="direction"):
+        beside(s, E_STAR, steps, direction="z", **kw)

@@ -205,7 +205,8 @@ def _leak_run(args, surface, material, out):
         base["references"] = list(sweep.results[0].references)
         # Persson's theory at the solid's (effective) mean pressure of each coupled step
         theory = beside(surface, material.E_star, steps,
-                        pressure_drop=abs(p_in - p_out) or None, viscosity=args.mu)
+                        pressure_drop=abs(p_in - p_out) or None, viscosity=args.mu,
+                        direction=args.direction)
         steps = theory["steps"]
         written.append(write_json(out / "results.json", {"inputs": base, "steps": steps,
                                                           "persson": theory["persson"]}))
@@ -217,7 +218,7 @@ def _leak_run(args, surface, material, out):
     check_small_strain(args, surface, [c.delta for c in sweep.contacts], material,
                        [c.mean_pressure for c in sweep.contacts])
     theory = beside(surface, material.E_star, sweep.records(), pressure_drop=dp,
-                    viscosity=args.mu)
+                    viscosity=args.mu, direction=args.direction)
     steps = theory["steps"]
     inputs = {**base, "reynolds": not args.no_reynolds,
               "references": list(sweep.leakages[0].references)}

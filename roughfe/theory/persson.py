@@ -347,15 +347,19 @@ class CriticalJunction:
     references: tuple = REFERENCES
 
 
-def _geometry_factor(source) -> float:
-    """Ly/Lx of a surface (flow along x = axis 0); 1 for a bare PSD."""
+def _geometry_factor(source, direction: str = "x") -> float:
+    """Width over length along the pressure drop of a surface: ``Ly/Lx`` for flow along x
+    (axis 0), ``Lx/Ly`` along y; 1 for a bare PSD."""
+    if direction not in ("x", "y"):
+        raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
     if isinstance(source, Surface) and source.ndim == 2:
-        return source.size[1] / source.size[0]
+        lx, ly = source.size
+        return ly / lx if direction == "x" else lx / ly
     return 1.0
 
 
 def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *,
-                      geometry_factor=None, threshold=PERCOLATION_THRESHOLD,
+                      direction="x", geometry_factor=None, threshold=PERCOLATION_THRESHOLD,
                       gamma=GAMMA_DEFAULT) -> CriticalJunction:
     """Critical-junction leak rate of Lorenz & Persson (2009), Eqs. (4)-(5).
 
@@ -371,9 +375,11 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
         Fluid pressure drop Delta P > 0 across the seal (Pa).
     viscosity : float
         Dynamic viscosity eta > 0 (Pa s).
+    direction : {"x", "y"}
+        Axis of the pressure drop (x = axis 0); sets the default geometry factor.
     geometry_factor : float, optional
-        Ly/Lx, width over length along the pressure drop; default from the surface size
-        (flow along x = axis 0: ``size[1] / size[0]``), 1 for a bare PSD.
+        Width over length along the pressure drop; default from the surface size
+        (``Ly/Lx`` along x, ``Lx/Ly`` along y), 1 for a bare PSD.
     threshold : float
         Percolation threshold A_c of the contact area, default 0.42.
     gamma : float
@@ -388,7 +394,7 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
         raise InputError("critical_junction needs a surface (2D): on a profile any contact "
                          "point seals the flow")
     if geometry_factor is None:
-        geometry_factor = _geometry_factor(source)
+        geometry_factor = _geometry_factor(source, direction)
     geometry_factor = check_finite_positive("geometry_factor Ly/Lx", geometry_factor)
     threshold = check_in_open_interval("threshold A_c", threshold, 0.0, 1.0)
     dp = check_finite_positive("pressure_drop (Pa)", pressure_drop)
@@ -421,7 +427,7 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
                             leak_rate=leak, sealed=False, **common)
 
 
-def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None,
+def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, direction="x",
            gamma=GAMMA_DEFAULT) -> dict:
     """Persson's theory at the mean pressure of each simulation step (results.json).
 
@@ -434,6 +440,10 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None,
         Step records with ``mean_pressure`` (Pa).
     pressure_drop, viscosity : float, optional
         Delta P (Pa) and eta (Pa s): add the critical-junction leak rate (surfaces).
+    direction : {"x", "y", "both"}
+        Flow direction(s) of the leak rate: the geometry factor (width over length along
+        the pressure drop) of each; ``"both"`` reports both and their mean (as the
+        simulated ``leak_rate`` of ``roughfe leak --direction both``).
     gamma : float
         As in :func:`persson`.
 
@@ -441,12 +451,16 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None,
     -------
     dict
         ``"steps"``: copies of ``steps`` with ``persson_area_fraction`` (-),
-        ``persson_mean_gap`` (m) and, with ``pressure_drop``, ``persson_leak_rate``
-        (m^3/s) added; steps with no positive finite pressure get None (no theory at zero
+        ``persson_mean_gap`` (m) and, with ``pressure_drop``, ``persson_leak_rate_<d>``
+        per direction and ``persson_leak_rate`` (their mean; m^3/s) added; steps with no positive finite pressure get None (no theory at zero
         load). ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
         percolation threshold, units, references).
     """
     psd = _spectrum(source)
+    if direction not in ("x", "y", "both"):
+        raise InputError(f"direction must be 'x', 'y' or 'both', got {direction!r}")
+    dirs = ("x", "y") if direction == "both" else (direction,)
+    factors = {d: _geometry_factor(source, d) for d in dirs}
     pressures = [s.get("mean_pressure") for s in steps]
     ok = [p is not None and np.isfinite(p) and p > 0 for p in pressures]
     theory = persson(psd, e_star, [p for p, k in zip(pressures, ok) if k] or [1.0],
@@ -457,9 +471,14 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None,
         rec["persson_area_fraction"] = float(theory.area_fraction[j]) if k else None
         rec["persson_mean_gap"] = float(theory.mean_gap[j]) if k else None
         if pressure_drop is not None:
-            rec["persson_leak_rate"] = (critical_junction(
-                psd, e_star, float(p), pressure_drop, viscosity, gamma=gamma,
-                geometry_factor=_geometry_factor(source)).leak_rate if k else None)
+            # Q is linear in the geometry factor: one junction per step, scaled per direction
+            unit = (critical_junction(psd, e_star, float(p), pressure_drop, viscosity,
+                                      gamma=gamma, geometry_factor=1.0).leak_rate
+                    if k else None)
+            for d, f in factors.items():
+                rec[f"persson_leak_rate_{d}"] = None if unit is None else unit * f
+            rec["persson_leak_rate"] = (None if unit is None else
+                                        float(np.mean([unit * f for f in factors.values()])))
         j += k
         out.append(rec)
     info = {"gamma": theory.gamma, "kappa": theory.kappa, "rms_gradient": theory.rms_gradient,
