@@ -75,7 +75,10 @@ def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
 
 FSI_KEYS = {"fluid_load_fraction", "coupled_iterations", "critical_gap", "critical_position",
             "leak_rate_critical_junction", "pocket_pressures", "trapped_volume", "persson_leak_rate",
-            "trapped_load_fraction", "leak_rate_one_way", "fsi_state", "external_pressure"}
+            "trapped_load_fraction", "leak_rate_one_way", "fsi_state", "external_pressure",
+            "contact_load_fraction", "pocket_volumes", "pockets_new", "pockets_released",
+            "pockets_merged", "pocket_passes", "pockets_settled", "trapped_fluid",
+            "bulk_modulus"}
 
 
 def test_leak_fsi_writes_coupled_steps(tmp_path, capsys):
@@ -102,7 +105,9 @@ def test_leak_fsi_writes_coupled_steps(tmp_path, capsys):
         assert f["fluid_pressure"].shape == s.shape and f["fluid_pressure"].max() <= 1e6 * (1 + 1e-9)
     # bad input: one line each, exit code 2
     bad = [["--delta", "1e-7"], ["--direction", "both"], ["--inlet-pressure", "1e6"],
-           ["--pressure-drop", "1", "--inlet-pressure", "1", "--outlet-pressure", "0"]]
+           ["--pressure-drop", "1", "--inlet-pressure", "1", "--outlet-pressure", "0"],
+           ["--trapped-fluid", "pressure", "--bulk-modulus", "2.2e9"],
+           ["--bulk-modulus", "-1"]]
     base = ["leak", str(path), "--fsi", "--no-figures", "--quiet", "--overwrite", "-o", str(out)]
     for extra in bad:
         args = list(base) + extra
@@ -116,6 +121,9 @@ def test_leak_fsi_writes_coupled_steps(tmp_path, capsys):
                  "--outlet-pressure", "1e6", "--no-figures", "--quiet", "--overwrite",
                  "-o", str(out)]) == 2
     assert "reversed flow" in capsys.readouterr().err
+    assert main(["leak", str(path), "--pressure", "1e6", "--bulk-modulus", "2.2e9",
+                 "--no-figures", "--quiet", "--overwrite", "-o", str(out)]) == 2
+    assert "--bulk-modulus needs --fsi" in capsys.readouterr().err
 
 
 def test_leak_takes_the_contact_physics_options(tmp_path, capsys):

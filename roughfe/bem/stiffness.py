@@ -74,3 +74,57 @@ def contact_set_pressure_rate(result: ContactResult) -> np.ndarray:
         raise InputError(f"no finite pressure rate with {int(c.sum())} of {c.size} points in "
                          f"contact")
     return pressure_rate(op, result.solver, c)[0]
+
+
+def load_controlled_gap_response(result: ContactResult, tractions, *,
+                                 released=None) -> np.ndarray:
+    """Gap change (m per Pa) under known normal tractions, contact set held fixed, mean
+    pressure held fixed (load control): the compliance of trapped-fluid pockets.
+
+    For each traction pattern ``t`` (Pa per unit amplitude) acting on the body with the
+    contact pressure of ``result``: the contact pressure changes by ``dp`` on the contact
+    set c and the approach by ``dD`` so that the gap stays 0 on c and the TOTAL load
+    (contact + ``t``) is unchanged (``sum dp = -sum t``, thesis Eq. 2.5 with Eq. 2.6):
+    ``dp = -a + dD b`` with ``H_cc a = (H t)_c`` and ``H_cc b = 1`` (:func:`pressure_rate`),
+    ``dD = (sum a - sum t) / sum b``; the gap change is ``H (dp + t) - dD`` off c, 0 on c.
+    By reciprocity (Maxwell-Betti) ``<s, dg(t)> = <t, dg(s)>``: the pocket compliance
+    matrix built from it is symmetric (tested).
+
+    Parameters
+    ----------
+    result : ContactResult
+        Elastic BEM solution (its kernel and contact set).
+    tractions : sequence of ndarray
+        Traction patterns with the surface's shape (Pa).
+    released : ndarray of bool, optional
+        Points taken out of the contact set (e.g. those under a fluid pressure that
+        will open them).
+
+    Returns
+    -------
+    ndarray, shape (len(tractions),) + shape
+        ``dg`` per pattern (m per unit amplitude).
+    """
+    from .contact import _cg_preconditioner, _operator
+
+    if result.kernel is None or result.plastic_area_fraction:
+        raise InputError("load_controlled_gap_response needs an elastic BEM result")
+    c = np.asarray(result.contact, bool)
+    if released is not None:
+        c = c & ~np.asarray(released, bool)
+    op = _operator(c.shape, tuple(result.size), result.e_star, result.kernel)
+    if not c.any() or (op.periodic and c.all()):
+        raise InputError(f"no fixed-set response with {int(c.sum())} of {c.size} points in "
+                         f"contact")
+    b = pressure_rate(op, result.solver, c)[0]
+    precond = _cg_preconditioner(op)
+    out = []
+    for t in tractions:
+        t = np.asarray(t, dtype=float).reshape(c.shape)
+        ht = np.asarray(op.apply(t)).reshape(c.shape)
+        a, _ = restricted_cg(op.apply, c, ht, precond=precond, tol=1e-10)
+        dD = (a.sum() - t.sum()) / b.sum()
+        dp = np.where(c, dD * b - a, 0.0)
+        dg = np.asarray(op.apply(dp + t)).reshape(c.shape) - dD
+        out.append(np.where(c, 0.0, dg))
+    return np.array(out).reshape((len(out),) + c.shape)

@@ -53,10 +53,16 @@ def _add_coupling_options(p):
                          "--pressure-drop; PI < PO reverses the flow with --fsi)")
     fs.add_argument("--outlet-pressure", type=float, default=None, metavar="PO",
                     help="absolute outlet pressure in Pa")
-    fs.add_argument("--trapped-fluid", choices=("film", "pressure"), default="film",
-                    help="trapped pockets: 'film' take the pressure of their surroundings "
-                         "(drained), 'pressure' keep their pressure at closure (the volume "
-                         "model is not implemented)")
+    fs.add_argument("--trapped-fluid", choices=("volume", "pressure", "film"),
+                    default="volume",
+                    help="pockets sealed by contact: 'volume' keep their liquid (pressure an "
+                         "unknown carrying load; incompressible unless --bulk-modulus), "
+                         "'pressure' keep their pressure at closure, 'film' are drained "
+                         "(pressure of their surroundings)")
+    fs.add_argument("--bulk-modulus", type=positive_float, default=None, metavar="K",
+                    help="bulk modulus of the liquid in Pa for --trapped-fluid volume "
+                         "(p = p_closure + K ln(V_closure/V); water 2.2e9); default: "
+                         "incompressible")
 
 
 def _fluid_pressures(args):
@@ -103,12 +109,14 @@ def _leak(args) -> int:
     with output_folder_of(args, "leak") as out:
         sweep, steps, written = _leak_run(args, surface, material, out)
     if args.fsi:
-        print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>7} {'fluid':>6} {'iter':>5} "
+        print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>7} {'fluid':>6} {'trap':>6} "
+              f"{'iter':>5} "
               f"{'Q (m^3/s)':>11} {'Q one-way':>11} {'u_c (m)':>10}")
         for s in steps:
             fmt = lambda v, f: "-" if v is None else format(v, f)  # noqa: E731
             print(f"{s['step']:>4} {s['external_pressure']:>11.4g} {s['fsi_state']:>8} "
                   f"{fmt(s.get('area_fraction'), '.4f'):>7} {s['fluid_load_fraction']:>6.3f} "
+                  f"{s['trapped_load_fraction']:>6.3f} "
                   f"{s['coupled_iterations']:>5} {fmt(s['leak_rate'], '.4e'):>11} "
                   f"{fmt(s['leak_rate_one_way'], '.4e'):>11} "
                   f"{fmt(s.get('critical_gap'), '.3e'):>10}")
@@ -138,13 +146,18 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
         raise InputError("--fsi solves one flow direction: give --direction x or --direction y")
     if args.no_reynolds:
         raise InputError("--fsi needs the Reynolds solve; drop --no-reynolds")
+    if args.bulk_modulus is not None and args.trapped_fluid != "volume":
+        raise InputError(f"--bulk-modulus belongs to --trapped-fluid volume, not "
+                         f"{args.trapped_fluid!r}")
     sweep = coupled_leakage_sweep(surface, material, args.pressure, direction=args.direction,
                                   p_in=p_in, p_out=p_out, mu=args.mu,
-                                  trapped=args.trapped_fluid)
+                                  trapped=args.trapped_fluid,
+                                  bulk_modulus=(np.inf if args.bulk_modulus is None
+                                                else args.bulk_modulus))
     steps = sweep.records()
     written = []
     for k, (r, lk) in enumerate(zip(sweep.results, sweep.leakages)):
-        arrays = {"fluid_pressure": r.fluid_pressure}
+        arrays = {"fluid_pressure": r.fluid_pressure, "pockets": r.fluid_state.pockets.labels}
         if r.contact is not None:
             arrays.update(gap=r.contact.gap, contact=r.contact.contact,
                           pressure_contact=r.contact.pressure, flux=r.flow.flux,
@@ -186,12 +199,15 @@ def _leak_run(args, surface, material, out):
 
     p_in, p_out = _fluid_pressures(args)
     physics = contact_physics_from_args(args)
+    if args.bulk_modulus is not None and not args.fsi:
+        raise InputError("--bulk-modulus needs --fsi (trapped fluid of the coupled solve)")
     base = {"surface": str(args.surface), "shape": list(surface.shape),
             "size": list(surface.size), "periodic": surface.periodic,
             "surface_metadata": dict(surface.metadata), "E": args.E, "nu": args.nu,
             "mu": args.mu, "inlet_pressure": p_in, "outlet_pressure": p_out,
             "pressure_drop": p_in - p_out, "direction": args.direction, "fsi": args.fsi,
-            "trapped_fluid": args.trapped_fluid, "delta": args.delta,
+            "trapped_fluid": args.trapped_fluid, "bulk_modulus": args.bulk_modulus,
+            "delta": args.delta,
             "pressure": args.pressure, "detrend": args.detrend,
             "hardness": physics["hardness"], "unload": physics["unload"],
             "adhesion": physics["adhesion"] and physics["adhesion"].describe(),

@@ -20,27 +20,20 @@ displacement ``u = H (p_c + p_f)``, and
 * the fluid pressure is the Reynolds solution (Eq. 2.12, cell-centred finite volumes,
   :mod:`roughfe.leakage.finite_volume`) on the gap regularised by a film of
   ``h_reg`` (default ``1e-3`` times the rms height) in the contact cells, and the
-  trapped-pocket pressure (below) in the pockets. The regularised film conducts
-  ``(h_reg/h)^3 ~ 1e-9`` of a typical open cell: it leaves the open-film pressure
-  unchanged to that order, defines the pressure inside contact spots as the limit of the
-  surrounding film's, and makes the fluid load a continuous function of the gap (with
-  the fluid acting on open cells only, or with an extension of the open-cell pressure
-  into the spots, cells that open and close jump the load by up to half of ``p_in`` and
-  the fixed point cycles: measured on 32^2 and 64^2 surfaces). The leak rate is the
-  unregularised FV solve on the final gap.
+  trapped-pocket pressure (below) in the pockets. The film conducts ``(h_reg/h)^3 ~ 1e-9``
+  of an open cell: it leaves the open-film pressure unchanged to that order, defines the
+  pressure inside contact spots as the limit of the surrounding film's (with the fluid on
+  open cells only the exactness below fails: 0.5 % gap error, measured), and keeps the
+  fluid load continuous in the gap (else cells that open and close jump the load by up to
+  ``p_in/2`` and the fixed point cycles, measured). The leak rate is the unregularised
+  FV solve on the final gap.
 
-Why the pressure acts under contact spots: with the fluid pressure on the open cells
-only and the solid stress ``>= 0`` on contact cells, a contact spot may carry less than
-the fluid around it (which would invade it), and the uniform-pressure exactness below
-fails (measured: 0.5 % gap error, different contact sets).
-
-The unknown is the fluid-pressure field ``x`` (Pa, one value per cell); one evaluation
-``G(x)`` is a contact solve plus a Reynolds solve. The fixed point ``x = G(x)`` is found
-with Anderson acceleration (type II, memory ``anderson``; Walker & Ni 2011), starting
-from the one-way solution (``x = 0``: dry contact at ``p_ext``, then Reynolds); the
-coupled residual is ``||G(x) - x|| / ||G(x)||`` (2-norms), required ``<= tol`` (default
-1e-8). An extrapolated iterate that would lift the body off is replaced by the plain
-iterate (memory cleared).
+The unknown is the fluid-pressure field ``x`` (Pa per cell); ``G(x)`` is a contact solve
+plus a Reynolds solve. ``x = G(x)`` is solved by Anderson acceleration
+(:func:`roughfe.optim.anderson.anderson_fixed_point`) from the previous step's fluid
+pressure (else 0) to ``||G(x) - x|| / ||G(x)|| <= tol`` (default 1e-8); an extrapolated
+iterate that would lift the body off is replaced by the plain iterate. The one-way
+leak rate is that of the dry contact at ``p_ext``.
 
 Exactness. On a periodic surface with ``p_in = p_out = p_f`` (no flow) the coupled
 contact is the dry contact at ``p_ext - p_f``, point by point, with the solid contact
@@ -55,30 +48,32 @@ naming the residual reached.
 
 Trapped fluid
 -------------
-Pockets are open cells whose face-connected component reaches neither inlet nor outlet
-(cells open by less than ``h_reg`` count as closed here).
+Pockets (:mod:`roughfe.leakage.pockets`): wet components (gap > ``h_reg``) reaching
+neither inlet nor outlet. ``trapped`` selects their law:
 
-* ``trapped="film"`` (default): a pocket's pressure is the regularised film's, the limit
-  of its surroundings (a drained pocket); the fluid load is then a continuous function of
-  the gap and the fixed point converges robustly (load sweeps on 32^2-64^2 surfaces in
-  5-17 iterations).
-Their fluid was trapped when they closed; the **reference state** (``history``) holds the
-per-cell fluid pressure and fluid volume of the previous load step (for the first step:
-the first-contact state, gap ``max h - h``, with its Reynolds pressure). Per pocket:
+* ``"volume"`` (default): a sealed pocket keeps its fluid: incompressible
+  (``bulk_modulus=inf``, its volume is kept) or a liquid of bulk modulus ``K``
+  (``P = P_c + K ln(V_c/V)``). The default because a pocket sealed by contact holds a
+  fixed mass of liquid, and a liquid's volume hardly changes under the pressures of a
+  contact (water: K = 2.2 GPa); keeping the pressure at closure instead lets the pocket be
+  crushed at constant pressure, which only a gas near K -> 0 does.
+* ``"pressure"``: the pocket keeps its pressure at closure (the ``K -> 0`` limit of an
+  open pocket; a pocket squeezed shut keeps no fluid here, with any ``K > 0`` its
+  pressure rises to the solid contact pressure that opens it).
+* ``"film"`` (extra, not in the issue): drained pockets, the regularised film's pressure
+  (a leaky seal; also the state in which a pocket closes).
 
-* ``trapped="pressure"``: the pocket keeps its pressure at closure: the volume-weighted
-  mean over its cells of the incoming iterate's fluid pressure (the reference state's at
-  the first evaluation). The coupled iteration is then a pseudo-time loading path from
-  the one-way state: a pocket that closes during the iteration keeps the pressure it had
-  when it closed, and the fluid pressure stays a continuous function of the iterate
-  (with the previous step's pressure instead, a closing pocket jumps between two
-  pressures and the fixed point cycles: measured on a 64^2 surface);
-* ``trapped="volume"`` (the pocket keeps its fluid mass, incompressible or with a bulk
-  modulus) is NOT implemented: a first version (pocket pressure as an unknown updated with
-  the compliance of a pressurised penny, Anderson-accelerated) diverged on a 32^2 load
-  sweep (residual 1.6 after 60 iterations), see docs/theory/leakage.md.
+Pocket pressures are unknowns (one per pocket): for ``"volume"`` each evaluation of
+``G`` ends with a Newton step on them with the BEM pocket compliance
+(:class:`roughfe.leakage.pockets.PocketNewton`); Anderson then treats pockets and film
+alike, and at its fixed point the pocket volumes are exact.
 
-Per step: trapped volume, pocket pressures, the load carried by trapped fluid.
+The pocket cells are frozen during one fixed-point solve (a pass) so that ``G`` is a
+continuous map; after the pass the pockets of the coupled gap are found again
+(:func:`roughfe.leakage.pockets.transfer`: merge, split, reopening, new pockets closing
+at this load), and the pass is repeated with them until the cells no longer change
+(``max_passes``; ``pockets_settled`` reports it). Why round 2's first ``"pressure"``
+model stalled in load sweeps: docs/theory/04b_leakage_ii.md.
 """
 from __future__ import annotations
 
@@ -91,9 +86,9 @@ from ..errors import InputError, NoConvergenceError, check_finite_positive
 from ..optim.anderson import RejectedIterate, anderson_fixed_point, check_options
 from ..surfaces import Surface
 from .channel import check_absolute_pressures
-from .finite_volume import FVSolution, components_reaching, solve_reynolds_fv
+from .finite_volume import FVSolution, solve_reynolds_fv
+from .pockets import SEALED, TRAPPED_MODELS, PocketNewton, Pockets, transfer
 
-TRAPPED_MODELS = ("film", "pressure")
 REFERENCES = (
     "Anderson acceleration: Walker & Ni, SIAM J. Numer. Anal. 49 (2011) 1715",
     "Critical junction: Lorenz & Persson, EPL 86 (2009) 44006",
@@ -103,10 +98,18 @@ REFERENCES = (
 
 @dataclass(frozen=True, eq=False)
 class FluidState:
-    """Per-cell fluid pressure (Pa) of a load step: the reference of the trapped-fluid
-    model for the next step."""
+    """Fluid state at the end of a load step: the reference of the next step.
+
+    Attributes
+    ----------
+    pressure : ndarray
+        Fluid pressure per cell (Pa).
+    pockets : Pockets
+        Sealed pockets and their fluid (:class:`roughfe.leakage.pockets.Pockets`).
+    """
 
     pressure: np.ndarray
+    pockets: Pockets
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,35 +121,44 @@ class CoupledResult:
     state : {"contact", "lift-off"}
     contact : roughfe.model.ContactResult or None
         The final contact solve (of the shifted heights): its ``gap`` and ``contact`` are
-        the coupled ones, its ``pressure`` the *solid* contact pressure ``p_c`` on top of the fluid pressure (Pa). None
-        at lift-off.
+        the coupled ones, its ``pressure`` the *solid* contact pressure ``p_c`` on top of
+        the fluid pressure (Pa). None at lift-off.
     flow : FVSolution or None
         Reynolds solution on the coupled gap (absolute pressures).
     fluid_pressure : ndarray
-        Fluid pressure per cell (Pa): Reynolds pressure, pocket pressures and the
-        harmonic extension into the contact spots.
+        Fluid pressure per cell (Pa): film Reynolds pressure and the pocket pressures.
     external_pressure, inlet_pressure, outlet_pressure, mu : float
         ``p_ext``, ``p_in``, ``p_out`` (Pa), viscosity (Pa s).
+    trapped, bulk_modulus : str, float
+        Trapped-fluid model and the liquid's bulk modulus (Pa; inf: incompressible).
     leak_rate : float or None
         Coupled leak rate (m^3/s; negative for ``p_in < p_out``: reversed flow).
     one_way_leak_rate : float or None
         Leak rate of the one-way solution (dry contact at ``p_ext``).
     fluid_load_fraction : float
-        ``mean(p_f) / p_ext``: share of the external load carried by the fluid pressure
-        (over the nominal area; the solid carries ``mean(p_c) / p_ext``, the rest).
+        ``mean(p_f) / p_ext``: share of the external load carried by the fluid (flowing
+        and trapped) over the nominal area.
+    contact_load_fraction : float
+        ``mean(p_c) / p_ext``: the solid's share (``contact + fluid = 1`` to the coupled
+        residual).
     trapped_load_fraction : float
-        Share carried by the trapped pockets.
+        Share carried by the pockets (part of ``fluid_load_fraction``).
     trapped_volume : float
         Fluid volume in the pockets (m^3).
-    pocket_pressures : tuple of float
-        Pressure of each pocket (Pa), largest pocket first.
+    pocket_pressures, pocket_volumes : tuple of float
+        Pressure (Pa) and fluid volume (m^3) of each pocket, largest pocket first.
+    pockets_new, pockets_released, pockets_merged, pocket_passes : int
+        Pockets closed in this step, reopened to inlet/outlet, merges; fixed-point solves
+        with frozen pocket cells.
+    pockets_settled : bool
+        The pocket cells of the last pass are those of its solution.
     coupled_iterations : int
-        Evaluations of ``G`` after the one-way solve.
+        Evaluations of ``G`` after the one-way solve (all passes).
     residual : float
         Final relative coupled residual.
     residual_history : tuple of float
     fluid_state : FluidState
-        Reference for the next load step's trapped-fluid model.
+        Reference for the next load step.
     """
 
     state: str
@@ -157,12 +169,21 @@ class CoupledResult:
     inlet_pressure: float
     outlet_pressure: float
     mu: float
+    trapped: str
+    bulk_modulus: float
     leak_rate: Optional[float]
     one_way_leak_rate: Optional[float]
     fluid_load_fraction: float
+    contact_load_fraction: float
     trapped_load_fraction: float
     trapped_volume: float
     pocket_pressures: tuple
+    pocket_volumes: tuple
+    pockets_new: int
+    pockets_released: int
+    pockets_merged: int
+    pocket_passes: int
+    pockets_settled: bool
     coupled_iterations: int
     residual: float
     residual_history: tuple
@@ -170,14 +191,21 @@ class CoupledResult:
     references: tuple = field(default=REFERENCES)
 
     def record(self) -> dict:
-        """JSON-safe scalars of the coupled step."""
+        """JSON-safe scalars of the coupled step (keys documented in
+        docs/theory/04b_leakage_ii.md)."""
         return {"fsi_state": self.state, "external_pressure": self.external_pressure,
                 "inlet_pressure": self.inlet_pressure, "outlet_pressure": self.outlet_pressure,
+                "trapped_fluid": self.trapped, "bulk_modulus": self.bulk_modulus,
                 "leak_rate_coupled": self.leak_rate, "leak_rate_one_way": self.one_way_leak_rate,
                 "fluid_load_fraction": self.fluid_load_fraction,
+                "contact_load_fraction": self.contact_load_fraction,
                 "trapped_load_fraction": self.trapped_load_fraction,
                 "trapped_volume": self.trapped_volume,
                 "pocket_pressures": list(self.pocket_pressures),
+                "pocket_volumes": list(self.pocket_volumes),
+                "pockets_new": self.pockets_new, "pockets_released": self.pockets_released,
+                "pockets_merged": self.pockets_merged, "pocket_passes": self.pocket_passes,
+                "pockets_settled": self.pockets_settled,
                 "coupled_iterations": self.coupled_iterations,
                 "coupled_residual": self.residual}
 
@@ -186,37 +214,14 @@ class _LiftOff(RejectedIterate):
     """The fluid alone would carry the external load."""
 
 
-def _pockets(open_cells, connected, periodic, axis):
-    """Labels (-1 elsewhere) of the trapped pockets and their count."""
-    o = open_cells & ~connected
-    if not o.any():
-        return np.full(o.shape, -1), 0
-    lab, _, _ = components_reaching(o if axis == 0 else o.T, periodic=periodic)
-    lab = lab if axis == 0 else lab.T
-    used, inv = np.unique(lab[o], return_inverse=True)
-    out = np.full(o.shape, -1)
-    out[o] = inv
-    return out, used.size
-
-
-def first_contact_state(surface: Surface, *, direction: str = "x", mu: float = 1e-3,
-                        p_in: float, p_out: float) -> FluidState:
-    """Reference fluid state at first contact: gap ``max h - h``, its Reynolds pressure."""
-    h = surface.heights
-    gap = h.max() - h
-    sol = solve_reynolds_fv(gap, surface.spacing, direction=direction, mu=mu, p_in=p_in,
-                            p_out=p_out, periodic=surface.periodic)
-    p = np.where(sol.connected, sol.pressure, 0.5 * (p_in + p_out))
-    return FluidState(pressure=p)
-
-
 def coupled_leakage(surface: Surface, material, external_pressure: float, *,
                     p_in: float, p_out: float, mu: float = 1e-3, direction: str = "x",
-                    trapped: str = "film",
+                    trapped: str = "volume", bulk_modulus: float = np.inf,
                     history: Optional[FluidState] = None, tol: float = 1e-8,
                     max_iter: int = 60, anderson: int = 5, relaxation: float = 1.0,
                     kernel: str = "auto", contact_tol: float = 1e-11,
-                    h_reg: Optional[float] = None) -> CoupledResult:
+                    h_reg: Optional[float] = None, max_passes: int = 8,
+                    jacobian_pockets: int = 16) -> CoupledResult:
     """Two-way coupled contact and Reynolds flow at one external pressure (module docstring).
 
     Parameters
@@ -233,16 +238,16 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         Viscosity (Pa s).
     direction : {"x", "y"}
         Flow axis.
-    trapped : {"film", "pressure"}
-        Trapped pockets: ``"film"`` (default) take the regularised film's pressure (the
-        limit of their surroundings: drained pockets); ``"pressure"`` keep their pressure
-        at closure (may not converge in load sweeps: pockets that open and close jump).
+    trapped : {"volume", "pressure", "film"}
+        Trapped-pocket model (:mod:`roughfe.leakage.pockets`).
+    bulk_modulus : float
+        Bulk modulus of the liquid (Pa) for ``"volume"``; inf (default): incompressible.
     history : FluidState, optional
-        Reference state (previous load step); default :func:`first_contact_state`.
+        Reference state (previous load step); default: no pocket (first contact).
     tol : float
         Relative coupled residual to reach.
     max_iter : int
-        Coupled iterations allowed.
+        Coupled iterations allowed per pass.
     anderson : int
         Anderson memory (0: plain fixed point).
     relaxation : float
@@ -252,8 +257,9 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     contact_tol : float
         Tolerance of each contact solve (below ``tol``).
     h_reg : float, optional
-        Film regularising the fluid-pressure field in contact cells (m); default
-        ``1e-3`` times the rms height of the surface.
+        Film in contact cells (m); default ``1e-3`` times the rms height.
+    max_passes, jacobian_pockets : int
+        Pocket passes allowed; pockets (largest first) with an exact BEM compliance.
 
     Returns
     -------
@@ -264,7 +270,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     InputError
         Bad input (named).
     NoConvergenceError
-        The coupled residual did not reach ``tol``; ``result`` holds the last state.
+        The coupled residual did not reach ``tol`` (``result``: the last state).
     """
     from ..bem import solve_contact
     from ..bem.contact import surface_displacement
@@ -275,107 +281,144 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     p_in, p_out = check_absolute_pressures(p_in, p_out)
     if trapped not in TRAPPED_MODELS:
         raise InputError(f"trapped must be one of {TRAPPED_MODELS}, got {trapped!r}")
+    if not (bulk_modulus > 0) or (trapped != "volume" and np.isfinite(bulk_modulus)):
+        raise InputError(f"bulk modulus must be > 0 (Pa; inf: incompressible) and belongs to "
+                         f"trapped='volume', got {bulk_modulus!r} with {trapped!r}")
     if direction not in ("x", "y"):
         raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
     mu = check_finite_positive("mu", mu)
     tol, max_iter, anderson, relaxation = check_options(tol, max_iter, anderson, relaxation)
+    if int(max_passes) < 1:
+        raise InputError(f"max_passes must be >= 1, got {max_passes!r}")
     axis = 0 if direction == "x" else 1
     spacing = surface.spacing
     cell = float(np.prod(spacing))
     h = surface.heights
-    if history is None:
-        history = first_contact_state(surface, direction=direction, mu=mu, p_in=p_in,
-                                      p_out=p_out)
+    if history is not None and history.pressure.shape != h.shape:
+        raise InputError(f"history has shape {history.pressure.shape}, the surface {h.shape}")
+    frozen = (history.pockets if history is not None and trapped in SEALED
+              else Pockets.none(h.shape))
     h_reg = check_finite_positive("h_reg", 1e-3 * float(np.std(h)) if h_reg is None else h_reg)
-    last = {"contact": None, "flow": None, "pockets": (np.full(h.shape, -1), 0)}
+    last = {"contact": None, "flow": None}
 
-    def G(x, first=False):
+    def G(x, newton):
         """One contact solve and one Reynolds solve for the fluid traction x."""
         p_contact = p_ext - float(x.mean())
         if p_contact <= 0:
             raise _LiftOff()
         shifted = Surface(h - surface_displacement(surface, material, x, kernel),
                           surface.size, surface.periodic)
-        prev = last["contact"]
         c = solve_contact(shifted, material, mean_pressure=p_contact, kernel=kernel,
                           tol=contact_tol, compute_stiffness=False,
-                          initial=None if prev is None else prev.pressure)
+                          initial=last["contact"].pressure)
         gap = np.where(c.contact, 0.0, c.gap)
-        film = solve_reynolds_fv(np.maximum(gap, h_reg), spacing, direction=direction, mu=mu,
-                                 p_in=p_in, p_out=p_out, periodic=surface.periodic)
-        y = film.pressure
-        # cells open by less than the film count as closed for the pocket topology (else a
-        # cell flickering between contact and a sub-film gap splits and merges pockets)
-        wet = gap > h_reg
-        lab_all, t_in, t_out = components_reaching(wet if axis == 0 else wet.T,
-                                                   periodic=surface.periodic)
-        lab_all = lab_all if axis == 0 else lab_all.T
-        connected = np.zeros(gap.shape, bool)
-        connected[lab_all >= 0] = (t_in | t_out)[lab_all[lab_all >= 0]]
-        lab, n = _pockets(wet, connected, surface.periodic, axis)
-        if n and trapped == "pressure":
-            inp = lab >= 0
-            vol = np.bincount(lab[inp], gap[inp], n)
-            # pressure at closure: the pocket cells' pressure in the incoming iterate (the
-            # previous step's field at the first evaluation), weighted by the current gap
-            ref = history.pressure if first else x
-            p_pocket = np.bincount(lab[inp], (gap * ref)[inp], n) / vol
+        y = solve_reynolds_fv(np.maximum(gap, h_reg), spacing, direction=direction, mu=mu,
+                              p_in=p_in, p_out=p_out, periodic=surface.periodic).pressure
+        if frozen.n:
+            lab = frozen.labels
+            p_pocket = frozen.pressure if newton is None else newton(x, gap, c, p_ext)
             y = np.where(lab >= 0, p_pocket[np.maximum(lab, 0)], y)
-        last.update(contact=c, gap=gap, pockets=(lab, n))
+        last.update(contact=c, gap=gap)
         return y
 
     def _flow(gap):
         return solve_reynolds_fv(gap, spacing, direction=direction, mu=mu, p_in=p_in,
                                  p_out=p_out, periodic=surface.periodic)
 
-    x = np.zeros(h.shape)
-    gx = G(x, first=True)
-    one_way = _flow(last["gap"]).leak_rate
-    fp = anderson_fixed_point(G, x, gx, tol=tol, max_iter=max_iter, memory=anderson,
-                              relaxation=relaxation)
-    it, gx, residuals = fp.iterations, fp.gx, list(fp.residuals)
-    if fp.status == "max_iter":
-        last["flow"] = _flow(last["gap"])
-        partial = _result("contact", last, gx, p_ext, p_in, p_out, mu, one_way, it,
-                          fp.residual, residuals, cell)
-        raise NoConvergenceError(
-            f"fluid-structure coupling: relative residual {fp.residual:.3e} after {it} "
-            f"iterations (tolerance {tol:.1e}, Anderson memory {anderson})", result=partial)
-    state = "lift-off" if fp.status == "rejected" else "contact"
+    # the one-way state (dry contact at p_ext); the iteration starts from the previous
+    # step's fluid pressure (pocket pressures near their solution), else from 0
+    dry = solve_contact(surface, material, mean_pressure=p_ext, kernel=kernel, tol=contact_tol,
+                        compute_stiffness=False)
+    last["contact"] = dry
+    one_way = _flow(np.where(dry.contact, 0.0, dry.gap)).leak_rate
+    x = (np.array(history.pressure, dtype=float) if history is not None
+         and history.pressure.mean() < p_ext else np.zeros(h.shape))
+    residuals, counts = [], {"new": 0, "released": 0, "merged": 0}
+    it, passes, state, settled = 0, 0, "contact", False
+    while True:
+        newton = (PocketNewton(frozen, bulk_modulus, cell, material.E_star, jacobian_pockets)
+                  if trapped == "volume" and frozen.n else None)
+        try:
+            gx = G(x, newton)
+        except _LiftOff:
+            state = "lift-off"
+            break
+        fp = anderson_fixed_point(lambda v: G(v, newton), x, gx, tol=tol, max_iter=max_iter,
+                                  memory=anderson, relaxation=relaxation)
+        it += fp.iterations
+        residuals += fp.residuals
+        x, gx = fp.x, fp.gx
+        if fp.status == "max_iter":
+            last["flow"] = _flow(last["gap"])
+            last["next"], last["report"] = None, frozen
+            partial = _result("contact", last, gx, p_ext, p_in, p_out, mu, one_way, it,
+                              fp.residual, residuals, cell, trapped, bulk_modulus, counts,
+                              passes + 1, False)
+            raise NoConvergenceError(
+                f"fluid-structure coupling: relative residual {fp.residual:.3e} after "
+                f"{fp.iterations} iterations of pocket pass {passes + 1} (tolerance "
+                f"{tol:.1e}, Anderson memory {anderson})", result=partial)
+        if fp.status == "rejected":
+            state = "lift-off"
+            break
+        nxt, cnt = transfer(frozen, last["gap"], gx, cell, h_reg, axis=axis,
+                            periodic=surface.periodic,
+                            bulk_modulus=bulk_modulus if trapped == "volume" else 0.0)
+        passes += 1
+        for key in counts:
+            counts[key] += cnt[key]
+        settled = trapped not in SEALED or nxt.same_cells(frozen)
+        if settled or passes >= max_passes:
+            break
+        frozen, x = nxt, gx
     if state == "contact":
         last["flow"] = _flow(last["gap"])
-    return _result(state, last, gx, p_ext, p_in, p_out, mu, one_way, it,
-                   residuals[-1], residuals, cell)
+        last["next"] = nxt if trapped in SEALED else Pockets.none(h.shape)
+        last["report"] = frozen if trapped in SEALED else nxt
+    return _result(state, last, gx if state == "contact" else x, p_ext, p_in, p_out, mu,
+                   one_way, it, residuals[-1] if residuals else float("nan"), residuals, cell,
+                   trapped, bulk_modulus, counts, passes, settled)
 
 
-def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residuals, cell):
+def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residuals, cell,
+            trapped, bulk_modulus, counts, passes, settled):
+    common = dict(external_pressure=p_ext, inlet_pressure=p_in, outlet_pressure=p_out, mu=mu,
+                  trapped=trapped, bulk_modulus=float(bulk_modulus),
+                  one_way_leak_rate=one_way, pockets_new=counts["new"],
+                  pockets_released=counts["released"], pockets_merged=counts["merged"],
+                  pocket_passes=passes, pockets_settled=bool(settled), coupled_iterations=it,
+                  residual=res, residual_history=tuple(residuals))
     if state == "lift-off":
         p_f = np.full(fluid.shape, max(p_in, p_out))
         return CoupledResult(
-            state=state, contact=None, flow=None, fluid_pressure=p_f, external_pressure=p_ext,
-            inlet_pressure=p_in, outlet_pressure=p_out, mu=mu, leak_rate=None,
-            one_way_leak_rate=one_way, fluid_load_fraction=1.0, trapped_load_fraction=0.0,
-            trapped_volume=0.0, pocket_pressures=(), coupled_iterations=it, residual=res,
-            residual_history=tuple(residuals),
-            fluid_state=FluidState(pressure=p_f))
+            state=state, contact=None, flow=None, fluid_pressure=p_f, leak_rate=None,
+            fluid_load_fraction=1.0, contact_load_fraction=0.0, trapped_load_fraction=0.0,
+            trapped_volume=0.0, pocket_pressures=(), pocket_volumes=(),
+            fluid_state=FluidState(pressure=p_f, pockets=Pockets.none(p_f.shape)), **common)
     c, sol = last["contact"], last["flow"]
-    lab, n = last["pockets"]
     gap = np.where(c.contact, 0.0, c.gap)
+    report = last.get("report")
+    lab = report.labels if report is not None else np.full(gap.shape, -1)
+    n = report.n if report is not None else 0
     in_pocket = lab >= 0
-    pocket_p = []
+    pocket_p, pocket_v = [], []
     if n:
         area = np.bincount(lab[in_pocket], minlength=n)
-        p_sum = np.bincount(lab[in_pocket], fluid[in_pocket], n)
-        pocket_p = [float(v) for v in (p_sum / area)[np.argsort(-area)]]
-    state_next = FluidState(pressure=fluid)
+        order = np.argsort(-area, kind="stable")
+        pocket_p = (np.bincount(lab[in_pocket], fluid[in_pocket], n) / area)[order]
+        pocket_v = (np.bincount(lab[in_pocket], gap[in_pocket], n) * cell)[order]
+    nxt = last.get("next")
     return CoupledResult(
-        state=state, contact=c, flow=sol, fluid_pressure=fluid, external_pressure=p_ext,
-        inlet_pressure=p_in, outlet_pressure=p_out, mu=mu, leak_rate=sol.leak_rate,
-        one_way_leak_rate=one_way, fluid_load_fraction=float(fluid.mean() / p_ext),
+        state=state, contact=c, flow=sol, fluid_pressure=fluid, leak_rate=sol.leak_rate,
+        fluid_load_fraction=float(fluid.mean() / p_ext),
+        contact_load_fraction=float(c.pressure.mean() / p_ext),
         trapped_load_fraction=float(fluid[in_pocket].sum() / fluid.size / p_ext),
-        trapped_volume=float(gap[in_pocket].sum() * cell), pocket_pressures=tuple(pocket_p),
-        coupled_iterations=it, residual=res, residual_history=tuple(residuals),
-        fluid_state=state_next)
+        trapped_volume=float(gap[in_pocket].sum() * cell),
+        pocket_pressures=tuple(float(v) for v in pocket_p),
+        pocket_volumes=tuple(float(v) for v in pocket_v),
+        fluid_state=FluidState(pressure=fluid,
+                               pockets=nxt if nxt is not None else Pockets.none(gap.shape)),
+        **common)
 
 
 def coupled_sweep(surface: Surface, material, external_pressures, **kwargs) -> tuple:
