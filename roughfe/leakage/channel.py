@@ -22,8 +22,7 @@ contact closes the channel; there are no contact islands that the fluid can go r
 The pressure is then ``p_in`` upstream of the first closed sample and ``p_out``
 downstream of the last one; from the first to the last closed sample (contact spots and
 the pockets between them, whose pressure depends on the loading history: trapped fluid)
-it is set to ``(p_in + p_out) / 2``, the convention of
-:func:`roughfe.leakage.fsi.first_contact_state` for unconnected cells.
+it is set to ``(p_in + p_out) / 2`` (a convention for unconnected cells).
 """
 from __future__ import annotations
 
