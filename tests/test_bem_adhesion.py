@@ -209,3 +209,34 @@ def test_cell_averaged_law_keeps_the_work_and_locates_the_zone_end():
             for i in k:
                 _, tb = law.evaluate(g[i] + sub)
                 assert t[i] == pytest.approx(tb.mean(), abs=2e-2 * law.max_traction)
+
+
+@pytest.mark.parametrize("kind", ["exp", "md"])
+def test_preconditioned_cg_and_lbfgsb_reach_the_same_equilibrium(kind):
+    # two independent minimisers of Eq. (1) (roughfe.bem.adhesive_cg and scipy's L-BFGS-B)
+    # from the same elastic start: the same state to the traction tolerance (periodic
+    # surface with the mean-gap spring, and the sphere on the padded Love grid)
+    s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=1)
+    mat = Material(1e9, 0.3)
+    d = float(s.heights.max() - s.heights.mean() - 0.5e-6)
+    law = AdhesionLaw(kind, 0.01, 20e-9)
+    # tolerance 2e-6 of the traction scale: L-BFGS-B's line search stops on round-off
+    # near 1e-6 (module docstring)
+    a = solve_adhesive(s, mat, law, delta=d, solver="pcg", tol=2e-6)
+    b = solve_adhesive(s, mat, law, delta=d, solver="lbfgsb", tol=2e-6)
+    assert a.solver == f"adhesive-pcg-{kind}" and a.residual <= 2e-6
+    scale = np.max(np.abs(b.pressure))
+    assert np.max(np.abs(a.pressure - b.pressure)) <= 1e-4 * scale
+    assert a.mean_pressure == pytest.approx(b.mean_pressure, rel=1e-5)
+    assert np.count_nonzero(a.contact != b.contact) <= 2
+    sph = sphere(32, 0.21)
+    law = md_law(1.0) if kind == "md" else AdhesionLaw("exp", W, md_law(1.0).range)
+    a = solve_adhesive(sph, MAT, law, delta=0.1 * D_SCALE, solver="pcg", tol=2e-6)
+    b = solve_adhesive(sph, MAT, law, delta=0.1 * D_SCALE, solver="lbfgsb", tol=2e-6)
+    assert a.load == pytest.approx(b.load, rel=1e-5, abs=1e-6 * np.pi * W * R)
+    assert np.array_equal(a.contact, b.contact)
+
+
+def test_unknown_adhesive_solver_is_refused():
+    with pytest.raises(InputError, match="solver"):
+        solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=0.0, solver="newton")

@@ -64,6 +64,7 @@ from ..model import ContactResult, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
+from .adhesive_cg import adhesive_pcg
 from .interface_law import LAWS, AdhesionLaw
 
 __all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "solve_adhesive"]
@@ -197,7 +198,7 @@ def _elastic_start(surface, material, op, delta, c, energy):
 def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, delta,
                    kernel: str = "auto", initial=None, tol: float = 1e-5,
                    max_iter: int = 20000, spring=None, unloading: bool = False,
-                   cell_average: bool = True) -> ContactResult:
+                   cell_average: bool = True, solver: str = "pcg") -> ContactResult:
     """Equilibrium of the adhesive contact at the approach ``delta`` (Eq. (1)).
 
     Parameters
@@ -225,8 +226,11 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     unloading : bool
         The branch stored in the result (``ContactResult.unloading``).
     cell_average : bool
-        Maugis-Dugdale: evaluate the law averaged over each cell (module docstring,
-        "Cell-averaged law"); False samples it at the cell centres.
+        Maugis-Dugdale: evaluate the law averaged over each cell
+        (:mod:`roughfe.bem.interface_law`); False samples it at the cell centres.
+    solver : {"pcg", "lbfgsb"}
+        Preconditioned projected nonlinear CG (:mod:`roughfe.bem.adhesive_cg`; it hands
+        over to L-BFGS-B if it stalls) or L-BFGS-B alone.
 
     Returns
     -------
@@ -243,6 +247,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
         The residual stayed above ``tol``; ``result`` holds the last state.
     """
     d = _check(surface, material, law, delta)
+    if solver not in SOLVERS:
+        raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
     h = surface.heights
@@ -272,28 +278,45 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
         energy.spread = energy.cell_spread(x0)
     nit, x = 0, x0
     for _ in range(MAX_SPREAD_PASSES):
-        for _ in range(4):   # restarts with a fresh quasi-Newton memory (round-off stalls)
-            res = scipy.optimize.minimize(energy, x, jac=True, method="L-BFGS-B",
-                                          bounds=energy.bounds(),
-                                          options={"maxiter": int(max_iter) - nit,
-                                                   "maxcor": 10, "ftol": 0.0, "gtol": tol,
-                                                   "maxfun": 2 * int(max_iter)})
-            x, nit = res.x, nit + int(res.nit)
-            r = energy.residual(x)
-            if r <= tol or nit >= max_iter:
-                break
+        x, k, r, message = _minimise(energy, x, tol, int(max_iter) - nit, solver)
+        nit += k
         if not averaged or r > tol or not _update_spread(energy, x, law):
             break
     out = _adhesive_result(surface, material, op, law, energy, x, d, r, tol, nit,
-                           bool(unloading))
+                           bool(unloading), solver)
     if r > tol:
         raise NoConvergenceError(
-            f"adhesive L-BFGS-B did not converge: traction residual {r:.3e} (relative to "
-            f"{scale:.3e} Pa) after {nit} iterations ({res.message}), tolerance {tol:.1e}",
-            result=out)
+            f"adhesive solver ({solver}) did not converge: traction residual {r:.3e} "
+            f"(relative to {scale:.3e} Pa) after {nit} iterations ({message}), tolerance "
+            f"{tol:.1e}", result=out)
     return out
 
 
+def _minimise(energy, x, tol, max_iter, solver):
+    """``(x, iterations, residual, message)``: the preconditioned CG (``"pcg"``), which
+    hands over to L-BFGS-B from its last iterate if it stops above ``tol`` (a
+    non-convex stall), or L-BFGS-B alone (``"lbfgsb"``)."""
+    nit, message = 0, ""
+    if solver == "pcg":
+        x, nit, r, message = adhesive_pcg(energy, x, tol, max_iter)
+        r = energy.residual(x)
+        if r <= tol or nit >= max_iter:
+            return x, nit, r, message
+    for _ in range(4):       # restarts with a fresh quasi-Newton memory (round-off stalls)
+        res = scipy.optimize.minimize(energy, x, jac=True, method="L-BFGS-B",
+                                      bounds=energy.bounds(),
+                                      options={"maxiter": max_iter - nit, "maxcor": 10,
+                                               "ftol": 0.0, "gtol": tol,
+                                               "maxfun": 2 * max_iter})
+        x, nit, message = res.x, nit + int(res.nit), str(res.message)
+        r = energy.residual(x)
+        if r <= tol or nit >= max_iter:
+            break
+    return x, nit, r, message
+
+
+#: Minimisers of :func:`solve_adhesive`.
+SOLVERS = ("pcg", "lbfgsb")
 #: At most this many solves with the cell spread of the previous one (cell-averaged law).
 MAX_SPREAD_PASSES = 3
 
@@ -315,7 +338,7 @@ def _update_spread(energy, x, law) -> bool:
 
 
 def _adhesive_result(surface, material, op, law, energy, x, delta, resid, tol, nit,
-                     unloading):
+                     unloading, solver):
     p, pbar, g, u, _ = energy.pressure(x)
     h = surface.heights
     g = np.maximum(g, 0.0)
@@ -340,9 +363,9 @@ def _adhesive_result(surface, material, op, law, energy, x, delta, resid, tol, n
         free_volume=float(g.sum()) * surface.cell_area,
         free_volume_star=mean_gap / sigma if sigma > 0 else float("nan"),
         stiffness=float("nan"),
-        message=f"{'unloading' if unloading else 'loading'} ({law.kind}, L-BFGS-B)", nit=nit,
+        message=f"{'unloading' if unloading else 'loading'} ({law.kind}, {solver})", nit=nit,
         residual=float(resid), tolerance=float(tol), kernel=op.name,
-        solver=f"adhesive-lbfgsb-{law.kind}", e_star=material.E_star, rms_height=sigma,
+        solver=f"adhesive-{solver}-{law.kind}", e_star=material.E_star, rms_height=sigma,
         size=tuple(surface.size), spacing=tuple(surface.spacing), periodic=op.periodic,
         references=REFERENCES + op.references, method="bem", unloading=unloading,
         adhesive_area_fraction=float(np.count_nonzero(p < 0)) / n, fields=fields)
