@@ -270,3 +270,93 @@ def test_refined_piecewise_constant_gap_fe_and_fv_bracket_one_limit():
     assert np.all(np.diff(fv) > 0) and np.all(np.diff(fe) < 0) and np.all(fe > fv)
     gaps = fe / fv - 1
     assert np.all(np.diff(gaps) < 0)
+
+
+def _brute_force_components(open_cells, periodic):
+    """Reference labelling: the explicit graph of open face pairs, searched by scipy."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    nl, nt = open_cells.shape
+    idx = np.arange(nl * nt).reshape(nl, nt)
+    pairs = [(idx[:-1], idx[1:], open_cells[:-1] & open_cells[1:]),
+             (idx[:, :-1], idx[:, 1:], open_cells[:, :-1] & open_cells[:, 1:])]
+    if periodic:
+        pairs.append((idx[:, -1], idx[:, 0], open_cells[:, -1] & open_cells[:, 0]))
+    a = np.concatenate([p[0][p[2]] for p in pairs])
+    b = np.concatenate([p[1][p[2]] for p in pairs])
+    graph = coo_matrix((np.ones(a.size), (a, b)), shape=(nl * nt, nl * nt))
+    return connected_components(graph, directed=False)[1].reshape(nl, nt)
+
+
+def test_component_labels_equal_a_graph_search_across_the_periodic_seam():
+    from roughfe.leakage.finite_volume import components_reaching
+    rng = np.random.default_rng(11)
+    for trial in range(200):
+        shape = tuple(rng.integers(1, 15, size=2))
+        o = rng.random(shape) < rng.uniform(0.3, 0.8)
+        periodic = bool(trial % 2)
+        lab, t_in, t_out = components_reaching(o, periodic=periodic)
+        ref = _brute_force_components(o, periodic)
+        assert np.array_equal(lab < 0, ~o)
+        # the same partition of the open cells, labels 0..k-1
+        pairs = set(zip(lab[o].tolist(), ref[o].tolist()))
+        k = len(set(lab[o].tolist()))
+        assert len(pairs) == k == len(set(ref[o].tolist()))
+        assert set(lab[o].tolist()) == set(range(k))
+        assert np.array_equal(t_in, np.isin(np.arange(k), lab[0][o[0]]))
+        assert np.array_equal(t_out, np.isin(np.arange(k), lab[-1][o[-1]]))
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_live_system_is_symmetric_sorted_and_conservative(periodic):
+    # the operator on the live cells: symmetric, column indices sorted in every row (the
+    # seam neighbours included), and applied to a constant it leaves only the inlet and
+    # outlet transmissibilities (interior fluxes cancel: mass conservation)
+    import scipy.sparse as sps
+    from roughfe.leakage import finite_volume as fvm
+    captured = {}
+
+    def capture(matrix, rhs, **kw):
+        indptr, indices, data = matrix.getValuesCSR()
+        captured["A"] = sps.csr_matrix((data, indices, indptr), shape=matrix.getSize())
+        captured["A"].has_sorted_indices = False
+        captured["sorted"] = all(np.all(np.diff(indices[indptr[i]:indptr[i + 1]]) > 0)
+                                 for i in range(len(indptr) - 1))
+        return fvm_solve(matrix, rhs, **kw)
+
+    rng = np.random.default_rng(5)
+    g = np.maximum(rng.standard_normal((16, 11)) + 0.6, 0.0) * H
+    fvm_solve = fvm.ksp_solve
+    mp = pytest.MonkeyPatch()
+    mp.setattr(fvm, "ksp_solve", capture)
+    try:
+        sol = fvm.solve_reynolds_fv(g, (DX, DX), mu=MU, p_in=DP, p_out=0.0, periodic=periodic)
+    finally:
+        mp.undo()
+    A = captured["A"]
+    live = sol.connected
+    assert A.shape == (live.sum(),) * 2 and captured["sorted"]
+    assert abs(A - A.T).max() <= 1e-15 * abs(A).max()
+    k = g**3 / (12 * MU)
+    ends = np.zeros(g.shape)
+    ends[0] += 2 * k[0]                 # dt / (dl / 2) * k with square cells
+    ends[-1] += 2 * k[-1]
+    assert np.allclose(A @ np.ones(A.shape[0]), ends[live], rtol=1e-12,
+                       atol=1e-12 * abs(A).max())
+
+
+def test_absolute_pressure_level_changes_nothing_but_the_level():
+    # Eq. 2.12 contains only pressure gradients: the same drop at any absolute level gives
+    # the same flows (the solve works on p - p_out, so its tolerance is relative to the drop)
+    rng = np.random.default_rng(9)
+    g = np.maximum(rng.standard_normal((30, 24)) + 0.4, 0.0) * H
+    base = reynolds_flow(g, (DX, DX), mu=MU, pressure_drop=DP, periodic=True)
+    high = reynolds_flow(g, (DX, DX), mu=MU, pressure_drop=DP, p_out=1e8, periodic=True)
+    assert base.percolates and high.leak_rate == pytest.approx(base.leak_rate, rel=1e-9)
+    both = np.isfinite(base.pressure)
+    assert np.allclose(high.pressure[both] - 1e8, base.pressure[both], rtol=0, atol=1e-6 * DP)
+    # no drop, no wall motion: the pressure is the uniform level and nothing flows, exactly
+    from roughfe.leakage.finite_volume import solve_reynolds_fv
+    still = solve_reynolds_fv(g, (DX, DX), mu=MU, p_in=3e6, p_out=3e6, periodic=True)
+    assert np.all(still.pressure[both] == 3e6)
+    assert still.inlet_flow == 0.0 and still.outlet_flow == 0.0

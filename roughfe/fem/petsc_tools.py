@@ -111,6 +111,19 @@ def petsc_aij(matrix):
                            m.data.astype(PETSc.ScalarType, copy=False)), comm=PETSc.COMM_SELF)
 
 
+def petsc_aij_csr(shape, indptr, indices, data):
+    """A sequential PETSc AIJ matrix on CSR arrays (rows with sorted column indices).
+
+    The arrays are used in place when their types are PETSc's (``PetscInt``, ``PetscScalar``),
+    else converted once; the matrix keeps a reference to them.
+    """
+    from petsc4py import PETSc
+
+    return PETSc.Mat().createAIJWithArrays(
+        shape, (np.asarray(indptr, dtype=PETSc.IntType), np.asarray(indices, dtype=PETSc.IntType),
+                np.asarray(data, dtype=PETSc.ScalarType)), comm=PETSc.COMM_SELF)
+
+
 def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None):
     """Solve ``A x = b`` with a PETSc KSP; options under a unique prefix.
 
