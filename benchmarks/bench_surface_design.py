@@ -1,13 +1,13 @@
 """CPU time of a surface database and of a surface design run (issue 15 Sec. 3-4).
 
 Target (issue 15): a surface design run < 30 min. A 2D genome database of ``K`` Sobol
-genomes (64 x 64 periodic, M = 3 ridges, 10 approaches to 0.8 of full contact, E = 210
+genomes (N x N periodic, default 64, M = 3 ridges, 10 approaches to 0.8 of full contact, E = 210
 MPa, L = 100 um) is built in this process (CPU per genome printed), then M-CCO on the
 K(p) and A(p) of y_t1 (a surface genome outside the database) with the search at the
 target pressures (150 sweeps per candidate), the configuration of
 ``roughfe validate surface-genomics``. Process CPU times are printed with the load
 average (the machine may be shared); wall times are inflated by load.
-Run: .venv/bin/python benchmarks/bench_surface_design.py [K]
+Run: .venv/bin/python benchmarks/bench_surface_design.py [K [N]] (N nodes per side, 64)
 """
 import os
 import sys
@@ -22,8 +22,8 @@ from roughfe.genomics.design import (GcmmaOptions, combined_score, run_design,
 TARGET_S = 1800.0
 
 
-def main(n_genomes=16):
-    settings = gdb.DatabaseSettings(length=1e-4, n_nodes=64, youngs_modulus=210e6, n_steps=10,
+def main(n_genomes=16, n_nodes=64):
+    settings = gdb.DatabaseSettings(length=1e-4, n_nodes=n_nodes, youngs_modulus=210e6, n_steps=10,
                                     dim=2, top_fraction=0.8)
     design = gdb.SobolDesign(dim=2, n_pairs=n_genomes, n_vectors=1, n_ridges=3)
     print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
@@ -51,4 +51,4 @@ def main(n_genomes=16):
 
 
 if __name__ == "__main__":
-    sys.exit(main(*(int(a) for a in sys.argv[1:2])))
+    sys.exit(main(*(int(a) for a in sys.argv[1:3])))
