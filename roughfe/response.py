@@ -107,7 +107,7 @@ def _adhesive_response(surface, material, loading, options) -> SweepResult:
         raise InputError("hardness and adhesion together are not supported (the adhesive "
                          "solver has no pressure cap); give one of them")
     if options.get("solver", "auto") != "auto":
-        raise InputError("solver does not apply with adhesion (L-BFGS-B on the gap)")
+        raise InputError("solver does not apply with adhesion (its own minimiser on the gap)")
     if loading.controls_pressure:
         raise InputError("adhesion runs in displacement control (the load-approach curve "
                          "has unstable parts): give approaches (delta, deltas, n_steps), "

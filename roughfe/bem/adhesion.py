@@ -26,12 +26,14 @@ is the most tensile load of the unloading branch.
 
 Solver and continuation
 -----------------------
-Eq. (1) is minimised by L-BFGS-B (scipy; Byrd, Lu, Nocedal & Zhu 1995) in the gap
-variable, scaled by the range (x = g / range) and the gradient by the traction scale
-S = max(sigma0, E* gbar / 2) (gbar the rms slope: the elastic pressure scale of the
-roughness), so that the stopping measure is the largest projected traction residual over
-S (the
-``residual``; default tolerance 1e-6). The energy and its gradient cost two FFTs:
+Eq. (1) is minimised in the gap variable, scaled by the range (x = g / range), by the
+compliance-preconditioned projected nonlinear CG of :mod:`roughfe.bem.adhesive_cg`
+(default; two FFT pairs per iteration) or by L-BFGS-B (scipy; Byrd, Lu, Nocedal & Zhu
+1995; ``solver="lbfgsb"``, and the hand-over when the CG stalls), with the gradient
+scaled by the traction scale S = max(sigma0, E* gbar / 2) (gbar the rms slope: the
+elastic pressure scale of the roughness), so that the stopping measure is the largest
+projected traction residual over S (the ``residual``; default tolerance 1e-5). The
+energy and its gradient cost two FFTs:
 
 * periodic (``"spectral"``): K is the exact spectral stiffness E*|q|/2. An imposed
   Delta fixes the mean gap (mean u = 0, see :mod:`roughfe.bem.operators`); it is
@@ -46,7 +48,7 @@ S (the
   padding, so the solution is that of the isolated body.
 
 The continuation in the approach (:func:`adhesive_sweep`) starts each step from the
-previous gap shifted by the change of Delta: L-BFGS-B then descends to the nearest
+previous gap shifted by the change of Delta: the minimiser then descends to the nearest
 local minimum, which follows the stable branch until it disappears (jump-in on loading,
 jump-out on unloading), as a displacement-controlled experiment does. A solve that does
 not reach the tolerance raises :class:`~roughfe.errors.NoConvergenceError` with the
@@ -220,7 +222,7 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     tol : float
         Largest projected traction residual, relative to S = max(sigma0, E* gbar / 2).
     max_iter : int
-        L-BFGS-B iterations.
+        Iterations (CG and L-BFGS-B together).
     spring : float, optional
         Periodic only: stiffness k0 (Pa/m) of the spring imposing the mean gap.
     unloading : bool

@@ -148,7 +148,7 @@ def _adhesive_sweep(args, surface, material, law, tol):
         raise InputError("--adhesion runs in displacement control (the load-approach curve "
                          "has unstable parts): give --delta or --steps, not --pressure")
     if args.solver != "auto":
-        raise InputError("--solver does not apply with --adhesion (L-BFGS-B on the gap)")
+        raise InputError("--solver does not apply with --adhesion (its own minimiser on the gap)")
     deltas = args.delta
     if deltas is None:
         periodic = surface.periodic and args.kernel in ("auto", "spectral")
