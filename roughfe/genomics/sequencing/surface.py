@@ -54,138 +54,27 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
-import scipy.linalg
 from scipy.optimize import least_squares
 
-from ..genome import Genome, chromosome_range
+from ..genome import Genome
 from .lattice import comb_periods, label_q1, lattice_from_period
-from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, surface_acquisitions,
-                           surface_peaks)
+from .surface_data import (ANGLE_TOL, GridModel, SurfaceAcquisition, cluster_angles,
+                           surface_acquisitions, surface_peaks)
 
 
 #: nodes (over all acquisitions) used by the nonlinear fit; the final solve uses every node
 FIT_ROWS = 16384
 
 
-# -- step 4: variable projection ----------------------------------------------------------------
-class _Model:
-    """Design of the MWM surface model over all acquisitions (rows: valid nodes).
-
-    ``max_rows`` keeps a fixed pseudo-random subset of the valid nodes (the same share of
-    each acquisition): the nonlinear fit needs a few rows per unknown, not every node, and
-    its cost is linear in the rows; the final coefficients use every node.
-    """
-
-    def __init__(self, acqs, n_nodes, max_rows=None):
-        self.acqs = acqs
-        self.n_nodes = n_nodes
-        total = sum(int(a.valid.sum()) for a in acqs)
-        share = 1.0 if max_rows is None else min(1.0, max_rows / total)
-        rng = np.random.default_rng(0)
-        xs, ys, zs, blocks = [], [], [], []
-        for k, a in enumerate(acqs):
-            ok = a.valid
-            if share < 1.0:
-                ok = ok & (rng.random(ok.shape) < share)
-            xx, yy = np.meshgrid(a.x, a.y, indexing="ij")
-            xs.append(xx[ok])
-            ys.append(yy[ok])
-            zs.append(a.z[ok])
-            blocks.append(np.full(int(ok.sum()), k))
-        self.x, self.y = np.concatenate(xs), np.concatenate(ys)
-        self.z = np.concatenate(zs)
-        self.block = np.concatenate(blocks)
-        self.scale = float(np.sqrt(np.mean(self.z ** 2)))
-
-    def ranges(self, log_q1, log_gamma):
-        lam1 = 2 * math.pi / math.exp(log_q1)
-        return [chromosome_range(math.exp(log_gamma), lam1, a.length, self.n_nodes)
-                for a in self.acqs]
-
-    def waves(self, p, ranges, cap=None):
-        """Wave list (n, m) active in the model and the phase arguments (rows x waves)."""
-        lo = min(r[0] for r in ranges)
-        hi = max(r[1] for r in ranges) if cap is None else min(cap, max(r[1] for r in ranges))
-        n = np.arange(lo, hi + 1)
-        theta = np.asarray(p[2:])
-        nn, mm = np.meshgrid(n, np.arange(theta.size), indexing="ij")
-        nn, mm = nn.ravel(), mm.ravel()
-        q = np.exp(p[0] + (nn - 1) * p[1])
-        proj = np.multiply.outer(self.x, np.cos(theta)) + np.multiply.outer(self.y, np.sin(theta))
-        arg = proj[:, mm] * q
-        on = np.ones(arg.shape, bool)
-        for k, (ns, nf) in enumerate(ranges):
-            rows = self.block == k
-            on[rows] = ((nn >= ns) & (nn <= nf))[None, :]
-        return nn, mm, q, arg, on, proj
-
-    def design(self, arg, on):
-        n_acq = len(self.acqs)
-        cols = [np.where(on, np.cos(arg), 0.0), np.where(on, np.sin(arg), 0.0)]
-        plane = np.zeros((self.z.size, 3 * n_acq))
-        for k in range(n_acq):
-            rows = self.block == k
-            plane[rows, 3 * k] = 1.0
-            plane[rows, 3 * k + 1] = self.x[rows] / self.acqs[k].length
-            plane[rows, 3 * k + 2] = self.y[rows] / self.acqs[k].length
-        return np.hstack(cols + [plane])
-
-    def solve(self, p, ranges, cap=None, exact=False):
-        """Linear least squares for the wave and plane coefficients at the lattice ``p``.
-
-        Normal equations with a Cholesky factor of the column-scaled Gram matrix: the
-        columns (plane waves of distinct wavevectors) are nearly orthogonal, so the Gram
-        matrix is well conditioned, and one BLAS-3 product is several times cheaper than
-        a QR; a ridge duplicated by the fit makes it singular (LinAlgError).
-        """
-        nn, mm, q, arg, on, proj = self.waves(p, ranges, cap)
-        a = self.design(arg, on)
-        norm = np.linalg.norm(a, axis=0)
-        norm[norm == 0] = 1.0
-        a /= norm
-        gram = a.T @ a
-        gram[np.diag_indices_from(gram)] += 1e-13 * gram.shape[0]   # two ridges merging
-        chol = scipy.linalg.cho_factor(gram)
-        if exact:     # final coefficients: pivoted QR, no squared condition number
-            coef = scipy.linalg.lstsq(a, self.z, lapack_driver="gelsy", check_finite=False)[0]
-        else:
-            coef = scipy.linalg.cho_solve(chol, a.T @ self.z)
-        resid = self.z - a @ coef
-        return dict(nn=nn, mm=mm, q=q, arg=arg, on=on, proj=proj, coef=coef / norm,
-                    resid=resid, a=a, chol=chol)
-
-    def jacobian(self, p, sol):
-        """Kaufman's variable-projection Jacobian d(resid)/d(p) ~ -(I - P) (dA/dp) c."""
-        w = sol["nn"].size
-        u, v = sol["coef"][:w], sol["coef"][w:2 * w]
-        arg, on = sol["arg"], sol["on"]
-        s = np.where(on, -u * np.sin(arg) + v * np.cos(arg), 0.0)
-        theta = np.asarray(p[2:])
-        cols = [np.sum(s * arg, axis=1), np.sum(s * arg * (sol["nn"] - 1), axis=1)]
-        dproj = (-np.multiply.outer(self.x, np.sin(theta))
-                 + np.multiply.outer(self.y, np.cos(theta)))
-        for m in range(theta.size):
-            sel = sol["mm"] == m
-            cols.append(np.sum(s[:, sel] * sol["q"][sel], axis=1) * dproj[:, m])
-        d = np.column_stack(cols)
-        a = sol["a"]
-        return -(d - a @ scipy.linalg.cho_solve(sol["chol"], a.T @ d))
-
-
 def _fit(model, p0, budget=60, continuation=True):
     """Levenberg-Marquardt on (ln q1, ln gamma, theta), with continuation in the cap.
 
-    A direct fit of the whole model comes first (enough when the peaks put every wave in
-    the basin); when it does not reproduce the data to round-off, the fit is redone from
-    ``p0`` adding the chromosomes a few at a time (the basin in ln gamma shrinks like 1/n).
+    ``continuation=False``: a direct fit of the whole model (enough when the peaks put
+    every wave in the basin). ``continuation=True`` (the caller tried the direct fit and it
+    did not reproduce the data to round-off): the fit from ``p0`` adds the chromosomes a
+    few at a time (the basin in ln gamma shrinks like 1/n).
     """
-    if continuation:
-        p, ranges, nit = _fit(model, p0, budget=budget // 2, continuation=False)
-        sol = model.solve(p, ranges)
-        if float(sol["resid"] @ sol["resid"]) <= 1e-24 * float(model.z @ model.z):
-            return p, ranges, nit
-    else:
-        nit = 0
+    nit = 0
     ranges = model.ranges(p0[0], p0[1])
     lo = min(r[0] for r in ranges)
     hi = max(r[1] for r in ranges)
@@ -418,8 +307,9 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     groups = np.concatenate([np.full(pk.qx.size, k) for k, pk in enumerate(peaks)])[in_ridge]
     groups = groups * 1000 + labels[in_ridge]           # one peak per (acquisition, ridge, n)
     periods, _, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
-    model = _Model(acqs, n_nodes, max_rows=FIT_ROWS)     # the nonlinear fit
-    full = _Model(acqs, n_nodes)                          # the final coefficients
+    # the nonlinear fit on a tensor sub-grid of about FIT_ROWS nodes, the final solve on all
+    model = GridModel(acqs, n_nodes, axis_nodes=math.ceil(math.sqrt(FIT_ROWS / len(acqs))))
+    full = GridModel(acqs, n_nodes)
     tiny = 1e-24 * float(model.z @ model.z)
 
     def attempt(p0, continuation):
