@@ -62,10 +62,13 @@ def test_sequenced_genome_predicts_other_windows():
     np.testing.assert_allclose(fine.heights, ref, atol=1e-10 * np.abs(ref).max())
 
 
-def test_one_percent_white_noise():
+@pytest.mark.parametrize("seed", [11, 1])
+def test_one_percent_white_noise(seed):
     """Issue 15 targets: M exact, angles within 0.5 deg, gamma within 0.5 %, the
-    reconstruction misfit at the noise level (1 % rms)."""
-    g, acq, rng = _genome(11)
+    reconstruction misfit at the noise level (1 % rms). Seed 1: the lattice gamma^(1/3)
+    nests the true one and fits the noise with 3x the waves; chosen by the residual alone
+    it gave gamma 32 % low with success True (now by the information criterion)."""
+    g, acq, rng = _genome(seed)
     noisy = [a.with_heights(a.heights + 0.01 * a.heights.std() * rng.normal(size=a.shape))
              for a in acq]
     r = sequence_surfaces(noisy)

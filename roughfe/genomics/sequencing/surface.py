@@ -286,7 +286,8 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     rms_tolerance : float
         Relative rms misfit above which ``success`` is False (not WM-like, or noisy).
     n_restarts : int
-        Number of comb periods (gamma candidates) tried; the lowest residual wins.
+        Number of comb periods (gamma candidates) tried; the least Bayesian information
+        criterion wins (the residual alone prefers a lattice gamma^(1/j) on noisy data).
     """
     t0 = time.perf_counter()
     acqs = surface_acquisitions(surfaces, valid)
@@ -338,9 +339,20 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         if log_gamma > 0:
             starts.append(np.concatenate([[log_q1, log_gamma], centres[ridges]]))
     best, nit = None, 0
-    # direct fits from every gamma candidate; the best is completed with missed ridges;
-    # only when that does not reproduce the data to round-off (noise, measured data) is
-    # the continuation tried from every candidate as well, and the lowest cost wins
+    n_rows = model.z.size
+
+    def bic(out):
+        """Bayesian information criterion of a fit: n ln(RSS / n) + k ln n, k = linear
+        coefficients + lattice parameters. A lattice of period ln(gamma)/j nests the one
+        of ln(gamma) and fits noise with j times the waves, so the lowest residual alone
+        picks it on noisy data; the penalty keeps the coarsest lattice that explains the
+        data (on exact data both reach round-off and the coarser wins outright)."""
+        k = out[3]["a"].shape[1] + out[1].size
+        return n_rows * math.log(max(out[0], tiny) / n_rows) + k * math.log(n_rows)
+
+    # direct fits from every gamma candidate; the best (least BIC) is completed with
+    # missed ridges; only when that does not reproduce the data to round-off (noise,
+    # measured data) is the continuation tried from every candidate as well
     for continuation in (False, True):
         outs = []
         for p0 in starts:
@@ -351,9 +363,10 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         nit += sum(o[4] for o in outs)
         if not outs:
             continue
-        top = complete(min(outs, key=lambda o: o[0]))
-        nit += top[4] - min(outs, key=lambda o: o[0])[4]
-        if best is None or top[0] < best[0]:
+        chosen = min(outs, key=bic)
+        top = complete(chosen)
+        nit += top[4] - chosen[4]
+        if best is None or bic(top) < bic(best):
             best = top
         if best[0] <= tiny:
             break
