@@ -22,12 +22,18 @@ from roughfe.writers import write_json
 
 OUT = Path(__file__).resolve().parent / "output" / "bench_sequencing.json"
 TARGET_S = 10.0
-#: CPU seconds of the same cases before the fast linear algebra (commit b1dc6b2, same machine)
-BEFORE = {128: None, 256: None, 512: None}
+#: CPU seconds of the noise-free cases before the separable linear algebra (dense design on
+#: 16384 nodes, gelsy on all nodes; main at cd44962), measured on this machine under load
+BEFORE = {128: 40.8, 256: None, 512: None}
 
 
-def case(n, seed=3):
-    g, acq, _ = resolvable_surface_genome(seed, length=1e-3, n_nodes=n, n_ridges=4, gamma=1.6)
+def case(n, seed=3, noise=0.0):
+    """Sequence the seeded pair at n x n, with white noise of ``noise`` times the rms."""
+    g, acq, rng = resolvable_surface_genome(seed, length=1e-3, n_nodes=n, n_ridges=4,
+                                            gamma=1.6)
+    if noise:
+        acq = [a.with_heights(a.heights + noise * a.heights.std() * rng.normal(size=a.shape))
+               for a in acq]
     c0 = time.process_time()
     r = sequence_surfaces(acq)
     cpu = time.process_time() - c0
@@ -36,26 +42,35 @@ def case(n, seed=3):
     err = {"gamma": abs(s.gamma / g.gamma - 1), "A": abs(s.A / g.A - 1), "H": abs(s.H - g.H),
            "angles": float(np.abs(s.angles - g.angles).max()),
            "anisotropy": float(np.abs(s.anisotropy / g.anisotropy - 1).max())} if ok else {}
-    return {"n": n, "cpu_s": cpu, "cpu_before_s": BEFORE.get(n), "success": bool(r.success),
+    return {"n": n, "noise": noise, "cpu_s": cpu,
+            "cpu_before_s": None if noise else BEFORE.get(n), "success": bool(r.success),
             "M": None if s is None else s.M, "waves": int(r.amplitudes.size), "nit": r.nit,
             "max_gene_error": max(err.values()) if err else None,
+            "gamma_error": err.get("gamma"), "max_angle_error_deg": (
+                float(np.degrees(err["angles"])) if err else None),
             "max_rms_misfit": float(np.max(r.rms_errors))}
 
 
 def main(sizes):
     print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     rows = []
-    for n in sizes:
-        r = case(n)
+    for n, noise in [(n, 0.0) for n in sizes] + [(n, 0.01) for n in sizes if n == 512]:
+        r = case(n, noise=noise)
         rows.append(r)
-        print(f"{n:>5}^2 pair: cpu {r['cpu_s']:7.2f} s  success {r['success']}  M {r['M']}  "
-              f"waves {r['waves']}  nit {r['nit']}  gene error {r['max_gene_error']:.2g}  "
-              f"misfit {r['max_rms_misfit']:.2g}", flush=True)
-    targets = [{"name": f"sequencing a {r['n']}^2 pair (CPU s), genes to 1e-8",
-                "value": r["cpu_s"], "target": f"< {TARGET_S:g}",
-                "met": bool(r["cpu_s"] < TARGET_S and r["success"]
-                            and (r["max_gene_error"] or 1.0) < 1e-8)}
-               for r in rows if r["n"] == 512]
+        print(f"{n:>5}^2 pair, noise {noise:4.2f}: cpu {r['cpu_s']:7.2f} s  success "
+              f"{r['success']}  M {r['M']}  waves {r['waves']}  nit {r['nit']}  gene error "
+              f"{r['max_gene_error']:.2g}  misfit {r['max_rms_misfit']:.2g}", flush=True)
+    targets = []
+    for r in rows:
+        if r["n"] != 512:
+            continue
+        # noise-free: genes to 1e-8; 1 % noise: M exact, gamma 0.5 %, angles 0.5 deg
+        right = (r["success"] and r["max_gene_error"] is not None
+                 and (r["max_gene_error"] < 1e-8 if not r["noise"] else
+                      r["gamma_error"] < 5e-3 and r["max_angle_error_deg"] < 0.5))
+        targets.append({"name": f"sequencing a 512^2 pair, noise {r['noise']:g} (CPU s)",
+                        "value": r["cpu_s"], "target": f"< {TARGET_S:g}",
+                        "met": bool(r["cpu_s"] < TARGET_S and right)})
     write_json(OUT, {"benchmark": "bench_sequencing", "load_average": os.getloadavg()[0],
                      "targets": targets, "cases": rows,
                      "units": {"cpu_s": "s (process CPU time)"}})

@@ -178,3 +178,4 @@ def test_separable_grid_model_equals_the_dense_design():
         fd = (clean.solve(p + dp, ranges, exact=True)["resid"]
               - clean.solve(p - dp, ranges, exact=True)["resid"]) / (2 * h)
         np.testing.assert_allclose(jac[:, j], fd, atol=1e-5 * np.abs(fd).max())
+

@@ -41,7 +41,9 @@ Steps (:func:`sequence_surfaces`)
 4. Variable projection: the heights are linear in the cos/sin coefficients of every
    (m, n) wave plus a plane per acquisition (which absorbs a removed mean plane);
    (ln q1, ln gamma, theta_1..theta_M) are refined by Levenberg-Marquardt with the
-   Kaufman Jacobian, in continuation over the highest chromosome fitted.
+   Kaufman Jacobian, in continuation over the highest chromosome fitted; every product
+   is separable on the tensor grids of the acquisitions (:class:`.surface_data.GridModel`);
+   among the gamma candidates the lowest BIC wins (:func:`_bic`).
 5. Genes: b_mn, phi_mn from the coefficients; (ln G, H, ln alpha) by least squares on
    ln b_mn weighted by b_mn^2; A from G (Eq. 3.1).
 Undefined points (NaN) of a measured acquisition are left out of every step.
@@ -105,6 +107,22 @@ def _fit(model, p0, budget=60, continuation=True):
         if new != ranges:            # the lattice moved across an Eq. 3.5 boundary
             ranges = new
     return p, ranges, nit
+
+
+def _bic(model, cost, sol, p):
+    """Bayesian information criterion of a fit (lower is better): rows ln(cost / rows) +
+    unknowns ln(rows), unknowns = the wave and plane coefficients and the lattice.
+
+    The lowest cost alone would not do: a lattice gamma^(1/k) holds the true lattice as
+    every k-th chromosome, so with noise it always fits a little better (its extra waves
+    fit noise: measured, 1 % noise, gamma = 1.6: gamma^(1/3) won with the misfit at the
+    noise level, H and A wrong). Its 2 M n_c (k - 1) extra coefficients lower the cost by
+    about that share of rows; the penalty ln(rows) per unknown keeps the true lattice.
+    """
+    rows = model.z.size
+    unknowns = 2 * sol["nn"].size + 3 * len(model.acqs) + len(p)
+    floor = 1e-300 + 1e-32 * float(model.z @ model.z)      # round-off: costs are equal
+    return rows * math.log(max(cost, floor) / rows) + unknowns * math.log(rows)
 
 
 def _merge_duplicate_ridges(p, tol=ANGLE_TOL / 10):
@@ -339,20 +357,13 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         if log_gamma > 0:
             starts.append(np.concatenate([[log_q1, log_gamma], centres[ridges]]))
     best, nit = None, 0
-    n_rows = model.z.size
+    # direct fits from every gamma candidate; the best is completed with missed ridges;
+    # only when that does not reproduce the data to round-off (noise, measured data) is
+    # the continuation tried from every candidate as well; the lowest BIC wins
 
-    def bic(out):
-        """Bayesian information criterion of a fit: n ln(RSS / n) + k ln n, k = linear
-        coefficients + lattice parameters. A lattice of period ln(gamma)/j nests the one
-        of ln(gamma) and fits noise with j times the waves, so the lowest residual alone
-        picks it on noisy data; the penalty keeps the coarsest lattice that explains the
-        data (on exact data both reach round-off and the coarser wins outright)."""
-        k = out[3]["a"].shape[1] + out[1].size
-        return n_rows * math.log(max(out[0], tiny) / n_rows) + k * math.log(n_rows)
+    def score(out):
+        return _bic(model, out[0], out[3], out[1])
 
-    # direct fits from every gamma candidate; the best (least BIC) is completed with
-    # missed ridges; only when that does not reproduce the data to round-off (noise,
-    # measured data) is the continuation tried from every candidate as well
     for continuation in (False, True):
         outs = []
         for p0 in starts:
@@ -363,10 +374,10 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         nit += sum(o[4] for o in outs)
         if not outs:
             continue
-        chosen = min(outs, key=bic)
-        top = complete(chosen)
-        nit += top[4] - chosen[4]
-        if best is None or bic(top) < bic(best):
+        first = min(outs, key=score)
+        top = complete(first)
+        nit += top[4] - first[4]
+        if best is None or score(top) < score(best):
             best = top
         if best[0] <= tiny:
             break
