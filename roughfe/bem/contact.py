@@ -25,7 +25,8 @@ from ..errors import InputError, NoConvergenceError, check_finite_positive, chec
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
-from .operators import KERNELS, WORKERS, InfluenceOperator, influence_operator
+from .operators import (KERNELS, WORKERS, InfluenceOperator, _irfftn_owned,
+                        influence_operator)
 from .periodic import periodic_bounded_displacement, periodic_gap_control
 from .pk import polonsky_keer
 from .solvers import SolverOutput, dense_solve
@@ -238,8 +239,15 @@ def _coarse_start(surface, material, mean_pressure, hardness):
 
 
 def _periodic_full_contact(op, h):
-    """Zero-mean pressure p' with H p' = h - mean h (exact: the spectral stiffness)."""
-    return _preconditioner(op)(h - h.mean())
+    """Zero-mean pressure p' with H p' = h - mean h (exact: the spectral stiffness).
+
+    The half-spectrum of h divided by the compliance spectrum in place (its only zero is
+    the mean mode, set to zero): no zero-mean copy of h and no cached float64 stiffness
+    spectrum (two fields fewer in memory while a load-controlled solve runs)."""
+    hh = scipy.fft.rfftn(h, workers=WORKERS)
+    hh.flat[0] = 0.0
+    np.divide(hh, op.spectrum, out=hh, where=op.spectrum > 0)
+    return _irfftn_owned(hh, h.shape)
 
 
 def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pressure=None,
@@ -348,6 +356,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 p = p0 + level
                 p[p < 0] = 0.0
                 out = SolverOutput(p, h - h.mean(), delta_full, 0, 0.0, "closed form")
+            del p0            # not kept through the iterative solve (one field)
     if out is None:
         if gap_control:
             out = periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
