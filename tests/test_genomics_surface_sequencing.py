@@ -179,3 +179,21 @@ def test_separable_grid_model_equals_the_dense_design():
               - clean.solve(p - dp, ranges, exact=True)["resid"]) / (2 * h)
         np.testing.assert_allclose(jac[:, j], fd, atol=1e-5 * np.abs(fd).max())
 
+
+
+def test_an_exact_sub_lattice_is_told_from_the_lattice():
+    """On noise-free data the sub-lattice gamma^(1/3) also reproduces the data (its extra
+    chromosomes come out empty); the sequencer stops at the first exact candidate only
+    when every chromosome carries a wave, which tells the lattice from a sub-lattice."""
+    from roughfe.genomics.sequencing.surface import _every_chromosome_present
+    from roughfe.genomics.sequencing.surface_data import GridModel, surface_acquisitions
+    g, acq, _ = _genome(5)
+    model = GridModel(surface_acquisitions(acq), N)
+    true = model.ranges(np.log(2 * np.pi / g.lambda1), np.log(g.gamma))
+    for k, present in [(1, True), (3, False)]:
+        # chromosome n of the lattice is chromosome 1 + k (n - 1) of the sub-lattice
+        p = np.r_[np.log(2 * np.pi / g.lambda1), np.log(g.gamma) / k, g.angles]
+        sol = model.solve(p, [(1 + k * (a - 1), 1 + k * (b - 1)) for a, b in true], exact=True)
+        # both reproduce the data (the sub-lattice to 1e-7 rms: 3x the waves, closer in q)
+        assert float(sol["resid"] @ sol["resid"]) < 1e-12 * float(model.z @ model.z)
+        assert _every_chromosome_present(sol) is present

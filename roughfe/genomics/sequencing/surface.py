@@ -125,6 +125,18 @@ def _bic(model, cost, sol, p):
     return rows * math.log(max(cost, floor) / rows) + unknowns * math.log(rows)
 
 
+def _every_chromosome_present(sol, ratio=1e-6):
+    """True when every chromosome of the fit carries a wave above ``ratio`` times the
+    strongest. A fit that reproduces the data to round-off with this property is the
+    lattice: a sub-lattice gamma^(1/k) (also exact) leaves k - 1 of every k chromosomes
+    empty, so the remaining gamma candidates need not be tried."""
+    w = sol["nn"].size
+    b = np.hypot(sol["coef"][:w], sol["coef"][w:2 * w])
+    per_n = np.zeros(sol["nn"].max() + 1)
+    np.maximum.at(per_n, sol["nn"], b)
+    return bool(per_n[np.unique(sol["nn"])].min() > ratio * b.max())
+
+
 def _merge_duplicate_ridges(p, tol=ANGLE_TOL / 10):
     """Drop ridges whose angle (mod pi) lies within ``tol`` of an earlier ridge's."""
     theta = np.mod(p[2:], np.pi)
@@ -371,6 +383,8 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
                 outs.append(attempt(p0, continuation))
             except (np.linalg.LinAlgError, ValueError):
                 continue
+            if outs[-1][0] <= tiny and _every_chromosome_present(outs[-1][3]):
+                break        # exact, and not a sub-lattice: no other candidate can win
         nit += sum(o[4] for o in outs)
         if not outs:
             continue
