@@ -25,7 +25,8 @@ from roughfe.bem import solve_contact
 from roughfe.bem.adhesion import SOLVERS, AdhesionLaw, solve_adhesive
 from roughfe.model import Material
 from roughfe.surfaces.spectral import spectral_surface
-from roughfe.writers import write_json
+
+from _report import write_report  # benchmarks/_report.py
 
 OUT = Path(__file__).resolve().parent / "output" / "bench_adhesion.json"
 
@@ -78,11 +79,7 @@ def main(sizes):
                 "met": bool(r[f"ratio_{kind}"] <= 3)}
                for r in rows if r["n"] == 512 and r["solver"] == SOLVERS[0]
                for kind in ("cold", "warm")]
-    write_json(OUT, {"benchmark": "bench_adhesion", "load_average": os.getloadavg()[0],
-                     "targets": targets, "cases": rows,
-                     "units": {"cpu_*": "s (process CPU time)"}})
-    for t in targets:
-        print(f"{t['name']}: {t['value']:.2f} ({'met' if t['met'] else 'NOT met'})")
+    write_report(OUT, "bench_adhesion", targets, rows, {"cpu_*": "s (process CPU time)"})
     return 0
 
 

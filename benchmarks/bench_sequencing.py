@@ -18,7 +18,8 @@ import numpy as np
 
 from roughfe.genomics.sequencing import sequence_surfaces
 from roughfe.genomics.sequencing.surface_data import resolvable_surface_genome
-from roughfe.writers import write_json
+
+from _report import write_report  # benchmarks/_report.py
 
 OUT = Path(__file__).resolve().parent / "output" / "bench_sequencing.json"
 TARGET_S = 10.0
@@ -71,11 +72,7 @@ def main(sizes):
         targets.append({"name": f"sequencing a 512^2 pair, noise {r['noise']:g} (CPU s)",
                         "value": r["cpu_s"], "target": f"< {TARGET_S:g}",
                         "met": bool(r["cpu_s"] < TARGET_S and right)})
-    write_json(OUT, {"benchmark": "bench_sequencing", "load_average": os.getloadavg()[0],
-                     "targets": targets, "cases": rows,
-                     "units": {"cpu_s": "s (process CPU time)"}})
-    for t in targets:
-        print(f"{t['name']}: {t['value']:.2f} ({'met' if t['met'] else 'NOT met'})")
+    write_report(OUT, "bench_sequencing", targets, rows, {"cpu_s": "s (process CPU time)"})
     return 0
 
 
