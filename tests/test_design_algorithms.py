@@ -2,6 +2,7 @@
 genome, stage monotonicity, reproducibility of every reported score by an independent
 BEM run of the saved design, and bad input (GCMMA on an analytic problem: tests/test_optim_gcmma.py)."""
 import importlib.util
+from dataclasses import replace
 import json
 from pathlib import Path
 
@@ -106,29 +107,35 @@ def test_bad_inputs_are_clear(entries, targets):
         de.Design.from_dict({"format": "something-else"})
 
 
-def test_exact_sensitivities_equal_finite_differences_on_fixed_contact_sets():
-    """residual_jacobian (one sweep + H_cc solves) vs forward differences with a step small
-    enough to keep every contact set: K by differences and A, through Eq. 4.2 and the
-    interpolation at the target pressures."""
-    g = db.make_genome(1.6, 0.8, 7, SETTINGS)
+@pytest.mark.parametrize("stiffness", ["fd", "exact"])
+def test_exact_sensitivities_equal_finite_differences_on_fixed_contact_sets(stiffness):
+    """residual_jacobian (one sweep + H_cc solves) vs central differences with a step small
+    enough to keep every contact set (1e-6 rad): K (by differences over the steps, or the
+    exact per-step K) and A, through Eq. 4.2 and the interpolation at the target pressures
+    (another genome's, so off the design's steps, where the interpolation has kinks).
+    Agreement to the differences' truncation and round-off error, 1e-6 of the scale."""
+    settings = replace(SETTINGS, stiffness=stiffness)
+    g = db.make_genome(1.6, 0.8, 7, settings)
     d = de.Design((de.DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 2.0, "a"),), 1.3,
-                  SETTINGS.length, SETTINGS.n_nodes)
-    other = db.make_genome(1.5, 0.9, 8, SETTINGS)     # target pressures off the curve's nodes
-    c = de.Evaluator(SETTINGS)(de.Design((de.DesignPart(other, tuple(range(
-        other.n_first, other.n_last + 1))),), 1.0, SETTINGS.length, SETTINGS.n_nodes))
+                  settings.length, settings.n_nodes)
+    other = db.make_genome(1.5, 0.9, 8, settings)     # target pressures off the curve's nodes
+    c = de.Evaluator(settings)(de.Design((de.DesignPart(other, tuple(range(
+        other.n_first, other.n_last + 1))),), 1.0, settings.length, settings.n_nodes))
     obj = de.Objective((Target(c.pressure, c.stiffness, "K"),
                         Target(c.pressure[:-1], c.area_fraction[:-1], "A")))
     keys = d.keys([[1, 2, 4]])
-    r, jac = de.residual_jacobian(d, keys, obj, SETTINGS)
-    ev = de.Evaluator(SETTINGS)
+    r, jac = de.residual_jacobian(d, keys, obj, settings)
+    ev = de.Evaluator(settings)
     np.testing.assert_allclose(r, obj.residuals(ev(d)), atol=1e-12)
     v = d.phase_values(keys)
     for col in range(len(keys)):
-        w = v.copy()
-        w[col] += 1e-7
-        fd = (obj.residuals(ev(d.with_phases(keys, w))) - r) / 1e-7
-        np.testing.assert_allclose(jac[:, col], fd, atol=1e-5 * np.abs(jac).max())
-    assert np.abs(jac).max() > 1e-3
+        w = [v.copy(), v.copy()]
+        w[0][col] += 1e-6
+        w[1][col] -= 1e-6
+        fd = np.subtract(*(obj.residuals(ev(d.with_phases(keys, x))) for x in w)) / 2e-6
+        np.testing.assert_allclose(jac[:, col], fd, atol=1e-6 * np.abs(jac).max())
+    n_k = obj.targets[0].pressure.size
+    assert np.abs(jac[:n_k]).max() > 1e-3 and np.abs(jac[n_k:]).max() > 1e-3
 
 
 def test_refinement_stage_appends_a_reproducible_fourth_score(entries, targets):

@@ -38,9 +38,22 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     interpolation at the target pressures. Gene variables (``(part, name)`` keys) get
     forward differences. One BEM sweep plus n_t solves with H_cc replace the n + 1
     sweeps of finite differences; the derivative ignores contact-set changes, as any
-    derivative of this piecewise-smooth map must (measured in
-    ``validation/design_study.py``: GCMMA reaches the same scores as with finite
-    differences).
+    derivative of this piecewise-smooth map must.
+
+    Checked against central differences (issue 14; tests in
+    ``tests/test_design_algorithms.py`` and ``tests/test_surface_database.py``): on the
+    M-CCO design of the 60-genome database (N = 512, y_t1/y_t3, 10 phases) exact and
+    central differences agree to 3e-10 (K rows) and 5e-10 (A rows) relative at steps
+    1e-5 and 1e-6 rad. At 1e-4 rad and above a grazing node enters or leaves a contact
+    set inside the step and the A rows of the differences jump (a node is 1/512 of A:
+    differences up to 59 against an exact 0.15 at 1e-4 rad, "100 %" mismatch): that is
+    the staircase of the node count, not an error of J. A second, unrelated source of
+    apparent mismatch: a target pressure that coincides with a rescaled step of the
+    design sits on a kink of the linear interpolation, where J is the one-sided
+    derivative (of the segment below) and central differences average both sides
+    (the 12 % seen on a surface test whose targets were the design's own pressures).
+    So ``dA/dphi`` here is only the shift of the staircase along p (Eq. 4.2 and the
+    interpolation): it is exact, and it says nothing about which phase adds a node.
 
     Returns
     -------
