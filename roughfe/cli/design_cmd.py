@@ -86,7 +86,8 @@ def _targets(args) -> int:
         from ..surfaces.io import load_surface
         surface = load_surface(args.surface)
         name = Path(args.surface).stem.replace(" ", "_")
-        tk, ta, curve = surface_targets(surface, settings, name=name, detrend=args.detrend)
+        tk, ta, curve = surface_targets(surface, settings, name=name, detrend=args.detrend,
+                                        boundary=args.boundary, resolution=args.resolution)
         with output_folder_of(args, "design-targets") as out:
             for t in (tk, ta):
                 print(write_target_csv(out / f"{t.name}.csv", t))
@@ -163,6 +164,14 @@ def register(sub):
                         "and NAME_A.csv")
     t.add_argument("--detrend", choices=("none", "mean", "plane"), default="plane",
                    help="detrending of --surface before the BEM")
+    t.add_argument("--boundary", choices=("periodic", "window"), default="periodic",
+                   help="a non-periodic --surface: its evenly mirrored window with the "
+                        "periodic BEM (the designs' setting) or the window alone on the "
+                        "half-space (its K then includes the window's bulk compliance)")
+    t.add_argument("--resolution", choices=("design", "full"), default="design",
+                   help="a periodic target on a surface database: resampled onto the "
+                        "database spacing L/N (the band the designs hold) or at the file's "
+                        "own sampling")
     add_output_folder(t)
     add_run_options(t, figures=False)
     t.set_defaults(func=_targets)

@@ -229,9 +229,4 @@ def mirrored_profile(surface: Surface) -> Surface:
     those of one half period: interior samples appear twice in the mirror, end samples
     once, matching their tributary lengths dx and dx/2 in the FEM.
     """
-    surface = _check_profile(surface)
-    h = np.asarray(surface.heights)
-    hm = np.concatenate([h, h[-2:0:-1]])
-    dx = surface.spacing[0]
-    return Surface(hm, hm.size * dx, periodic=True,
-                   metadata={**surface.metadata, "mirrored": True})
+    return _check_profile(surface).mirrored()

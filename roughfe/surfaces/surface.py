@@ -143,6 +143,51 @@ class Surface:
             return self.with_heights(h - (a @ coef).reshape(h.shape), detrend="plane")
         raise InputError(f"detrend mode must be 'mean' or 'plane', got {mode!r}")
 
+    def mirrored(self) -> "Surface":
+        """The evenly mirrored window: a periodic surface (or profile) of period
+        ``2 (n - 1) d`` per axis.
+
+        Along each axis the samples ``h_0, ..., h_{n-1}, h_{n-2}, ..., h_1`` (``2 (n-1)``
+        values, spacing ``d`` kept): the periodic extension of a non-periodic window
+        without the height step a plain periodic wrap puts at its edges (which would be
+        an artificial ridge). Its edges are symmetry planes, so interior samples appear
+        twice per axis and edge samples once. Metadata ``mirrored = True``.
+        """
+        h = self.heights
+        for axis in range(h.ndim):
+            back = np.flip(np.take(h, np.arange(1, h.shape[axis] - 1), axis=axis), axis=axis)
+            h = np.concatenate([h, back], axis=axis)
+        size = tuple(m * d for m, d in zip(h.shape, self.spacing))
+        return Surface(h, size, periodic=True, metadata={**self.metadata, "mirrored": True})
+
+    def resampled(self, shape) -> "Surface":
+        """The band-limited Fourier interpolant of a periodic surface on another grid of
+        the same size (``shape`` points per axis).
+
+        The discrete spectrum is kept for the wavenumbers both grids resolve,
+        ``|k| < min(n, m)/2`` per axis, and zero beyond (the Nyquist modes, which a real
+        field cannot carry with a phase, are dropped); coarsening therefore low-passes the
+        heights to the new grid's Nyquist wavenumber instead of aliasing them as thinning
+        would. The mean height is kept exactly. Metadata ``resampled_from`` (old shape).
+        """
+        if not self.periodic:
+            raise InputError("resampled() is the Fourier interpolant of a periodic surface; "
+                             "mirror a non-periodic window first (Surface.mirrored)")
+        shape = tuple(int(m) for m in np.atleast_1d(shape))
+        if len(shape) != self.ndim or min(shape) < 2:
+            raise InputError(f"resampled shape must have {self.ndim} entries >= 2, got {shape}")
+        spec = np.fft.fftn(self.heights)
+        out = np.zeros(shape, dtype=complex)
+        index = []
+        for n, m in zip(self.shape, shape):
+            k = np.arange(-((min(n, m) - 1) // 2), (min(n, m) - 1) // 2 + 1)
+            index.append(k)
+        grids = np.ix_(*index)
+        out[grids] = spec[grids]
+        h = np.fft.ifftn(out).real * (np.prod(shape) / np.prod(self.shape))
+        return Surface(h, self.size, periodic=True,
+                       metadata={**self.metadata, "resampled_from": list(self.shape)})
+
     def __repr__(self):
         kind = "profile" if self.ndim == 1 else "surface"
         return (f"Surface({kind}, shape={self.shape}, size={self.size} m, "

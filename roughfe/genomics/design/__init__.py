@@ -26,9 +26,9 @@ from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, Desig
 from .objective import Evaluator, Objective, combined_score
 from .sensitivities import residual_jacobian
 from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
-from .targets import (Y_T1_GENES, Y_T1_SURFACE_GENES, rescore, rescore_at_target_pressures,
-                      score_at_target_pressures, surface_targets, target_genome_t1,
-                      thesis_targets)
+from .targets import (TARGET_BOUNDARIES, Y_T1_GENES, Y_T1_SURFACE_GENES, rescore,
+                      rescore_at_target_pressures, score_at_target_pressures, surface_targets,
+                      target_genome_t1, thesis_targets, window_compliance)
 
 __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
            "run_design", "score_database", "search_at_target_pressures", "sog",
@@ -38,5 +38,5 @@ __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "
            "residual_jacobian", "FORMULATIONS", "GcmmaOptions", "optimise_phases",
            "phase_bounds", "Y_T1_GENES", "Y_T1_SURFACE_GENES", "rescore",
            "rescore_at_target_pressures", "score_at_target_pressures", "surface_targets",
-           "target_genome_t1", "thesis_targets", "GcmmaResult", "gcmma_maximize",
+           "target_genome_t1", "thesis_targets", "TARGET_BOUNDARIES", "window_compliance", "GcmmaResult", "gcmma_maximize",
            "gcmma_minimax"]

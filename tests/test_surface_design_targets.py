@@ -1,0 +1,91 @@
+"""Targets of a measured (non-periodic) window for surface design (issue 15 Sec. 3): the
+evenly mirrored window is the periodic interface the designs are; the window alone on a
+half-space adds its own bulk compliance in series (1/K_window ~ 1/K_periodic + C)."""
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError
+from roughfe.genomics import database as db
+from roughfe.genomics.design import surface_targets, window_compliance
+from roughfe.surfaces import Surface
+from roughfe.surfaces.io import load_surface
+
+E = 210e6
+
+
+def test_mirrored_window_is_the_even_periodic_extension():
+    rng = np.random.default_rng(3)
+    h = rng.normal(size=(5, 7))
+    s = Surface(h, (5e-6, 14e-6))
+    m = s.mirrored()
+    assert m.periodic and m.shape == (8, 12) and m.spacing == pytest.approx(s.spacing)
+    np.testing.assert_array_equal(m.heights[:5, :7], h)
+    # even about both edges of the window: h(i) = h(-i) = h(2(n-1) - i)
+    np.testing.assert_array_equal(m.heights, np.roll(m.heights[::-1, ::-1], (1, 1), (0, 1)))
+    assert Surface(np.arange(4.0), 4.0).mirrored().heights.tolist() == [0, 1, 2, 3, 2, 1]
+
+
+def test_resampled_is_the_band_limited_interpolant():
+    """Waves both grids resolve are evaluated exactly on the new nodes; a wave beyond the
+    new Nyquist wavenumber is removed (thinning would alias it); the mean is kept;
+    resampling onto the same grid is the identity."""
+    x = np.arange(40) / 40
+    keep = 1.0 + np.cos(2 * np.pi * 3 * x)[:, None] + 0.5 * np.sin(2 * np.pi * (2 * x[:, None]
+                                                                              + 5 * x[None, :]))
+    s = Surface(keep + np.cos(2 * np.pi * 15 * x)[None, :], (1e-5, 1e-5), periodic=True)
+    r = s.resampled((16, 12))
+    xr, yr = np.arange(16) / 16, np.arange(12) / 12
+    exact = 1.0 + np.cos(2 * np.pi * 3 * xr)[:, None] + 0.5 * np.sin(
+        2 * np.pi * (2 * xr[:, None] + 5 * yr[None, :]))
+    np.testing.assert_allclose(r.heights, exact, atol=1e-13)
+    assert r.size == s.size and r.periodic
+    np.testing.assert_allclose(s.resampled((40, 40)).heights, s.heights, atol=1e-13)
+    with pytest.raises(InputError, match="periodic"):
+        Surface(keep, (1e-5, 1e-5)).resampled((8, 8))
+    with pytest.raises(InputError, match="shape"):
+        s.resampled((8,))
+
+
+def test_window_compliance_of_a_square_is_loves_mean_deflection():
+    """Mean deflection of a uniformly loaded square of side a on a half-space: 0.946 p a/E*
+    (the tabulated influence factors of a flexible square footing: centre 1.122, corner
+    2 ln(1 + sqrt 2)/pi = 0.561 (Love), mean 0.946); the grid sum converges to it."""
+    a = 1e-4
+    c = [window_compliance(Surface(np.zeros((n, n)), (a, a)), E) * E / a for n in (16, 32)]
+    assert abs(c[1] - 0.9462) < abs(c[0] - 0.9462) < 0.01
+    assert c[1] == pytest.approx(0.9462, rel=2e-3)
+
+
+def test_window_target_is_the_periodic_interface_in_series_with_the_window(topographies_dir):
+    """x3p-2 (thinned to 55 x 55 over its 83 x 204 um): the window alone on the half-space
+    (non-periodic kernel) is stiffer than nothing but saturates at 1/C, its bulk compliance
+    in series with the rough interface of the mirrored (periodic) window:
+    1/K_window = 1/K_periodic + C within 7 % beyond the first step (whose K is a one-sided
+    difference), and K_window < 1/C everywhere while K_periodic exceeds 1/C tenfold."""
+    x = load_surface(topographies_dir / "x3p-2.x3p")
+    h = x.heights[::12, ::12]
+    s = Surface(h, (h.shape[0] * x.spacing[0] * 12, h.shape[1] * x.spacing[1] * 12))
+    settings = db.DatabaseSettings(length=1e-4, n_nodes=32, dim=2, top_fraction=0.8,
+                                   youngs_modulus=E, n_steps=8)
+    kw, _, win = surface_targets(s, settings, boundary="window")
+    fine = db.DatabaseSettings(**{**settings.to_dict(), "top_fraction": 0.95, "n_steps": 24})
+    kp, ap, per = surface_targets(s, fine, resolution="full")
+    assert kp.metadata["boundary"] == "periodic" and kp.metadata["resolution"] == "full"
+    assert kp.metadata["solved_shape"] == [2 * (n - 1) for n in s.shape]
+    c = window_compliance(s.detrended("plane"), E)
+    assert c == pytest.approx(0.9 * np.sqrt(np.prod(s.size)) / E, rel=0.03)
+    k_per = np.exp(np.interp(np.log(win.pressure), np.log(per.pressure),
+                             np.log(per.stiffness)))
+    predicted = 1.0 / (1.0 / k_per + c)
+    assert np.all(win.stiffness < 1.0 / c)
+    assert per.stiffness.max() > 10.0 / c
+    np.testing.assert_allclose(predicted[1:], win.stiffness[1:], rtol=0.07)
+    # the default: resampled onto the database spacing L/N (same band as the designs)
+    kd, _, _ = surface_targets(s, settings)
+    spacing = settings.length / settings.n_nodes
+    assert kd.metadata["solved_shape"] == [round(2 * (n - 1) * d / spacing)
+                                           for n, d in zip(s.shape, s.spacing)]
+    with pytest.raises(InputError, match="boundary"):
+        surface_targets(s, settings, boundary="free")
+    with pytest.raises(InputError, match="resolution"):
+        surface_targets(s, settings, resolution="fine")
