@@ -240,3 +240,26 @@ def test_preconditioned_cg_and_lbfgsb_reach_the_same_equilibrium(kind):
 def test_unknown_adhesive_solver_is_refused():
     with pytest.raises(InputError, match="solver"):
         solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=0.0, solver="newton")
+
+
+def test_unloading_steps_grow_past_the_pull_off_until_separation():
+    # Rough periodic contact, soft body, strong exponential adhesion: the last patches
+    # peel off over a mean-gap opening ~ |p_pull| L / E* (microns), far beyond the loading
+    # range. With a fixed step 12 solves do not separate (the pull-off is then a bound);
+    # with steps growing once the load recovers from its minimum they do, and the
+    # pull-off (sampled at the fixed step while the states grow more tensile) is the same.
+    s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=2 * 2 * np.pi / 1e-5,
+                         q_short=8 * 2 * np.pi / 1e-5, rng=3)
+    mat, law = Material(1e6, 0.5), AdhesionLaw("exp", 0.02, 2e-9)
+    deltas = np.linspace(0.1, 0.6, 3) * float(s.heights.max() - s.heights.mean())
+    fixed = adhesive_sweep(s, mat, law, deltas, unload=True, max_unload_steps=12,
+                           unload_growth=1.0)
+    grown = adhesive_sweep(s, mat, law, deltas, unload=True, max_unload_steps=12)
+    assert not fixed.detached and grown.detached
+    assert grown.pull_off_pressure == pytest.approx(fixed.pull_off_pressure, rel=1e-12)
+    # a tensile pull-off no larger than the peak traction of the law; separated at the end
+    assert -law.max_traction < grown.pull_off_pressure < 0
+    last = grown.sweep.results[-1]
+    assert last.n_contact == 0 and abs(last.load) < 1e-3 * abs(grown.pull_off_force)
+    with pytest.raises(InputError, match="unload_growth"):
+        adhesive_sweep(s, mat, law, deltas, unload=True, unload_growth=0.5)

@@ -1,12 +1,14 @@
 """Pastewka-Robbins stickiness criterion (roughfe.theory.stickiness): the Hertzian edge
-constants, Eq. (2) in closed form, its scaling with w, the range and the roughness."""
+constants, the published Eq. (10) by hand and against our ring derivation, its scaling
+with w, the range and the roughness."""
 import numpy as np
 import pytest
 
 from roughfe.errors import InputError
 from roughfe.surfaces.spectral import spectral_surface
 from roughfe.surfaces.surface import Surface
-from roughfe.theory.stickiness import EDGE_COEFFICIENT, pastewka_robbins
+from roughfe.theory.stickiness import (EDGE_COEFFICIENT, pastewka_robbins, published_criterion,
+                                       ring_stickiness)
 
 
 def _surface(scale=1.0):
@@ -30,15 +32,38 @@ def test_edge_coefficients_are_the_hertzian_gap_expansions():
                                                                    rel=1e-5)
 
 
+def test_published_equation_10_by_hand():
+    # Pastewka & Robbins Eq. (10): C = (dr h' / (kappa l_a)) (h' d_rep / (4 dr))^(2/3),
+    # d_rep = 4 h'/h''. h' = 0.1, h'' = 1e7 /m, dr = l_a = 1 nm, kappa = 2:
+    # C = 0.05 (0.01 / (1e7 1e-9))^(2/3) = 0.05; kappa = 4 halves it.
+    assert published_criterion(0.1, 1e7, 1e-9, 1e-9) == pytest.approx(0.05, rel=1e-14)
+    assert published_criterion(0.1, 1e7, 1e-9, 1e-9, 4.0) == pytest.approx(0.025, rel=1e-14)
+
+
+def test_derived_ring_argument_equals_equation_10_at_kappa_2():
+    # our mean-field derivation (Hertzian edge, ring of the attraction) reproduces the
+    # published Eq. (10) for a surface at kappa_rep = 2; S C = (kappa/2)^(2/3)
+    # otherwise (the published form is what pastewka_robbins uses)
+    for slope, curv, la, dr in ((0.1, 1e7, 1e-9, 1e-9), (0.026, 3e6, 2.3e-8, 5e-9)):
+        s, _ = ring_stickiness(2, slope, curv, la, dr)
+        assert s == pytest.approx(1 / published_criterion(slope, curv, la, dr), rel=1e-12)
+        s3, _ = ring_stickiness(2, slope, curv, la, dr, 3.0)
+        c3 = published_criterion(slope, curv, la, dr, 3.0)
+        assert s3 * c3 == pytest.approx((3 / 2) ** (2 / 3), rel=1e-12)
+
+
 def test_closed_form_and_scaling():
     s = _surface()
     e_star, w, dr = 1.33e6, 1e-4, 5e-9
     r = pastewka_robbins(s, e_star, w, dr)
     h1, h2 = r.rms_slope, r.rms_curvature
-    a = 2 * h1 / h2
-    closed = 2 * (2 * w / e_star / (h1 * dr)) * (2 * dr / (2 * np.sqrt(2) * h1 * a)) ** (2 / 3)
-    assert r.stickiness == pytest.approx(closed, rel=1e-12)
+    closed = dr * h1 / (2 * w / e_star) * (h1 * h1 / (h2 * dr)) ** (2 / 3)
+    assert r.published and r.dimension == 2
+    assert r.criterion == pytest.approx(closed, rel=1e-12)
+    assert r.stickiness == pytest.approx(1 / closed, rel=1e-12)
     assert r.kappa_ratio == pytest.approx(1 / (1 - r.stickiness), rel=1e-12)
+    assert r.tabor_parameter == pytest.approx((w * w / e_star ** 2 / h2) ** (1 / 3) / dr,
+                                              rel=1e-12)
     # linear in w; Delta_r^(-1/3); heights x lambda -> lambda^(-5/3) (h_rms itself does not
     # enter, only slopes and curvatures); w and E* only as l_a = w / E*
     assert pastewka_robbins(s, e_star, 3 * w, dr).stickiness == pytest.approx(
@@ -49,8 +74,8 @@ def test_closed_form_and_scaling():
         r.stickiness * 2 ** (-5 / 3), rel=1e-9)
     assert pastewka_robbins(s, 2 * e_star, 2 * w, dr).stickiness == pytest.approx(
         r.stickiness, rel=1e-12)
-    # the verdict flips at S = 1
-    w1 = w / r.stickiness
+    # the verdict flips at C = 1
+    w1 = w * r.criterion
     assert not pastewka_robbins(s, e_star, 0.99 * w1, dr).sticky
     assert pastewka_robbins(s, e_star, 1.01 * w1, dr).sticky
     assert r.describe()["references"]
@@ -63,8 +88,9 @@ def test_profile_uses_the_strip_edge():
     r = pastewka_robbins(prof, 1e6, 1e-4, 5e-9)
     a = 2 * r.rms_slope / r.rms_curvature
     d = (5e-9 * np.sqrt(a) / (EDGE_COEFFICIENT[1] * r.rms_slope / 2)) ** (2 / 3)
-    assert r.dimension == 1 and r.ring_width == pytest.approx(d, rel=1e-12)
+    assert r.dimension == 1 and not r.published and r.ring_width == pytest.approx(d, rel=1e-12)
     assert r.stickiness == pytest.approx((1e-4 / 5e-9) / r.repulsive_pressure * d / a, rel=1e-12)
+    assert r.criterion == pytest.approx(1 / r.stickiness, rel=1e-12)
 
 
 @pytest.mark.parametrize("args, match", [((1e6, 0.0, 1e-9), "work of adhesion"),

@@ -406,8 +406,9 @@ class AdhesiveSweep:
 
 
 def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, deltas, *,
-                   unload: bool = False, max_unload_steps=None, kernel: str = "auto",
-                   tol: float = 1e-5, max_iter: int = 20000) -> AdhesiveSweep:
+                   unload: bool = False, max_unload_steps=None, unload_growth: float = 2.0,
+                   kernel: str = "auto", tol: float = 1e-5,
+                   max_iter: int = 20000) -> AdhesiveSweep:
     """Continuation in the approach: loading through ``deltas`` and, with ``unload``,
     back down past them until the surfaces separate (see the module docstring).
 
@@ -417,8 +418,16 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
         Increasing approaches (m) of the loading branch.
     unload : bool
         Also trace the unloading branch: the loading approaches in reverse, then further
-        apart with the last loading step size until separation (at most
-        ``max_unload_steps``, default 4 x the loading steps, beyond the loading range).
+        apart until separation (at most ``max_unload_steps`` solves beyond the loading
+        range, default 4 x the loading steps).
+    unload_growth : float
+        Step control beyond the loading range: the step is the last loading step while
+        each state is more tensile than every earlier one (the approach to the pull-off
+        is sampled at the loading resolution, in displacement control), and grows by
+        this factor per step once the load recovers from its minimum (the separation
+        tail: in a periodic cell the last patches peel off over a mean-gap opening of
+        order ``|pull-off pressure| L / E*``, far beyond the loading range). 1 keeps
+        the step fixed. Must be >= 1.
     Other parameters as in :func:`solve_adhesive`.
     """
     deltas = np.atleast_1d(np.asarray(deltas, float))
@@ -431,23 +440,33 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
         prev = solve_adhesive(surface, material, law, delta=d, kernel=kernel, initial=prev,
                               tol=tol, max_iter=max_iter, unloading=False)
         results.append(prev)
+    growth = float(unload_growth)
+    if not (np.isfinite(growth) and growth >= 1.0):
+        raise InputError(f"unload_growth must be a finite factor >= 1, got {unload_growth!r}")
     pull, detached = float("nan"), False
     if unload:
         step = float(deltas[-1] - deltas[-2]) if deltas.size > 1 else float(abs(deltas[0]))
         step = step if step > 0 else law.range
-        extra = int(max_unload_steps or 4 * deltas.size)
-        path = list(deltas[-2::-1]) + [deltas[0] - step * (k + 1) for k in range(extra)]
         loads = []
-        for k, d in enumerate(path):
-            prev = solve_adhesive(surface, material, law, delta=d, kernel=kernel, initial=prev,
-                                  tol=tol, max_iter=max_iter, unloading=True)
-            results.append(prev)
-            loads.append(prev.load)
-            low = min(loads)
-            if k >= deltas.size - 1 and prev.n_contact == 0 and low < 0 \
-                    and prev.load > 1e-3 * low:
+
+        def unload_to(d):
+            state = solve_adhesive(surface, material, law, delta=d, kernel=kernel,
+                                   initial=prev, tol=tol, max_iter=max_iter, unloading=True)
+            results.append(state)
+            loads.append(state.load)
+            return state
+
+        for d in deltas[-2::-1]:              # the loading approaches in reverse
+            prev = unload_to(d)
+        d, h = float(deltas[0]), step
+        for _ in range(int(max_unload_steps or 4 * deltas.size)):
+            low = min(loads) if loads else float("inf")
+            d -= h
+            prev = unload_to(d)
+            if prev.n_contact == 0 and min(loads) < 0 and prev.load > 1e-3 * min(loads):
                 detached = True
                 break
+            h = step if prev.load < low else growth * h
         pull = float(min(loads))
     sweep = SweepResult.from_results(results, rms_slope=rms_slope(surface),
                                      length=surface.size[0])

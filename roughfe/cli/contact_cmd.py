@@ -133,7 +133,7 @@ def _run(args) -> int:
         st = doc["derived"]["stickiness"]
         print(f"pull-off force {adhesive.pull_off_force:.4e} "
               f"({'detached' if adhesive.detached else 'NOT detached: a bound'}); "
-              f"Pastewka-Robbins S = {st['stickiness']:.3g} "
+              f"Pastewka-Robbins C = {st['criterion']:.3g} (Eq. 10, sticky if < 1) "
               f"({'sticky' if st['sticky'] else 'not sticky'})")
     print(f"wrote {out / 'results.json'}, {out / 'fields.h5'}")
     return 0

@@ -3,45 +3,53 @@
 Pastewka & Robbins (2014) found in simulations of self-affine surfaces that the
 repulsive contact area stays proportional to the load, ``A_rep / A0 = kappa p /
 (E* h'_rms)``, and that adhesion changes only the prefactor: ``kappa`` rises with the
-adhesive strength and, above a threshold, changes sign through infinity: the surfaces
-become *sticky* (contact survives at zero and tensile load, a finite force pulls them
-apart). Their mean-field argument, written out here in our notation (own derivation of
-the paper's argument; the O(1) constants follow from the Hertzian edge stated below):
+adhesive strength and, above a threshold, changes sign: the surfaces become *sticky*
+(the area-load line bends into the tensile quadrant; their simulations read its secant at
+A_rep / A0 ~ 1 %, Ciavarella & Papangelo 2018).
 
-1. Repulsive patches carry the mean pressure ``p_rep = h'_rms E* / kappa_rep`` (the
-   non-adhesive result; ``kappa_rep`` ~ 2 in BEM simulations, the default here) and
-   have the characteristic diameter ``d_rep = 4 h'_rms / h''_rms`` (rms slope over rms
-   curvature), half-width ``a = d_rep / 2``.
-2. Outside a repulsive patch the gap opens as at the edge of a Hertzian contact with
-   that mean pressure (non-adhesive, DMT-like: adhesion does not change the patch),
+**The published criterion (surfaces).** Their Eq. (10): the surfaces are sticky when
 
-       g(xi) = c_d (p_rep / E*) xi^(3/2) / sqrt(a),                                    (1)
+    C = (Delta_r h'_rms / (kappa_rep l_a)) (h'_rms d_rep / (4 Delta_r))^(2/3) < 1,     (10)
 
-   xi the distance from the edge; ``c_2 = 2 sqrt(2)`` for a circular patch of a surface
-   (the expansion of Hertz's gap for a sphere) and ``c_1 = 16 sqrt(2) / (3 pi)`` for a
-   strip of a profile in plane strain (Hertz's cylinder).
-3. The attraction (range ``Delta_r``, mean traction ``sigma_0 = w / Delta_r``: exact for
-   Maugis-Dugdale, the peak traction for the exponential law) acts where
-   ``g < Delta_r``: a ring of width ``d = (Delta_r sqrt(a) / (c_d p_rep / E*))^(2/3)``
-   around every patch, whose area per repulsive area is ``n_d d / a`` (perimeter over
-   area: ``n_2 = 2`` for a disc, ``n_1 = 1`` for a strip).
-4. The load is the repulsive minus the attractive force,
-   ``N = N_rep (1 - S)`` with the stickiness number
+``l_a = w / E*``, ``Delta_r`` the range of the attraction, ``kappa_rep`` ~ 2 the
+non-adhesive prefactor and ``d_rep = 4 h'_rms / h''_rms`` the characteristic diameter of
+the repulsive patches (rms slope h'_rms = sqrt<|grad h|^2>, rms curvature h''_rms =
+sqrt<(lap h / 2)^2>, :mod:`roughfe.surfaces.stats`). With that ``d_rep``,
+``C = (Delta_r h'_rms / (kappa_rep l_a)) (h'_rms^2 / (h''_rms Delta_r))^(2/3)``: the form
+in which the paper's first author's group evaluates "P&R equation 10, with kappa_rep = 2,
+d_rep = 4 h'_rms / h''_rms" (ContactEngineering/Adhesion, examples/
+adhesive_simulation_rough.py and its rough-adhesion tests; "only valid in the DMT
+regime"); ``kappa_rep`` enters only the prefactor there. The paper's own text
+(PNAS 111:3298, PMC3948287, arXiv:1311.1178) was not reachable offline: the stored copies
+hold only its abstract; the equation and its constants are taken from that
+implementation, which is written by the paper's first author's group.
 
-       S = N_att / N_rep = n_d (sigma_0 / p_rep) (d / a)
-         = n_d (kappa_rep l_a / (h'_rms Delta_r)) (kappa_rep Delta_r / (c_d h'_rms a))^(2/3),
-                                                                                       (2)
+**Our derivation gives the same** (kept for profiles and for the diagnostics): repulsive
+patches carry ``p_rep = h'_rms E* / kappa_rep`` and have half-width ``a = d_rep / 2``;
+outside a patch the gap opens as at a Hertzian edge of that mean pressure,
 
-   ``l_a = w / E*``. Hence ``A_rep = kappa_rep / (1 - S) N / (h'_rms E*)``: the prefactor
-   rises linearly for weak adhesion, diverges at ``S = 1`` and is negative beyond:
-   **sticky if S > 1**. Like the paper's criterion, S depends on the slopes and
-   curvatures (the finest scales) and on w, Delta_r and E*, not on h_rms.
+    g(xi) = c_d (p_rep / E*) xi^(3/2) / sqrt(a),                                       (1)
 
-Validity (reported): the ring is thin, ``d / a << 1`` (DMT side); for ``d / a`` of order
-one the patches are JKR-like and Eq. (1) no longer holds. The criterion is a mean-field
-estimate: Ciavarella (2016) and Ciavarella & Papangelo (2018) point out that finite
-pull-off forces are found in simulations that it calls non-sticky (see the measured
-comparison in docs/theory/07_adhesion_persson.md).
+``c_2 = 2 sqrt(2)`` (circular patch: Hertz's sphere), ``c_1 = 16 sqrt(2) / (3 pi)``
+(strip of a profile: Hertz's cylinder); the attraction ``sigma_0 = w / Delta_r`` acts on
+the ring ``g < Delta_r`` of width ``d = (Delta_r sqrt(a) / (c_d p_rep / E*))^(2/3)``, area
+per repulsive area ``n_d d / a`` (``n_2 = 2``, ``n_1 = 1``), so the attractive over the
+repulsive load is
+
+    S = n_d (kappa_rep l_a / (h'_rms Delta_r)) (kappa_rep Delta_r / (c_d h'_rms a))^(2/3). (2)
+
+For a surface with ``kappa_rep = 2``, ``S = 1 / C`` exactly (tested): the mean-field ring
+argument with the Hertzian edge reproduces Eq. (10); for other ``kappa_rep``,
+``S C = (kappa_rep / 2)^(2/3)`` and the published form is used. For a profile the
+paper gives no criterion: Eq. (2) with the strip constants is our analogue
+(``published`` is False), ``C = 1 / S``.
+
+Validity (reported): the ring is thin, ``d / a << 1``, and the contact DMT-like, Tabor
+parameter ``mu = (R l_a^2)^(1/3) / Delta_r`` of the asperity radius ``R = 1 / h''_rms``
+not large. The criterion is a mean-field estimate: Ciavarella (2016) and Ciavarella &
+Papangelo (2018) show that finite pull-off forces occur in simulations (the paper's own
+among them) that it calls non-sticky; the pull-off is therefore reported beside it, not
+compared with it (docs/theory/07_adhesion_persson.md).
 """
 from __future__ import annotations
 
@@ -60,9 +68,10 @@ EDGE_COEFFICIENT = {2: 2.0 * np.sqrt(2.0), 1: 16.0 * np.sqrt(2.0) / (3.0 * np.pi
 PERIMETER_FACTOR = {2: 2.0, 1: 1.0}
 
 REFERENCES = (
-    "Pastewka L., Robbins M.O. (2014) Proc. Natl. Acad. Sci. USA 111:3298-3303 "
+    "Pastewka L., Robbins M.O. (2014) Proc. Natl. Acad. Sci. USA 111:3298-3303, Eq. (10) "
     "(stickiness criterion)",
     "Ciavarella M. (2016) J. Tribol. 139:031404 (discussion of the criterion)",
+    "Ciavarella M., Papangelo A. (2018) J. Adhes. 94:155-165 (pull-off vs the criterion)",
 )
 
 
@@ -72,20 +81,28 @@ class Stickiness:
 
     Attributes
     ----------
+    criterion : float
+        C, the left-hand side of Pastewka & Robbins' Eq. (10) (-); sticky if C < 1.
     stickiness : float
-        S of Eq. (2) (-); sticky if S > 1.
+        S = 1 / C (-): the attractive over the repulsive load of the mean-field argument,
+        Eq. (2) (exact for kappa_rep = 2); sticky if S > 1.
     sticky : bool
-        ``S > 1``.
+        ``C < 1``.
+    published : bool
+        True for a surface (Eq. (10) of the paper); False for a profile (our strip
+        analogue, Eq. (2) with c_1, n_1: the paper has no 1D criterion).
     kappa_ratio : float
-        Predicted ``kappa / kappa_rep = 1 / (1 - S)`` (-), negative when sticky.
+        Mean-field ``kappa / kappa_rep = 1 / (1 - S)`` (-), negative when sticky.
     rms_slope, rms_curvature : float
         h'_rms (-) and h''_rms (1/m) of the surface.
     contact_diameter : float
         d_rep = 4 h'_rms / h''_rms (m).
     ring_width : float
-        Width d of the attractive ring around a repulsive patch (m).
+        Width d of the attractive ring around a repulsive patch, Eq. (1) (m).
     ring_over_half_width : float
         d / a (-): the criterion assumes d / a << 1.
+    tabor_parameter : float
+        ``(R l_a^2)^(1/3) / Delta_r`` with R = 1 / h''_rms (-): DMT-like when small.
     repulsive_pressure : float
         p_rep = h'_rms E* / kappa_rep (Pa).
     adhesion_length : float
@@ -96,14 +113,17 @@ class Stickiness:
         1 (profile) or 2 (surface).
     """
 
+    criterion: float
     stickiness: float
     sticky: bool
+    published: bool
     kappa_ratio: float
     rms_slope: float
     rms_curvature: float
     contact_diameter: float
     ring_width: float
     ring_over_half_width: float
+    tabor_parameter: float
     repulsive_pressure: float
     adhesion_length: float
     kappa_rep: float
@@ -122,9 +142,36 @@ class Stickiness:
         return out
 
 
+def published_criterion(slope, curvature, adhesion_length, interaction_range,
+                        kappa_rep=KAPPA_REP):
+    """Left-hand side C of Pastewka & Robbins' Eq. (10) (-): sticky if C < 1.
+
+    ``C = (Delta_r h' / (kappa_rep l_a)) (h' d_rep / (4 Delta_r))^(2/3)`` with
+    ``d_rep = 4 h' / h''``; ``slope`` h'_rms (-), ``curvature`` h''_rms (1/m),
+    ``adhesion_length`` l_a = w / E* (m), ``interaction_range`` Delta_r (m).
+    """
+    d_rep = 4.0 * slope / curvature
+    return (interaction_range * slope / (kappa_rep * adhesion_length)
+            * (slope * d_rep / (4.0 * interaction_range)) ** (2.0 / 3.0))
+
+
+def ring_stickiness(dimension, slope, curvature, adhesion_length, interaction_range,
+                    kappa_rep=KAPPA_REP):
+    """Mean-field S = N_att / N_rep of Eq. (2) and the ring width d (m) of Eq. (1).
+
+    Hertzian edge of the repulsive patches (``c_d``, ``n_d`` of the dimension); equals
+    ``1 / published_criterion`` for a surface at ``kappa_rep = 2``.
+    """
+    c, n = EDGE_COEFFICIENT[dimension], PERIMETER_FACTOR[dimension]
+    a = 2.0 * slope / curvature
+    p_over_e = slope / kappa_rep
+    ring = (interaction_range * np.sqrt(a) / (c * p_over_e)) ** (2.0 / 3.0)
+    return n * (adhesion_length / interaction_range) / p_over_e * ring / a, ring
+
+
 def pastewka_robbins(surface: Surface, e_star, work, interaction_range, *,
                      kappa_rep: float = KAPPA_REP) -> Stickiness:
-    """Pastewka-Robbins stickiness of ``surface`` against an elastic body (Eq. (2)).
+    """Pastewka-Robbins stickiness of ``surface`` against an elastic body (Eq. (10)).
 
     Parameters
     ----------
@@ -145,6 +192,7 @@ def pastewka_robbins(surface: Surface, e_star, work, interaction_range, *,
     Returns
     -------
     Stickiness
+        Eq. (10) for a surface; for a profile our strip analogue (``published`` False).
     """
     check_instance("surface", surface, Surface, "a roughfe Surface")
     e_star = check_finite_positive("E* (Pa)", e_star)
@@ -156,16 +204,18 @@ def pastewka_robbins(surface: Surface, e_star, work, interaction_range, *,
         raise InputError(f"the stickiness criterion needs a rough surface (rms slope "
                          f"{slope:.3g}, rms curvature {curv:.3g} 1/m; both must be > 0)")
     dim = surface.ndim
-    c, n = EDGE_COEFFICIENT[dim], PERIMETER_FACTOR[dim]
+    l_a = work / e_star
+    s, ring = ring_stickiness(dim, slope, curv, l_a, dr, kappa_rep)
+    published = dim == 2
+    c = published_criterion(slope, curv, l_a, dr, kappa_rep) if published else 1.0 / s
+    s = 1.0 / c
     d_rep = 4.0 * slope / curv
-    a = 0.5 * d_rep
-    p_rep = slope * e_star / kappa_rep
-    ring = (dr * np.sqrt(a) / (c * p_rep / e_star)) ** (2.0 / 3.0)
-    s = n * (work / dr) / p_rep * ring / a
-    return Stickiness(stickiness=float(s), sticky=bool(s > 1.0),
+    return Stickiness(criterion=float(c), stickiness=float(s), sticky=bool(c < 1.0),
+                      published=published,
                       kappa_ratio=float(1.0 / (1.0 - s)) if s != 1.0 else float("inf"),
                       rms_slope=slope, rms_curvature=curv, contact_diameter=float(d_rep),
-                      ring_width=float(ring), ring_over_half_width=float(ring / a),
-                      repulsive_pressure=float(p_rep), adhesion_length=work / e_star,
-                      kappa_rep=kappa_rep, work=work, range=dr, e_star=e_star,
-                      dimension=dim)
+                      ring_width=float(ring), ring_over_half_width=float(2.0 * ring / d_rep),
+                      tabor_parameter=float((l_a * l_a / curv) ** (1.0 / 3.0) / dr),
+                      repulsive_pressure=float(slope * e_star / kappa_rep),
+                      adhesion_length=l_a, kappa_rep=kappa_rep, work=work, range=dr,
+                      e_star=e_star, dimension=dim)
