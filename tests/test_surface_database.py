@@ -227,3 +227,29 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
     assert main(["db", "build", str(tmp_path / "x.sqlite"), "--dim", "2",
                  "--top-fraction", "1.5"]) == 2
     assert "top_fraction" in capsys.readouterr().err
+
+
+def test_match_spectrum_restores_a_genome_whose_hurst_exponent_moved(surface_db):
+    """Target: a database genome with H lowered by 0.3 (same phases, every chromosome's
+    amplitude changed: outside the database, and Eq. 4.2 cannot undo it). SOG without
+    GCMMA iterations keeps the parent; matching the chromosome amplitudes to the target
+    surface's band rms (match_spectrum) restores the target itself, so the strict score
+    goes to 1 (round-off), and a fresh BEM run of the saved design reproduces it."""
+    from roughfe.genomics.design import GcmmaOptions, match_spectrum
+
+    path, _ = surface_db
+    entries = db.load_entries(path)
+    g = Genome.from_dict(entries[1].genome)
+    g = replace(g, H=g.H - 0.3, A=2.0)
+    target = Design((DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "t"),), 1.0, L,
+                    32, "t", 2)
+    c = Evaluator(SETTINGS)(target)
+    tk = Target(c.pressure, c.stiffness, "K", "tK", {})
+    res = run_design("sog", [entries[1]], [tk], SETTINGS,
+                     options=GcmmaOptions(n_it_sog=0, n_it_micro=0))
+    before = rescore_at_target_pressures(res.best.design, [tk], SETTINGS)[0]
+    matched = match_spectrum(res, target.surface(), SETTINGS)
+    assert before < 0.9 and matched.best.at_targets[0] == pytest.approx(1.0, abs=1e-6)
+    assert matched.success and matched.nit == res.nit + 4     # strict before, 2 in _finish, after
+    assert rescore_at_target_pressures(matched.best.design, [tk], SETTINGS)[0] == \
+        matched.best.at_targets[0]

@@ -89,3 +89,24 @@ def test_window_target_is_the_periodic_interface_in_series_with_the_window(topog
         surface_targets(s, settings, boundary="free")
     with pytest.raises(InputError, match="resolution"):
         surface_targets(s, settings, resolution="fine")
+
+
+def test_spectrum_matched_recovers_the_chromosome_amplitudes_of_a_reweighted_design():
+    """A target that is the design with every chromosome's amplitude changed (same phases,
+    lattice waves on the axes): matching the band rms restores it exactly; a profile
+    design or a non-periodic target is refused."""
+    from roughfe.genomics.design import Design, DesignPart, spectrum_matched
+    from roughfe.genomics.genome import random_genome
+
+    length, n = 1e-4, 32
+    g = random_genome(1e-6, 0.8, 2.0, length, 2, 5, rng=4, angles=[0.0, np.pi / 2],
+                      anisotropy=[1.0, 0.6])
+    d = Design((DesignPart(g, (1, 2, 3, 4, 5), 1.0, "g"),), 1.0, length, n, "g", 2)
+    split = d.split_chromosomes()
+    w = np.random.default_rng(5).uniform(0.2, 3.0, len(split.parts))
+    target = split.with_phases([(k, "weight") for k in range(len(w))], w).surface()
+    matched = spectrum_matched(d, target).surface().heights
+    ref = target.heights - target.heights.mean()
+    np.testing.assert_allclose(matched - matched.mean(), ref, atol=1e-12 * np.ptp(ref))
+    with pytest.raises(InputError, match="periodic"):
+        spectrum_matched(d, Surface(target.heights, target.size))

@@ -14,17 +14,21 @@ of :mod:`roughfe.validation`).
       plane removed) on a grid thinned to <= 48 points per side, BEM curves of every band
       and TD/BU partial sum (8 approaches each); the bands sum exactly to the detrended
       surface and the TD sum of all bands is the complete surface (c_n = 1).
-(iv)  Surface design: a 2D genome database (``roughfe db build --dim 2``: 24 genomes,
-      32 x 32 periodic realisations, M = 3 ridges, Sobol angles and anisotropy, E = 210 MPa,
-      10 approaches to 0.8 of full contact), L = sqrt(Lx Ly) of x3p-2. Targets: K(p) and
-      A(p) of (a) y_t1, a 3-ridge genome outside the database, and (b) the measured x3p-2
-      (its own BEM sweep, non-periodic kernel, every fourth point: 163 x 163 over the full
-      82.98 x 204.48 um). The sizes are what the shared 2-core machine allowed (see
-      docs/theory/surface-design.md); the design code has no size limit. SOG/GCO/CCO on K, M-CCO on K and A,
-      each followed by the search at the target pressures. Goals (issue 15): s >= 0.98 on
-      K and f >= 0.9 on K+A, scored at the target's own pressures (load-controlled BEM),
-      every score reproduced by an independent BEM run of the saved design; a design run
-      < 30 min CPU.
+(iv)  Surface design: a 2D genome database (``roughfe db build --dim 2``: 48 genomes,
+      64 x 64 periodic realisations, M = 3 ridges, Sobol angles and anisotropy, H in
+      [0.1, 1.5], E = 210 MPa, 10 approaches to 0.8 of full contact), period L that of the
+      evenly mirrored x3p-2 window (259.7 um). Targets: K(p) and A(p) of (a) y_t1, a
+      3-ridge genome outside the database, and (b) the measured x3p-2 (every fourth point,
+      163 x 163 over the full 82.98 x 204.48 um, plane removed, evenly mirrored and solved
+      with the periodic BEM on the database spacing: the designs' own setting, see
+      docs/theory/surface-design.md; the window alone on the half-space is solved too, to
+      check that its K is the interface in series with the window's bulk compliance).
+      SOG/GCO/CCO on K, M-CCO on K and A; for x3p-2 the chromosome amplitudes matched to
+      its spectrum (match_spectrum, + 3 matched database genomes); each followed by the
+      search at the target pressures (phases and chromosome amplitudes). Goals (issue
+      15): s >= 0.98 on K and f >= 0.9 on K+A, scored at the target's own pressures
+      (load-controlled BEM), every score reproduced by an independent BEM run of the
+      saved design; a design run < 30 min CPU.
 """
 from __future__ import annotations
 
@@ -39,11 +43,14 @@ import numpy as np
 from roughfe.genomics import database as gdb
 from roughfe.genomics.band_mechanics import band_macro_micro, band_mechanics
 from roughfe.genomics.bands import band_chromosomes
-from roughfe.genomics.design import (Design, GcmmaOptions, combined_score, run_design,
-                                     score_at_target_pressures, search_at_target_pressures,
-                                     surface_targets, thesis_targets, window_compliance)
+from roughfe.genomics.design import (Design, GcmmaOptions, combined_score, match_spectrum,
+                                     run_design, score_at_target_pressures,
+                                     search_at_target_pressures,
+                                     surface_targets, target_surface, thesis_targets,
+                                     window_compliance)
 from roughfe.genomics.sequencing import sequence_surfaces
 from roughfe.genomics.sequencing.surface_data import resolvable_surface_genome
+from roughfe.errors import InputError
 from roughfe.model import DEFAULT_E
 from roughfe.surfaces import Surface
 from roughfe.surfaces.io import load_surface, save_surface
@@ -58,8 +65,11 @@ GOAL_S, GOAL_F, RUN_CPU_S = 0.98, 0.9, 1800.0
 #: x3p-2 (650 x 650) is solved on every fourth point (163 x 163, same size) as a target
 X3P_POINTS = 163
 #: nodes per side of the surface database (the cost of the whole study is set by the
-#: shared 2-core machine: see the docs page)
-DB_NODES = 32
+#: shared 2-core machine: see the docs page), Sobol points (x 2 phase matrices) and the
+#: H range: x3p-2 has H = 0.22-0.32, below the thesis range [0.5, 1.5]
+DB_NODES, DB_POINTS, DB_HURST = 64, 24, (0.1, 1.5)
+#: measured targets: database genomes added as spectrum-matched starts (match_spectrum)
+SPECTRUM_STARTS = 3
 
 
 def _cpu():
@@ -148,16 +158,21 @@ def measured_mechanics(names, n_max=96, n_steps=10):
     return out
 
 
-def surface_database(path: Path, length, n_pairs, n_vectors, n_nodes=64, n_steps=10):
+def surface_database(path: Path, length, n_pairs, n_vectors, n_nodes=64, n_steps=10,
+                     hurst_range=(0.5, 1.5)):
     settings = gdb.DatabaseSettings(length=length, n_nodes=n_nodes, youngs_modulus=DEFAULT_E,
                                     n_steps=n_steps, dim=2, top_fraction=0.8)
-    design = gdb.SobolDesign(dim=2, n_pairs=n_pairs, n_vectors=n_vectors, n_ridges=3)
+    design = gdb.SobolDesign(dim=2, n_pairs=n_pairs, n_vectors=n_vectors, n_ridges=3,
+                             hurst_range=tuple(hurst_range))
     have = set()
     if path.is_file():
         con = gdb.connect(path)
         try:
             if gdb.read_settings(con) == settings:
+                gdb.write_design(con, design)       # InputError: built with another design
                 have = set(gdb.labels(con))
+        except InputError:
+            have = set()
         finally:
             con.close()
         if not have:
@@ -174,6 +189,7 @@ def surface_database(path: Path, length, n_pairs, n_vectors, n_nodes=64, n_steps
     finally:
         con.close()
     return settings, {"n_genomes": len(have) + len(records), "computed": len(records),
+                      "n_nodes": n_nodes, "hurst_range": list(hurst_range),
                       "cpu_s": cpu, "cpu_per_genome_s": cpu / max(len(records), 1)}
 
 
@@ -210,14 +226,22 @@ def measured_targets(measured, settings):
                                              "cpu_s": cpu_window}}
 
 
-def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, tag):
+def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, tag,
+                surface=None):
+    """SOG/GCO/CCO on K, M-CCO on K and A; then, when the target's ``surface`` is given
+    (a measured topography), :func:`match_spectrum` (candidates and the SPECTRUM_STARTS
+    best genomes with the target's band amplitudes); then the search at the target
+    pressures (phases and per-chromosome amplitudes)."""
     rows = []
     for method in ("sog", "gco", "cco", "mcco"):
         targets = [targets_k, target_a] if method == "mcco" else [targets_k]
         t0 = _cpu()
         res = run_design(method, entries, targets, settings, pbar=pbar,
                          options=GcmmaOptions(bound="period"))
-        res = search_at_target_pressures(res, settings, n_eval=search)
+        if surface is not None:
+            res = match_spectrum(res, surface, settings, entries=entries,
+                                 n_entries=SPECTRUM_STARTS)
+        res = search_at_target_pressures(res, settings, n_eval=search, amplitudes=True)
         cpu = _cpu() - t0
         best = res.best
         saved = outdir / f"surface_design_{tag}_{method}"
@@ -255,7 +279,8 @@ def main(outdir: Path, quick: bool = False) -> bool:
     n_nodes, n_steps = (16, 5) if quick else (DB_NODES, 10)
     settings, db_info = surface_database(outdir / ("surface_db_quick.sqlite" if quick else
                                                    "surface_db.sqlite"), length,
-                                         2 if quick else 12, 1 if quick else 2, n_nodes, n_steps)
+                                         2 if quick else DB_POINTS, 1 if quick else 2,
+                                         n_nodes, n_steps, DB_HURST)
     entries = gdb.load_entries(outdir / ("surface_db_quick.sqlite" if quick else
                                          "surface_db.sqlite"))
     search = 5 if quick else 100
@@ -263,7 +288,7 @@ def main(outdir: Path, quick: bool = False) -> bool:
     designs = design_runs(entries, settings, t1, t3, 0.4 * curve.p_max, search, outdir, "y_t1")
     tk, ta, x3p_info = measured_targets(measured, settings)
     designs += design_runs(entries, settings, tk, ta, 0.4 * tk.p_max, search, outdir,
-                           "x3p-2")
+                           "x3p-2", target_surface(measured, settings))
     rows = _targets(rec, noise, mech, designs, db_info, x3p_info)
     ok = all(r.met for r in rows)
     report = {"targets": [r.to_dict() for r in rows], "quick": quick, "recovery": rec,
@@ -312,7 +337,8 @@ def _targets(rec, noise, mech, designs, db_info, x3p):
     rows.append(_row("measured files: TD sum of all bands = complete, Alg. 2 partitions",
                      "c_n = 1, macro + micro = all bands", f"min c = {c:.12f}, partition "
                      f"{part}", abs(c - 1) < 1e-12 and part, value=c))
-    rows.append(_row(f"surface database cost per genome ({DB_NODES}^2, M = 3, 10 steps)",
+    rows.append(_row(f"surface database cost per genome ({db_info['n_nodes']}^2, M = 3, "
+                     "10 steps)",
                      "reported", f"{db_info['cpu_per_genome_s']:.1f} s CPU "
                      f"({db_info['computed']} computed)", True,
                      "computed this run; 0 computed means the database was reused",

@@ -18,8 +18,9 @@ Modules, by idea (see ``docs/theory/genomics-layout.md``):
 Every public name is importable from ``roughfe.genomics.design``.
 """
 from ...optim.gcmma import GcmmaResult, gcmma_maximize, gcmma_minimax
-from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, mcco, refine,
-                         run_design, score_database, search_at_target_pressures, sog)
+from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, match_spectrum,
+                         mcco, refine, run_design, score_database, search_at_target_pressures,
+                         sog, spectrum_matched)
 from .io import result_to_dict, write_design_result
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
@@ -28,10 +29,11 @@ from .sensitivities import residual_jacobian
 from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
 from .targets import (TARGET_BOUNDARIES, Y_T1_GENES, Y_T1_SURFACE_GENES, rescore,
                       rescore_at_target_pressures, score_at_target_pressures, surface_targets,
-                      target_genome_t1, thesis_targets, window_compliance)
+                      target_genome_t1, target_surface, thesis_targets, window_compliance)
 
 __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
            "run_design", "score_database", "search_at_target_pressures", "sog",
+           "match_spectrum", "spectrum_matched", "target_surface",
            "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",
            "combine", "entry_design", "Evaluator", "Objective", "combined_score",

@@ -138,6 +138,23 @@ def surface_targets(surface, settings: DatabaseSettings, *, name="measured", det
 
     Returns ``(t_K, t_A, curve)``.
     """
+    surf = target_surface(surface, settings, detrend=detrend, boundary=boundary,
+                          resolution=resolution)
+    curve = profile_response(surf, **settings.response_options())
+    meta = {"surface": dict(surface.metadata), "shape": list(surface.shape),
+            "size_m": list(surface.size), "detrend": detrend, "boundary": boundary,
+            "resolution": resolution,
+            "solved_shape": list(surf.shape), "solved_size_m": list(surf.size),
+            "settings": settings.to_dict()}
+    return (Target(curve.pressure, curve.stiffness, "K", f"{name}_K", meta),
+            Target(curve.pressure, curve.area_fraction, "A", f"{name}_A", meta), curve)
+
+
+def target_surface(surface, settings: DatabaseSettings, *, detrend="plane",
+                   boundary="periodic", resolution="design"):
+    """The surface :func:`surface_targets` solves: detrended, evenly mirrored when
+    ``boundary="periodic"`` and the input is a non-periodic window, and resampled onto the
+    database spacing L/N when ``resolution="design"`` (see :func:`surface_targets`)."""
     if boundary not in TARGET_BOUNDARIES:
         raise InputError(f"boundary must be one of {TARGET_BOUNDARIES}, got {boundary!r}")
     if resolution not in TARGET_RESOLUTIONS:
@@ -148,14 +165,7 @@ def surface_targets(surface, settings: DatabaseSettings, *, name="measured", det
     if resolution == "design" and surf.periodic and settings.dim == 2:
         spacing = settings.length / settings.n_nodes
         surf = surf.resampled([max(2, int(round(s / spacing))) for s in surf.size])
-    curve = profile_response(surf, **settings.response_options())
-    meta = {"surface": dict(surface.metadata), "shape": list(surface.shape),
-            "size_m": list(surface.size), "detrend": detrend, "boundary": boundary,
-            "resolution": resolution,
-            "solved_shape": list(surf.shape), "solved_size_m": list(surf.size),
-            "settings": settings.to_dict()}
-    return (Target(curve.pressure, curve.stiffness, "K", f"{name}_K", meta),
-            Target(curve.pressure, curve.area_fraction, "A", f"{name}_A", meta), curve)
+    return surf
 
 
 def window_compliance(surface, youngs_modulus, poisson=0.0) -> float:
