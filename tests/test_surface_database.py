@@ -214,8 +214,11 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
     out = tmp_path / "d"
     assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "t_K.csv"),
                  "--second-target", str(tmp_path / "t" / "t_A.csv"), "--method", "mcco",
-                 "--iterations", "1", "--search", "3", "--no-figures", "-o", str(out)]) == 0
+                 "--iterations", "1", "--match-spectrum", str(tmp_path / "t.npz"),
+                 "--spectrum-starts", "1", "--search", "3", "--no-figures", "-o",
+                 str(out)]) == 0
     report = json.loads((out / "result.json").read_text())
+    assert "matched to the target spectrum" in report["message"]
     design = Design.from_dict(json.loads((out / "design.json").read_text()))
     assert design.dim == 2
     heights = load_surface(out / "profile.npz")

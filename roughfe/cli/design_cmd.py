@@ -52,6 +52,12 @@ def _run(args) -> int:
                             options=options, **extra)
         if args.refine:
             result = refine(result, settings, rounds=args.refine)
+        if args.match_spectrum:
+            from ..genomics.design import match_spectrum, target_surface
+            from ..surfaces.io import load_surface
+            surface = target_surface(load_surface(args.match_spectrum), settings)
+            result = match_spectrum(result, surface, settings, entries=entries,
+                                    n_entries=args.spectrum_starts)
         if args.search:
             result = search_at_target_pressures(result, settings, n_eval=args.search,
                                                 starts=args.search_starts,
@@ -146,6 +152,14 @@ def register(sub):
                         "the best kept")
     g.add_argument("--search-amplitudes", action="store_true",
                    help="--search: every chromosome's amplitude a variable too (+-30%%)")
+    g.add_argument("--match-spectrum", default=None, metavar="SURFACE",
+                   help="surface database, beyond the thesis, after --refine and before "
+                        "--search: set every chromosome's amplitude to the band rms of this "
+                        "(measured) topography, prepared as 'design-targets --surface' "
+                        "does by default (plane removed, mirrored, database spacing)")
+    g.add_argument("--spectrum-starts", type=nonnegative_int, default=3, metavar="K",
+                   help="--match-spectrum: also start from the K best database genomes, "
+                        "spectrum matched")
     p.add_argument("--pool", type=nonnegative_int, default=0, metavar="K",
                    help="mcco, beyond the thesis: start pool of the K best genomes of each "
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "

@@ -440,7 +440,8 @@ def match_spectrum(result: DesignResult, surface, settings: DatabaseSettings, *,
     """A stage beyond the thesis: every candidate replaced by :func:`spectrum_matched`
     when that raises its strict score (solved at the target pressures), and the
     ``n_entries`` best genomes of ``entries`` by Alg. 3 on the first target, spectrum
-    matched, added as candidates of their own (their stages: the Alg. 3 score). Four
+    matched, added as candidates of their own (their stages: the genome's Alg. 3 score,
+    then twice the matched design's score, no GCMMA stage having run). Four
     counted sweeps per candidate (three when it was already scored at the target
     pressures), three per added genome. Run it before :func:`search_at_target_pressures`,
     which then searches the phases and (``amplitudes=True``) the per-chromosome weights
@@ -465,8 +466,10 @@ def match_spectrum(result: DesignResult, surface, settings: DatabaseSettings, *,
             e = entries[int(i)]
             new = _finish(spectrum_matched(entry_design(e, settings), surface), (s0[i],),
                           objective, evaluate, (), (), e.label + " (spectrum)")
-            out.append(replace(new, at_targets=_at_targets(new.design, objective, settings,
-                                                           evaluate)))
+            s1 = combined_score(new.scores)
+            out.append(replace(new, stages=(float(s0[i]), s1, s1),
+                               at_targets=_at_targets(new.design, objective, settings,
+                                                      evaluate)))
     out.sort(key=lambda c: -combined_score(c.at_targets))
     f = combined_score(out[0].at_targets)
     return _extended(result, out, evaluate, t0, f"; chromosome amplitudes matched to the target "
