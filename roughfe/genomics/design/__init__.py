@@ -12,20 +12,23 @@ Modules, by idea (see ``docs/theory/genomics-layout.md``):
 * :mod:`.algorithms` -- Alg. 3 (:func:`score_database`), SOG/GCO/CCO/M-CCO (Algs. 4-7),
   :func:`refine` and :func:`search_at_target_pressures` (beyond the thesis) and
   :func:`run_design`;
-* :mod:`.targets` -- the thesis targets y_t1, y_t2, y_t3 and independent re-scoring;
+* :mod:`.spectrum` -- chromosome amplitudes matched to a target surface's spectrum
+  (:func:`match_spectrum`, beyond the thesis, surfaces);
+* :mod:`.targets` -- the thesis targets y_t1, y_t2, y_t3, targets of a (measured)
+  surface in the designs' periodic setting, and independent re-scoring;
 * :mod:`.io` -- the result files.
 
 Every public name is importable from ``roughfe.genomics.design``.
 """
 from ...optim.gcmma import GcmmaResult, gcmma_maximize, gcmma_minimax
-from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, match_spectrum,
-                         mcco, refine, run_design, score_database, search_at_target_pressures,
-                         sog, spectrum_matched)
+from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, mcco, refine,
+                         run_design, score_database, search_at_target_pressures, sog)
 from .io import result_to_dict, write_design_result
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
 from .objective import Evaluator, Objective, combined_score
 from .sensitivities import residual_jacobian
+from .spectrum import match_spectrum, spectrum_matched
 from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
 from .targets import (TARGET_BOUNDARIES, Y_T1_GENES, Y_T1_SURFACE_GENES, rescore,
                       rescore_at_target_pressures, score_at_target_pressures, surface_targets,
