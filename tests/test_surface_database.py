@@ -203,8 +203,9 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
     path = tmp_path / "s.sqlite"
     assert main(["db", "build", str(path), "--dim", "2", "--nodes", "16", "--steps", "5",
                  "--ridges", "2", "--limit", "2", "--length", "1e-4", "--quiet",
-                 "--workers", "1"]) == 0
+                 "--workers", "1", "--hurst-range", "0.2", "0.45"]) == 0
     settings = db.read_settings(path)
+    assert all(0.2 <= e.hurst <= 0.45 for e in db.load_entries(path))
     assert (settings.dim, settings.n_nodes, settings.top_fraction) == (2, 16, 0.8)
     g = Genome.from_dict(db.load_entries(path)[0].genome)
     tsurf = realize_periodic_surface(replace(g, A=2e-6, phases=g.phases + 0.2), 1e-4, 16)
@@ -230,6 +231,9 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
     assert main(["db", "build", str(tmp_path / "x.sqlite"), "--dim", "2",
                  "--top-fraction", "1.5"]) == 2
     assert "top_fraction" in capsys.readouterr().err
+    assert main(["db", "build", str(tmp_path / "x.sqlite"), "--dim", "2",
+                 "--hurst-range", "1.0", "0.2"]) == 2
+    assert "hurst_range must be 0 < low <= high" in capsys.readouterr().err
 
 
 def test_match_spectrum_restores_a_genome_whose_hurst_exponent_moved(surface_db):

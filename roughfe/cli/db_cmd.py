@@ -69,6 +69,7 @@ def _build(args) -> int:
     from ..genomics.database import SobolDesign
     from ..study import build_genome_db
     design = SobolDesign(seed=args.seed, scramble=not args.no_scramble, dim=args.dim,
+                         hurst_range=tuple(args.hurst_range),
                          **({"n_ridges": args.ridges} if args.dim == 2 else {}))
     run = build_genome_db(args.database, _settings(args), design, limit=args.limit,
                           **_runner(args))
@@ -154,6 +155,9 @@ def register(sub):
     s.add_argument("--no-scramble", action="store_true", help="unscrambled Sobol sequences")
     s.add_argument("--ridges", type=positive_int, default=3,
                    help="ridges M per surface genome (--dim 2)")
+    s.add_argument("--hurst-range", type=positive_float, nargs=2, default=(0.5, 1.5),
+                   metavar=("LO", "HI"), help="range of H in the Sobol design (thesis: 0.5 1.5; "
+                   "a measured target may need lower H, e.g. x3p-2 has 0.2-0.3)")
     s.add_argument("--limit", type=positive_int, default=None, help="build only the first K genomes")
     _add_runner_options(b)
     b.set_defaults(func=_build)

@@ -49,10 +49,11 @@ class SobolDesign:
             raise InputError(f"dim must be 1 (profiles) or 2 (surfaces), got {self.dim!r}")
         if int(self.n_ridges) < 1 or int(self.n_ridges) > 100:
             raise InputError(f"n_ridges must lie in 1..100, got {self.n_ridges!r}")
-        lo, hi = self.anisotropy_range
-        if not (0 < lo <= hi and np.isfinite(hi)):
-            raise InputError(f"anisotropy_range must be 0 < low <= high, got "
-                             f"{self.anisotropy_range!r}")
+        for name in ("anisotropy_range", "hurst_range"):
+            lo, hi = getattr(self, name)
+            if not (0 < lo <= hi and np.isfinite(hi)):
+                raise InputError(f"{name} must be 0 < low <= high, got "
+                                 f"{getattr(self, name)!r}")
 
     @property
     def rows(self) -> int:
