@@ -284,3 +284,26 @@ def test_thesis_kernel_is_a_boussinesq_line_of_punches():
     r = np.arange(50, 200) * dx
     # far field: the 3D point load u = F / (pi E* r), not the 2D logarithm
     assert np.allclose(op.kernel[50:200] * np.pi * E * r / dx ** 2, 1.0, rtol=2e-5)
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_secant_predicted_sweep_equals_cold_solves_to_the_tolerance(periodic):
+    """The sweep starts each elastic approach from the secant extrapolation of the two
+    previous pressures: only the start changes, so every step equals a cold solve of the
+    same approach to the solver tolerance, and the predictor saves CG iterations."""
+    surf = random_surface((48, 48), (1e-4, 1e-4), seed=4, periodic=periodic)
+    deltas = np.linspace(0.05, 0.6, 8) * (surf.heights.max() - surf.heights.mean())
+    kw = dict(solver="pk", tol=1e-10, compute_stiffness=False)
+    sweep = contact_sweep(surf, MAT, deltas=deltas, **kw)
+    cold = [solve_contact(surf, MAT, delta=d, **kw) for d in deltas]
+    previous = [solve_contact(surf, MAT, delta=d, initial=c.pressure, **kw)
+                for d, c in zip(deltas[1:], cold)]
+    for r, c in zip(sweep.results, cold):
+        assert r.residual <= 10 * r.tolerance
+        assert np.array_equal(r.contact, c.contact)
+        assert r.mean_pressure == pytest.approx(c.mean_pressure, rel=1e-7)
+        assert np.abs(r.pressure - c.pressure).max() <= 1e-6 * c.pressure.max()
+    # from the third step on the predictor starts closer than the previous pressure
+    # (measured 92 vs 111 iterations non-periodic; periodic gap control 99 vs 100)
+    nit, nit_previous = sum(r.nit for r in sweep.results[2:]), sum(r.nit for r in previous[1:])
+    assert nit < (0.9 if not periodic else 1.05) * nit_previous

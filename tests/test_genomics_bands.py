@@ -121,6 +121,24 @@ def test_flat_or_offset_surfaces_are_refused():
         band_chromosomes(Surface(z, 1e-3), detrend="none")
 
 
+def test_band_mechanics_in_two_threads_equals_one():
+    """The sweeps run two at a time (issue 15 §4 speed on 2 cores): every curve is the
+    same deterministic computation, so the result equals the serial one exactly."""
+    s = spectral_surface(32, 1e-3, 0.8, rms_height=1e-6, rng=5)
+    b = band_chromosomes(Surface(s.heights, s.size), 2.0)      # non-periodic window
+    one = band_mechanics(b, youngs_modulus=1e9, n_steps=5, workers=1)
+    two = band_mechanics(b, youngs_modulus=1e9, n_steps=5, workers=2)
+    assert one.nit == two.nit > 3 and one.success and two.success
+    for a, c in zip((one.complete,) + one.chromosome_curves + one.td_curves + one.bu_curves,
+                    (two.complete,) + two.chromosome_curves + two.td_curves + two.bu_curves):
+        assert (a is None) == (c is None)
+        if a is not None:
+            for q in ("pressure", "stiffness", "area_fraction"):
+                assert np.array_equal(getattr(a, q), getattr(c, q))
+    with pytest.raises(InputError, match="workers"):
+        band_mechanics(b, youngs_modulus=1e9, n_steps=5, workers=0)
+
+
 def test_band_mechanics_of_a_periodic_surface():
     """TD/BU sums end on the complete surface (same curve object), c_n of the complete
     curve with itself is 1, and the macro/micro split partitions the bands."""

@@ -31,6 +31,33 @@ def default_deltas(surface: Surface, n_steps: int, periodic: bool) -> np.ndarray
     return top * np.arange(1, n_steps + 1) / n_steps
 
 
+def _predicted_pressure(results, target, key, branch):
+    """Initial pressure (Pa) of the next step of a sweep, or None (cold start).
+
+    The previous step's pressure; on an elastic sweep in the approach (no hardness, no
+    unloading branch) after two steps with contact, the secant extrapolation
+    p_j + (Delta - Delta_j) / (Delta_j - Delta_{j-1}) (p_j - p_{j-1}), clipped at 0: the
+    contact patches grow between steps, and the predictor moves their pressure along.
+    Only the start changes: every step is solved to the same tolerance. Measured on the
+    20-step sweeps of 256^2 partial sums of a measured surface (di-1.di, Love kernel):
+    11-12 % fewer CG iterations (598 -> 532, 622 -> 544).
+    """
+    if not results or not results[-1].n_contact:
+        return None
+    last = results[-1]
+    if branch or key != "delta" or len(results) < 2 or not results[-2].n_contact:
+        return last.pressure
+    before = results[-2]
+    step = last.delta - before.delta
+    if not step > 0:
+        return last.pressure
+    p = last.pressure - before.pressure
+    p *= (float(target) - last.delta) / step
+    p += last.pressure
+    np.maximum(p, 0.0, out=p)
+    return p
+
+
 def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, deltas=None,
                   pressures=None, kernel: str = "auto", solver: str = "auto",
                   tol: float = 1e-10, max_iter=None, compute_stiffness: bool = True,
@@ -79,16 +106,16 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
         steps += [(float(v), True) for v in deltas[-2::-1]]
     branch = unload or hardness is not None
     results = []
-    prev = plastic = None
+    plastic = None
     for v, unloading in progress.iterate(steps, "BEM load steps"):
         r = solve_contact(surface, material, **{key: v}, kernel=kernel, solver=solver,
-                          tol=tol, max_iter=max_iter, initial=prev,
+                          tol=tol, max_iter=max_iter,
+                          initial=_predicted_pressure(results, v, key, branch),
                           compute_stiffness=compute_stiffness, hardness=hardness,
                           plastic_displacement=plastic)
         if branch:
             r = dataclasses.replace(r, unloading=unloading)
         results.append(r)
-        prev = r.pressure if r.n_contact else None
         plastic = r.plastic_displacement
     return SweepResult.from_results(results, rms_slope=rms_slope(surface),
                                     length=surface.size[0])

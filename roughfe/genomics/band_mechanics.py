@@ -32,8 +32,8 @@ REFERENCES = BAND_REFERENCES + ("thesis Sec. 3.4.1, Fig. 36-39 and Alg. 2, on ba
 
 def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: float = 0.0,
                    n_steps: int = 20, kernel: str = "auto",
-                   response: Optional[Callable[[Surface], ResponseCurve]] = None
-                   ) -> ChromosomeMechanics:
+                   response: Optional[Callable[[Surface], ResponseCurve]] = None,
+                   workers: int = 2) -> ChromosomeMechanics:
     """BEM curves of every band chromosome and TD/BU partial sum (see the module notes).
 
     Parameters
@@ -49,6 +49,10 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
     response : callable, optional
         ``Surface -> ResponseCurve``; default the BEM sweep of
         :func:`~roughfe.genomics.macro_micro.profile_response` with the above.
+    workers : int
+        Sweeps run at once (threads, :func:`~roughfe.genomics.mechanics.sweep_fields`):
+        the default 2 uses both cores of the issue 15 target machine; the curves are the
+        same for any value.
 
     Progress is reported through :func:`roughfe.progress.iterate` ("band sweeps").
     """
@@ -68,7 +72,8 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
     jobs.update({("c", k): chrom[k] for k in range(n_c)})
     jobs.update({("td", k): td[k] for k in range(1, n_c - 1)})
     jobs.update({("bu", k): bu[k] for k in range(1, n_c - 1)})
-    curves, failed, done = sweep_fields(jobs, bands.as_surface, response, "band sweeps")
+    curves, failed, done = sweep_fields(jobs, bands.as_surface, response, "band sweeps",
+                                        workers=workers)
     complete = curves["complete"]
     if complete is None:
         raise InputError("the surface is flat: no contact curve")

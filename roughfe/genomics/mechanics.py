@@ -27,7 +27,9 @@ profile (see :mod:`roughfe.bem.operators`), so both are offered and labelled.
 """
 from __future__ import annotations
 
+import contextlib
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import partial
 
@@ -169,7 +171,7 @@ def is_flat(z) -> bool:
     return bool(np.ptp(z) <= 1e-12 * max(float(np.max(np.abs(z))), 1e-300))
 
 
-def sweep_fields(fields: dict, surface_of, response, label=None):
+def sweep_fields(fields: dict, surface_of, response, label=None, workers: int = 1):
     """BEM curves of several height fields, one sweep each; the first field is the
     reference (the complete surface): its failure re-raises, since nothing compares
     without it.
@@ -184,6 +186,10 @@ def sweep_fields(fields: dict, surface_of, response, label=None):
         ``Surface -> ResponseCurve`` (a BEM sweep).
     label : str, optional
         Progress label (:func:`roughfe.progress.iterate`).
+    workers : int
+        Sweeps run at once, in threads (the sweeps are independent; the FFTs and the
+        array arithmetic of the BEM release the GIL). The curves do not depend on it:
+        each sweep is the same deterministic computation.
 
     Returns
     -------
@@ -195,18 +201,30 @@ def sweep_fields(fields: dict, surface_of, response, label=None):
     n_sweeps : int
         Sweeps run (flat fields are not run).
     """
+    workers = int(workers)
+    if workers < 1:
+        raise InputError(f"workers must be an integer >= 1, got {workers!r}")
     curves = {key: None for key, z in fields.items() if is_flat(z)}
     todo = [key for key in fields if key not in curves]
     first = next(iter(fields), None)
     failed = {}
-    for key in (progress.iterate(todo, label) if label else todo):
+
+    def sweep(key):
         try:
-            curves[key] = response(surface_of(fields[key]))
+            return key, response(surface_of(fields[key])), None
         except NoConvergenceError as exc:
             if key == first:
                 raise
-            curves[key], failed[key] = None, str(exc)
-    return curves, failed, len(todo)
+            return key, None, str(exc)
+
+    with ThreadPoolExecutor(workers) if workers > 1 and len(todo) > 1 else \
+            contextlib.nullcontext() as pool:
+        runs = pool.map(sweep, todo) if pool is not None else map(sweep, todo)
+        for key, curve, why in (progress.iterate(runs, label, len(todo)) if label else runs):
+            curves[key] = curve
+            if why is not None:
+                failed[key] = why
+    return {key: curves[key] for key in fields}, failed, len(todo)
 
 
 def sweep_report(failed: dict, names) -> tuple:
