@@ -128,6 +128,8 @@ class SurfacePeaks:
     qx: np.ndarray
     qy: np.ndarray
     power: np.ndarray
+    #: white-noise variance of the heights (m^2) from the periodogram's high-q plateau
+    noise_variance: float = 0.0
 
     @property
     def magnitude(self):
@@ -150,20 +152,33 @@ def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
     A peak is a local maximum over +-3 original bins whose power exceeds both
     ``dynamic_range`` times the largest peak and 30 times the median power (the noise
     floor); sub-bin positions by a parabola in log power along each axis.
+
+    ``noise_variance``: the variance sigma^2 (m^2) of white noise on the heights, from the
+    plateau of the periodogram above half the Nyquist wavenumber (|k_x| or |k_y|): there a
+    discrete (WM) spectrum holds a few peaks and the window's side lobes (~92 dB down),
+    so the median bin is noise. A bin of white noise is complex Gaussian with mean power
+    sigma^2 sum(w^2) (the window over the defined nodes; the zero padding adds nothing),
+    exponentially distributed: sigma^2 = median / (ln 2 sum(w^2)). On noise-free data it
+    is the side-lobe and round-off level.
     """
     n = acq.z.shape[0]
     d = acq.x[1] - acq.x[0]
     ok = acq.valid
     z = np.where(ok, acq.z - acq.z[ok].mean(), 0.0)
     w1 = blackmanharris(n)
-    spec = scipy.fft.rfft2(z * np.outer(w1, w1), s=(PAD * n, PAD * n))
+    window = np.outer(w1, w1)
+    spec = scipy.fft.rfft2(z * window, s=(PAD * n, PAD * n))
     power = np.abs(spec) ** 2
+    m_pad = PAD * n
+    high_x = np.abs(np.fft.fftfreq(m_pad)) >= 0.25         # above half the Nyquist wavenumber
+    high_y = np.arange(power.shape[1]) >= m_pad // 4
+    noise = float(np.median(power[high_x[:, None] | high_y[None, :]])) / (
+        math.log(2.0) * float(np.sum(window[ok] ** 2)))
     size = 2 * 3 * PAD + 1
     is_max = power == maximum_filter(power, size=size, mode="wrap")
     floor = 30.0 * float(np.median(power))
     top = float(power.max())
     cand = np.argwhere(is_max & (power > max(floor, dynamic_range * top)))
-    m_pad = PAD * n
     kx = np.where(cand[:, 0] <= m_pad // 2, cand[:, 0], cand[:, 0] - m_pad).astype(float)
     ky = cand[:, 1].astype(float)
     keep = ~((ky == 0) & (kx < 0))            # q and -q are one wave on the q_y = 0 row
@@ -177,7 +192,7 @@ def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
     qx, qy = (kx + dx) * dq, (ky + dy) * dq
     nyq = NYQUIST_FRACTION * np.pi / d
     inside = (np.abs(qx) < nyq) & (np.abs(qy) < nyq) & (np.hypot(qx, qy) > 0)
-    return SurfacePeaks(qx[inside], qy[inside], power[i, j][inside])
+    return SurfacePeaks(qx[inside], qy[inside], power[i, j][inside], noise)
 
 
 def cluster_angles(angles, weights, tol=ANGLE_TOL):
