@@ -72,7 +72,10 @@ The pocket cells are frozen during one fixed-point solve (a pass) so that ``G`` 
 continuous map; after the pass the pockets of the coupled gap are found again
 (:func:`roughfe.leakage.pockets.transfer`: merge, split, reopening, new pockets closing
 at this load), and the pass is repeated with them until the cells no longer change
-(``max_passes``; ``pockets_settled`` reports it). Why round 2's first ``"pressure"``
+(``pockets_settled``; membership has a hysteresis, a cell of a pocket stays in it until it
+closes: :mod:`roughfe.leakage.pockets`). The passes stop unsettled after ``max_passes``
+or when a layout already solved in this step comes back (a cycle, which would repeat).
+Why round 2's first ``"pressure"``
 model stalled in load sweeps: docs/theory/04b_leakage_ii.md.
 """
 from __future__ import annotations
@@ -334,7 +337,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     x = (np.array(history.pressure, dtype=float) if history is not None
          and history.pressure.mean() < p_ext else np.zeros(h.shape))
     residuals, counts = [], {"new": 0, "released": 0, "merged": 0}
-    it, passes, state, settled = 0, 0, "contact", False
+    it, passes, state, settled, solved = 0, 0, "contact", False, []
     while True:
         newton = (PocketNewton(frozen, bulk_modulus, cell, material.E_star, jacobian_pockets)
                   if trapped == "volume" and frozen.n else None)
@@ -368,8 +371,11 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         for key in counts:
             counts[key] += cnt[key]
         settled = trapped not in SEALED or nxt.same_cells(frozen)
-        if settled or passes >= max_passes:
+        # a layout already solved in this step would repeat its pass: a cycle, stop
+        cycle = not settled and any(nxt.same_cells(s) for s in solved)
+        if settled or cycle or passes >= max_passes:
             break
+        solved.append(frozen)
         frozen, x = nxt, gx
     if state == "contact":
         last["flow"] = _flow(last["gap"])

@@ -16,6 +16,29 @@ reference state ``(V_c, P_c)``: the volume ``V_c`` (m^3) the fluid takes at the 
 * ``"film"``: no pocket is sealed; a pocket takes the regularised film's pressure (the
   limit of its surroundings): a drained pocket (leaky seal, or the closure state itself).
 
+Membership hysteresis. A cell joins a pocket (or the flowing film) when its gap exceeds the
+film ``h_reg``, and a cell that holds pocket liquid stays in its pocket while it is open
+(``0 < gap <= h_reg``); it leaves when it closes (gap = 0, solid contact). Why: with one
+threshold both ways a rim cell whose gap sits at ``h_reg`` moves across it with its own
+pressure, in the pocket (pocket pressure) below it and in the film (film pressure) above
+it, so no layout was self-consistent and the pocket passes alternated between two
+layouts for ever (measured: 64^2 at 60 MPa, one cell at 0.91 / 1.03 ``h_reg``; 512^2 at
+30 MPa, 6-7 cells at 0.975-1.19 ``h_reg`` splitting and re-merging one pocket). Physically
+the liquid fills every open cell of its pocket; ``h_reg`` is the regularising film of the
+contact spots, not a gap a liquid cannot enter. The seal against the flowing film stays the
+film criterion: a pocket is released only when cells thicker than ``h_reg`` join it to
+inlet or outlet (so a thin cell of a pocket next to the flow does not reopen it), and held
+cells only count in a component with a wet cell (no pocket of thin cells alone).
+
+Contact spots inside a pocket. A closed component (cells neither wet nor held) that borders
+exactly one pocket, no flowing cell and neither inlet nor outlet belongs to that pocket:
+the liquid around it is the pocket's, so its pore pressure (the limit of its surroundings,
+:mod:`roughfe.leakage.fsi`) is the pocket pressure, not the film pressure of the
+regularised Reynolds solve, which does not see the seal. Without it a spot inside a
+cavitating (0 Pa) pocket felt the ambient film pressure, opened, joined the pocket, closed
+under its 0 Pa and left again: a 2-cycle of the passes (measured on a sealed box unloaded
+from 30 to 25 MPa, tests/test_leakage_pockets.py).
+
 A liquid cannot sustain tension: the pocket pressure is bounded below by 0 Pa
 (absolute; cavitation, the pocket then also holds vapour and ``V > V(P)``).
 
@@ -73,12 +96,72 @@ class Pockets:
         return pairs.size == self.n
 
 
-def wet_components(gap, h_reg, *, axis, periodic):
-    """Labels of the face-connected wet components (gap > ``h_reg``; -1 elsewhere) and
-    which of them reach inlet or outlet (flow along ``axis``)."""
-    wet = gap > h_reg
-    lab, t_in, t_out = components_reaching(wet if axis == 0 else wet.T, periodic=periodic)
+def _components(mask, axis, periodic):
+    lab, t_in, t_out = components_reaching(mask if axis == 0 else mask.T, periodic=periodic)
     return (lab if axis == 0 else lab.T), t_in | t_out
+
+
+def wet_components(gap, h_reg, *, axis, periodic, hold=None):
+    """Labels of the face-connected wet components (-1 elsewhere) and which of them reach
+    inlet or outlet (flow along ``axis``).
+
+    A cell is wet when its gap exceeds the film ``h_reg``; a cell of ``hold`` (the cells of
+    the previous pockets) stays wet while it is open (gap > 0) and not part of a component
+    that reaches inlet or outlet through cells thicker than the film: the hysteresis of
+    the module docstring. The flowing components are those of the plain criterion; held
+    cells count only in a component with a wet cell."""
+    wet = gap > h_reg
+    lab, connected = _components(wet, axis, periodic)
+    if hold is None or not np.any(hold):
+        return lab, connected
+    flowing = (lab >= 0) & connected[np.maximum(lab, 0)]
+    inner = (wet | (np.asarray(hold, bool) & (gap > 0))) & ~flowing
+    lab2, conn2 = _components(inner, axis, periodic)
+    # held cells only count with a wet cell of their component (no pocket of thin cells)
+    some_wet = np.bincount(lab2[inner & wet], minlength=conn2.size) > 0
+    inner &= some_wet[np.maximum(lab2, 0)]
+    out = np.where(inner, lab2, np.where(flowing, lab + conn2.size, -1))
+    return out, np.concatenate([conn2, connected])
+
+
+def _enclose(lab, connected, *, axis, periodic):
+    """``lab`` with every closed component (cells of label -1) that borders exactly one
+    pocket component, no flowing one and neither inlet nor outlet given to that pocket: the
+    contact spots inside a pocket (module docstring)."""
+    closed = lab < 0
+    if not closed.any() or closed.all():
+        return lab
+    cl, touch = _components(closed, axis, periodic)
+    # category of every cell: its pocket component, -2 flowing, -3 closed
+    cat = np.where(closed, -3, np.where(connected[np.maximum(lab, 0)], -2, lab))
+    src, dst = [], []
+    for ax in (0, 1):
+        wrap = periodic and ax != axis          # the flow axis has inlet and outlet
+        for step in (1, -1):
+            if wrap:
+                nb = np.roll(cat, step, axis=ax)
+                a, b = cl, nb
+            else:
+                sl = [slice(None)] * 2
+                sn = [slice(None)] * 2
+                sl[ax] = slice(1, None) if step == 1 else slice(None, -1)
+                sn[ax] = slice(None, -1) if step == 1 else slice(1, None)
+                a, b = cl[tuple(sl)], cat[tuple(sn)]
+            m = (a >= 0) & (b != -3)
+            src.append(a[m])
+            dst.append(b[m])
+    src, dst = np.concatenate(src), np.concatenate(dst)
+    if not src.size:
+        return lab
+    lo = np.full(touch.size, np.iinfo(np.int64).max)
+    hi = np.full(touch.size, -4)
+    np.minimum.at(lo, src, dst)
+    np.maximum.at(hi, src, dst)
+    owner = np.where((lo == hi) & (lo >= 0) & ~touch, hi, -1)
+    out = lab.copy()
+    inside = closed & (owner[np.maximum(cl, 0)] >= 0)
+    out[inside] = owner[cl[inside]]
+    return out
 
 
 def _merge(volume, pressure, bulk_modulus):
@@ -119,7 +202,9 @@ def transfer(previous: Pockets, gap, fluid, cell_area, h_reg, *, axis, periodic,
     (Pockets, dict)
         The current pockets and counts ``{"new", "released", "merged", "kept"}``.
     """
-    lab, connected = wet_components(gap, h_reg, axis=axis, periodic=periodic)
+    lab, connected = wet_components(gap, h_reg, axis=axis, periodic=periodic,
+                                    hold=previous.labels >= 0)
+    lab = _enclose(lab, connected, axis=axis, periodic=periodic)
     ncomp = connected.size
     vol_cell = gap * cell_area
     shares = {}                         # component -> list of (volume, pressure)
