@@ -72,11 +72,9 @@ The pocket cells are frozen during one fixed-point solve (a pass) so that ``G`` 
 continuous map; after the pass the pockets of the coupled gap are found again
 (:func:`roughfe.leakage.pockets.transfer`: merge, split, reopening, new pockets closing
 at this load), and the pass is repeated with them until the cells no longer change
-(``pockets_settled``; membership has a hysteresis, a cell of a pocket stays in it until it
-closes: :mod:`roughfe.leakage.pockets`). The passes stop unsettled after ``max_passes``
-or when a layout already solved in this step comes back (a cycle, which would repeat).
-Why round 2's first ``"pressure"``
-model stalled in load sweeps: docs/theory/04b_leakage_ii.md.
+(``pockets_settled``; membership rules: :mod:`roughfe.leakage.pockets`), else they stop
+after ``max_passes`` or when a layout already solved in this step comes back (a cycle).
+Why round 2's first ``"pressure"`` model stalled in sweeps: docs/theory/04b_leakage_ii.md.
 """
 from __future__ import annotations
 
