@@ -206,10 +206,14 @@ def measured_targets(measured, settings):
     cpu_window = _cpu() - t0
     c = window_compliance(measured.detrended("plane"), settings.youngs_modulus,
                           settings.poisson)
-    # the periodic curve reaches further (to 0.8 of full contact): read it at the window's p
-    sel = win.pressure <= curve.p_max
-    k_per = np.exp(np.interp(np.log(win.pressure[sel]), np.log(curve.pressure),
-                             np.log(curve.stiffness)))
+    # like with like: the mirrored window at the window's own sampling (not the design
+    # spacing), read at the window's pressures (it reaches further: 0.8 of full contact)
+    t0 = _cpu()
+    _, _, full = surface_targets(measured, settings, name="x3p-2", resolution="full")
+    cpu_full = _cpu() - t0
+    sel = win.pressure <= full.p_max
+    k_per = np.exp(np.interp(np.log(win.pressure[sel]), np.log(full.pressure),
+                             np.log(full.stiffness)))
     series = 1.0 / (1.0 / k_per + c)
     dev = np.abs(series[1:] / win.stiffness[sel][1:] - 1.0)
     return tk, ta, {"shape": list(measured.shape), "size_m": list(measured.size),
@@ -217,13 +221,18 @@ def measured_targets(measured, settings):
                     "solved_size_m": list(tk.metadata["solved_size_m"]),
                     "p_max": curve.p_max, "A_at_p_max": float(curve.area_fraction[-1]),
                     "K_range": [float(curve.stiffness[0]), float(curve.stiffness[-1])],
-                    "cpu_s": cpu, "window": {"p_max": win.p_max,
-                                             "A_at_p_max": float(win.area_fraction[-1]),
-                                             "K_range": [float(win.stiffness[0]),
-                                                         float(win.stiffness[-1])],
-                                             "compliance_m_per_Pa": c,
-                                             "series_deviation_max": float(dev.max()),
-                                             "cpu_s": cpu_window}}
+                    "cpu_s": cpu,
+                    "full_resolution": {"solved_shape": [2 * (n - 1) for n in measured.shape],
+                                        "p_max": full.p_max,
+                                        "A_at_p_max": float(full.area_fraction[-1]),
+                                        "K_range": [float(full.stiffness[0]),
+                                                    float(full.stiffness[-1])],
+                                        "cpu_s": cpu_full},
+                    "window": {"p_max": win.p_max, "A_at_p_max": float(win.area_fraction[-1]),
+                               "K_range": [float(win.stiffness[0]), float(win.stiffness[-1])],
+                               "compliance_m_per_Pa": c,
+                               "series_deviation_max": float(dev.max()),
+                               "cpu_s": cpu_window}}
 
 
 def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, tag,
