@@ -65,7 +65,8 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     """Warm-started sequence of contact solutions.
 
     Each step starts from the previous pressure (the first one, cold, from the coarse
-    grid). Measured (``benchmarks/bench_bem.py``, 512^2, p/E* = 0.005, 0.01, 0.05, 0.1,
+    grid); elastic steps in the approach from the secant extrapolation of the two
+    previous ones (:func:`_predicted_pressure`). Measured (``benchmarks/bench_bem.py``, 512^2, p/E* = 0.005, 0.01, 0.05, 0.1,
     2-5x apart): 159 iterations and 420 convolution-equivalents for the sweep against
     147 and 439 for four cold coarse-started solves, and 172 against 190 cold ones
     without the coarse start; closer steps gain more. With a ``hardness`` the plastic displacement is
