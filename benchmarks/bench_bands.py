@@ -7,7 +7,12 @@ window is not periodic); every chromosome, TD and BU sum is loaded in 20 approac
 the non-periodic (Love, DC-FFT) BEM, two sweeps at a time (``workers``, default 2). Wall
 and process CPU times (all threads) are reported with the load average: the machine may be
 shared, and then the wall time says little, while the CPU time bounds the wall time on 2
-quiet cores from above (CPU / 2 from below). Writes ``benchmarks/output/bench_bands.json``.
+quiet cores from above (CPU / 2 from below). The wall time on ``workers`` quiet cores is
+also projected: the CPU time of each sweep's thread (``time.thread_time``, scaled so that
+they add up to the process CPU time: the FFT's own helper threads are not in it) laid out
+in the order the thread pool takes them (each sweep to the first free worker); it leaves
+out the interpreter lock and the memory bandwidth the threads share, so it is a
+projection, not a measurement. Writes ``benchmarks/output/bench_bands.json``.
 Run: .venv/bin/python benchmarks/bench_bands.py [N [WORKERS]]
 """
 import os
@@ -17,6 +22,7 @@ from pathlib import Path
 
 from roughfe.genomics.band_mechanics import band_mechanics
 from roughfe.genomics.bands import band_chromosomes
+from roughfe.genomics.macro_micro import profile_response
 from roughfe.surfaces.io import load_surface
 from roughfe.surfaces.surface import Surface
 
@@ -25,6 +31,16 @@ from _report import write_report  # benchmarks/_report.py
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "topographies" / "di-1.di"
 OUT = Path(__file__).resolve().parent / "output" / "bench_bands.json"
 TARGET_S = 120.0
+
+
+def projected_wall(cpu_per_sweep, workers):
+    """Wall time (s) of the sweeps on ``workers`` dedicated cores: each, in order, to the
+    worker that frees first (how ``ThreadPoolExecutor.map`` hands them out)."""
+    free = [0.0] * int(workers)
+    for t in cpu_per_sweep:
+        k = free.index(min(free))
+        free[k] += t
+    return max(free)
 
 
 def main(n=256, workers=2):
@@ -40,21 +56,36 @@ def main(n=256, workers=2):
     t0, c0 = time.perf_counter(), time.process_time()
     bands = band_chromosomes(surf)
     t_dec = time.perf_counter() - t0
-    mech = band_mechanics(bands, youngs_modulus=1e9, poisson=0.3, n_steps=20, workers=workers)
+    sweeps = []
+
+    def timed(surface):
+        c = time.thread_time()
+        try:
+            return profile_response(surface, youngs_modulus=1e9, poisson=0.3, n_steps=20)
+        finally:
+            sweeps.append(time.thread_time() - c)
+    mech = band_mechanics(bands, youngs_modulus=1e9, poisson=0.3, n_steps=20, workers=workers,
+                          response=timed)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    projected = projected_wall([t * cpu / max(sum(sweeps), 1e-9) for t in sweeps], workers)
     print(f"{bands.n_chromosomes} bands, decomposition {t_dec:.2f} s; {mech.nit} sweeps of 20 "
           f"steps, {workers} at a time: wall {wall:.1f} s, cpu {cpu:.1f} s "
-          f"({cpu / mech.nit:.2f} s CPU per sweep)")
+          f"({cpu / mech.nit:.2f} s CPU per sweep); projected wall on {workers} quiet cores "
+          f"{projected:.1f} s")
     case = {"n": int(surf.shape[0]), "file": DATA.name, "bands": int(bands.n_chromosomes),
             "sweeps": int(mech.nit), "steps": 20, "workers": int(workers), "wall_s": wall,
-            "cpu_s": cpu, "load_average_start": load0, "success": bool(mech.success)}
+            "cpu_s": cpu, "projected_wall_s": projected, "sweep_thread_cpu_s": sweeps,
+            "load_average_start": load0, "success": bool(mech.success)}
     targets = [{"name": f"band mechanics {surf.shape[0]}^2, all TD/BU sums, 20 steps "
                         f"(wall s, {workers} workers)", "value": wall,
                 "target": f"< {TARGET_S:g}", "met": bool(wall < TARGET_S and mech.success)},
-               {"name": f"the same in CPU s (the wall time on one quiet core)", "value": cpu,
+               {"name": "the same in CPU s (the wall time on one quiet core)", "value": cpu,
                 "target": f"< {TARGET_S:g}", "met": bool(cpu < TARGET_S and mech.success)}]
+    print(f"projected (not measured) wall on {workers} quiet cores: {projected:.1f} s")
     write_report(OUT, "bench_bands", targets, [case],
-                 {"wall_s": "s (elapsed)", "cpu_s": "s (process CPU time, all threads)"})
+                 {"wall_s": "s (elapsed)", "cpu_s": "s (process CPU time, all threads)",
+                  "projected_wall_s": "s (per-sweep thread CPU laid out on the workers)",
+                  "sweep_thread_cpu_s": "s (thread CPU time of each sweep)"})
     return 0
 
 
