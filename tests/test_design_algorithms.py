@@ -175,17 +175,41 @@ def test_mcco_wider_pool_crosses_every_ordered_pair_and_weight(entries, targets)
         de.mcco(entries, t1, t3, SETTINGS, options=FAST, weights=(0.0,))
 
 
+def _design_study():
+    spec = importlib.util.spec_from_file_location(
+        "design_study", Path(__file__).resolve().parents[1] / "validation" / "design_study.py")
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    return study
+
+
 def _strict_scores_by_hand(design, targets, tmp_path):
     """Independent of design.rescore_at_target_pressures: the validation's check
     (validation/design_study.py: design.json reloaded, bem.contact_sweep directly, A as
     the contact-node count, K by central differences and Eq. 4.1 written out)."""
     path = tmp_path / "by_hand_design.json"
     path.write_text(json.dumps(design.to_dict()))
-    spec = importlib.util.spec_from_file_location(
-        "design_study", Path(__file__).resolve().parents[1] / "validation" / "design_study.py")
-    study = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(study)
-    return study.strict_scores_from_file(path, targets, SETTINGS)
+    return _design_study().strict_scores_from_file(path, targets, SETTINGS)
+
+
+def test_target_neighbourhood_scores_one_at_the_target_and_less_around_it(entries, targets,
+                                                                         tmp_path, monkeypatch):
+    """validation/design_study.target_neighbourhood: the y_t1 genome itself, saved and
+    re-scored by the hand-written load-controlled BEM, has f = 1 on (y_t1, y_t3); moving
+    its phases lowers f, more for larger moves (median over the draws); random phases
+    with its genes and the database genomes alone stay below 1."""
+    study = _design_study()
+    monkeypatch.setitem(study.NEIGHBOURHOOD, "sigmas", (0.003, 0.3))
+    monkeypatch.setitem(study.NEIGHBOURHOOD, "draws", 6)
+    monkeypatch.setitem(study.NEIGHBOURHOOD, "random_draws", 6)
+    t1, _, t3, _ = targets
+    nb = study.target_neighbourhood(entries, [t1, t3], SETTINGS, tmp_path)
+    assert nb["f_target_genome"] == pytest.approx(1.0, abs=1e-9)
+    small, large = (np.median(nb["phase_noise"][s]) for s in (0.003, 0.3))
+    assert 1.0 >= small > large
+    assert max(nb["random_phases"]) < 1 - 1e-3 and max(nb["database_alone"]) < 1 - 1e-3
+    assert len(nb["database_alone"]) == len(entries)
+    assert any("reachable" in line for line in study._neighbourhood_lines(nb))
 
 
 def test_search_at_target_pressures_raises_the_strict_score_reproducibly(entries, targets,
