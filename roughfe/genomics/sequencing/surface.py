@@ -47,8 +47,8 @@ Steps (:func:`sequence_surfaces`)
    first candidate that fits the data to round-off or down to its white-noise floor (the
    noise variance read from the periodogram's high-q plateau, :func:`_noise_floor`) with
    every chromosome above the noise: no other candidate, continuation or added ridge can
-   fit better than the noise allows (measured, 512^2 pair, 1 % noise, seeds 0-4: 4.8-33 s
-   CPU before, 0.9-2.7 s after, the same genes).
+   fit better than the noise allows (measured, 512^2 pair, 1 % noise, seeds 0-4: 4.4-32.5 s
+   CPU before, 0.9-2.6 s after, the same genes).
 5. Genes: b_mn, phi_mn from the coefficients; (ln G, H, ln alpha) by least squares on
    ln b_mn weighted by b_mn^2; A from G (Eq. 3.1).
 Undefined points (NaN) of a measured acquisition are left out of every step.
