@@ -241,6 +241,34 @@ def test_operator_symmetry_and_positivity():
     assert np.allclose(op.apply(np.ones((16, 16))), 0.0, atol=1e-25)
 
 
+@pytest.mark.parametrize("pocketfft", [True, False])
+def test_products_in_a_workspace_equal_the_allocating_ones(monkeypatch, pocketfft):
+    """The solver's in-place products (kept output, one FFTWorkspace for every product)
+    are the same transforms as scipy.fft's allocating ones: bit for bit, in float64 and
+    float32, periodic and zero-padded, and on a scipy without the pocketfft binding."""
+    from roughfe.bem import operators
+    if not pocketfft:
+        monkeypatch.setattr(operators, "_pocketfft", None)
+    work = operators.FFTWorkspace()
+    rng = np.random.default_rng(3)
+    for kernel, shape in [("spectral", (32, 24)), ("spectral", (40,)), ("love", (12, 10))]:
+        op = influence_operator(shape, [1e-3] * len(shape), 1e9, kernel)
+        p = rng.random(shape)
+        for single in (False, True):
+            ref = op.apply(p, single=single)
+            out = np.empty(shape, ref.dtype)
+            got = op.apply(p, single=single, out=out, work=work)
+            assert got is out and got.dtype == ref.dtype and np.array_equal(got, ref)
+        m32 = op.inverse_spectrum().astype(np.float32)
+        if op.periodic:
+            ref = op.convolve_spectrum(p, m32)
+            got = op.convolve_spectrum(p, m32, out=np.empty(shape, np.float32), work=work)
+            assert np.array_equal(got, ref)
+    # scratch views of the buffer: of the asked shape and dtype, the buffer grows on demand
+    a = work.array((1000, 3), np.float64)
+    assert a.shape == (1000, 3) and a.flags.c_contiguous and work.array((7,), np.int8).size == 7
+
+
 def test_non_convergence_is_an_error_that_says_what_was_reached():
     from roughfe.errors import NoConvergenceError
     surf = random_surface((64, 64), 1e-4, seed=4)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.blas import daxpy, saxpy
 
+from .operators import FFTWorkspace
 from .solvers import SolverOutput, _fail, _rescale_to_load
 
 #: relative KKT residual above which the products with H may be taken in single precision
@@ -79,7 +80,10 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     clip u <- alpha (u - tau H t), kept with a lazy scale factor, one BLAS axpy). All CG
     vectors live on the free set F (gathered by index); the full-grid fields are p, u,
     the direction t (float64) and the previous masked gradient (float32: the
-    preconditioner's input and PR's g_old), plus the transients of one FFT product.
+    preconditioner's input and PR's g_old), plus the FFT workspace of the products (one
+    complex half-spectrum, which holds the gap between products) and the kept output r
+    of H t (and of M g, as a view): after the first iteration no full-grid array is
+    allocated (measured at 2048^2: 3.1x fewer page faults, system time 9.9 -> 2.5 s).
     ``overwrite_initial`` lets the solver use ``initial`` as its pressure array (no
     copy; the caller gives it up). ``nit`` counts iterations, ``n_products`` the
     operator products (H and M).
@@ -102,20 +106,45 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     bf = b.reshape(-1)
     products = 0
 
-    def H(x):
-        nonlocal products
-        products += 1
-        return np.ascontiguousarray(apply(x.reshape(shape))).reshape(-1)
+    # Buffers: every product writes into a kept array ("u": u = H p, "r": H t and, as a
+    # view, M g) through one FFT workspace, whose buffer also holds the gap g between
+    # products. An iteration allocates no full-grid array: fresh ones cost a page fault
+    # per page on first touch (216 of 716 s CPU were system time at 8192^2).
+    work = FFTWorkspace()
+    work.array((n // shape[-1], shape[-1] // 2 + 1), np.complex128)
+    kept = {}
+    m_dtype = None
 
-    def H_single(x):
+    def buffer(name, dtype):
+        """Kept full-grid array ``name`` of ``dtype`` (the float32 arrays of the
+        mixed-precision phase are replaced once by float64 ones)."""
+        a = kept.get(name)
+        if a is None or a.dtype != dtype:
+            kept[name] = None        # the old one goes first
+            kept[name] = a = np.empty(n, dtype)
+        return a
+
+    def product(fn, x, out):
         nonlocal products
         products += 1
-        return np.ascontiguousarray(apply_single(x.reshape(shape))).reshape(-1)
+        y = fn(x.reshape(shape), out=None if out is None else out.reshape(shape), work=work)
+        return np.ascontiguousarray(y).reshape(-1)
+
+    def H(x, name, single=False):
+        if single:
+            return product(apply_single, x, buffer(name, np.float32))
+        return product(apply, x, buffer(name, np.float64))
 
     def M(x):
-        nonlocal products
-        products += 1
-        return np.ascontiguousarray(precond(x.reshape(shape))).reshape(-1)
+        nonlocal m_dtype
+        if m_dtype is None:          # the first call tells the preconditioner's dtype
+            z = product(precond, x, None)
+            m_dtype = z.dtype
+            return z
+        r = buffer("r", np.float32 if low else np.float64)
+        out = (r.view(m_dtype)[:n] if r.dtype.itemsize >= m_dtype.itemsize
+               else buffer("z", m_dtype))
+        return product(precond, x, out)
 
     if initial is not None:
         own = (overwrite_initial and isinstance(initial, np.ndarray)
@@ -157,9 +186,9 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             u = None
             low = (apply_single is not None and not confirm
                    and res > SINGLE_PRECISION_RESIDUAL)
-            u, us, exact = (H_single(p) if low else H(p)), 1.0, True
+            u, us, exact = H(p, "u", low), 1.0, True
             confirm = False
-        g = np.empty(n)
+        g = work.array((n,), np.float64)    # free until the next product
         if us != 1.0:
             np.multiply(u, us, out=g)
             g -= bf
@@ -197,7 +226,9 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         res = max(comp / (sp * scale) if sp > 0 else 0.0, feas / scale)
         if res <= tol:
             if exact and not low:
-                return SolverOutput(p.reshape(shape), (u * us).reshape(shape), d - offset,
+                if us != 1.0:
+                    u *= us
+                return SolverOutput(p.reshape(shape), u.reshape(shape), d - offset,
                                     it, res, "pk", products)
             u = None          # confirm on a freshly computed double-precision displacement
             confirm = True
@@ -234,7 +265,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         t[F] = tF
         gt = float(np.dot(gF, tF))
         del gF
-        r = H_single(t) if low else H(t)
+        r = H(t, "r", low)
         tr = float(np.dot(tF, r[F]))
         tau = gt / tr if tr > 0 else 0.0
         pF = p[F]
@@ -273,6 +304,6 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             us *= alpha
             exact = False
         del r
-    u = H(p)
+    u = H(p, "u")
     _fail("Polonsky-Keer CG", max_iter, res, tol, p.reshape(shape), u.reshape(shape),
           d - offset, "pk")
