@@ -104,9 +104,9 @@ class FVSolution:
     nit: int
 
 
-def _harmonic(a, b, scale, live):
+def _harmonic(a, b, scale, live, out=None):
     """``scale * 2ab / (a + b)`` where ``live``, else 0 (0 also where ``a + b = 0``)."""
-    t = np.multiply(a, b)
+    t = np.multiply(a, b, out=out)
     t *= 2.0 * scale
     s = np.add(a, b)
     np.divide(t, s, out=t, where=s > 0)
@@ -205,114 +205,133 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         g, dx, dy, ul, ut = g.T, dy, dx, ut, ul
     dl, dt = dx, dy
     nl, nt = g.shape
-    n = nl * nt
-    k = g * g
-    k *= g / (12.0 * mu)
+    k = np.multiply(g, g)
+    k *= g
+    k /= 12.0 * mu
     is_open = g > 0
     wrap = periodic and nt > 1
 
     lab, t_in_lab, t_out_lab = components_reaching(is_open, periodic=periodic)
-    live = np.zeros(lab.size, bool).reshape(nl, nt)
-    ok = lab >= 0
-    live[ok] = (t_in_lab | t_out_lab)[lab[ok]]
+    live = np.append(t_in_lab | t_out_lab, False)[lab]      # label -1 (closed): False
+    del lab
     percolates = bool((t_in_lab & t_out_lab).any())
 
-    # face transmissibilities (m^3/(Pa s)) and Couette face flows (m^3/s, along +axis);
-    # faces outside the live components carry nothing
-    lt_a = live if wrap else live[:, :-1]
+    # face transmissibilities (m^3/(Pa s)); T_t[:, j] joins columns j and j + 1 (with wrap,
+    # the last column is the seam face); faces outside the live components carry nothing
     T_l = _harmonic(k[:-1], k[1:], dt / dl, live[:-1])
-    T_t = _harmonic(k if wrap else k[:, :-1], np.roll(k, -1, axis=1) if wrap else k[:, 1:],
-                    dl / dt, lt_a)
+    T_t = np.empty((nl, nt if wrap else nt - 1))
+    _harmonic(k[:, :-1], k[:, 1:], dl / dt, live[:, :-1], out=T_t[:, :nt - 1])
+    if wrap:
+        _harmonic(k[:, -1:], k[:, :1], dl / dt, live[:, -1:], out=T_t[:, -1:])
+    # Couette face flows (m^3/s, along +axis; None without wall motion along that axis)
+    C_l = C_t = None
     if ul:
         C_l = np.where(is_open[:-1] & is_open[1:] & live[:-1],
                        0.25 * (g[:-1] + g[1:]) * ul * dt, 0.0)
-    else:
-        C_l = np.zeros(T_l.shape)
     if ut:
         gt_b = np.roll(g, -1, axis=1) if wrap else g[:, 1:]
         gt_a = g if wrap else g[:, :-1]
-        C_t = np.where((gt_a > 0) & (gt_b > 0) & lt_a, 0.25 * (gt_a + gt_b) * ut * dl, 0.0)
-    else:
-        C_t = np.zeros(T_t.shape)
+        C_t = np.where((gt_a > 0) & (gt_b > 0) & (live if wrap else live[:, :-1]),
+                       0.25 * (gt_a + gt_b) * ut * dl, 0.0)
     if wrap and nt == 2:                       # the wrap face joins the same two cells
-        T_t, C_t, wrap = T_t[:, :1] + T_t[:, 1:], C_t[:, :1] - C_t[:, 1:], False
+        T_t, wrap = T_t[:, :1] + T_t[:, 1:], False
+        if C_t is not None:
+            C_t = C_t[:, :1] - C_t[:, 1:]
     T_in = dt / (0.5 * dl) * k[0] * live[0]
     T_out = dt / (0.5 * dl) * k[-1] * live[-1]
+    del k
     C_in = 0.5 * g[0] * ul * dt * live[0]
     C_out = 0.5 * g[-1] * ul * dt * live[-1]
 
-    # cell balance: diagonal = sum of the face transmissibilities of the cell
-    diag = np.zeros((nl, nt))
-    diag[:-1] += T_l
-    diag[1:] += T_l
-    if wrap:
-        diag += T_t
-        diag += np.roll(T_t, 1, axis=1)
-    else:
-        diag[:, :-1] += T_t
-        diag[:, 1:] += T_t
-    diag[0] += T_in
-    diag[-1] += T_out
-    # right-hand side: boundary pressures and the net Couette inflow of each cell
-    rhs = np.zeros((nl, nt))
-    rhs[:-1] -= C_l
-    rhs[1:] += C_l
-    if wrap:
-        rhs -= C_t
-        rhs += np.roll(C_t, 1, axis=1)
-    else:
-        rhs[:, :-1] -= C_t
-        rhs[:, 1:] += C_t
+    # right-hand side: boundary pressures and the net Couette inflow of each cell;
     # unknown: p - p_out (every row of the operator applied to a constant gives its boundary
     # transmissibility), so the solver tolerance is relative to the drop p_in - p_out and
     # the Couette flow, not to the absolute pressure level
+    rhs = np.zeros((nl, nt))
     rhs[0] += T_in * (p_in - p_out) + C_in
     rhs[-1] -= C_out
+    if C_l is not None:
+        rhs[:-1] -= C_l
+        rhs[1:] += C_l
+    if C_t is not None:
+        rhs[:, :C_t.shape[1]] -= C_t
+        rhs[:, 1:] += C_t[:, :nt - 1]
+        if wrap:
+            rhs[:, 0] += C_t[:, -1]
 
     # unknowns on the live cells only: closed cells and pockets do not enter the system
-    p = np.zeros((nl, nt))
     nit, success, message = 0, True, "nothing to solve: no open cell reaches inlet or outlet"
     if live.any():
-        M = _live_system(T_l, T_t, diag, live, wrap)
-        del diag
+        M = _live_system(T_l, T_t, _diagonal(T_l, T_t, T_in, T_out, wrap), live, wrap)
         x, nit, success, message = ksp_solve(M, rhs[live], name="reynolds_fv",
                                              options={**REYNOLDS_FV, **dict(petsc_options or {})})
         M.destroy()
-        p[live] = x
-        del x
-    p[live] += p_out
     if not success:
         raise NoConvergenceError(f"Reynolds finite-volume solve: {message}")
+    p = rhs                                    # reuse the grid: pressure, 0 outside the live cells
+    p.fill(0.0)
+    if live.any():
+        x += p_out
+        p[live] = x
+        del x
 
-    # face flows (m^3/s, along +axis) and the inlet/outlet balance
-    F_l = T_l * (p[:-1] - p[1:]) + C_l
-    pt_b = np.roll(p, -1, axis=1) if wrap else p[:, 1:]
-    F_t = T_t * ((p if wrap else p[:, :-1]) - pt_b) + C_t
-    F_in = np.where(live[0], T_in * (p_in - p[0]) + C_in, 0.0)
-    F_out = np.where(live[-1], T_out * (p[-1] - p_out) + C_out, 0.0)
-    q_in, q_out = float(F_in.sum()), float(F_out.sum())
+    # face flows (m^3/s, along +axis): fl[i] enters row i (fl[0] inlet, fl[-1] outlet),
+    # ft[:, j] enters column j (ft[:, 0] = ft[:, -1]: the seam face, or a wall: 0)
+    fl = np.empty((nl + 1, nt))
+    np.subtract(p[:-1], p[1:], out=fl[1:-1])
+    fl[1:-1] *= T_l
+    fl[0] = np.where(live[0], T_in * (p_in - p[0]) + C_in, 0.0)
+    fl[-1] = np.where(live[-1], T_out * (p[-1] - p_out) + C_out, 0.0)
+    if C_l is not None:
+        fl[1:-1] += C_l
+    ft = np.zeros((nl, nt + 1))
+    np.subtract(p[:, :-1], p[:, 1:], out=ft[:, 1:-1])
+    ft[:, 1:-1] *= T_t[:, :nt - 1]
+    if wrap:
+        np.subtract(p[:, -1], p[:, 0], out=ft[:, -1])
+        ft[:, -1] *= T_t[:, -1]
+    if C_t is not None:
+        ft[:, 1:C_t.shape[1] + 1] += C_t
+    if wrap:
+        ft[:, 0] = ft[:, -1]
+    q_in, q_out = float(fl[0].sum()), float(fl[-1].sum())
     leak = 0.5 * (q_in + q_out)
     if not percolates and ul == 0.0:
         leak = 0.0                            # no open path: no through-flow, exactly
 
     # cell-centre flux per unit width: mean of the two opposite face flows
-    fl = np.concatenate([F_in[None], F_l, F_out[None]], axis=0)
-    q_l = 0.5 * (fl[:-1] + fl[1:]) / dt
-    if wrap:
-        q_t = 0.5 * (np.roll(F_t, 1, axis=1) + F_t) / dl
-    else:
-        z = np.zeros((nl, 1))
-        ft = np.concatenate([z, F_t, z], axis=1)
-        q_t = 0.5 * (ft[:, :-1] + ft[:, 1:]) / dl
-    pressure = np.where(live, p, np.nan)
-    flux = np.stack([q_l, q_t], axis=-1)
+    flux = np.empty((nl, nt, 2))
+    np.add(fl[:-1], fl[1:], out=flux[..., 0])
+    flux[..., 0] *= 0.5 / dt
+    del fl
+    np.add(ft[:, :-1], ft[:, 1:], out=flux[..., 1])
+    flux[..., 1] *= 0.5 / dl
+    del ft
+    p[~live] = np.nan
     if direction == "y":
-        pressure, live = pressure.T, live.T
-        flux = np.stack([q_t.T, q_l.T], axis=-1)
-    return FVSolution(pressure=np.ascontiguousarray(pressure), flux=np.ascontiguousarray(flux),
+        p, live, flux = p.T, live.T, flux.transpose(1, 0, 2)[..., ::-1]
+    return FVSolution(pressure=np.ascontiguousarray(p), flux=np.ascontiguousarray(flux),
                       connected=np.ascontiguousarray(live), inlet_flow=q_in,
                       outlet_flow=q_out, leak_rate=float(leak), percolates=percolates,
                       success=bool(success), message=message, nit=int(nit))
+
+
+def _diagonal(T_l, T_t, T_in, T_out, wrap):
+    """Diagonal of the 5-point operator: the sum of the face transmissibilities of every
+    cell (its mass balance), the inlet/outlet faces included (shapes as in
+    :func:`_live_system`)."""
+    nl = T_l.shape[0] + 1
+    nt = T_t.shape[1] + (0 if wrap else 1)
+    diag = np.zeros((nl, nt))
+    diag[:-1] += T_l
+    diag[1:] += T_l
+    diag[:, :T_t.shape[1]] += T_t
+    diag[:, 1:] += T_t[:, :nt - 1]
+    if wrap:
+        diag[:, 0] += T_t[:, -1]
+    diag[0] += T_in
+    diag[-1] += T_out
+    return diag
 
 
 def _live_system(T_l, T_t, diag, live, wrap):
