@@ -216,10 +216,10 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
     assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "t_K.csv"),
                  "--second-target", str(tmp_path / "t" / "t_A.csv"), "--method", "mcco",
                  "--iterations", "1", "--match-spectrum", str(tmp_path / "t.npz"),
-                 "--spectrum-starts", "1", "--search", "3", "--no-figures", "-o",
-                 str(out)]) == 0
+                 "--spectrum-starts", "1", "--match-directions", "--search", "3",
+                 "--no-figures", "-o", str(out)]) == 0
     report = json.loads((out / "result.json").read_text())
-    assert "matched to the target spectrum" in report["message"]
+    assert "wave amplitudes matched to the target spectrum" in report["message"]
     design = Design.from_dict(json.loads((out / "design.json").read_text()))
     assert design.dim == 2
     heights = load_surface(out / "profile.npz")
@@ -228,6 +228,9 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
     targets = [Target.from_dict(t) for t in report["targets"]]
     assert rescore_at_target_pressures(design, targets, settings) == pytest.approx(
         report["candidates"][0]["scores_at_target_pressures"], abs=1e-7)
+    assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "t_K.csv"),
+                 "--method", "sog", "--match-directions", "-o", str(tmp_path / "e")]) == 2
+    assert "--match-directions needs --match-spectrum" in capsys.readouterr().err
     assert main(["db", "build", str(tmp_path / "x.sqlite"), "--dim", "2",
                  "--top-fraction", "1.5"]) == 2
     assert "top_fraction" in capsys.readouterr().err

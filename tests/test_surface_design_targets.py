@@ -1,6 +1,8 @@
 """Targets of a measured (non-periodic) window for surface design (issue 15 Sec. 3): the
 evenly mirrored window is the periodic interface the designs are; the window alone on a
 half-space adds its own bulk compliance in series (1/K_window ~ 1/K_periodic + C)."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -110,3 +112,29 @@ def test_spectrum_matched_recovers_the_chromosome_amplitudes_of_a_reweighted_des
     np.testing.assert_allclose(matched - matched.mean(), ref, atol=1e-12 * np.ptp(ref))
     with pytest.raises(InputError, match="periodic"):
         spectrum_matched(d, Surface(target.heights, target.size))
+
+
+def test_directional_spectrum_matching_recovers_every_wave_amplitude():
+    """A target that is the design with every *wave* (ridge, chromosome) re-weighted on its
+    own (per-ridge factors of one-chromosome parts: not an MWM genome, nor reachable by
+    chromosome weights): directional matching restores it exactly, chromosome matching
+    does not (it keeps the design's ratio between the ridges of a chromosome). Angles and
+    chromosomes are chosen so that no rounded lattice wave lies half-way (in log q)
+    between two chromosomes (the longest wave rounded to the diagonal would)."""
+    from roughfe.genomics.design import Design, DesignPart, spectrum_matched
+    from roughfe.genomics.genome import random_genome
+
+    length, n = 1e-4, 32
+    g = random_genome(1e-6, 0.8, 2.0, length, 3, 5, rng=4, angles=[0.0, 1.0, 2.0],
+                      anisotropy=[1.0, 0.6, 1.4])
+    d = Design((DesignPart(g, (2, 3, 4, 5), 1.0, "g"),), 2.0, length, n, "g", 2)
+    split = d.split_chromosomes()
+    rng = np.random.default_rng(5)
+    parts = tuple(replace(p, genome=replace(p.genome, anisotropy=rng.uniform(0.2, 3.0, 3)))
+                  for p in split.parts)
+    target = replace(split, parts=parts).surface()
+    ref = target.heights - target.heights.mean()
+    for directional, ok in ((True, True), (False, False)):
+        matched = spectrum_matched(d, target, directional).surface().heights
+        err = np.abs(matched - matched.mean() - ref).max() / np.ptp(ref)
+        assert (err < 1e-12) == ok, (directional, err)

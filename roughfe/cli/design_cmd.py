@@ -44,6 +44,8 @@ def _run(args) -> int:
                            gradient=args.gradient,
                            **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
                               if args.iterations else {}))
+    if args.match_directions and not args.match_spectrum:
+        raise InputError("--match-directions needs --match-spectrum SURFACE")
     if args.pool and args.method != "mcco":
         raise InputError("--pool is used by --method mcco only")
     extra = ({"pool": args.pool, "swap": True, "weights": (0.5, 1.0, 2.0)} if args.pool else {})
@@ -57,7 +59,8 @@ def _run(args) -> int:
             from ..surfaces.io import load_surface
             surface = target_surface(load_surface(args.match_spectrum), settings)
             result = match_spectrum(result, surface, settings, entries=entries,
-                                    n_entries=args.spectrum_starts)
+                                    n_entries=args.spectrum_starts,
+                                    directional=args.match_directions)
         if args.search:
             result = search_at_target_pressures(result, settings, n_eval=args.search,
                                                 starts=args.search_starts,
@@ -160,6 +163,10 @@ def register(sub):
     g.add_argument("--spectrum-starts", type=nonnegative_int, default=3, metavar="K",
                    help="--match-spectrum: also start from the K best database genomes, "
                         "spectrum matched")
+    g.add_argument("--match-directions", action="store_true",
+                   help="--match-spectrum per wave: every (ridge, chromosome) wave gets the "
+                        "rms of the target's modes nearest to it in log q and direction "
+                        "(default: one rms per chromosome)")
     p.add_argument("--pool", type=nonnegative_int, default=0, metavar="K",
                    help="mcco, beyond the thesis: start pool of the K best genomes of each "
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "
