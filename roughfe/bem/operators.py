@@ -46,7 +46,6 @@ Kernels (``kernel=`` in :func:`roughfe.bem.solve_contact`):
 from __future__ import annotations
 
 import functools
-import os
 from dataclasses import dataclass
 from typing import Optional
 
@@ -59,11 +58,12 @@ except ImportError:     # pragma: no cover - a scipy without it takes the alloca
     _pocketfft = None
 
 from ..errors import InputError
+from . import _parallel
 from ..reference import uniform_rectangle_displacement, uniform_strip_displacement
 from ..surfaces.stats import angular_wavevectors, rfft_full_sum
 
 KERNELS = ("spectral", "strip", "thesis", "love")
-WORKERS = max(1, min(4, os.cpu_count() or 1))  # threads per FFT
+WORKERS = _parallel.THREADS  # threads per FFT (ROUGHFE_THREADS, see roughfe.bem._parallel)
 
 _KERNEL_REFERENCES = {
     "spectral": ("Stanley H.M., Kato T. (1997) J. Tribol. 119:481-485",),
@@ -144,7 +144,7 @@ class InfluenceOperator:
         """
         if single:
             if out is not None and work is not None and self.periodic:
-                np.copyto(out, p, casting="same_kind")   # the float32 input, in out
+                _copy(out, p)                     # the float32 input, in out
                 p = out
             else:
                 p = p.astype(np.float32, copy=False)
@@ -257,13 +257,38 @@ def _convolve(x, spectrum, fft_shape, out=None, work=None):
     xh = work.array(fft_shape[:-1] + (fft_shape[-1] // 2 + 1,),
                     np.complex64 if single else np.complex128)
     _pocketfft.r2c(x, axes, True, 0, xh, WORKERS)
-    np.multiply(xh, spectrum, out=xh)
+    _multiply(xh, spectrum)
     for axis in axes[:-1]:          # normalised by 1/n per axis, as irfftn
         _pocketfft.c2c(xh, [axis], False, 2, xh, WORKERS)
     if out is None:
         out = np.empty(fft_shape, x.dtype)
     _pocketfft.c2r(xh, [axes[-1]], fft_shape[-1], False, 2, out, WORKERS)
     return out
+
+
+def _flat(a):
+    """The flat view of a C-contiguous array, or None."""
+    return a.reshape(-1) if a.flags.c_contiguous else None
+
+
+def _copy(out, x):
+    """``out[...] = x`` (cast to ``out``'s dtype) over the threads when both are
+    contiguous."""
+    fo, fx = _flat(out), _flat(x)
+    if fo is None or fx is None or fo.size != fx.size:
+        np.copyto(out, x, casting="same_kind")
+        return
+    _parallel.blocks(fo.size, lambda a, b: np.copyto(fo[a:b], fx[a:b],
+                                                     casting="same_kind"))
+
+
+def _multiply(xh, spectrum):
+    """``xh *= spectrum`` (half-spectrum by the kernel's multiplier) over the threads."""
+    fx, fs = _flat(xh), _flat(spectrum)
+    if fx is None or fs is None or fx.size != fs.size:
+        np.multiply(xh, spectrum, out=xh)
+        return
+    _parallel.blocks(fx.size, lambda a, b: np.multiply(fx[a:b], fs[a:b], out=fx[a:b]))
 
 
 def _offsets(n, d):

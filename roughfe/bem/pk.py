@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.blas import daxpy, saxpy
 
+from . import _parallel as par
 from .operators import FFTWorkspace
 from .solvers import SolverOutput, _fail, _rescale_to_load
 
@@ -41,6 +42,18 @@ def _shift_to_load(x, target_sum, upper):
         lam = step if lo < step < hi else 0.5 * (lo + hi)
     x[...] = y
     return True
+
+
+def _gap(u, us, b, g, i, j):
+    """``g = us u - b`` on the block ``[i, j)`` (one pass, float64 out of a float32 or
+    float64 ``u``); returns the block's minimum of g (the largest penetration)."""
+    gi = g[i:j]
+    if us != 1.0:
+        np.multiply(u[i:j], us, out=gi)
+        gi -= b[i:j]
+    else:
+        np.subtract(u[i:j], b[i:j], out=gi)
+    return float(gi.min())
 
 
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
@@ -189,13 +202,9 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             u, us, exact = H(p, "u", low), 1.0, True
             confirm = False
         g = work.array((n,), np.float64)    # free until the next product
-        if us != 1.0:
-            np.multiply(u, us, out=g)
-            g -= bf
-        else:
-            np.subtract(u, bf, out=g)
-        gS = g[S]
-        pS = p[S]
+        gmin = min(par.blocks(n, lambda i, j: _gap(u, us, bf, g, i, j)))
+        gS = par.take(g, S)
+        pS = par.take(p, S)
         free_c = pS < upper if bounded else None
         if load:
             gE = gS[free_c] if bounded else gS
@@ -213,16 +222,16 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             np.abs(wS, out=wS)
             comp = float(np.dot(pS, wS))
         del gS, wS, pS        # the first iterations of a cold start have S = every point
-        np.less(g, d, out=mask)
+        par.blocks(n, lambda i, j: np.less(g[i:j], d, out=mask[i:j]))
         if bounded:           # points at the bound may interpenetrate
-            pen = np.flatnonzero(mask)
-            gpen = g[pen]
+            pen = par.flatnonzero(mask)
+            gpen = par.take(g, pen)
             gpen = gpen[p[pen] < upper]
             del pen
             feas = max(0.0, d - float(gpen.min())) if gpen.size else 0.0
             del gpen
         else:                 # the largest penetration, anywhere
-            feas = max(0.0, d - float(g.min()))
+            feas = max(0.0, d - gmin)
         res = max(comp / (sp * scale) if sp > 0 else 0.0, feas / scale)
         if res <= tol:
             if exact and not low:
@@ -233,24 +242,24 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             u = None          # confirm on a freshly computed double-precision displacement
             confirm = True
             continue
-        mask[S] = True
+        par.put(mask, S, True)
         del S
         if bounded:           # saturated points pushed further in stay at the bound
-            mask[fixed] = False
-        F_old, F = F, np.flatnonzero(mask)    # F_old: the support of gbuf and t
-        gF = g[F]
+            par.put(mask, fixed, False)
+        F_old, F = F, par.flatnonzero(mask)    # F_old: the support of gbuf and t
+        gF = par.take(g, F)
         del g
         gF -= d
         if load:
             gF -= gF.mean()
-        g_old = gbuf[F]       # previous masked gradient and direction on the new free set
-        tF = t[F]
-        gbuf[F_old] = 0.0
-        t[F_old] = 0.0
+        g_old = par.take(gbuf, F)   # previous masked gradient and direction on the new F
+        tF = par.take(t, F)
+        par.put(gbuf, F_old, 0.0)
+        par.put(t, F_old, 0.0)
         del F_old
-        gbuf[F] = gF
+        par.put(gbuf, F, gF)
         if precond is not None:
-            zF = M(gbuf)[F]
+            zF = par.take(M(gbuf), F)
             if load:
                 zF -= zF.mean()
         else:
@@ -262,13 +271,13 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         tF *= beta
         tF += zF
         del zF
-        t[F] = tF
+        par.put(t, F, tF)
         gt = float(np.dot(gF, tF))
         del gF
         r = H(t, "r", low)
-        tr = float(np.dot(tF, r[F]))
+        tr = float(np.dot(tF, par.take(r, F)))
         tau = gt / tr if tr > 0 else 0.0
-        pF = p[F]
+        pF = par.take(p, F)
         tF *= tau
         pF -= tF
         del tF
@@ -292,15 +301,16 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
                 if not bounded:       # every pressure was clipped: spread the load on F
                     pF[:] = carried / pF.size
                 elif not _shift_to_load(pF, carried, upper):
-                    p[F] = pF
+                    par.put(p, F, pF)
                     _shift_to_load(p, target, upper)
-                    pF = p[F]
-        p[F] = pF
+                    pF = par.take(p, F)
+        par.put(p, F, pF)
         S = np.flatnonzero(p) if bounded else F[pF > 0]
         if clipped:
             u = None          # the projection moved p off the line: recompute u = H p
         else:
-            (saxpy if low else daxpy)(r, u, a=-tau / us)
+            axpy, a = (saxpy if low else daxpy), -tau / us
+            par.blocks(n, lambda i, j: axpy(r[i:j], u[i:j], a=a))
             us *= alpha
             exact = False
         del r
