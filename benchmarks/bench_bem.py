@@ -28,7 +28,11 @@ hardness  n = --hardness-size: H_p = --hardness E*: the hardness-limited solve a
           (target: the same A* and plastic area fraction to 2e-3).
 large     n = --large (e.g. 4096 8192): one load p/E* = 0.05: time, iterations and the
           peak RSS of generation + solve (targets 4096^2 <= 1.2 GB, 8192^2 <= 4.5 GB and
-          <= 240 s).
+          <= 240 s, judged on process CPU and on wall time: the wall time is the user's
+          wait and is meaningful only on a quiet machine). ``solve_main_thread_cpu_s`` is
+          the CPU of the calling thread alone: the serial share of the solve (the FFTs
+          and the split full-grid passes run on ``threads`` threads, see
+          ``roughfe.bem._parallel``).
 
 Writes ``benchmarks/output/bench_bem.json`` (targets with met / NOT met, the tables) and
 prints the tables. Usage::
@@ -101,6 +105,11 @@ def _timed(fn):
     return out, time.process_time() - c0, time.perf_counter() - w0
 
 
+def _threads_fields():
+    from roughfe.bem._parallel import THREADS
+    return {"threads": THREADS, "cpus": os.cpu_count()}
+
+
 def _tamaas(heights, pressure, hardness=None):
     """Tamaas' PolonskyKeerRey (or KatoSaturated with ``hardness``): (cpu s, pressure,
     iterations) or None when tamaas is not importable."""
@@ -161,6 +170,7 @@ def case_elastic(n, loads, tamaas, sweep):
            "convolution_cpu_s_before_after": [conv0, conv1],
            "irfftn_unit_cpu_s": irfftn_unit, "rows": rows,
            "cold_cpu_s": sum(r["cpu_s"] for r in rows),
+           "cold_wall_s": sum(r["wall_s"] for r in rows),
            "cold_convolutions": sum(r["convolutions"] for r in rows),
            "cold_nit": sum(r["nit"] for r in rows)}
     if sweep:
@@ -203,16 +213,19 @@ def case_large(n, pm):
     surf, cpu_g, wall_g = _timed(lambda: _surface(n))
     rss_gen = _peak_rss_mb()
     r0 = resource.getrusage(resource.RUSAGE_SELF)
+    t0 = time.thread_time()
     r, cpu, wall = _timed(lambda: solve_contact(surf, Material(1.0, 0.0), mean_pressure=pm,
                                                 solver="pk", tol=TOL,
                                                 compute_stiffness=False))
+    main_cpu = time.thread_time() - t0
     r1 = resource.getrusage(resource.RUSAGE_SELF)
     return {"n": n, "p/E*": pm, "A*": r.area_fraction, "nit": r.nit,
             "generation_wall_s": wall_g, "generation_rss_mb": rss_gen,
             "solve_cpu_s": cpu, "solve_user_s": r1.ru_utime - r0.ru_utime,
             "solve_system_s": r1.ru_stime - r0.ru_stime,
             "solve_page_faults": r1.ru_minflt - r0.ru_minflt,
-            "solve_wall_s": wall, "peak_rss_mb": _peak_rss_mb(),
+            "solve_wall_s": wall, "solve_main_thread_cpu_s": main_cpu,
+            "peak_rss_mb": _peak_rss_mb(), **_threads_fields(),
             "bytes_per_point": _peak_rss_mb() * 2 ** 20 / n ** 2,
             "load_average": os.getloadavg()[0]}
 
@@ -297,6 +310,7 @@ def main(argv=None) -> int:
         large.append(run_case("large", n=n, pm=0.05))
         print(_table([large[-1]], ["n", "nit", "generation_wall_s", "solve_cpu_s",
                                    "solve_system_s", "solve_page_faults", "solve_wall_s",
+                                   "solve_main_thread_cpu_s",
                                    "peak_rss_mb", "bytes_per_point",
                                    "load_average"]), flush=True)
 
@@ -333,6 +347,10 @@ def main(argv=None) -> int:
         if r["n"] == 8192:
             targets.append(_target("8192^2 solve (process CPU s)", r["solve_cpu_s"], 240.0,
                                    r["solve_cpu_s"] <= 240.0, "s"))
+            # the 4 minutes are the user's wait: wall time of the solve on this machine,
+            # meaningful only on a quiet one (load_average is stored beside it)
+            targets.append(_target("8192^2 solve (wall s, quiet machine)", r["solve_wall_s"],
+                                   240.0, r["solve_wall_s"] <= 240.0, "s"))
     result = {"load_average_start": load0, "load_average_end": os.getloadavg()[0],
               "cpus": os.cpu_count(), "tol": TOL, "targets": targets,
               "elastic": [{k: v for k, v in e.items() if k != "rows"} for e in elastic],
