@@ -1,14 +1,20 @@
 """Pastewka-Robbins stickiness criterion (roughfe.theory.stickiness): the Hertzian edge
 constants, the published Eq. (10) by hand and against our ring derivation, its scaling
-with w, the range and the roughness."""
+with w, the range and the roughness; the load balance with a measured attractive area
+against the exact Hertzian ring."""
 import numpy as np
 import pytest
+import scipy.optimize
+
+from roughfe.bem import solve_contact
+from roughfe.model import Material
+from roughfe.surfaces.shapes import sphere_cap
 
 from roughfe.errors import InputError
 from roughfe.surfaces.spectral import spectral_surface
 from roughfe.surfaces.surface import Surface
-from roughfe.theory.stickiness import (EDGE_COEFFICIENT, pastewka_robbins, published_criterion,
-                                       ring_stickiness)
+from roughfe.theory.stickiness import (EDGE_COEFFICIENT, PERIMETER_FACTOR, load_balance,
+                                       pastewka_robbins, published_criterion, ring_stickiness)
 
 
 def _surface(scale=1.0):
@@ -62,6 +68,9 @@ def test_closed_form_and_scaling():
     assert r.criterion == pytest.approx(closed, rel=1e-12)
     assert r.stickiness == pytest.approx(1 / closed, rel=1e-12)
     assert r.kappa_ratio == pytest.approx(1 / (1 - r.stickiness), rel=1e-12)
+    assert r.attractive_over_repulsive == pytest.approx(
+        PERIMETER_FACTOR[2] * r.ring_over_half_width, rel=1e-12)
+    assert r.range_over_edge_gap == pytest.approx(dr * 3 * h2 / (16 * h1 * h1), rel=1e-12)
     assert r.tabor_parameter == pytest.approx((w * w / e_star ** 2 / h2) ** (1 / 3) / dr,
                                               rel=1e-12)
     # linear in w; Delta_r^(-1/3); heights x lambda -> lambda^(-5/3) (h_rms itself does not
@@ -105,3 +114,33 @@ def test_bad_input(args, match):
 def test_flat_surface_is_refused():
     with pytest.raises(InputError, match="rough surface"):
         pastewka_robbins(Surface(np.zeros((8, 8)), 1e-5, periodic=True), 1e6, 1e-3, 1e-9)
+
+
+def test_load_balance_on_a_hertz_contact_is_the_exact_ring():
+    # Non-adhesive BEM sphere (R = 1 mm, a = 20 um): the attraction of range dr acts on
+    # the ring a < r < a + d where the exact Hertzian gap (Johnson 1985, Eq. 3.42) is
+    # below dr; the DMT balance threshold is w_c = dr P / (pi ((a + d)^2 - a^2)).
+    # Converged to the cell-counting error of the ring (3.6 / 7.1 cells wide).
+    radius, a, dr = 1e-3, 20e-6, 5e-8
+    mat = Material(0.75e6, 0.5)
+    delta = a * a / radius
+    load = 4 / 3 * mat.E_star * np.sqrt(radius) * delta ** 1.5
+
+    def gap(r):
+        return (r * r / 2 - a * a + ((2 * a * a - r * r) * np.arcsin(a / r)
+                                     + a * np.sqrt(r * r - a * a)) / np.pi) / radius
+
+    d = scipy.optimize.brentq(lambda x: gap(a + x) - dr, 1e-12, a)
+    ring = np.pi * ((a + d) ** 2 - a * a)
+    for n in (128, 256):
+        res = solve_contact(sphere_cap(n, 8 * a, radius), mat, delta=delta,
+                            compute_stiffness=False)
+        lb = load_balance(res, dr)
+        assert lb.attractive_fraction * (8 * a) ** 2 == pytest.approx(ring, rel=0.04)
+        assert lb.threshold_work == pytest.approx(dr * load / ring, rel=0.04)
+        assert lb.attractive_over_repulsive == pytest.approx(
+            lb.attractive_fraction / res.area_fraction, rel=1e-12)
+    with pytest.raises(InputError, match="range"):
+        load_balance(res, -1.0)
+    with pytest.raises(InputError, match="below the range"):
+        load_balance(res, 1e-15)

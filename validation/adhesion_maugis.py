@@ -44,7 +44,7 @@ from roughfe.surfaces.spectral import spectral_surface
 from roughfe.surfaces.stats import rms_slope
 from roughfe.surfaces.surface import Surface
 from roughfe.theory import persson
-from roughfe.theory.stickiness import KAPPA_REP, pastewka_robbins
+from roughfe.theory.stickiness import KAPPA_REP, load_balance, pastewka_robbins
 from roughfe.writers import write_json
 
 OUT = Path(__file__).resolve().parent / "output" / "adhesion_maugis.json"
@@ -121,50 +121,85 @@ def rough_adhesive(growths=(2.0, 1.2)):
             "persson_area_fraction_nonadhesive": [float(a) for a in theory.area_fraction]}
 
 
-STICKY_AREA = 0.01     # A* at which the secant of A*(p) is read (Pastewka & Robbins' test)
+STICKY_AREA = 0.01     # A* at which the secant of A*(p) is read (the proportional prefactor)
+STICKY_WINDOW = (0.005, 0.02)   # small-load window of the tangent dp/dA* (cross-check)
 STICKY_FACTORS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 2.0)   # w / w_PR (C = 1 at w_PR: not sampled)
 STICKY_GRIDS = ((3, (128, 256)), (4, (128, 256)))           # (seed, grids)
+STICKY_RANGES = (2.5e-9, 1.25e-9)   # shorter ranges of the thinner-ring check (non-adhesive)
+
+
+def _branch(results):
+    """(A*, p) of the states with contact, sorted by area (a loading branch)."""
+    return np.array(sorted((r.area_fraction, r.mean_pressure) for r in results if r.n_contact)).T
 
 
 def _pressure_at_area(results, area):
     """Mean pressure (Pa) at the area fraction ``area``, interpolated along a loading
-    branch (states with contact, sorted by area); when the branch jumped into contact
-    beyond ``area`` the pressure of its smallest contact state (the secant's sign is
-    what is read)."""
-    pts = sorted((r.area_fraction, r.mean_pressure) for r in results if r.n_contact)
-    a, p = np.array(pts).T
+    branch; when the branch jumped into contact beyond ``area`` the pressure of its
+    smallest contact state (the secant's sign is what is read)."""
+    a, p = _branch(results)
     return float(np.interp(area, a, p))
+
+
+def _tangent(results, window=STICKY_WINDOW):
+    """Least-squares line ``p = p0 + s A*`` through the loading states with A* in
+    ``window``: the tangent s (Pa) of the area-load line at small load and the load p0
+    (Pa) at which its area vanishes; NaN when fewer than 3 states lie in the window
+    (the branch jumped into contact beyond it)."""
+    a, p = _branch(results)
+    m = (a >= window[0]) & (a <= window[1])
+    if m.sum() < 3:
+        return float("nan"), float("nan"), int(m.sum())
+    s, p0 = np.polyfit(a[m], p[m], 1)
+    return float(s), float(p0), int(m.sum())
 
 
 def _threshold(works, s_bem):
     """Work of adhesion (J/m^2) at which S_BEM crosses 1, interpolated in log w between
     the bracketing cases (NaN when the cases do not bracket it)."""
-    for (w0, s0), (w1, s1) in zip(zip(works, s_bem), zip(works[1:], s_bem[1:])):
+    pts = [(w, s) for w, s in zip(works, s_bem) if np.isfinite(s)]
+    for (w0, s0), (w1, s1) in zip(pts, pts[1:]):
         if s0 < 1.0 <= s1:
             return float(np.exp(np.interp(1.0, [s0, s1], np.log([w0, w1]))))
     return float("nan")
 
 
-def stickiness_cases(grids=STICKY_GRIDS, factors=STICKY_FACTORS):
+def _at_area(elastic, values, area=STICKY_AREA):
+    """``values`` (one per elastic state) interpolated at the area fraction ``area``."""
+    a = np.array([r.area_fraction for r in elastic])
+    order = np.argsort(a)
+    return float(np.interp(area, a[order], np.asarray(values, float)[order]))
+
+
+def stickiness_cases(grids=STICKY_GRIDS, factors=STICKY_FACTORS, interaction_range=5e-9,
+                     unload=True):
     """Pastewka-Robbins Eq. (10) against the adhesive BEM on rough surfaces.
 
     Periodic self-affine surfaces (H = 0.8, 10 nm rms, L = 10 um, roll-off 2 q0, cut-off
     32 q0; one realisation per seed, generated on the finest grid and sampled exactly on
     the coarser ones: it holds no wavelength below 32 q0, so 128^2 and 256^2 see the
     same surface with 4 / 8 cells per shortest wavelength), E* = 1.33 MPa,
-    Maugis-Dugdale law with range 5 nm, works of adhesion ``factors`` x w_PR (the work at
-    which Eq. (10) gives C = 1).
+    Maugis-Dugdale law with range ``interaction_range`` (5 nm), works of adhesion
+    ``factors`` x w_PR (the work at
+    which Eq. (10) gives C = 1); loading in 12 approach steps.
 
-    BEM verdict (Pastewka & Robbins' own test, which reads the secant of A_rep(p) at
-    A_rep / A0 ~ 1 %): sticky when the loading branch needs a tensile or zero mean
-    pressure to hold A* = 1 %, ``p_adh(1 %) <= 0``; the BEM's own stickiness number is
-    ``S_BEM = 1 - p_adh / p_el`` at that area (against the non-adhesive sweep; sticky
-    iff S_BEM >= 1), and its threshold w_BEM (S_BEM = 1, interpolated in log w). The
-    pull-off pressure of the unloading branch (growing steps until separation) is
-    reported beside it on 128^2: a finite pull-off is not the paper's criterion
-    (Ciavarella & Papangelo 2018)."""
+    BEM verdict: the sign of the prefactor of the area-load line (Pastewka & Robbins'
+    abstract: the area is initially proportional to the load, the prefactor changes sign
+    when the surfaces become sticky), read as the secant at A* = 1 %: sticky when the
+    loading branch needs a tensile or zero mean pressure to hold A* = 1 %,
+    ``p_adh(1 %) <= 0``; ``S_BEM = 1 - p_adh / p_el`` at that area (against the
+    non-adhesive sweep; sticky iff S_BEM >= 1) and its threshold w_BEM (S_BEM = 1,
+    interpolated in log w). Cross-checks: the tangent ``dp/dA*`` over A* in
+    ``STICKY_WINDOW`` (``S_tan = 1 - s_adh / s_el``, threshold w_tan; its intercept is the
+    load at which the area vanishes); the load balance behind Eq. (10) with the
+    attractive area measured on the non-adhesive contact at A* = 1 %
+    (:func:`roughfe.theory.stickiness.load_balance`, threshold w_LB), against the thin
+    Hertzian ring Eq. (10) assumes (also for the shorter ranges ``STICKY_RANGES``).
+    The pull-off pressure of the unloading branch (growing steps until separation) is
+    reported beside it on the coarsest grid (``unload``): a finite pull-off is not the
+    paper's criterion (Ciavarella & Papangelo 2018)."""
     mat = Material(1e6, 0.5)
-    dr = 5e-9
+    dr = interaction_range
     out = []
     for seed, ns in grids:
         fine = spectral_surface(max(ns), 1e-5, 0.8, rms_height=1e-8,
@@ -174,22 +209,36 @@ def stickiness_cases(grids=STICKY_GRIDS, factors=STICKY_FACTORS):
             k = max(ns) // n
             s = Surface(fine.heights[::k, ::k], fine.size, periodic=True)
             top = float(s.heights.max() - s.heights.mean())
+            deltas = np.linspace(0.05, 0.5, 12) * top
             t0 = time.process_time()
-            elastic = [solve_contact(s, mat, delta=d, compute_stiffness=False)
-                       for d in np.linspace(0.05, 0.5, 10) * top]
+            elastic = [solve_contact(s, mat, delta=d, compute_stiffness=False) for d in deltas]
             p_el = _pressure_at_area(elastic, STICKY_AREA)
+            s_el, p0_el, _ = _tangent(elastic)
             w_pr = 1e-4 * pastewka_robbins(s, mat.E_star, 1e-4, dr).criterion
+            touching = [r for r in elastic if r.n_contact]
+            ranges = []
+            for rng_ in (dr,) + tuple(r for r in STICKY_RANGES if r < dr):
+                lbs = [load_balance(r, rng_) for r in touching]
+                pr_r = pastewka_robbins(s, mat.E_star, 1e-4, rng_)
+                ranges.append({
+                    "range": rng_, "range_over_edge_gap": pr_r.range_over_edge_gap,
+                    "attractive_over_repulsive_measured": _at_area(
+                        touching, [b.attractive_over_repulsive for b in lbs]),
+                    "attractive_over_repulsive_ring": pr_r.attractive_over_repulsive,
+                    "w_load_balance": _at_area(touching, [b.threshold_work for b in lbs]),
+                    "w_pr": 1e-4 * pr_r.criterion})
+            w_lb = ranges[0]["w_load_balance"]
             cases = []
             for f in factors:
                 w = f * w_pr
                 law = AdhesionLaw("md", w, dr)
                 pr = pastewka_robbins(s, mat.E_star, w, dr)
-                unload = n == min(ns)
-                sw = adhesive_sweep(s, mat, law, np.linspace(0.05, 0.5, 6) * top,
-                                    unload=unload, max_unload_steps=30)
-                p_adh = _pressure_at_area([r for r in sw.sweep.results if not r.unloading],
-                                          STICKY_AREA)
-                first = min(r.area_fraction for r in sw.sweep.results if r.n_contact)
+                unloads = unload and n == min(ns)
+                sw = adhesive_sweep(s, mat, law, deltas, unload=unloads, max_unload_steps=30)
+                loading = [r for r in sw.sweep.results if not r.unloading]
+                p_adh = _pressure_at_area(loading, STICKY_AREA)
+                s_adh, p0_adh, n_win = _tangent(loading)
+                first = min(r.area_fraction for r in loading if r.n_contact)
                 cases.append({"work_of_adhesion": w, "w_over_w_pr": f,
                               "criterion_pastewka_robbins": pr.criterion,
                               "sticky_pastewka_robbins": pr.sticky,
@@ -197,30 +246,49 @@ def stickiness_cases(grids=STICKY_GRIDS, factors=STICKY_FACTORS):
                               "stickiness_bem": 1.0 - p_adh / p_el,
                               "sticky_bem": bool(p_adh <= 0),
                               "agree": bool(pr.sticky == (p_adh <= 0)),
+                              "tangent": s_adh, "tangent_states": n_win,
+                              "pressure_at_vanishing_area": p0_adh,
+                              "stickiness_tangent": 1.0 - s_adh / s_el,
+                              "stickiness_load_balance": w / w_lb,
                               "jumped_in_beyond_area": bool(first > STICKY_AREA),
-                              "pull_off_pressure": sw.pull_off_pressure if unload else None,
-                              "detached": sw.detached if unload else None})
+                              "pull_off_pressure": sw.pull_off_pressure if unloads else None,
+                              "detached": sw.detached if unloads else None})
             print(f"stickiness seed {seed}, {n}^2: " + ", ".join(
-                f"{c['w_over_w_pr']:g} w_PR: S_BEM {c['stickiness_bem']:.3f}" for c in cases),
-                flush=True)
+                f"{c['w_over_w_pr']:g} w_PR: S_BEM {c['stickiness_bem']:.3f} / tangent "
+                f"{c['stickiness_tangent']:.3f}" for c in cases), flush=True)
             works = [c["work_of_adhesion"] for c in cases]
             w_bem = _threshold(works, [c["stickiness_bem"] for c in cases])
+            w_tan = _threshold(works, [c["stickiness_tangent"] for c in cases])
+            kappa = STICKY_AREA * pr.rms_slope * mat.E_star / p_el
             out.append({"seed": seed, "n": n, "cells_per_shortest_wavelength": n // 32,
                         "rms_slope": pr.rms_slope, "rms_curvature": pr.rms_curvature,
                         "ring_cells": pr.ring_width / (s.size[0] / n),
                         "ring_over_half_width": pr.ring_over_half_width,
+                        "range_over_edge_gap": pr.range_over_edge_gap,
                         "tabor_parameter_at_w_pr": pastewka_robbins(
                             s, mat.E_star, w_pr, dr).tabor_parameter,
-                        "pressure_elastic_at_area": p_el,
-                        "kappa_rep_measured": STICKY_AREA * pr.rms_slope * mat.E_star / p_el,
+                        "pressure_elastic_at_area": p_el, "tangent_elastic": s_el,
+                        "pressure_elastic_at_vanishing_area": p0_el,
+                        "kappa_rep_measured": kappa,
                         "w_pr": w_pr, "w_bem": w_bem, "w_bem_over_w_pr": w_bem / w_pr,
+                        "w_tangent_over_w_pr": w_tan / w_pr,
+                        "w_load_balance_over_w_pr": w_lb / w_pr,
+                        "w_bem_over_w_load_balance": w_bem / w_lb,
                         # Eq. (10) with the measured kappa_rep: C ~ 1/kappa, w_PR ~ 2/kappa
-                        "w_bem_over_w_pr_measured_kappa": w_bem / w_pr * STICKY_AREA
-                        * pr.rms_slope * mat.E_star / p_el / KAPPA_REP,
+                        "w_bem_over_w_pr_measured_kappa": w_bem / w_pr * kappa / KAPPA_REP,
+                        # w_LB / w_PR = (kappa_rep / kappa) x ring / measured A_att / A_rep
+                        "attractive_area_over_ring": ranges[0][
+                            "attractive_over_repulsive_measured"] / ranges[0][
+                            "attractive_over_repulsive_ring"],
+                        "thinner_rings": ranges,
                         "cases": cases, "cpu_s": time.process_time() - t0})
+    for seed, ns in grids:
+        g = {r["n"]: r for r in out if r["seed"] == seed}
+        for key in ("w_bem_over_w_pr", "w_tangent_over_w_pr", "w_load_balance_over_w_pr"):
+            g[max(ns)]["refinement_" + key] = g[max(ns)][key] / g[min(ns)][key] - 1
     return {"surface": "periodic self-affine, H = 0.8, rms height 10 nm, L = 10 um, "
-                       "cut-off 32 q0", "E_star": mat.E_star, "range": dr,
-            "area_fraction": STICKY_AREA, "grids": out}
+                       "cut-off 32 q0", "E_star": mat.E_star, "range": dr, "factors": factors,
+            "area_fraction": STICKY_AREA, "tangent_window": list(STICKY_WINDOW), "grids": out}
 
 
 def johnson_sinusoid():
@@ -292,9 +360,18 @@ def main(outdir=None) -> bool:
     sticky = stickiness_cases()
     for g in sticky["grids"]:
         print(f"stickiness seed {g['seed']} {g['n']}^2 (ring {g['ring_cells']:.1f} cells, d/a "
-              f"{g['ring_over_half_width']:.2f}, kappa_rep {g['kappa_rep_measured']:.2f}): "
+              f"{g['ring_over_half_width']:.2f}, kappa_rep {g['kappa_rep_measured']:.2f}, "
+              f"A_att/A_rep measured / ring {g['attractive_area_over_ring']:.2f}): "
               f"w_PR {g['w_pr']:.3g}, w_BEM {g['w_bem']:.3g} J/m^2 "
-              f"(ratio {g['w_bem_over_w_pr']:.3f}), {g['cpu_s']:.0f} s CPU", flush=True)
+              f"(ratio {g['w_bem_over_w_pr']:.3f}; tangent {g['w_tangent_over_w_pr']:.3f}; "
+              f"load balance {g['w_load_balance_over_w_pr']:.3f}), {g['cpu_s']:.0f} s CPU",
+              flush=True)
+        for t in g["thinner_rings"]:
+            print(f"    range {t['range']:.3g} m (range / g0 {t['range_over_edge_gap']:.3f}): "
+                  f"A_att/A_rep measured "
+                  f"{t['attractive_over_repulsive_measured']:.3f}, ring "
+                  f"{t['attractive_over_repulsive_ring']:.3f}; w_LB / w_PR "
+                  f"{t['w_load_balance'] / t['w_pr']:.3f}", flush=True)
         for c in g["cases"]:
             print(f"    w = {c['work_of_adhesion']:.3g} ({c['w_over_w_pr']:.3g} w_PR): C_PR "
                   f"{c['criterion_pastewka_robbins']:.3f}, S_BEM {c['stickiness_bem']:.3f}, "

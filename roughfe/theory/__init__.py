@@ -3,7 +3,8 @@
 * :func:`persson` -> :class:`PerssonResult`: Persson's A*(p) and mean separation u(p).
 * :func:`critical_junction` -> :class:`CriticalJunction`: Lorenz & Persson's leak rate.
 * :func:`pastewka_robbins` -> :class:`Stickiness`: the stickiness criterion of a rough
-  adhesive contact (Pastewka & Robbins 2014).
+  adhesive contact (Pastewka & Robbins 2014); :func:`load_balance` -> :class:`LoadBalance`:
+  its load balance with the attractive area measured on a solved non-adhesive contact.
 * :func:`beside`: the theory added to the step records of a simulation (results.json).
 
 Layer: after :mod:`roughfe.surfaces` (it needs only the PSD), before the solvers and
@@ -12,8 +13,9 @@ their consumers, which draw the theory beside their results.
 from .persson import (GAMMA_DEFAULT, KAPPA_PERSSON, PERCOLATION_THRESHOLD, CriticalJunction,
                       PerssonResult, area_fraction, beside, critical_junction,
                       mean_separation, persson)
-from .stickiness import Stickiness, pastewka_robbins
+from .stickiness import LoadBalance, Stickiness, load_balance, pastewka_robbins
 
 __all__ = ["persson", "beside", "PerssonResult", "critical_junction", "CriticalJunction",
            "area_fraction", "mean_separation", "KAPPA_PERSSON", "GAMMA_DEFAULT",
-           "PERCOLATION_THRESHOLD", "pastewka_robbins", "Stickiness"]
+           "PERCOLATION_THRESHOLD", "pastewka_robbins", "Stickiness", "load_balance",
+           "LoadBalance"]

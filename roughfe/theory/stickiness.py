@@ -58,6 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, check_finite_positive, check_instance
+from ..model import ContactResult
 from ..surfaces.stats import rms_curvature, rms_slope
 from ..surfaces.surface import Surface
 
@@ -72,6 +73,8 @@ REFERENCES = (
     "(stickiness criterion)",
     "Ciavarella M. (2016) J. Tribol. 139:031404 (discussion of the criterion)",
     "Ciavarella M., Papangelo A. (2018) J. Adhes. 94:155-165 (pull-off vs the criterion)",
+    "Monti J.M., Sanner A., Pastewka L. (2021) Tribol. Lett. 69, "
+    "doi:10.1007/s11249-021-01454-6 (gaps near contact edges; validity Delta_r / g0 < 0.1)",
 )
 
 
@@ -101,6 +104,14 @@ class Stickiness:
         Width d of the attractive ring around a repulsive patch, Eq. (1) (m).
     ring_over_half_width : float
         d / a (-): the criterion assumes d / a << 1.
+    attractive_over_repulsive : float
+        n_d d / a (-): the attractive (ring) over the repulsive area that Eq. (10)
+        assumes; compare :func:`load_balance`, which measures it on a BEM contact.
+    range_over_edge_gap : float
+        ``Delta_r / g0`` with ``g0 = (16/3) h'_rms^2 / h''_rms`` (-), the gap scale of the
+        power-law gap distribution near contact edges (Monti, Sanner & Pastewka 2021);
+        the authors' group's examples require it below 0.1 for the assumptions of the
+        criterion (ContactEngineering/Adhesion).
     tabor_parameter : float
         ``(R l_a^2)^(1/3) / Delta_r`` with R = 1 / h''_rms (-): DMT-like when small.
     repulsive_pressure : float
@@ -123,6 +134,8 @@ class Stickiness:
     contact_diameter: float
     ring_width: float
     ring_over_half_width: float
+    attractive_over_repulsive: float
+    range_over_edge_gap: float
     tabor_parameter: float
     repulsive_pressure: float
     adhesion_length: float
@@ -167,6 +180,79 @@ def ring_stickiness(dimension, slope, curvature, adhesion_length, interaction_ra
     p_over_e = slope / kappa_rep
     ring = (interaction_range * np.sqrt(a) / (c * p_over_e)) ** (2.0 / 3.0)
     return n * (adhesion_length / interaction_range) / p_over_e * ring / a, ring
+
+
+@dataclass(frozen=True)
+class LoadBalance:
+    """Pastewka & Robbins' load balance on a solved non-adhesive contact (SI).
+
+    Attributes
+    ----------
+    area_fraction : float
+        A_rep / A0 of the non-adhesive contact (-).
+    attractive_fraction : float
+        Area where ``0 < g < Delta_r`` over A0 (-): where a DMT-like attraction of range
+        Delta_r acts on the rigid gaps of that contact.
+    attractive_over_repulsive : float
+        A_att / A_rep (-): measured here; Eq. (10) estimates it as the thin Hertzian ring,
+        ``Stickiness.attractive_over_repulsive`` = n_d d / a.
+    mean_pressure : float
+        Mean pressure p of the non-adhesive contact (Pa): sigma_rep A_rep / A0.
+    range : float
+        Delta_r (m).
+    threshold_work : float
+        ``w_c = Delta_r p / (A_att / A0)`` (J/m^2): the work of adhesion at which the
+        attraction ``(w / Delta_r) A_att`` balances the repulsive load, the sign change
+        of the area-load prefactor in this mean field.
+    """
+
+    area_fraction: float
+    attractive_fraction: float
+    attractive_over_repulsive: float
+    mean_pressure: float
+    range: float
+    threshold_work: float
+
+
+def load_balance(result: ContactResult, interaction_range) -> LoadBalance:
+    """Pastewka & Robbins' stickiness load balance with the attractive area *measured*.
+
+    The mechanism behind Eq. (10): with a weak (DMT-like) attraction the repulsive
+    patches keep the non-adhesive geometry and carry ``sigma_rep A_rep`` while the
+    attraction ``sigma_0 = w / Delta_r`` acts where the gap is below Delta_r, so the load
+    ``L = sigma_rep A_rep - sigma_0 A_att`` and the area-load prefactor changes sign
+    (the surfaces become sticky) at ``w_c = Delta_r sigma_rep A_rep / A_att``. Eq. (10)
+    estimates A_att as the thin ring of a Hertzian edge (Eq. (1)); here A_att is read
+    from the gaps of a solved non-adhesive contact, so the two can be compared
+    (docs/theory/07_adhesion_persson.md: on the validation surfaces the measured
+    A_att / A_rep is ~5x the ring's, which is the Eq. (10) vs BEM disagreement).
+
+    Parameters
+    ----------
+    result : ContactResult
+        A solved non-adhesive contact (gap field in m, mean pressure > 0 in Pa).
+    interaction_range : float
+        Delta_r (m): h0 of Maugis-Dugdale, rho of the exponential law.
+
+    Returns
+    -------
+    LoadBalance
+    """
+    check_instance("result", result, ContactResult, "a roughfe ContactResult")
+    dr = check_finite_positive("range of adhesion (m)", interaction_range)
+    if not (result.area_fraction > 0 and result.mean_pressure > 0):
+        raise InputError(f"the load balance needs a contact under compression (area fraction "
+                         f"{result.area_fraction:.3g}, mean pressure "
+                         f"{result.mean_pressure:.3g} Pa; both must be > 0)")
+    gap = np.asarray(result.gap)
+    f_att = float(np.mean((gap > 0) & (gap < dr)))
+    if f_att <= 0:
+        raise InputError(f"no gap of the contact is below the range {dr:.3g} m: the "
+                         f"attraction would act nowhere (refine the grid or widen the range)")
+    return LoadBalance(area_fraction=float(result.area_fraction), attractive_fraction=f_att,
+                       attractive_over_repulsive=f_att / float(result.area_fraction),
+                       mean_pressure=float(result.mean_pressure), range=dr,
+                       threshold_work=dr * float(result.mean_pressure) / f_att)
 
 
 def pastewka_robbins(surface: Surface, e_star, work, interaction_range, *,
@@ -215,6 +301,9 @@ def pastewka_robbins(surface: Surface, e_star, work, interaction_range, *,
                       kappa_ratio=float(1.0 / (1.0 - s)) if s != 1.0 else float("inf"),
                       rms_slope=slope, rms_curvature=curv, contact_diameter=float(d_rep),
                       ring_width=float(ring), ring_over_half_width=float(2.0 * ring / d_rep),
+                      attractive_over_repulsive=float(
+                          PERIMETER_FACTOR[dim] * 2.0 * ring / d_rep),
+                      range_over_edge_gap=float(dr / (16.0 / 3.0 * slope * slope / curv)),
                       tabor_parameter=float((l_a * l_a / curv) ** (1.0 / 3.0) / dr),
                       repulsive_pressure=float(slope * e_star / kappa_rep),
                       adhesion_length=l_a, kappa_rep=kappa_rep, work=work, range=dr,
