@@ -19,7 +19,10 @@ cell-averaged or sampled), a rough adhesive contact (periodic self-affine surfac
 exponential law) unloaded until the surfaces separate (pull-off pressure, its path
 dependence), and the Pastewka-Robbins criterion, Eq. (10) (roughfe.theory.stickiness),
 against the BEM's verdict on two seeds, 128^2 and 256^2, five works of adhesion from
-w_PR / 16 to 2 w_PR (stickiness_cases).
+w_PR / 16 to 2 w_PR (stickiness_cases), with the tangent of the area-load line and the
+load balance on the measured attractive area (roughfe.theory.stickiness.load_balance)
+reported beside it: the latter reproduces the BEM threshold, Eq. (10)'s ring area is
+~5x too small on these surfaces.
 
 Targets: |F_BEM / F_Maugis - 1| <= 2 % for lambda in {0.1, 0.3, 1, 2, 3, 5}; Johnson's
 sinusoid within 0.002 p* at zone/a ~ 0.5 %; the rough contact separates; the

@@ -1,11 +1,11 @@
 """Pastewka-Robbins stickiness criterion of a rough adhesive contact (SI).
 
-Pastewka & Robbins (2014) found in simulations of self-affine surfaces that the
-repulsive contact area stays proportional to the load, ``A_rep / A0 = kappa p /
-(E* h'_rms)``, and that adhesion changes only the prefactor: ``kappa`` rises with the
-adhesive strength and, above a threshold, changes sign: the surfaces become *sticky*
-(the area-load line bends into the tensile quadrant; their simulations read its secant at
-A_rep / A0 ~ 1 %, Ciavarella & Papangelo 2018).
+Pastewka & Robbins (2014) found in simulations of self-affine surfaces (their abstract)
+that the area of atomic contact is initially proportional to the load,
+``A_rep / A0 = kappa p / (E* h'_rms)``, that the prefactor rises linearly with the
+adhesive strength for weak attraction and that above a threshold it changes sign: the
+surfaces become *sticky* and a finite force is needed to separate them (the area-load
+line bends into the tensile quadrant, Ciavarella 2016).
 
 **The published criterion (surfaces).** Their Eq. (10): the surfaces are sticky when
 
@@ -22,7 +22,18 @@ adhesive_simulation_rough.py and its rough-adhesion tests; "only valid in the DM
 regime"); ``kappa_rep`` enters only the prefactor there. The paper's own text
 (PNAS 111:3298, PMC3948287, arXiv:1311.1178) was not reachable offline: the stored copies
 hold only its abstract; the equation and its constants are taken from that
-implementation, which is written by the paper's first author's group.
+implementation, which is written by the paper's first author's group. (Session 4: the
+stored PMC and ar5iv copies hold each page's beginning only: title, significance,
+abstract, first paragraph; the derivation and Methods are still unread.)
+
+**The load balance, measured** (:func:`load_balance`): the mechanism behind Eq. (10), the
+attraction ``w / Delta_r`` on the gaps below ``Delta_r`` against the repulsive load, can be
+evaluated with the attractive area read from a solved non-adhesive contact instead of the
+ring estimate below. On the validation surfaces (docs/theory/07_adhesion_persson.md) it
+reproduces the adhesive BEM's stickiness threshold to 0-13 %, while the measured
+attractive area is ~5x the ring's (2.6-3.8x for ranges inside the stated validity
+``Delta_r / g0 < 0.1``): Eq. (10) is the right balance with too small an attractive area
+there, and overestimates the work needed for stickiness accordingly.
 
 **Our derivation gives the same** (kept for profiles and for the diagnostics): repulsive
 patches carry ``p_rep = h'_rms E* / kappa_rep`` and have half-width ``a = d_rep / 2``;
