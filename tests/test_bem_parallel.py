@@ -1,5 +1,7 @@
 """The full-grid passes of the BEM over threads (roughfe.bem._parallel): the same results
 as the serial numpy calls, for the helpers, the FFT products and whole solves."""
+import multiprocessing
+
 import numpy as np
 import pytest
 
@@ -89,3 +91,26 @@ def test_bad_thread_count_is_a_clear_error(monkeypatch, value):
         _parallel._thread_count()
     monkeypatch.setenv("ROUGHFE_THREADS", "3")
     assert _parallel._thread_count() == 3
+
+
+def _split_pass_in_child():
+    a = np.arange(1000.0)
+    idx = np.arange(0, 1000, 3)
+    raise SystemExit(0 if np.array_equal(_parallel.take(a, idx), a[idx]) else 1)
+
+
+def test_a_forked_child_makes_its_own_pool(monkeypatch):
+    """The parent's pool threads do not exist in a forked child: a split pass there must
+    not wait for them (with one idle worker, as on 2 cores, it would hang for ever)."""
+    monkeypatch.setattr(_parallel, "MIN_BLOCK", 16)
+    monkeypatch.setattr(_parallel, "THREADS", 2)
+    monkeypatch.setattr(_parallel, "_pool", None)       # a fresh pool of one worker
+    _parallel.blocks(1000, lambda a, b: None)
+    pool = _parallel._pool
+    child = multiprocessing.get_context("fork").Process(target=_split_pass_in_child)
+    child.start()
+    child.join(30)
+    if child.exitcode is None:
+        child.kill()
+    pool.shutdown()
+    assert child.exitcode == 0

@@ -10,7 +10,8 @@ is that one idea: :func:`blocks` splits ``range(n)`` into contiguous blocks and 
 function on each, in a small persistent thread pool (created on first use, the calling
 thread does one block itself); :func:`take`, :func:`put` and :func:`flatnonzero` are
 the gather, scatter and index passes built on it. Below ``MIN_BLOCK`` elements per
-thread a pass stays serial (the hand-over costs ~10-50 us).
+thread a pass stays serial (the hand-over costs ~10-50 us). A forked child makes its
+own pool on first use.
 
 Thread count: ``THREADS`` = the environment variable ``ROUGHFE_THREADS`` (a positive
 integer) if set, else the number of CPUs, at most 4. It is read once, at import, and is
@@ -56,6 +57,18 @@ THREADS = _thread_count()
 
 _pool = None
 _pool_lock = threading.Lock()
+
+
+def _forget_pool():
+    """In a forked child the pool's threads do not exist: start afresh (a new pool on
+    first use), or a split pass would wait for a thread that never runs."""
+    global _pool, _pool_lock
+    _pool = None
+    _pool_lock = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pool)
 
 
 def _executor() -> ThreadPoolExecutor:
