@@ -104,11 +104,15 @@ def blocks(n: int, fn, min_block: int = None) -> list:
 
 
 def take(a, index, out=None):
-    """``a[index]`` (flat ``a``, integer ``index``) gathered in parallel blocks of
-    ``index``; into ``out`` if given (a 1D array of ``index``'s length)."""
+    """``a[index]`` (flat ``a``, integer ``index`` of valid positions ``0 <= i <
+    a.size``: they are not checked) gathered in parallel blocks of ``index``; into
+    ``out`` if given (a 1D array of ``index``'s length)."""
     if out is None:
         out = np.empty(index.size, a.dtype)
-    blocks(index.size, lambda i, j: np.take(a, index[i:j], out=out[i:j]))
+    # mode="wrap": the same values for valid indices, without the temporary that
+    # mode="raise" copies through when ``out`` is given (measured 2.1 vs 3.4-3.8 ms for
+    # 15 % of a 2048^2 grid)
+    blocks(index.size, lambda i, j: np.take(a, index[i:j], out=out[i:j], mode="wrap"))
     return out
 
 
