@@ -3,6 +3,7 @@
 #   make test   installs what is missing, runs the test suite
 #   make validate-quick   the reduced validation cases (CI, a few minutes); make validate: all
 #   make docs   builds the documentation (docs/_build/html)
+#   make bench-quick   the benchmarks at reduced sizes (< 3 min); make bench: all, full size
 VENV   := .venv
 PY     := $(VENV)/bin/python
 # vtk renders off-screen through EGL; this silences its X11 warning.
@@ -13,7 +14,7 @@ export OMPI_MCA_rmaps_base_oversubscribe := 1
 
 JOBS   ?= 2
 
-.PHONY: env test test-fast demo validate validate-quick bench docs clean
+.PHONY: env test test-fast demo validate validate-quick bench bench-quick docs clean
 
 env:
 	@bash tools/bootstrap.sh
@@ -43,9 +44,17 @@ validate: env
 validate-quick: env
 	$(PY) -m roughfe.cli validate all --quick -o validation/output-quick
 
+# make bench: every benchmark at full size (8192^2 BEM, 4096^2 Reynolds, Tamaas up to
+# 512^2; about an hour on 2 cores, ~4.2 GB peak), JSON in benchmarks/output and the one
+# table of every speed/memory target in benchmarks/output/SUMMARY.md. make bench-quick:
+# reduced sizes (< 3 min) into benchmarks/output-quick, for smoke use.
 bench: env
 	@bash tools/bootstrap.sh io,design,study,test,bench
 	$(PY) benchmarks/run_all.py
+
+bench-quick: env
+	@bash tools/bootstrap.sh io,design,study,test,bench
+	$(PY) benchmarks/run_all.py --quick
 
 # HTML documentation in docs/_build/html (warnings are errors); the API, validation and
 # benchmark pages are generated first from the sources and the JSON of validate/bench.
@@ -56,4 +65,4 @@ docs: env
 	@echo "open docs/_build/html/index.html"
 
 clean:
-	rm -rf demo-output validation/output validation/output-quick benchmarks/output .pytest_cache docs/_build docs/api/generated docs/validation/generated docs/benchmarks/generated
+	rm -rf demo-output validation/output validation/output-quick benchmarks/output benchmarks/output-quick .pytest_cache docs/_build docs/api/generated docs/validation/generated docs/benchmarks/generated docs/benchmarks/summary.md

@@ -1,15 +1,77 @@
 """The one way a benchmark script writes its report: ``benchmarks/output/<name>.json``
-(the target rows with met / NOT met, the measured cases, their units and the load average
-at the end of the run, since timings depend on it) and one printed line per target."""
+(the target rows with met / NOT met, the measured cases, their units, what was skipped and
+why, and the process figures a timing depends on: the load average at the start and the
+end, the process's CPU and wall time and its peak resident memory) and one printed line
+per target.
+
+``ROUGHFE_BENCH_OUTPUT`` (set by ``run_all.py --quick``) redirects every report to another
+folder, so that a smoke run never overwrites the full run's JSON.
+"""
+import datetime
 import os
+import resource
+import time
+from pathlib import Path
 
 from roughfe.writers import write_json
 
+#: 1-minute load average when this module was imported (the start of the benchmark)
+LOAD_AT_START = os.getloadavg()[0]
+_IMPORTED = time.perf_counter()
 
-def write_report(path, name, targets, cases, units, extra=None):
-    """Write the JSON report atomically and print each target's value and verdict;
-    ``extra`` (a dict) adds the benchmark's own keys (e.g. a fitted law, its settings)."""
-    write_json(path, {"benchmark": name, "load_average": os.getloadavg()[0],
-                      "targets": targets, "cases": cases, "units": units, **(extra or {})})
+
+def output_path(path) -> Path:
+    """``path`` itself, or its file name in ``$ROUGHFE_BENCH_OUTPUT`` when that is set."""
+    folder = os.environ.get("ROUGHFE_BENCH_OUTPUT")
+    return Path(folder) / Path(path).name if folder else Path(path)
+
+
+def _wall_since_start() -> float:
+    """Elapsed seconds since this process started (``/proc``: the start time in clock ticks
+    after boot against the uptime), else since this module was imported."""
+    try:
+        with open("/proc/self/stat") as fh:
+            start = int(fh.read().rsplit(")", 1)[1].split()[19])
+        with open("/proc/uptime") as fh:
+            uptime = float(fh.read().split()[0])
+        return uptime - start / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):  # pragma: no cover - not Linux
+        return time.perf_counter() - _IMPORTED
+
+
+def process_figures() -> dict:
+    """CPU (user + system, this process and its waited-for children: the cases that run in
+    a subprocess), wall time since the process started, peak RSS (the larger of this
+    process and its largest child), load averages and the UTC date."""
+    me, kids = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    return {"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+            "load_average_start": LOAD_AT_START, "load_average": os.getloadavg()[0],
+            "cpus": os.cpu_count(),
+            "cpu_s": me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime,
+            "wall_s": _wall_since_start(),
+            "peak_rss_mb": max(me.ru_maxrss, kids.ru_maxrss) / 1024.0}   # KiB on Linux
+
+
+def write_report(path, name, targets, cases, units, extra=None, skipped=()):
+    """Write the JSON report atomically and print each target's value and verdict.
+
+    ``targets``: records ``name, value, target, met`` (and ``unit``, ``note``); ``cases``:
+    the measured records; ``units``: field -> unit; ``extra`` (a dict) adds the benchmark's
+    own keys (e.g. a fitted law, its settings); ``skipped``: records ``name, reason`` of
+    the cases this run left out (shown in the summary table, never silently dropped).
+    Returns the path written.
+    """
+    path = output_path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_json(path, {"benchmark": name, **process_figures(), "targets": targets,
+                      "skipped": list(skipped), "cases": cases, "units": units,
+                      **(extra or {})})
     for t in targets:
-        print(f"{t['name']}: {t['value']:.2f} ({'met' if t['met'] else 'NOT met'})")
+        value = t["value"]
+        shown = f"{value:.4g}" if isinstance(value, (int, float)) else str(value)
+        print(f"{'met' if t['met'] else 'NOT met':>8s}  {t['name']}: {shown} "
+              f"(target {t['target']})")
+    for s in skipped:
+        print(f" skipped  {s['name']}: {s['reason']}")
+    print(f"wrote {path}")
+    return path

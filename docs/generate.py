@@ -9,6 +9,8 @@
   table with a met / NOT met column, its scalars and every table of records in it.
 * ``docs/benchmarks/generated/<script>.md``: the same for ``benchmarks/bench_*.py`` and
   ``benchmarks/output/<script>*.json``.
+* ``docs/benchmarks/summary.md``: the one table of every speed and memory target of the
+  benchmarks (``benchmarks/summary.py``, also written by ``make bench``).
 
 A page whose JSON is missing says so and shows the command that writes it; no number on
 these pages is typed by hand. Generated files are listed in ``.gitignore``.
@@ -301,6 +303,18 @@ def write_results(scripts, output: Path, outdir: Path, kind: str, commands,
     return report
 
 
+def benchmark_summary(folder: Path) -> str:
+    """The one table of every speed and memory target (``benchmarks/summary.py``, the same
+    generator ``make bench`` runs for ``benchmarks/output/SUMMARY.md``)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("bench_summary",
+                                                  ROOT / "benchmarks" / "summary.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return (GENERATED_MARK.format(source=_rel(folder)) + "\n\n"
+            + module.summary_markdown(folder, title="Benchmarks: every speed and memory target"))
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--validation", type=Path, default=ROOT / "validation" / "output",
@@ -323,6 +337,8 @@ def main(argv=None) -> int:
     report = write_results(benches, args.benchmarks, DOCS / "benchmarks" / "generated",
                            "Benchmark", {b.stem: "make bench" for b in benches})
     print("[docs] benchmark pages: " + ", ".join(f"{s} ({r})" for s, r in report))
+    _write(DOCS / "benchmarks" / "summary.md", benchmark_summary(args.benchmarks))
+    print("[docs] benchmark summary: docs/benchmarks/summary.md")
     return 0
 
 

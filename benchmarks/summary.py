@@ -1,0 +1,246 @@
+"""One table of every speed and memory target of issues 12-16, from the benchmarks' JSON.
+
+:data:`EXPECTED` lists each target once: the issue section, the benchmark that measures it,
+the text that finds its row among that benchmark's ``targets`` (the name a script gives
+it), the target in the issue's words (shown when the row is missing), the unit, and the
+text that finds the benchmark's ``skipped`` record that explains a missing row. For each,
+:func:`summary_rows` reads ``<folder>/<benchmark>.json`` (and ``<benchmark>_*.json``) and
+gives one row per matching target with its value, limit, unit, verdict (the script's own
+``met``), the date and the load average of the run:
+
+* ``met`` / ``NOT met``: as the script decided it against the stated limit;
+* ``not run``: the benchmark's JSON is missing (``make bench`` has not run it here);
+* ``not measured``: the JSON is there but has no such row (a reduced run, e.g.
+  ``--quick``, or a case left out): the reason from its ``skipped`` records;
+* ``not checked``: a row without a verdict.
+
+Target rows of the benchmarks that no expected entry claims are listed after them, so
+nothing measured is hidden. ``run_all.json`` adds the per-benchmark wall, CPU and peak
+memory of the run. No number in the table is typed by hand.
+
+Run: ``python benchmarks/summary.py [FOLDER] [OUT.md]`` (defaults ``benchmarks/output``,
+``FOLDER/SUMMARY.md``); ``make bench`` runs it last, ``make docs`` writes the same table to
+``docs/benchmarks/summary.md``.
+"""
+from __future__ import annotations
+
+import datetime
+import importlib.util
+import json
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+#: (issue section, benchmark, text of the target name, the target as the issue states it,
+#: unit, text of the benchmark's ``skipped`` record that explains a missing row)
+EXPECTED = (
+    ("12 §6, 16 §4", "bench_reynolds", "Reynolds FV 2048^2 CPU",
+     "Reynolds leak-rate solve 2048^2 < 10 s", "s CPU", "2048^2"),
+    ("12 §6, 16 §4", "bench_reynolds", "Reynolds FV 4096^2 CPU",
+     "Reynolds leak-rate solve 4096^2 < 60 s", "s CPU", "4096^2"),
+    ("16 §4", "bench_reynolds", "Reynolds FV 4096^2 peak memory",
+     "Reynolds 4096^2 < 8 GB", "GB", "4096^2"),
+    ("12 §6", "bench_reynolds", "coupled solve 512^2 CPU",
+     "coupled solve 512^2 < 1 min", "s CPU", "coupled"),
+    ("12 §6", "bench_fsi", "coupled solve 512^2, trapped",
+     "coupled solve 512^2 < 1 min, per trapped-fluid model", "s CPU", "coupled"),
+    ("13 §4", "bench_bem", "hardness/elastic time at 512^2",
+     "hardness-limited solve within 3x the elastic time at 512^2", "ratio of CPU times",
+     "hardness"),
+    ("13 §4", "bench_adhesion", "/ elastic CPU time at 512^2",
+     "adhesive solve within 3x the elastic time at 512^2", "ratio of CPU times", "512"),
+    ("15 §4", "bench_sequencing", "sequencing a 512^2 pair",
+     "sequencing a pair of 512^2 acquisitions < 10 s", "s CPU", "512"),
+    ("15 §4", "bench_bands", "band mechanics 256^2, all",
+     "chromosome mechanics of a 256^2 measured surface < 2 min on 2 cores",
+     "s wall (2 workers)", "256"),
+    ("15 §4", "bench_bands", "band mechanics 256^2, the same in CPU",
+     "the same, process CPU (bounds the 2-core wall time from above)", "s CPU", "256"),
+    ("15 §4", "bench_surface_design", "surface design run", "a surface design run < 30 min",
+     "s CPU", "design"),
+    ("16 §1", "bench_bem", "4 loads at 2048^2, cold (",
+     "4 loads at 2048^2 <= 500 convolution-equivalents", "convolution-equivalents", "2048"),
+    ("16 §1", "bench_bem", "stretch goal", "the same <= 400 (beyond the goal)",
+     "convolution-equivalents", "2048"),
+    ("16 §1", "bench_bem", "iteration growth", "iterations <= 1.15x per doubling of n",
+     "ratio per doubling", "growth"),
+    ("16 §1", "bench_bem", "|A* - A*_Tamaas|", "the same A* as Tamaas", "area fraction",
+     "Tamaas"),
+    ("16 §2", "bench_bem", "peak RSS 4096^2", "4096^2 in <= 1.2 GB", "MB", "4096^2"),
+    ("16 §2", "bench_bem", "peak RSS 8192^2", "8192^2 in <= 4.5 GB", "MB", "8192^2"),
+    ("16 §2", "bench_bem", "8192^2 solve", "8192^2 in <= 4 min", "s CPU", "8192^2"),
+    ("16 §3", "bench_cli", "process start to solve, wall",
+     "roughfe contact reaches the solve within 0.5 s of process start", "s wall", "start"),
+    ("16 §3", "bench_cli", "process start to solve, CPU", "the same, process CPU", "s CPU",
+     "start"),
+    ("16 §3", "bench_cli", "figures of a 2048^2 result, wall",
+     "figures of a 2048^2 result < 5 s", "s wall", "2048^2"),
+    ("16 §3", "bench_cli", "figures of a 2048^2 result, CPU", "the same, process CPU",
+     "s CPU", "2048^2"),
+    ("16 §4", "bench_fem", "MUMPS VI step",
+     "FEM time per VI step against dofs; the largest profile in < 30 s per step",
+     "s CPU per step", "fem"),
+)
+COLUMNS = ("issue", "target", "limit", "measured", "unit", "status", "date (UTC)", "load",
+           "benchmark", "note")
+
+
+def _docs_generate():
+    """``docs/generate.py``, whose reading of a report's target rows (``target_rows``: the
+    script's ``met`` as met / **NOT met** / not checked) and cell format this table shares."""
+    spec = importlib.util.spec_from_file_location("docs_generate",
+                                                  HERE.parent / "docs" / "generate.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+GEN = _docs_generate()
+
+
+def _cell(value) -> str:
+    return "" if value is None else GEN._fmt(value)
+
+
+def _load(path: Path):
+    """(data, error): one benchmark JSON, or None and why it could not be read."""
+    try:
+        return json.loads(path.read_text()), None
+    except (OSError, ValueError) as exc:
+        return None, f"unreadable: {exc}"
+
+
+def _run_facts(data: dict, path: Path) -> dict:
+    """Date and load average of a report (older reports without a date: the file's time)."""
+    date = data.get("date")
+    if date is None:
+        stamp = datetime.datetime.fromtimestamp(path.stat().st_mtime, datetime.timezone.utc)
+        date = stamp.isoformat(timespec="seconds") + " (file time)"
+    loads = [data.get(k) for k in ("load_average_start", "load_average")]
+    loads = [v for v in loads if isinstance(v, (int, float))]
+    load = "-".join(f"{v:.1f}" for v in loads) if loads else ""
+    return {"date (UTC)": date.replace("T", " ").replace("+00:00", ""), "load": load}
+
+
+def read_reports(folder: Path) -> dict:
+    """benchmark stem -> list of (path, data or None, error) of its JSON files."""
+    reports = {}
+    for path in sorted(Path(folder).glob("*.json")):
+        if path.stem == "run_all":
+            continue
+        stem = next((e[1] for e in EXPECTED if path.stem == e[1] or path.stem.startswith(
+            e[1] + "_")), path.stem)
+        reports.setdefault(stem, []).append((path, *_load(path)))
+    return reports
+
+
+def _targets(data) -> list:
+    """A report's target rows in the table's columns (``docs/generate.target_rows``)."""
+    return [{"target": t["name"], "limit": t.get("target"), "measured": t.get("value"),
+             "unit": t.get("unit"), "status": t["status"], "note": t.get("note")}
+            for t in (GEN.target_rows(data) if isinstance(data, dict) else [])]
+
+
+def summary_rows(folder, expected=EXPECTED) -> list:
+    """The rows of the table (dicts keyed by :data:`COLUMNS`), expected targets first."""
+    reports = read_reports(Path(folder))
+    rows, claimed = [], set()
+    for issue, stem, match, what, unit, skip_match in expected:
+        files = reports.get(stem, [])
+        base = {"issue": issue, "unit": unit, "benchmark": stem, "target": what}
+        found = []
+        for path, data, error in files:
+            if data is None:
+                continue
+            for k, t in enumerate(_targets(data)):
+                if match in str(t["target"]) and (path, k) not in claimed:
+                    claimed.add((path, k))
+                    found.append({**base, **_run_facts(data, path), **t,
+                                  "unit": t.get("unit") or unit})
+        if found:
+            rows += found
+            continue
+        readable = [(p, d) for p, d, _ in files if d is not None]
+        if not files:
+            rows.append({**base, "status": "not run",
+                         "note": f"{stem}.json missing: run make bench"})
+        elif not readable:
+            rows.append({**base, "status": "not run",
+                         "note": "; ".join(e for _, _, e in files)})
+        else:
+            reasons = [f"{s.get('name')}: {s.get('reason')}" for p, d in readable
+                       for s in d.get("skipped") or []
+                       if skip_match in str(s.get("name", ""))]
+            path, data = readable[0]
+            rows.append({**base, **_run_facts(data, path), "status": "not measured",
+                         "note": "; ".join(reasons) or "no such row in this run"})
+    for stem, files in sorted(reports.items()):
+        for path, data, error in files:
+            if data is None:
+                if stem not in {e[1] for e in expected}:
+                    rows.append({"issue": "-", "benchmark": stem, "target": path.name,
+                                 "status": "not run", "note": error})
+                continue
+            for k, t in enumerate(_targets(data)):
+                if (path, k) not in claimed:
+                    rows.append({"issue": "-", "benchmark": path.stem, **_run_facts(data, path),
+                                 **t})
+    return rows
+
+
+def _table(rows, columns) -> list:
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    return lines + ["| " + " | ".join(_cell(r.get(c)) for c in columns) + " |" for r in rows]
+
+
+def summary_markdown(folder, title="Benchmark summary") -> str:
+    """The Markdown page: the target table, what was skipped, and the run's own figures."""
+    folder = Path(folder)
+    rows = summary_rows(folder)
+    counts = {s: sum(r["status"] == s for r in rows)
+              for s in ("met", "**NOT met**", "not measured", "not run", "not checked")}
+    lines = [f"# {title}", "",
+             f"Every speed and memory target of issues 12-16 and every other target row of "
+             f"the benchmarks, from the JSON in `{folder.name}/` (written by `make bench`, "
+             "`benchmarks/run_all.py`; this table by `benchmarks/summary.py`). Values to 4 "
+             "significant digits; *load* is the 1-minute load average at the start and end "
+             "of the benchmark on the machine's cores: a time measured at a load above the "
+             "number of cores is inflated (CPU times much less than wall times).", "",
+             ", ".join(f"{n} {s.strip('*')}" for s, n in counts.items()) + ".", ""]
+    lines += _table(rows, COLUMNS) + [""]
+    skipped = []
+    for stem, files in sorted(read_reports(folder).items()):
+        for path, data, _ in files:
+            skipped += [{"benchmark": path.stem, "skipped": s.get("name"),
+                         "reason": s.get("reason")} for s in (data or {}).get("skipped") or []]
+    run, _ = _load(folder / "run_all.json") if (folder / "run_all.json").is_file() else (None, None)
+    if run:
+        skipped += [{"benchmark": s.get("name"), "skipped": "whole benchmark",
+                     "reason": s.get("reason")} for s in run.get("skipped") or []]
+    if skipped:
+        lines += ["## Skipped, and why", ""] + _table(skipped, ("benchmark", "skipped",
+                                                                "reason")) + [""]
+    if run:
+        lines += [f"## The run ({run.get('mode')}, started {run.get('started')} UTC)", "",
+                  f"Total {_cell(run.get('total_wall_s'))} s wall, "
+                  f"{_cell(run.get('total_cpu_s'))} s CPU on {run.get('cpus')} cores.", ""]
+        lines += _table(run.get("cases") or [], ("script", "args", "exit_code", "wall_s",
+                                                 "cpu_s", "peak_rss_mb", "load_average_start",
+                                                 "load_average_end")) + [""]
+    else:
+        lines += ["No `run_all.json`: the benchmarks above were run one by one.", ""]
+    return "\n".join(lines)
+
+
+def write_summary(folder, out) -> Path:
+    """Write :func:`summary_markdown` of ``folder`` to ``out`` (atomically)."""
+    from roughfe.writers import write_text
+    write_text(out, summary_markdown(folder))
+    return Path(out)
+
+
+if __name__ == "__main__":
+    folder = Path(sys.argv[1]) if len(sys.argv) > 1 else HERE / "output"
+    out = Path(sys.argv[2]) if len(sys.argv) > 2 else folder / "SUMMARY.md"
+    print(f"wrote {write_summary(folder, out)}")

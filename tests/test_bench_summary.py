@@ -1,0 +1,139 @@
+"""The benchmark summary table (benchmarks/summary.py, issue 16): a small fake set of
+benchmark JSON files becomes the right rows -- the scripts' met / NOT met verdicts kept,
+a missing benchmark reported "not run", a reduced run's missing row "not measured" with the
+reason from its skipped records, rows no expected target claims still listed, dates and
+load averages carried -- and the report writer records the process figures."""
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
+
+
+def _module(name):
+    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def summary():
+    return _module("summary")
+
+
+EXPECTED = (
+    ("16 §2", "bench_x", "peak RSS 8192^2", "8192^2 in <= 4.5 GB", "MB", "8192^2"),
+    ("16 §1", "bench_x", "iteration growth", "growth <= 1.15", "ratio", "growth"),
+    ("16 §2", "bench_x", "8192^2 solve", "8192^2 in <= 4 min", "s CPU", "8192^2"),
+    ("12 §6", "bench_y", "Reynolds 2048^2", "Reynolds 2048^2 < 10 s", "s CPU", "2048"),
+    ("15 §4", "bench_z", "sequencing", "sequencing < 10 s", "s CPU", "512"),
+    ("13 §4", "bench_w", "ratio", "within 3x", "ratio", "512"),
+)
+
+
+def _write(folder, name, **data):
+    (folder / f"{name}.json").write_text(json.dumps(data))
+
+
+def test_summary_rows_from_fake_reports(tmp_path, summary):
+    _write(tmp_path, "bench_x", date="2026-11-23T09:30:00+00:00", load_average_start=1.5,
+           load_average=2.25,
+           targets=[{"name": "iteration growth 512^2 -> 1024^2", "value": 1.2, "target": 1.15,
+                     "met": False, "unit": ""},
+                    {"name": "iteration growth 1024^2 -> 2048^2", "value": 1.1,
+                     "target": 1.15, "met": True},
+                    {"name": "peak RSS 4096^2 (MB)", "value": 1000.0, "target": 1200.0,
+                     "met": True, "unit": "MB"}],
+           skipped=[{"name": "large case 8192^2 (peak RSS, CPU time)",
+                     "reason": "not in --large"},
+                    {"name": "Tamaas at 2048^2", "reason": "too slow"}])
+    _write(tmp_path, "bench_y", load_average=17.0,
+           targets=[{"name": "Reynolds 2048^2 CPU time (s)", "value": 11.5, "target": "< 10",
+                     "met": False, "note": "wall 30 s"}])
+    (tmp_path / "bench_w.json").write_text("{not json")
+    rows = summary.summary_rows(tmp_path, EXPECTED)
+    by = {}
+    for r in rows:
+        by.setdefault(r["target"], []).append(r)
+
+    # the script's verdict is kept, one row per matching target, in the expected order
+    growth = [r for r in rows if r["target"].startswith("iteration growth")]
+    assert [r["status"] for r in growth] == ["**NOT met**", "met"]
+    assert growth[0]["unit"] == "ratio"                 # the expected unit fills a blank one
+    assert growth[0]["date (UTC)"] == "2026-11-23 09:30:00" and growth[0]["load"] == "1.5-2.2"
+    assert rows.index(growth[0]) < rows.index(by["Reynolds 2048^2 CPU time (s)"][0])
+    # a reduced run: the row is not measured, with the reason from its skipped records
+    for what in ("8192^2 in <= 4.5 GB", "8192^2 in <= 4 min"):
+        (r,) = by[what]
+        assert r["status"] == "not measured" and r.get("measured") is None
+        assert "not in --large" in r["note"] and "Tamaas" not in r["note"]
+    # a failed target under load: NOT met, with the load and the file time as its date
+    (rey,) = by["Reynolds 2048^2 CPU time (s)"]
+    assert rey["status"] == "**NOT met**" and rey["measured"] == 11.5
+    assert rey["load"] == "17.0" and rey["date (UTC)"].endswith("(file time)")
+    # a missing benchmark is "not run"; an unreadable one too, with the reason
+    (seq,) = by["sequencing < 10 s"]
+    assert seq["status"] == "not run" and "bench_z.json missing" in seq["note"]
+    (bad,) = by["within 3x"]
+    assert bad["status"] == "not run" and "unreadable" in bad["note"]
+    # a target no expected entry claims is still listed
+    (rss,) = by["peak RSS 4096^2 (MB)"]
+    assert rss["issue"] == "-" and rss["status"] == "met"
+    assert len(rows) == 8
+
+
+def test_summary_markdown_counts_and_lists_skips(tmp_path, summary):
+    _write(tmp_path, "bench_cli", targets=[
+        {"name": "roughfe contact 512^2: process start to solve, wall (s)", "value": 0.7,
+         "target": "< 0.5", "met": False},
+        {"name": "roughfe contact 512^2: process start to solve, CPU (s)", "value": 0.25,
+         "target": "< 0.5", "met": True}],
+        skipped=[{"name": "figures of a 2048^2 result", "reason": "--quick"}])
+    _write(tmp_path, "run_all", mode="quick", started="2026-11-23T09:00:00+00:00", cpus=2,
+           total_wall_s=100.0, total_cpu_s=80.0,
+           cases=[{"script": "bench_cli", "args": "--quick", "exit_code": 0, "wall_s": 100.0,
+                   "cpu_s": 80.0, "peak_rss_mb": 600.0, "load_average_start": 1.0,
+                   "load_average_end": 2.0}],
+           skipped=[{"name": "bench_fsi", "reason": "make bench only"}])
+    text = summary.summary_markdown(tmp_path)
+    n = len(summary.EXPECTED)
+    assert f"1 met, 1 NOT met, 2 not measured, {n - 4} not run, 0 not checked." in text
+    table = [line for line in text.splitlines() if "process start to solve, wall" in line]
+    assert len(table) == 1 and "| 0.7 |" in table[0] and "**NOT met**" in table[0]
+    assert "| bench_cli | figures of a 2048^2 result | --quick |" in text
+    assert "| bench_fsi | whole benchmark | make bench only |" in text
+    assert "Total 100 s wall, 80 s CPU on 2 cores." in text
+
+
+def test_report_records_process_figures_and_skips(tmp_path, monkeypatch, summary):
+    monkeypatch.syspath_prepend(str(BENCH))
+    report = _module("_report")
+    monkeypatch.setenv("ROUGHFE_BENCH_OUTPUT", str(tmp_path / "quick"))
+    path = report.write_report(tmp_path / "elsewhere" / "bench_q.json", "bench_q",
+                               [{"name": "t", "value": 1.0, "target": "< 2", "met": True}],
+                               [{"n": 1}], {"t": "s"}, skipped=[{"name": "big", "reason": "r"}])
+    assert path == tmp_path / "quick" / "bench_q.json"     # redirected, never overwritten
+    data = json.loads(path.read_text())
+    assert data["skipped"] == [{"name": "big", "reason": "r"}]
+    assert data["cpu_s"] > 0 and data["peak_rss_mb"] > 10 and data["wall_s"] > 0
+    assert data["wall_s"] >= data["cpu_s"] / (data["cpus"] or 1) - 1.0
+    assert {"date", "load_average", "load_average_start"} <= set(data)
+    rows = summary.summary_rows(tmp_path / "quick", ())
+    assert [(r["target"], r["status"]) for r in rows] == [("t", "met")]
+
+
+def test_docs_page_is_the_same_table(tmp_path, summary):
+    spec = importlib.util.spec_from_file_location(
+        "docs_generate", BENCH.parent / "docs" / "generate.py")
+    gen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gen)
+    _write(tmp_path, "bench_fem", targets=[{"name": "MUMPS VI step of 1025 nodes, CPU s",
+                                            "value": 3.0, "target": "< 30", "met": True}])
+    page = gen.benchmark_summary(tmp_path)
+    assert page.startswith("<!-- generated by docs/generate.py")
+    assert page.split("\n", 2)[2] == summary.summary_markdown(
+        tmp_path, title="Benchmarks: every speed and memory target")
+    assert "| 16 §4 | MUMPS VI step of 1025 nodes, CPU s | < 30 | 3 |" in page
