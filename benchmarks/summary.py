@@ -57,7 +57,8 @@ EXPECTED = (
      "s wall (2 workers)", "256"),
     ("15 §4", "bench_bands", "band mechanics 256^2, the same in CPU",
      "the same, process CPU (bounds the 2-core wall time from above)", "s CPU", "256"),
-    ("15 §4", "bench_surface_design", "surface design run", "a surface design run < 30 min",
+    ("15 §4", "bench_surface_design", "surface design run 64^2",
+     "a surface design run < 30 min (64^2 database, as the validation)",
      "s CPU", "design"),
     ("16 §1", "bench_bem", "4 loads at 2048^2, cold (",
      "4 loads at 2048^2 <= 500 convolution-equivalents", "convolution-equivalents", "2048"),
@@ -222,7 +223,8 @@ def summary_markdown(folder, title="Benchmark summary") -> str:
         lines += ["## Skipped, and why", ""] + _table(skipped, ("benchmark", "skipped",
                                                                 "reason")) + [""]
     if run:
-        lines += [f"## The run ({run.get('mode')}, started {run.get('started')} UTC)", "",
+        started = str(run.get("started", "")).replace("T", " ").replace("+00:00", "")
+        lines += [f"## The run ({run.get('mode')}, started {started} UTC)", "",
                   f"Total {_cell(run.get('total_wall_s'))} s wall, "
                   f"{_cell(run.get('total_cpu_s'))} s CPU on {run.get('cpus')} cores.", ""]
         lines += _table(run.get("cases") or [], ("script", "args", "exit_code", "wall_s",
