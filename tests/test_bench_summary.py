@@ -137,3 +137,13 @@ def test_docs_page_is_the_same_table(tmp_path, summary):
     assert page.split("\n", 2)[2] == summary.summary_markdown(
         tmp_path, title="Benchmarks: every speed and memory target")
     assert "| 16 §4 | MUMPS VI step of 1025 nodes, CPU s | < 30 | 3 |" in page
+
+
+def test_every_benchmark_has_a_plan_and_every_expected_target_a_script(summary, monkeypatch):
+    monkeypatch.syspath_prepend(str(BENCH))
+    run_all = _module("run_all")
+    scripts = {p.stem for p in BENCH.glob("bench_*.py")}
+    assert set(run_all.PLAN) == scripts
+    assert {s for s, (_, quick) in run_all.PLAN.items() if quick is None} == set(
+        run_all.NOT_IN_QUICK)
+    assert {e[1] for e in summary.EXPECTED} <= scripts
