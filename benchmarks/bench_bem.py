@@ -367,7 +367,7 @@ def main(argv=None) -> int:
                                       "179 s at 1024^2 and 1284 s at 2048^2 for the 4 loads "
                                       "(issue 16)"})
     for n in sorted(set(limits) - set(args.large)):
-        skipped.append({"name": f"large case {n}^2 (peak RSS" + (", CPU time)" if n == 8192
+        skipped.append({"name": f"large case {n}^2 (peak RSS" + (", CPU and wall time)" if n == 8192
                                                                   else ")"),
                         "reason": f"not in --large (add --large {n}; make bench runs it)"})
     write_report(args.output, "bench_bem", targets,
