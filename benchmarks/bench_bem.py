@@ -367,8 +367,8 @@ def main(argv=None) -> int:
                                       "179 s at 1024^2 and 1284 s at 2048^2 for the 4 loads "
                                       "(issue 16)"})
     for n in sorted(set(limits) - set(args.large)):
-        skipped.append({"name": f"large case {n}^2 (peak RSS" + (", CPU and wall time)" if n == 8192
-                                                                  else ")"),
+        what = ", CPU and wall time)" if n == 8192 else ")"
+        skipped.append({"name": f"large case {n}^2 (peak RSS{what}",
                         "reason": f"not in --large (add --large {n}; make bench runs it)"})
     write_report(args.output, "bench_bem", targets,
                  [r for e in elastic for r in e["rows"]],
