@@ -5,10 +5,11 @@ genomes (K points x 2 phase matrices; N x N periodic, default 64, M = 3 ridges, 
 [0.1, 1.5], 10 approaches to 0.8 of full contact, E = 210 MPa) is built in this process
 (CPU per genome recorded), with the period of the evenly mirrored x3p-2 window (259.7 um),
 the configuration of ``roughfe validate surface-genomics``. Then M-CCO + the search at the
-target pressures (100 sweeps per candidate, phases and chromosome amplitudes) on (a)
-K(p), A(p) of y_t1 (a surface genome outside the database) and (b) K(p), A(p) of the
+target pressures (phases and chromosome amplitudes) on (a) K(p), A(p) of y_t1 (a surface
+genome outside the database; 100 sweeps per candidate) and (b) K(p), A(p) of the
 measured x3p-2 (mirrored, periodic BEM, on the database spacing; `surface_targets`),
-after `match_spectrum` (its spectrum, 3 matched database starts). Process CPU times (the machine may be
+after `match_spectrum` per wave (its spectrum, 3 matched database starts; 300 sweeps per
+candidate). Process CPU times (the machine may be
 shared; wall times are inflated by load) go to ``benchmarks/output/
 bench_surface_design.json`` with the scores (the scores are the validation's business:
 here they only show the run did its work).
@@ -72,8 +73,10 @@ def main(n_points=24, n_nodes=64):
         res = run_design("mcco", entries, [k, a], settings, pbar=0.4 * c.p_max,
                          options=GcmmaOptions(bound="period"))
         if surface is not None:             # a measured target: its spectrum, 3 more starts
-            res = match_spectrum(res, surface, settings, entries=entries, n_entries=3)
-        res = search_at_target_pressures(res, settings, n_eval=100, amplitudes=True)
+            res = match_spectrum(res, surface, settings, entries=entries, n_entries=3,
+                                 directional=True)
+        res = search_at_target_pressures(res, settings, n_eval=100 if surface is None else 300,
+                                         amplitudes=True)
         cpu = _cpu() - c0
         cases.append({"case": f"M-CCO + search, {name}", "n_nodes": n_nodes, "cpu_s": cpu,
                       "bem_sweeps": int(res.nit), "f": combined_score(res.best.at_targets)})
