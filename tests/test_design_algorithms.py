@@ -261,3 +261,46 @@ def test_multi_start_and_chromosome_amplitudes(entries, targets, tmp_path):
         assert len(c.design.parts) == len(split.parts)
     np.testing.assert_allclose(_strict_scores_by_hand(c.design, [t1, t3], tmp_path), c.at_targets,
                                atol=1e-7)
+
+
+def test_batched_strict_scores_equal_the_single_rescore(entries, targets):
+    """score_batch_at_target_pressures (all designs solved together, bem.batch) gives
+    rescore_at_target_pressures of each design to round-off: the target genome scores
+    1, its moved phases and database genomes less."""
+    t1, _, t3, _ = targets
+    g = de.target_genome_t1(SETTINGS)
+    d = de.Design((de.DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "y_t1"),), 1.0,
+                  SETTINGS.length, SETTINGS.n_nodes, "y_t1", SETTINGS.dim)
+    keys = d.keys("all")
+    rng = np.random.default_rng(3)
+    designs = [d] + [d.with_phases(keys, d.phase_values(keys) + s * rng.standard_normal(len(keys)))
+                     for s in (0.02, 0.1, 0.5)] + [de.entry_design(e, SETTINGS) for e in entries[:3]]
+    batch = de.score_batch_at_target_pressures(designs, [t1, t3], SETTINGS)
+    single = np.array([de.rescore_at_target_pressures(x, [t1, t3], SETTINGS) for x in designs])
+    np.testing.assert_allclose(batch, single, rtol=0, atol=1e-9)
+    assert batch[0] == pytest.approx([1.0, 1.0], abs=1e-9) and np.all(batch[1:].min(axis=1) < 1)
+
+
+def test_global_search_raises_the_strict_score_reproducibly(entries, targets, tmp_path):
+    """search_global (IPOP-CMA-ES on the batched strict score): strict f not below the
+    start and above the (1+1)-ES of the same budget here; the saved design's strict
+    scores equal the hand-written load-controlled BEM run; its best-so-far curve rises."""
+    t1, _, t3, _ = targets
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    f0 = de.combined_score(de.rescore_at_target_pressures(r.best.design, [t1, t3], SETTINGS))
+    rg = de.search_global(r, SETTINGS, n_eval=300, sigma=0.5, seed=1)
+    c = rg.best
+    assert rg.success and c.stages == r.best.stages and "CMA-ES" in rg.message
+    assert de.combined_score(c.at_targets) > f0 + 0.05
+    h = rg.search_history[0]
+    assert h[-1, 0] <= 300 and np.all(np.diff(h[:, 1]) >= 0)
+    assert h[-1, 1] == pytest.approx(de.combined_score(c.at_targets), abs=1e-9)
+    paths = de.write_design_result(rg, SETTINGS, tmp_path)
+    saved = json.loads(paths["result"].read_text())["candidates"][0]
+    dd = de.Design.from_dict(json.loads(paths["design"].read_text()))
+    np.testing.assert_allclose(_strict_scores_by_hand(dd, [t1, t3], tmp_path),
+                               saved["scores_at_target_pressures"], atol=1e-7)
+    with pytest.raises(InputError, match="n_eval"):
+        de.search_global(r, SETTINGS, n_eval=1)
+    with pytest.raises(InputError, match="method"):
+        de.search_global(r, SETTINGS, method="annealing")

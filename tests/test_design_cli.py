@@ -26,7 +26,8 @@ def test_db_and_design_commands(tmp_path, capsys):
     assert main(["design-targets", "--db", str(path), "-o", str(tmp_path / "t")]) == 0
     out = tmp_path / "sog"
     assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "y_t1.csv"),
-                 "--method", "sog", "--iterations", "1", "--search", "3", "-o", str(out)]) == 0
+                 "--method", "sog", "--iterations", "1", "--search", "3", "--global", "cmaes",
+                 "--global-eval", "30", "-o", str(out)]) == 0
     for name in ("result.json", "design.json", "genome.json", "profile.npz", "curves.csv",
                  "stages.csv", "curves.png", "stages.png", "profile.png", "psd.png"):
         assert (out / name).is_file(), name

@@ -29,7 +29,7 @@ def _run(args) -> int:
     from ..genomics.database import load_entries, read_settings
     from ..genomics.design import (GcmmaOptions, refine, rescore_at_target_pressures,
                                    run_design, search_at_target_pressures,
-                                   write_design_result)
+                                   search_global, write_design_result)
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}
@@ -65,6 +65,10 @@ def _run(args) -> int:
             result = search_at_target_pressures(result, settings, n_eval=args.search,
                                                 starts=args.search_starts,
                                                 amplitudes=args.search_amplitudes)
+        if args.global_search:
+            result = search_global(result, settings, n_eval=args.global_eval,
+                                   amplitudes=args.search_amplitudes,
+                                   method=args.global_search)
         if not args.no_figures:
             from ..plotting.design import (plot_design_curves, plot_profiles, plot_psds,
                                            plot_stages)
@@ -155,6 +159,13 @@ def register(sub):
                         "the best kept")
     g.add_argument("--search-amplitudes", action="store_true",
                    help="--search: every chromosome's amplitude a variable too (+-30%%)")
+    g.add_argument("--global", dest="global_search", choices=("cmaes",), default=None,
+                   help="extra stage beyond the thesis, after --search: IPOP-CMA-ES on all "
+                        "phases and part weights maximising the score solved at the target "
+                        "pressures, a generation of designs solved together (batched BEM)")
+    g.add_argument("--global-eval", type=positive_int, default=20000, metavar="N",
+                   help="--global: strict evaluations (profiles solved at the target "
+                        "pressures) for the best candidate")
     g.add_argument("--match-spectrum", default=None, metavar="SURFACE",
                    help="surface database, beyond the thesis, after --refine and before "
                         "--search: set every chromosome's amplitude to the band rms of this "

@@ -10,8 +10,10 @@ Modules, by idea (see ``docs/theory/genomics-layout.md``):
 * :mod:`.stages` -- one GCMMA stage (Sec. 4.3.1) through the one driver
   :func:`roughfe.optim.gcmma.gcmma`, its options and the phase box;
 * :mod:`.algorithms` -- Alg. 3 (:func:`score_database`), SOG/GCO/CCO/M-CCO (Algs. 4-7),
-  :func:`refine` and :func:`search_at_target_pressures` (beyond the thesis) and
-  :func:`run_design`;
+  :func:`refine` (beyond the thesis) and :func:`run_design`;
+* :mod:`.search` -- search stages on the score solved at the target pressures (beyond
+  the thesis): :func:`search_at_target_pressures` ((1+1)-ES) and :func:`search_global`
+  (IPOP-CMA-ES on batched BEM solves);
 * :mod:`.spectrum` -- chromosome amplitudes matched to a target surface's spectrum
   (:func:`match_spectrum`, beyond the thesis, surfaces);
 * :mod:`.targets` -- the thesis targets y_t1, y_t2, y_t3, targets of a (measured)
@@ -22,20 +24,23 @@ Every public name is importable from ``roughfe.genomics.design``.
 """
 from ...optim.gcmma import GcmmaResult, gcmma_maximize, gcmma_minimax
 from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, mcco, refine,
-                         run_design, score_database, search_at_target_pressures, sog)
+                         run_design, score_database, sog)
 from .io import result_to_dict, write_design_result
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
 from .objective import Evaluator, Objective, combined_score
+from .search import GLOBAL_METHODS, search_at_target_pressures, search_global
 from .sensitivities import residual_jacobian
 from .spectrum import match_spectrum, spectrum_matched
 from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
 from .targets import (TARGET_BOUNDARIES, Y_T1_GENES, Y_T1_SURFACE_GENES, rescore,
-                      rescore_at_target_pressures, score_at_target_pressures, surface_targets,
+                      rescore_at_target_pressures, score_at_target_pressures,
+                      score_batch_at_target_pressures, surface_targets,
                       target_genome_t1, target_surface, thesis_targets, window_compliance)
 
 __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
            "run_design", "score_database", "search_at_target_pressures", "sog",
+           "search_global", "GLOBAL_METHODS", "score_batch_at_target_pressures",
            "match_spectrum", "spectrum_matched", "target_surface",
            "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",

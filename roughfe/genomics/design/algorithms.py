@@ -24,7 +24,6 @@ import numpy as np
 
 from ...errors import InputError
 from ...frozen import freeze_containers
-from ...optim.es import one_plus_one_es
 from ..database import DatabaseEntry, DatabaseSettings
 from ..macro_micro import classify
 from ..similarity import ResponseCurve, Target, similarity, split_ranges
@@ -100,6 +99,9 @@ class DesignResult:
     nit: int
     elapsed: float
     references: tuple = REFERENCES
+    #: :func:`roughfe.genomics.design.search.search_global`: per searched candidate,
+    #: rows (strict evaluations spent, best strict f so far)
+    search_history: tuple = ()
 
     def __post_init__(self):
         freeze_containers(self)
@@ -397,81 +399,6 @@ def _at_targets(design, objective, settings, evaluate):
     """Scores of ``design`` solved at the targets' own pressures (one counted sweep)."""
     evaluate.n_sweeps += 1
     return rescore_at_target_pressures(design, objective.targets, settings)
-
-
-def search_at_target_pressures(result: DesignResult, settings: DatabaseSettings, *,
-                               n_eval: int = 400, width: float = math.pi,
-                               weight_fraction: float = 0.3, sigma: float = 0.3, seed: int = 0,
-                               starts: int = 1, amplitudes: bool = False,
-                               evaluate=None) -> DesignResult:
-    """An optional stage beyond the thesis: a derivative-free search of every phase and
-    part weight on the score solved *at the target's own pressures*.
-
-    The thesis stages (and :func:`refine`) maximise Eq. (4.1) on the design's n_t equal
-    approaches interpolated at the target pressures, by GCMMA within +-10 % boxes. Two
-    things stop them on a multi-target design (Alg. 7): A(p) is a count of contact nodes,
-    so s_A is a staircase whose derivative on the fixed contact sets is zero, and the
-    boxes keep the phases near a local optimum. Here the objective is f of
-    :func:`rescore_at_target_pressures` (load-controlled BEM steps at the pressures
-    ``p_t / eta``, Eq. 4.2; A is the exact node fraction, K central differences), i.e.
-    the strict score itself. Variables: all phases (box +-``width`` around their current
-    values; the default is the whole period) and each part's weight (the macro/micro
-    amplitude ratio, +-``weight_fraction``), mapped to the unit box. Optimiser: a (1+1)
-    evolution strategy (Rechenberg's 1/5 success rule, step ``sigma`` in the unit box,
-    ``default_rng(seed)``, :func:`roughfe.optim.es.one_plus_one_es`) that accepts equal
-    scores, so it walks across the plateaus of the staircase; ``n_eval`` sweeps per run.
-    (Measured on y_t1/y_t3, N = 512: Powell's method stops on the first plateau it meets.)
-
-    ``starts``: a deterministic multi-start, ``starts`` independent runs from each
-    candidate's design (one generator, drawn on in order), the best strict f kept.
-    Measured on y_t1/y_t3, N = 512, from the thesis-stage M-CCO result: 4 x 400 sweeps
-    give f at p_t = 0.843 against 0.820 with one start (4890 against 1284 sweeps).
-    ``amplitudes``: the amplitude of every chromosome is a variable too (the design is
-    split into one part per chromosome, :meth:`Design.split_chromosomes`, the same
-    profile), each within +-``weight_fraction`` of its start: the spectrum, which sets
-    K(p) at the higher loads, moves with the phases, which set the first contacts.
-
-    Each candidate keeps its thesis stages; its design is replaced only when the strict
-    f improves, its ``scores``/``curve`` are re-evaluated on the n_t approaches (as
-    everywhere, so :func:`rescore` reproduces them) and ``at_targets`` holds the strict
-    scores. Candidates are re-sorted by the strict f.
-    """
-    if n_eval < 1 or not width > 0 or not 0 < weight_fraction < 1 or not sigma > 0 \
-            or int(starts) < 1:
-        raise InputError(f"n_eval >= 1, width > 0, 0 < weight_fraction < 1, sigma > 0 and "
-                         f"starts >= 1 needed, got {n_eval!r}, {width!r}, {weight_fraction!r}, "
-                         f"{sigma!r}, {starts!r}")
-    t0 = time.perf_counter()
-    evaluate = evaluate or Evaluator(settings)
-    objective = result.objective
-    rng = np.random.default_rng(seed)
-    out = []
-    for c in result.candidates:
-        d0 = c.design.split_chromosomes() if amplitudes else c.design
-        keys = d0.keys("all") + [(k, "weight") for k in range(len(d0.parts))]
-        x0 = d0.phase_values(keys)
-        is_w = np.array([len(k) == 2 for k in keys])
-        lo = np.where(is_w, x0 * (1 - weight_fraction), x0 - width)
-        hi = np.where(is_w, x0 * (1 + weight_fraction), x0 + width)
-
-        def strict(u):
-            d = d0.with_phases(keys, lo + (hi - lo) * u)
-            return combined_score(_at_targets(d, objective, settings, evaluate))
-
-        runs = [one_plus_one_es(strict, (x0 - lo) / (hi - lo), n_eval, sigma=sigma, rng=rng)
-                for _ in range(int(starts))]
-        best = max(runs, key=lambda r: r.fun)          # the first of equals: deterministic
-        d_best = d0.with_phases(keys, lo + (hi - lo) * best.x) if best.fun > best.fun0 else \
-            c.design
-        new = _finish(d_best, c.stages, objective, evaluate, c.macro, c.micro, c.origin)
-        out.append(replace(new, at_targets=_at_targets(new.design, objective, settings,
-                                                       evaluate)))
-    out.sort(key=lambda c: -combined_score(c.at_targets))
-    f = combined_score(out[0].at_targets)
-    return _extended(result, out, evaluate, t0, f"; search at the target pressures ((1+1)-ES, "
-                     f"all phases +-{width:.3g} rad, "
-                     f"{'chromosome' if amplitudes else 'part'} weights +-{weight_fraction:.0%}, "
-                     f"{starts} x {n_eval} sweeps per candidate): f at p_t = {f:.4f}")
 
 
 def run_design(method: str, entries, targets, settings: DatabaseSettings, *, pbar=None,

@@ -1,6 +1,6 @@
 """Design variables beyond the phases (issue 15 Sec. 3): the chromosome amplitudes of a
 design set to the power spectrum of a given target surface, a stage beyond the thesis
-between its GCMMA stages and :func:`~.algorithms.search_at_target_pressures`."""
+between its GCMMA stages and :func:`~.search.search_at_target_pressures`."""
 from __future__ import annotations
 
 import time

@@ -1,0 +1,113 @@
+"""The batched contact solvers (roughfe.bem.batch) against the single solver, an analytic
+solution and themselves: exact pivoting gives the single dense solver's contact states
+to round-off (load and displacement control, warm-started sweeps), the batched CG agrees
+to its tolerance, a row does not depend on the rows beside it, and a cylinder's contact
+half-width follows plane-strain Hertz."""
+import numpy as np
+import pytest
+
+from roughfe.bem import contact_sweep, influence_operator, solve_contact
+from roughfe.bem.batch import batch_sweep, solve_batch, solve_batch_exact
+from roughfe.errors import InputError
+from roughfe.model import Material, central_differences
+from roughfe.surfaces import Surface
+
+N, L = 256, 1e-3
+MAT = Material(1e6, 0.0)
+
+
+def profiles(B, seed=0):
+    """B random profiles: a few cosines of random phases (rough, contact on a few peaks)."""
+    rng = np.random.default_rng(seed)
+    x = np.arange(N) * L / N
+    k = np.arange(1, 9)
+    amp = 1e-6 * k ** -1.6
+    ph = rng.uniform(0, 2 * np.pi, (B, k.size))
+    return np.einsum("k,bkx->bx", amp, np.cos(2 * np.pi * k[None, :, None] * x / L + ph[..., None]))
+
+
+def op():
+    return influence_operator((N,), (L,), MAT.E_star, "strip")
+
+
+def surface(h):
+    return Surface(h, (L,), periodic=False)
+
+
+@pytest.mark.parametrize("control", ["delta", "mean_pressure"])
+def test_exact_batch_equals_the_single_dense_solver(control):
+    h = profiles(6)
+    value = 0.3 * np.ptp(h, axis=1) if control == "delta" else np.full(6, 2e3)
+    st = solve_batch_exact(op(), h, **{control: value})
+    for b in range(6):
+        r = solve_contact(surface(h[b]), MAT, kernel="strip", solver="dense",
+                          compute_stiffness=False, **{control: float(value[b])})
+        assert st.n_contact[b] == r.n_contact > 0
+        np.testing.assert_allclose(st.pressure[b], r.pressure, rtol=0,
+                                   atol=1e-9 * r.pressure.max())
+        assert st.delta[b] == pytest.approx(r.delta, rel=1e-10)
+        assert st.mean_pressure[b] == pytest.approx(r.mean_pressure, rel=1e-10)
+    assert np.all(st.residual < 1e-10)
+
+
+def test_batched_cg_agrees_to_its_tolerance_and_rows_are_independent():
+    h = profiles(5, seed=1)
+    pk = solve_batch(op(), h, mean_pressure=np.linspace(1e3, 4e3, 5), tol=1e-10)
+    ex = solve_batch_exact(op(), h, mean_pressure=np.linspace(1e3, 4e3, 5))
+    np.testing.assert_array_equal(pk.n_contact, ex.n_contact)
+    np.testing.assert_allclose(pk.delta, ex.delta, rtol=1e-8)
+    assert np.all(pk.residual <= 1e-10)
+    alone = solve_batch_exact(op(), h[2:3], mean_pressure=2.5e3)
+    np.testing.assert_array_equal(alone.pressure[0], ex.pressure[2])       # same arithmetic
+    d = solve_batch(op(), h, delta=0.2 * np.ptp(h, axis=1))
+    r = solve_contact(surface(h[3]), MAT, kernel="strip", solver="dense",
+                      delta=0.2 * float(np.ptp(h[3])), compute_stiffness=False)
+    assert d.n_contact[3] == r.n_contact and d.mean_pressure[3] == pytest.approx(
+        r.mean_pressure, rel=1e-7)
+
+
+@pytest.mark.parametrize("method", ["exact", "pk"])
+def test_sweep_equals_contact_sweep_area_and_stiffness(method):
+    h = profiles(4, seed=2)
+    p = np.geomspace(3e2, 2e4, 8)
+    pr = p[None, :] * np.array([1.0, 0.7, 1.3, 1.1])[:, None]
+    sw = batch_sweep(op(), h, pr, method=method)
+    for b in range(4):
+        ref = contact_sweep(surface(h[b]), MAT, pressures=tuple(pr[b]), kernel="strip",
+                            compute_stiffness=False)
+        np.testing.assert_array_equal(np.round(sw.area_fraction[b] * N),
+                                      np.round(np.asarray(ref.area_fraction) * N))
+        tol = 1e-10 if method == "exact" else 1e-7
+        np.testing.assert_allclose(sw.delta[b], ref.delta, rtol=tol)
+        np.testing.assert_allclose(sw.stiffness[b], central_differences(ref.delta, ref.mean_pressure),
+                                   rtol=100 * tol)
+
+
+def test_cylinder_follows_plane_strain_hertz():
+    """A parabolic profile h = -x^2/(2R) under a line load P': a = sqrt(4 R P'/(pi E*))
+    (Johnson 1985, Eq. 4.43); the node count 2a/dx within two nodes, in every row of a
+    batch of different loads."""
+    x = (np.arange(N) - N / 2 + 0.5) * L / N
+    R = 5e-3
+    h = np.tile(-x ** 2 / (2 * R), (3, 1))
+    pm = np.array([0.5, 1.0, 2.0]) * 1e3                 # mean pressure over L (Pa)
+    st = solve_batch_exact(op(), h, mean_pressure=pm)
+    a = np.sqrt(4 * R * pm * L / (np.pi * MAT.E_star))
+    assert np.all(np.abs(st.n_contact - 2 * a / (L / N)) <= 2)
+    assert np.all(np.diff(st.n_contact) > 0)
+
+
+def test_bad_input_is_refused():
+    h = profiles(2)
+    with pytest.raises(InputError, match="exactly one"):
+        solve_batch_exact(op(), h)
+    with pytest.raises(InputError, match="shape"):
+        solve_batch(op(), h[:, :10], delta=1e-7)
+    with pytest.raises(InputError, match="flat"):
+        solve_batch_exact(op(), np.zeros((2, N)), delta=1e-7)
+    with pytest.raises(InputError, match="increasing"):
+        batch_sweep(op(), h, np.array([[2.0, 1.0], [1.0, 2.0]]))
+    with pytest.raises(InputError, match="profile operator"):
+        solve_batch_exact(influence_operator((N,), (L,), 1e6, "spectral"), h, delta=1e-7)
+    with pytest.raises(InputError, match="mean_pressure"):
+        solve_batch(op(), h, mean_pressure=np.array([1.0, -1.0]))
