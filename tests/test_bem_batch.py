@@ -111,3 +111,32 @@ def test_bad_input_is_refused():
         solve_batch_exact(influence_operator((N,), (L,), 1e6, "spectral"), h, delta=1e-7)
     with pytest.raises(InputError, match="mean_pressure"):
         solve_batch(op(), h, mean_pressure=np.array([1.0, -1.0]))
+
+
+def test_schur_complement_on_the_top_set_equals_the_direct_solves():
+    """set_inverse of the p_max state and the Schur complement of its subsets give the
+    direct solutions of H_FF x = [c_F, 1] to round-off; a sweep warm-started with that
+    basis equals the sweep without it (the same exact contact states)."""
+    from roughfe.bem.batch import _set_solutions, set_inverse
+    h = profiles(4, seed=5)
+    o = op()
+    top = solve_batch_exact(o, h, delta=np.ptp(h, axis=1))
+    basis = set_inverse(o, top)
+    c = h - h.max(axis=1, keepdims=True)
+    F = top.pressure > 0
+    for b in range(4):                                   # leave some points of U out
+        F[b, np.flatnonzero(F[b])[: 2 + b]] = False
+    direct = _set_solutions(o.dense(), c, F)
+    schur = _set_solutions(o.dense(), c, F, basis, np.arange(4))
+
+    def scatter(idx, valid, x):
+        out = np.zeros((4, N, 2))
+        r, s = np.nonzero(valid)
+        out[r, idx[r, s]] = x[r, s]
+        return out
+    a, b = scatter(*direct), scatter(*schur)
+    assert np.abs(a - b).max() <= 1e-12 * np.abs(a).max()
+    pr = np.geomspace(0.05, 1.0, 8)[None, :] * top.mean_pressure[:, None]
+    s1, s2 = batch_sweep(o, h, pr), batch_sweep(o, h, pr, top=top)
+    np.testing.assert_array_equal(s1.area_fraction, s2.area_fraction)
+    np.testing.assert_allclose(s2.delta, s1.delta, rtol=1e-12)

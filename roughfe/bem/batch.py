@@ -250,16 +250,90 @@ def _exact_ok(op) -> bool:
     return not op.periodic and len(op.shape) == 1 and op.shape[0] <= 4096
 
 
-def _gather(F):
-    """Indices (R, m) of the True entries of each row of ``F`` (R, n), padded with 0 on
-    the right, and their mask (R, m); m = the largest row count (at least 1)."""
-    m = max(int(F.sum(axis=1).max()), 1)
+def _gather(F, width=0):
+    """Indices (R, m) of the True entries of each row of ``F`` (R, n), then of False
+    ones as padding, and the mask of the True ones (R, m); m = the largest row count
+    (at least 1, at least ``width``)."""
+    m = min(max(int(F.sum(axis=1).max()), 1, int(width)), F.shape[1])
     order = np.argsort(~F, axis=1, kind="stable")[:, :m]
     return order, np.take_along_axis(F, order, axis=1)
 
 
+#: rows per stacked LAPACK call of the direct solves, grouped by set size (a group is
+#: padded to its largest set)
+DIRECT_GROUP = 16
+
+
+def _set_solutions(Hd, c, F, basis=None, rows=None):
+    """Solutions ``x`` (R, m, 2) of ``H_FF x = [c_F, 1]`` for every row's set ``F``
+    (R, n), on the slots ``idx`` (R, m) where ``valid`` (R, m); returns (idx, valid, x).
+
+    Direct: the systems gathered, padded with the identity and solved by LAPACK together,
+    in groups of :data:`DIRECT_GROUP` rows of similar set size. With a ``basis``
+    (idx_U, valid_U, G) of all B rows (``rows``: which of them ``F`` holds): G = H_UU^-1
+    of a set U per row (the state at the largest load of a sweep); a row whose F lies in
+    U and leaves fewer points of U out than it holds takes the Schur complement instead,
+    ``H_FF^-1 = G_FF - G_FR G_RR^-1 G_RF`` (one small solve of |R| unknowns and products
+    with G, no factorisation of H_FF)."""
+    R = F.shape[0]
+    use = np.zeros(R, bool)
+    if basis is not None:
+        iu, vu = basis[0][rows], basis[1][rows]
+        fm = vu & np.take_along_axis(F, iu, axis=1)
+        rm = vu & ~fm
+        use = (fm.sum(axis=1) == F.sum(axis=1)) & (rm.sum(axis=1) < fm.sum(axis=1))
+    width = iu.shape[1] if use.any() else 0
+    idx, valid = _gather(F, width)
+    x = np.zeros(idx.shape + (2,))
+
+    def rhs_of(cc, i, v):
+        return np.stack([np.where(v, np.take_along_axis(cc, i, axis=1), 0.0),
+                         v.astype(float)], axis=-1)
+
+    d = np.flatnonzero(~use)
+    d = d[np.argsort(F[d].sum(axis=1), kind="stable")]
+    for g in range(0, d.size, DIRECT_GROUP):
+        dg = d[g:g + DIRECT_GROUP]
+        i, v = _gather(F[dg])
+        m = i.shape[1]
+        A = np.where(v[:, :, None] & v[:, None, :], Hd[i[:, :, None], i[:, None, :]],
+                     np.eye(m))
+        x[dg, :m] = np.linalg.solve(A, rhs_of(c[dg], i, v))
+    if use.any():
+        s_ = np.flatnonzero(use)
+        whole = s_.size == basis[2].shape[0] and np.array_equal(rows[s_], s_)
+        iu, fm, rm = iu[s_], fm[s_], rm[s_]
+        G = basis[2] if whole else basis[2][rows[s_]]      # no copy of every row's G
+        y = G @ rhs_of(c[s_], iu, fm)
+        ir, vr = _gather(rm)
+        if vr.any():
+            r = ir.shape[1]
+            Gur = np.take_along_axis(G, ir[:, None, :], axis=2)
+            Grr = np.take_along_axis(Gur, ir[:, :, None], axis=1)
+            Grr = np.where(vr[:, :, None] & vr[:, None, :], Grr, np.eye(r))
+            yr = np.where(vr[..., None], np.take_along_axis(y, ir[..., None], axis=1), 0.0)
+            Gur = np.where(vr[:, None, :], Gur, 0.0)
+            y = y - Gur @ np.linalg.solve(Grr, yr)
+        M = iu.shape[1]
+        x[s_] = 0.0
+        x[s_, :M] = np.where(fm[..., None], y, 0.0)
+        idx[s_], valid[s_] = 0, False
+        idx[s_, :M], valid[s_, :M] = iu, fm
+        if idx.shape[1] > M:                   # padding slots: nodes outside U (not in F)
+            out = np.argsort(_members(iu, F.shape[1]), axis=1, kind="stable")
+            idx[s_, M:] = out[:, :idx.shape[1] - M]
+    return idx, valid, x
+
+
+def _members(idx, n):
+    """(R, n) bool: the nodes named by each row of ``idx``."""
+    out = np.zeros((idx.shape[0], n), bool)
+    np.put_along_axis(out, idx, True, axis=1)
+    return out
+
+
 def solve_batch_exact(op: InfluenceOperator, heights, *, delta=None, mean_pressure=None,
-                      initial=None, max_exchanges: int = 60) -> BatchState:
+                      initial=None, max_exchanges: int = 60, basis=None) -> BatchState:
     """The exact solution of B contact problems of a non-periodic profile operator by
     batched block principal pivoting (Judice & Pires 1994, as
     :func:`roughfe.bem.solvers.lcp_bpp`), displacement or load control.
@@ -277,7 +351,10 @@ def solve_batch_exact(op: InfluenceOperator, heights, *, delta=None, mean_pressu
     one or two exchanges); without them the set starts at the highest point (load
     control) or at the points that :func:`solve_batch` (the CG, to 1e-4) puts in
     contact. A row that does not settle in ``max_exchanges`` is finished by the CG.
-    Dense: the operator as an n x n matrix (n <= 4096 points).
+    Dense: the operator as an n x n matrix (n <= 4096 points). ``basis``: the inverse of
+    H on a superset of the contact sets per row (:func:`set_inverse` of a state at a
+    larger load), so that most sets are solved by a small Schur complement
+    (:func:`_set_solutions`).
     """
     h = np.asarray(heights, dtype=float)
     if not _exact_ok(op):
@@ -321,27 +398,20 @@ def solve_batch_exact(op: InfluenceOperator, heights, *, delta=None, mean_pressu
         Fa = F[act]
         if it == 1 and cached is not None:     # the warm set was solved by the last step
             idx, valid, x = cached
-            R, m = idx.shape
         else:
-            idx, valid = _gather(Fa)
-            R, m = idx.shape
-            A = Hd[idx[:, :, None], idx[:, None, :]]
-            both = valid[:, :, None] & valid[:, None, :]
-            A = np.where(both, A, np.eye(m))
-            rhs = np.stack([np.where(valid, np.take_along_axis(c[act], idx, axis=1), 0.0),
-                            valid.astype(float)], axis=-1)
             try:
-                x = np.linalg.solve(A, rhs)
+                idx, valid, x = _set_solutions(Hd, c[act], Fa, basis, act)
             except np.linalg.LinAlgError:
                 break                          # a singular set: the CG finishes these rows
+        R, m = idx.shape
         if load:
             da = (target[act] - x[..., 0].sum(axis=1)) / x[..., 1].sum(axis=1)
         else:
             da = d[act]
         pF = np.where(valid, x[..., 0] + da[:, None] * x[..., 1], 0.0)
         pa = np.zeros((R, n))
-        np.put_along_axis(pa, idx, pF, axis=1)
-        pa[~Fa] = 0.0
+        ri, si = np.nonzero(valid)              # padding slots name no point of F
+        pa[ri, idx[ri, si]] = pF[ri, si]
         w = bop.apply(pa) - c[act] - da[:, None]
         w[Fa] = 0.0
         eps = 1e-12 * scale[act][:, None]
@@ -388,19 +458,35 @@ def solve_batch_exact(op: InfluenceOperator, heights, *, delta=None, mean_pressu
     return BatchState(p, u, d, p.mean(axis=1), (p > 0).sum(axis=1), nit, res, pivots)
 
 
+def set_inverse(op: InfluenceOperator, state: BatchState) -> tuple:
+    """The ``basis`` of :func:`solve_batch_exact` from a state it returned: per row the
+    slots of its final pivoting set and the inverse of H on them (padded with the
+    identity), ``(idx, valid, G)``."""
+    if state.pivots is None:
+        raise InputError("set_inverse needs a settled state of solve_batch_exact")
+    _, idx, valid, _ = state.pivots
+    m = idx.shape[1]
+    A = np.where(valid[:, :, None] & valid[:, None, :],
+                 op.dense()[idx[:, :, None], idx[:, None, :]], np.eye(m))
+    return idx, valid, np.linalg.inv(A)
+
+
 def batch_operator(shape, size, material: Material, kernel: str) -> InfluenceOperator:
     """The operator of :func:`solve_batch` for grids of ``shape`` and ``size`` (m)."""
     return influence_operator(shape, size, material.E_star, kernel)
 
 
 def batch_sweep(op: InfluenceOperator, heights, pressures, *, method: str = "auto",
-                tol: float = 1e-10, max_iter: int = 2000) -> BatchSweep:
+                tol: float = 1e-10, max_iter: int = 2000, top=None) -> BatchSweep:
     """Load-controlled sweeps of B surfaces: row ``b`` solved at the increasing mean
     pressures ``pressures[b]`` (Pa, shape (B, m)), each step warm-started from the
     previous one; A = contact points / all points, K = dp/dDelta by central differences
     over the steps. ``method``: "exact" (:func:`solve_batch_exact`, pivoting), "pk"
     (:func:`solve_batch`, the CG to ``tol``), "auto" = exact for a non-periodic profile
-    of at most 4096 points, else pk."""
+    of at most 4096 points, else pk. ``top``: a state of :func:`solve_batch_exact` of
+    the same rows at a load at least the last one (e.g. the p_max solve of Eq. 4.2):
+    its contact sets contain the sweep's, and their inverses (:func:`set_inverse`) turn
+    the pivoting solves into small Schur complements (exact as well)."""
     if method not in ("auto", "exact", "pk"):
         raise InputError(f"method must be 'auto', 'exact' or 'pk', got {method!r}")
     if method == "auto":
@@ -416,8 +502,11 @@ def batch_sweep(op: InfluenceOperator, heights, pressures, *, method: str = "aut
     dl, pm, a = np.empty((B, m)), np.empty((B, m)), np.empty((B, m))
     nit = np.zeros(B, int)
     st = None
+    basis = set_inverse(op, top) if method == "exact" and getattr(top, "pivots", None) \
+        is not None else None
     for j in range(m):
-        st = solve_batch_exact(op, h, mean_pressure=pr[:, j], initial=st) if method == "exact" \
+        st = solve_batch_exact(op, h, mean_pressure=pr[:, j], initial=st, basis=basis) \
+            if method == "exact" \
             else solve_batch(op, h, mean_pressure=pr[:, j], initial=st, tol=tol,
                              max_iter=max_iter)
         dl[:, j], pm[:, j], a[:, j] = st.delta, st.mean_pressure, st.n_contact / n

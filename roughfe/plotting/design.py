@@ -219,3 +219,20 @@ def plot_psds(named, path, title="") -> "Path":
         ax.legend(fontsize=7)
     fig.suptitle(title)
     return save_figure(fig, path)
+
+
+def plot_search_history(named, path, goal=None, title="") -> "Path":
+    """Best strict f against the strict evaluations spent (``name -> (k, 2) array`` of
+    :attr:`DesignResult.search_history` rows), log abscissa; ``goal`` a horizontal line."""
+    fig, ax = new_figure()
+    for name, h in named.items():
+        h = np.asarray(h, dtype=float)
+        ax.step(h[:, 0], h[:, 1], where="post", label=name)
+    if goal is not None:
+        ax.axhline(goal, color="k", ls=":", label=f"goal {goal:g}")
+    ax.set_xscale("log")
+    ax.set_xlabel("strict evaluations (profiles solved at the target pressures)")
+    ax.set_ylabel("best f at the target pressures")
+    ax.set_title(title)
+    ax.legend()
+    return save_figure(fig, path)

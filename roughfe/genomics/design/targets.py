@@ -103,7 +103,7 @@ def score_batch_at_target_pressures(designs, targets, settings: DatabaseSettings
     top = solve_batch_exact(op, h, delta=np.ptp(h, axis=1))
     eta = targets[0].p_max / top.mean_pressure
     p = np.unique(np.concatenate([t.pressure for t in targets]))
-    sw = batch_sweep(op, h, p[None, :] / eta[:, None], method="exact")
+    sw = batch_sweep(op, h, p[None, :] / eta[:, None], method="exact", top=top)
     out = np.full((len(designs), len(targets)), -np.inf)
     for b in range(len(designs)):
         try:
