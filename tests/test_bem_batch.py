@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from roughfe.bem import contact_sweep, influence_operator, solve_contact
-from roughfe.bem.batch import batch_sweep, solve_batch, solve_batch_exact
+from roughfe.bem.batch import solve_batch
+from roughfe.bem.batch_exact import batch_sweep, solve_batch_exact
 from roughfe.errors import InputError
 from roughfe.model import Material, central_differences
 from roughfe.surfaces import Surface
@@ -117,7 +118,7 @@ def test_schur_complement_on_the_top_set_equals_the_direct_solves():
     """set_inverse of the p_max state and the Schur complement of its subsets give the
     direct solutions of H_FF x = [c_F, 1] to round-off; a sweep warm-started with that
     basis equals the sweep without it (the same exact contact states)."""
-    from roughfe.bem.batch import _set_solutions, set_inverse
+    from roughfe.bem.batch_exact import _set_solutions, set_inverse
     h = profiles(4, seed=5)
     o = op()
     top = solve_batch_exact(o, h, delta=np.ptp(h, axis=1))

@@ -494,7 +494,7 @@ def main(outdir: Path, quick: bool = False) -> bool:
               "IPOP-CMA-ES (own implementation, `roughfe.optim.cmaes`) on every phase and part "
               "weight of the thesis stages' best candidate, maximising f solved at the target "
               "pressures; each generation's profiles are solved together by the batched exact "
-              "BEM (`roughfe.bem.batch`, block principal pivoting on stacked systems; the same "
+              "BEM (`roughfe.bem.batch_exact`, block principal pivoting on stacked systems; the same "
               "contact states as the single solver to round-off). The design found is scored "
               f"again by one single solve and by the hand-written BEM above. {rg.message}. CPU "
               f"{cpu_global:.0f} s for {int(hist[-1, 0])} strict evaluations.", "",

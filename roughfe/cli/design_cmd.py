@@ -160,12 +160,10 @@ def register(sub):
     g.add_argument("--search-amplitudes", action="store_true",
                    help="--search: every chromosome's amplitude a variable too (+-30%%)")
     g.add_argument("--global", dest="global_search", choices=("cmaes",), default=None,
-                   help="extra stage beyond the thesis, after --search: IPOP-CMA-ES on all "
-                        "phases and part weights maximising the score solved at the target "
-                        "pressures, a generation of designs solved together (batched BEM)")
+                   help="after --search: IPOP-CMA-ES on all phases and part weights, on the "
+                        "score at the target pressures (batched BEM; beyond the thesis)")
     g.add_argument("--global-eval", type=positive_int, default=20000, metavar="N",
-                   help="--global: strict evaluations (profiles solved at the target "
-                        "pressures) for the best candidate")
+                   help="--global: strict evaluations for the best candidate")
     g.add_argument("--match-spectrum", default=None, metavar="SURFACE",
                    help="surface database, beyond the thesis, after --refine and before "
                         "--search: set every chromosome's amplitude to the band rms of this "

@@ -1,7 +1,7 @@
 """Search stages beyond the thesis on the score solved at the target's own pressures
 (issue 14): :func:`search_at_target_pressures` (a (1+1)-ES, one design per BEM sweep)
 and :func:`search_global` (IPOP-CMA-ES, a generation of designs solved together by the
-batched BEM of :mod:`roughfe.bem.batch`). Both take a :class:`DesignResult` of Algs.
+batched BEM of :mod:`roughfe.bem.batch_exact`). Both take a :class:`DesignResult` of Algs.
 4-7 and return it with the searched candidates."""
 from __future__ import annotations
 
@@ -122,7 +122,7 @@ def search_global(result: DesignResult, settings: DatabaseSettings, *, n_eval: i
     Objective: f (:func:`combined_score`) of :func:`score_batch_at_target_pressures`,
     the strict score of :func:`rescore_at_target_pressures` (load-controlled exact BEM
     at ``p_t / eta``, Eq. 4.2; A the exact node count, K central differences) for a
-    whole CMA-ES generation at once (:mod:`roughfe.bem.batch`). Variables: every phase
+    whole CMA-ES generation at once (:mod:`roughfe.bem.batch_exact`). Variables: every phase
     (rad, unbounded: a phase is periodic) and every part weight, ``w = w_0 (1 +
     weight_fraction tanh v)`` (with ``amplitudes`` every chromosome's,
     :meth:`Design.split_chromosomes`). Optimiser: :func:`roughfe.optim.cmaes.ipop_cmaes`

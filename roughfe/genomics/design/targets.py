@@ -5,7 +5,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...bem.batch import batch_sweep, solve_batch_exact
+from ...bem.batch_exact import batch_sweep, solve_batch_exact
 from ...bem.operators import influence_operator
 from ...errors import InputError
 from ...model import Loading, Material, central_differences
@@ -72,7 +72,7 @@ def _strict_scores(pressure, stiffness, area_fraction, targets) -> tuple:
 
 def batch_scoring(settings: DatabaseSettings) -> bool:
     """True when :func:`score_batch_at_target_pressures` solves the designs together
-    (the batched exact BEM of :mod:`roughfe.bem.batch`: profiles on the non-periodic
+    (the batched exact BEM of :mod:`roughfe.bem.batch_exact`: profiles on the non-periodic
     strip kernel, the thesis database); otherwise it scores them one by one."""
     return settings.dim == 1 and settings.kernel in ("auto", "strip") \
         and settings.top_fraction == 1.0 and int(settings.n_nodes) <= 4096
@@ -84,9 +84,9 @@ def score_batch_at_target_pressures(designs, targets, settings: DatabaseSettings
     at a fraction of the cost.
 
     With :func:`batch_scoring` the B profiles are solved together by
-    :func:`roughfe.bem.batch.solve_batch_exact` (block principal pivoting, stacked):
+    :func:`roughfe.bem.batch_exact.solve_batch_exact` (block principal pivoting, stacked):
     one displacement solve at Delta = peak-valley for p_max (Eq. 4.2 factor eta per
-    row), then :func:`roughfe.bem.batch.batch_sweep` at the pressures ``p_j / eta``; A
+    row), then :func:`roughfe.bem.batch_exact.batch_sweep` at the pressures ``p_j / eta``; A
     is the exact node fraction, K the central differences over the steps, as in
     :func:`score_at_target_pressures`. Measured in ``docs/theory/06_design.md``.
     A row whose curve is not a valid response (e.g. a flat design) scores -inf."""
