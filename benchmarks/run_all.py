@@ -40,11 +40,14 @@ PLAN = {
     "bench_fsi": ([[], ["--steps"]], None),
     "bench_bands": ([[]], [["64"]]),
     "bench_surface_design": ([[]], [["4", "32"]]),
+    "bench_design_global": ([["20000"]], None),
     "bench_bem": ([["--sizes", "512", "1024", "2048", "--large", "4096", "8192"]],
                   [["--quick", "--tamaas-max", "0"]]),
 }
 NOT_IN_QUICK = {"bench_fsi": "the coupled 512^2 solve takes 15-35 s CPU per trapped-fluid "
-                             "model: make bench only"}
+                             "model: make bench only",
+                "bench_design_global": "the profile database (N = 512) and a 20000-evaluation "
+                                       "global search take ~4-5 min CPU: make bench only"}
 
 
 def run_one(script: Path, args, env) -> dict:
