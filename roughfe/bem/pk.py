@@ -9,6 +9,7 @@ import numpy as np
 from scipy.linalg.blas import daxpy, saxpy
 
 from . import _parallel as par
+from ..errors import InputError
 from .operators import FFTWorkspace
 from .solvers import SolverOutput, _fail, _rescale_to_load
 
@@ -58,7 +59,8 @@ def _gap(u, us, b, g, i, j):
 
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
                   diagonal=1.0, precond=None, tol=1e-10, max_iter=10000, offset=0.0,
-                  hardness=None, overwrite_initial=False, apply_single=None):
+                  hardness=None, overwrite_initial=False, apply_single=None,
+                  deflation=None):
     """Polonsky & Keer (1999) constrained CG with FFT operator products, bounded form.
 
     Solves Eq. 2.5-2.6 for ``0 <= p <= hardness`` with the gap ``w = H p - b - offset -
@@ -109,9 +111,21 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     product is float64, so the converged residual is the float64 one (a solution is
     only returned after a double-precision u confirmed it).
 
+    ``deflation`` (load control only): a two-level coarse correction of the direction,
+    an object with ``correct(F, gF, zF, apply_free) -> zF`` that turns the
+    preconditioned gradient ``zF = (M g)_F`` into the two-level one, given the flat
+    free-set indices ``F``, the gradient ``gF`` and ``apply_free(xF) = (H x)_F`` (a
+    counted product, single precision when ``apply_single`` is given). The Polak-Ribiere
+    beta keeps the CG flexible for such a (possibly inexact) preconditioner. The
+    reference form is :class:`roughfe.bem.deflation.ProbedBlockDeflation`, measured in
+    ``docs/theory/02b_bem_performance.md``; ``solve_contact`` does not use one.
+
     Returns a :class:`SolverOutput`.
     """
     load = mean_pressure is not None
+    if deflation is not None and not load:
+        raise InputError("a deflation (coarse correction) needs load control "
+                         "(mean_pressure): its coarse space is the zero-mean one")
     upper = np.inf if hardness is None else float(hardness)
     bounded = np.isfinite(upper)
     shape = b.shape
@@ -158,6 +172,15 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         out = (r.view(m_dtype)[:n] if r.dtype.itemsize >= m_dtype.itemsize
                else buffer("z", m_dtype))
         return product(precond, x, out)
+
+    def H_free(xF):
+        """(H x)_F of x supported on F, in single precision when possible (it only
+        steers the search direction)."""
+        single = apply_single is not None
+        y = buffer("y", np.float32 if single else np.float64)
+        y.fill(0.0)
+        y[F] = xF
+        return product(apply_single if single else apply, y, y)[F]
 
     if initial is not None:
         own = (overwrite_initial and isinstance(initial, np.ndarray)
@@ -262,6 +285,8 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             zF = par.take(M(gbuf), F)
             if load:
                 zF -= zF.mean()
+            if deflation is not None:
+                zF = deflation.correct(F, gF, zF, H_free)
         else:
             zF = gF.copy()
         gz = float(np.dot(gF, zF))

@@ -1,0 +1,139 @@
+"""Two-level (deflation) coarse correction of the Polonsky-Keer CG on its free set: the
+measured reference form (issue 16 §1, ``docs/theory/02b_bem_performance.md``).
+
+:class:`ProbedBlockDeflation` is passed to :func:`roughfe.bem.pk.polonsky_keer` as
+``deflation=``. It is exact in what matters for the iteration count (the Galerkin
+coarse matrix of the current free set, its near field probed by fine products every
+iteration, its coarse system solved directly) and therefore far too dear for
+production: ``(2 r + 1)^2`` or more extra fine products per iteration and a dense
+coarse factorisation. It measures how many outer iterations a two-level method saves
+in the real, contact-set-changing loop; ``solve_contact`` does not use it.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+from ..errors import InputError
+from .operators import InfluenceOperator
+
+
+class ProbedBlockDeflation:
+    """A-DEF2 coarse correction on b x b block aggregates of the free set F.
+
+    On its free set F the CG of :func:`roughfe.bem.pk.polonsky_keer` solves the
+    restricted system H_FF p_F = rhs of Eq. 2.5 (with the zero-mean projection of the
+    load in load control). Its preconditioner M = E*|q|/2 is the exact inverse of H on
+    the whole grid but not of H_FF: the large eigenvalues of M_FF H_FF belong to the
+    smooth modes of each contact patch. The coarse space Z (columns: the indicators of
+    the b x b grid blocks intersected with F) removes them through the two-level
+    "A-DEF2" preconditioner (Tang, Nabben, Vuik & Erlangga 2009, J. Sci. Comput.
+    39:340-370; for contact: Vollebregt 2014, J. Comput. Phys. 257:333-351)
+
+        z = M g + Z E^-1 Z^T (g - H_FF M g),    E = Z^T H_FF Z,
+
+    one more fine product (in single precision: it only steers the search direction)
+    plus the coarse matrix. E is built every iteration for the current F: the entries
+    of blocks within Chebyshev distance ``radius`` of each other by probing (the sum
+    of the block indicators of one colour of an s x s colouring of the blocks, s >=
+    2 radius + 1 and dividing the coarse grid, multiplied by H and summed over each
+    block: s^2 fine products), corrected for the farther blocks of the same colour by
+    the far-field approximation N_i N_j K(i - j) (K: the Galerkin matrix of the full
+    blocks, a coarse circulant; N: the blocks' fill fractions), which also gives all
+    farther entries. Measured: with ``radius`` = 1 the outer iterations equal those of
+    the exact E; the far-field approximation alone on the diagonal (``radius`` = 0)
+    loses most of the gain (see the docs page). The coarse system is solved by a dense
+    Cholesky factorisation (O(k^3) for k active blocks: small grids only).
+
+    Parameters
+    ----------
+    op : InfluenceOperator
+        The periodic operator H on a 2D grid whose sides are multiples of ``block``.
+    block : int
+        Aggregate edge b in grid points.
+    radius : int
+        Block distance up to which E is probed exactly.
+    """
+
+    def __init__(self, op: InfluenceOperator, block: int = 8, radius: int = 1):
+        block, radius = int(block), int(radius)
+        if (not op.periodic or len(op.shape) != 2 or block < 1
+                or any(n % block for n in op.shape)):
+            raise InputError(f"block deflation needs a periodic 2D grid whose sides are "
+                             f"multiples of block = {block}, got shape {op.shape}")
+        m0, m1 = op.shape[0] // block, op.shape[1] // block
+        colours = [s for s in range(2 * radius + 1, min(m0, m1) + 1)
+                   if m0 % s == 0 and m1 % s == 0]
+        if radius < 0 or not colours:
+            raise InputError(f"radius = {radius} needs a colouring of the {m0} x {m1} "
+                             f"coarse grid by s >= {2 * radius + 1} dividing both sides")
+        self.shape = op.shape
+        self.block = block
+        self.radius = radius
+        self.colours = colours[0]
+        self.coarse_shape = (m0, m1)
+        # Galerkin matrix of the full blocks (m/Pa summed over block pairs): H applied
+        # to the indicator of block 0, summed over every block
+        chi = np.zeros(op.shape)
+        chi[:block, :block] = 1.0
+        self.full_block = op.apply(chi).reshape(m0, block, m1, block).sum(axis=(1, 3))
+
+    def correct(self, F, gF, zF, apply_free):
+        """The A-DEF2 direction on F from the gradient ``gF`` and ``zF`` = (M g)_F.
+
+        ``F``: the flat indices of the free set; ``apply_free(xF)`` returns (H x)_F for
+        x supported on F (a fine product). The vectors live in the zero-mean subspace
+        of F (load control: the only mode of :func:`~roughfe.bem.pk.polonsky_keer`
+        with a deflation; displacement control of a periodic H is singular on F = the
+        whole grid).
+        """
+        b = self.block
+        m0, m1 = self.coarse_shape
+        s = gF - apply_free(zF)
+        s -= s.mean()
+        i, j = np.divmod(F, self.shape[1])
+        bi, bj = i // b, j // b
+        blk = bi * m1 + bj
+        counts = np.bincount(blk, minlength=m0 * m1).astype(float)
+        act = np.flatnonzero(counts)
+        ai, aj = np.divmod(act, m1)
+        di = (ai[:, None] - ai[None, :]) % m0
+        dj = (aj[:, None] - aj[None, :]) % m1
+        fill = counts[act] / (b * b)
+        E = fill[:, None] * fill[None, :] * self.full_block[di, dj]   # far field
+        sc = self.colours
+        # a block has at most one block of each colour within (s - 1) // 2 (>= radius),
+        # and exactly one in all when every block has its own colour (s = m0 = m1)
+        reach = np.inf if sc == m0 == m1 else (sc - 1) // 2
+        near = np.maximum(np.minimum(di, m0 - di), np.minimum(dj, m1 - dj)) <= reach
+        del di, dj
+        colour_point = (bi % sc) * sc + bj % sc
+        colour_block = (ai % sc) * sc + aj % sc
+        del i, j, bi, bj
+        for c in range(sc * sc):
+            cols = np.flatnonzero(colour_block == c)
+            if not cols.size:
+                continue
+            probe = apply_free((colour_point == c).astype(float))
+            sums = np.bincount(blk, weights=probe, minlength=m0 * m1)[act]
+            # the probe sum over a block minus the far-field approximation of the
+            # farther blocks of colour c: its entry with the near one
+            sub_near = near[:, cols]
+            far = (E[:, cols] * ~sub_near).sum(axis=1)
+            rows, which = np.nonzero(sub_near)
+            E[rows, cols[which]] = sums[rows] - far[rows]
+        E = 0.5 * (E + E.T)
+        rc = np.bincount(blk, weights=s, minlength=m0 * m1)[act]
+        # the coarse space of zero-mean vectors: Z T c with T c = c - (n.c / |F|) 1;
+        # T^T E T is singular along 1 only, which Z T maps to zero
+        t = -counts[act] / float(F.size)
+        Et = E + np.outer(E.sum(axis=1), t)
+        E = Et + np.outer(t, Et.sum(axis=0))
+        E += float(np.mean(np.diag(E))) / act.size
+        c = scipy.linalg.cho_solve(scipy.linalg.cho_factor(E, check_finite=False), rc,
+                                   check_finite=False)
+        full = np.zeros(m0 * m1)
+        full[act] = c
+        out = zF + full[blk]
+        out -= out.mean()
+        return out
