@@ -32,6 +32,7 @@ import scipy.fft
 
 from ..errors import InputError, NoConvergenceError
 from .operators import InfluenceOperator, influence_operator
+from .solvers import kkt_residual
 
 #: threads per batched FFT: one. The transforms are many short rows; a second thread
 #: only adds a barrier per product, which on a shared machine waits for a free core
@@ -188,10 +189,7 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
         else:
             da = d[act]
         w = g - col(da)
-        sp = pa.sum(axis=ax)
-        comp = np.where(sp > 0, (pa * np.abs(w)).sum(axis=ax) / (np.where(sp > 0, sp, 1)
-                                                                  * scale[act]), 0.0)
-        res_a = np.maximum(comp, np.maximum(0.0, -w.min(axis=ax)) / scale[act])
+        res_a = kkt_residual(pa, w, scale[act], axis=ax)
         res[act] = res_a
         nit[act] = it
         done = (res_a <= tol) & fresh[act]

@@ -41,23 +41,26 @@ class SolverOutput:
     n_products: int = 0
 
 
-def kkt_residual(p, w, scale, upper=np.inf):
+def kkt_residual(p, w, scale, upper=np.inf, axis=None):
     """Relative KKT residual (see the module docstring); ``scale`` in m.
 
     With a finite ``upper`` bound of the pressure (the hardness, Pa) the points at the
     bound may interpenetrate (w <= 0): there only w > 0 violates complementarity, and
-    the feasibility term counts only points below the bound.
+    the feasibility term counts only points below the bound. With ``axis`` (the grid
+    axes of stacked problems, e.g. ``(1, 2)``) one residual per row is returned as an
+    array, ``scale`` then per row (:func:`roughfe.bem.batch.solve_batch`).
     """
-    sp = float(np.sum(p))
     if not np.isfinite(upper):
-        comp = float(np.sum(p * np.abs(w)))
-        feas = max(0.0, -float(np.min(w)))
+        comp = np.sum(p * np.abs(w), axis=axis)
+        feas = np.maximum(0.0, -np.min(w, axis=axis))
     else:
         sat = p >= upper
-        comp = float(np.sum(p * np.where(sat, np.maximum(w, 0.0), np.abs(w))))
-        feas = max(0.0, -float(np.min(w, initial=np.inf, where=~sat)))
-    comp = comp / (sp * scale) if sp > 0 else 0.0
-    return max(comp, feas / scale)
+        comp = np.sum(p * np.where(sat, np.maximum(w, 0.0), np.abs(w)), axis=axis)
+        feas = np.maximum(0.0, -np.min(w, axis=axis, initial=np.inf, where=~sat))
+    sp = np.sum(p, axis=axis)
+    comp = np.where(sp > 0, comp / (np.where(sp > 0, sp, 1.0) * scale), 0.0)
+    res = np.maximum(comp, feas / scale)
+    return float(res) if axis is None else res
 
 
 def _fail(name, nit, res, tol, p, u, delta, solver):
