@@ -304,3 +304,48 @@ def test_global_search_raises_the_strict_score_reproducibly(entries, targets, tm
         de.search_global(r, SETTINGS, n_eval=1)
     with pytest.raises(InputError, match="method"):
         de.search_global(r, SETTINGS, method="annealing")
+
+
+def test_global_search_with_chromosome_amplitudes_bounded_and_reproduced(entries, targets,
+                                                                         tmp_path):
+    """search_global with every chromosome's amplitude a variable (log scale, x
+    exp(+-0.25)): the strict f rises above the start, every chromosome of the saved design
+    keeps its wavenumber and stays strictly within exp(+-0.25) of its start amplitude,
+    the batched score of the found design (the last history value) equals its single
+    unbatched solve, and the hand-written load-controlled BEM run of the saved design.json
+    reproduces the reported strict scores."""
+    t1, _, t3, _ = targets
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    d0 = r.best.design
+    f0 = de.combined_score(de.rescore_at_target_pressures(d0, [t1, t3], SETTINGS))
+    opts = de.GlobalSearchOptions(n_eval=200, sigma=0.5, amplitudes=0.25, seed=2)
+    rg = de.search_global(r, SETTINGS, opts)
+    c = rg.best
+    assert rg.success and "chromosome amplitudes x exp(+-0.25)" in rg.message
+    assert de.combined_score(c.at_targets) > f0
+    assert rg.search_history[0][-1, 1] == pytest.approx(de.combined_score(c.at_targets),
+                                                        abs=1e-9)
+    split = d0.split_chromosomes()               # one part per chromosome, same heights
+    assert len(c.design.parts) == len(split.parts)   # (scale: the Eq. 4.2 factor of _finish)
+    for p, q in zip(c.design.parts, split.parts):
+        assert p.chromosomes == q.chromosomes and p.genome.gamma == q.genome.gamma
+    ratio = np.array([p.weight / q.weight for p, q in zip(c.design.parts, split.parts)])
+    assert np.all(ratio > np.exp(-0.25)) and np.all(ratio < np.exp(0.25))
+    assert np.ptp(ratio) > 1e-3                              # the amplitudes did move
+    paths = de.write_design_result(rg, SETTINGS, tmp_path)
+    saved = json.loads(paths["result"].read_text())["candidates"][0]
+    dd = de.Design.from_dict(json.loads(paths["design"].read_text()))
+    np.testing.assert_allclose(_strict_scores_by_hand(dd, [t1, t3], tmp_path),
+                               saved["scores_at_target_pressures"], atol=1e-7)
+
+
+@pytest.mark.parametrize("bad, match", [({"amplitudes": 2.5}, "amplitudes <= 2"),
+                                        ({"amplitudes": float("nan")}, "amplitudes"),
+                                        ({"sigma": 0.0}, "sigma > 0"),
+                                        ({"popsize": -1}, "popsize >= 0"),
+                                        ({"n_candidates": 0}, "n_candidates >= 1"),
+                                        ({"weight_fraction": 1.0}, "weight_fraction"),
+                                        ({"method": "annealing"}, "method")])
+def test_global_search_options_reject_bad_input(bad, match):
+    with pytest.raises(InputError, match=match):
+        de.GlobalSearchOptions(**bad)

@@ -39,6 +39,17 @@ def test_db_and_design_commands(tmp_path, capsys):
     assert s == pytest.approx(report["candidates"][0]["score"], abs=1e-7)
     assert de.rescore_at_target_pressures(design, [target], settings) == pytest.approx(
         report["candidates"][0]["scores_at_target_pressures"], abs=1e-7)
+    # the global stage with chromosome amplitudes as variables: bounded, strict scores
+    # of the saved design reproduced
+    amp = tmp_path / "sog_amp"
+    assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "y_t1.csv"),
+                 "--method", "sog", "--iterations", "1", "--global", "cmaes", "--global-eval",
+                 "30", "--global-amplitudes", "0.2", "--no-figures", "-o", str(amp)]) == 0
+    rep = json.loads((amp / "result.json").read_text())
+    assert "chromosome amplitudes x exp(+-0.2)" in rep["message"]
+    d_amp = de.Design.from_dict(json.loads((amp / "design.json").read_text()))
+    assert de.rescore_at_target_pressures(d_amp, [target], settings) == pytest.approx(
+        rep["candidates"][0]["scores_at_target_pressures"], abs=1e-7)
     # a single-genome design is a genome with the rescaled amplitude gene
     genome = json.loads((out / "genome.json").read_text())
     assert genome["format"] == "roughfe-genome"
@@ -79,4 +90,9 @@ def test_design_command_reports_bad_input(tmp_path, capsys):
     assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",
                  "--search", "5", "--search-starts", "0", "-o", str(tmp_path / "o")]) == 2
     assert "--search-starts" in capsys.readouterr().err
+    for flag, value, why in (("--global-amplitudes", "-0.5", ">= 0"),
+                             ("--global-amplitudes", "3", "amplitudes <= 2")):
+        assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",
+                     "--global", "cmaes", flag, value, "-o", str(tmp_path / "o")]) == 2
+        assert why in capsys.readouterr().err
     np.testing.assert_equal((tmp_path / "o").exists(), False)

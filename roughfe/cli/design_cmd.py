@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import (add_output_folder, add_run_options, nonnegative_int, output_folder_of,
-                      positive_float, positive_int)
+from .options import (add_output_folder, add_run_options, nonnegative_float, nonnegative_int,
+                      output_folder_of, positive_float, positive_int)
 
 BUILTIN = ("y_t1", "y_t2", "y_t3")
 
@@ -27,9 +27,10 @@ def _target(spec, quantity, settings, cache):
 def _run(args) -> int:
     from ..errors import InputError
     from ..genomics.database import load_entries, read_settings
-    from ..genomics.design import (GcmmaOptions, refine, rescore_at_target_pressures,
-                                   run_design, search_at_target_pressures,
-                                   search_global, write_design_result)
+    from ..genomics.design import (GcmmaOptions, GlobalSearchOptions, refine,
+                                   rescore_at_target_pressures, run_design,
+                                   search_at_target_pressures, search_global,
+                                   write_design_result)
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}
@@ -49,6 +50,10 @@ def _run(args) -> int:
     if args.pool and args.method != "mcco":
         raise InputError("--pool is used by --method mcco only")
     extra = ({"pool": args.pool, "swap": True, "weights": (0.5, 1.0, 2.0)} if args.pool else {})
+    global_options = GlobalSearchOptions(
+        method=args.global_search or "cmaes", n_eval=args.global_eval,
+        popsize=args.global_popsize, amplitudes=args.global_amplitudes,
+        n_candidates=args.global_candidates)      # checked before any solve
     with output_folder_of(args, "design") as out:
         result = run_design(args.method, entries, targets, settings, pbar=args.pbar,
                             options=options, **extra)
@@ -66,9 +71,7 @@ def _run(args) -> int:
                                                 starts=args.search_starts,
                                                 amplitudes=args.search_amplitudes)
         if args.global_search:
-            result = search_global(result, settings, n_eval=args.global_eval,
-                                   amplitudes=args.search_amplitudes,
-                                   method=args.global_search)
+            result = search_global(result, settings, global_options)
         if not args.no_figures:
             from ..plotting.design import (plot_design_curves, plot_profiles, plot_psds,
                                            plot_stages)
@@ -163,7 +166,15 @@ def register(sub):
                    help="after --search: IPOP-CMA-ES on all phases and part weights, on the "
                         "score at the target pressures (batched BEM; beyond the thesis)")
     g.add_argument("--global-eval", type=positive_int, default=20000, metavar="N",
-                   help="--global: strict evaluations for the best candidate")
+                   help="--global: strict evaluations per searched candidate")
+    g.add_argument("--global-amplitudes", type=nonnegative_float, default=0.0, metavar="X",
+                   help="--global: every chromosome's amplitude a variable too, within "
+                        "exp(+-X) of its start (log scale, X <= 2; 0: part weights +-30%%)")
+    g.add_argument("--global-popsize", type=nonnegative_int, default=0, metavar="L",
+                   help="--global: population of the first CMA-ES run, doubled at each "
+                        "restart (0: 4 + 3 ln n)")
+    g.add_argument("--global-candidates", type=positive_int, default=1, metavar="K",
+                   help="--global: search the K best candidates (by strict f)")
     g.add_argument("--match-spectrum", default=None, metavar="SURFACE",
                    help="surface database, beyond the thesis, after --refine and before "
                         "--search: set every chromosome's amplitude to the band rms of this "

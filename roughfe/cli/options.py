@@ -99,6 +99,7 @@ def _check(kind, test, what):
 positive_int = _check(int, lambda v: v >= 1, "an integer >= 1")
 nonnegative_int = _check(int, lambda v: v >= 0, "an integer >= 0")
 positive_float = _check(float, lambda v: 0.0 < v < float("inf"), "a finite number > 0")
+nonnegative_float = _check(float, lambda v: 0.0 <= v < float("inf"), "a finite number >= 0")
 
 
 # -- surfaces ------------------------------------------------------------------------------

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -108,28 +108,101 @@ def search_at_target_pressures(result: DesignResult, settings: DatabaseSettings,
                      f"{starts} x {n_eval} sweeps per candidate): f at p_t = {f:.4f}")
 
 
-#: global search stages (``search_global(method=...)``, CLI ``--global``)
+#: global search stages (``GlobalSearchOptions.method``, CLI ``--global``)
 GLOBAL_METHODS = ("cmaes",)
 
 
-def search_global(result: DesignResult, settings: DatabaseSettings, *, n_eval: int = 20000,
-                  sigma: float = 0.5, popsize: int = 0, weight_fraction: float = 0.3,
-                  amplitudes: bool = False, seed: int = 0, n_candidates: int = 1,
-                  method: str = "cmaes") -> DesignResult:
+@dataclass(frozen=True)
+class GlobalSearchOptions:
+    """Settings of :func:`search_global` (CLI ``design --global cmaes`` and its
+    ``--global-*`` flags).
+
+    Attributes
+    ----------
+    method : str
+        ``"cmaes"``: IPOP-CMA-ES, :func:`roughfe.optim.cmaes.ipop_cmaes`.
+    n_eval : int
+        Strict evaluations per searched candidate (one evaluation: a profile solved at
+        its p_max approach and at the target pressures ``p_t / eta``, Eq. 4.2), >= 2.
+    sigma : float
+        First CMA-ES step (rad for the phases; the weight variables are mapped through
+        tanh, so the same number is a fraction of their range), > 0.
+    popsize : int
+        Population of the first run (0: ``4 + 3 ln n``), doubled at each restart.
+    weight_fraction : float
+        Part weights (the macro/micro mixing of a cross-over) vary as
+        ``w = w_0 (1 + weight_fraction tanh v)`` (-), 0 < weight_fraction < 1; used when
+        ``amplitudes`` is 0.
+    amplitudes : float
+        0: off. > 0: the design is split into one part per chromosome
+        (:meth:`Design.split_chromosomes`, the same heights) and every chromosome's
+        amplitude (Eq. 3.2's ``a_n``, with its part's weight and the Eq. 4.2 scale
+        folded in) is a variable on a log scale, ``a_n = a_n0 exp(amplitudes tanh v)``,
+        so within ``[a_n0 e^-amplitudes, a_n0 e^amplitudes]`` (strictly); replaces the
+        part weights (each chromosome carries its own). At most 2.
+    seed : int
+        ``numpy.random.default_rng(seed)``: the search is deterministic.
+    n_candidates : int
+        The best candidates (by strict f) searched, one after the other, >= 1.
+    """
+
+    method: str = "cmaes"
+    n_eval: int = 20000
+    sigma: float = 0.5
+    popsize: int = 0
+    weight_fraction: float = 0.3
+    amplitudes: float = 0.0
+    seed: int = 0
+    n_candidates: int = 1
+
+    def __post_init__(self):
+        if self.method not in GLOBAL_METHODS:
+            raise InputError(f"method must be one of {GLOBAL_METHODS}, got {self.method!r}")
+        checks = (("n_eval >= 2", int(self.n_eval) >= 2, self.n_eval),
+                  ("sigma > 0", self.sigma > 0 and math.isfinite(self.sigma), self.sigma),
+                  ("popsize >= 0", int(self.popsize) >= 0, self.popsize),
+                  ("0 < weight_fraction < 1", 0 < self.weight_fraction < 1,
+                   self.weight_fraction),
+                  ("0 <= amplitudes <= 2 (log half-range)", 0 <= self.amplitudes <= 2,
+                   self.amplitudes),
+                  ("n_candidates >= 1", int(self.n_candidates) >= 1, self.n_candidates))
+        for what, ok, value in checks:
+            if not ok:
+                raise InputError(f"global search: {what} needed, got {value!r}")
+
+    def weights(self, w0, v):
+        """Weights (-) of the variables ``v`` around their start values ``w0``."""
+        if self.amplitudes > 0:
+            return w0 * np.exp(self.amplitudes * np.tanh(v))
+        return w0 * (1 + self.weight_fraction * np.tanh(v))
+
+    def describe(self) -> str:
+        if self.amplitudes > 0:
+            return f"chromosome amplitudes x exp(+-{self.amplitudes:g})"
+        return f"part weights +-{self.weight_fraction:.0%}"
+
+
+def search_global(result: DesignResult, settings: DatabaseSettings,
+                  options: GlobalSearchOptions = GlobalSearchOptions(), **overrides
+                  ) -> DesignResult:
     """An optional global stage beyond the thesis: IPOP-CMA-ES on the score solved at
     the target's own pressures, with the designs of a population solved together.
 
-    Objective: f (:func:`combined_score`) of :func:`score_batch_at_target_pressures`,
-    the strict score of :func:`rescore_at_target_pressures` (load-controlled exact BEM
-    at ``p_t / eta``, Eq. 4.2; A the exact node count, K central differences) for a
-    whole CMA-ES generation at once (:mod:`roughfe.bem.batch_exact`). Variables: every phase
-    (rad, unbounded: a phase is periodic) and every part weight, ``w = w_0 (1 +
-    weight_fraction tanh v)`` (with ``amplitudes`` every chromosome's,
-    :meth:`Design.split_chromosomes`). Optimiser: :func:`roughfe.optim.cmaes.ipop_cmaes`
-    from the candidate's design with step ``sigma`` (rad), population ``popsize``
-    (default 4 + 3 ln n), doubled at each restart, ``n_eval`` strict evaluations per
-    candidate, ``default_rng(seed)``; the ``n_candidates`` best candidates (by strict f)
-    are searched, the others kept.
+    ``options`` (:class:`GlobalSearchOptions`); keyword ``overrides`` replace its fields
+    (``search_global(r, s, n_eval=60)``).
+
+    Objective: f (:func:`combined_score`, Alg. 7 Step 10) of
+    :func:`score_batch_at_target_pressures`, the strict score of
+    :func:`rescore_at_target_pressures` (load-controlled exact BEM at ``p_t / eta``,
+    Eq. 4.2; A the exact node count, K central differences, Eq. 4.1) for a whole CMA-ES
+    generation at once (:mod:`roughfe.bem.batch_exact`). Variables: every phase (rad,
+    unbounded: a phase is periodic) and either every part weight, ``w = w_0 (1 +
+    weight_fraction tanh v)``, or (``amplitudes > 0``) every chromosome's amplitude on a
+    log scale, ``a_n = a_n0 exp(amplitudes tanh v)``. Optimiser:
+    :func:`roughfe.optim.cmaes.ipop_cmaes` from the candidate's design with step
+    ``sigma``, population ``popsize`` (default 4 + 3 ln n), doubled at each restart,
+    ``n_eval`` strict evaluations per candidate, ``default_rng(seed)``; the
+    ``n_candidates`` best candidates (by strict f) are searched, the others kept.
 
     Why: the thesis stages and the (1+1)-ES of :func:`search_at_target_pressures`
     stop at f <= 0.843 at p_t on y_t1/y_t3, while the set f >= 0.9 around the target
@@ -141,17 +214,11 @@ def search_global(result: DesignResult, settings: DatabaseSettings, *, n_eval: i
     and replaces the candidate's design only when its strict f rose; candidates are
     re-sorted by the strict f. ``nit`` counts every strict evaluation as one sweep.
     """
-    if method not in GLOBAL_METHODS:
-        raise InputError(f"method must be one of {GLOBAL_METHODS}, got {method!r}")
-    if int(n_eval) < 2 or not sigma > 0 or not 0 < weight_fraction < 1 \
-            or int(n_candidates) < 1:
-        raise InputError(f"n_eval >= 2, sigma > 0, 0 < weight_fraction < 1 and "
-                         f"n_candidates >= 1 needed, got {n_eval!r}, {sigma!r}, "
-                         f"{weight_fraction!r}, {n_candidates!r}")
+    opts = replace(options, **overrides) if overrides else options
     t0 = time.perf_counter()
     evaluate = Evaluator(settings)
     objective = result.objective
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(opts.seed)
     cands = list(result.candidates)
     strict0 = [combined_score(c.at_targets) if c.at_targets else
                combined_score(_at_targets(c.design, objective, settings, evaluate))
@@ -160,14 +227,14 @@ def search_global(result: DesignResult, settings: DatabaseSettings, *, n_eval: i
     out, runs = [], []
     for rank, i in enumerate(order):
         c = cands[i]
-        if rank >= int(n_candidates):
+        if rank >= int(opts.n_candidates):
             out.append(c if c.at_targets else replace(c, at_targets=_at_targets(
                 c.design, objective, settings, evaluate)))
             continue
-        d0, keys, x0, is_w = _search_variables(c.design, amplitudes)
+        d0, keys, x0, is_w = _search_variables(c.design, opts.amplitudes > 0)
 
         def designs(X, d0=d0, keys=keys, x0=x0, is_w=is_w):
-            V = np.where(is_w, x0 * (1 + weight_fraction * np.tanh(X)), X)
+            V = np.where(is_w, opts.weights(x0, X), X)
             return [d0.with_phases(keys, v) for v in V]
 
         def fun(X, designs=designs):
@@ -176,7 +243,8 @@ def search_global(result: DesignResult, settings: DatabaseSettings, *, n_eval: i
             return np.array([combined_score(r) for r in sc])
 
         u0 = np.where(is_w, 0.0, x0)
-        run = ipop_cmaes(fun, u0, sigma, int(n_eval), popsize=popsize, rng=rng)
+        run = ipop_cmaes(fun, u0, opts.sigma, int(opts.n_eval), popsize=int(opts.popsize),
+                         rng=rng)
         runs.append(run)
         d_best = designs(run.x[None, :])[0] if run.fun > run.fun0 else c.design
         out.append(_searched(c, d_best, objective, settings, evaluate))
@@ -186,5 +254,6 @@ def search_global(result: DesignResult, settings: DatabaseSettings, *, n_eval: i
                      f"{', '.join(map(str, r.popsizes))}): f {r.fun0:.4f} -> {r.fun:.4f}"
                      for r in runs)
     res = _extended(result, out, evaluate, t0, f"; global search at the target pressures "
-                    f"(IPOP-CMA-ES, sigma {sigma:g} rad, {hist}): f at p_t = {f:.4f}")
+                    f"(IPOP-CMA-ES, sigma {opts.sigma:g}, phases and {opts.describe()}, "
+                    f"{hist}): f at p_t = {f:.4f}")
     return replace(res, search_history=tuple(r.history for r in runs))
