@@ -31,6 +31,10 @@ def _run(args) -> int:
                                    rescore_at_target_pressures, run_design,
                                    search_at_target_pressures, search_global,
                                    write_design_result)
+    global_options = GlobalSearchOptions(
+        method=args.global_search or "cmaes", n_eval=args.global_eval,
+        popsize=args.global_popsize, amplitudes=args.global_amplitudes,
+        n_candidates=args.global_candidates)      # checked before the database is read
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}
@@ -50,10 +54,6 @@ def _run(args) -> int:
     if args.pool and args.method != "mcco":
         raise InputError("--pool is used by --method mcco only")
     extra = ({"pool": args.pool, "swap": True, "weights": (0.5, 1.0, 2.0)} if args.pool else {})
-    global_options = GlobalSearchOptions(
-        method=args.global_search or "cmaes", n_eval=args.global_eval,
-        popsize=args.global_popsize, amplitudes=args.global_amplitudes,
-        n_candidates=args.global_candidates)      # checked before any solve
     with output_folder_of(args, "design") as out:
         result = run_design(args.method, entries, targets, settings, pbar=args.pbar,
                             options=options, **extra)
