@@ -35,6 +35,32 @@ def surface(h):
     return Surface(h, (L,), periodic=False)
 
 
+@pytest.mark.parametrize("kernel, shape", [("strip", (48,)), ("spectral", (40,)),
+                                           ("spectral", (16, 12)), ("love", (10, 8))])
+def test_stacked_products_are_the_single_field_products(kernel, shape):
+    """The batched operator is the single-field convolution over the trailing axes: a
+    stack of B fields gives each field's own product (to rounding: the same transforms,
+    one thread) and H equals its dense matrix; the preconditioner is M = the inverse
+    spectrum's circular convolution, row by row as on one field."""
+    from roughfe.bem.batch import BatchOperator
+    rng = np.random.default_rng(5)
+    o = influence_operator(shape, [1e-3] * len(shape), 1e9, kernel)
+    bop = BatchOperator(o)
+    p = rng.random((3,) + shape)
+    u, z = bop.apply(p), bop.precondition(p)
+    assert u.shape == z.shape == p.shape
+    dense = o.dense()
+    for b in range(3):
+        np.testing.assert_allclose(u[b], o.apply(p[b]), rtol=0, atol=1e-14 * np.abs(u).max())
+        np.testing.assert_allclose(u[b].reshape(-1), dense @ p[b].reshape(-1), rtol=0,
+                                   atol=1e-12 * np.abs(u).max())
+        np.testing.assert_allclose(z[b], o.convolve_spectrum(p[b], bop.inverse), rtol=0,
+                                   atol=1e-14 * np.abs(z).max())
+    if o.periodic:     # M inverts H exactly off the zero mode
+        np.testing.assert_allclose(bop.precondition(u), p - p.mean(axis=tuple(
+            range(1, p.ndim)), keepdims=True), rtol=0, atol=1e-12)
+
+
 @pytest.mark.parametrize("control", ["delta", "mean_pressure"])
 def test_exact_batch_equals_the_single_dense_solver(control):
     h = profiles(6)

@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.fft
 
 from ..errors import InputError, NoConvergenceError
 from .operators import InfluenceOperator, influence_operator
@@ -75,27 +74,21 @@ class BatchSweep:
 
 
 class BatchOperator:
-    """``u = H p`` for a stack of pressures ``(B, *shape)`` (one FFT over the trailing
-    axes of the stack) and its Strang-circulant approximate inverse (the CG
-    preconditioner of :meth:`InfluenceOperator.inverse_spectrum`)."""
+    """``u = H p`` for a stack of pressures ``(B, *shape)`` and its Strang-circulant
+    approximate inverse (the CG preconditioner of
+    :meth:`InfluenceOperator.inverse_spectrum`): the operator's own products over the
+    trailing axes of the stack (:func:`roughfe.bem.operators._convolve`, one FFT per
+    product for all rows) with ``WORKERS`` threads."""
 
     def __init__(self, op: InfluenceOperator):
         self.op = op
-        self.shape = tuple(op.shape)
-        self.axes = tuple(range(-len(self.shape), 0))
-        self.fft_shape = tuple(op.fft_shape)
         self.inverse = op.inverse_spectrum()
 
     def apply(self, p):
-        ph = scipy.fft.rfftn(p, s=self.fft_shape, axes=self.axes, workers=WORKERS)
-        ph *= self.op.spectrum
-        u = scipy.fft.irfftn(ph, s=self.fft_shape, axes=self.axes, workers=WORKERS)
-        return u[(Ellipsis,) + tuple(slice(0, n) for n in self.shape)]
+        return self.op.apply(p, workers=WORKERS)
 
     def precondition(self, g):
-        gh = scipy.fft.rfftn(g, axes=self.axes, workers=WORKERS)
-        gh *= self.inverse
-        return scipy.fft.irfftn(gh, s=self.shape, axes=self.axes, workers=WORKERS)
+        return self.op.convolve_spectrum(g, self.inverse, workers=WORKERS)
 
 
 def _rows(x, B, name):

@@ -133,14 +133,17 @@ class InfluenceOperator:
     def references(self) -> tuple:
         return _KERNEL_REFERENCES[self.name]
 
-    def apply(self, p, single=False, out=None, work=None):
-        """Displacement u = H p (m) of the pressure ``p`` (Pa, array of ``shape``).
+    def apply(self, p, single=False, out=None, work=None, workers=None):
+        """Displacement u = H p (m) of the pressure ``p`` (Pa, array of ``shape``, or a
+        stack ``(..., *shape)`` of them: one product over the trailing axes).
 
         ``single``: in single precision (``p`` rounded to float32, float32 result,
         relative error ~1e-7 of max |u|; half the FFT work), for iterates far from
         convergence (:func:`roughfe.bem.pk.polonsky_keer`). ``out`` (an array of
-        ``shape`` and the result's dtype) receives the result; with an
+        ``p``'s shape and the result's dtype) receives the result; with an
         :class:`FFTWorkspace` ``work`` a periodic product allocates nothing.
+        ``workers``: threads per FFT (default ``WORKERS``; the batched solvers of
+        :mod:`roughfe.bem.batch` take 1).
         """
         if single:
             if out is not None and work is not None and self.periodic:
@@ -149,10 +152,10 @@ class InfluenceOperator:
             else:
                 p = p.astype(np.float32, copy=False)
         u = _convolve(p, self.spectrum, self.fft_shape, out if self.periodic else None,
-                      work)
+                      work, workers)
         if self.periodic:
             return u
-        u = u[tuple(slice(0, n) for n in self.shape)]
+        u = u[(Ellipsis,) + tuple(slice(0, n) for n in self.shape)]
         if out is None:
             return u
         out[...] = u
@@ -175,17 +178,19 @@ class InfluenceOperator:
         with np.errstate(divide="ignore"):
             return np.where(spec > 0, 1.0 / np.where(spec > 0, spec, 1.0), 0.0)
 
-    def convolve_spectrum(self, v, spectrum, out=None, work=None):
-        """Circular convolution of ``v`` (``shape``) with a multiplier on its rFFT.
+    def convolve_spectrum(self, v, spectrum, out=None, work=None, workers=None):
+        """Circular convolution of ``v`` (``shape``, or a stack ``(..., *shape)``) with a
+        multiplier on its rFFT over the ``shape`` grid.
 
         A ``float32`` multiplier makes it a single-precision product (``v`` is rounded
         to float32, the result is float32): half the FFT work, for preconditioners,
         whose rounding only perturbs the search direction, never the residual.
-        ``out`` and ``work`` as in :meth:`apply`.
+        ``out``, ``work`` and ``workers`` as in :meth:`apply`.
         """
         if spectrum.dtype == np.float32:
             v = v.astype(np.float32, copy=False)
-        return _convolve(v, spectrum, v.shape, out, work)
+        return _convolve(v, spectrum, v.shape[v.ndim - len(self.shape):], out, work,
+                         workers)
 
     def dense(self, index=None):
         """The dense matrix H (m/Pa), rows and columns in C order of the grid.
@@ -200,15 +205,16 @@ class InfluenceOperator:
         return self.kernel[tuple(diff)]
 
 
-def _irfftn_owned(vh, shape):
-    """``irfftn(vh, s=shape)`` of a half-spectrum the caller gives up (it is destroyed):
-    in-place inverse c2c transforms over the leading axes, then one c2r along the last.
-    pocketfft's multi-axis c2r would allocate a full complex temporary (one more grid in
-    memory, measured +134 MB at 4096^2) and is slower (0.35 s vs 0.19 s CPU there)."""
-    for axis in range(len(shape) - 1):
-        vh = scipy.fft.ifft(vh, axis=axis, overwrite_x=True, workers=WORKERS)
-    return scipy.fft.irfft(vh, n=shape[-1], axis=-1, overwrite_x=True, workers=WORKERS)
-
+def _irfftn_owned(vh, shape, workers=None):
+    """``irfftn(vh, s=shape)`` over the trailing ``len(shape)`` axes of a half-spectrum
+    the caller gives up (it is destroyed; leading axes are a batch): in-place inverse
+    c2c transforms over the leading grid axes, then one c2r along the last. pocketfft's
+    multi-axis c2r would allocate a full complex temporary (one more grid in memory,
+    measured +134 MB at 4096^2) and is slower (0.35 s vs 0.19 s CPU there)."""
+    workers = WORKERS if workers is None else workers
+    for axis in range(vh.ndim - len(shape), vh.ndim - 1):
+        vh = scipy.fft.ifft(vh, axis=axis, overwrite_x=True, workers=workers)
+    return scipy.fft.irfft(vh, n=shape[-1], axis=-1, overwrite_x=True, workers=workers)
 
 class FFTWorkspace:
     """The one complex buffer of the FFT products of a solve, reused by every product.
@@ -237,16 +243,22 @@ class FFTWorkspace:
         return self._raw[:nbytes].view(dtype).reshape(shape)
 
 
-def _convolve(x, spectrum, fft_shape, out=None, work=None):
-    """``irfftn(rfftn(x, s=fft_shape) * spectrum)``: float32 in, float32 out; float64
-    otherwise. With ``work`` (and an unpadded grid) in place in its buffer: r2c into it,
-    multiply, inverse c2c over the leading axes, c2r into ``out`` (allocated if None)."""
+def _convolve(x, spectrum, fft_shape, out=None, work=None, workers=None):
+    """``irfftn(rfftn(x, s=fft_shape) * spectrum)`` over the trailing ``len(fft_shape)``
+    axes of ``x`` (leading axes are a batch of independent fields; ``x`` is zero-padded
+    to ``fft_shape`` and the result has the padded shape): the one FFT convolution of
+    the BEM, for single fields and stacks. float32 in, float32 out; float64 otherwise.
+    With ``work`` (and an unpadded grid) in place in its buffer: r2c into it, multiply,
+    inverse c2c over the leading grid axes, c2r into ``out`` (allocated if None).
+    ``workers``: threads per transform (default ``WORKERS``)."""
     fft_shape = tuple(fft_shape)
-    axes = list(range(x.ndim))
-    if work is None or _pocketfft is None or x.shape != fft_shape:
-        xh = scipy.fft.rfftn(x, s=fft_shape, axes=axes, workers=WORKERS)
-        xh *= spectrum
-        y = _irfftn_owned(xh, fft_shape)
+    workers = WORKERS if workers is None else workers
+    axes = list(range(x.ndim - len(fft_shape), x.ndim))
+    full = x.shape[:x.ndim - len(fft_shape)] + fft_shape
+    if work is None or _pocketfft is None or x.shape != full:
+        xh = scipy.fft.rfftn(x, s=fft_shape, axes=axes, workers=workers)
+        _multiply(xh, spectrum)
+        y = _irfftn_owned(xh, fft_shape, workers)
         if out is None:
             return y
         out[...] = y
@@ -254,15 +266,15 @@ def _convolve(x, spectrum, fft_shape, out=None, work=None):
     single = x.dtype == np.float32
     if not single and x.dtype != np.float64:
         x = x.astype(np.float64)
-    xh = work.array(fft_shape[:-1] + (fft_shape[-1] // 2 + 1,),
+    xh = work.array(full[:-1] + (fft_shape[-1] // 2 + 1,),
                     np.complex64 if single else np.complex128)
-    _pocketfft.r2c(x, axes, True, 0, xh, WORKERS)
+    _pocketfft.r2c(x, axes, True, 0, xh, workers)
     _multiply(xh, spectrum)
     for axis in axes[:-1]:          # normalised by 1/n per axis, as irfftn
-        _pocketfft.c2c(xh, [axis], False, 2, xh, WORKERS)
+        _pocketfft.c2c(xh, [axis], False, 2, xh, workers)
     if out is None:
-        out = np.empty(fft_shape, x.dtype)
-    _pocketfft.c2r(xh, [axes[-1]], fft_shape[-1], False, 2, out, WORKERS)
+        out = np.empty(full, x.dtype)
+    _pocketfft.c2r(xh, [axes[-1]], fft_shape[-1], False, 2, out, workers)
     return out
 
 
