@@ -145,7 +145,7 @@ class InfluenceOperator:
         ``workers``: threads per FFT (default ``WORKERS``; the batched solvers of
         :mod:`roughfe.bem.batch` take 1).
         """
-        if single:
+        if single and p.dtype != np.float32:
             if out is not None and work is not None and self.periodic:
                 _copy(out, p)                     # the float32 input, in out
                 p = out
