@@ -327,10 +327,9 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         beta = max(0.0, (gz - float(np.dot(zF, g_old))) / gz_old) if gz_old > 0 else 0.0
         del g_old             # free-set vectors go as soon as they are used: early on F
         gz_old = gz           # can hold half the grid
-        if beta:
-            tF *= beta
-            zF += tF
-        tF = zF               # the new direction on F (float64)
+        # the new direction on F, float64 (t and zF may be float32)
+        tF = np.multiply(tF, beta, dtype=np.float64)
+        tF += zF
         del zF
         par.put(t, F, tF)
         gt = float(np.dot(gF, tF))
