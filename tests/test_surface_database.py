@@ -217,9 +217,12 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
                  "--second-target", str(tmp_path / "t" / "t_A.csv"), "--method", "mcco",
                  "--iterations", "1", "--match-spectrum", str(tmp_path / "t.npz"),
                  "--spectrum-starts", "1", "--match-directions", "--search", "3",
+                 "--search-amplitudes", "wave", "--global", "cmaes", "--global-eval", "6",
+                 "--global-amplitudes", "0.5", "--global-waves",
                  "--no-figures", "-o", str(out)]) == 0
     report = json.loads((out / "result.json").read_text())
     assert "wave amplitudes matched to the target spectrum" in report["message"]
+    assert "wave weights" in report["message"] and "wave amplitudes x exp" in report["message"]
     design = Design.from_dict(json.loads((out / "design.json").read_text()))
     assert design.dim == 2
     heights = load_surface(out / "profile.npz")
@@ -263,3 +266,87 @@ def test_match_spectrum_restores_a_genome_whose_hurst_exponent_moved(surface_db)
     assert matched.success and matched.nit == res.nit + 4     # strict before, 2 in _finish, after
     assert rescore_at_target_pressures(matched.best.design, [tk], SETTINGS)[0] == \
         matched.best.at_targets[0]
+
+
+def test_ridge_keys_scale_every_wave_on_its_own():
+    """Per-wave amplitude variables (Design.ridge_keys on one-chromosome parts): the
+    surface is linear in every wave's factor alpha_m (Eq. 3.17), so setting the factors
+    gives exactly the sum of the waves times their factors; phase_values reads them back."""
+    g = _genome()
+    d = Design((DesignPart(g, (3, 4, 5), 2.0, "g"),), 1.5, L, 32, "g", 2).split_chromosomes()
+    keys = d.ridge_keys()
+    assert len(keys) == 3 * 3 and all(k[1] == "alpha" for k in keys)
+    x0 = d.phase_values(keys)
+    np.testing.assert_array_equal(x0, np.tile(g.anisotropy, 3))
+    f = np.random.default_rng(2).uniform(0.3, 2.0, x0.size)
+    new = d.with_phases(keys, x0 * f)
+    np.testing.assert_array_equal(new.phase_values(keys), x0 * f)
+    waves = sum(f[3 * k + m] * d.parts[k].weight
+                * periodic_heights(p.genome, L, 32, p.chromosomes, rows=[m])
+                for k, p in enumerate(d.parts) for m in range(3))
+    h = new.surface().heights
+    assert np.max(np.abs(h - waves)) <= 1e-12 * np.ptp(h)
+
+
+def _perturbed_target(surface_db):
+    path, _ = surface_db
+    entries = db.load_entries(path)
+    g = Genome.from_dict(entries[1].genome)
+    g = replace(g, A=3.0, phases=g.phases + np.random.default_rng(5).normal(0, 0.6, g.phases.shape))
+    target = Design((DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "t"),), 1.0, L,
+                    32, "t", 2)
+    c = Evaluator(SETTINGS)(target)
+    return entries, Target(c.pressure, c.stiffness, "K", "tK", {}), \
+        Target(c.pressure, c.area_fraction, "A", "tA", {})
+
+
+def test_batched_surface_scores_equal_the_single_strict_scores(surface_db):
+    """score_batch_at_target_pressures on periodic surfaces (batched Polonsky-Keer CG at
+    the target pressures) gives the scores of the single load-controlled BEM
+    (rescore_at_target_pressures) to the CG tolerance, for several different designs."""
+    from roughfe.genomics.design import score_batch_at_target_pressures
+    from roughfe.genomics.design.targets import batch_scoring
+
+    entries, tk, ta = _perturbed_target(surface_db)
+    assert batch_scoring(SETTINGS)
+    rng = np.random.default_rng(3)
+    designs = []
+    for e in entries[:3]:
+        d = Design((DesignPart(Genome.from_dict(e.genome), e.macro + e.micro, 1.0, e.label),),
+                   1.0, L, 32, e.label, 2)
+        keys = d.keys("all")
+        designs.append(d.with_phases(keys, d.phase_values(keys) + rng.normal(0, 0.5, len(keys))))
+    batch = score_batch_at_target_pressures(designs, [tk, ta], SETTINGS)
+    single = np.array([rescore_at_target_pressures(d, [tk, ta], SETTINGS) for d in designs])
+    assert np.ptp(single) > 0.05                       # the designs differ
+    np.testing.assert_allclose(batch, single, rtol=0, atol=1e-8)
+
+
+def test_global_search_of_a_surface_design_with_wave_amplitudes(surface_db):
+    """search_global (IPOP-CMA-ES on batched strict scores) on a surface design, every
+    wave's amplitude a variable: f at the target pressures never falls, the searched
+    design is re-scored by one single BEM run (at_targets), which an independent run of
+    its heights reproduces; an unknown amplitude kind is one clear error."""
+    from roughfe.genomics.design import (GcmmaOptions, combined_score,
+                                         score_at_target_pressures,
+                                         search_at_target_pressures, search_global)
+
+    entries, tk, ta = _perturbed_target(surface_db)
+    res = run_design("mcco", entries, [tk, ta], SETTINGS,
+                     options=GcmmaOptions(n_it_sog=0, n_it_cross=0, n_it_micro=0))
+    out = search_global(res, SETTINGS, n_eval=40, amplitudes=0.5, waves=True, seed=1)
+    f0 = max(combined_score(rescore_at_target_pressures(c.design, [tk, ta], SETTINGS))
+             for c in res.candidates)
+    best = out.best
+    assert combined_score(best.at_targets) > f0      # 40 evaluations from a poor start
+    # the searched design: one part per chromosome, its waves' factors moved on their own
+    assert all(len(p.chromosomes) == 1 for p in best.design.parts)
+    alphas = np.array([p.genome.anisotropy / p.genome.anisotropy[0] for p in best.design.parts])
+    assert np.ptp(alphas, axis=0).max() > 1e-3
+    again = score_at_target_pressures(best.design.surface(), [tk, ta], SETTINGS)
+    np.testing.assert_allclose(again, best.at_targets, rtol=0, atol=1e-12)
+    assert "wave amplitudes x exp(+-0.5)" in out.message
+    with pytest.raises(InputError, match="waves=True needs amplitudes > 0"):
+        search_global(res, SETTINGS, n_eval=4, waves=True)
+    with pytest.raises(InputError, match="amplitudes must be one of"):
+        search_at_target_pressures(res, SETTINGS, n_eval=4, amplitudes="ridge")

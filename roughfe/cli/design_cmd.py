@@ -34,6 +34,7 @@ def _run(args) -> int:
     global_options = GlobalSearchOptions(
         method=args.global_search or "cmaes", n_eval=args.global_eval,
         popsize=args.global_popsize, amplitudes=args.global_amplitudes,
+        waves=args.global_waves,
         n_candidates=args.global_candidates)      # checked before the database is read
     settings = read_settings(args.db)
     entries = load_entries(args.db)
@@ -160,16 +161,23 @@ def register(sub):
     g.add_argument("--search-starts", type=positive_int, default=1, metavar="K",
                    help="--search: K independent runs per candidate (deterministic seeds), "
                         "the best kept")
-    g.add_argument("--search-amplitudes", action="store_true",
-                   help="--search: every chromosome's amplitude a variable too (+-30%%)")
+    g.add_argument("--search-amplitudes", nargs="?", const="chromosome", default="part",
+                   choices=("part", "chromosome", "wave"), metavar="KIND",
+                   help="--search amplitude variables (+-30%%): part (each part's weight, "
+                        "default), chromosome (every chromosome's; the value when the option "
+                        "is given alone) or wave (surfaces: every ridge of every chromosome)")
     g.add_argument("--global", dest="global_search", choices=("cmaes",), default=None,
-                   help="after --search: IPOP-CMA-ES on all phases and part weights, on the "
-                        "score at the target pressures (batched BEM; beyond the thesis)")
+                   help="after --search: IPOP-CMA-ES on all phases and the amplitudes of "
+                        "--global-amplitudes, on the score at the target pressures (batched "
+                        "BEM, profiles and surfaces; beyond the thesis)")
     g.add_argument("--global-eval", type=positive_int, default=20000, metavar="N",
                    help="--global: strict evaluations per searched candidate")
     g.add_argument("--global-amplitudes", type=nonnegative_float, default=0.0, metavar="X",
                    help="--global: every chromosome's amplitude a variable too, within "
                         "exp(+-X) of its start (log scale, X <= 2; 0: part weights +-30%%)")
+    g.add_argument("--global-waves", action="store_true",
+                   help="--global-amplitudes per wave (every ridge of every chromosome, "
+                        "surfaces) instead of per chromosome")
     g.add_argument("--global-popsize", type=nonnegative_int, default=0, metavar="L",
                    help="--global: population of the first CMA-ES run, doubled at each "
                         "restart (0: 4 + 3 ln n)")

@@ -29,7 +29,7 @@ from .io import result_to_dict, write_design_result
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
 from .objective import Evaluator, Objective, combined_score
-from .search import (GLOBAL_METHODS, GlobalSearchOptions, search_at_target_pressures,
+from .search import (AMPLITUDE_VARIABLES, GLOBAL_METHODS, GlobalSearchOptions, search_at_target_pressures,
                      search_global)
 from .sensitivities import residual_jacobian
 from .spectrum import match_spectrum, spectrum_matched
@@ -41,7 +41,8 @@ from .targets import (TARGET_BOUNDARIES, Y_T1_GENES, Y_T1_SURFACE_GENES, rescore
 
 __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
            "run_design", "score_database", "search_at_target_pressures", "sog",
-           "search_global", "GLOBAL_METHODS", "GlobalSearchOptions", "score_batch_at_target_pressures",
+           "search_global", "GLOBAL_METHODS", "GlobalSearchOptions",
+           "AMPLITUDE_VARIABLES", "score_batch_at_target_pressures",
            "match_spectrum", "spectrum_matched", "target_surface",
            "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",

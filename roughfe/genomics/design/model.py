@@ -28,6 +28,13 @@ DESIGN_FORMAT = "roughfe-design"
 DESIGN_VERSION = 1
 
 
+def is_amplitude_key(key) -> bool:
+    """True for a design variable that is a (positive) amplitude factor: a part weight
+    ``(part, "weight")`` or a ridge factor ``(part, "alpha", m)``; False for a phase
+    ``(part, m, n)`` or another gene."""
+    return isinstance(key[1], str) and key[1] in ("weight", "alpha")
+
+
 @dataclass(frozen=True, eq=False)
 class DesignPart:
     """Chromosomes ``chromosomes`` (indices n) of ``genome`` times ``weight`` (-)."""
@@ -99,13 +106,23 @@ class Design:
         (its amplitude gene relative to the other parts)."""
         return [(k, g) for k in range(len(self.parts)) for g in GENE_VARIABLES]
 
+    def ridge_keys(self) -> list:
+        """Per-ridge amplitude variables ``(part, "alpha", m)``: the factor alpha_m of
+        ridge m of each part's genome (Eq. 3.17's anisotropy; 1 where the genome has none).
+        After :meth:`split_chromosomes` each part is one chromosome, so these are the
+        amplitudes of every wave (ridge m, chromosome n) on its own."""
+        return [(k, "alpha", m) for k, p in enumerate(self.parts) for m in range(p.genome.M)]
+
     def phase_values(self, keys) -> np.ndarray:
-        """Current values of the variables ``keys``: phases (rad) ``(part, m, n)`` and
-        genes ``(part, name)``."""
+        """Current values of the variables ``keys``: phases (rad) ``(part, m, n)``, genes
+        ``(part, name)`` and ridge factors ``(part, "alpha", m)`` (:meth:`ridge_keys`)."""
         out = []
         for key in keys:
             part = self.parts[key[0]]
-            if len(key) == 2:
+            if key[1] == "alpha":
+                a = part.genome.anisotropy
+                out.append(1.0 if a is None else a[key[2]])
+            elif len(key) == 2:
                 out.append(part.weight if key[1] == "weight" else getattr(part.genome, key[1]))
             else:
                 _, m, n = key
@@ -113,18 +130,28 @@ class Design:
         return np.array(out, dtype=float)
 
     def with_phases(self, keys, values) -> "Design":
-        """A new design with the variables ``keys`` (phases and genes) set to ``values``."""
+        """A new design with the variables ``keys`` (phases, genes and ridge factors) set
+        to ``values``."""
         phases = [np.array(p.genome.phases) for p in self.parts]
+        alphas = [None if p.genome.anisotropy is None else np.array(p.genome.anisotropy, float)
+                  for p in self.parts]
         genes = [{} for _ in self.parts]
         for key, v in zip(keys, np.asarray(values, dtype=float)):
-            if len(key) == 2:
+            if key[1] == "alpha":
+                k, _, m = key
+                if alphas[k] is None:
+                    alphas[k] = np.ones(self.parts[k].genome.M)
+                alphas[k][m] = v
+            elif len(key) == 2:
                 genes[key[0]][key[1]] = float(v)
             else:
                 k, m, n = key
                 phases[k][m, n - self.parts[k].genome.n_first] = v
         parts = []
-        for p, ph, g in zip(self.parts, phases, genes):
+        for p, ph, al, g in zip(self.parts, phases, alphas, genes):
             w = g.pop("weight", p.weight)
+            if al is not None:
+                g["anisotropy"] = al
             parts.append(replace(p, genome=replace(p.genome, phases=ph, **g), weight=w))
         return replace(self, parts=tuple(parts))
 

@@ -16,18 +16,38 @@ from ...optim.cmaes import ipop_cmaes
 from ...optim.es import one_plus_one_es
 from ..database import DatabaseSettings
 from .algorithms import Candidate, DesignResult, _at_targets, _extended, _finish
-from .model import Design
+from .model import Design, is_amplitude_key
 from .objective import Evaluator, combined_score
 from .targets import score_batch_at_target_pressures
 
 
-def _search_variables(design: Design, amplitudes: bool):
-    """The variables of a search stage: every phase and every part weight (with
-    ``amplitudes`` every chromosome's, :meth:`Design.split_chromosomes`). Returns the
-    design they act on, their keys, start values and a mask of the weights."""
-    d0 = design.split_chromosomes() if amplitudes else design
-    keys = d0.keys("all") + [(k, "weight") for k in range(len(d0.parts))]
-    return d0, keys, d0.phase_values(keys), np.array([len(k) == 2 for k in keys])
+#: amplitude variables of a search stage (``amplitudes=``, CLI ``--search-amplitudes``):
+#: "part" (each part's weight), "chromosome" (each chromosome's,
+#: :meth:`Design.split_chromosomes`) or "wave" (each ridge m of each chromosome n: the
+#: factor alpha_m of a one-chromosome part, :meth:`Design.ridge_keys`; surfaces, beyond
+#: Eq. 3.17's one amplitude per ridge)
+AMPLITUDE_VARIABLES = ("part", "chromosome", "wave")
+
+
+def _amplitude_kind(amplitudes) -> str:
+    """``amplitudes`` as one of :data:`AMPLITUDE_VARIABLES` (False -> "part", True ->
+    "chromosome", the older boolean spelling)."""
+    kind = {False: "part", True: "chromosome"}[amplitudes] if isinstance(amplitudes, bool) \
+        else amplitudes
+    if kind not in AMPLITUDE_VARIABLES:
+        raise InputError(f"amplitudes must be one of {AMPLITUDE_VARIABLES}, got {amplitudes!r}")
+    return kind
+
+
+def _search_variables(design: Design, amplitudes):
+    """The variables of a search stage: every phase and the amplitudes of
+    :data:`AMPLITUDE_VARIABLES` ``amplitudes``. Returns the design they act on, their
+    keys, start values and a mask of the (positive, multiplicative) amplitudes."""
+    kind = _amplitude_kind(amplitudes)
+    d0 = design if kind == "part" else design.split_chromosomes()
+    amps = d0.ridge_keys() if kind == "wave" else [(k, "weight") for k in range(len(d0.parts))]
+    keys = d0.keys("all") + amps
+    return d0, keys, d0.phase_values(keys), np.array([is_amplitude_key(k) for k in keys])
 
 
 def _searched(c: Candidate, design: Design, objective, settings, evaluate) -> Candidate:
@@ -41,7 +61,7 @@ def _searched(c: Candidate, design: Design, objective, settings, evaluate) -> Ca
 def search_at_target_pressures(result: DesignResult, settings: DatabaseSettings, *,
                                n_eval: int = 400, width: float = math.pi,
                                weight_fraction: float = 0.3, sigma: float = 0.3, seed: int = 0,
-                               starts: int = 1, amplitudes: bool = False,
+                               starts: int = 1, amplitudes="part",
                                evaluate=None) -> DesignResult:
     """An optional stage beyond the thesis: a derivative-free search of every phase and
     part weight on the score solved *at the target's own pressures*.
@@ -65,10 +85,15 @@ def search_at_target_pressures(result: DesignResult, settings: DatabaseSettings,
     candidate's design (one generator, drawn on in order), the best strict f kept.
     Measured on y_t1/y_t3, N = 512, from the thesis-stage M-CCO result: 4 x 400 sweeps
     give f at p_t = 0.843 against 0.820 with one start (4890 against 1284 sweeps).
-    ``amplitudes``: the amplitude of every chromosome is a variable too (the design is
-    split into one part per chromosome, :meth:`Design.split_chromosomes`, the same
-    profile), each within +-``weight_fraction`` of its start: the spectrum, which sets
-    K(p) at the higher loads, moves with the phases, which set the first contacts.
+    ``amplitudes`` (:data:`AMPLITUDE_VARIABLES`; ``True`` is "chromosome"): "chromosome"
+    makes the amplitude of every chromosome a variable too (the design is split into one
+    part per chromosome, :meth:`Design.split_chromosomes`, the same profile), each within
+    +-``weight_fraction`` of its start: the spectrum, which sets K(p) at the higher
+    loads, moves with the phases, which set the first contacts. "wave" (surfaces) makes
+    every wave's amplitude (ridge m of chromosome n, :meth:`Design.ridge_keys`) a
+    variable instead: the directional spread of each band's energy moves too (measured
+    on x3p-2 SOG, 300 sweeps: 0.946 against 0.955 per chromosome, the larger search
+    space costs more than it gains at this budget; ``docs/theory/surface-design.md``).
 
     Each candidate keeps its thesis stages; its design is replaced only when the strict
     f improves, its ``scores``/``curve`` are re-evaluated on the n_t approaches (as
@@ -104,7 +129,7 @@ def search_at_target_pressures(result: DesignResult, settings: DatabaseSettings,
     f = combined_score(out[0].at_targets)
     return _extended(result, out, evaluate, t0, f"; search at the target pressures ((1+1)-ES, "
                      f"all phases +-{width:.3g} rad, "
-                     f"{'chromosome' if amplitudes else 'part'} weights +-{weight_fraction:.0%}, "
+                     f"{_amplitude_kind(amplitudes)} weights +-{weight_fraction:.0%}, "
                      f"{starts} x {n_eval} sweeps per candidate): f at p_t = {f:.4f}")
 
 
@@ -140,6 +165,11 @@ class GlobalSearchOptions:
         folded in) is a variable on a log scale, ``a_n = a_n0 exp(amplitudes tanh v)``,
         so within ``[a_n0 e^-amplitudes, a_n0 e^amplitudes]`` (strictly); replaces the
         part weights (each chromosome carries its own). At most 2.
+    waves : bool
+        With ``amplitudes > 0``: every *wave* (ridge m of chromosome n, the factor
+        alpha_m of a one-chromosome part, :meth:`Design.ridge_keys`) is a log-scale
+        amplitude variable instead of every chromosome (surfaces; beyond Eq. 3.17's one
+        amplitude per ridge).
     seed : int
         ``numpy.random.default_rng(seed)``: the search is deterministic.
     n_candidates : int
@@ -152,6 +182,7 @@ class GlobalSearchOptions:
     popsize: int = 0
     weight_fraction: float = 0.3
     amplitudes: float = 0.0
+    waves: bool = False
     seed: int = 0
     n_candidates: int = 1
 
@@ -169,6 +200,14 @@ class GlobalSearchOptions:
         for what, ok, value in checks:
             if not ok:
                 raise InputError(f"global search: {what} needed, got {value!r}")
+        if self.waves and not self.amplitudes > 0:
+            raise InputError("global search: waves=True needs amplitudes > 0 (the log "
+                             "half-range of the wave amplitudes)")
+
+    @property
+    def kind(self) -> str:
+        """The amplitude variables, one of :data:`AMPLITUDE_VARIABLES`."""
+        return "part" if not self.amplitudes > 0 else "wave" if self.waves else "chromosome"
 
     def weights(self, w0, v):
         """Weights (-) of the variables ``v`` around their start values ``w0``."""
@@ -178,7 +217,7 @@ class GlobalSearchOptions:
 
     def describe(self) -> str:
         if self.amplitudes > 0:
-            return f"chromosome amplitudes x exp(+-{self.amplitudes:g})"
+            return f"{self.kind} amplitudes x exp(+-{self.amplitudes:g})"
         return f"part weights +-{self.weight_fraction:.0%}"
 
 
@@ -231,7 +270,7 @@ def search_global(result: DesignResult, settings: DatabaseSettings,
             out.append(c if c.at_targets else replace(c, at_targets=_at_targets(
                 c.design, objective, settings, evaluate)))
             continue
-        d0, keys, x0, is_w = _search_variables(c.design, opts.amplitudes > 0)
+        d0, keys, x0, is_w = _search_variables(c.design, opts.kind)
 
         def designs(X, d0=d0, keys=keys, x0=x0, is_w=is_w):
             V = np.where(is_w, opts.weights(x0, X), X)

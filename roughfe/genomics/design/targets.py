@@ -5,9 +5,10 @@ from dataclasses import replace
 
 import numpy as np
 
+from ...bem.batch import solve_batch
 from ...bem.batch_exact import batch_sweep, solve_batch_exact
 from ...bem.operators import influence_operator
-from ...errors import InputError
+from ...errors import InputError, NoConvergenceError
 from ...model import Loading, Material, central_differences
 from ...response import response
 from ..database import DatabaseSettings, make_genome
@@ -71,10 +72,14 @@ def _strict_scores(pressure, stiffness, area_fraction, targets) -> tuple:
 
 
 def batch_scoring(settings: DatabaseSettings) -> bool:
-    """True when :func:`score_batch_at_target_pressures` solves the designs together
-    (the batched exact BEM of :mod:`roughfe.bem.batch_exact`: profiles on the non-periodic
-    strip kernel, the thesis database); otherwise it scores them one by one."""
-    return settings.dim == 1 and settings.kernel in ("auto", "strip") \
+    """True when :func:`score_batch_at_target_pressures` solves the designs together:
+    profiles on the non-periodic strip kernel (the thesis database) by the batched exact
+    BEM of :mod:`roughfe.bem.batch_exact`, periodic surfaces (a surface database, dim 2)
+    by the batched Polonsky-Keer CG of :mod:`roughfe.bem.batch`; otherwise it scores them
+    one by one."""
+    if settings.dim == 2:
+        return settings.kernel in ("auto", "spectral")
+    return settings.kernel in ("auto", "strip") \
         and settings.top_fraction == 1.0 and int(settings.n_nodes) <= 4096
 
 
@@ -83,13 +88,17 @@ def score_batch_at_target_pressures(designs, targets, settings: DatabaseSettings
     of Eq. (4.1) scores, the same numbers (to round-off: the same exact contact states)
     at a fraction of the cost.
 
-    With :func:`batch_scoring` the B profiles are solved together by
-    :func:`roughfe.bem.batch_exact.solve_batch_exact` (block principal pivoting, stacked):
-    one displacement solve at Delta = peak-valley for p_max (Eq. 4.2 factor eta per
-    row), then :func:`roughfe.bem.batch_exact.batch_sweep` at the pressures ``p_j / eta``; A
-    is the exact node fraction, K the central differences over the steps, as in
-    :func:`score_at_target_pressures`. Measured in ``docs/theory/06_design.md``.
-    A row whose curve is not a valid response (e.g. a flat design) scores -inf."""
+    With :func:`batch_scoring` the B designs are solved together: one displacement solve
+    at the last approach of the database sweep (:func:`top_approach`: peak-valley for a
+    profile, ``top_fraction`` of full contact for a periodic surface) for p_max (Eq. 4.2
+    factor eta per row), then :func:`roughfe.bem.batch_exact.batch_sweep` at the pressures
+    ``p_j / eta``; A is the exact node fraction, K the central differences over the
+    steps, as in :func:`score_at_target_pressures`. Profiles: exact pivoting
+    (:func:`roughfe.bem.batch_exact.solve_batch_exact`, the same contact states to
+    round-off; measured in ``docs/theory/06_design.md``); periodic surfaces: the batched
+    CG to a relative KKT residual of 1e-10 (scores within ~1e-10 of the single solver,
+    ``docs/theory/surface-design.md``). A row whose curve is not a valid response (e.g. a
+    flat design) scores -inf."""
     designs = list(designs)
     targets = list(targets)
     if not designs:
@@ -99,11 +108,22 @@ def score_batch_at_target_pressures(designs, targets, settings: DatabaseSettings
     surfs = [d.surface() for d in designs]
     h = np.array([sf.heights for sf in surfs])
     mat = Material(settings.youngs_modulus, settings.poisson)
-    op = influence_operator(h.shape[1:], surfs[0].size, mat.E_star, "strip")
-    top = solve_batch_exact(op, h, delta=np.ptp(h, axis=1))
-    eta = targets[0].p_max / top.mean_pressure
     p = np.unique(np.concatenate([t.pressure for t in targets]))
-    sw = batch_sweep(op, h, p[None, :] / eta[:, None], method="exact", top=top)
+    if settings.dim == 2:
+        op = influence_operator(h.shape[1:], surfs[0].size, mat.E_star, "spectral")
+        delta = [top_approach(sf, settings.kernel, settings.top_fraction) for sf in surfs]
+        try:
+            top = solve_batch(op, h, delta=np.array(delta))
+            eta = targets[0].p_max / top.mean_pressure
+            sw = batch_sweep(op, h, p[None, :] / eta[:, None], method="pk")
+        except NoConvergenceError:          # a row the CG cannot settle: one by one
+            return np.array([rescore_at_target_pressures(d, targets, settings)
+                             for d in designs])
+    else:
+        op = influence_operator(h.shape[1:], surfs[0].size, mat.E_star, "strip")
+        top = solve_batch_exact(op, h, delta=np.ptp(h, axis=1))
+        eta = targets[0].p_max / top.mean_pressure
+        sw = batch_sweep(op, h, p[None, :] / eta[:, None], method="exact", top=top)
     out = np.full((len(designs), len(targets)), -np.inf)
     for b in range(len(designs)):
         try:
