@@ -31,11 +31,13 @@ LOADS = (0.005, 0.01, 0.05, 0.1)
 TOL = 1e-10
 
 
-def solve_pair(surface, pm, block, radius):
-    """The plain and the deflated solve of one load from the same coarse start."""
+def solve_pair(surface, pm, block, radius, method="production"):
+    """The plain and the deflated solve of one load from the same coarse start
+    (``method``: "production", :class:`~roughfe.bem.deflation.BlockDeflation`, or
+    "reference", :class:`~roughfe.bem.deflation.ProbedBlockDeflation`)."""
     from roughfe.bem import Material
     from roughfe.bem.contact import _cg_preconditioner, _coarse_start, _operator
-    from roughfe.bem.deflation import ProbedBlockDeflation
+    from roughfe.bem.deflation import BlockDeflation, ProbedBlockDeflation
     from roughfe.bem.pk import polonsky_keer
 
     mat = Material(1.0, 0.0)
@@ -44,7 +46,9 @@ def solve_pair(surface, pm, block, radius):
     start = _coarse_start(surface, mat, pm, None)
     rows = {}
     for name, deflation in (("plain", None),
-                            ("deflated", ProbedBlockDeflation(op, block, radius))):
+                            ("deflated", BlockDeflation(op, block)
+                             if method == "production"
+                             else ProbedBlockDeflation(op, block, radius))):
         c0 = time.process_time()
         out = polonsky_keer(op.apply, h, float(np.ptp(h)), mean_pressure=pm,
                             initial=None if start is None else start.copy(),
@@ -66,6 +70,7 @@ def main(argv=None) -> int:
     ap.add_argument("--loads", type=float, nargs="+", default=list(LOADS))
     ap.add_argument("--block", type=int, default=8)
     ap.add_argument("--radius", type=int, default=1)
+    ap.add_argument("--method", choices=("production", "reference"), default="production")
     ap.add_argument("--output", type=Path,
                     default=HERE / "output" / "deflation_iterations.json")
     args = ap.parse_args(argv)
@@ -75,18 +80,25 @@ def main(argv=None) -> int:
     tables = []
     for n in args.sizes:
         surface = spectral_surface(n, 1.0, 0.8, rms_slope=1.0, rng=1)
-        rows = [solve_pair(surface, pm, args.block, args.radius) for pm in args.loads]
+        rows = [solve_pair(surface, pm, args.block, args.radius, args.method)
+                for pm in args.loads]
         for r in rows:
             print(f"n = {n} p/E* = {r['p/E*']}: iterations {r['nit_plain']} -> "
                   f"{r['nit_deflated']}, products {r['n_products_plain']} -> "
-                  f"{r['n_products_deflated']}, A* {r['A*_plain']:.6g} / "
+                  f"{r['n_products_deflated']}, CPU {r['cpu_s_plain']:.2f} -> "
+                  f"{r['cpu_s_deflated']:.2f} s, A* {r['A*_plain']:.6g} / "
                   f"{r['A*_deflated']:.6g}, max|dp|/max p {r['max|dp|/max p']:.2e}",
                   flush=True)
-        tables.append({"n": n, "block": args.block, "radius": args.radius, "rows": rows,
+        tables.append({"n": n, "method": args.method, "block": args.block,
+                       "radius": args.radius, "rows": rows,
+                       "cpu_plain": sum(r["cpu_s_plain"] for r in rows),
+                       "cpu_deflated": sum(r["cpu_s_deflated"] for r in rows),
                        "nit_plain": sum(r["nit_plain"] for r in rows),
                        "nit_deflated": sum(r["nit_deflated"] for r in rows)})
-        print(f"n = {n}: {tables[-1]['nit_plain']} -> {tables[-1]['nit_deflated']} "
-              f"iterations ({len(rows)} loads)", flush=True)
+        t = tables[-1]
+        print(f"n = {n}: {t['nit_plain']} -> {t['nit_deflated']} iterations, CPU "
+              f"{t['cpu_plain']:.2f} -> {t['cpu_deflated']:.2f} s ({len(rows)} loads)",
+              flush=True)
     write_json(args.output, {"tol": TOL, "load_average": os.getloadavg()[0],
                              "tables": tables})
     print(f"wrote {args.output}")

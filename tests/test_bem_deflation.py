@@ -127,9 +127,27 @@ def test_block_deflation_same_solution_fewer_iterations():
     assert defl.delta == pytest.approx(plain.delta, rel=1e-8)
 
 
+def test_block_deflation_update_is_exact():
+    # the near field is recomputed only where the free set changed: after a first F,
+    # the coarse matrix of a second one equals that of a fresh object
+    n, b = 64, 8
+    op = influence_operator((n, n), (1.0, 1.0), 1.0)
+    rng = np.random.default_rng(3)
+    u = rng.random(n * n)
+    F1, F2 = np.flatnonzero(u < 0.3), np.flatnonzero((u < 0.3) ^ (u > 0.995))
+    c = rng.standard_normal((n // b, n // b))
+    kept = BlockDeflation(op, b)
+    kept.coarse_operator(F1)
+    again, counts, diag = kept.coarse_operator(F2)
+    fresh, counts0, diag0 = BlockDeflation(op, b).coarse_operator(F2)
+    assert np.array_equal(counts, counts0) and np.array_equal(diag, diag0)
+    assert np.allclose(again(c), fresh(c), rtol=0, atol=1e-12 * np.abs(fresh(c)).max())
+
+
 @pytest.mark.parametrize("shape, block, kw", [((64, 64), 6, {}), ((16, 16), 8, {}),
-                                              ((64, 64), 8, {"coarse_tol": 0.0})])
+                                              ((64, 64), 8, {"coarse_tol": 0.0}),
+                                              ((64, 64), 8, {"settle": -1.0})])
 def test_block_deflation_bad_input(shape, block, kw):
     op = influence_operator(shape, (1.0, 1.0), 1.0)
-    with pytest.raises(InputError, match="multiples of block|coarse_tol"):
+    with pytest.raises(InputError, match="multiples of block|coarse_tol|settle"):
         BlockDeflation(op, block, **kw)

@@ -186,7 +186,7 @@ class BlockDeflation:
     """
 
     def __init__(self, op: InfluenceOperator, block: int = 8, coarse_tol: float = 1e-6,
-                 coarse_max_iter: int = 500):
+                 coarse_max_iter: int = 500, settle: float = 0.3):
         block = int(block)
         if (not op.periodic or len(op.shape) != 2 or block < 1
                 or any(n % block for n in op.shape)
@@ -196,10 +196,14 @@ class BlockDeflation:
                              f"side, got shape {op.shape}")
         if not 0.0 < coarse_tol < 1.0:
             raise InputError(f"coarse_tol must lie in (0, 1), got {coarse_tol}")
+        if not settle >= 0.0:
+            raise InputError(f"settle must be >= 0 (a fraction of the active blocks), "
+                             f"got {settle}")
         self.shape = op.shape
         self.block = b = block
         self.coarse_tol = float(coarse_tol)
         self.coarse_max_iter = int(coarse_max_iter)
+        self.settle = float(settle)
         self.coarse_shape = (m0, m1) = (op.shape[0] // b, op.shape[1] // b)
         kern = np.asarray(op.kernel)
         a0, a1 = np.divmod(np.arange(b * b), b)          # position in a block
@@ -221,28 +225,52 @@ class BlockDeflation:
         kinv.flat[0] = 0.0
         self._kinv = kinv
         self.inner_iterations = []
+        self._last = None                                 # the last free set's block rows
+        self._mask = None                                 # those of the last coarse matrix
+        self._exact = [np.zeros(m0 * m1) for _ in _NEAR]  # its exact near-field entries
+
+    def _rows(self, F):
+        """Block index of each point of F, the blocks' b^2 mask rows and point counts."""
+        b = self.block
+        m1 = self.coarse_shape[1]
+        i, j = np.divmod(F, self.shape[1])
+        blk = (i // b) * m1 + j // b
+        X = np.zeros((self.coarse_shape[0] * m1, b * b), bool)
+        X[blk, (i % b) * b + j % b] = True
+        return blk, X, np.bincount(blk, minlength=X.shape[0])
 
     def coarse_operator(self, F):
         """The coarse matrix E of the free set ``F`` (flat indices) as a map of coarse
-        vectors (``coarse_shape`` arrays, zero off the active blocks), its active-block
-        mask and the blocks' point counts."""
+        vectors (``coarse_shape`` arrays, zero off the active blocks), the blocks' point
+        counts and the diagonal of E."""
+        return self._coarse(*self._rows(F)[1:])
+
+    def _coarse(self, X, counts):
         b = self.block
         m0, m1 = self.coarse_shape
-        i, j = np.divmod(F, self.shape[1])
-        blk = (i // b) * m1 + j // b
-        counts = np.bincount(blk, minlength=m0 * m1)
-        X = np.zeros((m0 * m1, b * b), np.float32)
-        X[blk, (i % b) * b + j % b] = 1.0
-        del i, j
-        act = np.flatnonzero(counts)
-        V = X[act] @ self._near
-        ai, aj = np.divmod(act, m1)
+        # the exact near field, recomputed only where a block's mask or that of its
+        # neighbour changed since the last coarse matrix (the free set settles: measured
+        # at 1024^2, p/E* = 0.1, the changed blocks fall from ~7000 of 7500 active ones
+        # to none in the second half of the iterations)
+        if self._mask is None:
+            changed = np.ones((m0, m1), bool)
+        else:
+            changed = (X != self._mask).any(axis=1).reshape(m0, m1)
+        self._mask = X
+        dirty = [(changed | np.roll(changed, (-d0, -d1), axis=(0, 1))).ravel()
+                 for d0, d1 in _NEAR]
+        rows = np.flatnonzero(np.logical_or.reduce(dirty) & (counts > 0))
+        V = X[rows].astype(np.float32) @ self._near
+        ri, rj = np.divmod(rows, m1)
         N = (counts / float(b * b)).reshape(m0, m1)
         coef = []
         for o, (d0, d1) in enumerate(_NEAR):
-            nb = ((ai + d0) % m0) * m1 + (aj + d1) % m1
-            e = np.zeros(m0 * m1)
-            e[act] = np.einsum("ij,ij->i", V[:, o * b * b:(o + 1) * b * b], X[nb])
+            e = self._exact[o]
+            e[dirty[o]] = 0.0
+            sel = dirty[o][rows]
+            nb = ((ri[sel] + d0) % m0) * m1 + (rj[sel] + d1) % m1
+            e[rows[sel]] = np.einsum("ij,ij->i", V[sel, o * b * b:(o + 1) * b * b],
+                                     X[nb].astype(np.float32))
             c = e.reshape(m0, m1) - N * np.roll(N, (-d0, -d1), axis=(0, 1)) * self._knear[o]
             coef.append(c)
         diag = coef[0] + N * N * self._k0
@@ -299,16 +327,18 @@ class BlockDeflation:
         return c
 
     def correct(self, F, gF, zF, apply_free):
-        """The A-DEF2 direction on F (the interface of :class:`ProbedBlockDeflation`)."""
-        b = self.block
-        m0, m1 = self.coarse_shape
+        """The A-DEF2 direction on F (the interface of :class:`ProbedBlockDeflation`);
+        ``zF`` itself while more than ``settle`` of the active blocks changed their part
+        of F since the last call (the contact-set search)."""
+        blk, X, counts = self._rows(F)
+        last, self._last = self._last, X
+        if last is None or (np.count_nonzero((X != last).any(axis=1))
+                            > self.settle * np.count_nonzero(counts)):
+            return zF
         s = gF - apply_free(zF)
         s -= s.mean()
-        apply, counts, diag = self.coarse_operator(F)
-        i, j = np.divmod(F, self.shape[1])
-        blk = (i // b) * m1 + j // b
-        del i, j
-        rc = np.bincount(blk, weights=s, minlength=m0 * m1).reshape(m0, m1)
+        apply, counts, diag = self._coarse(X, counts)
+        rc = np.bincount(blk, weights=s, minlength=counts.size).reshape(counts.shape)
         c = self._coarse_solve(apply, counts, diag, rc)
         out = zF + c.ravel()[blk]
         out -= out.mean()
