@@ -31,7 +31,7 @@ import numpy as np
 
 from ..errors import InputError, NoConvergenceError
 from .operators import InfluenceOperator, influence_operator
-from .solvers import kkt_residual
+from .solvers import kkt_residual, penetration_start
 
 #: threads per batched FFT: one. The transforms are many short rows; a second thread
 #: only adds a barrier per product, which on a shared machine waits for a free core
@@ -152,7 +152,7 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
     elif load:
         p = np.broadcast_to(pm.reshape((B,) + (1,) * len(ax)), shape).copy()
     else:
-        p = np.clip((dl.reshape((B,) + (1,) * len(ax)) + c) / op.diagonal, 0.0, None)
+        p = penetration_start(dl.reshape((B,) + (1,) * len(ax)) + c, op.diagonal)
     if load:
         s = p.sum(axis=ax)
         p[s == 0] = pm[s == 0].reshape((-1,) + (1,) * len(ax))

@@ -11,7 +11,7 @@ from scipy.linalg.blas import daxpy, saxpy
 from . import _parallel as par
 from ..errors import InputError
 from .operators import FFTWorkspace
-from .solvers import SolverOutput, _fail, _rescale_to_load
+from .solvers import SolverOutput, _fail, _rescale_to_load, penetration_start
 
 #: relative KKT residual above which the products with H may be taken in single precision
 #: (``apply_single``): a hundred times the float32 rounding of u = H p (~1e-7 of max |u|)
@@ -114,7 +114,8 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     ``precond`` (a linear map M ~ H^-1, e.g. the stiffness operator E*|q|/2) makes it a
     preconditioned CG (direction from z = P_F M P_F g): on rough surfaces it cuts the
     iterations 3-4 fold and they grow much more slowly with n. ``diagonal`` (m/Pa, H_ii)
-    scales the first trial pressure in displacement control.
+    scales the first trial pressure in displacement control
+    (:func:`roughfe.bem.solvers.penetration_start`).
 
     Cost and memory: one product with H and one with M per iteration, plus a third with
     H after an iteration whose projection clipped (u = H p is then recomputed; without a
@@ -225,9 +226,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     elif load:
         p = np.full(n, float(mean_pressure))
     else:
-        p = -(delta + offset + bf)
-        p /= diagonal
-        np.clip(p, 0.0, upper, out=p)
+        p = penetration_start(bf + (delta + offset), diagonal, upper)
     target = float(mean_pressure) * n if load else 0.0
     if load:
         _rescale_to_load(p, target, upper)
