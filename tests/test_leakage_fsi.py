@@ -238,3 +238,28 @@ def test_unloading_reopens_pockets_and_section6_states_hold(surface, kw):
     assert rev.state == "contact" and rev.leak_rate < 0
     with pytest.raises(NoConvergenceError, match="residual"):
         coupled_sweep(surface, MAT, [1e7, 3e7], p_in=5e6, p_out=0.0, max_iter=2, **kw)
+
+
+def test_reynolds_solves_warm_started_from_the_last_pressure(surface, flowing, monkeypatch):
+    """Each Reynolds solve of the coupling loop starts from the previous finite-volume
+    pressure: the coupled state is the one of cold solves (to the tolerances) and the
+    loop spends fewer CG iterations on Reynolds."""
+    from roughfe.leakage import fsi
+    its = {}
+
+    def counting(key, cold):
+        def solve(*args, initial=None, **kw):
+            sol = solve_reynolds_fv(*args, initial=None if cold else initial, **kw)
+            its[key] = its.get(key, 0) + sol.nit
+            return sol
+        return solve
+
+    monkeypatch.setattr(fsi, "solve_reynolds_fv", counting("warm", False))
+    warm = coupled_leakage(surface, MAT, P_EXT, p_in=2e7, p_out=0.0)
+    monkeypatch.setattr(fsi, "solve_reynolds_fv", counting("cold", True))
+    cold = coupled_leakage(surface, MAT, P_EXT, p_in=2e7, p_out=0.0)
+    assert warm.coupled_iterations == flowing.coupled_iterations
+    assert warm.leak_rate == pytest.approx(cold.leak_rate, rel=1e-7)
+    np.testing.assert_allclose(warm.fluid_pressure, cold.fluid_pressure, rtol=0, atol=1e-6 * 2e7)
+    assert np.array_equal(warm.contact.contact, cold.contact.contact)
+    assert its["warm"] < 0.8 * its["cold"]

@@ -125,7 +125,7 @@ def petsc_aij_csr(shape, indptr, indices, data):
                 np.asarray(data, dtype=PETSc.ScalarType)), comm=PETSc.COMM_SELF)
 
 
-def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None):
+def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None, x0=None):
     """Solve ``A x = b`` with a PETSc KSP; options under a unique prefix.
 
     Parameters
@@ -138,6 +138,11 @@ def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None):
         Options prefix stem and the name in messages.
     options : mapping, optional
         PETSc options overriding :data:`CG_AMG`.
+    x0 : ndarray, optional
+        Initial guess (a nonzero start of the Krylov iteration). The stopping test stays
+        PETSc's default, relative to the norm of the (preconditioned) right-hand side,
+        not to the initial residual: the same accuracy as from x = 0, in fewer
+        iterations when ``x0`` is close.
 
     Returns
     -------
@@ -156,6 +161,9 @@ def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None):
     ksp = PETSc.KSP().create(PETSc.COMM_SELF)
     ksp.setOperators(A)
     apply_options(ksp, unique_prefix(name), {**CG_AMG, **dict(options or {})})
+    if x0 is not None:
+        x.setArray(np.asarray(x0, dtype=PETSc.ScalarType))
+        ksp.setInitialGuessNonzero(True)
     t0 = time.process_time()
     ksp.setUp()
     t1 = time.process_time()

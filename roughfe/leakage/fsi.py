@@ -300,7 +300,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     frozen = (history.pockets if history is not None and trapped in SEALED
               else Pockets.none(h.shape))
     h_reg = check_finite_positive("h_reg", 1e-3 * float(np.std(h)) if h_reg is None else h_reg)
-    last = {"contact": None, "flow": None}
+    last = {"contact": None, "flow": None, "fluid": None}   # fluid: start of the next FV solve
 
     def G(x, newton):
         """One contact solve and one Reynolds solve for the fluid traction x."""
@@ -313,8 +313,9 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
                           tol=contact_tol, compute_stiffness=False,
                           initial=last["contact"].pressure)
         gap = np.where(c.contact, 0.0, c.gap)
-        y = solve_reynolds_fv(np.maximum(gap, h_reg), spacing, direction=direction, mu=mu,
-                              p_in=p_in, p_out=p_out, periodic=surface.periodic).pressure
+        last["fluid"] = y = solve_reynolds_fv(
+            np.maximum(gap, h_reg), spacing, direction=direction, mu=mu, p_in=p_in, p_out=p_out,
+            periodic=surface.periodic, initial=last["fluid"]).pressure
         if frozen.n:
             lab = frozen.labels
             p_pocket = frozen.pressure if newton is None else newton(x, gap, c, p_ext)
@@ -324,7 +325,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
 
     def _flow(gap):
         return solve_reynolds_fv(gap, spacing, direction=direction, mu=mu, p_in=p_in,
-                                 p_out=p_out, periodic=surface.periodic)
+                                 p_out=p_out, periodic=surface.periodic, initial=last["fluid"])
 
     # the one-way state (dry contact at p_ext); the iteration starts from the previous
     # step's fluid pressure (pocket pressures near their solution), else from 0
