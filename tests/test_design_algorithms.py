@@ -345,7 +345,57 @@ def test_global_search_with_chromosome_amplitudes_bounded_and_reproduced(entries
                                         ({"popsize": -1}, "popsize >= 0"),
                                         ({"n_candidates": 0}, "n_candidates >= 1"),
                                         ({"weight_fraction": 1.0}, "weight_fraction"),
+                                        ({"rounds": 0}, "rounds >= 1"),
+                                        ({"genes": 1.0}, "genes < 1"),
+                                        ({"genes": 0.1, "amplitudes": 0.1}, "genes = 0"),
                                         ({"method": "annealing"}, "method")])
 def test_global_search_options_reject_bad_input(bad, match):
     with pytest.raises(InputError, match=match):
         de.GlobalSearchOptions(**bad)
+
+
+def test_global_search_rounds_continue_from_the_best_design(entries, targets, tmp_path):
+    """rounds = 2: the first round is the one-round search (same seed, same draws), the
+    second starts from its best design, so the strict f is not lower, the joined curve
+    rises monotonically through both rounds, and the saved design's strict scores equal
+    the hand-written load-controlled BEM run."""
+    t1, _, t3, _ = targets
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    one = de.search_global(r, SETTINGS, n_eval=120, seed=3)
+    two = de.search_global(r, SETTINGS, n_eval=120, seed=3, rounds=2)
+    f1, f2 = (de.combined_score(x.best.at_targets) for x in (one, two))
+    h1, h2 = one.search_history[0], two.search_history[0]
+    assert f2 >= f1 and "2 rounds from the best" in two.message
+    np.testing.assert_array_equal(h2[:len(h1)], h1)              # round 1 = the one-round run
+    assert np.all(np.diff(h2[:, 0]) > 0) and np.all(np.diff(h2[:, 1]) >= 0)
+    assert h2[-1, 1] == pytest.approx(f2, abs=1e-9)
+    if f1 > de.combined_score(de.rescore_at_target_pressures(r.best.design, [t1, t3],
+                                                            SETTINGS)):
+        assert len(h2) > len(h1)                                 # a second round was run
+    paths = de.write_design_result(two, SETTINGS, tmp_path)
+    saved = json.loads(paths["result"].read_text())["candidates"][0]
+    dd = de.Design.from_dict(json.loads(paths["design"].read_text()))
+    np.testing.assert_allclose(_strict_scores_by_hand(dd, [t1, t3], tmp_path),
+                               saved["scores_at_target_pressures"], atol=1e-7)
+
+
+def test_global_search_with_genes_bounded_and_reproduced(entries, targets, tmp_path):
+    """genes = 0.15: every part's gamma, H and lambda1 stay strictly within +-15 % of
+    their start (and move), the strict f rises, and the hand-written load-controlled BEM run
+    of the saved design.json reproduces its strict scores."""
+    t1, _, t3, _ = targets
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    f0 = de.combined_score(de.rescore_at_target_pressures(r.best.design, [t1, t3], SETTINGS))
+    rg = de.search_global(r, SETTINGS, n_eval=200, seed=2, genes=0.15)
+    c = rg.best
+    assert "genes gamma/H/lambda1 +-15%" in rg.message
+    assert de.combined_score(c.at_targets) > f0
+    ratios = np.array([getattr(p.genome, g) / getattr(q.genome, g)
+                       for p, q in zip(c.design.parts, r.best.design.parts)
+                       for g in ("gamma", "H", "lambda1")])
+    assert np.all(np.abs(ratios - 1) < 0.15) and np.ptp(ratios) > 1e-3
+    paths = de.write_design_result(rg, SETTINGS, tmp_path)
+    saved = json.loads(paths["result"].read_text())["candidates"][0]
+    dd = de.Design.from_dict(json.loads(paths["design"].read_text()))
+    np.testing.assert_allclose(_strict_scores_by_hand(dd, [t1, t3], tmp_path),
+                               saved["scores_at_target_pressures"], atol=1e-7)

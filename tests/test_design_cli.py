@@ -44,7 +44,8 @@ def test_db_and_design_commands(tmp_path, capsys):
     amp = tmp_path / "sog_amp"
     assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "y_t1.csv"),
                  "--method", "sog", "--iterations", "1", "--global", "cmaes", "--global-eval",
-                 "30", "--global-amplitudes", "0.2", "--no-figures", "-o", str(amp)]) == 0
+                 "15", "--global-amplitudes", "0.2", "--global-rounds", "2", "--no-figures",
+                 "-o", str(amp)]) == 0
     rep = json.loads((amp / "result.json").read_text())
     assert "chromosome amplitudes x exp(+-0.2)" in rep["message"]
     d_amp = de.Design.from_dict(json.loads((amp / "design.json").read_text()))
@@ -91,7 +92,9 @@ def test_design_command_reports_bad_input(tmp_path, capsys):
                  "--search", "5", "--search-starts", "0", "-o", str(tmp_path / "o")]) == 2
     assert "--search-starts" in capsys.readouterr().err
     for flag, value, why in (("--global-amplitudes", "-0.5", ">= 0"),
-                             ("--global-amplitudes", "3", "amplitudes <= 2")):
+                             ("--global-amplitudes", "3", "amplitudes <= 2"),
+                             ("--global-genes", "1.5", "genes < 1"),
+                             ("--global-rounds", "0", ">= 1")):
         assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",
                      "--global", "cmaes", flag, value, "-o", str(tmp_path / "o")]) == 2
         assert why in capsys.readouterr().err

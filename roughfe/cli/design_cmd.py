@@ -35,7 +35,8 @@ def _run(args) -> int:
         method=args.global_search or "cmaes", n_eval=args.global_eval,
         popsize=args.global_popsize, amplitudes=args.global_amplitudes,
         waves=args.global_waves,
-        n_candidates=args.global_candidates)      # checked before the database is read
+        n_candidates=args.global_candidates, rounds=args.global_rounds,
+        genes=args.global_genes)      # checked before the database is read
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}
@@ -183,6 +184,12 @@ def register(sub):
                         "restart (0: 4 + 3 ln n)")
     g.add_argument("--global-candidates", type=positive_int, default=1, metavar="K",
                    help="--global: search the K best candidates (by strict f)")
+    g.add_argument("--global-rounds", type=positive_int, default=1, metavar="R",
+                   help="--global: R IPOP-CMA-ES runs, each from the best design of the one "
+                        "before (N evaluations each)")
+    g.add_argument("--global-genes", type=nonnegative_float, default=0.0, metavar="X",
+                   help="--global: every part's gamma, H, lambda1 a variable too, within "
+                        "+-X (fraction, < 1) of its start (0: off)")
     g.add_argument("--match-spectrum", default=None, metavar="SURFACE",
                    help="surface database, beyond the thesis, after --refine and before "
                         "--search: set every chromosome's amplitude to the band rms of this "

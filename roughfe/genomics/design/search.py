@@ -39,15 +39,23 @@ def _amplitude_kind(amplitudes) -> str:
     return kind
 
 
-def _search_variables(design: Design, amplitudes):
+#: genes of every part that :attr:`GlobalSearchOptions.genes` makes variables
+SEARCH_GENES = ("gamma", "H", "lambda1")
+
+
+def _search_variables(design: Design, amplitudes, genes: bool = False):
     """The variables of a search stage: every phase and the amplitudes of
-    :data:`AMPLITUDE_VARIABLES` ``amplitudes``. Returns the design they act on, their
-    keys, start values and a mask of the (positive, multiplicative) amplitudes."""
+    :data:`AMPLITUDE_VARIABLES` ``amplitudes`` (with ``genes`` also every part's
+    :data:`SEARCH_GENES`). Returns the design they act on, their keys, start values and
+    a mask of the variables that are not phases (amplitudes and genes)."""
     kind = _amplitude_kind(amplitudes)
     d0 = design if kind == "part" else design.split_chromosomes()
     amps = d0.ridge_keys() if kind == "wave" else [(k, "weight") for k in range(len(d0.parts))]
     keys = d0.keys("all") + amps
-    return d0, keys, d0.phase_values(keys), np.array([is_amplitude_key(k) for k in keys])
+    if genes:
+        keys += [(k, g) for k in range(len(d0.parts)) for g in SEARCH_GENES]
+    return d0, keys, d0.phase_values(keys), np.array([is_amplitude_key(k) or k[1] in
+                                                      SEARCH_GENES for k in keys])
 
 
 def _searched(c: Candidate, design: Design, objective, settings, evaluate) -> Candidate:
@@ -170,10 +178,23 @@ class GlobalSearchOptions:
         alpha_m of a one-chromosome part, :meth:`Design.ridge_keys`) is a log-scale
         amplitude variable instead of every chromosome (surfaces; beyond Eq. 3.17's one
         amplitude per ridge).
+    genes : float
+        0: off. > 0: every part's genes gamma, H and lambda1 (Eq. 3.2: the wavenumbers
+        ``q_n = 2 pi gamma^(n-1) / lambda1`` and amplitudes ``G gamma^((1-n) H)`` of its
+        chromosomes) are variables too, ``g = g_0 (1 + genes tanh v)`` (-), 0 <= genes
+        < 1; not with ``amplitudes`` (a split design would give every chromosome its own
+        gamma).
     seed : int
-        ``numpy.random.default_rng(seed)``: the search is deterministic.
+        Every IPOP-CMA-ES run draws from ``numpy.random.default_rng(seed)``: the search
+        is deterministic (rounds differ by their start, candidates by their design).
     n_candidates : int
         The best candidates (by strict f) searched, one after the other, >= 1.
+    rounds : int
+        IPOP-CMA-ES runs one after the other, each from the best design of the round
+        before (population back to ``popsize``, step back to ``sigma``), ``n_eval``
+        evaluations each, >= 1. Measured (``docs/theory/06_design.md``): the restarts
+        of IPOP return to the start design, and the basin of the best design found is
+        explored only by a run that starts there.
     """
 
     method: str = "cmaes"
@@ -183,8 +204,10 @@ class GlobalSearchOptions:
     weight_fraction: float = 0.3
     amplitudes: float = 0.0
     waves: bool = False
+    genes: float = 0.0
     seed: int = 0
     n_candidates: int = 1
+    rounds: int = 1
 
     def __post_init__(self):
         if self.method not in GLOBAL_METHODS:
@@ -196,7 +219,11 @@ class GlobalSearchOptions:
                    self.weight_fraction),
                   ("0 <= amplitudes <= 2 (log half-range)", 0 <= self.amplitudes <= 2,
                    self.amplitudes),
-                  ("n_candidates >= 1", int(self.n_candidates) >= 1, self.n_candidates))
+                  ("0 <= genes < 1", 0 <= self.genes < 1, self.genes),
+                  ("genes = 0 with amplitudes", not (self.genes and self.amplitudes),
+                   self.genes),
+                  ("n_candidates >= 1", int(self.n_candidates) >= 1, self.n_candidates),
+                  ("rounds >= 1", int(self.rounds) >= 1, self.rounds))
         for what, ok, value in checks:
             if not ok:
                 raise InputError(f"global search: {what} needed, got {value!r}")
@@ -209,16 +236,22 @@ class GlobalSearchOptions:
         """The amplitude variables, one of :data:`AMPLITUDE_VARIABLES`."""
         return "part" if not self.amplitudes > 0 else "wave" if self.waves else "chromosome"
 
-    def weights(self, w0, v):
-        """Weights (-) of the variables ``v`` around their start values ``w0``."""
+    def values(self, keys, x0, X) -> np.ndarray:
+        """The design variables ``keys`` (start values ``x0``) of the CMA-ES points ``X``
+        (rows): phases as they are (rad), weights and genes mapped into their bounds."""
+        is_gene = np.array([len(k) == 2 and k[1] in SEARCH_GENES for k in keys])
+        is_w = np.array([is_amplitude_key(k) for k in keys])
         if self.amplitudes > 0:
-            return w0 * np.exp(self.amplitudes * np.tanh(v))
-        return w0 * (1 + self.weight_fraction * np.tanh(v))
+            w = x0 * np.exp(self.amplitudes * np.tanh(X))
+        else:
+            w = x0 * (1 + self.weight_fraction * np.tanh(X))
+        return np.where(is_w, w, np.where(is_gene, x0 * (1 + self.genes * np.tanh(X)), X))
 
     def describe(self) -> str:
-        if self.amplitudes > 0:
-            return f"{self.kind} amplitudes x exp(+-{self.amplitudes:g})"
-        return f"part weights +-{self.weight_fraction:.0%}"
+        what = (f"{self.kind} amplitudes x exp(+-{self.amplitudes:g})" if self.amplitudes > 0
+                else f"part weights +-{self.weight_fraction:.0%}")
+        return what + (f", genes {'/'.join(SEARCH_GENES)} +-{self.genes:.0%}"
+                       if self.genes > 0 else "")
 
 
 def search_global(result: DesignResult, settings: DatabaseSettings,
@@ -240,8 +273,9 @@ def search_global(result: DesignResult, settings: DatabaseSettings,
     log scale, ``a_n = a_n0 exp(amplitudes tanh v)``. Optimiser:
     :func:`roughfe.optim.cmaes.ipop_cmaes` from the candidate's design with step
     ``sigma``, population ``popsize`` (default 4 + 3 ln n), doubled at each restart,
-    ``n_eval`` strict evaluations per candidate, ``default_rng(seed)``; the
-    ``n_candidates`` best candidates (by strict f) are searched, the others kept.
+    ``n_eval`` strict evaluations per candidate and round, ``default_rng(seed)``; with
+    ``rounds`` > 1 the next run starts from the best design found; the ``n_candidates``
+    best candidates (by strict f) are searched, the others kept.
 
     Why: the thesis stages and the (1+1)-ES of :func:`search_at_target_pressures`
     stop at f <= 0.843 at p_t on y_t1/y_t3, while the set f >= 0.9 around the target
@@ -257,42 +291,71 @@ def search_global(result: DesignResult, settings: DatabaseSettings,
     t0 = time.perf_counter()
     evaluate = Evaluator(settings)
     objective = result.objective
-    rng = np.random.default_rng(opts.seed)
     cands = list(result.candidates)
     strict0 = [combined_score(c.at_targets) if c.at_targets else
                combined_score(_at_targets(c.design, objective, settings, evaluate))
                for c in cands]
     order = np.argsort(strict0, kind="stable")[::-1]
-    out, runs = [], []
+    out, runs, curves = [], [], []
     for rank, i in enumerate(order):
         c = cands[i]
         if rank >= int(opts.n_candidates):
             out.append(c if c.at_targets else replace(c, at_targets=_at_targets(
                 c.design, objective, settings, evaluate)))
             continue
-        d0, keys, x0, is_w = _search_variables(c.design, opts.kind)
+        c, c_runs = _global_rounds(c, opts, objective, settings, evaluate)
+        out.append(c)
+        runs += c_runs
+        curves.append(_joined_history([r.history for r in c_runs]))
+    out.sort(key=lambda c: -combined_score(c.at_targets))
+    f = combined_score(out[0].at_targets)
+    hist = "; ".join(f"{r.nfev} evaluations in {r.n_runs} runs (populations "
+                     f"{', '.join(map(str, r.popsizes))}): f {r.fun0:.4f} -> {r.fun:.4f}"
+                     for r in runs)
+    rounds = f"{opts.rounds} rounds from the best, " if opts.rounds > 1 else ""
+    res = _extended(result, out, evaluate, t0, f"; global search at the target pressures "
+                    f"(IPOP-CMA-ES, sigma {opts.sigma:g}, phases and {opts.describe()}, "
+                    f"{rounds}{hist}): f at p_t = {f:.4f}")
+    return replace(res, search_history=tuple(curves))
 
-        def designs(X, d0=d0, keys=keys, x0=x0, is_w=is_w):
-            V = np.where(is_w, opts.weights(x0, X), X)
-            return [d0.with_phases(keys, v) for v in V]
+
+def _global_rounds(c: Candidate, opts: GlobalSearchOptions, objective, settings, evaluate):
+    """``opts.rounds`` IPOP-CMA-ES runs of :func:`search_global` on candidate ``c``, each
+    from the best design of the round before (re-scored by one single solve in between,
+    :func:`_searched`); stops early when a round finds nothing better (the next would
+    repeat it). Returns the candidate and the :class:`~roughfe.optim.cmaes.CmaResult`
+    of each round."""
+    runs = []
+    for _ in range(int(opts.rounds)):
+        d0, keys, x0, is_w = _search_variables(c.design, opts.kind, opts.genes > 0)
+
+        def designs(X, d0=d0, keys=keys, x0=x0):
+            return [d0.with_phases(keys, v) for v in opts.values(keys, x0, X)]
 
         def fun(X, designs=designs):
             sc = score_batch_at_target_pressures(designs(X), objective.targets, settings)
             evaluate.n_sweeps += len(X)
             return np.array([combined_score(r) for r in sc])
 
-        u0 = np.where(is_w, 0.0, x0)
-        run = ipop_cmaes(fun, u0, opts.sigma, int(opts.n_eval), popsize=int(opts.popsize),
-                         rng=rng)
+        run = ipop_cmaes(fun, np.where(is_w, 0.0, x0), opts.sigma, int(opts.n_eval),
+                         popsize=int(opts.popsize), rng=np.random.default_rng(opts.seed))
         runs.append(run)
-        d_best = designs(run.x[None, :])[0] if run.fun > run.fun0 else c.design
-        out.append(_searched(c, d_best, objective, settings, evaluate))
-    out.sort(key=lambda c: -combined_score(c.at_targets))
-    f = combined_score(out[0].at_targets)
-    hist = "; ".join(f"{r.nfev} evaluations in {r.n_runs} runs (populations "
-                     f"{', '.join(map(str, r.popsizes))}): f {r.fun0:.4f} -> {r.fun:.4f}"
-                     for r in runs)
-    res = _extended(result, out, evaluate, t0, f"; global search at the target pressures "
-                    f"(IPOP-CMA-ES, sigma {opts.sigma:g}, phases and {opts.describe()}, "
-                    f"{hist}): f at p_t = {f:.4f}")
-    return replace(res, search_history=tuple(r.history for r in runs))
+        improved = run.fun > run.fun0
+        c = _searched(c, designs(run.x[None, :])[0] if improved else c.design, objective,
+                      settings, evaluate)
+        if not improved:
+            break
+    return c, runs
+
+
+def _joined_history(histories) -> np.ndarray:
+    """Rows (strict evaluations spent, best f so far) of consecutive rounds as one curve."""
+    spent, rows = 0, []
+    for h in histories:
+        h = np.array(h, dtype=float)
+        h[:, 0] += spent
+        spent = h[-1, 0]
+        rows.append(h)
+    h = np.concatenate(rows)
+    h[:, 1] = np.maximum.accumulate(h[:, 1])
+    return h
