@@ -11,6 +11,21 @@ from .options import (add_output_folder, add_run_options, nonnegative_float, non
                       output_folder_of, positive_float, positive_int)
 
 BUILTIN = ("y_t1", "y_t2", "y_t3")
+#: the numeric ``--global-*`` flags (GlobalSearchOptions): flag, type, default, metavar, help
+GLOBAL_FLAGS = (
+    ("--global-eval", positive_int, 20000, "N",
+     "strict evaluations per searched candidate and round"),
+    ("--global-amplitudes", nonnegative_float, 0.0, "X",
+     "every chromosome's amplitude a variable too, within exp(+-X) of its start (log "
+     "scale, X <= 2; 0: part weights +-30%%)"),
+    ("--global-popsize", nonnegative_int, 0, "L",
+     "population of the first CMA-ES run, doubled at each restart (0: 4 + 3 ln n)"),
+    ("--global-candidates", positive_int, 1, "K", "search the K best candidates (by strict f)"),
+    ("--global-rounds", positive_int, 1, "R",
+     "R IPOP-CMA-ES runs, each from the best design of the one before (N evaluations each)"),
+    ("--global-genes", nonnegative_float, 0.0, "X",
+     "every part's gamma, H, lambda1 a variable too, within +-X (fraction, < 1) of its "
+     "start (0: off)"))
 
 
 def _target(spec, quantity, settings, cache):
@@ -171,25 +186,12 @@ def register(sub):
                    help="after --search: IPOP-CMA-ES on all phases and the amplitudes of "
                         "--global-amplitudes, on the score at the target pressures (batched "
                         "BEM, profiles and surfaces; beyond the thesis)")
-    g.add_argument("--global-eval", type=positive_int, default=20000, metavar="N",
-                   help="--global: strict evaluations per searched candidate")
-    g.add_argument("--global-amplitudes", type=nonnegative_float, default=0.0, metavar="X",
-                   help="--global: every chromosome's amplitude a variable too, within "
-                        "exp(+-X) of its start (log scale, X <= 2; 0: part weights +-30%%)")
+    for flag, kind, default, metavar, text in GLOBAL_FLAGS:
+        g.add_argument(flag, type=kind, default=default, metavar=metavar,
+                       help="--global: " + text)
     g.add_argument("--global-waves", action="store_true",
                    help="--global-amplitudes per wave (every ridge of every chromosome, "
                         "surfaces) instead of per chromosome")
-    g.add_argument("--global-popsize", type=nonnegative_int, default=0, metavar="L",
-                   help="--global: population of the first CMA-ES run, doubled at each "
-                        "restart (0: 4 + 3 ln n)")
-    g.add_argument("--global-candidates", type=positive_int, default=1, metavar="K",
-                   help="--global: search the K best candidates (by strict f)")
-    g.add_argument("--global-rounds", type=positive_int, default=1, metavar="R",
-                   help="--global: R IPOP-CMA-ES runs, each from the best design of the one "
-                        "before (N evaluations each)")
-    g.add_argument("--global-genes", type=nonnegative_float, default=0.0, metavar="X",
-                   help="--global: every part's gamma, H, lambda1 a variable too, within "
-                        "+-X (fraction, < 1) of its start (0: off)")
     g.add_argument("--match-spectrum", default=None, metavar="SURFACE",
                    help="surface database, beyond the thesis, after --refine and before "
                         "--search: set every chromosome's amplitude to the band rms of this "
