@@ -40,6 +40,11 @@ why, load average, CPU, wall and peak RSS of the whole run) and prints the table
 
     .venv/bin/python benchmarks/bench_bem.py [--sizes 512 1024 2048] [--tamaas-max 512]
         [--hardness-size 512] [--large 4096] [--quick]
+
+The 8192^2 solve alone (about 4 GB, minutes of CPU: run it on a quiet machine, once)::
+
+    nice -n 10 .venv/bin/python benchmarks/bench_bem.py --large-only --large 8192 \
+        --output benchmarks/output/bench_bem_8192.json
 """
 from __future__ import annotations
 
@@ -275,6 +280,9 @@ def main(argv=None) -> int:
                     help="sizes of the single-load memory case (8192 takes minutes and "
                          "~4 GB: run it alone)")
     ap.add_argument("--quick", action="store_true", help="256 and 512 only, no large case")
+    ap.add_argument("--large-only", action="store_true",
+                    help="only the --large cases (no cold/warm sweeps, no hardness case): "
+                         "e.g. the 8192^2 solve alone on a quiet machine")
     ap.add_argument("--output", type=Path, default=HERE / "output" / "bench_bem.json")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -284,6 +292,8 @@ def main(argv=None) -> int:
         return 0
     if args.quick:
         args.sizes, args.large, args.hardness_size = [256, 512], [], 256
+    if args.large_only:
+        args.sizes = []
     sys.path.insert(0, str(HERE))
     from _report import write_report  # benchmarks/_report.py
 
@@ -303,11 +313,13 @@ def main(argv=None) -> int:
               f"warm sweep {e['warm_nit']} iterations, {e['warm_convolutions']:.0f} "
               f"convolutions; peak RSS {e['peak_rss_mb']:.0f} MB",
               flush=True)
-    hard = run_case("hardness", n=args.hardness_size, loads=args.loads[:3],
-                    hardness=args.hardness, tamaas=args.hardness_size <= args.tamaas_max)
-    print(_table(hard["rows"], ["n", "p/E*", "A*", "plastic", "nit", "elastic_nit",
-                                "hardness/elastic", "tamaas_A*", "tamaas_plastic", "|dA*|",
-                                "|dplastic|"]), flush=True)
+    hard = {"rows": []}
+    if not args.large_only:
+        hard = run_case("hardness", n=args.hardness_size, loads=args.loads[:3],
+                        hardness=args.hardness, tamaas=args.hardness_size <= args.tamaas_max)
+        print(_table(hard["rows"], ["n", "p/E*", "A*", "plastic", "nit", "elastic_nit",
+                                    "hardness/elastic", "tamaas_A*", "tamaas_plastic",
+                                    "|dA*|", "|dplastic|"]), flush=True)
     large = []
     for n in args.large:
         large.append(run_case("large", n=n, pm=0.05))
@@ -360,7 +372,9 @@ def main(argv=None) -> int:
                         "reason": "tamaas is not installed (pip install tamaas==2.8.1: "
                                   "pyproject extra 'bench')"})
     else:
-        beyond = sorted({n for n in [*args.sizes, args.hardness_size] if n > args.tamaas_max})
+        beyond = sorted({n for n in [*args.sizes, *([] if args.large_only else
+                                                   [args.hardness_size])]
+                         if n > args.tamaas_max})
         if beyond:
             skipped.append({"name": "Tamaas at " + ", ".join(f"{n}^2" for n in beyond),
                             "reason": f"--tamaas-max {args.tamaas_max}: Tamaas 2.8.1 takes "

@@ -370,7 +370,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         step = (pF - par.take(p, F) if clipped and single and not low and not whole
                 else None)
         par.put(p, F, pF)
-        S = np.flatnonzero(p) if bounded else F[pF > 0]
+        S = par.flatnonzero(p) if bounded else F[pF > 0]
         if clipped and step is None:
             u = None          # the projection moved p off the line: recompute u = H p
         elif clipped:
