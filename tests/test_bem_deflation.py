@@ -151,3 +151,27 @@ def test_block_deflation_bad_input(shape, block, kw):
     op = influence_operator(shape, (1.0, 1.0), 1.0)
     with pytest.raises(InputError, match="multiples of block|coarse_tol|settle"):
         BlockDeflation(op, block, **kw)
+
+
+def test_solve_contact_uses_it_in_its_range(monkeypatch):
+    # solve_contact takes the two-level correction for periodic elastic load-controlled
+    # solves with sides in DEFLATION_SIDES (here widened to 128): the same contact
+    # (A*, pressures within the KKT tolerance, Delta) as without, in fewer iterations
+    from roughfe.bem import Material, solve_contact
+    from roughfe.bem import contact
+
+    surface = spectral_surface(128, 1.0, 0.8, rms_slope=1.0, rng=1)
+    mat = Material(1.0, 0.0)
+    plain = solve_contact(surface, mat, mean_pressure=0.05)
+    monkeypatch.setattr(contact, "DEFLATION_SIDES", (128, 128))
+    assert isinstance(contact._deflation(contact._operator(
+        surface.shape, surface.size, 1.0, "spectral"), None, None), BlockDeflation)
+    defl = solve_contact(surface, mat, mean_pressure=0.05)
+    assert defl.nit < 0.8 * plain.nit
+    assert defl.n_contact == plain.n_contact
+    scale = float(plain.pressure.max())
+    assert np.abs(defl.pressure - plain.pressure).max() <= 1e-8 * scale
+    assert defl.delta == pytest.approx(plain.delta, rel=1e-8)
+    # not with a hardness (its saturated points are not in the coarse space's load)
+    assert contact._deflation(contact._operator(surface.shape, surface.size, 1.0,
+                                                "spectral"), 1.0, None) is None

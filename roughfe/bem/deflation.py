@@ -145,6 +145,10 @@ class ProbedBlockDeflation:
 _NEAR = ((0, 0), (0, 1), (1, -1), (1, 0), (1, 1))
 
 
+#: blocks per matrix product of the near field (bounds its temporaries to ~20 MB)
+_CHUNK = 16384
+
+
 class BlockDeflation:
     """A-DEF2 coarse correction on b x b block aggregates of the free set: production form.
 
@@ -205,18 +209,22 @@ class BlockDeflation:
         self.coarse_max_iter = int(coarse_max_iter)
         self.settle = float(settle)
         self.coarse_shape = (m0, m1) = (op.shape[0] // b, op.shape[1] // b)
-        kern = np.asarray(op.kernel)
+        # the real-space kernel G within 2b - 1 of the origin (a temporary full grid:
+        # the operator keeps no real-space kernel) and K, the Galerkin matrix of full
+        # blocks: H applied to a block indicator, summed over every block
+        kern = scipy.fft.irfftn(op.spectrum, s=op.shape)
         a0, a1 = np.divmod(np.arange(b * b), b)          # position in a block
         near = []
         for d0, d1 in _NEAR:
             r0 = (d0 * b + a0[None, :] - a0[:, None]) % op.shape[0]
             r1 = (d1 * b + a1[None, :] - a1[:, None]) % op.shape[1]
             near.append(kern[r0, r1])                    # [a, c] = G(d b + c - a)
+        del kern
         self._near = np.concatenate(near, axis=1).astype(np.float32)
-        # K: the Galerkin matrix of full blocks, sum over block pairs of G
         chi = np.zeros(op.shape)
         chi[:b, :b] = 1.0
         K = op.apply(chi).reshape(m0, b, m1, b).sum(axis=(1, 3))
+        del chi
         self._k0 = float(K[0, 0])
         self._knear = [float(K[d0 % m0, d1 % m1]) for d0, d1 in _NEAR]
         self._khat = scipy.fft.rfft2(K)
@@ -260,17 +268,23 @@ class BlockDeflation:
         dirty = [(changed | np.roll(changed, (-d0, -d1), axis=(0, 1))).ravel()
                  for d0, d1 in _NEAR]
         rows = np.flatnonzero(np.logical_or.reduce(dirty) & (counts > 0))
-        V = X[rows].astype(np.float32) @ self._near
-        ri, rj = np.divmod(rows, m1)
+        for o in range(len(_NEAR)):
+            self._exact[o][dirty[o]] = 0.0
+        # in chunks of rows: the products take 20 bytes per point of the chunk
+        for start in range(0, rows.size, _CHUNK):
+            chunk = rows[start:start + _CHUNK]
+            V = X[chunk].astype(np.float32) @ self._near
+            ri, rj = np.divmod(chunk, m1)
+            for o, (d0, d1) in enumerate(_NEAR):
+                sel = dirty[o][chunk]
+                nb = ((ri[sel] + d0) % m0) * m1 + (rj[sel] + d1) % m1
+                self._exact[o][chunk[sel]] = np.einsum(
+                    "ij,ij->i", V[sel, o * b * b:(o + 1) * b * b], X[nb].astype(np.float32))
+            del V
         N = (counts / float(b * b)).reshape(m0, m1)
         coef = []
         for o, (d0, d1) in enumerate(_NEAR):
             e = self._exact[o]
-            e[dirty[o]] = 0.0
-            sel = dirty[o][rows]
-            nb = ((ri[sel] + d0) % m0) * m1 + (rj[sel] + d1) % m1
-            e[rows[sel]] = np.einsum("ij,ij->i", V[sel, o * b * b:(o + 1) * b * b],
-                                     X[nb].astype(np.float32))
             c = e.reshape(m0, m1) - N * np.roll(N, (-d0, -d1), axis=(0, 1)) * self._knear[o]
             coef.append(c)
         diag = coef[0] + N * N * self._k0

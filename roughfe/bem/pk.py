@@ -150,8 +150,9 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     free-set indices ``F``, the gradient ``gF`` and ``apply_free(xF) = (H x)_F`` (a
     counted product, single precision when ``apply_single`` is given). The Polak-Ribiere
     beta keeps the CG flexible for such a (possibly inexact) preconditioner. The
-    reference form is :class:`roughfe.bem.deflation.ProbedBlockDeflation`, measured in
-    ``docs/theory/02b_bem_performance.md``; ``solve_contact`` does not use one.
+    reference form is :class:`roughfe.bem.deflation.ProbedBlockDeflation`, the production
+    one :class:`roughfe.bem.deflation.BlockDeflation` (used by ``solve_contact`` in its
+    measured range), both measured in ``docs/theory/02b_bem_performance.md``.
 
     Returns a :class:`SolverOutput`.
     """
