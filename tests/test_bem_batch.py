@@ -167,3 +167,41 @@ def test_schur_complement_on_the_top_set_equals_the_direct_solves():
     s1, s2 = batch_sweep(o, h, pr), batch_sweep(o, h, pr, top=top)
     np.testing.assert_array_equal(s1.area_fraction, s2.area_fraction)
     np.testing.assert_allclose(s2.delta, s1.delta, rtol=1e-12)
+
+
+def test_batched_and_single_field_cg_are_one_algorithm():
+    """solve_batch (masked full rows) and pk.polonsky_keer (gathered free set) share the
+    CG's pieces (solvers.pr_beta, step_length, relative_residual): on one periodic
+    field they take the same iterations to the same state. The pieces give the same
+    numbers as scalars (pk) and per row (batch); tau is the exact minimiser of the
+    quadratic energy along t; beta restarts (0) without a previous iteration."""
+    import functools
+    from roughfe.bem.contact import _cg_preconditioner
+    from roughfe.bem.pk import polonsky_keer
+    from roughfe.bem.solvers import pr_beta, relative_residual, step_length
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(128, 1e-3, 0.8, rms_slope=1.0, rng=3)
+    h = s.heights
+    o = influence_operator(h.shape, s.size, MAT.E_star)
+    pm = 0.05 * MAT.E_star
+    st = solve_batch(o, h[None], mean_pressure=pm, tol=1e-10)
+    pk = polonsky_keer(o.apply, h, float(np.ptp(h)), mean_pressure=pm, offset=-h.max(),
+                       precond=_cg_preconditioner(o),
+                       apply_single=functools.partial(o.apply, single=True))
+    assert abs(int(st.nit[0]) - pk.nit) <= 1
+    np.testing.assert_array_equal(st.pressure[0] > 0, pk.pressure > 0)
+    np.testing.assert_allclose(st.pressure[0], pk.pressure, rtol=0, atol=1e-8 * pk.pressure.max())
+    # the pieces, scalar and per row
+    num, den = np.array([3.0, -2.0, 1.0, 5.0]), np.array([2.0, 4.0, 0.0, -1.0])
+    rows = pr_beta(num, den), step_length(num, den), relative_residual(num, den, den, 2.0)
+    for i in range(4):
+        assert pr_beta(num[i], den[i]) == rows[0][i] and step_length(num[i], den[i]) == rows[1][i]
+        assert relative_residual(num[i], den[i], den[i], 2.0) == rows[2][i]
+    np.testing.assert_array_equal(rows[0], [1.5, 0.0, 0.0, 0.0])
+    rng = np.random.default_rng(0)
+    a = rng.standard_normal((6, 6))
+    A, b, x, t = a @ a.T + 6 * np.eye(6), *rng.standard_normal((3, 6))
+    g = A @ x - b                                       # gradient of 1/2 x'Ax - b'x
+    tau = step_length(g @ t, t @ A @ t)
+    energy = [0.5 * y @ A @ y - b @ y for y in (x - (tau + e) * t for e in (-1e-4, 0, 1e-4))]
+    assert energy[1] < min(energy[0], energy[2])

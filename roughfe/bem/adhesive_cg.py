@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .solvers import pr_beta
+
 
 def _line_search(df, alpha0, slope0):
     """First zero of the directional derivative ``df(a)`` (increasing through it) for
@@ -104,9 +106,7 @@ def adhesive_pcg(energy, x0, tol, max_iter):
         z = op.convolve_spectrum(rf, hspec).astype(np.float64)
         z[pinned] = 0.0
         gz = float(np.vdot(rf, z))
-        beta = 0.0
-        if z_old is not None and gz_old > 0:
-            beta = max(0.0, float(np.vdot(rf, z - z_old)) / gz_old)
+        beta = 0.0 if z_old is None else float(pr_beta(float(np.vdot(rf, z - z_old)), gz_old))
         d *= beta
         d -= z
         d[pinned] = 0.0

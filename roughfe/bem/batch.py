@@ -31,7 +31,7 @@ import numpy as np
 
 from ..errors import InputError, NoConvergenceError
 from .operators import InfluenceOperator, influence_operator
-from .solvers import kkt_residual, penetration_start
+from .solvers import kkt_residual, penetration_start, pr_beta, step_length
 
 #: threads per batched FFT: one. The transforms are many short rows; a second thread
 #: only adds a barrier per product, which on a shared machine waits for a free core
@@ -203,15 +203,14 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
             z -= np.where(F, col(z.sum(axis=ax) / nF), 0.0)
         gz = (gF * z).sum(axis=ax)
         go = gz_old[act]
-        beta = np.where(go > 0, np.maximum(0.0, (gz - (z * g_old[act] * F).sum(axis=ax))
-                                           / np.where(go > 0, go, 1.0)), 0.0)
+        beta = pr_beta(gz - (z * g_old[act] * F).sum(axis=ax), go)
         ta = np.where(F, col(beta) * t[act] + z, 0.0)
         gz_old[act] = gz
         g_old[act] = gF
         gt = (gF * ta).sum(axis=ax)
         r = bop.apply(ta)
         tr = (ta * r).sum(axis=ax)
-        tau = np.where(tr > 0, gt / np.where(tr > 0, tr, 1.0), 0.0)
+        tau = step_length(gt, tr)
         pa = pa - col(tau) * ta
         clipped = (pa < 0).any(axis=ax)
         np.clip(pa, 0.0, None, out=pa)

@@ -15,6 +15,7 @@ from ..errors import InputError
 from ..model import central_differences
 from .batch import BatchOperator, BatchState, BatchSweep, _rows, solve_batch
 from .operators import InfluenceOperator
+from .solvers import kkt_residual
 
 
 def _exact_ok(op) -> bool:
@@ -221,10 +222,7 @@ def solve_batch_exact(op: InfluenceOperator, heights, *, delta=None, mean_pressu
         p[act], d[act] = st.pressure, st.delta
     u = bop.apply(p)
     w = u - c - d[:, None]
-    sp = p.sum(axis=1)
-    res = np.maximum(np.where(sp > 0, (p * np.abs(w)).sum(axis=1) / (np.where(sp > 0, sp, 1)
-                                                                       * scale), 0.0),
-                     np.maximum(0.0, -w.min(axis=1)) / scale)
+    res = kkt_residual(p, w, scale, axis=1)
     pivots = None if act.size else (F, *sets)
     return BatchState(p, u, d, p.mean(axis=1), (p > 0).sum(axis=1), nit, res, pivots)
 

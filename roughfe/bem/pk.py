@@ -11,7 +11,8 @@ from scipy.linalg.blas import daxpy, saxpy
 from . import _parallel as par
 from ..errors import InputError
 from .operators import FFTWorkspace
-from .solvers import SolverOutput, _fail, _rescale_to_load, penetration_start
+from .solvers import (SolverOutput, _fail, _rescale_to_load, penetration_start, pr_beta,
+                      relative_residual, step_length)
 
 #: relative KKT residual above which the products with H may be taken in single precision
 #: (``apply_single``): a hundred times the float32 rounding of u = H p (~1e-7 of max |u|)
@@ -289,7 +290,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             del gpen
         else:                 # the largest penetration, anywhere
             feas = max(0.0, d - gmin)
-        res = max(comp / (sp * scale) if sp > 0 else 0.0, feas / scale)
+        res = float(relative_residual(comp, feas, sp, scale))
         if res <= tol:
             if exact and not low:
                 if us != 1.0:
@@ -324,7 +325,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         else:
             zF = gF.copy()
         gz = float(np.dot(gF, zF))
-        beta = max(0.0, (gz - float(np.dot(zF, g_old))) / gz_old) if gz_old > 0 else 0.0
+        beta = float(pr_beta(gz - float(np.dot(zF, g_old)), gz_old))
         del g_old             # free-set vectors go as soon as they are used: early on F
         gz_old = gz           # can hold half the grid
         # the new direction on F, float64 (t and zF may be float32)
@@ -336,7 +337,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         del gF
         r = H(t, "r", single)
         tr = float(np.dot(tF, par.take(r, F)))
-        tau = gt / tr if tr > 0 else 0.0
+        tau = float(step_length(gt, tr))
         pF = par.take(p, F)
         tF *= tau
         pF -= tF

@@ -57,10 +57,42 @@ def kkt_residual(p, w, scale, upper=np.inf, axis=None):
         sat = p >= upper
         comp = np.sum(p * np.where(sat, np.maximum(w, 0.0), np.abs(w)), axis=axis)
         feas = np.maximum(0.0, -np.min(w, axis=axis, initial=np.inf, where=~sat))
-    sp = np.sum(p, axis=axis)
-    comp = np.where(sp > 0, comp / (np.where(sp > 0, sp, 1.0) * scale), 0.0)
-    res = np.maximum(comp, feas / scale)
+    res = relative_residual(comp, feas, np.sum(p, axis=axis), scale)
     return float(res) if axis is None else res
+
+
+# -- the pieces of the Polonsky-Keer CG shared by its single-field form (roughfe.bem.pk) and
+# its batched form (roughfe.bem.batch): scalars there, per-row arrays here -----------------
+def ratio_or_zero(num, den):
+    """``num / den`` where ``den > 0``, else 0: scalars (Python arithmetic, ~2 us: the
+    single-field CG calls it every iteration; numpy's where costs ~12 us) or arrays."""
+    if np.ndim(den) == 0 and np.ndim(num) == 0:
+        return num / den if den > 0 else 0.0
+    ok = np.asarray(den) > 0
+    return np.where(ok, num / np.where(ok, den, 1.0), 0.0)
+
+
+def relative_residual(comp, feas, total, scale):
+    """The relative KKT residual of Eq. 2.5-2.6 from its parts (module docstring):
+    max(comp / (total scale), feas / scale) with ``comp`` = sum p |w| (Pa m), ``feas``
+    the largest interpenetration (m), ``total`` = sum p (Pa; 0 gives a complementarity
+    term of 0) and ``scale`` (m)."""
+    return np.maximum(ratio_or_zero(comp, total * scale), feas / scale)
+
+
+def pr_beta(numerator, gz_old):
+    """Polak-Ribiere+ conjugation coefficient of the preconditioned CG:
+    beta = max(0, numerator / gz_old) with numerator = z.(g - g_old) and gz_old =
+    g_old.z_old of the last iteration; 0 (a restart: steepest descent) when there is
+    none (``gz_old`` <= 0). Restarting itself whenever the new gradient is not conjugate
+    keeps the CG correct on a changing free set and for inexact preconditioners."""
+    return np.maximum(0.0, ratio_or_zero(numerator, gz_old))
+
+
+def step_length(gt, tr):
+    """Exact line search along the direction t: tau = g.t / t.H t (the minimiser of the
+    quadratic energy, Eq. 2.5), 0 when t.H t <= 0 (no descent possible along t)."""
+    return ratio_or_zero(gt, tr)
 
 
 def penetration_start(penetration, diagonal, upper=np.inf):
