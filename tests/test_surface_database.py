@@ -151,14 +151,7 @@ def test_sog_recovers_a_surface_genome_near_the_database(surface_db):
     """Target: a database genome with every phase moved by N(0, 0.3 rad) and amplitude x3
     (a genome outside the database). SOG picks its parent and GCMMA raises s on K(p) to
     >= 0.95; a fresh BEM run of the saved design reproduces the reported score."""
-    path, _ = surface_db
-    entries = db.load_entries(path)
-    g = Genome.from_dict(entries[1].genome)
-    g = replace(g, A=3.0, phases=g.phases + np.random.default_rng(5).normal(0, 0.3, g.phases.shape))
-    target = Design((DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "t"),), 1.0, L,
-                    32, "t", 2)
-    c = Evaluator(SETTINGS)(target)
-    tk = Target(c.pressure, c.stiffness, "K", "tK", {})
+    entries, tk, _ = _perturbed_target(surface_db, 0.3)
     res = run_design("sog", entries, [tk], SETTINGS)
     best = res.best
     assert best.origin == entries[1].label
@@ -288,11 +281,14 @@ def test_ridge_keys_scale_every_wave_on_its_own():
     assert np.max(np.abs(h - waves)) <= 1e-12 * np.ptp(h)
 
 
-def _perturbed_target(surface_db):
+def _perturbed_target(surface_db, spread=0.6):
+    """Database genome 1 with amplitude x3 and every phase moved by N(0, spread) (rad):
+    (entries, K target, A target) of its own BEM sweep."""
     path, _ = surface_db
     entries = db.load_entries(path)
     g = Genome.from_dict(entries[1].genome)
-    g = replace(g, A=3.0, phases=g.phases + np.random.default_rng(5).normal(0, 0.6, g.phases.shape))
+    g = replace(g, A=3.0, phases=g.phases + np.random.default_rng(5).normal(0, spread,
+                                                                          g.phases.shape))
     target = Design((DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "t"),), 1.0, L,
                     32, "t", 2)
     c = Evaluator(SETTINGS)(target)
