@@ -399,3 +399,48 @@ def test_global_search_with_genes_bounded_and_reproduced(entries, targets, tmp_p
     dd = de.Design.from_dict(json.loads(paths["design"].read_text()))
     np.testing.assert_allclose(_strict_scores_by_hand(dd, [t1, t3], tmp_path),
                                saved["scores_at_target_pressures"], atol=1e-7)
+
+
+@pytest.mark.parametrize("method", ["sog", "gco", "cco"])
+def test_single_target_global_stage_without_refine_raises_the_strict_score(entries, targets,
+                                                                           method, tmp_path):
+    """SOG/GCO/CCO for y_t1 followed by the global stage (issue 14 section 2, no refine):
+    IPOP-CMA-ES on every phase and chromosome amplitude of the best thesis-stage candidate,
+    on s solved at the target pressures. The thesis stages of every candidate are kept
+    unchanged (no regression), the strict s rises strictly above the best thesis-stage
+    candidate's, and the saved design's strict s is the hand-written load-controlled BEM
+    run of design.json while its interpolated s is a fresh sweep (design.rescore)."""
+    t1 = targets[0]
+    r = de.run_design(method, entries, [t1], SETTINGS, pbar=0.5 * t1.p_max, options=FAST)
+    s0 = max(de.combined_score(de.rescore_at_target_pressures(c.design, [t1], SETTINGS))
+             for c in r.candidates)
+    rg = de.search_global(r, SETTINGS, de.GlobalSearchOptions(n_eval=300, amplitudes=0.3,
+                                                              seed=0))
+    assert rg.success and rg.method == method
+    assert sorted(c.stages for c in rg.candidates) == sorted(c.stages for c in r.candidates)
+    c = rg.best
+    assert de.combined_score(c.at_targets) > s0
+    assert rg.search_history[0][-1, 1] == pytest.approx(c.at_targets[0], abs=1e-9)
+    paths = de.write_design_result(rg, SETTINGS, tmp_path)
+    saved = json.loads(paths["result"].read_text())["candidates"][0]
+    dd = de.Design.from_dict(json.loads(paths["design"].read_text()))
+    np.testing.assert_allclose(_strict_scores_by_hand(dd, [t1], tmp_path),
+                               saved["scores_at_target_pressures"], atol=1e-7)
+    np.testing.assert_allclose(de.rescore(dd, [t1], SETTINGS), c.scores, atol=1e-6)
+
+
+def test_design_study_yt1_without_refine_rows(entries, targets, tmp_path, monkeypatch):
+    """validation/design_study.yt1_without_refine (the issue 14 rows): per method the
+    strict and interpolated s of the global stage's best design, not below the thesis
+    stages' strict s, each reproduced by independent BEM runs of the saved design."""
+    study = _design_study()
+    monkeypatch.setattr(study, "YT1_GLOBAL", de.GlobalSearchOptions(n_eval=60, amplitudes=0.3))
+    t1 = targets[0]
+    r = de.run_design("sog", entries, [t1], SETTINGS, options=FAST)
+    free = study.yt1_without_refine([r], t1, SETTINGS, tmp_path)
+    (w,) = free["rows"]
+    assert w["method"] == "sog" and w["strict"] >= w["thesis_strict"] and w["n_eval"] <= 60
+    assert len(free["errors"]) == 2 and max(free["errors"]) <= 1e-7
+    saved = json.loads((tmp_path / "yt1_sog_global" / "result.json").read_text())
+    assert saved["candidates"][0]["scores_at_target_pressures"][0] == pytest.approx(w["strict"])
+    assert any("| SOG |" in line for line in free["lines"])
