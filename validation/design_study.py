@@ -153,7 +153,7 @@ def _neighbourhood_lines(nb) -> list:
 #: y_t1 without the refine stage (issue 14 section 2): the global stage
 #: (``design.search_global``) on the best thesis-stage candidate of SOG, GCO and CCO,
 #: every phase and every chromosome amplitude (log scale, x exp(+-0.3)) as variables
-YT1_GLOBAL = de.GlobalSearchOptions(n_eval=6000, sigma=0.5, amplitudes=0.3, seed=0)
+YT1_GLOBAL = de.GlobalSearchOptions(n_eval=10000, sigma=0.5, amplitudes=0.3, seed=0)
 
 
 def yt1_without_refine(results, t1, settings, out: Path) -> dict:
