@@ -1,13 +1,15 @@
-"""Two-level (deflation) coarse correction of the Polonsky-Keer CG on its free set: the
-measured reference form (issue 16 §1, ``docs/theory/02b_bem_performance.md``).
+"""Two-level (deflation) coarse correction of the Polonsky-Keer CG on its free set
+(issue 16 §1, ``docs/theory/02b_bem_performance.md``).
 
-:class:`ProbedBlockDeflation` is passed to :func:`roughfe.bem.pk.polonsky_keer` as
-``deflation=``. It is exact in what matters for the iteration count (the Galerkin
-coarse matrix of the current free set, its near field probed by fine products every
-iteration, its coarse system solved directly) and therefore far too dear for
-production: ``(2 r + 1)^2`` or more extra fine products per iteration and a dense
-coarse factorisation. It measures how many outer iterations a two-level method saves
-in the real, contact-set-changing loop; ``solve_contact`` does not use it.
+Both classes are passed to :func:`roughfe.bem.pk.polonsky_keer` as ``deflation=`` and
+give the same A-DEF2 direction on b x b block aggregates of the free set.
+:class:`ProbedBlockDeflation` is the measured reference: exact in what matters for the
+iteration count (the Galerkin coarse matrix of the current free set, its near field
+probed by fine products every iteration, its coarse system solved directly) and
+therefore far too dear for production: ``(2 r + 1)^2`` or more extra fine products per
+iteration and a dense coarse factorisation. :class:`BlockDeflation` is the production
+form (coarse matrix from the free-set mask, coarse CG), used by ``solve_contact`` in
+its measured range.
 """
 from __future__ import annotations
 
@@ -17,6 +19,33 @@ import scipy.linalg
 
 from ..errors import InputError
 from .operators import InfluenceOperator
+
+
+def _check_grid(op: InfluenceOperator, block: int, min_blocks: int = 1) -> None:
+    """A periodic 2D grid whose sides are multiples of ``block`` (>= ``min_blocks``
+    blocks per side), else a one-line InputError."""
+    if (not op.periodic or len(op.shape) != 2 or block < 1
+            or any(n % block for n in op.shape) or min(op.shape) < min_blocks * block):
+        least = f" with at least {min_blocks} blocks per side" if min_blocks > 1 else ""
+        raise InputError(f"block deflation needs a periodic 2D grid whose sides are "
+                         f"multiples of block = {block}{least}, got shape {op.shape}")
+
+
+def _full_block_galerkin(op: InfluenceOperator, block: int) -> np.ndarray:
+    """K, the Galerkin matrix of full b x b blocks (m/Pa summed over block pairs), a
+    circulant on the coarse grid: H applied to the indicator of block 0, summed over
+    every block; K[d] couples blocks d apart."""
+    m0, m1 = op.shape[0] // block, op.shape[1] // block
+    chi = np.zeros(op.shape)
+    chi[:block, :block] = 1.0
+    return op.apply(chi).reshape(m0, block, m1, block).sum(axis=(1, 3))
+
+
+def _block_of(F, shape, block):
+    """Flat coarse-block index of each flat grid index in ``F`` and the points' (row,
+    column) on the grid."""
+    i, j = np.divmod(F, shape[1])
+    return (i // block) * (shape[1] // block) + j // block, i, j
 
 
 class ProbedBlockDeflation:
@@ -58,10 +87,7 @@ class ProbedBlockDeflation:
 
     def __init__(self, op: InfluenceOperator, block: int = 8, radius: int = 1):
         block, radius = int(block), int(radius)
-        if (not op.periodic or len(op.shape) != 2 or block < 1
-                or any(n % block for n in op.shape)):
-            raise InputError(f"block deflation needs a periodic 2D grid whose sides are "
-                             f"multiples of block = {block}, got shape {op.shape}")
+        _check_grid(op, block)
         m0, m1 = op.shape[0] // block, op.shape[1] // block
         colours = [s for s in range(2 * radius + 1, min(m0, m1) + 1)
                    if m0 % s == 0 and m1 % s == 0]
@@ -73,11 +99,7 @@ class ProbedBlockDeflation:
         self.radius = radius
         self.colours = colours[0]
         self.coarse_shape = (m0, m1)
-        # Galerkin matrix of the full blocks (m/Pa summed over block pairs): H applied
-        # to the indicator of block 0, summed over every block
-        chi = np.zeros(op.shape)
-        chi[:block, :block] = 1.0
-        self.full_block = op.apply(chi).reshape(m0, block, m1, block).sum(axis=(1, 3))
+        self.full_block = _full_block_galerkin(op, block)
 
     def correct(self, F, gF, zF, apply_free):
         """The A-DEF2 direction on F from the gradient ``gF`` and ``zF`` = (M g)_F.
@@ -92,9 +114,8 @@ class ProbedBlockDeflation:
         m0, m1 = self.coarse_shape
         s = gF - apply_free(zF)
         s -= s.mean()
-        i, j = np.divmod(F, self.shape[1])
+        blk, i, j = _block_of(F, self.shape, b)
         bi, bj = i // b, j // b
-        blk = bi * m1 + bj
         counts = np.bincount(blk, minlength=m0 * m1).astype(float)
         act = np.flatnonzero(counts)
         ai, aj = np.divmod(act, m1)
@@ -192,12 +213,7 @@ class BlockDeflation:
     def __init__(self, op: InfluenceOperator, block: int = 8, coarse_tol: float = 1e-6,
                  coarse_max_iter: int = 500, settle: float = 0.3):
         block = int(block)
-        if (not op.periodic or len(op.shape) != 2 or block < 1
-                or any(n % block for n in op.shape)
-                or min(op.shape) < 3 * block):
-            raise InputError(f"block deflation needs a periodic 2D grid whose sides are "
-                             f"multiples of block = {block} with at least 3 blocks per "
-                             f"side, got shape {op.shape}")
+        _check_grid(op, block, 3)
         if not 0.0 < coarse_tol < 1.0:
             raise InputError(f"coarse_tol must lie in (0, 1), got {coarse_tol}")
         if not settle >= 0.0:
@@ -221,10 +237,7 @@ class BlockDeflation:
             near.append(kern[r0, r1])                    # [a, c] = G(d b + c - a)
         del kern
         self._near = np.concatenate(near, axis=1).astype(np.float32)
-        chi = np.zeros(op.shape)
-        chi[:b, :b] = 1.0
-        K = op.apply(chi).reshape(m0, b, m1, b).sum(axis=(1, 3))
-        del chi
+        K = _full_block_galerkin(op, b)
         self._k0 = float(K[0, 0])
         self._knear = [float(K[d0 % m0, d1 % m1]) for d0, d1 in _NEAR]
         self._khat = scipy.fft.rfft2(K)
@@ -241,8 +254,7 @@ class BlockDeflation:
         """Block index of each point of F, the blocks' b^2 mask rows and point counts."""
         b = self.block
         m1 = self.coarse_shape[1]
-        i, j = np.divmod(F, self.shape[1])
-        blk = (i // b) * m1 + j // b
+        blk, i, j = _block_of(F, self.shape, b)
         X = np.zeros((self.coarse_shape[0] * m1, b * b), bool)
         X[blk, (i % b) * b + j % b] = True
         return blk, X, np.bincount(blk, minlength=X.shape[0])

@@ -216,6 +216,7 @@ def _irfftn_owned(vh, shape, workers=None):
         vh = scipy.fft.ifft(vh, axis=axis, overwrite_x=True, workers=workers)
     return scipy.fft.irfft(vh, n=shape[-1], axis=-1, overwrite_x=True, workers=workers)
 
+
 class FFTWorkspace:
     """The one complex buffer of the FFT products of a solve, reused by every product.
 
