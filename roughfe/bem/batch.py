@@ -132,6 +132,10 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
     shape = h.shape
     ax = tuple(range(1, h.ndim))
     load = mean_pressure is not None
+
+    def col(x):                     # per-row scalar broadcast over the grid
+        return np.reshape(x, (-1,) + (1,) * len(ax))
+
     hmax = h.max(axis=ax, keepdims=True)
     c = h - hmax                                    # gap = u - c - Delta
     scale = np.ptp(h.reshape(B, -1), axis=1)
@@ -150,16 +154,13 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
         p = np.clip(np.array(getattr(initial, "pressure", initial), dtype=float).reshape(shape),
                     0.0, None)
     elif load:
-        p = np.broadcast_to(pm.reshape((B,) + (1,) * len(ax)), shape).copy()
+        p = np.broadcast_to(col(pm), shape).copy()
     else:
-        p = penetration_start(dl.reshape((B,) + (1,) * len(ax)) + c, op.diagonal)
+        p = penetration_start(col(dl) + c, op.diagonal)
     if load:
         s = p.sum(axis=ax)
-        p[s == 0] = pm[s == 0].reshape((-1,) + (1,) * len(ax))
-        p *= (target / p.sum(axis=ax)).reshape((B,) + (1,) * len(ax))
-
-    def col(x):                     # per-row scalar broadcast over the grid
-        return x.reshape((-1,) + (1,) * len(ax))
+        p[s == 0] = col(pm[s == 0])
+        p *= col(target / p.sum(axis=ax))
 
     u = bop.apply(p)
     t = np.zeros(shape)
