@@ -175,3 +175,72 @@ def test_solve_contact_uses_it_in_its_range(monkeypatch):
     # not with a hardness (its saturated points are not in the coarse space's load)
     assert contact._deflation(contact._operator(surface.shape, surface.size, 1.0,
                                                 "spectral"), 1.0, None) is None
+
+
+@pytest.mark.parametrize("points", [1, 1 << 30])
+def test_lean_passes_are_the_dense_formulas(monkeypatch, points):
+    # the coarse correction's passes over F (whole block rows, bit-packed masks, no
+    # F-sized index array) give what the one-line dense formulas give: the block
+    # sums Z^T s, the prolongation z + Z c, the blocks' mask rows and point counts;
+    # one block row per pass (points = 1) and one pass over the whole grid
+    from roughfe.bem import deflation
+    monkeypatch.setattr(deflation, "_POINTS", points)
+    shape, b = (48, 64), 8
+    n0, n1 = shape
+    m1 = n1 // b
+    op = influence_operator(shape, (0.75, 1.0), 1.0)
+    rng = np.random.default_rng(4)
+    F = np.flatnonzero(rng.random(n0 * n1) < 0.3)
+    blk = (F // n1 // b) * m1 + (F % n1) // b
+    s = rng.standard_normal(F.size)
+    assert np.array_equal(deflation._restrict(F, s, shape, b),
+                          np.bincount(blk, weights=s, minlength=(n0 // b) * m1))
+    c = rng.standard_normal((n0 // b) * m1)
+    z = rng.standard_normal(F.size)
+    out = deflation._a_def2(F, s, z, lambda x: np.zeros_like(x), shape, b, lambda r: c)
+    dense = z + c[blk]
+    assert np.array_equal(out, dense - dense.mean())
+    X, counts = BlockDeflation(op, b)._rows(F)
+    Xd = np.zeros(((n0 // b) * m1, b * b), bool)
+    Xd[blk, (F // n1 % b) * b + F % n1 % b] = True
+    assert X.dtype == np.uint8 and X.shape == ((n0 // b) * m1, b * b // 8)
+    assert np.array_equal(np.unpackbits(X, axis=1).astype(bool), Xd)
+    assert np.array_equal(counts, np.bincount(blk, minlength=Xd.shape[0]))
+
+
+def test_kernel_and_full_blocks_from_the_half_spectrum():
+    # the near-field kernel window and K (Galerkin matrix of full blocks) are built from
+    # the half spectrum without a full grid: they equal the real-space kernel
+    # irfftn(spectrum) and H applied to a block indicator summed over blocks (their
+    # definitions) to rounding, on a non-square grid
+    from roughfe.bem.deflation import _full_block_galerkin, _kernel_window
+    import scipy.fft
+    shape, b = (48, 64), 8
+    op = influence_operator(shape, (0.75, 1.0), 1.0)
+    kern = scipy.fft.irfftn(op.spectrum, s=shape)
+    rows, cols = np.arange(1 - b, 2 * b), np.arange(1 - 2 * b, 2 * b)
+    window = _kernel_window(op, rows, cols)
+    assert np.allclose(window, kern[np.ix_(rows % shape[0], cols % shape[1])],
+                       rtol=0, atol=1e-14 * np.abs(kern).max())
+    chi = np.zeros(shape)
+    chi[:b, :b] = 1.0
+    K = op.apply(chi).reshape(shape[0] // b, b, shape[1] // b, b).sum(axis=(1, 3))
+    assert np.allclose(_full_block_galerkin(op, b), K, rtol=0, atol=1e-14 * np.abs(K).max())
+
+
+@pytest.mark.parametrize("n", [256, 512])
+def test_lean_passes_same_solve(monkeypatch, n):
+    # in the real loop (cold, load control, tol 1e-10) the correction in passes of one
+    # block row gives the solve of a single pass over the grid (the unchunked layout):
+    # the same outer and coarse iterations and pressures
+    from roughfe.bem import deflation
+    runs = []
+    for points in (8 * n, 1 << 40):
+        monkeypatch.setattr(deflation, "_POINTS", points)
+        made = []
+        out = _solve(n, lambda op: made.append(BlockDeflation(op, 8)) or made[-1],
+                     mean_pressure=0.05)
+        runs.append((out, made[0].inner_iterations))
+    (a, ia), (b, ib) = runs
+    assert a.nit == b.nit and ia == ib and len(ia) > 0
+    assert np.abs(a.pressure - b.pressure).max() <= 1e-12 * float(b.pressure.max())

@@ -31,21 +31,105 @@ def _check_grid(op: InfluenceOperator, block: int, min_blocks: int = 1) -> None:
                          f"multiples of block = {block}{least}, got shape {op.shape}")
 
 
+def _fejer(n: int, block: int) -> np.ndarray:
+    """|sum_{a < block} exp(2 pi i k a / n)|^2 for k = 0 .. n - 1: the squared Fourier
+    transform of a block's indicator along one axis."""
+    k = np.arange(n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = (np.sin(np.pi * block * k / n) / np.sin(np.pi * k / n)) ** 2
+    w[0] = block * block
+    return w
+
+
 def _full_block_galerkin(op: InfluenceOperator, block: int) -> np.ndarray:
     """K, the Galerkin matrix of full b x b blocks (m/Pa summed over block pairs), a
     circulant on the coarse grid: H applied to the indicator of block 0, summed over
-    every block; K[d] couples blocks d apart."""
-    m0, m1 = op.shape[0] // block, op.shape[1] // block
-    chi = np.zeros(op.shape)
-    chi[:block, :block] = 1.0
-    return op.apply(chi).reshape(m0, block, m1, block).sum(axis=(1, 3))
+    every block; K[d] couples blocks d apart.
+
+    Built from the half spectrum without a full grid: in Fourier space K is the fine
+    spectrum times the blocks' squared transform |B(k)|^2, summed over the aliases k of
+    each coarse wavevector (k = kappa mod the coarse grid) and divided by b^2; the
+    columns k1 > n1 / 2 of the full spectrum are conj(spectrum[-k0, n1 - k1])."""
+    n0, n1 = op.shape
+    m0, m1 = n0 // block, n1 // block
+    spec = op.spectrum
+    half = spec.shape[1]
+    w0 = _fejer(n0, block)
+    s = np.zeros((m0, half), spec.dtype)
+    for rows in range(0, n0, m0):                   # the aliases k0 = kappa0 + l m0
+        s += w0[rows:rows + m0, None] * spec[rows:rows + m0]
+    full = np.empty((m0, n1), s.dtype)
+    full[:, :half] = s
+    full[:, half:] = np.conj(s[(-np.arange(m0)) % m0][:, n1 - np.arange(half, n1)])
+    full *= _fejer(n1, block)
+    khat = full.reshape(m0, block, m1).sum(axis=1) / float(block * block)
+    return np.fft.ifft2(khat).real
 
 
-def _block_of(F, shape, block):
-    """Flat coarse-block index of each flat grid index in ``F`` and the points' (row,
-    column) on the grid."""
-    i, j = np.divmod(F, shape[1])
-    return (i // block) * (shape[1] // block) + j // block, i, j
+def _kernel_window(op: InfluenceOperator, rows, cols) -> np.ndarray:
+    """The periodic real-space kernel G (m/Pa) at the offsets ``rows`` x ``cols`` (grid
+    points, any sign), from the half spectrum without a full grid: the inverse DFT
+    along axis 0 at ``rows`` only (real matrix products with the spectrum), then an
+    inverse real FFT along axis 1."""
+    n0, n1 = op.shape
+    rows = np.asarray(rows) % n0
+    phase = (2.0 * np.pi / n0) * ((rows[:, None] * np.arange(n0)[None, :]) % n0)
+    spec = op.spectrum
+    part = np.cos(phase) @ spec + 1j * (np.sin(phase) @ spec)
+    return scipy.fft.irfft(part / n0, n=n1, axis=1)[:, np.asarray(cols) % n1]
+
+
+#: grid points per pass over the free set in the coarse correction (whole block rows;
+#: bounds the index temporaries to ~8 MB, so that no F-sized integer array is made)
+_POINTS = 1 << 20
+
+
+def _chunks(F, shape, block):
+    """Passes over the flat free set ``F`` (sorted, as ``flatnonzero`` gives) by runs of
+    whole block rows of about ``_POINTS`` grid points: (slice of F, first grid row, the
+    run's first and end coarse-block index). Every block's points lie in one slice."""
+    n0, n1 = shape
+    m1 = n1 // block
+    rows = block * max(1, _POINTS // (block * n1))
+    starts = np.arange(0, n0, rows)
+    ends = np.searchsorted(F, np.append(starts[1:], n0) * n1)
+    begin = 0
+    for r0, end in zip(starts.tolist(), ends.tolist()):
+        yield slice(begin, end), r0, r0 // block * m1, min(r0 + rows, n0) // block * m1
+        begin = end
+
+
+def _block_index(Fc, r0, shape, block):
+    """Flat coarse-block index of the flat grid indices ``Fc`` (one pass of
+    :func:`_chunks` from grid row ``r0``), relative to the pass's first block."""
+    i, j = np.divmod(Fc - r0 * shape[1], shape[1])
+    i //= block
+    i *= shape[1] // block
+    j //= block
+    i += j
+    return i
+
+
+def _restrict(F, s, shape, block):
+    """Z^T s: the sums of ``s`` (values on F) over each b x b block (flat coarse)."""
+    out = np.zeros((shape[0] // block) * (shape[1] // block))
+    for sl, r0, lo, hi in _chunks(F, shape, block):
+        out[lo:hi] = np.bincount(_block_index(F[sl], r0, shape, block), weights=s[sl],
+                                 minlength=hi - lo)
+    return out
+
+
+def _a_def2(F, gF, zF, apply_free, shape, block, coarse_solve):
+    """The A-DEF2 direction z_F + Z c, c = coarse_solve(Z^T (g - H_FF z)), in the
+    zero-mean subspace of F (``coarse_solve`` maps flat coarse right-hand sides to flat
+    coarse solutions); written over the vector of the right-hand side."""
+    s = gF - apply_free(zF)
+    s -= s.mean()
+    c = coarse_solve(_restrict(F, s, shape, block))
+    for sl, r0, lo, hi in _chunks(F, shape, block):
+        np.add(zF[sl], c[lo:hi][_block_index(F[sl], r0, shape, block)], out=s[sl])
+    s -= s.mean()
+    return s
 
 
 class ProbedBlockDeflation:
@@ -112,10 +196,10 @@ class ProbedBlockDeflation:
         """
         b = self.block
         m0, m1 = self.coarse_shape
-        s = gF - apply_free(zF)
-        s -= s.mean()
-        blk, i, j = _block_of(F, self.shape, b)
-        bi, bj = i // b, j // b
+        bi, bj = np.divmod(F, self.shape[1])      # a reference for small grids: F-sized
+        bi //= b                                  # index arrays are affordable here
+        bj //= b
+        blk = bi * m1 + bj
         counts = np.bincount(blk, minlength=m0 * m1).astype(float)
         act = np.flatnonzero(counts)
         ai, aj = np.divmod(act, m1)
@@ -131,7 +215,7 @@ class ProbedBlockDeflation:
         del di, dj
         colour_point = (bi % sc) * sc + bj % sc
         colour_block = (ai % sc) * sc + aj % sc
-        del i, j, bi, bj
+        del bi, bj
         for c in range(sc * sc):
             cols = np.flatnonzero(colour_block == c)
             if not cols.size:
@@ -145,20 +229,20 @@ class ProbedBlockDeflation:
             rows, which = np.nonzero(sub_near)
             E[rows, cols[which]] = sums[rows] - far[rows]
         E = 0.5 * (E + E.T)
-        rc = np.bincount(blk, weights=s, minlength=m0 * m1)[act]
         # the coarse space of zero-mean vectors: Z T c with T c = c - (n.c / |F|) 1;
         # T^T E T is singular along 1 only, which Z T maps to zero
         t = -counts[act] / float(F.size)
         Et = E + np.outer(E.sum(axis=1), t)
         E = Et + np.outer(t, Et.sum(axis=0))
         E += float(np.mean(np.diag(E))) / act.size
-        c = scipy.linalg.cho_solve(scipy.linalg.cho_factor(E, check_finite=False), rc,
-                                   check_finite=False)
-        full = np.zeros(m0 * m1)
-        full[act] = c
-        out = zF + full[blk]
-        out -= out.mean()
-        return out
+        factor = scipy.linalg.cho_factor(E, check_finite=False)
+
+        def solve(rc):
+            full = np.zeros(m0 * m1)
+            full[act] = scipy.linalg.cho_solve(factor, rc[act], check_finite=False)
+            return full
+
+        return _a_def2(F, gF, zF, apply_free, self.shape, b, solve)
 
 
 #: the block offsets of the near field (Chebyshev distance 1) up to symmetry: E[I, I+d]
@@ -225,15 +309,15 @@ class BlockDeflation:
         self.coarse_max_iter = int(coarse_max_iter)
         self.settle = float(settle)
         self.coarse_shape = (m0, m1) = (op.shape[0] // b, op.shape[1] // b)
-        # the real-space kernel G within 2b - 1 of the origin (a temporary full grid:
-        # the operator keeps no real-space kernel) and K, the Galerkin matrix of full
-        # blocks: H applied to a block indicator, summed over every block
-        kern = scipy.fft.irfftn(op.spectrum, s=op.shape)
+        # the real-space kernel G at the offsets of the near field (rows -b < r0 < 2b,
+        # columns |r1| < 2b) and K, the Galerkin matrix of full blocks, both from the
+        # half spectrum without a full grid (the operator keeps no real-space kernel)
+        kern = _kernel_window(op, np.arange(1 - b, 2 * b), np.arange(1 - 2 * b, 2 * b))
         a0, a1 = np.divmod(np.arange(b * b), b)          # position in a block
         near = []
         for d0, d1 in _NEAR:
-            r0 = (d0 * b + a0[None, :] - a0[:, None]) % op.shape[0]
-            r1 = (d1 * b + a1[None, :] - a1[:, None]) % op.shape[1]
+            r0 = d0 * b + a0[None, :] - a0[:, None] + b - 1
+            r1 = d1 * b + a1[None, :] - a1[:, None] + 2 * b - 1
             near.append(kern[r0, r1])                    # [a, c] = G(d b + c - a)
         del kern
         self._near = np.concatenate(near, axis=1).astype(np.float32)
@@ -249,21 +333,37 @@ class BlockDeflation:
         self._last = None                                 # the last free set's block rows
         self._mask = None                                 # those of the last coarse matrix
         self._exact = [np.zeros(m0 * m1) for _ in _NEAR]  # its exact near-field entries
+        self._scratch = None                              # one pass's grid mask (_rows)
 
     def _rows(self, F):
-        """Block index of each point of F, the blocks' b^2 mask rows and point counts."""
+        """The blocks' b^2 mask rows of F, bit-packed (``np.packbits`` along a row:
+        ceil(b^2 / 8) bytes a block, n / 8 bytes in all for b = 8), and their point counts;
+        built in passes of whole block rows through one reused scratch mask."""
         b = self.block
+        n1 = self.shape[1]
         m1 = self.coarse_shape[1]
-        blk, i, j = _block_of(F, self.shape, b)
-        X = np.zeros((self.coarse_shape[0] * m1, b * b), bool)
-        X[blk, (i % b) * b + j % b] = True
-        return blk, X, np.bincount(blk, minlength=X.shape[0])
+        X = np.empty((self.coarse_shape[0] * m1, (b * b + 7) // 8), np.uint8)
+        counts = np.empty(X.shape[0], np.int64)
+        for sl, r0, lo, hi in _chunks(F, self.shape, b):
+            if self._scratch is None or self._scratch.size < (hi - lo) * b * b:
+                self._scratch = np.empty((hi - lo) * b * b, bool)
+            part = self._scratch[:(hi - lo) * b * b]
+            part.fill(False)
+            part[F[sl] - r0 * n1] = True
+            rows = part.reshape(-1, b, m1, b).transpose(0, 2, 1, 3).reshape(hi - lo, b * b)
+            X[lo:hi] = np.packbits(rows, axis=1)
+            counts[lo:hi] = np.count_nonzero(rows, axis=1)
+        return X, counts
+
+    def _unpack(self, rows):
+        """Mask rows (packed by :meth:`_rows`) as float32 b^2-vectors."""
+        return np.unpackbits(rows, axis=1, count=self.block ** 2).astype(np.float32)
 
     def coarse_operator(self, F):
         """The coarse matrix E of the free set ``F`` (flat indices) as a map of coarse
         vectors (``coarse_shape`` arrays, zero off the active blocks), the blocks' point
         counts and the diagonal of E."""
-        return self._coarse(*self._rows(F)[1:])
+        return self._coarse(*self._rows(F))
 
     def _coarse(self, X, counts):
         b = self.block
@@ -285,13 +385,13 @@ class BlockDeflation:
         # in chunks of rows: the products take 20 bytes per point of the chunk
         for start in range(0, rows.size, _CHUNK):
             chunk = rows[start:start + _CHUNK]
-            V = X[chunk].astype(np.float32) @ self._near
+            V = self._unpack(X[chunk]) @ self._near
             ri, rj = np.divmod(chunk, m1)
             for o, (d0, d1) in enumerate(_NEAR):
                 sel = dirty[o][chunk]
                 nb = ((ri[sel] + d0) % m0) * m1 + (rj[sel] + d1) % m1
                 self._exact[o][chunk[sel]] = np.einsum(
-                    "ij,ij->i", V[sel, o * b * b:(o + 1) * b * b], X[nb].astype(np.float32))
+                    "ij,ij->i", V[sel, o * b * b:(o + 1) * b * b], self._unpack(X[nb]))
             del V
         N = (counts / float(b * b)).reshape(m0, m1)
         coef = []
@@ -356,16 +456,12 @@ class BlockDeflation:
         """The A-DEF2 direction on F (the interface of :class:`ProbedBlockDeflation`);
         ``zF`` itself while more than ``settle`` of the active blocks changed their part
         of F since the last call (the contact-set search)."""
-        blk, X, counts = self._rows(F)
+        X, counts = self._rows(F)
         last, self._last = self._last, X
         if last is None or (np.count_nonzero((X != last).any(axis=1))
                             > self.settle * np.count_nonzero(counts)):
             return zF
-        s = gF - apply_free(zF)
-        s -= s.mean()
         apply, counts, diag = self._coarse(X, counts)
-        rc = np.bincount(blk, weights=s, minlength=counts.size).reshape(counts.shape)
-        c = self._coarse_solve(apply, counts, diag, rc)
-        out = zF + c.ravel()[blk]
-        out -= out.mean()
-        return out
+        return _a_def2(F, gF, zF, apply_free, self.shape, self.block,
+                       lambda rc: self._coarse_solve(apply, counts, diag,
+                                                     rc.reshape(counts.shape)).ravel())
