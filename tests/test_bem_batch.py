@@ -110,6 +110,30 @@ def test_sweep_equals_contact_sweep_area_and_stiffness(method):
                                    rtol=100 * tol)
 
 
+@pytest.mark.parametrize("method", ["exact", "pk"])
+def test_displacement_sweep_equals_contact_sweep(method):
+    """batch_sweep(deltas=) (displacement control, each row at its own increasing
+    approaches; exact: from the top state's contact sets by Schur complements) gives
+    contact_sweep's contact counts, mean pressures and K = dp/dDelta at those approaches."""
+    h = profiles(4, seed=3)
+    dl = np.ptp(h, axis=1)[:, None] * np.arange(1, 9) / 8
+    top = solve_batch_exact(op(), h, delta=np.ptp(h, axis=1)) if method == "exact" else None
+    sw = batch_sweep(op(), h, deltas=dl, method=method, top=top)
+    tol = 1e-10 if method == "exact" else 1e-7
+    for b in range(4):
+        ref = contact_sweep(surface(h[b]), MAT, deltas=tuple(dl[b]), kernel="strip",
+                            compute_stiffness=False)
+        np.testing.assert_array_equal(np.round(sw.area_fraction[b] * N),
+                                      np.round(np.asarray(ref.area_fraction) * N))
+        np.testing.assert_allclose(sw.delta[b], dl[b], rtol=1e-14)
+        np.testing.assert_allclose(sw.mean_pressure[b], ref.mean_pressure, rtol=tol)
+        np.testing.assert_allclose(sw.stiffness[b], ref.stiffness_fd, rtol=100 * tol)
+    with pytest.raises(InputError, match="exactly one"):
+        batch_sweep(op(), h, dl, deltas=dl)
+    with pytest.raises(InputError, match="deltas must be"):
+        batch_sweep(op(), h, deltas=dl[:, ::-1])
+
+
 def test_cylinder_follows_plane_strain_hertz():
     """A parabolic profile h = -x^2/(2R) under a line load P': a = sqrt(4 R P'/(pi E*))
     (Johnson 1985, Eq. 4.43); the node count 2a/dx within two nodes, in every row of a

@@ -263,22 +263,82 @@ def test_multi_start_and_chromosome_amplitudes(entries, targets, tmp_path):
                                atol=1e-7)
 
 
+def _around_target(entries, seed, scale=1.0):
+    """The y_t1 genome as a design (heights x ``scale``), the same with every phase moved
+    by N(0, s) for s = 0.02, 0.1, 0.5 (``default_rng(seed)``) and 3 database genomes."""
+    g = de.target_genome_t1(SETTINGS)
+    d = de.Design((de.DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "y_t1"),), 1.0,
+                  SETTINGS.length, SETTINGS.n_nodes, "y_t1", SETTINGS.dim)
+    keys = d.keys("all")
+    rng = np.random.default_rng(seed)
+    return [d.rescaled(scale)] + [d.with_phases(keys, d.phase_values(keys) + s *
+                                                rng.standard_normal(len(keys)))
+                                  for s in (0.02, 0.1, 0.5)] + \
+        [de.entry_design(e, SETTINGS) for e in entries[:3]]
+
+
 def test_batched_strict_scores_equal_the_single_rescore(entries, targets):
     """score_batch_at_target_pressures (all designs solved together, bem.batch) gives
     rescore_at_target_pressures of each design to round-off: the target genome scores
     1, its moved phases and database genomes less."""
     t1, _, t3, _ = targets
-    g = de.target_genome_t1(SETTINGS)
-    d = de.Design((de.DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0, "y_t1"),), 1.0,
-                  SETTINGS.length, SETTINGS.n_nodes, "y_t1", SETTINGS.dim)
-    keys = d.keys("all")
-    rng = np.random.default_rng(3)
-    designs = [d] + [d.with_phases(keys, d.phase_values(keys) + s * rng.standard_normal(len(keys)))
-                     for s in (0.02, 0.1, 0.5)] + [de.entry_design(e, SETTINGS) for e in entries[:3]]
+    designs = _around_target(entries, seed=3)
     batch = de.score_batch_at_target_pressures(designs, [t1, t3], SETTINGS)
     single = np.array([de.rescore_at_target_pressures(x, [t1, t3], SETTINGS) for x in designs])
     np.testing.assert_allclose(batch, single, rtol=0, atol=1e-9)
     assert batch[0] == pytest.approx([1.0, 1.0], abs=1e-9) and np.all(batch[1:].min(axis=1) < 1)
+
+
+def test_batched_interpolated_scores_equal_the_single_sweep(entries, targets):
+    """score_batch's "interpolated" kind (displacement-controlled batched exact sweep at
+    each design's own n_t approaches, sharing the p_max solve with the strict kind)
+    equals Objective.scores of each design's single BEM sweep, and rescore of the design
+    rescaled to p_max^t (Eq. 4.2), to 1e-7; the target genome scores 1 both ways; the
+    strict kind of the same call equals score_batch_at_target_pressures."""
+    t1, _, t3, _ = targets
+    designs = _around_target(entries, seed=5, scale=3.0)
+    both = de.score_batch(designs, [t1, t3], SETTINGS)
+    assert set(both) == {"strict", "interpolated"}
+    objective = de.Objective((t1, t3))
+    single = np.array([objective.scores(de.Evaluator(SETTINGS)(x)) for x in designs])
+    np.testing.assert_allclose(both["interpolated"], single, rtol=0, atol=1e-7)
+    np.testing.assert_allclose(de.score_batch_interpolated(designs, [t1, t3], SETTINGS),
+                               single, rtol=0, atol=1e-12)
+    for x, s in zip(designs[:3], single):
+        eta = t1.p_max / de.Evaluator(SETTINGS)(x).p_max
+        np.testing.assert_allclose(de.rescore(x.rescaled(eta), [t1, t3], SETTINGS), s,
+                                   atol=1e-7)
+    np.testing.assert_allclose(both["strict"], de.score_batch_at_target_pressures(
+        designs, [t1, t3], SETTINGS), rtol=0, atol=1e-12)
+    assert both["interpolated"][0] == pytest.approx([1.0, 1.0], abs=1e-9)
+    assert np.all(both["interpolated"][1:].min(axis=1) < 1)
+    with pytest.raises(InputError, match="scoring"):
+        de.score_batch(designs, [t1, t3], SETTINGS, ("exact",))
+
+
+def test_global_search_on_min_of_strict_and_interpolated(entries, targets, tmp_path):
+    """search_global(score="min") maximises the smaller of the strict and the interpolated
+    f: the best-so-far curve ends at min(strict f, interpolated f) of the design found,
+    which is not below the start's; the saved design's strict scores equal the
+    hand-written load-controlled BEM run and its interpolated scores a fresh sweep
+    (rescore) to 1e-7."""
+    t1, _, t3, _ = targets
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    c0 = r.best
+    m0 = min(de.combined_score(de.rescore_at_target_pressures(c0.design, [t1, t3], SETTINGS)),
+             de.combined_score(c0.scores))
+    rg = de.search_global(r, SETTINGS, n_eval=150, sigma=0.5, seed=1, score="min")
+    c = rg.best
+    m = min(de.combined_score(c.at_targets), de.combined_score(c.scores))
+    assert rg.success and "min(f at the target pressures, interpolated f)" in rg.message
+    assert m > m0
+    assert rg.search_history[0][-1, 1] == pytest.approx(m, abs=1e-9)
+    paths = de.write_design_result(rg, SETTINGS, tmp_path)
+    saved = json.loads(paths["result"].read_text())["candidates"][0]
+    dd = de.Design.from_dict(json.loads(paths["design"].read_text()))
+    np.testing.assert_allclose(_strict_scores_by_hand(dd, [t1, t3], tmp_path),
+                               saved["scores_at_target_pressures"], atol=1e-7)
+    np.testing.assert_allclose(de.rescore(dd, [t1, t3], SETTINGS), saved["scores"], atol=1e-7)
 
 
 def test_global_search_raises_the_strict_score_reproducibly(entries, targets, tmp_path):
@@ -348,7 +408,8 @@ def test_global_search_with_chromosome_amplitudes_bounded_and_reproduced(entries
                                         ({"rounds": 0}, "rounds >= 1"),
                                         ({"genes": 1.0}, "genes < 1"),
                                         ({"genes": 0.1, "amplitudes": 0.1}, "genes = 0"),
-                                        ({"method": "annealing"}, "method")])
+                                        ({"method": "annealing"}, "method"),
+                                        ({"score": "interpolated"}, "score must be one of")])
 def test_global_search_options_reject_bad_input(bad, match):
     with pytest.raises(InputError, match=match):
         de.GlobalSearchOptions(**bad)

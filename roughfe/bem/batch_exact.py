@@ -240,26 +240,33 @@ def set_inverse(op: InfluenceOperator, state: BatchState) -> tuple:
     return idx, valid, np.linalg.inv(A)
 
 
-def batch_sweep(op: InfluenceOperator, heights, pressures, *, method: str = "auto",
-                tol: float = 1e-10, max_iter: int = 2000, top=None) -> BatchSweep:
-    """Load-controlled sweeps of B surfaces: row ``b`` solved at the increasing mean
-    pressures ``pressures[b]`` (Pa, shape (B, m)), each step warm-started from the
-    previous one; A = contact points / all points, K = dp/dDelta by central differences
-    over the steps. ``method``: "exact" (:func:`solve_batch_exact`, pivoting), "pk"
-    (:func:`solve_batch`, the CG to ``tol``), "auto" = exact for a non-periodic profile
-    of at most 4096 points, else pk. ``top``: a state of :func:`solve_batch_exact` of
-    the same rows at a load at least the last one (e.g. the p_max solve of Eq. 4.2):
-    its contact sets contain the sweep's, and their inverses (:func:`set_inverse`) turn
-    the pivoting solves into small Schur complements (exact as well)."""
+def batch_sweep(op: InfluenceOperator, heights, pressures=None, *, deltas=None,
+                method: str = "auto", tol: float = 1e-10, max_iter: int = 2000,
+                top=None) -> BatchSweep:
+    """Sweeps of B surfaces, each step warm-started from the previous one: row ``b``
+    solved at the increasing mean pressures ``pressures[b]`` (Pa, shape (B, m); load
+    control) or at the increasing approaches ``deltas[b]`` (m, shape (B, m);
+    displacement control, e.g. the n_t equal approaches of a design's own sweep, Sec.
+    4.2.1); exactly one of the two. A = contact points / all points, K = dp/dDelta by
+    central differences over the steps. ``method``: "exact" (:func:`solve_batch_exact`,
+    pivoting), "pk" (:func:`solve_batch`, the CG to ``tol``), "auto" = exact for a
+    non-periodic profile of at most 4096 points, else pk. ``top``: a state of
+    :func:`solve_batch_exact` of the same rows at a load at least the last one (e.g. the
+    p_max solve of Eq. 4.2): its contact sets contain the sweep's, and their inverses
+    (:func:`set_inverse`) turn the pivoting solves into small Schur complements (exact
+    as well)."""
     if method not in ("auto", "exact", "pk"):
         raise InputError(f"method must be 'auto', 'exact' or 'pk', got {method!r}")
+    if (pressures is None) == (deltas is None):
+        raise InputError("batch_sweep: give exactly one of pressures (Pa) or deltas (m)")
     if method == "auto":
         method = "exact" if _exact_ok(op) else "pk"
+    key, name = ("mean_pressure", "pressures") if deltas is None else ("delta", "deltas")
     h = np.asarray(heights, dtype=float)
-    pr = np.asarray(pressures, dtype=float)
+    pr = np.asarray(pressures if deltas is None else deltas, dtype=float)
     if pr.ndim != 2 or pr.shape[0] != h.shape[0] or pr.shape[1] < 2 \
             or np.any(np.diff(pr, axis=1) <= 0):
-        raise InputError(f"pressures must be (B, m >= 2), increasing along each row, got "
+        raise InputError(f"{name} must be (B, m >= 2), increasing along each row, got "
                          f"shape {pr.shape}")
     B, m = pr.shape
     n = int(np.prod(op.shape))
@@ -269,9 +276,9 @@ def batch_sweep(op: InfluenceOperator, heights, pressures, *, method: str = "aut
     basis = set_inverse(op, top) if method == "exact" and getattr(top, "pivots", None) \
         is not None else None
     for j in range(m):
-        st = solve_batch_exact(op, h, mean_pressure=pr[:, j], initial=st, basis=basis) \
+        st = solve_batch_exact(op, h, **{key: pr[:, j]}, initial=st, basis=basis) \
             if method == "exact" \
-            else solve_batch(op, h, mean_pressure=pr[:, j], initial=st, tol=tol,
+            else solve_batch(op, h, **{key: pr[:, j]}, initial=st, tol=tol,
                              max_iter=max_iter)
         dl[:, j], pm[:, j], a[:, j] = st.delta, st.mean_pressure, st.n_contact / n
         nit += st.nit

@@ -51,7 +51,7 @@ def _run(args) -> int:
         popsize=args.global_popsize, amplitudes=args.global_amplitudes,
         waves=args.global_waves,
         n_candidates=args.global_candidates, rounds=args.global_rounds,
-        genes=args.global_genes)      # checked before the database is read
+        genes=args.global_genes, score=args.global_score)   # checked before the database is read
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}
@@ -189,6 +189,10 @@ def register(sub):
     for flag, kind, default, metavar, text in GLOBAL_FLAGS:
         g.add_argument(flag, type=kind, default=default, metavar=metavar,
                        help="--global: " + text)
+    g.add_argument("--global-score", default="strict", metavar="{strict,min}",
+                   help="--global: maximise f at the target pressures (strict, default) or "
+                        "min(strict f, interpolated f) (min: the thesis scoring on the "
+                        "design's own approaches too; checked by GlobalSearchOptions)")
     g.add_argument("--global-waves", action="store_true",
                    help="--global-amplitudes per wave (every ridge of every chromosome, "
                         "surfaces) instead of per chromosome")

@@ -29,20 +29,22 @@ from .io import result_to_dict, write_design_result
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
 from .objective import Evaluator, Objective, combined_score
-from .search import (AMPLITUDE_VARIABLES, GLOBAL_METHODS, GlobalSearchOptions, search_at_target_pressures,
-                     search_global)
+from .search import (AMPLITUDE_VARIABLES, GLOBAL_METHODS, GLOBAL_SCORES, GlobalSearchOptions,
+                     search_at_target_pressures, search_global)
 from .sensitivities import residual_jacobian
 from .spectrum import match_spectrum, spectrum_matched
 from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
 from .targets import (TARGET_BOUNDARIES, Y_T1_GENES, Y_T1_SURFACE_GENES, rescore,
-                      rescore_at_target_pressures, score_at_target_pressures,
-                      score_batch_at_target_pressures, surface_targets,
+                      rescore_at_target_pressures, score_at_target_pressures, SCORINGS,
+                      score_batch, score_batch_at_target_pressures, score_batch_interpolated,
+                      surface_targets,
                       target_genome_t1, target_surface, thesis_targets, window_compliance)
 
 __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "mcco", "refine",
            "run_design", "score_database", "search_at_target_pressures", "sog",
            "search_global", "GLOBAL_METHODS", "GlobalSearchOptions",
-           "AMPLITUDE_VARIABLES", "score_batch_at_target_pressures",
+           "AMPLITUDE_VARIABLES", "score_batch_at_target_pressures", "GLOBAL_SCORES",
+           "SCORINGS", "score_batch", "score_batch_interpolated",
            "match_spectrum", "spectrum_matched", "target_surface",
            "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",

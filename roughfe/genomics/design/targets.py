@@ -16,7 +16,7 @@ from ..genome import Genome
 from ..macro_micro import profile_response, top_approach
 from ..similarity import ResponseCurve, Target, linear_then_flat_target, similarity
 from .model import Design, DesignPart
-from .objective import Evaluator
+from .objective import Evaluator, Objective
 
 
 def rescore(design: Design, targets, settings: DatabaseSettings, response=None) -> tuple:
@@ -83,52 +83,120 @@ def batch_scoring(settings: DatabaseSettings) -> bool:
         and settings.top_fraction == 1.0 and int(settings.n_nodes) <= 4096
 
 
-def score_batch_at_target_pressures(designs, targets, settings: DatabaseSettings) -> np.ndarray:
-    """:func:`rescore_at_target_pressures` of many designs at once: an array (B, targets)
-    of Eq. (4.1) scores, the same numbers (to round-off: the same exact contact states)
-    at a fraction of the cost.
+#: the scores :func:`score_batch` gives: "strict" (:func:`rescore_at_target_pressures`,
+#: solved at the target pressures) and "interpolated" (Eq. 4.1 on the design's own n_t
+#: equal approaches after Eq. 4.2, as the thesis stages and :func:`rescore` score)
+SCORINGS = ("strict", "interpolated")
 
-    With :func:`batch_scoring` the B designs are solved together: one displacement solve
-    at the last approach of the database sweep (:func:`top_approach`: peak-valley for a
-    profile, ``top_fraction`` of full contact for a periodic surface) for p_max (Eq. 4.2
-    factor eta per row), then :func:`roughfe.bem.batch_exact.batch_sweep` at the pressures
-    ``p_j / eta``; A is the exact node fraction, K the central differences over the
-    steps, as in :func:`score_at_target_pressures`. Profiles: exact pivoting
-    (:func:`roughfe.bem.batch_exact.solve_batch_exact`, the same contact states to
-    round-off; measured in ``docs/theory/06_design.md``); periodic surfaces: the batched
-    CG to a relative KKT residual of 1e-10 (scores within ~1e-10 of the single solver,
-    ``docs/theory/surface-design.md``). A row whose curve is not a valid response (e.g. a
+
+def score_batch(designs, targets, settings: DatabaseSettings, scoring=SCORINGS) -> dict:
+    """Eq. (4.1) scores of many designs at once: ``{kind: array (B, targets)}`` for every
+    kind in ``scoring`` (:data:`SCORINGS`), the same numbers as the single functions (to
+    round-off: the same exact contact states) at a fraction of the cost.
+
+    * ``"strict"``: :func:`rescore_at_target_pressures` of each design.
+    * ``"interpolated"``: :meth:`Objective.scores` of each design's own BEM sweep, i.e.
+      the n_t equal approaches ``Delta_j = j/n_t * top`` (Sec. 4.2.1;
+      :func:`~roughfe.genomics.macro_micro.top_approach`), K by central differences,
+      Eq. (4.2) rescaling to p_max^t, Eq. (4.1) interpolated at the target pressures:
+      the score the thesis stages maximise and :func:`rescore` reproduces.
+
+    With :func:`batch_scoring` the B designs are solved together and both kinds share
+    the one displacement solve at the last approach (``top``, p_max and the Eq. 4.2
+    factor eta per row; "interpolated" only with the database's K by differences,
+    ``stiffness="fd"``): "strict" continues with
+    :func:`roughfe.bem.batch_exact.batch_sweep` at the pressures ``p_j / eta`` (load
+    control), "interpolated" with the same sweep at the approaches ``Delta_j``
+    (displacement control). Profiles: exact pivoting
+    (:func:`roughfe.bem.batch_exact.solve_batch_exact`, warm-started and, from the top
+    state's contact sets, by Schur complements; the same contact states to round-off,
+    ``docs/theory/06_design.md``); periodic surfaces: the batched CG to a relative KKT
+    residual of 1e-10 (scores within ~1e-10 of the single solver,
+    ``docs/theory/surface-design.md``). Otherwise (or when the CG cannot settle a row)
+    the designs are scored one by one. A row whose curve is not a valid response (e.g. a
     flat design) scores -inf."""
     designs = list(designs)
     targets = list(targets)
+    scoring = tuple(scoring)
+    if not scoring or any(k not in SCORINGS for k in scoring):
+        raise InputError(f"scoring must name some of {SCORINGS}, got {scoring!r}")
     if not designs:
-        return np.zeros((0, len(targets)))
-    if not batch_scoring(settings):
-        return np.array([rescore_at_target_pressures(d, targets, settings) for d in designs])
+        return {k: np.zeros((0, len(targets))) for k in scoring}
+    out = {}
+    together = tuple(k for k in scoring if batch_scoring(settings) and
+                     (k == "strict" or settings.stiffness == "fd"))
+    if together:
+        try:
+            out = _scores_together(designs, targets, settings, together)
+        except NoConvergenceError:          # a row the CG cannot settle: one by one
+            pass
+    for k in scoring:
+        if k not in out:
+            out[k] = np.array([_score_one(k, d, targets, settings) for d in designs])
+    return out
+
+
+def _score_one(kind, design, targets, settings: DatabaseSettings) -> tuple:
+    """One design's scores of kind ``kind`` (:data:`SCORINGS`) by the single solvers."""
+    if kind == "strict":
+        return rescore_at_target_pressures(design, targets, settings)
+    return Objective(targets).scores(Evaluator(settings)(design))
+
+
+def score_batch_at_target_pressures(designs, targets, settings: DatabaseSettings) -> np.ndarray:
+    """:func:`rescore_at_target_pressures` of many designs at once, an array (B, targets):
+    the ``"strict"`` kind of :func:`score_batch`."""
+    return score_batch(designs, targets, settings, ("strict",))["strict"]
+
+
+def score_batch_interpolated(designs, targets, settings: DatabaseSettings) -> np.ndarray:
+    """Eq. (4.1) of many designs on their own n_t approaches (after Eq. 4.2), an array
+    (B, targets): the ``"interpolated"`` kind of :func:`score_batch`, equal to
+    :meth:`Objective.scores` of each design's BEM sweep (and to :func:`rescore` of a
+    design rescaled to p_max^t)."""
+    return score_batch(designs, targets, settings, ("interpolated",))["interpolated"]
+
+
+def _scores_together(designs, targets, settings: DatabaseSettings, scoring) -> dict:
+    """:func:`score_batch` with the designs solved together (:func:`batch_scoring`)."""
     surfs = [d.surface() for d in designs]
     h = np.array([sf.heights for sf in surfs])
     mat = Material(settings.youngs_modulus, settings.poisson)
-    p = np.unique(np.concatenate([t.pressure for t in targets]))
-    if settings.dim == 2:
-        op = influence_operator(h.shape[1:], surfs[0].size, mat.E_star, "spectral")
-        delta = [top_approach(sf, settings.kernel, settings.top_fraction) for sf in surfs]
-        try:
-            top = solve_batch(op, h, delta=np.array(delta))
-            eta = targets[0].p_max / top.mean_pressure
-            sw = batch_sweep(op, h, p[None, :] / eta[:, None], method="pk")
-        except NoConvergenceError:          # a row the CG cannot settle: one by one
-            return np.array([rescore_at_target_pressures(d, targets, settings)
-                             for d in designs])
-    else:
-        op = influence_operator(h.shape[1:], surfs[0].size, mat.E_star, "strip")
-        top = solve_batch_exact(op, h, delta=np.ptp(h, axis=1))
+    periodic = settings.dim == 2
+    op = influence_operator(h.shape[1:], surfs[0].size, mat.E_star,
+                            "spectral" if periodic else "strip")
+    method = "pk" if periodic else "exact"
+    delta = np.array([top_approach(sf, settings.kernel, settings.top_fraction) for sf in surfs])
+    top = solve_batch(op, h, delta=delta) if periodic else solve_batch_exact(op, h, delta=delta)
+    out = {}
+    if "strict" in scoring:
         eta = targets[0].p_max / top.mean_pressure
-        sw = batch_sweep(op, h, p[None, :] / eta[:, None], method="exact", top=top)
-    out = np.full((len(designs), len(targets)), -np.inf)
-    for b in range(len(designs)):
+        p = np.unique(np.concatenate([t.pressure for t in targets]))
+        sw = batch_sweep(op, h, p[None, :] / eta[:, None], method=method, top=top)
+        out["strict"] = _rows_scored(lambda b: _strict_scores(
+            sw.mean_pressure[b] * eta[b], sw.stiffness[b], sw.area_fraction[b], targets),
+            len(designs), len(targets))
+    if "interpolated" in scoring:
+        n = int(settings.n_steps)
+        sw = batch_sweep(op, h, deltas=delta[:, None] * np.arange(1, n + 1) / n,
+                         method=method, top=top)
+        objective = Objective(targets)
+
+        def interpolated(b):
+            keep = sw.mean_pressure[b] > 0
+            return objective.scores(ResponseCurve(sw.mean_pressure[b][keep],
+                                                  sw.stiffness[b][keep],
+                                                  sw.area_fraction[b][keep]))
+        out["interpolated"] = _rows_scored(interpolated, len(designs), len(targets))
+    return out
+
+
+def _rows_scored(score_row, n_rows, n_targets) -> np.ndarray:
+    """(n_rows, n_targets) of ``score_row(b)``; -inf in a row whose curve is refused."""
+    out = np.full((n_rows, n_targets), -np.inf)
+    for b in range(n_rows):
         try:
-            out[b] = _strict_scores(sw.mean_pressure[b] * eta[b], sw.stiffness[b],
-                                    sw.area_fraction[b], targets)
+            out[b] = score_row(b)
         except InputError:
             pass
     return out
