@@ -505,3 +505,22 @@ def test_design_study_yt1_without_refine_rows(entries, targets, tmp_path, monkey
     saved = json.loads((tmp_path / "yt1_sog_global" / "result.json").read_text())
     assert saved["candidates"][0]["scores_at_target_pressures"][0] == pytest.approx(w["strict"])
     assert any("| SOG |" in line for line in free["lines"])
+
+
+def test_design_study_min_round_rows(entries, targets, tmp_path):
+    """validation/design_study.min_round (the M-CCO row 'one design, min(f at p_t,
+    interpolated f)'): from a strict global stage's design, the round on the min does not
+    lower the min of the two f; f_min is that min of the design found, its curve ends
+    there, and the report lines carry the curve table."""
+    study = _design_study()
+    t1, _, t3, _ = targets
+    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    rg = de.search_global(r, SETTINGS, n_eval=40, seed=1)
+    m0 = min(de.combined_score(rg.best.at_targets), de.combined_score(rg.best.scores))
+    both = study.min_round(rg, SETTINGS, de.GlobalSearchOptions(n_eval=60, seed=1, score="min"))
+    c = both["result"].best
+    assert both["f_min"] == min(de.combined_score(c.at_targets), de.combined_score(c.scores))
+    assert both["f_min"] >= m0 - 1e-12                  # re-scored design: round-off
+    assert both["history"][-1, 1] == pytest.approx(both["f_min"], abs=1e-9)
+    assert both["cpu_s"] > 0 and any("best min(f at p_t, interpolated f)" in x
+                                     for x in both["lines"])

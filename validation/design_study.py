@@ -48,6 +48,11 @@ SEARCH_STARTS = 4
 GLOBAL_EVAL = 20000
 GLOBAL_SIGMA = 0.5
 GLOBAL_ROUNDS = 2
+#: one more global round (issue 14 section 2, session 6) from that stage's design, on
+#: min(f at p_t, interpolated f) (``score="min"``: the batched strict and interpolated
+#: scores of each design, ~1.8 strict evaluations each), so that one design meets the
+#: goal under both scorings; measured in docs/theory/06_design.md
+GLOBAL_MIN = de.GlobalSearchOptions(n_eval=5000, sigma=GLOBAL_SIGMA, seed=0, score="min")
 
 
 def strict_scores_from_file(design_json: Path, targets, settings) -> list:
@@ -203,6 +208,38 @@ def yt1_without_refine(results, t1, settings, out: Path) -> dict:
               f"{w['strict']:.4f} | {w['interpolated']:.4f} | {w['n_eval']} | {w['cpu_s']:.0f} "
               f"| {w['origin']} |" for w in rows]
     return {"rows": rows, "errors": errors, "lines": lines + [""]}
+
+
+def min_round(rg, settings, options: de.GlobalSearchOptions = GLOBAL_MIN) -> dict:
+    """One more global round from the best design of ``rg`` (the M-CCO global stage) on
+    min(f at p_t, interpolated f) (``options.score == "min"``): per design of a
+    generation the strict and the interpolated scores, batched, sharing the p_max solve
+    (``design.score_batch``). Returns ``{"result", "cpu_s", "history", "f_min",
+    "lines"}``: the DesignResult, its CPU time, the best-so-far curve (evaluations, best
+    min), the min of its best design's two f and the report lines."""
+    t0 = time.process_time()
+    rgm = de.search_global(rg, settings, options)
+    cpu = time.process_time() - t0
+    hist = np.asarray(rgm.search_history[0])
+    b = rgm.best
+    f_min = min(de.combined_score(b.at_targets), de.combined_score(b.scores))
+    marks = [n for n in (100, 300, 1000, 2000, 3000, 4000, 5000, 10000) if n <= hist[-1, 0]]
+    at = [float(hist[np.searchsorted(hist[:, 0], n, side="right") - 1, 1]) for n in marks]
+    lines = [f"Then one more round from that design on min(f at p_t, interpolated f) "
+             f"(`search_global(..., score=\"min\")`, sigma {options.sigma:g}, seed "
+             f"{options.seed}, {options.n_eval} evaluations): each design of a generation is "
+             "solved at the target pressures and along its own n_t approaches (the thesis "
+             "scoring, displacement control), both batched and sharing the p_max solve "
+             f"(`design.score_batch`). {rgm.message}. CPU {cpu:.0f} s. Its design: f at p_t "
+             f"{de.combined_score(b.at_targets):.4f} ({b.at_targets[0]:.4f}, "
+             f"{b.at_targets[1]:.4f}), interpolated f {de.combined_score(b.scores):.4f} "
+             f"({b.scores[0]:.4f}, {b.scores[1]:.4f}), both reproduced from design.json "
+             "(hand-written BEM, fresh sweep).", "",
+             "| evaluations (strict + interpolated) | " + " | ".join(map(str, marks)) + " |",
+             "|---" * (len(marks) + 1) + "|",
+             "| best min(f at p_t, interpolated f) | " + " | ".join(f"{v:.4f}" for v in at)
+             + " |", ""]
+    return {"result": rgm, "cpu_s": cpu, "history": hist, "f_min": f_min, "lines": lines}
 
 
 def _table1(out, lines):
@@ -473,6 +510,9 @@ def main(outdir: Path, quick: bool = False) -> bool:
     rg = de.search_global(rm, settings, n_eval=GLOBAL_EVAL, sigma=GLOBAL_SIGMA, seed=0,
                           rounds=GLOBAL_ROUNDS)
     cpu_global = time.process_time() - t0
+    # (f) one more round from (e)'s design on min(f at p_t, interpolated f)
+    both = min_round(rg, settings)
+    rgm, cpu_min, hist_min, f_both = (both[k] for k in ("result", "cpu_s", "history", "f_min"))
     runs += [(f"wide pool ({rp.n_cross} starts), thesis stages", rp), ("wide pool + GCMMA 3 (6 x 20 it.)", rp2),
              ("6 starts + GCMMA 3 (6 x 20 it.)", rm2),
              (f"thesis stages + search at p_t ({SEARCH_EVAL} sweeps per candidate)", rs),
@@ -480,12 +520,15 @@ def main(outdir: Path, quick: bool = False) -> bool:
              (f"thesis stages + multi-start search at p_t ({SEARCH_STARTS} x {SEARCH_EVAL} "
               f"sweeps per candidate)", rms),
              (f"thesis stages + global search at p_t (IPOP-CMA-ES, {GLOBAL_ROUNDS} rounds x "
-              f"{GLOBAL_EVAL} strict evaluations, best candidate)", rg)]
+              f"{GLOBAL_EVAL} strict evaluations, best candidate)", rg),
+             (f"the same + a round on min(f at p_t, interpolated f) ({GLOBAL_MIN.n_eval} "
+              f"evaluations, sigma {GLOBAL_MIN.sigma:g})", rgm)]
     strict_errors = []
     folder_of = {id(rm): out / "mcco"}          # where each run's result.json is saved
     for name, r in (("mcco_pool", rp), ("mcco_pool_refined", rp2), ("mcco_refined", rm2),
                     ("mcco_search", rs), ("mcco_pool_refined_search", rps),
-                    ("mcco_multistart_search", rms), ("mcco_global", rg)):
+                    ("mcco_multistart_search", rms), ("mcco_global", rg),
+                    ("mcco_global_min", rgm)):
         de.write_design_result(r, settings, out / name)
         folder_of[id(r)] = out / name
         err = float(np.max(np.abs(np.asarray(de.rescore(r.best.design, [t1, t3], settings))
@@ -497,7 +540,9 @@ def main(outdir: Path, quick: bool = False) -> bool:
               f"{err:.1e}]", flush=True)
         reproducible.append(err)
     hist = np.asarray(rg.search_history[0])
-    dplot.plot_search_history({"IPOP-CMA-ES from the thesis stages": hist},
+    dplot.plot_search_history({"IPOP-CMA-ES from the thesis stages": hist,
+                               "+ a round on min(f at p_t, interpolated f)":
+                                   hist_min + [hist[-1, 0], 0.0]},
                               out / "search_global.png", goal=GOALS["f_multi"],
                               title="M-CCO (y_t1, y_t3): global search at p_t")
     dplot.plot_design_curves([rm, rm2, rs, rms, rg], out / "curves_mcco.png",
@@ -567,8 +612,8 @@ def main(outdir: Path, quick: bool = False) -> bool:
               f"{cpu_global:.0f} s for {int(hist[-1, 0])} strict evaluations.", "",
               "| strict evaluations | " + " | ".join(str(n) for n in marks) + " |",
               "|---" * (len(marks) + 1) + "|",
-              "| best f at p_t | " + " | ".join(f"{v:.4f}" for v in at) + " |", "",
-              "![](design/search_global.png)", ""]
+              "| best f at p_t | " + " | ".join(f"{v:.4f}" for v in at) + " |", ""]
+    lines += both["lines"] + ["![](design/search_global.png)", ""]
     nb = target_neighbourhood(entries, [t1, t3], settings, out)
     reproducible.append(abs(1.0 - nb["f_target_genome"]))
     lines += _neighbourhood_lines(nb)
@@ -602,6 +647,7 @@ def main(outdir: Path, quick: bool = False) -> bool:
     rep = max(reproducible)
     ok = {"s_yt1": best_t1 >= GOALS["s_yt1"], "f_multi": best_f >= GOALS["f_multi"],
           "f_multi_at_target_pressures": best_f_strict >= GOALS["f_multi"],
+          "f_multi_one_design": f_both >= GOALS["f_multi"],
           "reproducible": rep <= GOALS["reproducible"]}
     free_best = {k: max(free["rows"], key=lambda w: w[k]) for k in ("strict", "interpolated")}
     for k in ("strict", "interpolated"):
@@ -639,6 +685,8 @@ def main(outdir: Path, quick: bool = False) -> bool:
               f"* best f for (y_t1, y_t3) solved at the target pressures: {best_f_strict:.4f} "
               f"(goal >= {GOALS['f_multi']}): "
               f"{'met' if ok['f_multi_at_target_pressures'] else 'NOT met: ' + f_strict_reason}",
+              f"* one M-CCO design with both: min(f at p_t, interpolated f) = {f_both:.4f} "
+              f"(goal >= {GOALS['f_multi']}): {'met' if ok['f_multi_one_design'] else 'NOT met'}",
               f"* largest difference between a reported score and an independent BEM run of the "
               f"saved design: {rep:.1e} (goal <= {GOALS['reproducible']:.0e}): "
               f"{'met' if ok['reproducible'] else 'NOT met'}",
@@ -666,6 +714,10 @@ def main(outdir: Path, quick: bool = False) -> bool:
                            f">= {GOALS['f_multi']}", f"{best_f_strict:.4f}",
                            ok["f_multi_at_target_pressures"], f_strict_reason or
                            "search at p_t (beyond the thesis) included", best_f_strict),
+                    Target("(y_t1, y_t3): one M-CCO design, min(f at p_t, interpolated f)",
+                           f">= {GOALS['f_multi']}", f"{f_both:.4f}", ok["f_multi_one_design"],
+                           f"global stage + a round on the min ({GLOBAL_MIN.n_eval} "
+                           f"evaluations, {cpu_min:.0f} s CPU)", f_both),
                     Target("reported scores = independent BEM runs of the saved designs",
                            f"<= {GOALS['reproducible']:.0e}", f"{rep:.1e}", ok["reproducible"],
                            "", rep))],
@@ -678,6 +730,10 @@ def main(outdir: Path, quick: bool = False) -> bool:
                                   "n_eval": GLOBAL_EVAL, "sigma": GLOBAL_SIGMA,
                                   "rounds": GLOBAL_ROUNDS,
                                   "message": rg.message},
+                "global_search_min": {"history": hist_min.tolist(), "cpu_s": cpu_min,
+                                      "n_eval": GLOBAL_MIN.n_eval, "sigma": GLOBAL_MIN.sigma,
+                                      "seed": GLOBAL_MIN.seed, "f_min": f_both,
+                                      "message": rgm.message},
                 "target_neighbourhood": {**nb, "phase_noise": {f"{k:g}": v for k, v in
                                                               nb["phase_noise"].items()}},
                 "pbar_sweep": {"pbar": pbars.tolist(), "best": best, "n_cross": n_cross,
