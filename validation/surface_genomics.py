@@ -30,7 +30,7 @@ of :mod:`roughfe.validation`).
       300 sweeps before the global stage, which keeps the start when it finds nothing
       better) and, for the runs in
       GLOBAL, the global stage (IPOP-CMA-ES, GLOBAL[run] batched strict evaluations of
-      the best candidate). Goals (issue
+      the best candidate, first step GLOBAL_SIGMA[run] where given). Goals (issue
       15): s >= 0.98 on K and f >= 0.9 on K+A, scored at the target's own pressures
       (load-controlled BEM), every score reproduced by an independent BEM run of the
       saved design; a design run < 30 min CPU.
@@ -48,7 +48,8 @@ import numpy as np
 from roughfe.genomics import database as gdb
 from roughfe.genomics.band_mechanics import band_macro_micro, band_mechanics
 from roughfe.genomics.bands import band_chromosomes
-from roughfe.genomics.design import (Design, GcmmaOptions, combined_score, match_spectrum,
+from roughfe.genomics.design import (Design, GcmmaOptions, GlobalSearchOptions,
+                                     combined_score, match_spectrum,
                                      run_design, score_at_target_pressures,
                                      search_at_target_pressures, search_global,
                                      surface_targets, target_surface, thesis_targets,
@@ -90,7 +91,13 @@ SEARCH, SEARCH_LONG = 100, {("y_t1", "cco"): 300, ("x3p-2", "mcco"): 300}
 #: x3p-2 M-CCO gets 100 search sweeps and this stage instead of 300 sweeps. About 55 s
 #: CPU per 1000 batched evaluations at 64 x 64: x3p-2 GCO (its winner is SOG's matched
 #: genome) and CCO are left out to keep the study near 15 min
-GLOBAL = {("x3p-2", "sog"): 5000, ("x3p-2", "mcco"): 2000, ("y_t1", "mcco"): 2000}
+GLOBAL = {("x3p-2", "sog"): 5000, ("x3p-2", "mcco"): 2000, ("y_t1", "mcco"): 4000}
+#: the global stage's first CMA-ES step (rad for the phases; ``GlobalSearchOptions.sigma``)
+#: where it is not the default 0.5: M-CCO starts from the search's optimum, and a step
+#: of 0.5 rad leaves its basin (measured 2026-11-23, y_t1 M-CCO from the 100-sweep
+#: search f 0.827, docs/theory/surface-design.md): sigma 0.5 f 0.8445 at 2000
+#: evaluations, 0.870 at 4000; sigma 0.2 0.890 at 2000, 0.913 at 3000, 0.921 at 4000
+GLOBAL_SIGMA = {("y_t1", "mcco"): 0.2}
 #: measured targets: runs whose spectrum matching is per wave (match_spectrum
 #: directional=True): x3p-2 M-CCO f 0.621 -> 0.700 (SOG 0.933 -> 0.885: kept per chromosome)
 DIRECTIONAL = {("x3p-2", "mcco")}
@@ -283,8 +290,9 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
         sweeps = (long or {}).get(method, search)
         res = search_at_target_pressures(res, settings, n_eval=sweeps, amplitudes=True)
         n_global = min(GLOBAL.get((tag, method), 0), 12 if quick else np.inf)
+        sigma = GLOBAL_SIGMA.get((tag, method), GlobalSearchOptions.sigma)
         if n_global:
-            res = search_global(res, settings, n_eval=n_global)
+            res = search_global(res, settings, n_eval=n_global, sigma=sigma)
         cpu = _cpu() - t0
         best = res.best
         saved = outdir / f"surface_design_{tag}_{method}"
@@ -304,6 +312,7 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
                                                                    best.at_targets)))),
                      "bem_sweeps": int(res.nit), "cpu_s": cpu, "search_sweeps": sweeps,
                      "global_evaluations": n_global,
+                     "global_sigma": sigma if n_global else None,
                      "matching": None if surface is None else
                      ("wave" if (tag, method) in DIRECTIONAL else "chromosome")})
     return rows
@@ -427,7 +436,8 @@ def _reason(d):
     return (f"from {d['origin']}; GCMMA stages {', '.join(f'{s:.3f}' for s in d['stages'])} "
             f"(interpolated on the design's own steps){match}, then the search at the target "
             f"pressures ({d['search_sweeps']} sweeps per candidate)"
-            + (f", then IPOP-CMA-ES ({d['global_evaluations']} strict evaluations, batched)"
+            + (f", then IPOP-CMA-ES ({d['global_evaluations']} strict evaluations, batched, "
+               f"sigma {d['global_sigma']:g})"
                if d.get("global_evaluations") else ""))
 
 
