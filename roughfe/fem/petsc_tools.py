@@ -125,6 +125,143 @@ def petsc_aij_csr(shape, indptr, indices, data):
                 np.asarray(data, dtype=PETSc.ScalarType)), comm=PETSc.COMM_SELF)
 
 
+#: Fewest iterations a solve with a kept preconditioner is allowed before
+#: :class:`KrylovSolver` builds a fresh one (otherwise: 2 more than the solve that built it).
+REUSE_MIN_IT = 8
+
+
+class KrylovSolver:
+    """A PETSc KSP for a sequence of linear systems, optionally keeping its preconditioner.
+
+    With ``reuse_preconditioner=True`` a system whose matrix has the size and the sparsity
+    pattern of the one the preconditioner was built on (e.g. the Reynolds operator of
+    every iteration of a fluid-structure coupling loop, whose gap changes a little) is
+    solved with that preconditioner (an AMG hierarchy is not set up again): the Krylov
+    iteration runs on the new matrix, so the answer meets the same tolerance; only the
+    iteration count can grow. A solve that has not converged with a kept preconditioner
+    after 2 iterations more than the solve that built it took (at least ``reuse_min_it``)
+    builds a fresh one on its matrix and continues from its last iterate (the stopping
+    test stays relative to the right-hand side), so a poor kept hierarchy costs at most
+    that many iterations. Measured on the 23 Reynolds solves of a 256^2 coupling loop
+    (every solve against every kept hierarchy): the hierarchies of the first 2-3 solves
+    fit no later matrix (hundreds of iterations), those built later give the fresh
+    iteration count to +-1; this rule builds 6 hierarchies instead of 23 (20 % fewer
+    CG-iteration equivalents, a set-up costing ~9 iterations).
+
+    Parameters
+    ----------
+    name : str
+        Options prefix stem and the name in messages.
+    options : mapping, optional
+        PETSc options overriding :data:`CG_AMG`.
+    reuse_preconditioner : bool
+        Keep the preconditioner across solves with an unchanged sparsity pattern.
+    reuse_min_it : int
+        Iterations always allowed with a kept preconditioner before it is rebuilt.
+
+    Attributes
+    ----------
+    setups : int
+        Preconditioner set-ups so far.
+    """
+
+    def __init__(self, name: str, options: Mapping | None = None, *,
+                 reuse_preconditioner: bool = False, reuse_min_it: int = REUSE_MIN_IT):
+        from petsc4py import PETSc
+
+        self.name = name
+        self.reuse = bool(reuse_preconditioner)
+        self.reuse_min_it = int(reuse_min_it)
+        self.setups = 0
+        self._cap = self.reuse_min_it
+        self._ksp = PETSc.KSP().create(PETSc.COMM_SELF)
+        apply_options(self._ksp, unique_prefix(name), {**CG_AMG, **dict(options or {})})
+        self._max_it = self._ksp.getTolerances()[3]
+        self._A = self._own = self._pattern = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def close(self) -> None:
+        """Destroy the KSP (and the last matrix if the solver owns it)."""
+        self._release()
+        self._ksp.destroy()
+
+    def _release(self):
+        if self._own and self._A is not None:
+            self._A.destroy()
+        self._A = None
+
+    def solve(self, matrix, rhs, x0=None, *, own: bool = False):
+        """Solve ``A x = b``; see :func:`ksp_solve` for the arguments and the return value.
+
+        ``own=True`` hands the PETSc matrix to the solver, which destroys it when the next
+        matrix arrives or at :meth:`close` (a scipy matrix is always copied and owned).
+        """
+        from petsc4py import PETSc
+
+        if not isinstance(matrix, PETSc.Mat):
+            matrix, own = petsc_aij(matrix), True
+        pattern = None
+        if self.reuse:
+            indptr, indices, _ = matrix.getValuesCSR()
+            pattern = (matrix.getSize(), indptr, indices)
+        keep = (self.reuse and self._pattern is not None and pattern[0] == self._pattern[0]
+                and np.array_equal(pattern[1], self._pattern[1])
+                and np.array_equal(pattern[2], self._pattern[2]))
+        ksp, pc = self._ksp, self._ksp.getPC()
+        if self._A is not None and matrix.getSize() != self._A.getSize():
+            ksp.reset()                        # PETSc refuses new sizes on a used KSP
+        pc.setReusePreconditioner(keep)
+        ksp.setOperators(matrix)
+        self._release()
+        self._A, self._own = matrix, own
+        b = matrix.createVecLeft()
+        b.setArray(np.asarray(rhs, dtype=PETSc.ScalarType))
+        x = matrix.createVecRight()
+        if x0 is not None:
+            x.setArray(np.asarray(x0, dtype=PETSc.ScalarType))
+        ksp.setInitialGuessNonzero(x0 is not None)
+        ksp.setTolerances(max_it=min(self._cap, self._max_it) if keep else self._max_it)
+        t0 = time.process_time()
+        ksp.setUp()
+        t1 = time.process_time()
+        ksp.solve(b, x)
+        nit = int(ksp.getIterationNumber())
+        kept = keep
+        if keep and ksp.getConvergedReason() == PETSc.KSP.ConvergedReason.DIVERGED_MAX_IT:
+            # the kept hierarchy no longer fits: build one on this matrix, go on from x
+            pc.setReusePreconditioner(False)
+            ksp.setInitialGuessNonzero(True)
+            ksp.setTolerances(max_it=self._max_it)
+            t1 -= time.process_time()
+            pc.setUp()                         # (the KSP counts itself set up)
+            t1 += time.process_time()
+            ksp.solve(b, x)
+            built = int(ksp.getIterationNumber())
+            nit += built
+            keep = False
+        t2 = time.process_time()
+        if not keep:
+            self.setups += 1
+            self._pattern = pattern
+            self._cap = max((built if kept else nit) + 2, self.reuse_min_it)
+        reason = ksp.getConvergedReason()
+        message = (f"KSP {ksp.getType()}/{pc.getType()} "
+                   f"{reason_name(PETSc.KSP.ConvergedReason, reason)} in {nit} iterations, "
+                   f"residual norm {ksp.getResidualNorm():.3e}, "
+                   f"set-up {t1 - t0:.3g} s + solve {t2 - t1:.3g} s CPU"
+                   + (", kept preconditioner" if keep else
+                      ", preconditioner rebuilt after the kept one stalled" if kept else ""))
+        out = x.array.copy()
+        x.destroy()
+        b.destroy()
+        return out, nit, reason > 0, message
+
+
 def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None, x0=None):
     """Solve ``A x = b`` with a PETSc KSP; options under a unique prefix.
 
@@ -151,31 +288,5 @@ def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None, x0=None
         converged reason, iterations, residual norm, process CPU time of the
         preconditioner set-up and of the iterations).
     """
-    from petsc4py import PETSc
-
-    own = not isinstance(matrix, PETSc.Mat)
-    A = petsc_aij(matrix) if own else matrix
-    b = A.createVecLeft()
-    b.setArray(np.asarray(rhs, dtype=PETSc.ScalarType))
-    x = A.createVecRight()
-    ksp = PETSc.KSP().create(PETSc.COMM_SELF)
-    ksp.setOperators(A)
-    apply_options(ksp, unique_prefix(name), {**CG_AMG, **dict(options or {})})
-    if x0 is not None:
-        x.setArray(np.asarray(x0, dtype=PETSc.ScalarType))
-        ksp.setInitialGuessNonzero(True)
-    t0 = time.process_time()
-    ksp.setUp()
-    t1 = time.process_time()
-    ksp.solve(b, x)
-    t2 = time.process_time()
-    reason = ksp.getConvergedReason()
-    nit = int(ksp.getIterationNumber())
-    message = (f"KSP {ksp.getType()}/{ksp.getPC().getType()} "
-               f"{reason_name(PETSc.KSP.ConvergedReason, reason)} in {nit} iterations, "
-               f"residual norm {ksp.getResidualNorm():.3e}, "
-               f"set-up {t1 - t0:.3g} s + solve {t2 - t1:.3g} s CPU")
-    out = x.array.copy()
-    for obj in (ksp, x, b) + ((A,) if own else ()):
-        obj.destroy()
-    return out, nit, reason > 0, message
+    with KrylovSolver(name, options) as solver:
+        return solver.solve(matrix, rhs, x0)

@@ -26,7 +26,8 @@ A* most of the grid). The unknown is ``p - p_out``, so the solver tolerance is r
 the pressure drop (and the Couette flow), never to the absolute pressure level. The
 symmetric positive definite system is assembled with array operations straight into CSR
 (no loop over cells, no COO duplicates) and solved with CG + BoomerAMG (PETSc, through
-:func:`roughfe.fem.petsc_tools.ksp_solve`, options :data:`REYNOLDS_FV`). ``percolates`` is
+:class:`roughfe.fem.petsc_tools.KrylovSolver`, options :data:`REYNOLDS_FV`; a sequence of
+solves on one grid can keep the AMG hierarchy, :func:`reynolds_fv_solver`). ``percolates`` is
 True when one open component touches both inlet and outlet: by construction the same
 verdict as the free-volume network with ``corner_rule="closed"``
 (:func:`roughfe.leakage.network.free_volume_network`).
@@ -55,7 +56,7 @@ from scipy import ndimage
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
-from ..fem.petsc_tools import ksp_solve, petsc_aij_csr
+from ..fem.petsc_tools import KrylovSolver, petsc_aij_csr
 
 #: PETSc options of the finite-volume Reynolds solve, over
 #: :data:`roughfe.fem.petsc_tools.CG_AMG` (CG + BoomerAMG, rtol 1e-10 of the preconditioned
@@ -157,7 +158,7 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
                       p_in: float = 1.0, p_out: float = 0.0, periodic: bool = False,
                       wall_velocity=(0.0, 0.0),
                       petsc_options: Optional[Mapping] = None,
-                      initial=None) -> FVSolution:
+                      initial=None, solver: Optional[KrylovSolver] = None) -> FVSolution:
     """Solve Eq. 2.12 by cell-centred finite volumes (see the module docstring).
 
     Parameters
@@ -186,6 +187,10 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         start at ``p_out``. The answer is the same to the solver tolerance (it is
         relative to the right-hand side, not to the start): only the iteration count
         changes.
+    solver : KrylovSolver, optional
+        A solver kept across calls (:func:`reynolds_fv_solver`; not with
+        ``petsc_options``): it reuses its AMG hierarchy while the live system keeps its
+        sparsity pattern, same tolerance. Default: a fresh CG + BoomerAMG solve.
 
     Returns
     -------
@@ -209,6 +214,8 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     if u.size != 2 or not np.all(np.isfinite(u)):
         raise InputError(f"wall_velocity must be two finite numbers (m/s), got {wall_velocity!r}")
     ul, ut = u
+    if solver is not None and petsc_options:
+        raise InputError("give petsc_options to reynolds_fv_solver, not beside a solver")
     if initial is not None:
         initial = np.asarray(initial, dtype=float)
         if initial.shape != g.shape:
@@ -280,10 +287,14 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         if initial is not None:                # unknown p - p_out; NaN (pockets) -> 0
             x0 = initial[live] - p_out
             x0[~np.isfinite(x0)] = 0.0
-        x, nit, success, message = ksp_solve(M, rhs[live], name="reynolds_fv",
-                                             options={**REYNOLDS_FV, **dict(petsc_options or {})},
-                                             x0=x0)
-        M.destroy()
+        one_shot = solver is None
+        if one_shot:
+            solver = reynolds_fv_solver(petsc_options, reuse=False)
+        try:
+            x, nit, success, message = solver.solve(M, rhs[live], x0, own=True)
+        finally:
+            if one_shot:
+                solver.close()
     if not success:
         raise NoConvergenceError(f"Reynolds finite-volume solve: {message}")
     p = rhs                                    # reuse the grid: pressure, 0 outside the live cells
@@ -332,6 +343,22 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
                       connected=np.ascontiguousarray(live), inlet_flow=q_in,
                       outlet_flow=q_out, leak_rate=float(leak), percolates=percolates,
                       success=bool(success), message=message, nit=int(nit))
+
+
+def reynolds_fv_solver(petsc_options: Optional[Mapping] = None, *,
+                       reuse: bool = True) -> KrylovSolver:
+    """The CG + BoomerAMG solver of :func:`solve_reynolds_fv` (:data:`REYNOLDS_FV` with
+    ``petsc_options`` over it), to keep across a sequence of solves (``solver=``).
+
+    With ``reuse`` the AMG hierarchy is built once and kept while the live system keeps
+    its sparsity pattern (e.g. the regularised gaps of a coupling loop, every cell live):
+    CG then runs on each new matrix to the same tolerance, preconditioned by the kept
+    hierarchy, and builds a fresh one when a solve stalls
+    (:class:`roughfe.fem.petsc_tools.KrylovSolver`). Close it after use (a context
+    manager).
+    """
+    return KrylovSolver("reynolds_fv", {**REYNOLDS_FV, **dict(petsc_options or {})},
+                        reuse_preconditioner=reuse)
 
 
 def _diagonal(T_l, T_t, T_in, T_out, wrap):

@@ -87,7 +87,7 @@ from ..errors import InputError, NoConvergenceError, check_finite_positive
 from ..optim.anderson import RejectedIterate, anderson_fixed_point, check_options
 from ..surfaces import Surface
 from .channel import check_absolute_pressures
-from .finite_volume import FVSolution, solve_reynolds_fv
+from .finite_volume import FVSolution, reynolds_fv_solver, solve_reynolds_fv
 from .pockets import SEALED, TRAPPED_MODELS, PocketNewton, Pockets, transfer
 
 REFERENCES = (
@@ -315,7 +315,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         gap = np.where(c.contact, 0.0, c.gap)
         last["fluid"] = y = solve_reynolds_fv(
             np.maximum(gap, h_reg), spacing, direction=direction, mu=mu, p_in=p_in, p_out=p_out,
-            periodic=surface.periodic, initial=last["fluid"]).pressure
+            periodic=surface.periodic, initial=last["fluid"], solver=krylov).pressure
         if frozen.n:
             lab = frozen.labels
             p_pocket = frozen.pressure if newton is None else newton(x, gap, c, p_ext)
@@ -327,71 +327,72 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         return solve_reynolds_fv(gap, spacing, direction=direction, mu=mu, p_in=p_in,
                                  p_out=p_out, periodic=surface.periodic, initial=last["fluid"])
 
-    # the one-way state (dry contact at p_ext); the iteration starts from the previous
-    # step's fluid pressure (pocket pressures near their solution), else from 0
-    dry = solve_contact(surface, material, mean_pressure=p_ext, kernel=kernel, tol=contact_tol,
-                        compute_stiffness=False)
-    last["contact"] = dry
-    one_way = _flow(np.where(dry.contact, 0.0, dry.gap)).leak_rate
-    x = (np.array(history.pressure, dtype=float) if history is not None
-         and history.pressure.mean() < p_ext else np.zeros(h.shape))
-    residuals, counts = [], {"new": 0, "released": 0, "merged": 0}
-    it, passes, state, settled, solved = 0, 0, "contact", False, []
-    while True:
-        newton = (PocketNewton(frozen, bulk_modulus, cell, material.E_star, jacobian_pockets)
-                  if trapped == "volume" and frozen.n else None)
-        try:
-            gx = G(x, newton)
-        except _LiftOff:
-            state = "lift-off"
-            break
-        fp = anderson_fixed_point(lambda v: G(v, newton), x, gx, tol=tol, max_iter=max_iter,
-                                  memory=anderson, relaxation=relaxation)
-        it += fp.iterations
-        residuals += fp.residuals
-        x, gx = fp.x, fp.gx
-        if fp.status == "max_iter":
+    # one Reynolds solver for the loop: every cell is live, so it keeps its AMG hierarchy
+    with reynolds_fv_solver() as krylov:
+        # the one-way state (dry contact at p_ext); the iteration starts from the previous
+        # step's fluid pressure (pocket pressures near their solution), else from 0
+        dry = solve_contact(surface, material, mean_pressure=p_ext, kernel=kernel, tol=contact_tol,
+                            compute_stiffness=False)
+        last["contact"] = dry
+        one_way = _flow(np.where(dry.contact, 0.0, dry.gap)).leak_rate
+        x = (np.array(history.pressure, dtype=float) if history is not None
+             and history.pressure.mean() < p_ext else np.zeros(h.shape))
+        residuals, counts = [], {"new": 0, "released": 0, "merged": 0}
+        it, passes, state, settled, solved = 0, 0, "contact", False, []
+        while True:
+            newton = (PocketNewton(frozen, bulk_modulus, cell, material.E_star, jacobian_pockets)
+                      if trapped == "volume" and frozen.n else None)
+            try:
+                gx = G(x, newton)
+            except _LiftOff:
+                state = "lift-off"
+                break
+            fp = anderson_fixed_point(lambda v: G(v, newton), x, gx, tol=tol, max_iter=max_iter,
+                                      memory=anderson, relaxation=relaxation)
+            it += fp.iterations
+            residuals += fp.residuals
+            x, gx = fp.x, fp.gx
+            if fp.status == "max_iter":
+                last["flow"] = _flow(last["gap"])
+                last["next"], last["report"] = None, frozen
+                partial = _result("contact", last, gx, p_ext, p_in, p_out, mu, one_way, it,
+                                  fp.residual, residuals, cell, trapped, bulk_modulus, counts,
+                                  passes + 1, False)
+                raise NoConvergenceError(
+                    f"fluid-structure coupling: relative residual {fp.residual:.3e} after "
+                    f"{fp.iterations} iterations of pocket pass {passes + 1} (tolerance "
+                    f"{tol:.1e}, Anderson memory {anderson})", result=partial)
+            if fp.status == "rejected":
+                state = "lift-off"
+                break
+            nxt, cnt = transfer(frozen, last["gap"], gx, cell, h_reg, axis=axis,
+                                periodic=surface.periodic,
+                                bulk_modulus=bulk_modulus if trapped == "volume" else 0.0)
+            passes += 1
+            for key in counts:
+                counts[key] += cnt[key]
+            settled = trapped not in SEALED or nxt.same_cells(frozen)
+            # a layout already solved in this step would repeat its pass: a cycle, stop
+            cycle = not settled and any(nxt.same_cells(s) for s in solved)
+            if settled or cycle or passes >= max_passes:
+                break
+            solved.append(frozen)
+            frozen, x = nxt, gx
+        if state == "contact":
             last["flow"] = _flow(last["gap"])
-            last["next"], last["report"] = None, frozen
-            partial = _result("contact", last, gx, p_ext, p_in, p_out, mu, one_way, it,
-                              fp.residual, residuals, cell, trapped, bulk_modulus, counts,
-                              passes + 1, False)
-            raise NoConvergenceError(
-                f"fluid-structure coupling: relative residual {fp.residual:.3e} after "
-                f"{fp.iterations} iterations of pocket pass {passes + 1} (tolerance "
-                f"{tol:.1e}, Anderson memory {anderson})", result=partial)
-        if fp.status == "rejected":
-            state = "lift-off"
-            break
-        nxt, cnt = transfer(frozen, last["gap"], gx, cell, h_reg, axis=axis,
-                            periodic=surface.periodic,
-                            bulk_modulus=bulk_modulus if trapped == "volume" else 0.0)
-        passes += 1
-        for key in counts:
-            counts[key] += cnt[key]
-        settled = trapped not in SEALED or nxt.same_cells(frozen)
-        # a layout already solved in this step would repeat its pass: a cycle, stop
-        cycle = not settled and any(nxt.same_cells(s) for s in solved)
-        if settled or cycle or passes >= max_passes:
-            break
-        solved.append(frozen)
-        frozen, x = nxt, gx
-    if state == "contact":
-        last["flow"] = _flow(last["gap"])
-        last["next"] = nxt if trapped in SEALED else Pockets.none(h.shape)
-        last["report"] = frozen if trapped in SEALED else nxt
-    return _result(state, last, gx if state == "contact" else x, p_ext, p_in, p_out, mu,
-                   one_way, it, residuals[-1] if residuals else float("nan"), residuals, cell,
-                   trapped, bulk_modulus, counts, passes, settled)
+            last["next"] = nxt if trapped in SEALED else Pockets.none(h.shape)
+            last["report"] = frozen if trapped in SEALED else nxt
+        return _result(state, last, gx if state == "contact" else x, p_ext, p_in, p_out, mu,
+                       one_way, it, residuals[-1] if residuals else float("nan"), residuals, cell,
+                       trapped, bulk_modulus, counts, passes, settled)
 
 
 def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residuals, cell,
             trapped, bulk_modulus, counts, passes, settled):
     common = dict(external_pressure=p_ext, inlet_pressure=p_in, outlet_pressure=p_out, mu=mu,
-                  trapped=trapped, bulk_modulus=float(bulk_modulus),
-                  one_way_leak_rate=one_way, pockets_new=counts["new"],
-                  pockets_released=counts["released"], pockets_merged=counts["merged"],
-                  pocket_passes=passes, pockets_settled=bool(settled), coupled_iterations=it,
+                  trapped=trapped, bulk_modulus=float(bulk_modulus), one_way_leak_rate=one_way,
+                  **{f"pockets_{key}": n for key, n in counts.items()}, pocket_passes=passes,
+                  pockets_settled=bool(settled), coupled_iterations=it,
                   residual=res, residual_history=tuple(residuals))
     if state == "lift-off":
         p_f = np.full(fluid.shape, max(p_in, p_out))
@@ -435,8 +436,7 @@ def coupled_sweep(surface: Surface, material, external_pressures, **kwargs) -> t
     out = []
     history = kwargs.pop("history", None)
     for p in external_pressures:
-        r = coupled_leakage(surface, material, p, history=history, **kwargs)
-        out.append(r)
+        out.append(r := coupled_leakage(surface, material, p, history=history, **kwargs))
         if r.state == "lift-off":
             break
         history = r.fluid_state
