@@ -387,3 +387,22 @@ def test_displacement_control_starts_from_the_rigid_overlap():
                                        atol=1e-7 * out["zero"].pressure.max())
     assert total["default"] <= 1.2 * total["zero"]
     assert total["default"] <= 0.7 * total["flipped"]
+
+
+def test_load_sweep_starts_every_grid_level_from_its_previous_step():
+    """A periodic load sweep starts each step from the coarse-to-fine chain corrected by
+    each level's previous solution (contact._coarse_start with ``previous``): the same
+    contact sets and pressures (to 1e-8 of max p) as cold solves, in no more iterations
+    (86 against 87 at 256^2); the previous pressure alone (the old warm start) took more
+    (97)."""
+    surf = random_surface((256, 256), 1e-3, seed=3)
+    loads = [f * MAT.E_star for f in (2.5e-4, 5e-4, 2.5e-3)]      # A* = 2 %, 4 %, 18 %
+    cold = [solve_contact(surf, MAT, mean_pressure=p, compute_stiffness=False) for p in loads]
+    sweep = contact_sweep(surf, MAT, pressures=loads, compute_stiffness=False)
+    for a, b in zip(cold, sweep.results):
+        assert a.n_contact == b.n_contact and a.n_contact > 0
+        assert np.abs(a.pressure - b.pressure).max() <= 1e-8 * a.pressure.max()
+    old = [cold[0].nit] + [solve_contact(surf, MAT, mean_pressure=p, initial=a.pressure,
+                                         compute_stiffness=False).nit
+                           for a, p in zip(cold, loads[1:])]
+    assert sweep.nit <= sum(r.nit for r in cold) <= sum(old)

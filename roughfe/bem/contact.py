@@ -234,7 +234,7 @@ def _coarse_surface(surface: Surface) -> Surface:
     return Surface(hc, surface.size, periodic=True)
 
 
-def _coarse_start(surface, material, mean_pressure, hardness):
+def _coarse_start(surface, material, mean_pressure, hardness, previous=None):
     """Coarse-to-fine initial pressure (Pa) of a periodic load-controlled solve, or None.
 
     The problem is solved on the grid coarsened by 2 (Fourier-truncated heights, the
@@ -242,18 +242,43 @@ def _coarse_start(surface, material, mean_pressure, hardness):
     ``COARSE_START_TOL`` and its pressure injected on 2 x 2 blocks. Each level costs a
     quarter of the next; measured (H = 0.8, p/E* = 0.005-0.1, 4 loads) it saves 15-20 %
     of the fine-grid iterations at 512^2-1024^2 (see docs/theory/02b_bem_performance.md).
+
+    ``previous`` (a dict, updated in place) makes it the start of the next step of a
+    load sweep: it maps each grid shape to the previous step's solution on that grid
+    (the caller stores the fine one). Every level is then started from the injected
+    coarser solution plus the previous step's fine detail, i.e. the previous solution
+    minus its own injected coarser solution, ``P_c(new) + (p_prev - P_c(prev))``
+    clipped at 0 (a full-approximation-scheme correction: the coarse grid moves the
+    contact patches to the new load, the previous step supplies what the coarse grid
+    cannot resolve), and the coarse solves store their solutions. The previous step's
+    pressure alone, a cheaper-looking start, is dearer than the cold coarse start
+    (512^2-2048^2, loads 2-5x apart: the new contact patches must be found by the fine
+    CG; see docs/theory/02b_bem_performance.md).
     """
     shape = surface.shape
     if (not surface.periodic or surface.ndim != 2 or min(shape) < COARSE_START_MIN
             or any(n % 2 for n in shape)):
         return None
+    coarse = _coarse_surface(surface)
+    initial = None
+    if previous is not None:
+        before = previous.get(coarse.shape)
+        initial = _coarse_start(coarse, material, mean_pressure, hardness, previous)
     try:
-        pc = solve_contact(_coarse_surface(surface), material, mean_pressure=mean_pressure,
-                           solver="pk", tol=COARSE_START_TOL, compute_stiffness=False,
-                           hardness=hardness).pressure
+        pc = solve_contact(coarse, material, mean_pressure=mean_pressure, solver="pk",
+                           tol=COARSE_START_TOL, compute_stiffness=False,
+                           hardness=hardness, initial=initial).pressure
     except NoConvergenceError as exc:
         pc = exc.result.pressure
-    return np.repeat(np.repeat(pc, 2, axis=0), 2, axis=1)
+    start = np.repeat(np.repeat(pc, 2, axis=0), 2, axis=1)
+    if previous is not None:
+        previous[coarse.shape] = pc
+        last = previous.get(shape)
+        if last is not None and before is not None:
+            start += last
+            start -= np.repeat(np.repeat(before, 2, axis=0), 2, axis=1)
+            np.maximum(start, 0.0, out=start)
+    return start
 
 
 def _periodic_full_contact(op, h):

@@ -3,7 +3,7 @@
 :func:`contact_sweep` solves a sequence of approaches Delta (default: ``n_steps``
 equispaced from h_pv/n to the peak-to-valley height h_pv, as in the thesis; for a
 periodic surface up to max h - mean h, where contact becomes full) or of mean
-pressures, each step starting from the previous pressure. The result type is the one
+pressures, each step starting from the previous one (:func:`contact_sweep`). The result type is the one
 :class:`roughfe.model.SweepResult` (re-exported here with :data:`RECORD_KEYS` and
 :func:`central_differences`).
 """
@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..model import RECORD_KEYS, Loading, Material, SweepResult, central_differences
 from ..surfaces.stats import rms_slope
 from ..surfaces.surface import Surface
-from .contact import solve_contact
+from .contact import _check_surface, _coarse_start, solve_contact
 
 __all__ = ["contact_sweep", "default_deltas", "SweepResult", "RECORD_KEYS",
            "central_differences"]
@@ -64,12 +64,17 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
                   hardness=None, unload: bool = False) -> SweepResult:
     """Warm-started sequence of contact solutions.
 
-    Each step starts from the previous pressure (the first one, cold, from the coarse
-    grid); elastic steps in the approach from the secant extrapolation of the two
-    previous ones (:func:`_predicted_pressure`). Measured (``benchmarks/bench_bem.py``, 512^2, p/E* = 0.005, 0.01, 0.05, 0.1,
-    2-5x apart): 159 iterations and 420 convolution-equivalents for the sweep against
-    147 and 439 for four cold coarse-started solves, and 172 against 190 cold ones
-    without the coarse start; closer steps gain more. With a ``hardness`` the plastic displacement is
+    Elastic load-controlled steps on a periodic surface (2D, >= 256 points per axis)
+    start from the coarse-to-fine chain of :func:`roughfe.bem.contact._coarse_start`,
+    each grid level corrected by its own solution of the previous step; other steps
+    from the previous pressure, elastic steps in the approach from the secant
+    extrapolation of the two previous ones (:func:`_predicted_pressure`). Measured
+    (H = 0.8 surfaces of ``benchmarks/bench_bem.py``, p/E* = 0.005, 0.01, 0.05, 0.1, tol
+    1e-10, process CPU in convolution-equivalents, sweep against 4 cold solves): 512^2
+    304 against 372 (-18 %), 1024^2 434 against 422 (even), 2048^2 507 against 517
+    (-2 %); the previous pressure alone had made the sweep dearer than cold (512^2 467
+    against 439, 1024^2 512 against 395, 2048^2 593 against 503): loads 2-5x apart
+    open new contact patches, which the fine CG then has to find. With a ``hardness`` the plastic displacement is
     carried from step to step (it is permanent); ``unload`` appends the unloading
     branch: the same steps in reverse order, below the highest one, with the plastic
     displacement of the loading branch (its steps have ``unloading=True``).
@@ -90,6 +95,7 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     unload : bool
         Append the unloading branch.
     """
+    _check_surface(surface)
     if deltas is not None and pressures is not None:
         raise InputError("give at most one of deltas (m) or pressures (Pa)")
     # one validation of the loading for every method (roughfe.model.Loading)
@@ -108,15 +114,24 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     branch = unload or hardness is not None
     results = []
     plastic = None
+    # elastic load-controlled steps on the periodic kernel: the coarse-to-fine start of
+    # every grid level corrected by that level's previous solution (_coarse_start)
+    levels = ({} if key == "mean_pressure" and not branch and solver in ("auto", "pk")
+              and kernel in ("auto", "spectral") else None)
     for v, unloading in progress.iterate(steps, "BEM load steps"):
+        initial = None if levels is None else _coarse_start(surface, material, v, None,
+                                                             levels)
+        if initial is None:
+            initial = _predicted_pressure(results, v, key, branch)
         r = solve_contact(surface, material, **{key: v}, kernel=kernel, solver=solver,
-                          tol=tol, max_iter=max_iter,
-                          initial=_predicted_pressure(results, v, key, branch),
+                          tol=tol, max_iter=max_iter, initial=initial,
                           compute_stiffness=compute_stiffness, hardness=hardness,
                           plastic_displacement=plastic)
         if branch:
             r = dataclasses.replace(r, unloading=unloading)
         results.append(r)
         plastic = r.plastic_displacement
+        if levels is not None:
+            levels[surface.shape] = r.pressure
     return SweepResult.from_results(results, rms_slope=rms_slope(surface),
                                     length=surface.size[0])
