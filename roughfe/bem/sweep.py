@@ -74,8 +74,9 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     304 against 372 (-18 %), 1024^2 434 against 422 (even), 2048^2 507 against 517
     (-2 %); the previous pressure alone had made the sweep dearer than cold (512^2 467
     against 439, 1024^2 512 against 395, 2048^2 593 against 503): loads 2-5x apart
-    open new contact patches, which the fine CG then has to find. With a ``hardness`` the plastic displacement is
-    carried from step to step (it is permanent); ``unload`` appends the unloading
+    open new contact patches, which the fine CG then has to find. With a ``hardness``
+    the plastic displacement is carried from step to step (it is permanent);
+    ``unload`` appends the unloading
     branch: the same steps in reverse order, below the highest one, with the plastic
     displacement of the loading branch (its steps have ``unloading=True``).
 
