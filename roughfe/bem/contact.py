@@ -200,11 +200,9 @@ COARSE_START_MIN = 256
 COARSE_START_TOL = 1e-4
 #: elastic, load-controlled, periodic surface solves whose sides lie in this range (and
 #: are multiples of 8) use the two-level coarse correction
-#: :class:`roughfe.bem.deflation.BlockDeflation` (8 x 8 blocks): where it is measured
-#: faster in CPU (4 loads, cold, tol 1e-10: 1024^2 177 -> 94 iterations, 7.8 -> 5.6 s;
-#: 2048^2 237 -> 111, 38.6 -> 26.3 s;
-#: at 512^2 147 -> 84 iterations, CPU even); larger grids are not measured (its F-sized
-#: integer temporaries would count against the memory of the largest solves)
+#: :class:`roughfe.bem.deflation.BlockDeflation` (8 x 8 blocks), measured faster in CPU
+#: (4 loads, cold, tol 1e-10: 1024^2 177 -> 94 iterations, 7.8 -> 5.6 s; 2048^2 237 ->
+#: 111, 38.6 -> 26.3 s; 512^2 147 -> 84 iterations, CPU even; larger grids not measured)
 DEFLATION_SIDES = (1024, 2048)
 
 
@@ -239,46 +237,36 @@ def _coarse_start(surface, material, mean_pressure, hardness, previous=None):
 
     The problem is solved on the grid coarsened by 2 (Fourier-truncated heights, the
     same load, recursively down to ``COARSE_START_MIN`` points per axis) to
-    ``COARSE_START_TOL`` and its pressure injected on 2 x 2 blocks. Each level costs a
-    quarter of the next; measured (H = 0.8, p/E* = 0.005-0.1, 4 loads) it saves 15-20 %
-    of the fine-grid iterations at 512^2-1024^2 (see docs/theory/02b_bem_performance.md).
+    ``COARSE_START_TOL`` and its pressure injected on 2 x 2 blocks (a level costs a
+    quarter of the next; 15-20 % fewer fine iterations at 512^2-1024^2, 4 loads, 02b).
 
-    ``previous`` (a dict, updated in place) makes it the start of the next step of a
-    load sweep: it maps each grid shape to the previous step's solution on that grid
-    (the caller stores the fine one). Every level is then started from the injected
-    coarser solution plus the previous step's fine detail, i.e. the previous solution
-    minus its own injected coarser solution, ``P_c(new) + (p_prev - P_c(prev))``
-    clipped at 0 (a full-approximation-scheme correction: the coarse grid moves the
-    contact patches to the new load, the previous step supplies what the coarse grid
-    cannot resolve), and the coarse solves store their solutions. The previous step's
-    pressure alone, a cheaper-looking start, is dearer than the cold coarse start
-    (512^2-2048^2, loads 2-5x apart: the new contact patches must be found by the fine
-    CG; see docs/theory/02b_bem_performance.md).
+    ``previous`` (dict grid shape -> the previous sweep step's solution on that grid,
+    updated in place; the caller stores the fine one): every level then starts from
+    the injected coarser solution plus its previous detail, P_c(new) + p_prev -
+    P_c(prev), clipped at 0 (a full-approximation-scheme start; measured in
+    :func:`roughfe.bem.sweep.contact_sweep`).
     """
     shape = surface.shape
     if (not surface.periodic or surface.ndim != 2 or min(shape) < COARSE_START_MIN
             or any(n % 2 for n in shape)):
         return None
     coarse = _coarse_surface(surface)
-    initial = None
+    before = initial = None
     if previous is not None:
-        before = previous.get(coarse.shape)
-        initial = _coarse_start(coarse, material, mean_pressure, hardness, previous)
+        before, initial = previous.get(coarse.shape), _coarse_start(
+            coarse, material, mean_pressure, hardness, previous)
     try:
         pc = solve_contact(coarse, material, mean_pressure=mean_pressure, solver="pk",
                            tol=COARSE_START_TOL, compute_stiffness=False,
                            hardness=hardness, initial=initial).pressure
     except NoConvergenceError as exc:
         pc = exc.result.pressure
-    start = np.repeat(np.repeat(pc, 2, axis=0), 2, axis=1)
     if previous is not None:
         previous[coarse.shape] = pc
-        last = previous.get(shape)
-        if last is not None and before is not None:
-            start += last
-            start -= np.repeat(np.repeat(before, 2, axis=0), 2, axis=1)
-            np.maximum(start, 0.0, out=start)
-    return start
+        if before is not None and shape in previous:     # the previous detail
+            start = np.repeat(np.repeat(pc - before, 2, axis=0), 2, axis=1)
+            return np.maximum(start + previous[shape], 0.0, out=start)
+    return np.repeat(np.repeat(pc, 2, axis=0), 2, axis=1)
 
 
 def _periodic_full_contact(op, h):
