@@ -96,8 +96,10 @@ GLOBAL = {("x3p-2", "sog"): 5000, ("x3p-2", "mcco"): 2000, ("y_t1", "mcco"): 400
 #: where it is not the default 0.5: M-CCO starts from the search's optimum, and a step
 #: of 0.5 rad leaves its basin (measured 2026-11-23, y_t1 M-CCO from the 100-sweep
 #: search f 0.827, docs/theory/surface-design.md): sigma 0.5 f 0.8445 at 2000
-#: evaluations, 0.870 at 4000; sigma 0.2 0.890 at 2000, 0.913 at 3000, 0.921 at 4000
-GLOBAL_SIGMA = {("y_t1", "mcco"): 0.2}
+#: evaluations, 0.870 at 4000; sigma 0.2 0.890 at 2000, 0.913 at 3000, 0.921 at 4000;
+#: x3p-2 M-CCO from its 300-sweep search f 0.7773: sigma 0.5 found nothing better in 2000
+#: evaluations (session 5), sigma 0.2 0.7824 at 1000, 0.8083 at 2000 (0.826 at 4000)
+GLOBAL_SIGMA = {("y_t1", "mcco"): 0.2, ("x3p-2", "mcco"): 0.2}
 #: measured targets: runs whose spectrum matching is per wave (match_spectrum
 #: directional=True): x3p-2 M-CCO f 0.621 -> 0.700 (SOG 0.933 -> 0.885: kept per chromosome)
 DIRECTIONAL = {("x3p-2", "mcco")}
