@@ -120,11 +120,16 @@ def test_surface_db_rows(surface_db):
 
 def test_exact_sensitivities_of_a_surface_design_agree_with_differences(surface_db):
     """The fixed-contact-set Jacobian (periodic approach: f (max h - mean h)) of the K and
-    A residuals against central differences (step 1e-6 rad keeps every contact set): the
-    same derivative to 1e-4 of its scale. The target pressures lie between the design's
-    rescaled steps: at a step the linear interpolation has a kink (one-sided derivatives),
-    which is what an earlier version of this test, with targets on the steps, measured
-    as a 12 % "mismatch"."""
+    A residuals against central differences: the same derivative to 1e-4 of its scale at
+    one of the steps 1e-5, 1e-4, 1e-6 rad (tried in that order). A central difference
+    errs by the solver's rounding over the step (~1e-12/h of the scale) plus, when a
+    contact set changes inside the step, by a kink of O(1). Measured on rows 1-3 of this
+    database: <= 2.5e-6 at 1e-6 rad, <= 1.8e-7 at 1e-5 except 2.8e-5 on row 3 (a contact
+    set changing within 1e-5 rad), O(1) from 1e-3 on. A wrong sensitivity fails at every
+    step; rounding or a kink at one step does not fail the test. The target pressures lie
+    between the design's rescaled steps: at a step the linear interpolation has a kink
+    (one-sided derivatives), which is what an earlier version of this test, with targets
+    on the steps, measured as a 12 % "mismatch"."""
     path, _ = surface_db
     e = db.load_entries(path)[1]
     d = Design((DesignPart(Genome.from_dict(e.genome), e.macro + e.micro, 1e-6, e.label),),
@@ -139,11 +144,16 @@ def test_exact_sensitivities_of_a_surface_design_agree_with_differences(surface_
     x0 = d.phase_values(keys)
     ev = Evaluator(SETTINGS)
     for i in range(len(keys)):
-        x = [x0.copy(), x0.copy()]
-        x[0][i] += 1e-6
-        x[1][i] -= 1e-6
-        fd = np.subtract(*(obj.residuals(ev(d.with_phases(keys, v))) for v in x)) / 2e-6
-        assert np.max(np.abs(fd - jac[:, i])) <= 1e-4 * np.max(np.abs(jac))
+        errors = []
+        for h in (1e-5, 1e-4, 1e-6):
+            x = [x0.copy(), x0.copy()]
+            x[0][i] += h
+            x[1][i] -= h
+            fd = np.subtract(*(obj.residuals(ev(d.with_phases(keys, v))) for v in x)) / (2 * h)
+            errors.append(np.max(np.abs(fd - jac[:, i])) / np.max(np.abs(jac)))
+            if errors[-1] <= 1e-4:
+                break
+        assert min(errors) <= 1e-4, f"phase {keys[i]}: relative errors {errors}"
     assert np.abs(jac[pt.size:]).max() > 1e-2        # the A rows are not trivially zero
 
 
