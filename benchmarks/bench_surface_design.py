@@ -14,7 +14,9 @@ starts): the validation's configuration of both runs. Process CPU times (the mac
 shared; wall times are inflated by load) go to ``benchmarks/output/
 bench_surface_design.json`` with the scores (the scores are the validation's business:
 here they only show the run did its work).
-Run: .venv/bin/python benchmarks/bench_surface_design.py [K [N]]
+Run: .venv/bin/python benchmarks/bench_surface_design.py [K [N]]. Exit status 0 when the
+report is written, a missed target included (its row says NOT met), as for every
+benchmark (``benchmarks/run_all.py``); a crash exits non-zero.
 """
 import resource
 import sys
@@ -91,7 +93,7 @@ def main(n_points=24, n_nodes=64):
         print(f"{c['case']}: f = {c['f']:.4f}, {c['bem_sweeps']} sweeps, {c['cpu_s']:.1f} s CPU")
     write_report(OUT, "bench_surface_design", targets, cases,
                  {"cpu_s": "s (process CPU time)", "f": "- (strict, at the target pressures)"})
-    return 0 if all(t["met"] for t in targets) else 1
+    return 0
 
 
 if __name__ == "__main__":
