@@ -10,7 +10,8 @@ are reported apart. Solvers of the inner linear systems (``FemSolverOptions.pets
 
 * ``mumps``: LU (the default);
 * ``cg-hypre``: CG + BoomerAMG, rtol 1e-10;
-* ``cg-gamg``: CG + PETSc GAMG, rtol 1e-10.
+* ``cg-gamg``: CG + PETSc GAMG, rtol 1e-10 (in the VI, rebuilt when the reduced system
+  changes size: ``roughfe.fem.petsc_tools.FreshOnResize``).
 
 Timings are process CPU seconds (the machine is shared; wall time is printed beside it);
 the iterative solvers are stopped at the first size whose step exceeds ``ITERATIVE_CAP``

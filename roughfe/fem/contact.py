@@ -59,7 +59,8 @@ from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
 from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
-from .petsc_tools import LU_MUMPS, apply_options, check_snes, unique_prefix
+from .petsc_tools import (LU_MUMPS, apply_options, check_snes, fresh_pc_on_resize,
+                          unique_prefix)
 
 Method = Literal["vi", "penalty"]
 METHODS = ("vi", "penalty")
@@ -253,6 +254,8 @@ class _ContactProblem:
                                      if k not in self.ksp_options})
         ksp = snes.getKSP()
         apply_options(ksp, prefix, self.ksp_options)
+        if opt.method == "vi" and self.ksp_options.get("pc_type") == "gamg":
+            fresh_pc_on_resize(ksp, self.ksp_options)      # the reduced system changes size
         self.lower = self.x.duplicate()
         self.upper = self.x.duplicate()
         self.lower.set(-PETSc.INFINITY)

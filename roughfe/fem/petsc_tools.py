@@ -94,6 +94,56 @@ def check_snes(snes, what: str, result=None) -> int:
     return nit
 
 
+class FreshOnResize:
+    """A PETSc ``python`` preconditioner context that builds its inner PC from scratch
+    whenever the operator changes size (e.g. ``PCGAMG`` inside SNES ``vinewtonrsls``).
+
+    The VI Newton solver hands its KSP the stiffness restricted to the inactive set, whose
+    size changes with the contact set; PETSc 3.18's GAMG then re-uses its coarse levels
+    on the new size and stops with error 60 ("Cannot change local size of Amat after use",
+    PCSetUp_GAMG -> KSPSetOperators of a level). Here the inner PC (configured by
+    ``options``, the ``pc_*`` keys) is destroyed and created anew when the size changes and
+    set up as usual otherwise. Install with :func:`fresh_pc_on_resize`.
+    """
+
+    def __init__(self, options: Mapping):
+        self.options = dict(options)
+        self.inner = None
+        self.size = None
+
+    def setUp(self, pc):                       # noqa: N802 (petsc4py's name)
+        from petsc4py import PETSc
+
+        A, P = pc.getOperators()
+        if self.inner is None or P.getSize() != self.size:
+            if self.inner is not None:
+                self.inner.destroy()
+            self.inner = PETSc.PC().create(pc.getComm())
+            self.inner.setOperators(A, P)
+            apply_options(self.inner, unique_prefix("inner"), self.options)
+            self.size = P.getSize()
+        else:
+            self.inner.setOperators(A, P)
+        self.inner.setUp()
+
+    def apply(self, pc, x, y):
+        self.inner.apply(x, y)
+
+    def destroy(self, pc):
+        if self.inner is not None:
+            self.inner.destroy()
+            self.inner = None
+
+
+def fresh_pc_on_resize(ksp, options: Mapping) -> None:
+    """Give ``ksp`` a :class:`FreshOnResize` preconditioner built from the ``pc_*`` keys of
+    ``options`` (the KSP's own ``ksp_*`` options stay as they are)."""
+    pc = ksp.getPC()
+    pc.setType("python")
+    pc.setPythonContext(FreshOnResize({k: v for k, v in options.items()
+                                       if k.startswith("pc_")}))
+
+
 #: CG + BoomerAMG (hypre): the default for the symmetric positive definite Reynolds
 #: systems (FE and FV). rtol 1e-10 relative to the right-hand side.
 CG_AMG = {"ksp_type": "cg", "pc_type": "hypre", "pc_hypre_type": "boomeramg",
