@@ -21,7 +21,8 @@ Cases
 -----
 elastic   n = --sizes: cold solves of every load; the 4-load sum in convolutions is the
           issue-16 target (<= 500 at 2048^2); a warm-started sweep over the same loads
-          (each from the previous pressure) measures the warm-start saving; Tamaas 2.8.1
+          (``contact_sweep``: each grid level of the coarse start corrected by the
+          previous step) measures the warm-start saving (``warm/cold_cpu``); Tamaas 2.8.1
           (``PolonskyKeerRey``, when importable) for n <= --tamaas-max.
 hardness  n = --hardness-size: H_p = --hardness E*: the hardness-limited solve against
           the elastic one (target: <= 3x its time) and against Tamaas' ``KatoSaturated``
@@ -185,7 +186,8 @@ def case_elastic(n, loads, tamaas, sweep):
            "cold_nit": sum(r["nit"] for r in rows)}
     if sweep:
         out.update({"warm_cpu_s": warm_cpu, "warm_convolutions": warm_cpu / conv,
-                    "warm_nit": sw.nit, "warm_A*": [float(a) for a in sw.area_fraction]})
+                    "warm_nit": sw.nit, "warm_A*": [float(a) for a in sw.area_fraction],
+                    "warm/cold_cpu": warm_cpu / out["cold_cpu_s"]})
     out["peak_rss_mb"] = _peak_rss_mb()
     return out
 
@@ -320,7 +322,8 @@ def main(argv=None) -> int:
               f"{e['irfftn_unit_cpu_s']:.4g} s); cold {e['cold_nit']} iterations, "
               f"{e['cold_cpu_s']:.1f} s CPU, {e['cold_convolutions']:.0f} convolutions; "
               f"warm sweep {e['warm_nit']} iterations, {e['warm_convolutions']:.0f} "
-              f"convolutions; peak RSS {e['peak_rss_mb']:.0f} MB",
+              f"convolutions ({e['warm/cold_cpu']:.2f} x cold); peak RSS "
+              f"{e['peak_rss_mb']:.0f} MB",
               flush=True)
     hard = {"rows": []}
     if not args.large_only:

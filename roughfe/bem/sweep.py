@@ -70,10 +70,10 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     from the previous pressure, elastic steps in the approach from the secant
     extrapolation of the two previous ones (:func:`_predicted_pressure`). Measured
     (H = 0.8 surfaces of ``benchmarks/bench_bem.py``, p/E* = 0.005, 0.01, 0.05, 0.1, tol
-    1e-10, process CPU in convolution-equivalents, sweep against 4 cold solves): 512^2
-    304 against 372 (-18 %), 1024^2 434 against 422 (even), 2048^2 507 against 517
-    (-2 %); the previous pressure alone had made the sweep dearer than cold (512^2 467
-    against 439, 1024^2 512 against 395, 2048^2 593 against 503): loads 2-5x apart
+    1e-10, against 4 cold solves): fine iterations 512^2 147 -> 142, 1024^2 94 -> 93,
+    2048^2 115 -> 112, CPU even within the noise (docs/theory/02b_bem_performance.md);
+    the previous pressure alone had made the sweep dearer than cold (159, 121, 147
+    iterations; 2048^2 593 against 503 convolution-equivalents): loads 2-5x apart
     open new contact patches, which the fine CG then has to find. With a ``hardness``
     the plastic displacement is carried from step to step (it is permanent);
     ``unload`` appends the unloading
