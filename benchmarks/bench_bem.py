@@ -47,8 +47,9 @@ The 8192^2 solve alone (about 4 GB, minutes of CPU: run it on a quiet machine, o
     nice -n 10 .venv/bin/python benchmarks/bench_bem.py --large-only --large 8192 \
         --output benchmarks/output/bench_bem_8192.json
 
-with ``--deflation-max 8192`` the same solve with the two-level correction (not in
-``DEFLATION_SIDES`` at 8192^2 until measured).
+``--deflation-max N`` sets the upper bound of ``DEFLATION_SIDES`` for the run (the
+two-level correction is on up to 8192^2 since session 6: ``--deflation-max 4096`` gives
+the plain 8192^2 solve).
 """
 from __future__ import annotations
 

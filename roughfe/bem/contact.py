@@ -202,8 +202,8 @@ COARSE_START_TOL = 1e-4
 #: are multiples of 8) use the two-level coarse correction
 #: :class:`roughfe.bem.deflation.BlockDeflation` (8 x 8 blocks), measured faster in CPU
 #: (4 loads, cold, tol 1e-10: 1024^2 177 -> 94 its, 7.8 -> 5.6 s; 2048^2 237 -> 111, 38.6
-#: -> 26.3 s; 512^2 CPU even; 4096^2, one load: 99 -> 42 its, 82.7 -> 54.4 s, 1101 MB)
-DEFLATION_SIDES = (1024, 4096)
+#: -> 26.3 s; 512^2 CPU even; one load: 4096^2 99 -> 42 its, 1101 MB; 8192^2 123 -> 53)
+DEFLATION_SIDES = (1024, 8192)
 
 
 def _deflation(op: InfluenceOperator, hardness, plastic):
