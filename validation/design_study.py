@@ -210,6 +210,15 @@ def yt1_without_refine(results, t1, settings, out: Path) -> dict:
     return {"rows": rows, "errors": errors, "lines": lines + [""]}
 
 
+def _curve_table(hist, marks, head: str, label: str) -> list:
+    """Markdown rows of a search curve ``hist`` (rows: evaluations spent, best so far)
+    read at the evaluation counts ``marks`` that it reached."""
+    marks = [n for n in marks if n <= hist[-1, 0]]
+    at = [float(hist[np.searchsorted(hist[:, 0], n, side="right") - 1, 1]) for n in marks]
+    return [f"| {head} | " + " | ".join(map(str, marks)) + " |", "|---" * (len(marks) + 1) + "|",
+            f"| {label} | " + " | ".join(f"{v:.4f}" for v in at) + " |"]
+
+
 def min_round(rg, settings, options: de.GlobalSearchOptions = GLOBAL_MIN) -> dict:
     """One more global round from the best design of ``rg`` (the M-CCO global stage) on
     min(f at p_t, interpolated f) (``options.score == "min"``): per design of a
@@ -223,8 +232,6 @@ def min_round(rg, settings, options: de.GlobalSearchOptions = GLOBAL_MIN) -> dic
     hist = np.asarray(rgm.search_history[0])
     b = rgm.best
     f_min = min(de.combined_score(b.at_targets), de.combined_score(b.scores))
-    marks = [n for n in (100, 300, 1000, 2000, 3000, 4000, 5000, 10000) if n <= hist[-1, 0]]
-    at = [float(hist[np.searchsorted(hist[:, 0], n, side="right") - 1, 1]) for n in marks]
     lines = [f"Then one more round from that design on min(f at p_t, interpolated f) "
              f"(`search_global(..., score=\"min\")`, sigma {options.sigma:g}, seed "
              f"{options.seed}, {options.n_eval} evaluations): each design of a generation is "
@@ -235,10 +242,9 @@ def min_round(rg, settings, options: de.GlobalSearchOptions = GLOBAL_MIN) -> dic
              f"{b.at_targets[1]:.4f}), interpolated f {de.combined_score(b.scores):.4f} "
              f"({b.scores[0]:.4f}, {b.scores[1]:.4f}), both reproduced from design.json "
              "(hand-written BEM, fresh sweep).", "",
-             "| evaluations (strict + interpolated) | " + " | ".join(map(str, marks)) + " |",
-             "|---" * (len(marks) + 1) + "|",
-             "| best min(f at p_t, interpolated f) | " + " | ".join(f"{v:.4f}" for v in at)
-             + " |", ""]
+             *_curve_table(hist, (100, 300, 1000, 2000, 3000, 4000, 5000, 10000),
+                           "evaluations (strict + interpolated)",
+                           "best min(f at p_t, interpolated f)"), ""]
     return {"result": rgm, "cpu_s": cpu, "history": hist, "f_min": f_min, "lines": lines}
 
 
@@ -596,9 +602,6 @@ def main(outdir: Path, quick: bool = False) -> bool:
         f_p = max(strict[(label, k)] for k in range(1, len(r.candidates) + 1))
         lines.append(f"| {label} | {r.nit} | {r.elapsed:.0f} | {de.combined_score(r.best.scores):.3f} "
                      f"| {f_p:.3f} | " + ("yes" if r.best.at_targets else "-") + " |")
-    marks = [n for n in (100, 300, 1000, 3000, 10000, 20000, 30000, 40000, 100000)
-             if n <= hist[-1, 0]]
-    at = [float(hist[np.searchsorted(hist[:, 0], n, side="right") - 1, 1]) for n in marks]
     lines += ["", "### Global search at p_t (beyond the thesis, `design.search_global`)", "",
               "IPOP-CMA-ES (own implementation, `roughfe.optim.cmaes`) on every phase and part "
               "weight of the thesis stages' best candidate, maximising f solved at the target "
@@ -610,9 +613,8 @@ def main(outdir: Path, quick: bool = False) -> bool:
               "best design of the round before. The design found is scored "
               f"again by one single solve and by the hand-written BEM above. {rg.message}. CPU "
               f"{cpu_global:.0f} s for {int(hist[-1, 0])} strict evaluations.", "",
-              "| strict evaluations | " + " | ".join(str(n) for n in marks) + " |",
-              "|---" * (len(marks) + 1) + "|",
-              "| best f at p_t | " + " | ".join(f"{v:.4f}" for v in at) + " |", ""]
+              *_curve_table(hist, (100, 300, 1000, 3000, 10000, 20000, 30000, 40000, 100000),
+                            "strict evaluations", "best f at p_t"), ""]
     lines += both["lines"] + ["![](design/search_global.png)", ""]
     nb = target_neighbourhood(entries, [t1, t3], settings, out)
     reproducible.append(abs(1.0 - nb["f_target_genome"]))
