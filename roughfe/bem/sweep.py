@@ -3,9 +3,9 @@
 :func:`contact_sweep` solves a sequence of approaches Delta (default: ``n_steps``
 equispaced from h_pv/n to the peak-to-valley height h_pv, as in the thesis; for a
 periodic surface up to max h - mean h, where contact becomes full) or of mean
-pressures, each step starting from the previous one (:func:`contact_sweep`). The result type is the one
-:class:`roughfe.model.SweepResult` (re-exported here with :data:`RECORD_KEYS` and
-:func:`central_differences`).
+pressures, each step starting from the previous one (:func:`contact_sweep`). The
+result type is the one :class:`roughfe.model.SweepResult` (re-exported here with
+:data:`RECORD_KEYS` and :func:`central_differences`).
 """
 from __future__ import annotations
 
