@@ -359,6 +359,59 @@ def stickiness_cases(case=STICKY_WIDE, factors=STICKY_FACTORS):
             "area_fraction": STICKY_AREA, "tangent_window": list(STICKY_WINDOW), "grids": out}
 
 
+#: (q_s / q_r, roll-off / q0, seed, cells per shortest wavelength) of the bandwidth scan
+BANDWIDTH_SCAN = tuple((b, 2.0, seed, 8) for b in (16, 32, 64, 128) for seed in (3, 4)) + tuple(
+    (b, 2.0, seed, 4) for b in (128, 256, 512) for seed in (3, 4))
+
+
+def bandwidth_scan(cases=BANDWIDTH_SCAN, range_over_edge_gap=0.06):
+    """The criterion's domain, non-adhesive: at A* = STICKY_AREA, kappa_rep, the measured
+    attractive area over Eq. (10)'s ring and w_LB / w_PR against the bandwidth q_s / q_r
+    (docs/theory/07_adhesion_persson.md, "The criterion's domain"; not run by ``main``:
+    the 4096^2 cases take ~40 s CPU and 2 GB each). Each surface (H = 0.8, 10 nm rms,
+    L = 10 um) is generated on its own grid; Delta_r = ``range_over_edge_gap`` x g0; two
+    load-controlled solves bracket A* (a third when the second misses it by > 3 %), and
+    the quantities are interpolated linearly in A*."""
+    mat = Material(1e6, 0.5)
+    q0 = 2 * np.pi / 1e-5
+    out = []
+    for band, roll, seed, cells in cases:
+        n = int(round(roll * band * cells))
+        t0 = time.process_time()
+        s = spectral_surface(n, 1e-5, 0.8, rms_height=1e-8, q_roll=roll * q0,
+                             q_short=roll * band * q0, rng=seed)
+        dr = range_over_edge_gap * 1e-9 / pastewka_robbins(
+            s, mat.E_star, 1e-4, 1e-9).range_over_edge_gap
+        pr = pastewka_robbins(s, mat.E_star, 1e-4, dr)
+        p = STICKY_AREA * pr.rms_slope * mat.E_star / KAPPA_REP
+        states = []
+        while len(states) < 2 or (len(states) < 3
+                                  and abs(states[-1].area_fraction / STICKY_AREA - 1) > 0.03):
+            states.append(solve_contact(s, mat, mean_pressure=p, compute_stiffness=False))
+            p *= STICKY_AREA / states[-1].area_fraction
+        lbs = [load_balance(r, dr) for r in states]
+        p_el = _at_area(states, [r.mean_pressure for r in states])
+        att = _at_area(states, [b.attractive_over_repulsive for b in lbs])
+        out.append({"bandwidth": band, "roll_off": roll, "seed": seed, "n": n,
+                    "cells_per_shortest_wavelength": cells, "range": dr,
+                    "rms_height_over_range": 1e-8 / dr,
+                    "ring_cells": pr.ring_width / (1e-5 / n),
+                    "kappa_rep_measured": STICKY_AREA * pr.rms_slope * mat.E_star / p_el,
+                    "attractive_over_repulsive_measured": att,
+                    "attractive_over_repulsive_ring": pr.attractive_over_repulsive,
+                    "attractive_area_over_ring": att / pr.attractive_over_repulsive,
+                    "w_load_balance_over_w_pr": _at_area(
+                        states, [b.threshold_work for b in lbs]) / (1e-4 * pr.criterion),
+                    "cpu_s": time.process_time() - t0})
+        r = out[-1]
+        print(f"bandwidth scan q_s/q_r {band:g} (roll-off {roll:g} q0), seed {seed}, {n}^2: "
+              f"ring {r['ring_cells']:.1f} cells, h_rms/Delta_r "
+              f"{r['rms_height_over_range']:.1f}, kappa_rep {r['kappa_rep_measured']:.2f}, "
+              f"A_att/A_rep measured / ring {r['attractive_area_over_ring']:.2f}, w_LB/w_PR "
+              f"{r['w_load_balance_over_w_pr']:.3f}, {r['cpu_s']:.1f} s CPU", flush=True)
+    return out
+
+
 def johnson_sinusoid():
     """Johnson (1995): periodic profile h = D cos(2 pi x / l), plane strain, JKR-type
     adhesion: p = p* sin^2(psi) - sqrt(2 w E* tan(psi) / l), psi = pi a / l,
@@ -492,4 +545,7 @@ def main(outdir=None) -> bool:
 
 
 if __name__ == "__main__":
+    if sys.argv[1:] == ["--bandwidth-scan"]:    # docs/theory/07, not a validation target
+        bandwidth_scan()
+        sys.exit(0)
     sys.exit(0 if main() else 1)
