@@ -90,6 +90,25 @@ def test_closed_form_and_scaling():
     assert r.describe()["references"]
 
 
+def test_threshold_geometry_depends_only_on_range_over_edge_gap():
+    # at Delta_r = r g0, g0 = (16/3) h'^2 / h'', the ring's d / a and area per repulsive
+    # area and the Tabor parameter at w_PR (C = 1) depend on r alone, whatever the band:
+    # with x = Delta_r h'' / h'^2 = 16 r / 3, l_a(w_PR) = (Delta_r h' / 2) x^(-2/3), so
+    # mu^3 = l_a^2 / (h'' Delta_r^3) = x^(-7/3) / 4 (docs/theory/07, the criterion's domain)
+    e_star, r = 1.33e6, 0.06
+    x = 16 * r / 3
+    for n, q_s, hurst in ((64, 16, 0.8), (256, 128, 0.8), (128, 32, 0.5)):
+        s = spectral_surface(n, 1e-5, hurst, rms_height=1e-8, q_roll=2 * np.pi / 1e-5,
+                             q_short=q_s * 2 * np.pi / 1e-5, rng=5)
+        g0 = 1e-9 / pastewka_robbins(s, e_star, 1e-4, 1e-9).range_over_edge_gap
+        w_pr = 1e-4 * pastewka_robbins(s, e_star, 1e-4, r * g0).criterion
+        at = pastewka_robbins(s, e_star, w_pr, r * g0)
+        assert at.criterion == pytest.approx(1.0, rel=1e-12)
+        assert at.tabor_parameter == pytest.approx(x ** (-7 / 9) / 4 ** (1 / 3), rel=1e-9)
+        assert at.ring_over_half_width == pytest.approx(
+            (x / EDGE_COEFFICIENT[2]) ** (2 / 3), rel=1e-9)
+
+
 def test_profile_uses_the_strip_edge():
     x = np.arange(256) / 256
     prof = Surface(1e-8 * (np.cos(2 * np.pi * 8 * x) + 0.3 * np.cos(2 * np.pi * 21 * x)), 1e-5,
