@@ -30,7 +30,8 @@ of :mod:`roughfe.validation`).
       300 sweeps before the global stage, which keeps the start when it finds nothing
       better) and, for the runs in
       GLOBAL, the global stage (IPOP-CMA-ES, GLOBAL[run] batched strict evaluations of
-      the best candidate, first step GLOBAL_SIGMA[run] where given). Goals (issue
+      the best candidate, first step GLOBAL_SIGMA[run] and chromosome amplitudes
+      GLOBAL_AMPLITUDES[run] where given). Goals (issue
       15): s >= 0.98 on K and f >= 0.9 on K+A, scored at the target's own pressures
       (load-controlled BEM), every score reproduced by an independent BEM run of the
       saved design; a design run < 30 min CPU.
@@ -88,10 +89,16 @@ SEARCH, SEARCH_LONG = 100, {("y_t1", "cco"): 300, ("x3p-2", "mcco"): 300}
 #: strict evaluations per run, for the runs the search leaves below their goal. Measured
 #: (one run each, x3p-2 SOG from its 100-sweep search, docs/theory/surface-design.md):
 #: 0.933 -> 0.964 at 1990 evaluations, 0.978 at 4993 (the (1+1)-ES saturates at 0.955);
-#: x3p-2 M-CCO gets 100 search sweeps and this stage instead of 300 sweeps. About 55 s
+#: x3p-2 M-CCO keeps its 300 search sweeps before this stage (SEARCH_LONG). About 55 s
 #: CPU per 1000 batched evaluations at 64 x 64: x3p-2 GCO (its winner is SOG's matched
-#: genome) and CCO are left out to keep the study near 15 min
-GLOBAL = {("x3p-2", "sog"): 5000, ("x3p-2", "mcco"): 2000, ("y_t1", "mcco"): 4000}
+#: genome; flat at 0.939 from 1000 to 3000 evaluations, session 6) is left out. Session 7
+#: (one run each from the study's start, seed 0, sigma 0.5, ~37 ms CPU per evaluation):
+#: x3p-2 SOG 0.9784 at 5000, 0.9819 at 6000, 0.9834 at 7000, 0.9842 at 8000 (goal met);
+#: x3p-2 CCO with part weights 0.9266 -> 0.9632 at 5000, 0.9646 at 8000 (levels off);
+#: with chromosome amplitudes x exp(+-0.6) (GLOBAL_AMPLITUDES) 0.9791 at 5000, 0.9805 at
+#: 6000, 0.9815 at 7000, 0.9822 at 8000 (goal met; 265 s CPU)
+GLOBAL = {("x3p-2", "sog"): 8000, ("x3p-2", "cco"): 8000, ("x3p-2", "mcco"): 2000,
+          ("y_t1", "mcco"): 4000}
 #: the global stage's first CMA-ES step (rad for the phases; ``GlobalSearchOptions.sigma``)
 #: where it is not the default 0.5: M-CCO starts from the search's optimum, and a step
 #: of 0.5 rad leaves its basin (measured 2026-11-23, y_t1 M-CCO from the 100-sweep
@@ -100,6 +107,15 @@ GLOBAL = {("x3p-2", "sog"): 5000, ("x3p-2", "mcco"): 2000, ("y_t1", "mcco"): 400
 #: x3p-2 M-CCO from its 300-sweep search f 0.7773: sigma 0.5 found nothing better in 2000
 #: evaluations (session 5), sigma 0.2 0.7824 at 1000, 0.8083 at 2000 (0.826 at 4000)
 GLOBAL_SIGMA = {("y_t1", "mcco"): 0.2, ("x3p-2", "mcco"): 0.2}
+#: the global stage's amplitude variables where they are not the default part weights
+#: +-30 % (``GlobalSearchOptions.amplitudes``: every chromosome's amplitude on a log scale,
+#: a_n0 exp(+-X tanh v)). Measured (session 7, x3p-2 M-CCO from its 300-sweep search f
+#: 0.7773, sigma 0.2, 2000 evaluations, one run each): part weights +-30 % f 0.8083 (the
+#: session-6 study), chromosome amplitudes x exp(+-0.6) 0.8477 (s_K 0.953, s_A 0.889;
+#: 0.8576 at 4000), x exp(+-1.0) 0.8247 (s_K 0.949, s_A 0.869), wave amplitudes x
+#: exp(+-0.3) 0.8041 (s_K 0.915, s_A 0.879); x3p-2 CCO (sigma 0.5, from its 100-sweep
+#: search 0.9266): part weights 0.9632 at 5000, x exp(+-0.6) 0.9791 at 5000 (see GLOBAL)
+GLOBAL_AMPLITUDES = {("x3p-2", "mcco"): 0.6, ("x3p-2", "cco"): 0.6}
 #: measured targets: runs whose spectrum matching is per wave (match_spectrum
 #: directional=True): x3p-2 M-CCO f 0.621 -> 0.700 (SOG 0.933 -> 0.885: kept per chromosome)
 DIRECTIONAL = {("x3p-2", "mcco")}
@@ -293,8 +309,10 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
         res = search_at_target_pressures(res, settings, n_eval=sweeps, amplitudes=True)
         n_global = min(GLOBAL.get((tag, method), 0), 12 if quick else np.inf)
         sigma = GLOBAL_SIGMA.get((tag, method), GlobalSearchOptions.sigma)
+        amplitudes = GLOBAL_AMPLITUDES.get((tag, method), GlobalSearchOptions.amplitudes)
         if n_global:
-            res = search_global(res, settings, n_eval=n_global, sigma=sigma)
+            res = search_global(res, settings, n_eval=n_global, sigma=sigma,
+                                amplitudes=amplitudes)
         cpu = _cpu() - t0
         best = res.best
         saved = outdir / f"surface_design_{tag}_{method}"
@@ -315,6 +333,7 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
                      "bem_sweeps": int(res.nit), "cpu_s": cpu, "search_sweeps": sweeps,
                      "global_evaluations": n_global,
                      "global_sigma": sigma if n_global else None,
+                     "global_amplitudes": amplitudes if n_global else None,
                      "matching": None if surface is None else
                      ("wave" if (tag, method) in DIRECTIONAL else "chromosome")})
     return rows
@@ -439,7 +458,9 @@ def _reason(d):
             f"(interpolated on the design's own steps){match}, then the search at the target "
             f"pressures ({d['search_sweeps']} sweeps per candidate)"
             + (f", then IPOP-CMA-ES ({d['global_evaluations']} strict evaluations, batched, "
-               f"sigma {d['global_sigma']:g})"
+               f"sigma {d['global_sigma']:g}, "
+               + (f"chromosome amplitudes x exp(+-{d['global_amplitudes']:g})"
+                  if d.get("global_amplitudes") else "part weights +-30 %") + ")"
                if d.get("global_evaluations") else ""))
 
 
