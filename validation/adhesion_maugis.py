@@ -227,11 +227,21 @@ def _approaches(surface, mat, case):
     if case.approaches is None:
         return np.linspace(0.05, 0.5, 12) * float(surface.heights.max() - surface.heights.mean())
     lo, hi, steps = case.approaches
+    return np.linspace(lo, hi, steps) * _states_near_area(surface, mat)[-1].delta
+
+
+def _states_near_area(surface, mat, extra_if_off=None):
+    """Non-adhesive load-controlled states that bracket A* = STICKY_AREA: the first at
+    p = STICKY_AREA h'_rms E* / KAPPA_REP, the second one secant step on (A* ~ p), and a
+    third when ``extra_if_off`` is given and the second misses STICKY_AREA by more than
+    that relative amount."""
     p = STICKY_AREA * rms_slope(surface) * mat.E_star / KAPPA_REP
-    for _ in range(2):     # A* ~ p: one secant step puts the state at ~STICKY_AREA
-        r = solve_contact(surface, mat, mean_pressure=p, compute_stiffness=False)
-        p *= STICKY_AREA / r.area_fraction
-    return np.linspace(lo, hi, steps) * r.delta
+    states = []
+    while len(states) < 2 or (extra_if_off is not None and len(states) < 3 and abs(
+            states[-1].area_fraction / STICKY_AREA - 1) > extra_if_off):
+        states.append(solve_contact(surface, mat, mean_pressure=p, compute_stiffness=False))
+        p *= STICKY_AREA / states[-1].area_fraction
+    return states
 
 
 def stickiness_cases(case=STICKY_WIDE, factors=STICKY_FACTORS):
@@ -383,12 +393,7 @@ def bandwidth_scan(cases=BANDWIDTH_SCAN, range_over_edge_gap=0.06):
         dr = range_over_edge_gap * 1e-9 / pastewka_robbins(
             s, mat.E_star, 1e-4, 1e-9).range_over_edge_gap
         pr = pastewka_robbins(s, mat.E_star, 1e-4, dr)
-        p = STICKY_AREA * pr.rms_slope * mat.E_star / KAPPA_REP
-        states = []
-        while len(states) < 2 or (len(states) < 3
-                                  and abs(states[-1].area_fraction / STICKY_AREA - 1) > 0.03):
-            states.append(solve_contact(s, mat, mean_pressure=p, compute_stiffness=False))
-            p *= STICKY_AREA / states[-1].area_fraction
+        states = _states_near_area(s, mat, extra_if_off=0.03)
         lbs = [load_balance(r, dr) for r in states]
         p_el = _at_area(states, [r.mean_pressure for r in states])
         att = _at_area(states, [b.attractive_over_repulsive for b in lbs])
