@@ -207,6 +207,15 @@ class GlobalSearchOptions:
         :func:`~.targets.rescore`), so that a design found meets a goal under both
         scorings; one evaluation then costs about 1.8 strict ones (the two sweeps share
         the p_max solve; measured in ``docs/theory/06_design.md``).
+    peak : float
+        0: off. > 0 (surfaces): the maximised value is lowered by ``peak_weight x max(0,
+        z_max - peak)``, ``z_max = (max Z - mean Z) / rms Z`` the design's highest node
+        in rms heights (-), e.g. the target's own z_max: the level of A(p) at the target
+        pressures hinges on it (Eq. 4.2 scales p by the design's p_max, reached at
+        ``top_fraction x (max Z - mean Z)``; :mod:`.crest`). The reported scores stay
+        the strict ones.
+    peak_weight : float
+        Penalty per rms height of ``z_max`` above ``peak`` (-), > 0.
     """
 
     method: str = "cmaes"
@@ -221,6 +230,8 @@ class GlobalSearchOptions:
     n_candidates: int = 1
     rounds: int = 1
     score: str = "strict"
+    peak: float = 0.0
+    peak_weight: float = 1.0
 
     def __post_init__(self):
         if self.method not in GLOBAL_METHODS:
@@ -239,7 +250,10 @@ class GlobalSearchOptions:
                   ("genes = 0 with amplitudes", not (self.genes and self.amplitudes),
                    self.genes),
                   ("n_candidates >= 1", int(self.n_candidates) >= 1, self.n_candidates),
-                  ("rounds >= 1", int(self.rounds) >= 1, self.rounds))
+                  ("rounds >= 1", int(self.rounds) >= 1, self.rounds),
+                  ("peak >= 0", self.peak >= 0 and math.isfinite(self.peak), self.peak),
+                  ("peak_weight > 0", self.peak_weight > 0 and math.isfinite(self.peak_weight),
+                   self.peak_weight))
         for what, ok, value in checks:
             if not ok:
                 raise InputError(f"global search: {what} needed, got {value!r}")
@@ -267,7 +281,9 @@ class GlobalSearchOptions:
         what = (f"{self.kind} amplitudes x exp(+-{self.amplitudes:g})" if self.amplitudes > 0
                 else f"part weights +-{self.weight_fraction:.0%}")
         return what + (f", genes {'/'.join(SEARCH_GENES)} +-{self.genes:.0%}"
-                       if self.genes > 0 else "")
+                       if self.genes > 0 else "") + (
+            f", z_max above {self.peak:g} rms penalised x {self.peak_weight:g}"
+            if self.peak > 0 else "")
 
     @property
     def scorings(self) -> tuple:
@@ -279,6 +295,15 @@ class GlobalSearchOptions:
         f (:func:`combined_score`) of the strict scores, or the smaller of the strict and
         the interpolated f (``score="min"``)."""
         return np.min([[combined_score(r) for r in scores[k]] for k in self.scorings], axis=0)
+
+    def peak_penalty(self, designs) -> np.ndarray:
+        """``peak_weight x max(0, z_max - peak)`` of every design (0 with ``peak`` off),
+        ``z_max = (max Z - mean Z) / rms Z`` of its realised heights (-)."""
+        if not self.peak > 0:
+            return np.zeros(len(designs))
+        z = [d.surface().heights for d in designs]
+        z_max = np.array([(h.max() - h.mean()) / h.std() for h in z])
+        return self.peak_weight * np.maximum(0.0, z_max - self.peak)
 
 
 def search_global(result: DesignResult, settings: DatabaseSettings,
@@ -366,9 +391,10 @@ def _global_rounds(c: Candidate, opts: GlobalSearchOptions, objective, settings,
             return [d0.with_phases(keys, v) for v in opts.values(keys, x0, X)]
 
         def fun(X, designs=designs):
-            sc = score_batch(designs(X), objective.targets, settings, opts.scorings)
+            ds = designs(X)
+            sc = score_batch(ds, objective.targets, settings, opts.scorings)
             evaluate.n_sweeps += len(X)
-            return opts.objective_values(sc)
+            return opts.objective_values(sc) - opts.peak_penalty(ds)
 
         run = ipop_cmaes(fun, np.where(is_w, 0.0, x0), opts.sigma, int(opts.n_eval),
                          popsize=int(opts.popsize), rng=np.random.default_rng(opts.seed))
