@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from roughfe.errors import InputError
-from roughfe.genomics.design import Design, DesignPart, GlobalSearchOptions
-from roughfe.genomics.design.crest import clipped_phases, crest_phases, wave_modes
+from roughfe.genomics.design import (Design, DesignPart, GlobalSearchOptions, clipped_phases,
+                                     crest_phases, wave_modes)
 from roughfe.genomics.genome import random_genome
 
 LENGTH, N = 1e-4, 32

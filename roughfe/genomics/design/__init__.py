@@ -16,6 +16,8 @@ Modules, by idea (see ``docs/theory/genomics-layout.md``):
   (IPOP-CMA-ES on batched BEM solves);
 * :mod:`.spectrum` -- chromosome amplitudes matched to a target surface's spectrum
   (:func:`match_spectrum`, beyond the thesis, surfaces);
+* :mod:`.crest` -- a surface design's highest peak lowered by its phases alone
+  (:func:`crest_phases`, multisine crest-factor reduction, beyond the thesis);
 * :mod:`.targets` -- the thesis targets y_t1, y_t2, y_t3, targets of a (measured)
   surface in the designs' periodic setting, and independent re-scoring;
 * :mod:`.io` -- the result files.
@@ -26,6 +28,7 @@ from ...optim.gcmma import GcmmaResult, gcmma_maximize, gcmma_minimax
 from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, mcco, refine,
                          run_design, score_database, sog)
 from .io import result_to_dict, write_design_result
+from .crest import clipped_phases, crest_phases, wave_modes
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
 from .objective import Evaluator, Objective, combined_score
@@ -46,6 +49,7 @@ __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "
            "AMPLITUDE_VARIABLES", "score_batch_at_target_pressures", "GLOBAL_SCORES",
            "SCORINGS", "score_batch", "score_batch_interpolated",
            "match_spectrum", "spectrum_matched", "target_surface",
+           "clipped_phases", "crest_phases", "wave_modes",
            "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",
            "combine", "entry_design", "Evaluator", "Objective", "combined_score",

@@ -17,17 +17,11 @@ clipped surface's phase, repeat.
 """
 from __future__ import annotations
 
-import time
-from dataclasses import replace
-
 import numpy as np
 
 from ...errors import InputError
-from ..database import DatabaseSettings
 from ..periodic import lattice_wavevectors
-from .algorithms import DesignResult, _at_targets, _extended, _finish
 from .model import Design
-from .objective import Evaluator, combined_score
 
 
 def wave_modes(design: Design):
@@ -109,25 +103,3 @@ def crest_phases(design: Design, z_max: float, clip: float = 1.0, n_iter: int = 
     phases = design.phase_values(keys) + sign * rotations[step]
     return design.with_phases(keys, phases)
 
-
-def lower_peaks(result: DesignResult, settings: DatabaseSettings, z_max: float,
-                clip: float = 1.0, n_iter: int = 100, evaluate=None) -> DesignResult:
-    """A stage beyond the thesis: every candidate's design replaced by
-    :func:`crest_phases` (its highest peak lowered towards ``z_max`` rms heights by the
-    phases, every wave's amplitude kept), Eq. (4.2) re-applied and the strict score
-    solved at the target pressures; candidates re-sorted by it. The replacement is
-    unconditional (a start for :func:`~.search.search_at_target_pressures` and
-    :func:`~.search.search_global`, not a search of its own). Two counted sweeps and one
-    strict solve per candidate."""
-    t0 = time.perf_counter()
-    evaluate = evaluate or Evaluator(settings)
-    out = []
-    for c in result.candidates:
-        new = _finish(crest_phases(c.design, z_max, clip, n_iter), c.stages, result.objective,
-                      evaluate, c.macro, c.micro, c.origin + " (crest)")
-        out.append(replace(new, at_targets=_at_targets(new.design, result.objective,
-                                                       settings, evaluate)))
-    out.sort(key=lambda c: -combined_score(c.at_targets))
-    return _extended(result, out, evaluate, t0, f"; highest peaks lowered towards z_max = "
-                     f"{z_max:g} rms (phases, clip x {clip:g}, <= {int(n_iter)} steps): f at "
-                     f"p_t = {combined_score(out[0].at_targets):.4f}")
