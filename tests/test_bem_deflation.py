@@ -279,9 +279,9 @@ def test_stable_part_coarse_matrix_is_the_galerkin_one():
 def test_stable_part_during_the_search_same_solution(monkeypatch):
     # solve_contact at 512^2 (coarse start, two-level range widened to 512), p/E* =
     # 0.05, tol 1e-10: the correction on the stable part of F while the contact set is
-    # searched (search = 1, the default) against the session-7 form that skipped it
-    # (search = settle = 0.3): the same solution to the KKT tolerance in fewer
-    # iterations (measured 23 -> 21; 2048^2, 4 loads: 115 -> 97)
+    # searched (search = 1) against the default that skips it there (search = settle
+    # = 0.3): the same solution to the KKT tolerance in fewer iterations (measured
+    # 23 -> 21; 2048^2, 4 loads: 115 -> 97)
     from roughfe.bem import Material, contact, solve_contact
     surface = spectral_surface(512, 1.0, 0.8, rms_slope=1.0, rng=1)
     monkeypatch.setattr(contact, "DEFLATION_SIDES", (512, 8192))

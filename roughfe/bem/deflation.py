@@ -276,9 +276,9 @@ class BlockDeflation:
       counts: the load-control constraint of Eq. 2.5) by projected CG preconditioned by
       S^-1 K^-1 S^-1 (S = sqrt(diag E / K(0))), to the relative residual ``coarse_tol``;
     * while the contact set is searched (more than ``settle`` of the active blocks
-      changed their part of F since the last iteration) the coarse space holds only the
-      blocks whose part of F did not change: the stable part of F (round 2, session 8;
-      until then the correction was skipped in those iterations).
+      changed their part of F since the last iteration) the correction is skipped (the
+      default) or, with ``search`` above ``settle``, acts on the stable part of F: the
+      coarse space holds only the blocks whose part of F did not change (session 8).
 
     Parameters
     ----------
@@ -300,13 +300,17 @@ class BlockDeflation:
         Fraction of the active blocks (those holding points of F) whose part of F may
         change from one iteration to the next with every active block in the coarse
         space; above it only the unchanged blocks are.
-    search : float
+    search : float, optional
         Fraction of changed active blocks above which the correction is skipped (the
-        plain direction M g). 1.0 (session 8): never skipped after the first iteration;
-        ``search = settle`` is the form of sessions 5-7, which skipped the whole search
-        (4 loads p/E* = 0.005-0.1, cold, tol 1e-10, the ``bench_bem`` surfaces: 1024^2
-        94 -> 91, 2048^2 115 -> 97 outer iterations, growth 1.22x -> 1.07x per
-        doubling; 4096^2 p/E* = 0.05 42 -> 42; see ``docs/theory/02b_bem_performance.md``).
+        plain direction M g); between ``settle`` and ``search`` it acts on the stable
+        part of F. Default ``settle`` (the form of sessions 5-7: skipped in the whole
+        search). Measured with 1.0 (never skipped after the first iteration; 4 loads
+        p/E* = 0.005-0.1, cold, tol 1e-10, 2048^2, paired CPU against the default): the
+        ``bench_bem`` surface 115 -> 97 outer iterations (1024^2 94 -> 91: growth 1.22x
+        -> 1.07x per doubling) at even CPU, a second seed 109 -> 100 at +11 % CPU,
+        H = 0.5 129 -> 123 at +22 % CPU; 0.75 did not converge within 6 min of CPU on
+        H = 0.5 at p/E* = 0.1. Not the default for that reason
+        (``docs/theory/02b_bem_performance.md``, session 8).
 
     Measured (real loop, cold, tol 1e-10, H = 0.8, 4 loads p/E* = 0.005-0.1, b = 8):
     the outer iterations of the probed reference (256^2 117 -> 62, 512^2 147 -> 72),
@@ -315,11 +319,12 @@ class BlockDeflation:
     """
 
     def __init__(self, op: InfluenceOperator, block: int = 8, coarse_tol: float = 1e-4,
-                 coarse_max_iter: int = 500, settle: float = 0.3, search: float = 1.0):
+                 coarse_max_iter: int = 500, settle: float = 0.3, search=None):
         block = int(block)
         _check_grid(op, block, 3)
         if not 0.0 < coarse_tol < 1.0:
             raise InputError(f"coarse_tol must lie in (0, 1), got {coarse_tol}")
+        search = settle if search is None else search
         if not (settle >= 0.0 and search >= 0.0):
             raise InputError(f"settle and search must be >= 0 (fractions of the active "
                              f"blocks), got {settle} and {search}")
@@ -479,8 +484,9 @@ class BlockDeflation:
     def correct(self, F, gF, zF, apply_free):
         """The A-DEF2 direction on F (the interface of :class:`ProbedBlockDeflation`);
         on the stable part of F (the blocks whose part of F did not change since the
-        last call) while more than ``settle`` of the active blocks changed, ``zF``
-        itself at the first call and while more than ``search`` of them changed."""
+        last call) while more than ``settle`` (and at most ``search``) of the active
+        blocks changed, ``zF`` itself at the first call and while more than ``search``
+        of them changed (the contact-set search)."""
         X, counts = self._rows(F)
         last, self._last = self._last, X
         if last is None:
