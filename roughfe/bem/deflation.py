@@ -299,7 +299,8 @@ class BlockDeflation:
     settle : float
         Fraction of the active blocks (those holding points of F) whose part of F may
         change from one iteration to the next with every active block in the coarse
-        space; above it only the unchanged blocks are.
+        space; above it the correction is skipped (or, up to ``search``, restricted to
+        the unchanged blocks).
     search : float, optional
         Fraction of changed active blocks above which the correction is skipped (the
         plain direction M g); between ``settle`` and ``search`` it acts on the stable
