@@ -266,15 +266,19 @@ class BlockDeflation:
 
     * near field (blocks I, J at Chebyshev distance <= 1): exact, E[I, J] = sum over
       i in I & F, j in J & F of G(x_j - x_i) (G the periodic real-space kernel of H,
-      m/Pa), as one single-precision matrix product of the blocks' b^2 mask rows with
+      m/Pa), as single-precision matrix products of the blocks' b^2 mask rows with
       the five b^2 x b^2 kernel blocks of the offsets (0,0), (0,1), (1,-1), (1,0),
-      (1,1) (the other four by symmetry of G): 10 b^2 flops per grid point of the
-      active blocks, no FFT;
+      (1,1) (the other four by symmetry of G): 2 b^2 flops per grid point and offset,
+      no FFT, kept between calls and recomputed only where a block's mask changed;
     * far field: N_I N_J K(I - J) (N the blocks' fill fractions, K the Galerkin matrix
       of full blocks, a circulant on the coarse grid), applied by coarse FFTs;
     * the coarse system on the zero-mean coarse space (n . c = 0, n the blocks' point
       counts: the load-control constraint of Eq. 2.5) by projected CG preconditioned by
-      S^-1 K^-1 S^-1 (S = sqrt(diag E / K(0))), to the relative residual ``coarse_tol``.
+      S^-1 K^-1 S^-1 (S = sqrt(diag E / K(0))), to the relative residual ``coarse_tol``;
+    * while the contact set is searched (more than ``settle`` of the active blocks
+      changed their part of F since the last iteration) the correction is skipped (the
+      default) or, with ``search`` above ``settle``, acts on the stable part of F: the
+      coarse space holds only the blocks whose part of F did not change (session 8).
 
     Parameters
     ----------
@@ -292,6 +296,22 @@ class BlockDeflation:
         0.05: 54 (1e-6: 53), the same A*.
     coarse_max_iter : int
         Iteration limit of the coarse CG (its last iterate is used if reached).
+    settle : float
+        Fraction of the active blocks (those holding points of F) whose part of F may
+        change from one iteration to the next with every active block in the coarse
+        space; above it the correction is skipped (or, up to ``search``, restricted to
+        the unchanged blocks).
+    search : float, optional
+        Fraction of changed active blocks above which the correction is skipped (the
+        plain direction M g); between ``settle`` and ``search`` it acts on the stable
+        part of F. Default ``settle`` (the form of sessions 5-7: skipped in the whole
+        search). Measured with 1.0 (never skipped after the first iteration; 4 loads
+        p/E* = 0.005-0.1, cold, tol 1e-10, 2048^2, paired CPU against the default): the
+        ``bench_bem`` surface 115 -> 97 outer iterations (1024^2 94 -> 91: growth 1.22x
+        -> 1.07x per doubling) at even CPU, a second seed 109 -> 100 at +11 % CPU,
+        H = 0.5 129 -> 123 at +22 % CPU; 0.75 did not converge within 6 min of CPU on
+        H = 0.5 at p/E* = 0.1. Not the default for that reason
+        (``docs/theory/02b_bem_performance.md``, session 8).
 
     Measured (real loop, cold, tol 1e-10, H = 0.8, 4 loads p/E* = 0.005-0.1, b = 8):
     the outer iterations of the probed reference (256^2 117 -> 62, 512^2 147 -> 72),
@@ -300,19 +320,21 @@ class BlockDeflation:
     """
 
     def __init__(self, op: InfluenceOperator, block: int = 8, coarse_tol: float = 1e-4,
-                 coarse_max_iter: int = 500, settle: float = 0.3):
+                 coarse_max_iter: int = 500, settle: float = 0.3, search=None):
         block = int(block)
         _check_grid(op, block, 3)
         if not 0.0 < coarse_tol < 1.0:
             raise InputError(f"coarse_tol must lie in (0, 1), got {coarse_tol}")
-        if not settle >= 0.0:
-            raise InputError(f"settle must be >= 0 (a fraction of the active blocks), "
-                             f"got {settle}")
+        search = settle if search is None else search
+        if not (settle >= 0.0 and search >= 0.0):
+            raise InputError(f"settle and search must be >= 0 (fractions of the active "
+                             f"blocks), got {settle} and {search}")
         self.shape = op.shape
         self.block = b = block
         self.coarse_tol = float(coarse_tol)
         self.coarse_max_iter = int(coarse_max_iter)
         self.settle = float(settle)
+        self.search = float(search)
         self.coarse_shape = (m0, m1) = (op.shape[0] // b, op.shape[1] // b)
         # the real-space kernel G at the offsets of the near field (rows -b < r0 < 2b,
         # columns |r1| < 2b) and K, the Galerkin matrix of full blocks, both from the
@@ -336,8 +358,9 @@ class BlockDeflation:
         self._kinv = kinv
         self.inner_iterations = []
         self._last = None                                 # the last free set's block rows
-        self._mask = None                                 # those of the last coarse matrix
-        self._exact = [np.zeros(m0 * m1) for _ in _NEAR]  # its exact near-field entries
+        self._mask = None                                 # those of the kept near field
+        self._exact = [np.zeros(m0 * m1) for _ in _NEAR]  # exact near-field entries
+        self._valid = [np.zeros(m0 * m1, bool) for _ in _NEAR]   # ... still exact
         self._scratch = None                              # one pass's grid mask (_rows)
 
     def _rows(self, F):
@@ -371,33 +394,35 @@ class BlockDeflation:
         return self._coarse(*self._rows(F))
 
     def _coarse(self, X, counts):
+        """The coarse operator of :meth:`coarse_operator` from the mask rows ``X`` of F;
+        ``counts`` (the blocks' points in F, or zero where a block is left out of the
+        coarse space) sets the coarse space: its blocks with a nonzero count."""
         b = self.block
         m0, m1 = self.coarse_shape
-        # the exact near field, recomputed only where a block's mask or that of its
-        # neighbour changed since the last coarse matrix (the free set settles: measured
-        # at 1024^2, p/E* = 0.1, the changed blocks fall from ~7000 of 7500 active ones
-        # to none in the second half of the iterations)
-        if self._mask is None:
-            changed = np.ones((m0, m1), bool)
-        else:
-            changed = (X != self._mask).any(axis=1).reshape(m0, m1)
+        # the exact near field E[I, I + d], kept between calls: an entry is recomputed
+        # only when it is needed (both blocks in the coarse space) and the mask of I or
+        # I + d changed since it was computed (the free set settles: measured at 1024^2,
+        # p/E* = 0.1, the changed blocks fall from ~7000 of 7500 active ones to none in
+        # the second half of the iterations). Entries with a block outside the coarse
+        # space never act: the coarse vectors are zero there.
+        changed = (np.ones(m0 * m1, bool) if self._mask is None
+                   else (X != self._mask).any(axis=1)).reshape(m0, m1)
         self._mask = X
-        dirty = [(changed | np.roll(changed, (-d0, -d1), axis=(0, 1))).ravel()
-                 for d0, d1 in _NEAR]
-        rows = np.flatnonzero(np.logical_or.reduce(dirty) & (counts > 0))
-        for o in range(len(_NEAR)):
-            self._exact[o][dirty[o]] = 0.0
-        # in chunks of rows: the products take 20 bytes per point of the chunk
-        for start in range(0, rows.size, _CHUNK):
-            chunk = rows[start:start + _CHUNK]
-            V = self._unpack(X[chunk]) @ self._near
-            ri, rj = np.divmod(chunk, m1)
-            for o, (d0, d1) in enumerate(_NEAR):
-                sel = dirty[o][chunk]
-                nb = ((ri[sel] + d0) % m0) * m1 + (rj[sel] + d1) % m1
-                self._exact[o][chunk[sel]] = np.einsum(
-                    "ij,ij->i", V[sel, o * b * b:(o + 1) * b * b], self._unpack(X[nb]))
-            del V
+        on = (counts > 0).reshape(m0, m1)
+        for o, (d0, d1) in enumerate(_NEAR):
+            valid = self._valid[o]
+            valid &= ~(changed | np.roll(changed, (-d0, -d1), axis=(0, 1))).ravel()
+            need = np.flatnonzero(on.ravel() & np.roll(on, (-d0, -d1), axis=(0, 1)).ravel()
+                                  & ~valid)
+            kern = self._near[:, o * b * b:(o + 1) * b * b]
+            # in chunks of rows: the product takes 4 b^2 bytes per row of the chunk
+            for start in range(0, need.size, _CHUNK):
+                chunk = need[start:start + _CHUNK]
+                ri, rj = np.divmod(chunk, m1)
+                nb = ((ri + d0) % m0) * m1 + (rj + d1) % m1
+                self._exact[o][chunk] = np.einsum(
+                    "ij,ij->i", self._unpack(X[chunk]) @ kern, self._unpack(X[nb]))
+            valid[need] = True
         N = (counts / float(b * b)).reshape(m0, m1)
         coef = []
         for o, (d0, d1) in enumerate(_NEAR):
@@ -459,13 +484,23 @@ class BlockDeflation:
 
     def correct(self, F, gF, zF, apply_free):
         """The A-DEF2 direction on F (the interface of :class:`ProbedBlockDeflation`);
-        ``zF`` itself while more than ``settle`` of the active blocks changed their part
-        of F since the last call (the contact-set search)."""
+        on the stable part of F (the blocks whose part of F did not change since the
+        last call) while more than ``settle`` (and at most ``search``) of the active
+        blocks changed, ``zF`` itself at the first call and while more than ``search``
+        of them changed (the contact-set search)."""
         X, counts = self._rows(F)
         last, self._last = self._last, X
-        if last is None or (np.count_nonzero((X != last).any(axis=1))
-                            > self.settle * np.count_nonzero(counts)):
+        if last is None:
             return zF
+        changed = (X != last).any(axis=1)
+        moved = np.count_nonzero(changed)
+        active = np.count_nonzero(counts)
+        if moved > self.search * active:
+            return zF
+        if moved > self.settle * active:          # the stable part of F only
+            counts = np.where(changed, 0, counts)
+            if np.count_nonzero(counts) < 2:
+                return zF
         apply, counts, diag = self._coarse(X, counts)
         return _a_def2(F, gF, zF, apply_free, self.shape, self.block,
                        lambda rc: self._coarse_solve(apply, counts, diag,
