@@ -118,11 +118,12 @@ GLOBAL_AMPLITUDES = {("x3p-2", "mcco"): 0.6, ("x3p-2", "cco"): 0.6, ("x3p-2", "g
 #: the global stage's first population where it is not 4 + 3 ln n (13 for the 24 variables
 #: of an x3p-2 design; ``GlobalSearchOptions.popsize``). x3p-2 GCO (session 8, one run each
 #: from the study's start 0.9281, seed 0, sigma 0.5, 8000 evaluations, ~38 ms CPU each,
-#: docs/theory/surface-design.md): the best sample of a run is an early one near the start
-#: (the search's optimum), the drifting population does not pass it within 10 + 30 n /
-#: lambda generations, so the run stops and IPOP restarts from the start: part weights
-#: +-30 % 0.9391 (found at evaluation 196, then 4 runs, nothing better), x exp(+-0.6) with
-#: lambda 13 0.9357 to 4000 (run 1 stopped at 1353), 0.9676 at 8000 (run 2, lambda 26);
+#: docs/theory/surface-design.md): with lambda 13 a run's best is one lucky early sample
+#: (x exp(+-0.6): 0.9357 at evaluation 469, population median 0.79) that the population
+#: does not pass within 10 + 30 n / lambda = 66 generations, so the run stops and IPOP
+#: restarts from the start: part weights +-30 % 0.9391 (at evaluation 196; 4 runs, nothing
+#: better), x exp(+-0.6) 0.9357 to 4000 (run 1 stopped at 1353), 0.9676 at 8000 (run 2,
+#: lambda 26, climbing from 4000);
 #: x exp(+-0.6) with lambda 26 from the start: one run, 0.9456 at 2000, 0.9725 at 4000,
 #: 0.9791 at 6000, 0.9822 at 7000, 0.9842 at 8000 (goal met; 311 s CPU)
 GLOBAL_POPSIZE = {("x3p-2", "gco"): 26}
