@@ -328,6 +328,35 @@ def test_batched_surface_scores_equal_the_single_strict_scores(surface_db):
     np.testing.assert_allclose(batch, single, rtol=0, atol=1e-8)
 
 
+def test_global_stage_objective_moves_with_every_variable_and_not_with_its_symmetries(
+        surface_db):
+    """The global stage's variables on a split surface design (every phase and every
+    chromosome amplitude, as search_global with amplitudes > 0) all reach the strict
+    score: one step in any single variable changes it. It is flat only along the exact
+    symmetries of the objective: one overall height factor (Eq. 4.2 rescales it out) and
+    a translation by one node (every phase + 2 pi k / N, k the wave's lattice index)."""
+    from roughfe.genomics.design import score_batch_at_target_pressures
+
+    entries, tk, _ = _perturbed_target(surface_db)
+    e = entries[2]
+    d = Design((DesignPart(Genome.from_dict(e.genome), e.macro + e.micro, 1.0, e.label),),
+               1.0, L, 32, e.label, 2).split_chromosomes()
+    keys = d.keys("all") + [(k, "weight") for k in range(len(d.parts))]
+    x0 = d.phase_values(keys)
+    is_w = np.array([k[1] == "weight" for k in keys])
+    step = np.where(is_w, x0 * (np.exp(0.05) - 1), 0.05)
+    shift = np.concatenate([2 * np.pi * lattice_wavevectors(p.genome, p.chromosomes, L)[0][:, 0]
+                            / 32 for p in d.parts] + [np.zeros(is_w.sum())])
+    rows = [x0 + np.diag(step)[i] for i in range(len(keys))] + \
+        [x0, np.where(is_w, 1.7 * x0, x0), x0 + shift]
+    f = score_batch_at_target_pressures([d.with_phases(keys, x) for x in rows], [tk],
+                                        SETTINGS)[:, 0]
+    f0 = f[len(keys)]
+    assert np.isfinite(f).all() and 0 < f0 < 1
+    assert np.abs(f[:len(keys)] - f0).min() > 1e-6       # no frozen variable
+    np.testing.assert_allclose(f[-2:], f0, rtol=0, atol=1e-8)   # CG tolerance
+
+
 def test_global_search_of_a_surface_design_with_wave_amplitudes(surface_db):
     """search_global (IPOP-CMA-ES on batched strict scores) on a surface design, every
     wave's amplitude a variable: f at the target pressures never falls, the searched

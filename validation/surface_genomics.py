@@ -30,11 +30,11 @@ of :mod:`roughfe.validation`).
       300 sweeps before the global stage, which keeps the start when it finds nothing
       better) and, for the runs in
       GLOBAL, the global stage (IPOP-CMA-ES, GLOBAL[run] batched strict evaluations of
-      the best candidate, first step GLOBAL_SIGMA[run] and chromosome amplitudes
-      GLOBAL_AMPLITUDES[run] where given). Goals (issue
-      15): s >= 0.98 on K and f >= 0.9 on K+A, scored at the target's own pressures
-      (load-controlled BEM), every score reproduced by an independent BEM run of the
-      saved design; a design run < 30 min CPU.
+      the best candidate, first step GLOBAL_SIGMA[run], chromosome amplitudes
+      GLOBAL_AMPLITUDES[run] and first population GLOBAL_POPSIZE[run] where given).
+      Goals (issue 15): s >= 0.98 on K and f >= 0.9 on K+A, scored at the target's own
+      pressures (load-controlled BEM), every score reproduced by an independent BEM run
+      of the saved design; a design run < 30 min CPU.
 """
 from __future__ import annotations
 
@@ -90,8 +90,7 @@ SEARCH, SEARCH_LONG = 100, {("y_t1", "cco"): 300, ("x3p-2", "mcco"): 300}
 #: (one run each, x3p-2 SOG from its 100-sweep search, docs/theory/surface-design.md):
 #: 0.933 -> 0.964 at 1990 evaluations, 0.978 at 4993 (the (1+1)-ES saturates at 0.955);
 #: x3p-2 M-CCO keeps its 300 search sweeps before this stage (SEARCH_LONG). About 55 s
-#: CPU per 1000 batched evaluations at 64 x 64: x3p-2 GCO (its winner is SOG's matched
-#: genome; flat at 0.939 from 1000 to 3000 evaluations, session 6) is left out. Session 7
+#: CPU per 1000 batched evaluations at 64 x 64 (x3p-2 GCO: see GLOBAL_POPSIZE). Session 7
 #: (one run each from the study's start, seed 0, sigma 0.5, ~37 ms CPU per evaluation):
 #: x3p-2 SOG 0.9784 at 5000, 0.9819 at 6000, 0.9834 at 7000, 0.9842 at 8000 (goal met);
 #: x3p-2 CCO with part weights 0.9266 -> 0.9632 at 5000, 0.9646 at 8000 (levels off);
@@ -107,7 +106,7 @@ SEARCH, SEARCH_LONG = 100, {("y_t1", "cco"): 300, ("x3p-2", "mcco"): 300}
 #: the target's z_max 2.714: 0.8186 / 0.8446, a second 2000 from the best 0.8477 (none
 #: better): not adopted (docs/theory/surface-design.md, session 8)
 GLOBAL = {("x3p-2", "sog"): 8000, ("x3p-2", "cco"): 8000, ("x3p-2", "mcco"): 6000,
-          ("y_t1", "mcco"): 4000}
+          ("y_t1", "mcco"): 4000, ("x3p-2", "gco"): 8000}
 #: the global stage's first CMA-ES step (rad for the phases; ``GlobalSearchOptions.sigma``)
 #: where it is not the default 0.5: M-CCO starts from the search's optimum, and a step
 #: of 0.5 rad leaves its basin (measured 2026-11-23, y_t1 M-CCO from the 100-sweep
@@ -124,7 +123,19 @@ GLOBAL_SIGMA = {("y_t1", "mcco"): 0.2, ("x3p-2", "mcco"): 0.2}
 #: 0.8576 at 4000), x exp(+-1.0) 0.8247 (s_K 0.949, s_A 0.869), wave amplitudes x
 #: exp(+-0.3) 0.8041 (s_K 0.915, s_A 0.879); x3p-2 CCO (sigma 0.5, from its 100-sweep
 #: search 0.9266): part weights 0.9632 at 5000, x exp(+-0.6) 0.9791 at 5000 (see GLOBAL)
-GLOBAL_AMPLITUDES = {("x3p-2", "mcco"): 0.6, ("x3p-2", "cco"): 0.6}
+GLOBAL_AMPLITUDES = {("x3p-2", "mcco"): 0.6, ("x3p-2", "cco"): 0.6, ("x3p-2", "gco"): 0.6}
+#: the global stage's first population where it is not 4 + 3 ln n (13 for the 24 variables
+#: of an x3p-2 design; ``GlobalSearchOptions.popsize``). x3p-2 GCO (session 8, one run each
+#: from the study's start 0.9281, seed 0, sigma 0.5, 8000 evaluations, ~38 ms CPU each,
+#: docs/theory/surface-design.md): with lambda 13 a run's best is one lucky early sample
+#: (x exp(+-0.6): 0.9357 at evaluation 469, population median 0.79) that the population
+#: does not pass within 10 + 30 n / lambda = 66 generations, so the run stops and IPOP
+#: restarts from the start: part weights +-30 % 0.9391 (at evaluation 196; 4 runs, nothing
+#: better), x exp(+-0.6) 0.9357 to 4000 (run 1 stopped at 1353), 0.9676 at 8000 (run 2,
+#: lambda 26, climbing from 4000);
+#: x exp(+-0.6) with lambda 26 from the start: one run, 0.9456 at 2000, 0.9725 at 4000,
+#: 0.9791 at 6000, 0.9822 at 7000, 0.9842 at 8000 (goal met; 311 s CPU)
+GLOBAL_POPSIZE = {("x3p-2", "gco"): 26}
 #: measured targets: runs whose spectrum matching is per wave (match_spectrum
 #: directional=True): x3p-2 M-CCO f 0.621 -> 0.700 (SOG 0.933 -> 0.885: kept per chromosome)
 DIRECTIONAL = {("x3p-2", "mcco")}
@@ -319,9 +330,11 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
         n_global = min(GLOBAL.get((tag, method), 0), 12 if quick else np.inf)
         sigma = GLOBAL_SIGMA.get((tag, method), GlobalSearchOptions.sigma)
         amplitudes = GLOBAL_AMPLITUDES.get((tag, method), GlobalSearchOptions.amplitudes)
+        # quick: the default population (26 would not fit its 12 evaluations)
+        popsize = 0 if quick else GLOBAL_POPSIZE.get((tag, method), GlobalSearchOptions.popsize)
         if n_global:
             res = search_global(res, settings, n_eval=n_global, sigma=sigma,
-                                amplitudes=amplitudes)
+                                amplitudes=amplitudes, popsize=popsize)
         cpu = _cpu() - t0
         best = res.best
         saved = outdir / f"surface_design_{tag}_{method}"
@@ -343,6 +356,7 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
                      "global_evaluations": n_global,
                      "global_sigma": sigma if n_global else None,
                      "global_amplitudes": amplitudes if n_global else None,
+                     "global_popsize": popsize if n_global else None,
                      "matching": None if surface is None else
                      ("wave" if (tag, method) in DIRECTIONAL else "chromosome")})
     return rows
@@ -469,7 +483,9 @@ def _reason(d):
             + (f", then IPOP-CMA-ES ({d['global_evaluations']} strict evaluations, batched, "
                f"sigma {d['global_sigma']:g}, "
                + (f"chromosome amplitudes x exp(+-{d['global_amplitudes']:g})"
-                  if d.get("global_amplitudes") else "part weights +-30 %") + ")"
+                  if d.get("global_amplitudes") else "part weights +-30 %")
+               + (f", population {d['global_popsize']}" if d.get("global_popsize") else "")
+               + ")"
                if d.get("global_evaluations") else ""))
 
 
