@@ -482,7 +482,7 @@ def _reason(d):
             f"(interpolated on the design's own steps){match}, then the search at the target "
             f"pressures ({d['search_sweeps']} sweeps per candidate)"
             + (f", then IPOP-CMA-ES ({d['global_evaluations']} strict evaluations, batched, "
-               f"sigma {d['global_sigma']:g}, "
+               f"one run, seed {GlobalSearchOptions.seed}, sigma {d['global_sigma']:g}, "
                + (f"chromosome amplitudes x exp(+-{d['global_amplitudes']:g})"
                   if d.get("global_amplitudes") else "part weights +-30 %")
                + (f", population {d['global_popsize']}" if d.get("global_popsize") else "")
