@@ -309,33 +309,46 @@ def measured_targets(measured, settings):
                                "cpu_s": cpu_window}}
 
 
+def design_chain(entries, settings, targets, pbar, tag, method, surface=None, sweeps=SEARCH,
+                 quick=False):
+    """One design run of the study (also timed by benchmarks/bench_surface_design.py):
+    ``run_design``, then for a measured target (``surface``) :func:`match_spectrum`, the
+    search at the target pressures (``sweeps`` per candidate) and, for the runs in GLOBAL,
+    the global stage with the study's constants. Returns the result and the global
+    stage's settings (``global_evaluations`` 0 when it was not run)."""
+    res = run_design(method, entries, targets, settings, pbar=pbar,
+                     options=GcmmaOptions(bound="period"))
+    if surface is not None:
+        res = match_spectrum(res, surface, settings, entries=entries,
+                             n_entries=SPECTRUM_STARTS,
+                             directional=(tag, method) in DIRECTIONAL)
+    res = search_at_target_pressures(res, settings, n_eval=sweeps, amplitudes=True)
+    n_global = min(GLOBAL.get((tag, method), 0), 12 if quick else np.inf)
+    sigma = GLOBAL_SIGMA.get((tag, method), GlobalSearchOptions.sigma)
+    amplitudes = GLOBAL_AMPLITUDES.get((tag, method), GlobalSearchOptions.amplitudes)
+    # quick: the default population (26 would not fit its 12 evaluations)
+    popsize = 0 if quick else GLOBAL_POPSIZE.get((tag, method), GlobalSearchOptions.popsize)
+    if n_global:
+        res = search_global(res, settings, n_eval=n_global, sigma=sigma,
+                            amplitudes=amplitudes, popsize=popsize)
+    return res, {"global_evaluations": n_global,
+                 "global_sigma": sigma if n_global else None,
+                 "global_amplitudes": amplitudes if n_global else None,
+                 "global_popsize": popsize if n_global else None}
+
+
 def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, tag,
                 surface=None, long=None, quick=False):
-    """SOG/GCO/CCO on K, M-CCO on K and A; then, when the target's ``surface`` is given
-    (a measured topography), :func:`match_spectrum` (candidates and the SPECTRUM_STARTS
-    best genomes with the target's band amplitudes, per wave for the runs in DIRECTIONAL);
-    then the search at the target pressures (phases and per-chromosome amplitudes),
-    ``search`` sweeps per candidate, or ``long[method]`` where given."""
+    """SOG/GCO/CCO on K, M-CCO on K and A (:func:`design_chain` each, ``search`` sweeps
+    per candidate or ``long[method]`` where given), every design saved and re-scored by
+    an independent BEM run of its saved heights."""
     rows = []
     for method in ("sog", "gco", "cco", "mcco"):
         targets = [targets_k, target_a] if method == "mcco" else [targets_k]
         t0 = _cpu()
-        res = run_design(method, entries, targets, settings, pbar=pbar,
-                         options=GcmmaOptions(bound="period"))
-        if surface is not None:
-            res = match_spectrum(res, surface, settings, entries=entries,
-                                 n_entries=SPECTRUM_STARTS,
-                                 directional=(tag, method) in DIRECTIONAL)
         sweeps = (long or {}).get(method, search)
-        res = search_at_target_pressures(res, settings, n_eval=sweeps, amplitudes=True)
-        n_global = min(GLOBAL.get((tag, method), 0), 12 if quick else np.inf)
-        sigma = GLOBAL_SIGMA.get((tag, method), GlobalSearchOptions.sigma)
-        amplitudes = GLOBAL_AMPLITUDES.get((tag, method), GlobalSearchOptions.amplitudes)
-        # quick: the default population (26 would not fit its 12 evaluations)
-        popsize = 0 if quick else GLOBAL_POPSIZE.get((tag, method), GlobalSearchOptions.popsize)
-        if n_global:
-            res = search_global(res, settings, n_eval=n_global, sigma=sigma,
-                                amplitudes=amplitudes, popsize=popsize)
+        res, stage = design_chain(entries, settings, targets, pbar, tag, method, surface,
+                                  sweeps, quick)
         cpu = _cpu() - t0
         best = res.best
         saved = outdir / f"surface_design_{tag}_{method}"
@@ -354,10 +367,7 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
                      "reproduced": float(np.max(np.abs(np.subtract(independent,
                                                                    best.at_targets)))),
                      "bem_sweeps": int(res.nit), "cpu_s": cpu, "search_sweeps": sweeps,
-                     "global_evaluations": n_global,
-                     "global_sigma": sigma if n_global else None,
-                     "global_amplitudes": amplitudes if n_global else None,
-                     "global_popsize": popsize if n_global else None,
+                     **stage,
                      "matching": None if surface is None else
                      ("wave" if (tag, method) in DIRECTIONAL else "chromosome")})
     return rows
