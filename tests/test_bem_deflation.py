@@ -183,8 +183,8 @@ def test_lean_passes_are_the_dense_formulas(monkeypatch, points):
     # F-sized index array) give what the one-line dense formulas give: the block
     # sums Z^T s, the prolongation z + Z c, the blocks' mask rows and point counts;
     # one block row per pass (points = 1) and one pass over the whole grid
-    from roughfe.bem import deflation
-    monkeypatch.setattr(deflation, "_POINTS", points)
+    from roughfe.bem import coarse_blocks
+    monkeypatch.setattr(coarse_blocks, "_POINTS", points)
     shape, b = (48, 64), 8
     n0, n1 = shape
     m1 = n1 // b
@@ -193,11 +193,11 @@ def test_lean_passes_are_the_dense_formulas(monkeypatch, points):
     F = np.flatnonzero(rng.random(n0 * n1) < 0.3)
     blk = (F // n1 // b) * m1 + (F % n1) // b
     s = rng.standard_normal(F.size)
-    assert np.array_equal(deflation._restrict(F, s, shape, b),
+    assert np.array_equal(coarse_blocks._restrict(F, s, shape, b),
                           np.bincount(blk, weights=s, minlength=(n0 // b) * m1))
     c = rng.standard_normal((n0 // b) * m1)
     z = rng.standard_normal(F.size)
-    out = deflation._a_def2(F, s, z, lambda x: np.zeros_like(x), shape, b, lambda r: c)
+    out = coarse_blocks._a_def2(F, s, z, lambda x: np.zeros_like(x), shape, b, lambda r: c)
     dense = z + c[blk]
     assert np.array_equal(out, dense - dense.mean())
     X, counts = BlockDeflation(op, b)._rows(F)
@@ -213,7 +213,7 @@ def test_kernel_and_full_blocks_from_the_half_spectrum():
     # the half spectrum without a full grid: they equal the real-space kernel
     # irfftn(spectrum) and H applied to a block indicator summed over blocks (their
     # definitions) to rounding, on a non-square grid
-    from roughfe.bem.deflation import _full_block_galerkin, _kernel_window
+    from roughfe.bem.coarse_blocks import _full_block_galerkin, _kernel_window
     import scipy.fft
     shape, b = (48, 64), 8
     op = influence_operator(shape, (0.75, 1.0), 1.0)
@@ -233,10 +233,10 @@ def test_lean_passes_same_solve(monkeypatch, n):
     # in the real loop (cold, load control, tol 1e-10) the correction in passes of one
     # block row gives the solve of a single pass over the grid (the unchunked layout):
     # the same outer and coarse iterations and pressures
-    from roughfe.bem import deflation
+    from roughfe.bem import coarse_blocks
     runs = []
     for points in (8 * n, 1 << 40):
-        monkeypatch.setattr(deflation, "_POINTS", points)
+        monkeypatch.setattr(coarse_blocks, "_POINTS", points)
         made = []
         out = _solve(n, lambda op: made.append(BlockDeflation(op, 8)) or made[-1],
                      mean_pressure=0.05)
