@@ -8,8 +8,11 @@ A periodic surface design is a sum of lattice plane waves (:mod:`..periodic`),
 and the height of its highest node over the mean, in rms units, ``z_max = (max Z - mean
 Z) / rms Z``, is set by the phases phi_w (the rms by the amplitudes a_w alone, Parseval).
 A design is loaded to ``top_fraction x (max Z - mean Z)`` and scored at pressures scaled
-by its own p_max (Eq. 4.2), so z_max sets the level of A(p) at every target pressure
-(``docs/theory/surface-design.md``, session 7). :func:`crest_phases` lowers z_max with
+by its own p_max (Eq. 4.2), so session 7 read z_max as what sets the level of A(p) at
+every target pressure. Measured in session 8 (``docs/theory/surface-design.md``): lowering
+z_max of the x3p-2 M-CCO designs this way (or by a penalty in the global stage) did not
+raise A(p_max) and cost K, so the validation study does not use it; it stays a tool for
+the crest factor of a design. :func:`crest_phases` lowers z_max with
 the multisine crest-factor reduction by clipping and projection (Van der Ouderaa, Schoukens
 and Renneboog 1988, IEEE Trans. Instrum. Meas. 37(2) 207; the Gerchberg-Saxton step):
 clip the heights at a level, take the FFT, keep every lattice mode's modulus and the
