@@ -210,10 +210,11 @@ class GlobalSearchOptions:
     peak : float
         0: off. > 0 (surfaces): the maximised value is lowered by ``peak_weight x max(0,
         z_max - peak)``, ``z_max = (max Z - mean Z) / rms Z`` the design's highest node
-        in rms heights (-), e.g. the target's own z_max: the level of A(p) at the target
-        pressures hinges on it (Eq. 4.2 scales p by the design's p_max, reached at
-        ``top_fraction x (max Z - mean Z)``; :mod:`.crest`). The reported scores stay
-        the strict ones.
+        in rms heights (-), e.g. the target's own z_max (Eq. 4.2 scales p by the
+        design's p_max, reached at ``top_fraction x (max Z - mean Z)``; :mod:`.crest`).
+        Measured in session 8 on x3p-2 M-CCO: it lowers z_max but not the level of A(p)
+        (``docs/theory/surface-design.md``), so the study leaves it off. The reported
+        scores stay the strict ones.
     peak_weight : float
         Penalty per rms height of ``z_max`` above ``peak`` (-), > 0.
     """
