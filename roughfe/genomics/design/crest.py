@@ -27,6 +27,12 @@ from ..periodic import lattice_wavevectors
 from .model import Design
 
 
+def peak_height(heights) -> float:
+    """z_max = (max Z - mean Z) / rms Z (-): the highest node over the mean in rms heights."""
+    h = np.asarray(heights, dtype=float)
+    return float((h.max() - h.mean()) / h.std())
+
+
 def wave_modes(design: Design):
     """The lattice mode of every wave whose phase moves its realised mode: keys ``(part,
     ridge m, chromosome n)`` (:meth:`Design.keys`), the FFT index ``(i, j)`` of the mode of
@@ -85,11 +91,11 @@ def crest_phases(design: Design, z_max: float, clip: float = 1.0, n_iter: int = 
     :func:`clipped_phases` with the level ``clip * z_max * rms``; the result is the first
     step whose ``(max Z - mean Z) / rms Z <= z_max``, else the step of the lowest. Waves
     that share a lattice mode (two parts, or a wave and its conjugate) are rotated
-    together (their relative phases, hence the mode's modulus, kept). Why: a design's
-    A(p) level at the target pressures hinges on z_max (Eq. 4.2 normalises p by the
-    design's own p_max, reached at ``top_fraction x (max Z - mean Z)``): x3p-2's M-CCO
-    design had z_max 2.95 against the target's 2.71 and A(p) 8-10 % low at every point
-    with the right shape (``docs/theory/surface-design.md``, sessions 7 and 8).
+    together (their relative phases, hence the mode's modulus, kept). Built to test
+    session 7's reading that a design's A(p) level hinges on z_max (Eq. 4.2 normalises p
+    by the design's own p_max, reached at ``top_fraction x (max Z - mean Z)``); measured
+    in session 8 on x3p-2 M-CCO: it lowers z_max but not the level of A(p), and costs K
+    (``docs/theory/surface-design.md``).
     """
     if not (np.isfinite(z_max) and z_max > 0 and clip > 0 and int(n_iter) >= 1):
         raise InputError(f"crest_phases: z_max > 0, clip > 0 and n_iter >= 1 needed, got "
@@ -97,10 +103,10 @@ def crest_phases(design: Design, z_max: float, clip: float = 1.0, n_iter: int = 
     keys, modes, sign = wave_modes(design)
     z = design.surface().heights
     rms = float(np.std(z))
-    if not keys or rms == 0 or (z.max() - z.mean()) / rms <= z_max:
+    if not keys or rms == 0 or peak_height(z) <= z_max:
         return design
     fields, rotations = clipped_phases(z, modes, clip * z_max * rms, n_iter)
-    peaks = np.array([f.max() / rms for f in fields])
+    peaks = np.array([peak_height(f) for f in fields])
     below = np.flatnonzero(peaks <= z_max)
     step = int(below[0]) if below.size else int(np.argmin(peaks))
     phases = design.phase_values(keys) + sign * rotations[step]

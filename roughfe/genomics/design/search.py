@@ -16,6 +16,7 @@ from ...optim.cmaes import ipop_cmaes
 from ...optim.es import one_plus_one_es
 from ..database import DatabaseSettings
 from .algorithms import Candidate, DesignResult, _at_targets, _extended, _finish
+from .crest import peak_height
 from .model import Design, is_amplitude_key
 from .objective import Evaluator, combined_score
 from .targets import SCORINGS, score_batch
@@ -302,8 +303,7 @@ class GlobalSearchOptions:
         ``z_max = (max Z - mean Z) / rms Z`` of its realised heights (-)."""
         if not self.peak > 0:
             return np.zeros(len(designs))
-        z = [d.surface().heights for d in designs]
-        z_max = np.array([(h.max() - h.mean()) / h.std() for h in z])
+        z_max = np.array([peak_height(d.surface().heights) for d in designs])
         return self.peak_weight * np.maximum(0.0, z_max - self.peak)
 
 
