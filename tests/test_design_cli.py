@@ -94,6 +94,7 @@ def test_design_command_reports_bad_input(tmp_path, capsys):
     for flag, value, why in (("--global-amplitudes", "-0.5", ">= 0"),
                              ("--global-amplitudes", "3", "amplitudes <= 2"),
                              ("--global-genes", "1.5", "genes < 1"),
+                             ("--global-modulation", "2.5", "modulation <= 2"),
                              ("--global-rounds", "0", ">= 1"),
                              ("--global-score", "best", "score must be one of")):
         assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",

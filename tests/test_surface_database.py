@@ -385,3 +385,29 @@ def test_global_search_of_a_surface_design_with_wave_amplitudes(surface_db):
         search_global(res, SETTINGS, n_eval=4, waves=True)
     with pytest.raises(InputError, match="amplitudes must be one of"):
         search_at_target_pressures(res, SETTINGS, n_eval=4, amplitudes="ridge")
+
+
+def test_global_search_with_the_modulation_variable(surface_db):
+    """search_global with ``modulation`` > 0: one more variable, the depth of the short
+    waves' modulation by the long-wave height; the searched design carries it (within
+    +-0.5 of the start's 0), its strict score is reproduced by an independent BEM run of
+    its heights and by its JSON read back."""
+    from roughfe.genomics.design import (GcmmaOptions, combined_score,
+                                         score_at_target_pressures, search_global)
+
+    entries, tk, ta = _perturbed_target(surface_db)
+    res = run_design("mcco", entries, [tk, ta], SETTINGS,
+                     options=GcmmaOptions(n_it_sog=0, n_it_cross=0, n_it_micro=0))
+    out = search_global(res, SETTINGS, n_eval=40, amplitudes=0.5, modulation=0.5, seed=1)
+    f0 = max(combined_score(rescore_at_target_pressures(c.design, [tk, ta], SETTINGS))
+             for c in res.candidates)
+    best = out.best
+    assert combined_score(best.at_targets) > f0
+    assert 0 < abs(best.design.modulation) <= 0.5
+    again = score_at_target_pressures(best.design.surface(), [tk, ta], SETTINGS)
+    np.testing.assert_allclose(again, best.at_targets, rtol=0, atol=1e-12)
+    read = Design.from_dict(best.design.to_dict())
+    np.testing.assert_array_equal(read.surface().heights, best.design.surface().heights)
+    assert "short-wave modulation +-0.5" in out.message
+    with pytest.raises(InputError, match="modulation <= 2"):
+        search_global(res, SETTINGS, n_eval=4, modulation=3.0)

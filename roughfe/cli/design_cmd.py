@@ -25,7 +25,10 @@ GLOBAL_FLAGS = (
      "R IPOP-CMA-ES runs, each from the best design of the one before (N evaluations each)"),
     ("--global-genes", nonnegative_float, 0.0, "X",
      "every part's gamma, H, lambda1 a variable too, within +-X (fraction, < 1) of its "
-     "start (0: off)"))
+     "start (0: off)"),
+    ("--global-modulation", nonnegative_float, 0.0, "X",
+     "surfaces: the depth of the short waves' modulation by the long-wave height a "
+     "variable too, within +-X of its start (X <= 2; 0: off)"))
 
 
 def _target(spec, quantity, settings, cache):
@@ -51,7 +54,8 @@ def _run(args) -> int:
         popsize=args.global_popsize, amplitudes=args.global_amplitudes,
         waves=args.global_waves,
         n_candidates=args.global_candidates, rounds=args.global_rounds,
-        genes=args.global_genes, score=args.global_score)   # checked before the database is read
+        genes=args.global_genes, score=args.global_score,
+        modulation=args.global_modulation)   # checked before the database is read
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}

@@ -18,6 +18,9 @@ Modules, by idea (see ``docs/theory/genomics-layout.md``):
   (:func:`match_spectrum`, beyond the thesis, surfaces);
 * :mod:`.crest` -- a surface design's highest peak lowered by its phases alone
   (:func:`crest_phases`, multisine crest-factor reduction, beyond the thesis);
+* :mod:`.modulation` -- short waves modulated by the long-wave height
+  (:func:`modulated_heights`, :attr:`Design.modulation`, beyond the thesis and the MWM
+  model) and its measure :func:`crest_roughness`;
 * :mod:`.targets` -- the thesis targets y_t1, y_t2, y_t3, targets of a (measured)
   surface in the designs' periodic setting, and independent re-scoring;
 * :mod:`.io` -- the result files.
@@ -29,6 +32,7 @@ from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco,
                          run_design, score_database, sog)
 from .io import result_to_dict, write_design_result
 from .crest import clipped_phases, crest_phases, wave_modes
+from .modulation import MODULATION_CUT, crest_roughness, modulated_heights, wave_split
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
 from .objective import Evaluator, Objective, combined_score
@@ -50,6 +54,7 @@ __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "
            "SCORINGS", "score_batch", "score_batch_interpolated",
            "match_spectrum", "spectrum_matched", "target_surface",
            "clipped_phases", "crest_phases", "wave_modes",
+           "MODULATION_CUT", "crest_roughness", "modulated_heights", "wave_split",
            "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",
            "combine", "entry_design", "Evaluator", "Objective", "combined_score",

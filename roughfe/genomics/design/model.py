@@ -21,11 +21,14 @@ from ...surfaces.surface import Surface
 from ..database import THESIS_SETTINGS, DatabaseEntry, DatabaseSettings
 from ..genome import Genome, node_coordinates
 from ..periodic import check_dim, periodic_heights, realization
+from .modulation import modulated_heights
 
 #: genes other than the phases that CCO optimises ("all genes", Sec. 4.2.4)
 GENE_VARIABLES = ("H", "gamma", "lambda1", "weight")
 DESIGN_FORMAT = "roughfe-design"
-DESIGN_VERSION = 1
+#: version 2: a surface design may carry ``modulation`` (written only when it is not 0, so
+#: a design without it is still written as version 1, byte for byte as before)
+DESIGN_VERSION = 2
 
 
 def is_amplitude_key(key) -> bool:
@@ -72,6 +75,12 @@ class Design:
     dim : {1, 2}
         1: a profile (thesis); 2: a periodic surface, every part realised by
         :func:`roughfe.genomics.periodic.realize_periodic_surface` (surface database).
+    modulation : float
+        Surfaces, beyond the thesis and the MWM model: the depth epsilon (-) by which the
+        short-wave part of the summed heights is modulated by the long-wave height
+        (:func:`~.modulation.modulated_heights`; 0: off, the plain sum of the parts).
+        Set by the global stage (``GlobalSearchOptions.modulation``); the exact phase
+        sensitivities of the GCMMA stages assume 0.
     """
 
     parts: tuple
@@ -80,6 +89,7 @@ class Design:
     n_nodes: int = THESIS_SETTINGS.n_nodes
     name: str = ""
     dim: int = 1
+    modulation: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "parts", tuple(self.parts))
@@ -88,6 +98,9 @@ class Design:
         if not (np.isfinite(self.scale) and self.scale > 0):
             raise InputError(f"design scale must be finite and > 0, got {self.scale!r}")
         object.__setattr__(self, "dim", check_dim(self.dim))
+        if not np.isfinite(self.modulation) or (self.modulation and self.dim != 2):
+            raise InputError(f"modulation must be finite and needs a surface design (dim 2), "
+                             f"got {self.modulation!r} with dim {self.dim}")
 
     # -- geometry ----------------------------------------------------------------------
     def keys(self, which="all") -> list:
@@ -192,9 +205,12 @@ class Design:
         return factor * a * (np.sin(g.wavenumber(n) * x + phi) - np.sin(phi))
 
     def surface(self) -> Surface:
-        """The designed profile or periodic surface (heights in m) on the nodes."""
+        """The designed profile or periodic surface (heights in m) on the nodes: the sum of
+        the parts, its short waves modulated by ``modulation`` where that is not 0."""
         surfs = [self.part_surface(k) for k in range(len(self.parts))]
         h = np.sum([s.heights for s in surfs], axis=0)
+        if self.modulation:
+            h = modulated_heights(h, self.modulation)
         meta = {"generator": "roughfe.design", "name": self.name, "length": self.length,
                 "n_nodes": self.n_nodes, "x0": surfs[0].metadata["x0"],
                 "parts": [{"label": p.label, "chromosomes": list(p.chromosomes)}
@@ -222,14 +238,16 @@ class Design:
                                  "chromosomes": list(p.chromosomes)})
 
     def as_genome(self) -> Optional[Genome]:
-        """The single genome equal to this design when it has one part, else None."""
-        return self.part_genome(0) if len(self.parts) == 1 else None
+        """The single genome equal to this design when it has one part (and no
+        ``modulation``), else None."""
+        return self.part_genome(0) if len(self.parts) == 1 and not self.modulation else None
 
     # -- JSON --------------------------------------------------------------------------
     def to_dict(self) -> dict:
-        return {"format": DESIGN_FORMAT, "version": DESIGN_VERSION, "name": self.name,
-                "scale": self.scale, "length": self.length, "n_nodes": self.n_nodes,
-                "dim": self.dim,
+        return {"format": DESIGN_FORMAT, "version": 2 if self.modulation else 1,
+                "name": self.name, "scale": self.scale, "length": self.length,
+                "n_nodes": self.n_nodes, "dim": self.dim,
+                **({"modulation": self.modulation} if self.modulation else {}),
                 "parts": [{"label": p.label, "weight": p.weight,
                            "chromosomes": list(p.chromosomes), "genome": p.genome.to_dict()}
                           for p in self.parts]}
@@ -242,7 +260,7 @@ class Design:
         parts = tuple(DesignPart(Genome.from_dict(p["genome"]), tuple(p["chromosomes"]),
                                  float(p["weight"]), p.get("label", "")) for p in d["parts"])
         return cls(parts, float(d["scale"]), float(d["length"]), int(d["n_nodes"]),
-                   d.get("name", ""), int(d.get("dim", 1)))
+                   d.get("name", ""), int(d.get("dim", 1)), float(d.get("modulation", 0.0)))
 
 
 def entry_design(entry: DatabaseEntry, settings: DatabaseSettings, weight=1.0,

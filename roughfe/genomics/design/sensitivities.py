@@ -59,6 +59,9 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     -------
     (r, J) : ndarray (n_r,), ndarray (n_r, len(keys))
     """
+    if design.modulation:
+        raise InputError("exact sensitivities of a modulated design are not derived (the "
+                         "modulation is set by the global stage, after the GCMMA stages)")
     surf = design.surface()
     h = surf.heights.ravel()
     n_nodes = h.size
