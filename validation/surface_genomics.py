@@ -105,7 +105,8 @@ SEARCH, SEARCH_LONG = 100, {("y_t1", "cco"): 300, ("x3p-2", "mcco"): 300}
 #: phases, and GlobalSearchOptions.peak, a z_max penalty; 2000 evaluations each): crest
 #: step before the stage 0.7872, before the search 0.7921, penalty 1.0 / 0.3 per rms above
 #: the target's z_max 2.714: 0.8186 / 0.8446, a second 2000 from the best 0.8477 (none
-#: better): not adopted (docs/theory/surface-design.md, session 8)
+#: better): not adopted (docs/theory/surface-design.md, session 8). Session 9: with the
+#: modulation variable (GLOBAL_MODULATION) the same 6000 give 0.9085
 GLOBAL = {("x3p-2", "sog"): 8000, ("x3p-2", "cco"): 8000, ("x3p-2", "mcco"): 6000,
           ("y_t1", "mcco"): 4000, ("x3p-2", "gco"): 8000}
 #: the global stage's first CMA-ES step (rad for the phases; ``GlobalSearchOptions.sigma``)
@@ -146,7 +147,10 @@ GLOBAL_POPSIZE = {("x3p-2", "gco"): 26}
 #: made uniform, the target's A*(p_max) falls 0.428 -> 0.368 (cuts 0.25 / 0.75: 0.377 /
 #: 0.388), the design's level. Measured (one run each from the 300-sweep search f 0.7773,
 #: sigma 0.2, x exp(+-0.6), seed 0, 2000 evaluations): without 0.8477, with +-0.5 0.8732
-#: (s_K 0.9296, s_A 0.9393, epsilon 0.22); other levers of session 9 gave less (docs)
+#: (s_K 0.9296, s_A 0.9393, epsilon 0.22); the other levers of session 9 gave less
+#: (docs/theory/surface-design.md). With GLOBAL's 6000: f 0.8197 at 1000, 0.8732 at 2000,
+#: 0.8884 at 3000, 0.9007 at 4000, 0.9069 at 5000, 0.9085 at 6000 (s_K 0.9482, s_A
+#: 0.9582, epsilon 0.253; 220 s CPU for the stage), goal met at seed 0
 GLOBAL_MODULATION = {("x3p-2", "mcco"): 0.5}
 #: measured targets: runs whose spectrum matching is per wave (match_spectrum
 #: directional=True): x3p-2 M-CCO f 0.621 -> 0.700 (SOG 0.933 -> 0.885: kept per chromosome)

@@ -223,9 +223,9 @@ class GlobalSearchOptions:
         modulation by the long-wave height (:attr:`Design.modulation`,
         :func:`~.modulation.modulated_heights`), ``epsilon = epsilon_0 + modulation tanh
         v`` (-), epsilon_0 the start design's (0 after the thesis stages). Measured in
-        session 9 on x3p-2 M-CCO (2000 evaluations from the study's 300-sweep search, f
-        0.7773): 0.5 gives f 0.8732 (epsilon 0.22) against 0.8477 without
-        (``docs/theory/surface-design.md``).
+        session 9 on x3p-2 M-CCO (from the study's 300-sweep search, f 0.7773, seed 0):
+        0.5 gives f 0.8732 at 2000 evaluations (0.8477 without) and 0.9085 at 6000
+        (0.8607 without; ``docs/theory/surface-design.md``).
     """
 
     method: str = "cmaes"
