@@ -9,11 +9,11 @@ periodic BEM, on the database spacing), each run by the study's own ``design_cha
 (GCMMA stages, spectrum matching for the measured target, the search at the target
 pressures and the global stage, with the study's constants SEARCH_LONG, GLOBAL,
 GLOBAL_SIGMA, GLOBAL_AMPLITUDES, GLOBAL_POPSIZE, GLOBAL_MODULATION): the benchmark times
-the configuration the validation runs, not a copy of it. Process CPU times (the machine may be shared; wall
-times are inflated by load) go to ``benchmarks/output/bench_surface_design.json`` with
-the scores (the scores are the validation's business: here they only show the run did
-its work; with the full database they equal the validation's, the runs being
-deterministic).
+the configuration the validation runs, not a copy of it. Process CPU times (the machine
+may be shared; wall times are inflated by load) go to
+``benchmarks/output/bench_surface_design.json`` with the scores (the scores are the
+validation's business: here they only show the run did its work; with the full database
+they equal the validation's, the runs being deterministic).
 Run: .venv/bin/python benchmarks/bench_surface_design.py [K [N]] [--quick] (--quick: the
 study's reduced global stage of 12 evaluations, for smoke use). Exit status 0 when the
 report is written, a missed target included (its row says NOT met), as for every

@@ -7,9 +7,10 @@ short-wave roughness is the same on the crests of its long waves as in their val
 measured surface need not be: on x3p-2 (the mirrored window, 41 x 100 on the database
 spacing) the short-wave part (|q| > q_N / 2) has 0.79 of its rms on the nodes where the
 long-wave part is in its highest 10 % (:func:`crest_roughness`), the study's 0.8607
-M-CCO design 0.99 (session 9, ``docs/theory/surface-design.md``). Made uniform, the target loses
-14 % of its contact area at the top approach (A* 0.428 -> 0.368) and its highest node
-rises from 2.71 to 3.07 rms: the level of A(p) that the x3p-2 M-CCO designs lacked.
+M-CCO design 0.99 (session 9, ``docs/theory/surface-design.md``). Made uniform, the
+target loses 14 % of its contact area at the top approach (A* 0.428 -> 0.368) and its
+highest node rises from 2.71 to 3.07 rms: the level of A(p) that the x3p-2 M-CCO designs
+lacked.
 
 The modulation of depth epsilon (-), split at ``cut`` (a fraction of the Nyquist
 wavenumber of each axis, q_N = pi / spacing):
@@ -39,8 +40,8 @@ def wave_split(heights, cut: float = MODULATION_CUT):
     rest, mean removed (module notes; ``Z_lo + Z_hi = Z - mean Z``)."""
     h = np.asarray(heights, dtype=float)
     if h.ndim != 2 or not 0 < cut < np.sqrt(2):
-        raise InputError(f"a 2D height array and 0 < cut < sqrt 2 needed, got shape {h.shape} "
-                         f"and cut {cut!r}")
+        raise InputError(f"a 2D height array and 0 < cut < sqrt 2 needed, got shape "
+                         f"{h.shape} and cut {cut!r}")
     h = h - h.mean()
     n0, n1 = h.shape
     r = np.hypot(np.fft.fftfreq(n0)[:, None] * 2, np.fft.fftfreq(n1)[None, :] * 2)
