@@ -150,7 +150,9 @@ GLOBAL_POPSIZE = {("x3p-2", "gco"): 26}
 #: (s_K 0.9296, s_A 0.9393, epsilon 0.22); the other levers of session 9 gave less
 #: (docs/theory/surface-design.md). With GLOBAL's 6000: f 0.8197 at 1000, 0.8732 at 2000,
 #: 0.8884 at 3000, 0.9007 at 4000, 0.9069 at 5000, 0.9085 at 6000 (s_K 0.9482, s_A
-#: 0.9582, epsilon 0.253; 220 s CPU for the stage), goal met at seed 0
+#: 0.9582, epsilon 0.253; 220 s CPU for the stage), goal met at seed 0; seeds 1-4: 0.9176,
+#: 0.8499 (epsilon stays ~0), 0.9156, 0.9050 (without the modulation seeds 0-2: 0.8607,
+#: 0.8488, 0.8518); +-0.25 / +-1.0 at 2000: 0.8510 / 0.8540
 GLOBAL_MODULATION = {("x3p-2", "mcco"): 0.5}
 #: measured targets: runs whose spectrum matching is per wave (match_spectrum
 #: directional=True): x3p-2 M-CCO f 0.621 -> 0.700 (SOG 0.933 -> 0.885: kept per chromosome)
