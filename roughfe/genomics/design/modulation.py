@@ -9,10 +9,9 @@ spacing) the short-wave part (|q| > q_N / 2) has 0.79 of its rms on the nodes wh
 long-wave part is in its highest 10 % (:func:`crest_roughness`), the study's 0.8607
 M-CCO design 0.99; random phases with the target's spectrum scatter over 0.78-1.11 (6
 seeds), so the target sits at the low end of that scatter (session 9,
-``docs/theory/surface-design.md``). Made uniform, the
-target loses 14 % of its contact area at the top approach (A* 0.428 -> 0.368) and its
-highest node rises from 2.71 to 3.07 rms: the level of A(p) that the x3p-2 M-CCO designs
-lacked.
+``docs/theory/surface-design.md``). Made uniform, the target loses 14 % of its contact
+area at the top approach (A* 0.428 -> 0.368) and its highest node rises from 2.71 to
+3.07 rms: the level of A(p) that the x3p-2 M-CCO designs lacked.
 
 The modulation of depth epsilon (-), split at ``cut`` (a fraction of the Nyquist
 wavenumber of each axis, q_N = pi / spacing):
