@@ -37,7 +37,9 @@ if [ -n "$missing" ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
 fi
 
-stamp_value="$(cat pyproject.toml tools/bootstrap.sh tools/constraints.txt | sha256sum | cut -c1-16)-$EXTRAS"
+# the checkout's path is part of the stamp: the editable install maps `roughfe` to one
+# checkout, so a venv shared with (or moved from) another checkout is re-pointed here
+stamp_value="$(cat pyproject.toml tools/bootstrap.sh tools/constraints.txt | sha256sum | cut -c1-16)-$EXTRAS-$(pwd)"
 if [ -x "$VENV/bin/python" ] && [ -f "$VENV/.roughfe-stamp" ] && [ "$(cat "$VENV/.roughfe-stamp")" = "$stamp_value" ]; then
   exit 0
 fi
