@@ -244,7 +244,7 @@ class Design:
 
     # -- JSON --------------------------------------------------------------------------
     def to_dict(self) -> dict:
-        return {"format": DESIGN_FORMAT, "version": 2 if self.modulation else 1,
+        return {"format": DESIGN_FORMAT, "version": DESIGN_VERSION if self.modulation else 1,
                 "name": self.name, "scale": self.scale, "length": self.length,
                 "n_nodes": self.n_nodes, "dim": self.dim,
                 **({"modulation": self.modulation} if self.modulation else {}),
