@@ -177,16 +177,17 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     all-float64 phase, 8 % (2048^2) to 12 % (1024^2) less CPU).
 
     ``deflation`` (load control only): a two-level coarse correction of the direction,
-    an object with ``correct(F, gF, zF, apply_free) -> zF`` that turns the
+    an object with ``correct(F, gF, zF, apply_free, positive) -> zF`` that turns the
     preconditioned gradient ``zF = (M g)_F`` into the two-level one, given the flat
     free-set indices ``F``, the gradient ``gF`` and ``apply_free(xF) = (H x)_F`` (a
     counted product, single precision when ``apply_single`` is given). The Polak-Ribiere
     beta keeps the CG flexible for such a (possibly inexact) preconditioner. The
     reference form is :class:`roughfe.bem.deflation.ProbedBlockDeflation`, the production
     one :class:`roughfe.bem.deflation.BlockDeflation` (used by ``solve_contact`` in its
-    measured range), both measured in ``docs/theory/02b_bem_performance.md``. With a
-    deflation the direction also drops its steps below p = 0 at the points of F where p
-    is 0 (:func:`_bind_lower`, the binding set of projected-gradient methods).
+    measured range), both measured in ``docs/theory/02b_bem_performance.md``; it is also
+    given ``positive`` (p > 0 on F, bool), the contact part of F. With a deflation the
+    direction also drops its steps below p = 0 at the points of F where p is 0
+    (:func:`_bind_lower`, the binding set of projected-gradient methods).
 
     Returns a :class:`SolverOutput`.
     """
@@ -349,12 +350,19 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         par.put(t, F_old, 0.0)
         del F_old
         par.put(gbuf, F, gF)
+        positive = None
+        if deflation is not None:
+            # p > 0 on F (mask is free until the next iteration: a byte a point, no
+            # gather of p): the contact part of F, for the coarse correction's test of
+            # a settled contact set and for the binding set below
+            par.blocks(n, lambda i, j: np.greater(p[i:j], 0.0, out=mask[i:j]))
+            positive = par.take(mask, F)
         if precond is not None:
             zF = par.take(M(gbuf), F)
             if load:
                 zF -= zF.mean()
             if deflation is not None:
-                zF = deflation.correct(F, gF, zF, H_free)
+                zF = deflation.correct(F, gF, zF, H_free, positive=positive)
         else:
             zF = gF.copy()
         gz = float(np.dot(gF, zF))
@@ -365,11 +373,9 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         tF = np.multiply(tF, beta, dtype=np.float64)
         tF += zF
         del zF
-        if deflation is not None:
-            # the binding set: no step below p = 0 where p is 0 (mask is free until the
-            # next iteration: it holds p > 0 here, a byte a point, no gather of p)
-            par.blocks(n, lambda i, j: np.greater(p[i:j], 0.0, out=mask[i:j]))
-            _bind_lower(tF, par.take(mask, F), load)
+        if positive is not None:   # the binding set: no step below p = 0 where p is 0
+            _bind_lower(tF, positive, load)
+        del positive
         par.put(t, F, tF)
         gt = float(np.dot(gF, tF))
         del gF
