@@ -100,7 +100,7 @@ def _bind_lower(tF, positive, load):
     Not in Polonsky & Keer (1999), whose rule admits the point with the raw direction.
     Used with the two-level correction only (``deflation``), where it was measured to
     pay (4 cold loads p/E* = 0.005-0.1, tol 1e-10, the ``bench_bem`` surface: 1024^2
-    94 -> 89 iterations, 2048^2 115 -> 102, one load p/E* = 0.05 at 4096^2 42 -> 33);
+    94 -> 89 iterations, 2048^2 115 -> 103, one load p/E* = 0.05 at 4096^2 42 -> 33);
     in the plain CG it does not (256^2 117 -> 119, 512^2 147 -> 150). Details:
     ``docs/theory/02b_bem_performance.md``, "The binding set" (session 10).
     """
