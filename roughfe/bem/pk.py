@@ -177,17 +177,18 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     all-float64 phase, 8 % (2048^2) to 12 % (1024^2) less CPU).
 
     ``deflation`` (load control only): a two-level coarse correction of the direction,
-    an object with ``correct(F, gF, zF, apply_free, positive) -> zF`` that turns the
-    preconditioned gradient ``zF = (M g)_F`` into the two-level one, given the flat
-    free-set indices ``F``, the gradient ``gF`` and ``apply_free(xF) = (H x)_F`` (a
-    counted product, single precision when ``apply_single`` is given). The Polak-Ribiere
-    beta keeps the CG flexible for such a (possibly inexact) preconditioner. The
-    reference form is :class:`roughfe.bem.deflation.ProbedBlockDeflation`, the production
-    one :class:`roughfe.bem.deflation.BlockDeflation` (used by ``solve_contact`` in its
-    measured range), both measured in ``docs/theory/02b_bem_performance.md``; it is also
-    given ``positive`` (p > 0 on F, bool), the contact part of F. With a deflation the
-    direction also drops its steps below p = 0 at the points of F where p is 0
-    (:func:`_bind_lower`, the binding set of projected-gradient methods).
+    an object with ``correct(F, gF, zF, apply_free, free_mask, contact_mask) -> zF``
+    that turns the preconditioned gradient ``zF = (M g)_F`` into the two-level one,
+    given the flat free-set indices ``F``, the gradient ``gF``, ``apply_free(xF) =
+    (H x)_F`` (a counted product, single precision when ``apply_single`` is given) and
+    the grid masks (bool, a byte a point) of F and of its contact part p > 0. The
+    Polak-Ribiere beta keeps the CG flexible for such a (possibly inexact)
+    preconditioner. The reference form is
+    :class:`roughfe.bem.deflation.ProbedBlockDeflation`, the production one
+    :class:`roughfe.bem.deflation.BlockDeflation` (used by ``solve_contact`` in its
+    measured range), both measured in ``docs/theory/02b_bem_performance.md``. With a
+    deflation the direction also drops its steps below p = 0 at the points of F where
+    p is 0 (:func:`_bind_lower`, the binding set of projected-gradient methods).
 
     Returns a :class:`SolverOutput`.
     """
@@ -274,7 +275,8 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     # masked gradient of the last iteration, zero off F: the preconditioner's input and
     # the g_old of the Polak-Ribiere beta, both only needed to single precision
     gbuf = np.zeros(n, np.float32)
-    mask = np.empty(n, bool)
+    mask = np.empty(n, bool)          # F as a grid mask
+    cmask = None                      # p > 0 as a grid mask (with a deflation)
     F = np.empty(0, np.intp)
     S = np.flatnonzero(p)
     gz_old = 0.0
@@ -352,17 +354,20 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         par.put(gbuf, F, gF)
         positive = None
         if deflation is not None:
-            # p > 0 on F (mask is free until the next iteration: a byte a point, no
-            # gather of p): the contact part of F, for the coarse correction's test of
-            # a settled contact set and for the binding set below
-            par.blocks(n, lambda i, j: np.greater(p[i:j], 0.0, out=mask[i:j]))
-            positive = par.take(mask, F)
+            # the contact set p > 0 (within F) as a grid mask, a byte a point: the
+            # coarse correction's test of a settled contact set, and on F (positive)
+            # the binding set below
+            if cmask is None:
+                cmask = np.empty(n, bool)
+            par.blocks(n, lambda i, j: np.greater(p[i:j], 0.0, out=cmask[i:j]))
+            positive = par.take(cmask, F)
         if precond is not None:
             zF = par.take(M(gbuf), F)
             if load:
                 zF -= zF.mean()
             if deflation is not None:
-                zF = deflation.correct(F, gF, zF, H_free, positive=positive)
+                zF = deflation.correct(F, gF, zF, H_free, free_mask=mask,
+                                       contact_mask=cmask)
         else:
             zF = gF.copy()
         gz = float(np.dot(gF, zF))
