@@ -193,11 +193,10 @@ def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
     return hp, plastic_displacement
 
 
-#: cold, load-controlled, periodic surface solves with at least this many points per
-#: (even) axis start from the solution on the grid coarsened twice (recursively)
+#: cold, load-controlled, periodic surface solves with at least this many points per (even)
+#: axis start from the solution on the grid coarsened twice (recursively)
 COARSE_START_MIN = 256
-#: KKT tolerance of those coarse solves (only a starting guess)
-COARSE_START_TOL = 1e-4
+COARSE_START_TOL = 1e-4  #: KKT tolerance of those coarse solves (only a starting guess)
 #: elastic, load-controlled, periodic surface solves whose sides lie in this range (and
 #: are multiples of 8) use the two-level coarse correction
 #: :class:`roughfe.bem.deflation.BlockDeflation` (8 x 8 blocks), measured faster in CPU
@@ -207,7 +206,8 @@ DEFLATION_SIDES = (1024, 8192)
 
 
 def _deflation(op: InfluenceOperator, hardness, plastic):
-    """The coarse correction of a solve with ``op`` (None outside ``DEFLATION_SIDES``)."""
+    """The coarse correction of a solve with ``op`` (None outside ``DEFLATION_SIDES``); its
+    solves alone take the split line search (``polonsky_keer(split=)``, 02b session 11)."""
     lo, hi = DEFLATION_SIDES
     if (not op.periodic or len(op.shape) != 2 or hardness is not None
             or plastic is not None or any(n % 8 or not lo <= n <= hi for n in op.shape)):
@@ -400,18 +400,11 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
             own = initial is None and mean_pressure is not None and plastic is None
             if own:
                 initial = _coarse_start(surface, material, mean_pressure, hardness)
-            deflation = (None if mean_pressure is None
-                         else _deflation(op, hardness, plastic))
-            # the line search's t . H t from the forward transform (H t only when the
-            # step is kept): with the two-level correction, whose range it was measured
-            # in (session 11: 5-10 % less CPU at 1024^2-2048^2, the same iterations and
-            # contact sets, pressures within 1e-8 of max p; at 512^2 without the
-            # correction ~1 %, left off so that those solves stay bit-identical)
+            deflation = None if mean_pressure is None else _deflation(op, hardness, plastic)
             out = polonsky_keer(op.apply, h, scale, delta=delta, mean_pressure=mean_pressure,
-                                initial=initial, diagonal=op.diagonal,
-                                precond=_cg_preconditioner(op), tol=tol,
+                                initial=initial, diagonal=op.diagonal, tol=tol,
+                                precond=_cg_preconditioner(op), overwrite_initial=own,
                                 max_iter=max_iter or 20000, offset=-hmax, hardness=hardness,
-                                overwrite_initial=own,
                                 apply_single=functools.partial(op.apply, single=True),
                                 deflation=deflation,
                                 split=None if deflation is None else op.split_product)
