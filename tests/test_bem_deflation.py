@@ -201,12 +201,15 @@ def test_lean_passes_are_the_dense_formulas(monkeypatch, points):
     out = coarse_blocks._a_def2(F, s, z, lambda x: np.zeros_like(x), shape, b, lambda r: c)
     dense = z + c[blk]
     assert np.array_equal(out, dense - dense.mean())
-    X, counts = BlockDeflation(op, b)._free_rows(F)
-    Xd = np.zeros(((n0 // b) * m1, b * b), bool)
-    Xd[blk, (F // n1 % b) * b + F % n1 % b] = True
-    assert X.dtype == np.uint8 and X.shape == ((n0 // b) * m1, b * b // 8)
-    assert np.array_equal(np.unpackbits(X, axis=1).astype(bool), Xd)
-    assert np.array_equal(counts, np.bincount(blk, minlength=Xd.shape[0]))
+    for bb in (8, 16):      # the blocks' mask rows from the grid mask: a block row is
+        mb = n1 // bb       # one byte (b = 8) or several (b = 16)
+        X, counts = BlockDeflation(op, bb)._free_rows(F)
+        bk = (F // n1 // bb) * mb + (F % n1) // bb
+        Xd = np.zeros(((n0 // bb) * mb, bb * bb), bool)
+        Xd[bk, (F // n1 % bb) * bb + F % n1 % bb] = True
+        assert X.dtype == np.uint8 and X.shape == ((n0 // bb) * mb, bb * bb // 8)
+        assert np.array_equal(np.unpackbits(X, axis=1).astype(bool), Xd)
+        assert np.array_equal(counts, np.bincount(bk, minlength=Xd.shape[0]))
 
 
 def test_kernel_and_full_blocks_from_the_half_spectrum():
