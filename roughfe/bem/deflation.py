@@ -18,6 +18,7 @@ import scipy.fft
 import scipy.linalg
 
 from ..errors import InputError
+from . import coarse_blocks
 from .coarse_blocks import (_a_def2, _check_grid, _chunks, _full_block_galerkin,
                             _kernel_window)
 from .operators import InfluenceOperator
@@ -76,15 +77,16 @@ class ProbedBlockDeflation:
         self.coarse_shape = (m0, m1)
         self.full_block = _full_block_galerkin(op, block)
 
-    def correct(self, F, gF, zF, apply_free, free_mask=None, contact_mask=None):
+    def correct(self, F, gF, zF, apply_free, free_mask=None, pressure=None):
         """The A-DEF2 direction on F from the gradient ``gF`` and ``zF`` = (M g)_F.
 
         ``F``: the flat indices of the free set; ``apply_free(xF)`` returns (H x)_F for
         x supported on F (a fine product). The vectors live in the zero-mean subspace
         of F (load control: the only mode of :func:`~roughfe.bem.pk.polonsky_keer`
         with a deflation; displacement control of a periodic H is singular on F = the
-        whole grid). ``free_mask`` and ``contact_mask`` (the grid masks of F and of its
-        points with p > 0) are not used: this reference corrects at every iteration.
+        whole grid). ``free_mask`` and ``pressure`` (F's grid mask and the pressure,
+        whose positive part is the contact set) are not used: this reference corrects at
+        every iteration.
         """
         b = self.block
         m0, m1 = self.coarse_shape
@@ -261,17 +263,24 @@ class BlockDeflation:
         self._exact = [np.zeros(m0 * m1) for _ in _NEAR]  # exact near-field entries
         self._valid = [np.zeros(m0 * m1, bool) for _ in _NEAR]   # ... still exact
 
-    def _rows(self, mask):
-        """The blocks' b^2 mask rows of a grid mask (bool, the grid's shape or flat),
-        bit-packed (ceil(b^2 / 8) bytes a block, n / 8 bytes in all), and their point
-        counts. A byte of ``np.packbits`` along the grid's rows is 8 columns of one row:
-        for b a multiple of 8 a block's row is whole bytes, so the packed grid only has
-        its n / 8 bytes reordered (no full-grid temporary; measured at 2048^2: ~1 ms,
+    def _rows(self, grid, positive=False):
+        """The blocks' b^2 mask rows of a grid mask (``grid`` bool, the grid's shape or
+        flat; with ``positive`` the mask ``grid > 0`` of a real grid, built a few block
+        rows at a time), bit-packed (ceil(b^2 / 8) bytes a block, n / 8 bytes in all),
+        and their point counts. A byte of ``np.packbits`` along the grid's rows is 8
+        columns of one row: for b a multiple of 8 a block's row is whole bytes, so the
+        packed grid only has its n / 8 bytes reordered (measured at 2048^2: ~1 ms,
         against 8 ms for the two scatters and transpositions from the free set's
         indices that it replaced in session 11)."""
         b = self.block
         m0, m1 = self.coarse_shape
-        packed = np.packbits(mask.reshape(self.shape), axis=1)
+        n0, n1 = self.shape
+        grid = grid.reshape(self.shape)
+        packed = np.empty((n0, n1 // 8), np.uint8)
+        rows = b * max(1, coarse_blocks._POINTS // (b * n1))
+        for r in range(0, n0, rows):
+            part = grid[r:r + rows]
+            packed[r:r + rows] = np.packbits(part > 0.0 if positive else part, axis=1)
         X = np.ascontiguousarray(packed.reshape(m0, b, m1, b // 8).transpose(0, 2, 1, 3)
                                  ).reshape(m0 * m1, b * b // 8)
         return X, _POPCOUNT[X].sum(axis=1, dtype=np.int64)
@@ -381,7 +390,7 @@ class BlockDeflation:
         self.inner_iterations.append(it)
         return c
 
-    def correct(self, F, gF, zF, apply_free, free_mask=None, contact_mask=None):
+    def correct(self, F, gF, zF, apply_free, free_mask=None, pressure=None):
         """The A-DEF2 direction on F (the interface of :class:`ProbedBlockDeflation`);
         on the stable part of F (the blocks whose part of the contact set did not change
         since the last call) while more than ``settle`` (and at most ``search``) of the
@@ -389,15 +398,14 @@ class BlockDeflation:
         ``search`` of them changed (the contact-set search).
 
         ``free_mask`` (bool, flat grid): F as a mask, built from ``F`` when not given.
-        ``contact_mask`` (bool, flat grid, within F): the contact set, the points of F
-        with p > 0 (:func:`~roughfe.bem.pk.polonsky_keer` passes both); F itself when
-        not given. Points at p = 0 that enter F for one iteration (they interpenetrate)
+        ``pressure`` (flat grid, Pa): the contact set is where it is positive (within F;
+        :func:`~roughfe.bem.pk.polonsky_keer` passes both); F itself when not given. Points at p = 0 that enter F for one iteration (they interpenetrate)
         and leave it the next, without ever carrying a pressure, do not change the
         pressure field the coarse space acts on; counted as changes they kept blocks out
         of it (measured, session 10: the bench surface 1024^2 / 2048^2, 4 cold loads,
         89 / 103 -> 87 / 99 iterations; ``docs/theory/02b_bem_performance.md``)."""
         X, counts = self._free_rows(F) if free_mask is None else self._rows(free_mask)
-        mark = X if contact_mask is None else self._rows(contact_mask)[0]
+        mark = X if pressure is None else self._rows(pressure, positive=True)[0]
         last, self._last = self._last, mark
         if last is None:
             return zF

@@ -98,16 +98,32 @@ def _gap_mask(u, us, b, d, mask, i, j):
 
 def _gap_take(u, us, b, index):
     """The gap ``us u - b`` (float64, the values :func:`_gap_mask` tests) at the flat
-    ``index``, gathered in parallel."""
+    ``index``, gathered in parallel in cache-sized chunks."""
     out = np.empty(index.size)
 
     def one(i, j):
-        k, o = index[i:j], out[i:j]
-        if us != 1.0:
-            np.multiply(u.take(k, mode="wrap"), us, out=o)
-            o -= b.take(k, mode="wrap")
-        else:
-            np.subtract(u.take(k, mode="wrap"), b.take(k, mode="wrap"), out=o)
+        for c in range(i, j, _GAP_CHUNK):     # cache-sized gathers, no index-sized ones
+            e = min(j, c + _GAP_CHUNK)
+            k, o = index[c:e], out[c:e]
+            if us != 1.0:
+                np.multiply(u.take(k, mode="wrap"), us, out=o)
+                o -= b.take(k, mode="wrap")
+            else:
+                np.subtract(u.take(k, mode="wrap"), b.take(k, mode="wrap"), out=o)
+
+    par.blocks(index.size, one)
+    return out
+
+
+def _positive_at(p, index):
+    """``p[index] > 0`` (bool) in parallel, gathered in cache-sized chunks (no
+    index-sized float temporary)."""
+    out = np.empty(index.size, bool)
+
+    def one(i, j):
+        for k in range(i, j, _GAP_CHUNK):
+            e = min(j, k + _GAP_CHUNK)
+            np.greater(p.take(index[k:e], mode="wrap"), 0.0, out=out[k:e])
 
     par.blocks(index.size, one)
     return out
@@ -185,8 +201,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     the direction t (float64) and the previous masked gradient (float32: the
     preconditioner's input and PR's g_old), the FFT workspace of the products (one
     complex half-spectrum) and the kept output r of H t (and of M g, as a view), plus
-    the free set's grid mask (and, with a deflation, the contact set's: a byte a
-    point). The gap u - b is never stored on the whole grid: it is computed in
+    the free set's grid mask (a byte a point). The gap u - b is never stored on the whole grid: it is computed in
     cache-sized chunks where it is tested and gathered where it is used. After the
     first iteration no full-grid array is allocated (measured at 2048^2: 3.1x fewer
     page faults, system time 9.9 -> 2.5 s).
@@ -209,11 +224,11 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     all-float64 phase, 8 % (2048^2) to 12 % (1024^2) less CPU).
 
     ``deflation`` (load control only): a two-level coarse correction of the direction,
-    an object with ``correct(F, gF, zF, apply_free, free_mask, contact_mask) -> zF``
+    an object with ``correct(F, gF, zF, apply_free, free_mask, pressure) -> zF``
     that turns the preconditioned gradient ``zF = (M g)_F`` into the two-level one,
     given the flat free-set indices ``F``, the gradient ``gF``, ``apply_free(xF) =
-    (H x)_F`` (a counted product, single precision when ``apply_single`` is given) and
-    the grid masks (bool, a byte a point) of F and of its contact part p > 0. The
+    (H x)_F`` (a counted product, single precision when ``apply_single`` is given),
+    F's grid mask (bool) and the pressure p (its contact part: p > 0). The
     Polak-Ribiere beta keeps the CG flexible for such a (possibly inexact)
     preconditioner. The reference form is
     :class:`roughfe.bem.deflation.ProbedBlockDeflation`, the production one
@@ -317,7 +332,6 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     # the g_old of the Polak-Ribiere beta, both only needed to single precision
     gbuf = np.zeros(n, np.float32)
     mask = np.empty(n, bool)          # F as a grid mask
-    cmask = None                      # p > 0 as a grid mask (with a deflation)
     F = np.empty(0, np.intp)
     S = np.flatnonzero(p)
     gz_old = 0.0
@@ -393,22 +407,14 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         par.put(t, F_old, 0.0)
         del F_old
         par.put(gbuf, F, gF)
-        positive = None
-        if deflation is not None:
-            # the contact set p > 0 (within F) as a grid mask, a byte a point: the
-            # coarse correction's test of a settled contact set, and on F (positive)
-            # the binding set below
-            if cmask is None:
-                cmask = np.empty(n, bool)
-            par.blocks(n, lambda i, j: np.greater(p[i:j], 0.0, out=cmask[i:j]))
-            positive = par.take(cmask, F)
+        # with a deflation: p > 0 on F, the binding set's test below
+        positive = None if deflation is None else _positive_at(p, F)
         if precond is not None:
             zF = par.take(M(gbuf), F)
             if load:
                 zF -= zF.mean()
             if deflation is not None:
-                zF = deflation.correct(F, gF, zF, H_free, free_mask=mask,
-                                       contact_mask=cmask)
+                zF = deflation.correct(F, gF, zF, H_free, free_mask=mask, pressure=p)
         else:
             zF = gF.copy()
         gz = float(np.dot(gF, zF))
