@@ -399,11 +399,12 @@ class BlockDeflation:
 
         ``free_mask`` (bool, flat grid): F as a mask, built from ``F`` when not given.
         ``pressure`` (flat grid, Pa): the contact set is where it is positive (within F;
-        :func:`~roughfe.bem.pk.polonsky_keer` passes both); F itself when not given. Points at p = 0 that enter F for one iteration (they interpenetrate)
-        and leave it the next, without ever carrying a pressure, do not change the
-        pressure field the coarse space acts on; counted as changes they kept blocks out
-        of it (measured, session 10: the bench surface 1024^2 / 2048^2, 4 cold loads,
-        89 / 103 -> 87 / 99 iterations; ``docs/theory/02b_bem_performance.md``)."""
+        :func:`~roughfe.bem.pk.polonsky_keer` passes both); F itself when not given.
+        Points at p = 0 that enter F for one iteration (they interpenetrate) and leave
+        it the next, without ever carrying a pressure, do not change the pressure field
+        the coarse space acts on; counted as changes they kept blocks out of it
+        (measured, session 10: the bench surface 1024^2 / 2048^2, 4 cold loads, 89 / 103
+        -> 87 / 99 iterations; ``docs/theory/02b_bem_performance.md``)."""
         X, counts = self._free_rows(F) if free_mask is None else self._rows(free_mask)
         mark = X if pressure is None else self._rows(pressure, positive=True)[0]
         last, self._last = self._last, mark

@@ -318,7 +318,7 @@ def _convolve(x, spectrum, fft_shape, out=None, work=None, workers=None):
     return out
 
 
-#: rows of the half-spectrum per chunk of :func:`_spectral_energy` (its float64 copy)
+#: rows of the half-spectrum per chunk of :func:`_spectral_energy` (its squares' buffer)
 _ENERGY_ROWS = 32
 
 
