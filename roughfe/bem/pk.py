@@ -76,6 +76,16 @@ def _axpy(u, a, r):
 _GAP_CHUNK = 1 << 16
 
 
+def _gap_into(u, us, b, out):
+    """``out = us u - b`` (float64 out of a float32 or float64 ``u``); returns ``out``."""
+    if us != 1.0:
+        np.multiply(u, us, out=out)
+        out -= b
+    else:
+        np.subtract(u, b, out=out)
+    return out
+
+
 def _gap_mask(u, us, b, d, mask, i, j):
     """``mask = (us u - b < d)`` on the block ``[i, j)`` (the free-set test), the gap
     ``us u - b`` computed in cache-sized chunks and never stored; returns the block's
@@ -85,12 +95,7 @@ def _gap_mask(u, us, b, d, mask, i, j):
     low = np.inf
     for k in range(i, j, _GAP_CHUNK):
         e = min(j, k + _GAP_CHUNK)
-        c = buf[:e - k]
-        if us != 1.0:
-            np.multiply(u[k:e], us, out=c)
-            c -= b[k:e]
-        else:
-            np.subtract(u[k:e], b[k:e], out=c)
+        c = _gap_into(u[k:e], us, b[k:e], buf[:e - k])
         low = min(low, float(c.min()))
         np.less(c, d, out=mask[k:e])
     return low
@@ -104,12 +109,8 @@ def _gap_take(u, us, b, index):
     def one(i, j):
         for c in range(i, j, _GAP_CHUNK):     # cache-sized gathers, no index-sized ones
             e = min(j, c + _GAP_CHUNK)
-            k, o = index[c:e], out[c:e]
-            if us != 1.0:
-                np.multiply(u.take(k, mode="wrap"), us, out=o)
-                o -= b.take(k, mode="wrap")
-            else:
-                np.subtract(u.take(k, mode="wrap"), b.take(k, mode="wrap"), out=o)
+            k = index[c:e]
+            _gap_into(u.take(k, mode="wrap"), us, b.take(k, mode="wrap"), out[c:e])
 
     par.blocks(index.size, one)
     return out
