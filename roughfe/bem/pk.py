@@ -10,6 +10,7 @@ from scipy.linalg.blas import daxpy, saxpy
 
 from . import _parallel as par
 from ..errors import InputError
+from .directions import _bind_lower, _descent_guard
 from .operators import FFTWorkspace
 from .solvers import (SolverOutput, _fail, _rescale_to_load, penetration_start, pr_beta,
                       relative_residual, step_length)
@@ -128,37 +129,6 @@ def _positive_at(p, index):
 
     par.blocks(index.size, one)
     return out
-
-
-def _bind_lower(tF, positive, load):
-    """Drop the components of the search direction ``tF`` (in place; the step is
-    p <- p - tau t) that would push a point of F at p = 0 below zero (``positive``:
-    p > 0 on F, bool). This is the binding set of a projected-gradient method (Bertsekas
-    1982; More & Toraldo 1991, GPCG) applied to the preconditioned direction: PK's free
-    set admits a point at p = 0 whose gap is negative (it interpenetrates), but the
-    preconditioned, conjugated direction there may still lower p. Without this rule the
-    step gives such a point a negative pressure, the projection clips it back, the step
-    is spent and u must be recomputed; the point then leaves F (measured at 2048^2,
-    p/E* = 0.05: a third to a half of the points leaving F in each search iteration had
-    entered it in the iteration before). In load control the kept components are
-    shifted back to zero mean, so that the step keeps the load.
-
-    Not in Polonsky & Keer (1999), whose rule admits the point with the raw direction.
-    Used with the two-level correction only (``deflation``), where it was measured to
-    pay (4 cold loads p/E* = 0.005-0.1, tol 1e-10, the ``bench_bem`` surface: 1024^2
-    94 -> 89 iterations, 2048^2 115 -> 103, one load p/E* = 0.05 at 4096^2 42 -> 33);
-    in the plain CG it does not (256^2 117 -> 119, 512^2 147 -> 150). Details:
-    ``docs/theory/02b_bem_performance.md``, "The binding set" (session 10).
-    """
-    bound = tF > 0.0
-    bound &= ~positive
-    nb = int(np.count_nonzero(bound))
-    if not nb:
-        return
-    tF[bound] = 0.0
-    if load and nb < tF.size:
-        tF -= float(tF.sum()) / (tF.size - nb)
-        tF[bound] = 0.0
 
 
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
@@ -415,7 +385,8 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             if load:
                 zF -= zF.mean()
             if deflation is not None:
-                zF = deflation.correct(F, gF, zF, H_free, free_mask=mask, pressure=p)
+                zF = _descent_guard(gF, zF, deflation.correct(F, gF, zF, H_free,
+                                                              free_mask=mask, pressure=p))
         else:
             zF = gF.copy()
         gz = float(np.dot(gF, zF))

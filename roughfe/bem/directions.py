@@ -1,0 +1,70 @@
+"""Safeguards of the search direction of the two-level Polonsky-Keer CG
+(:func:`roughfe.bem.pk.polonsky_keer` with a ``deflation``): the binding set at p = 0
+(round 2, session 10) and the descent guard of the coarse correction (session 12).
+Both act on the direction's values on the free set F only (numpy vectors), never on
+the iterate."""
+from __future__ import annotations
+
+import numpy as np
+
+#: the two-level direction is used only while it keeps at least this share of the descent
+#: of the plain one, g . z_2level > DESCENT_GUARD g . (M g); otherwise that iteration takes
+#: M g (:func:`_descent_guard`)
+DESCENT_GUARD = 0.1
+
+
+def _descent_guard(gF, zF, z2):
+    """The two-level direction ``z2`` if it is still a descent direction worth the name,
+    else the plain preconditioned one ``zF`` (both on F, ``gF`` the gradient there).
+
+    The A-DEF2 correction of :mod:`roughfe.bem.deflation` is exact only with the exact
+    coarse matrix Z^T H_FF Z solved exactly. The production form approximates the far
+    field (N_I N_J K) and solves the coarse system to ``coarse_tol``, so the corrected
+    preconditioner is not guaranteed positive definite: g . z2 can fall far below
+    g . z = g . M g > 0, or below zero. Then the step length g . t / t . H t goes to 0
+    and the Polak-Ribiere beta restarts at every iteration: the solve stalls. Measured
+    (round 2, session 12): the ratio g . z2 / g . z is 0.18-0.5 in the first corrected
+    iterations of a solve and 0.85-0.98 after that on the ``bench_bem`` surfaces; on
+    a band-limited surface resampled to 4096^2 (p/E* = 0.1) it fell to 0.01-0.05 for ten
+    iterations (34 iterations instead of 23), and resampled to 8192^2 (p/E* = 0.05) it
+    turned negative at the 22nd iteration and the residual froze at 9.7e-6 (tau -> 0:
+    the solve would have run to ``max_iter``). With the guard (threshold
+    :data:`DESCENT_GUARD`) those take 23 and 27 iterations, and the 4 loads of six
+    self-affine surfaces at 1024^2 and 2048^2 keep their iteration counts. Details:
+    ``docs/theory/02b_bem_performance.md``, "A stall of the two-level direction".
+    """
+    if z2 is zF:              # the correction was skipped (the contact-set search)
+        return zF
+    gz2 = float(np.dot(gF, z2))
+    return z2 if gz2 > DESCENT_GUARD * float(np.dot(gF, zF)) else zF
+
+
+def _bind_lower(tF, positive, load):
+    """Drop the components of the search direction ``tF`` (in place; the step is
+    p <- p - tau t) that would push a point of F at p = 0 below zero (``positive``:
+    p > 0 on F, bool). This is the binding set of a projected-gradient method (Bertsekas
+    1982; More & Toraldo 1991, GPCG) applied to the preconditioned direction: PK's free
+    set admits a point at p = 0 whose gap is negative (it interpenetrates), but the
+    preconditioned, conjugated direction there may still lower p. Without this rule the
+    step gives such a point a negative pressure, the projection clips it back, the step
+    is spent and u must be recomputed; the point then leaves F (measured at 2048^2,
+    p/E* = 0.05: a third to a half of the points leaving F in each search iteration had
+    entered it in the iteration before). In load control the kept components are
+    shifted back to zero mean, so that the step keeps the load.
+
+    Not in Polonsky & Keer (1999), whose rule admits the point with the raw direction.
+    Used with the two-level correction only (``deflation``), where it was measured to
+    pay (4 cold loads p/E* = 0.005-0.1, tol 1e-10, the ``bench_bem`` surface: 1024^2
+    94 -> 89 iterations, 2048^2 115 -> 103, one load p/E* = 0.05 at 4096^2 42 -> 33);
+    in the plain CG it does not (256^2 117 -> 119, 512^2 147 -> 150). Details:
+    ``docs/theory/02b_bem_performance.md``, "The binding set" (session 10).
+    """
+    bound = tF > 0.0
+    bound &= ~positive
+    nb = int(np.count_nonzero(bound))
+    if not nb:
+        return
+    tF[bound] = 0.0
+    if load and nb < tF.size:
+        tF -= float(tF.sum()) / (tF.size - nb)
+        tF[bound] = 0.0

@@ -1,0 +1,66 @@
+"""The descent guard of the two-level Polonsky-Keer CG (round 2, session 12): a coarse
+correction that leaves the direction without descent (g . z2 <= DESCENT_GUARD g . M g)
+is dropped for that iteration, so that an inexact coarse operator can slow a solve but
+never stall it (measured: a band-limited surface resampled to 8192^2 froze at a KKT
+residual of 9.7e-6 without it; ``docs/theory/02b_bem_performance.md``)."""
+import numpy as np
+import pytest
+
+from roughfe.bem import directions, pk
+from roughfe.bem.contact import _cg_preconditioner
+from roughfe.bem.operators import influence_operator
+from roughfe.bem.solvers import kkt_residual
+from roughfe.errors import NoConvergenceError
+from roughfe.surfaces.spectral import spectral_surface
+
+
+def test_guard_keeps_a_descent_direction_and_drops_the_others():
+    rng = np.random.default_rng(5)
+    g = rng.standard_normal(500)
+    z = g + 0.1 * rng.standard_normal(500)            # g . z > 0: the plain direction
+    assert pk._descent_guard(g, z, z) is z             # skipped correction: z itself
+    good = 0.5 * z + 0.05 * rng.standard_normal(500)  # keeps ~half of the descent
+    assert pk._descent_guard(g, z, good) is good
+    for bad in (-z, 0.05 * z, np.zeros(500)):         # ascent, too little, none
+        assert pk._descent_guard(g, z, bad) is z
+
+
+class _Adversary:
+    """A 'coarse correction' that turns the direction uphill at every iteration."""
+
+    def __init__(self):
+        self.calls = 0
+
+    def correct(self, F, gF, zF, apply_free, free_mask=None, pressure=None):
+        self.calls += 1
+        return -zF
+
+
+def _solve(h, op, deflation, max_iter=400):
+    return pk.polonsky_keer(op.apply, h, float(np.ptp(h)), diagonal=op.diagonal,
+                            precond=_cg_preconditioner(op), tol=1e-10,
+                            offset=-float(h.max()), mean_pressure=0.05,
+                            max_iter=max_iter, deflation=deflation)
+
+
+def test_an_uphill_correction_cannot_stall_the_solve(monkeypatch):
+    # 128^2, p/E* = 0.05: with the guard the adversarial correction is dropped at every
+    # iteration and the solve is the plain preconditioned one (same contact set and
+    # pressures within the KKT tolerance scale); without it the same solve does not
+    # converge at all
+    h = spectral_surface(128, 1.0, 0.8, rms_slope=1.0, rng=2).heights
+    op = influence_operator((128, 128), (1.0, 1.0), 1.0)
+    bad = _Adversary()
+    guarded = _solve(h, op, bad)
+    plain = _solve(h, op, None)
+    assert bad.calls >= guarded.nit - 3      # every iteration but the confirmations
+    p, q = guarded.pressure, plain.pressure
+    assert np.array_equal(p > 0, q > 0)
+    assert np.abs(p - q).max() <= 2e-8 * q.max()
+    assert p.mean() == pytest.approx(0.05, rel=1e-12)
+    gap = op.apply(p) - (h - h.max()) - guarded.delta
+    assert kkt_residual(p, gap, float(np.ptp(h))) <= 1e-10
+
+    monkeypatch.setattr(directions, "DESCENT_GUARD", -np.inf)   # the guard off
+    with pytest.raises(NoConvergenceError):
+        _solve(h, op, _Adversary(), max_iter=200)
