@@ -175,3 +175,19 @@ def test_every_benchmark_exits_0_once_its_report_is_written():
             assert not bad, f"{path.name}: main returns {bad}, not 0"
             checked.append(path.stem)
     assert "bench_surface_design" in checked and len(checked) >= 8
+
+
+def test_growth_benchmark_judges_each_doubling_and_the_seed_mean(monkeypatch):
+    # benchmarks/bench_bem_growth.py: one verdict per surface and pair of sizes n -> 2n,
+    # one for the mean over the seeds; pairs that are not a doubling give no row
+    monkeypatch.syspath_prepend(str(BENCH))
+    growth = _module("bench_bem_growth")
+    rows = [{"kind": "octaves", "n": n, "hurst": 0.8, "seed": seed, "total_nit": nit}
+            for seed, counts in ((1, (87, 99, 120)), (2, (84, 98, 111)))
+            for n, nit in zip((1024, 2048, 8192), counts)]
+    out = growth._growth_targets(rows, lambda r: r["seed"], lambda k: f"seed {k}")
+    assert [(t["name"].split(":")[0], t["value"], t["met"]) for t in out] == [
+        ("seed 1", round(99 / 87, 4), True), ("seed 2", round(98 / 84, 4), False)]
+    (mean,) = growth._mean_targets(rows, 0.8)
+    assert mean["value"] == round(98.5 / 85.5, 4) and not mean["met"]
+    assert "85.50 -> 98.50" in mean["name"] and "mean of 2 seeds" in mean["name"]
