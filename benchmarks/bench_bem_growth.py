@@ -23,8 +23,10 @@ Usage::
 
     .venv/bin/python benchmarks/bench_bem_growth.py [--quick]
 
-The full run takes ~15 min of CPU (grids up to 4096^2, 1.1 GB); ``--quick`` (~1 min)
-solves one load on the refinement of one surface, 1024^2 -> 2048^2. Writes ``benchmarks/output/bench_bem_growth.json``.
+The full run takes ~20 min of CPU: 4 loads up to 4096^2, and one load (p/E* = 0.05) up
+to 4096^2 on the new surfaces and up to 8192^2 on a refined one (~4.5 GB). ``--quick``
+(~10 s) solves one load on the refinement of one surface, 1024^2 -> 2048^2. Writes
+``benchmarks/output/bench_bem_growth.json``.
 """
 from __future__ import annotations
 
@@ -127,10 +129,13 @@ def main(argv=None) -> int:
     if args.quick:
         sizes, big, seeds, loads = [1024], [], {0.8: [1]}, (0.05,)
         refine = [(512, [1024, 2048], 0.8, 1)]
+        refine_big = []
     else:
         sizes, big, seeds, loads = [1024, 2048], [4096], {0.8: [1, 2, 3, 4], 0.5: [1, 2]}, LOADS
         refine = [(512, [1024, 2048, 4096], 0.8, 1), (512, [1024, 2048, 4096], 0.5, 1),
                   (1024, [1024, 2048, 4096], 0.8, 1)]
+        # the case that stalled before the descent guard of session 12 (8192^2)
+        refine_big = [(1024, [2048, 4096, 8192], 0.8, 1)]
     rows = []
     for hurst, ss in seeds.items():
         for seed in ss:
@@ -153,6 +158,13 @@ def main(argv=None) -> int:
             print(f"refinement H = {hurst} base {base} n = {n:5d}: {r['total_nit']:4d} "
                   f"{r['nit']}  A* {np.round(r['A*'], 4).tolist()}  ({r['cpu_s']:.1f} s CPU)",
                   flush=True)
+    for base, ns, hurst, seed in refine_big:     # one load, up to 8192^2 (~4.5 GB)
+        for n in ns:
+            rows.append({**refinement_case(base, n, hurst, seed, (0.05,)),
+                         "kind": "refinement-0.05"})
+            r = rows[-1]
+            print(f"refinement H = {hurst} base {base} n = {n:5d}, p/E* = 0.05: "
+                  f"{r['total_nit']:4d}  ({r['cpu_s']:.1f} s CPU)", flush=True)
     octave_rows = [r for r in rows if r["kind"] == "octaves"]
     targets = _growth_targets(octave_rows, lambda r: (r["hurst"], r["seed"]),
                               lambda k: f"octaves, H = {k[0]}, seed {k[1]}, {_loads(loads)}")
@@ -168,6 +180,10 @@ def main(argv=None) -> int:
                                lambda r: (r["hurst"], r["base"]),
                                lambda k: f"refinement of the {k[1]}^2 surface, H = {k[0]}, "
                                          f"{_loads(loads)}")
+    targets += _growth_targets([r for r in rows if r["kind"] == "refinement-0.05"],
+                               lambda r: (r["hurst"], r["base"]),
+                               lambda k: f"refinement of the {k[1]}^2 surface, H = {k[0]}, "
+                                         f"{_loads((0.05,))}")
     write_report(args.output, "bench_bem_growth", targets, rows,
                  {"nit": "iterations of the finest grid per load", "A*": "contact fraction",
                   "cpu_s": "s (process CPU time, generation included)"},
