@@ -21,7 +21,7 @@ def test_guard_keeps_a_descent_direction_and_drops_the_others():
     assert pk._descent_guard(g, z, z) is z             # skipped correction: z itself
     good = 0.5 * z + 0.05 * rng.standard_normal(500)  # keeps ~half of the descent
     assert pk._descent_guard(g, z, good) is good
-    for bad in (-z, 0.05 * z, np.zeros(500)):         # ascent, too little, none
+    for bad in (-z, 0.02 * z, np.zeros(500)):         # ascent, too little, none
         assert pk._descent_guard(g, z, bad) is z
 
 
