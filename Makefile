@@ -45,7 +45,7 @@ validate-quick: env
 	$(PY) -m roughfe.cli validate all --quick -o validation/output-quick
 
 # make bench: every benchmark at full size (8192^2 BEM, 4096^2 Reynolds, Tamaas up to
-# 512^2; about an hour on 2 cores, ~4.2 GB peak), JSON in benchmarks/output and the one
+# 512^2; over an hour on 2 cores, ~4.6 GB peak), JSON in benchmarks/output and the one
 # table of every speed/memory target in benchmarks/output/SUMMARY.md. make bench-quick:
 # reduced sizes (< 3 min) into benchmarks/output-quick, for smoke use.
 bench: env
