@@ -130,14 +130,18 @@ def _run_facts(data: dict, path: Path) -> dict:
     return {"date (UTC)": date.replace("T", " ").replace("+00:00", ""), "load": load}
 
 
-def read_reports(folder: Path) -> dict:
-    """benchmark stem -> list of (path, data or None, error) of its JSON files."""
+def read_reports(folder: Path, expected=EXPECTED) -> dict:
+    """benchmark stem -> list of (path, data or None, error) of its JSON files: a file
+    belongs to the benchmark of its name, else to the longest expected benchmark name it
+    extends (``bench_bem_8192.json`` to ``bench_bem``, ``bench_bem_growth.json`` to
+    ``bench_bem_growth`` itself)."""
+    names = sorted({e[1] for e in expected}, key=len, reverse=True)
     reports = {}
     for path in sorted(Path(folder).glob("*.json")):
         if path.stem == "run_all":
             continue
-        stem = next((e[1] for e in EXPECTED if path.stem == e[1] or path.stem.startswith(
-            e[1] + "_")), path.stem)
+        stem = path.stem if path.stem in names else next(
+            (b for b in names if path.stem.startswith(b + "_")), path.stem)
         reports.setdefault(stem, []).append((path, *_load(path)))
     return reports
 
@@ -151,7 +155,7 @@ def _targets(data) -> list:
 
 def summary_rows(folder, expected=EXPECTED) -> list:
     """The rows of the table (dicts keyed by :data:`COLUMNS`), expected targets first."""
-    reports = read_reports(Path(folder))
+    reports = read_reports(Path(folder), expected)
     rows, claimed = [], set()
     for issue, stem, match, what, unit, skip_match in expected:
         files = reports.get(stem, [])

@@ -191,3 +191,18 @@ def test_growth_benchmark_judges_each_doubling_and_the_seed_mean(monkeypatch):
     (mean,) = growth._mean_targets(rows, 0.8)
     assert mean["value"] == round(98.5 / 85.5, 4) and not mean["met"]
     assert "85.50 -> 98.50" in mean["name"] and "mean of 2 seeds" in mean["name"]
+
+
+def test_a_report_belongs_to_its_own_benchmark_before_a_prefix(tmp_path, summary):
+    # bench_x_big.json is a run of bench_x (e.g. bench_bem_8192.json), but bench_x_growth
+    # is a benchmark of its own: its rows must not be read as bench_x's
+    expected = (("16 §1", "bench_x", "growth", "x growth", "ratio", "growth"),
+                ("16 §1", "bench_x_growth", "refinement", "refined", "ratio", "growth"))
+    row = {"name": "refinement growth 1 -> 2", "value": 1.0, "target": 1.15, "met": True}
+    _write(tmp_path, "bench_x_growth", targets=[row])
+    _write(tmp_path, "bench_x_big", targets=[{**row, "name": "iteration growth 1 -> 2"}])
+    assert set(summary.read_reports(tmp_path, expected)) == {"bench_x", "bench_x_growth"}
+    rows = summary.summary_rows(tmp_path, expected)
+    by = {(r["benchmark"], r["target"]): r["status"] for r in rows}
+    assert by == {("bench_x", "iteration growth 1 -> 2"): "met",
+                  ("bench_x_growth", "refinement growth 1 -> 2"): "met"}
