@@ -1,0 +1,71 @@
+"""The coarse-to-fine start of a periodic, load-controlled BEM solve (02b): the same
+problem on the grid coarsened by 2 (Fourier-truncated heights), recursively, its
+pressure injected on 2 x 2 blocks as the initial guess of the finer grid."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft
+
+from ..errors import NoConvergenceError
+from ..surfaces.surface import Surface
+from .operators import WORKERS
+
+#: cold, load-controlled, periodic surface solves with at least this many points per (even)
+#: axis start from the solution on the grid coarsened twice (recursively)
+COARSE_START_MIN = 256
+COARSE_START_TOL = 1e-4  #: KKT tolerance of those coarse solves (only a starting guess)
+
+
+def _coarse_surface(surface: Surface) -> Surface:
+    """The same periodic surface on a grid coarsened by 2 per axis: its Fourier modes
+    below the coarse Nyquist wavenumber (the coarse Nyquist row/column dropped)."""
+    h = surface.heights
+    n0, n1 = h.shape
+    m0, m1 = n0 // 2, n1 // 2
+    spec = scipy.fft.rfftn(h, workers=WORKERS)
+    coarse = np.zeros((m0, m1 // 2 + 1), complex)
+    k0, k1 = m0 // 2, m1 // 2
+    coarse[:k0, :k1] = spec[:k0, :k1]
+    coarse[m0 - k0 + 1:, :k1] = spec[n0 - k0 + 1:, :k1]
+    del spec
+    hc = scipy.fft.irfftn(coarse, s=(m0, m1), workers=WORKERS)
+    hc *= (m0 * m1) / (n0 * n1)
+    return Surface(hc, surface.size, periodic=True)
+
+
+def _coarse_start(surface, material, mean_pressure, hardness, previous=None):
+    """Coarse-to-fine initial pressure (Pa) of a periodic load-controlled solve, or None.
+
+    The problem is solved on the grid coarsened by 2 (Fourier-truncated heights, the
+    same load, recursively down to ``COARSE_START_MIN`` points per axis) to
+    ``COARSE_START_TOL`` and its pressure injected on 2 x 2 blocks (a level costs a
+    quarter of the next; 15-20 % fewer fine iterations at 512^2-1024^2, 4 loads, 02b).
+
+    ``previous`` (dict grid shape -> the previous sweep step's solution on that grid,
+    updated in place; the caller stores the fine one): every level then starts from
+    the injected coarser solution plus its previous detail, P_c(new) + p_prev -
+    P_c(prev), clipped at 0 (a full-approximation-scheme start; measured in
+    :func:`roughfe.bem.sweep.contact_sweep`).
+    """
+    shape = surface.shape
+    if (not surface.periodic or surface.ndim != 2 or min(shape) < COARSE_START_MIN
+            or any(n % 2 for n in shape)):
+        return None
+    coarse = _coarse_surface(surface)
+    before = initial = None
+    if previous is not None:
+        before, initial = previous.get(coarse.shape), _coarse_start(
+            coarse, material, mean_pressure, hardness, previous)
+    from .contact import solve_contact   # the coarse level is a solve of its own
+    try:
+        pc = solve_contact(coarse, material, mean_pressure=mean_pressure, solver="pk",
+                           tol=COARSE_START_TOL, compute_stiffness=False,
+                           hardness=hardness, initial=initial).pressure
+    except NoConvergenceError as exc:
+        pc = exc.result.pressure
+    if previous is not None:
+        previous[coarse.shape] = pc
+        if before is not None and shape in previous:     # the previous detail
+            start = np.repeat(np.repeat(pc - before, 2, axis=0), 2, axis=1)
+            return np.maximum(start + previous[shape], 0.0, out=start)
+    return np.repeat(np.repeat(pc, 2, axis=0), 2, axis=1)
