@@ -33,7 +33,8 @@ def _coarse_surface(surface: Surface) -> Surface:
     return Surface(hc, surface.size, periodic=True)
 
 
-def _coarse_start(surface, material, mean_pressure, hardness, previous=None):
+def _coarse_start(surface, material, mean_pressure, hardness, previous=None,
+                  coarse_correction=None):
     """Coarse-to-fine initial pressure (Pa) of a periodic load-controlled solve, or None.
 
     The problem is solved on the grid coarsened by 2 (Fourier-truncated heights, the
@@ -45,8 +46,11 @@ def _coarse_start(surface, material, mean_pressure, hardness, previous=None):
     updated in place; the caller stores the fine one): every level then starts from
     the injected coarser solution plus its previous detail, P_c(new) + p_prev -
     P_c(prev), clipped at 0 (a full-approximation-scheme start; measured in
-    :func:`roughfe.bem.sweep.contact_sweep`).
+    :func:`roughfe.bem.sweep.contact_sweep`). ``coarse_correction`` False (see
+    :func:`roughfe.bem.solve_contact`) keeps the two-level correction off on every
+    level; otherwise the levels choose it automatically.
     """
+    level = False if coarse_correction is False else None
     shape = surface.shape
     if (not surface.periodic or surface.ndim != 2 or min(shape) < COARSE_START_MIN
             or any(n % 2 for n in shape)):
@@ -55,12 +59,13 @@ def _coarse_start(surface, material, mean_pressure, hardness, previous=None):
     before = initial = None
     if previous is not None:
         before, initial = previous.get(coarse.shape), _coarse_start(
-            coarse, material, mean_pressure, hardness, previous)
+            coarse, material, mean_pressure, hardness, previous, level)
     from .contact import solve_contact   # the coarse level is a solve of its own
     try:
         pc = solve_contact(coarse, material, mean_pressure=mean_pressure, solver="pk",
                            tol=COARSE_START_TOL, compute_stiffness=False,
-                           hardness=hardness, initial=initial).pressure
+                           hardness=hardness, initial=initial,
+                           coarse_correction=level).pressure
     except NoConvergenceError as exc:
         pc = exc.result.pressure
     if previous is not None:

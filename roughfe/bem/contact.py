@@ -202,14 +202,39 @@ def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
 DEFLATION_SIDES = (1024, 8192)
 
 
-def _deflation(op: InfluenceOperator, hardness, plastic):
-    """The coarse correction of a solve with ``op`` (None outside ``DEFLATION_SIDES``); its
-    solves alone take the split line search (``polonsky_keer(split=)``, 02b session 11)."""
+def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None):
+    """The coarse correction of a load-controlled pk solve with ``op``, or None; its
+    solves alone take the split line search (``polonsky_keer(split=)``, 02b session 11).
+    ``coarse_correction``: None = where measured to pay (sides in ``DEFLATION_SIDES``),
+    False = never, True = wherever it applies (:func:`_check_coarse_correction`)."""
     lo, hi = DEFLATION_SIDES
-    if (not op.periodic or len(op.shape) != 2 or hardness is not None
-            or plastic is not None or any(n % 8 or not lo <= n <= hi for n in op.shape)):
+    if (coarse_correction is False or not op.periodic or len(op.shape) != 2
+            or hardness is not None or plastic is not None
+            or any(n % 8 or n < 24 for n in op.shape)
+            or (coarse_correction is None and not all(lo <= n <= hi for n in op.shape))):
         return None
     return BlockDeflation(op, 8)
+
+
+def _check_coarse_correction(value, op, solver, mean_pressure, hardness):
+    """``coarse_correction`` of :func:`solve_contact`: None, True or False; True only
+    where the two-level correction applies (else an InputError that says why)."""
+    if value is None or value is False:
+        return value
+    if value is not True:
+        raise InputError(f"coarse_correction must be None (automatic), True or False, "
+                         f"got {value!r}")
+    why = ("a periodic surface (the spectral kernel)" if not op.periodic else
+           "a 2D surface, not a profile" if len(op.shape) != 2 else
+           "load control (mean_pressure)" if mean_pressure is None else
+           "an elastic interface (no hardness)" if hardness is not None else
+           "solver 'pk'" if solver != "pk" else
+           f"grid sides that are multiples of 8 and >= 24, got {op.shape}"
+           if any(n % 8 or n < 24 for n in op.shape) else None)
+    if why:
+        raise InputError(f"coarse_correction=True (the two-level correction of the "
+                         f"Polonsky-Keer CG) needs {why}")
+    return True
 
 
 def _periodic_full_contact(op, h):
@@ -228,7 +253,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                   kernel: str = "auto", solver: str = "auto", tol: float = 1e-10,
                   max_iter: Optional[int] = None, initial=None,
                   compute_stiffness: bool = True, hardness=None,
-                  plastic_displacement=None) -> ContactResult:
+                  plastic_displacement=None, coarse_correction=None) -> ContactResult:
     """Solve the frictionless contact of a rigid rough surface on an elastic half-space.
 
     Displacement control (``delta``) or load control (``mean_pressure``), Eq. 2.5-2.6;
@@ -281,6 +306,14 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         Permanent displacement (m, >= 0, grid shape) left by an earlier loading, e.g. on
         the unloading branch of a cycle: the elastic body's surface is recessed by it,
         so the gap is u + u_pl + max h - h - Delta.
+    coarse_correction : bool, optional
+        The two-level (deflation) correction of the Polonsky-Keer CG
+        (:class:`roughfe.bem.deflation.BlockDeflation`, 8 x 8 blocks; elastic, periodic,
+        load-controlled surface solves). None: on for sides in ``DEFLATION_SIDES``, where
+        it was measured to pay on rough surfaces (2-3x fewer iterations). False: off,
+        e.g. for smooth geometries, where it buys no iterations and costs 1.2-1.6x CPU
+        (docs/theory/02b_bem_performance.md, session 12). True: on at any size it applies
+        to (an InputError says why it does not).
 
     Raises
     ------
@@ -297,6 +330,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
     solver = _choose_solver(surface.heights.size, op, solver, hardness is not None)
+    coarse_correction = _check_coarse_correction(coarse_correction, op, solver,
+                                                 mean_pressure, hardness)
     h = surface.heights
     hmax = float(h.max())
     if plastic is not None:
@@ -342,8 +377,10 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         elif solver == "pk":
             own = initial is None and mean_pressure is not None and plastic is None
             if own:
-                initial = _coarse_start(surface, material, mean_pressure, hardness)
-            deflation = None if mean_pressure is None else _deflation(op, hardness, plastic)
+                initial = _coarse_start(surface, material, mean_pressure, hardness,
+                                        coarse_correction=coarse_correction)
+            deflation = (None if mean_pressure is None else
+                         _deflation(op, hardness, plastic, coarse_correction))
             out = polonsky_keer(op.apply, h, scale, delta=delta, mean_pressure=mean_pressure,
                                 initial=initial, diagonal=op.diagonal, tol=tol,
                                 precond=_cg_preconditioner(op), overwrite_initial=own,

@@ -61,7 +61,8 @@ def _predicted_pressure(results, target, key, branch):
 def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, deltas=None,
                   pressures=None, kernel: str = "auto", solver: str = "auto",
                   tol: float = 1e-10, max_iter=None, compute_stiffness: bool = True,
-                  hardness=None, unload: bool = False) -> SweepResult:
+                  hardness=None, unload: bool = False,
+                  coarse_correction=None) -> SweepResult:
     """Warm-started sequence of contact solutions.
 
     Elastic load-controlled steps on a periodic surface (2D, >= 256 points per axis)
@@ -82,7 +83,7 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
 
     Parameters
     ----------
-    surface, material, kernel, solver, tol, max_iter, compute_stiffness
+    surface, material, kernel, solver, tol, max_iter, compute_stiffness, coarse_correction
         As in :func:`roughfe.bem.solve_contact`.
     n_steps : int
         Number of equispaced approaches (default 20, as in the thesis) when neither
@@ -120,14 +121,15 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     levels = ({} if key == "mean_pressure" and not branch and solver in ("auto", "pk")
               and kernel in ("auto", "spectral") else None)
     for v, unloading in progress.iterate(steps, "BEM load steps"):
-        initial = None if levels is None else _coarse_start(surface, material, v, None,
-                                                             levels)
+        initial = None if levels is None else _coarse_start(
+            surface, material, v, None, levels, coarse_correction)
         if initial is None:
             initial = _predicted_pressure(results, v, key, branch)
         r = solve_contact(surface, material, **{key: v}, kernel=kernel, solver=solver,
                           tol=tol, max_iter=max_iter, initial=initial,
                           compute_stiffness=compute_stiffness, hardness=hardness,
-                          plastic_displacement=plastic)
+                          plastic_displacement=plastic,
+                          coarse_correction=coarse_correction)
         if branch:
             r = dataclasses.replace(r, unloading=unloading)
         results.append(r)

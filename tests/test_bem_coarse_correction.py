@@ -1,0 +1,89 @@
+"""The switch of the two-level correction, ``solve_contact(coarse_correction=)`` (round 2,
+session 12): None chooses it where it was measured to pay (``DEFLATION_SIDES``), False
+gives the plain solve, True puts it on wherever it applies; the answer is the same
+solution of Eq. 2.5-2.6 either way, and a request it cannot honour is a clear error."""
+import numpy as np
+import pytest
+
+from roughfe.bem import Material, contact, contact_sweep, solve_contact
+from roughfe.errors import InputError
+from roughfe.surfaces.shapes import sphere_cap
+from roughfe.surfaces.spectral import spectral_surface
+from roughfe.surfaces.surface import Surface
+
+KW = dict(solver="pk", tol=1e-10, compute_stiffness=False)
+
+
+def _counting(monkeypatch):
+    made = []
+    original = contact.BlockDeflation
+
+    def make(op, block):
+        made.append(op.shape)
+        return original(op, block)
+    monkeypatch.setattr(contact, "BlockDeflation", make)
+    return made
+
+
+def test_off_is_the_plain_solve_and_on_is_the_same_solution(monkeypatch):
+    # 1024^2 (the correction on by default): False is bit for bit the solve with the
+    # correction's range emptied; the default reaches the same contact set with fewer
+    # iterations (a rough surface: 23 against 49 at p/E* = 0.05)
+    s = spectral_surface(1024, 1.0, 0.8, rms_slope=1.0, rng=1)
+    m = Material(1.0, 0.0)
+    made = _counting(monkeypatch)
+    auto = solve_contact(s, m, mean_pressure=0.05, **KW)
+    assert made and made[-1] == (1024, 1024)
+    made.clear()
+    off = solve_contact(s, m, mean_pressure=0.05, coarse_correction=False, **KW)
+    assert not made                   # no level of the coarse start used it either
+    monkeypatch.setattr(contact, "DEFLATION_SIDES", (10 ** 9, 10 ** 9))
+    plain = solve_contact(s, m, mean_pressure=0.05, **KW)
+    assert np.array_equal(off.pressure, plain.pressure) and off.nit == plain.nit
+    assert auto.nit < off.nit
+    assert np.array_equal(auto.contact, off.contact)
+    assert np.abs(auto.pressure - off.pressure).max() <= 2e-8 * off.pressure.max()
+
+
+def test_on_below_the_automatic_range(monkeypatch):
+    # a sphere on 256^2 (automatic: plain), forced on: the same solution, Hertz-like
+    s = sphere_cap(256, 1.0, 1.0)
+    s = Surface(s.heights, s.size, periodic=True)
+    m = Material(1.0, 0.0)
+    made = _counting(monkeypatch)
+    plain = solve_contact(s, m, mean_pressure=1e-3, **KW)
+    assert not made
+    on = solve_contact(s, m, mean_pressure=1e-3, coarse_correction=True, **KW)
+    assert made == [(256, 256)]       # the fine grid only: the coarse levels choose
+    assert np.array_equal(on.contact, plain.contact)
+    assert np.abs(on.pressure - plain.pressure).max() <= 1e-6 * plain.pressure.max()
+    sweep = contact_sweep(s, m, pressures=[1e-3], coarse_correction=False,
+                          compute_stiffness=False)
+    assert np.array_equal(sweep.results[0].contact, plain.contact)
+
+
+@pytest.mark.parametrize("kw, why", [
+    (dict(delta=1e-3), "load control"),
+    (dict(mean_pressure=1e-3, hardness=0.5), "elastic interface"),
+    (dict(mean_pressure=1e-3, kernel="love"), "periodic surface"),
+    (dict(mean_pressure=1e-3, solver="dense"), "solver 'pk'"),
+])
+def test_on_where_it_cannot_apply_says_why(kw, why):
+    s = spectral_surface(32, 1.0, 0.8, rms_slope=1.0, rng=1)
+    with pytest.raises(InputError, match=why):
+        solve_contact(s, Material(1.0, 0.0), coarse_correction=True,
+                      compute_stiffness=False, **kw)
+
+
+def test_bad_values_and_grids():
+    m = Material(1.0, 0.0)
+    s = spectral_surface(32, 1.0, 0.8, rms_slope=1.0, rng=1)
+    with pytest.raises(InputError, match="None .automatic., True or False"):
+        solve_contact(s, m, mean_pressure=1e-3, coarse_correction="yes")
+    odd = spectral_surface(36, 1.0, 0.8, rms_slope=1.0, rng=1)
+    with pytest.raises(InputError, match="multiples of 8"):
+        solve_contact(odd, m, mean_pressure=1e-3, coarse_correction=True)
+    profile = spectral_surface(1024, 1.0, 0.8, rms_slope=1.0, rng=1).heights[0]
+    with pytest.raises(InputError, match="2D surface"):
+        solve_contact(Surface(profile, 1.0, periodic=True), m, mean_pressure=1e-3,
+                      coarse_correction=True)
