@@ -202,15 +202,25 @@ def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
 DEFLATION_SIDES = (1024, 8192)
 
 
+def _two_level_unfit(op, hardness):
+    """Why the two-level correction cannot act on a load-controlled pk solve with ``op``
+    (what it needs), or None."""
+    return ("a periodic surface (the spectral kernel)" if not op.periodic else
+            "a 2D surface, not a profile" if len(op.shape) != 2 else
+            "an elastic interface (no hardness)" if hardness is not None else
+            f"grid sides that are multiples of 8 and >= 24, got {op.shape}"
+            if any(n % 8 or n < 24 for n in op.shape) else None)
+
+
 def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None):
     """The coarse correction of a load-controlled pk solve with ``op``, or None; its
     solves alone take the split line search (``polonsky_keer(split=)``, 02b session 11).
     ``coarse_correction``: None = where measured to pay (sides in ``DEFLATION_SIDES``),
-    False = never, True = wherever it applies (:func:`_check_coarse_correction`)."""
+    False = never, True = wherever it applies (:func:`_check_coarse_correction`). A
+    plastic displacement comes with a hardness, which rules the correction out."""
     lo, hi = DEFLATION_SIDES
-    if (coarse_correction is False or not op.periodic or len(op.shape) != 2
-            or hardness is not None or plastic is not None
-            or any(n % 8 or n < 24 for n in op.shape)
+    if (coarse_correction is False or plastic is not None
+            or _two_level_unfit(op, hardness)
             or (coarse_correction is None and not all(lo <= n <= hi for n in op.shape))):
         return None
     return BlockDeflation(op, 8)
@@ -224,13 +234,8 @@ def _check_coarse_correction(value, op, solver, mean_pressure, hardness):
     if value is not True:
         raise InputError(f"coarse_correction must be None (automatic), True or False, "
                          f"got {value!r}")
-    why = ("a periodic surface (the spectral kernel)" if not op.periodic else
-           "a 2D surface, not a profile" if len(op.shape) != 2 else
-           "load control (mean_pressure)" if mean_pressure is None else
-           "an elastic interface (no hardness)" if hardness is not None else
-           "solver 'pk'" if solver != "pk" else
-           f"grid sides that are multiples of 8 and >= 24, got {op.shape}"
-           if any(n % 8 or n < 24 for n in op.shape) else None)
+    why = ("load control (mean_pressure)" if mean_pressure is None else
+           "solver 'pk'" if solver != "pk" else _two_level_unfit(op, hardness))
     if why:
         raise InputError(f"coarse_correction=True (the two-level correction of the "
                          f"Polonsky-Keer CG) needs {why}")
