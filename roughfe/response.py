@@ -19,7 +19,7 @@ METHODS = ("bem", "fem")
 
 #: keyword options of each method (everything else is refused with the list below)
 BEM_OPTIONS = ("kernel", "solver", "tol", "max_iter", "compute_stiffness", "hardness",
-               "unload", "adhesion")
+               "coarse_correction", "unload", "adhesion")
 FEM_MESH_OPTIONS = ("depth", "growth", "formulation", "size_max")
 FEM_SOLVER_OPTIONS = ("solver", "penalty_factor", "rtol", "atol", "max_it", "petsc_options")
 FEM_OPTIONS = FEM_MESH_OPTIONS + FEM_SOLVER_OPTIONS + ("keep_fields",)
@@ -57,7 +57,7 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         ``surface`` itself.
     **solver_options
         BEM: ``kernel``, ``solver``, ``tol``, ``max_iter``, ``compute_stiffness``,
-        ``hardness`` (see :func:`roughfe.bem.solve_contact`), ``unload``
+        ``hardness``, ``coarse_correction`` (see :func:`roughfe.bem.solve_contact`), ``unload``
         (:func:`roughfe.bem.contact_sweep`), ``adhesion`` (an
         :class:`roughfe.bem.adhesion.AdhesionLaw`: the adhesive continuation
         :func:`roughfe.bem.adhesion.adhesive_sweep` in the approaches, with ``unload``
@@ -106,8 +106,10 @@ def _adhesive_response(surface, material, loading, options) -> SweepResult:
     if options.get("hardness") is not None:
         raise InputError("hardness and adhesion together are not supported (the adhesive "
                          "solver has no pressure cap); give one of them")
-    if options.get("solver", "auto") != "auto":
-        raise InputError("solver does not apply with adhesion (its own minimiser on the gap)")
+    for name, default in (("solver", "auto"), ("coarse_correction", None)):
+        if options.get(name, default) != default:
+            raise InputError(f"{name} does not apply with adhesion (its own minimiser on "
+                             f"the gap)")
     if loading.controls_pressure:
         raise InputError("adhesion runs in displacement control (the load-approach curve "
                          "has unstable parts): give approaches (delta, deltas, n_steps), "

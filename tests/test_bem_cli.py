@@ -132,6 +132,8 @@ def test_contact_cli_adhesion_unload_pull_off(tmp_path):
     (["--work-of-adhesion", "0.1"], "need --adhesion"),
     (["--adhesion", "exp", "--work-of-adhesion", "0.1", "--range", "1e-9", "--pressure",
       "1e3"], "displacement control"),
+    (["--adhesion", "exp", "--work-of-adhesion", "0.1", "--range", "1e-9",
+      "--coarse-correction", "off"], "--coarse-correction does not apply with --adhesion"),
 ])
 def test_contact_cli_adhesion_bad_input(tmp_path, capsys, extra, message):
     path = _sphere_file(tmp_path, n=8)
@@ -178,3 +180,23 @@ def test_contact_cli_hardness_load_unload_cycle(tmp_path, capsys):
                  "--adhesion", "md", "--work-of-adhesion", "0.1", "--range", "1e-7",
                  "-o", str(tmp_path / "z")]) == 2
     assert "not supported" in capsys.readouterr().err
+
+
+def test_contact_cli_coarse_correction_switch(tmp_path, capsys):
+    # --coarse-correction on/off reaches solve_contact (recorded in the inputs); on in
+    # displacement control is refused with the reason
+    from roughfe.surfaces.spectral import spectral_surface
+    path = save_surface(spectral_surface(64, 1e-4, 0.8, rms_slope=0.1, rng=1),
+                        tmp_path / "rough.npz")
+    answers = {}
+    for mode in ("on", "off"):
+        out = tmp_path / mode
+        assert main(["contact", str(path), "--E", "1e9", "--nu", "0.3", "--pressure", "1e7",
+                     "--coarse-correction", mode, "-o", str(out), "--no-figures"]) == 0
+        doc = json.loads((out / "results.json").read_text())
+        assert doc["inputs"]["coarse_correction"] == mode
+        answers[mode] = doc["steps"][0]["area_fraction"]
+    assert answers["on"] == pytest.approx(answers["off"], abs=1e-12)
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0.3", "--delta", "1e-7",
+                 "--coarse-correction", "on", "-o", str(tmp_path / "x"), "--no-figures"]) == 2
+    assert "needs load control" in capsys.readouterr().err

@@ -87,3 +87,16 @@ def test_bad_values_and_grids():
     with pytest.raises(InputError, match="2D surface"):
         solve_contact(Surface(profile, 1.0, periodic=True), m, mean_pressure=1e-3,
                       coarse_correction=True)
+
+
+def test_response_passes_the_switch_and_refuses_it_with_adhesion():
+    from roughfe.bem.adhesion import AdhesionLaw
+    from roughfe.model import Loading
+    from roughfe.response import response
+    s = spectral_surface(32, 1.0, 0.8, rms_slope=1.0, rng=1)
+    m = Material(1.0, 0.0)
+    with pytest.raises(InputError, match="load control"):
+        response(s, m, Loading(deltas=[1e-3]), coarse_correction=True)
+    with pytest.raises(InputError, match="coarse_correction does not apply with adhesion"):
+        response(s, m, Loading(deltas=[1e-3]), coarse_correction=False,
+                 adhesion=AdhesionLaw("exp", 0.01, 0.01))

@@ -26,6 +26,8 @@ from .options import (add_contact_physics_options, add_detrend_option, add_mater
                       output_folder_of, positive_float, positive_int, surface_from_args)
 
 DEFAULT_STEPS = 20
+#: --coarse-correction -> solve_contact(coarse_correction=)
+COARSE = {"auto": None, "on": True, "off": False}
 
 
 def register(subparsers) -> None:
@@ -54,6 +56,10 @@ def register(subparsers) -> None:
                           "profiles and love for surfaces; 'thesis' = Eq. 2.4")
     num.add_argument("--solver", default="auto", choices=SOLVERS,
                      help="dense pivoting, scipy NNLS, or matrix-free Polonsky-Keer PCG")
+    num.add_argument("--coarse-correction", default="auto", choices=tuple(COARSE),
+                     help="the two-level correction of the Polonsky-Keer CG (periodic "
+                          "surfaces, --pressure): auto = from 1024^2 on; off for smooth "
+                          "geometries, where it buys no iterations")
     num.add_argument("--tol", type=positive_float, default=None,
                      help="relative KKT residual at which a load step is converged (default "
                           "1e-10); with --adhesion the traction residual (default 1e-5)")
@@ -74,7 +80,8 @@ def _run(args) -> int:
                    Loading(deltas=args.delta) if args.delta else
                    Loading(n_steps=args.steps or DEFAULT_STEPS))
         sweep = response(surface, material, loading, kernel=args.kernel, solver=args.solver,
-                         tol=tol, unload=args.unload, hardness=args.hardness)
+                         tol=tol, unload=args.unload, hardness=args.hardness,
+                         coarse_correction=COARSE[args.coarse_correction])
     else:
         adhesive = _adhesive_sweep(args, surface, material, law, tol)
         sweep = adhesive.sweep
@@ -84,6 +91,7 @@ def _run(args) -> int:
               "size": list(surface.size), "periodic": surface.periodic,
               "E": material.E, "nu": material.nu, "E_star": material.E_star,
               "kernel": r0.kernel, "solver": r0.solver, "tol": tol,
+              "coarse_correction": args.coarse_correction,
               "control": "pressure" if args.pressure else "delta",
               "hardness": args.hardness, "unload": args.unload,
               "detrend": args.detrend,
@@ -147,8 +155,11 @@ def _adhesive_sweep(args, surface, material, law, tol):
     if args.pressure is not None:
         raise InputError("--adhesion runs in displacement control (the load-approach curve "
                          "has unstable parts): give --delta or --steps, not --pressure")
-    if args.solver != "auto":
-        raise InputError("--solver does not apply with --adhesion (its own minimiser on the gap)")
+    for flag, value in (("--solver", args.solver), ("--coarse-correction",
+                                                     args.coarse_correction)):
+        if value != "auto":
+            raise InputError(f"{flag} does not apply with --adhesion (its own minimiser on "
+                             f"the gap)")
     deltas = args.delta
     if deltas is None:
         periodic = surface.periodic and args.kernel in ("auto", "spectral")
