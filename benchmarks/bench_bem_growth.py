@@ -121,7 +121,7 @@ def _mean_targets(rows, hurst):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true",
-                    help="512^2 -> 1024^2 only (the two-level solver starts at 1024^2)")
+                    help="one load on the refined 512^2 surface, 1024^2 -> 2048^2 (smoke run)")
     ap.add_argument("--output", type=Path, default=HERE / "output" / "bench_bem_growth.json")
     args = ap.parse_args(argv)
     # the two-level solver runs from 1024^2 on (``contact.DEFLATION_SIDES``): a pair
