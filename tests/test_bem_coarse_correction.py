@@ -1,11 +1,13 @@
 """The switch of the two-level correction, ``solve_contact(coarse_correction=)`` (round 2,
-session 12): None chooses it where it was measured to pay (``DEFLATION_SIDES``), False
-gives the plain solve, True puts it on wherever it applies; the answer is the same
-solution of Eq. 2.5-2.6 either way, and a request it cannot honour is a clear error."""
+sessions 12-13): None chooses it where it was measured to pay (``DEFLATION_SIDES``, and a
+start whose contact set has many parts), False gives the plain solve, True puts it on
+wherever it applies; the answer is the same solution of Eq. 2.5-2.6 either way, and a
+request it cannot honour is a clear error."""
 import numpy as np
 import pytest
 
 from roughfe.bem import Material, contact, contact_sweep, solve_contact
+from roughfe.bem.coarse_start import CORRECTION_MIN_PARTS, _contact_parts
 from roughfe.errors import InputError
 from roughfe.surfaces.shapes import sphere_cap
 from roughfe.surfaces.spectral import spectral_surface
@@ -60,6 +62,43 @@ def test_on_below_the_automatic_range(monkeypatch):
     sweep = contact_sweep(s, m, pressures=[1e-3], coarse_correction=False,
                           compute_stiffness=False)
     assert np.array_equal(sweep.results[0].contact, plain.contact)
+
+
+def test_contact_parts_counts_patches_and_islands():
+    # k disjoint square patches on a 64^2 grid: k patches + the one non-contact region;
+    # a hole punched in a patch adds an island; no structure (all or nothing) is None
+    p = np.zeros((64, 64))
+    for k in range(5):
+        p[4 + 12 * k: 10 + 12 * k, 8:20] = 1.0
+    assert _contact_parts(p) == 5 + 1
+    p[4:10, 8:20] = 1.0
+    p[6:8, 12:16] = 0.0              # an island inside the first patch
+    assert _contact_parts(p) == 5 + 2
+    assert _contact_parts(np.zeros((64, 64))) is None
+    assert _contact_parts(np.ones((64, 64))) is None
+
+
+def test_automatic_choice_reads_the_contact_structure(monkeypatch):
+    # in the automatic range (1024^2) a sphere's start has 2 parts (one patch, one
+    # non-contact region): the correction is left off and the solve is bit for bit the
+    # plain one, in a single solve and in a warm-started sweep; a rough surface's start
+    # has hundreds of parts at a light and at a heavy load (A* = 0.97): it stays on
+    m = Material(1.0, 0.0)
+    sphere = sphere_cap(1024, 1.0, 1.0)
+    sphere = Surface(sphere.heights, sphere.size, periodic=True)
+    made = _counting(monkeypatch)
+    auto = solve_contact(sphere, m, mean_pressure=1e-2, **KW)
+    assert not made
+    off = solve_contact(sphere, m, mean_pressure=1e-2, coarse_correction=False, **KW)
+    assert np.array_equal(auto.pressure, off.pressure) and auto.nit == off.nit
+    contact_sweep(sphere, m, pressures=[1e-3, 1e-2], compute_stiffness=False)
+    assert not made
+    rough = spectral_surface(1024, 1.0, 0.8, rms_slope=1.0, rng=1)
+    for load in (0.005, 1.0):
+        from roughfe.bem.coarse_start import _coarse_start
+        assert _contact_parts(_coarse_start(rough, m, load, None)) >= 10 * CORRECTION_MIN_PARTS
+    solve_contact(rough, m, mean_pressure=1.0, **KW)
+    assert made and made[-1] == (1024, 1024)
 
 
 @pytest.mark.parametrize("kw, why", [

@@ -28,7 +28,7 @@ from ..model import ContactResult, Material
 from .operators import (KERNELS, WORKERS, InfluenceOperator, _irfftn_owned,
                         influence_operator)
 from .periodic import periodic_bounded_displacement, periodic_gap_control
-from .coarse_start import _coarse_start
+from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
 from .deflation import BlockDeflation
 from .pk import polonsky_keer
 from .solvers import SolverOutput, dense_solve
@@ -212,10 +212,13 @@ def _two_level_unfit(op, hardness):
             if any(n % 8 or n < 24 for n in op.shape) else None)
 
 
-def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None):
+def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
+               start=None):
     """The coarse correction of a load-controlled pk solve with ``op``, or None; its
     solves alone take the split line search (``polonsky_keer(split=)``, 02b session 11).
-    ``coarse_correction``: None = where measured to pay (sides in ``DEFLATION_SIDES``),
+    ``coarse_correction``: None = where measured to pay (sides in ``DEFLATION_SIDES``,
+    and a ``start`` pressure, when given, whose contact set has at least
+    ``CORRECTION_MIN_PARTS`` parts: :func:`~roughfe.bem.coarse_start._contact_parts`),
     False = never, True = wherever it applies (:func:`_check_coarse_correction`). A
     plastic displacement comes with a hardness, which rules the correction out."""
     lo, hi = DEFLATION_SIDES
@@ -223,6 +226,10 @@ def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None)
             or _two_level_unfit(op, hardness)
             or (coarse_correction is None and not all(lo <= n <= hi for n in op.shape))):
         return None
+    if coarse_correction is None and start is not None:
+        parts = _contact_parts(start)
+        if parts is not None and parts < CORRECTION_MIN_PARTS:
+            return None
     return BlockDeflation(op, 8)
 
 
@@ -315,10 +322,12 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         The two-level (deflation) correction of the Polonsky-Keer CG
         (:class:`roughfe.bem.deflation.BlockDeflation`, 8 x 8 blocks; elastic, periodic,
         load-controlled surface solves). None: on for sides in ``DEFLATION_SIDES``, where
-        it was measured to pay on rough surfaces (2-3x fewer iterations). False: off,
-        e.g. for smooth geometries, where it buys no iterations and costs 1.2-1.6x CPU
-        (docs/theory/02b_bem_performance.md, session 12). True: on at any size it applies
-        to (an InputError says why it does not).
+        it was measured to pay on rough surfaces (2-3x fewer iterations), unless the
+        start's contact set has fewer than ``CORRECTION_MIN_PARTS`` connected parts
+        (patches plus non-contact islands: a sphere, a sinusoid, a few asperities),
+        where it buys no iterations and costs 1.2-1.6x CPU
+        (docs/theory/02b_bem_performance.md, sessions 12-13). False: off. True: on at
+        any size it applies to (an InputError says why it does not).
 
     Raises
     ------
@@ -385,7 +394,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 initial = _coarse_start(surface, material, mean_pressure, hardness,
                                         coarse_correction=coarse_correction)
             deflation = (None if mean_pressure is None else
-                         _deflation(op, hardness, plastic, coarse_correction))
+                         _deflation(op, hardness, plastic, coarse_correction, initial))
             out = polonsky_keer(op.apply, h, scale, delta=delta, mean_pressure=mean_pressure,
                                 initial=initial, diagonal=op.diagonal, tol=tol,
                                 precond=_cg_preconditioner(op), overwrite_initial=own,
