@@ -100,7 +100,6 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
 def _adhesive_response(surface, material, loading, options) -> SweepResult:
     """``response(..., adhesion=law)``: the adhesive continuation in the approach."""
     from .bem.adhesion import adhesive_sweep
-    from .bem.sweep import default_deltas
 
     law = options.pop("adhesion")
     if options.get("hardness") is not None:
@@ -114,15 +113,10 @@ def _adhesive_response(surface, material, loading, options) -> SweepResult:
         raise InputError("adhesion runs in displacement control (the load-approach curve "
                          "has unstable parts): give approaches (delta, deltas, n_steps), "
                          "not mean pressures")
-    args = loading.sweep_arguments()
-    kernel = options.get("kernel", "auto")
-    deltas = args.get("deltas")
-    if deltas is None:
-        deltas = default_deltas(surface, args["n_steps"], surface.periodic and kernel in
-                                ("auto", "spectral"))
     extra = {k: options[k] for k in ("tol", "max_iter") if options.get(k) is not None}
-    return adhesive_sweep(surface, material, law, deltas, unload=bool(options.get("unload")),
-                          kernel=kernel, **extra).sweep
+    return adhesive_sweep(surface, material, law, **loading.sweep_arguments(),
+                          unload=bool(options.get("unload")),
+                          kernel=options.get("kernel", "auto"), **extra).sweep
 
 
 def _fem_response(surface, material, loading, options) -> SweepResult:

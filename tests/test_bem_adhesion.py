@@ -307,3 +307,27 @@ def test_cell_averaged_law_in_2d_against_quadrature_on_a_paraboloid():
             assert np.max(np.abs(err[:, 0] - err[:, 1])) <= 0.7 * bound
             bias.append(np.mean(err[:, 0]))
         assert bias[0] > 0 and bias[0] / bias[1] > 3           # second order
+
+
+def test_adhesive_sweep_default_approaches():
+    # n_steps: equispaced approaches short of full contact (periodic kernel: the
+    # adhesive state is not defined by the approach there, and the solver refuses it)
+    # or up to the peak-to-valley height (Love); both deltas and n_steps, or a bad
+    # n_steps, is a clear error
+    s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=2 * 2 * np.pi / 1e-5,
+                         q_short=8 * 2 * np.pi / 1e-5, rng=3)
+    mat, law = Material(1e6, 0.5), AdhesionLaw("exp", 0.02, 2e-9)
+    h = s.heights
+    # (a reported Delta is the equilibrium's own, within pbar / k0 of the imposed one:
+    # the sweeps are compared with those of the explicit approaches)
+    sw = adhesive_sweep(s, mat, law, n_steps=3).sweep
+    ref = adhesive_sweep(s, mat, law, (h.max() - h.mean()) * np.array([1, 2, 3]) / 4).sweep
+    assert np.array_equal(sw.delta, ref.delta) and np.array_equal(sw.load, ref.load)
+    assert np.all(np.diff(sw.load) > 0)                  # loading: more load
+    love = adhesive_sweep(s, mat, law, n_steps=2, kernel="love").sweep
+    ref = adhesive_sweep(s, mat, law, np.ptp(h) * np.array([0.5, 1.0]), kernel="love").sweep
+    assert np.array_equal(love.delta, ref.delta)
+    with pytest.raises(InputError, match="not both"):
+        adhesive_sweep(s, mat, law, [1e-9], n_steps=3)
+    with pytest.raises(InputError, match="n_steps must be an integer >= 1"):
+        adhesive_sweep(s, mat, law, n_steps=0)

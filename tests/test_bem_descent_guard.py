@@ -1,8 +1,11 @@
-"""The descent guard of the two-level Polonsky-Keer CG (round 2, session 12): a coarse
-correction that leaves the direction without descent (g . z2 <= DESCENT_GUARD g . M g)
-is dropped for that iteration, so that an inexact coarse operator can slow a solve but
-never stall it (measured: a band-limited surface resampled to 8192^2 froze at a KKT
-residual of 9.7e-6 without it; ``docs/theory/02b_bem_performance.md``)."""
+"""The safeguards of the two-level Polonsky-Keer CG. The descent guard (round 2, session
+12): a coarse correction that leaves the direction without descent (g . z2 <=
+DESCENT_GUARD g . M g) is dropped for that iteration, so that an inexact coarse operator
+can slow a solve but not stall it (measured: a band-limited surface resampled to 8192^2
+froze at a KKT residual of 9.7e-6 without it; ``docs/theory/02b_bem_performance.md``).
+The stall watch (session 13): a correction that keeps the descent but makes no progress
+is dropped for the rest of the solve after STALL_WINDOW iterations without halving the
+residual."""
 import numpy as np
 import pytest
 
@@ -46,8 +49,8 @@ def _solve(h, op, deflation, max_iter=400):
 def test_an_uphill_correction_cannot_stall_the_solve(monkeypatch):
     # 128^2, p/E* = 0.05: with the guard the adversarial correction is dropped at every
     # iteration and the solve is the plain preconditioned one (same contact set and
-    # pressures within the KKT tolerance scale); without it the same solve does not
-    # converge at all
+    # pressures within the KKT tolerance scale); without it the stall watch drops the
+    # correction after its window, and without both the same solve does not converge
     h = spectral_surface(128, 1.0, 0.8, rms_slope=1.0, rng=2).heights
     op = influence_operator((128, 128), (1.0, 1.0), 1.0)
     bad = _Adversary()
@@ -61,6 +64,55 @@ def test_an_uphill_correction_cannot_stall_the_solve(monkeypatch):
     gap = op.apply(p) - (h - h.max()) - guarded.delta
     assert kkt_residual(p, gap, float(np.ptp(h))) <= 1e-10
 
-    monkeypatch.setattr(directions, "DESCENT_GUARD", -np.inf)   # the guard off
+    monkeypatch.setattr(directions, "DESCENT_GUARD", -np.inf)   # the guard off:
+    with pytest.warns(RuntimeWarning, match="made no progress"):  # the stall watch
+        late = _solve(h, op, _Adversary())                         # catches it, later
+    assert late.nit > guarded.nit and np.array_equal(late.pressure > 0, q > 0)
+    monkeypatch.setattr(directions, "STALL_WINDOW", 10 ** 9)    # and without both
     with pytest.raises(NoConvergenceError):
         _solve(h, op, _Adversary(), max_iter=200)
+
+
+class _Useless:
+    """A 'coarse correction' that keeps the plain direction's descent exactly (so the
+    guard lets it through) but buries it under a large random part orthogonal to the
+    gradient: the exact line search then takes steps ~1e-3 of the plain ones."""
+
+    def __init__(self):
+        self.rng, self.calls = np.random.default_rng(0), 0
+
+    def correct(self, F, gF, zF, apply_free, free_mask=None, pressure=None):
+        self.calls += 1
+        v = self.rng.standard_normal(zF.size)
+        v -= v.mean()                                  # gF has zero mean: so keeps v
+        v -= (np.dot(gF, v) / np.dot(gF, gF)) * gF     # g . v = 0: g . z2 = g . zF
+        return zF + 1e3 * np.linalg.norm(zF) / np.linalg.norm(v) * v
+
+
+def test_a_correction_without_progress_is_dropped(monkeypatch):
+    h = spectral_surface(128, 1.0, 0.8, rms_slope=1.0, rng=2).heights
+    op = influence_operator((128, 128), (1.0, 1.0), 1.0)
+    useless = _Useless()
+    with pytest.warns(RuntimeWarning, match="dropped at iteration"):
+        out = _solve(h, op, useless)
+    plain = _solve(h, op, None)
+    # the watch fired after its window (the correction was called every iteration up
+    # to then, never after) and the plain CG finished the solve
+    assert useless.calls >= directions.STALL_WINDOW
+    assert out.nit <= useless.calls + 2 * plain.nit
+    p, q = out.pressure, plain.pressure
+    assert np.array_equal(p > 0, q > 0)
+    assert np.abs(p - q).max() <= 2e-8 * q.max()
+    gap = op.apply(p) - (h - h.max()) - out.delta
+    assert kkt_residual(p, gap, float(np.ptp(h))) <= 1e-10
+
+    monkeypatch.setattr(directions, "STALL_WINDOW", 10 ** 9)     # the watch off
+    with pytest.raises(NoConvergenceError):
+        _solve(h, op, _Useless(), max_iter=200)
+
+
+def test_stall_watch_counts_iterations_without_halving():
+    w = directions._StallWatch(3)
+    assert not any(w.stalled(r) for r in (1.0, 0.9, 0.8))      # mark 1.0, 2 without
+    assert not w.stalled(0.5)                                    # halved: new mark 0.5
+    assert [w.stalled(r) for r in (0.4, 0.3, 0.26)] == [False, False, True]

@@ -62,7 +62,7 @@ import numpy as np
 import scipy.optimize
 
 from ..errors import InputError, NoConvergenceError, check_instance
-from ..model import ContactResult, Material, SweepResult
+from ..model import ContactResult, Loading, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
@@ -405,17 +405,25 @@ class AdhesiveSweep:
         return self.sweep.to_records()
 
 
-def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, deltas, *,
-                   unload: bool = False, max_unload_steps=None, unload_growth: float = 2.0,
-                   kernel: str = "auto", tol: float = 1e-5,
+def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, deltas=None, *,
+                   n_steps=None, unload: bool = False, max_unload_steps=None,
+                   unload_growth: float = 2.0, kernel: str = "auto", tol: float = 1e-5,
                    max_iter: int = 20000) -> AdhesiveSweep:
     """Continuation in the approach: loading through ``deltas`` and, with ``unload``,
     back down past them until the surfaces separate (see the module docstring).
 
     Parameters
     ----------
-    deltas : sequence of float
+    deltas : sequence of float, optional
         Increasing approaches (m) of the loading branch.
+    n_steps : int, optional
+        Instead of ``deltas``: that many equispaced approaches, k / n of the
+        peak-to-valley height, or with a periodic kernel k / (n + 1) of max h - mean h
+        (k = 1..n: full contact itself is left out, where the adhesive state is not
+        defined by the approach; :func:`roughfe.bem.sweep.default_deltas` gives the
+        non-adhesive sweep's); ``Loading.DEFAULT_STEPS`` when neither is given. The one
+        place where ``response(..., adhesion=)`` and ``roughfe contact --adhesion`` get
+        their default approaches.
     unload : bool
         Also trace the unloading branch: the loading approaches in reverse, then further
         apart until separation (at most ``max_unload_steps`` solves beyond the loading
@@ -430,6 +438,13 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
         the step fixed. Must be >= 1.
     Other parameters as in :func:`solve_adhesive`.
     """
+    if deltas is None:
+        from .sweep import default_deltas
+        n_steps = Loading(n_steps=n_steps).n_steps     # checked, default 20
+        periodic = surface.periodic and kernel in ("auto", "spectral")
+        deltas = default_deltas(surface, n_steps + periodic, periodic)[:n_steps]
+    elif n_steps is not None:
+        raise InputError(f"give deltas or n_steps, not both (got n_steps={n_steps!r})")
     deltas = np.atleast_1d(np.asarray(deltas, float))
     if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)):
         raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "

@@ -1,8 +1,9 @@
 """Safeguards of the search direction of the two-level Polonsky-Keer CG
 (:func:`roughfe.bem.pk.polonsky_keer` with a ``deflation``): the binding set at p = 0
-(round 2, session 10) and the descent guard of the coarse correction (session 12).
-Both act on the direction's values on the free set F only (numpy vectors), never on
-the iterate."""
+(round 2, session 10) and the descent guard of the coarse correction (session 12) act
+on the direction's values on the free set F only (numpy vectors), never on the iterate;
+the stall watch (session 13) drops the correction from a solve that stopped making
+progress with it."""
 from __future__ import annotations
 
 import numpy as np
@@ -11,6 +12,9 @@ import numpy as np
 #: of the plain one, g . z_2level > DESCENT_GUARD g . (M g); otherwise that iteration takes
 #: M g (:func:`_descent_guard`)
 DESCENT_GUARD = 0.05
+#: a two-level solve whose KKT residual has not halved for this many iterations drops its
+#: coarse correction for the rest of the solve (:class:`_StallWatch`)
+STALL_WINDOW = 25
 
 
 def _descent_guard(gF, zF, z2):
@@ -71,3 +75,29 @@ def _bind_lower(tF, positive, load):
     if load and nb < tF.size:
         tF -= float(tF.sum()) / (tF.size - nb)
         tF[bound] = 0.0
+
+
+class _StallWatch:
+    """The last line of defence of the two-level solve: ``stalled(res)`` is True once
+    the relative KKT residual ``res`` has gone ``window`` iterations without halving
+    (the mark moves to every residual at or below half the last mark).
+
+    The descent guard keeps the corrected direction a descent direction, but a
+    correction can still be a useless one (a coarse operator far from the Galerkin
+    matrix): the steps then shrink and the solve crawls towards ``max_iter`` (20000 in
+    :func:`roughfe.bem.solve_contact`, hours at 8192^2). A healthy solve halves its
+    residual every 1-3 iterations (1 to 1e-10 in 20-40 iterations at 1024^2-8192^2,
+    the slowest phase 0.1-0.2 decades an iteration: 02b, session 12), so 25 without
+    halving is a stall, not a slow phase; the plain preconditioned CG (M = E*|q|/2,
+    positive definite) then takes over and always converges."""
+
+    def __init__(self, window=None):
+        self.window = STALL_WINDOW if window is None else int(window)
+        self.mark, self.since = np.inf, 0
+
+    def stalled(self, res):
+        if res <= 0.5 * self.mark:
+            self.mark, self.since = res, 0
+            return False
+        self.since += 1
+        return self.since >= self.window

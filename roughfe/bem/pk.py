@@ -5,12 +5,14 @@ and memory are measured in ``docs/theory/02b_bem_performance.md``.
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from scipy.linalg.blas import daxpy, saxpy
 
 from . import _parallel as par
 from ..errors import InputError
-from .directions import _bind_lower, _descent_guard
+from .directions import _StallWatch, _bind_lower, _descent_guard
 from .operators import FFTWorkspace
 from .solvers import (SolverOutput, _fail, _rescale_to_load, penetration_start, pr_beta,
                       relative_residual, step_length)
@@ -206,7 +208,10 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     :class:`roughfe.bem.deflation.BlockDeflation` (used by ``solve_contact`` in its
     measured range), both measured in ``docs/theory/02b_bem_performance.md``. With a
     deflation the direction also drops its steps below p = 0 at the points of F where
-    p is 0 (:func:`_bind_lower`, the binding set of projected-gradient methods).
+    p is 0 (:func:`_bind_lower`, the binding set of projected-gradient methods), keeps
+    the correction only where it leaves a descent direction (:func:`_descent_guard`),
+    and drops it for good, with a RuntimeWarning, when the residual has not halved for
+    ``STALL_WINDOW`` iterations (:class:`~roughfe.bem.directions._StallWatch`).
 
     ``split`` (optional, the operator's
     :meth:`~roughfe.bem.operators.InfluenceOperator.split_product`): the product H t
@@ -312,6 +317,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     d = 0.0 if load else float(delta) + offset
     u, us, exact = None, 1.0, False
     low = confirm = False     # u (and H t) in single precision; a final check pending
+    watch = None if deflation is None else _StallWatch()
     for it in range(1, max_iter + 1):
         if low and res <= SINGLE_PRECISION_RESIDUAL:
             u = None          # near the solution: double precision from here on
@@ -363,6 +369,12 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             u = None          # confirm on a freshly computed double-precision displacement
             confirm = True
             continue
+        if watch is not None and watch.stalled(res):
+            warnings.warn(f"Polonsky-Keer CG: the two-level correction made no progress "
+                          f"(KKT residual {res:.2e}, not halved in {watch.window} "
+                          f"iterations); dropped at iteration {it}, the plain "
+                          f"preconditioned CG goes on", RuntimeWarning, stacklevel=2)
+            deflation = watch = None
         par.put(mask, S, True)
         del S
         if bounded:           # saturated points pushed further in stay at the bound

@@ -25,7 +25,7 @@ from .options import (add_contact_physics_options, add_detrend_option, add_mater
                       check_small_strain, contact_physics_from_args, material_from_args,
                       output_folder_of, positive_float, positive_int, surface_from_args)
 
-DEFAULT_STEPS = 20
+DEFAULT_STEPS = Loading.DEFAULT_STEPS
 #: --coarse-correction -> solve_contact(coarse_correction=)
 COARSE = {"auto": None, "on": True, "off": False}
 
@@ -151,7 +151,6 @@ def _run(args) -> int:
 def _adhesive_sweep(args, surface, material, law, tol):
     """The adhesive continuation in the approach (``--delta`` or ``--steps``)."""
     from ..bem.adhesion import adhesive_sweep
-    from ..bem.sweep import default_deltas
 
     if args.pressure is not None:
         raise InputError("--adhesion runs in displacement control (the load-approach curve "
@@ -161,12 +160,9 @@ def _adhesive_sweep(args, surface, material, law, tol):
         if value != "auto":
             raise InputError(f"{flag} does not apply with --adhesion (its own minimiser on "
                              f"the gap)")
-    deltas = args.delta
-    if deltas is None:
-        periodic = surface.periodic and args.kernel in ("auto", "spectral")
-        deltas = default_deltas(surface, args.steps or DEFAULT_STEPS, periodic)
-    return adhesive_sweep(surface, material, law, deltas, unload=args.unload,
-                          kernel=args.kernel, tol=tol)
+    return adhesive_sweep(surface, material, law, args.delta,
+                          n_steps=None if args.delta else args.steps or DEFAULT_STEPS,
+                          unload=args.unload, kernel=args.kernel, tol=tol)
 
 
 # -- demo section (appended to roughfe.cli.demo_cmd.SECTIONS) ------------------------------
