@@ -112,7 +112,11 @@ def test_a_correction_without_progress_is_dropped(monkeypatch):
 
 
 def test_stall_watch_counts_iterations_without_halving():
+    # window 3: stalled when none of the last 3 residuals is at most half the one before
     w = directions._StallWatch(3)
-    assert not any(w.stalled(r) for r in (1.0, 0.9, 0.8))      # mark 1.0, 2 without
-    assert not w.stalled(0.5)                                    # halved: new mark 0.5
-    assert [w.stalled(r) for r in (0.4, 0.3, 0.26)] == [False, False, True]
+    assert [w.stalled(r) for r in (1.0, 0.9, 0.8, 0.5)] == [False] * 4   # 0.5 halves 1.0
+    assert w.stalled(0.46)          # 0.9 -> 0.8, 0.5, 0.46: not halved in 3
+    w = directions._StallWatch(5)   # a rise after a good start, back below half of it
+    assert not any(w.stalled(r) for r in (1e-6, 1e-4, 4e-5, 1e-5, 2e-6, 4e-7, 1e-7))
+    w = directions._StallWatch(5)   # the same rise, not back within the window
+    assert [w.stalled(r) for r in (1e-6, 1e-4, 4e-5, 1e-5, 2e-6, 6e-7)][-1]

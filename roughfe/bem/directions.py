@@ -6,6 +6,9 @@ the stall watch (session 13) drops the correction from a solve that stopped maki
 progress with it."""
 from __future__ import annotations
 
+import collections
+import itertools
+
 import numpy as np
 
 #: the two-level direction is used only while it keeps at least this share of the descent
@@ -79,8 +82,9 @@ def _bind_lower(tF, positive, load):
 
 class _StallWatch:
     """The last line of defence of the two-level solve: ``stalled(res)`` is True once
-    the relative KKT residual ``res`` has gone ``window`` iterations without halving
-    (the mark moves to every residual at or below half the last mark).
+    the relative KKT residual ``res`` is no lower than half of what it was ``window``
+    iterations ago, at any iteration since then (a sliding window: a start that was
+    luckily good, a warm start whose residual rises before it falls, only shift it).
 
     The descent guard keeps the corrected direction a descent direction, but a
     correction can still be a useless one (a coarse operator far from the Galerkin
@@ -93,11 +97,9 @@ class _StallWatch:
 
     def __init__(self, window=None):
         self.window = STALL_WINDOW if window is None else int(window)
-        self.mark, self.since = np.inf, 0
+        self.history = collections.deque(maxlen=self.window + 1)
 
     def stalled(self, res):
-        if res <= 0.5 * self.mark:
-            self.mark, self.since = res, 0
-            return False
-        self.since += 1
-        return self.since >= self.window
+        h = self.history
+        h.append(res)
+        return len(h) == h.maxlen and min(itertools.islice(h, 1, None)) > 0.5 * h[0]
