@@ -66,7 +66,8 @@ def test_on_below_the_automatic_range(monkeypatch):
 
 def test_contact_parts_counts_patches_and_islands():
     # k disjoint square patches on a 64^2 grid: k patches + the one non-contact region;
-    # a hole punched in a patch adds an island; no structure (all or nothing) is None
+    # a hole punched in a patch adds an island; contact everywhere is one part, no
+    # contact at all says nothing (None)
     p = np.zeros((64, 64))
     for k in range(5):
         p[4 + 12 * k: 10 + 12 * k, 8:20] = 1.0
@@ -75,7 +76,7 @@ def test_contact_parts_counts_patches_and_islands():
     p[6:8, 12:16] = 0.0              # an island inside the first patch
     assert _contact_parts(p) == 5 + 2
     assert _contact_parts(np.zeros((64, 64))) is None
-    assert _contact_parts(np.ones((64, 64))) is None
+    assert _contact_parts(np.ones((64, 64))) == 1
 
 
 def test_automatic_choice_reads_the_contact_structure(monkeypatch):

@@ -27,7 +27,8 @@ def _contact_parts(pressure):
     patches (p > 0) plus its non-contact islands (p = 0), 4-connected, counted on every
     second point per axis (the 2 x 2 injection of :func:`_coarse_start` makes that the
     coarse solution itself; the periodic wrap is not joined, which adds at most a few).
-    None when the start has no structure: contact everywhere or nowhere.
+    Contact everywhere is one part (a nearly full contact: one patch, nothing to
+    exchange); None when there is no contact at all (nothing to read).
 
     The two-level correction exists for the exchange of load between many patches (and
     around many islands), the smooth modes the stiffness preconditioner handles poorly;
@@ -37,7 +38,7 @@ def _contact_parts(pressure):
     parts at every load measured (p/E* = 0.005-1)."""
     c = np.greater(pressure[::2, ::2], 0.0)
     patches = scipy.ndimage.label(c)[1]
-    if patches == 0 or c.all():
+    if patches == 0:
         return None
     np.logical_not(c, out=c)
     return int(patches) + int(scipy.ndimage.label(c)[1])
