@@ -161,7 +161,7 @@ def _adhesive_sweep(args, surface, material, law, tol):
             raise InputError(f"{flag} does not apply with --adhesion (its own minimiser on "
                              f"the gap)")
     return adhesive_sweep(surface, material, law, args.delta,
-                          n_steps=None if args.delta else args.steps or DEFAULT_STEPS,
+                          n_steps=None if args.delta else args.steps,
                           unload=args.unload, kernel=args.kernel, tol=tol)
 
 
