@@ -21,11 +21,15 @@ def test_guard_keeps_a_descent_direction_and_drops_the_others():
     rng = np.random.default_rng(5)
     g = rng.standard_normal(500)
     z = g + 0.1 * rng.standard_normal(500)            # g . z > 0: the plain direction
-    assert pk._descent_guard(g, z, z) is z             # skipped correction: z itself
+    # (with the gradient's dot product with the direction returned, the CG's g . z)
+    out, gz = pk._descent_guard(g, z, z)
+    assert out is z and gz == float(np.dot(g, z))     # skipped correction: z itself
     good = 0.5 * z + 0.05 * rng.standard_normal(500)  # keeps ~half of the descent
-    assert pk._descent_guard(g, z, good) is good
+    out, gz = pk._descent_guard(g, z, good)
+    assert out is good and gz == float(np.dot(g, good))
     for bad in (-z, 0.02 * z, np.zeros(500)):         # ascent, too little, none
-        assert pk._descent_guard(g, z, bad) is z
+        out, gz = pk._descent_guard(g, z, bad)
+        assert out is z and gz == float(np.dot(g, z))
 
 
 class _Adversary:

@@ -22,7 +22,9 @@ STALL_WINDOW = 25
 
 def _descent_guard(gF, zF, z2):
     """The two-level direction ``z2`` if it is still a descent direction worth the name,
-    else the plain preconditioned one ``zF`` (both on F, ``gF`` the gradient there).
+    else the plain preconditioned one ``zF`` (both on F, ``gF`` the gradient there), and
+    the gradient's dot product with the direction returned (the CG's g . z, computed here
+    once).
 
     The A-DEF2 correction of :mod:`roughfe.bem.deflation` is exact only with the exact
     coarse matrix Z^T H_FF Z solved exactly. The production form approximates the far
@@ -43,10 +45,11 @@ def _descent_guard(gF, zF, z2):
     factor of 1.5-3 on most surfaces at 1024^2 and 2048^2. Details:
     ``docs/theory/02b_bem_performance.md``, "A stall of the two-level direction".
     """
+    gz = float(np.dot(gF, zF))
     if z2 is zF:              # the correction was skipped (the contact-set search)
-        return zF
+        return zF, gz
     gz2 = float(np.dot(gF, z2))
-    return z2 if gz2 > DESCENT_GUARD * float(np.dot(gF, zF)) else zF
+    return (z2, gz2) if gz2 > DESCENT_GUARD * gz else (zF, gz)
 
 
 def _bind_lower(tF, positive, load):

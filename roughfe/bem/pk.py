@@ -397,11 +397,13 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             if load:
                 zF -= zF.mean()
             if deflation is not None:
-                zF = _descent_guard(gF, zF, deflation.correct(F, gF, zF, H_free,
-                                                              free_mask=mask, pressure=p))
+                zF, gz = _descent_guard(gF, zF, deflation.correct(F, gF, zF, H_free,
+                                                                  free_mask=mask,
+                                                                  pressure=p))
         else:
             zF = gF.copy()
-        gz = float(np.dot(gF, zF))
+        if precond is None or deflation is None:
+            gz = float(np.dot(gF, zF))
         beta = float(pr_beta(gz - float(np.dot(zF, g_old)), gz_old))
         del g_old             # free-set vectors go as soon as they are used: early on F
         gz_old = gz           # can hold half the grid
