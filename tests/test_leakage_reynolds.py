@@ -176,6 +176,15 @@ def test_bad_input_is_named():
         reynolds_flow(np.ones((3, 3)), (DX, DY), scheme="q2")
 
 
+@pytest.mark.parametrize("scheme", ["fv", "fe"])
+@pytest.mark.parametrize("spacing", [DX, (DX, DY, DX), ((DX, DY),)])
+def test_bad_spacing_is_named_by_both_schemes(scheme, spacing):
+    # one check of the Reynolds data for both discretisations: a cell size that is not
+    # (dx, dy) is an InputError naming it, never an unpacking error from inside
+    with pytest.raises(InputError, match=r"spacing must be the cell size \(dx, dy\)"):
+        reynolds_flow(np.ones((3, 3)), spacing, mu=MU, pressure_drop=DP, scheme=scheme)
+
+
 def test_mesh_convergence_and_agreement_with_finite_volumes():
     # smooth 2D gap: Q1-FE and an independent finite-volume scheme converge (2nd order)
     # to the same leak rate

@@ -230,6 +230,36 @@ def vertex_components(open_cells: np.ndarray, *, periodic_axis: Optional[int] = 
     return labels.reshape(nx + 1, ny + 1)
 
 
+def check_reynolds_data(gap, spacing, mu, p_in, p_out, direction, wall_velocity):
+    """The data of the Reynolds problem (Eq. 2.12) as both discretisations take them
+    (this Q1 solver and :func:`roughfe.leakage.finite_volume.solve_reynolds_fv`),
+    checked once with a clear :class:`~roughfe.errors.InputError` per bad value.
+
+    Returns ``(gap, (dx, dy), mu, u)``: the gap as a float array (nx, ny) in m, finite
+    and >= 0; the cell size in m; the viscosity in Pa s; the wall velocity as a float
+    array of two components in m/s. ``p_in`` and ``p_out`` (Pa) must be finite and
+    ``direction`` one of ``"x"``, ``"y"``.
+    """
+    gap = np.asarray(gap, dtype=float)
+    if gap.ndim != 2 or min(gap.shape) < 1:
+        raise InputError(f"gap must be a 2D array (nx, ny) of metres, got shape {gap.shape}")
+    if not np.all(np.isfinite(gap)) or gap.min() < 0:
+        raise InputError(f"gap must be finite and >= 0 (m), got min {np.nanmin(gap)!r} "
+                         f"and {int((~np.isfinite(gap)).sum())} non-finite value(s)")
+    if direction not in ("x", "y"):
+        raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
+    mu = check_finite_positive("mu", mu)
+    if np.ndim(spacing) != 1 or len(spacing) != 2:
+        raise InputError(f"spacing must be the cell size (dx, dy) in m, got {spacing!r}")
+    dx, dy = (check_finite_positive("spacing", s) for s in spacing)
+    if not (np.isfinite(p_in) and np.isfinite(p_out)):
+        raise InputError(f"p_in and p_out must be finite (Pa), got {p_in!r}, {p_out!r}")
+    u = np.asarray(wall_velocity, dtype=float).reshape(-1)
+    if u.size != 2 or not np.all(np.isfinite(u)):
+        raise InputError(f"wall_velocity must be two finite numbers (m/s), got {wall_velocity!r}")
+    return gap, (dx, dy), mu, u
+
+
 def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
                       p_in: float = 1.0, p_out: float = 0.0, periodic: bool = False,
                       wall_velocity=(0.0, 0.0), h_min: float = 0.0,
@@ -264,21 +294,8 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     """
     import dolfinx.fem.petsc as fem_petsc
 
-    gap = np.asarray(gap, dtype=float)
-    if gap.ndim != 2 or min(gap.shape) < 1:
-        raise InputError(f"gap must be a 2D array (nx, ny) of metres, got shape {gap.shape}")
-    if not np.all(np.isfinite(gap)) or gap.min() < 0:
-        raise InputError(f"gap must be finite and >= 0 (m), got min {np.nanmin(gap)!r} "
-                         f"and {int((~np.isfinite(gap)).sum())} non-finite value(s)")
-    if direction not in ("x", "y"):
-        raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
-    mu = check_finite_positive("mu", mu)
-    dx, dy = (check_finite_positive("spacing", s) for s in spacing)
-    if not (np.isfinite(p_in) and np.isfinite(p_out)):
-        raise InputError(f"p_in and p_out must be finite (Pa), got {p_in!r}, {p_out!r}")
-    u = np.asarray(wall_velocity, dtype=float).reshape(-1)
-    if u.size != 2 or not np.all(np.isfinite(u)):
-        raise InputError(f"wall_velocity must be two finite numbers (m/s), got {wall_velocity!r}")
+    gap, (dx, dy), mu, u = check_reynolds_data(gap, spacing, mu, p_in, p_out, direction,
+                                               wall_velocity)
     if not (h_min >= 0 and np.isfinite(h_min)):
         raise InputError(f"h_min must be finite and >= 0 (m), got {h_min!r}")
 

@@ -57,6 +57,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
 from ..fem.petsc_tools import KrylovSolver, petsc_aij_csr
+from ..fem.reynolds import check_reynolds_data
 
 #: PETSc options of the finite-volume Reynolds solve, over
 #: :data:`roughfe.fem.petsc_tools.CG_AMG` (CG + BoomerAMG, rtol 1e-10 of the preconditioned
@@ -196,24 +197,8 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     -------
     FVSolution
     """
-    g = np.asarray(gap, dtype=float)
-    if g.ndim != 2 or min(g.shape) < 1:
-        raise InputError(f"gap must be a 2D array (nx, ny) of metres, got shape {g.shape}")
-    if not np.all(np.isfinite(g)) or g.min() < 0:
-        raise InputError(f"gap must be finite and >= 0 (m), got min {np.nanmin(g)!r} "
-                         f"and {int((~np.isfinite(g)).sum())} non-finite value(s)")
-    if direction not in ("x", "y"):
-        raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
-    mu = check_finite_positive("mu", mu)
-    if len(spacing) != 2:
-        raise InputError(f"spacing must be (dx, dy) in m, got {spacing!r}")
-    dx, dy = (check_finite_positive("spacing", s) for s in spacing)
-    if not (np.isfinite(p_in) and np.isfinite(p_out)):
-        raise InputError(f"p_in and p_out must be finite (Pa), got {p_in!r}, {p_out!r}")
-    u = np.asarray(wall_velocity, dtype=float).reshape(-1)
-    if u.size != 2 or not np.all(np.isfinite(u)):
-        raise InputError(f"wall_velocity must be two finite numbers (m/s), got {wall_velocity!r}")
-    ul, ut = u
+    g, (dx, dy), mu, (ul, ut) = check_reynolds_data(gap, spacing, mu, p_in, p_out,
+                                                     direction, wall_velocity)
     if solver is not None and petsc_options:
         raise InputError("give petsc_options to reynolds_fv_solver, not beside a solver")
     if initial is not None:
