@@ -3,6 +3,7 @@
 Every exception is a subclass of a builtin so that callers that expect ``ValueError``
 (bad input) or ``RuntimeError`` (a solver that did not converge) keep working.
 """
+import operator
 
 
 class RoughfeError(Exception):
@@ -48,6 +49,18 @@ def check_in_open_interval(name, value, low, high):
         raise InputError(f"{name} must be a number in ({low}, {high}), got {value!r}") from None
     if not (low < v < high):
         raise InputError(f"{name} must lie in the open interval ({low}, {high}), got {value!r}")
+    return v
+
+
+def check_int(name, value, minimum):
+    """Return ``int(value)`` or raise :class:`InputError` unless it is an integer (a Python
+    or numpy integer, not a bool and not a float such as 3.5 or 4.0) >= ``minimum``."""
+    try:
+        v = None if isinstance(value, bool) else operator.index(value)
+    except TypeError:
+        v = None
+    if v is None or v < minimum:
+        raise InputError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return v
 
 

@@ -176,6 +176,12 @@ def test_spectral_is_real_hermitian_and_band_limited():
     (lambda: spectral_surface(32, 0.0, 0.5, rms_height=1e-6), ["size", "0.0"]),
     (lambda: spectral_surface(32, 1e-4, 0.5), ["rms_height", "rms_slope"]),
     (lambda: spectral_surface(32, 1e-4, 0.5, rms_height=1e-6, rng=-3), ["rng", "-3"]),
+    # a grid size that is not an integer is refused, not truncated (3.5 used to give 3)
+    (lambda: spectral_surface(32.5, 1e-4, 0.5, rms_height=1e-6), ["n", "integer", "32.5"]),
+    (lambda: spectral_surface((32, 16.0), 1e-4, 0.5, rms_height=1e-6), ["axis 1", "16.0"]),
+    (lambda: spectral_surface(32, (1e-4, 1e-4, 1e-4), 0.5, rms_height=1e-6),
+     ["size", "one entry per axis"]),
+    (lambda: wm_profile(100.0, 1e-3, 0.5), ["n", "integer", "100.0"]),
 ])
 def test_generators_reject_bad_input(call, words):
     with pytest.raises(ValueError) as info:
@@ -190,6 +196,7 @@ def test_generators_reject_bad_input(call, words):
     (np.zeros((3, 3, 3)), 1.0, ["1D", "2D", "(3, 3, 3)"]),
     (np.zeros((4, 4)), -1.0, ["size", "-1.0"]),
     (np.zeros((4, 4)), (1.0, 0.0), ["size[1]", "0.0"]),
+    (np.zeros((4, 4)), "1e-4 m", ["size", "'1e-4 m'"]),
 ])
 def test_surface_rejects_bad_input(heights, size, words):
     with pytest.raises(ValueError) as info:

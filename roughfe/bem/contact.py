@@ -21,7 +21,8 @@ import numpy as np
 import scipy.fft
 
 from ..caching import MB, bytes_bounded_cache
-from ..errors import InputError, NoConvergenceError, check_finite_positive, check_instance
+from ..errors import (InputError, NoConvergenceError, check_finite_positive, check_instance,
+                      check_int)
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
@@ -160,14 +161,7 @@ def _check_target(delta, mean_pressure):
             raise InputError(f"delta (approach from first contact, m) must be finite and "
                              f">= 0, got {delta!r}")
         return d, None
-    try:
-        pm = float(mean_pressure)
-    except (TypeError, ValueError):
-        raise InputError(f"mean_pressure must be a number of Pa > 0, got {mean_pressure!r}") \
-            from None
-    if not (np.isfinite(pm) and pm > 0):
-        raise InputError(f"mean_pressure (Pa) must be finite and > 0, got {mean_pressure!r}")
-    return None, pm
+    return None, check_finite_positive("mean_pressure (Pa)", mean_pressure)
 
 
 def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
@@ -298,7 +292,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     tol : float
         Relative KKT residual to reach.
     max_iter : int, optional
-        Iteration limit (pk CG iterations / Newton steps of dense load control).
+        Iteration limit (pk CG iterations / Newton steps of dense load control), >= 1;
+        None (the default) takes the solver's own limit.
     initial : ndarray, optional
         Initial pressure (Pa), e.g. the previous step of a sweep.
     compute_stiffness : bool
@@ -339,6 +334,9 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     _check_surface(surface)
     check_instance("material", material, Material, "a roughfe.model.Material")
     delta, mean_pressure = _check_target(delta, mean_pressure)
+    tol = check_finite_positive("tol (relative KKT residual)", tol)
+    if max_iter is not None:
+        max_iter = check_int("max_iter (None: the solver's default)", max_iter, 1)
     hardness, plastic = _check_hardness(hardness, mean_pressure, plastic_displacement,
                                         surface.shape)
     kernel = _choose_kernel(surface, kernel)
@@ -355,6 +353,9 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         initial = np.asarray(initial, dtype=float)
         if initial.shape != h.shape:
             raise InputError(f"initial pressure has shape {initial.shape}, expected {h.shape}")
+        if not np.all(np.isfinite(initial)):
+            raise InputError(f"initial pressure must be finite (Pa): "
+                             f"{int(np.count_nonzero(~np.isfinite(initial)))} non-finite value(s)")
 
     out = None
     # the gap-variable CG accepts a primal residual of 10 tol (its dual reaches tol)

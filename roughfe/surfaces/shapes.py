@@ -8,16 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive
+from ..errors import check_finite_positive, check_int
 from .surface import Surface
 
 
 def sphere_cap(n, length, radius) -> Surface:
     """Parabolic sphere ``h = -(x^2 + y^2) / (2 R)`` (m) on an ``n x n`` grid of side
     ``length`` (m), centred, non-periodic; ``metadata`` records the radius."""
-    n = int(n)
-    if n < 2:
-        raise InputError(f"n must be an integer >= 2, got {n!r}")
+    n = check_int("n (grid points per side)", n, 2)
     length = check_finite_positive("length (m)", length)
     radius = check_finite_positive("radius (m)", radius)
     x = (np.arange(n) - n / 2 + 0.5) * length / n

@@ -25,9 +25,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive, check_in_open_interval
+from ..errors import InputError, check_finite_positive, check_in_open_interval, check_int
 from .stats import angular_wavevectors, periodic_moment
-from .surface import Surface
+from .surface import Surface, _as_size
 from .wm import resolve_rng
 
 
@@ -45,11 +45,13 @@ def self_affine_psd(q, hurst, q_roll, q_short, q_long=0.0, ndim=2):
 
 
 def _shape_and_size(n, size, ndim):
-    shape = (int(n),) * ndim if np.ndim(n) == 0 else tuple(int(v) for v in n)
-    if len(shape) != ndim or any(v < 2 for v in shape):
+    """(shape, size) of the grid: ``n`` points per axis (one integer or one per axis) and
+    ``size`` in m (one number or one per axis, as :class:`Surface` takes it)."""
+    ns = (n,) * ndim if np.ndim(n) == 0 else tuple(n)
+    if len(ns) != ndim:
         raise InputError(f"n must give {ndim} grid size(s) >= 2, got {n!r}")
-    sizes = np.broadcast_to(np.asarray(size, dtype=float), (ndim,))
-    return shape, tuple(check_finite_positive(f"size[{k}] (m)", s) for k, s in enumerate(sizes))
+    shape = tuple(check_int(f"n (grid points along axis {k})", v, 2) for k, v in enumerate(ns))
+    return shape, _as_size(size, ndim)
 
 
 def _synthesise(ndim, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_short,

@@ -28,7 +28,13 @@ from ..frozen import FrozenMapping
 
 
 def _as_size(size, ndim):
-    sizes = np.atleast_1d(np.asarray(size, dtype=float)).ravel()
+    """``size`` (m: one number, or one per axis) as a tuple of ``ndim`` finite, positive
+    floats, or an InputError naming what is wrong."""
+    try:
+        sizes = np.atleast_1d(np.asarray(size, dtype=float)).ravel()
+    except (TypeError, ValueError):
+        raise InputError(f"size must be a number of metres or one per axis ({ndim}), "
+                         f"got {size!r}") from None
     if sizes.size == 1 and ndim == 2:
         sizes = np.repeat(sizes, 2)
     if sizes.size != ndim:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive, check_in_open_interval
+from ..errors import InputError, check_finite_positive, check_in_open_interval, check_int
 from .surface import Surface
 
 
@@ -98,9 +98,8 @@ def resolve_rng(rng):
 # -- WM profile (Eq. 2.1) and MWM surface (Eq. 2.2 / 3.17) ---------------------------------
 def _grid(n, length, ndim):
     length = check_finite_positive("length L (m)", length)
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-        raise InputError(f"n (grid points per side) must be an integer >= 2, got {n!r}")
-    x = np.arange(int(n)) * length / n
+    n = check_int("n (grid points per side)", n, 2)
+    x = np.arange(n) * length / n
     return (x,) if ndim == 1 else (x[:, None], x[None, :]), length
 
 
