@@ -73,6 +73,23 @@ def test_json_round_trip_and_errors(tmp_path):
         Genome.from_dict(bad)
 
 
+@pytest.mark.parametrize("kwargs, words", [
+    ({"n_max": 2.5}, ["n_max", "integer", "2.5"]),     # used to be truncated to 2
+    ({"n_max": 0}, ["n_max", ">= 1", "0"]),
+    ({"rng": -1}, ["rng", "-1"]),
+    ({"rng": "seed"}, ["rng", "'seed'"]),
+])
+def test_random_genome_refuses_what_it_would_truncate(kwargs, words):
+    with pytest.raises(InputError) as info:
+        table1_genome(**{"rng": 0, **kwargs})
+    for w in words:
+        assert w in str(info.value)
+    # the same seed still gives the same phases (the seed is kept in the metadata)
+    a, b = table1_genome(rng=7), table1_genome(rng=7)
+    np.testing.assert_array_equal(a.phases, b.phases)
+    assert a.metadata["seed"] == 7
+
+
 def test_surface_realisation_with_ridges_along_x_repeats_the_profile():
     from roughfe.genomics.genome import Genome, realize_surface
     g = table1_genome(rng=5)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from roughfe.errors import InputError
-from roughfe.leakage import analyse_leakage, hydraulic_aperture, reynolds_flow
+from roughfe.leakage import analyse_leakage, hydraulic_aperture, leakage_of_contact, reynolds_flow
 from roughfe.leakage.finite_volume import finite_volume_leak_rate
 
 MU = 1.0e-3          # Pa s (water)
@@ -174,6 +174,8 @@ def test_bad_input_is_named():
         reynolds_flow(np.ones((3, 3)), (DX, DY), pressure_drop=0.0)
     with pytest.raises(InputError, match="scheme"):
         reynolds_flow(np.ones((3, 3)), (DX, DY), scheme="q2")
+    with pytest.raises(InputError, match="contact_result must be a roughfe.model.ContactResult"):
+        leakage_of_contact(np.ones((3, 3)), mu=MU, pressure_drop=DP)   # a gap, not a result
 
 
 @pytest.mark.parametrize("scheme", ["fv", "fe"])

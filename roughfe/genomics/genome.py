@@ -53,10 +53,10 @@ from typing import Any, Mapping, Optional
 
 import numpy as np
 
-from ..errors import FileFormatError, InputError, check_finite_positive
+from ..errors import FileFormatError, InputError, check_finite_positive, check_int
 from ..frozen import FrozenMapping
 from ..surfaces.surface import Surface
-from ..surfaces.wm import wm_series
+from ..surfaces.wm import resolve_rng, wm_series
 from ..writers import write_json
 
 GENOME_FORMAT = "roughfe-genome"
@@ -339,13 +339,12 @@ def random_genome(A, H, gamma, lambda1, M, n_max, *, rng, n_first=1, angles=None
         Source of the phases (an int is used as a seed). The seed, when an int, is kept
         in ``metadata["seed"]``.
     """
-    seed = rng if isinstance(rng, (int, np.integer)) else None
-    gen = np.random.default_rng(rng)
-    if int(M) < 1:
-        raise InputError(f"M (number of ridges) must be >= 1, got {M!r}")
-    if int(n_max) < int(n_first):
-        raise InputError(f"n_max ({n_max}) must be >= n_first ({n_first})")
-    phases = gen.uniform(0.0, 2 * np.pi, size=(int(M), int(n_max) - int(n_first) + 1))
+    gen, seed = resolve_rng(rng)
+    seed = seed if isinstance(rng, (int, np.integer)) else None
+    M = check_int("M (number of ridges)", M, 1)
+    n_first = check_int("n_first (index of the first phase column)", n_first, 1)
+    n_max = check_int(f"n_max (last chromosome index, >= n_first = {n_first})", n_max, n_first)
+    phases = gen.uniform(0.0, 2 * np.pi, size=(M, n_max - n_first + 1))
     meta = {"generator": "random_genome"}
     if seed is not None:
         meta["seed"] = int(seed)

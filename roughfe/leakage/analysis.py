@@ -13,8 +13,9 @@ from typing import Mapping, Optional
 import numpy as np
 
 from .. import progress
-from ..errors import InputError
+from ..errors import InputError, check_instance
 from ..frozen import FrozenMapping
+from ..model import ContactResult
 from .junction import CriticalConstriction, critical_constriction
 from .network import NetworkResult, free_volume_network
 from .reynolds import ReynoldsResult, reynolds_flow
@@ -206,6 +207,8 @@ def leakage_of_contact(contact_result, **kwargs) -> LeakageResult:
     Uses its ``gap``, ``contact``, ``spacing``, ``periodic`` and ``rms_height`` (sigma);
     keyword arguments are passed on (``direction``, ``mu``, ``pressure_drop``, ...).
     """
+    check_instance("contact_result", contact_result, ContactResult,
+                   "a roughfe.model.ContactResult (solve_contact, response)")
     if np.ndim(contact_result.gap) != 2:
         raise InputError("leakage needs a 2D surface; got a contact result of a profile")
     kwargs.setdefault("periodic", bool(contact_result.periodic))
