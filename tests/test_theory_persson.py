@@ -10,7 +10,8 @@ from roughfe.surfaces import stats
 from roughfe.surfaces.spectral import spectral_profile, spectral_surface
 from roughfe.surfaces.stats import PowerSpectrum
 from roughfe.surfaces.surface import Surface
-from roughfe.theory import KAPPA_PERSSON, area_fraction, beside, critical_junction, persson
+from roughfe.theory import (KAPPA_PERSSON, area_fraction, beside, critical_junction,
+                            mean_separation, persson)
 
 E_STAR = 1e9
 
@@ -166,6 +167,18 @@ def test_bad_input_is_a_clear_error(surface, kwargs, match):
     gamma = args.pop("gamma", 0.45)
     with pytest.raises(InputError, match=match):
         persson(surface, args["e_star"], args["mean_pressure"], gamma=gamma)
+
+
+@pytest.mark.parametrize("q, power, match", [
+    ([1.0, 2.0], [1.0], "same length"),                 # was an IndexError from numpy
+    ([[1.0, 2.0]], [[1.0, 1.0]], "1D"),
+    ([2.0, 1.0], [1.0, 1.0], "increasing"),
+    ([-1.0, 2.0], [1.0, 1.0], ">= 0"),
+    ([1.0, 2.0], [1.0, np.nan], "finite"),
+])
+def test_mean_separation_checks_its_spectrum(q, power, match):
+    with pytest.raises(InputError, match=match):
+        mean_separation(np.array(q), np.array(power), E_STAR, 1e6)
 
 
 def test_bad_input_critical_junction(surface):

@@ -215,8 +215,16 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
     e = check_finite_positive("e_star (Pa)", e_star)
     gamma = check_in_open_interval("gamma", gamma, 0.0, 1.0 + 1e-12)
     p = _pressures(mean_pressure)
-    sel = np.asarray(q) > q_min
-    q, power = np.asarray(q, float)[sel], np.asarray(power, float)[sel]
+    q, power = np.asarray(q, float), np.asarray(power, float)
+    if q.ndim != 1 or q.shape != power.shape:
+        raise InputError(f"q and power must be 1D arrays of the same length, got shapes "
+                         f"{q.shape} and {power.shape}")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(power))) \
+            or q.min(initial=0.0) < 0 or power.min(initial=0.0) < 0 or np.any(np.diff(q) < 0):
+        raise InputError("q (rad/m) must be finite, >= 0 and increasing, and power (m^2) "
+                         "finite and >= 0")
+    sel = q > q_min
+    q, power = q[sel], power[sel]
     if q.size == 0:
         return np.zeros(p.shape)
     w = np.sqrt(2.0 / _cumulative_gradient(q, power))
