@@ -108,6 +108,19 @@ def test_hurst_fit_flags_non_self_affine_and_bad_range():
     assert not fit.success and "outside (0, 1)" in fit.message
     with pytest.raises(InputError, match="q_range"):
         fit_hurst(s, q_range=(1e6, 1e5))
+    for bad in ((1e5,), "x", (1e5, "high")):     # were unpacking/float errors from inside
+        with pytest.raises(InputError, match="q_range must be two wavenumbers"):
+            fit_hurst(s, q_range=bad)
+
+
+@pytest.mark.parametrize("statistic", [power_spectrum, spectral_moments, rms_height, rms_slope,
+                                       rms_curvature, peak_to_valley, fit_hurst,
+                                       surface_statistics])
+def test_statistics_name_a_non_surface(statistic):
+    # heights given as a bare array (no size, no periodicity): an InputError that says what
+    # is expected, not an AttributeError from inside
+    with pytest.raises(InputError, match="surface must be a roughfe Surface"):
+        statistic(np.zeros((8, 8)))
 
 
 def test_statistics_are_json_safe():

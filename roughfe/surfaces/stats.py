@@ -41,7 +41,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive
+from ..errors import InputError, check_finite_positive, check_instance
 from .surface import Surface
 
 
@@ -117,6 +117,10 @@ def periodic_moment(heights, size, order: int) -> float:
     return rfft_full_sum(power, m)
 
 
+def _check_surface(surface):
+    check_instance("surface", surface, Surface, "a roughfe Surface (roughfe.surfaces.Surface)")
+
+
 def _default_window(surface, window):
     if window == "auto":
         return None if surface.periodic else "hann"
@@ -173,6 +177,7 @@ def power_spectrum(surface: Surface, window="auto", bin_width=None) -> PowerSpec
     -------
     PowerSpectrum
     """
+    _check_surface(surface)
     window = _default_window(surface, window)
     power, qs = _fourier_power(surface, window)
     label = "none" if window is None else window
@@ -213,6 +218,7 @@ def spectral_moments(surface: Surface):
     i.e. spectrally for periodic data and by finite differences for non-periodic data
     (whose spectral derivatives would be dominated by the jump at the edges).
     """
+    _check_surface(surface)
     m0 = rms_height(surface) ** 2
     slope2, curv2 = rms_slope(surface) ** 2, rms_curvature(surface) ** 2
     if surface.ndim == 1:
@@ -222,6 +228,7 @@ def spectral_moments(surface: Surface):
 
 def rms_height(surface: Surface) -> float:
     """Root-mean-square height about the mean, Rq/Sq (m)."""
+    _check_surface(surface)
     return float(np.std(surface.heights))
 
 
@@ -232,6 +239,7 @@ def rms_slope(surface: Surface) -> float:
     profile, ``sqrt(2 m2)`` for a surface). Non-periodic data: forward differences (the
     spectral derivative would see the jump at the edge).
     """
+    _check_surface(surface)
     if surface.periodic:
         return float(np.sqrt(periodic_moment(surface.heights, surface.size, 1)))
     h = surface.heights
@@ -245,6 +253,7 @@ def rms_curvature(surface: Surface) -> float:
 
     Periodic: Fourier interpolant; non-periodic: second central differences inside.
     """
+    _check_surface(surface)
     factor = 1.0 if surface.ndim == 1 else 0.5
     if surface.periodic:
         return factor * float(np.sqrt(periodic_moment(surface.heights, surface.size, 2)))
@@ -261,6 +270,7 @@ def rms_curvature(surface: Surface) -> float:
 
 def peak_to_valley(surface: Surface) -> float:
     """Peak-to-valley amplitude ``max h - min h`` (m), Rt/Sz-like."""
+    _check_surface(surface)
     return float(np.ptp(surface.heights))
 
 
@@ -300,6 +310,7 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     -------
     HurstFit
     """
+    _check_surface(surface)
     psd = power_spectrum(surface, window=window)
     if q_range is None:
         qlo, qhi = 4 * 2 * np.pi / max(surface.size), np.pi / (2 * max(surface.spacing))
@@ -308,7 +319,11 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
                             "grid too small for the default q_range (needs > 16 points per "
                             "side); give q_range")
         q_range = (qlo, qhi)
-    qlo, qhi = (float(v) for v in q_range)
+    try:
+        qlo, qhi = (float(v) for v in q_range)
+    except (TypeError, ValueError):
+        raise InputError(f"q_range must be two wavenumbers (q_min, q_max) in rad/m, got "
+                         f"{q_range!r}") from None
     if not (0 < qlo < qhi):
         raise InputError(f"q_range must satisfy 0 < q_min < q_max (rad/m), got {q_range!r}")
     sel = (psd.q >= qlo) & (psd.q <= qhi) & (psd.C > 0)
@@ -376,6 +391,7 @@ class SurfaceStatistics:
 
 def surface_statistics(surface: Surface, q_range=None) -> SurfaceStatistics:
     """All statistics of this module for one surface (see the module docstring)."""
+    _check_surface(surface)
     h = surface.heights
     dev = h - h.mean()
     rq = rms_height(surface)
