@@ -163,6 +163,16 @@ def test_mirrored_profile_and_bad_input():
         FemSolverOptions(method="lagrange")
     with pytest.raises(InputError, match="nu < 0.5"):
         fem_solve_contact(mesh_profile(s), Material(E=1e9, nu=0.5), 1e-7)
+    # solver controls and the mesh argument are named before any PETSc object is made
+    # (rtol = -1 and max_it = 2.5 were accepted, a path instead of the mesh was an
+    # AttributeError)
+    for kwargs, words in (({"rtol": -1.0}, "rtol"), ({"atol": -1.0}, "atol"),
+                          ({"max_it": 2.5}, "max_it"), ({"max_it": 0}, "max_it")):
+        with pytest.raises(InputError, match=words):
+            FemSolverOptions(**kwargs)
+    assert FemSolverOptions(atol=0.0).atol == 0.0            # relative tolerance only
+    with pytest.raises(InputError, match="pmesh must be a roughfe.fem.ProfileMesh"):
+        fem_solve_contact("profile.msh", Material(E=1e9, nu=0.3), 1e-7)
 
 
 def test_mesh_files_for_inspection(tmp_path):

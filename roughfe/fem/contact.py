@@ -53,7 +53,8 @@ from typing import Literal, Mapping
 
 import numpy as np
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive, check_instance
+from ..errors import (InputError, NoConvergenceError, check_finite_positive, check_instance,
+                      check_int)
 from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
@@ -122,8 +123,11 @@ class FemSolverOptions:
         if self.method not in METHODS:
             raise InputError(f"method must be one of {METHODS}, got {self.method!r}")
         check_finite_positive("penalty_factor", self.penalty_factor)
-        if int(self.max_it) < 1:
-            raise InputError(f"max_it must be >= 1, got {self.max_it!r}")
+        check_finite_positive("rtol (SNES relative tolerance)", self.rtol)
+        if not (isinstance(self.atol, (int, float)) and 0 <= self.atol < float("inf")):
+            raise InputError(f"atol (SNES absolute tolerance) must be finite and >= 0, "
+                             f"got {self.atol!r}")
+        check_int("max_it (SNES iterations per step)", self.max_it, 1)
         if self.petsc_options is not None:
             object.__setattr__(self, "petsc_options", FrozenMapping(self.petsc_options))
 
@@ -578,8 +582,10 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
         Naming the SNES converged reason of the failed step; ``result`` holds the list
         of the steps solved before it.
     """
+    check_instance("pmesh", pmesh, ProfileMesh, "a roughfe.fem.ProfileMesh (mesh_profile)")
     material = _check_material(material)
     options = FemSolverOptions() if options is None else options
+    check_instance("options", options, FemSolverOptions, "a roughfe.fem.FemSolverOptions")
     given = {k: v for k, v in (("deltas", deltas), ("applied_deltas", applied_deltas),
                                ("pressures", pressures)) if v is not None}
     if len(given) != 1:
