@@ -1,5 +1,7 @@
 """Sequencing (Sec. 3.3.1): exact recovery of the identifiable genes of the Table 1 genome,
 M-free maximum likelihood of A and H, quality report on non-WM data, clear input errors."""
+import re
+
 import numpy as np
 import pytest
 
@@ -92,6 +94,15 @@ def test_bad_input_is_reported():
     shifted = Surface(a.heights, a.size, metadata={**a.metadata, "x0": 0.0})
     with pytest.raises(InputError, match="not nested"):
         sequence_profiles([shifted, realize(g, scale="100x")][::-1] + [realize(g, scale="20x")])
+    # the controls are checked before any work (M = 2.5 and n_restarts = 1.5 were
+    # truncated, a negative rms_tolerance flagged every fit, seed = -1 failed inside numpy)
+    pair = [a, realize(g, scale="20x")]
+    for kwargs, words in (({"M": 2.5}, "M (number of ridges"), ({"M": 0}, "M (number of ridges"),
+                          ({"n_restarts": 1.5}, "n_restarts"), ({"rms_tolerance": -0.1},
+                                                                  "rms_tolerance"),
+                          ({"seed": -1}, "seed must be")):
+        with pytest.raises(InputError, match=re.escape(words)):
+            sequence_profiles(pair, **kwargs)
 
 
 def test_measured_profile_is_sequenced_with_an_honest_report(topographies_dir):

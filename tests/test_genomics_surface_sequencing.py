@@ -119,6 +119,10 @@ def test_bad_acquisitions_name_the_mismatch():
         sequence_surfaces([a1, a1])
     with pytest.raises(InputError, match="one mask per acquisition"):
         sequence_surfaces([a1, a2], valid=[None])
+    with pytest.raises(InputError, match="n_restarts"):           # was truncated to 2
+        sequence_surfaces([a1, a2], n_restarts=2.5)
+    with pytest.raises(InputError, match="rms_tolerance"):
+        sequence_surfaces([a1, a2], rms_tolerance=0.0)
 
 
 def test_genome_sequence_command_on_surfaces(tmp_path, capsys):

@@ -77,12 +77,13 @@ def wm_series(coords, amplitudes, wavenumbers, phases, angles=None, chunk=1 << 2
 
 
 # -- random sources ------------------------------------------------------------------------
-def resolve_rng(rng):
+def resolve_rng(rng, name="rng"):
     """``(generator, seed)`` from a numpy Generator, an integer seed or None.
 
     An integer is used as the seed and returned for the metadata. ``None`` draws a fresh
     seed from the operating system's entropy (so the result is still reproducible from
-    its metadata). A Generator is used as is; its seed is unknown (``None``).
+    its metadata). A Generator is used as is; its seed is unknown (``None``). ``name``
+    is the caller's name of the argument, for the error message.
     """
     if isinstance(rng, np.random.Generator):
         return rng, None
@@ -90,7 +91,7 @@ def resolve_rng(rng):
         seed = int(np.random.SeedSequence().entropy % (2 ** 63))
         return np.random.default_rng(seed), seed
     if isinstance(rng, bool) or not isinstance(rng, (int, np.integer)) or rng < 0:
-        raise InputError(f"rng must be a numpy Generator, a non-negative integer seed or None, "
+        raise InputError(f"{name} must be a numpy Generator, a non-negative integer seed or None, "
                          f"got {rng!r}")
     return np.random.default_rng(int(rng)), int(rng)
 

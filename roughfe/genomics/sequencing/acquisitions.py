@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError, check_instance
+from ...errors import InputError, check_finite_positive, check_instance, check_int
 from ...surfaces.surface import Surface
 from ..genome import observation_coordinates
 
@@ -20,6 +20,15 @@ class Acquisition:
     x: np.ndarray
     z: np.ndarray
     length: float
+
+
+def check_controls(rms_tolerance, n_restarts):
+    """The controls both sequencers take (:func:`~roughfe.genomics.sequencing.
+    sequence_profiles`, :func:`~roughfe.genomics.sequencing.sequence_surfaces`), checked:
+    ``rms_tolerance`` (relative rms error, > 0) and ``n_restarts`` (comb periods tried, an
+    integer >= 1). Returns them as float and int."""
+    return (check_finite_positive("rms_tolerance (relative rms error)", rms_tolerance),
+            check_int("n_restarts (comb periods tried)", n_restarts, 1))
 
 
 def acquisitions_from_surfaces(surfaces) -> list:

@@ -8,9 +8,10 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
-from ...errors import InputError
+from ...errors import InputError, check_int
+from ...surfaces.wm import resolve_rng
 from ..genome import Genome, profile_heights
-from .acquisitions import acquisitions_from_surfaces
+from .acquisitions import acquisitions_from_surfaces, check_controls
 from .genes import (amplitude_genes, peak_slope_H, phases_with_sums, ridge_likelihood,
                     variance_amplitude)
 from .lattice import (comb_periods, design_matrix, fit_lattice, label_q1, lattice_from_period,
@@ -47,9 +48,12 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     SequencingResult
     """
     t0 = time.perf_counter()
+    rms_tolerance, n_restarts = check_controls(rms_tolerance, n_restarts)
+    if M is not None:
+        M = check_int("M (number of ridges; None: maximum likelihood)", M, 1)
+    rng = resolve_rng(seed, "seed")[0]
     acqs = acquisitions_from_surfaces(surfaces)
     n_nodes = acqs[0].z.size
-    rng = np.random.default_rng(seed)
     weights = [1.0 / max(math.sqrt(float(np.mean(a.z ** 2))), 1e-300) for a in acqs]
     rhs = np.concatenate([a.z * w for a, w in zip(acqs, weights)])
 
@@ -61,7 +65,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         messages.append(f"only {log_q.size} PSD peaks found: the spectrum is not a discrete WM spectrum")
         periods, refs = np.array([math.log(1.5)]), np.array([math.log(2 * math.pi / acqs[0].length)])
     else:
-        periods, _, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
+        periods, _, refs = comb_periods(log_q, n_best=n_restarts)
     bins = np.concatenate([s.peak_q / (s.q[1] - s.q[0]) for s in spectra])
     groups = np.concatenate([np.full(s.peak_q.size, i) for i, s in enumerate(spectra)])
     gamma_psd = float(math.exp(periods[0]))
@@ -131,8 +135,6 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         M = m_values[int(np.argmax(loglik))] if np.isfinite(loglik).any() else \
             max(2, int(math.ceil(float(np.max(u)) ** 2)))
     M = int(M)
-    if M < 1:
-        raise InputError(f"M must be >= 1, got {M}")
     target = u * math.sqrt(M) * np.exp(1j * thetas)
     over = np.abs(target) > M
     if over.any():

@@ -64,6 +64,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..genome import Genome
+from .acquisitions import check_controls
 from .lattice import comb_periods, label_q1, lattice_from_period
 from .surface_data import (ANGLE_TOL, GridModel, SurfaceAcquisition, cluster_angles,
                            surface_acquisitions, surface_peaks)
@@ -351,6 +352,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         criterion wins (the residual alone prefers a lattice gamma^(1/j) on noisy data).
     """
     t0 = time.perf_counter()
+    rms_tolerance, n_restarts = check_controls(rms_tolerance, n_restarts)
     acqs = surface_acquisitions(surfaces, valid)
     n_nodes = acqs[0].z.shape[0]
     peaks = [surface_peaks(a) for a in acqs]
@@ -368,7 +370,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     log_q = np.log(q[in_ridge])
     groups = np.concatenate([np.full(pk.qx.size, k) for k, pk in enumerate(peaks)])[in_ridge]
     groups = groups * 1000 + labels[in_ridge]           # one peak per (acquisition, ridge, n)
-    periods, _, refs = comb_periods(log_q, n_best=max(1, int(n_restarts)))
+    periods, _, refs = comb_periods(log_q, n_best=n_restarts)
     # the nonlinear fit on a tensor sub-grid of about FIT_ROWS nodes, the final solve on all
     model = GridModel(acqs, n_nodes, axis_nodes=math.ceil(math.sqrt(FIT_ROWS / len(acqs))))
     full = GridModel(acqs, n_nodes)
