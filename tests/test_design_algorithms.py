@@ -402,10 +402,14 @@ def test_global_search_with_chromosome_amplitudes_bounded_and_reproduced(entries
 @pytest.mark.parametrize("bad, match", [({"amplitudes": 2.5}, "amplitudes <= 2"),
                                         ({"amplitudes": float("nan")}, "amplitudes"),
                                         ({"sigma": 0.0}, "sigma > 0"),
-                                        ({"popsize": -1}, "popsize >= 0"),
-                                        ({"n_candidates": 0}, "n_candidates >= 1"),
+                                        ({"popsize": -1}, "popsize must be an integer >= 0"),
+                                        ({"n_candidates": 0},
+                                         "n_candidates must be an integer >= 1"),
                                         ({"weight_fraction": 1.0}, "weight_fraction"),
-                                        ({"rounds": 0}, "rounds >= 1"),
+                                        ({"rounds": 0}, "rounds must be an integer >= 1"),
+                                        # were truncated / accepted before session 14
+                                        ({"n_eval": 2.5}, "n_eval must be an integer >= 2"),
+                                        ({"seed": -1}, "seed must be an integer >= 0"),
                                         ({"genes": 1.0}, "genes < 1"),
                                         ({"genes": 0.1, "amplitudes": 0.1}, "genes = 0"),
                                         ({"method": "annealing"}, "method"),
@@ -413,6 +417,33 @@ def test_global_search_with_chromosome_amplitudes_bounded_and_reproduced(entries
 def test_global_search_options_reject_bad_input(bad, match):
     with pytest.raises(InputError, match=match):
         de.GlobalSearchOptions(**bad)
+
+
+@pytest.mark.parametrize("bad, match", [({"n_it_sog": 2.5}, "n_it_sog must be an integer"),
+                                        ({"n_micro": -1}, "n_micro must be an integer >= 0"),
+                                        ({"fraction": 0.0}, r"fraction must be in \(0, 1\]"),
+                                        ({"fraction": 1.5}, "fraction"),
+                                        ({"eps": -0.02}, "eps"),
+                                        ({"bound": "box"}, "bound must be one of"),
+                                        ({"formulation": "lsq"}, "formulation must be one of"),
+                                        ({"gradient": "adjoint"}, "gradient must be one of"),
+                                        ({"cco_genes": "yes"}, "cco_genes")])
+def test_gcmma_options_reject_bad_input_when_made(bad, match):
+    # checked when the options are made: formulation and gradient used to be read only
+    # when a stage reached them (after the database work), the others never
+    with pytest.raises(InputError, match=match):
+        de.GcmmaOptions(**bad)
+    assert de.GcmmaOptions(n_it_micro=0).n_it_micro == 0        # a skipped stage is allowed
+
+
+def test_objective_checks_its_targets_and_pressure_range():
+    t = Target(np.array([1e6, 2e6, 4e6]), np.array([1e12, 2e12, 3e12]), "K")
+    with pytest.raises(InputError, match=r"targets\[0\] must be a"):
+        de.Objective(((1e6, 1e12),))
+    for bad in ((2e6, 1e6), (-1.0, 1e6), ("low", "high"), (1e6,)):
+        with pytest.raises(InputError, match="p_range"):
+            de.Objective((t,), p_range=bad)
+    assert de.Objective((t,), p_range=(1e6, 3e6)).p_range == (1e6, 3e6)
 
 
 def test_global_search_rounds_continue_from_the_best_design(entries, targets, tmp_path):

@@ -7,10 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_instance
 from ..database import DatabaseSettings
 from ..macro_micro import profile_response
-from ..similarity import ResponseCurve, similarity
+from ..similarity import ResponseCurve, Target, similarity
 from .model import Design
 
 
@@ -30,6 +30,17 @@ class Objective:
         t = tuple(self.targets)
         if not 1 <= len(t) <= 2:
             raise InputError(f"one or two targets, got {len(t)}")
+        for k, target in enumerate(t):
+            check_instance(f"targets[{k}]", target, Target,
+                           "a roughfe.genomics.similarity.Target")
+        try:
+            lo, hi = (float(v) for v in self.p_range)
+        except (TypeError, ValueError):
+            lo = hi = math.nan
+        if not 0 <= lo < hi:
+            raise InputError(f"p_range must be (p_low, p_high) in Pa with 0 <= p_low < p_high, "
+                             f"got {self.p_range!r}")
+        object.__setattr__(self, "p_range", (lo, hi))
         if len(t) == 2 and t[1].p_max > t[0].p_max * (1 + 1e-6):
             raise InputError(f"the second target reaches p = {t[1].p_max:.6g} Pa beyond the "
                              f"first target's p_max = {t[0].p_max:.6g} Pa (Eq. 4.2 matches one "

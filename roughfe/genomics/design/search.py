@@ -11,7 +11,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_int
 from ...optim.cmaes import ipop_cmaes
 from ...optim.es import one_plus_one_es
 from ..database import DatabaseSettings
@@ -250,9 +250,10 @@ class GlobalSearchOptions:
         if self.score not in GLOBAL_SCORES:
             raise InputError(f"global search: score must be one of {GLOBAL_SCORES}, got "
                              f"{self.score!r}")
-        checks = (("n_eval >= 2", int(self.n_eval) >= 2, self.n_eval),
-                  ("sigma > 0", self.sigma > 0 and math.isfinite(self.sigma), self.sigma),
-                  ("popsize >= 0", int(self.popsize) >= 0, self.popsize),
+        for name, low in (("n_eval", 2), ("popsize", 0), ("n_candidates", 1), ("rounds", 1),
+                          ("seed", 0)):
+            check_int(f"global search: {name}", getattr(self, name), low)
+        checks = (("sigma > 0", self.sigma > 0 and math.isfinite(self.sigma), self.sigma),
                   ("0 < weight_fraction < 1", 0 < self.weight_fraction < 1,
                    self.weight_fraction),
                   ("0 <= amplitudes <= 2 (log half-range)", 0 <= self.amplitudes <= 2,
@@ -260,8 +261,6 @@ class GlobalSearchOptions:
                   ("0 <= genes < 1", 0 <= self.genes < 1, self.genes),
                   ("genes = 0 with amplitudes", not (self.genes and self.amplitudes),
                    self.genes),
-                  ("n_candidates >= 1", int(self.n_candidates) >= 1, self.n_candidates),
-                  ("rounds >= 1", int(self.rounds) >= 1, self.rounds),
                   ("peak >= 0", self.peak >= 0 and math.isfinite(self.peak), self.peak),
                   ("peak_weight > 0", self.peak_weight > 0 and math.isfinite(self.peak_weight),
                    self.peak_weight),

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_finite_positive, check_int
 from ...optim.gcmma import gcmma
 from .model import Design
 from .objective import Evaluator, Objective, combined_score
@@ -22,6 +22,8 @@ from .sensitivities import residual_jacobian
 #: GCMMA subproblems of a stage: "minimax" (Svanberg's min-max form, the default) or
 #: "thesis" (minimise (1 - s)^2), see :mod:`roughfe.optim.gcmma`
 FORMULATIONS = ("minimax", "thesis")
+BOUNDS = ("start", "period")
+GRADIENTS = ("exact", "fd")
 
 
 def phase_bounds(phi0, fraction: float = 0.1, bound: str = "start"):
@@ -69,6 +71,24 @@ class GcmmaOptions:
     cco_genes: bool = True
     gradient: str = "exact"
 
+    def __post_init__(self):
+        """Every option checked when the options are made, before any database or BEM
+        work (they were read only when a stage reached them)."""
+        for name in ("n_it_sog", "n_it_cross", "n_it_micro", "n_micro"):
+            check_int(f"GcmmaOptions.{name}", getattr(self, name), 0)
+        f = self.fraction
+        if isinstance(f, bool) or not isinstance(f, (int, float)) or not 0 < f <= 1:
+            raise InputError(f"GcmmaOptions.fraction must be in (0, 1], got {f!r}")
+        check_finite_positive("GcmmaOptions.eps (forward-difference step, unit box)", self.eps)
+        for name, allowed in (("bound", BOUNDS), ("formulation", FORMULATIONS),
+                              ("gradient", GRADIENTS)):
+            if getattr(self, name) not in allowed:
+                raise InputError(f"GcmmaOptions.{name} must be one of {allowed}, "
+                                 f"got {getattr(self, name)!r}")
+        if not isinstance(self.cco_genes, bool):
+            raise InputError(f"GcmmaOptions.cco_genes must be True or False, "
+                             f"got {self.cco_genes!r}")
+
 
 def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evaluator, n_it: int,
                     options: GcmmaOptions, f0=None):
@@ -82,8 +102,6 @@ def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evalua
     if is_gene.any():                       # genes (> 0): +-fraction of their start value
         lo[is_gene] = phi0[is_gene] * (1.0 - options.fraction)
         hi[is_gene] = phi0[is_gene] * (1.0 + options.fraction)
-    if options.formulation not in FORMULATIONS:
-        raise InputError(f"formulation must be 'minimax' or 'thesis', got {options.formulation!r}")
 
     def designed(x):
         return evaluate(design.with_phases(keys, x))
@@ -105,8 +123,6 @@ def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evalua
             evaluate.n_sweeps += 1
             return residual_jacobian(design.with_phases(keys, x), keys, objective,
                                      evaluate.settings)[1]
-    elif options.gradient != "fd":
-        raise InputError(f"gradient must be 'exact' or 'fd', got {options.gradient!r}")
     res = gcmma(lambda x: objective.residuals(designed(x)), phi0, lo, hi, form="minimax",
                 score=score, n_it=n_it, eps=options.eps, jacobian=jacobian,
                 label="GCMMA min-max")
