@@ -23,10 +23,11 @@ class Acquisition:
 
 
 def check_controls(rms_tolerance, n_restarts):
-    """The controls both sequencers take (:func:`~roughfe.genomics.sequencing.
-    sequence_profiles`, :func:`~roughfe.genomics.sequencing.sequence_surfaces`), checked:
-    ``rms_tolerance`` (relative rms error, > 0) and ``n_restarts`` (comb periods tried, an
-    integer >= 1). Returns them as float and int."""
+    """The controls both sequencers take, checked: ``rms_tolerance`` (relative rms
+    error, > 0) and ``n_restarts`` (comb periods tried, an integer >= 1). Returns them
+    as float and int. Used by
+    :func:`~roughfe.genomics.sequencing.profile.sequence_profiles` and
+    :func:`~roughfe.genomics.sequencing.surface.sequence_surfaces`."""
     return (check_finite_positive("rms_tolerance (relative rms error)", rms_tolerance),
             check_int("n_restarts (comb periods tried)", n_restarts, 1))
 
