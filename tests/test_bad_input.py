@@ -164,6 +164,17 @@ def _leak_delta_and_pressure(t):
              str(t / "o")], "not allowed with argument")
 
 
+def _negative_seed(t):
+    # the flag's own name and rule, where the library's message named its "rng" argument
+    return (["generate", "spectral", "--n", "16", "--seed", "-1", "-o", str(t / "s.npz")],
+            "--seed: must be an integer >= 0")
+
+
+def _fractional_grid_size(t):
+    return (["generate", "spectral", "--n", "3.5", "-o", str(t / "s.npz")],
+            "--n: expected an integer >= 1")
+
+
 CASES = [_truncated_npz, _output_is_a_file, _output_not_writable, _output_foreign_folder,
          _generate_existing_file, _genome_example_existing_file, _huge_grid, _genome_h_string,
          _genome_m_fraction, _genome_h_bool, _npz_as_genome, _steps_zero,
@@ -171,7 +182,8 @@ CASES = [_truncated_npz, _output_is_a_file, _output_not_writable, _output_foreig
          _db_list_empty_sqlite, _channel_on_npz, _damaged_instrument_file,
          _study_into_a_foreign_folder, _tol_zero,
          _empty_npy, _directory_as_input, _db_build_workers_zero, _negative_young_modulus,
-         _negative_poisson_exponent, _leak_delta_and_pressure]
+         _negative_poisson_exponent, _leak_delta_and_pressure, _negative_seed,
+         _fractional_grid_size]
 
 
 def _snapshot(root):

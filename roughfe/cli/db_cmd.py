@@ -28,8 +28,8 @@ whose angles and anisotropy are part of the Sobol design. Under MPI run:
 
 from ..genomics.database.settings import THESIS_SETTINGS as THESIS
 from .options import (add_material_options, add_output_folder, add_run_options,
-                      add_runner_options, output_folder_of, positive_float, positive_int,
-                      show_progress)
+                      add_runner_options, nonnegative_int, output_folder_of, positive_float,
+                      positive_int, show_progress)
 
 
 #: defaults of a surface database (``--dim 2``) where they differ from the thesis profiles:
@@ -151,7 +151,7 @@ def register(sub):
     add_material_options(b, "material (stored in the database; the thesis used E = 1 MPa: "
                             "pressures scale with E*)")
     s = b.add_argument_group("Sobol design")
-    s.add_argument("--seed", type=int, default=20240, help="Sobol scrambling seed (recorded)")
+    s.add_argument("--seed", type=nonnegative_int, default=20240, help="Sobol scrambling seed (recorded)")
     s.add_argument("--no-scramble", action="store_true", help="unscrambled Sobol sequences")
     s.add_argument("--ridges", type=positive_int, default=3,
                    help="ridges M per surface genome (--dim 2)")

@@ -25,8 +25,8 @@ from ..writers import atomic_path, write_json
 from .options import (add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, check_small_strain, contact_physics_from_args,
-                      material_from_args, output_folder_of, positive_float, positive_int,
-                      show_progress, surface_from_args)
+                      material_from_args, nonnegative_int, output_folder_of, positive_float,
+                      positive_int, show_progress, surface_from_args)
 
 
 def _add_fluid_material(p):
@@ -342,7 +342,7 @@ def register(sub):
                    help="surfaces per (D, m) set; the same seeds across D and m (thesis: 20)")
     s.add_argument("--steps", type=positive_int, default=6, help="approach steps up to h_s")
     s.add_argument("--length", type=positive_float, default=1.0e-4, help="lateral size L in m")
-    s.add_argument("--seed", type=int, default=2016, help="base seed of the study")
+    s.add_argument("--seed", type=nonnegative_int, default=2016, help="base seed of the study")
     _add_fluid_material(s)
     add_runner_options(s)
     s.add_argument("-o", "--output", required=True, metavar="OUTDIR",

@@ -5,8 +5,8 @@ import numpy as np
 
 from ..errors import check_memory
 from .options import (add_detrend_option, add_output_file, add_run_options,
-                      add_surface_options, output_file_of, positive_float, positive_int,
-                      surface_from_args)
+                      add_surface_options, nonnegative_int, output_file_of, positive_float,
+                      positive_int, surface_from_args)
 
 # (key, label, unit, scale) rows of the info table
 _TABLE = (
@@ -139,7 +139,7 @@ def _register_generate(sub):
     def common(q, help_, make):
         m = models.add_parser(q, help=help_, description=help_)
         add_output_file(m, "output .npz file (the figure goes beside it, FILE.png)")
-        m.add_argument("--seed", type=int, default=None,
+        m.add_argument("--seed", type=nonnegative_int, default=None,
                        help="random seed (default: fresh, recorded in the file)")
         m.add_argument("--rms-height", type=positive_float, default=None,
                        help="rescale to this rms height (m)")
