@@ -46,6 +46,8 @@ def test_resampled_is_the_band_limited_interpolant():
         Surface(keep, (1e-5, 1e-5)).resampled((8, 8))
     with pytest.raises(InputError, match="shape"):
         s.resampled((8,))
+    with pytest.raises(InputError, match=r"shape\[1\].*integer >= 2, got 12.5"):
+        s.resampled((16, 12.5))                 # was truncated to 12 points
 
 
 def test_window_compliance_of_a_square_is_loves_mean_deflection():

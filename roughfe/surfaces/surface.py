@@ -23,7 +23,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_int
 from ..frozen import FrozenMapping
 
 
@@ -179,9 +179,11 @@ class Surface:
         if not self.periodic:
             raise InputError("resampled() is the Fourier interpolant of a periodic surface; "
                              "mirror a non-periodic window first (Surface.mirrored)")
-        shape = tuple(int(m) for m in np.atleast_1d(shape))
-        if len(shape) != self.ndim or min(shape) < 2:
+        given = (shape,) if np.ndim(shape) == 0 else tuple(shape)
+        if len(given) != self.ndim:
             raise InputError(f"resampled shape must have {self.ndim} entries >= 2, got {shape}")
+        shape = tuple(check_int(f"resampled shape[{k}] (points along axis {k})", m, 2)
+                      for k, m in enumerate(given))
         spec = np.fft.fftn(self.heights)
         out = np.zeros(shape, dtype=complex)
         index = []
