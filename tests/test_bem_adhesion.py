@@ -147,6 +147,12 @@ def test_bad_adhesion_parameters(args, match):
 def test_bad_approach():
     with pytest.raises(InputError, match="delta"):
         solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=float("nan"))
+    # the solver controls are named before any work (tol = 0 and max_iter = 0 ran into a
+    # NoConvergenceError after the elastic start)
+    for kwargs, match in (({"tol": 0.0}, "tol"), ({"max_iter": 0}, "max_iter"),
+                          ({"max_iter": 2.5}, "max_iter")):
+        with pytest.raises(InputError, match=match):
+            solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=0.1 * D_SCALE, **kwargs)
 
 
 def test_periodic_full_contact_approach_is_refused():

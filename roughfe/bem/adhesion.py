@@ -61,7 +61,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
-from ..errors import InputError, NoConvergenceError, check_instance
+from ..errors import (InputError, NoConvergenceError, check_finite_positive, check_instance,
+                      check_int)
 from ..model import ContactResult, Loading, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
@@ -251,6 +252,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     d = _check(surface, material, law, delta)
     if solver not in SOLVERS:
         raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    tol = check_finite_positive("tol (relative traction residual)", tol)
+    max_iter = check_int("max_iter", max_iter, 1)
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
     h = surface.heights
