@@ -41,6 +41,17 @@ def check_finite_positive(name, value):
     return v
 
 
+def check_finite_nonnegative(name, value):
+    """Return ``float(value)`` or raise :class:`InputError` unless it is finite and >= 0."""
+    try:
+        v = None if isinstance(value, bool) else float(value)
+    except (TypeError, ValueError):
+        v = None
+    if v is None or not (0.0 <= v < float("inf")):
+        raise InputError(f"{name} must be a finite number >= 0, got {value!r}")
+    return v
+
+
 def check_in_open_interval(name, value, low, high):
     """Return ``float(value)`` or raise :class:`InputError` unless low < value < high."""
     try:
@@ -62,6 +73,19 @@ def check_int(name, value, minimum):
     if v is None or v < minimum:
         raise InputError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return v
+
+
+def check_spacing(spacing, ndim=2):
+    """Return the cell size ``(dx, dy)`` (``ndim`` finite, positive floats, m) or raise
+    :class:`InputError` naming what is wrong (a bare number, the wrong length, a string)."""
+    try:
+        values = tuple(spacing)
+    except TypeError:
+        values = None
+    if values is None or len(values) != ndim:
+        names = "(dx, dy)" if ndim == 2 else f"{ndim} numbers"
+        raise InputError(f"spacing must be the cell size {names} in m, got {spacing!r}")
+    return tuple(check_finite_positive(f"spacing[{k}] (m)", v) for k, v in enumerate(values))
 
 
 def available_memory() -> int:

@@ -113,6 +113,13 @@ def test_bad_input_is_named(surface):
     with pytest.raises(InputError, match="bulk modulus"):
         coupled_leakage(surface, MAT, P_EXT, p_in=1.0, p_out=0.0, trapped="pressure",
                         bulk_modulus=2e9)
+    # the loop controls (a fractional max_iter was truncated and ran into a
+    # NoConvergenceError; a negative jacobian_pockets was accepted)
+    for kwargs, match in (({"max_iter": 2.5}, "max_iter"), ({"anderson": -1}, "anderson"),
+                          ({"max_passes": 0}, "max_passes"),
+                          ({"jacobian_pockets": -1}, "jacobian_pockets")):
+        with pytest.raises(InputError, match=match):
+            coupled_leakage(surface, MAT, P_EXT, p_in=1.0, p_out=0.0, **kwargs)
 
 
 LOADS = [1e7, 2e7, 3e7, 6e7]

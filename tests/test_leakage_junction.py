@@ -97,3 +97,5 @@ def test_sealed_field_and_record():
     assert rec["leak_rate_critical_junction_y"] == pytest.approx(UM ** 3 / 12e-3)
     with pytest.raises(InputError, match="channel_factor"):
         critical_constriction(g, (UM, UM), channel_factor=0.5)
+    with pytest.raises(InputError, match="spacing must be the cell size"):
+        critical_constriction(g, UM)                              # was a TypeError

@@ -181,3 +181,8 @@ def test_bad_input_is_named():
         free_volume_network(-np.ones((3, 3)), None, SP)
     with pytest.raises(InputError, match="contact mask"):
         free_volume_network(np.ones((3, 3)), np.zeros((2, 3), bool), SP)
+    with pytest.raises(InputError, match=r"spacing must be the cell size \(dx, dy\)"):
+        free_volume_network(np.ones((3, 3)), None, 1e-6)          # was a TypeError
+    for name in ("gap_tol", "min_hydraulic_diameter"):                # were accepted
+        with pytest.raises(InputError, match=name):
+            free_volume_network(np.ones((3, 3)), None, SP, **{name: -1e-9})

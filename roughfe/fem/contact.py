@@ -53,8 +53,8 @@ from typing import Literal, Mapping
 
 import numpy as np
 
-from ..errors import (InputError, NoConvergenceError, check_finite_positive, check_instance,
-                      check_int)
+from ..errors import (InputError, NoConvergenceError, check_finite_nonnegative,
+                      check_finite_positive, check_instance, check_int)
 from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
@@ -124,9 +124,7 @@ class FemSolverOptions:
             raise InputError(f"method must be one of {METHODS}, got {self.method!r}")
         check_finite_positive("penalty_factor", self.penalty_factor)
         check_finite_positive("rtol (SNES relative tolerance)", self.rtol)
-        if not (isinstance(self.atol, (int, float)) and 0 <= self.atol < float("inf")):
-            raise InputError(f"atol (SNES absolute tolerance) must be finite and >= 0, "
-                             f"got {self.atol!r}")
+        check_finite_nonnegative("atol (SNES absolute tolerance)", self.atol)
         check_int("max_it (SNES iterations per step)", self.max_it, 1)
         if self.petsc_options is not None:
             object.__setattr__(self, "petsc_options", FrozenMapping(self.petsc_options))

@@ -60,7 +60,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..errors import InputError, NoConvergenceError, check_finite_positive, check_spacing
 from .petsc_tools import CG_AMG, ksp_solve, petsc_aij
 
 DEFAULT_PETSC_OPTIONS = CG_AMG
@@ -249,9 +249,7 @@ def check_reynolds_data(gap, spacing, mu, p_in, p_out, direction, wall_velocity)
     if direction not in ("x", "y"):
         raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
     mu = check_finite_positive("mu", mu)
-    if np.ndim(spacing) != 1 or len(spacing) != 2:
-        raise InputError(f"spacing must be the cell size (dx, dy) in m, got {spacing!r}")
-    dx, dy = (check_finite_positive("spacing", s) for s in spacing)
+    dx, dy = check_spacing(spacing)
     if not (np.isfinite(p_in) and np.isfinite(p_out)):
         raise InputError(f"p_in and p_out must be finite (Pa), got {p_in!r}, {p_out!r}")
     u = np.asarray(wall_velocity, dtype=float).reshape(-1)

@@ -83,7 +83,7 @@ from typing import Optional
 
 import numpy as np
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..errors import InputError, NoConvergenceError, check_finite_positive, check_int
 from ..optim.anderson import RejectedIterate, anderson_fixed_point, check_options
 from ..surfaces import Surface
 from .channel import check_absolute_pressures
@@ -289,8 +289,8 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
     mu = check_finite_positive("mu", mu)
     tol, max_iter, anderson, relaxation = check_options(tol, max_iter, anderson, relaxation)
-    if int(max_passes) < 1:
-        raise InputError(f"max_passes must be >= 1, got {max_passes!r}")
+    max_passes = check_int("max_passes (pocket passes)", max_passes, 1)
+    jacobian_pockets = check_int("jacobian_pockets", jacobian_pockets, 0)
     axis = 0 if direction == "x" else 1
     spacing = surface.spacing
     cell = float(np.prod(spacing))

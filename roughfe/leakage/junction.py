@@ -35,7 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import breadth_first_order
 
-from ..errors import InputError, check_finite_positive
+from ..errors import InputError, check_spacing
 from .finite_volume import components_reaching
 
 
@@ -151,7 +151,7 @@ def critical_constriction(gap, spacing, *, direction: str = "x", periodic: bool 
         raise InputError("gap must be a finite 2D array of metres >= 0")
     if direction not in ("x", "y"):
         raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
-    dx, dy = (check_finite_positive("spacing", s) for s in spacing)
+    dx, dy = check_spacing(spacing)
     factor = float(channel_factor)
     if not (np.isfinite(factor) and factor > 1):
         raise InputError(f"channel_factor must be > 1, got {channel_factor!r}")

@@ -69,7 +69,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ..errors import InputError, check_finite_positive
+from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
+                      check_spacing)
 from ..frozen import FrozenMapping
 
 _AXES = {"x": 0, "y": 1}
@@ -406,9 +407,10 @@ def free_volume_network(gap, contact, spacing, *, directions: Sequence[str] = ("
     if not np.all(np.isfinite(g)) or g.min() < 0:
         raise InputError("gap must be finite and >= 0 (m); got min "
                          f"{np.nanmin(g)!r} and {int((~np.isfinite(g)).sum())} non-finite value(s)")
-    if len(spacing) != 2:
-        raise InputError(f"spacing must be (dx, dy) in m, got {spacing!r}")
-    dx, dy = (check_finite_positive("spacing", s) for s in spacing)
+    dx, dy = check_spacing(spacing)
+    gap_tol = check_finite_nonnegative("gap_tol (m)", gap_tol)
+    min_hydraulic_diameter = check_finite_nonnegative("min_hydraulic_diameter (m)",
+                                                      min_hydraulic_diameter)
     if not directions or any(d not in _AXES for d in directions):
         raise InputError(f"directions must be a non-empty subset of ('x', 'y'), got {directions!r}")
     closed = g <= gap_tol

@@ -22,7 +22,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive
+from ..errors import InputError, check_finite_positive, check_int
 
 REFERENCES = ("Walker H.F., Ni P. (2011) SIAM J. Numer. Anal. 49:1715-1735 (Anderson)",)
 
@@ -68,10 +68,9 @@ def check_options(tol, max_iter, memory, relaxation) -> tuple:
     tol = check_finite_positive("tol", tol)
     if not (0 < relaxation <= 1):
         raise InputError(f"relaxation must be in (0, 1], got {relaxation!r}")
-    if int(max_iter) < 1 or int(memory) < 0:
-        raise InputError(f"max_iter must be >= 1 and the Anderson memory >= 0, got "
-                         f"{max_iter!r}, {memory!r}")
-    return tol, int(max_iter), int(memory), float(relaxation)
+    max_iter = check_int("max_iter (fixed-point iterations)", max_iter, 1)
+    memory = check_int("anderson (the Anderson memory)", memory, 0)
+    return tol, max_iter, memory, float(relaxation)
 
 
 def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
