@@ -100,19 +100,12 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
 def _adhesive_response(surface, material, loading, options) -> SweepResult:
     """``response(..., adhesion=law)``: the adhesive continuation in the approach."""
     from .bem.adhesion import adhesive_sweep
+    from .bem.adhesive_rules import check_adhesive_run
 
     law = options.pop("adhesion")
-    if options.get("hardness") is not None:
-        raise InputError("hardness and adhesion together are not supported (the adhesive "
-                         "solver has no pressure cap); give one of them")
-    for name, default in (("solver", "auto"), ("coarse_correction", None)):
-        if options.get(name, default) != default:
-            raise InputError(f"{name} does not apply with adhesion (its own minimiser on "
-                             f"the gap)")
-    if loading.controls_pressure:
-        raise InputError("adhesion runs in displacement control (the load-approach curve "
-                         "has unstable parts): give approaches (delta, deltas, n_steps), "
-                         "not mean pressures")
+    check_adhesive_run(hardness=options.get("hardness"), solver=options.get("solver", "auto"),
+                       coarse_correction=options.get("coarse_correction"),
+                       pressure_control=loading.controls_pressure)
     extra = {k: options[k] for k in ("tol", "max_iter") if options.get(k) is not None}
     return adhesive_sweep(surface, material, law, **loading.sweep_arguments(),
                           unload=bool(options.get("unload")),

@@ -337,3 +337,26 @@ def test_adhesive_sweep_default_approaches():
         adhesive_sweep(s, mat, law, [1e-9], n_steps=3)
     with pytest.raises(InputError, match="n_steps must be an integer >= 1"):
         adhesive_sweep(s, mat, law, n_steps=0)
+
+
+def test_the_adhesive_rules_speak_each_front_end_s_words():
+    """One function holds the rules; the library and the command line get the same
+    message in their own vocabulary."""
+    from roughfe.bem.adhesive_rules import check_adhesive_run
+    from roughfe.cli.options import ADHESION_WORDS
+    check_adhesive_run()                                   # the defaults keep every rule
+    cases = [({"hardness": 1e9}, "hardness and adhesion", "--hardness and --adhesion"),
+             ({"solver": "pk"}, "solver does not apply with adhesion",
+              "--solver does not apply with --adhesion"),
+             ({"coarse_correction": False}, "coarse_correction does not apply",
+              "--coarse-correction does not apply"),
+             ({"pressure_control": True}, "give approaches (delta, deltas, n_steps), not mean",
+              "give --delta or --steps, not --pressure")]
+    for kwargs, library, cli in cases:
+        with pytest.raises(InputError) as info:
+            check_adhesive_run(**kwargs)
+        assert library in str(info.value)
+        with pytest.raises(InputError) as info:
+            check_adhesive_run(**kwargs, words=ADHESION_WORDS)
+        assert cli in str(info.value)
+

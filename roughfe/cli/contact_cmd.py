@@ -13,17 +13,17 @@ from pathlib import Path
 import numpy as np
 
 from ..bem import KERNELS
-from ..errors import InputError
 from ..model import Loading, Material
 from ..response import response
 from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5, write_results_json
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
-from .options import (add_contact_physics_options, add_detrend_option, add_material_options,
-                      add_output_folder, add_run_options, add_surface_options,
-                      check_small_strain, contact_physics_from_args, material_from_args,
-                      output_folder_of, positive_float, positive_int, surface_from_args)
+from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
+                      add_material_options, add_output_folder, add_run_options,
+                      add_surface_options, check_small_strain, contact_physics_from_args,
+                      material_from_args, output_folder_of, positive_float, positive_int,
+                      surface_from_args)
 
 DEFAULT_STEPS = Loading.DEFAULT_STEPS
 #: --coarse-correction -> solve_contact(coarse_correction=)
@@ -151,15 +151,11 @@ def _run(args) -> int:
 def _adhesive_sweep(args, surface, material, law, tol):
     """The adhesive continuation in the approach (``--delta`` or ``--steps``)."""
     from ..bem.adhesion import adhesive_sweep
+    from ..bem.adhesive_rules import check_adhesive_run
 
-    if args.pressure is not None:
-        raise InputError("--adhesion runs in displacement control (the load-approach curve "
-                         "has unstable parts): give --delta or --steps, not --pressure")
-    for flag, value in (("--solver", args.solver), ("--coarse-correction",
-                                                     args.coarse_correction)):
-        if value != "auto":
-            raise InputError(f"{flag} does not apply with --adhesion (its own minimiser on "
-                             f"the gap)")
+    check_adhesive_run(solver=args.solver, coarse_correction=(
+        None if args.coarse_correction == "auto" else args.coarse_correction),
+        pressure_control=args.pressure is not None, words=ADHESION_WORDS)
     return adhesive_sweep(surface, material, law, args.delta,
                           n_steps=None if args.delta else args.steps,
                           unload=args.unload, kernel=args.kernel, tol=tol)

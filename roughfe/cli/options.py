@@ -236,12 +236,18 @@ def contact_physics_from_args(args) -> dict:
     """``{"adhesion": AdhesionLaw or None, "hardness": float or None, "unload": bool}``
     of :func:`add_contact_physics_options` (the keyword options of
     :func:`roughfe.response.response`); --hardness with --adhesion is one clear error."""
-    from ..errors import InputError
     law = adhesion_from_args(args)
-    if law is not None and args.hardness is not None:
-        raise InputError("--hardness and --adhesion together are not supported (the adhesive "
-                         "solver has no pressure cap); give one of them")
+    if law is not None:
+        from ..bem.adhesive_rules import check_adhesive_run
+        check_adhesive_run(hardness=args.hardness, words=ADHESION_WORDS)
     return {"adhesion": law, "hardness": args.hardness, "unload": bool(args.unload)}
+
+
+#: the command line's words for the names in the messages of
+#: :func:`roughfe.bem.adhesive_rules.check_adhesive_run`
+ADHESION_WORDS = {"hardness": "--hardness", "adhesion": "--adhesion", "solver": "--solver",
+                  "coarse_correction": "--coarse-correction",
+                  "approaches": "--delta or --steps", "mean pressures": "--pressure"}
 
 
 # -- outputs and runs ----------------------------------------------------------------------
