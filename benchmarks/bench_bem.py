@@ -151,10 +151,17 @@ def _tamaas(heights, pressure, hardness=None):
             os.dup2(saved, 2)
             os.close(saved)
         log.seek(0)
-        its = [int(r.split()[0]) for r in log.read().splitlines()
-               if r.split() and r.split()[0].isdigit()]
+        # one table per inner solve ("Iter Cost_f Error" header, then one row every 100
+        # iterations and the last one); KatoSaturated may log a second, short one
+        blocks = []
+        for r in log.read().splitlines():
+            words = r.split()
+            if words and words[0] == "Iter":
+                blocks.append(0)
+            elif words and words[0].isdigit() and blocks:
+                blocks[-1] = int(words[0])
     p = np.array(model.traction, copy=True).reshape(heights.shape)
-    return cpu, p, (its[-1] if its else None)
+    return cpu, p, (sum(blocks) if blocks else None)
 
 
 def case_elastic(n, loads, tamaas, sweep):
