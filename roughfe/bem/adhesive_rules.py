@@ -12,12 +12,17 @@ def check_adhesive_run(*, hardness=None, solver="auto", coarse_correction=None,
     """Raise :class:`InputError` unless the run keeps the rules: no hardness (the
     adhesive solver has no pressure cap), no choice of the non-adhesive solver or of its
     two-level correction (the adhesive one is its own minimiser on the gap), and
-    displacement control (the load-approach curve has unstable parts). ``words`` maps the names used in the messages (``hardness``,
-    ``adhesion``, ``solver``, ``coarse_correction``, ``approaches``, ``mean pressures``)
-    to the front end's own (the command line's flags); by default they are the keyword
-    arguments of the library."""
+    displacement control (the load-approach curve has unstable parts).
+
+    ``words`` maps the names used in the messages (``hardness``, ``adhesion``,
+    ``solver``, ``coarse_correction``, ``approaches``, ``mean pressures``) to the front
+    end's own (the command line's flags); by default they are the library's keyword
+    arguments."""
     say = {"approaches": "approaches (delta, deltas, n_steps)", **(words or {})}
-    word = lambda name: say.get(name, name)          # noqa: E731
+
+    def word(name):
+        return say.get(name, name)
+
     if hardness is not None:
         raise InputError(f"{word('hardness')} and {word('adhesion')} together are not "
                          f"supported (the adhesive solver has no pressure cap); give one "

@@ -151,7 +151,8 @@ def register(sub):
     add_material_options(b, "material (stored in the database; the thesis used E = 1 MPa: "
                             "pressures scale with E*)")
     s = b.add_argument_group("Sobol design")
-    s.add_argument("--seed", type=nonnegative_int, default=20240, help="Sobol scrambling seed (recorded)")
+    s.add_argument("--seed", type=nonnegative_int, default=20240,
+                   help="Sobol scrambling seed (recorded)")
     s.add_argument("--no-scramble", action="store_true", help="unscrambled Sobol sequences")
     s.add_argument("--ridges", type=positive_int, default=3,
                    help="ridges M per surface genome (--dim 2)")

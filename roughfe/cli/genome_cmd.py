@@ -284,7 +284,8 @@ def register(sub):
                                   "gamma = 1.5, M = 8, lambda1 = 1 mm) with seeded phases "
                                   "(the thesis does not publish its phases).")
     add_output_file(p, "genome JSON file to write")
-    p.add_argument("--seed", type=nonnegative_int, default=0, help="seed of the (unpublished) phases")
+    p.add_argument("--seed", type=nonnegative_int, default=0,
+                   help="seed of the (unpublished) phases")
     p.add_argument("--n-max", type=positive_int, default=22,
                    help="last chromosome with a phase (22 covers the 100x scale)")
     p.set_defaults(func=_example)
@@ -311,7 +312,8 @@ def register(sub):
     p.add_argument("profiles", nargs="+", metavar="ACQUISITION.npz",
                    help="acquisitions of one profile or surface (same N, nested windows "
                         "centred on the origin)")
-    p.add_argument("--seed", type=nonnegative_int, default=0, help="seed of the M likelihood and the phase draws")
+    p.add_argument("--seed", type=nonnegative_int, default=0,
+                   help="seed of the M likelihood and the phase draws")
     p.add_argument("--ridges", type=positive_int, default=None,
                    help="impose M (default: maximum likelihood)")
     p.add_argument("--tolerance", type=positive_float, default=0.05,
@@ -345,7 +347,8 @@ def register(sub):
     p.add_argument("--fractions", type=positive_float, nargs="+", default=list(DEFAULT_FRACTIONS),
                    help="nested window lengths as fractions of the row")
     p.add_argument("--nodes", type=positive_int, default=512, help="nodes per acquisition")
-    p.add_argument("--seed", type=nonnegative_int, default=0, help="seed of the M likelihood and phase draws")
+    p.add_argument("--seed", type=nonnegative_int, default=0,
+                   help="seed of the M likelihood and phase draws")
     _add_response_options(p, "*", "BEM kernels for A(p), K(p) (none: sequencing only)")
     p.add_argument("--tolerance", type=positive_float, default=0.05,
                    help="relative rms error below which a profile counts as WM-like")
@@ -384,6 +387,7 @@ def register(sub):
                    help="random phase draws per number of ridges M")
     p.add_argument("--max-ridges", type=positive_int, default=20,
                    help="largest number of ridges M (from 2)")
-    p.add_argument("--seed", type=nonnegative_int, default=0, help="seed of the random phases")
+    p.add_argument("--seed", type=nonnegative_int, default=0,
+                   help="seed of the random phases")
     add_output_file(p, "figure (.png) to write")
     p.set_defaults(func=_validity)

@@ -9,6 +9,7 @@ contact sets (:mod:`.sensitivities`). Eq. (4.2) is re-applied at every evaluatio
 """
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,7 +78,7 @@ class GcmmaOptions:
         for name in ("n_it_sog", "n_it_cross", "n_it_micro", "n_micro"):
             check_int(f"GcmmaOptions.{name}", getattr(self, name), 0)
         f = self.fraction
-        if isinstance(f, bool) or not isinstance(f, (int, float)) or not 0 < f <= 1:
+        if isinstance(f, bool) or not isinstance(f, numbers.Real) or not 0 < f <= 1:
             raise InputError(f"GcmmaOptions.fraction must be in (0, 1], got {f!r}")
         check_finite_positive("GcmmaOptions.eps (forward-difference step, unit box)", self.eps)
         for name, allowed in (("bound", BOUNDS), ("formulation", FORMULATIONS),
