@@ -335,12 +335,11 @@ def random_genome(A, H, gamma, lambda1, M, n_max, *, rng, n_first=1, angles=None
         Number of ridges.
     n_max : int
         Largest chromosome index that gets a phase column (e.g. 22 for Table 1 at 100x).
-    rng : numpy.random.Generator or int
-        Source of the phases (an int is used as a seed). The seed, when an int, is kept
-        in ``metadata["seed"]``.
+    rng : numpy.random.Generator, int or None
+        Source of the phases (an int is used as a seed; None draws a fresh one). The seed,
+        when known (not for a Generator), is kept in ``metadata["seed"]``.
     """
     gen, seed = resolve_rng(rng)
-    seed = seed if isinstance(rng, (int, np.integer)) else None
     M = check_int("M (number of ridges)", M, 1)
     n_first = check_int("n_first (index of the first phase column)", n_first, 1)
     n_max = check_int(f"n_max (last chromosome index, >= n_first = {n_first})", n_max, n_first)
