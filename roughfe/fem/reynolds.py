@@ -60,7 +60,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive, check_spacing
+from ..errors import (InputError, NoConvergenceError, check_finite_nonnegative,
+                      check_finite_positive, check_spacing)
 from .petsc_tools import CG_AMG, ksp_solve, petsc_aij
 
 DEFAULT_PETSC_OPTIONS = CG_AMG
@@ -294,8 +295,7 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
 
     gap, (dx, dy), mu, u = check_reynolds_data(gap, spacing, mu, p_in, p_out, direction,
                                                wall_velocity)
-    if not (h_min >= 0 and np.isfinite(h_min)):
-        raise InputError(f"h_min must be finite and >= 0 (m), got {h_min!r}")
+    h_min = check_finite_nonnegative("h_min (m)", h_min)
 
     h = np.maximum(gap, h_min) if h_min > 0 else gap
     nx, ny = h.shape

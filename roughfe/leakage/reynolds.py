@@ -24,7 +24,7 @@ from typing import Mapping, Optional
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive
+from ..errors import InputError, check_finite_nonnegative, check_finite_positive
 from ..fem.reynolds import solve_reynolds_fe
 from .finite_volume import solve_reynolds_fv
 
@@ -173,8 +173,7 @@ def reynolds_flow(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     if scheme not in SCHEMES:
         raise InputError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
     g = np.asarray(gap, dtype=float)
-    if not (np.isfinite(h_min) and h_min >= 0):
-        raise InputError(f"h_min must be finite and >= 0 (m), got {h_min!r}")
+    h_min = check_finite_nonnegative("h_min (m)", h_min)
     h = np.maximum(g, h_min) if h_min > 0 else g
     if scheme == "fv":
         sol = solve_reynolds_fv(h, spacing, direction=direction, mu=mu, p_in=p_out + dp,
