@@ -88,6 +88,32 @@ def check_spacing(spacing, ndim=2):
     return tuple(check_finite_positive(f"spacing[{k}] (m)", v) for k, v in enumerate(values))
 
 
+def check_real_array(name, value, ndim=None, unit="m"):
+    """Return ``value`` as a float ndarray (not copied when it already is one) or raise
+    :class:`InputError` naming what is wrong: complex or non-numeric entries, a number of
+    axes not in ``ndim`` (an int or a tuple of ints; None: any), non-finite entries
+    (their count and the first one's index)."""
+    import numpy as np
+
+    if np.iscomplexobj(value):     # np.asarray(..., float) would drop the imaginary part
+        raise InputError(f"{name} must be real numbers ({unit}), got a complex array")
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a numeric array ({unit}), "
+                         f"got {type(value).__name__}") from None
+    allowed = (ndim,) if isinstance(ndim, int) else ndim
+    if allowed is not None and a.ndim not in allowed:
+        axes = " or ".join(f"{k}D" for k in allowed)
+        raise InputError(f"{name} must be a {axes} array, got shape {a.shape}")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise InputError(f"{name} must be finite: {int(bad.sum())} non-finite value(s), "
+                         f"first at index {idx} = {a[idx]!r}")
+    return a
+
+
 def available_memory() -> int:
     """Bytes of memory this process may still use: ``MemAvailable`` on Linux, else the
     physical memory."""

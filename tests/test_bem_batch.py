@@ -158,6 +158,15 @@ def test_bad_input_is_refused():
         solve_batch_exact(op(), np.zeros((2, N)), delta=1e-7)
     with pytest.raises(InputError, match="increasing"):
         batch_sweep(op(), h, np.array([[2.0, 1.0], [1.0, 2.0]]))
+    bad = h.copy()
+    bad[1, 7] = np.inf
+    for call in (lambda: solve_batch(op(), bad, delta=1e-7),
+                 lambda: solve_batch_exact(op(), bad, delta=1e-7),
+                 lambda: batch_sweep(op(), bad, np.array([[1.0, 2.0], [1.0, 2.0]]))):
+        with pytest.raises(InputError, match=r"heights must be finite: 1 non-finite"):
+            call()
+    with pytest.raises(InputError, match="pressures must be a numeric array"):
+        batch_sweep(op(), h, "light")
     with pytest.raises(InputError, match="profile operator"):
         solve_batch_exact(influence_operator((N,), (L,), 1e6, "spectral"), h, delta=1e-7)
     with pytest.raises(InputError, match="mean_pressure"):

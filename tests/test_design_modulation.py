@@ -56,6 +56,15 @@ def test_positive_depth_moves_short_wave_roughness_off_the_crests():
         wave_split(h, cut=0.0)
     with pytest.raises(InputError, match="long and short waves"):
         modulated_heights(np.ones((8, 8)), 0.3)
+    # a non-array, a profile or a NaN is named, not a numpy error from inside
+    with pytest.raises(InputError, match="heights must be a numeric array"):
+        crest_roughness("x")
+    with pytest.raises(InputError, match=r"heights must be a 2D array, got shape \(8,\)"):
+        wave_split(np.ones(8))
+    bad = h.copy()
+    bad[3, 4] = np.nan
+    with pytest.raises(InputError, match=r"1 non-finite value\(s\), first at index \(3, 4\)"):
+        modulated_heights(bad, 0.3)
 
 
 def test_a_modulated_design_round_trips_and_an_unmodulated_one_stays_version_1():

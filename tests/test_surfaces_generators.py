@@ -197,6 +197,9 @@ def test_generators_reject_bad_input(call, words):
     (np.zeros((4, 4)), -1.0, ["size", "-1.0"]),
     (np.zeros((4, 4)), (1.0, 0.0), ["size[1]", "0.0"]),
     (np.zeros((4, 4)), "1e-4 m", ["size", "'1e-4 m'"]),
+    (np.zeros((4, 4)) * 1j, 1.0, ["real", "complex"]),
+    ("flat", 1.0, ["numeric array", "str"]),
+    (np.zeros((1, 4)), 1.0, ["at least 2 points", "(1, 4)"]),
 ])
 def test_surface_rejects_bad_input(heights, size, words):
     with pytest.raises(ValueError) as info:

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, NoConvergenceError
+from ..errors import InputError, NoConvergenceError, check_real_array
 from .operators import InfluenceOperator, influence_operator
 from .solvers import kkt_residual, penetration_start, pr_beta, step_length
 
@@ -121,10 +121,9 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
     max_iter : int
         CG iterations; a row above ``tol`` after them raises NoConvergenceError.
     """
-    h = np.asarray(heights, dtype=float)
-    if h.ndim != len(op.shape) + 1 or h.shape[1:] != tuple(op.shape) or h.shape[0] < 1 \
-            or not np.all(np.isfinite(h)):
-        raise InputError(f"heights must be finite, shape (B, {', '.join(map(str, op.shape))}),"
+    h = check_real_array("heights", heights, len(op.shape) + 1)
+    if h.shape[1:] != tuple(op.shape) or h.shape[0] < 1:
+        raise InputError(f"heights must have shape (B, {', '.join(map(str, op.shape))}),"
                          f" got {h.shape}")
     if (delta is None) == (mean_pressure is None):
         raise InputError("give exactly one of delta (m) or mean_pressure (Pa)")

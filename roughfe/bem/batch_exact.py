@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_real_array
 from ..model import central_differences
 from .batch import BatchOperator, BatchState, BatchSweep, _rows, solve_batch
 from .operators import InfluenceOperator
@@ -128,12 +128,12 @@ def solve_batch_exact(op: InfluenceOperator, heights, *, delta=None, mean_pressu
     larger load), so that most sets are solved by a small Schur complement
     (:func:`_set_solutions`).
     """
-    h = np.asarray(heights, dtype=float)
+    h = check_real_array("heights", heights, 2)
     if not _exact_ok(op):
         raise InputError("solve_batch_exact takes a non-periodic profile operator of at most "
                          f"4096 points, got {op.name!r} on {op.shape}")
-    if h.ndim != 2 or h.shape[1] != op.shape[0] or not np.all(np.isfinite(h)):
-        raise InputError(f"heights must be finite, shape (B, {op.shape[0]}), got {h.shape}")
+    if h.shape[1] != op.shape[0]:
+        raise InputError(f"heights must have shape (B, {op.shape[0]}), got {h.shape}")
     if (delta is None) == (mean_pressure is None):
         raise InputError("give exactly one of delta (m) or mean_pressure (Pa)")
     B, n = h.shape
@@ -262,9 +262,10 @@ def batch_sweep(op: InfluenceOperator, heights, pressures=None, *, deltas=None,
     if method == "auto":
         method = "exact" if _exact_ok(op) else "pk"
     key, name = ("mean_pressure", "pressures") if deltas is None else ("delta", "deltas")
-    h = np.asarray(heights, dtype=float)
-    pr = np.asarray(pressures if deltas is None else deltas, dtype=float)
-    if pr.ndim != 2 or pr.shape[0] != h.shape[0] or pr.shape[1] < 2 \
+    h = check_real_array("heights", heights, len(op.shape) + 1)
+    pr = check_real_array(name, pressures if deltas is None else deltas, 2,
+                          "Pa" if deltas is None else "m")
+    if pr.shape[0] != h.shape[0] or pr.shape[1] < 2 \
             or np.any(np.diff(pr, axis=1) <= 0):
         raise InputError(f"{name} must be (B, m >= 2), increasing along each row, got "
                          f"shape {pr.shape}")

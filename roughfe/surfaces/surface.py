@@ -23,7 +23,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InputError, check_int
+from ..errors import InputError, check_int, check_real_array
 from ..frozen import FrozenMapping
 
 
@@ -72,23 +72,9 @@ class Surface:
     metadata: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self):
-        if np.iscomplexobj(self.heights):  # np.array(..., float) would drop the imaginary part
-            raise InputError("heights must be real numbers (m), got a complex array")
-        try:
-            h = np.array(self.heights, dtype=float, copy=True)
-        except (TypeError, ValueError):
-            raise InputError("heights must be a numeric array of metres") from None
-        if h.ndim not in (1, 2):
-            raise InputError(
-                f"heights must be 1D (profile) or 2D (surface), got an array of shape {h.shape}")
+        h = check_real_array("heights", self.heights, (1, 2)).copy()
         if min(h.shape) < 2:
             raise InputError(f"heights need at least 2 points along each axis, got shape {h.shape}")
-        bad = ~np.isfinite(h)
-        if bad.any():
-            idx = tuple(int(i) for i in np.argwhere(bad)[0])
-            raise InputError(
-                f"heights must be finite: {int(bad.sum())} non-finite value(s), first at index "
-                f"{idx} = {h[idx]!r}")
         h.setflags(write=False)
         object.__setattr__(self, "heights", h)
         object.__setattr__(self, "size", _as_size(self.size, h.ndim))

@@ -22,14 +22,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_real_array
 from ..periodic import lattice_wavevectors
 from .model import Design
 
 
 def peak_height(heights) -> float:
     """z_max = (max Z - mean Z) / rms Z (-): the highest node over the mean in rms heights."""
-    h = np.asarray(heights, dtype=float)
+    h = check_real_array("heights", heights)
     return float((h.max() - h.mean()) / h.std())
 
 
@@ -66,7 +66,8 @@ def clipped_phases(heights, modes, level, n_iter):
     with the phase of the clipped field (the conjugate mode to match); the other modes
     keep their values. Returns the heights after every step (list, mean removed) and the
     phase rotation (rad) of every mode after every step (list of shape (K,) arrays)."""
-    z = np.asarray(heights, dtype=float) - np.mean(heights)
+    z = check_real_array("heights", heights, 2)
+    z = z - z.mean()
     spec = np.fft.fft2(z)
     i, j = modes[:, 0], modes[:, 1]
     ci, cj = -i % z.shape[0], -j % z.shape[1]

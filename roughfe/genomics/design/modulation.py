@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_real_array
 
 #: the split between long and short waves, a fraction of each axis' Nyquist wavenumber
 MODULATION_CUT = 0.5
@@ -39,10 +39,9 @@ MODULATION_CUT = 0.5
 def wave_split(heights, cut: float = MODULATION_CUT):
     """``(Z_lo, Z_hi)`` of periodic ``heights`` (m): the modes at ``|q| <= cut q_N`` and the
     rest, mean removed (module notes; ``Z_lo + Z_hi = Z - mean Z``)."""
-    h = np.asarray(heights, dtype=float)
-    if h.ndim != 2 or not 0 < cut < np.sqrt(2):
-        raise InputError(f"a 2D height array and 0 < cut < sqrt 2 needed, got shape "
-                         f"{h.shape} and cut {cut!r}")
+    h = check_real_array("heights", heights, 2)
+    if not 0 < cut < np.sqrt(2):
+        raise InputError(f"0 < cut < sqrt 2 needed, got cut {cut!r}")
     h = h - h.mean()
     n0, n1 = h.shape
     r = np.hypot(np.fft.fftfreq(n0)[:, None] * 2, np.fft.fftfreq(n1)[None, :] * 2)
