@@ -50,16 +50,63 @@ def test_tiny_contact_sweep_study_runs_and_is_reproducible(tmp_path):
     assert collect(tmp_path / "b", parquet=False)[0][0].read_text() == paths[0].read_text()
 
 
-def test_contact_sweep_rejects_unknown_generator_per_task(tmp_path):
+def test_a_bad_value_anywhere_in_the_grid_refuses_the_study_before_any_task(tmp_path):
+    """The analysis' input check runs on every distinct task before submission: one bad
+    grid value (an unknown generator) or fixed value (E < 0) fails the study at once,
+    naming the task's parameters, and nothing is written (no task ran)."""
     pytest.importorskip("roughfe.bem")
-    study = {"study": {"analysis": "contact_sweep", "output": str(tmp_path / "g"),
-                       "max_attempts": 1},
-             "grid": {"generator": ["rmd", "fourier"]}, "fixed": {"m": 3, "n_steps": 2}}
-    summary = run_study(spec_from_mapping(study), workers=1, progress=False)
-    assert (summary.n_done, summary.n_failed) == (1, 1)
-    (failure,) = study_status(tmp_path / "g").failures
-    assert failure[1] == {"generator": "fourier", "m": 3, "n_steps": 2}
-    assert "generator must be 'rmd' or 'spectral'" in failure[2]
+    base = {"study": {"analysis": "contact_sweep", "output": str(tmp_path / "g"),
+                      "max_attempts": 1}}
+    study = {**base, "grid": {"generator": ["rmd", "fourier"]},
+             "fixed": {"m": 3, "n_steps": 2}}
+    with pytest.raises(InputError) as info:
+        run_study(spec_from_mapping(study), workers=1, progress=False)
+    assert "generator must be 'rmd' or 'spectral', got 'fourier'" in str(info.value)
+    assert "{'generator': 'fourier', 'm': 3, 'n_steps': 2}" in str(info.value)
+    assert not (tmp_path / "g").exists()
+    study = {**base, "grid": {"m": [3, 4]}, "fixed": {"E": -1.0}}
+    with pytest.raises(InputError, match=r"E \(Young's modulus, Pa\)"):
+        run_study(spec_from_mapping(study), workers=1, progress=False)
+    assert not (tmp_path / "g").exists()
+
+
+@pytest.mark.parametrize("name, params, words", [
+    ("contact_sweep", {"fractal_dimension": 3.5}, "fractal_dimension D of a surface"),
+    ("contact_sweep", {"kernel": "fft"}, "kernel must be one of"),
+    ("contact_sweep", {"solver": "cg"}, "solver must be one of"),
+    ("contact_sweep", {"tol": 0.0}, "tol"),
+    ("contact_sweep", {"nu": 0.6}, "nu"),
+    ("contact_sweep", {"n_steps": 0}, "n_steps"),
+    ("leakage", {"D": 2.3, "m": 3, "mu": -1.0}, "mu (Pa s)"),
+    ("leakage", {"D": 2.3, "m": 3, "direction": "z"}, "direction must be"),
+    ("leakage", {"D": 1.5, "m": 3}, "D (fractal dimension)"),
+    ("leakage", {"D": 2.3, "m": 3, "pressure_drop": 0.0}, "pressure_drop"),
+    ("genome_db", {"gamma": 1.5, "hurst": 0.7, "n_nodes": 8}, "n_nodes must be >= 16"),
+    ("genome_db", {"gamma": 1.5, "hurst": 0.7, "E": 0.0}, "youngs_modulus"),
+    ("genome_entry", {"entry": {"label": "a"}}, "needs gamma, hurst and phases"),
+    ("genome_entry", {"entry": {"label": "a", "gamma": 1.5, "hurst": 0.7, "phases": 1},
+                      "threshold": 1.5}, "threshold must lie in (0, 1)"),
+])
+def test_the_input_checks_of_the_analyses_name_the_bad_value(name, params, words):
+    pytest.importorskip("roughfe.leakage.study")
+    with pytest.raises(InputError) as info:
+        check_parameters(name, params)
+    assert words in str(info.value) and f"analysis {name!r}, task" in str(info.value)
+
+
+def test_the_input_checks_accept_the_defaults_and_do_no_work():
+    """Good values pass every check quickly (no surface is generated: m = 13 would take
+    seconds and 500 MB with RMD), and the check is the task's own first step."""
+    import time
+
+    pytest.importorskip("roughfe.leakage.study")
+    t0 = time.perf_counter()
+    check_parameters("contact_sweep", {"m": 13})
+    check_parameters("leakage", {"D": 2.3, "m": 13})
+    check_parameters("genome_db", {"gamma": 1.5, "hurst": 0.7})
+    check_parameters("genome_entry", {"entry": {"label": "a", "source": "sobol",
+                                                "gamma": 1.5, "hurst": 0.7, "phases": 3}})
+    assert time.perf_counter() - t0 < 2.0
 
 
 def test_genome_db_parameters_bind():

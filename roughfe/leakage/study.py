@@ -77,15 +77,16 @@ def leakage_task(D: float, m: int, seed: int, n_steps: int = 6, L: float = 1.0e-
         (``free_volume_star``, ``percolating_volume_star``, ``trapped_volume_star``,
         ``percolates_x/y``, ``percolates_reynolds_x/y``, ``leak_rate``, ...).
     """
+    material = leakage_inputs(D=D, m=m, n_steps=n_steps, L=L, E=E, nu=nu, mu=mu,
+                              pressure_drop=pressure_drop, reynolds=reynolds,
+                              direction=direction, kernel=kernel)
     n_steps = int(n_steps)
-    if n_steps < 1:
-        raise InputError(f"n_steps must be >= 1, got {n_steps!r}")
     surface = rmd_surface(int(m), float(D), float(L), rng=int(seed))
     sigma = float(np.std(surface.heights))
     h_s = float(np.ptp(surface.heights))
     m0_ref, m2_ref, _ = spectral_moments(surface)
     deltas = h_s * np.arange(1, n_steps + 1) / n_steps
-    sweep = leakage_sweep(surface, Material(E, nu), deltas=deltas, kernel=kernel,
+    sweep = leakage_sweep(surface, material, deltas=deltas, kernel=kernel,
                           direction=direction, mu=mu, pressure_drop=pressure_drop,
                           reynolds=reynolds, sigma=sigma)
     records = []
@@ -125,6 +126,31 @@ def _stats(values):
     if vals.size == 0:
         return None, None
     return float(vals.mean()), float(vals.std(ddof=1)) if vals.size > 1 else 0.0
+
+
+def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, direction,
+                   kernel):
+    """The input check of :func:`leakage_task` (its keywords without ``seed``): the RMD
+    parameters, the step count, the fluid and the flow directions checked, the
+    :class:`Material` returned; no surface is generated (the study runner calls it on
+    every task before submitting any, :func:`roughfe.study.analyses.check_parameters`)."""
+    from ..bem.operators import KERNELS
+    from ..errors import check_finite_positive, check_in_open_interval, check_int
+    from .analysis import _direction_list
+
+    check_in_open_interval("D (fractal dimension)", D, 2.0, 3.0)
+    check_int("m (RMD levels)", m, 1)
+    check_int("n_steps", n_steps, 1)
+    check_finite_positive("L (m)", L)
+    check_finite_positive("mu (Pa s)", mu)
+    if not isinstance(reynolds, bool):
+        raise InputError(f"reynolds must be true or false, got {reynolds!r}")
+    if reynolds:      # the Reynolds solve's own rule (no wall velocity here: > 0)
+        check_finite_positive("pressure_drop (Pa)", pressure_drop)
+    _direction_list(direction)
+    if kernel not in ("auto",) + KERNELS:
+        raise InputError(f"kernel must be one of {('auto',) + KERNELS}, got {kernel!r}")
+    return Material(E, nu)
 
 
 def summarise(records: Iterable[dict]) -> dict:

@@ -1,9 +1,16 @@
 """The explicit registry of analyses a study can run.
 
 ``ANALYSES`` maps a name to an :class:`Analysis`: the dotted path ``"module:function"``
-of a task function, a version string and a one-line description. Nothing is imported
-until a task runs (or the runner checks the parameters before submitting), so a missing
-or not-yet-installed analysis gives a clear error at run time, not at import time.
+of a task function, a version string, a one-line description and, optionally, the
+dotted path of its input check. Nothing is imported until a task runs (or the runner
+checks the parameters before submitting), so a missing or not-yet-installed analysis
+gives a clear error at run time, not at import time.
+
+The input check is the first part of the task itself (it builds the task's inputs and
+refuses bad values), so a study whose fixed or grid values are out of range (``E = -1``,
+``D = 3.5``, an unknown kernel) is refused by :func:`check_parameters` before anything
+is submitted, naming the task's parameters, instead of failing every task on the
+workers. It never does the expensive work (no surface is generated, nothing solved).
 
 A task function is called as ``function(**params, seed=seed)`` and returns one JSON-safe
 record (a dict) or a list of them; each record becomes one row of the collected table,
@@ -37,11 +44,16 @@ class Analysis:
         Part of every task key; change it when the results change.
     description : str
         One line for ``roughfe study run --help``.
+    inputs : str
+        ``"package.module:function"`` of the input check, called with the task's
+        keywords (defaults applied, without ``seed``): raises InputError for bad values,
+        cheaply; the task calls the same function first. Empty: names are checked only.
     """
 
     target: str
     version: str
     description: str
+    inputs: str = ""
 
 
 ANALYSES = {
@@ -50,34 +62,42 @@ ANALYSES = {
         "analytic function of x, y (cheap; options to sleep and to fail) for testing the runner"),
     "contact_sweep": Analysis(
         "roughfe.study.analyses:contact_sweep_task", "1",
-        "generate a random surface, run the BEM load sweep (roughfe.response.response)"),
+        "generate a random surface, run the BEM load sweep (roughfe.response.response)",
+        "roughfe.study.analyses:contact_sweep_inputs"),
     "leakage": Analysis(
         "roughfe.leakage.study:leakage_task", "1",
-        "leakage of one surface over approach steps (thesis Sec. 2.4)"),
+        "leakage of one surface over approach steps (thesis Sec. 2.4)",
+        "roughfe.leakage.study:leakage_inputs"),
     "genome_db": Analysis(
         "roughfe.study.analyses:genome_db_task", "1",
         "one entry of the genome database: WM genome, Alg. 2 macro/micro, BEM sweep "
-        "(roughfe.genomics.database.genome_entry_task)"),
+        "(roughfe.genomics.database.genome_entry_task)",
+        "roughfe.study.analyses:genome_db_inputs"),
     "genome_entry": Analysis(
         "roughfe.study.analyses:genome_entry_study_task", "1",
         "one given genome (Sobol design or a genome JSON) of a genome database: Alg. 2, BEM "
-        "sweep; what `roughfe db build|extend` run"),
+        "sweep; what `roughfe db build|extend` run",
+        "roughfe.study.analyses:genome_entry_study_inputs"),
 }
 
 
-def resolve(name: str):
-    """Import and return the task function of analysis ``name``.
+def resolve(name: str, what: str = "target"):
+    """Import and return the task function of analysis ``name`` (``what="inputs"``: its
+    input check, None when it has none).
 
     Raises :class:`InputError` naming the analysis and the module when it cannot be
     imported (for example when that part of roughfe is not installed yet).
     """
     if name not in ANALYSES:
         raise InputError(f"analysis {name!r} is unknown; choose from {sorted(ANALYSES)}")
-    module_name, _, attr = ANALYSES[name].target.partition(":")
+    path = getattr(ANALYSES[name], what)
+    if not path:
+        return None
+    module_name, _, attr = path.partition(":")
     try:
         module = importlib.import_module(module_name)
     except ImportError as exc:
-        raise InputError(f"analysis {name!r} needs {ANALYSES[name].target}, which cannot be "
+        raise InputError(f"analysis {name!r} needs {path}, which cannot be "
                          f"imported here: {exc}") from None
     try:
         return getattr(module, attr)
@@ -86,19 +106,31 @@ def resolve(name: str):
 
 
 def check_parameters(name: str, params) -> None:
-    """Raise :class:`InputError` unless ``function(**params, seed=...)`` can bind.
+    """Raise :class:`InputError` unless ``function(**params, seed=...)`` can bind and
+    the analysis' input check (:class:`Analysis` ``inputs``) accepts the values.
 
-    Run by the driver before any task is submitted, so that a typo in a spec fails at
-    once with the allowed names instead of failing every task on the workers.
+    Run by the driver on every distinct parameter set before any task is submitted, so
+    that a typo or an out-of-range value in a spec fails at once, naming the allowed
+    names or the bad value and the task's parameters, instead of failing every task on
+    the workers.
     """
     func = resolve(name)
     sig = inspect.signature(func)
     try:
-        sig.bind(**params, seed=0)
+        bound = sig.bind(**params, seed=0)
     except TypeError as exc:
         allowed = [p for p in sig.parameters if p != "seed"]
         raise InputError(f"analysis {name!r} does not accept the parameters "
                          f"{sorted(params)}: {exc}; its parameters are {allowed}") from None
+    check = resolve(name, "inputs")
+    if check is None:
+        return
+    bound.apply_defaults()
+    values = {k: v for k, v in bound.arguments.items() if k != "seed"}
+    try:
+        check(**values)
+    except InputError as exc:
+        raise InputError(f"analysis {name!r}, task {dict(params)}: {exc}") from None
 
 
 def as_records(value, name: str) -> list[dict]:
@@ -185,20 +217,44 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
     list of dict
         One record per approach step: ``step`` and :data:`roughfe.bem.RECORD_KEYS` (SI).
     """
-    from ..model import Loading, Material
     from ..response import response
     from ..surfaces import rmd_surface, spectral_surface
 
+    material, loading = contact_sweep_inputs(
+        generator=generator, fractal_dimension=fractal_dimension, m=m, length=length,
+        rms_height=rms_height, E=E, nu=nu, n_steps=n_steps, kernel=kernel, solver=solver,
+        tol=tol)
     if generator == "rmd":
         surface = rmd_surface(m, fractal_dimension, length, rng=seed, rms_height=rms_height)
-    elif generator == "spectral":
+    else:
         surface = spectral_surface(2 ** int(m), length, 3.0 - float(fractal_dimension),
                                    rms_height=rms_height, rng=seed)
-    else:
-        raise InputError(f"generator must be 'rmd' or 'spectral', got {generator!r}")
-    sweep = response(surface, Material(E, nu), Loading(n_steps=n_steps),
-                     kernel=kernel, solver=solver, tol=tol)
+    sweep = response(surface, material, loading, kernel=kernel, solver=solver, tol=tol)
     return [{"step": k, **record} for k, record in enumerate(sweep.to_records())]
+
+
+def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height, E, nu,
+                         n_steps, kernel, solver, tol):
+    """The input check of :func:`contact_sweep_task` (its keywords without ``seed``):
+    the generator's parameters, the BEM vocabulary and tolerance checked, and the
+    ``(Material, Loading)`` of the sweep returned; no surface is generated."""
+    from ..bem.contact import SOLVERS
+    from ..bem.operators import KERNELS
+    from ..errors import check_finite_positive, check_in_open_interval, check_int
+    from ..model import Loading, Material
+
+    if generator not in ("rmd", "spectral"):
+        raise InputError(f"generator must be 'rmd' or 'spectral', got {generator!r}")
+    check_in_open_interval("fractal_dimension D of a surface", fractal_dimension, 2.0, 3.0)
+    check_int("m (resolution level)", m, 1)
+    check_finite_positive("length (m)", length)
+    check_finite_positive("rms_height (m)", rms_height)
+    check_finite_positive("tol", tol)
+    if kernel not in ("auto",) + KERNELS:
+        raise InputError(f"kernel must be one of {('auto',) + KERNELS}, got {kernel!r}")
+    if solver not in SOLVERS:
+        raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    return Material(E, nu), Loading(n_steps=n_steps)
 
 
 def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=None,
@@ -225,6 +281,31 @@ def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=Non
         gamma, hurst, seed, label=label if label is not None else f"genome-{seed}",
         source="study", amplitude=amplitude, lambda1=lambda1, length=length, n_nodes=n_nodes,
         youngs_modulus=E, poisson=nu, n_steps=n_steps, threshold=threshold, kernel=kernel)
+
+
+def genome_db_inputs(*, gamma, hurst, amplitude, lambda1, label, length, n_nodes, E, nu,
+                     n_steps, threshold, kernel):
+    """The input check of :func:`genome_db_task` (its keywords without ``seed``): the
+    database settings and the genome of seed 0 (:func:`~roughfe.genomics.database.task.
+    genome_entry_inputs`); nothing realised or solved."""
+    from ..genomics.database.task import genome_entry_inputs
+
+    return genome_entry_inputs(gamma, hurst, 0, amplitude=amplitude, lambda1=lambda1,
+                               length=length, n_nodes=n_nodes, youngs_modulus=E, poisson=nu,
+                               n_steps=n_steps, threshold=threshold, kernel=kernel)
+
+
+def genome_entry_study_inputs(*, entry, **settings):
+    """The input check of :func:`genome_entry_study_task` (its keywords without ``seed``):
+    :func:`~roughfe.genomics.database.task.genome_entry_inputs` of the entry (``label``
+    and ``source`` aside) and the database settings."""
+    from ..genomics.database.task import genome_entry_inputs
+
+    if not isinstance(entry, dict):
+        raise InputError(f"entry must be a table of genome_entry_task keywords, "
+                         f"got {type(entry).__name__}")
+    genes = {k: v for k, v in entry.items() if k not in ("label", "source")}
+    return genome_entry_inputs(**genes, **settings)
 
 
 def genome_entry_study_task(*, entry, seed, length=_THESIS.length, n_nodes=_THESIS.n_nodes,

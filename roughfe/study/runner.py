@@ -141,6 +141,20 @@ class _Progress:
             self.bar.close()
 
 
+def _check_tasks(analysis: str, tasks) -> None:
+    """:func:`~roughfe.study.analyses.check_parameters` on every distinct parameter set
+    of ``tasks`` (the seeds aside), before anything is written or submitted: a bad value
+    anywhere in the grid fails the whole study at once, naming that task's parameters."""
+    from .spec import canonical_json
+
+    seen = set()
+    for t in tasks:
+        key = canonical_json(t.kwargs)
+        if key not in seen:
+            seen.add(key)
+            check_parameters(analysis, t.kwargs)
+
+
 def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=True,
               log=None) -> StudySummary:
     """Run every missing task of ``spec`` and store the results in ``spec.output``.
@@ -166,7 +180,7 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     log = log or (lambda message: None)
     t_start = time.perf_counter()
     tasks = spec.tasks()
-    check_parameters(spec.analysis, tasks[0].kwargs)
+    _check_tasks(spec.analysis, tasks)
     outdir = spec.output
     with store.study_lock(outdir):
         store.write_study(outdir, spec, tasks, __version__)

@@ -44,14 +44,9 @@ def genome_entry_task(gamma=None, hurst=None, phases=None, *, label, source="sob
         ``label, source, genome, p_max, curve, chromosome_curves, corr_k, corr_a,
         macro, micro, settings`` (all JSON-safe).
     """
-    settings = settings_from(settings)
-    if genome_json is not None:
-        genome = Genome.from_dict(genome_json)
-    elif gamma is None or hurst is None or phases is None:
-        raise InputError("genome_entry_task needs gamma, hurst and phases, or genome_json")
-    else:
-        genome = make_genome(gamma, hurst, phases, settings, amplitude=amplitude,
-                             lambda1=lambda1, angles=angles, anisotropy=anisotropy)
+    settings, genome = genome_entry_inputs(
+        gamma, hurst, phases, amplitude=amplitude, lambda1=lambda1, genome_json=genome_json,
+        angles=angles, anisotropy=anisotropy, **settings)
     mm = macro_micro(genome, settings)
     genome = _with_metadata(genome, label=str(label), source=str(source))
     return {"label": str(label), "source": str(source), "genome": genome.to_dict(),
@@ -59,6 +54,21 @@ def genome_entry_task(gamma=None, hurst=None, phases=None, *, label, source="sob
             "chromosome_curves": [c.to_dict() for c in mm.chromosome_curves],
             "corr_k": mm.corr_k.tolist(), "corr_a": mm.corr_a.tolist(),
             "macro": list(mm.macro), "micro": list(mm.micro), "settings": settings.to_dict()}
+
+
+def genome_entry_inputs(gamma=None, hurst=None, phases=None, *, amplitude=1.0, lambda1=None,
+                        genome_json=None, angles=None, anisotropy=None, **settings):
+    """``(DatabaseSettings, Genome)`` of :func:`genome_entry_task`'s keywords (``label``
+    and ``source`` aside): the settings and the genes checked, the genome built, nothing
+    realised or solved. The task's first step, and the input check of the study
+    analyses that run it (:mod:`roughfe.study.analyses`)."""
+    settings = settings_from(settings)
+    if genome_json is not None:
+        return settings, Genome.from_dict(genome_json)
+    if gamma is None or hurst is None or phases is None:
+        raise InputError("genome_entry_task needs gamma, hurst and phases, or genome_json")
+    return settings, make_genome(gamma, hurst, phases, settings, amplitude=amplitude,
+                                 lambda1=lambda1, angles=angles, anisotropy=anisotropy)
 
 
 def _with_metadata(genome, **facts):
