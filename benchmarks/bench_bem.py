@@ -402,9 +402,12 @@ def main(argv=None) -> int:
                          if n > args.tamaas_max})
         if beyond:
             skipped.append({"name": "Tamaas at " + ", ".join(f"{n}^2" for n in beyond),
-                            "reason": f"--tamaas-max {args.tamaas_max}: Tamaas 2.8.1 takes "
-                                      "179 s at 1024^2 and 1284 s at 2048^2 for the 4 loads "
-                                      "(issue 16)"})
+                            "reason": f"--tamaas-max {args.tamaas_max}: the issue's Tamaas "
+                                      "2.8.1 times, 179 s at 1024^2 and 1284 s at 2048^2 for "
+                                      "the 4 loads, were taken at its default cap of 1000 "
+                                      "iterations; converged it needs more (one load at "
+                                      "2048^2 reaches that cap unconverged in ~450 s CPU; "
+                                      "docs/theory/02b, session 14)"})
     for n in sorted(set(limits) - set(args.large)):
         what = ", CPU and wall time)" if n == 8192 else ")"
         skipped.append({"name": f"large case {n}^2 (peak RSS{what}",
