@@ -77,6 +77,8 @@ def test_a_bad_value_anywhere_in_the_grid_refuses_the_study_before_any_task(tmp_
     ("contact_sweep", {"tol": 0.0}, "tol"),
     ("contact_sweep", {"nu": 0.6}, "nu"),
     ("contact_sweep", {"n_steps": 0}, "n_steps"),
+    ("contact_sweep", {"m": 14}, "1 <= m <= 13"),
+    ("leakage", {"D": 2.3, "m": 20}, "1 <= m <= 13"),
     ("leakage", {"D": 2.3, "m": 3, "mu": -1.0}, "mu (Pa s)"),
     ("leakage", {"D": 2.3, "m": 3, "direction": "z"}, "direction must be"),
     ("leakage", {"D": 1.5, "m": 3}, "D (fractal dimension)"),

@@ -136,14 +136,15 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     every task before submitting any, :func:`roughfe.study.analyses.check_parameters`)."""
     from ..bem.operators import KERNELS
     from ..errors import check_finite_positive, check_in_open_interval, check_int
+    from ..surfaces.rmd import _check_m
     from .analysis import _direction_list
 
     check_in_open_interval("D (fractal dimension)", D, 2.0, 3.0)
-    check_int("m (RMD levels)", m, 1)
+    _check_m(m)
     check_int("n_steps", n_steps, 1)
     check_finite_positive("L (m)", L)
     check_finite_positive("mu (Pa s)", mu)
-    if not isinstance(reynolds, bool):
+    if not isinstance(reynolds, (bool, np.bool_)):
         raise InputError(f"reynolds must be true or false, got {reynolds!r}")
     if reynolds:      # the Reynolds solve's own rule (no wall velocity here: > 0)
         check_finite_positive("pressure_drop (Pa)", pressure_drop)

@@ -242,11 +242,15 @@ def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height,
     from ..bem.operators import KERNELS
     from ..errors import check_finite_positive, check_in_open_interval, check_int
     from ..model import Loading, Material
+    from ..surfaces.rmd import _check_m
 
     if generator not in ("rmd", "spectral"):
         raise InputError(f"generator must be 'rmd' or 'spectral', got {generator!r}")
     check_in_open_interval("fractal_dimension D of a surface", fractal_dimension, 2.0, 3.0)
-    check_int("m (resolution level)", m, 1)
+    if generator == "rmd":
+        _check_m(m)
+    else:
+        check_int("m (resolution level: 2**m points per side)", m, 1)
     check_finite_positive("length (m)", length)
     check_finite_positive("rms_height (m)", rms_height)
     check_finite_positive("tol", tol)
