@@ -258,6 +258,45 @@ def test_operator_symmetry_and_positivity():
     assert np.allclose(op.apply(np.ones((16, 16))), 0.0, atol=1e-25)
 
 
+@pytest.mark.parametrize("shape", [(13, 7), (257,), (17, 16)])
+def test_padded_products_are_the_exact_linear_convolution_on_a_fast_grid(shape):
+    """Non-periodic H p on the DC-FFT grid of m >= 2n - 1 points with only the factors 2,
+    5 (7 and 11 too on the complex axes; not 2n: 2 x 13, 2 x 257 carry a large prime),
+    checked against the direct sum
+    of the analytic cell kernel over every pair of cells (Love's rectangle, the strip)."""
+    from roughfe.bem.operators import padded_length
+    from roughfe.reference import uniform_rectangle_displacement, uniform_strip_displacement
+
+    size = [1e-3 * n / 16 for n in shape]
+    kernel = "love" if len(shape) == 2 else "strip"
+    op = influence_operator(shape, size, 1e9, kernel)
+    for axis, (n, m) in enumerate(zip(shape, op.fft_shape)):
+        last = axis == len(shape) - 1        # the real transform's axis: radices 2, 3, 5
+        assert 2 * n - 1 <= m <= 2.2 * n + 16 and m == padded_length(n, real=last)
+        for f in (2, 3, 5) if last else (2, 3, 5, 7, 11):
+            while m % f == 0:
+                m //= f
+        assert m == 1
+    p = np.random.default_rng(3).random(shape)
+    d = [L / n for L, n in zip(size, shape)]
+    if kernel == "love":
+        x, y = (np.arange(n) * dx for n, dx in zip(shape, d))
+        X = x[:, None, None, None] - x[None, None, :, None]
+        Y = y[None, :, None, None] - y[None, None, None, :]
+        K = uniform_rectangle_displacement(X, Y, d[0] / 2, d[1] / 2, 1e9)
+        direct = np.einsum("ijkl,kl->ij", K, p)
+    else:
+        x = np.arange(shape[0]) * d[0]
+        K = uniform_strip_displacement(x[:, None] - x[None, :], d[0] / 2, 1e9, 1.0, size[0])
+        direct = K @ p
+    np.testing.assert_allclose(op.apply(p), direct, rtol=1e-12, atol=1e-12 * np.abs(direct).max())
+    # the padded kernel is one symmetric function of the periodic-image offset
+    k = op.kernel
+    axes = tuple(range(k.ndim))
+    assert np.allclose(k, np.flip(np.roll(k, -1, axis=axes), axis=axes), rtol=0,
+                       atol=1e-13 * np.abs(k).max())
+
+
 @pytest.mark.parametrize("pocketfft", [True, False])
 def test_products_in_a_workspace_equal_the_allocating_ones(monkeypatch, pocketfft):
     """The solver's in-place products (kept output, one FFTWorkspace for every product)

@@ -9,9 +9,16 @@ Every operator is a discrete convolution, stored as its real-space kernel ``kern
 * periodic kernels (``"spectral"``) live on the grid itself (``fft_shape == shape``);
   ``apply`` is a circular convolution.
 * non-periodic kernels (``"strip"``, ``"thesis"``, ``"love"``) live on a zero-padded
-  grid of twice the size (DC-FFT, Liu, Wang & Liu 2000): offsets ``0..n-1`` are stored
-  at ``0..n-1`` and ``-(n-1)..-1`` at ``n+1..2n-1``; the linear convolution of the
-  ``n``-point pressure is then exact.
+  grid of about twice the size (DC-FFT, Liu, Wang & Liu 2000): ``m >= 2n - 1`` points
+  per axis, offsets ``0..n-1`` stored at ``0..n-1`` and ``-(n-1)..-1`` at
+  ``m-n+1..m-1``; the linear convolution of the ``n``-point pressure is then exact.
+  ``m`` is the first length from ``2n - 1`` on whose FFT is fast (:func:`padded_length`:
+  only factors 2, 3, 5), not ``2n``: ``2n`` has a large prime factor whenever ``n`` has,
+  e.g. RMD grids ``2**m + 1`` (257 -> 514 = 2 x 257: 4.9x slower transforms than 525 x
+  540) and instrument grids such as 563 x 484 (3.4x). The entries between the two
+  halves are never reached by the product; they hold the kernel at the periodic-image
+  distance of the padded grid, so that the padded kernel stays one smooth symmetric
+  function (the non-periodic adhesion solver works on the padded torus).
 
 Kernels (``kernel=`` in :func:`roughfe.bem.solve_contact`):
 
@@ -374,10 +381,20 @@ def _multiply(xh, spectrum):
     _parallel.blocks(fx.size, lambda a, b: np.multiply(fx[a:b], fs[a:b], out=fx[a:b]))
 
 
-def _offsets(n, d):
-    """Signed offsets (m) of the DC-FFT padded grid of 2n points (index n unused -> 0)."""
-    k = np.arange(2 * n)
-    return np.where(k < n, k, k - 2 * n) * d
+def padded_length(n: int, real: bool = True) -> int:
+    """Points per axis of the DC-FFT padded grid of an ``n``-point axis: the first length
+    >= 2n - 1 (an exact linear convolution) whose FFT is fast (``scipy.fft.next_fast_len``;
+    ``real`` for the axis of the real transform, the last one)."""
+    return int(scipy.fft.next_fast_len(2 * int(n) - 1, real=real))
+
+
+def _offsets(n, d, m):
+    """Signed offsets (m) of the ``m``-point padded grid of an ``n``-point axis of spacing
+    ``d``: index k holds offset k for k <= m // 2 and k - m above, so that 0..n-1 and
+    -(n-1)..-1 are exact (m >= 2n - 1) and the unused middle holds the periodic-image
+    distance."""
+    k = np.arange(m)
+    return np.where(k <= m // 2, k, k - m) * d
 
 
 def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOperator:
@@ -408,14 +425,16 @@ def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOpera
         with np.errstate(divide="ignore"):
             spec = np.where(qmod > 0, 2.0 / (e_star * qmod), 0.0)
         return InfluenceOperator(kernel, shape, spacing, True, e_star, spec)
+    padded = [padded_length(n, real=a == ndim - 1) for a, n in enumerate(shape)]
     if kernel == "strip":
         if ndim != 1:
             raise InputError("kernel 'strip' is for profiles (1D); use 'love' or 'spectral' "
                              "for surfaces")
-        r = _offsets(shape[0], spacing[0])
+        r = _offsets(shape[0], spacing[0], padded[0])
         kern = uniform_strip_displacement(r, spacing[0] / 2, e_star, 1.0, size[0])
     elif kernel == "thesis":
-        grids = np.meshgrid(*[_offsets(n, d) for n, d in zip(shape, spacing)], indexing="ij")
+        grids = np.meshgrid(*[_offsets(n, d, m) for n, d, m in zip(shape, spacing, padded)],
+                            indexing="ij")
         r = np.sqrt(sum(g ** 2 for g in grids))
         delta = float(np.prod(spacing)) ** (1.0 / ndim)
         arg = np.where(r > 0, np.minimum(1.0, delta / (2 * np.where(r > 0, r, 1.0))), 1.0)
@@ -425,8 +444,8 @@ def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOpera
         if ndim != 2:
             raise InputError("kernel 'love' is for surfaces (2D); use 'strip' or 'thesis' "
                              "for profiles")
-        x, y = np.meshgrid(_offsets(shape[0], spacing[0]), _offsets(shape[1], spacing[1]),
-                           indexing="ij")
+        x, y = np.meshgrid(_offsets(shape[0], spacing[0], padded[0]),
+                           _offsets(shape[1], spacing[1], padded[1]), indexing="ij")
         kern = uniform_rectangle_displacement(x, y, spacing[0] / 2, spacing[1] / 2, e_star)
     spec = scipy.fft.rfftn(kern)
     return InfluenceOperator(kernel, shape, spacing, False, e_star, spec, kern)
