@@ -42,6 +42,7 @@ PLAN = {
     "bench_surface_design": ([[]], [["4", "32", "--quick"]]),
     "bench_design_global": ([["20000"]], None),
     "bench_bem_choice": ([[]], [["--quick"]]),
+    "bench_bem_padding": ([[]], [["--quick"]]),
     "bench_bem_growth": ([[]], [["--quick"]]),
     "bench_bem": ([["--sizes", "512", "1024", "2048", "--large", "4096", "8192"]],
                   [["--quick", "--tamaas-max", "0"]]),
