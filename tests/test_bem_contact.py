@@ -290,6 +290,9 @@ def test_padded_products_are_the_exact_linear_convolution_on_a_fast_grid(shape):
         K = uniform_strip_displacement(x[:, None] - x[None, :], d[0] / 2, 1e9, 1.0, size[0])
         direct = K @ p
     np.testing.assert_allclose(op.apply(p), direct, rtol=1e-12, atol=1e-12 * np.abs(direct).max())
+    # a positive definite circulant on the padded grid (the non-periodic adhesion
+    # solver inverts it there, docs/theory/07)
+    assert op.spectrum.real.min() > 0
     # the padded kernel is one symmetric function of the periodic-image offset
     k = op.kernel
     axes = tuple(range(k.ndim))
