@@ -290,8 +290,9 @@ def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=Non
 def genome_db_inputs(*, gamma, hurst, amplitude, lambda1, label, length, n_nodes, E, nu,
                      n_steps, threshold, kernel):
     """The input check of :func:`genome_db_task` (its keywords without ``seed``): the
-    database settings and the genome of seed 0 (:func:`~roughfe.genomics.database.task.
-    genome_entry_inputs`); nothing realised or solved."""
+    database settings and the genome of seed 0
+    (:func:`~roughfe.genomics.database.task.genome_entry_inputs`); nothing realised or
+    solved."""
     from ..genomics.database.task import genome_entry_inputs
 
     return genome_entry_inputs(gamma, hurst, 0, amplitude=amplitude, lambda1=lambda1,
