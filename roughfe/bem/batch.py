@@ -88,7 +88,7 @@ class BatchOperator:
         return self.op.apply(p, workers=WORKERS)
 
     def precondition(self, g):
-        return self.op.convolve_spectrum(g, self.inverse, workers=WORKERS)
+        return self.op.precondition(g, self.inverse, workers=WORKERS)
 
 
 def _rows(x, B, name):
