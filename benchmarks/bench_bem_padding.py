@@ -26,8 +26,10 @@ Targets of a case:
 * the fast grids are not slower: CPU(2n) / CPU(fast) >= 0.95 (1 within the scatter of
   the CPU timer), per case where the layouts differ (a grid whose n is already a fast
   length, e.g. 512 or 640 points, has one layout only and is skipped, saying so);
-* the same answer: the largest difference in A* is 0, and the loads agree to 1e-9
-  relative;
+* the same answer: the largest difference in A* is 0, and the loads agree to
+  ``SAME_LOAD`` = 1e-8 relative. The two are independent solves to a relative KKT
+  residual of 1e-10 that take different search directions, so their loads differ at
+  that level (measured: up to 8.1e-10 on sur-2), not at the rounding of one product;
 * the mean speed-up over the cases is recorded, with no target.
 
 The measured files come from ``../shared/data/topographies`` (``ROUGHFE_TOPOGRAPHIES``
@@ -58,6 +60,7 @@ TOL = 1e-10
 #: the fast grid is "not slower" when CPU(2n) / CPU(fast) >= this: 1 within the ~5 %
 #: scatter of process CPU times of one sweep on this machine (set before measuring)
 NOT_SLOWER = 0.95
+SAME_LOAD = 1e-8     #: the loads of the two layouts, relative difference at most
 STEPS = tuple(np.linspace(0.1, 0.6, 6))
 TOPOGRAPHIES = Path(os.environ.get("ROUGHFE_TOPOGRAPHIES",
                                    HERE.parents[1] / "shared" / "data" / "topographies"))
@@ -159,12 +162,12 @@ def main(argv=None) -> int:
               f"{sum(r['nit']['fast'])}; max|dA*| {r['max|dA*|']:.1e}, "
               f"max dp/p {r['max dp/p']:.1e}", flush=True)
         label = f"{r['case']} {r['shape'][0]} x {r['shape'][1]}"
-        targets += [{"name": f"{label}: CPU with 2n padding / fast padding",
+        targets += [{"name": f"{label}: CPU of the 2n layout / the fast grids",
                      "value": round(r["speedup"], 3), "target": f">= {NOT_SLOWER}",
                      "met": r["speedup"] >= NOT_SLOWER},
                     {"name": f"{label}: the same answer (max |dA*|, max dp/p)",
-                     "value": [r["max|dA*|"], r["max dp/p"]], "target": "0, <= 1e-9",
-                     "met": r["max|dA*|"] == 0 and r["max dp/p"] <= 1e-9}]
+                     "value": [r["max|dA*|"], r["max dp/p"]], "target": f"0, <= {SAME_LOAD:g}",
+                     "met": r["max|dA*|"] == 0 and r["max dp/p"] <= SAME_LOAD}]
     mean = float(np.exp(np.mean(np.log([r["speedup"] for r in rows])))) if rows else None
     write_report(args.output, "bench_bem_padding", targets, rows,
                  {"cpu_s": "s (process CPU time of the 6-step sweep, the smaller of two "
