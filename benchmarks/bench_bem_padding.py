@@ -103,9 +103,9 @@ def sweep(surface, double):
 def _fast(shape):
     """Whether every axis of ``shape`` is its own fast FFT length (the preconditioner's grid
     is then the grid itself)."""
-    import scipy.fft
+    from roughfe.bem.operators import fast_length
     last = len(shape) - 1
-    return all(scipy.fft.next_fast_len(n, real=a == last) == n for a, n in enumerate(shape))
+    return all(fast_length(n, real=a == last) == n for a, n in enumerate(shape))
 
 
 def clear_operator_cache():

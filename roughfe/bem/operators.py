@@ -13,7 +13,7 @@ Every operator is a discrete convolution, stored as its real-space kernel ``kern
   per axis, offsets ``0..n-1`` stored at ``0..n-1`` and ``-(n-1)..-1`` at
   ``m-n+1..m-1``; the linear convolution of the ``n``-point pressure is then exact.
   ``m`` is the first length from ``2n - 1`` on whose FFT is fast (:func:`padded_length`:
-  only factors 2, 3, 5), not ``2n``: ``2n`` has a large prime factor whenever ``n`` has,
+  the factors 2, 3 and 5, and 7 and 11 on the complex axes), not ``2n``: ``2n`` has a large prime factor whenever ``n`` has,
   e.g. RMD grids ``2**m + 1`` (257 -> 514 = 2 x 257: 4.9x slower transforms than 525 x
   540) and instrument grids such as 563 x 484 (3.4x). The entries between the two
   halves are never reached by the product; they hold the kernel at the periodic-image
@@ -214,8 +214,7 @@ class InfluenceOperator:
         if self.periodic:
             return self.shape
         last = len(self.shape) - 1
-        return tuple(int(scipy.fft.next_fast_len(n, real=a == last))
-                     for a, n in enumerate(self.shape))
+        return tuple(fast_length(n, real=a == last) for a, n in enumerate(self.shape))
 
     def inverse_spectrum(self):
         """Spectrum (Pa/m) of an approximate inverse of H on the :attr:`precond_shape` grid.
@@ -417,11 +416,18 @@ def _multiply(xh, spectrum):
     _parallel.blocks(fx.size, lambda a, b: np.multiply(fx[a:b], fs[a:b], out=fx[a:b]))
 
 
+def fast_length(target: int, real: bool = True) -> int:
+    """The first length >= ``target`` whose FFT is fast (``scipy.fft.next_fast_len``:
+    factors 2, 3, 5 for the real transform's axis, ``real``, the last one; 7 and 11 too
+    for the complex axes)."""
+    return int(scipy.fft.next_fast_len(int(target), real=real))
+
+
 def padded_length(n: int, real: bool = True) -> int:
-    """Points per axis of the DC-FFT padded grid of an ``n``-point axis: the first length
-    >= 2n - 1 (an exact linear convolution) whose FFT is fast (``scipy.fft.next_fast_len``;
-    ``real`` for the axis of the real transform, the last one)."""
-    return int(scipy.fft.next_fast_len(2 * int(n) - 1, real=real))
+    """Points per axis of the DC-FFT padded grid of an ``n``-point axis: the first fast
+    length (:func:`fast_length`) >= 2n - 1, the least grid of an exact linear
+    convolution."""
+    return fast_length(2 * int(n) - 1, real)
 
 
 def _offsets(n, d, m):
