@@ -72,7 +72,7 @@ def test_a_bad_value_anywhere_in_the_grid_refuses_the_study_before_any_task(tmp_
 
 @pytest.mark.parametrize("name, params, words", [
     ("contact_sweep", {"fractal_dimension": 3.5}, "fractal_dimension D of a surface"),
-    ("contact_sweep", {"kernel": "fft"}, "kernel must be one of"),
+    ("contact_sweep", {"kernel": "fft"}, "kernel must be 'auto' or one of"),
     ("contact_sweep", {"solver": "cg"}, "solver must be one of"),
     ("contact_sweep", {"tol": 0.0}, "tol"),
     ("contact_sweep", {"nu": 0.6}, "nu"),

@@ -26,7 +26,7 @@ from ..errors import (InputError, NoConvergenceError, check_finite_positive, che
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
-from .operators import (KERNELS, WORKERS, InfluenceOperator, _irfftn_owned,
+from .operators import (WORKERS, InfluenceOperator, _irfftn_owned, check_kernel_name,
                         influence_operator)
 from .periodic import periodic_bounded_displacement, periodic_gap_control
 from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
@@ -107,13 +107,18 @@ def _dense(op: InfluenceOperator) -> np.ndarray:
     return H
 
 
+def check_solver_name(solver: str) -> str:
+    """Return ``solver`` or raise :class:`InputError` unless it is one of :data:`SOLVERS`."""
+    if solver not in SOLVERS:
+        raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    return solver
+
+
 def _choose_kernel(surface: Surface, kernel: str) -> str:
-    if kernel == "auto":
+    if check_kernel_name(kernel) == "auto":
         if surface.periodic:
             return "spectral"
         return "strip" if surface.ndim == 1 else "love"
-    if kernel not in KERNELS:
-        raise InputError(f"kernel must be 'auto' or one of {KERNELS}, got {kernel!r}")
     if kernel == "spectral" and not surface.periodic:
         raise InputError("kernel 'spectral' is periodic and needs a periodic surface "
                          "(Surface(..., periodic=True)); use 'strip'/'love' otherwise")
@@ -122,9 +127,7 @@ def _choose_kernel(surface: Surface, kernel: str) -> str:
 
 def _choose_solver(n_points: int, op: InfluenceOperator, solver: str,
                    bounded: bool = False) -> str:
-    if solver not in SOLVERS:
-        raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
-    if solver == "auto":
+    if check_solver_name(solver) == "auto":
         if bounded:   # the dense bounded path is BVLS, which needs a definite operator
             return "nnls" if n_points <= DENSE_MAX_POINTS and not op.periodic else "pk"
         return "dense" if n_points <= DENSE_MAX_POINTS else "pk"

@@ -9,16 +9,13 @@ Every operator is a discrete convolution, stored as its real-space kernel ``kern
 * periodic kernels (``"spectral"``) live on the grid itself (``fft_shape == shape``);
   ``apply`` is a circular convolution.
 * non-periodic kernels (``"strip"``, ``"thesis"``, ``"love"``) live on a zero-padded
-  grid of about twice the size (DC-FFT, Liu, Wang & Liu 2000): ``m >= 2n - 1`` points
-  per axis, offsets ``0..n-1`` stored at ``0..n-1`` and ``-(n-1)..-1`` at
-  ``m-n+1..m-1``; the linear convolution of the ``n``-point pressure is then exact.
-  ``m`` is the first length from ``2n - 1`` on whose FFT is fast (:func:`padded_length`:
-  the factors 2, 3 and 5, and 7 and 11 on the complex axes), not ``2n``: ``2n`` has a large prime factor whenever ``n`` has,
-  e.g. RMD grids ``2**m + 1`` (257 -> 514 = 2 x 257: 4.9x slower transforms than 525 x
-  540) and instrument grids such as 563 x 484 (3.4x). The entries between the two
-  halves are never reached by the product; they hold the kernel at the periodic-image
-  distance of the padded grid, so that the padded kernel stays one smooth symmetric
-  function (the non-periodic adhesion solver works on the padded torus).
+  grid (DC-FFT, Liu, Wang & Liu 2000) of m >= 2n - 1 points per axis, the first fast FFT
+  length (:func:`padded_length`), not 2n, which keeps n's large prime factors (RMD grids
+  2**m + 1: 257 -> 514 = 2 x 257, 4.9x slower transforms than 525 x 540; instrument grids
+  such as 563 x 484: 3.4x). Offsets 0..n-1 are stored at 0..n-1 and -(n-1)..-1 at
+  m-n+1..m-1, so the linear convolution of the n-point pressure is exact; the unused
+  middle holds the kernel at the periodic-image distance (one smooth symmetric kernel:
+  the non-periodic adhesion solver works on the padded torus).
 
 Kernels (``kernel=`` in :func:`roughfe.bem.solve_contact`):
 
@@ -414,6 +411,15 @@ def _multiply(xh, spectrum):
         np.multiply(xh, spectrum, out=xh)
         return
     _parallel.blocks(fx.size, lambda a, b: np.multiply(fx[a:b], fs[a:b], out=fx[a:b]))
+
+
+def check_kernel_name(kernel: str) -> str:
+    """Return ``kernel`` or raise :class:`InputError` unless it is ``"auto"`` or one of
+    :data:`KERNELS` (the vocabulary only; which kernel fits a surface is decided when the
+    surface is known, :func:`roughfe.bem.solve_contact`)."""
+    if kernel != "auto" and kernel not in KERNELS:
+        raise InputError(f"kernel must be 'auto' or one of {KERNELS}, got {kernel!r}")
+    return kernel
 
 
 def fast_length(target: int, real: bool = True) -> int:

@@ -134,7 +134,7 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     parameters, the step count, the fluid and the flow directions checked, the
     :class:`Material` returned; no surface is generated (the study runner calls it on
     every task before submitting any, :func:`roughfe.study.analyses.check_parameters`)."""
-    from ..bem.operators import KERNELS
+    from ..bem.operators import check_kernel_name
     from ..errors import check_finite_positive, check_in_open_interval, check_int
     from ..surfaces.rmd import _check_m
     from .analysis import _direction_list
@@ -149,8 +149,7 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     if reynolds:      # the Reynolds solve's own rule (no wall velocity here: > 0)
         check_finite_positive("pressure_drop (Pa)", pressure_drop)
     _direction_list(direction)
-    if kernel not in ("auto",) + KERNELS:
-        raise InputError(f"kernel must be one of {('auto',) + KERNELS}, got {kernel!r}")
+    check_kernel_name(kernel)
     return Material(E, nu)
 
 

@@ -238,8 +238,8 @@ def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height,
     """The input check of :func:`contact_sweep_task` (its keywords without ``seed``):
     the generator's parameters, the BEM vocabulary and tolerance checked, and the
     ``(Material, Loading)`` of the sweep returned; no surface is generated."""
-    from ..bem.contact import SOLVERS
-    from ..bem.operators import KERNELS
+    from ..bem.contact import check_solver_name
+    from ..bem.operators import check_kernel_name
     from ..errors import check_finite_positive, check_in_open_interval, check_int
     from ..model import Loading, Material
     from ..surfaces.rmd import _check_m
@@ -254,10 +254,8 @@ def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height,
     check_finite_positive("length (m)", length)
     check_finite_positive("rms_height (m)", rms_height)
     check_finite_positive("tol", tol)
-    if kernel not in ("auto",) + KERNELS:
-        raise InputError(f"kernel must be one of {('auto',) + KERNELS}, got {kernel!r}")
-    if solver not in SOLVERS:
-        raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    check_kernel_name(kernel)
+    check_solver_name(solver)
     return Material(E, nu), Loading(n_steps=n_steps)
 
 
