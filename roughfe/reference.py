@@ -259,6 +259,25 @@ def uniform_rectangle_displacement(x, y, half_a, half_b, e_star, pressure=1.0):
     return pressure / (np.pi * e_star) * s
 
 
+def uniform_cell_displacement_grid(n0, n1, d0, d1, e_star):
+    """:func:`uniform_rectangle_displacement` of one grid cell (d0 x d1 m, unit pressure:
+    m/Pa) at the grid offsets (k0 d0, k1 d1), k0 = 0 .. n0 - 1, k1 = 0 .. n1 - 1.
+
+    The same sum of Love's primitive F over the cell's corners, with F evaluated once per
+    corner of the lattice ((k -+ 1/2) d) and the kernel its mixed second difference: one
+    evaluation of F per point instead of four (the displacement is even in x and y, so
+    the non-negative offsets are all a BEM kernel needs; measured 16x less work than the
+    four-corner form on the padded 2n x 2n grid of a non-periodic operator)."""
+    X = (np.arange(n0 + 1) - 0.5) * d0
+    Y = (np.arange(n1 + 1) - 0.5) * d1
+    F = _love_primitive(X[:, None], Y[None, :])
+    s = F[1:, 1:] - F[1:, :-1]
+    s -= F[:-1, 1:]
+    s += F[:-1, :-1]
+    s *= 1.0 / (np.pi * e_star)
+    return s
+
+
 # -- Maugis-Dugdale: adhesive sphere ------------------------------------------------------
 REFERENCES_MAUGIS = ("Maugis D. (1992) J. Colloid Interface Sci. 150:243-269",
                      "Johnson K.L., Greenwood J.A. (1997) J. Colloid Interface Sci. 192:326-333")

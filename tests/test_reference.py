@@ -68,6 +68,24 @@ def test_love_rectangle_against_quadrature_and_centre_value():
         8 * np.log(1 + np.sqrt(2)) / np.pi, rel=1e-14)
 
 
+def test_love_cell_lattice_matches_the_four_corner_form_and_the_point_load():
+    """The one-evaluation-per-corner kernel of a grid cell equals Love's four-corner sum
+    (the same formula, near field to rounding, far field within its cancellation), and far
+    away it is the Boussinesq point load of the cell's force, p d0 d1 / (pi E* r)."""
+    from roughfe.reference import uniform_cell_displacement_grid
+    d0, d1, e = 2e-6, 3e-6, 2e9
+    g = uniform_cell_displacement_grid(400, 300, d0, d1, e)
+    assert g.shape == (400, 300)
+    k0, k1 = np.meshgrid(np.arange(400), np.arange(300), indexing="ij")
+    four = uniform_rectangle_displacement(k0 * d0, k1 * d1, d0 / 2, d1 / 2, e)
+    np.testing.assert_allclose(g[:20, :20], four[:20, :20], rtol=1e-11)
+    np.testing.assert_allclose(g, four, rtol=1e-7)
+    assert g[0, 0] == pytest.approx(four[0, 0], rel=1e-14)
+    r = np.hypot(k0 * d0, k1 * d1)
+    far = r > 100 * max(d0, d1)
+    np.testing.assert_allclose(g[far], d0 * d1 / (np.pi * e * r[far]), rtol=1e-4)
+
+
 def test_strip_against_quadrature_and_reference_point():
     for x in (0.0, 0.3, 2.0):
         pts = [x] if abs(x) < 0.5 else None

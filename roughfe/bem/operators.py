@@ -45,7 +45,7 @@ Kernels (``kernel=`` in :func:`roughfe.bem.solve_contact`):
     sqrt(dx dy) for a surface.
 ``"love"`` (non-periodic surfaces)
     Love's exact displacement of a uniformly loaded rectangle dx x dy (Love 1929;
-    Johnson 1985, Eq. 3.25), see :func:`roughfe.reference.uniform_rectangle_displacement`.
+    Johnson 1985, Eq. 3.25), see :func:`roughfe.reference.uniform_cell_displacement_grid`.
 """
 from __future__ import annotations
 
@@ -63,7 +63,7 @@ except ImportError:     # pragma: no cover - a scipy without it takes the alloca
 
 from ..errors import InputError
 from . import _parallel
-from ..reference import uniform_rectangle_displacement, uniform_strip_displacement
+from ..reference import uniform_cell_displacement_grid, uniform_strip_displacement
 from ..surfaces.stats import angular_wavevectors, rfft_full_sum
 
 KERNELS = ("spectral", "strip", "thesis", "love")
@@ -492,8 +492,9 @@ def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOpera
         if ndim != 2:
             raise InputError("kernel 'love' is for surfaces (2D); use 'strip' or 'thesis' "
                              "for profiles")
-        x, y = np.meshgrid(_offsets(shape[0], spacing[0], padded[0]),
-                           _offsets(shape[1], spacing[1], padded[1]), indexing="ij")
-        kern = uniform_rectangle_displacement(x, y, spacing[0] / 2, spacing[1] / 2, e_star)
+        k0, k1 = (np.abs(np.rint(_offsets(n, 1.0, m)).astype(np.intp))
+                  for n, m in zip(shape, padded))
+        kern = uniform_cell_displacement_grid(k0.max() + 1, k1.max() + 1, *spacing,
+                                              e_star)[np.ix_(k0, k1)]
     spec = scipy.fft.rfftn(kern)
     return InfluenceOperator(kernel, shape, spacing, False, e_star, spec, kern)
