@@ -105,7 +105,6 @@ def test_automatic_choice_reads_the_contact_structure(monkeypatch):
 @pytest.mark.parametrize("kw, why", [
     (dict(delta=1e-3), "load control"),
     (dict(mean_pressure=1e-3, hardness=0.5), "elastic interface"),
-    (dict(mean_pressure=1e-3, kernel="love"), "periodic surface"),
     (dict(mean_pressure=1e-3, solver="dense"), "solver 'pk'"),
 ])
 def test_on_where_it_cannot_apply_says_why(kw, why):
@@ -123,6 +122,9 @@ def test_bad_values_and_grids():
     odd = spectral_surface(36, 1.0, 0.8, rms_slope=1.0, rng=1)
     with pytest.raises(InputError, match="multiples of 8"):
         solve_contact(odd, m, mean_pressure=1e-3, coarse_correction=True)
+    tiny = Surface(np.random.default_rng(1).random((10, 10)), 1.0, periodic=False)
+    with pytest.raises(InputError, match="grid sides >= 12"):
+        solve_contact(tiny, m, mean_pressure=1e-3, solver="pk", coarse_correction=True)
     profile = spectral_surface(1024, 1.0, 0.8, rms_slope=1.0, rng=1).heights[0]
     with pytest.raises(InputError, match="2D surface"):
         solve_contact(Surface(profile, 1.0, periodic=True), m, mean_pressure=1e-3,

@@ -31,6 +31,7 @@ from .operators import (WORKERS, InfluenceOperator, _irfftn_owned, check_kernel_
 from .periodic import periodic_bounded_displacement, periodic_gap_control
 from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
 from .deflation import BlockDeflation
+from .padded_deflation import PaddedBlockDeflation
 from .pk import polonsky_keer
 from .solvers import SolverOutput, dense_solve
 from .stiffness import exact_stiffness
@@ -191,22 +192,21 @@ def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
     return hp, plastic_displacement
 
 
-#: elastic, load-controlled, periodic surface solves whose sides lie in this range (and
-#: are multiples of 8) use the two-level coarse correction
-#: :class:`roughfe.bem.deflation.BlockDeflation` (8 x 8 blocks), measured faster in CPU
-#: (4 loads, cold, tol 1e-10: 1024^2 177 -> 94 its, 7.8 -> 5.6 s; 2048^2 237 -> 111, 38.6
-#: -> 26.3 s; 512^2 CPU even; one load: 4096^2 99 -> 42 its, 1101 MB; 8192^2 123 -> 53)
+#: elastic load-controlled surface solves whose FFT grid's sides lie in this range use the
+#: two-level correction: BlockDeflation when periodic (4 loads, cold, tol 1e-10: 1024^2 177
+#: -> 94 its, 7.8 -> 5.6 s CPU; 2048^2 237 -> 111, 38.6 -> 26.3 s; 4096^2 one load 99 -> 42),
+#: PaddedBlockDeflation on the ~2n padded grid of a non-periodic one (02b, session 16)
 DEFLATION_SIDES = (1024, 8192)
 
 
 def _two_level_unfit(op, hardness):
     """Why the two-level correction cannot act on a load-controlled pk solve with ``op``
     (what it needs), or None."""
-    return ("a periodic surface (the spectral kernel)" if not op.periodic else
-            "a 2D surface, not a profile" if len(op.shape) != 2 else
+    return ("a 2D surface, not a profile" if len(op.shape) != 2 else
             "an elastic interface (no hardness)" if hardness is not None else
             f"grid sides that are multiples of 8 and >= 24, got {op.shape}"
-            if any(n % 8 or n < 24 for n in op.shape) else None)
+            if op.periodic and any(n % 8 or n < 24 for n in op.shape) else
+            f"grid sides >= 12, got {op.shape}" if min(op.shape) < 12 else None)
 
 
 def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
@@ -221,13 +221,13 @@ def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
     lo, hi = DEFLATION_SIDES
     if (coarse_correction is False or plastic is not None
             or _two_level_unfit(op, hardness)
-            or (coarse_correction is None and not all(lo <= n <= hi for n in op.shape))):
+            or (coarse_correction is None and not all(lo <= n <= hi for n in op.fft_shape))):
         return None
     if coarse_correction is None and start is not None:
         parts = _contact_parts(start)
         if parts is not None and parts < CORRECTION_MIN_PARTS:
             return None
-    return BlockDeflation(op, 8)
+    return BlockDeflation(op, 8) if op.periodic else PaddedBlockDeflation(op, 8)
 
 
 def _check_coarse_correction(value, op, solver, mean_pressure, hardness):
@@ -318,8 +318,9 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         so the gap is u + u_pl + max h - h - Delta.
     coarse_correction : bool, optional
         The two-level (deflation) correction of the Polonsky-Keer CG
-        (:class:`roughfe.bem.deflation.BlockDeflation`, 8 x 8 blocks; elastic, periodic,
-        load-controlled surface solves). None: on for sides in ``DEFLATION_SIDES``, where
+        (:class:`roughfe.bem.deflation.BlockDeflation`, 8 x 8 blocks, on the padded grid
+        of a non-periodic kernel: :mod:`roughfe.bem.padded_deflation`; elastic,
+        load-controlled surface solves). None: on for FFT grid sides in ``DEFLATION_SIDES``, where
         it was measured to pay on rough surfaces (2-3x fewer iterations), unless the
         start's contact set has fewer than ``CORRECTION_MIN_PARTS`` connected parts
         (patches plus non-contact islands: a sphere, a sinusoid, a few asperities),
@@ -396,7 +397,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
             own = initial is None and mean_pressure is not None and plastic is None
             if own:
                 initial = _coarse_start(surface, material, mean_pressure, hardness,
-                                        coarse_correction=coarse_correction)
+                                        coarse_correction=coarse_correction, kernel=op.name)
             deflation = (None if mean_pressure is None else
                          _deflation(op, hardness, plastic, coarse_correction, initial))
             out = polonsky_keer(op.apply, h, scale, delta=delta, mean_pressure=mean_pressure,
@@ -405,7 +406,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                                 max_iter=max_iter or 20000, offset=-hmax, hardness=hardness,
                                 apply_single=functools.partial(op.apply, single=True),
                                 deflation=deflation,
-                                split=None if deflation is None else op.split_product)
+                                split=op.split_product if deflation and op.periodic else None)
         else:
             H = _dense(op)
             if initial is None:

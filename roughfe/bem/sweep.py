@@ -119,10 +119,10 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     # elastic load-controlled steps on the periodic kernel: the coarse-to-fine start of
     # every grid level corrected by that level's previous solution (_coarse_start)
     levels = ({} if key == "mean_pressure" and not branch and solver in ("auto", "pk")
-              and kernel in ("auto", "spectral") else None)
+              else None)
     for v, unloading in progress.iterate(steps, "BEM load steps"):
         initial = None if levels is None else _coarse_start(
-            surface, material, v, None, levels, coarse_correction)
+            surface, material, v, None, levels, coarse_correction, kernel)
         if initial is None:
             initial = _predicted_pressure(results, v, key, branch)
         r = solve_contact(surface, material, **{key: v}, kernel=kernel, solver=solver,
