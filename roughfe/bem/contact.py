@@ -406,7 +406,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                                 max_iter=max_iter or 20000, offset=-hmax, hardness=hardness,
                                 apply_single=functools.partial(op.apply, single=True),
                                 deflation=deflation,
-                                split=op.split_product if deflation and op.periodic else None)
+                                split=op.split_product if deflation else None)
         else:
             H = _dense(op)
             if initial is None:

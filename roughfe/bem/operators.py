@@ -56,18 +56,13 @@ from typing import Optional
 import numpy as np
 import scipy.fft
 
-try:        # scipy's pocketfft binding: its transforms take ``out=`` (scipy.fft's do not)
-    from scipy.fft._pocketfft import pypocketfft as _pocketfft
-except ImportError:     # pragma: no cover - a scipy without it takes the allocating path
-    _pocketfft = None
-
 from ..errors import InputError
-from . import _parallel
+from .fft import (WORKERS, FFTWorkspace, _backward, _convolve, _copy, _forward,  # noqa: F401
+                  _irfftn_owned, _multiply, _pocketfft, _spectral_energy, fast_length)
 from ..reference import uniform_cell_displacement_grid, uniform_strip_displacement
 from ..surfaces.stats import angular_wavevectors, rfft_full_sum
 
 KERNELS = ("spectral", "strip", "thesis", "love")
-WORKERS = _parallel.THREADS  # threads per FFT (ROUGHFE_THREADS, see roughfe.bem._parallel)
 
 _KERNEL_REFERENCES = {
     "spectral": ("Stanley H.M., Kato T. (1997) J. Tribol. 119:481-485",),
@@ -160,46 +155,44 @@ class InfluenceOperator:
         if self.periodic:
             return u
         u = u[(Ellipsis,) + tuple(slice(0, n) for n in self.shape)]
-        if out is None:
-            return u
+        if out is None:         # with a workspace u is its padded output: copied
+            return u if work is None else np.array(u)
         out[...] = u
         return out
 
     def split_product(self, p, single=False, out=None, work=None, workers=None):
-        """The product u = H p of a periodic operator in its two halves: returns the
-        energy ``p . H p`` (m Pa: sum over the grid of p u) read from the forward
-        transform, and ``finish()``, which completes the product (the inverse
-        transform) into ``out`` and returns it.
+        """The product u = H p in its two halves: returns the energy ``p . H p`` (m Pa:
+        sum over the grid of p u) read from the forward transform, and ``finish()``,
+        which completes the product (the inverse transform) into ``out`` and returns it.
 
         By Parseval, p . H p = (1/N) sum_q S(q) |p(q)|^2 (S the kernel's multiplier,
-        ``spectrum``; the interior columns of the rfft half-spectrum stand for two
-        modes), summed in float64. A caller that needs the energy only, as the exact
-        line search of the Polonsky-Keer CG does (tau = g.t / t.H t) whenever its step
-        is then clipped and u recomputed, skips the inverse half of the FFT work.
-        ``finish`` must be called before ``work`` is used again. ``single``, ``out`` and
-        ``workers`` as in :meth:`apply`; needs a ``work`` (:class:`FFTWorkspace`).
+        ``spectrum``, N the FFT grid's points; the interior columns of the rfft
+        half-spectrum stand for two modes), summed in float64. On the zero-padded grid
+        of a non-periodic kernel the same sum is p . H p too: p is zero off the
+        surface. A caller that needs the energy only, as the exact line search of the
+        Polonsky-Keer CG does (tau = g.t / t.H t) whenever its step is then clipped
+        and u recomputed, skips the inverse half of the FFT work. ``finish`` must be
+        called before ``work`` is used again. ``single``, ``out`` and ``workers`` as
+        in :meth:`apply`; needs a ``work`` (:class:`FFTWorkspace`).
         """
-        if not self.periodic or work is None or _pocketfft is None:
-            raise InputError("split_product needs a periodic operator and an FFTWorkspace")
+        if work is None or _pocketfft is None:
+            raise InputError("split_product needs an FFTWorkspace")
         workers = WORKERS if workers is None else workers
         dtype = np.float32 if single else np.float64
         if out is None:
             out = np.empty(self.shape, dtype)
-        if p.dtype != dtype:
+        if p.dtype != dtype and self.periodic:
             _copy(out, p)
             p = out
-        axes = list(range(len(self.shape)))
-        xh = work.array(self.shape[:-1] + (self.shape[-1] // 2 + 1,),
-                        np.complex64 if single else np.complex128)
-        _pocketfft.r2c(p, axes, True, 0, xh, workers)
-        energy = _spectral_energy(xh, self.spectrum, self.shape[-1])
-        energy /= float(np.prod(self.shape))
+        shape = self.fft_shape
+        xh = _forward(p, shape, work, workers, dtype)
+        energy = _spectral_energy(xh, self.spectrum, shape[-1]) / float(np.prod(shape))
 
         def finish():
             _multiply(xh, self.spectrum)
-            for axis in axes[:-1]:          # normalised by 1/n per axis, as irfftn
-                _pocketfft.c2c(xh, [axis], False, 2, xh, workers)
-            _pocketfft.c2r(xh, [axes[-1]], self.shape[-1], False, 2, out, workers)
+            if self.periodic:
+                return _backward(xh, shape, work, workers, out)
+            out[...] = _backward(xh, shape, work, workers)[tuple(map(slice, self.shape))]
             return out
 
         return energy, finish
@@ -249,7 +242,7 @@ class InfluenceOperator:
             return self.convolve_spectrum(v, spectrum, out, work, workers)
         if spectrum.dtype == np.float32:
             v = v.astype(np.float32, copy=False)
-        y = _convolve(v, spectrum, pshape, None, None, workers)
+        y = _convolve(v, spectrum, pshape, None, work, workers)
         crop = (Ellipsis,) + tuple(slice(0, n) for n in self.shape)
         if out is None:
             return np.ascontiguousarray(y[crop])
@@ -283,136 +276,6 @@ class InfluenceOperator:
         return self.kernel[tuple(diff)]
 
 
-def _irfftn_owned(vh, shape, workers=None):
-    """``irfftn(vh, s=shape)`` over the trailing ``len(shape)`` axes of a half-spectrum
-    the caller gives up (it is destroyed; leading axes are a batch): in-place inverse
-    c2c transforms over the leading grid axes, then one c2r along the last. pocketfft's
-    multi-axis c2r would allocate a full complex temporary (one more grid in memory,
-    measured +134 MB at 4096^2) and is slower (0.35 s vs 0.19 s CPU there)."""
-    workers = WORKERS if workers is None else workers
-    for axis in range(vh.ndim - len(shape), vh.ndim - 1):
-        vh = scipy.fft.ifft(vh, axis=axis, overwrite_x=True, workers=workers)
-    return scipy.fft.irfft(vh, n=shape[-1], axis=-1, overwrite_x=True, workers=workers)
-
-
-class FFTWorkspace:
-    """The one complex buffer of the FFT products of a solve, reused by every product.
-
-    A solve makes two to three full-grid products per iteration; each used to allocate
-    its half-spectrum and its result afresh. Arrays of more than 32 MB come from the
-    kernel (mmap) and every page of a fresh one costs a page fault on its first touch:
-    at 8192^2 that was 216 s of system time in a 716 s solve. With a workspace (and an
-    ``out`` array) a periodic product runs scipy's pocketfft transforms in place in this
-    buffer and writes its result into the caller's array. Between products the buffer
-    is free scratch memory (:meth:`array`). It grows on demand and is never shared
-    between threads (one per solve).
-    """
-
-    def __init__(self):
-        self._raw = np.empty(0, np.uint8)
-
-    def array(self, shape, dtype) -> np.ndarray:
-        """A C-contiguous view of the buffer of ``shape`` and ``dtype`` (grown if
-        needed): valid until the next product or call."""
-        shape = tuple(int(n) for n in shape)
-        nbytes = int(np.prod(shape)) * np.dtype(dtype).itemsize
-        if self._raw.nbytes < nbytes:
-            self._raw = np.empty(0, np.uint8)     # the old buffer goes first
-            self._raw = np.empty(nbytes, np.uint8)
-        return self._raw[:nbytes].view(dtype).reshape(shape)
-
-
-def _convolve(x, spectrum, fft_shape, out=None, work=None, workers=None):
-    """``irfftn(rfftn(x, s=fft_shape) * spectrum)`` over the trailing ``len(fft_shape)``
-    axes of ``x`` (leading axes are a batch of independent fields; ``x`` is zero-padded
-    to ``fft_shape`` and the result has the padded shape): the one FFT convolution of
-    the BEM, for single fields and stacks. float32 in, float32 out; float64 otherwise.
-    With ``work`` (and an unpadded grid) in place in its buffer: r2c into it, multiply,
-    inverse c2c over the leading grid axes, c2r into ``out`` (allocated if None).
-    ``workers``: threads per transform (default ``WORKERS``)."""
-    fft_shape = tuple(fft_shape)
-    workers = WORKERS if workers is None else workers
-    axes = list(range(x.ndim - len(fft_shape), x.ndim))
-    full = x.shape[:x.ndim - len(fft_shape)] + fft_shape
-    if work is None or _pocketfft is None or x.shape != full:
-        xh = scipy.fft.rfftn(x, s=fft_shape, axes=axes, workers=workers)
-        _multiply(xh, spectrum)
-        y = _irfftn_owned(xh, fft_shape, workers)
-        if out is None:
-            return y
-        out[...] = y
-        return out
-    single = x.dtype == np.float32
-    if not single and x.dtype != np.float64:
-        x = x.astype(np.float64)
-    xh = work.array(full[:-1] + (fft_shape[-1] // 2 + 1,),
-                    np.complex64 if single else np.complex128)
-    _pocketfft.r2c(x, axes, True, 0, xh, workers)
-    _multiply(xh, spectrum)
-    for axis in axes[:-1]:          # normalised by 1/n per axis, as irfftn
-        _pocketfft.c2c(xh, [axis], False, 2, xh, workers)
-    if out is None:
-        out = np.empty(full, x.dtype)
-    _pocketfft.c2r(xh, [axes[-1]], fft_shape[-1], False, 2, out, workers)
-    return out
-
-
-#: rows of the half-spectrum per chunk of :func:`_spectral_energy` (its squares' buffer)
-_ENERGY_ROWS = 32
-
-
-def _spectral_energy(xh, spectrum, n_last):
-    """sum over all modes of S |x|^2 from the half-spectrum ``xh`` (complex, the rfft
-    over the last axis of a real grid with ``n_last`` points there) and the real
-    multiplier ``spectrum`` (S) of its shape: |x|^2 in the precision of ``xh``, summed
-    in float64 over cache-sized row chunks, over the threads."""
-    x2 = xh.reshape(-1, xh.shape[-1])
-    s2 = spectrum.reshape(-1, spectrum.shape[-1])
-    even = n_last % 2 == 0
-
-    def one(i, j):
-        total = 0.0
-        buf = np.empty((min(_ENERGY_ROWS, j - i), 2 * x2.shape[1]), x2.real.dtype)
-        for k in range(i, j, _ENERGY_ROWS):
-            e = min(j, k + _ENERGY_ROWS)
-            c = np.multiply(x2[k:e].view(buf.dtype), x2[k:e].view(buf.dtype),
-                            out=buf[:e - k])
-            a = c[:, 0::2] + c[:, 1::2]       # |x|^2 (rounded as x: float32 or 64)
-            s = s2[k:e]
-            part = 2.0 * float(np.vdot(s, a)) - float(np.dot(s[:, 0], a[:, 0]))
-            if even:
-                part -= float(np.dot(s[:, -1], a[:, -1]))
-            total += part
-        return total
-
-    return float(sum(_parallel.blocks(x2.shape[0], one, min_block=_ENERGY_ROWS)))
-
-
-def _flat(a):
-    """The flat view of a C-contiguous array, or None."""
-    return a.reshape(-1) if a.flags.c_contiguous else None
-
-
-def _copy(out, x):
-    """``out[...] = x`` (cast to ``out``'s dtype) over the threads when both are
-    contiguous."""
-    fo, fx = _flat(out), _flat(x)
-    if fo is None or fx is None or fo.size != fx.size:
-        np.copyto(out, x, casting="same_kind")
-        return
-    _parallel.blocks(fo.size, lambda a, b: np.copyto(fo[a:b], fx[a:b],
-                                                     casting="same_kind"))
-
-
-def _multiply(xh, spectrum):
-    """``xh *= spectrum`` (half-spectrum by the kernel's multiplier) over the threads."""
-    fx, fs = _flat(xh), _flat(spectrum)
-    if fx is None or fs is None or fx.size != fs.size:
-        np.multiply(xh, spectrum, out=xh)
-        return
-    _parallel.blocks(fx.size, lambda a, b: np.multiply(fx[a:b], fs[a:b], out=fx[a:b]))
-
-
 def check_kernel_name(kernel: str) -> str:
     """Return ``kernel`` or raise :class:`InputError` unless it is ``"auto"`` or one of
     :data:`KERNELS` (the vocabulary only; which kernel fits a surface is decided when the
@@ -420,13 +283,6 @@ def check_kernel_name(kernel: str) -> str:
     if kernel != "auto" and kernel not in KERNELS:
         raise InputError(f"kernel must be 'auto' or one of {KERNELS}, got {kernel!r}")
     return kernel
-
-
-def fast_length(target: int, real: bool = True) -> int:
-    """The first length >= ``target`` whose FFT is fast (``scipy.fft.next_fast_len``:
-    factors 2, 3, 5 for the real transform's axis, ``real``, the last one; 7 and 11 too
-    for the complex axes)."""
-    return int(scipy.fft.next_fast_len(int(target), real=real))
 
 
 def padded_length(n: int, real: bool = True) -> int:
@@ -496,5 +352,8 @@ def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOpera
                   for n, m in zip(shape, padded))
         kern = uniform_cell_displacement_grid(k0.max() + 1, k1.max() + 1, *spacing,
                                               e_star)[np.ix_(k0, k1)]
-    spec = scipy.fft.rfftn(kern)
+    # the padded kernel is even in every offset, so its spectrum is real (the imaginary
+    # parts are rounding): kept real, as the periodic one (half the memory, and the
+    # Parseval energy of split_product needs a real multiplier)
+    spec = np.ascontiguousarray(scipy.fft.rfftn(kern).real)
     return InfluenceOperator(kernel, shape, spacing, False, e_star, spec, kern)
