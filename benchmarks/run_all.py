@@ -43,6 +43,7 @@ PLAN = {
     "bench_design_global": ([["20000"]], None),
     "bench_bem_choice": ([[]], [["--quick"]]),
     "bench_bem_padding": ([[]], [["--quick"]]),
+    "bench_bem_nonperiodic": ([[]], [["--quick"]]),
     "bench_bem_growth": ([[]], [["--quick"]]),
     "bench_bem": ([["--sizes", "512", "1024", "2048", "--large", "4096", "8192"]],
                   [["--quick", "--tamaas-max", "0"]]),

@@ -270,12 +270,20 @@ def write_results(scripts, output: Path, outdir: Path, kind: str, commands,
     the page then says); returns ``(stem, status)`` pairs."""
     outdir.mkdir(parents=True, exist_ok=True)
     pages, report = {}, []
+    stems = [script.stem for script in scripts]
+
+    def own(stem, path):
+        """A result file belongs to the longest script stem it starts with (the page of
+        bench_bem must not take bench_bem_padding.json)."""
+        return max((s for s in stems if path.stem.startswith(s)), key=len, default=None) == stem
+
     for script in scripts:
         stem = script.stem
         command = commands.get(stem, f"python {_rel(script)}")
         for folder in (output, fallback):
             found = [] if folder is None else sorted(folder.glob(f"{stem}.json")) + sorted(
-                p for p in folder.glob(f"{stem}*.json") if p.name != f"{stem}.json")
+                p for p in folder.glob(f"{stem}*.json")
+                if p.name != f"{stem}.json" and own(stem, p))
             if found:
                 break
         if found and folder is fallback:

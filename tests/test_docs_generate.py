@@ -76,6 +76,21 @@ def test_quick_run_is_used_and_named_when_the_full_run_is_missing(gen, tmp_path)
     assert "| w | 0.002 | <= 1 % | 0.2 % |" in page
 
 
+def test_a_page_takes_its_own_variants_not_another_scripts_results(gen, tmp_path):
+    # bench_x.py writes bench_x.json and a variant bench_x_8192.json; bench_x_pad.py is a
+    # script of its own: its JSON is on its page only
+    page = _pages(gen, tmp_path, {"bench_x": {"targets": [{"name": "x", "met": True}]},
+                                  "bench_x_pad": {"targets": [{"name": "pad", "met": False}]}})
+    (tmp_path / "output" / "bench_x_8192.json").write_text(
+        json.dumps({"targets": [{"name": "big", "met": True}]}))
+    scripts, output, pages = (tmp_path / d for d in ("validation", "output", "pages"))
+    gen.write_results(sorted(scripts.glob("*.py")), output, pages, "Benchmark", {})
+    own, pad = ((pages / f"{s}.md").read_text() for s in ("bench_x", "bench_x_pad"))
+    assert "| x |" in own and "| big |" in own and "| pad |" not in own
+    assert "| pad |" in pad and "| x |" not in pad and "| big |" not in pad
+    assert page["bench_x"].count("| pad |") == 0
+
+
 def test_missing_json_says_so_and_shows_no_numbers(gen, tmp_path):
     page = _pages(gen, tmp_path, {"gamma": None})["gamma"]
     assert "Not run yet" in page and "gamma.json" in page

@@ -1,0 +1,190 @@
+"""Non-periodic BEM in load control: the two-level solver against the plain one (round 2,
+session 16).
+
+Three changes made the load-controlled solve of a non-periodic surface (Love's kernel on
+the DC-FFT padded grid, ``kernel="auto"``) what the periodic one had been since session 6:
+
+* the coarse-to-fine start (``roughfe.bem.coarse_start``: 2 x 2 block means, recursively
+  down to 256 points per side, each level solved to 1e-4; in a sweep every level starts
+  from its own previous solution);
+* the two-level correction on the operator's padded torus
+  (``roughfe.bem.padded_deflation.PaddedBlockDeflation``), on by default where the FFT
+  grid's sides are in ``roughfe.bem.contact.DEFLATION_SIDES`` and the start's contact
+  has at least 32 parts;
+* padded products in place in the solve's workspace and the split line search
+  (``InfluenceOperator.split_product``: t . H t from the forward transform).
+
+Each case runs its loads twice in this process:
+
+* "two-level": the production code (``contact_sweep``, defaults);
+* "plain": ``coarse_correction=False`` and no coarse start (``COARSE_START_MIN`` patched
+  out of reach): the session-15 solver, except for the in-place products, which both use.
+
+Cases: RMD surfaces (D = 2.3, 2^m + 1 points per side) and the five measured files of
+``../shared/data/topographies`` (``ROUGHFE_TOPOGRAPHIES`` overrides the folder; a file
+that is missing is skipped, and the report says so). Loads p / (E* h'_rms) = 0.005, 0.01,
+0.02, 0.05, 0.1, 0.2 (a warm-started sweep, ``contact_sweep(pressures=)``), except the
+largest RMD case: one cold load 0.05 (``solve_contact``). Tol 1e-10, E = 1 GPa, nu = 0.3.
+The two alternate over two rounds; the reported CPU (process CPU time) is the smaller.
+
+Targets of a case:
+
+* the same answer: the contact fractions of the two differ by at most ``SAME_AREA`` =
+  2e-6 (a point or two of a 1025^2 grid; both are independent solves to a relative KKT
+  residual of 1e-10) and their loads by at most ``SAME_LOAD`` = 1e-9 relative;
+* where the correction is on by default, the two-level solver is not slower:
+  CPU(plain) / CPU(two-level) >= 0.95 (1 within the scatter of the CPU timer). Where it
+  is off (an FFT grid side below 1024), the start alone must not be slower either.
+
+Usage::
+
+    .venv/bin/python benchmarks/bench_bem_nonperiodic.py [--quick]
+
+``--quick``: RMD 513^2 only (~10 s). Writes ``benchmarks/output/bench_bem_nonperiodic.json``.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))
+from _report import write_report  # noqa: E402  (benchmarks/_report.py)
+
+TOL = 1e-10
+NOT_SLOWER = 0.95    #: CPU(plain) / CPU(two-level) at least this
+SAME_AREA = 2e-6     #: |A*(two-level) - A*(plain)| at most this
+SAME_LOAD = 1e-9     #: relative load difference at most this
+LOADS = (0.005, 0.01, 0.02, 0.05, 0.1, 0.2)   #: p / (E* h'_rms)
+ONE_LOAD = 0.05
+TOPOGRAPHIES = Path(os.environ.get("ROUGHFE_TOPOGRAPHIES",
+                                   HERE.parents[1] / "shared" / "data" / "topographies"))
+
+
+def surface_of(case):
+    """The case's non-periodic surface, or None when its file is missing."""
+    from roughfe.surfaces import rmd_surface
+    from roughfe.surfaces.io import load_surface
+    kind, arg = case
+    if kind == "rmd":
+        return rmd_surface(arg, 2.3, 1e-4, rng=1)
+    path = TOPOGRAPHIES / arg
+    return load_surface(path) if path.exists() else None
+
+
+def rms_slope_x(surface):
+    """h'_rms along the first axis (centred differences), the load's scale."""
+    g = np.gradient(surface.heights, surface.spacing[0], axis=0)
+    return float(np.sqrt(np.mean(g * g)))
+
+
+def solve(surface, plain, sweep):
+    """CPU, iterations, A* and loads of the case's loads; ``plain``: the session-15 solver."""
+    from roughfe.bem import Material, coarse_start, contact_sweep, solve_contact
+    material = Material(1e9, 0.3)
+    scale = material.E_star * rms_slope_x(surface)
+    lowest = coarse_start.COARSE_START_MIN
+    if plain:
+        coarse_start.COARSE_START_MIN = 10 ** 9
+    try:
+        c0 = time.process_time()
+        if sweep:
+            results = contact_sweep(surface, material, pressures=[x * scale for x in LOADS],
+                                    tol=TOL, compute_stiffness=False,
+                                    coarse_correction=False if plain else None).results
+        else:
+            results = [solve_contact(surface, material, mean_pressure=ONE_LOAD * scale,
+                                     tol=TOL, compute_stiffness=False,
+                                     coarse_correction=False if plain else None)]
+        cpu = time.process_time() - c0
+    finally:
+        coarse_start.COARSE_START_MIN = lowest
+    return {"cpu_s": cpu, "nit": [int(r.nit) for r in results],
+            "A*": [float(r.area_fraction) for r in results],
+            "mean_pressure": [float(r.mean_pressure) for r in results]}
+
+
+def correction_on(surface) -> bool:
+    """Whether the automatic choice can put the correction on (the FFT grid's sides)."""
+    from roughfe.bem.contact import DEFLATION_SIDES
+    from roughfe.bem.operators import padded_length
+    lo, hi = DEFLATION_SIDES
+    return all(lo <= padded_length(n, real=k == surface.ndim - 1) <= hi
+               for k, n in enumerate(surface.shape))
+
+
+def run_case(case, sweep):
+    """The two solves of one case, or the reason it was not timed (a str)."""
+    from roughfe.bem import solve_contact, Material
+    surface = surface_of(case)
+    if surface is None:
+        return f"not found in {TOPOGRAPHIES}"
+    # the operators of every level, built once before the clock runs
+    solve_contact(surface, Material(1e9, 0.3), mean_pressure=1e-3 * 1e9 * rms_slope_x(surface),
+                  tol=1e-4, compute_stiffness=False)
+    runs = {"two-level": [], "plain": []}
+    for order in (("two-level", "plain"), ("plain", "two-level")):
+        for mode in order:
+            runs[mode].append(solve(surface, mode == "plain", sweep))
+    best = {m: min(r["cpu_s"] for r in v) for m, v in runs.items()}
+    a, b = runs["two-level"][0], runs["plain"][0]
+    return {"case": f"{case[0]} {case[1]}", "shape": list(surface.shape),
+            "loads": list(LOADS) if sweep else [ONE_LOAD],
+            "correction_on_by_default": correction_on(surface),
+            "cpu_s": best, "speedup": best["plain"] / best["two-level"],
+            "nit": {"two-level": a["nit"], "plain": b["nit"]},
+            "max|dA*|": max(abs(x - y) for x, y in zip(a["A*"], b["A*"])),
+            "max dp/p": max(abs(x - y) / abs(y) for x, y in
+                            zip(a["mean_pressure"], b["mean_pressure"]) if y)}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="RMD 513^2 only")
+    ap.add_argument("--output", type=Path,
+                    default=HERE / "output" / "bench_bem_nonperiodic.json")
+    args = ap.parse_args(argv)
+    cases = [(("rmd", 9), True)]
+    if not args.quick:
+        cases += [(("rmd", 10), True), (("rmd", 11), False)]
+        cases += [(("file", f), True) for f in ("x3p-2.x3p", "plu-1.plu", "di-1.di",
+                                                  "sur-2.sur", "opd-1.opd")]
+    rows, targets, skipped = [], [], []
+    for case, sweep in cases:
+        r = run_case(case, sweep)
+        if isinstance(r, str):
+            skipped.append({"name": f"{case[0]} {case[1]}", "reason": r})
+            print(f"{case[0]} {case[1]}: skipped, {r}", flush=True)
+            continue
+        rows.append(r)
+        on = "on" if r["correction_on_by_default"] else "off (start only)"
+        print(f"{r['case']:14s} {tuple(r['shape'])} correction {on}: plain "
+              f"{r['cpu_s']['plain']:.2f} s, two-level {r['cpu_s']['two-level']:.2f} s "
+              f"(x{r['speedup']:.2f}); iterations {sum(r['nit']['plain'])} -> "
+              f"{sum(r['nit']['two-level'])}; max|dA*| {r['max|dA*|']:.1e}, "
+              f"max dp/p {r['max dp/p']:.1e}", flush=True)
+        label = f"{r['case']} {r['shape'][0]} x {r['shape'][1]}, {len(r['loads'])} load(s)"
+        targets += [{"name": f"{label}: CPU plain / two-level (correction {on})",
+                     "value": round(r["speedup"], 3), "target": f">= {NOT_SLOWER}",
+                     "met": r["speedup"] >= NOT_SLOWER},
+                    {"name": f"{label}: the same answer (max |dA*|, max dp/p)",
+                     "value": [r["max|dA*|"], r["max dp/p"]],
+                     "target": f"<= {SAME_AREA:g}, <= {SAME_LOAD:g}",
+                     "met": r["max|dA*|"] <= SAME_AREA and r["max dp/p"] <= SAME_LOAD}]
+    mean = float(np.exp(np.mean(np.log([r["speedup"] for r in rows])))) if rows else None
+    write_report(args.output, "bench_bem_nonperiodic", targets, rows,
+                 {"cpu_s": "s (process CPU time of the case's loads, the smaller of two "
+                           "rounds)", "speedup": "CPU(plain) / CPU(two-level)",
+                  "nit": "iterations per load", "max dp/p": "relative load difference"},
+                 extra={"tol": TOL, "loads_over_E*_h'rms": list(LOADS),
+                        "geometric_mean_speedup": mean}, skipped=skipped)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
