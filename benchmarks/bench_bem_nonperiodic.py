@@ -9,8 +9,8 @@ the DC-FFT padded grid, ``kernel="auto"``) what the periodic one had been since 
   from its own previous solution);
 * the two-level correction on the operator's padded torus
   (``roughfe.bem.padded_deflation.PaddedBlockDeflation``), on by default where the FFT
-  grid's sides are in ``roughfe.bem.contact.DEFLATION_SIDES`` and the start's contact
-  has at least 32 parts;
+  grid has 1024^2 to 8192^2 points (``roughfe.bem.contact.DEFLATION_SIDES``) and the
+  start's contact has at least 32 parts;
 * padded products in place in the solve's workspace and the split line search
   (``InfluenceOperator.split_product``: t . H t from the forward transform).
 
@@ -34,7 +34,7 @@ Targets of a case:
   residual of 1e-10) and their loads by at most ``SAME_LOAD`` = 1e-9 relative;
 * where the correction is on by default, the two-level solver is not slower:
   CPU(plain) / CPU(two-level) >= 0.95 (1 within the scatter of the CPU timer). Where it
-  is off (an FFT grid side below 1024), the start alone must not be slower either.
+  is off (an FFT grid below 1024^2 points), the start alone must not be slower either.
 
 Usage::
 
@@ -110,12 +110,13 @@ def solve(surface, plain, sweep):
 
 
 def correction_on(surface) -> bool:
-    """Whether the automatic choice can put the correction on (the FFT grid's sides)."""
+    """Whether the automatic choice can put the correction on (the FFT grid's points)."""
     from roughfe.bem.contact import DEFLATION_SIDES
     from roughfe.bem.operators import padded_length
     lo, hi = DEFLATION_SIDES
-    return all(lo <= padded_length(n, real=k == surface.ndim - 1) <= hi
-               for k, n in enumerate(surface.shape))
+    points = np.prod([padded_length(n, real=k == surface.ndim - 1)
+                      for k, n in enumerate(surface.shape)], dtype=float)
+    return lo * lo <= points <= hi * hi
 
 
 def run_case(case, sweep):

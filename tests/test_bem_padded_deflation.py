@@ -4,7 +4,7 @@ block deflation on the operator's padded torus (:mod:`roughfe.bem.padded_deflati
 Its premise is checked directly (between two surface points the torus kernel is the
 half-space kernel, so the torus operator on a field that vanishes off the surface is the
 non-periodic H), then its use: the same solution of Eq. 2.5-2.6 as the plain solve, in
-fewer iterations, on by default where the FFT grid is in ``DEFLATION_SIDES``."""
+fewer iterations, on by default where the FFT grid has ``DEFLATION_SIDES``^2 points."""
 import numpy as np
 import pytest
 

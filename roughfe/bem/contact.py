@@ -192,7 +192,7 @@ def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
     return hp, plastic_displacement
 
 
-#: elastic load-controlled surface solves whose FFT grid's sides lie in this range use the
+#: elastic load-controlled surface solves whose FFT grid has lo^2 to hi^2 points use the
 #: two-level correction: BlockDeflation when periodic (4 loads, cold, tol 1e-10: 1024^2 177
 #: -> 94 its, 7.8 -> 5.6 s CPU; 2048^2 237 -> 111, 38.6 -> 26.3 s; 4096^2 one load 99 -> 42),
 #: PaddedBlockDeflation on the ~2n padded grid of a non-periodic one (02b, session 16)
@@ -213,7 +213,7 @@ def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
                start=None):
     """The coarse correction of a load-controlled pk solve with ``op``, or None; its
     solves alone take the split line search (``polonsky_keer(split=)``, 02b session 11).
-    ``coarse_correction``: None = where measured to pay (sides in ``DEFLATION_SIDES``,
+    ``coarse_correction``: None = where measured to pay (``DEFLATION_SIDES``,
     and a ``start`` pressure, when given, whose contact set has at least
     ``CORRECTION_MIN_PARTS`` parts: :func:`~roughfe.bem.coarse_start._contact_parts`),
     False = never, True = wherever it applies (:func:`_check_coarse_correction`). A
@@ -221,7 +221,8 @@ def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
     lo, hi = DEFLATION_SIDES
     if (coarse_correction is False or plastic is not None
             or _two_level_unfit(op, hardness)
-            or (coarse_correction is None and not all(lo <= n <= hi for n in op.fft_shape))):
+            or (coarse_correction is None
+                and not lo * lo <= float(np.prod(op.fft_shape)) <= hi * hi)):
         return None
     if coarse_correction is None and start is not None:
         parts = _contact_parts(start)
@@ -320,7 +321,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         The two-level (deflation) correction of the Polonsky-Keer CG
         (:class:`roughfe.bem.deflation.BlockDeflation`, 8 x 8 blocks, on the padded grid
         of a non-periodic kernel: :mod:`roughfe.bem.padded_deflation`; elastic,
-        load-controlled surface solves). None: on for FFT grid sides in ``DEFLATION_SIDES``, where
+        load-controlled surface solves). None: on for FFT grids of ``DEFLATION_SIDES``^2 points, where
         it was measured to pay on rough surfaces (2-3x fewer iterations), unless the
         start's contact set has fewer than ``CORRECTION_MIN_PARTS`` connected parts
         (patches plus non-contact islands: a sphere, a sinusoid, a few asperities),

@@ -55,11 +55,12 @@ class PaddedBlockDeflation:
     """:class:`~roughfe.bem.deflation.BlockDeflation` of a non-periodic operator, on its
     padded torus (module docstring): the interface of ``polonsky_keer(deflation=)``.
 
-    Measured (RMD surfaces, D = 2.3, cold, tol 1e-10, p/E* h'_rms = 0.005, 0.05, 0.2,
-    with the coarse-to-fine start; ``docs/theory/02b_bem_performance.md``, session 16):
-    1025^2 41 -> 21, 60 -> 26, 82 -> 29 iterations, CPU -14 %, -18 %, -32 %; 513^2
-    31 -> 20, 45 -> 21, 61 -> 25, CPU +7 %, -23 %, -25 %; 257^2 even or dearer (the
-    solve's range, ``roughfe.bem.contact.DEFLATION_SIDES``, is on the FFT grid's sides).
+    Measured (``benchmarks/bench_bem_nonperiodic.py``, 6-load sweeps p/E* h'_rms =
+    0.005-0.2, tol 1e-10, against the plain solver without the coarse start; 02b,
+    session 16): RMD 513^2 281 -> 132 iterations, 1.15x less CPU; RMD 1025^2 381 -> 148,
+    1.61x; RMD 2049^2 (one load) 98 -> 29, 1.96x; the measured files 1.1-1.5x; the same
+    contact sets. RMD 257^2 is dearer with it (0.75 -> 0.95 s): the automatic range,
+    ``roughfe.bem.contact.DEFLATION_SIDES``, starts at an FFT grid of 1024^2 points.
     """
 
     def __init__(self, op: InfluenceOperator, block: int = 8, **options):

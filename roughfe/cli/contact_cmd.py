@@ -57,10 +57,11 @@ def register(subparsers) -> None:
     num.add_argument("--solver", default="auto", choices=SOLVERS,
                      help="dense pivoting, scipy NNLS, or matrix-free Polonsky-Keer PCG")
     num.add_argument("--coarse-correction", default="auto", choices=tuple(COARSE),
-                     help="the two-level correction of the Polonsky-Keer CG (periodic "
-                          "surfaces, --pressure): auto = from 1024^2 on, where the "
-                          "start's contact has >= 32 parts (patches plus islands), off "
-                          "for smooth geometries, where it buys no iterations")
+                     help="the two-level correction of the Polonsky-Keer CG (2D "
+                          "surfaces, --pressure): auto = from an FFT grid of 1024^2 points "
+                          "on (~512^2 points of a non-periodic surface), where the start's "
+                          "contact has >= 32 parts (patches plus islands), off for smooth "
+                          "geometries, where it buys no iterations")
     num.add_argument("--tol", type=positive_float, default=None,
                      help="relative KKT residual at which a load step is converged (default "
                           "1e-10); with --adhesion the traction residual (default 1e-5)")
