@@ -14,15 +14,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, NoConvergenceError
 from ..model import ContactResult
-from .solvers import restricted_cg, solve_spd
+from .directions import _descent_guard
+from .fft import FFTWorkspace
+from .solvers import pr_beta, restricted_cg, solve_spd, step_length
 
 
 def pressure_rate(op, solver, contact):
     """x = dp/dDelta (Pa/m) at every point for the FIXED contact set ``contact``:
     ``H_cc x_c = 1``, x = 0 outside. Cholesky on the cached dense matrix for the dense
-    solvers, restricted preconditioned CG otherwise. Returns ``(x, x_c)``."""
+    solvers, the load-controlled CG of :func:`unit_load_rate` otherwise. Returns
+    ``(x, x_c)``."""
     from .contact import _cg_preconditioner, _dense   # the solver's caches (contact imports us)
 
     if solver in ("dense", "nnls"):
@@ -31,9 +34,78 @@ def pressure_rate(op, solver, contact):
         x = np.zeros(contact.size)
         x[idx] = xc
         return x.reshape(contact.shape), xc
-    x, _ = restricted_cg(op.apply, contact, np.ones(contact.shape),
-                         precond=_cg_preconditioner(op))
+    x = unit_load_rate(op, contact)
     return x, x
+
+
+def unit_load_rate(op, contact, tol=1e-8, max_iter=2000):
+    """x = dp/dDelta (Pa/m, grid) on the FIXED contact set ``contact`` (bool grid), by the
+    load-controlled form of ``H_cc x_c = 1``: the pressure y of unit total load on c
+    with a uniform gap there, ``H_cc y_c = mu 1``, ``sum y = 1``; then ``x = y / mu``
+    (H is linear: the unit-load pressure times the approach rate of the load, and the
+    stiffness K = mean x = 1 / (N mu), N grid points).
+
+    The load-controlled form is the linear phase of the Polonsky-Keer CG itself (the
+    gradient is the gap's deviation from its mean on c), so the two-level correction
+    of the contact solve applies to it as it is (:func:`roughfe.bem.contact._deflation`,
+    its automatic choice for this contact set): preconditioned CG in the zero-mean
+    subspace of c (flexible: Polak-Ribiere's beta), stopped when the gap's deviation is
+    at most ``tol`` of its mean (rms); the displacement is updated by recursion and
+    recomputed once at the end, and mu is read from it. Measured (RMD 1025^2,
+    non-periodic, A* = 0.006 / 0.058 / 0.29; round 2, session 16): 14 iterations at every
+    load with the correction, 24 / 36 / 50 without, against 27 / 38 / 55 for the unit
+    right-hand side (:func:`~roughfe.bem.solvers.restricted_cg`), K within 1e-9 of a
+    1e-12 reference.
+    """
+    from .contact import _cg_preconditioner, _deflation   # the solver's caches and rule
+
+    shape = contact.shape
+    mask = np.ascontiguousarray(contact, dtype=bool).reshape(-1)
+    c = np.flatnonzero(mask)
+    nc = c.size
+    if nc == 0:                          # no contact: no point responds
+        return np.zeros(shape)
+    work = FFTWorkspace()
+    grid = np.zeros(mask.size)           # zero off c: only c is ever written
+    out = np.empty(shape)
+    precond = _cg_preconditioner(op)
+    deflation = _deflation(op, None, None, None, contact) if len(shape) == 2 else None
+
+    def apply_free(xF):
+        grid[c] = xF
+        return op.apply(grid.reshape(shape), out=out, work=work).reshape(-1)[c]
+
+    y = np.full(nc, 1.0 / nc)
+    u = apply_free(y)
+    g = u - u.mean()
+    t = g_old = None
+    gz_old = 0.0
+    for _ in range(max_iter):
+        if float(np.linalg.norm(g)) <= tol * float(u.mean()) * np.sqrt(nc):
+            break
+        grid[c] = g
+        z = precond(grid.reshape(shape), work=work).reshape(-1)[c].astype(np.float64)
+        z -= z.mean()
+        if deflation is not None:
+            z, gz = _descent_guard(g, z, deflation.correct(c, g, z, apply_free,
+                                                           free_mask=mask))
+        else:
+            gz = float(np.dot(g, z))
+        t = z if t is None else z + float(pr_beta(gz - float(np.dot(z, g_old)), gz_old)) * t
+        ht = apply_free(t)
+        tau = float(step_length(float(np.dot(g, t)), float(np.dot(t, ht))))
+        y -= tau * t
+        u -= tau * ht
+        g_old, gz_old = g, gz
+        g = u - u.mean()
+    else:
+        dev = float(np.linalg.norm(g)) / (float(u.mean()) * np.sqrt(nc))
+        raise NoConvergenceError(f"stiffness CG: the gap's deviation on the contact set is "
+                                 f"{dev:.2e} of its mean after {max_iter} iterations")
+    mu = float(apply_free(y).mean())      # recomputed: no drift of the recursion in K
+    x = np.zeros(mask.size)
+    x[c] = y / mu
+    return x.reshape(shape)
 
 
 def exact_stiffness(op, solver, contact, w, scale) -> float:
