@@ -45,7 +45,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -53,7 +52,8 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent))
+sys.path.insert(0, str(HERE))
+from _cases import TOPOGRAPHIES, paired_runs, paired_targets, surface_of  # noqa: E402  (benchmarks/_cases.py)
 from _report import write_report  # noqa: E402  (benchmarks/_report.py)
 
 TOL = 1e-10
@@ -62,19 +62,6 @@ SAME_AREA = 2e-6     #: |A*(two-level) - A*(plain)| at most this
 SAME_LOAD = 1e-9     #: relative load difference at most this
 LOADS = (0.005, 0.01, 0.02, 0.05, 0.1, 0.2)   #: p / (E* h'_rms)
 ONE_LOAD = 0.05
-TOPOGRAPHIES = Path(os.environ.get("ROUGHFE_TOPOGRAPHIES",
-                                   HERE.parents[1] / "shared" / "data" / "topographies"))
-
-
-def surface_of(case):
-    """The case's non-periodic surface, or None when its file is missing."""
-    from roughfe.surfaces import rmd_surface
-    from roughfe.surfaces.io import load_surface
-    kind, arg = case
-    if kind == "rmd":
-        return rmd_surface(arg, 2.3, 1e-4, rng=1)
-    path = TOPOGRAPHIES / arg
-    return load_surface(path) if path.exists() else None
 
 
 def rms_slope_x(surface):
@@ -128,21 +115,11 @@ def run_case(case, sweep):
     # the operators of every level, built once before the clock runs
     solve_contact(surface, Material(1e9, 0.3), mean_pressure=1e-3 * 1e9 * rms_slope_x(surface),
                   tol=1e-4, compute_stiffness=False)
-    runs = {"two-level": [], "plain": []}
-    for order in (("two-level", "plain"), ("plain", "two-level")):
-        for mode in order:
-            runs[mode].append(solve(surface, mode == "plain", sweep))
-    best = {m: min(r["cpu_s"] for r in v) for m, v in runs.items()}
-    a, b = runs["two-level"][0], runs["plain"][0]
     return {"case": f"{case[0]} {case[1]}", "shape": list(surface.shape),
             "loads": list(LOADS) if sweep else [ONE_LOAD],
             "correction_on_by_default": correction_on(surface),
-            "cpu_s": best, "speedup": best["plain"] / best["two-level"],
-            "nit": {"two-level": a["nit"], "plain": b["nit"]},
-            "max|dA*|": max(abs(x - y) for x, y in zip(a["A*"], b["A*"])),
-            "max dp/p": max(abs(x - y) / abs(y) for x, y in
-                            zip(a["mean_pressure"], b["mean_pressure"]) if y)}
-
+            **paired_runs(lambda mode: solve(surface, mode == "plain", sweep),
+                          "two-level", "plain")}
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -170,13 +147,8 @@ def main(argv=None) -> int:
               f"{sum(r['nit']['two-level'])}; max|dA*| {r['max|dA*|']:.1e}, "
               f"max dp/p {r['max dp/p']:.1e}", flush=True)
         label = f"{r['case']} {r['shape'][0]} x {r['shape'][1]}, {len(r['loads'])} load(s)"
-        targets += [{"name": f"{label}: CPU plain / two-level (correction {on})",
-                     "value": round(r["speedup"], 3), "target": f">= {NOT_SLOWER}",
-                     "met": r["speedup"] >= NOT_SLOWER},
-                    {"name": f"{label}: the same answer (max |dA*|, max dp/p)",
-                     "value": [r["max|dA*|"], r["max dp/p"]],
-                     "target": f"<= {SAME_AREA:g}, <= {SAME_LOAD:g}",
-                     "met": r["max|dA*|"] <= SAME_AREA and r["max dp/p"] <= SAME_LOAD}]
+        targets += paired_targets(label, r, f"CPU plain / two-level (correction {on})",
+                                  NOT_SLOWER, SAME_AREA, SAME_LOAD)
     mean = float(np.exp(np.mean(np.log([r["speedup"] for r in rows])))) if rows else None
     write_report(args.output, "bench_bem_nonperiodic", targets, rows,
                  {"cpu_s": "s (process CPU time of the case's loads, the smaller of two "

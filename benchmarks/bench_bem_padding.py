@@ -45,7 +45,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -54,6 +53,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+from _cases import TOPOGRAPHIES, paired_runs, paired_targets, surface_of  # noqa: E402  (benchmarks/_cases.py)
 from _report import write_report  # noqa: E402  (benchmarks/_report.py)
 
 TOL = 1e-10
@@ -62,19 +62,6 @@ TOL = 1e-10
 NOT_SLOWER = 0.95
 SAME_LOAD = 1e-8     #: the loads of the two layouts, relative difference at most
 STEPS = tuple(np.linspace(0.1, 0.6, 6))
-TOPOGRAPHIES = Path(os.environ.get("ROUGHFE_TOPOGRAPHIES",
-                                   HERE.parents[1] / "shared" / "data" / "topographies"))
-
-
-def surface_of(case):
-    """The case's non-periodic surface, or None when its file is missing."""
-    from roughfe.surfaces import rmd_surface
-    from roughfe.surfaces.io import load_surface
-    kind, arg = case
-    if kind == "rmd":
-        return rmd_surface(arg, 2.3, 1e-4, rng=1)
-    path = TOPOGRAPHIES / arg
-    return load_surface(path) if path.exists() else None
 
 
 def sweep(surface, double):
@@ -125,19 +112,8 @@ def run_case(case):
     if padded == [2 * n for n in surface.shape] and _fast(surface.shape):
         return (f"{surface.shape[0]} x {surface.shape[1]}: n and 2n are already fast "
                 f"lengths (the same grids), nothing to compare")
-    runs = {"fast": [], "2n": []}
-    for order in (("fast", "2n"), ("2n", "fast")):
-        for mode in order:
-            runs[mode].append(sweep(surface, mode == "2n"))
-    best = {m: min(r["cpu_s"] for r in v) for m, v in runs.items()}
-    a, b = runs["fast"][0], runs["2n"][0]
     return {"case": f"{case[0]} {case[1]}", "shape": list(surface.shape), "padded": padded,
-            "cpu_s": best, "speedup": best["2n"] / best["fast"],
-            "nit": {"fast": a["nit"], "2n": b["nit"]},
-            "max|dA*|": max(abs(x - y) for x, y in zip(a["A*"], b["A*"])),
-            "max dp/p": max(abs(x - y) / abs(y) for x, y in
-                            zip(a["mean_pressure"], b["mean_pressure"]) if y)}
-
+            **paired_runs(lambda mode: sweep(surface, mode == "2n"), "fast", "2n")}
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -162,12 +138,8 @@ def main(argv=None) -> int:
               f"{sum(r['nit']['fast'])}; max|dA*| {r['max|dA*|']:.1e}, "
               f"max dp/p {r['max dp/p']:.1e}", flush=True)
         label = f"{r['case']} {r['shape'][0]} x {r['shape'][1]}"
-        targets += [{"name": f"{label}: CPU of the 2n layout / the fast grids",
-                     "value": round(r["speedup"], 3), "target": f">= {NOT_SLOWER}",
-                     "met": r["speedup"] >= NOT_SLOWER},
-                    {"name": f"{label}: the same answer (max |dA*|, max dp/p)",
-                     "value": [r["max|dA*|"], r["max dp/p"]], "target": f"0, <= {SAME_LOAD:g}",
-                     "met": r["max|dA*|"] == 0 and r["max dp/p"] <= SAME_LOAD}]
+        targets += paired_targets(label, r, "CPU of the 2n layout / the fast grids",
+                                  NOT_SLOWER, 0.0, SAME_LOAD)
     mean = float(np.exp(np.mean(np.log([r["speedup"] for r in rows])))) if rows else None
     write_report(args.output, "bench_bem_padding", targets, rows,
                  {"cpu_s": "s (process CPU time of the 6-step sweep, the smaller of two "

@@ -19,3 +19,20 @@ def topographies_dir():
     if not TOPOGRAPHIES.is_dir():
         pytest.skip(f"measured topographies not found at {TOPOGRAPHIES}")
     return TOPOGRAPHIES
+
+
+@pytest.fixture
+def deflations_made(monkeypatch):
+    """The grid shapes of the two-level corrections the BEM solves make from now on (the
+    periodic BlockDeflation and the non-periodic PaddedBlockDeflation, as
+    ``roughfe.bem.contact`` makes them), in order."""
+    from roughfe.bem import contact
+    made = []
+    for name in ("BlockDeflation", "PaddedBlockDeflation"):
+        original = getattr(contact, name)
+
+        def make(op, block, _original=original):
+            made.append(op.shape)
+            return _original(op, block)
+        monkeypatch.setattr(contact, name, make)
+    return made

@@ -16,24 +16,13 @@ from roughfe.surfaces.surface import Surface
 KW = dict(solver="pk", tol=1e-10, compute_stiffness=False)
 
 
-def _counting(monkeypatch):
-    made = []
-    original = contact.BlockDeflation
-
-    def make(op, block):
-        made.append(op.shape)
-        return original(op, block)
-    monkeypatch.setattr(contact, "BlockDeflation", make)
-    return made
-
-
-def test_off_is_the_plain_solve_and_on_is_the_same_solution(monkeypatch):
+def test_off_is_the_plain_solve_and_on_is_the_same_solution(monkeypatch, deflations_made):
     # 1024^2 (the correction on by default): False is bit for bit the solve with the
     # correction's range emptied; the default reaches the same contact set with fewer
     # iterations (a rough surface: 23 against 49 at p/E* = 0.05)
     s = spectral_surface(1024, 1.0, 0.8, rms_slope=1.0, rng=1)
     m = Material(1.0, 0.0)
-    made = _counting(monkeypatch)
+    made = deflations_made
     auto = solve_contact(s, m, mean_pressure=0.05, **KW)
     assert made and made[-1] == (1024, 1024)
     made.clear()
@@ -47,12 +36,12 @@ def test_off_is_the_plain_solve_and_on_is_the_same_solution(monkeypatch):
     assert np.abs(auto.pressure - off.pressure).max() <= 2e-8 * off.pressure.max()
 
 
-def test_on_below_the_automatic_range(monkeypatch):
+def test_on_below_the_automatic_range(monkeypatch, deflations_made):
     # a sphere on 256^2 (automatic: plain), forced on: the same solution, Hertz-like
     s = sphere_cap(256, 1.0, 1.0)
     s = Surface(s.heights, s.size, periodic=True)
     m = Material(1.0, 0.0)
-    made = _counting(monkeypatch)
+    made = deflations_made
     plain = solve_contact(s, m, mean_pressure=1e-3, **KW)
     assert not made
     on = solve_contact(s, m, mean_pressure=1e-3, coarse_correction=True, **KW)
@@ -79,7 +68,7 @@ def test_contact_parts_counts_patches_and_islands():
     assert _contact_parts(np.ones((64, 64))) == 1
 
 
-def test_automatic_choice_reads_the_contact_structure(monkeypatch):
+def test_automatic_choice_reads_the_contact_structure(monkeypatch, deflations_made):
     # in the automatic range (1024^2) a sphere's start has 2 parts (one patch, one
     # non-contact region): the correction is left off and the solve is bit for bit the
     # plain one, in a single solve and in a warm-started sweep; a rough surface's start
@@ -87,7 +76,7 @@ def test_automatic_choice_reads_the_contact_structure(monkeypatch):
     m = Material(1.0, 0.0)
     sphere = sphere_cap(1024, 1.0, 1.0)
     sphere = Surface(sphere.heights, sphere.size, periodic=True)
-    made = _counting(monkeypatch)
+    made = deflations_made
     auto = solve_contact(sphere, m, mean_pressure=1e-2, **KW)
     assert not made
     off = solve_contact(sphere, m, mean_pressure=1e-2, coarse_correction=False, **KW)
