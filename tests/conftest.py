@@ -31,8 +31,8 @@ def deflations_made(monkeypatch):
     for name in ("BlockDeflation", "PaddedBlockDeflation"):
         original = getattr(contact, name)
 
-        def make(op, block, _original=original):
+        def make(op, block, _original=original, **options):
             made.append(op.shape)
-            return _original(op, block)
+            return _original(op, block, **options)
         monkeypatch.setattr(contact, name, make)
     return made

@@ -111,14 +111,17 @@ def _restrict(F, s, shape, block):
     return out
 
 
-def _a_def2(F, gF, zF, apply_free, shape, block, coarse_solve):
+def _a_def2(F, gF, zF, apply_free, shape, block, coarse_solve, zero_mean=True):
     """The A-DEF2 direction z_F + Z c, c = coarse_solve(Z^T (g - H_FF z)), in the
-    zero-mean subspace of F (``coarse_solve`` maps flat coarse right-hand sides to flat
-    coarse solutions); written over the vector of the right-hand side."""
+    zero-mean subspace of F (load control; ``zero_mean`` False: on all of F, displacement
+    control) (``coarse_solve`` maps flat coarse right-hand sides to flat coarse
+    solutions); written over the vector of the right-hand side."""
     s = gF - apply_free(zF)
-    s -= s.mean()
+    if zero_mean:
+        s -= s.mean()
     c = coarse_solve(_restrict(F, s, shape, block))
     for sl, r0, lo, hi in _chunks(F, shape, block):
         np.add(zF[sl], c[lo:hi][_block_index(F[sl], r0, shape, block)], out=s[sl])
-    s -= s.mean()
+    if zero_mean:
+        s -= s.mean()
     return s

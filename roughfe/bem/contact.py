@@ -50,10 +50,9 @@ REFERENCES = (
 
 
 # -- cached operators ---------------------------------------------------------------------
-#: Memory budgets of the operator caches (bytes of the arrays kept). A sweep reuses one
-#: operator, its preconditioner and (dense solvers) its matrix: the budgets keep a few
-#: of them; larger ones (a 2048^2 surface's operator, a dense matrix of more than ~5800
-#: points) are rebuilt per solve instead of being pinned for the life of the process.
+#: Memory budgets of the operator caches (bytes of the arrays kept): a sweep reuses one
+#: operator, its preconditioner and (dense solvers) its matrix; larger ones (a 2048^2
+#: operator, a dense matrix of > ~5800 points) are rebuilt per solve, not pinned.
 OPERATOR_CACHE_BYTES = 256 * MB
 DENSE_CACHE_BYTES = 256 * MB
 
@@ -210,16 +209,17 @@ def _two_level_unfit(op, hardness):
 
 
 def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
-               start=None):
+               start=None, load=True):
     """The coarse correction of a load-controlled pk solve with ``op``, or None; its
     solves alone take the split line search (``polonsky_keer(split=)``, 02b session 11).
     ``coarse_correction``: None = where measured to pay (``DEFLATION_SIDES``,
     and a ``start`` pressure, when given, whose contact set has at least
     ``CORRECTION_MIN_PARTS`` parts: :func:`~roughfe.bem.coarse_start._contact_parts`),
     False = never, True = wherever it applies (:func:`_check_coarse_correction`). A
-    plastic displacement comes with a hardness, which rules the correction out."""
+    plastic displacement comes with a hardness, which rules the correction out; without
+    ``load`` (displacement control) only a non-periodic H takes it (its full space)."""
     lo, hi = DEFLATION_SIDES
-    if (coarse_correction is False or plastic is not None
+    if (coarse_correction is False or plastic is not None or (op.periodic and not load)
             or _two_level_unfit(op, hardness)
             or (coarse_correction is None
                 and not lo * lo <= float(np.prod(op.fft_shape)) <= hi * hi)):
@@ -228,7 +228,8 @@ def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
         parts = _contact_parts(start)
         if parts is not None and parts < CORRECTION_MIN_PARTS:
             return None
-    return BlockDeflation(op, 8) if op.periodic else PaddedBlockDeflation(op, 8)
+    return BlockDeflation(op, 8) if op.periodic else PaddedBlockDeflation(op, 8,
+                                                                          zero_mean=load)
 
 
 def _check_coarse_correction(value, op, solver, mean_pressure, hardness):
@@ -239,7 +240,7 @@ def _check_coarse_correction(value, op, solver, mean_pressure, hardness):
     if value is not True:
         raise InputError(f"coarse_correction must be None (automatic), True or False, "
                          f"got {value!r}")
-    why = ("load control (mean_pressure)" if mean_pressure is None else
+    why = ("load control (mean_pressure)" if mean_pressure is None and op.periodic else
            "solver 'pk'" if solver != "pk" else _two_level_unfit(op, hardness))
     if why:
         raise InputError(f"coarse_correction=True (the two-level correction of the "
@@ -318,15 +319,13 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         the unloading branch of a cycle: the elastic body's surface is recessed by it,
         so the gap is u + u_pl + max h - h - Delta.
     coarse_correction : bool, optional
-        The two-level (deflation) correction of the Polonsky-Keer CG
-        (:class:`roughfe.bem.deflation.BlockDeflation`, 8 x 8 blocks, on the padded grid
-        of a non-periodic kernel: :mod:`roughfe.bem.padded_deflation`; elastic,
-        load-controlled surface solves). None: on for FFT grids of ``DEFLATION_SIDES``^2 points, where
-        it was measured to pay on rough surfaces (2-3x fewer iterations), unless the
-        start's contact set has fewer than ``CORRECTION_MIN_PARTS`` connected parts
-        (patches plus non-contact islands: a sphere, a sinusoid, a few asperities),
-        where it buys no iterations and costs 1.2-1.6x CPU
-        (docs/theory/02b_bem_performance.md, sessions 12-13). False: off. True: on at
+        The two-level correction of the Polonsky-Keer CG (8 x 8 blocks: BlockDeflation,
+        on the padded torus of a non-periodic kernel PaddedBlockDeflation; elastic
+        surface solves, load-controlled or non-periodic). None: on for FFT grids of
+        ``DEFLATION_SIDES``^2 points, where it pays on rough surfaces (2-3x fewer
+        iterations), unless the start's contact set (or the rigid interpenetration of a
+        cold approach) has fewer than ``CORRECTION_MIN_PARTS`` connected parts: there it
+        costs 1.2-1.6x CPU (02b, sessions 12-13 and 16). False: off. True: on at
         any size it applies to (an InputError says why it does not).
 
     Raises
@@ -399,8 +398,9 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
             if own:
                 initial = _coarse_start(surface, material, mean_pressure, hardness,
                                         coarse_correction=coarse_correction, kernel=op.name)
-            deflation = (None if mean_pressure is None else
-                         _deflation(op, hardness, plastic, coarse_correction, initial))
+            deflation = _deflation(op, hardness, plastic, coarse_correction, initial if (
+                initial is not None or delta is None) else np.maximum(h - hmax + delta, 0),
+                                   load=mean_pressure is not None)   # cold: h's contact
             out = polonsky_keer(op.apply, h, scale, delta=delta, mean_pressure=mean_pressure,
                                 initial=initial, diagonal=op.diagonal, tol=tol,
                                 precond=_cg_preconditioner(op), overwrite_initial=own,

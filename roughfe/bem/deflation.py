@@ -227,6 +227,10 @@ class BlockDeflation:
         0.05: 54 (1e-6: 53), the same A*.
     coarse_max_iter : int
         Iteration limit of the coarse CG (its last iterate is used if reached).
+    zero_mean : bool
+        Load control (default): the correction lives in the zero-mean subspace of F.
+        False: displacement control of a positive definite H (the non-periodic torus of
+        :mod:`roughfe.bem.padded_deflation`): no projection, the coarse mean mode kept.
     settle : float
         Fraction of the active blocks (those holding points of F) whose part of F may
         change from one iteration to the next with every active block in the coarse
@@ -251,7 +255,8 @@ class BlockDeflation:
     """
 
     def __init__(self, op: InfluenceOperator, block: int = 8, coarse_tol: float = 1e-4,
-                 coarse_max_iter: int = 500, settle: float = 0.3, search=None):
+                 coarse_max_iter: int = 500, settle: float = 0.3, search=None,
+                 zero_mean: bool = True):
         block = int(block)
         if block < 8 or block % 8:
             raise InputError(f"block must be a multiple of 8 (a block's row is whole bytes "
@@ -269,8 +274,12 @@ class BlockDeflation:
         self.coarse_max_iter = int(coarse_max_iter)
         self.settle = float(settle)
         self.search = float(search)
+        self.zero_mean = bool(zero_mean)
         self.coarse_shape = (m0, m1) = (op.shape[0] // b, op.shape[1] // b)
         self._near, self._k0, self._knear, self._khat, self._kinv = _block_constants(op, b)
+        if not self.zero_mean:     # the coarse mean mode is a mode of the solve too
+            self._kinv = self._kinv.copy()
+            self._kinv.flat[0] = 1.0 / self._khat.flat[0] if self._khat.flat[0] else 0.0
         self.inner_iterations = []
         self._last = None                                 # the last contact set's block rows
         self._mask = None                                 # those of the kept near field
@@ -365,7 +374,8 @@ class BlockDeflation:
         return apply, counts.reshape(m0, m1), diag
 
     def _coarse_solve(self, apply, counts, diag, rc):
-        """Projected PCG for E c = rc on {counts . c = 0} (the zero-mean coarse space)."""
+        """Projected PCG for E c = rc on {counts . c = 0} (the zero-mean coarse space; on
+        the active blocks only without ``zero_mean``)."""
         m0, m1 = self.coarse_shape
         active = counts > 0
         nn = counts.astype(float)
@@ -373,7 +383,8 @@ class BlockDeflation:
 
         def proj(v):
             v = np.where(active, v, 0.0)
-            v -= nn * float(np.vdot(nn, v))
+            if self.zero_mean:
+                v -= nn * float(np.vdot(nn, v))
             return v
 
         s = np.where(active, np.sqrt(np.maximum(diag, 0.0) / self._k0), 0.0)
@@ -436,4 +447,5 @@ class BlockDeflation:
         apply, counts, diag = self._coarse(X, counts)
         return _a_def2(F, gF, zF, apply_free, self.shape, self.block,
                        lambda rc: self._coarse_solve(apply, counts, diag,
-                                                     rc.reshape(counts.shape)).ravel())
+                                                     rc.reshape(counts.shape)).ravel(),
+                       self.zero_mean)

@@ -73,6 +73,11 @@ class PaddedBlockDeflation:
         self._inner = BlockDeflation(_torus_operator(op, int(block)), block, **options)
 
     @property
+    def zero_mean(self) -> bool:
+        """Load control (True) or displacement control (as BlockDeflation's)."""
+        return self._inner.zero_mean
+
+    @property
     def inner_iterations(self) -> list:
         """Coarse CG iterations of each correction (as BlockDeflation's)."""
         return self._inner.inner_iterations

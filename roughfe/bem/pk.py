@@ -196,8 +196,10 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     512^2-2048^2, the same contact sets, pressures within 4e-9 of max p of the
     all-float64 phase, 8 % (2048^2) to 12 % (1024^2) less CPU).
 
-    ``deflation`` (load control only): a two-level coarse correction of the direction,
-    an object with ``correct(F, gF, zF, apply_free, free_mask, pressure) -> zF``
+    ``deflation``: a two-level coarse correction of the direction (its ``zero_mean``
+    must be the control: True in load control, False in displacement control of a
+    positive definite H), an object with ``correct(F, gF, zF, apply_free, free_mask,
+    pressure) -> zF``
     that turns the preconditioned gradient ``zF = (M g)_F`` into the two-level one,
     given the flat free-set indices ``F``, the gradient ``gF``, ``apply_free(xF) =
     (H x)_F`` (a counted product, single precision when ``apply_single`` is given),
@@ -226,9 +228,10 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     """
     load = mean_pressure is not None
     single = apply_single is not None
-    if deflation is not None and not load:
-        raise InputError("a deflation (coarse correction) needs load control "
-                         "(mean_pressure): its coarse space is the zero-mean one")
+    if deflation is not None and getattr(deflation, "zero_mean", True) != load:
+        raise InputError("a deflation (coarse correction) must match the control: its "
+                         "coarse space is the zero-mean one in load control "
+                         "(mean_pressure) only (zero_mean=False for delta)")
     upper = np.inf if hardness is None else float(hardness)
     bounded = np.isfinite(upper)
     shape = b.shape
