@@ -47,7 +47,7 @@ def _torus_operator(op: InfluenceOperator, block: int) -> InfluenceOperator:
         k = np.arange(p)
         index.append(np.minimum(np.minimum(k, p - k), m // 2))
     kern = op.padded_kernel[np.ix_(*index)]
-    spectrum = scipy.fft.rfftn(kern, workers=WORKERS)
+    spectrum = np.ascontiguousarray(scipy.fft.rfftn(kern, workers=WORKERS).real)  # even
     return InfluenceOperator(op.name, torus, op.spacing, True, op.e_star, spectrum)
 
 
