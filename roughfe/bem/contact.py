@@ -191,16 +191,16 @@ def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
     return hp, plastic_displacement
 
 
-#: elastic load-controlled surface solves whose FFT grid has lo^2 to hi^2 points use the
-#: two-level correction: BlockDeflation when periodic (4 loads, cold, tol 1e-10: 1024^2 177
-#: -> 94 its, 7.8 -> 5.6 s CPU; 2048^2 237 -> 111, 38.6 -> 26.3 s; 4096^2 one load 99 -> 42),
+#: elastic surface solves (load-controlled, or non-periodic) whose FFT grid has lo^2 to
+#: hi^2 points use the two-level correction: BlockDeflation when periodic (4 loads, cold,
+#: tol 1e-10: 1024^2 177 -> 94 its, 7.8 -> 5.6 s CPU; 2048^2 237 -> 111, 38.6 -> 26.3 s),
 #: PaddedBlockDeflation on the ~2n padded grid of a non-periodic one (02b, session 16)
 DEFLATION_SIDES = (1024, 8192)
 
 
 def _two_level_unfit(op, hardness):
-    """Why the two-level correction cannot act on a load-controlled pk solve with ``op``
-    (what it needs), or None."""
+    """Why the two-level correction cannot act on a pk solve with ``op`` (what it
+    needs), or None."""
     return ("a 2D surface, not a profile" if len(op.shape) != 2 else
             "an elastic interface (no hardness)" if hardness is not None else
             f"grid sides that are multiples of 8 and >= 24, got {op.shape}"
@@ -210,7 +210,7 @@ def _two_level_unfit(op, hardness):
 
 def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
                start=None, load=True):
-    """The coarse correction of a load-controlled pk solve with ``op``, or None; its
+    """The coarse correction of a pk solve with ``op``, or None; its
     solves alone take the split line search (``polonsky_keer(split=)``, 02b session 11).
     ``coarse_correction``: None = where measured to pay (``DEFLATION_SIDES``,
     and a ``start`` pressure, when given, whose contact set has at least
@@ -407,7 +407,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                                 max_iter=max_iter or 20000, offset=-hmax, hardness=hardness,
                                 apply_single=functools.partial(op.apply, single=True),
                                 deflation=deflation,
-                                split=op.split_product if deflation else None)
+                                split=None if deflation is None else op.split_product)
         else:
             H = _dense(op)
             if initial is None:
