@@ -46,7 +46,8 @@ Usage::
 
     .venv/bin/python benchmarks/bench_bem_nonperiodic.py [--quick]
 
-``--quick``: RMD 513^2 only, load and displacement control (~20 s). Writes ``benchmarks/output/bench_bem_nonperiodic.json``.
+``--quick``: RMD 513^2 only, load and displacement control (~20 s). Writes
+``benchmarks/output/bench_bem_nonperiodic.json``.
 """
 from __future__ import annotations
 
@@ -59,7 +60,8 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from _cases import TOPOGRAPHIES, paired_runs, paired_targets, surface_of  # noqa: E402  (benchmarks/_cases.py)
+from _cases import (TOPOGRAPHIES, paired_runs, paired_targets,  # noqa: E402
+                    surface_of)  # benchmarks/_cases.py
 from _report import write_report  # noqa: E402  (benchmarks/_report.py)
 
 TOL = 1e-10

@@ -53,7 +53,8 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from _cases import TOPOGRAPHIES, paired_runs, paired_targets, surface_of  # noqa: E402  (benchmarks/_cases.py)
+from _cases import (TOPOGRAPHIES, paired_runs, paired_targets,  # noqa: E402
+                    surface_of)  # benchmarks/_cases.py
 from _report import write_report  # noqa: E402  (benchmarks/_report.py)
 
 TOL = 1e-10
