@@ -55,20 +55,22 @@ class FFTWorkspace:
         self._out = np.empty(0, np.uint8)
         self._zero = {}
 
-    @staticmethod
-    def _view(raw, shape, dtype):
+    def _grown(self, name, shape, dtype) -> np.ndarray:
+        """A C-contiguous view of ``shape`` and ``dtype`` of the raw buffer ``name``,
+        grown if needed (the old buffer is released first)."""
+        shape = tuple(int(n) for n in shape)
         nbytes = int(np.prod(shape)) * np.dtype(dtype).itemsize
+        raw = getattr(self, name)
+        if raw.nbytes < nbytes:
+            setattr(self, name, None)
+            raw = np.empty(nbytes, np.uint8)
+            setattr(self, name, raw)
         return raw[:nbytes].view(dtype).reshape(shape)
 
     def array(self, shape, dtype) -> np.ndarray:
         """A C-contiguous view of the buffer of ``shape`` and ``dtype`` (grown if
         needed): valid until the next product or call."""
-        shape = tuple(int(n) for n in shape)
-        nbytes = int(np.prod(shape)) * np.dtype(dtype).itemsize
-        if self._raw.nbytes < nbytes:
-            self._raw = np.empty(0, np.uint8)     # the old buffer goes first
-            self._raw = np.empty(nbytes, np.uint8)
-        return self._view(self._raw, shape, dtype)
+        return self._grown("_raw", shape, dtype)
 
     def padded(self, shape, dtype) -> np.ndarray:
         """The input grid of ``shape`` and ``dtype`` of a zero-padded product: zero
@@ -80,11 +82,7 @@ class FFTWorkspace:
 
     def padded_output(self, shape, dtype) -> np.ndarray:
         """The output grid of a zero-padded product (scratch, valid until the next)."""
-        nbytes = int(np.prod(shape)) * np.dtype(dtype).itemsize
-        if self._out.nbytes < nbytes:
-            self._out = np.empty(0, np.uint8)
-            self._out = np.empty(nbytes, np.uint8)
-        return self._view(self._out, tuple(int(n) for n in shape), dtype)
+        return self._grown("_out", shape, dtype)
 
 
 def _convolve(x, spectrum, fft_shape, out=None, work=None, workers=None):
