@@ -154,7 +154,7 @@ class InfluenceOperator:
                       work, workers)
         if self.periodic:
             return u
-        u = u[(Ellipsis,) + tuple(slice(0, n) for n in self.shape)]
+        u = u[(Ellipsis,) + self._surface]
         if out is None:         # with a workspace u is its padded output: copied
             return u if work is None else np.array(u)
         out[...] = u
@@ -192,10 +192,27 @@ class InfluenceOperator:
             _multiply(xh, self.spectrum)
             if self.periodic:
                 return _backward(xh, shape, work, workers, out)
-            out[...] = _backward(xh, shape, work, workers)[tuple(map(slice, self.shape))]
+            out[...] = _backward(xh, shape, work, workers)[self._surface]
             return out
 
         return energy, finish
+
+    @property
+    def _surface(self) -> tuple:
+        """The slices of the surface's grid in a padded (or torus) grid: its corner."""
+        return tuple(slice(0, n) for n in self.shape)
+
+    def circulant_kernel(self, shape) -> np.ndarray:
+        """The real-space kernel (m/Pa) of a non-periodic operator laid out as a circulant
+        on a grid of ``shape``: at index k the kernel at the periodic-image offset
+        min(k, m - k), clamped to the largest offset of the padded grid (offsets up to
+        n - 1 are exact). The preconditioner's Strang circulant (:meth:`inverse_spectrum`)
+        and the two-level correction's torus (:mod:`roughfe.bem.padded_deflation`)."""
+        index = []
+        for m, M in zip(shape, self.fft_shape):
+            k = np.arange(m)
+            index.append(np.minimum(np.minimum(k, m - k), M // 2))
+        return self.kernel[np.ix_(*index)]
 
     @property
     def precond_shape(self) -> tuple:
@@ -223,9 +240,7 @@ class InfluenceOperator:
         if self.periodic:
             spec = self.spectrum
         else:
-            idx = np.ix_(*[np.where(np.arange(m) <= m // 2, np.arange(m), np.arange(m) - m)
-                           % M for m, M in zip(self.precond_shape, self.fft_shape)])
-            spec = scipy.fft.rfftn(self.kernel[idx]).real
+            spec = scipy.fft.rfftn(self.circulant_kernel(self.precond_shape)).real
             spec = np.maximum(spec, 1e-12 * spec.max())
         with np.errstate(divide="ignore"):
             return np.where(spec > 0, 1.0 / np.where(spec > 0, spec, 1.0), 0.0)
@@ -243,7 +258,7 @@ class InfluenceOperator:
         if spectrum.dtype == np.float32:
             v = v.astype(np.float32, copy=False)
         y = _convolve(v, spectrum, pshape, None, work, workers)
-        crop = (Ellipsis,) + tuple(slice(0, n) for n in self.shape)
+        crop = (Ellipsis,) + self._surface
         if out is None:
             return np.ascontiguousarray(y[crop])
         out[...] = y[crop]

@@ -42,11 +42,7 @@ def _torus_operator(op: InfluenceOperator, block: int) -> InfluenceOperator:
     """The periodic operator on the torus of ``op`` (non-periodic, 2D): its padded kernel
     laid out at the periodic-image offsets of :func:`torus_shape`."""
     torus = torus_shape(op.shape, block)
-    index = []
-    for m, p in zip(op.fft_shape, torus):
-        k = np.arange(p)
-        index.append(np.minimum(np.minimum(k, p - k), m // 2))
-    kern = op.padded_kernel[np.ix_(*index)]
+    kern = op.circulant_kernel(torus)
     spectrum = np.ascontiguousarray(scipy.fft.rfftn(kern, workers=WORKERS).real)  # even
     return InfluenceOperator(op.name, torus, op.spacing, True, op.e_star, spectrum)
 
