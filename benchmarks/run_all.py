@@ -44,6 +44,7 @@ PLAN = {
     "bench_bem_choice": ([[]], [["--quick"]]),
     "bench_bem_padding": ([[]], [["--quick"]]),
     "bench_bem_nonperiodic": ([[]], [["--quick"]]),
+    "bench_bem_approach": ([[]], [["--quick"]]),
     "bench_bem_growth": ([[]], [["--quick"]]),
     "bench_bem": ([["--sizes", "512", "1024", "2048", "--large", "4096", "8192"]],
                   [["--quick", "--tamaas-max", "0"]]),

@@ -28,8 +28,11 @@ from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
 from .operators import (WORKERS, InfluenceOperator, _irfftn_owned, check_kernel_name,
                         influence_operator)
+from .approach import approach_by_load, approach_start
 from .periodic import periodic_bounded_displacement, periodic_gap_control
 from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
+from .contact_checks import (_check_coarse_correction, _check_hardness, _check_surface,
+                             _check_target)
 from .deflation import BlockDeflation
 from .padded_deflation import PaddedBlockDeflation
 from .pk import polonsky_keer
@@ -145,52 +148,6 @@ def _choose_solver(n_points: int, op: InfluenceOperator, solver: str,
     return solver
 
 
-def _check_surface(surface):
-    check_instance("surface", surface, Surface, "a roughfe Surface")
-    if np.ptp(surface.heights) == 0.0:
-        raise InputError("the surface is flat (constant heights): contact of a flat on a "
-                         "flat is uniform and has no rough-contact solution")
-
-
-def _check_target(delta, mean_pressure):
-    if (delta is None) == (mean_pressure is None):
-        raise InputError("give exactly one of delta (approach, m) or mean_pressure (Pa)")
-    if delta is not None:
-        try:
-            d = float(delta)
-        except (TypeError, ValueError):
-            raise InputError(f"delta must be a number of metres >= 0, got {delta!r}") from None
-        if not (np.isfinite(d) and d >= 0):
-            raise InputError(f"delta (approach from first contact, m) must be finite and "
-                             f">= 0, got {delta!r}")
-        return d, None
-    return None, check_finite_positive("mean_pressure (Pa)", mean_pressure)
-
-
-def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
-    """Validate the hardness (Pa) and a prior plastic displacement (m)."""
-    if hardness is None:
-        if plastic_displacement is not None:
-            raise InputError("plastic_displacement needs a hardness (it is the permanent "
-                             "deformation of a perfectly plastic interface)")
-        return None, None
-    if isinstance(hardness, bool):
-        raise InputError(f"hardness must be a number of Pa > 0, got {hardness!r}")
-    hp = check_finite_positive("hardness (Pa, the pressure cap of the perfectly plastic "
-                               "interface)", hardness)
-    if mean_pressure is not None and not mean_pressure < hp:
-        raise InputError(f"mean_pressure = {mean_pressure:.6g} Pa must be below the hardness "
-                         f"{hp:.6g} Pa (at p = hardness every point is plastic)")
-    if plastic_displacement is not None:
-        up = np.asarray(plastic_displacement, dtype=float)
-        if up.shape != shape:
-            raise InputError(f"plastic_displacement has shape {up.shape}, expected {shape}")
-        if not np.all(np.isfinite(up)) or float(up.min()) < 0:
-            raise InputError("plastic_displacement (m) must be finite and >= 0")
-        plastic_displacement = up
-    return hp, plastic_displacement
-
-
 #: elastic surface solves (load-controlled, or non-periodic) whose FFT grid has lo^2 to
 #: hi^2 points use the two-level correction: BlockDeflation when periodic (4 loads, cold,
 #: tol 1e-10: 1024^2 177 -> 94 its, 7.8 -> 5.6 s CPU; 2048^2 237 -> 111, 38.6 -> 26.3 s),
@@ -232,20 +189,16 @@ def _deflation(op: InfluenceOperator, hardness, plastic, coarse_correction=None,
                                                                           zero_mean=load)
 
 
-def _check_coarse_correction(value, op, solver, mean_pressure, hardness):
-    """``coarse_correction`` of :func:`solve_contact`: None, True or False; True only
-    where the two-level correction applies (else an InputError that says why)."""
-    if value is None or value is False:
-        return value
-    if value is not True:
-        raise InputError(f"coarse_correction must be None (automatic), True or False, "
-                         f"got {value!r}")
-    why = ("load control (mean_pressure)" if mean_pressure is None and op.periodic else
-           "solver 'pk'" if solver != "pk" else _two_level_unfit(op, hardness))
-    if why:
-        raise InputError(f"coarse_correction=True (the two-level correction of the "
-                         f"Polonsky-Keer CG) needs {why}")
-    return True
+def _pk(op, h, hmax, scale, tol, max_iter, initial, own, deflation, **target):
+    """The Polonsky-Keer CG on ``op`` for the heights ``h`` (max ``hmax``): the float32
+    products and preconditioner of its direction, the split line search with a
+    ``deflation``; ``target``: delta or mean_pressure (and hardness, approach)."""
+    return polonsky_keer(op.apply, h, scale, initial=initial, diagonal=op.diagonal, tol=tol,
+                         precond=_cg_preconditioner(op), overwrite_initial=own,
+                         max_iter=max_iter or 20000, offset=-hmax,
+                         apply_single=functools.partial(op.apply, single=True),
+                         deflation=deflation,
+                         split=None if deflation is None else op.split_product, **target)
 
 
 def _periodic_full_contact(op, h):
@@ -347,7 +300,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
     solver = _choose_solver(surface.heights.size, op, solver, hardness is not None)
     coarse_correction = _check_coarse_correction(coarse_correction, op, solver,
-                                                 mean_pressure, hardness)
+                                                 mean_pressure, hardness, _two_level_unfit)
     h = surface.heights
     hmax = float(h.max())
     if plastic is not None:
@@ -387,8 +340,24 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
             del p0            # not kept through the iterative solve (one field)
     if out is None:
         if gap_control:
-            out = periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
-                                       max_iter or 20000, _preconditioner(op))
+            # a 2D surface through load control (roughfe.bem.approach); the gap-variable
+            # CG where there is no estimate of the load or that solve fails
+            start = (approach_start(surface, material, delta, initial, coarse_correction)
+                     if surface.ndim == 2 else None)
+            if start is not None:
+                p0, deflation = start[0], _deflation(op, None, None, coarse_correction,
+                                                     start[0])
+                try:
+                    out = approach_by_load(lambda pm, t, hook: _pk(
+                        op, h, hmax, scale, t, max_iter, p0, True, deflation,
+                        mean_pressure=pm, approach=hook), h, hmax, scale, delta, start[1],
+                        rms_height(surface), tol)
+                    tolerance = tol
+                except NoConvergenceError:
+                    out = None
+            if out is None:
+                out = periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
+                                           max_iter or 20000, _preconditioner(op))
         elif periodic_delta:
             out = periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol,
                                                 max_iter or 20000, hardness,
@@ -401,13 +370,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
             deflation = _deflation(op, hardness, plastic, coarse_correction, initial if (
                 initial is not None or delta is None) else np.maximum(h - hmax + delta, 0),
                                    load=mean_pressure is not None)   # cold: h's contact
-            out = polonsky_keer(op.apply, h, scale, delta=delta, mean_pressure=mean_pressure,
-                                initial=initial, diagonal=op.diagonal, tol=tol,
-                                precond=_cg_preconditioner(op), overwrite_initial=own,
-                                max_iter=max_iter or 20000, offset=-hmax, hardness=hardness,
-                                apply_single=functools.partial(op.apply, single=True),
-                                deflation=deflation,
-                                split=None if deflation is None else op.split_product)
+            out = _pk(op, h, hmax, scale, tol, max_iter, initial, own, deflation,
+                      delta=delta, mean_pressure=mean_pressure, hardness=hardness)
         else:
             H = _dense(op)
             if initial is None:

@@ -1,0 +1,71 @@
+"""Input checks of :func:`roughfe.bem.solve_contact`: what was wrong, which value, what is
+allowed (InputError)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError, check_finite_positive, check_instance
+from ..surfaces.surface import Surface
+
+
+def _check_surface(surface):
+    check_instance("surface", surface, Surface, "a roughfe Surface")
+    if np.ptp(surface.heights) == 0.0:
+        raise InputError("the surface is flat (constant heights): contact of a flat on a "
+                         "flat is uniform and has no rough-contact solution")
+
+
+def _check_target(delta, mean_pressure):
+    if (delta is None) == (mean_pressure is None):
+        raise InputError("give exactly one of delta (approach, m) or mean_pressure (Pa)")
+    if delta is not None:
+        try:
+            d = float(delta)
+        except (TypeError, ValueError):
+            raise InputError(f"delta must be a number of metres >= 0, got {delta!r}") from None
+        if not (np.isfinite(d) and d >= 0):
+            raise InputError(f"delta (approach from first contact, m) must be finite and "
+                             f">= 0, got {delta!r}")
+        return d, None
+    return None, check_finite_positive("mean_pressure (Pa)", mean_pressure)
+
+
+def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
+    """Validate the hardness (Pa) and a prior plastic displacement (m)."""
+    if hardness is None:
+        if plastic_displacement is not None:
+            raise InputError("plastic_displacement needs a hardness (it is the permanent "
+                             "deformation of a perfectly plastic interface)")
+        return None, None
+    if isinstance(hardness, bool):
+        raise InputError(f"hardness must be a number of Pa > 0, got {hardness!r}")
+    hp = check_finite_positive("hardness (Pa, the pressure cap of the perfectly plastic "
+                               "interface)", hardness)
+    if mean_pressure is not None and not mean_pressure < hp:
+        raise InputError(f"mean_pressure = {mean_pressure:.6g} Pa must be below the hardness "
+                         f"{hp:.6g} Pa (at p = hardness every point is plastic)")
+    if plastic_displacement is not None:
+        up = np.asarray(plastic_displacement, dtype=float)
+        if up.shape != shape:
+            raise InputError(f"plastic_displacement has shape {up.shape}, expected {shape}")
+        if not np.all(np.isfinite(up)) or float(up.min()) < 0:
+            raise InputError("plastic_displacement (m) must be finite and >= 0")
+        plastic_displacement = up
+    return hp, plastic_displacement
+
+
+def _check_coarse_correction(value, op, solver, mean_pressure, hardness, two_level_unfit):
+    """``coarse_correction`` of :func:`solve_contact`: None, True or False; True only
+    where the two-level correction applies (``two_level_unfit(op, hardness)``: why
+    not, or None; else an InputError that says why)."""
+    if value is None or value is False:
+        return value
+    if value is not True:
+        raise InputError(f"coarse_correction must be None (automatic), True or False, "
+                         f"got {value!r}")
+    why = ("load control (mean_pressure)" if mean_pressure is None and op.periodic else
+           "solver 'pk'" if solver != "pk" else two_level_unfit(op, hardness))
+    if why:
+        raise InputError(f"coarse_correction=True (the two-level correction of the "
+                         f"Polonsky-Keer CG) needs {why}")
+    return True

@@ -1,0 +1,109 @@
+"""An imposed approach on a periodic surface solved through load control
+(roughfe.bem.approach): the same solution as the gap-variable CG, the round trip with load
+control, the secant hook on a known Delta(P), and the fallbacks."""
+import numpy as np
+import pytest
+
+from roughfe.bem import Material, contact, contact_sweep, solve_contact
+from roughfe.bem.approach import LoadSecant, approach_start
+from roughfe.bem.coarse_start import _coarse_surface
+from roughfe.surfaces.spectral import spectral_surface
+from roughfe.surfaces.surface import Surface
+
+MAT = Material(1.0, 0.0)
+
+
+@pytest.fixture(scope="module")
+def rough():
+    return spectral_surface(256, 1.0, 0.8, rms_slope=1.0, rng=3)
+
+
+def _gap_variable(monkeypatch):
+    """solve_contact with the approach path switched off (the gap-variable CG)."""
+    monkeypatch.setattr(contact, "approach_start", lambda *a, **k: None)
+
+
+@pytest.mark.parametrize("fraction", [0.15, 0.4, 0.8])
+def test_by_load_equals_the_gap_variable_solution(rough, fraction, monkeypatch):
+    """Two independent solvers of Eq. 2.5-2.6 at an imposed Delta: the same contact set,
+    pressures within the KKT tolerance, and the load-path answer meets the tolerance in
+    displacement control (gap >= 0 and p g = 0 at the imposed Delta itself)."""
+    delta = fraction * (rough.heights.max() - rough.heights.mean())
+    a = solve_contact(rough, MAT, delta=delta, compute_stiffness=False)
+    assert a.tolerance == 1e-10 and a.residual <= 1e-10 and a.delta == delta
+    h = rough.heights
+    w = a.displacement + h.max() - h - delta            # the gap at the imposed Delta
+    scale = np.ptp(h)
+    assert w.min() >= -1e-10 * scale
+    assert np.sum(a.pressure * np.abs(w)) <= 1e-10 * scale * a.pressure.sum()
+    _gap_variable(monkeypatch)
+    b = solve_contact(rough, MAT, delta=delta, compute_stiffness=False)
+    assert np.array_equal(a.contact, b.contact)
+    assert np.abs(a.pressure - b.pressure).max() <= 1e-7 * b.pressure.max()
+    assert a.mean_pressure == pytest.approx(b.mean_pressure, rel=1e-8)
+
+
+def test_round_trip_with_load_control(rough):
+    """The approach of a load-controlled solution, imposed, gives back its load."""
+    p = solve_contact(rough, MAT, mean_pressure=0.03, compute_stiffness=False)
+    d = solve_contact(rough, MAT, delta=p.delta, compute_stiffness=False)
+    assert d.mean_pressure == pytest.approx(0.03, rel=1e-8)
+    assert np.array_equal(d.contact, p.contact)
+
+
+def test_the_secant_reaches_a_known_law():
+    """On Delta(P) = c log(P / P0) (the exponential law of rough contacts) the hook,
+    fed exact estimates, reaches the target within its tolerance in a few moves; it
+    never moves while the residual is above the offset, nor within the tolerance."""
+    c, p0, target = 0.3, 1e-3, 1.0
+    law = lambda P: c * np.log(P / p0)                  # noqa: E731
+    hook = LoadSecant(target, 1e-2, 1e-2 / 0.5, 1e-12, 1.0, 1e-12)
+    assert hook(1.0, law(1e-2)) is None                 # residual 1 > |offset| 0.31
+    P = 1e-2
+    for _ in range(20):
+        new = hook(1e-14, law(P))
+        if new is None:
+            break
+        P = new
+    assert abs(law(P) - target) <= 1e-12 and hook.moves <= 10
+    assert P == pytest.approx(p0 * np.exp(target / c), rel=1e-11)
+
+
+def test_the_start_and_its_fallbacks(rough):
+    """A coarse estimate of the load from the same flat height on the coarsened grid;
+    none below 256 points per axis, on profiles, or where the coarse surface does not
+    touch (those take the gap-variable CG, and still solve)."""
+    top = rough.heights.max() - rough.heights.mean()
+    p, pm = approach_start(rough, MAT, 0.3 * top, None)
+    assert p.shape == rough.shape and pm > 0 and p.mean() == pytest.approx(pm)
+    low = spectral_surface(256, 1.0, 0.8, rms_slope=1.0, rng=1)
+    below = low.heights.max() - _coarse_surface(low).heights.max()   # its coarse top
+    assert below > 0 and approach_start(low, MAT, 0.5 * below, None) is None
+    small = spectral_surface(64, 1.0, 0.8, rms_slope=1.0, rng=1)
+    assert approach_start(small, MAT, 0.3, None) is None
+    r = solve_contact(small, MAT, delta=0.3 * (small.heights.max() - small.heights.mean()))
+    assert r.residual <= 10 * r.tolerance
+    given = np.full(rough.shape, 2.0)
+    assert approach_start(rough, MAT, 0.3 * top, given)[1] == 2.0
+    assert approach_start(rough, MAT, 0.3 * top, np.zeros(rough.shape)) is None
+
+
+def test_approach_sweep_equals_the_load_sweep(rough):
+    """The default sweep (equispaced approaches, each started from the secant of the
+    last two) against load control at its own mean pressures: the same contact areas,
+    and every step at its imposed Delta."""
+    s = contact_sweep(rough, MAT, n_steps=8, compute_stiffness=False)
+    loads = [r.mean_pressure for r in s.results[:-1]]
+    q = contact_sweep(rough, MAT, pressures=loads, compute_stiffness=False)
+    assert np.array_equal(s.n_contact[:-1], q.n_contact)
+    top = rough.heights.max() - rough.heights.mean()
+    assert np.allclose(s.delta, top * np.arange(1, 9) / 8, rtol=0, atol=1e-15)
+    assert all(r.residual <= r.tolerance for r in s.results)
+
+
+def test_profiles_keep_the_gap_variable_solver():
+    """A periodic profile (1D) is solved as before (its solves are cheap)."""
+    x = np.arange(1024) / 1024      # above DENSE_MAX_POINTS: the pk path
+    prof = Surface(0.01 * np.cos(2 * np.pi * x), 1.0, periodic=True)
+    r = solve_contact(prof, MAT, delta=0.005)
+    assert r.tolerance == 1e-9 and 0 < r.area_fraction < 1
