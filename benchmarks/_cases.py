@@ -1,6 +1,7 @@
 """The non-periodic surfaces of the BEM benchmarks (bench_bem_padding, bench_bem_nonperiodic):
 RMD surfaces (D = 2.3, 2^m + 1 points per side) and the measured instrument files of
-``../shared/data/topographies`` (``ROUGHFE_TOPOGRAPHIES`` overrides the folder)."""
+``../shared/data/topographies`` (``ROUGHFE_TOPOGRAPHIES`` overrides the folder); and the
+paired runs of two solvers on one case, with their targets (also bench_bem_approach)."""
 from __future__ import annotations
 
 import os
@@ -21,6 +22,14 @@ def surface_of(case):
         return rmd_surface(arg, 2.3, 1e-4, rng=1)
     path = TOPOGRAPHIES / arg
     return load_surface(path) if path.exists() else None
+
+
+def run_summary(cpu, results):
+    """One run of :func:`paired_runs`: its CPU (s) and, per step of ``results``
+    (ContactResults), the iterations, A* and mean pressure."""
+    return {"cpu_s": cpu, "nit": [int(r.nit) for r in results],
+            "A*": [float(r.area_fraction) for r in results],
+            "mean_pressure": [float(r.mean_pressure) for r in results]}
 
 
 def paired_runs(run, new, old):

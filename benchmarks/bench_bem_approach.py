@@ -43,7 +43,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from _cases import paired_runs, paired_targets  # noqa: E402  (benchmarks/_cases.py)
+from _cases import paired_runs, paired_targets, run_summary  # noqa: E402
 from _report import write_report  # noqa: E402  (benchmarks/_report.py)
 
 TOL = 1e-10
@@ -72,9 +72,7 @@ def solve(surface, gap, kind):
         cpu = time.process_time() - c0
     finally:
         contact.approach_start = start
-    return {"cpu_s": cpu, "nit": [int(r.nit) for r in results],
-            "A*": [float(r.area_fraction) for r in results],
-            "mean_pressure": [float(r.mean_pressure) for r in results]}
+    return run_summary(cpu, results)
 
 
 def main(argv=None) -> int:

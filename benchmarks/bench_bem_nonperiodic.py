@@ -61,7 +61,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from _cases import (TOPOGRAPHIES, paired_runs, paired_targets,  # noqa: E402
-                    surface_of)  # benchmarks/_cases.py
+                    run_summary, surface_of)  # benchmarks/_cases.py
 from _report import write_report  # noqa: E402  (benchmarks/_report.py)
 
 TOL = 1e-10
@@ -103,9 +103,7 @@ def solve(surface, plain, control):
         cpu = time.process_time() - c0
     finally:
         coarse_start.COARSE_START_MIN = lowest
-    return {"cpu_s": cpu, "nit": [int(r.nit) for r in results],
-            "A*": [float(r.area_fraction) for r in results],
-            "mean_pressure": [float(r.mean_pressure) for r in results]}
+    return run_summary(cpu, results)
 
 
 def correction_on(surface) -> bool:

@@ -71,8 +71,9 @@ def test_the_secant_reaches_a_known_law():
 
 def test_the_start_and_its_fallbacks(rough):
     """A coarse estimate of the load from the same flat height on the coarsened grid;
-    none below 256 points per axis, on profiles, or where the coarse surface does not
-    touch (those take the gap-variable CG, and still solve)."""
+    none below 256 points per axis, where the coarse surface does not touch, or where
+    the start is in contact on more than half the grid (those take the gap-variable CG,
+    and still solve)."""
     top = rough.heights.max() - rough.heights.mean()
     p, pm = approach_start(rough, MAT, 0.3 * top, None)
     assert p.shape == rough.shape and pm > 0 and p.mean() == pytest.approx(pm)
@@ -83,9 +84,13 @@ def test_the_start_and_its_fallbacks(rough):
     assert approach_start(small, MAT, 0.3, None) is None
     r = solve_contact(small, MAT, delta=0.3 * (small.heights.max() - small.heights.mean()))
     assert r.residual <= 10 * r.tolerance
-    given = np.full(rough.shape, 2.0)
-    assert approach_start(rough, MAT, 0.3 * top, given)[1] == 2.0
+    given = np.zeros(rough.shape)
+    given[:64] = 2.0                                     # a quarter of the grid
+    assert approach_start(rough, MAT, 0.3 * top, given)[1] == 0.5
     assert approach_start(rough, MAT, 0.3 * top, np.zeros(rough.shape)) is None
+    # nearly full contact: the gap-variable CG (its unknowns are the few open points)
+    assert approach_start(rough, MAT, 0.3 * top, np.ones(rough.shape)) is None
+    assert approach_start(rough, MAT, 0.999 * top, None) is None
 
 
 def test_approach_sweep_equals_the_load_sweep(rough):
