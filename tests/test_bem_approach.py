@@ -112,3 +112,25 @@ def test_profiles_keep_the_gap_variable_solver():
     prof = Surface(0.01 * np.cos(2 * np.pi * x), 1.0, periodic=True)
     r = solve_contact(prof, MAT, delta=0.005)
     assert r.tolerance == 1e-9 and 0 < r.area_fraction < 1
+
+
+def test_load_increment_goes_onto_the_contact_set():
+    """The move of the load inside the PK (pk_passes._load_increment): the new total is
+    the target, p stays >= 0 and zero off the contact set, and the increment is M 1_S
+    (positive inside a patch, largest at its edge)."""
+    from roughfe.bem.contact import _cg_preconditioner, _operator
+    from roughfe.bem.pk_passes import _load_increment
+    op = _operator((64, 64), (1.0, 1.0), 1.0, "spectral")
+    M = _cg_preconditioner(op)
+    x = np.arange(64) - 31.5
+    disc = (x[:, None] ** 2 + x[None, :] ** 2 < 15.0 ** 2).ravel()
+    S = np.flatnonzero(disc)
+    p = np.where(disc, 1.0, 0.0)
+    buf = np.zeros(p.size, np.float32)
+    before = p.copy()
+    assert _load_increment(p, S, 100.0, lambda v: M(v.reshape(64, 64)).ravel(), buf,
+                           before.sum() + 100.0)
+    assert p.sum() == pytest.approx(before.sum() + 100.0, rel=1e-12)
+    assert p.min() >= 0 and not p[~disc].any() and not buf.any()
+    inc = (p - before).reshape(64, 64)
+    assert inc[32, 32] >= 0 and inc[32, 17] > inc[32, 32]       # the edge takes more
