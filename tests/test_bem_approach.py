@@ -134,3 +134,19 @@ def test_load_increment_goes_onto_the_contact_set():
     assert p.min() >= 0 and not p[~disc].any() and not buf.any()
     inc = (p - before).reshape(64, 64)
     assert inc[32, 32] >= 0 and inc[32, 17] > inc[32, 32]       # the edge takes more
+
+
+def test_a_failed_load_path_says_so_and_falls_back(rough, monkeypatch):
+    """When the load path does not converge (here: an iteration cap it cannot meet) the
+    gap-variable CG solves, and a RuntimeWarning says why."""
+    import roughfe.bem.approach as approach
+    real = approach.approach_by_load
+
+    def capped(solve, *args):
+        return real(lambda pm, t, hook: solve(pm, t * 1e-12, hook), *args)
+
+    monkeypatch.setattr(contact, "approach_by_load", capped)
+    delta = 0.4 * (rough.heights.max() - rough.heights.mean())
+    with pytest.warns(RuntimeWarning, match="gap variable instead"):
+        r = solve_contact(rough, MAT, delta=delta, max_iter=300, compute_stiffness=False)
+    assert r.tolerance == 1e-9 and r.residual <= 1e-9

@@ -15,6 +15,7 @@ and Paggi & He 2015); with the periodic kernel mean(u) = 0, so d equals the mean
 from __future__ import annotations
 
 import functools
+import warnings
 from typing import Optional
 
 import numpy as np
@@ -353,7 +354,9 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                         mean_pressure=pm, approach=hook), h, hmax, scale, delta, start[1],
                         rms_height(surface), tol)
                     tolerance = tol
-                except NoConvergenceError:
+                except NoConvergenceError as exc:
+                    warnings.warn(f"{exc}; solved in the gap variable instead",
+                                  RuntimeWarning, stacklevel=2)
                     out = None
             if out is None:
                 out = periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
