@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import NoConvergenceError
 from ..surfaces.surface import Surface
-from .coarse_start import COARSE_START_MIN, COARSE_START_TOL, _coarse_surface, _inject
+from .coarse_start import COARSE_START_MIN, _coarse_pressure, _coarse_surface, _inject
 from .solvers import SolverOutput, kkt_residual
 
 #: the secant's first slope dP/dDelta = P / (SLOPE_LENGTH sigma): the exponential law
@@ -92,15 +92,8 @@ def approach_start(surface: Surface, material, delta, initial, coarse_correction
     dc = delta - float(h.max()) + float(hc.max())
     if dc <= 0:
         return None
-    from .contact import solve_contact   # the coarse level is a solve of its own
-    try:
-        pc = solve_contact(coarse, material, delta=dc, solver="pk", tol=COARSE_START_TOL,
-                           compute_stiffness=False,
-                           coarse_correction=False if coarse_correction is False else None
-                           ).pressure
-    except NoConvergenceError as exc:
-        pc = exc.result.pressure
-    return _fit(_inject(pc, shape))
+    return _fit(_inject(_coarse_pressure(coarse, material, coarse_correction, delta=dc),
+                        shape))
 
 
 def _fit(p):

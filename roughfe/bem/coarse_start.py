@@ -72,6 +72,22 @@ def _coarse_surface(surface: Surface) -> Surface:
     return Surface(hc, surface.size, periodic=True)
 
 
+def _coarse_pressure(coarse, material, coarse_correction, **target):
+    """The pressure (Pa) of the ``coarse`` surface solved by pk to ``COARSE_START_TOL``
+    without the stiffness (``target``: the other keywords of
+    :func:`~roughfe.bem.solve_contact`, the load or the approach first), or its last
+    iterate when it stops short: a start needs no more. ``coarse_correction`` False
+    stays off on the coarse level; otherwise the level chooses."""
+    from .contact import solve_contact   # the coarse level is a solve of its own
+    try:
+        return solve_contact(coarse, material, solver="pk", tol=COARSE_START_TOL,
+                             compute_stiffness=False,
+                             coarse_correction=False if coarse_correction is False else None,
+                             **target).pressure
+    except NoConvergenceError as exc:
+        return exc.result.pressure
+
+
 def _inject(pc, shape):
     """The coarse pressure ``pc`` (Pa) on the fine grid ``shape``: each value on its 2 x 2
     block, cropped to ``shape`` (odd non-periodic sides; the solver scales its start to
@@ -110,14 +126,8 @@ def _coarse_start(surface, material, mean_pressure, hardness, previous=None,
     if previous is not None:
         before, initial = previous.get(coarse.shape), _coarse_start(
             coarse, material, mean_pressure, hardness, previous, level, kernel)
-    from .contact import solve_contact   # the coarse level is a solve of its own
-    try:
-        pc = solve_contact(coarse, material, mean_pressure=mean_pressure, solver="pk",
-                           kernel=kernel, tol=COARSE_START_TOL, compute_stiffness=False,
-                           hardness=hardness, initial=initial,
-                           coarse_correction=level).pressure
-    except NoConvergenceError as exc:
-        pc = exc.result.pressure
+    pc = _coarse_pressure(coarse, material, level, mean_pressure=mean_pressure,
+                          kernel=kernel, hardness=hardness, initial=initial)
     if previous is not None:
         previous[coarse.shape] = pc
         if before is not None and shape in previous:     # the previous detail
