@@ -150,3 +150,19 @@ def test_a_failed_load_path_says_so_and_falls_back(rough, monkeypatch):
     with pytest.warns(RuntimeWarning, match="gap variable instead"):
         r = solve_contact(rough, MAT, delta=delta, max_iter=300, compute_stiffness=False)
     assert r.tolerance == 1e-9 and r.residual <= 1e-9
+
+
+def test_the_elastic_state_of_a_hardness_solve(rough, monkeypatch):
+    """With a hardness, a cold periodic approach starts its bounded CG from the elastic
+    state at that approach, now solved through load control: the same answer as from
+    the gap-variable elastic state (plastic and contact sets, pressures to the
+    tolerance)."""
+    delta = 0.6 * (rough.heights.max() - rough.heights.mean())
+    hp = 0.3 * MAT.E_star * 1.0          # below the elastic peak: points flow
+    a = solve_contact(rough, MAT, delta=delta, hardness=hp, compute_stiffness=False)
+    _gap_variable(monkeypatch)
+    b = solve_contact(rough, MAT, delta=delta, hardness=hp, compute_stiffness=False)
+    assert a.plastic_area_fraction > 0.01
+    assert np.array_equal(a.contact, b.contact)
+    assert np.array_equal(a.pressure >= hp, b.pressure >= hp)
+    assert np.abs(a.pressure - b.pressure).max() <= 1e-7 * hp

@@ -202,6 +202,29 @@ def _pk(op, h, hmax, scale, tol, max_iter, initial, own, deflation, **target):
                          split=None if deflation is None else op.split_product, **target)
 
 
+def _elastic_approach(surface, material, op, h, hmax, scale, delta, tol, max_iter,
+                      coarse_correction, initial):
+    """The elastic periodic solve at the imposed approach ``delta`` (m) and its
+    tolerance: a 2D surface through load control (:mod:`roughfe.bem.approach`, ``tol``)
+    where the load has an estimate; otherwise, or when that solve does not converge
+    (with a RuntimeWarning), the gap-variable CG (:func:`periodic_gap_control`, which
+    accepts a primal residual of 10 ``tol``)."""
+    start = (approach_start(surface, material, delta, initial, coarse_correction)
+             if surface.ndim == 2 else None)
+    if start is not None:
+        p0, deflation = start[0], _deflation(op, None, None, coarse_correction, start[0])
+        try:
+            return approach_by_load(lambda pm, t, hook: _pk(
+                op, h, hmax, scale, t, max_iter, p0, True, deflation, mean_pressure=pm,
+                approach=hook), h, hmax, scale, delta, start[1], rms_height(surface),
+                tol), tol
+        except NoConvergenceError as exc:
+            warnings.warn(f"{exc}; solved in the gap variable instead", RuntimeWarning,
+                          stacklevel=3)
+    return periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
+                                max_iter or 20000, _preconditioner(op)), 10 * tol
+
+
 def _periodic_full_contact(op, h):
     """Zero-mean pressure p' with H p' = h - mean h (exact: the spectral stiffness).
 
@@ -340,31 +363,15 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 out = SolverOutput(p, h - h.mean(), delta_full, 0, 0.0, "closed form")
             del p0            # not kept through the iterative solve (one field)
     if out is None:
+        elastic = functools.partial(_elastic_approach, surface, material, op, h, hmax,
+                                    scale, delta, tol, max_iter, coarse_correction)
         if gap_control:
-            # a 2D surface through load control (roughfe.bem.approach); the gap-variable
-            # CG where there is no estimate of the load or that solve fails
-            start = (approach_start(surface, material, delta, initial, coarse_correction)
-                     if surface.ndim == 2 else None)
-            if start is not None:
-                p0, deflation = start[0], _deflation(op, None, None, coarse_correction,
-                                                     start[0])
-                try:
-                    out = approach_by_load(lambda pm, t, hook: _pk(
-                        op, h, hmax, scale, t, max_iter, p0, True, deflation,
-                        mean_pressure=pm, approach=hook), h, hmax, scale, delta, start[1],
-                        rms_height(surface), tol)
-                    tolerance = tol
-                except NoConvergenceError as exc:
-                    warnings.warn(f"{exc}; solved in the gap variable instead",
-                                  RuntimeWarning, stacklevel=2)
-                    out = None
-            if out is None:
-                out = periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
-                                           max_iter or 20000, _preconditioner(op))
+            out, tolerance = elastic(initial)
         elif periodic_delta:
             out = periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol,
                                                 max_iter or 20000, hardness,
-                                                _preconditioner(op), _cg_preconditioner(op))
+                                                lambda: elastic(None)[0],
+                                                _cg_preconditioner(op))
         elif solver == "pk":
             own = initial is None and mean_pressure is not None and plastic is None
             if own:

@@ -19,16 +19,17 @@ from .solvers import SolverOutput, kkt_residual
 
 
 def periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol, max_iter,
-                                  hardness, stiff, precond):
+                                  hardness, elastic_state, precond):
     """Periodic displacement control with a hardness (bounded PK on the pressure).
 
-    The elastic state comes first (gap-variable CG, :func:`periodic_gap_control`, for
-    Delta below max h - mean h): if no pressure exceeds H_p it is the answer. Otherwise
-    the bounded CG starts from it clipped to [0, H_p] (``precond``: the CG's stiffness
-    preconditioner); the points at the cap fix the mean pressure, the direction of zero
-    curvature of the periodic operator that stalls the unbounded primal CG."""
+    The elastic state comes first (``elastic_state()``, the caller's elastic solve at
+    this Delta: through load control or in the gap variable, :func:`periodic_gap_control`;
+    for Delta below max h - mean h): if no pressure exceeds H_p it is the answer.
+    Otherwise the bounded CG starts from it clipped to [0, H_p] (``precond``: the CG's
+    stiffness preconditioner); the points at the cap fix the mean pressure, the direction
+    of zero curvature of the periodic operator that stalls the unbounded primal CG."""
     if initial is None and delta < hmax - float(h.mean()):
-        elastic = periodic_gap_control(op, h - hmax, scale, delta, None, tol, max_iter, stiff)
+        elastic = elastic_state()
         if float(elastic.pressure.max()) <= hardness:
             return elastic
         initial = elastic.pressure
