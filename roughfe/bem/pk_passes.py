@@ -1,7 +1,8 @@
 """The full-grid passes of the Polonsky-Keer iteration (:mod:`roughfe.bem.pk`): the
-Euclidean projection on the load, the threaded axpy, and the gap u - b tested, reduced and
+Euclidean projection on the load, the threaded axpy, the gap u - b tested, reduced and
 gathered in cache-sized chunks without a full-grid temporary (measured in
-``docs/theory/02b_bem_performance.md``, sessions 4 and 11)."""
+``docs/theory/02b_bem_performance.md``, sessions 4 and 11), and the increment of a moving
+load put onto the contact set (:func:`_load_increment`, session 17)."""
 from __future__ import annotations
 
 import numpy as np
