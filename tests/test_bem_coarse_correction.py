@@ -53,6 +53,36 @@ def test_on_below_the_automatic_range(monkeypatch, deflations_made):
     assert np.array_equal(sweep.results[0].contact, plain.contact)
 
 
+def test_on_for_an_imposed_approach_through_load_control(deflations_made):
+    # a rough 256^2 periodic surface at an imposed approach (solved through load control,
+    # where the automatic choice leaves the correction off at this size): forced on, the
+    # fine solve takes it and reaches the same contact set and load as the plain solve
+    s = spectral_surface(256, 1.0, 0.8, rms_slope=1.0, rng=3)
+    m = Material(1.0, 0.0)
+    delta = 0.3 * float(np.ptp(s.heights))
+    made = deflations_made
+    plain = solve_contact(s, m, delta=delta, **KW)
+    assert not made
+    on = solve_contact(s, m, delta=delta, coarse_correction=True, **KW)
+    assert made == [(256, 256)]
+    assert np.array_equal(on.contact, plain.contact)
+    assert on.mean_pressure == pytest.approx(plain.mean_pressure, rel=1e-8)
+    assert on.delta == pytest.approx(delta, rel=1e-9)
+
+
+def test_on_for_an_approach_without_a_load_start_warns():
+    # an approach near full contact (the coarse start touches more than half of the
+    # grid): no start in load control, so the gap-variable CG solves it, without the
+    # correction, and says so
+    s = spectral_surface(256, 1.0, 0.8, rms_slope=1.0, rng=3)
+    m = Material(1.0, 0.0)
+    delta = 0.99 * float(s.heights.max() - s.heights.mean())
+    with pytest.warns(RuntimeWarning, match="without the two-level correction"):
+        on = solve_contact(s, m, delta=delta, coarse_correction=True, **KW)
+    plain = solve_contact(s, m, delta=delta, **KW)
+    assert np.array_equal(on.pressure, plain.pressure)
+
+
 def test_contact_parts_counts_patches_and_islands():
     # k disjoint square patches on a 64^2 grid: k patches + the one non-contact region;
     # a hole punched in a patch adds an island; contact everywhere is one part, no
@@ -92,7 +122,7 @@ def test_automatic_choice_reads_the_contact_structure(monkeypatch, deflations_ma
 
 
 @pytest.mark.parametrize("kw, why", [
-    (dict(delta=1e-3), "load control"),
+    (dict(delta=1e-3), "load control"),   # an approach below 256^2: the gap variable
     (dict(mean_pressure=1e-3, hardness=0.5), "elastic interface"),
     (dict(mean_pressure=1e-3, solver="dense"), "solver 'pk'"),
 ])

@@ -221,6 +221,11 @@ def _elastic_approach(surface, material, op, h, hmax, scale, delta, tol, max_ite
         except NoConvergenceError as exc:
             warnings.warn(f"{exc}; solved in the gap variable instead", RuntimeWarning,
                           stacklevel=3)
+    elif coarse_correction is True:
+        warnings.warn(f"coarse_correction=True: the approach {delta:.6g} m has no start in "
+                      f"load control (the coarsened grid does not touch, or the start is in "
+                      f"contact on more than half of the grid); solved in the gap variable, "
+                      f"without the two-level correction", RuntimeWarning, stacklevel=3)
     return periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
                                 max_iter or 20000, _preconditioner(op)), 10 * tol
 
@@ -298,12 +303,16 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     coarse_correction : bool, optional
         The two-level correction of the Polonsky-Keer CG (8 x 8 blocks: BlockDeflation,
         on the padded torus of a non-periodic kernel PaddedBlockDeflation; elastic
-        surface solves, load-controlled or non-periodic). None: on for FFT grids of
+        surface solves: load-controlled, non-periodic, or an imposed approach on a
+        periodic 2D grid of at least ``COARSE_START_MIN`` points per axis, which is
+        solved through load control). None: on for FFT grids of
         ``DEFLATION_SIDES``^2 points, where it pays on rough surfaces (2-3x fewer
         iterations), unless the start's contact set (or the rigid interpenetration of a
         cold approach) has fewer than ``CORRECTION_MIN_PARTS`` connected parts: there it
         costs 1.2-1.6x CPU (02b, sessions 12-13 and 16). False: off. True: on at
-        any size it applies to (an InputError says why it does not).
+        any size it applies to (an InputError says why it does not; an approach whose
+        load-control start fails falls back to the gap-variable CG without it, with a
+        RuntimeWarning).
 
     Raises
     ------

@@ -6,6 +6,7 @@ import numpy as np
 
 from ..errors import InputError, check_finite_positive, check_instance
 from ..surfaces.surface import Surface
+from .coarse_start import COARSE_START_MIN
 
 
 def _check_surface(surface):
@@ -57,14 +58,21 @@ def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
 def _check_coarse_correction(value, op, solver, mean_pressure, hardness, two_level_unfit):
     """``coarse_correction`` of :func:`solve_contact`: None, True or False; True only
     where the two-level correction applies (``two_level_unfit(op, hardness)``: why
-    not, or None; else an InputError that says why)."""
+    not, or None; an imposed approach on a periodic grid only from ``COARSE_START_MIN``
+    points per axis, where it is solved through load control); else an InputError that
+    says why."""
     if value is None or value is False:
         return value
     if value is not True:
         raise InputError(f"coarse_correction must be None (automatic), True or False, "
                          f"got {value!r}")
-    why = ("load control (mean_pressure)" if mean_pressure is None and op.periodic else
-           "solver 'pk'" if solver != "pk" else two_level_unfit(op, hardness))
+    why = ("solver 'pk'" if solver != "pk" else two_level_unfit(op, hardness))
+    if not why and mean_pressure is None and op.periodic and min(op.shape) < COARSE_START_MIN:
+        # an imposed approach on a periodic surface takes the correction only where it
+        # is solved through load control (roughfe.bem.approach)
+        why = (f"load control (mean_pressure), or an imposed approach on a grid of at "
+               f"least {COARSE_START_MIN} points per axis (solved through load control), "
+               f"got {op.shape}")
     if why:
         raise InputError(f"coarse_correction=True (the two-level correction of the "
                          f"Polonsky-Keer CG) needs {why}")

@@ -58,7 +58,9 @@ def register(subparsers) -> None:
                      help="dense pivoting, scipy NNLS, or matrix-free Polonsky-Keer PCG")
     num.add_argument("--coarse-correction", default="auto", choices=tuple(COARSE),
                      help="the two-level correction of the Polonsky-Keer CG (2D "
-                          "surfaces, --pressure): auto = from an FFT grid of 1024^2 points "
+                          "surfaces: --pressure; --delta on non-periodic surfaces and on "
+                          "periodic grids from 256^2 points, there solved through load "
+                          "control): auto = from an FFT grid of 1024^2 points "
                           "on (~512^2 points of a non-periodic surface), where the start's "
                           "contact has >= 32 parts (patches plus islands), off for smooth "
                           "geometries, where it buys no iterations")
