@@ -29,7 +29,7 @@ from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
 from .operators import (WORKERS, InfluenceOperator, _irfftn_owned, check_kernel_name,
                         influence_operator)
-from .approach import approach_by_load, approach_start
+from .approach import MAX_START_AREA, approach_by_load, approach_start
 from .periodic import periodic_bounded_displacement, periodic_gap_control
 from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
 from .contact_checks import (_check_coarse_correction, _check_hardness, _check_surface,
@@ -224,8 +224,9 @@ def _elastic_approach(surface, material, op, h, hmax, scale, delta, tol, max_ite
     elif coarse_correction is True:
         warnings.warn(f"coarse_correction=True: the approach {delta:.6g} m has no start in "
                       f"load control (the coarsened grid does not touch, or the start is in "
-                      f"contact on more than half of the grid); solved in the gap variable, "
-                      f"without the two-level correction", RuntimeWarning, stacklevel=3)
+                      f"contact on more than {MAX_START_AREA:g} of the grid); solved in the "
+                      f"gap variable, without the two-level correction", RuntimeWarning,
+                      stacklevel=3)
     return periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
                                 max_iter or 20000, _preconditioner(op)), 10 * tol
 
