@@ -1,4 +1,4 @@
-"""All roughfe exceptions in one place.
+"""All roughfe exceptions (and warnings) in one place.
 
 Every exception is a subclass of a builtin so that callers that expect ``ValueError``
 (bad input) or ``RuntimeError`` (a solver that did not converge) keep working.
@@ -28,6 +28,12 @@ class NoConvergenceError(RoughfeError, RuntimeError):
 
 class FileFormatError(RoughfeError, ValueError):
     """A file could not be read or does not follow the documented format."""
+
+
+class ResolutionWarning(UserWarning):
+    """The input is valid but the grid does not resolve a length the physics needs: the
+    result depends on the discretisation (the message says which length, by how much,
+    and what to change)."""
 
 
 def check_finite_positive(name, value):

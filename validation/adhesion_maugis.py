@@ -5,14 +5,14 @@ and force is reported in Maugis' units, so the scale drops out), work of adhesio
 w = 2.83e-4 J/m^2, Maugis-Dugdale law with h0 set by Maugis' parameter
 lambda = 2 sigma0 (R / (pi w K^2))^(1/3), K = 4 E*/3. Non-periodic Love kernel on a grid
 that holds the attraction zone and puts >= 8 cells in the Dugdale zone c - a at pull-off
-(capped at 128^2; 256^2 at lambda = 3 and 5); continuation in the approach
+(capped at 128^2; 256^2 at lambda = 3, 512^2 at 5); continuation in the approach
 (steps of 0.1 in Maugis' approach unit), loading to delta_bar = 0.2, then unloading until
 the sphere separates. The pull-off is the most tensile load of the unloading branch; Maugis' is the minimum of his load over
 the contact radius (roughfe.reference.maugis_pull_off), the load-control pull-off, which
 the displacement-controlled branch passes through.
 
 Also a refinement study at lambda = 2 (2, 4 and 8 cells in c - a), the JKR side at
-lambda = 3 (256^2, 7.3 cells in c - a) and lambda = 5 (256^2, 2.7 cells), Johnson's (1995)
+lambda = 3 (256^2, 7.3 cells in c - a) and lambda = 5 (512^2, 5.5 cells), Johnson's (1995)
 adhesive sinusoid (JKR-type closed form against the Maugis-Dugdale BEM: the O(zone/a)
 difference at two Dugdale-zone widths, and the grid convergence with the default law,
 cell-averaged or sampled), a rough adhesive contact (periodic self-affine surface,
@@ -491,7 +491,7 @@ def main(outdir=None) -> bool:
     True when every target is met."""
     out_json = OUT if outdir is None else Path(outdir) / OUT.name
     rows = []
-    for lam, n_max in ((0.1, 128), (0.3, 128), (1.0, 128), (2.0, 128), (3.0, 256), (5.0, 256)):
+    for lam, n_max in ((0.1, 128), (0.3, 128), (1.0, 128), (2.0, 128), (3.0, 256), (5.0, 512)):
         r = run_sphere(lam, n_max=n_max)
         rows.append(r)
         print(f"lambda {lam:4.1f}: n = {r['n']:4d}, {r['cells_in_dugdale_zone']:5.1f} cells in "

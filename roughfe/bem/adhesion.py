@@ -48,9 +48,14 @@ energy and its gradient cost two FFTs:
   padding, so the solution is that of the isolated body.
 
 The continuation in the approach (:func:`adhesive_sweep`) starts each step from the
-previous gap shifted by the change of Delta: the minimiser then descends to the nearest
-local minimum, which follows the stable branch until it disappears (jump-in on loading,
-jump-out on unloading), as a displacement-controlled experiment does. A solve that does
+previous state carried along its branch by the elastic tangent of its contact set (the
+Euler predictor, :func:`roughfe.bem.adhesive_start.continued_start`; until round 2,
+session 19 the previous gap shifted by the change of Delta): the minimiser then descends
+to the nearest local minimum, which follows the stable branch until it disappears
+(jump-in on loading, jump-out on unloading), as a quasi-static displacement-controlled
+experiment does. On a law whose process zone the grid does not resolve the branch
+breaks into a jump per cell and the path depends on the steps
+(:func:`roughfe.bem.interface_law.check_resolution` warns). A solve that does
 not reach the tolerance raises :class:`~roughfe.errors.NoConvergenceError` with the
 residual.
 """
@@ -68,7 +73,8 @@ from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
 from .adhesive_cg import adhesive_pcg
-from .interface_law import LAWS, AdhesionLaw
+from .adhesive_start import continued_start, elastic_start
+from .interface_law import LAWS, AdhesionLaw, check_resolution
 
 __all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "solve_adhesive"]
 
@@ -86,7 +92,7 @@ class _Energy:
 
     def __init__(self, op, law, c, spring, traction_scale):
         self.op, self.law, self.c = op, law, c
-        self.spread = None
+        self.spread = None            # the cell spread of the law (m), and its ramp
         self.ell, self.s0 = law.range, traction_scale
         self.n = c.size
         if op.periodic:
@@ -127,7 +133,7 @@ class _Energy:
 
     def __call__(self, x):
         p, pbar, g, u, ku = self.pressure(x)
-        phi, traction = self.law.evaluate(g, self.spread)
+        phi, traction = self.law_at(g)
         value = 0.5 * float(np.vdot(u, ku)) + float(phi.sum())
         grad = ku
         if self.op.periodic:
@@ -138,6 +144,22 @@ class _Energy:
             grad[self.phys] += traction
         # Pi*A per (S range) and the traction residual per S: both O(1) per cell
         return value / (self.s0 * self.ell), (grad / self.s0).ravel()
+
+    @property
+    def spread(self):
+        return self._spread
+
+    @spread.setter
+    def spread(self, value):
+        self._spread = value
+        self._ramp = None if value is None else self.law.cell_ramp(value)
+
+    def law_at(self, g):
+        """``(phi, phi')`` of the interface law at the gap ``g`` (m), cell-averaged with
+        the current spread."""
+        if self._ramp is None:
+            return self.law.evaluate(g)
+        return self.law.evaluate(g, ramp=self._ramp)
 
     def cell_spread(self, x):
         """Half-range of the gap across each cell (m), ``|grad g| dx / 2`` by central
@@ -174,30 +196,6 @@ def _check(surface, material, law, delta):
     return d
 
 
-def _elastic_start(surface, material, op, delta, c, energy):
-    """Start of a cold solve (m, on the unknowns' grid): the non-adhesive equilibrium at
-    the same approach (Polonsky-Keer, preconditioned: cheap), or the rigid gap when
-    there is none (Delta <= 0, or full periodic contact)."""
-    from .contact import solve_contact
-
-    h = surface.heights
-    rigid = np.maximum(c, 0.0)
-    if delta <= 0 or (op.periodic and delta >= float(h.max() - h.mean())):
-        if op.periodic:
-            return rigid
-        x0 = np.zeros(energy.shape)
-        x0[energy.phys] = rigid
-        return x0
-    r = solve_contact(surface, material, delta=delta, kernel=op.name, solver="pk", tol=1e-6,
-                      compute_stiffness=False)
-    if op.periodic:
-        return np.array(r.gap, float)
-    x0 = op.convolve_spectrum(np.pad(r.pressure, [(0, m - n) for n, m in
-                                                  zip(op.shape, op.fft_shape)]), op.spectrum)
-    x0[energy.phys] = r.gap
-    return x0
-
-
 def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, delta,
                    kernel: str = "auto", initial=None, tol: float = 1e-5,
                    max_iter: int = 20000, spring=None, unloading: bool = False,
@@ -217,8 +215,9 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     kernel : str
         As in :func:`roughfe.bem.solve_contact`.
     initial : ContactResult, optional
-        A previous adhesive state (its gap, shifted by the change of delta, starts the
-        descent: the continuation of :func:`adhesive_sweep`). Without it the descent
+        A previous adhesive state, carried to ``delta`` by the elastic tangent of its
+        contact set, starts the descent (the continuation of :func:`adhesive_sweep`;
+        :func:`roughfe.bem.adhesive_start.continued_start`). Without it the descent
         starts from the non-adhesive equilibrium at ``delta`` (Polonsky-Keer).
     tol : float
         Largest projected traction residual, relative to S = max(sigma0, E* gbar / 2).
@@ -248,6 +247,11 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
         Bad input.
     NoConvergenceError
         The residual stayed above ``tol``; ``result`` holds the last state.
+
+    Warns
+    -----
+    ResolutionWarning
+        The law's process zone is below half a grid spacing (``check_resolution``).
     """
     d = _check(surface, material, law, delta)
     if solver not in SOLVERS:
@@ -255,6 +259,7 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     tol = check_finite_positive("tol (relative traction residual)", tol)
     max_iter = check_int("max_iter", max_iter, 1)
     kernel = _choose_kernel(surface, kernel)
+    check_resolution(law, material.E_star, surface.spacing)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
     h = surface.heights
     if op.periodic and d >= float(h.max() - h.mean()):
@@ -266,17 +271,9 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     scale = max(law.max_traction, 0.5 * material.E_star * rms_slope(surface))
     energy = _Energy(op, law, c, spring, scale)
     if initial is not None:
-        g_prev = np.asarray(initial.gap, float) + (initial.delta - d)
-        if g_prev.shape != h.shape:
-            raise InputError(f"initial state has shape {g_prev.shape}, expected {h.shape}")
-        x0 = g_prev
-        if not op.periodic:
-            x0 = np.zeros(energy.shape)
-            if initial.fields is not None:
-                x0 = np.array(initial.fields["padded_displacement"], float)
-            x0[energy.phys] = g_prev
+        x0 = continued_start(initial, d, op, energy)
     else:
-        x0 = _elastic_start(surface, material, op, d, c, energy)
+        x0 = elastic_start(surface, material, op, d, c, energy)
     x0 = np.maximum(x0 / law.range, energy.bounds().lb.reshape(x0.shape)).ravel()
     averaged = bool(cell_average) and law.kind == "md"
     if averaged:

@@ -61,7 +61,7 @@ def adhesive_pcg(energy, x0, tol, max_iter):
     """Minimise ``energy`` (an ``adhesion._Energy``) from ``x0`` (scaled unknowns);
     returns ``(x, nit, residual, message)``. The residual is the largest projected
     traction over the traction scale (``energy.residual``)."""
-    op, law, ell, scale = energy.op, energy.law, energy.ell, energy.s0
+    op, ell, scale = energy.op, energy.ell, energy.s0
     shape = energy.shape
     v = x0.reshape(shape) * ell                  # gap (and padding displacement), m
     periodic = op.periodic
@@ -86,7 +86,7 @@ def adhesive_pcg(energy, x0, tol, max_iter):
     res, it, message = np.inf, 0, "max_iter reached"
     for it in range(1, int(max_iter) + 1):
         g = v[phys]
-        _, phi1 = law.evaluate(g, energy.spread)
+        _, phi1 = energy.law_at(g)
         r = ku.copy()
         pbar = 0.0
         if periodic:
@@ -126,7 +126,7 @@ def adhesive_pcg(energy, x0, tol, max_iter):
         def df(a):
             # the law on the projected gap (the step is clipped at g = 0 afterwards; an
             # exponential law would overflow on a long step into g < 0)
-            _, t = law.evaluate(np.maximum(g + a * dphys, 0.0), energy.spread)
+            _, t = energy.law_at(np.maximum(g + a * dphys, 0.0))
             val = dku + a * dkd + float(np.vdot(dphys, t))
             if periodic:
                 val += energy.k0 * n * (gmean + a * gd - energy.gbar) * gd
