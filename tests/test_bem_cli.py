@@ -202,6 +202,23 @@ def test_contact_cli_coarse_correction_switch(tmp_path, capsys):
     assert "needs load control" in capsys.readouterr().err
 
 
+def test_cli_prints_the_library_s_warnings_as_one_line(tmp_path, capsys):
+    # a law whose process zone (1e-10 m) the grid (0.31 um) does not resolve: the
+    # library's ResolutionWarning reaches the user as "roughfe contact: warning: ...",
+    # not as a Python file:line with a source line
+    from roughfe.surfaces.io import save_surface
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=4 * np.pi / 1e-5,
+                         q_short=16 * np.pi / 1e-5, rng=3)
+    path = save_surface(s, tmp_path / "periodic.npz")
+    assert main(["contact", str(path), "--E", "1e6", "--nu", "0.5", "--adhesion", "exp",
+                 "--work-of-adhesion", "0.02", "--range", "2e-9", "--steps", "1",
+                 "--no-figures", "-o", str(tmp_path / "adh")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("roughfe contact: warning: the exp adhesion law")
+    assert "process zone" in err[0] and ".py:" not in err[0]
+
+
 def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path):
     # the default approaches of --adhesion on a periodic surface stop short of full
     # contact (max h - mean h), where the adhesive state is not defined by the approach

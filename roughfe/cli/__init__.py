@@ -17,6 +17,7 @@ import contextlib
 import importlib
 import os
 import sys
+import warnings
 
 from .. import progress
 from ..errors import RoughfeError
@@ -60,9 +61,24 @@ def _command_of(argv) -> str | None:
     return word if word in known else None
 
 
+def _warning_printer(name, show):
+    """A ``warnings.showwarning`` that prints roughfe's own warnings as one line
+    ``roughfe CMD: warning: ...`` on stderr (the library's file and line mean nothing to
+    a command-line user); other packages' warnings go to ``show`` unchanged."""
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+    def printer(message, category, filename, lineno, file=None, line=None):
+        if not os.path.abspath(filename).startswith(package + os.sep):
+            return show(message, category, filename, lineno, file, line)
+        print(f"roughfe {name}: warning: {' '.join(str(message).split())}",
+              file=sys.stderr if file is None else file)
+    return printer
+
+
 def main(argv=None) -> int:
     """Run ``roughfe ARGV``; return the exit code (0 ok, 1 targets/checks missed, 2 bad
-    input: one line ``roughfe CMD: error: ...`` on stderr, nothing written)."""
+    input: one line ``roughfe CMD: error: ...`` on stderr, nothing written). The
+    library's warnings are printed as one line ``roughfe CMD: warning: ...``."""
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command_of(argv))
     try:
@@ -78,6 +94,8 @@ def main(argv=None) -> int:
     bars = ProgressBars() if show_progress(args) else None
     try:
         with contextlib.ExitStack() as stack:
+            stack.enter_context(warnings.catch_warnings())   # restores showwarning
+            warnings.showwarning = _warning_printer(name, warnings.showwarning)
             if quiet:
                 stack.enter_context(contextlib.redirect_stdout(quiet))
             if bars:
