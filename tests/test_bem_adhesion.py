@@ -303,6 +303,38 @@ def test_pull_off_converges_as_the_continuation_step_shrinks():
     assert abs(d2) < 0.02 * abs(pull[2])
 
 
+@pytest.mark.parametrize("kernel", ["spectral", "love"])
+def test_the_continuation_start_is_the_elastic_gap_increment_of_a_fixed_contact_set(kernel):
+    # The tangent predictor of adhesive_sweep (roughfe.bem.adhesive_start): from an
+    # elastic state at Delta1, the gap g + dDelta (H x - 1), H_cc x_c = 1, is the elastic
+    # gap at Delta2 when the contact set does not change (Eq. 2.5 is linear in Delta on a
+    # fixed set); the shifted gap g - dDelta is not. Measured here: 9.8e-5 / 7.2e-5 of the
+    # increment (periodic / Love), the rate's tolerance 1e-4; the shift 0.90 / 1.47.
+    from roughfe.bem.adhesion import _Energy
+    from roughfe.bem.adhesive_start import continued_start
+    from roughfe.bem.contact import _operator
+    s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=4)
+    if kernel == "love":
+        s = Surface(s.heights, s.size, periodic=False)
+    mat = Material(1e9, 0.3)
+    top = float(s.heights.max() - (s.heights.mean() if kernel == "spectral" else
+                                   s.heights.min()))
+    d1 = 0.3 * top
+    r1 = solve_contact(s, mat, delta=d1, kernel=kernel, tol=1e-12)
+    # the largest step that keeps the contact set: a tenth of the smallest gap off it
+    step = 0.1 * float(np.min(r1.gap[~r1.contact]))
+    r2 = solve_contact(s, mat, delta=d1 + step, kernel=kernel, tol=1e-12)
+    assert np.array_equal(r1.contact, r2.contact)
+    op = _operator(s.shape, s.size, mat.E_star, kernel)
+    c = float(s.heights.max()) - s.heights - (d1 + step)
+    energy = _Energy(op, AdhesionLaw("exp", 1e-3, 1e-7), c, None, 1.0)
+    x0 = continued_start(r1, d1 + step, op, energy)
+    g = x0 if kernel == "spectral" else x0[energy.phys]
+    change = np.abs(r2.gap - r1.gap).max()
+    assert np.abs(g - r2.gap).max() <= 1e-3 * change
+    assert np.abs((r1.gap - step) - r2.gap).max() > 0.1 * change     # the shift is not
+
+
 def test_an_unresolved_process_zone_is_a_warning_that_names_the_lengths():
     # The peel-off surface with w = 0.02 J/m^2 over 2 nm: a process zone of 1e-10 m on a
     # 0.31 um grid. There the pull-off scatters by tens of percent with the step of the
