@@ -39,11 +39,10 @@ no convergence down to 1/128 of the step.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
-
-import warnings
 
 from ..errors import InputError, ResolutionWarning, check_finite_positive
 
