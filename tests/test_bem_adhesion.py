@@ -335,6 +335,40 @@ def test_the_continuation_start_is_the_elastic_gap_increment_of_a_fixed_contact_
     assert np.abs((r1.gap - step) - r2.gap).max() > 0.1 * change     # the shift is not
 
 
+def _pull_off_on_refined_grids(law, sizes):
+    """Pull-off pressures (Pa) of one band-limited rough cell (resolved at 32^2: four
+    points per shortest wavelength) on the grids ``sizes``, loaded to the same mean-plane
+    separations and unloaded until separation."""
+    length = 1e-5
+    base = spectral_surface(32, length, 0.8, rms_height=1e-8, q_roll=4 * np.pi / length,
+                            q_short=16 * np.pi / length, rng=3)
+    sep = float(base.heights.max() - base.heights.mean()) * (1 - np.linspace(0.1, 0.6, 6))
+    out = []
+    for n in sizes:
+        s = base if n == 32 else base.resampled((n, n))
+        top = float(s.heights.max() - s.heights.mean())
+        sw = adhesive_sweep(s, Material(1e6, 0.5), law, top - sep, unload=True,
+                            max_unload_steps=80)
+        assert sw.detached
+        out.append(sw.pull_off_pressure)
+    return np.array(out)
+
+
+def test_rough_pull_off_converges_under_grid_refinement_only_when_the_zone_is_resolved():
+    # One rough cell on 32^2, 64^2, 128^2 (the same band-limited surface). A law whose
+    # process zone spans 1.7, 3.4, 6.7 spacings: first-order convergence (measured -79235,
+    # -79030, -78926 Pa: differences 205, 104 Pa). The law of the old peel-off test (zone
+    # 3.4e-4 of a spacing on 32^2): no convergence (-6.70, -4.61, -3.07 MPa on the same
+    # grids, measured; 32^2 and 64^2 here).
+    p = _pull_off_on_refined_grids(RESOLVED_EXP, (32, 64, 128))
+    d1, d2 = p[1] - p[0], p[2] - p[1]
+    assert np.sign(d1) == np.sign(d2) and abs(d2) <= 0.6 * abs(d1)
+    assert abs(d2) <= 2e-3 * abs(p[2])
+    with pytest.warns(ResolutionWarning):
+        q = _pull_off_on_refined_grids(AdhesionLaw("exp", 0.02, 2e-9), (32, 64))
+    assert abs(q[1] / q[0] - 1) > 0.2
+
+
 def test_an_unresolved_process_zone_is_a_warning_that_names_the_lengths():
     # The peel-off surface with w = 0.02 J/m^2 over 2 nm: a process zone of 1e-10 m on a
     # 0.31 um grid. There the pull-off scatters by tens of percent with the step of the
