@@ -127,11 +127,10 @@ class AdhesionLaw:
             e = np.exp(-g / self.range)
             return -w * e, s0 * e
         if ramp is None:
-            g1, g2 = self._ramp(spread)
-            if spread is None and g2 <= g1:
+            if spread is None and self.smoothing == 0.0:     # the sharp Dugdale step
                 near = g < self.range
                 return np.where(near, s0 * g - w, 0.0), np.where(near, s0, 0.0)
-            ramp = g1, np.maximum(g2 - g1, 1e-300)
+            ramp = self.cell_ramp(spread)
         g1, width = ramp
         t = np.subtract(g, g1, out=np.empty(np.broadcast(g, g1).shape))  # clipped to
         # [0, width] in place below (one pass each; also for a scalar g)
