@@ -217,6 +217,14 @@ def test_cli_prints_the_library_s_warnings_as_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("roughfe contact: warning: the exp adhesion law")
     assert "process zone" in err[0] and ".py:" not in err[0]
+    # ... and results.json keeps the numbers of the warning: (pi/8) E* w / sigma0^2 with
+    # sigma0 = w / range (the exponential law) against the 10 um / 32 spacing
+    res = json.loads((tmp_path / "adh" / "results.json").read_text())["derived"]["resolution"]
+    e_star = 1e6 / (1 - 0.5 ** 2)
+    zone = np.pi / 8 * e_star * 0.02 / (0.02 / 2e-9) ** 2
+    assert res["process_zone"] == pytest.approx(zone, rel=1e-12)
+    assert res["grid_spacing"] == pytest.approx(1e-5 / 32, rel=1e-12)
+    assert not res["resolved"] and res["process_zone_cells"] == pytest.approx(zone * 32 / 1e-5)
 
 
 def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path):

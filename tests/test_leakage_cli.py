@@ -151,6 +151,10 @@ def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
     hp = 0.3 * max(st["mean_pressure"] for st in el["steps"]) / el["steps"][-1]["area_fraction"]
     hard = run("hardness", "--hardness", str(hp), "--unload")
     assert adh["inputs"]["adhesion"]["law"] == "md" and hard["inputs"]["hardness"] == hp
+    res = adh["inputs"]["adhesion_resolution"]  # the process zone against the grid, kept
+    assert res["resolved"] and res["process_zone_cells"] == pytest.approx(
+        res["process_zone"] / res["grid_spacing"]) and res["process_zone_cells"] > 0.5
+    assert "adhesion_resolution" not in el["inputs"]
     for other in (adh, hard):
         for e, o in zip(el["steps"], other["steps"]):
             assert o["delta"] == pytest.approx(e["delta"], rel=1e-6)

@@ -163,15 +163,28 @@ class AdhesionLaw:
                 "smoothing": self.smoothing if self.kind == "md" else None}
 
 
+def resolution(law: AdhesionLaw, e_star: float, spacing) -> dict:
+    """The law's process zone against the grid, JSON-safe (the provenance a result file
+    keeps beside the warning of :func:`check_resolution`): ``process_zone`` (m,
+    :meth:`AdhesionLaw.process_zone`), ``grid_spacing`` (m, the largest of ``spacing``),
+    ``process_zone_cells`` (their ratio), ``threshold_cells``
+    (:data:`PROCESS_ZONE_CELLS`) and ``resolved`` (ratio >= threshold)."""
+    zone = law.process_zone(e_star)
+    dx = float(np.max(spacing))
+    return {"process_zone": zone, "grid_spacing": dx, "process_zone_cells": zone / dx,
+            "threshold_cells": PROCESS_ZONE_CELLS,
+            "resolved": bool(zone >= PROCESS_ZONE_CELLS * dx)}
+
+
 def check_resolution(law: AdhesionLaw, e_star: float, spacing) -> bool:
     """Warn (:class:`~roughfe.errors.ResolutionWarning`) when the law's process zone
     (:meth:`AdhesionLaw.process_zone`) is shorter than :data:`PROCESS_ZONE_CELLS` of the
     largest grid spacing ``spacing`` (m, a number or one per axis); returns True when it
-    is resolved."""
-    zone = law.process_zone(e_star)
-    dx = float(np.max(spacing))
-    if zone >= PROCESS_ZONE_CELLS * dx:
+    is resolved (:func:`resolution`)."""
+    r = resolution(law, e_star, spacing)
+    if r["resolved"]:
         return True
+    zone, dx = r["process_zone"], r["grid_spacing"]
     warnings.warn(
         f"the {law.kind} adhesion law (w = {law.work:.3g} J/m^2, range {law.range:.3g} m, "
         f"sigma0 = {law.max_traction:.3g} Pa) has a process zone (pi/8) E* w / sigma0^2 = "

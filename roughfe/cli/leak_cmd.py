@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..bem.interface_law import resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
@@ -212,6 +213,9 @@ def _leak_run(args, surface, material, out):
             "hardness": physics["hardness"], "unload": physics["unload"],
             "adhesion": physics["adhesion"] and physics["adhesion"].describe(),
             "units": "SI (m, Pa, Pa s, m^3/s)"}
+    if physics["adhesion"] is not None:  # the process zone against the grid (provenance)
+        base["adhesion_resolution"] = resolution(physics["adhesion"], material.E_star,
+                                                 surface.spacing)
     if args.fsi:
         if physics["adhesion"] is not None or physics["hardness"] is not None \
                 or physics["unload"]:
