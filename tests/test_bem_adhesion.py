@@ -384,6 +384,12 @@ def test_an_unresolved_process_zone_is_a_warning_that_names_the_lengths():
     with warnings.catch_warnings():
         warnings.simplefilter("error", ResolutionWarning)
         solve_adhesive(s, mat, RESOLVED_EXP, delta=0.3 * top)     # resolved: silent
+    # the sweep keeps the numbers (what roughfe contact writes to results.json)
+    with pytest.warns(ResolutionWarning):
+        res = adhesive_sweep(s, mat, law, [0.3 * top]).resolution
+    assert not res["resolved"] and res["grid_spacing"] == pytest.approx(1e-5 / 32)
+    assert res["process_zone_cells"] == pytest.approx(3.36e-4, rel=1e-2)
+    assert adhesive_sweep(s, mat, RESOLVED_EXP, [0.3 * top]).resolution["resolved"]
 
 
 def test_cell_averaged_law_in_2d_against_quadrature_on_a_paraboloid():

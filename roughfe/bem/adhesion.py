@@ -74,7 +74,7 @@ from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
 from .adhesive_cg import adhesive_pcg
 from .adhesive_start import continued_start, elastic_start
-from .interface_law import LAWS, AdhesionLaw, check_resolution
+from .interface_law import LAWS, AdhesionLaw, check_resolution, resolution
 
 __all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "solve_adhesive"]
 
@@ -391,6 +391,10 @@ class AdhesiveSweep:
         The unloading reached separation (no contact, load back above 1e-3 of the
         pull-off load); if False the pull-off force is a bound (the branch was cut).
     law : AdhesionLaw
+    resolution : dict
+        The law's process zone against the grid
+        (:func:`roughfe.bem.interface_law.resolution`; ``resolved`` False where the
+        solves warned).
     """
 
     sweep: SweepResult
@@ -398,6 +402,7 @@ class AdhesiveSweep:
     pull_off_pressure: float
     detached: bool
     law: AdhesionLaw
+    resolution: dict = None
 
     def records(self) -> list:
         """Per-step records (``sweep.to_records()``: with ``unloading`` and
@@ -487,4 +492,4 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
                                      length=surface.size[0])
     return AdhesiveSweep(sweep=sweep, pull_off_force=pull,
                          pull_off_pressure=pull / surface.nominal_area, detached=detached,
-                         law=law)
+                         law=law, resolution=resolution(law, material.E_star, surface.spacing))

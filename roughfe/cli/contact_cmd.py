@@ -16,7 +16,6 @@ from ..bem import KERNELS
 from ..model import Loading, Material
 from ..response import response
 from ..bem.contact import SOLVERS
-from ..bem.interface_law import resolution
 from ..bem.output import sweep_document, write_fields_h5, write_results_json
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
@@ -109,7 +108,7 @@ def _run(args) -> int:
         doc["derived"]["detached"] = adhesive.detached
         doc["derived"]["units"]["pull_off_force"] = "N (surface) or N/m (profile)"
         # the process zone against the grid (the ResolutionWarning's numbers, kept)
-        doc["derived"]["resolution"] = resolution(law, material.E_star, surface.spacing)
+        doc["derived"]["resolution"] = adhesive.resolution
         doc["derived"]["units"].update(process_zone="m", grid_spacing="m")
         doc["derived"]["stickiness"] = pastewka_robbins(surface, material.E_star, law.work,
                                                         law.range).describe()
