@@ -151,8 +151,8 @@ def test_bad_approach():
         solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=float("nan"))
     # the solver controls are named before any work (tol = 0 and max_iter = 0 ran into a
     # NoConvergenceError after the elastic start)
-    for kwargs, match in (({"tol": 0.0}, "tol"), ({"max_iter": 0}, "max_iter"),
-                          ({"max_iter": 2.5}, "max_iter")):
+    for kwargs, match in (({"tol": 0.0}, "tol"), ({"tol": 1.5}, "tol"),
+                          ({"max_iter": 0}, "max_iter"), ({"max_iter": 2.5}, "max_iter")):
         with pytest.raises(InputError, match=match):
             solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=0.1 * D_SCALE, **kwargs)
 

@@ -88,6 +88,11 @@ def test_contact_cli_bad_input_is_reported(tmp_path, capsys):
     assert main(["contact", str(path), "--E", "-1", "--nu", "0.3", "-o",
                  str(tmp_path / "x")]) == 2
     assert "E (Young's modulus, Pa) must be finite and > 0" in capsys.readouterr().err
+    # a relative tolerance of 1 or more asks nothing of the solver: refused
+    for tol in ("2", "1", "0"):
+        assert main(["contact", str(path), "--E", "1e9", "--nu", "0.3", "--tol", tol,
+                     "-o", str(tmp_path / "x")]) == 2
+        assert f"--tol: must be a number in (0, 1), got '{tol}'" in capsys.readouterr().err
 
 
 def _sphere_file(tmp_path, n=40, length=0.8):

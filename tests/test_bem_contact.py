@@ -220,14 +220,16 @@ def test_bad_input_raises_value_error(kwargs):
 
 @pytest.mark.parametrize("kwargs, words", [
     ({"tol": 0.0}, ["tol", "0.0"]), ({"tol": -1e-8}, ["tol", "-1e-08"]),
-    ({"tol": float("nan")}, ["tol", "nan"]), ({"max_iter": 0}, ["max_iter", "0"]),
+    ({"tol": float("nan")}, ["tol", "nan"]), ({"tol": 1.0}, ["tol", "(0.0, 1.0)", "1.0"]),
+    ({"tol": 2.0}, ["tol", "2.0"]), ({"max_iter": 0}, ["max_iter", "0"]),
     ({"max_iter": -3}, ["max_iter", "-3"]), ({"max_iter": 2.5}, ["max_iter", "2.5"]),
     ({"initial": np.full(64, np.nan)}, ["initial", "64 non-finite"]),
 ])
 def test_solver_controls_are_checked_before_solving(kwargs, words):
     # tol = 0 used to run 20000 iterations into a NoConvergenceError, a negative max_iter
     # to fail "after -3 iterations" and a NaN start to be clipped silently: each is now
-    # an InputError that names the argument and the value
+    # an InputError that names the argument and the value; a relative tolerance >= 1
+    # (which accepted the start as the answer) too
     with pytest.raises(InputError) as info:
         solve_contact(sinusoid(64), MAT, mean_pressure=1e6, **kwargs)
     for w in words:

@@ -66,8 +66,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
-from ..errors import (InputError, NoConvergenceError, check_finite_positive, check_instance,
-                      check_int)
+from ..errors import (InputError, NoConvergenceError, check_in_open_interval,
+                      check_instance, check_int)
 from ..model import ContactResult, Loading, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
@@ -256,7 +256,7 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     d = _check(surface, material, law, delta)
     if solver not in SOLVERS:
         raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
-    tol = check_finite_positive("tol (relative traction residual)", tol)
+    tol = check_in_open_interval("tol (relative traction residual)", tol, 0.0, 1.0)
     max_iter = check_int("max_iter", max_iter, 1)
     kernel = _choose_kernel(surface, kernel)
     check_resolution(law, material.E_star, surface.spacing)

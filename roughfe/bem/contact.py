@@ -22,8 +22,8 @@ import numpy as np
 import scipy.fft
 
 from ..caching import MB, bytes_bounded_cache
-from ..errors import (InputError, NoConvergenceError, check_finite_positive, check_instance,
-                      check_int)
+from ..errors import (InputError, NoConvergenceError, check_in_open_interval,
+                      check_instance, check_int)
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
@@ -325,7 +325,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     _check_surface(surface)
     check_instance("material", material, Material, "a roughfe.model.Material")
     delta, mean_pressure = _check_target(delta, mean_pressure)
-    tol = check_finite_positive("tol (relative KKT residual)", tol)
+    tol = check_in_open_interval("tol (relative KKT residual)", tol, 0.0, 1.0)
     if max_iter is not None:
         max_iter = check_int("max_iter (None: the solver's default)", max_iter, 1)
     hardness, plastic = _check_hardness(hardness, mean_pressure, plastic_displacement,

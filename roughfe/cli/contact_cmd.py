@@ -23,7 +23,7 @@ from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_o
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, check_small_strain, contact_physics_from_args,
                       material_from_args, output_folder_of, positive_float, positive_int,
-                      surface_from_args)
+                      surface_from_args, unit_fraction)
 
 DEFAULT_STEPS = Loading.DEFAULT_STEPS
 #: --coarse-correction -> solve_contact(coarse_correction=)
@@ -64,9 +64,10 @@ def register(subparsers) -> None:
                           "on (~512^2 points of a non-periodic surface), where the start's "
                           "contact has >= 32 parts (patches plus islands), off for smooth "
                           "geometries, where it buys no iterations")
-    num.add_argument("--tol", type=positive_float, default=None,
-                     help="relative KKT residual at which a load step is converged (default "
-                          "1e-10); with --adhesion the traction residual (default 1e-5)")
+    num.add_argument("--tol", type=unit_fraction, default=None,
+                     help="relative KKT residual at which a load step is converged, in "
+                          "(0, 1) (default 1e-10); with --adhesion the traction residual "
+                          "(default 1e-5)")
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_run)

@@ -100,6 +100,8 @@ positive_int = _check(int, lambda v: v >= 1, "an integer >= 1")
 nonnegative_int = _check(int, lambda v: v >= 0, "an integer >= 0")
 positive_float = _check(float, lambda v: 0.0 < v < float("inf"), "a finite number > 0")
 nonnegative_float = _check(float, lambda v: 0.0 <= v < float("inf"), "a finite number >= 0")
+#: a relative tolerance: 1 or more asks nothing of a solver (its start is accepted)
+unit_fraction = _check(float, lambda v: 0.0 < v < 1.0, "a number in (0, 1)")
 
 
 # -- surfaces ------------------------------------------------------------------------------
