@@ -132,7 +132,7 @@ def _study_into_a_foreign_folder(t):
 
 
 def _tol_zero(t):
-    return ["contact", str(_surface(t)), "--tol", "0", "-o", str(t / "o")], "number > 0"
+    return ["contact", str(_surface(t)), "--tol", "0", "-o", str(t / "o")], "a number in (0, 1)"
 
 
 def _empty_npy(t):
