@@ -232,7 +232,7 @@ def test_cli_prints_the_library_s_warnings_as_one_line(tmp_path, capsys):
     assert not res["resolved"] and res["process_zone_cells"] == pytest.approx(zone * 32 / 1e-5)
 
 
-def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path):
+def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path, capsys):
     # the default approaches of --adhesion on a periodic surface stop short of full
     # contact (max h - mean h), where the adhesive state is not defined by the approach
     # and the solver refuses it: until round 2 session 13 the last default step did
@@ -246,8 +246,12 @@ def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path):
     assert main(["contact", str(path), "--E", "1e6", "--nu", "0.5", "--adhesion", "exp",
                  "--work-of-adhesion", "1e-3", "--range", "1e-7", "--steps", "3",
                  "-o", str(out)]) == 0
-    steps = json.loads((out / "results.json").read_text())["steps"]
+    doc = json.loads((out / "results.json").read_text())
+    steps = doc["steps"]
     assert len(steps) == 3 and all(not st["unloading"] for st in steps)
+    # without --unload there is no pull-off: null in the file, "not traced" on the screen
+    assert doc["derived"]["pull_off_force"] is None
+    assert "pull-off force not traced (--unload traces it)" in capsys.readouterr().out
     # (the reported Delta is the equilibrium's own: adhesion may close the last step
     # fully, at Delta = max h - mean h, below the imposed approach's 3/4 of it)
     assert np.all(np.diff([st["load"] for st in steps]) > 0)

@@ -147,8 +147,10 @@ def _run(args) -> int:
               f"{k:12.4e} {s['mean_gap']:12.4e} {s['iterations']:5d}")
     if adhesive is not None:
         st = doc["derived"]["stickiness"]
-        print(f"pull-off force {adhesive.pull_off_force:.4e} "
-              f"({'detached' if adhesive.detached else 'NOT detached: a bound'}); "
+        pull = (f"pull-off force {adhesive.pull_off_force:.4e} "
+                f"({'detached' if adhesive.detached else 'NOT detached: a bound'})"
+                if args.unload else "pull-off force not traced (--unload traces it)")
+        print(f"{pull}; "
               f"Pastewka-Robbins C = {st['criterion']:.3g} (Eq. 10, sticky if < 1) "
               f"({'sticky' if st['sticky'] else 'not sticky'})")
     print(f"wrote {out / 'results.json'}, {out / 'fields.h5'}")
