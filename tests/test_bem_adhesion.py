@@ -310,7 +310,7 @@ def test_the_continuation_start_is_the_elastic_gap_increment_of_a_fixed_contact_
     # gap at Delta2 when the contact set does not change (Eq. 2.5 is linear in Delta on a
     # fixed set); the shifted gap g - dDelta is not. Measured here: 9.8e-5 / 7.2e-5 of the
     # increment (periodic / Love), the rate's tolerance 1e-4; the shift 0.90 / 1.47.
-    from roughfe.bem.adhesion import _Energy
+    from roughfe.bem.adhesive_energy import AdhesiveEnergy
     from roughfe.bem.adhesive_start import continued_start
     from roughfe.bem.contact import _operator
     s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=4)
@@ -327,7 +327,7 @@ def test_the_continuation_start_is_the_elastic_gap_increment_of_a_fixed_contact_
     assert np.array_equal(r1.contact, r2.contact)
     op = _operator(s.shape, s.size, mat.E_star, kernel)
     c = float(s.heights.max()) - s.heights - (d1 + step)
-    energy = _Energy(op, AdhesionLaw("exp", 1e-3, 1e-7), c, None, 1.0)
+    energy = AdhesiveEnergy(op, AdhesionLaw("exp", 1e-3, 1e-7), c, None, 1.0)
     x0 = continued_start(r1, d1 + step, op, energy)
     g = x0 if kernel == "spectral" else x0[energy.phys]
     change = np.abs(r2.gap - r1.gap).max()

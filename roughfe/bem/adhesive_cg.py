@@ -19,8 +19,8 @@ Polonsky-Keer CG is preconditioned by the stiffness:
   clipped, and every 50 iterations.
 
 Each iteration costs two FFT pairs (Kd, H r), like the elastic CG. The periodic mean gap
-is held by the machine spring of :class:`roughfe.bem.adhesion._Energy`, whose stiffness
-k0 is the preconditioner of the uniform mode.
+is held by the machine spring of :class:`roughfe.bem.adhesive_energy.AdhesiveEnergy`,
+whose stiffness k0 is the preconditioner of the uniform mode.
 """
 from __future__ import annotations
 
@@ -58,7 +58,7 @@ def _line_search(df, alpha0, slope0):
 
 
 def adhesive_pcg(energy, x0, tol, max_iter):
-    """Minimise ``energy`` (an ``adhesion._Energy``) from ``x0`` (scaled unknowns);
+    """Minimise ``energy`` (an ``adhesive_energy.AdhesiveEnergy``) from ``x0`` (scaled unknowns);
     returns ``(x, nit, residual, message)``. The residual is the largest projected
     traction over the traction scale (``energy.residual``)."""
     op, ell, scale = energy.op, energy.ell, energy.s0
