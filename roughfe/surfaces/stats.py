@@ -30,8 +30,8 @@ of a profile cut in any direction: profile ``m_n = sum q^n |h~|^2``; surface
 how they are evaluated on non-periodic data. Nayak's bandwidth parameter is
 ``alpha = m0 m4 / m2^2`` (>= 1.5 for a surface; large for broad spectra).
 
-The Hurst exponent is fitted on the PSD (log-log least squares, uniform weight per
-decade): a self-affine profile has ``C ~ q^-(1+2H)``, a surface ``C ~ q^-2(1+H)``; the
+The Hurst exponent is fitted on the PSD by the weighted Whittle likelihood of a power law
+(every decade of q weighted alike; unbiased, unlike least squares on log C): a self-affine profile has ``C ~ q^-(1+2H)``, a surface ``C ~ q^-2(1+H)``; the
 fractal dimension is ``D = d + 1 - H`` with ``d`` the topological dimension (1 or 2),
 as in the thesis text after Eq. (2.1).
 """
@@ -40,6 +40,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
+import scipy.optimize
 
 from ..errors import InputError, check_finite_positive, check_instance
 from .surface import Surface
@@ -294,8 +295,45 @@ class HurstFit:
     message: str
 
 
+def _whittle_power_law(q, c, weight):
+    """Slope s and prefactor A of ``C = A q**s`` by the weighted Whittle likelihood.
+
+    Minimises ``sum_i weight_i [ln(A q_i^s) + c_i / (A q_i^s)]`` over A and s, with
+    ``weight`` the number of Fourier modes behind each PSD value ``c_i`` times the
+    weight given to each mode. A is then ``sum weight c q^-s / sum weight`` and the
+    profile likelihood in s, ``ln(sum weight c q^-s) + s <ln q>``, is convex (a
+    log-sum-exp plus a linear term): a bounded scalar minimisation finds it.
+
+    Why not least squares on log C: a periodogram value of a Gaussian surface is an
+    exponential variable, and the log of the mean of k of them is biased low by
+    ln k - psi(k) (0.58 for k = 1). The few modes per logarithmic bin at the low-q end
+    of a profile flatten a log-log fit: H = 0.8 fitted as 0.74 on average over 200
+    seeds of 1024-point profiles. The Whittle score equations are unbiased for any
+    weights (E[c_i] = A q_i^s), and working with C itself, not its logarithm, keeps the
+    empty bins between the lines of a Weierstrass-Mandelbrot spectrum from dragging the
+    fit (H = 0.3 and 0.5 fitted as 0.79 and 0.99 by the binned log-log fit).
+    """
+    lq = np.log(q)
+    lw = np.log(weight * c)              # c > 0 by the caller's selection
+    wbar = float(np.sum(weight * lq) / np.sum(weight))
+    shift = float(lq.mean())
+
+    def objective(s):
+        z = lw - s * (lq - shift)
+        zmax = float(z.max())
+        return zmax + float(np.log(np.sum(np.exp(z - zmax)))) + s * (wbar - shift)
+
+    best = scipy.optimize.minimize_scalar(objective, bounds=(-12.0, 4.0), method="bounded",
+                                          options={"xatol": 1e-10})
+    s = float(best.x)
+    prefactor = float(np.sum(weight * c * np.exp(-s * lq)) / np.sum(weight))
+    return s, prefactor
+
+
 def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
-    """Fit the Hurst exponent on the (radially averaged) PSD, log-log least squares.
+    """Fit the Hurst exponent on the (radially averaged) PSD: a power law ``C = A q^s``
+    by the weighted Whittle likelihood (:func:`_whittle_power_law`), each decade of q
+    weighted alike.
 
     Parameters
     ----------
@@ -331,25 +369,15 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     if n < 3:
         return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
                         f"only {n} PSD points in q_range; widen it")
-    # Average C over logarithmic bins (10 per decade, weighted by the q-space measure)
-    # before the log-log fit: every decade then counts the same, and averaging before
-    # taking the log removes the scatter (and log-bias) of single Fourier modes.
     q, c, w = psd.q[sel], psd.C[sel], psd.weight[sel]
-    nb = max(int(np.ceil(10 * np.log10(q[-1] / q[0]))), 1)
-    idx = np.minimum((np.log(q / q[0]) / np.log(q[-1] / q[0]) * nb).astype(int), nb - 1) \
-        if q[-1] > q[0] else np.zeros(q.size, int)
-    wsum = np.bincount(idx, weights=w, minlength=nb)
-    full = wsum > 0
-    lq = np.log(np.bincount(idx, weights=q * w, minlength=nb)[full] / wsum[full])
-    lc = np.log(np.bincount(idx, weights=c * w, minlength=nb)[full] / wsum[full])
-    if lq.size < 2:
+    if q[-1] <= q[0] * 10 ** 0.1:
         return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
-                        "q_range spans less than two logarithmic bins; widen it")
-    slope, intercept = np.polyfit(lq, lc, 1)
+                        "q_range spans less than 0.1 decade of PSD points; widen it")
+    slope, prefactor = _whittle_power_law(q, c, w / q ** surface.ndim)
     d = surface.ndim
     hurst = -slope / 2 - 1 if d == 2 else (-slope - 1) / 2
     ok = 0 < hurst < 1
-    return HurstFit(float(hurst), float(d + 1 - hurst), float(slope), float(np.exp(intercept)),
+    return HurstFit(float(hurst), float(d + 1 - hurst), float(slope), float(prefactor),
                     (qlo, qhi), n, bool(ok),
                     "fit converged" if ok else f"H = {hurst:.3f} outside (0, 1): not self-affine")
 
