@@ -67,7 +67,11 @@ def test_channel_sizes_and_junction_leak_rate():
     assert c.critical_gap == 0.6 * UM and c.junction[0] == 10
     assert c.width == pytest.approx(3 * 2 * UM)                 # 3 cells of dy = 2 um
     assert c.parent_channel_length == pytest.approx(6 * UM)     # 6 cells of dx = 1 um
-    assert c.position[0] == pytest.approx(10.5 * UM)
+    assert c.position[0] == pytest.approx(10 * UM)   # cell centres from 0 (was 10.5 um)
+    # the same point as Surface.coordinates() gives that cell
+    from roughfe.surfaces import Surface
+    x, y = Surface(g, (nx * UM, ny * 2 * UM), periodic=False).coordinates()
+    assert c.position == pytest.approx((x[c.junction[0]], y[c.junction[1]]))
     # the same in y (transposed field)
     cy = critical_constriction(g.T, (2 * UM, UM), direction="y")
     assert cy.junction == c.junction[::-1] and cy.width == pytest.approx(c.width)

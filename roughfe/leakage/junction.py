@@ -10,7 +10,8 @@ face-connected, the connectivity of the default finite-volume Reynolds scheme):
   one connected-component labelling (scipy, linear) per step, so ``O(N log N)``.
 * **Junction**: the cell with ``gap = u_c`` on the widest path; every inlet-outlet path
   through ``{gap >= u_c}`` passes through it (removing it, ``{gap > u_c}`` does not
-  percolate). ``position`` is its centre (m).
+  percolate). ``position`` is its centre ``(i dx, j dy)`` (m), the coordinates of
+  :meth:`roughfe.surfaces.Surface.coordinates` (cell centres from 0).
 * **Widest path**: the shortest (fewest cells) inlet-outlet path inside ``{gap >= u_c}``
   (breadth-first search), which passes through the junction.
 * **Width** ``w_c``: the length of the open cross-section (run of cells with gap > 0)
@@ -53,7 +54,7 @@ class CriticalConstriction:
     junction : tuple of int or None
         Grid index ``(i, j)`` of the junction cell.
     position : tuple of float or None
-        Centre of the junction cell (m).
+        Centre of the junction cell, ``(i dx, j dy)`` (m; :meth:`Surface.coordinates`).
     width : float or None
         Open cross-section through the junction, transverse to the path (m).
     parent_channel_length : float or None
@@ -194,7 +195,7 @@ def critical_constriction(gap, spacing, *, direction: str = "x", periodic: bool 
     along = np.abs(np.diff(path[:, 0])) != 0
     along = np.concatenate([along[:1] if along.size else [True], along])
     length = float(np.where(along, dl, dt)[a:b + 1].sum())
-    centre = ((i + 0.5) * dl, (j + 0.5) * dt)
+    centre = (i * dl, j * dt)           # the cell centres of Surface.coordinates()
     if direction == "y":
         path, seg = path[:, ::-1], seg[:, ::-1]
         i, j = j, i

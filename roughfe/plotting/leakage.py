@@ -92,7 +92,9 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
     pl = offscreen_plotter(window_size=(900, 900))
     pl.add_mesh(img, scalars="colour", rgb=True, show_scalar_bar=False, lighting=False)
     if junctions:
-        pts = np.array([[x * UM, y * UM, 0.5] for x, y in junctions])
+        # cell centres from 0 (Surface.coordinates) on an image whose cells start at 0
+        half = (0.5 * size[0] / g.shape[0], 0.5 * size[1] / g.shape[1])
+        pts = np.array([[(x + half[0]) * UM, (y + half[1]) * UM, 0.5] for x, y in junctions])
         pl.add_points(pts, color="yellow", point_size=22, render_points_as_spheres=True)
         legend += ("  " if legend else "\n") + "yellow: critical junction"
     n_p, n_t, n_c = int(np.sum(percolating)), int(np.sum(trapped)), int(
