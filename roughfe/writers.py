@@ -256,6 +256,9 @@ class OutputFolder:
         self.command = command
         self.overwrite = overwrite
         self._check(self.path)
+        # the command's work starts here (checked before the computation), not when the
+        # folder is taken for the writes
+        self._started, self._t0 = _now(), time.perf_counter()
 
     def _check(self, folder: Path):
         if folder.exists() and not folder.is_dir():
@@ -296,8 +299,7 @@ class OutputFolder:
         self._lock.enter_context(folder_lock(folder, f"`roughfe {self.command}`"))
         _clear(folder)
         self._record = {"command": self.command, "status": "running", "pid": os.getpid(),
-                        "started": _now()}
-        self._t0 = time.perf_counter()
+                        "started": self._started, "writing": _now()}
         write_text(folder / UNFINISHED_FILE,
                    f"`roughfe {self.command}` started {self._record['started']} and has not "
                    "finished: the files here are incomplete. Rerun the command to replace "

@@ -61,13 +61,14 @@ residual.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize
 
-from ..errors import (InputError, NoConvergenceError, check_in_open_interval,
-                      check_instance, check_int)
+from ..errors import (InputError, NoConvergenceError, ResolutionWarning,
+                      check_in_open_interval, check_instance, check_int)
 from ..model import ContactResult, Loading, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
@@ -359,40 +360,43 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)):
         raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "
                          f"got {deltas!r}")
-    results = []
-    prev = None
-    for d in deltas:
-        prev = solve_adhesive(surface, material, law, delta=d, kernel=kernel, initial=prev,
-                              tol=tol, max_iter=max_iter, unloading=False)
-        results.append(prev)
-    growth = float(unload_growth)
-    if not (np.isfinite(growth) and growth >= 1.0):
-        raise InputError(f"unload_growth must be a finite factor >= 1, got {unload_growth!r}")
-    pull, detached = float("nan"), False
-    if unload:
-        step = float(deltas[-1] - deltas[-2]) if deltas.size > 1 else float(abs(deltas[0]))
-        step = step if step > 0 else law.range
-        loads = []
+    check_resolution(law, material.E_star, surface.spacing)   # once for the sweep
+    with warnings.catch_warnings():       # not again at every step
+        warnings.simplefilter("ignore", ResolutionWarning)
+        results = []
+        prev = None
+        for d in deltas:
+            prev = solve_adhesive(surface, material, law, delta=d, kernel=kernel, initial=prev,
+                                  tol=tol, max_iter=max_iter, unloading=False)
+            results.append(prev)
+        growth = float(unload_growth)
+        if not (np.isfinite(growth) and growth >= 1.0):
+            raise InputError(f"unload_growth must be a finite factor >= 1, got {unload_growth!r}")
+        pull, detached = float("nan"), False
+        if unload:
+            step = float(deltas[-1] - deltas[-2]) if deltas.size > 1 else float(abs(deltas[0]))
+            step = step if step > 0 else law.range
+            loads = []
 
-        def unload_to(d):
-            state = solve_adhesive(surface, material, law, delta=d, kernel=kernel,
-                                   initial=prev, tol=tol, max_iter=max_iter, unloading=True)
-            results.append(state)
-            loads.append(state.load)
-            return state
+            def unload_to(d):
+                state = solve_adhesive(surface, material, law, delta=d, kernel=kernel,
+                                       initial=prev, tol=tol, max_iter=max_iter, unloading=True)
+                results.append(state)
+                loads.append(state.load)
+                return state
 
-        for d in deltas[-2::-1]:              # the loading approaches in reverse
-            prev = unload_to(d)
-        d, h = float(deltas[0]), step
-        for _ in range(int(max_unload_steps or 4 * deltas.size)):
-            low = min(loads) if loads else float("inf")
-            d -= h
-            prev = unload_to(d)
-            if prev.n_contact == 0 and min(loads) < 0 and prev.load > 1e-3 * min(loads):
-                detached = True
-                break
-            h = step if prev.load < low else growth * h
-        pull = float(min(loads))
+            for d in deltas[-2::-1]:              # the loading approaches in reverse
+                prev = unload_to(d)
+            d, h = float(deltas[0]), step
+            for _ in range(int(max_unload_steps or 4 * deltas.size)):
+                low = min(loads) if loads else float("inf")
+                d -= h
+                prev = unload_to(d)
+                if prev.n_contact == 0 and min(loads) < 0 and prev.load > 1e-3 * min(loads):
+                    detached = True
+                    break
+                h = step if prev.load < low else growth * h
+            pull = float(min(loads))
     sweep = SweepResult.from_results(results, rms_slope=rms_slope(surface),
                                      length=surface.size[0])
     return AdhesiveSweep(sweep=sweep, pull_off_force=pull,

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..bem import KERNELS
+from ..errors import InputError
 from ..model import Loading, Material
 from ..response import response
 from ..bem.contact import SOLVERS
@@ -84,9 +85,13 @@ def _run(args) -> int:
         loading = (Loading(pressures=args.pressure) if args.pressure else
                    Loading(deltas=args.delta) if args.delta else
                    Loading(n_steps=args.steps or DEFAULT_STEPS))
-        sweep = response(surface, material, loading, kernel=args.kernel, solver=args.solver,
-                         tol=tol, unload=args.unload, hardness=args.hardness,
-                         coarse_correction=COARSE[args.coarse_correction])
+        try:
+            sweep = response(surface, material, loading, kernel=args.kernel,
+                             solver=args.solver, tol=tol, unload=args.unload,
+                             hardness=args.hardness,
+                             coarse_correction=COARSE[args.coarse_correction])
+        except InputError as exc:      # the solver's rules, said in this command's flags
+            raise InputError(_in_flags(str(exc))) from None
     else:
         adhesive = _adhesive_sweep(args, surface, material, law, tol)
         sweep = adhesive.sweep
@@ -141,10 +146,11 @@ def _run(args) -> int:
         write_json(out / "results.json", doc)  # last: the run is complete
     print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} {'K (Pa/m)':>12s} {'gap (m)':>12s} "
           f"{'nit':>5s}")
-    for s in sweep.to_records():
-        k = s["stiffness"] if s["stiffness"] is not None else float("inf")
+    for s, k in zip(sweep.to_records(), sweep.stiffness):
+        # inf at full periodic contact; "-" where it was not computed (adhesion)
+        k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.4f} "
-              f"{k:12.4e} {s['mean_gap']:12.4e} {s['iterations']:5d}")
+              f"{k} {s['mean_gap']:12.4e} {s['iterations']:5d}")
     if adhesive is not None:
         st = doc["derived"]["stickiness"]
         pull = (f"pull-off force {adhesive.pull_off_force:.4e} "
@@ -155,6 +161,21 @@ def _run(args) -> int:
               f"({'sticky' if st['sticky'] else 'not sticky'})")
     print(f"wrote {out / 'results.json'}, {out / 'fields.h5'}")
     return 0
+
+
+#: the solver's keyword phrases in its InputErrors -> this command's flags
+_FLAGS = (("solver='pk'", "--solver pk"), ("solver 'dense'", "--solver dense"),
+          ("coarse_correction=True", "--coarse-correction on"),
+          ("load control (mean_pressure)", "load control (--pressure)"),
+          ("kernel 'spectral'", "--kernel spectral"),
+          ("(Surface(..., periodic=True))", "(without --non-periodic)"),
+          ("use 'strip'/'love' otherwise", "use --kernel strip/love otherwise"))
+
+
+def _in_flags(message: str) -> str:
+    for phrase, flag in _FLAGS:
+        message = message.replace(phrase, flag)
+    return message
 
 
 def _adhesive_sweep(args, surface, material, law, tol):

@@ -8,11 +8,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import (add_material_options, add_output_file, add_output_folder,
-                      add_run_options, add_surface_options, material_from_args,
-                      nonnegative_int, output_file_of, output_folder_of, positive_float,
-                      positive_int,
-                      surface_from_args, add_detrend_option)
+from .options import (add_detrend_option, add_material_options, add_output_file,
+                      add_output_folder, add_run_options, add_surface_options, at_least_two,
+                      material_from_args, nonnegative_int, output_file_of,
+                      output_folder_of, positive_float, positive_int, surface_from_args)
 
 from ..genomics.genome import SCALES
 from ..genomics.natural import DEFAULT_FRACTIONS
@@ -385,7 +384,7 @@ def register(sub):
                                   "draws for which Eq. 3.10 holds, beside the arccos form.")
     p.add_argument("--trials", type=positive_int, default=1000,
                    help="random phase draws per number of ridges M")
-    p.add_argument("--max-ridges", type=positive_int, default=20,
+    p.add_argument("--max-ridges", type=at_least_two, default=20,
                    help="largest number of ridges M (from 2)")
     p.add_argument("--seed", type=nonnegative_int, default=0,
                    help="seed of the random phases")

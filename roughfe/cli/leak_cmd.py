@@ -55,11 +55,11 @@ def _add_coupling_options(p):
     fs.add_argument("--outlet-pressure", type=float, default=None, metavar="PO",
                     help="absolute outlet pressure in Pa")
     fs.add_argument("--trapped-fluid", choices=("volume", "pressure", "film"),
-                    default="volume",
-                    help="pockets sealed by contact: 'volume' keep their liquid (pressure an "
-                         "unknown carrying load; incompressible unless --bulk-modulus), "
-                         "'pressure' keep their pressure at closure, 'film' are drained "
-                         "(pressure of their surroundings)")
+                    default=None,
+                    help="with --fsi: pockets sealed by contact: 'volume' keep their liquid "
+                         "(pressure an unknown carrying load; incompressible unless "
+                         "--bulk-modulus), 'pressure' keep their pressure at closure, 'film' "
+                         "are drained (pressure of their surroundings) (default: volume)")
     fs.add_argument("--bulk-modulus", type=positive_float, default=None, metavar="K",
                     help="bulk modulus of the liquid in Pa for --trapped-fluid volume "
                          "(p = p_closure + K ln(V_closure/V); water 2.2e9); default: "
@@ -147,12 +147,12 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
         raise InputError("--fsi solves one flow direction: give --direction x or --direction y")
     if args.no_reynolds:
         raise InputError("--fsi needs the Reynolds solve; drop --no-reynolds")
-    if args.bulk_modulus is not None and args.trapped_fluid != "volume":
+    if args.bulk_modulus is not None and args.trapped_fluid not in (None, "volume"):
         raise InputError(f"--bulk-modulus belongs to --trapped-fluid volume, not "
                          f"{args.trapped_fluid!r}")
     sweep = coupled_leakage_sweep(surface, material, args.pressure, direction=args.direction,
                                   p_in=p_in, p_out=p_out, mu=args.mu,
-                                  trapped=args.trapped_fluid,
+                                  trapped=args.trapped_fluid or "volume",
                                   bulk_modulus=(np.inf if args.bulk_modulus is None
                                                 else args.bulk_modulus))
     steps = sweep.records()
@@ -200,14 +200,17 @@ def _leak_run(args, surface, material, out):
 
     p_in, p_out = _fluid_pressures(args)
     physics = contact_physics_from_args(args)
-    if args.bulk_modulus is not None and not args.fsi:
-        raise InputError("--bulk-modulus needs --fsi (trapped fluid of the coupled solve)")
+    for flag, value in (("--bulk-modulus", args.bulk_modulus),
+                        ("--trapped-fluid", args.trapped_fluid)):
+        if value is not None and not args.fsi:
+            raise InputError(f"{flag} needs --fsi (trapped fluid of the coupled solve)")
     base = {"surface": str(args.surface), "shape": list(surface.shape),
             "size": list(surface.size), "periodic": surface.periodic,
             "surface_metadata": dict(surface.metadata), "E": args.E, "nu": args.nu,
             "mu": args.mu, "inlet_pressure": p_in, "outlet_pressure": p_out,
             "pressure_drop": p_in - p_out, "direction": args.direction, "fsi": args.fsi,
-            "trapped_fluid": args.trapped_fluid, "bulk_modulus": args.bulk_modulus,
+            "trapped_fluid": (args.trapped_fluid or "volume") if args.fsi else None,
+            "bulk_modulus": args.bulk_modulus,
             "delta": args.delta,
             "pressure": args.pressure, "detrend": args.detrend,
             "hardness": physics["hardness"], "unload": physics["unload"],

@@ -97,6 +97,7 @@ def _check(kind, test, what):
 
 
 positive_int = _check(int, lambda v: v >= 1, "an integer >= 1")
+at_least_two = _check(int, lambda v: v >= 2, "an integer >= 2")
 nonnegative_int = _check(int, lambda v: v >= 0, "an integer >= 0")
 positive_float = _check(float, lambda v: 0.0 < v < float("inf"), "a finite number > 0")
 nonnegative_float = _check(float, lambda v: 0.0 <= v < float("inf"), "a finite number >= 0")

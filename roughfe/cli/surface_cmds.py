@@ -110,7 +110,12 @@ def _grid_points(a) -> tuple:
 def _generate(args) -> int:
     from ..surfaces.io import save_surface
     from ..surfaces.stats import rms_height
+    from ..writers import output_file
     out = output_file_of(args, suffixes=(".npz",))
+    png = out.with_suffix(".png")          # the figure of this surface, beside it
+    replaced = out.exists()                # (with --overwrite)
+    if not args.no_figures:
+        output_file(png, overwrite=args.overwrite)
     shape = _grid_points(args)
     check_memory(f"a {' x '.join(map(str, shape))} grid", 8.0 * float(np.prod(shape)))
     surface = args.make(args)
@@ -119,9 +124,11 @@ def _generate(args) -> int:
     save_surface(surface, out)
     print(f"wrote {out}: {surface!r}, rms height {rms_height(surface) * 1e6:.4g} um, "
           f"seed {surface.metadata.get('seed')}")
+    if args.no_figures and replaced and png.is_file():
+        png.unlink()      # the old surface's picture must not stand beside the new one
+        print(f"removed {png} (the figure of the surface this file replaced)")
     if not args.no_figures:
         from ..plotting.surfaces import plot_profile, render_surface
-        png = out.with_suffix(".png")
         kind = "surface" if surface.ndim == 2 else "profile"
         title = f"{args.model} {kind}, seed {surface.metadata.get('seed')}"
         (render_surface if surface.ndim == 2 else plot_profile)(surface, png, title=title)
@@ -161,7 +168,7 @@ def _register_generate(sub):
     m.add_argument("--length", type=positive_float, default=1e-3, help="profile length (m)")
     m.add_argument("--hurst", type=float, default=0.7, help="Hurst exponent in (0,1)")
     m.add_argument("--gamma", type=float, default=1.5, help="frequency density > 1")
-    m.add_argument("--amplitude", type=float, default=1e-7, help="A (m)")
+    m.add_argument("--amplitude", type=positive_float, default=1e-7, help="A (m)")
     m.add_argument("--k-range", type=int, nargs=2, metavar=("K1", "K2"), default=None,
                    help="truncation k1 k2 (default: profile length to Nyquist)")
 
@@ -170,11 +177,12 @@ def _register_generate(sub):
     m.add_argument("--length", type=positive_float, default=1e-4, help="side (m)")
     m.add_argument("--hurst", type=float, default=0.7, help="Hurst exponent in (0,1)")
     m.add_argument("--gamma", type=float, default=1.5, help="frequency density > 1")
-    m.add_argument("--wavelength", type=float, default=None, help="lambda (m), default L")
+    m.add_argument("--wavelength", type=positive_float, default=None, help="lambda (m), default L")
     m.add_argument("--n-range", type=int, nargs=2, metavar=("NS", "NF"), default=None,
                    help="frequency indices n_s n_f (default: 1 to Nyquist)")
     m.add_argument("--ridges", type=positive_int, default=10, help="number of ridges M")
-    m.add_argument("--amplitude", type=float, default=1e-6, help="A of Eq. 3.17 (m^(1-H))")
+    m.add_argument("--amplitude", type=positive_float, default=1e-6,
+                   help="A of Eq. 3.17 (m^(1-H))")
     m.add_argument("--anisotropy", type=float, nargs="+", default=None,
                    help="M factors a_m (default all 1)")
     m.add_argument("--random-angles", action="store_true",

@@ -10,6 +10,7 @@ from __future__ import annotations
 import collections
 import json
 import os
+import shutil
 import socket
 import subprocess
 import sys
@@ -19,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import __version__
+from ..errors import InputError
 from ..writers import to_jsonable, write_json
 from . import store
 from .analyses import ANALYSES, as_records, check_parameters, resolve
@@ -182,23 +184,31 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     tasks = spec.tasks()
     _check_tasks(spec.analysis, tasks)
     outdir = spec.output
-    with store.study_lock(outdir):
-        store.write_study(outdir, spec, tasks, __version__)
-        keys = [t.key for t in tasks]
-        done = store.done_keys(outdir)
-        todo = [t for t in tasks if t.key not in done]
-        n_cached = len(tasks) - len(todo)
-        counts = collections.Counter()
-        description = "nothing to run"
-        if todo:
-            log(f"study {spec.name!r}: {len(tasks)} tasks, {n_cached} already done, "
-                f"{len(todo)} to run")
-            with make_executor(executor, workers=workers, scheduler=scheduler) as ex:
-                description = ex.describe()
-                log(description)
-                _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
-                       n_cached=n_cached, commit=code_commit())
-        store.write_index(outdir, keys)
+    fresh = not Path(outdir).exists()
+    try:
+        with store.study_lock(outdir):
+            store.write_study(outdir, spec, tasks, __version__)
+            keys = [t.key for t in tasks]
+            done = store.done_keys(outdir)
+            todo = [t for t in tasks if t.key not in done]
+            n_cached = len(tasks) - len(todo)
+            counts = collections.Counter()
+            description = "nothing to run"
+            if todo:
+                log(f"study {spec.name!r}: {len(tasks)} tasks, {n_cached} already done, "
+                    f"{len(todo)} to run")
+                with make_executor(executor, workers=workers, scheduler=scheduler) as ex:
+                    description = ex.describe()
+                    log(description)
+                    _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
+                           n_cached=n_cached, commit=code_commit())
+            store.write_index(outdir, keys)
+    except InputError:
+        # a run refused before any task finished (e.g. an executor that cannot start)
+        # leaves no study folder behind: the command wrote nothing
+        if fresh and Path(outdir).is_dir() and not store.done_keys(outdir):
+            shutil.rmtree(outdir, ignore_errors=True)
+        raise
     summary = StudySummary(n_tasks=len(tasks), n_cached=n_cached, n_done=counts["done"],
                            n_failed=counts["failed"], n_retries=counts["retries"],
                            wall_s=time.perf_counter() - t_start, task_s=counts["task_s"],

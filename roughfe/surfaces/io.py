@@ -79,6 +79,9 @@ def _single_channel(path, channel, what):
 
 def _read_native(path, size, periodic, channel):
     _single_channel(path, channel, "a roughfe .npz surface")
+    if Path(path).is_file() and not zipfile.is_zipfile(path):
+        raise FileFormatError(f"{path}: cannot read as a roughfe .npz (truncated or not a "
+                              f"zip archive, which an .npz is: another format?)")
     try:
         with np.load(path, allow_pickle=False) as data:
             keys = set(data.files)
@@ -96,6 +99,9 @@ def _read_native(path, size, periodic, channel):
             file_size = tuple(float(s) for s in np.atleast_1d(data["size"]))
             file_periodic = bool(data["periodic"])
             metadata = json.loads(str(data["metadata"]))
+            if not isinstance(metadata, dict):
+                raise FileFormatError(f"{path}: its metadata must be a JSON object, got "
+                                      f"{type(metadata).__name__} {str(data['metadata'])[:60]!r}")
     except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, zlib.error) as exc:
         if isinstance(exc, FileFormatError):
             raise
@@ -223,6 +229,15 @@ def _read_instrument(path, size, periodic, channel):
                              f"in metres (--size)")
         kwargs["physical_sizes"] = tuple(np.atleast_1d(size).astype(float))
     unit = ch.unit if isinstance(ch.unit, str) else None
+    if isinstance(ch.unit, tuple) and len(ch.unit) == 2 and ch.unit[1] is None:
+        heights = [f"{c.index} {c.name!r}" for c in reader.channels
+                   if isinstance(c.unit, str) or (isinstance(c.unit, tuple)
+                                                  and c.unit[-1] is not None)]
+        raise FileFormatError(
+            f"{path}: channel {ch.index} {ch.name!r} has no height unit (lateral unit "
+            f"{ch.unit[0]!r}): its values are not heights (a phase, amplitude or error "
+            f"signal), not a topography; height channels of this file: "
+            f"{', '.join(heights) or 'none'} (channel=, --channel)")
     if unit is None and isinstance(ch.unit, tuple) and ch.unit and isinstance(ch.unit[0], str):
         unit = ch.unit[0]
     if unit is None:

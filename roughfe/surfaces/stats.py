@@ -65,6 +65,9 @@ def _window(name, shape):
         return None
     if name != "hann":
         raise InputError(f"window must be None, 'none' or 'hann', got {name!r}")
+    if min(shape) < 3:
+        raise InputError(f"a Hann window needs at least 3 points per side (it is zero on 2), "
+                         f"got shape {tuple(shape)}; use window='none'")
     w = np.ones(shape)
     for axis, n in enumerate(shape):
         w1 = np.hanning(n).reshape([-1 if a == axis else 1 for a in range(len(shape))])
@@ -252,13 +255,16 @@ def rms_curvature(surface: Surface) -> float:
     """Rms curvature (1/m): profile ``sqrt<h''^2>``; surface rms mean curvature
     ``sqrt<(lap h / 2)^2>``.
 
-    Periodic: Fourier interpolant; non-periodic: second central differences inside.
+    Periodic: Fourier interpolant; non-periodic: second central differences inside (NaN
+    when a side has fewer than 3 points: no inner point).
     """
     _check_surface(surface)
     factor = 1.0 if surface.ndim == 1 else 0.5
     if surface.periodic:
         return factor * float(np.sqrt(periodic_moment(surface.heights, surface.size, 2)))
     h = surface.heights
+    if min(h.shape) < 3:
+        return float("nan")
     inner = tuple(slice(1, -1) for _ in range(h.ndim))
     lap = np.zeros_like(h[inner])
     for a, d in enumerate(surface.spacing):
@@ -349,7 +355,6 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     HurstFit
     """
     _check_surface(surface)
-    psd = power_spectrum(surface, window=window)
     if q_range is None:
         qlo, qhi = 4 * 2 * np.pi / max(surface.size), np.pi / (2 * max(surface.spacing))
         if qlo >= qhi:
@@ -364,6 +369,7 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
                          f"{q_range!r}") from None
     if not (0 < qlo < qhi):
         raise InputError(f"q_range must satisfy 0 < q_min < q_max (rad/m), got {q_range!r}")
+    psd = power_spectrum(surface, window=window)
     sel = (psd.q >= qlo) & (psd.q <= qhi) & (psd.C > 0)
     n = int(sel.sum())
     if n < 3:

@@ -148,6 +148,7 @@ def wm_profile(n, length, hurst, gamma=1.5, amplitude=1e-6, q0=None, k_range=Non
     """
     (x,), length = _grid(n, length, 1)
     gamma, hurst = _check_gamma_hurst(gamma, hurst)
+    amplitude = check_finite_positive("amplitude A (m)", amplitude)
     q0 = 2 * np.pi / length if q0 is None else float(q0)
     if not (np.isfinite(q0) and q0 > 0):
         raise InputError(f"q0 must be > 0 (rad/m), got {q0!r}")
@@ -234,8 +235,10 @@ def mwm_surface(n, length, hurst, gamma=1.5, wavelength=None, n_range=None, ridg
         Non-periodic surface (m).
     """
     (x, y), length = _grid(n, length, 2)
-    wavelength = length if wavelength is None else wavelength
+    wavelength = length if wavelength is None else check_finite_positive(
+        "wavelength lambda (m)", wavelength)
     gamma, hurst = _check_gamma_hurst(gamma, hurst)
+    amplitude = check_finite_positive("amplitude A (m^(1-H))", amplitude)
     if n_range is None:
         n_f = 1 + int(np.floor(np.log(np.pi * n / length * float(wavelength) / (2 * np.pi))
                                / np.log(gamma) + 1e-9))

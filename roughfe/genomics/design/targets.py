@@ -288,6 +288,9 @@ def surface_targets(surface, settings: DatabaseSettings, *, name="measured", det
             Target(curve.pressure, curve.area_fraction, "A", f"{name}_A", meta), curve)
 
 
+#: fewest points per side of a target surface resampled onto the database spacing
+MIN_DESIGN_POINTS = 8
+
 def target_surface(surface, settings: DatabaseSettings, *, detrend="plane",
                    boundary="periodic", resolution="design"):
     """The surface :func:`surface_targets` solves: detrended, evenly mirrored when
@@ -302,7 +305,16 @@ def target_surface(surface, settings: DatabaseSettings, *, detrend="plane",
         surf = surf.mirrored()
     if resolution == "design" and surf.periodic and settings.dim == 2:
         spacing = settings.length / settings.n_nodes
-        surf = surf.resampled([max(2, int(round(s / spacing))) for s in surf.size])
+        points = [int(round(s / spacing)) for s in surf.size]
+        if min(points) < MIN_DESIGN_POINTS:
+            raise InputError(
+                f"the surface ({' x '.join(f'{s:.3g}' for s in surf.size)} m"
+                f"{', evenly mirrored' if not surface.periodic else ''}) "
+                f"resampled onto the database spacing L/N = {spacing:.3g} m has "
+                f"{' x '.join(map(str, points))} points, fewer than {MIN_DESIGN_POINTS} per "
+                f"side: solve it on its own grid (resolution='full', --resolution full) or "
+                f"use a database of finer spacing")
+        surf = surf.resampled(points)
     return surf
 
 

@@ -1,0 +1,174 @@
+"""What a user's review of the command line found (round 2, session 21): each test fails
+on the code before its fix. Wrong numbers in a printed table, tracebacks for bad input,
+messages in the library's words, files that did not match their command."""
+import json
+import time
+import warnings
+
+import numpy as np
+import pytest
+
+from roughfe.cli import main
+from roughfe.writers import OWNER_FILE, OutputFolder, write_text
+
+
+@pytest.fixture
+def surface64(tmp_path):
+    path = tmp_path / "s64.npz"
+    assert main(["generate", "spectral", "--n", "64", "--seed", "3", "--no-figures",
+                 "-o", str(path)]) == 0
+    return path
+
+
+def _error(capsys):
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    return err
+
+
+def test_adhesive_contact_table_prints_no_stiffness_where_none_was_computed(
+        surface64, tmp_path, capsys):
+    # the adhesive solver computes no K: the table said "inf" on every row (full contact
+    # is the only place where inf is the answer, and it still reads inf there)
+    capsys.readouterr()
+    assert main(["contact", str(surface64), "--E", "1e6", "--nu", "0.5", "--steps", "2",
+                 "--adhesion", "md", "--work-of-adhesion", "0.05", "--range", "1e-7",
+                 "--no-figures", "-o", str(tmp_path / "ad")]) == 0
+    out = capsys.readouterr()
+    rows = [line.split() for line in out.out.splitlines()[1:3]]
+    assert all(len(r) == 6 and r[3] == "-" for r in rows), out.out
+    # the unresolved law is said once for the run, not once per solve
+    assert out.err.count("warning: the md adhesion law") == 1
+    steps = json.loads((tmp_path / "ad" / "results.json").read_text())["steps"]
+    assert all(s["stiffness"] is None for s in steps)
+    assert main(["contact", str(surface64), "--E", "1e9", "--nu", "0.3", "--steps", "3",
+                 "--no-figures", "-o", str(tmp_path / "el")]) == 0
+    last = capsys.readouterr().out.splitlines()[3].split()
+    assert float(last[2]) == 1.0 and last[3] == "inf"        # full periodic contact
+
+
+@pytest.mark.parametrize("args, flag", [
+    (["--pressure", "1e7", "--solver", "dense"], "use --solver pk above 8192 points"),
+    (["--delta", "1e-7", "--coarse-correction", "on"], "--coarse-correction on"),
+    (["--pressure", "1e7", "--non-periodic", "--kernel", "spectral"],
+     "(without --non-periodic); use --kernel strip/love otherwise"),
+])
+def test_contact_solver_rules_are_said_in_the_command_flags(tmp_path, capsys, args, flag):
+    path = tmp_path / "s.npz"
+    n = "128" if "dense" in args else "64"
+    main(["generate", "spectral", "--n", n, "--seed", "1", "--no-figures", "-o", str(path)])
+    capsys.readouterr()
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0.3", *args, "--no-figures",
+                 "-o", str(tmp_path / "out")]) == 2
+    err = _error(capsys)
+    assert flag in err and "solver='" not in err and "coarse_correction=" not in err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("model, option", [("wm", "--amplitude"), ("mwm", "--amplitude"),
+                                           ("mwm", "--wavelength")])
+@pytest.mark.parametrize("value", ["0", "-1", "nan"])
+def test_generator_lengths_must_be_positive(tmp_path, capsys, model, option, value):
+    # --amplitude 0 with --rms-height divided by zero; --wavelength 0 overflowed
+    out = tmp_path / "z.npz"
+    assert main(["generate", model, "--n", "32", option, value, "--rms-height", "1e-6",
+                 "--no-figures", "-o", str(out)]) == 2
+    assert "must be a finite number > 0" in _error(capsys) and not out.exists()
+
+
+def test_generate_keeps_its_figure_with_its_surface(tmp_path, capsys):
+    # a PNG of another name's stem is not replaced without --overwrite ...
+    mine = tmp_path / "other.png"
+    mine.write_bytes(b"mine")
+    assert main(["generate", "spectral", "--n", "32", "--seed", "2",
+                 "-o", str(tmp_path / "other.npz")]) == 2
+    assert "other.png exists" in _error(capsys) and mine.read_bytes() == b"mine"
+    assert not (tmp_path / "other.npz").exists()
+    # ... and a surface replaced without figures does not keep the old surface's picture
+    out = tmp_path / "st.npz"
+    assert main(["generate", "spectral", "--n", "32", "--seed", "1", "-o", str(out)]) == 0
+    assert out.with_suffix(".png").is_file()
+    assert main(["generate", "spectral", "--n", "32", "--seed", "2", "--overwrite",
+                 "--no-figures", "-o", str(out)]) == 0
+    assert not out.with_suffix(".png").exists()
+
+
+def test_unreadable_npz_files_say_what_is_wrong(tmp_path, surface64, capsys):
+    text = tmp_path / "bad.npz"
+    text.write_text("hello\n")
+    assert main(["info", str(text)]) == 2
+    assert "not a zip archive" in _error(capsys)
+    data = dict(np.load(surface64))
+    data["metadata"] = np.array("[1, 2]")            # valid JSON, but not an object
+    odd = tmp_path / "odd.npz"
+    np.savez(odd, **data)
+    assert main(["info", str(odd)]) == 2
+    assert "metadata must be a JSON object, got list" in _error(capsys)
+
+
+def test_info_of_a_tiny_grid_has_no_numpy_warnings(tmp_path, capsys):
+    path = tmp_path / "m2.txt"
+    path.write_text("1e-6 2e-6\n3e-6 5e-6\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert main(["info", str(path), "--size", "1e-3"]) == 0
+    out = capsys.readouterr()
+    assert "warning" not in out.err and "rms curvature" in out.out
+
+
+def test_a_channel_without_height_unit_is_refused_by_name(topographies_dir, capsys):
+    # di-1.di: channels Height, Height, Phase, AmplitudeError; the last two have no height
+    # unit (a ValueError 'Unknown unit' traceback from SurfaceTopography before)
+    for channel in ("2", "Phase", "AmplitudeError"):
+        assert main(["info", str(topographies_dir / "di-1.di"), "--channel", channel]) == 2
+        err = _error(capsys)
+        assert "has no height unit" in err and "0 'Height', 1 'Height'" in err
+
+
+def test_genome_validity_needs_two_ridges(tmp_path, capsys):
+    assert main(["genome", "validity", "--max-ridges", "1", "-o",
+                 str(tmp_path / "v.png")]) == 2
+    assert "--max-ridges: must be an integer >= 2" in _error(capsys)
+
+
+def test_trapped_fluid_without_fsi_is_refused(surface64, tmp_path, capsys):
+    assert main(["leak", str(surface64), "--E", "1e9", "--nu", "0.3", "--pressure", "1e7",
+                 "--trapped-fluid", "pressure", "--no-figures", "-o",
+                 str(tmp_path / "lk")]) == 2
+    assert "--trapped-fluid needs --fsi" in _error(capsys)
+    assert not (tmp_path / "lk").exists()
+
+
+def test_a_refused_leak_study_leaves_no_folder(tmp_path, capsys):
+    out = tmp_path / "ls"
+    assert main(["leak-study", "--D", "2.3", "--m", "3", "--surfaces", "1", "--steps", "3",
+                 "--scheduler", "tcp://127.0.0.1:1", "--no-figures", "-o", str(out)]) == 2
+    assert "--scheduler is for the dask executor" in _error(capsys)
+    assert not out.exists()
+
+
+def test_output_record_times_the_whole_run(tmp_path):
+    # the folder is checked before the computation and taken for the writes after it:
+    # elapsed_s is the whole run (it timed the writes alone)
+    folder = OutputFolder(tmp_path / "run", "contact")
+    time.sleep(0.3)                                     # "the solve"
+    with folder as d:
+        write_text(d / "results.json", "{}")
+    record = json.loads((tmp_path / "run" / OWNER_FILE).read_text())
+    assert record["status"] == "complete" and record["elapsed_s"] >= 0.3
+    assert record["started"] <= record["writing"] <= record["finished"]
+
+
+def test_a_target_surface_too_small_for_the_database_spacing_is_named(topographies_dir):
+    # di-1.di (1 um, mirrored) on the spacing of a 2D database: 0 x 0 points; the error
+    # said "the surface is flat"
+    from roughfe.errors import InputError
+    from roughfe.genomics.database import DatabaseSettings
+    from roughfe.genomics.design.targets import target_surface
+    from roughfe.surfaces import load_surface
+    settings = DatabaseSettings(dim=2, n_nodes=16)
+    surface = load_surface(topographies_dir / "di-1.di")
+    with pytest.raises(InputError, match=r"database spacing L/N = .* has 0 x 0 points, "
+                                         r"fewer than 8 per side: .*--resolution full"):
+        target_surface(surface, settings)
+    assert target_surface(surface, settings, resolution="full").shape == (1022, 1022)   # mirrored
