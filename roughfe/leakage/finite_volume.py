@@ -116,6 +116,21 @@ def _harmonic(a, b, scale, live, out=None):
     return t
 
 
+def _series_gap(a, b, live):
+    """The gap (m) that carries the Couette flow U/2 h across the face between two open
+    cells of gaps ``a`` and ``b`` where ``live`` (else 0): the two half-cells in series,
+    as the pressure term's harmonic transmissibility. Each half-cell passes
+    q = (k / (dl/2)) dp_half + (U/2) h with k = h^3 / (12 mu); eliminating the face
+    pressure gives q = T (p_a - p_b) + (U/2) (h_a/k_a + h_b/k_b) / (1/k_a + 1/k_b), i.e.
+    the gap (a^-2 + b^-2) / (a^-3 + b^-3): a for a = b, and exact for strips in series
+    (the arithmetic mean of the two gaps was first-order wrong on a gap that jumps)."""
+    ok = (a > 0) & (b > 0) & live
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ia, ib = 1.0 / a, 1.0 / b
+        h = (ia * ia + ib * ib) / (ia * ia * ia + ib * ib * ib)
+    return np.where(ok, h, 0.0)
+
+
 def _open_components(open_cells: np.ndarray, periodic: bool):
     """Face-connected components of the open cells (labels 0..k-1 per cell, -1 closed).
 
@@ -231,13 +246,11 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     # Couette face flows (m^3/s, along +axis; None without wall motion along that axis)
     C_l = C_t = None
     if ul:
-        C_l = np.where(is_open[:-1] & is_open[1:] & live[:-1],
-                       0.25 * (g[:-1] + g[1:]) * ul * dt, 0.0)
+        C_l = _series_gap(g[:-1], g[1:], live[:-1]) * (0.5 * ul * dt)
     if ut:
         gt_b = np.roll(g, -1, axis=1) if wrap else g[:, 1:]
         gt_a = g if wrap else g[:, :-1]
-        C_t = np.where((gt_a > 0) & (gt_b > 0) & (live if wrap else live[:, :-1]),
-                       0.25 * (gt_a + gt_b) * ut * dl, 0.0)
+        C_t = _series_gap(gt_a, gt_b, live if wrap else live[:, :-1]) * (0.5 * ut * dl)
     if wrap and nt == 2:                       # the wrap face joins the same two cells
         T_t, wrap = T_t[:, :1] + T_t[:, 1:], False
         if C_t is not None:
