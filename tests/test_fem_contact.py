@@ -258,6 +258,20 @@ def test_load_control_reaches_the_pressure_and_equals_displacement_control(weste
         fem_contact_sweep(westergaard_mesh, MAT, pressures=[0.0, 1.0])
 
 
+def test_full_contact_approach_is_the_least_full_contact_load(westergaard_mesh):
+    """Delta = max h - mean h of the mirrored profile is full contact: beyond it the
+    half-plane approach no longer grows with the load, and the Newton on it ran off
+    (a NoConvergenceError at Delta_full, an imposed approach of 1e7 m beyond it). The
+    step is now the state at the least full-contact load, Westergaard's p* = pi E* g /
+    lambda, as the BEM's closed form; beyond it, a clear InputError."""
+    p_star = np.pi * MAT.E_star * G / LAM
+    sweep = fem_contact_sweep(westergaard_mesh, MAT, [0.5 * G, G])
+    assert sweep.mean_pressure[-1] == pytest.approx(p_star, rel=1e-3)
+    assert sweep.area_fraction[-1] > 0.95 and sweep.delta[-1] == pytest.approx(G, rel=1e-3)
+    with pytest.raises(InputError, match="exceeds max h - mean h .* full contact already"):
+        fem_contact_sweep(westergaard_mesh, MAT, [0.5 * G, 1.2 * G])
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("pc", ["hypre", "gamg"])
 def test_iterative_inner_solver_gives_the_direct_solution(westergaard_mesh, pc):

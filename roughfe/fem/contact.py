@@ -600,6 +600,15 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     if np.any(np.diff(values) <= 0):
         raise InputError(f"{name} must be strictly increasing (load stepping)")
     keep = {int(k) % values.size for k in keep_fields}
+    full = None
+    if name == "deltas":
+        full = _full_contact(pmesh, material)
+        if values[-1] > full[0] * (1 + 1e-9):
+            raise InputError(
+                f"delta = {values[-1]:.6g} m exceeds max h - mean h = {full[0]:.6g} m of the "
+                f"evenly mirrored profile (the body's periodic reference problem): that is "
+                f"full contact already, and the half-plane approach no longer grows with "
+                f"the load; give pressures (Pa) to go beyond it")
     problem = _ContactProblem(pmesh, material, options)
     if name == "pressures" and guesses is None:
         guesses = _applied_guesses(pmesh, material, values)
@@ -613,6 +622,11 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
             return problem.solve_mean_pressure(values[k], guesses[k], k in keep)
         if name == "applied_deltas":
             return problem.solve(values[k], k in keep)
+        if values[k] >= full[0] * (1 - 1e-9):
+            # full contact: the half-plane approach is flat in the load beyond it, so the
+            # Newton on it cannot land; the state is that of the least full-contact
+            # pressure, the BEM's closed form (load control from there)
+            return problem.solve_mean_pressure(full[1], full[2], k in keep)
         return problem.solve_half_plane(values[k], k in keep)
 
     results = []
@@ -624,6 +638,24 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     finally:
         problem.destroy()
     return SweepResult.from_results(results, rms_slope=problem.rms_slope, length=pmesh.width)
+
+
+def _full_contact(pmesh: ProfileMesh, material: Material):
+    """``(Delta_full, p_full, applied)``: the half-plane approach of full contact (m, max h
+    - mean h of the evenly mirrored profile), the least mean pressure that closes every
+    gap (Pa, the periodic BEM's closed form) and the imposed approach expected there
+    (m)."""
+    from ..bem import solve_contact
+    from ..surfaces import Surface
+    from .mesh import mirrored_profile
+
+    profile = Surface(np.asarray(pmesh.heights), pmesh.heights.size * pmesh.element_size)
+    mirrored = mirrored_profile(profile)
+    h = mirrored.heights
+    d_full = float(h.max() - h.mean())
+    p_full = solve_contact(mirrored, material, delta=d_full, kernel="spectral",
+                           compute_stiffness=False).mean_pressure
+    return d_full, p_full, d_full + p_full * pmesh.depth / p_wave_modulus(material)
 
 
 def _applied_guesses(pmesh: ProfileMesh, material: Material, pressures) -> np.ndarray:

@@ -8,7 +8,6 @@ where it stopped and ends with the same table as an uninterrupted run.
 from __future__ import annotations
 
 import collections
-import json
 import os
 import shutil
 import socket

@@ -10,9 +10,10 @@
 Layer: after :mod:`roughfe.surfaces` (it needs only the PSD), before the solvers and
 their consumers, which draw the theory beside their results.
 """
-from .persson import (GAMMA_DEFAULT, KAPPA_PERSSON, PERCOLATION_THRESHOLD, CriticalJunction,
-                      PerssonResult, area_fraction, beside, critical_junction,
-                      mean_separation, persson)
+from .beside import beside
+from .junction import CriticalJunction, critical_junction
+from .persson import (GAMMA_DEFAULT, KAPPA_PERSSON, PERCOLATION_THRESHOLD, PerssonResult,
+                      area_fraction, mean_separation, persson)
 from .stickiness import LoadBalance, Stickiness, load_balance, pastewka_robbins
 
 __all__ = ["persson", "beside", "PerssonResult", "critical_junction", "CriticalJunction",

@@ -57,26 +57,8 @@ pressures ``u = u0 ln(p_ref / p)``, i.e. ``p ~ exp(-u / u0)``, with
 order-of-magnitude statement (the ratio u0 / (gamma h_rms) depends on the spectrum, see
 docs/theory/adhesion-persson.md); Eq. (3) is what the theory gives.
 
-Critical junction (Lorenz & Persson 2009)
------------------------------------------
-Increasing the magnification, A(q, p) falls from 1; the contact area stops percolating
-at ``A(q_c, p) = A_c``. Lorenz & Persson take the site-percolation threshold A_c ~ 0.42
-(used here, changeable). The fluid then flows through the critical junction, whose
-surface separation is the mean separation of the roughness *below* the critical scale
-pressed by the local pressure on the contact patches at that scale:
-
-    u_c = u(p_c; |q| > q_c),     p_c = p / A(q_c, p)                                   (4)
-
-(Eq. (2) with the PSD restricted to ``|q| > q_c`` and ``m`` summed from ``q_c``; Lorenz
-& Persson add a small term ``u1`` for the deformation of the junction, omitted here).
-Each square of the nominal contact holds one critical junction; a seal of length Lx (the
-direction of the pressure drop) and width Ly holds Ly/Lx such squares in parallel, each
-a narrow gap of height u_c, so
-
-    Q = (Ly / Lx) * (Delta P / eta) * u_c^3 / 12          (m^3/s)                     (5)
-
-(Delta P in Pa, eta in Pa s, u_c in m). For a profile (1D) every contact point seals,
-so no critical junction exists; :func:`critical_junction` accepts surfaces only.
+The critical junction of Lorenz & Persson is in :mod:`roughfe.theory.junction`, the
+theory beside a simulation's steps in :mod:`roughfe.theory.beside`.
 """
 from __future__ import annotations
 
@@ -123,17 +105,20 @@ def _pressures(mean_pressure):
 
 
 def _arrays(psd: PowerSpectrum):
+    """``(q, q2, power)`` of the PSD's values with power: q (rad/m), the power-weighted
+    mean |q|^2 of each value's modes (:attr:`PowerSpectrum.q2`; exact gradient moments
+    of a binned surface spectrum), |h~|^2 per value (m^2)."""
     q = np.asarray(psd.q, float)
     power = np.asarray(psd.C, float) * np.asarray(psd.weight, float)     # |h~|^2 per value
     keep = power > 0
     if not keep.any():
         raise InputError("the PSD is zero everywhere: a flat surface has no Persson theory")
-    return q[keep], power[keep]
+    return q[keep], np.asarray(psd.q_squared, float)[keep], power[keep]
 
 
-def _cumulative_gradient(q, power):
+def _cumulative_gradient(q2, power):
     """m(q_k): mean-square gradient of the roughness up to q_k (midpoint in the bin)."""
-    term = q ** 2 * power
+    term = q2 * power
     return np.cumsum(term) - 0.5 * term
 
 
@@ -189,7 +174,8 @@ def area_fraction(rms_gradient, e_star, mean_pressure, kappa=KAPPA_PERSSON):
     return scipy.special.erf(0.5 * k * np.sqrt(np.pi) * p / (e * g))
 
 
-def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=0.0):
+def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=0.0,
+                    q2=None):
     """Persson's mean separation u(p) (m), Eq. (2), from the roughness with |q| > q_min.
 
     Parameters
@@ -206,6 +192,9 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
         Persson's elastic-energy factor, in (0, 1].
     q_min : float
         Only the roughness at |q| > q_min counts (Eq. (4) of the critical junction).
+    q2 : array, optional
+        |q|^2 of each value for the gradient moment m(q) (rad^2/m^2; default q**2; the
+        :attr:`~roughfe.surfaces.stats.PowerSpectrum.q2` of a binned surface spectrum).
 
     Returns
     -------
@@ -223,11 +212,14 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
             or q.min(initial=0.0) < 0 or power.min(initial=0.0) < 0 or np.any(np.diff(q) < 0):
         raise InputError("q (rad/m) must be finite, >= 0 and increasing, and power (m^2) "
                          "finite and >= 0")
+    q2 = q * q if q2 is None else np.asarray(q2, float)
+    if q2.shape != q.shape:
+        raise InputError(f"q2 must have the shape of q {q.shape}, got {q2.shape}")
     sel = q > q_min
-    q, power = q[sel], power[sel]
+    q, q2, power = q[sel], q2[sel], power[sel]
     if q.size == 0:
         return np.zeros(p.shape)
-    w = np.sqrt(2.0 / _cumulative_gradient(q, power))
+    w = np.sqrt(2.0 / _cumulative_gradient(q2, power))
     weight = 0.25 * q * power * w                                   # m per unit J
     return j_function(np.outer(p, w / e), gamma) @ weight
 
@@ -300,199 +292,13 @@ def persson(source, e_star, mean_pressure, *, gamma=GAMMA_DEFAULT,
     PerssonResult
     """
     psd = _spectrum(source)
-    q, power = _arrays(psd)
+    q, q2, power = _arrays(psd)
     p = _pressures(mean_pressure)
-    gbar = float(np.sqrt(np.sum(q ** 2 * power)))
-    u = mean_separation(q, power, e_star, p, gamma)
-    w = np.sqrt(2.0 / _cumulative_gradient(q, power))
+    gbar = float(np.sqrt(np.sum(q2 * power)))          # <|grad h|^2>^1/2, every mode
+    u = mean_separation(q, power, e_star, p, gamma, q2=q2)
+    w = np.sqrt(2.0 / _cumulative_gradient(q2, power))
     u0 = float(gamma / (2 * np.sqrt(np.pi)) * np.sum(q * power * w))
     return PerssonResult(mean_pressure=p, area_fraction=area_fraction(gbar, e_star, p, kappa),
                          mean_gap=u, rms_gradient=gbar, rms_height=float(np.sqrt(power.sum())),
                          u0=u0, e_star=float(e_star), gamma=float(gamma), kappa=float(kappa),
                          ndim=psd.ndim)
-
-
-@dataclass(frozen=True, eq=False)
-class CriticalJunction:
-    """Lorenz & Persson's critical-junction leak estimate at one pressure, Eqs. (4)-(5).
-
-    Attributes
-    ----------
-    mean_pressure : float
-        p (Pa).
-    q_c : float
-        Wavenumber at which A(q, p) falls to the percolation threshold (rad/m); NaN when
-        the contact still percolates at full magnification (sealed: u_c = Q = 0).
-    area_fraction_c : float
-        A(q_c, p) (-).
-    pressure_c : float
-        Local pressure p / A(q_c, p) on the junction (Pa).
-    u_c : float
-        Surface separation at the critical junction (m).
-    leak_rate : float
-        Q, Eq. (5) (m^3/s).
-    geometry_factor : float
-        Ly/Lx (-).
-    pressure_drop, viscosity : float
-        Delta P (Pa), eta (Pa s).
-    threshold : float
-        A_c used (-).
-    sealed : bool
-        True when the real contact percolates (A(q1, p) >= A_c).
-    """
-
-    mean_pressure: float
-    q_c: float
-    area_fraction_c: float
-    pressure_c: float
-    u_c: float
-    leak_rate: float
-    geometry_factor: float
-    pressure_drop: float
-    viscosity: float
-    threshold: float
-    sealed: bool
-    references: tuple = REFERENCES
-
-
-def _geometry_factor(source, direction: str = "x") -> float:
-    """Width over length along the pressure drop of a surface: ``Ly/Lx`` for flow along x
-    (axis 0), ``Lx/Ly`` along y; 1 for a bare PSD."""
-    if direction not in ("x", "y"):
-        raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
-    if isinstance(source, Surface) and source.ndim == 2:
-        lx, ly = source.size
-        return ly / lx if direction == "x" else lx / ly
-    return 1.0
-
-
-def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *,
-                      direction="x", geometry_factor=None, threshold=PERCOLATION_THRESHOLD,
-                      gamma=GAMMA_DEFAULT) -> CriticalJunction:
-    """Critical-junction leak rate of Lorenz & Persson (2009), Eqs. (4)-(5).
-
-    Parameters
-    ----------
-    source : Surface or PowerSpectrum
-        A 2D surface (a profile has no leak path once in contact).
-    e_star : float
-        E* (Pa).
-    mean_pressure : float
-        Nominal contact pressure p > 0 (Pa).
-    pressure_drop : float
-        Fluid pressure drop Delta P > 0 across the seal (Pa).
-    viscosity : float
-        Dynamic viscosity eta > 0 (Pa s).
-    direction : {"x", "y"}
-        Axis of the pressure drop (x = axis 0); sets the default geometry factor.
-    geometry_factor : float, optional
-        Width over length along the pressure drop; default from the surface size
-        (``Ly/Lx`` along x, ``Lx/Ly`` along y), 1 for a bare PSD.
-    threshold : float
-        Percolation threshold A_c of the contact area, default 0.42.
-    gamma : float
-        As in :func:`persson`.
-
-    Returns
-    -------
-    CriticalJunction
-    """
-    psd = _spectrum(source)
-    if psd.ndim != 2:
-        raise InputError("critical_junction needs a surface (2D): on a profile any contact "
-                         "point seals the flow")
-    if geometry_factor is None:
-        geometry_factor = _geometry_factor(source, direction)
-    geometry_factor = check_finite_positive("geometry_factor Ly/Lx", geometry_factor)
-    threshold = check_in_open_interval("threshold A_c", threshold, 0.0, 1.0)
-    dp = check_finite_positive("pressure_drop (Pa)", pressure_drop)
-    eta = check_finite_positive("viscosity (Pa s)", viscosity)
-    if np.ndim(mean_pressure) != 0:
-        raise InputError(f"mean_pressure must be one number (Pa), got {mean_pressure!r}")
-    p = float(_pressures(mean_pressure)[0])
-    e = check_finite_positive("e_star (Pa)", e_star)
-    q, power = _arrays(psd)
-    m = np.cumsum(q ** 2 * power)                    # m(q) with the bin fully resolved
-    a = scipy.special.erf(np.sqrt(2.0) * p / (e * np.sqrt(m)))
-    below = np.flatnonzero(a < threshold)
-    common = dict(mean_pressure=p, geometry_factor=geometry_factor, pressure_drop=dp,
-                  viscosity=eta, threshold=threshold)
-    if below.size == 0:
-        return CriticalJunction(q_c=float("nan"), area_fraction_c=float(a[-1]),
-                                pressure_c=p / float(a[-1]), u_c=0.0, leak_rate=0.0,
-                                sealed=True, **common)
-    k = int(below[0])
-    if k == 0:
-        q_c, a_c = float(q[0]), float(a[0])
-    else:   # log-linear interpolation of A(q) between the bracketing wavenumbers
-        t = (a[k - 1] - threshold) / (a[k - 1] - a[k])
-        q_c = float(np.exp(np.log(q[k - 1]) + t * (np.log(q[k]) - np.log(q[k - 1]))))
-        a_c = threshold
-    p_c = p / a_c
-    u_c = float(mean_separation(q, power, e, p_c, gamma, q_min=q_c)[0])
-    leak = geometry_factor * dp / eta * u_c ** 3 / 12.0
-    return CriticalJunction(q_c=q_c, area_fraction_c=a_c, pressure_c=p_c, u_c=u_c,
-                            leak_rate=leak, sealed=False, **common)
-
-
-def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, direction="x",
-           gamma=GAMMA_DEFAULT) -> dict:
-    """Persson's theory at the mean pressure of each simulation step (results.json).
-
-    Parameters
-    ----------
-    source : Surface or PowerSpectrum
-    e_star : float
-        E* (Pa).
-    steps : list of dict
-        Step records with ``mean_pressure`` (Pa).
-    pressure_drop, viscosity : float, optional
-        Delta P (Pa) and eta (Pa s): add the critical-junction leak rate (surfaces).
-    direction : {"x", "y", "both"}
-        Flow direction(s) of the leak rate: the geometry factor (width over length along
-        the pressure drop) of each; ``"both"`` reports both and their mean (as the
-        simulated ``leak_rate`` of ``roughfe leak --direction both``).
-    gamma : float
-        As in :func:`persson`.
-
-    Returns
-    -------
-    dict
-        ``"steps"``: copies of ``steps`` with ``persson_area_fraction`` (-),
-        ``persson_mean_gap`` (m) and, with ``pressure_drop``, ``persson_leak_rate_<d>``
-        per direction and ``persson_leak_rate`` (their mean; m^3/s) added; steps with no positive finite pressure get None (no theory at zero
-        load). ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
-        percolation threshold, units, references).
-    """
-    psd = _spectrum(source)
-    if direction not in ("x", "y", "both"):
-        raise InputError(f"direction must be 'x', 'y' or 'both', got {direction!r}")
-    dirs = ("x", "y") if direction == "both" else (direction,)
-    factors = {d: _geometry_factor(source, d) for d in dirs}
-    pressures = [s.get("mean_pressure") for s in steps]
-    ok = [p is not None and np.isfinite(p) and p > 0 for p in pressures]
-    theory = persson(psd, e_star, [p for p, k in zip(pressures, ok) if k] or [1.0],
-                     gamma=gamma)
-    out, j = [], 0
-    for step, p, k in zip(steps, pressures, ok):
-        rec = dict(step)
-        rec["persson_area_fraction"] = float(theory.area_fraction[j]) if k else None
-        rec["persson_mean_gap"] = float(theory.mean_gap[j]) if k else None
-        if pressure_drop is not None:
-            # Q is linear in the geometry factor: one junction per step, scaled per direction
-            unit = (critical_junction(psd, e_star, float(p), pressure_drop, viscosity,
-                                      gamma=gamma, geometry_factor=1.0).leak_rate
-                    if k else None)
-            for d, f in factors.items():
-                rec[f"persson_leak_rate_{d}"] = None if unit is None else unit * f
-            rec["persson_leak_rate"] = (None if unit is None else
-                                        float(np.mean([unit * f for f in factors.values()])))
-        j += k
-        out.append(rec)
-    info = {"gamma": theory.gamma, "kappa": theory.kappa, "rms_gradient": theory.rms_gradient,
-            "u0": theory.u0, "units": {"persson_mean_gap": "m", "u0": "m",
-                                       "persson_leak_rate": "m^3/s"},
-            "references": list(REFERENCES)}
-    if pressure_drop is not None:
-        info["percolation_threshold"] = PERCOLATION_THRESHOLD
-    return {"steps": out, "persson": info}

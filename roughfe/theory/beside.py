@@ -1,0 +1,73 @@
+"""Persson's theory beside the steps of a simulation (the ``persson_*`` keys of
+results.json): A*(p) and u(p) of :mod:`roughfe.theory.persson` and the critical-junction
+leak rate of :mod:`roughfe.theory.junction` at each step's mean pressure (SI)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from .junction import _geometry_factor, critical_junction
+from .persson import GAMMA_DEFAULT, PERCOLATION_THRESHOLD, REFERENCES, _spectrum, persson
+
+
+def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, direction="x",
+           gamma=GAMMA_DEFAULT) -> dict:
+    """Persson's theory at the mean pressure of each simulation step (results.json).
+
+    Parameters
+    ----------
+    source : Surface or PowerSpectrum
+    e_star : float
+        E* (Pa).
+    steps : list of dict
+        Step records with ``mean_pressure`` (Pa).
+    pressure_drop, viscosity : float, optional
+        Delta P (Pa) and eta (Pa s): add the critical-junction leak rate (surfaces).
+    direction : {"x", "y", "both"}
+        Flow direction(s) of the leak rate: the geometry factor (width over length along
+        the pressure drop) of each; ``"both"`` reports both and their mean (as the
+        simulated ``leak_rate`` of ``roughfe leak --direction both``).
+    gamma : float
+        As in :func:`persson`.
+
+    Returns
+    -------
+    dict
+        ``"steps"``: copies of ``steps`` with ``persson_area_fraction`` (-),
+        ``persson_mean_gap`` (m) and, with ``pressure_drop``, ``persson_leak_rate_<d>``
+        per direction and ``persson_leak_rate`` (their mean; m^3/s) added; steps with no positive finite pressure get None (no theory at zero
+        load). ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
+        percolation threshold, units, references).
+    """
+    psd = _spectrum(source)
+    if direction not in ("x", "y", "both"):
+        raise InputError(f"direction must be 'x', 'y' or 'both', got {direction!r}")
+    dirs = ("x", "y") if direction == "both" else (direction,)
+    factors = {d: _geometry_factor(source, d) for d in dirs}
+    pressures = [s.get("mean_pressure") for s in steps]
+    ok = [p is not None and np.isfinite(p) and p > 0 for p in pressures]
+    theory = persson(psd, e_star, [p for p, k in zip(pressures, ok) if k] or [1.0],
+                     gamma=gamma)
+    out, j = [], 0
+    for step, p, k in zip(steps, pressures, ok):
+        rec = dict(step)
+        rec["persson_area_fraction"] = float(theory.area_fraction[j]) if k else None
+        rec["persson_mean_gap"] = float(theory.mean_gap[j]) if k else None
+        if pressure_drop is not None:
+            # Q is linear in the geometry factor: one junction per step, scaled per direction
+            unit = (critical_junction(psd, e_star, float(p), pressure_drop, viscosity,
+                                      gamma=gamma, geometry_factor=1.0).leak_rate
+                    if k else None)
+            for d, f in factors.items():
+                rec[f"persson_leak_rate_{d}"] = None if unit is None else unit * f
+            rec["persson_leak_rate"] = (None if unit is None else
+                                        float(np.mean([unit * f for f in factors.values()])))
+        j += k
+        out.append(rec)
+    info = {"gamma": theory.gamma, "kappa": theory.kappa, "rms_gradient": theory.rms_gradient,
+            "u0": theory.u0, "units": {"persson_mean_gap": "m", "u0": "m",
+                                       "persson_leak_rate": "m^3/s"},
+            "references": list(REFERENCES)}
+    if pressure_drop is not None:
+        info["percolation_threshold"] = PERCOLATION_THRESHOLD
+    return {"steps": out, "persson": info}
