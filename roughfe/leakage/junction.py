@@ -25,7 +25,7 @@ face-connected, the connectivity of the default finite-volume Reynolds scheme):
 * ``leak_rate_junction`` = ``(W/L) u_c^3 dp / (12 mu)``: Lorenz & Persson's (2009)
   critical-junction formula (Eq. 5 there) with the *measured* ``u_c``, beside the
   Reynolds leak rate and beside the PSD-based estimate of
-  :func:`roughfe.theory.persson.critical_junction`.
+  :func:`roughfe.theory.junction.critical_junction`.
 """
 from __future__ import annotations
 
