@@ -140,3 +140,24 @@ def test_directional_spectrum_matching_recovers_every_wave_amplitude():
         matched = spectrum_matched(d, target, directional).surface().heights
         err = np.abs(matched - matched.mean() - ref).max() / np.ptp(ref)
         assert (err < 1e-12) == ok, (directional, err)
+
+
+def test_profile_target_defaults_to_the_profile_databases_own_setting():
+    """On a profile database the designs are non-periodic profiles on the strip kernel:
+    the default boundary of a profile target is then the window itself, and a design's
+    own profile is its own target exactly. The old default ("periodic": the mirrored
+    profile with the periodic BEM) scored a database genome against its own profile
+    s = 0.009 (K 130x off at p_max)."""
+    from roughfe.genomics.database import make_genome
+    from roughfe.genomics.macro_micro import profile_response
+    from roughfe.genomics.periodic import realization
+    settings = db.DatabaseSettings(n_nodes=128, n_steps=6)
+    genome = make_genome(1.5, 0.8, 3, settings)                  # seeded phases
+    profile = realization(genome, settings.length, settings.n_nodes, settings.dim)
+    own = profile_response(profile, **settings.response_options())
+    tk, ta, curve = surface_targets(profile, settings, detrend="none")
+    assert tk.metadata["boundary"] == "window"
+    np.testing.assert_allclose(curve.pressure, own.pressure, rtol=1e-12)
+    np.testing.assert_allclose(curve.stiffness, own.stiffness, rtol=1e-12)
+    _, _, mirrored = surface_targets(profile, settings, detrend="none", boundary="periodic")
+    assert mirrored.stiffness[-1] > 10 * own.stiffness[-1]

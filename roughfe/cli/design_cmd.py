@@ -230,10 +230,12 @@ def register(sub):
                         "and NAME_A.csv")
     t.add_argument("--detrend", choices=("none", "mean", "plane"), default="plane",
                    help="detrending of --surface before the BEM")
-    t.add_argument("--boundary", choices=("periodic", "window"), default="periodic",
+    t.add_argument("--boundary", choices=("auto", "periodic", "window"), default="auto",
                    help="a non-periodic --surface: its evenly mirrored window with the "
-                        "periodic BEM (the designs' setting) or the window alone on the "
-                        "half-space (its K then includes the window's bulk compliance)")
+                        "periodic BEM, or the window alone on the half-space (its K then "
+                        "includes the window's bulk compliance); auto: the designs' own "
+                        "setting, periodic on a surface database (--dim 2), window on a "
+                        "profile database")
     t.add_argument("--resolution", choices=("design", "full"), default="design",
                    help="a periodic target on a surface database: resampled onto the "
                         "database spacing L/N (the band the designs hold) or at the file's "

@@ -232,13 +232,13 @@ def target_genome_t1(settings: DatabaseSettings) -> Genome:
 #: how :func:`surface_targets` loads a non-periodic (measured) window: "periodic" (the
 #: evenly mirrored window with the periodic BEM, the interface the designs are; default) or
 #: "window" (the window alone on the half-space, non-periodic kernel)
-TARGET_BOUNDARIES = ("periodic", "window")
+TARGET_BOUNDARIES = ("auto", "periodic", "window")
 #: sampling of a periodic surface target: "design" (the database's spacing L/N) or "full"
 TARGET_RESOLUTIONS = ("design", "full")
 
 
 def surface_targets(surface, settings: DatabaseSettings, *, name="measured", detrend="plane",
-                    boundary="periodic", resolution="design"):
+                    boundary="auto", resolution="design"):
     """Targets K(p) and A(p) of a given (e.g. measured) surface: its own BEM sweep.
 
     The surface is detrended (``"plane"`` by default: instruments leave a tilt) and
@@ -247,9 +247,13 @@ def surface_targets(surface, settings: DatabaseSettings, *, name="measured", det
     points: the design is then scored at these pressures (Eq. 4.1 after Eq. 4.2).
 
     ``boundary`` (a non-periodic window only; a periodic surface is always solved as it
-    is):
+    is): ``"auto"`` (default) is the designs' own setting, ``"periodic"`` on a surface
+    database (``settings.dim == 2``) and ``"window"`` on a profile database, whose
+    genomes are solved as non-periodic profiles on the strip kernel (a profile target
+    mirrored and solved periodically scored a database genome's own profile s = 0.009
+    against s = 1 in its own setting).
 
-    * ``"periodic"`` (default): the evenly mirrored window (:meth:`Surface.mirrored`,
+    * ``"periodic"``: the evenly mirrored window (:meth:`Surface.mirrored`,
       period twice the window, no height step at the edges) with the periodic BEM,
       approaches up to ``top_fraction`` of its full contact. This is the setting of the
       designs (periodic interfaces of a nominally infinite plane, K and p per nominal
@@ -276,6 +280,7 @@ def surface_targets(surface, settings: DatabaseSettings, *, name="measured", det
 
     Returns ``(t_K, t_A, curve)``.
     """
+    boundary = _boundary(boundary, settings)
     surf = target_surface(surface, settings, detrend=detrend, boundary=boundary,
                           resolution=resolution)
     curve = profile_response(surf, **settings.response_options())
@@ -291,13 +296,21 @@ def surface_targets(surface, settings: DatabaseSettings, *, name="measured", det
 #: fewest points per side of a target surface resampled onto the database spacing
 MIN_DESIGN_POINTS = 8
 
+def _boundary(boundary, settings) -> str:
+    """``boundary`` with ``"auto"`` resolved: the designs' setting of the database."""
+    if boundary not in TARGET_BOUNDARIES:
+        raise InputError(f"boundary must be one of {TARGET_BOUNDARIES}, got {boundary!r}")
+    if boundary == "auto":
+        return "periodic" if settings.dim == 2 else "window"
+    return boundary
+
+
 def target_surface(surface, settings: DatabaseSettings, *, detrend="plane",
-                   boundary="periodic", resolution="design"):
+                   boundary="auto", resolution="design"):
     """The surface :func:`surface_targets` solves: detrended, evenly mirrored when
     ``boundary="periodic"`` and the input is a non-periodic window, and resampled onto the
     database spacing L/N when ``resolution="design"`` (see :func:`surface_targets`)."""
-    if boundary not in TARGET_BOUNDARIES:
-        raise InputError(f"boundary must be one of {TARGET_BOUNDARIES}, got {boundary!r}")
+    boundary = _boundary(boundary, settings)
     if resolution not in TARGET_RESOLUTIONS:
         raise InputError(f"resolution must be one of {TARGET_RESOLUTIONS}, got {resolution!r}")
     surf = surface.detrended(detrend) if detrend != "none" else surface
