@@ -175,6 +175,20 @@ def test_mcco_wider_pool_crosses_every_ordered_pair_and_weight(entries, targets)
         de.mcco(entries, t1, t3, SETTINGS, options=FAST, weights=(0.0,))
 
 
+def test_mcco_when_one_genome_tops_both_rankings(entries):
+    """Targets K(p) and A(p) of genome 1-2's own profile, on a database of 1-2 alone: U1 =
+    U2 = [1-2], so the only pair is the genome with itself (its macro and micro parts at
+    one amplitude: the genome), which M-CCO now solves (it skipped self-pairs, found
+    nothing and raised an IndexError)."""
+    e = next(x for x in entries if x.label == "1-2")
+    surf = realize(Genome.from_dict(e.genome), SETTINGS.length, SETTINGS.n_nodes)
+    c = profile_response(surf, youngs_modulus=SETTINGS.youngs_modulus, n_steps=SETTINGS.n_steps)
+    tk, ta = Target(c.pressure, c.stiffness, "K"), Target(c.pressure, c.area_fraction, "A")
+    r = de.mcco([e], tk, ta, SETTINGS, options=FAST, n_best=1)
+    assert r.n_cross == 1 and r.best.origin.startswith("1-2+1-2")
+    assert r.best.stages[0] == pytest.approx(1.0, abs=1e-6)
+
+
 def _design_study():
     spec = importlib.util.spec_from_file_location(
         "design_study", Path(__file__).resolve().parents[1] / "validation" / "design_study.py")

@@ -39,6 +39,20 @@ def test_db_and_design_commands(tmp_path, capsys):
     assert s == pytest.approx(report["candidates"][0]["score"], abs=1e-7)
     assert de.rescore_at_target_pressures(design, [target], settings) == pytest.approx(
         report["candidates"][0]["scores_at_target_pressures"], abs=1e-7)
+    # without --search / --global the strict scores the command prints are saved too
+    # (they were printed only: result.json had [])
+    plain = tmp_path / "plain"
+    capsys.readouterr()
+    assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "y_t1.csv"),
+                 "--method", "sog", "--iterations", "1", "--no-figures", "-o",
+                 str(plain)]) == 0
+    printed = capsys.readouterr().out.split("(no interpolation): ")[1].split()[0]
+    saved = json.loads((plain / "result.json").read_text())["candidates"][0]
+    assert len(saved["scores_at_target_pressures"]) == 1
+    assert f"{saved['scores_at_target_pressures'][0]:.4f}" == printed
+    plain_design = de.Design.from_dict(json.loads((plain / "design.json").read_text()))
+    assert de.rescore_at_target_pressures(plain_design, [target], settings) == pytest.approx(
+        saved["scores_at_target_pressures"], abs=1e-7)
     # the global stage with chromosome amplitudes as variables: bounded, strict scores
     # of the saved design reproduced
     amp = tmp_path / "sog_amp"

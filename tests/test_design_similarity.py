@@ -54,6 +54,19 @@ def test_target_y_t2_shape_and_bad_inputs(tmp_path):
     path = write_target_csv(tmp_path / "t.csv", t)
     back = read_target_csv(path)
     np.testing.assert_allclose(back.values, t.values)
+    # the file says what it holds: an A(p) target is read as A, and asking K of it is an
+    # error (it was read as a stiffness: a silent, meaningless design objective)
+    area = write_target_csv(tmp_path / "a.csv", Target(t.pressure, 0.01 * t.values, "A",
+                                                       "y_t3"))
+    assert read_target_csv(area).quantity == "A" and back.quantity == "K"
+    assert read_target_csv(area, "A").quantity == "A"
+    with pytest.raises(InputError, match=r"holds contact area fraction .* \(A\), not "
+                                         r"normal contact stiffness .*--quantity A"):
+        read_target_csv(area, "K")
+    plain = tmp_path / "plain.csv"
+    plain.write_text("pressure_Pa,value\n1e5,0.1\n2e5,0.2\n")
+    assert read_target_csv(plain).quantity == "K"             # says nothing: the default
+    assert read_target_csv(plain, "A").quantity == "A"
     with pytest.raises(InputError, match="finite"):
         Target([0.1, 0.2], [1.0, np.nan])
     with pytest.raises(InputError, match=">= 0"):

@@ -5,6 +5,7 @@ y_t1, y_t2, y_t3, or the K(p), A(p) of a given (measured) surface, as CSV for a 
 settings."""
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from .options import (add_output_folder, add_run_options, nonnegative_float, nonnegative_int,
@@ -31,7 +32,7 @@ GLOBAL_FLAGS = (
      "variable too, within +-X of its start (X <= 2; 0: off)"))
 
 
-def _target(spec, quantity, settings, cache):
+def _target(spec, quantity, settings, cache, default):
     from ..genomics.design import thesis_targets
     from ..genomics.similarity import read_target_csv
     if spec in BUILTIN and not Path(spec).exists():
@@ -39,7 +40,7 @@ def _target(spec, quantity, settings, cache):
             cache["t"] = thesis_targets(settings)
         t1, t2, t3, _ = cache["t"]
         return {"y_t1": t1, "y_t2": t2, "y_t3": t3}[spec]
-    return read_target_csv(spec, quantity)
+    return read_target_csv(spec, quantity, default=default)
 
 
 def _run(args) -> int:
@@ -59,9 +60,10 @@ def _run(args) -> int:
     settings = read_settings(args.db)
     entries = load_entries(args.db)
     cache = {}
-    targets = [_target(args.target, args.quantity, settings, cache)]
+    targets = [_target(args.target, args.quantity, settings, cache, "K")]
     if args.second_target:
-        targets.append(_target(args.second_target, args.second_quantity, settings, cache))
+        targets.append(_target(args.second_target, args.second_quantity, settings, cache,
+                               "A"))
     if args.method == "mcco" and len(targets) == 2 and targets[0].quantity == "A":
         targets.reverse()
     if args.method != "mcco" and args.second_target:
@@ -101,13 +103,17 @@ def _run(args) -> int:
             plot_stages([result], out / "stages.png")
             plot_profiles({result.method: best.surface()}, out / "profile.png")  # 2D: a map
             plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
+        strict = tuple(result.best.at_targets) or tuple(
+            rescore_at_target_pressures(result.best.design, targets, settings))
+        if not result.best.at_targets:      # saved with the design, not only printed
+            result = replace(result, candidates=(replace(result.best, at_targets=strict),)
+                             + tuple(result.candidates[1:]))
         paths = write_design_result(result, settings, out)
     print(result.message)
     for k, c in enumerate(result.candidates, 1):
         print(f"  ({k}) {c.origin:>16}  GCMMA 0/1/2{'/3' if len(c.stages) > 3 else ''}: "
               + " ".join(f"{s:.4f}" for s in c.stages)
               + "  per target: " + " ".join(f"{s:.4f}" for s in c.scores))
-    strict = rescore_at_target_pressures(result.best.design, targets, settings)
     print("best design solved at the target pressures (no interpolation): "
           + " ".join(f"{s:.4f}" for s in strict))
     print(f"{result.nit} BEM sweeps in {result.elapsed:.1f} s; wrote {paths['design'].parent}/")
@@ -150,12 +156,15 @@ def register(sub):
     p.add_argument("--db", required=True, help="SQLite genome database ('roughfe db build')")
     p.add_argument("--target", required=True,
                    help="CSV 'pressure_Pa,value' or a thesis target y_t1|y_t2|y_t3")
-    p.add_argument("--quantity", choices=("K", "A"), default="K",
-                   help="what the target CSV holds: stiffness K (Pa/m) or area fraction A")
+    p.add_argument("--quantity", choices=("K", "A"), default=None,
+                   help="what the target CSV holds: stiffness K (Pa/m) or area fraction A "
+                        "(default: what the file's comment says, as design-targets writes "
+                        "it; else K)")
     p.add_argument("--second-target", default=None,
                    help="M-CCO: the second target (CSV or y_t3), usually A(p)")
-    p.add_argument("--second-quantity", choices=("K", "A"), default="A",
-                   help="what the second target CSV holds")
+    p.add_argument("--second-quantity", choices=("K", "A"), default=None,
+                   help="what the second target CSV holds (default: what its comment "
+                        "says; else A)")
     p.add_argument("--method", choices=("sog", "gco", "cco", "mcco"), required=True,
                    help="Alg. 4 (sog), 5 (gco), 6 (cco) or 7 (mcco)")
     p.add_argument("--pbar", type=positive_float, default=None,

@@ -316,18 +316,28 @@ def linear_then_flat_target(p_max: float, pbar: float, plateau: float, n_points:
                                          "start": None if start is None else float(start)})
 
 
-def read_target_csv(path, quantity: Quantity = "K", name=None) -> Target:
+def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> Target:
     """Read a target from a CSV file with two columns: pressure (Pa), value (K in Pa/m or A).
 
-    Lines starting with ``#`` and a non-numeric header line are skipped.
+    Lines starting with ``#`` and a non-numeric header line are skipped. The quantity is
+    the one the file's ``# name: <label> (unit) vs pressure (Pa)`` comment names (as
+    :func:`write_target_csv` writes it); ``quantity`` ("K" or "A") must then agree with
+    it (an area target read as a stiffness was a silent, meaningless objective), and is
+    taken as given for a file that names none (``default`` when None).
     """
     path = Path(path)
     if not path.is_file():
         raise InputError(f"target file {path} does not exist")
-    rows = []
+    if quantity is not None:
+        _check_quantity(quantity)
+    rows, said = [], None
     with path.open(newline="") as fh:
         for k, row in enumerate(csv.reader(fh)):
             if not row or row[0].lstrip().startswith("#"):
+                line = ",".join(row)
+                for q, (label, _) in QUANTITY_LABELS.items():
+                    if said is None and label in line:
+                        said = q
                 continue
             try:
                 rows.append([float(row[0]), float(row[1])])
@@ -337,8 +347,13 @@ def read_target_csv(path, quantity: Quantity = "K", name=None) -> Target:
                                           f"{row!r}") from None
     if not rows:
         raise FileFormatError(f"{path}: no 'pressure,value' rows found")
+    if said is not None and quantity is not None and said != quantity:
+        raise InputError(f"{path} holds {QUANTITY_LABELS[said][0]} ({said}), not "
+                         f"{QUANTITY_LABELS[quantity][0]} ({quantity}); give the quantity "
+                         f"the file holds (--quantity {said}), or none")
     a = np.asarray(rows)
-    return Target(a[:, 0], a[:, 1], quantity, name or path.stem, {"source": str(path)})
+    return Target(a[:, 0], a[:, 1], said or quantity or default, name or path.stem,
+                  {"source": str(path)})
 
 
 def write_target_csv(path, target: Target):

@@ -335,10 +335,12 @@ def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings
     ws = tuple(float(w) for w in weights)
     if not ws or any(not (np.isfinite(w) and w > 0) for w in ws):
         raise InputError(f"weights must be finite and > 0, got {weights!r}")
+    # pairs of two genomes; a genome with itself (its macro and micro parts at one
+    # amplitude: the genome alone, as GCO and CCO allow) only when no other pair exists,
+    # e.g. one genome tops both rankings (there were no pairs left, and an IndexError)
+    pairs = [(i1, i2) for i1, i2 in pairs if i1 != i2] or pairs
     found = []
     for i1, i2 in pairs:
-        if i1 == i2:
-            continue
         e1, e2 = entries[i1], entries[i2]
         d1 = entry_design(e1, settings, objective.p_max / e1.p_max, e1.macro or e1.micro[:1])
         for w in ws:
