@@ -172,3 +172,34 @@ def test_a_target_surface_too_small_for_the_database_spacing_is_named(topographi
                                          r"fewer than 8 per side: .*--resolution full"):
         target_surface(surface, settings)
     assert target_surface(surface, settings, resolution="full").shape == (1022, 1022)   # mirrored
+
+
+def test_db_build_is_quiet_and_its_database_honours_the_umask(tmp_path, capsys):
+    # --quiet printed three lines of progress and summary; SQLite made its file 0644
+    # whatever the umask (every other output is 0666 & ~umask)
+    import os
+    import stat
+    path = tmp_path / "db.sqlite"
+    old = os.umask(0o002)
+    try:
+        assert main(["db", "build", str(path), "--nodes", "128", "--steps", "4", "--limit",
+                     "1", "--workers", "1", "--quiet"]) == 0
+    finally:
+        os.umask(old)
+    out = capsys.readouterr()
+    assert out.out == "" and out.err == ""
+    assert stat.S_IMODE(path.stat().st_mode) == 0o664
+
+
+def test_extend_and_sequence_say_what_is_wrong(tmp_path, capsys):
+    genome = tmp_path / "g.json"
+    assert main(["genome", "example", "--seed", "0", "-o", str(genome)]) == 0
+    assert main(["genome", "sequence", str(genome), "-o", str(tmp_path / "sq")]) == 2
+    assert "is a JSON file (a genome?), not an acquisition" in _error(capsys)
+    text = tmp_path / "p.txt"
+    text.write_text("1e-6 2e-6 3e-6 1e-6\n")
+    assert main(["genome", "sequence", str(text), "-o", str(tmp_path / "sq")]) == 2
+    err = _error(capsys)
+    assert "takes no --size: give files that carry their size" in err
+    assert main(["genome", "realize", str(genome), "-o", str(tmp_path / "r.npz")]) == 2
+    assert "give --length L (m) or --scale" in _error(capsys)

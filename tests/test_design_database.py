@@ -93,6 +93,14 @@ def test_build_through_the_runner_equals_the_task_and_resumes(tmp_path):
     assert db.load_entries(path, labels_=["seq-1"])[0].source == "extend"
     with pytest.raises(InputError, match="already"):
         extend_genome_db(path, [new], labels=["seq-1"], progress=False)
+    # a label given twice is named as such (the study runner's "[grid] entry lists the
+    # value {...the genome JSON...} more than once" before); the default labels count
+    # on past the labels a user chose (x-<n + 1> clashed with a user's x-6)
+    with pytest.raises(InputError, match=r"given more than once: \['twin'\]"):
+        extend_genome_db(path, [new, new], labels=["twin", "twin"], progress=False)
+    extend_genome_db(path, [new], labels=["x-6"], workers=1, progress=False)
+    extend_genome_db(path, [new], workers=1, progress=False)
+    assert {"x-6", "x-7"} <= {e.label for e in db.load_entries(path)}
     empty = tmp_path / "empty.sqlite"
     db.connect(empty, create=True).close()
     with pytest.raises(InputError, match="empty"):

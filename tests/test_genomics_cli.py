@@ -47,3 +47,34 @@ def test_genome_cli_reports_bad_input(tmp_path, capsys):
     assert main(["genome", "sequence", str(tmp_path / "a.npz"), str(tmp_path / "b.npz"),
                  "-o", str(tmp_path / "s")]) == 2
     assert "same number of nodes" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("dim, n_nodes", [(1, 128), (2, 16)])
+def test_parts_of_a_design_realise_their_share_by_default(tmp_path, dim, n_nodes):
+    """genome_partK.json of a design of several genomes carries its chromosomes, the
+    design's L, N and dimension: `genome realize` without options gives its share, and
+    the shares sum to the design (a profile, or a periodic surface for dim 2). Before,
+    every chromosome of the genome was realised (a relative error of 1.5-2.7 against the
+    design) and a 2D part came out as a 1D profile."""
+    from roughfe.genomics import database as db
+    from roughfe.genomics.design.model import Design, DesignPart
+    from roughfe.genomics.genome import save_genome
+    from roughfe.surfaces.io import load_surface
+    settings = db.DatabaseSettings(n_nodes=n_nodes, dim=dim)
+    kw = {"angles": [0.3, 1.4]} if dim == 2 else {}
+    g1 = db.make_genome(1.5, 0.8, 1, settings, **kw)
+    g2 = db.make_genome(1.7, 0.6, 2, settings, **kw)
+    n1 = sorted(int(n) for n in range(g1.n_first, g1.n_first + g1.phases.shape[1]))
+    n2 = sorted(int(n) for n in range(g2.n_first, g2.n_first + g2.phases.shape[1]))
+    design = Design((DesignPart(g1, tuple(n1[:2])), DesignPart(g2, tuple(n2[2:]), 0.7)),
+                    scale=2.0, length=settings.length, n_nodes=n_nodes, dim=dim)
+    total = 0.0
+    for k in range(2):
+        path = save_genome(design.part_genome(k), tmp_path / f"part{k + 1}.json")
+        out = tmp_path / f"part{k + 1}.npz"
+        assert main(["genome", "realize", str(path), "-o", str(out)]) == 0
+        s = load_surface(out)
+        assert s.ndim == dim and s.periodic == (dim == 2)
+        total = total + s.heights
+    ref = design.surface().heights
+    np.testing.assert_allclose(total, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())

@@ -53,11 +53,13 @@ def _settings(args):
 def _runner(args) -> dict:
     return dict(executor=args.executor, workers=args.workers, scheduler=args.scheduler,
                 study_dir=args.study_dir, progress=show_progress(args),
-                log=lambda message: print(message, file=sys.stderr))
+                log=(lambda message: None) if getattr(args, "quiet", False) else
+                (lambda message: print(message, file=sys.stderr)))
 
 
 def _report(args, run) -> int:
-    print(f"{args.database}: {run.describe()}")
+    if not getattr(args, "quiet", False):
+        print(f"{args.database}: {run.describe()}")
     if not run.complete:
         print(f"some genomes failed; `roughfe study status {run.study_dir}` shows why; rerun "
               "the same command to retry them (finished genomes are kept)", file=sys.stderr)

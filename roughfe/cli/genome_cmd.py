@@ -6,6 +6,7 @@ its outputs (atomically) and prints a summary; figures come from
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from .options import (add_detrend_option, add_material_options, add_output_file,
@@ -33,15 +34,33 @@ def _example(args) -> int:
 
 
 def _realize(args) -> int:
+    from ..errors import InputError
     from ..genomics.genome import load_genome, realize
+    from ..genomics.periodic import realization
     from ..surfaces.io import save_surface
     g = load_genome(args.genome)
     out = output_file_of(args, suffixes=(".npz",))
-    s = realize(g, length=args.length, scale=args.scale, n_nodes=args.nodes,
-                chromosomes=args.chromosomes)
+    # a part of a design (genome_partK.json of `roughfe design`) carries its chromosomes,
+    # the design's L and N and its dimension: by default it realises its share of the
+    # design (the sum of the parts is the designed profile or surface)
+    meta = g.metadata or {}
+    chromosomes = args.chromosomes or meta.get("chromosomes")
+    nodes = args.nodes or int(meta.get("n_nodes", 512))
+    length = args.length if (args.length is not None or args.scale is not None) \
+        else meta.get("length")
+    if length is None and args.scale is None:
+        raise InputError("give --length L (m) or --scale (a part of a design has its own L)")
+    if meta.get("dim") == 2:
+        if args.scale is not None:
+            raise InputError("--scale is for profiles; this genome is a part of a periodic "
+                             "surface design: give --length (default: the design's)")
+        s = realization(g, length, nodes, 2, chromosomes)
+    else:
+        s = realize(g, length=length, scale=args.scale, n_nodes=nodes, chromosomes=chromosomes)
     save_surface(s, out)
     m = s.metadata
-    print(f"realised L = {m['length']:.6g} m, N = {m['n_nodes']}, chromosomes "
+    print(f"realised {'periodic surface ' if s.ndim == 2 else ''}L = {m['length']:.6g} m, "
+          f"N = {m['n_nodes']}, chromosomes "
           f"{m['chromosomes'][0]}..{m['chromosomes'][-1]} (Eq. 3.5: n_s = {m['n_s']}, n_f = {m['n_f']}) "
           f"-> {out}")
     return 0
@@ -63,8 +82,9 @@ def _print_sequencing(res):
     print("sequenced genome:")
     _print_genome(res.genome)
     for k, (L, r, e) in enumerate(zip(res.lengths, res.ranges, res.rms_errors)):
+        err = f"{100 * e:.4g} %" if math.isfinite(e) else "not defined (no genome fits it)"
         print(f"  acquisition {k + 1}: L = {L:.6g} m, n = {r[0]}..{r[1]}, relative rms error "
-              f"{100 * e:.4g} %")
+              f"{err}")
     print(f"  PSD-only estimates (thesis): gamma = {res.gamma_psd:.5g}, H (peak slope) = {res.H_psd:.4g}")
     print(f"  {'success' if res.success else 'FAILED quality check'}: {res.message}")
 
@@ -72,7 +92,22 @@ def _print_sequencing(res):
 def _sequence(args) -> int:
     from ..errors import InputError
     from ..surfaces.io import load_surface
-    surfaces = [load_surface(p) for p in args.profiles]
+    for p in args.profiles:
+        if Path(p).suffix.lower() == ".json":
+            raise InputError(f"{p} is a JSON file (a genome?), not an acquisition: sequence "
+                             f"reads realised profiles or surfaces (.npz, e.g. from `roughfe "
+                             f"genome realize GENOME.json -o X.npz`) or instrument files")
+    surfaces = []
+    for p in args.profiles:
+        try:
+            surfaces.append(load_surface(p))
+        except InputError as exc:   # this command has no --size: files must carry theirs
+            if "--size" not in str(exc):
+                raise
+            raise InputError(f"{str(exc).split('; give size')[0]}; `roughfe genome sequence` "
+                             f"takes no --size: give files that carry their size (.npz from "
+                             f"`roughfe generate` or `genome realize`, instrument files)"
+                             ) from None
     dims = sorted({s.ndim for s in surfaces})
     if dims == [2]:
         return _sequence_surfaces(args, surfaces)
@@ -294,11 +329,13 @@ def register(sub):
                                   "L (Eq. 3.1 with the chromosomes of Eq. 3.5) and save it as "
                                   "a roughfe .npz surface.")
     p.add_argument("genome", metavar="GENOME.json", help="roughfe-genome JSON file")
-    _length_or_scale(p)
-    p.add_argument("--nodes", type=positive_int, default=512,
-                   help="number of nodes N (spacing L/(N-1))")
+    _length_or_scale(p, required=False)      # required, unless the genome is a design part
+    p.add_argument("--nodes", type=positive_int, default=None,
+                   help="number of nodes N (spacing L/(N-1)); default 512, or the design's "
+                        "for a part of a design")
     p.add_argument("--chromosomes", type=positive_int, nargs="+",
-                   help="sum only these chromosome indices (default: those of Eq. 3.5)")
+                   help="sum only these chromosome indices (default: those of Eq. 3.5, or "
+                        "the part's own for a part of a design)")
     add_output_file(p, "profile .npz to write (roughfe surface format)")
     p.set_defaults(func=_realize)
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import os
 import sqlite3
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -85,6 +86,10 @@ def connect(path, *, create=False) -> sqlite3.Connection:
                                 " (build it with 'roughfe db build')"))
         return _connect_read_only(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    try:       # created by us with 0666 & ~umask (SQLite's own default is 0644)
+        os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+    except FileExistsError:
+        pass
     con = sqlite3.connect(str(path), timeout=30.0)
     try:
         with con:
@@ -211,8 +216,9 @@ def extend_tasks(con, genomes, labels_=None) -> list:
     """:func:`genome_entry_task` arguments (label, source, genome_json) to add ``genomes``.
 
     ``genomes`` are Genome objects or Genome JSON dicts (e.g. sequenced ones); labels
-    default to ``"x-<k>"``. The database must hold settings already (an empty database
-    is an error: build it first); a label already present is an error.
+    default to ``"x-<k>"`` with k counting on from the database's size, past any label
+    already there. The database must hold settings already (an empty database is an
+    error: build it first); a label given twice, or already present, is an error.
     """
     read_settings(con)
     dicts = [g if isinstance(g, dict) else g.to_dict() for g in genomes]
@@ -220,10 +226,17 @@ def extend_tasks(con, genomes, labels_=None) -> list:
         raise InputError("no genomes given to add to the database")
     have = set(labels(con))
     if labels_ is None:
-        start = len(have) + 1
-        labels_ = [f"x-{start + k}" for k in range(len(dicts))]
+        labels_, k = [], len(have)
+        while len(labels_) < len(dicts):
+            k += 1
+            if f"x-{k}" not in have:        # a user may have taken x-<k> already
+                labels_.append(f"x-{k}")
     if len(labels_) != len(dicts):
         raise InputError(f"{len(labels_)} label(s) for {len(dicts)} genome(s)")
+    twice = sorted({lab for lab in labels_ if list(labels_).count(lab) > 1})
+    if twice:
+        raise InputError(f"label(s) given more than once: {twice}; every genome needs its "
+                         f"own label")
     clash = sorted(set(labels_) & have)
     if clash:
         raise InputError(f"labels already in the database: {clash}")

@@ -235,7 +235,8 @@ class Design:
         g = p.genome
         return replace(g, A=g.A * p.weight * self.scale,
                        metadata={**g.metadata, "design": self.name, "part": k + 1,
-                                 "chromosomes": list(p.chromosomes)})
+                                 "chromosomes": list(p.chromosomes), "dim": self.dim,
+                                 "length": self.length, "n_nodes": self.n_nodes})
 
     def as_genome(self) -> Optional[Genome]:
         """The single genome equal to this design when it has one part (and no
