@@ -10,11 +10,12 @@ top-level key ``"targets"``: a list of rows
      "target": str,      the criterion as text, e.g. "<= 1 %"
      "measured": str,    the measured value as text, e.g. "0.42 %"
      "value": float|null the measured value as a number (SI or a fraction), if any
-     "met": bool,
+     "met": bool|null,   null: not checked (a row reported beside the targets, e.g. a
+                         number fixed by construction, or a script not run by --quick)
      "reason": str}      why it is (not) met, or what it measures; "" when obvious
 
 and ``roughfe validate`` writes ``<outdir>/summary.json``: ``{"validations": {name: {"met":
-bool, "targets": [rows]}}, "all_met": bool}``. The documentation pages are generated from
+bool|null, "targets": [rows], "not_run": [scripts]}}, "all_met": bool, "not_run": [...]}``. The documentation pages are generated from
 these files; no number is typed by hand.
 
 Richardson extrapolation
@@ -48,13 +49,13 @@ class Target:
     name: str
     target: str
     measured: str
-    met: bool
+    met: bool | None          # None: reported, not a target (it cannot decide anything)
     reason: str = ""
     value: float | None = None
 
     def to_dict(self) -> dict:
         d = asdict(self)
-        d["met"] = bool(self.met)
+        d["met"] = None if self.met is None else bool(self.met)
         if d["value"] is not None:
             d["value"] = float(d["value"]) if math.isfinite(d["value"]) else None
         return d
@@ -65,20 +66,40 @@ def percent(value: float, digits: int = 2) -> str:
     return f"{100 * value:.{digits}f} %" if np.isfinite(value) else "n/a"
 
 
-def within(name: str, value: float, limit: float, reason: str = "") -> Target:
-    """A target ``|value| <= limit`` for a relative quantity (fractions, shown in %)."""
+def fraction(value: float) -> str:
+    """A relative quantity as text: in % with 3 decimals from 1e-4 up (``"0.012 %"``), in
+    scientific notation below (``"1.8e-12"``: a 1e-8 limit printed as "0 %" read as a
+    verdict that could not be checked); non-finite -> ``"n/a"``."""
     v = float(value)
-    return Target(name=name, target=f"<= {percent(limit, 3).replace('.000', '')}",
-                  measured=percent(v, 3), met=bool(np.isfinite(v) and abs(v) <= limit),
-                  reason=reason, value=v)
+    if not np.isfinite(v):
+        return "n/a"
+    if v != 0.0 and abs(v) < 1e-4:
+        return f"{v:.2g}"
+    return percent(v, 3).replace(".000 %", " %")
+
+
+def reported(row: Target, why: str) -> Target:
+    """``row`` kept in the report as a number, not a target (``met`` None): e.g. a quantity
+    that the method fixes by construction, which no error could move."""
+    return Target(row.name, row.target, row.measured, None,
+                  f"{why}: reported, not a target" + (f"; {row.reason}" if row.reason else ""),
+                  row.value)
+
+
+def within(name: str, value: float, limit: float, reason: str = "") -> Target:
+    """A target ``|value| <= limit`` for a relative quantity (fractions, in % or, below
+    1e-4, in scientific notation: :func:`fraction`)."""
+    v = float(value)
+    return Target(name=name, target=f"<= {fraction(limit)}", measured=fraction(v),
+                  met=bool(np.isfinite(v) and abs(v) <= limit), reason=reason, value=v)
 
 
 def targets_markdown(rows) -> str:
     """The rows as a Markdown table (target | criterion | measured | status | reason)."""
     lines = ["| target | criterion | measured | status | reason |", "|---|---|---|---|---|"]
     for t in rows:
-        lines.append(f"| {t.name} | {t.target} | {t.measured} | "
-                     f"{'met' if t.met else '**NOT met**'} | {t.reason} |")
+        status = "not checked" if t.met is None else "met" if t.met else "**NOT met**"
+        lines.append(f"| {t.name} | {t.target} | {t.measured} | {status} | {t.reason} |")
     return "\n".join(lines) + "\n"
 
 

@@ -52,7 +52,7 @@ def studies(tmp_path, monkeypatch):
     return tmp_path
 
 
-def test_validate_owns_its_folder_and_reports_every_study(studies, capsys):
+def test_validate_owns_its_folder_and_reports_every_study(studies, capsys, monkeypatch):
     out = studies / "report"
     assert main(["validate", "good", "--quick", "-o", str(out)]) == 0
     summary = json.loads((out / "summary.json").read_text())
@@ -84,6 +84,24 @@ def test_validate_owns_its_folder_and_reports_every_study(studies, capsys):
     assert main(["validate", "good", "-o", str(foreign)]) == 2
     assert (foreign / "notes.txt").read_text() == "keep me"
     assert sorted(p.name for p in foreign.iterdir()) == ["notes.txt"]
+
+    # --quick leaves out a script without a reduced case: a "not run" row (met null),
+    # never "met"; a validation none of whose scripts ran is not "met" either (it read
+    # "all validation targets met" with no row at all)
+    capsys.readouterr()
+    assert main(["validate", "bad", "--quick", "-o", str(studies / "q")]) == 1
+    summary = json.loads((studies / "q" / "summary.json").read_text())
+    rows = {t["name"]: t for t in summary["validations"]["bad"]["targets"]}
+    assert rows["beta: not run"]["met"] is None and "without --quick" in rows[
+        "beta: not run"]["reason"]
+    assert summary["not_run"] == ["beta"] and not summary["all_met"]
+    assert "not run: beta" in capsys.readouterr().out
+    monkeypatch.setattr(validate_cmd, "NOT_QUICK", {"alpha"})
+    assert main(["validate", "good", "--quick", "-o", str(studies / "q2")]) == 0
+    summary = json.loads((studies / "q2" / "summary.json").read_text())
+    assert summary["validations"]["good"]["met"] is None and not summary["all_met"]
+    assert "nothing validated: no reduced case in alpha" in capsys.readouterr().out
+    monkeypatch.setattr(validate_cmd, "NOT_QUICK", {"beta"})
 
     # the same validation again replaces its own earlier output
     (out / "alpha.json").write_text("{}")

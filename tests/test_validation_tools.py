@@ -64,4 +64,8 @@ def test_target_rows_follow_the_schema():
     row = t.to_dict()
     assert set(row) == {"name", "target", "measured", "met", "reason", "value"}
     assert not within("x", np.nan, 0.01).met
+    # a limit and a value below 1e-4 keep their digits (a 1e-8 limit read "<= 0 %", beside
+    # a measured "0.000 %" of 1.8e-12: a verdict the row itself could not show)
+    tiny = within("dense vs PCG", 1.82e-12, 1e-8)
+    assert tiny.met and tiny.target == "<= 1e-08" and tiny.measured == "1.8e-12"
     assert json.loads(json.dumps(Target("a", "b", "c", False, value=np.inf).to_dict()))["value"] is None

@@ -28,7 +28,7 @@ from roughfe.genomics.similarity import write_target_csv
 from roughfe.model import Material
 from roughfe.plotting import design as dplot
 from roughfe.study import build_genome_db
-from roughfe.validation import Target, targets_markdown
+from roughfe.validation import Target, reported, targets_markdown
 from roughfe.writers import write_json, write_text
 
 GOALS = {"s_yt1": 0.98, "f_multi": 0.9, "reproducible": 1e-6}
@@ -337,6 +337,9 @@ def quick_case(outdir: Path) -> bool:
     de.write_design_result(rg, settings, out / "yt1_sog_global")
     strict_g = de.combined_score(rg.best.at_targets)
     err_strict = max(err_strict, _strict_error(rg, [t1], settings, out / "yt1_sog_global"))
+    # the stages keep their start when they do not improve (algorithms.py, search.py):
+    # their gains are >= 0 by construction, reported beside the two real targets
+    monotone = "a stage keeps its start when it does not improve, so >= 0 by construction"
     rows = [Target("SOG stage for y_t1 (quick): score after GCMMA >= best start", ">= 0",
                    f"{gain:+.4f}", bool(gain >= 0), f"6-genome database, s = "
                    f"{de.combined_score(r.best.scores):.4f}", gain),
@@ -352,11 +355,12 @@ def quick_case(outdir: Path) -> bool:
                    "<= 1e-6", f"{err_strict:.1e}", bool(err_strict <= GOALS["reproducible"]),
                    "design.json reloaded, bem.contact_sweep at the target pressures",
                    err_strict)]
+    rows = [reported(t, monotone) if ">= best start" in t.name else t for t in rows]
     write_json(outdir / "design_study.json", {"name": "design_study", "quick": True,
                                               "targets": [t.to_dict() for t in rows]})
     write_text(outdir / "design_study.md", "# Roughness design (quick)\n\n"
                + targets_markdown(rows))
-    return all(t.met for t in rows)
+    return all(t.met for t in rows if t.met is not None)
 
 
 def main(outdir: Path, quick: bool = False) -> bool:

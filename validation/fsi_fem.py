@@ -52,7 +52,8 @@ from roughfe.leakage.profile_fsi import coupled_channel
 from roughfe.model import Material
 from roughfe.plotting.common import new_figure, save_figure
 from roughfe.surfaces import Surface
-from roughfe.validation import Target, percent, richardson, targets_markdown, within
+from roughfe.validation import (Target, percent, reported, richardson, targets_markdown,
+                                within)
 from roughfe.writers import write_json, write_text
 
 W, A = 1e-3, 5e-6                     # channel length, wave amplitude (m)
@@ -112,8 +113,8 @@ def case_targets(name: str, levels: list) -> tuple[list, dict]:
                "r = " + rs + ": " + ", ".join(percent(v, 3) for v in rel["leak_rate"])),
     ]
     if "approach" in CASES[name]:
-        rows.append(within(
-            f"{name}: mean gap FEM vs BEM, worst r", max(rel["mean_gap"], key=abs), 0.01,
+        rows.append(reported(within(
+            f"{name}: mean gap FEM vs BEM, worst r", max(rel["mean_gap"], key=abs), 0.01),
             "fixed by Delta in both (mean-level convention), not an elasticity test"))
     else:
         rows += [within(f"{name}: mean-gap limits FEM vs BEM", lim["mean_gap"], 0.01,
@@ -199,7 +200,7 @@ def run(outdir: Path, quick: bool = False) -> tuple[bool, list]:
         cases[name] = {**case, "levels": levels, "analysis": analysis}
         print(f"[fsi fem] {name}: leak-rate limits FEM/BEM - 1 = "
               f"{percent(analysis['leak_rate']['limit_rel_diff'], 4)}", flush=True)
-    ok = all(t.met for t in rows)
+    ok = all(t.met for t in rows if t.met is not None)
     write_json(outdir / "fsi_fem.json",
                {"name": "fsi_fem", "title": "FEM vs BEM fluid-structure coupling on a profile",
                 "targets": [t.to_dict() for t in rows], "quick": quick, "base_intervals": base,

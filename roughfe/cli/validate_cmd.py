@@ -4,8 +4,10 @@ Each script ``validation/<script>.py`` defines ``main(outdir: pathlib.Path, quic
 -> bool`` (True when every target is met) and writes ``<outdir>/<script>.md`` with its
 figures and ``<outdir>/<script>.json`` whose ``"targets"`` rows follow the schema of
 :mod:`roughfe.validation`; ``roughfe validate`` collects them in ``<outdir>/summary.json``.
-``--quick`` runs the reduced cases of every script (``make validate-quick``, CI): same
-targets, smaller problems. They are readable physics scripts that compare roughfe with
+``--quick`` runs the reduced cases of the scripts that have them (``make validate-quick``,
+CI): same kinds of targets, smaller problems. A script without a reduced case
+(:data:`NOT_QUICK`) is reported as a row with ``"met": null`` ("not run"), and a
+validation none of whose scripts ran has ``"met": null``: never "met". They are readable physics scripts that compare roughfe with
 analytic solutions, FEM and the literature; they need the repository checkout (they are
 not installed modules).
 
@@ -78,12 +80,18 @@ def _targets(outdir: Path, script: str, ok: bool) -> list:
 
 
 def run_validation(name: str, outdir: Path, quick: bool = False) -> dict:
-    """Run the scripts of validation ``name``; ``{"met": bool, "targets": [rows], ...}``."""
+    """Run the scripts of validation ``name``; ``{"met": bool or None, "targets": [rows],
+    "not_run": [scripts], ...}`` (``met`` None when no script ran)."""
     if name not in VALIDATIONS:
         raise InputError(f"unknown validation {name!r}; choose from {sorted(VALIDATIONS)} or 'all'")
-    out = {"met": True, "targets": [], "seconds": {}, "cpu_seconds": {}}
+    out = {"met": True, "targets": [], "seconds": {}, "cpu_seconds": {}, "not_run": []}
     for script in VALIDATIONS[name]:
         if quick and script in NOT_QUICK:
+            out["not_run"].append(script)
+            row = Target(f"{script}: not run", "its targets", "not run", False,
+                         f"no reduced case: `roughfe validate {name}` (without --quick) "
+                         f"runs it").to_dict()
+            out["targets"].append({**row, "met": None})
             continue
         module = _load(script)
         takes_quick = "quick" in inspect.signature(module.main).parameters
@@ -102,6 +110,8 @@ def run_validation(name: str, outdir: Path, quick: bool = False) -> dict:
         out["cpu_seconds"][script] = _cpu_seconds() - c0
         out["met"] = out["met"] and ok
         out["targets"] += rows
+    if len(out["not_run"]) == len(VALIDATIONS[name]):
+        out["met"] = None                       # nothing was checked
     return out
 
 
@@ -135,15 +145,31 @@ def _run(args) -> int:
                 print(f"   {script}: {summary[name]['seconds'][script]:.0f} s wall, "
                       f"{summary[name]['cpu_seconds'][script]:.0f} s CPU", flush=True)
             for t in summary[name]["targets"]:
-                if not t["met"]:
+                if t["met"] is None and t.get("name", "").endswith(": not run"):
+                    print(f"   not run: {t['name'][:-len(': not run')]} ({t.get('reason')})")
+                elif t["met"] is None:
+                    continue                            # reported beside the targets
+                elif not t["met"]:
                     print(f"   NOT met: {t.get('name')}: {t.get('measured', t.get('value'))} "
                           f"(target {t.get('target')})")
-            failed = [n for n, v in summary.items() if not v["met"]]
+            failed = [n for n, v in summary.items() if v["met"] is False]
+            not_run = [s for v in summary.values() for s in v["not_run"]]
             # after every study, so that a killed run still has the finished ones
             write_json(outdir / "summary.json", {"validations": summary,
                                                  "quick": bool(args.quick),
-                                                 "all_met": not failed})
-    print("all validation targets met" if not failed else f"targets missed in: {', '.join(failed)}")
+                                                 "all_met": not failed and not not_run,
+                                                 "not_run": not_run})
+    ran = [n for n, v in summary.items() if v["met"] is not None]
+    if failed:
+        print(f"targets missed in: {', '.join(failed)}")
+    elif not ran:
+        print(f"nothing validated: no reduced case in {', '.join(not_run)} (run without "
+              f"--quick)")
+    elif not_run:
+        print(f"all targets met of the studies that ran; not run (no reduced case): "
+              f"{', '.join(not_run)}")
+    else:
+        print("all validation targets met")
     return 1 if failed else 0
 
 
@@ -164,5 +190,6 @@ def register(sub):
                              "figures there, and summary.json)", required=False,
                           default="validation/output")
         v.add_argument("--quick", action="store_true",
-                       help="reduced cases of every script, same targets (make validate-quick)")
+                       help="the reduced cases of the scripts that have one (make "
+                            "validate-quick); the others are reported as not run")
         v.set_defaults(func=_run, renders_with_dolfinx=True)
