@@ -36,10 +36,19 @@ class ResolutionWarning(UserWarning):
     and what to change)."""
 
 
+def _number(value):
+    """``value``, or a TypeError for text and bools, which ``float()`` would take ("2.3" in
+    a study spec ran, under a key of its own, beside 2.3)."""
+    if isinstance(value, (str, bytes, bool)):
+        raise TypeError(value)
+    return value
+
+
 def check_finite_positive(name, value):
-    """Return ``float(value)`` or raise :class:`InputError` unless it is finite and > 0."""
+    """Return ``float(value)`` or raise :class:`InputError` unless it is finite and > 0 (a
+    number: not a string such as "2.3", not a bool)."""
     try:
-        v = float(value)
+        v = float(_number(value))
     except (TypeError, ValueError):
         raise InputError(f"{name} must be a positive number, got {value!r}") from None
     if not (v > 0.0 and v < float("inf")):
@@ -59,9 +68,10 @@ def check_finite_nonnegative(name, value):
 
 
 def check_in_open_interval(name, value, low, high):
-    """Return ``float(value)`` or raise :class:`InputError` unless low < value < high."""
+    """Return ``float(value)`` or raise :class:`InputError` unless low < value < high (a
+    number: not a string, not a bool)."""
     try:
-        v = float(value)
+        v = float(_number(value))
     except (TypeError, ValueError):
         raise InputError(f"{name} must be a number in ({low}, {high}), got {value!r}") from None
     if not (low < v < high):

@@ -203,3 +203,29 @@ def test_extend_and_sequence_say_what_is_wrong(tmp_path, capsys):
     assert "takes no --size: give files that carry their size" in err
     assert main(["genome", "realize", str(genome), "-o", str(tmp_path / "r.npz")]) == 2
     assert "give --length L (m) or --scale" in _error(capsys)
+
+
+@pytest.mark.parametrize("extra, message", [
+    ('tol = 5.0', "tol (relative KKT residual) must lie in the open interval (0.0, 1.0)"),
+    ('kernel = "spectral"', "kernel 'spectral' is periodic and needs a periodic surface"),
+    ('kernel = "strip"', "kernel 'strip' is for profiles"),
+])
+def test_a_study_refuses_values_its_tasks_would_refuse(tmp_path, capsys, extra, message):
+    # these passed the study's up-front check and then failed on every worker (retried)
+    spec = tmp_path / "s.toml"
+    spec.write_text('[study]\nanalysis = "contact_sweep"\n[grid]\nm = [3]\n[fixed]\n'
+                    f'fractal_dimension = 2.3\n{extra}\n')
+    assert main(["study", "run", str(spec), "--workers", "1", "-o", str(tmp_path / "o")]) == 2
+    assert message in _error(capsys) and not (tmp_path / "o").exists()
+
+
+def test_numbers_given_as_text_are_refused():
+    # "2.3" ran (float() takes it) and keyed its task apart from 2.3
+    from roughfe.errors import InputError, check_finite_positive, check_in_open_interval
+    with pytest.raises(InputError, match="must be a number in"):
+        check_in_open_interval("D", "2.3", 2.0, 3.0)
+    with pytest.raises(InputError, match="must be a positive number"):
+        check_finite_positive("L", "1e-3")
+    with pytest.raises(InputError):
+        check_finite_positive("L", True)
+    assert check_finite_positive("L", np.float32(2.0)) == 2.0

@@ -253,9 +253,14 @@ def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height,
         check_int("m (resolution level: 2**m points per side)", m, 1)
     check_finite_positive("length (m)", length)
     check_finite_positive("rms_height (m)", rms_height)
-    check_finite_positive("tol", tol)
-    check_kernel_name(kernel)
+    check_in_open_interval("tol (relative KKT residual)", tol, 0.0, 1.0)
     check_solver_name(solver)
+    # the kernel on the generator's kind of surface (rmd: non-periodic, spectral:
+    # periodic; 2D), by the solver's own rules on a 4 x 4 stand-in
+    from ..bem.contact import _choose_kernel, _operator
+    from ..surfaces.surface import Surface
+    probe = Surface(np.zeros((4, 4)), float(length), periodic=generator == "spectral")
+    _operator(probe.shape, probe.size, 1.0, _choose_kernel(probe, check_kernel_name(kernel)))
     return Material(E, nu), Loading(n_steps=n_steps)
 
 
