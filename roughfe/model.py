@@ -421,18 +421,30 @@ class ContactResult(Frozen):
         return json_scalars(self, STEP_SCALARS + self.optional_scalars())
 
 
-def central_differences(x, y):
+def central_differences(x, y, branch=None):
     """dy/dx: (y[i+1] - y[i-1]) / (x[i+1] - x[i-1]) inside, one-sided at the ends; NaN
-    where the spacing is zero (e.g. repeated full-contact steps) or fewer than 2 points."""
+    where the spacing is zero to round-off (1e-12 of max |x|: e.g. repeated full-contact
+    steps) or fewer than 2 points.
+
+    ``branch`` (optional, one flag per point, e.g. 1 on an unloading branch): the
+    differences are taken within each run of equal flags, one-sided at its ends, never
+    across the turn of a loading-unloading sweep (where the two neighbours of the top
+    step are the same load on either branch, and the difference read K = 0)."""
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     out = np.full(x.shape, np.nan)
+    if branch is not None:
+        edges = np.flatnonzero(np.diff(np.asarray(branch)) != 0) + 1
+        for run in np.split(np.arange(x.size), edges):
+            out[run] = central_differences(x[run], y[run])
+        return out
     if x.size < 2:
         return out
+    tiny = 1e-12 * float(np.max(np.abs(x)))
     with np.errstate(divide="ignore", invalid="ignore"):
-        out[1:-1] = (y[2:] - y[:-2]) / (x[2:] - x[:-2])
-        out[0] = (y[1] - y[0]) / (x[1] - x[0])
-        out[-1] = (y[-1] - y[-2]) / (x[-1] - x[-2])
+        dx = np.concatenate([[x[1] - x[0]], x[2:] - x[:-2], [x[-1] - x[-2]]])
+        dy = np.concatenate([[y[1] - y[0]], y[2:] - y[:-2], [y[-1] - y[-2]]])
+        out = np.where(np.abs(dx) > tiny, dy / dx, np.nan)
     out[~np.isfinite(out)] = np.nan
     return out
 
@@ -531,7 +543,8 @@ class SweepResult(Frozen):
                      "separation_star": arr["mean_plane_separation"] / sigma}
         return cls(results=results, **arr, **optional, **stars,
                    n_contact=np.array([r.n_contact for r in results], dtype=np.int64),
-                   stiffness_fd=central_differences(arr["delta"], pm),
+                   stiffness_fd=central_differences(arr["delta"], pm,
+                                                    optional.get("unloading")),
                    rms_height=sigma, rms_slope=float(rms_slope), e_star=e)
 
     @property

@@ -497,3 +497,59 @@ def test_load_sweep_starts_every_grid_level_from_its_previous_step():
                                          compute_stiffness=False).nit
                            for a, p in zip(cold, loads[1:])]
     assert sweep.nit <= sum(r.nit for r in cold) <= sum(old)
+
+
+def test_thesis_kernel_refuses_long_cells_where_it_is_not_positive_definite():
+    """Eq. 2.4's patch of diameter sqrt(dx dy) overlaps the nearer neighbours of a long
+    cell: at 4:1 the matrix is indefinite (PK ran 20000 iterations, NNLS raised numpy's
+    LinAlgError); above THESIS_MAX_ASPECT = 2.5 it is refused by name, and at the limit
+    its padded circulant is positive definite."""
+    import scipy.fft
+    from roughfe.bem.operators import THESIS_MAX_ASPECT, influence_operator
+    with pytest.raises(InputError, match=r"kernel 'thesis' .* aspect ratio 4 .* 'love'"):
+        influence_operator((12, 12), (1.0, 0.25), 1.0, "thesis")
+    op = influence_operator((12, 12), (1.0, 1.0 / THESIS_MAX_ASPECT), 1.0, "thesis")
+    assert op.spectrum.real.min() > 0
+    pc = scipy.fft.rfftn(op.circulant_kernel(op.precond_shape)).real
+    assert pc.min() > 0
+
+
+def test_finite_difference_stiffness_stays_on_its_branch():
+    """A load-controlled sweep that unloads passes the top load once: its two neighbours
+    are the same load on either branch, so the central difference across the turn read
+    K_fd = 0 (the approaches differ by round-off, 2e-17 m). Differences are taken within
+    each branch: at the top, one-sided on the loading branch; and the elastic unloading
+    branch retraces the loading one."""
+    from roughfe.bem import contact_sweep
+    from roughfe.model import central_differences
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=0)
+    sw = contact_sweep(s, Material(1e9, 0.3), pressures=[1e6, 3e6, 1e7, 3e7], unload=True)
+    assert list(sw.unloading) == [0, 0, 0, 0, 1, 1, 1]
+    top = (sw.mean_pressure[3] - sw.mean_pressure[2]) / (sw.delta[3] - sw.delta[2])
+    assert sw.stiffness_fd[3] == pytest.approx(top, rel=1e-12) and top > 0
+    assert np.all(sw.stiffness_fd > 0)
+    np.testing.assert_allclose(sw.stiffness_fd[:3], central_differences(
+        sw.delta[:4], sw.mean_pressure[:4])[:3], rtol=1e-12)
+    np.testing.assert_allclose(sw.area_fraction[4:], sw.area_fraction[2::-1], rtol=0, atol=0)
+    # round-off spacing is no spacing: NaN, not a number from noise
+    assert np.isnan(central_differences([1.0, 1.0 + 1e-17], [2.0, 3.0])).all()
+
+
+def test_a_sweep_back_to_first_touch_is_quick_and_equals_the_cold_solve():
+    """An unloading sweep that returns to Delta = 0 on a periodic surface: the warm step
+    went to load control, whose secant halves P towards 0 and never reaches it (20000
+    iterations, a fallback with a RuntimeWarning, 4-9 s on 32^2-128^2). At Delta <= 0
+    there is no load to steer to: the step is the gap-variable solve, p = 0, as cold."""
+    import warnings
+    from roughfe.bem import contact_sweep
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=0)
+    mat = Material(1e9, 0.3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        sw = contact_sweep(s, mat, deltas=[0.0, 0.5e-6, 1.0e-6, 1.5e-6], unload=True)
+        back = contact_sweep(s, mat, deltas=[1.8e-6, 0.0])
+    assert sw.nit < 1000 and back.nit < 1000
+    for r in (sw.results[-1], back.results[-1]):
+        assert r.delta == 0.0 and r.mean_pressure == 0.0 and r.n_contact == 0

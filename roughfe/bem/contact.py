@@ -14,6 +14,7 @@ and Paggi & He 2015); with the periodic kernel mean(u) = 0, so d equals the mean
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 import warnings
 from typing import Optional
@@ -216,6 +217,7 @@ def _elastic_approach(surface, material, op, h, hmax, scale, delta, tol, max_ite
     accepts a primal residual of 10 ``tol``)."""
     start = (approach_start(surface, material, delta, initial, coarse_correction)
              if surface.ndim == 2 else None)
+    spent = 0                  # iterations of a load-controlled attempt that fell back
     if start is not None:
         p0, deflation = start[0], _deflation(op, None, None, coarse_correction, start[0])
         try:
@@ -226,14 +228,16 @@ def _elastic_approach(surface, material, op, h, hmax, scale, delta, tol, max_ite
         except NoConvergenceError as exc:
             warnings.warn(f"{exc}; solved in the gap variable instead", RuntimeWarning,
                           stacklevel=3)
+            spent = exc.result.nit if exc.result is not None else 0
     elif coarse_correction is True:
         warnings.warn(f"coarse_correction=True: the approach {delta:.6g} m has no start in "
                       f"load control (the coarsened grid does not touch, or the start is in "
                       f"contact on more than {MAX_START_AREA:g} of the grid); solved in the "
                       f"gap variable, without the two-level correction", RuntimeWarning,
                       stacklevel=3)
-    return periodic_gap_control(op, h - hmax, scale, delta, initial, tol,
-                                max_iter or 20000, _preconditioner(op)), 10 * tol
+    out = periodic_gap_control(op, h - hmax, scale, delta, initial, tol, max_iter or 20000,
+                               _preconditioner(op))
+    return dataclasses.replace(out, nit=out.nit + spent), 10 * tol     # every one counted
 
 
 def _periodic_full_contact(op, h):
@@ -354,6 +358,11 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                              f"{int(np.count_nonzero(~np.isfinite(initial)))} non-finite value(s)")
 
     out = None
+    if delta is not None and delta <= 0:
+        # the flat at or above the highest point (of the heights before any plastic recess,
+        # which only lowers them): no contact and no load, exactly. A warm step there went
+        # to load control, whose secant never reaches P = 0 (20000 iterations)
+        out = SolverOutput(np.zeros(h.shape), np.zeros(h.shape), delta, 0, 0.0, solver)
     # the gap-variable CG accepts a primal residual of 10 tol (its dual reaches tol)
     periodic_delta = solver == "pk" and op.periodic and delta is not None
     gap_control = periodic_delta and hardness is None

@@ -316,6 +316,13 @@ def _offsets(n, d, m):
     return np.where(k <= m // 2, k, k - m) * d
 
 
+#: largest cell aspect ratio max(dx, dy) / min(dx, dy) of the ``"thesis"`` kernel: its
+#: patch of diameter sqrt(dx dy) overlaps the nearer neighbours of a long cell, and the
+#: zero-padded circulant loses positive definiteness near 3 (measured on 8^2-128^2: its
+#: smallest eigenvalue over the largest +1.3e-2..+5.9e-4 at 2.5, -2.8e-3 at 3 on 8^2)
+THESIS_MAX_ASPECT = 2.5
+
+
 def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOperator:
     """Build the influence operator of a grid ``shape`` of physical ``size`` (m).
 
@@ -352,6 +359,13 @@ def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOpera
         r = _offsets(shape[0], spacing[0], padded[0])
         kern = uniform_strip_displacement(r, spacing[0] / 2, e_star, 1.0, size[0])
     elif kernel == "thesis":
+        aspect = max(spacing) / min(spacing)
+        if aspect > THESIS_MAX_ASPECT:
+            raise InputError(
+                f"kernel 'thesis' (Eq. 2.4: patches of diameter sqrt(dx dy)) is not positive "
+                f"definite on cells of aspect ratio {aspect:.3g} (dx = {spacing[0]:.4g} m, "
+                f"dy = {spacing[-1]:.4g} m; at most {THESIS_MAX_ASPECT:g}): the contact "
+                f"problem would not be convex; use kernel 'love' (exact for rectangles)")
         grids = np.meshgrid(*[_offsets(n, d, m) for n, d, m in zip(shape, spacing, padded)],
                             indexing="ij")
         r = np.sqrt(sum(g ** 2 for g in grids))

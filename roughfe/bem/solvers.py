@@ -25,7 +25,7 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
-from ..errors import NoConvergenceError
+from ..errors import InputError, NoConvergenceError
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,7 +177,12 @@ def lcp_nnls(H, s, upper=np.inf):
     problem by Stark & Parker's bounded-variable least squares (BVLS, the bounded
     Lawson-Hanson active set, ``scipy.optimize.lsq_linear(method="bvls")``).
     """
-    C = scipy.linalg.cholesky(H, lower=False, check_finite=False)
+    try:
+        C = scipy.linalg.cholesky(H, lower=False, check_finite=False)
+    except np.linalg.LinAlgError:
+        raise InputError("solver 'nnls' needs a positive definite influence matrix (a "
+                         "Cholesky factor); this one is not: use solver 'pk' or 'dense'"
+                         ) from None
     d = scipy.linalg.solve_triangular(C, s, trans="T", check_finite=False)
     if np.isfinite(upper):
         sol = scipy.optimize.lsq_linear(C, d, bounds=(0.0, upper), method="bvls",
