@@ -229,3 +229,47 @@ def test_numbers_given_as_text_are_refused():
     with pytest.raises(InputError):
         check_finite_positive("L", True)
     assert check_finite_positive("L", np.float32(2.0)) == 2.0
+
+
+def test_a_study_run_never_leaves_an_earlier_table_beside_new_results(tmp_path, capsys):
+    # table.csv of a collect after a partial run stayed, stale, once the run completed
+    from roughfe.study import collect
+    spec = tmp_path / "s.toml"
+    out = tmp_path / "st"
+    spec.write_text('[study]\nanalysis = "selftest"\n[grid]\nx = [0.5, 1.5]\n')
+    assert main(["study", "run", str(spec), "--workers", "1", "--quiet", "-o", str(out)]) == 0
+    assert capsys.readouterr().out == ""                           # --quiet: no summary
+    collect(out, parquet=False)
+    assert (out / "table.csv").is_file()
+    spec.write_text('[study]\nanalysis = "selftest"\n[grid]\nx = [0.5, 1.5, 2.5]\n')
+    assert main(["study", "run", str(spec), "--workers", "1", "--quiet", "-o", str(out)]) == 0
+    assert not (out / "table.csv").exists()
+    # a spec that names no parameter the analysis needs says so
+    spec.write_text('[study]\nanalysis = "selftest"\n')
+    assert main(["study", "run", str(spec), "-o", str(tmp_path / "none")]) == 2
+    assert "analysis 'selftest' needs ['x'] (in [grid] or [fixed])" in _error(capsys)
+
+
+def test_collect_waits_for_no_run(tmp_path):
+    # collect wrote a partial table while a run held the folder's lock
+    from roughfe.errors import InputError
+    from roughfe.study import collect
+    from roughfe.writers import folder_lock
+    spec = tmp_path / "s.toml"
+    spec.write_text('[study]\nanalysis = "selftest"\n[grid]\nx = [0.5]\n')
+    out = tmp_path / "st"
+    assert main(["study", "run", str(spec), "--workers", "1", "--quiet", "-o", str(out)]) == 0
+    with folder_lock(out, "a run"):
+        with pytest.raises(InputError, match="is writing to"):
+            collect(out, parquet=False)
+    assert not (out / "table.csv").exists()
+
+
+def test_demo_contact_results_carry_persson_like_roughfe_contact(tmp_path):
+    from roughfe.cli.contact_cmd import section_contact
+    text = section_contact(tmp_path, {})
+    doc = json.loads((tmp_path / "contact" / "results.json").read_text())
+    assert {"shape", "size", "periodic"} <= set(doc["inputs"]) and "persson" in doc["derived"]
+    steps = doc["steps"]
+    assert all(0 < s["persson_area_fraction"] < 1 for s in steps if s["mean_pressure"] > 0)
+    assert "A* Persson" in text

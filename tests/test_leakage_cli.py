@@ -67,10 +67,15 @@ def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
     assert summary["n_records"] == 2 * 2 * 6
     assert {(f["D"], f["m"]) for f in summary["fits"]} == {(2.3, 3), (2.7, 3)}
     assert (out / "figures" / "fits_g_beta.png").stat().st_size > 5000
+    assert capsys.readouterr().err == ""                          # --quiet is quiet
     # rerun: every task is already done, the summary is the same
-    assert main(argv) == 0
+    loud = [a for a in argv if a != "--quiet"]
+    assert main(loud) == 0
     assert json.loads((out / "summary.json").read_text()) == summary
     assert "4 already done" in capsys.readouterr().err
+    # a rerun without figures leaves none of the earlier run's beside its summary
+    assert main(argv + ["--no-figures"]) == 0
+    assert not (out / "figures").exists()
 
 
 FSI_KEYS = {"fluid_load_fraction", "coupled_iterations", "critical_gap", "critical_position",

@@ -114,8 +114,10 @@ def test_the_input_checks_accept_the_defaults_and_do_no_work():
 def test_genome_db_parameters_bind():
     pytest.importorskip("roughfe.genomics.database")
     check_parameters("genome_db", {"gamma": 1.5, "hurst": 0.7, "n_nodes": 64, "n_steps": 3})
-    with pytest.raises(InputError, match="does not accept"):
+    with pytest.raises(InputError, match=r"needs \['hurst'\] \(in \[grid\] or \[fixed\]\)"):
         check_parameters("genome_db", {"gamma": 1.5})
+    with pytest.raises(InputError, match="does not accept"):
+        check_parameters("genome_db", {"gamma": 1.5, "hurst": 0.7, "colour": "red"})
 
 
 def test_tiny_leakage_study_keeps_the_seed_across_D(tmp_path):

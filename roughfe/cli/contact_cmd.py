@@ -17,7 +17,7 @@ from ..errors import InputError
 from ..model import Loading, Material
 from ..response import response
 from ..bem.contact import SOLVERS
-from ..bem.output import sweep_document, write_fields_h5, write_results_json
+from ..bem.output import sweep_document, write_fields_h5
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
@@ -97,8 +97,7 @@ def _run(args) -> int:
         sweep = adhesive.sweep
     check_small_strain(args, surface, sweep.delta, material, sweep.mean_pressure)
     r0 = sweep.results[0]
-    inputs = {"surface": str(args.surface), "shape": list(surface.shape),
-              "size": list(surface.size), "periodic": surface.periodic,
+    inputs = {"surface": str(args.surface),
               "E": material.E, "nu": material.nu, "E_star": material.E_star,
               "kernel": r0.kernel, "solver": r0.solver, "tol": tol,
               "coarse_correction": args.coarse_correction,
@@ -106,7 +105,7 @@ def _run(args) -> int:
               "hardness": args.hardness, "unload": args.unload,
               "detrend": args.detrend,
               "metadata": dict(surface.metadata)}
-    doc = sweep_document(sweep, inputs)
+    doc = contact_document(sweep, surface, material, inputs)
     if adhesive is not None:
         doc["inputs"]["adhesion"] = law.describe()
         doc["derived"]["pull_off_force"] = adhesive.pull_off_force
@@ -118,8 +117,6 @@ def _run(args) -> int:
         doc["derived"]["units"].update(process_zone="m", grid_spacing="m")
         doc["derived"]["stickiness"] = pastewka_robbins(surface, material.E_star, law.work,
                                                         law.range).describe()
-    theory = beside(surface, material.E_star, doc["steps"])
-    doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
     with folder as out:
         write_fields_h5(out / "fields.h5", sweep)
         if not args.no_figures:
@@ -195,6 +192,22 @@ def _adhesive_sweep(args, surface, material, law, tol):
 THESIS_FIG7 = {"A_star": 0.25, "P_star": 0.56, "h_s": 6.72e-6}
 
 
+def _fmt(value, spec):
+    return "-" if value is None else format(value, spec)
+
+
+def contact_document(sweep, surface, material, inputs: dict) -> dict:
+    """results.json of a contact sweep (the one builder of ``roughfe contact`` and of the
+    demo): :func:`~roughfe.bem.output.sweep_document` with the surface's grid in its
+    inputs and Persson's theory beside every step (``persson_*`` keys, ``derived.persson``)."""
+    doc = sweep_document(sweep, {"surface": inputs.get("surface"),
+                                 "shape": list(surface.shape), "size": list(surface.size),
+                                 "periodic": surface.periodic, **inputs})
+    theory = beside(surface, material.E_star, doc["steps"])
+    doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
+    return doc
+
+
 def section_contact(outdir: Path, context: dict) -> str:
     """20-step BEM sweep of the demo RMD surface (thesis Fig. 7: D = 2.3, m = 7, L = 0.1
     mm, non-periodic, Love kernel) up to Delta = h_s = peak-to-valley; A* and P* at
@@ -216,9 +229,10 @@ def section_contact(outdir: Path, context: dict) -> str:
     inputs = {"surface": "demo RMD surface (rmd_surface.npz)", "E": material.E,
               "nu": material.nu, "E_star": material.E_star, "kernel": sweep.results[0].kernel,
               "solver": sweep.results[0].solver, "steps": 20, "metadata": dict(surface.metadata)}
-    write_results_json(sub / "results.json", sweep, inputs)
+    doc = contact_document(sweep, surface, material, inputs)
+    write_json(sub / "results.json", doc)
     write_fields_h5(sub / "fields.h5", sweep)
-    fig = plot_area_stiffness(sweep.to_records(), sub / "contact_area_stiffness.png",
+    fig = plot_area_stiffness(doc["steps"], sub / "contact_area_stiffness.png",
                               title="RMD D = 2.3, m = 7: A(p), K(p), V*(d/sigma)",
                               rms_height=sweep.rms_height)
     last = sweep.results[-1]
@@ -233,6 +247,7 @@ def section_contact(outdir: Path, context: dict) -> str:
     picks = sorted(set(range(0, len(sweep.results), 4)) | {len(sweep.results) - 1})
     rows = "\n".join(
         f"| {r.delta * 1e6:.3f} | {r.mean_pressure * 1e-6:.4g} | {r.area_fraction:.4f} | "
+        f"{_fmt(doc['steps'][i].get('persson_area_fraction'), '.4f')} | "
         f"{sweep.load_star[i]:.3f} | {r.stiffness * 1e-12:.4g} | {r.mean_gap * 1e6:.4f} | "
         f"{r.free_volume_star:.3f} | {r.nit} |"
         for i, r in ((i, sweep.results[i]) for i in picks))
@@ -255,8 +270,10 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"(DC-FFT), {sweep.results[0].solver} solver, 20 approaches Delta up to h_s = "
         f"peak-to-valley = {np.ptp(surface.heights) * 1e6:.3f} um; {elapsed:.1f} s for the "
         f"sweep (shared 2-core machine). Files: `contact/results.json`, `contact/fields.h5`.\n\n"
-        "| Delta (um) | p (MPa) | A* | P* = pL/(E* sigma) | K (MPa/um) | mean gap (um) | V* "
-        "| iterations |\n|---|---|---|---|---|---|---|---|\n" + rows + "\n\n"
+        "| Delta (um) | p (MPa) | A* | A* Persson | P* = pL/(E* sigma) | K (MPa/um) | "
+        "mean gap (um) | V* | iterations |\n|---|---|---|---|---|---|---|---|---|\n" + rows
+        + "\n\n(Persson's A* = erf(sqrt 2 p/(E* gbar)) of the surface's PSD, beside every step "
+        "of `contact/results.json` as in `roughfe contact`; docs/theory/07.)\n\n"
         f"**At Delta = h_s:** A* = {last.area_fraction:.3f} (thesis 0.25), "
         f"P* = {p_star:.2f} (thesis 0.56); with the thesis kernel Eq. 2.4 instead of Love's: "
         f"A* = {thesis_kernel.area_fraction:.3f}, P* = {p_star_t:.2f}.\n\n"

@@ -28,8 +28,8 @@ whose angles and anisotropy are part of the Sobol design. Under MPI run:
 
 from ..genomics.database.settings import THESIS_SETTINGS as THESIS
 from .options import (add_material_options, add_output_folder, add_run_options,
-                      add_runner_options, nonnegative_int, output_folder_of, positive_float,
-                      positive_int, show_progress)
+                      add_runner_options, log_of, nonnegative_int, output_folder_of,
+                      positive_float, positive_int, show_progress)
 
 
 #: defaults of a surface database (``--dim 2``) where they differ from the thesis profiles:
@@ -53,8 +53,7 @@ def _settings(args):
 def _runner(args) -> dict:
     return dict(executor=args.executor, workers=args.workers, scheduler=args.scheduler,
                 study_dir=args.study_dir, progress=show_progress(args),
-                log=(lambda message: None) if getattr(args, "quiet", False) else
-                (lambda message: print(message, file=sys.stderr)))
+                log=log_of(args))
 
 
 def _report(args, run) -> int:

@@ -14,6 +14,7 @@ figures.
 """
 from __future__ import annotations
 
+import shutil
 import sys
 from pathlib import Path
 
@@ -27,17 +28,17 @@ from .options import (add_contact_physics_options, add_detrend_option, add_mater
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, check_small_strain, contact_physics_from_args,
                       material_from_args, nonnegative_int, output_folder_of, positive_float,
-                      positive_int, show_progress, surface_from_args)
+                      log_of, positive_int, show_progress, surface_from_args)
 
 
-def _add_fluid_material(p):
+def _add_fluid_material(p, fsi=True):
     add_material_options(p, "material (elastic body against the rigid surface)")
     fl = p.add_argument_group("fluid")
     fl.add_argument("--mu", type=positive_float, default=1.0e-3,
                     help="dynamic viscosity in Pa s (1e-3: water)")
     fl.add_argument("--pressure-drop", type=positive_float, default=None,
                     help="fluid pressure drop p_in - p_out in Pa (Q is linear in it; "
-                         "default 1; with --fsi: p_in = DP, p_out = 0)")
+                         "default 1" + ("; with --fsi: p_in = DP, p_out = 0)" if fsi else ")"))
     fl.add_argument("--direction", choices=("x", "y", "both"), default="both",
                     help="flow direction(s); the percolating volume is their union")
     fl.add_argument("--no-reynolds", action="store_true",
@@ -289,12 +290,14 @@ def _leak_study(args) -> int:
         "grid": study_grid(args.D, args.m, args.surfaces), "fixed": fixed})
     summary = run_study(spec, executor=args.executor, workers=args.workers,
                         scheduler=args.scheduler, progress=show_progress(args),
-                        log=lambda msg: print(msg, file=sys.stderr))
+                        log=log_of(args))
     _, rows, missing = table_rows(out)
     if not rows:
         raise InputError(f"no task of the study in {out} finished; see `roughfe study status {out}`")
     result = summarise(rows)
     write_json(out / "summary.json", result)
+    # the figures are this summary's: an earlier run's never stand beside it
+    shutil.rmtree(out / "figures", ignore_errors=True)
     paths = [] if args.no_figures else figs.study_figures(result, out / "figures")
     perc = result["percolation"]
     print(f"{len(rows)} step records from {spec.n_tasks - missing} surfaces; "
@@ -350,7 +353,7 @@ def register(sub):
     s.add_argument("--steps", type=positive_int, default=6, help="approach steps up to h_s")
     s.add_argument("--length", type=positive_float, default=1.0e-4, help="lateral size L in m")
     s.add_argument("--seed", type=nonnegative_int, default=2016, help="base seed of the study")
-    _add_fluid_material(s)
+    _add_fluid_material(s, fsi=False)
     add_runner_options(s)
     s.add_argument("-o", "--output", required=True, metavar="OUTDIR",
                    help="study folder (rerun the same command to resume)")

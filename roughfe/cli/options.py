@@ -293,6 +293,14 @@ def add_run_options(parser, figures: bool = True) -> None:
                         help="no progress bar and no summary on stdout (errors still on stderr)")
 
 
+def log_of(args):
+    """The log of a long run's driver: one line per message on stderr, nothing with
+    ``--quiet``."""
+    if getattr(args, "quiet", False):
+        return lambda message: None
+    return lambda message: print(message, file=sys.stderr)
+
+
 def show_progress(args) -> bool:
     """True when a progress bar should be drawn: stderr is a terminal and no ``--quiet``."""
     return not getattr(args, "quiet", False) and sys.stderr.isatty()

@@ -12,20 +12,18 @@ import sys
 
 from ..study import (ANALYSES, collect, genome_db_to_sqlite, load_spec, run_study,
                      study_status)
-from .options import (add_run_options, add_runner_options, show_progress)
-
-
-def _log(message):
-    print(message, file=sys.stderr)
+from .options import add_run_options, add_runner_options, log_of, show_progress
 
 
 def _run(args) -> int:
     spec = load_spec(args.spec, output=args.output)
     summary = run_study(spec, executor=args.executor, workers=args.workers,
-                        scheduler=args.scheduler, progress=show_progress(args), log=_log)
-    print(summary.describe())
-    print(f"results in {spec.output}; `roughfe study status {spec.output}` lists failures, "
-          f"`roughfe study collect {spec.output}` writes the table")
+                        scheduler=args.scheduler, progress=show_progress(args),
+                        log=log_of(args))
+    if not args.quiet:
+        print(summary.describe())
+        print(f"results in {spec.output}; `roughfe study status {spec.output}` lists "
+              f"failures, `roughfe study collect {spec.output}` writes the table")
     return 0 if summary.complete else 1
 
 

@@ -120,6 +120,13 @@ def check_parameters(name: str, params) -> None:
         bound = sig.bind(**params, seed=0)
     except TypeError as exc:
         allowed = [p for p in sig.parameters if p != "seed"]
+        required = [p for p, v in sig.parameters.items()
+                    if p != "seed" and v.default is inspect.Parameter.empty]
+        missing = [p for p in required if p not in params]
+        if missing:          # a name the spec did not give ([grid] or [fixed] missing it)
+            raise InputError(f"analysis {name!r} needs {missing} (in [grid] or [fixed]); "
+                             f"the spec gives {sorted(params) or 'no parameter'}; its "
+                             f"parameters are {allowed}") from None
         raise InputError(f"analysis {name!r} does not accept the parameters "
                          f"{sorted(params)}: {exc}; its parameters are {allowed}") from None
     check = resolve(name, "inputs")

@@ -62,8 +62,16 @@ def study_lock(outdir):
         yield
 
 
+#: files derived from the results by ``collect``: stale once a run changes the results
+TABLE_FILES = ("table.csv", "table.parquet")
+
+
 def write_study(outdir, spec, tasks, code_version):
-    """Write ``study.json``: the spec and the task list (index, key, params, seed)."""
+    """Write ``study.json``: the spec and the task list (index, key, params, seed); the
+    tables of an earlier ``collect`` (:data:`TABLE_FILES`) are removed, since they
+    describe an earlier state of the study (``collect`` writes them again)."""
+    for name in TABLE_FILES:
+        (Path(outdir) / name).unlink(missing_ok=True)
     write_json(study_file(outdir), {
         "spec": spec.to_dict(), "code_version": code_version, "n_tasks": len(tasks),
         "tasks": [{"index": t.index, "key": t.key, "params": dict(t.params), "seed": t.seed}
@@ -265,6 +273,12 @@ def collect(outdir, *, parquet=True):
     where ``note`` says why Parquet was not written (or is empty).
     """
     outdir = Path(outdir)
+    read_study(outdir)                        # a study folder, or a one-line error
+    with folder_lock(outdir, "`roughfe study run` (or collect)"):   # not under a run
+        return _collect(outdir, parquet)
+
+
+def _collect(outdir, parquet):
     columns, rows, missing = table_rows(outdir)
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
