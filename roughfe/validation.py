@@ -15,7 +15,8 @@ top-level key ``"targets"``: a list of rows
      "reason": str}      why it is (not) met, or what it measures; "" when obvious
 
 and ``roughfe validate`` writes ``<outdir>/summary.json``: ``{"validations": {name: {"met":
-bool|null, "targets": [rows], "not_run": [scripts]}}, "all_met": bool, "not_run": [...]}``. The documentation pages are generated from
+bool|null, "targets": [rows], "not_run": [scripts]}}, "all_met": bool, "not_run": [...]}``.
+The documentation pages are generated from
 these files; no number is typed by hand.
 
 Richardson extrapolation

@@ -7,9 +7,9 @@ figures and ``<outdir>/<script>.json`` whose ``"targets"`` rows follow the schem
 ``--quick`` runs the reduced cases of the scripts that have them (``make validate-quick``,
 CI): same kinds of targets, smaller problems. A script without a reduced case
 (:data:`NOT_QUICK`) is reported as a row with ``"met": null`` ("not run"), and a
-validation none of whose scripts ran has ``"met": null``: never "met". They are readable physics scripts that compare roughfe with
-analytic solutions, FEM and the literature; they need the repository checkout (they are
-not installed modules).
+validation none of whose scripts ran has ``"met": null``: never "met". They are readable
+physics scripts that compare roughfe with analytic solutions, FEM and the literature;
+they need the repository checkout (they are not installed modules).
 
 ``OUTDIR`` is owned like every output folder (:class:`roughfe.writers.OutputFolder`):
 locked, ``UNFINISHED`` while the studies run, refused when it holds files that are not an

@@ -31,8 +31,9 @@ how they are evaluated on non-periodic data. Nayak's bandwidth parameter is
 ``alpha = m0 m4 / m2^2`` (>= 1.5 for a surface; large for broad spectra).
 
 The Hurst exponent is fitted on the PSD by the weighted Whittle likelihood of a power law
-(every decade of q weighted alike; unbiased, unlike least squares on log C): a self-affine profile has ``C ~ q^-(1+2H)``, a surface ``C ~ q^-2(1+H)``; the
-fractal dimension is ``D = d + 1 - H`` with ``d`` the topological dimension (1 or 2),
+(every decade of q weighted alike; unbiased, unlike least squares on log C): a
+self-affine profile has ``C ~ q^-(1+2H)``, a surface ``C ~ q^-2(1+H)``; the fractal
+dimension is ``D = d + 1 - H`` with ``d`` the topological dimension (1 or 2),
 as in the thesis text after Eq. (2.1).
 """
 from __future__ import annotations

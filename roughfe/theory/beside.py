@@ -35,8 +35,8 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     dict
         ``"steps"``: copies of ``steps`` with ``persson_area_fraction`` (-),
         ``persson_mean_gap`` (m) and, with ``pressure_drop``, ``persson_leak_rate_<d>``
-        per direction and ``persson_leak_rate`` (their mean; m^3/s) added; steps with no positive finite pressure get None (no theory at zero
-        load). ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
+        per direction and ``persson_leak_rate`` (their mean; m^3/s) added; steps with no
+        positive finite pressure get None (no theory at zero load). ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
         percolation threshold, units, references).
     """
     psd = _spectrum(source)
