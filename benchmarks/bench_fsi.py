@@ -49,7 +49,7 @@ def one(model):
 
 def closure_steps(steps=(10e6, 5e6, 2.5e6, 1.25e6, 0.625e6)):
     import numpy as np
-    from roughfe.leakage.fsi import coupled_sweep
+    from roughfe.leakage.fsi_sweep import coupled_sweep
     from roughfe.model import Material
     from roughfe.surfaces.spectral import spectral_surface
     s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=4)
@@ -64,19 +64,19 @@ def closure_steps(steps=(10e6, 5e6, 2.5e6, 1.25e6, 0.625e6)):
             if p in (20, 40, 60):
                 cases.append({"step_mpa": dp / 1e6, "load_mpa": p, "cpu_s": cpu,
                               "settled": all(x.pockets_settled for x in rs),
-                              "trapped_volume": r.trapped_volume,
+                              "pocket_volume": r.pocket_volume,
                               "trapped_load_fraction": r.trapped_load_fraction,
                               "contact_load_fraction": r.contact_load_fraction,
                               "area_fraction": r.contact.area_fraction,
                               "pockets": len(r.pocket_pressures), "leak_rate": r.leak_rate})
                 c = cases[-1]
                 print(f"step {dp / 1e6:6.3f} MPa, {p:4.0f} MPa: trapped volume "
-                      f"{c['trapped_volume']:.4e} m^3, trapped {c['trapped_load_fraction']:.4f}, "
+                      f"{c['pocket_volume']:.4e} m^3, trapped {c['trapped_load_fraction']:.4f}, "
                       f"contact {c['contact_load_fraction']:.4f}, A* {c['area_fraction']:.4f}, "
                       f"{c['pockets']} pockets, Q {c['leak_rate']:.4e} (sweep cpu {cpu:.1f} s)",
                       flush=True)
     write_report(OUT / "bench_fsi_steps.json", "bench_fsi --steps", [], cases,
-                 {"trapped_volume": "m^3", "leak_rate": "m^3/s", "cpu_s": "s"})
+                 {"pocket_volume": "m^3", "leak_rate": "m^3/s", "cpu_s": "s"})
     return 0
 
 

@@ -79,7 +79,7 @@ def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
 
 
 FSI_KEYS = {"fluid_load_fraction", "coupled_iterations", "critical_gap", "critical_position",
-            "leak_rate_critical_junction", "pocket_pressures", "trapped_volume", "persson_leak_rate",
+            "leak_rate_critical_junction", "pocket_pressures", "pocket_volume", "persson_leak_rate",
             "trapped_load_fraction", "leak_rate_one_way", "fsi_state", "external_pressure",
             "contact_load_fraction", "pocket_volumes", "pockets_new", "pockets_released",
             "pockets_merged", "pocket_passes", "pockets_settled", "trapped_fluid",
@@ -106,6 +106,11 @@ def test_leak_fsi_writes_coupled_steps(tmp_path, capsys):
         # external load = solid (effective) + fluid share
         assert st["mean_pressure"] == pytest.approx(
             st["external_pressure"] * (1 - st["fluid_load_fraction"]), rel=1e-8)
+        # the network's volumes partition the free volume (its trapped_volume was
+        # overwritten by the pockets' fluid volume, now pocket_volume)
+        assert st["percolating_volume"] + st["trapped_volume"] == pytest.approx(
+            st["free_volume"], rel=1e-9)
+        assert 0 <= st["pocket_volume"] <= st["free_volume"]
     with np.load(out / "fields" / "step_000.npz") as f:
         assert f["fluid_pressure"].shape == s.shape and f["fluid_pressure"].max() <= 1e6 * (1 + 1e-9)
     # bad input: one line each, exit code 2

@@ -16,7 +16,8 @@ from roughfe.bem import solve_contact
 from roughfe.bem.contact import surface_displacement
 from roughfe.errors import InputError, NoConvergenceError
 from roughfe.leakage.finite_volume import solve_reynolds_fv
-from roughfe.leakage.fsi import coupled_leakage, coupled_sweep
+from roughfe.leakage.fsi import coupled_leakage
+from roughfe.leakage.fsi_sweep import coupled_sweep
 from roughfe.model import Material
 from roughfe.surfaces import Surface
 from roughfe.surfaces.spectral import spectral_surface
@@ -96,7 +97,13 @@ def test_reversed_flow_is_the_mirror_image(surface, flowing):
 def test_lift_off_is_a_state_and_non_convergence_raises(surface):
     r = coupled_leakage(surface, MAT, P_EXT, p_in=4e7, p_out=3.5e7)
     assert r.state == "lift-off" and r.leak_rate is None and r.contact is None
-    assert r.fluid_load_fraction == 1.0
+    # the field of the open channel, linear from p_in to p_out along x, and the load share
+    # its mean carries (> 1: the fluid pushes the surfaces apart); it was max(p_in, p_out)
+    # everywhere beside a share of 1
+    assert np.allclose(r.fluid_pressure[0], 4e7 - 5e6 * 0.5 / r.fluid_pressure.shape[0])
+    assert np.ptp(r.fluid_pressure, axis=1).max() == 0.0
+    assert r.fluid_load_fraction == pytest.approx(3.75e7 / P_EXT, rel=1e-12)
+    assert r.fluid_load_fraction > 1.0
     with pytest.raises(NoConvergenceError, match="residual"):
         coupled_leakage(surface, MAT, P_EXT, p_in=2e7, p_out=0.0, max_iter=2)
 
@@ -296,3 +303,29 @@ def test_reynolds_amg_hierarchy_kept_across_the_coupling_loop(surface, flowing, 
     assert np.array_equal(kept.contact.contact, fresh.contact.contact)
     assert kept.coupled_iterations == fresh.coupled_iterations
     assert solves > 10 and made[-1].setups < 0.5 * solves
+
+
+def test_a_vanishing_fluid_pressure_is_the_dry_contact_for_every_model():
+    """p_in = p_out -> 0: the coupled state is the dry contact. The volume model stalled
+    (a residual of 1e-6 after 60 iterations, the CLI's default p_in = 1 Pa) because the
+    residual was relative to |G(x)| alone, which is noise there; it is now relative to
+    the scale of a field at p_ext."""
+    s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=4)
+    dry = solve_contact(s, MAT, mean_pressure=1e7)
+    for trapped in ("volume", "pressure", "film"):
+        for p_in in (0.0, 1.0):
+            r = coupled_leakage(s, MAT, 1e7, p_in=p_in, p_out=0.0, trapped=trapped)
+            assert r.state == "contact" and r.contact.area_fraction == dry.area_fraction
+            assert np.abs(r.contact.gap - dry.gap).max() <= 1e-6 * dry.gap.max()
+
+
+def test_a_sweep_step_that_stalls_from_the_previous_fluid_restarts_from_zero():
+    """64^2, p_in = 20 MPa, film: 35 MPa after 30 MPa stopped 60 iterations short from the
+    previous step's fluid pressure, while from zero it converges; the sweep now retries
+    from zero (with the previous pockets) and ends at the cold step's state."""
+    s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=4)
+    rs = coupled_sweep(s, MAT, [2.5e7, 3e7, 3.5e7], p_in=2e7, p_out=0.0, trapped="film")
+    cold = coupled_leakage(s, MAT, 3.5e7, p_in=2e7, p_out=0.0, trapped="film")
+    assert len(rs) == 3 and rs[-1].residual <= 1e-8
+    assert np.array_equal(rs[-1].contact.contact, cold.contact.contact)
+    assert rs[-1].leak_rate == pytest.approx(cold.leak_rate, rel=1e-5)

@@ -13,7 +13,7 @@
 import numpy as np
 import pytest
 
-from roughfe.leakage.fsi import coupled_sweep
+from roughfe.leakage.fsi_sweep import coupled_sweep
 from roughfe.leakage.pockets import Pockets, transfer
 from roughfe.model import Material
 from roughfe.surfaces import Surface

@@ -139,7 +139,7 @@ def _leak(args) -> int:
 
 def _leak_fsi(args, surface, material, out, p_in, p_out):
     """``roughfe leak --fsi``: the coupled sweep, its fields and figures; results.json last."""
-    from ..leakage.fsi import coupled_leakage_sweep
+    from ..leakage.fsi_sweep import coupled_leakage_sweep
     from ..plotting import leakage as figs
 
     if args.pressure is None:

@@ -21,7 +21,8 @@ from .analysis import (LeakageResult, LeakageSweep, analyse_leakage, leakage_of_
                        leakage_sweep)
 from .network import DirectionalNetwork, NetworkResult, directional_network, free_volume_network
 from .finite_volume import finite_volume_leak_rate
-from .fsi import CoupledResult, coupled_leakage, coupled_leakage_sweep
+from .fsi import CoupledResult, coupled_leakage
+from .fsi_sweep import coupled_leakage_sweep
 from .junction import CriticalConstriction, critical_constriction
 from .channel import ChannelFlow, channel_flow
 from .profile_fsi import ChannelCoupledResult, coupled_channel

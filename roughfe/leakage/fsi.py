@@ -31,7 +31,9 @@ displacement ``u = H (p_c + p_f)``, and
 The unknown is the fluid-pressure field ``x`` (Pa per cell); ``G(x)`` is a contact solve
 plus a Reynolds solve. ``x = G(x)`` is solved by Anderson acceleration
 (:func:`roughfe.optim.anderson.anderson_fixed_point`) from the previous step's fluid
-pressure (else 0) to ``||G(x) - x|| / ||G(x)|| <= tol`` (default 1e-8); an extrapolated
+pressure (else 0) to ``||G(x) - x|| / max(||G(x)||, p_ext sqrt(N)) <= tol`` (default 1e-8;
+N cells: a fluid pressure far below ``p_ext`` is resolved to ``tol p_ext``, the scale
+the contact resolves); an extrapolated
 iterate that would lift the body off is replaced by the plain iterate. The one-way
 leak rate is that of the dry contact at ``p_ext``.
 
@@ -127,7 +129,8 @@ class CoupledResult:
     flow : FVSolution or None
         Reynolds solution on the coupled gap (absolute pressures).
     fluid_pressure : ndarray
-        Fluid pressure per cell (Pa): film Reynolds pressure and the pocket pressures.
+        Fluid pressure per cell (Pa): film Reynolds pressure and the pocket pressures; at
+        lift-off the field of a wide uniform gap (linear from ``p_in`` to ``p_out``).
     external_pressure, inlet_pressure, outlet_pressure, mu : float
         ``p_ext``, ``p_in``, ``p_out`` (Pa), viscosity (Pa s).
     trapped, bulk_modulus : str, float
@@ -138,14 +141,15 @@ class CoupledResult:
         Leak rate of the one-way solution (dry contact at ``p_ext``).
     fluid_load_fraction : float
         ``mean(p_f) / p_ext``: share of the external load carried by the fluid (flowing
-        and trapped) over the nominal area.
+        and trapped) over the nominal area (at lift-off that of the open field).
     contact_load_fraction : float
         ``mean(p_c) / p_ext``: the solid's share (``contact + fluid = 1`` to the coupled
         residual).
     trapped_load_fraction : float
         Share carried by the pockets (part of ``fluid_load_fraction``).
-    trapped_volume : float
-        Fluid volume in the pockets (m^3).
+    pocket_volume : float
+        Fluid volume in the pockets (m^3; the network's ``trapped_volume`` of the same
+        step is another quantity: the free volume of the components reaching no edge).
     pocket_pressures, pocket_volumes : tuple of float
         Pressure (Pa) and fluid volume (m^3) of each pocket, largest pocket first.
     pockets_new, pockets_released, pockets_merged, pocket_passes : int
@@ -177,7 +181,7 @@ class CoupledResult:
     fluid_load_fraction: float
     contact_load_fraction: float
     trapped_load_fraction: float
-    trapped_volume: float
+    pocket_volume: float
     pocket_pressures: tuple
     pocket_volumes: tuple
     pockets_new: int
@@ -201,7 +205,7 @@ class CoupledResult:
                 "fluid_load_fraction": self.fluid_load_fraction,
                 "contact_load_fraction": self.contact_load_fraction,
                 "trapped_load_fraction": self.trapped_load_fraction,
-                "trapped_volume": self.trapped_volume,
+                "pocket_volume": self.pocket_volume,
                 "pocket_pressures": list(self.pocket_pressures),
                 "pocket_volumes": list(self.pocket_volumes),
                 "pockets_new": self.pockets_new, "pockets_released": self.pockets_released,
@@ -292,6 +296,11 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
     max_passes = check_int("max_passes (pocket passes)", max_passes, 1)
     jacobian_pockets = check_int("jacobian_pockets", jacobian_pockets, 0)
     axis = 0 if direction == "x" else 1
+    # the residual's scale: a fluid field at the external pressure. Relative to |G(x)|
+    # alone, a fluid pressure far below p_ext (p_in -> 0: the dry contact) was asked for
+    # digits the contact mechanics, which resolves pressures on the scale of p_ext, does
+    # not carry (the volume model's pockets stalled at 1e-6 with p_in = 1 Pa)
+    floor = p_ext * np.sqrt(surface.heights.size)
     spacing = surface.spacing
     cell = float(np.prod(spacing))
     h = surface.heights
@@ -348,7 +357,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
                 state = "lift-off"
                 break
             fp = anderson_fixed_point(lambda v: G(v, newton), x, gx, tol=tol, max_iter=max_iter,
-                                      memory=anderson, relaxation=relaxation)
+                                      memory=anderson, relaxation=relaxation, floor=floor)
             it += fp.iterations
             residuals += fp.residuals
             x, gx = fp.x, fp.gx
@@ -384,22 +393,29 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
             last["report"] = frozen if trapped in SEALED else nxt
         return _result(state, last, gx if state == "contact" else x, p_ext, p_in, p_out, mu,
                        one_way, it, residuals[-1] if residuals else float("nan"), residuals, cell,
-                       trapped, bulk_modulus, counts, passes, settled)
+                       trapped, bulk_modulus, counts, passes, settled, axis)
 
 
 def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residuals, cell,
-            trapped, bulk_modulus, counts, passes, settled):
+            trapped, bulk_modulus, counts, passes, settled, axis=0):
     common = dict(external_pressure=p_ext, inlet_pressure=p_in, outlet_pressure=p_out, mu=mu,
                   trapped=trapped, bulk_modulus=float(bulk_modulus), one_way_leak_rate=one_way,
                   **{f"pockets_{key}": n for key, n in counts.items()}, pocket_passes=passes,
                   pockets_settled=bool(settled), coupled_iterations=it,
                   residual=res, residual_history=tuple(residuals))
     if state == "lift-off":
-        p_f = np.full(fluid.shape, max(p_in, p_out))
+        # the surfaces apart: the Reynolds field of a wide, uniform gap, linear from p_in
+        # to p_out along the flow (it was max(p_in, p_out) everywhere beside a fluid load
+        # fraction of 1, a field whose mean was not the load it reported)
+        n = fluid.shape[axis]
+        ramp = p_in + (p_out - p_in) * (np.arange(n) + 0.5) / n
+        p_f = np.broadcast_to(ramp.reshape([-1 if a == axis else 1 for a in range(fluid.ndim)]),
+                              fluid.shape).copy()
         return CoupledResult(
             state=state, contact=None, flow=None, fluid_pressure=p_f, leak_rate=None,
-            fluid_load_fraction=1.0, contact_load_fraction=0.0, trapped_load_fraction=0.0,
-            trapped_volume=0.0, pocket_pressures=(), pocket_volumes=(),
+            fluid_load_fraction=float(p_f.mean() / p_ext), contact_load_fraction=0.0,
+            trapped_load_fraction=0.0,
+            pocket_volume=0.0, pocket_pressures=(), pocket_volumes=(),
             fluid_state=FluidState(pressure=p_f, pockets=Pockets.none(p_f.shape)), **common)
     c, sol = last["contact"], last["flow"]
     gap = np.where(c.contact, 0.0, c.gap)
@@ -419,82 +435,9 @@ def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residu
         fluid_load_fraction=float(fluid.mean() / p_ext),
         contact_load_fraction=float(c.pressure.mean() / p_ext),
         trapped_load_fraction=float(fluid[in_pocket].sum() / fluid.size / p_ext),
-        trapped_volume=float(gap[in_pocket].sum() * cell),
+        pocket_volume=float(gap[in_pocket].sum() * cell),
         pocket_pressures=tuple(float(v) for v in pocket_p),
         pocket_volumes=tuple(float(v) for v in pocket_v),
         fluid_state=FluidState(pressure=fluid,
                                pockets=nxt if nxt is not None else Pockets.none(gap.shape)),
         **common)
-
-
-def coupled_sweep(surface: Surface, material, external_pressures, **kwargs) -> tuple:
-    """:func:`coupled_leakage` over increasing external pressures (Pa), each step's fluid
-    state the trapped-fluid reference of the next. Stops after a lift-off step.
-
-    Returns a tuple of :class:`CoupledResult`.
-    """
-    out = []
-    history = kwargs.pop("history", None)
-    for p in external_pressures:
-        out.append(r := coupled_leakage(surface, material, p, history=history, **kwargs))
-        if r.state == "lift-off":
-            break
-        history = r.fluid_state
-    return tuple(out)
-
-
-@dataclass(frozen=True, eq=False)
-class CoupledSweep:
-    """Coupled results over a load sweep and the network/junction analysis of each
-    coupled gap (:func:`roughfe.leakage.analyse_leakage`, Reynolds not re-solved)."""
-
-    surface: Surface
-    results: tuple
-    leakages: tuple
-
-    @property
-    def success(self) -> bool:
-        return all(r.state in ("contact", "lift-off") for r in self.results)
-
-    def records(self) -> list:
-        """One JSON-safe dict per step: contact scalars (``mean_pressure`` is the solid's
-        effective pressure), the coupled scalars (:meth:`CoupledResult.record`), the network
-        and critical constriction of the coupled gap; ``leak_rate`` is the coupled one."""
-        out = []
-        sigma = float(np.std(self.surface.heights))
-        for k, (r, lk) in enumerate(zip(self.results, self.leakages)):
-            rec = {"step": k}
-            if r.contact is not None:
-                rec.update(r.contact.scalars())
-                rec["separation_star"] = float(r.contact.mean_plane_separation / sigma)
-            if lk is not None:
-                rec.update(lk.record())
-            rec.update(r.record())
-            rec["leak_rate"] = r.leak_rate
-            if lk is not None:
-                rec[f"leak_rate_{lk.directions[0]}"] = r.leak_rate
-            out.append(rec)
-        return out
-
-
-def coupled_leakage_sweep(surface: Surface, material, external_pressures, *,
-                          direction: str = "x", **kwargs) -> CoupledSweep:
-    """:func:`coupled_sweep`, then the free-volume network and critical constriction of
-    each coupled gap (``corner_rule="closed"``, as the FV scheme).
-
-    ``kwargs`` go to :func:`coupled_leakage` (``p_in``, ``p_out``, ``mu``, ``trapped``, ...).
-    """
-    from .analysis import analyse_leakage
-
-    results = coupled_sweep(surface, material, external_pressures, direction=direction,
-                            **kwargs)
-    leaks = []
-    for r in results:
-        if r.contact is None:
-            leaks.append(None)
-            continue
-        leaks.append(analyse_leakage(
-            r.contact.gap, r.contact.contact, surface.spacing, direction=direction,
-            periodic=surface.periodic, sigma=float(np.std(surface.heights)), mu=r.mu,
-            pressure_drop=abs(r.inlet_pressure - r.outlet_pressure), reynolds=False))
-    return CoupledSweep(surface=surface, results=results, leakages=tuple(leaks))

@@ -75,7 +75,7 @@ def check_options(tol, max_iter, memory, relaxation) -> tuple:
 
 def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
                          tol: float = 1e-8, max_iter: int = 60, memory: int = 5,
-                         relaxation: float = 1.0) -> FixedPoint:
+                         relaxation: float = 1.0, floor: float = 0.0) -> FixedPoint:
     """Solve ``x = G(x)`` from ``x0`` (module docstring).
 
     Parameters
@@ -94,6 +94,10 @@ def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
         Anderson memory ``m`` (0: relaxed Picard).
     relaxation : float
         Mixing ``beta`` in (0, 1].
+    floor : float
+        The residual is ``||G(x) - x|| / max(||G(x)||, floor)``: a norm below which the
+        iterate counts as small (the caller's scale of x; 0: purely relative, which asks
+        digits of a field that is noise next to the scale the problem resolves).
 
     Returns
     -------
@@ -110,7 +114,7 @@ def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
     status: Optional[str] = None
     while status is None:
         r = gx - x
-        res = float(np.linalg.norm(r) / max(np.linalg.norm(gx), 1e-300))
+        res = float(np.linalg.norm(r) / max(np.linalg.norm(gx), floor, 1e-300))
         residuals.append(res)
         if res <= tol:
             status = "converged"
