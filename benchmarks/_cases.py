@@ -4,12 +4,9 @@ RMD surfaces (D = 2.3, 2^m + 1 points per side) and the measured instrument file
 paired runs of two solvers on one case, with their targets (also bench_bem_approach)."""
 from __future__ import annotations
 
-import os
-from pathlib import Path
+from roughfe.surfaces.io import topographies_folder
 
-TOPOGRAPHIES = Path(os.environ.get("ROUGHFE_TOPOGRAPHIES",
-                                   Path(__file__).resolve().parents[2] / "shared" / "data"
-                                   / "topographies"))
+TOPOGRAPHIES = topographies_folder()
 
 
 def surface_of(case):

@@ -23,12 +23,12 @@ from pathlib import Path
 from roughfe.genomics.band_mechanics import band_mechanics
 from roughfe.genomics.bands import band_chromosomes
 from roughfe.genomics.macro_micro import profile_response
-from roughfe.surfaces.io import load_surface
+from roughfe.surfaces.io import load_surface, topographies_folder
 from roughfe.surfaces.surface import Surface
 
 from _report import write_report  # benchmarks/_report.py
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "topographies" / "di-1.di"
+DATA = topographies_folder() / "di-1.di"
 OUT = Path(__file__).resolve().parent / "output" / "bench_bands.json"
 TARGET_S = 120.0
 
@@ -44,8 +44,12 @@ def projected_wall(cpu_per_sweep, workers):
 
 
 def main(n=256, workers=2):
-    if not DATA.is_file():
-        print(f"measured file not found: {DATA}; skipped")
+    if not DATA.is_file():        # said in the report, not only on stdout
+        reason = (f"measured file not found: {DATA} (the topographies folder, "
+                  f"$ROUGHFE_TOPOGRAPHIES or ../shared/data/topographies)")
+        print(f"{reason}; skipped")
+        write_report(OUT, "bench_bands", [], [], {},
+                     skipped=[{"name": f"band mechanics {n}^2", "reason": reason}])
         return 0
     s = load_surface(DATA)
     stride = max(1, s.shape[0] // n)

@@ -156,9 +156,19 @@ def _targets(data) -> list:
             for t in (GEN.target_rows(data) if isinstance(data, dict) else [])]
 
 
+def _runs(folder: Path) -> list:
+    """The per-script records of ``run_all.json`` (script, exit code, files written), or
+    [] without it."""
+    path = folder / "run_all.json"
+    data = _load(path)[0] if path.is_file() else None
+    cases = data.get("cases") if isinstance(data, dict) else None
+    return [c for c in cases if isinstance(c, dict)] if isinstance(cases, list) else []
+
+
 def summary_rows(folder, expected=EXPECTED) -> list:
     """The rows of the table (dicts keyed by :data:`COLUMNS`), expected targets first."""
     reports = read_reports(Path(folder), expected)
+    runs = _runs(Path(folder))
     rows, claimed = [], set()
     for issue, stem, match, what, unit, skip_match in expected:
         files = reports.get(stem, [])
@@ -176,7 +186,12 @@ def summary_rows(folder, expected=EXPECTED) -> list:
             rows += found
             continue
         readable = [(p, d) for p, d, _ in files if d is not None]
-        if not files:
+        ran = [r for r in runs if r.get("script") == stem]
+        if not files and ran:        # it ran and wrote no report: it crashed
+            rows.append({**base, "status": "not measured",
+                         "note": f"{stem} ran (exit code {ran[-1].get('exit_code')}) and "
+                                 f"wrote no report: see its output"})
+        elif not files:
             rows.append({**base, "status": "not run",
                          "note": f"{stem}.json missing: run make bench"})
         elif not readable:

@@ -9,8 +9,10 @@ from roughfe._runtime import load_render_backend  # noqa: E402
 
 load_render_backend()
 
+from roughfe.surfaces.io import topographies_folder  # noqa: E402
+
 REPO = Path(__file__).resolve().parents[1]
-TOPOGRAPHIES = REPO.parent / "shared" / "data" / "topographies"
+TOPOGRAPHIES = topographies_folder()
 
 
 @pytest.fixture(scope="session")

@@ -206,3 +206,14 @@ def test_a_report_belongs_to_its_own_benchmark_before_a_prefix(tmp_path, summary
     by = {(r["benchmark"], r["target"]): r["status"] for r in rows}
     assert by == {("bench_x", "iteration growth 1 -> 2"): "met",
                   ("bench_x_growth", "refinement growth 1 -> 2"): "met"}
+
+
+def test_a_benchmark_that_ran_and_wrote_nothing_is_not_reported_as_not_run(tmp_path, summary):
+    # run_all.json knows it ran (and its exit code); the table said "not run: run make
+    # bench" for a benchmark that had just crashed
+    _write(tmp_path, "run_all", targets=[], cases=[
+        {"script": "bench_z", "args": "", "exit_code": 1, "wrote": []}])
+    rows = {r["benchmark"]: r for r in summary.summary_rows(tmp_path, EXPECTED)}
+    assert rows["bench_z"]["status"] == "not measured"
+    assert "ran (exit code 1) and wrote no report" in rows["bench_z"]["note"]
+    assert rows["bench_y"]["status"] == "not run"           # this one never ran

@@ -31,13 +31,13 @@ from roughfe.genomics.mechanics import chromosome_mechanics, curve_difference, r
 from roughfe.genomics.natural import sequence_measured
 from roughfe.genomics.sequencing import sequence_profiles, thesis_zd_fit
 from roughfe.plotting import genomics as gp
-from roughfe.surfaces.io import load_surface
+from roughfe.surfaces.io import load_surface, topographies_folder
 from roughfe.validation import within
 from roughfe.writers import write_json, write_text
 
 SEEDS = tuple(range(20))
 KERNELS = ("thesis", "strip")
-TOPOGRAPHIES = Path(__file__).resolve().parents[2] / "shared" / "data" / "topographies"
+TOPOGRAPHIES = topographies_folder()
 TARGETS = {"gamma": 0.01, "rms": 0.02, "curves": 0.02, "H_mean": 0.02}
 
 

@@ -61,11 +61,11 @@ from roughfe.genomics.sequencing.surface_data import resolvable_surface_genome
 from roughfe.errors import InputError
 from roughfe.model import DEFAULT_E
 from roughfe.surfaces import Surface
-from roughfe.surfaces.io import load_surface, save_surface
+from roughfe.surfaces.io import load_surface, save_surface, topographies_folder
 from roughfe.validation import Target, percent, targets_markdown
 from roughfe.writers import write_json, write_text
 
-TOPOGRAPHIES = Path(__file__).resolve().parents[2] / "shared" / "data" / "topographies"
+TOPOGRAPHIES = topographies_folder()
 MEASURED = ("x3p-2.x3p", "sur-2.sur", "opd-1.opd", "plu-1.plu", "di-1.di")
 N_SEQ, L1 = 48, 1e-3
 NOISE = (0.001, 0.01, 0.03)

@@ -11,14 +11,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..surfaces.io import load_surface, save_surface
+from ..surfaces.io import load_surface, save_surface, topographies_folder
 from ..surfaces.rmd import rmd_surface
 from ..surfaces.stats import fit_hurst, power_spectrum, surface_statistics
 from ..writers import write_json, write_text
 from .options import add_output_folder, add_run_options, output_folder_of
 
-# Measured topographies shipped beside the repository (../shared/data/topographies).
-_TOPOGRAPHIES = Path(__file__).resolve().parents[3] / "shared" / "data" / "topographies"
+#: the measured topography of the demo (in :func:`roughfe.surfaces.io.topographies_folder`)
 _MEASURED_FILE = "x3p-2.x3p"
 
 
@@ -61,7 +60,7 @@ def section_surface(outdir: Path, context: dict) -> str:
 
 def section_measured(outdir: Path, context: dict) -> str:
     """One measured instrument file (ISO 25178 .x3p) read through SurfaceTopography."""
-    path = _TOPOGRAPHIES / _MEASURED_FILE
+    path = topographies_folder() / _MEASURED_FILE
     if not path.is_file():
         return (f"## Measured surface\n\nskipped: {path} not found (the measured topographies "
                 f"live in ../shared/data/topographies beside the repository).\n")

@@ -43,6 +43,22 @@ NATIVE_VERSION = 1
 
 
 # -- JSON-safe metadata ------------------------------------------------------------------
+#: environment variable naming the folder of the measured instrument files
+TOPOGRAPHIES_ENV = "ROUGHFE_TOPOGRAPHIES"
+
+
+def topographies_folder() -> Path:
+    """The folder of the five measured instrument files that the demo, the validation
+    studies, the benchmarks and the tests read: ``$ROUGHFE_TOPOGRAPHIES`` when set, else
+    ``../shared/data/topographies`` beside the repository checkout. (It may not exist;
+    each caller says what it leaves out then.)"""
+    import os
+    env = os.environ.get(TOPOGRAPHIES_ENV)
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[3] / "shared" / "data" / "topographies"
+
+
 def json_safe(value, depth=0):
     """Return a JSON-serialisable copy of ``value`` (dicts, lists, numbers, strings).
 
