@@ -152,7 +152,10 @@ def test_band_mechanics_of_a_periodic_surface():
     assert m.td_curves[-1] is m.complete and m.bu_curves[-1] is m.complete
     assert m.td_curves[0] is m.chromosome_curves[0]
     assert m.c_td["K"][-1] == pytest.approx(1.0) and m.c_bu["A"][-1] == pytest.approx(1.0)
-    assert m.nit == calls[-1][0] == calls[-1][1] == 1 + n_c + 2 * max(n_c - 2, 0)
+    # the last band holds round-off only (ptp 9e-22 m on a 3e-6 m surface): flat against
+    # the complete surface, no sweep (it was swept, judged against its own round-off)
+    assert np.ptp(b.chromosomes[-1]) < 1e-15 and m.chromosome_curves[-1] is None
+    assert m.nit == calls[-1][0] == calls[-1][1] == n_c + 2 * max(n_c - 2, 0)
     # the longest-wave TD sums carry most of the stiffness shape of the complete surface
     assert m.c_td["K"][n_c - 2] > 0.9
     mm = band_macro_micro(m, threshold=0.95)

@@ -76,7 +76,10 @@ def test_one_percent_white_noise(seed):
     assert s.M == g.M
     assert np.degrees(np.abs(s.angles - g.angles)).max() < 0.5
     assert s.gamma == pytest.approx(g.gamma, rel=5e-3)
-    assert np.all((r.rms_errors > 0.008) & (r.rms_errors < 0.012)), r.rms_errors
+    # the misfit is over the heights about their plane (the model's plane takes the rest):
+    # the noise, 1 % of the rms about the mean, is that share of signal_rms
+    noise = np.array([0.01 * a.heights.std() for a in acq]) / r.signal_rms
+    assert np.all((r.rms_errors > 0.8 * noise) & (r.rms_errors < 1.2 * noise)), r.rms_errors
     assert r.success
 
 
@@ -233,7 +236,8 @@ def test_the_noise_floor_ends_the_search(seed, monkeypatch):
     assert r.success and s.M == g.M
     assert np.degrees(np.abs(s.angles - g.angles)).max() < 0.5
     assert s.gamma == pytest.approx(g.gamma, rel=5e-3)
-    assert np.all((r.rms_errors > 0.008) & (r.rms_errors < 0.012)), r.rms_errors
+    noise = np.array([0.01 * a.heights.std() for a in acq]) / r.signal_rms
+    assert np.all((r.rms_errors > 0.8 * noise) & (r.rms_errors < 1.2 * noise)), r.rms_errors
     if seed < 2:
         monkeypatch.setattr(seq, "NOISE_FLOOR_FACTOR", 0.0)
         full = sequence_surfaces(noisy)
@@ -263,3 +267,54 @@ def test_a_noisy_sub_lattice_holds_noise_only_in_its_extra_chromosomes():
         assert float(sol["resid"] @ sol["resid"]) <= NOISE_FLOOR_FACTOR * cost
         assert _every_chromosome_present(sol) is True          # noise passes 1e-6
         assert _every_chromosome_present(sol, noise=amplitude) is present
+
+
+def test_a_tilt_does_not_make_a_poor_fit_pass():
+    """The model fits a plane per acquisition; the misfit was over the variance about the
+    mean, so a tilt of 100 rms added to 10 %-noisy acquisitions read 0.34 % (success)
+    where the same data without it read 9.9 % (FAILED; here: 0.34 % / 0.36 %, success,
+    against 28 % / 65 % without the tilt). Over the heights about their plane neither
+    passes."""
+    g, acq, rng = _genome(5)
+    noisy = [a.with_heights(a.heights + 0.1 * a.heights.std() * rng.normal(size=a.shape))
+             for a in acq]
+    tilted = []
+    for a in noisy:
+        x = np.arange(a.shape[0])[:, None] / a.shape[0]
+        tilted.append(a.with_heights(a.heights + 100 * a.heights.std() * x))
+    r, t = sequence_surfaces(noisy), sequence_surfaces(tilted)
+    assert not r.success and not t.success
+    assert r.rms_errors.min() > 0.05 and t.rms_errors.min() > 0.05
+
+
+def test_a_fit_with_an_impossible_exponent_is_a_failed_sequencing(topographies_dir):
+    """di-1.di on every fourth point (128^2): the lattice fit's amplitudes grow towards
+    short waves (H = -0.45); the Genome refused it with an InputError about an H the user
+    never gave (exit 2, no report). Now a failed sequencing that says why."""
+    from roughfe.surfaces import Surface
+    from roughfe.surfaces.io import load_surface
+    s = load_surface(topographies_dir / "di-1.di")
+    h = s.heights[::4, ::4]
+    crop = Surface(h, (h.shape[0] * 4 * s.spacing[0], h.shape[1] * 4 * s.spacing[1]))
+    r = sequence_surfaces([crop])
+    assert not r.success and r.genome is None
+    assert "H = -0.454, outside (0, 3]" in r.message
+
+
+@pytest.mark.slow
+def test_an_overfit_of_a_measured_profile_is_not_a_genome(topographies_dir):
+    """di-1.di's nested acquisitions (genome natural): the lattice fit reproduced them to
+    0.1-0.3 % with 145 chromosomes, H at the end of its search interval (3) and waves of
+    2.9 m on a profile of 15 nm rms, and said success; off by 1e8 on windows it was not
+    fitted to. A fit at the end of the H interval, or with waves far larger than the data,
+    is not a genome."""
+    import time
+    from roughfe.genomics.natural import nested_acquisitions
+    from roughfe.genomics.sequencing import sequence_profiles
+    from roughfe.surfaces.io import load_surface
+    t0 = time.perf_counter()
+    acq = nested_acquisitions(load_surface(topographies_dir / "di-1.di"))
+    r = sequence_profiles(acq)
+    assert not r.success and "not a genome" in r.message
+    assert np.all(r.rms_errors < 0.05)            # the overfit itself: a tiny misfit
+    assert time.perf_counter() - t0 < 60

@@ -208,7 +208,12 @@ def noise_table(seeds):
                          "angle_error_deg": float(np.degrees(np.max(_wrapped(s.angles - g.angles))))
                          if ok else None,
                          "gamma_error": abs(s.gamma / g.gamma - 1) if s is not None else None,
-                         "misfit_over_noise": float(np.max(r.rms_errors)) / level,
+                         # the noise as a share of the heights about their plane, the
+                         # misfit's denominator (sequence_surfaces' signal_rms)
+                         "misfit_over_noise": float(np.max(
+                             r.rms_errors * r.signal_rms / (level * np.array(
+                                 [a.heights.std() for a in acq])))) if s is not None
+                         else None,
                          "success": bool(r.success)})
     return rows
 

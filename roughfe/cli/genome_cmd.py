@@ -12,7 +12,8 @@ from pathlib import Path
 from .options import (add_detrend_option, add_material_options, add_output_file,
                       add_output_folder, add_run_options, add_surface_options, at_least_two,
                       material_from_args, nonnegative_int, output_file_of,
-                      output_folder_of, positive_float, positive_int, surface_from_args)
+                      output_folder_of, positive_float, positive_int, surface_from_args,
+                      unit_fraction)
 
 from ..genomics.genome import SCALES
 from ..genomics.natural import DEFAULT_FRACTIONS
@@ -78,13 +79,16 @@ def _sequence_figures(res, outdir: Path, stem: str):
     return paths
 
 
+def _percent_or_undefined(e):
+    return f"{100 * e:.4g} %" if math.isfinite(e) else "not defined (no genome fits it)"
+
+
 def _print_sequencing(res):
     print("sequenced genome:")
     _print_genome(res.genome)
     for k, (L, r, e) in enumerate(zip(res.lengths, res.ranges, res.rms_errors)):
-        err = f"{100 * e:.4g} %" if math.isfinite(e) else "not defined (no genome fits it)"
         print(f"  acquisition {k + 1}: L = {L:.6g} m, n = {r[0]}..{r[1]}, relative rms error "
-              f"{err}")
+              f"{_percent_or_undefined(e)}")
     print(f"  PSD-only estimates (thesis): gamma = {res.gamma_psd:.5g}, H (peak slope) = {res.H_psd:.4g}")
     print(f"  {'success' if res.success else 'FAILED quality check'}: {res.message}")
 
@@ -137,7 +141,8 @@ def _sequence_surfaces(args, surfaces) -> int:
         print("  ridge angles (deg): " + " ".join(f"{a:.4f}" for a in res.genome.angles * 57.29577951308232))
         print("  anisotropy        : " + " ".join(f"{a:.4f}" for a in res.genome.anisotropy))
     for k, (L, e) in enumerate(zip(res.lengths, res.rms_errors)):
-        print(f"  acquisition {k + 1}: L = {L:.6g} m, relative rms error {100 * e:.4g} %")
+        print(f"  acquisition {k + 1}: L = {L:.6g} m, relative rms error "
+              f"{_percent_or_undefined(e)}")
     print(f"  {'success' if res.success else 'FAILED quality check'}: {res.message}")
     print(f"report -> {out / 'report.json'}")
     return 0 if res.success or not args.strict else 1
@@ -403,14 +408,15 @@ def register(sub):
                                   "(chromosomes, surface, q_bounds, ...), mechanics.json, "
                                   "macro_micro.json and figures.")
     add_surface_options(p)
-    add_detrend_option(p)
+    add_detrend_option(p, default="plane")    # band_chromosomes' (a tilt fills band 1)
     p.add_argument("--gamma", type=positive_float, default=2 ** 0.5,
                    help="band ratio q_{n+1}/q_n (the genome's gamma when known)")
     add_material_options(p)
     p.add_argument("--steps", type=nonnegative_int, default=20,
                    help="equal approaches per A(p), K(p) curve (0: decomposition only)")
-    p.add_argument("--threshold", type=positive_float, default=0.95,
-                   help="Alg. 2: c_n of K(p) above which a band is macro-scale roughness")
+    p.add_argument("--threshold", type=unit_fraction, default=0.95,
+                   help="Alg. 2: c_n of K(p) above which a band is macro-scale roughness "
+                        "(checked before the sweeps)")
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_chromosomes)

@@ -147,10 +147,12 @@ def surface_from_args(args):
     return surface if detrend == "none" else surface.detrended(detrend)
 
 
-def add_detrend_option(parser) -> None:
-    """``--detrend none|mean|plane`` with the one default (``mean``)."""
+def add_detrend_option(parser, default: str = DEFAULT_DETREND) -> None:
+    """``--detrend none|mean|plane``; the default is ``mean``, or the library's own
+    default of the command's function where that differs (``genome chromosomes``:
+    ``plane``, as :func:`roughfe.genomics.bands.band_chromosomes`)."""
     parser.add_argument(
-        "--detrend", choices=DETRENDS, default=DEFAULT_DETREND,
+        "--detrend", choices=DETRENDS, default=default,
         help="remove nothing, the mean height, or the least-squares plane before the "
              "analysis (measured topographies usually need 'plane'; a plane fit breaks "
              "the periodicity of a periodic surface)")

@@ -119,6 +119,17 @@ def profile_response(surface: Surface, *, youngs_modulus: float, poisson: float 
 CORRELATION_AXES = ("steps", "pressure")
 
 
+def is_flat(z, scale: float = 0.0) -> bool:
+    """True when heights are constant to round-off: such a field has no contact curve.
+
+    Round-off is judged against ``scale`` (m, e.g. the largest height of the complete
+    surface a chromosome belongs to) as well as the field itself: a chromosome whose
+    waves cancel (3e-22 m on a 2e-6 m profile) is round-off of the surface, which its
+    own maximum could never show."""
+    ref = max(float(np.max(np.abs(z))), float(scale), 1e-300)
+    return bool(np.ptp(z) <= 1e-12 * ref)
+
+
 def correlation(reference: ResponseCurve, curve: ResponseCurve, quantity: str = "K",
                 axis: str = "steps") -> float:
     """c_n of Alg. 2: Pearson coefficient of two curves (see the module notes).
@@ -174,8 +185,13 @@ class MacroMicroResult:
 
 
 def classify(full: ResponseCurve, chromosome_curves, chromosomes, threshold: float = 0.95,
-             axis: str = "steps") -> MacroMicroResult:
-    """Steps 4 and 6 of Alg. 2 from computed curves: c_n and the macro/micro split."""
+             axis: str = "steps", flat=None) -> MacroMicroResult:
+    """Steps 4 and 6 of Alg. 2 from computed curves: c_n and the macro/micro split.
+
+    ``flat`` (optional, one bool per chromosome): chromosomes whose realisation is
+    round-off of the complete profile (waves that cancel) take c_n = 0, micro: Alg. 2
+    loads each chromosome to its own peak-to-valley, so its curve does not see that the
+    chromosome is nothing (a cancelled one was classified macro with c_n = 0.97-0.99)."""
     if not (0.0 < float(threshold) < 1.0):
         raise InputError(f"threshold must lie in (0, 1), got {threshold!r}")
     chromosomes = np.asarray(chromosomes, dtype=int)
@@ -184,6 +200,9 @@ def classify(full: ResponseCurve, chromosome_curves, chromosomes, threshold: flo
         raise InputError(f"{len(curves)} chromosome curves for {chromosomes.size} chromosomes")
     ck = np.array([correlation(full, c, "K", axis) for c in curves])
     ca = np.array([correlation(full, c, "A", axis) for c in curves])
+    if flat is not None:
+        ck[np.asarray(flat, bool)] = 0.0
+        ca[np.asarray(flat, bool)] = 0.0
     macro = tuple(int(n) for n, c in zip(chromosomes, ck) if c > threshold)
     micro = tuple(int(n) for n, c in zip(chromosomes, ck) if not c > threshold)
     return MacroMicroResult(chromosomes, full, curves, ck, ca, float(threshold), macro, micro,
@@ -199,7 +218,9 @@ def classify_profiles(total: Surface, parts, chromosomes, response: Callable[[Su
     """
     full = response(total)
     curves = [response(p) for p in parts]
-    return classify(full, curves, chromosomes, threshold, axis)
+    scale = float(np.max(np.abs(total.heights)))
+    return classify(full, curves, chromosomes, threshold, axis,
+                    flat=[is_flat(p.heights, scale) for p in parts])
 
 
 def macro_micro(genome, settings, *, response=None) -> MacroMicroResult:

@@ -12,7 +12,9 @@ and the correlation coefficients c_n of each of those curves with the complete o
 (Fig. 39, 45). The curves are :class:`~roughfe.genomics.similarity.ResponseCurve` and
 the BEM call and c_n are :func:`~roughfe.genomics.macro_micro.profile_response` and
 :func:`~roughfe.genomics.macro_micro.correlation` (shared with roughness design): c_n is
-Pearson's coefficient on the complete profile's pressures after the Eq. (4.2) stretch.
+Pearson's coefficient of the two curves paired step by step (each loaded to its own
+peak-to-valley in the same number of steps; ``axis="steps"``, the default), or on the
+complete profile's pressures after the Eq. (4.2) stretch (``axis="pressure"``).
 
 Amplitude. The genes of Table 1 read in SI (A = 1 m^0.25, lambda1 = 1 mm) give a 10x
 profile with rms height 0.73 mm and rms slope ~27: far outside the small-slope
@@ -42,7 +44,7 @@ from ..surfaces.surface import Surface
 from ..writers import to_jsonable
 from .chromosomes import reconstruction
 from .genome import DEFAULT_NODES, Genome
-from .macro_micro import correlation, profile_response
+from .macro_micro import correlation, is_flat, profile_response
 from .similarity import ResponseCurve
 
 THESIS_YOUNGS_MODULUS = 210e6     # Pa (Sec. 3.4.1)
@@ -166,11 +168,6 @@ class ChromosomeMechanics:
                    nit=int(d.get("nit", 0)), elapsed=float(d.get("elapsed_s", 0.0)))
 
 
-def is_flat(z) -> bool:
-    """True when heights are constant to round-off: such a field has no contact curve."""
-    return bool(np.ptp(z) <= 1e-12 * max(float(np.max(np.abs(z))), 1e-300))
-
-
 def sweep_fields(fields: dict, surface_of, response, label=None, workers: int = 1):
     """BEM curves of several height fields, one sweep each; the first field is the
     reference (the complete surface): its failure re-raises, since nothing compares
@@ -204,9 +201,10 @@ def sweep_fields(fields: dict, surface_of, response, label=None, workers: int = 
     workers = int(workers)
     if workers < 1:
         raise InputError(f"workers must be an integer >= 1, got {workers!r}")
-    curves = {key: None for key, z in fields.items() if is_flat(z)}
-    todo = [key for key in fields if key not in curves]
     first = next(iter(fields), None)
+    scale = float(np.max(np.abs(fields[first]))) if first is not None else 0.0
+    curves = {key: None for key, z in fields.items() if is_flat(z, scale)}
+    todo = [key for key in fields if key not in curves]
     failed = {}
 
     def sweep(key):

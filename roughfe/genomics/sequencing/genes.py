@@ -10,6 +10,10 @@ from scipy.optimize import minimize_scalar
 from ...errors import InputError
 
 
+#: the search interval of the scaling exponent H: a fit at either end is not a power law
+H_SEARCH = (1e-3, 3.0)
+
+
 def amplitude_genes(n, c, gamma, lambda1):
     """Maximum-likelihood A (m^(1-H)) and H from the chromosome amplitudes c_n (m).
 
@@ -34,7 +38,7 @@ def amplitude_genes(n, c, gamma, lambda1):
         s = s0(h) * gamma ** (-2 * (n - 1) * h)
         return float(np.sum(np.log(s) + c2 / s))
 
-    h = minimize_scalar(nll, bounds=(1e-3, 3.0), method="bounded", options={"xatol": 1e-10}).x
+    h = minimize_scalar(nll, bounds=H_SEARCH, method="bounded", options={"xatol": 1e-10}).x
     a = math.sqrt(s0(h) / lg) * q1 ** h
     return a, float(h)
 

@@ -12,12 +12,17 @@ from ...errors import InputError, check_int
 from ...surfaces.wm import resolve_rng
 from ..genome import Genome, profile_heights
 from .acquisitions import acquisitions_from_surfaces, check_controls
-from .genes import (amplitude_genes, peak_slope_H, phases_with_sums, ridge_likelihood,
-                    variance_amplitude)
+from .genes import (H_SEARCH, amplitude_genes, peak_slope_H, phases_with_sums,
+                    ridge_likelihood, variance_amplitude)
 from .lattice import (comb_periods, design_matrix, fit_lattice, label_q1, lattice_from_period,
                       lattice_ranges, solve_linear, vp_residual)
 from .peaks import spectrum_peaks
 from .result import SequencingResult
+
+
+#: a chromosome amplitude this many times the largest height of the acquisitions is a fit
+#: of waves that cancel (an overfit), not a genome (WM fits stay below 1)
+OVERFIT_FACTOR = 10.0
 
 
 def _rel_rms(z, fit):
@@ -161,6 +166,18 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     if not ok:
         messages.insert(0, "not WM-like: relative rms error " +
                         ", ".join(f"{e:.3g}" for e in rms) + f" exceeds {rms_tolerance:g}")
+    # a small misfit does not make a genome: a fit with as many waves as data nodes
+    # reproduces any acquisitions (di-1.di: 145 chromosomes, H = 3, waves of 2.9 m on a
+    # profile of 15 nm rms, off by 1e8 on windows it was not fitted to)
+    z_scale = max(float(np.max(np.abs(a.z - a.z.mean()))) for a in acqs)
+    at_bound = not (H_SEARCH[0] * (1 + 1e-6) < H < H_SEARCH[1] * (1 - 1e-6))
+    if at_bound or float(np.max(amps)) > OVERFIT_FACTOR * z_scale:
+        ok = False
+        messages.insert(0, "not a genome: " + (
+            f"H = {H:.4g} is the end of its search interval {H_SEARCH} (the chromosome "
+            f"amplitudes follow no power law)" if at_bound else
+            f"chromosome amplitudes up to {float(np.max(amps)):.3g} m on acquisitions of "
+            f"at most {z_scale:.3g} m (waves that cancel: an overfit)"))
     message = "; ".join(messages) if messages else \
         "sequenced: relative rms errors " + ", ".join(f"{e:.2e}" for e in rms)
     meta_report = {"rms_errors": rms.tolist(), "success": ok}
