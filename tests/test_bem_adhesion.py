@@ -284,23 +284,28 @@ def test_unloading_steps_grow_past_the_pull_off_until_separation():
         adhesive_sweep(s, mat, law, deltas, unload=True, unload_growth=0.5)
 
 
-def test_pull_off_converges_as_the_continuation_step_shrinks():
+def test_pull_off_is_a_property_of_the_contact_not_of_the_step():
     # The quasi-static pull-off of a resolved law is a property of the contact, not of
-    # the continuation: refining the approach step (loading and unloading) moves it by
-    # amounts that shrink at least twofold per halving of the step (measured: -77.57,
-    # -78.94, -79.74, -80.18 kPa at 3, 5, 9, 17 loading points: differences 1.37, 0.80,
-    # 0.45 kPa), and the tangent start of each step gives the states that the previous
-    # gap shifted by the change of Delta gives (docs/theory/07, same pull-off to 1e-12
-    # at every step size). Below the tensile strength sigma0 = w / rho.
+    # the continuation. Here the most tensile state of the unloading branch is its start,
+    # the largest approach (-80.65 kPa), whatever the step: the pull-off is the same at
+    # 3, 5 and 9 loading points to the solver's tolerance. Until round 2, session 21 the
+    # branch's loads left that start out, and the pull-off read -77.57, -78.94, -79.74
+    # kPa, creeping towards it as the step shrank (taken then for first-order
+    # convergence). Below the tensile strength sigma0 = w / rho.
     s, mat = _peel_case()
     top = float(s.heights.max() - s.heights.mean())
-    pull = [adhesive_sweep(s, mat, RESOLVED_EXP, np.linspace(0.1, 0.6, k) * top,
-                           unload=True, max_unload_steps=200).pull_off_pressure
-            for k in (3, 5, 9)]
-    d1, d2 = pull[1] - pull[0], pull[2] - pull[1]
-    assert d1 < 0 and d2 < 0 and abs(d2) < 0.75 * abs(d1)   # more tensile, converging
-    assert -RESOLVED_EXP.max_traction < pull[2] < 0
-    assert abs(d2) < 0.02 * abs(pull[2])
+    runs = [adhesive_sweep(s, mat, RESOLVED_EXP, np.linspace(0.1, 0.6, k) * top,
+                           unload=True, max_unload_steps=200) for k in (3, 5, 9)]
+    pull = [r.pull_off_pressure for r in runs]
+    assert max(pull) - min(pull) < 1e-5 * abs(pull[0])
+    for r, k in zip(runs, (3, 5, 9)):
+        branch = r.sweep.mean_pressure[k - 1:]          # from the largest approach on
+        assert r.pull_off_pressure == branch.min() and r.detached
+    assert -RESOLVED_EXP.max_traction < pull[0] < 0
+    # max_unload_steps = 0: no solve beyond the loading range (it meant the default)
+    none = adhesive_sweep(s, mat, RESOLVED_EXP, np.linspace(0.1, 0.6, 3) * top,
+                          unload=True, max_unload_steps=0)
+    assert len(none.sweep.results) == 3 + 2
 
 
 @pytest.mark.parametrize("kernel", ["spectral", "love"])

@@ -338,7 +338,8 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     unload : bool
         Also trace the unloading branch: the loading approaches in reverse, then further
         apart until separation (at most ``max_unload_steps`` solves beyond the loading
-        range, default 4 x the loading steps).
+        range, default 4 x the loading steps; 0: none). The pull-off force is the most
+        tensile load of the branch, its starting state at the largest approach included.
     unload_growth : float
         Step control beyond the loading range: the step is the last loading step while
         each state is more tensile than every earlier one (the approach to the pull-off
@@ -376,7 +377,10 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
         if unload:
             step = float(deltas[-1] - deltas[-2]) if deltas.size > 1 else float(abs(deltas[0]))
             step = step if step > 0 else law.range
-            loads = []
+            # the branch starts at the largest approach: its state (often the most
+            # tensile of a sticky contact) is the first of the unloading loads (it was
+            # left out, and the pull-off read up to 4 % short, converging with the step)
+            loads = [prev.load]
 
             def unload_to(d):
                 state = solve_adhesive(surface, material, law, delta=d, kernel=kernel,
@@ -388,7 +392,9 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
             for d in deltas[-2::-1]:              # the loading approaches in reverse
                 prev = unload_to(d)
             d, h = float(deltas[0]), step
-            for _ in range(int(max_unload_steps or 4 * deltas.size)):
+            extra = 4 * deltas.size if max_unload_steps is None else check_int(
+                "max_unload_steps", max_unload_steps, 0)
+            for _ in range(extra):
                 low = min(loads) if loads else float("inf")
                 d -= h
                 prev = unload_to(d)
