@@ -4,7 +4,7 @@ and Richardson extrapolation of a refinement sequence.
 Target rows
 -----------
 Every validation script (``roughfe validate NAME``) writes ``<outdir>/<script>.json`` with a
-top-level key ``"targets"``: a list of rows
+top-level key ``"targets"``: a list of rows::
 
     {"name": str,        what is compared, e.g. "RMD: A* limits FEM vs BEM"
      "target": str,      the criterion as text, e.g. "<= 1 %"
@@ -16,8 +16,7 @@ top-level key ``"targets"``: a list of rows
 
 and ``roughfe validate`` writes ``<outdir>/summary.json``: ``{"validations": {name: {"met":
 bool|null, "targets": [rows], "not_run": [scripts]}}, "all_met": bool, "not_run": [...]}``.
-The documentation pages are generated from
-these files; no number is typed by hand.
+The documentation pages are generated from these files; no number is typed by hand.
 
 Richardson extrapolation
 ------------------------
