@@ -96,13 +96,12 @@ def _print_sequencing(res):
 def _sequence(args) -> int:
     from ..errors import InputError
     from ..surfaces.io import load_surface
+    surfaces = []
     for p in args.profiles:
         if Path(p).suffix.lower() == ".json":
             raise InputError(f"{p} is a JSON file (a genome?), not an acquisition: sequence "
                              f"reads realised profiles or surfaces (.npz, e.g. from `roughfe "
                              f"genome realize GENOME.json -o X.npz`) or instrument files")
-    surfaces = []
-    for p in args.profiles:
         try:
             surfaces.append(load_surface(p))
         except InputError as exc:   # this command has no --size: files must carry theirs
