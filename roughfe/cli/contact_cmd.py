@@ -23,8 +23,8 @@ from ..writers import write_json
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, check_small_strain, contact_physics_from_args,
-                      material_from_args, output_folder_of, positive_float, positive_int,
-                      surface_from_args, unit_fraction)
+                      fmt_or_dash, material_from_args, output_folder_of, positive_float,
+                      positive_int, surface_from_args, unit_fraction)
 
 DEFAULT_STEPS = Loading.DEFAULT_STEPS
 #: --coarse-correction -> solve_contact(coarse_correction=)
@@ -192,10 +192,6 @@ def _adhesive_sweep(args, surface, material, law, tol):
 THESIS_FIG7 = {"A_star": 0.25, "P_star": 0.56, "h_s": 6.72e-6}
 
 
-def _fmt(value, spec):
-    return "-" if value is None else format(value, spec)
-
-
 def contact_document(sweep, surface, material, inputs: dict) -> dict:
     """results.json of a contact sweep (the one builder of ``roughfe contact`` and of the
     demo): :func:`~roughfe.bem.output.sweep_document` with the surface's grid in its
@@ -247,7 +243,7 @@ def section_contact(outdir: Path, context: dict) -> str:
     picks = sorted(set(range(0, len(sweep.results), 4)) | {len(sweep.results) - 1})
     rows = "\n".join(
         f"| {r.delta * 1e6:.3f} | {r.mean_pressure * 1e-6:.4g} | {r.area_fraction:.4f} | "
-        f"{_fmt(doc['steps'][i].get('persson_area_fraction'), '.4f')} | "
+        f"{fmt_or_dash(doc['steps'][i].get('persson_area_fraction'), '.4f')} | "
         f"{sweep.load_star[i]:.3f} | {r.stiffness * 1e-12:.4g} | {r.mean_gap * 1e6:.4f} | "
         f"{r.free_volume_star:.3f} | {r.nit} |"
         for i, r in ((i, sweep.results[i]) for i in picks))

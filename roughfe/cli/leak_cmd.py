@@ -15,7 +15,6 @@ figures.
 from __future__ import annotations
 
 import shutil
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +27,8 @@ from .options import (add_contact_physics_options, add_detrend_option, add_mater
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, check_small_strain, contact_physics_from_args,
                       material_from_args, nonnegative_int, output_folder_of, positive_float,
-                      log_of, positive_int, show_progress, surface_from_args)
+                      fmt_or_dash, log_of, positive_int, show_progress,
+                      surface_from_args)
 
 
 def _add_fluid_material(p, fsi=True):
@@ -115,13 +115,12 @@ def _leak(args) -> int:
               f"{'iter':>5} "
               f"{'Q (m^3/s)':>11} {'Q one-way':>11} {'u_c (m)':>10}")
         for s in steps:
-            fmt = lambda v, f: "-" if v is None else format(v, f)  # noqa: E731
             print(f"{s['step']:>4} {s['external_pressure']:>11.4g} {s['fsi_state']:>8} "
-                  f"{fmt(s.get('area_fraction'), '.4f'):>7} {s['fluid_load_fraction']:>6.3f} "
+                  f"{fmt_or_dash(s.get('area_fraction'), '.4f'):>7} {s['fluid_load_fraction']:>6.3f} "
                   f"{s['trapped_load_fraction']:>6.3f} "
-                  f"{s['coupled_iterations']:>5} {fmt(s['leak_rate'], '.4e'):>11} "
-                  f"{fmt(s['leak_rate_one_way'], '.4e'):>11} "
-                  f"{fmt(s.get('critical_gap'), '.3e'):>10}")
+                  f"{s['coupled_iterations']:>5} {fmt_or_dash(s['leak_rate'], '.4e'):>11} "
+                  f"{fmt_or_dash(s['leak_rate_one_way'], '.4e'):>11} "
+                  f"{fmt_or_dash(s.get('critical_gap'), '.3e'):>10}")
         print(f"wrote {len(written)} files in {out}")
         return 0 if sweep.success else 1
     print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>7} {'Vp*':>9} {'Vnp*':>9} "
@@ -132,7 +131,7 @@ def _leak(args) -> int:
               f"{s['area_fraction']:>7.4f} {s['percolating_volume_star'] or 0:>9.3e} "
               f"{s['trapped_volume_star'] or 0:>9.3e} "
               f"{str(s['percolates_x'])[0]}/{str(s['percolates_y'])[0]:>6} "
-              f"{'-' if q is None else format(q, '.4e'):>11}")
+              f"{fmt_or_dash(q, '.4e'):>11}")
     print(f"wrote {len(written)} files in {out}")
     return 0 if sweep.success else 1
 

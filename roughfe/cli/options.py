@@ -295,6 +295,12 @@ def add_run_options(parser, figures: bool = True) -> None:
                         help="no progress bar and no summary on stdout (errors still on stderr)")
 
 
+def fmt_or_dash(value, spec: str) -> str:
+    """``format(value, spec)`` for a table cell, ``"-"`` where the value is None (not
+    computed for that step)."""
+    return "-" if value is None else format(value, spec)
+
+
 def log_of(args):
     """The log of a long run's driver: one line per message on stderr, nothing with
     ``--quiet``."""
