@@ -208,7 +208,7 @@ def test_contact_cli_coarse_correction_switch(tmp_path, capsys):
 
 
 def test_cli_prints_the_library_s_warnings_as_one_line(tmp_path, capsys):
-    # a law whose process zone (1e-10 m) the grid (0.31 um) does not resolve: the
+    # a law whose process zone (2.1e-10 m) the grid (0.31 um) does not resolve: the
     # library's ResolutionWarning reaches the user as "roughfe contact: warning: ...",
     # not as a Python file:line with a source line
     from roughfe.surfaces.io import save_surface
@@ -222,11 +222,11 @@ def test_cli_prints_the_library_s_warnings_as_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("roughfe contact: warning: the exp adhesion law")
     assert "process zone" in err[0] and ".py:" not in err[0]
-    # ... and results.json keeps the numbers of the warning: (pi/8) E* w / sigma0^2 with
+    # ... and results.json keeps the numbers of the warning: (pi/4) E* w / sigma0^2 with
     # sigma0 = w / range (the exponential law) against the 10 um / 32 spacing
     res = json.loads((tmp_path / "adh" / "results.json").read_text())["derived"]["resolution"]
     e_star = 1e6 / (1 - 0.5 ** 2)
-    zone = np.pi / 8 * e_star * 0.02 / (0.02 / 2e-9) ** 2
+    zone = np.pi / 4 * e_star * 0.02 / (0.02 / 2e-9) ** 2
     assert res["process_zone"] == pytest.approx(zone, rel=1e-12)
     assert res["grid_spacing"] == pytest.approx(1e-5 / 32, rel=1e-12)
     assert not res["resolved"] and res["process_zone_cells"] == pytest.approx(zone * 32 / 1e-5)
@@ -236,7 +236,7 @@ def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path, caps
     # the default approaches of --adhesion on a periodic surface stop short of full
     # contact (max h - mean h), where the adhesive state is not defined by the approach
     # and the solver refuses it: until round 2 session 13 the last default step did
-    # (a weak law whose process zone, 5 um, spans 17 grid spacings: resolved)
+    # (a weak law whose process zone, 10 um, spans 34 grid spacings: resolved)
     from roughfe.surfaces.io import save_surface
     from roughfe.surfaces.spectral import spectral_surface
     s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=4 * np.pi / 1e-5,

@@ -499,9 +499,9 @@ def rough_grid_convergence(sizes=(64, 128, 256)):
     (H = 0.8, rms 10 nm, L = 10 um, wavelengths down to L/8: eight points per shortest
     wavelength on 64^2, resampled to the finer grids), E* = 1.33 MPa, loaded to the same
     mean-plane separations on every grid and unloaded until separation. Two laws: one
-    whose process zone (pi/8) E* w / sigma0^2 = 0.52 um the grids resolve (exponential,
-    w = 0.01 J/m^2, rho = 100 nm: 3.4-13 spacings) and the law of :func:`rough_adhesive`
-    (zone 1e-10 m: 0.7-2.7e-3 of a spacing), whose ResolutionWarning is silenced here."""
+    whose process zone (pi/4) E* w / sigma0^2 = 1.05 um the grids resolve (exponential,
+    w = 0.01 J/m^2, rho = 100 nm: 6.7-27 spacings) and the law of :func:`rough_adhesive`
+    (zone 2.1e-10 m: 1.3-5.4e-3 of a spacing), whose ResolutionWarning is silenced here."""
     length = 1e-5
     base = spectral_surface(sizes[0], length, 0.8, rms_height=1e-8,
                             q_roll=4 * np.pi / length, q_short=16 * np.pi / length, rng=3)

@@ -157,7 +157,7 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     Warns
     -----
     ResolutionWarning
-        The law's process zone is below half a grid spacing (``check_resolution``).
+        The law's process zone is shorter than one grid spacing (``check_resolution``).
     """
     d = _check(surface, material, law, delta)
     if solver not in SOLVERS:

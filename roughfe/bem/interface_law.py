@@ -25,17 +25,18 @@ each converged solve (at most ``roughfe.bem.adhesion.MAX_SPREAD_PASSES`` solves;
 only when it moved by more than 10 % of the ramp on a cell in the ramp).
 
 Resolution: the law acts over a cohesive (process) zone at the edge of each contact
-patch, of length ``(pi/8) E* w / sigma0^2`` at a crack front (the Dugdale-Barenblatt
+patch, of length ``(pi/4) E* w / sigma0^2`` at a crack front (the Dugdale-Barenblatt
 strip; :meth:`AdhesionLaw.process_zone`). When it is far below the grid spacing each
 cell is an independent bistable spring: the pull-off and the hysteresis then depend on
 the grid and on the steps of the continuation, and :func:`check_resolution` warns below
-half a grid spacing (:data:`PROCESS_ZONE_CELLS`)
+one grid spacing (:data:`PROCESS_ZONE_CELLS`)
 (:class:`~roughfe.errors.ResolutionWarning`). Measured on a rough 32^2 periodic contact
 (docs/theory/07_adhesion_persson.md, "The continuation's predictor and the process
-zone"): with the zone at 1.7 and 0.21 grid spacings the pull-off converges as the step
-shrinks (differences halving) and does not depend on the predictor of the
-continuation; at 0.034 it scatters by +-5 %, at 3e-4 by +-40 % (-3.5 to -8.4 MPa) with
-no convergence down to 1/128 of the step.
+zone"): with the zone at 3.4 and 0.42 grid spacings the pull-off does not depend on the
+step or on the predictor of the continuation; at 0.068 it scatters by +-5 %, at 7e-4 by
++-40 % (-3.5 to -8.4 MPa) with no convergence down to 1/128 of the step. (Up to round 2,
+session 21 the zone was written (pi/8) E* w / sigma0^2 with a threshold of 0.5: half the
+length, the same criterion.)
 """
 from __future__ import annotations
 
@@ -49,10 +50,10 @@ from ..errors import InputError, ResolutionWarning, check_finite_positive
 LAWS = ("md", "exp")
 
 #: A process zone shorter than this many grid spacings is a ResolutionWarning: below
-#: about half a spacing the elastic stiffness of one cell, E* / (1.12 dx) (its own
+#: about one spacing (0.88) the elastic stiffness of one cell, E* / (1.12 dx) (its own
 #: displacement under a uniform pressure on it), falls below the peak stiffness of the
-#: exponential law, sigma0 / rho = (pi/8) E* / zone, so every cell can snap on its own
-PROCESS_ZONE_CELLS = 0.5
+#: exponential law, sigma0 / rho = (pi/4) E* / zone, so every cell can snap on its own
+PROCESS_ZONE_CELLS = 1.0
 
 
 @dataclass(frozen=True)
@@ -99,11 +100,18 @@ class AdhesionLaw:
         return self.range - half, self.range + half
 
     def process_zone(self, e_star: float) -> float:
-        """Length (m) of the law's cohesive zone at a crack front, ``(pi/8) E* w /
-        sigma0^2`` (the Dugdale-Barenblatt strip of plane-strain fracture mechanics, Rice
-        1980; ``e_star`` the pair's E* in Pa): the length over which the traction falls
-        from sigma0 to 0 at the edge of an adhesive patch in the JKR-like limit."""
-        return float(np.pi / 8 * e_star * self.work / self.max_traction ** 2)
+        """Length (m) of the law's cohesive zone at a crack front, ``(pi/4) E* w /
+        sigma0^2`` (``e_star`` the pair's E* in Pa): the length over which the traction
+        falls from sigma0 to 0 at the edge of an adhesive patch in the JKR-like limit.
+
+        The Dugdale-Barenblatt strip: a uniform traction sigma0 over a length d cancels a
+        stress intensity K = sigma0 sqrt(8 d / pi), so d = (pi/8) (K / sigma0)^2; at the
+        edge of a contact between a rigid and an elastic body (or two, through E*) the
+        energy release rate is G = K^2 / (2 E*), and G = w at the front gives
+        d = (pi/4) E* w / sigma0^2. The form (pi/8) E* w / sigma0^2 (used here up to
+        round 2, session 21) takes G = K^2 / E*, a crack inside one body of modulus E*:
+        half the length. Measured on Johnson's adhesive sinusoid (tests)."""
+        return float(np.pi / 4 * e_star * self.work / self.max_traction ** 2)
 
     def cell_ramp(self, spread):
         """``(g1, width)`` (m, per point): the start and width of the ramp that the
@@ -187,7 +195,7 @@ def check_resolution(law: AdhesionLaw, e_star: float, spacing) -> bool:
     zone, dx = r["process_zone"], r["grid_spacing"]
     warnings.warn(
         f"the {law.kind} adhesion law (w = {law.work:.3g} J/m^2, range {law.range:.3g} m, "
-        f"sigma0 = {law.max_traction:.3g} Pa) has a process zone (pi/8) E* w / sigma0^2 = "
+        f"sigma0 = {law.max_traction:.3g} Pa) has a process zone (pi/4) E* w / sigma0^2 = "
         f"{zone:.3g} m, {zone / dx:.2g} of the grid spacing {dx:.3g} m (below "
         f"{PROCESS_ZONE_CELLS:g}): each cell then acts as a bistable spring of its own, and "
         f"the pull-off and the hysteresis depend on the grid and on the continuation's "
