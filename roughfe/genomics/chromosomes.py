@@ -141,11 +141,13 @@ class Reconstruction:
 def reconstruction(genome: Genome, length, n_nodes=DEFAULT_NODES, order="td") -> Reconstruction:
     """Top-down (``"td"``) or bottom-up (``"bu"``) partial sums of the chromosomes (Eq. 3.3).
 
-    All chromosomes n_s..n_f of Eq. (3.5) at observation length ``length`` (m) are used.
+    The chromosomes n_s..n_f of Eq. (3.5) at observation length ``length`` (m) that the
+    genome holds (:meth:`Genome.held_range`, as :func:`~roughfe.genomics.genome.realize`:
+    the complete sum is the realised profile).
     """
     if order not in ("td", "bu"):
         raise InputError(f"order must be 'td' (top-down) or 'bu' (bottom-up), got {order!r}")
-    n_s, n_f = genome.chromosome_range(length, n_nodes)
+    n_s, n_f = genome.held_range(length, n_nodes)
     idx = np.arange(n_s, n_f + 1) if order == "td" else np.arange(n_f, n_s - 1, -1)
     x = node_coordinates(length, n_nodes)
     chrom = chromosome_heights(genome, x, idx)

@@ -141,10 +141,3 @@ def realization(genome: Genome, length, n_nodes, dim=1, chromosomes=None) -> Sur
     if check_dim(dim) == 1:
         return realize(genome, length, n_nodes, chromosomes=chromosomes)
     return realize_periodic_surface(genome, length, n_nodes, chromosomes)
-
-
-def realization_range(genome: Genome, length, n_nodes, dim=1):
-    """(n_s, n_f) of :func:`realization`: Eq. (3.5) (dim 1) or the periodic range (dim 2)."""
-    if check_dim(dim) == 1:
-        return genome.chromosome_range(length, n_nodes)
-    return periodic_chromosome_range(genome.gamma, genome.lambda1, length, n_nodes)
