@@ -196,10 +196,10 @@ def check_resolution(law: AdhesionLaw, e_star: float, spacing) -> bool:
     warnings.warn(
         f"the {law.kind} adhesion law (w = {law.work:.3g} J/m^2, range {law.range:.3g} m, "
         f"sigma0 = {law.max_traction:.3g} Pa) has a process zone (pi/4) E* w / sigma0^2 = "
-        f"{zone:.3g} m, {zone / dx:.2g} of the grid spacing {dx:.3g} m (below "
-        f"{PROCESS_ZONE_CELLS:g}): each cell then acts as a bistable spring of its own, and "
-        f"the pull-off and the hysteresis depend on the grid and on the continuation's "
-        f"steps. Resolve it: a grid spacing <= {zone / PROCESS_ZONE_CELLS:.3g} m, or the "
+        f"{zone:.3g} m, {zone / dx:.2g} of the grid spacing {dx:.3g} m (a resolved zone "
+        f"spans at least {PROCESS_ZONE_CELLS:g}): each cell then acts as a bistable spring "
+        f"of its own, and the pull-off and the hysteresis depend on the grid and on the "
+        f"continuation's steps. Resolve it: a grid spacing <= {zone / PROCESS_ZONE_CELLS:.3g} m, or the "
         f"same work of adhesion over a longer range",
         ResolutionWarning, stacklevel=3)
     return False
