@@ -199,7 +199,7 @@ def check_resolution(law: AdhesionLaw, e_star: float, spacing) -> bool:
         f"{zone:.3g} m, {zone / dx:.2g} of the grid spacing {dx:.3g} m (a resolved zone "
         f"spans at least {PROCESS_ZONE_CELLS:g}): each cell then acts as a bistable spring "
         f"of its own, and the pull-off and the hysteresis depend on the grid and on the "
-        f"continuation's steps. Resolve it: a grid spacing <= {zone / PROCESS_ZONE_CELLS:.3g} m, or the "
-        f"same work of adhesion over a longer range",
+        f"continuation's steps. Resolve it: a grid spacing <= "
+        f"{zone / PROCESS_ZONE_CELLS:.3g} m, or the same work of adhesion over a longer range",
         ResolutionWarning, stacklevel=3)
     return False
