@@ -553,3 +553,23 @@ def test_a_sweep_back_to_first_touch_is_quick_and_equals_the_cold_solve():
     assert sw.nit < 1000 and back.nit < 1000
     for r in (sw.results[-1], back.results[-1]):
         assert r.delta == 0.0 and r.mean_pressure == 0.0 and r.n_contact == 0
+
+
+def test_a_patch_pressed_far_beyond_its_roughness_converges_to_the_dense_answer():
+    # A non-periodic 100 um patch of 1 um rms roughness at 3e10 and 1e12 Pa on E = 1 GPa:
+    # the approach (2.6 mm, 8.8 cm) is 560 and 19000 times the peak-to-valley height. The float32 rounding of
+    # u = H p (1e-7 of Delta) then exceeds the residual at which the Polonsky-Keer CG
+    # left single precision, and it stalled (20000 iterations, KKT residual 7e-4 -
+    # 3e-2) until round 2, session 22. Now it ends in double precision and agrees with
+    # the dense pivoting solver: the flat-punch-like full contact.
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=1)
+    s = Surface(s.heights, s.size, periodic=False)
+    mat = Material(1e9, 0.0)
+    for p in (3e10, 1e12):
+        pk = solve_contact(s, mat, mean_pressure=p, tol=1e-10)
+        dense = solve_contact(s, mat, mean_pressure=p, tol=1e-10, solver="dense")
+        assert pk.solver == "pk" and pk.nit < 100 and pk.area_fraction == 1.0
+        assert np.max(np.abs(pk.pressure - dense.pressure)) < 1e-9 * p
+        assert pk.delta == pytest.approx(dense.delta, rel=1e-12)
+        assert pk.delta > 500 * np.ptp(s.heights)

@@ -20,7 +20,21 @@ from .solvers import (SolverOutput, _fail, _rescale_to_load, penetration_start, 
 
 #: relative KKT residual above which the products with H may be taken in single precision
 #: (``apply_single``): a hundred times the float32 rounding of u = H p (~1e-7 of max |u|)
+#: when |u| is about the residual's ``scale``; scaled up by Delta / scale where the
+#: approach exceeds it (:func:`_single_until`)
 SINGLE_PRECISION_RESIDUAL = 1e-5
+
+
+def _single_until(approach, scale):
+    """The relative residual down to which u may be kept in single precision:
+    ``SINGLE_PRECISION_RESIDUAL`` times max(1, |Delta| / scale). The float32 rounding
+    of u is ~1e-7 of max |u|, and u is about Delta where the approach is far beyond the
+    heights (a non-periodic patch pressed into nearly full contact: Delta = 8 cm on
+    1 um of roughness). With the fixed threshold the residual of such a solve stalled at
+    that rounding, above the threshold, and never went to double precision (20000
+    iterations, KKT residual 3e-2; round 2, session 22). Below Delta = scale it is the
+    fixed threshold: no solve of the usual range changes."""
+    return SINGLE_PRECISION_RESIDUAL * max(1.0, abs(approach) / scale)
 
 
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
@@ -73,7 +87,8 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     operator products (H and M).
 
     ``apply_single`` (H in single precision: float32 in and out) makes the iterations
-    with a residual above ``SINGLE_PRECISION_RESIDUAL`` mixed precision: u and H t are
+    with a residual above ``SINGLE_PRECISION_RESIDUAL`` (times Delta / scale where that
+    exceeds 1: :func:`_single_until`) mixed precision: u and H t are
     float32 (half the FFT work and half the memory of u in the first iterations, where
     the free set is large and most steps clip), the gradient, the CG vectors and p stay
     float64. Below that residual u is recomputed once in double precision and kept in
@@ -225,12 +240,12 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     low = confirm = False     # u (and H t) in single precision; a final check pending
     watch = None if deflation is None else _StallWatch()
     for it in range(1, max_iter + 1):
-        if low and res <= SINGLE_PRECISION_RESIDUAL:
+        if low and res <= _single_until(d - offset, scale):
             u = None          # near the solution: double precision from here on
         if u is None or it % 50 == 0:
             u = None
             low = (apply_single is not None and not confirm
-                   and res > SINGLE_PRECISION_RESIDUAL)
+                   and res > _single_until(d - offset, scale))
             u, us, exact = H(p, "u", low), 1.0, True
             confirm = False
         # the gap g = u - b: on S here, its test g < d (mask) and minimum in one pass
