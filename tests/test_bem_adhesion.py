@@ -495,3 +495,24 @@ def test_the_adhesive_rules_speak_each_front_end_s_words():
             check_adhesive_run(**kwargs, words=ADHESION_WORDS)
         assert cli in str(info.value)
 
+
+
+def test_the_adhesive_cg_hands_a_stalled_jump_in_to_lbfgsb():
+    # Johnson's sinusoid (alpha = 0.5) with an exponential law at its jump-in: the warm
+    # step from the last open state lands on the non-convex branch, where the CG crawled
+    # for all 20000 iterations (traction residual 21) and the sweep raised, while
+    # L-BFGS-B from the same start converges (found by a reviewer, round 2, session 22).
+    # Now the CG stops when its residual has not halved in ADHESIVE_STALL_WINDOW
+    # iterations and L-BFGS-B finishes: the jumped-in state, as L-BFGS-B alone finds it.
+    mat, length, amp = Material(0.91, 0.3), 1.0, 0.01
+    law = AdhesionLaw("exp", 0.25 * np.pi ** 2 * amp ** 2 / 2, 9e-4)
+    n = 1024
+    s = Surface(amp * np.cos(2 * np.pi * np.arange(n) / n), length, periodic=True)
+    open_state = solve_adhesive(s, mat, law, delta=-0.375 * amp)
+    assert open_state.n_contact == 0
+    jumped = solve_adhesive(s, mat, law, delta=-0.35 * amp, initial=open_state)
+    alone = solve_adhesive(s, mat, law, delta=-0.35 * amp, initial=open_state,
+                           solver="lbfgsb")
+    assert jumped.nit < 2000 and jumped.n_contact > 0.15 * n
+    assert jumped.mean_pressure == pytest.approx(alone.mean_pressure, rel=1e-4)
+    assert jumped.mean_pressure < -0.18 * np.pi * amp * mat.E_star   # tensile: attached

@@ -26,7 +26,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from .directions import _StallWatch
 from .solvers import pr_beta
+
+#: The adhesive CG gives up (``_minimise`` hands over to L-BFGS-B) when its residual has
+#: not halved in this many iterations: on the non-convex branch of a jump-in it crawled
+#: for all 20000 (n = 1024, Johnson's sinusoid, exponential law; round 2, session 22),
+#: where a warm step takes 30-60
+ADHESIVE_STALL_WINDOW = 200
 
 
 def _line_search(df, alpha0, slope0):
@@ -84,6 +91,7 @@ def adhesive_pcg(energy, x0, tol, max_iter):
     d = np.zeros(shape)
     z_old, gz_old = None, 0.0
     res, it, message = np.inf, 0, "max_iter reached"
+    watch = _StallWatch(ADHESIVE_STALL_WINDOW)
     for it in range(1, int(max_iter) + 1):
         g = v[phys]
         _, phi1 = energy.law_at(g)
@@ -102,6 +110,9 @@ def adhesive_pcg(energy, x0, tol, max_iter):
             res = max(res, float(np.max(np.abs(rf))) / scale)
         if res <= tol:
             message = "converged"
+            break
+        if watch.stalled(res):
+            message = f"stalled (residual not halved in {ADHESIVE_STALL_WINDOW} iterations)"
             break
         z = op.convolve_spectrum(rf, hspec).astype(np.float64)
         z[pinned] = 0.0
