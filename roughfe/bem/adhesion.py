@@ -157,7 +157,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     Warns
     -----
     ResolutionWarning
-        The law's process zone is shorter than one grid spacing (``check_resolution``).
+        The law's process zone spans fewer grid spacings than it needs
+        (``check_resolution``, ``AdhesionLaw.resolution_cells``).
     """
     d = _check(surface, material, law, delta)
     if solver not in SOLVERS:
@@ -165,8 +166,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     tol = check_in_open_interval("tol (relative traction residual)", tol, 0.0, 1.0)
     max_iter = check_int("max_iter", max_iter, 1)
     kernel = _choose_kernel(surface, kernel)
-    check_resolution(law, material.E_star, surface.spacing)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
+    check_resolution(law, material.E_star, surface.spacing, _compliance(op, surface))
     h = surface.heights
     if op.periodic and d >= float(h.max() - h.mean()):
         raise InputError(f"delta = {d:.6g} m reaches max h - mean h = "
@@ -221,6 +222,11 @@ def _minimise(energy, x, tol, max_iter, solver):
         if r <= tol or nit >= max_iter:
             break
     return x, nit, r, message
+
+
+def _compliance(op, surface) -> float:
+    """The cell's self-compliance H_ii E*/dx of the operator (the resolution's measure)."""
+    return float(op.diagonal * op.e_star / max(surface.spacing))
 
 
 #: Minimisers of :func:`solve_adhesive`.
@@ -361,7 +367,10 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)):
         raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "
                          f"got {deltas!r}")
-    check_resolution(law, material.E_star, surface.spacing)   # once for the sweep
+    op = _operator(surface.shape, surface.size, material.E_star,
+                   _choose_kernel(surface, kernel))
+    grid = (law, material.E_star, surface.spacing, _compliance(op, surface))
+    check_resolution(*grid)   # once for the sweep
     with warnings.catch_warnings():       # not again at every step
         warnings.simplefilter("ignore", ResolutionWarning)
         results = []
@@ -407,4 +416,4 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
                                      length=surface.size[0])
     return AdhesiveSweep(sweep=sweep, pull_off_force=pull,
                          pull_off_pressure=pull / surface.nominal_area, detached=detached,
-                         law=law, resolution=resolution(law, material.E_star, surface.spacing))
+                         law=law, resolution=resolution(*grid))

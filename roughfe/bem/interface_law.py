@@ -29,7 +29,8 @@ patch, of length ``(pi/4) E* w / sigma0^2`` at a crack front (the Dugdale-Barenb
 strip; :meth:`AdhesionLaw.process_zone`). When it is far below the grid spacing each
 cell is an independent bistable spring: the pull-off and the hysteresis then depend on
 the grid and on the steps of the continuation, and :func:`check_resolution` warns below
-one grid spacing (:data:`PROCESS_ZONE_CELLS`)
+the zone the law needs on the grid (:meth:`AdhesionLaw.resolution_cells`: one spacing
+for the exponential law on a surface, three for Maugis-Dugdale, more on profiles)
 (:class:`~roughfe.errors.ResolutionWarning`). Measured on a rough 32^2 periodic contact
 (docs/theory/07_adhesion_persson.md, "The continuation's predictor and the process
 zone"): with the zone at 3.4 and 0.42 grid spacings the pull-off does not depend on the
@@ -49,11 +50,17 @@ from ..errors import InputError, ResolutionWarning, check_finite_positive
 
 LAWS = ("md", "exp")
 
-#: A process zone shorter than this many grid spacings is a ResolutionWarning: below
-#: about one spacing (0.88) the elastic stiffness of one cell, E* / (1.12 dx) (its own
-#: displacement under a uniform pressure on it), falls below the peak stiffness of the
-#: exponential law, sigma0 / rho = (pi/4) E* / zone, so every cell can snap on its own
+#: A process zone shorter than this many grid spacings is a ResolutionWarning for the
+#: exponential law on a square cell of a surface: below about one spacing (0.88) the
+#: elastic stiffness of one cell, E* / (1.12 dx) (its own displacement under a uniform
+#: pressure on it), falls below the peak stiffness of the exponential law,
+#: sigma0 / rho = (pi/4) E* / zone, so every cell can snap on its own. Other laws and
+#: profiles: :meth:`AdhesionLaw.resolution_cells`
 PROCESS_ZONE_CELLS = 1.0
+#: The centre displacement of a square cell of a surface under a uniform pressure p on
+#: it, in units of p dx / E* (the influence operator's diagonal H_ii E* / dx: 1.12 with
+#: the Love kernel, 1.10-1.12 with the periodic spectral one)
+SQUARE_CELL_COMPLIANCE = 1.12
 
 
 @dataclass(frozen=True)
@@ -113,6 +120,36 @@ class AdhesionLaw:
         half the length. Measured on Johnson's adhesive sinusoid (tests)."""
         return float(np.pi / 4 * e_star * self.work / self.max_traction ** 2)
 
+    def resolution_cells(self, cell_compliance: float, ndim: int) -> float:
+        """The least process zone, in grid spacings, that resolves this law on a grid
+        whose cell has the self-compliance ``cell_compliance`` (its centre displacement
+        under a uniform pressure on it, in p dx / E*: the influence operator's diagonal
+        H_ii E*/dx; :data:`SQUARE_CELL_COMPLIANCE` on a surface, 3-7 on a profile,
+        growing as log n) in ``ndim`` dimensions.
+
+        * exponential: 0.9 c (1.0 on a surface). The cell's stiffness E*/(c dx) must
+          exceed the law's peak stiffness sigma0/rho = (pi/4) E*/zone: zone >= (pi/4) c
+          dx, with a margin. Measured (round 2, session 22): the pull-off of Maugis'
+          sphere 1.25 % off its grid limit at 1.0 cell, branches that retrace (hysteresis
+          < 1e-5 of the pull-off); Johnson's sinusoid (a profile, c = 3.3-5.9) +0.5 % at
+          2 cells and 2 % hysteresis, +0.1 % and none at 4.
+        * Maugis-Dugdale on a surface: 2.7 c (3 cells). Its ramp is 1/s times stiffer
+          than the exponential law, but the cell spread of the step (module docstring)
+          widens it where the gap varies across a cell: measured on Maugis' sphere
+          (lambda 1-3, s = 0.05-0.5), +5.6 % pull-off and 6 % hysteresis at 1.0 cell,
+          +0.9-1.0 % and 0.7-1.5 % at 3.1-3.5 cells, the same for every s <= 0.2.
+        * Maugis-Dugdale on a profile: max(3.2, 0.6 / s) c. On Johnson's sinusoid the
+          hysteresis where the state is unique (positive approach) falls below 1 % of the
+          pull-off at about 16, 20-32, 32 and 64 cells for s = 0.5, 0.2, 0.1, 0.05
+          (c = 4-5.6 there); the ramp's own stiffness sets it, as the spread does not.
+        """
+        c = float(cell_compliance)
+        if self.kind == "exp":
+            return 0.9 * c
+        if ndim >= 2:
+            return 2.7 * c
+        return max(3.2, 0.6 / max(self.smoothing, 1e-12)) * c
+
     def cell_ramp(self, spread):
         """``(g1, width)`` (m, per point): the start and width of the ramp that the
         Dugdale step becomes under the cell spread ``spread`` (:meth:`evaluate`), for a
@@ -171,35 +208,46 @@ class AdhesionLaw:
                 "smoothing": self.smoothing if self.kind == "md" else None}
 
 
-def resolution(law: AdhesionLaw, e_star: float, spacing) -> dict:
+def resolution(law: AdhesionLaw, e_star: float, spacing,
+               cell_compliance: float | None = None) -> dict:
     """The law's process zone against the grid, JSON-safe (the provenance a result file
     keeps beside the warning of :func:`check_resolution`): ``process_zone`` (m,
-    :meth:`AdhesionLaw.process_zone`), ``grid_spacing`` (m, the largest of ``spacing``),
-    ``process_zone_cells`` (their ratio), ``threshold_cells``
-    (:data:`PROCESS_ZONE_CELLS`) and ``resolved`` (ratio >= threshold)."""
+    :meth:`AdhesionLaw.process_zone`), ``grid_spacing`` (m, the largest of ``spacing``,
+    one per axis), ``process_zone_cells`` (their ratio), ``cell_compliance`` (the
+    operator's diagonal H_ii E*/dx; default :data:`SQUARE_CELL_COMPLIANCE` on a surface,
+    required for a profile), ``threshold_cells`` (:meth:`AdhesionLaw.resolution_cells`)
+    and ``resolved`` (ratio >= threshold)."""
     zone = law.process_zone(e_star)
-    dx = float(np.max(spacing))
+    spacing = np.atleast_1d(np.asarray(spacing, float))
+    dx, ndim = float(np.max(spacing)), spacing.size
+    if cell_compliance is None:
+        if ndim < 2:
+            raise InputError("the resolution of a law on a profile needs the cell's "
+                             "compliance (the influence operator's diagonal H_ii E*/dx)")
+        cell_compliance = SQUARE_CELL_COMPLIANCE
+    need = law.resolution_cells(cell_compliance, ndim)
     return {"process_zone": zone, "grid_spacing": dx, "process_zone_cells": zone / dx,
-            "threshold_cells": PROCESS_ZONE_CELLS,
-            "resolved": bool(zone >= PROCESS_ZONE_CELLS * dx)}
+            "cell_compliance": float(cell_compliance), "threshold_cells": need,
+            "resolved": bool(zone >= need * dx)}
 
 
-def check_resolution(law: AdhesionLaw, e_star: float, spacing) -> bool:
+def check_resolution(law: AdhesionLaw, e_star: float, spacing,
+                     cell_compliance: float | None = None) -> bool:
     """Warn (:class:`~roughfe.errors.ResolutionWarning`) when the law's process zone
-    (:meth:`AdhesionLaw.process_zone`) is shorter than :data:`PROCESS_ZONE_CELLS` of the
-    largest grid spacing ``spacing`` (m, a number or one per axis); returns True when it
-    is resolved (:func:`resolution`)."""
-    r = resolution(law, e_star, spacing)
+    (:meth:`AdhesionLaw.process_zone`) spans fewer grid spacings than the law needs
+    (:meth:`AdhesionLaw.resolution_cells`, :func:`resolution` for the arguments);
+    returns True when it is resolved."""
+    r = resolution(law, e_star, spacing, cell_compliance)
     if r["resolved"]:
         return True
-    zone, dx = r["process_zone"], r["grid_spacing"]
+    zone, dx, need = r["process_zone"], r["grid_spacing"], r["threshold_cells"]
     warnings.warn(
         f"the {law.kind} adhesion law (w = {law.work:.3g} J/m^2, range {law.range:.3g} m, "
         f"sigma0 = {law.max_traction:.3g} Pa) has a process zone (pi/4) E* w / sigma0^2 = "
-        f"{zone:.3g} m, {zone / dx:.2g} of the grid spacing {dx:.3g} m (a resolved zone "
-        f"spans at least {PROCESS_ZONE_CELLS:g}): each cell then acts as a bistable spring "
+        f"{zone:.3g} m, {zone / dx:.2g} of the grid spacing {dx:.3g} m (this law on this "
+        f"grid needs at least {need:.2g}): each cell then acts as a bistable spring "
         f"of its own, and the pull-off and the hysteresis depend on the grid and on the "
         f"continuation's steps. Resolve it: a grid spacing <= "
-        f"{zone / PROCESS_ZONE_CELLS:.3g} m, or the same work of adhesion over a longer range",
+        f"{zone / need:.3g} m, or the same work of adhesion over a longer range",
         ResolutionWarning, stacklevel=3)
     return False
