@@ -169,6 +169,9 @@ def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
     assert res["grid_spacing"] == pytest.approx(max(s.spacing), rel=1e-12)
     assert res["resolved"] and res["process_zone_cells"] == pytest.approx(
         zone / max(s.spacing), rel=1e-12)
+    # the Maugis-Dugdale law on a surface needs 2.7 cell compliances (about 3 cells)
+    assert res["cell_compliance"] == pytest.approx(1.11, abs=0.02)
+    assert res["threshold_cells"] == pytest.approx(2.7 * res["cell_compliance"], rel=1e-12)
     assert "adhesion_resolution" not in el["inputs"]
     for other in (adh, hard):
         for e, o in zip(el["steps"], other["steps"]):
@@ -201,6 +204,22 @@ def test_leak_contact_physics_bad_input(tmp_path, capsys, extra, message):
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+def test_leak_of_a_profile_with_adhesion_says_leakage_needs_a_surface(tmp_path, capsys):
+    # the law's resolution (written beside the inputs) is taken on the profile's own
+    # operator, and the run then says what is wrong: leakage is 2D (it said the
+    # resolution needed the cell's compliance, round 2, session 22)
+    from roughfe.cli import main
+    from roughfe.surfaces.spectral import spectral_profile
+
+    path = save_surface(spectral_profile(256, 1e-4, 0.8, rms_height=1e-6, rng=1),
+                        tmp_path / "p.npz")
+    assert main(["leak", str(path), "--quiet", "-o", str(tmp_path / "o"), "--adhesion",
+                 "md", "--work-of-adhesion", "0.01", "--range", "1e-7", "--delta",
+                 "1e-7"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "leakage needs a 2D surface" in err and len(err.splitlines()) == 1
 
 
 def test_leak_direction_y_is_direction_x_of_the_transpose(tmp_path):

@@ -78,7 +78,8 @@ from .adhesive_energy import AdhesiveEnergy
 from .adhesive_start import continued_start, elastic_start
 from .interface_law import LAWS, AdhesionLaw, check_resolution, resolution
 
-__all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "solve_adhesive"]
+__all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "cell_compliance",
+           "solve_adhesive"]
 
 REFERENCES = (
     "Maugis D. (1992) J. Colloid Interface Sci. 150:243-269 (Maugis-Dugdale law)",
@@ -167,7 +168,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     max_iter = check_int("max_iter", max_iter, 1)
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
-    check_resolution(law, material.E_star, surface.spacing, _compliance(op, surface))
+    check_resolution(law, material.E_star, surface.spacing,
+                     cell_compliance(surface, material.E_star, kernel))
     h = surface.heights
     if op.periodic and d >= float(h.max() - h.mean()):
         raise InputError(f"delta = {d:.6g} m reaches max h - mean h = "
@@ -224,8 +226,13 @@ def _minimise(energy, x, tol, max_iter, solver):
     return x, nit, r, message
 
 
-def _compliance(op, surface) -> float:
-    """The cell's self-compliance H_ii E*/dx of the operator (the resolution's measure)."""
+def cell_compliance(surface: Surface, e_star: float, kernel: str = "auto") -> float:
+    """The self-compliance of one cell of ``surface``'s grid, H_ii E*/dx (the centre
+    displacement under a uniform pressure p on the cell, in p dx / E*; dx the largest
+    spacing): the measure of :meth:`AdhesionLaw.resolution_cells`. 1.12 on a square cell
+    of a surface; 3-7 on a profile (growing as log n)."""
+    kernel = _choose_kernel(surface, kernel)
+    op = _operator(surface.shape, surface.size, float(e_star), kernel)
     return float(op.diagonal * op.e_star / max(surface.spacing))
 
 
@@ -367,9 +374,8 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)):
         raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "
                          f"got {deltas!r}")
-    op = _operator(surface.shape, surface.size, material.E_star,
-                   _choose_kernel(surface, kernel))
-    grid = (law, material.E_star, surface.spacing, _compliance(op, surface))
+    grid = (law, material.E_star, surface.spacing,
+            cell_compliance(surface, material.E_star, kernel))
     check_resolution(*grid)   # once for the sweep
     with warnings.catch_warnings():       # not again at every step
         warnings.simplefilter("ignore", ResolutionWarning)

@@ -217,8 +217,10 @@ def _leak_run(args, surface, material, out):
             "adhesion": physics["adhesion"] and physics["adhesion"].describe(),
             "units": "SI (m, Pa, Pa s, m^3/s)"}
     if physics["adhesion"] is not None:  # the process zone against the grid (provenance)
-        base["adhesion_resolution"] = resolution(physics["adhesion"], material.E_star,
-                                                 surface.spacing)
+        from ..bem.adhesion import cell_compliance
+        base["adhesion_resolution"] = resolution(
+            physics["adhesion"], material.E_star, surface.spacing,
+            cell_compliance(surface, material.E_star))
     if args.fsi:
         if physics["adhesion"] is not None or physics["hardness"] is not None \
                 or physics["unload"]:
