@@ -343,7 +343,8 @@ class ContactResult(Frozen):
         the displacement on the zero padding; its warm start).
     plastic_area_fraction : float, BEM with a hardness
         Fraction of the nominal area at p = H_p (perfectly plastic flow; within
-        ``roughfe.bem.contact.YIELD_RTOL`` or 100 tol of H_p, the solver's accuracy).
+        ``roughfe.bem.contact.YIELD_RTOL`` or 100 tol of H_p, the solver's accuracy,
+        at most 1 %).
     plastic_displacement : ndarray, BEM with a hardness
         Permanent displacement u_pl >= 0 (m) of the elastic surface after this step
         (read-only); kept by the next steps of a sweep.

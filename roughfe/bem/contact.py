@@ -46,11 +46,11 @@ SOLVERS = ("auto", "dense", "nnls", "pk")
 #: (measured: a 20-step sweep of a 512-point profile takes the same time with both, at
 #: 1024 points pk is 3x faster, at 2048 15x)
 DENSE_MAX_POINTS = 512
-#: a point whose pressure is within max(YIELD_RTOL, 100 tol) of the hardness is at yield
-#: (plastic area, no stiffness): the solver's pressures are exact to ~1e-8 of max p at
-#: tol 1e-10, and a point that reaches the hardness through the elastic equations (an
-#: elastic reload to the previous maximum load) comes out just below it, not clipped to it
-YIELD_RTOL = 1e-6
+#: a contact point with p within max(YIELD_RTOL, min(100 tol, YIELD_BAND_MAX)) of the
+#: hardness is at yield (no stiffness): pressures are exact to ~1e-8 of max p at tol
+#: 1e-10, and an elastic reload to the previous peak load comes out just below H_p. The
+#: cap: at tol 1e-3 the band was all of 0..H_p, so every point yielded (K = 0)
+YIELD_RTOL, YIELD_BAND_MAX = 1e-6, 1e-2
 
 REFERENCES = (
     "Bemporad A., Paggi M. (2015) Int. J. Solids Struct. 69-70:94-105 (NNLS BEM)",
@@ -443,7 +443,8 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
     gap = np.where(contact, 0.0, np.maximum(w, 0.0))
     plastic_fraction = None
     if hardness is not None:
-        flowing = p >= hardness * (1.0 - max(YIELD_RTOL, 100.0 * tolerance))
+        band = max(YIELD_RTOL, min(100.0 * tolerance, YIELD_BAND_MAX))
+        flowing = contact & (p >= hardness * (1.0 - band))
         plastic_fraction = float(np.count_nonzero(flowing)) / p.size
         new = np.where(flowing, np.maximum(-w, 0.0), 0.0)
         plastic = new if plastic is None else plastic + new
