@@ -561,3 +561,8 @@ def test_the_resolution_a_law_needs_depends_on_the_law_and_the_grid():
         solve_adhesive(s, mat, law, delta=0.0)
     with pytest.raises(InputError, match="compliance"):
         resolution(law, mat.E_star, (1.0 / n,))
+    # below s = 0.05 the cell spread sets the ramp: s = 0 solves the same law and needs
+    # the same grid (0.6 / s asked for 3e12 cells)
+    sharp = AdhesionLaw("md", law.work, law.range, smoothing=0.0)
+    assert sharp.resolution_cells(4.6, 1) == law.resolution_cells(4.6, 1) == pytest.approx(
+        0.6 / 0.05 * 4.6)

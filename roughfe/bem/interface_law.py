@@ -138,17 +138,21 @@ class AdhesionLaw:
           widens it where the gap varies across a cell: measured on Maugis' sphere
           (lambda 1-3, s = 0.05-0.5), +5.6 % pull-off and 6 % hysteresis at 1.0 cell,
           +0.9-1.0 % and 0.7-1.5 % at 3.1-3.5 cells, the same for every s <= 0.2.
-        * Maugis-Dugdale on a profile: max(3.2, 0.6 / s) c. On Johnson's sinusoid the
-          hysteresis where the state is unique (positive approach) falls below 1 % of the
-          pull-off at about 16, 20-32, 32 and 64 cells for s = 0.5, 0.2, 0.1, 0.05
-          (c = 4-5.6 there); the ramp's own stiffness sets it, as the spread does not.
+        * Maugis-Dugdale on a profile: max(3.2, 0.6 / max(s, 0.05)) c. On Johnson's
+          sinusoid the hysteresis where the state is unique (positive approach) falls
+          below 1 % of the pull-off at about 16, 20-32, 32 and 64 cells for s = 0.5, 0.2,
+          0.1, 0.05 (c = 4-5.6 there): the ramp's own stiffness sets it. Below s = 0.05
+          the cell spread sets the ramp at these resolutions (s = 0 and 0.05 gave the
+          same sweeps at 1024-4096 cells), hence the floor (a reviewer found 0.6 / s
+          asking for 3e12 cells at s = 0). With ``cell_average=False`` (the law sampled
+          at the cell centres) more cells are needed than this.
         """
         c = float(cell_compliance)
         if self.kind == "exp":
             return 0.9 * c
         if ndim >= 2:
             return 2.7 * c
-        return max(3.2, 0.6 / max(self.smoothing, 1e-12)) * c
+        return max(3.2, 0.6 / max(self.smoothing, 0.05)) * c
 
     def cell_ramp(self, spread):
         """``(g1, width)`` (m, per point): the start and width of the ramp that the
