@@ -428,16 +428,25 @@ def central_differences(x, y, branch=None):
     steps) or fewer than 2 points.
 
     ``branch`` (optional, one flag per point, e.g. 1 on an unloading branch): the
-    differences are taken within each run of equal flags, one-sided at its ends, never
-    across the turn of a loading-unloading sweep (where the two neighbours of the top
-    step are the same load on either branch, and the difference read K = 0)."""
+    differences are taken within each run of equal flags, never across the turn of a
+    loading-unloading sweep (where the two neighbours of the top step are the same load
+    on either branch, and the difference read K = 0). A run after a turn starts at the
+    turning point (the last point before it: the unloading curve leaves the top state),
+    which is used as its first neighbour; the turning point's own value is its run's
+    one-sided one. (Until round 2, session 22 the unloading run was differenced
+    without it: an elastic unloading 30 -> 10 -> 1 MPa read K = 1.3e13 Pa/m at 10 MPa
+    where the loading run and the exact K read 2.5e13.)"""
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     out = np.full(x.shape, np.nan)
     if branch is not None:
         edges = np.flatnonzero(np.diff(np.asarray(branch)) != 0) + 1
         for run in np.split(np.arange(x.size), edges):
-            out[run] = central_differences(x[run], y[run])
+            if run[0] == 0:
+                out[run] = central_differences(x[run], y[run])
+            else:             # with the turning point in front
+                ext = np.concatenate([[run[0] - 1], run])
+                out[run] = central_differences(x[ext], y[ext])[1:]
         return out
     if x.size < 2:
         return out
