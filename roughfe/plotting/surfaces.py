@@ -83,6 +83,20 @@ def plot_profile(surface, path, title=None, axis=0):
     return save_figure(fig, path)
 
 
+def _not_one_power_law(psd, fit) -> str:
+    """A legend note when the data sit off the fitted line: the median of data / fit
+    over the fit's range outside [0.5, 2] (the Whittle prefactor is the weighted mean
+    of C q^-s, which the few long waves dominate when the spectrum is not one power
+    law: x3p-2.x3p, median 0.29)."""
+    sel = (psd.q >= fit.q_range[0]) & (psd.q <= fit.q_range[1]) & (psd.C > 0)
+    if not sel.any():
+        return ""
+    ratio = float(np.median(psd.C[sel] / (fit.prefactor * psd.q[sel] ** fit.slope)))
+    if 0.5 <= ratio <= 2.0:
+        return ""
+    return f"\n(median data/fit {ratio:.2g}: not one power law)"
+
+
 def plot_psd(spectra, path, title=None, fits=None):
     """Log-log plot of power spectra.
 
@@ -104,7 +118,8 @@ def plot_psd(spectra, path, title=None, fits=None):
         if fit is not None and fit.success:
             qf = np.geomspace(*fit.q_range, 20)
             ax.loglog(qf, fit.prefactor * qf ** fit.slope, "k--", lw=1,
-                      label=f"fit: H = {fit.hurst:.3f}, D = {fit.fractal_dimension:.3f}")
+                      label=f"fit: H = {fit.hurst:.3f}, D = {fit.fractal_dimension:.3f}"
+                            + _not_one_power_law(psd, fit))
     ax.set_xlabel("wavenumber q (rad/m)")
     unit = "m$^4$" if units == {2} else ("m$^3$" if units == {1} else "m$^3$ or m$^4$")
     ax.set_ylabel(f"PSD C(q) ({unit})")
