@@ -113,13 +113,20 @@ def plot_design_curves(results, path, title="") -> "Path":
     results = list(results)
     fig, axes = new_figure(1, 2, figsize=(11, 4))
     for t in results[0].objective.targets:
-        ax = axes[0] if t.quantity == "K" else axes[1]
+        ax = axes[0] if t.quantity == "K" else axes[1]   # the targets' own panels
         ax.plot(t.pressure, t.values, "r-", lw=2.5, label=f"target {t.name}")
+    targets = results[0].objective.targets
     for r, m in zip(results, ("o", "s", "^", "x")):
         c = r.best.curve
-        s = combined_score(r.best.scores)
-        axes[0].plot(c.pressure, c.stiffness, "--" + m, ms=4, label=f"{r.method} s={s:.3f}")
-        axes[1].plot(c.pressure, c.area_fraction, "--" + m, ms=4, label=r.method)
+        labels = []
+        for quantity in ("K", "A"):      # each panel: the scores of its own targets
+            own = [f"{sc:.3f}" for t, sc in zip(targets, r.best.scores)
+                   if t.quantity == quantity]
+            labels.append(f"{r.method} s={', '.join(own)}" if own else r.method)
+        if len(targets) > 1:
+            labels[0] += f" (product {combined_score(r.best.scores):.3f})"
+        axes[0].plot(c.pressure, c.stiffness, "--" + m, ms=4, label=labels[0])
+        axes[1].plot(c.pressure, c.area_fraction, "--" + m, ms=4, label=labels[1])
     axes[0].set_xlabel("p (Pa)")
     axes[0].set_ylabel("K (Pa/m)")
     axes[1].set_xlabel("p (Pa)")
