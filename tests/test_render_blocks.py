@@ -39,3 +39,27 @@ def test_a_large_contact_render_is_drawn_from_blocks(tmp_path):
     r = solve_contact(s, Material(1e9, 0.0), mean_pressure=2e6, tol=1e-4)
     path = render_contact(s.heights, r, tmp_path / "r.png", title="t", window_size=(400, 300))
     assert path.stat().st_size > 5000
+
+
+def test_the_deformed_surface_puts_every_contact_point_on_the_flat():
+    # with a hardness, yielded points carry a plastic displacement: z = h - u - u_pl is
+    # max h - Delta on the whole contact set (without u_pl the render spread the yielded
+    # points over 43 % of the height range)
+    from roughfe.bem import Material, contact_sweep
+    from roughfe.cli.contact_cmd import _shown_step
+    from roughfe.plotting.contact import deformed_heights
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=3)
+    top = s.heights.max() - s.heights.mean()
+    sw = contact_sweep(s, Material(1e9, 0.3), deltas=[0.3 * top, 0.6 * top], hardness=5e7,
+                       unload=True)
+    assert max(r.plastic_area_fraction for r in sw.results) > 0.05
+    for r in (r for r in sw.results if r.n_contact):
+        z = deformed_heights(s.heights, r)[r.contact]
+        assert np.ptp(z) < 1e-6 * np.ptp(s.heights)
+        assert z.mean() == pytest.approx(s.heights.max() - r.delta, abs=1e-6 * np.ptp(s.heights))
+    # the state figure shows the largest contact below full contact (full contact is a
+    # blank plane), the last such step; full contact only when every step is
+    assert _shown_step([0.1, 0.4, 1.0]) == 1
+    assert _shown_step([0.1, 0.4, 0.4, 0.2, 0.0]) == 2
+    assert _shown_step([1.0, 1.0]) == 1

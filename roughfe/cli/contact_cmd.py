@@ -131,9 +131,7 @@ def _run(args) -> int:
                               pull_off_force=adhesive.pull_off_force,
                               title=f"{Path(args.surface).name}, {law.kind}: w = {law.work:.3g} "
                                     f"J/m^2, range {law.range:.3g} m")
-            # the state of largest contact (the last of a loading sweep; not the
-            # detached end of an unloading branch)
-            last = sweep.results[len(sweep.results) - 1 - int(np.argmax(sweep.area_fraction[::-1]))]
+            last = sweep.results[_shown_step(sweep.area_fraction)]
             if surface.ndim == 2:
                 render_contact(surface.heights, last, out / "contact_render.png",
                                title=Path(args.surface).name)
@@ -173,6 +171,17 @@ def _in_flags(message: str) -> str:
     for phrase, flag in _FLAGS:
         message = message.replace(phrase, flag)
     return message
+
+
+def _shown_step(area_fraction) -> int:
+    """The step the state figure shows: the one of largest contact below full contact
+    (a fully flattened periodic surface, the last default step, is a blank plane), the
+    last such one; full contact only when every step is (not the detached end of an
+    unloading branch)."""
+    a = np.asarray(area_fraction)
+    partial = np.flatnonzero(a < 1.0)
+    pool = partial if partial.size else np.arange(a.size)
+    return int(pool[len(pool) - 1 - int(np.argmax(a[pool][::-1]))])
 
 
 def _adhesive_sweep(args, surface, material, law, tol):

@@ -130,27 +130,47 @@ def plot_adhesion(steps, path, pull_off_force=None, title=None):
     return save_figure(fig, path)
 
 
+def deformed_heights(heights, result):
+    """The rough surface as the deformable body (thesis Fig. 7b), z = h - u - u_pl (m):
+    u the elastic displacement, u_pl the plastic one of a state with a hardness (the gap
+    is g = u + u_pl + max h - h - Delta, roughfe.bem.contact). Every contact point is
+    at z = max h - Delta, elastic or yielded (without u_pl the yielded points of a
+    hardness run were drawn over 43 % of the height range; round 2, session 22)."""
+    plastic = getattr(result, "plastic_displacement", None)
+    z = np.asarray(heights) - result.displacement
+    return z if plastic is None else z - plastic
+
+
+def _state_label(result) -> str:
+    """Delta, p and A* of the state shown (and the plastic area with a hardness)."""
+    label = (f"Delta = {result.delta * UM:.3g} um, p = {result.mean_pressure * MPA:.3g} MPa, "
+             f"A* = {result.area_fraction:.3f}")
+    plastic = getattr(result, "plastic_area_fraction", None)
+    return label + ("" if plastic is None else f", plastic area {plastic:.3f}")
+
+
 def plot_profile_state(heights, result, path, title=None):
     """Profile contact: rigid rough profile, deformed elastic flat and pressure."""
     x = np.arange(result.pressure.size) * result.spacing[0] * UM
     h = np.asarray(heights)
-    flat = (h.max() - result.delta + result.displacement)
+    # the elastic flat: max h - Delta + u + u_pl, which touches h where z = max h - Delta
+    flat = h.max() - result.delta + (h - deformed_heights(h, result))
     fig, (ax1, ax2) = new_figure(2, 1, figsize=(9, 5), sharex=True)
     ax1.plot(x, h * UM, lw=0.8, label="rough profile")
     ax1.plot(x, flat * UM, lw=0.8, label="deformed elastic surface")
     ax1.set_ylabel("height (um)")
-    ax1.legend(loc="lower right")
+    ax1.legend(loc="best", fontsize=8, framealpha=0.8)
     ax2.plot(x, result.pressure * MPA, lw=0.8)
     ax2.set_xlabel("x (um)")
     ax2.set_ylabel("pressure (MPa)")
-    if title:
-        ax1.set_title(title)
+    ax1.set_title(((title + ": ") if title else "") + _state_label(result), fontsize=10)
     return save_figure(fig, path)
 
 
 def render_contact(heights, result, path, title=None, exaggeration=None,
                    window_size=(1000, 800)):
-    """Off-screen render of the deformed rough surface z = h - u coloured by pressure.
+    """Off-screen render of the deformed rough surface z = h - u (- u_pl with a hardness)
+    coloured by pressure.
 
     The thesis treats the rough surface as the deformable body (Fig. 7b): z = h - u puts
     every contact point on the flat at max h - Delta. Contact points are coloured by
@@ -167,7 +187,7 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     nx, ny = h.shape
     dx, dy = result.spacing
     blocks = render_blocks(h.shape)
-    z = block_means(h - result.displacement, blocks) * UM
+    z = block_means(deformed_heights(h, result), blocks) * UM
     z -= z.mean()
     ptp = float(np.ptp(h)) * UM or 1.0
     if exaggeration is None:
@@ -187,10 +207,8 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
                      scalar_bar_args={"title": "pressure (MPa)", "vertical": True,
                                       "position_x": 0.86, "position_y": 0.15,
                                       "height": 0.7, "fmt": "%.3g"})
-    label = (title or "") + (f"\nDelta = {result.delta * UM:.3g} um, A* = "
-                             f"{result.area_fraction:.3f}, p = {result.mean_pressure * MPA:.3g} "
-                             f"MPa (free area grey), vertical x{exaggeration:.3g}"
-                             + decimation_note(h.shape, z.shape))
+    label = (title or "") + (f"\n{_state_label(result)} (free area grey), vertical "
+                             f"x{exaggeration:.3g}" + decimation_note(h.shape, z.shape))
     plotter.add_text(label.strip(), position="upper_left", font_size=10)
     plotter.set_background("white")
     plotter.camera_position = "iso"
