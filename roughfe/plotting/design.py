@@ -64,14 +64,19 @@ def plot_genetic_map(rows, path, n_max=None) -> "Path":
               origin="lower", extent=(-0.5, len(rows) - 0.5, 0.5, n_max + 0.5),
               interpolation="nearest")
     ax.set_xticks(range(len(rows)))
-    ax.set_xticklabels([r["label"] for r in rows], rotation=90, fontsize=6)
+    ax.set_xticklabels([r["label"] for r in rows], rotation=90, fontsize=7)
+    ax.set_xlabel("genome")
     ax.set_ylabel("chromosome n")
     ax.set_title("genetic map: macro (red) / micro (blue) chromosomes")
     return save_figure(fig, path)
 
 
-def plot_map_summary(rows, path, n_max=10) -> "Path":
-    """Fig. 55: share of genomes in which chromosome n (1..n_max) is macro or micro."""
+def plot_map_summary(rows, path, n_max=None) -> "Path":
+    """Fig. 55: share of genomes in which chromosome n (1..n_max) is macro or micro;
+    ``n_max`` defaults to the largest n_c of the rows (the thesis' figure stops at 10;
+    a fixed 10 dropped the chromosomes beyond it without a note)."""
+    if n_max is None:
+        n_max = max([int(r["n_c"]) for r in rows] or [1])
     n = np.arange(1, n_max + 1)
     macro = np.array([sum(1 for r in rows if k in r["macro"]) for k in n])
     present = np.array([sum(1 for r in rows if k <= r["n_c"]) for k in n])
@@ -79,10 +84,15 @@ def plot_map_summary(rows, path, n_max=10) -> "Path":
     ax.bar(n, macro / np.maximum(present, 1), color=_MACRO, label="macro")
     ax.bar(n, (present - macro) / np.maximum(present, 1), bottom=macro / np.maximum(present, 1),
            color=_MICRO, label="micro")
+    for k, m in zip(n, present):          # how many genomes hold chromosome n
+        ax.text(k, 1.01, str(int(m)), ha="center", va="bottom", fontsize=7)
     ax.set_xlabel("chromosome n")
     ax.set_ylabel("fraction of genomes")
+    ax.set_ylim(0, 1.1)
     ax.set_xticks(n)
-    ax.legend()
+    ax.set_title(f"macro / micro share over {len(rows)} genomes (number holding n above)",
+                 fontsize=10)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
     return save_figure(fig, path)
 
 
