@@ -6,6 +6,7 @@ matplotlib figures. Every file is written atomically (roughfe.plotting.common).
 """
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -40,7 +41,9 @@ def _cells(a):
 def _finish(plotter, title, path, size):
     # no cube-axes labels: vtk's label formatting aborts (std::bad_alloc in its regex)
     # in processes that also loaded dolfinx; the size goes into the caption instead
-    plotter.add_text(f"{title}\nx to the right, y up; {size[0] * UM:.4g} x {size[1] * UM:.4g} um",
+    # long titles (a coupled step's tag) wrapped: centred text is clipped at both ends
+    text = "\n".join(textwrap.fill(line, 80) for line in title.split("\n"))
+    plotter.add_text(f"{text}\nx to the right, y up; {size[0] * UM:.4g} x {size[1] * UM:.4g} um",
                      font_size=10, position="upper_edge")
     plotter.view_xy()
     plotter.camera.zoom(0.9)
@@ -118,7 +121,8 @@ def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="ce
         img.point_data["p (Pa)"] = p.ravel(order="F")
     pl = offscreen_plotter(window_size=(900, 900))
     pl.add_mesh(img, scalars="p (Pa)", cmap="viridis", nan_color="grey", lighting=False,
-                scalar_bar_args={"vertical": True, "title": "p (Pa)"})
+                scalar_bar_args={"vertical": True, "title": "p (Pa)", "fmt": "%.3g",
+                                 "position_x": 0.85, "position_y": 0.1, "height": 0.7})
     return _finish(pl, title, path, size)
 
 
@@ -129,12 +133,15 @@ def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
                                  size=list(size), path=str(path), title=title)
     q = np.asarray(flux_magnitude, float)
     pos = q[q > 0]
+    if not pos.size:       # a sealed step: say so, not a black square with "0.00" ticks
+        title += "\nno flow: no percolating path in this direction (sealed)"
     floor = pos.max() * 1e-8 if pos.size else 1.0
     img = _image(q.shape, size)
     img.cell_data["log10 |q|"] = _cells(np.log10(np.maximum(q, floor)))
     pl = offscreen_plotter(window_size=(900, 900))
     pl.add_mesh(img, scalars="log10 |q|", cmap="inferno", lighting=False,
-                scalar_bar_args={"vertical": True, "title": "log10 q"})
+                scalar_bar_args={"vertical": True, "title": "log10 q, m^2/s", "fmt": "%.3g",
+                                 "position_x": 0.85, "position_y": 0.1, "height": 0.7})
     return _finish(pl, title, path, size)
 
 
