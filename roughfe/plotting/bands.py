@@ -112,6 +112,8 @@ def plot_band_curves(mech, path) -> Path:
             ax.plot(mech.complete.pressure * _MPA, getattr(mech.complete, q), color="black",
                     lw=2, label="complete" if col == 0 else None)
             ax.set_xscale("log")
+            if col == 1:          # K spans decades over the pressures (as roughfe contact)
+                ax.set_yscale("log")
             ax.set_xlabel("p (MPa)")
             ax.set_ylabel("A*" if col == 0 else "K (Pa/m)")
             ax.set_title(f"{name} partial sums: {'A(p)' if col == 0 else 'K(p)'}", fontsize=9)
@@ -134,7 +136,13 @@ def plot_band_correlations(mech, path, macro_micro=None) -> Path:
             ax.axvspan(m - 0.5, m + 0.5, color="tab:red", alpha=0.08)
     ax.set_xlabel("band n")
     ax.set_ylabel("c_n of K(p)")
-    ax.set_ylim(min(-0.1, float(np.nanmin(mech.c_chromosome["K"])) - 0.05), 1.05)
+    ax.set_xticks(n)
+    # the range of the bars (and the threshold): c_n near 1 are told apart
+    shown = np.concatenate([np.asarray(mech.c_chromosome["K"], float),
+                            np.asarray(mech.c_td["K"], float), np.asarray(mech.c_bu["K"], float),
+                            [macro_micro.threshold] if macro_micro is not None else []])
+    low = float(np.nanmin(shown)) if np.isfinite(shown).any() else 0.0
+    ax.set_ylim(min(low - 0.05 * (1.0 - low) - 0.01, 0.95), 1.005)
     ax.set_title("correlation with the complete K(p) (Alg. 2); shaded: macro bands", fontsize=9)
-    ax.legend(fontsize=8, loc="lower right", framealpha=0.9)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0), framealpha=0.9)
     return save_figure(fig, path)
