@@ -32,18 +32,19 @@ def plot_sequenced_profiles(result, path) -> Path:
         ax.set_title(f"{_scale_name(k, n)}: L = {result.lengths[k] * _MM:.4g} mm, n = {ns}..{nf}, "
                      f"relative rms error {100 * result.rms_errors[k]:.3g} %", fontsize=9)
         ax.set_ylabel("Z (um)")
-        ax.legend(fontsize=8, loc="upper right")
+        ax.set_xlabel("x (mm)", fontsize=8)     # each acquisition has its own window
+        ax.legend(fontsize=8, loc="best", framealpha=0.8)
     ax = axes[n]
     if result.zd.size:
         ax.plot(result.zd_x * _MM, result.zd * _UM, color="tab:red", lw=1.0, label="Z_d = Z_1 - Z_2")
         ax.plot(result.zd_x * _MM, result.zd_fit * _UM, "--", color="black", lw=1.0,
                 label="sequenced Z_d")
-        ax.legend(fontsize=8, loc="upper right")
+        ax.legend(fontsize=8, loc="best", framealpha=0.8)
     ax.set_title("Z_d at the nodes shared by the two coarsest acquisitions", fontsize=9)
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("Z_d (um)")
     g = result.genome
-    fig.suptitle(f"sequenced genome: A = {g.A:.4g}, H = {g.H:.4g}, gamma = {g.gamma:.6g}, "
+    fig.suptitle(f"sequenced genome: A = {g.A:.4g}, H = {g.H:.4g}, gamma = {g.gamma:.6g},\n"
                  f"lambda1 = {g.lambda1 * _MM:.5g} mm, M = {g.M}"
                  + ("" if result.success else "  [NOT WM-like]"), fontsize=10)
     return save_figure(fig, path)
