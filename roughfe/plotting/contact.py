@@ -44,29 +44,43 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None):
     a = _column(steps, "area_fraction")
     k = _column(steps, "stiffness") * MPA * 1e-6      # MPa/um
     kfd = _column(steps, "stiffness_fd") * MPA * 1e-6
+    # the branches apart: an unloading branch drawn as one line with the loading one
+    # zig-zagged back over it (hardness, adhesion)
+    unl = np.array([bool(s.get("unloading")) for s in steps])
+    branches = [(~unl, "o", "", "-")] + ([(unl, "v", " (unloading)", ":")] if unl.any() else [])
     ncol = 3 if rms_height is None else 4
     fig, axes = new_figure(1, ncol, figsize=(5 * ncol, 4))
     ax1, ax2, ax3 = axes[0], axes[1], axes[2]
     if rms_height is not None:
         d = _column(steps, "mean_plane_separation") / rms_height
-        axes[3].plot(d, _column(steps, "free_volume_star"), "o-", ms=4)
+        v = _column(steps, "free_volume_star")
+        for on, mk, tag, ls in branches:
+            axes[3].plot(d[on], v[on], mk + ls, ms=4, label="BEM" + tag)
         axes[3].set_xlabel("d / sigma")
         axes[3].set_ylabel("V* = V / (A_n sigma)")
         axes[3].set_title("free volume V*(d/sigma), Eq. 2.8")
         axes[3].grid(True, alpha=0.3)
-    ok = p > 0
-    ax1.loglog(p[ok], a[ok], "o", ms=4, label="BEM")
+        if unl.any():
+            axes[3].legend(fontsize=8)
+    # states in compression with contact (a detached or tensile adhesive state has no
+    # place on log axes: roughfe contact draws those in adhesion_load_approach.png)
+    ok = (p > 0) & (a > 0)
     a_th = _theory(steps, "persson_area_fraction")
-    if a_th is not None:
-        ax1.loglog(p[ok], a_th[ok], "-", label="Persson (2001)")
-        ax1.legend()
-    gap = _column(steps, "mean_gap") * UM
-    okg = ok & (gap > 0)
-    ax3.semilogx(p[okg], gap[okg], "o", ms=4, label="BEM")
     u_th = _theory(steps, "persson_mean_gap")
+    gap = _column(steps, "mean_gap") * UM
+    theory = ok & ~unl                 # Persson's theory has no branch: drawn once
+    order = np.argsort(p[theory])
+    for on, mk, tag, _ in branches:
+        ax1.loglog(p[ok & on], a[ok & on], mk, ms=4, label="BEM" + tag)
+        okg = ok & on & (gap > 0)
+        ax3.semilogx(p[okg], gap[okg], mk, ms=4, label="BEM" + tag)
+    if a_th is not None:
+        ax1.loglog(p[theory][order], a_th[theory][order], "-", label="Persson (2001)")
     if u_th is not None:
-        ax3.semilogx(p[ok], u_th[ok] * UM, "-", label="Persson (2007)")
-        ax3.legend()
+        ax3.semilogx(p[theory][order], u_th[theory][order] * UM, "-", label="Persson (2007)")
+    for ax in (ax1, ax3):
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=8)
     ax3.set_xlabel("mean pressure p (MPa)")
     ax3.set_ylabel("mean gap (um)")
     ax3.set_title("mean interfacial separation u(p)")
@@ -75,15 +89,19 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None):
     ax1.set_ylabel("A* = A_r / A_n")
     ax1.set_title("contact area A(p)")
     ax1.grid(True, which="both", alpha=0.3)
-    ok2 = ok & np.isfinite(k) & (k > 0)
-    ax2.loglog(p[ok2], k[ok2], "o-", ms=4, label="exact, H_cc x = 1")
-    ok3 = ok & np.isfinite(kfd) & (kfd > 0)
-    ax2.loglog(p[ok3], kfd[ok3], "x--", ms=5, label="central differences")
+    for on, mk, tag, ls in branches:
+        ok2 = ok & on & np.isfinite(k) & (k > 0)
+        if ok2.any():
+            ax2.loglog(p[ok2], k[ok2], mk + ls, ms=4, label="exact, H_cc x = 1" + tag)
+        ok3 = ok & on & np.isfinite(kfd) & (kfd > 0)
+        if ok3.any():
+            ax2.loglog(p[ok3], kfd[ok3], "x" + ls, ms=5, label="finite differences" + tag)
     ax2.set_xlabel("mean pressure p (MPa)")
     ax2.set_ylabel("K = dp/dDelta (MPa/um)")
     ax2.set_title("contact stiffness K(p), Eq. 2.7")
     ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend()
+    if ax2.get_legend_handles_labels()[0]:
+        ax2.legend(fontsize=8)
     if title:
         fig.suptitle(title)
     return save_figure(fig, path)
