@@ -131,7 +131,13 @@ def plot_adhesion(steps, path, pull_off_force=None, title=None):
             ax2.plot(d[mask], a[mask], style, ms=4, label=label)
     if pull_off_force is not None and np.isfinite(pull_off_force):
         ax1.axhline(pull_off_force, color="k", lw=0.8, ls=":",
-                    label=f"pull-off {pull_off_force:.3g}")
+                    label=f"pull-off {pull_off_force:.3g} (load unit)")
+        # a tensile loop orders of magnitude below the compressive loads sat on the zero
+        # line: linear within twice the pull-off, logarithmic beyond
+        tension = abs(pull_off_force)
+        if tension > 0 and np.nanmax(np.abs(f)) > 20 * tension:
+            ax1.set_yscale("symlog", linthresh=2 * tension)
+            ax1.set_ylim(bottom=-4 * tension)
     ax1.axhline(0.0, color="0.5", lw=0.5)
     ax1.set_xlabel("approach Delta (um)")
     ax1.set_ylabel("load (N, or N/m for profiles)")
