@@ -229,12 +229,12 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     plotter.add_mesh(grid, scalars="pressure (MPa)", cmap="plasma", smooth_shading=True,
                      nan_color="lightgrey",
                      scalar_bar_args={"title": "pressure (MPa)", "vertical": True,
-                                      "position_x": 0.86, "position_y": 0.15,
+                                      "position_x": 0.88, "position_y": 0.15,
                                       "height": 0.7, "fmt": "%.3g"})
     label = (title or "") + (f"\n{_state_label(result)} (free area grey), vertical "
                              f"x{exaggeration:.3g}" + decimation_note(h.shape, z.shape))
     plotter.add_text(label.strip(), position="upper_left", font_size=10)
     plotter.set_background("white")
     plotter.camera_position = "iso"
-    plotter.camera.zoom(1.3)
+    plotter.camera.zoom(1.0)    # the nearest corner clear of the colour bar
     return save_screenshot(plotter, path)

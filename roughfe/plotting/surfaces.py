@@ -27,8 +27,9 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
         Text in the upper-left corner.
     exaggeration : float, optional
         Vertical exaggeration of the heights; default: peak-to-valley shown as 25 % of
-        the larger lateral size. The colour bar always shows true heights in um (block
-        means when the grid has more than ``MAX_RENDER_POINTS`` points per side).
+        the larger lateral size. The colour bar shows the true heights about their mean
+        in um (block means when the grid has more than ``MAX_RENDER_POINTS`` points per
+        side).
 
     Returns
     -------
@@ -46,11 +47,11 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
     spacing = [d * UM for d in surface.spacing]
     xx, yy = np.meshgrid(*block_centres(blocks, surface.shape, spacing), indexing="ij")
     grid = pv.StructuredGrid(xx, yy, h * exaggeration)
-    grid["height (um)"] = h.ravel(order="F")
+    grid["h - mean h (um)"] = h.ravel(order="F")
     plotter = offscreen_plotter(window_size=window_size)
-    plotter.add_mesh(grid, scalars="height (um)", cmap=cmap, smooth_shading=True,
-                     scalar_bar_args={"title": "height (um)", "vertical": True,
-                                      "position_x": 0.86, "position_y": 0.15,
+    plotter.add_mesh(grid, scalars="h - mean h (um)", cmap=cmap, smooth_shading=True,
+                     scalar_bar_args={"title": "h - mean h (um)", "vertical": True,
+                                      "position_x": 0.88, "position_y": 0.15,
                                       "height": 0.7, "fmt": "%.3g"})
     label = title or ""
     label += (f"\n{surface.size[0] * UM:.4g} um x {surface.size[1] * UM:.4g} um, "
@@ -59,7 +60,8 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
     plotter.set_background("white")
     plotter.camera_position = "iso"
     aspect = max(surface.size) / min(surface.size)
-    plotter.camera.zoom(1.35 / aspect ** 0.25)     # long surfaces need more room
+    # long surfaces need more room; the corner nearest the colour bar stays clear of it
+    plotter.camera.zoom(1.0 / aspect ** 0.25)
     return save_screenshot(plotter, path)
 
 
