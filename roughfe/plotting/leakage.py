@@ -148,25 +148,57 @@ def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
 def steps_figure(steps, path):
     """Leak rate and volumes over the load steps of ``roughfe leak`` (results.json steps);
     with ``persson_leak_rate`` in the records also Lorenz & Persson's critical-junction
-    estimate beside the Reynolds leak rates."""
+    estimate beside the Reynolds leak rates, and with ``leak_rate_one_way`` (``--fsi``)
+    the one-way leak rate beside the coupled one and a third panel of load shares.
+    Sealed steps (Q = 0) are marked on the axis, not dropped."""
     a = np.array([s["area_fraction"] for s in steps], float)
-    fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 4))
-    for key, mk, label in (("leak_rate_x", "o-", "x"), ("leak_rate_y", "s--", "y"),
-                           ("persson_leak_rate", "k:", "critical junction (Persson)")):
+    coupled = any(s.get("leak_rate_one_way") is not None for s in steps)
+    fig, axes = new_figure(1, 3 if coupled else 2, figsize=(15 if coupled else 10, 4))
+    ax1, ax2 = axes[0], axes[1]
+    series = [("leak_rate_x", "o-", "x"), ("leak_rate_y", "s--", "y")]
+    if coupled:
+        series.append(("leak_rate_one_way", "^:", "one-way (rigid gap)"))
+    series.append(("persson_leak_rate", "k:", "critical junction (Persson)"))
+    sealed = np.zeros(a.shape, bool)
+    for key, mk, label in series:
         q = [s.get(key) for s in steps]
         if any(v is not None for v in q):
             ax1.semilogy(a, [np.nan if v is None or v <= 0 else v for v in q], mk, label=label)
+            if key.startswith("leak_rate_") and key != "leak_rate_one_way":
+                sealed |= np.array([v is not None and v <= 0 for v in q])
+    for x in a[sealed]:
+        ax1.axvline(x, color="0.6", lw=0.8, ls="--")
     ax1.set_xlabel("A* = A_r / A_n")
     ax1.set_ylabel("leak rate Q (m$^3$/s)")
-    ax1.legend(title="flow")
+    ax1.set_title("leak rate" + (" (dashed lines: sealed steps, Q = 0)" if sealed.any() else ""),
+                  fontsize=10)
+    ax1.legend(title="flow", fontsize=8)
+    vols = {}
     for key, label in (("free_volume_star", "V*"), ("percolating_volume_star", "V$_p$*"),
                        ("trapped_volume_star", "$\\bar V_p$*")):
         vals = [s.get(key) for s in steps]
         if all(v is not None for v in vals):
-            ax2.plot(a, vals, "o-", label=label)
+            vols[label] = np.array(vals, float)
+    for label, vals in vols.items():
+        ax2.plot(a, vals, "o-", label=label)
+    positive = [v[v > 0] for v in vols.values() if np.any(v > 0)]
+    if positive and max(v.max() for v in positive) > 100 * min(v.min() for v in positive):
+        ax2.set_yscale("log")      # the trapped volume is decades below the free one
     ax2.set_xlabel("A* = A_r / A_n")
     ax2.set_ylabel("dimensionless volume")
-    ax2.legend()
+    ax2.set_title("free, percolating and trapped volume", fontsize=10)
+    ax2.legend(fontsize=8)
+    if coupled:
+        for key, label in (("contact_load_fraction", "solid contact"),
+                           ("fluid_load_fraction", "fluid film"),
+                           ("trapped_load_fraction", "trapped fluid")):
+            vals = [s.get(key) for s in steps]
+            if any(v is not None for v in vals):
+                axes[2].plot(a, [np.nan if v is None else v for v in vals], "o-", label=label)
+        axes[2].set_xlabel("A* = A_r / A_n")
+        axes[2].set_ylabel("share of the external load")
+        axes[2].set_title("load shares (two-way coupled)", fontsize=10)
+        axes[2].legend(fontsize=8)
     return save_figure(fig, path)
 
 
