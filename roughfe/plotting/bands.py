@@ -43,9 +43,15 @@ def render_band_sums(bands, path, which: str = "td", max_panels: int = 6) -> Pat
     complete surface for partial sums); grids above ``RENDER_MAX_POINTS`` per axis are
     strided for the render (the heights are not changed).
     """
+    from ..genomics.macro_micro import is_flat
     fields, labels = _panels(bands, which)
     pick = _pick(len(fields), int(max_panels))
     surf = bands.surface
+    scale = float(np.max(np.abs(surf.heights)))
+    # a band that is round-off of the surface (is_flat, as Alg. 2 treats it) is said to
+    # be empty, not stretched to a full-height comb of noise
+    flat = [is_flat(fields[k], scale) for k in range(len(fields))]
+    labels = [lab + (" (empty: round-off)" if f else "") for lab, f in zip(labels, flat)]
     if surf.ndim == 1:
         fig, axes = new_figure(len(pick), 1, figsize=(8, 1.5 * len(pick) + 0.6), sharex=True)
         x = surf.coordinates()[0] * _UM
@@ -66,11 +72,15 @@ def render_band_sums(bands, path, which: str = "td", max_panels: int = 6) -> Pat
     for j, k in enumerate(pick):
         plotter.subplot(j // cols, j % cols)
         h = fields[k][::stride[0], ::stride[1]] * _UM
+        if flat[k]:
+            h = np.zeros_like(h)
         ptp = float(np.ptp(h)) or 1.0
         grid = pv.StructuredGrid(xx, yy, h * 0.25 * lateral / ptp)
         grid["z (um)"] = h.ravel(order="F")
         plotter.add_mesh(grid, scalars="z (um)", cmap="viridis", show_scalar_bar=False)
-        plotter.add_text(f"{labels[k]}\nrms {np.std(fields[k]) * _UM:.3g} um", font_size=9)
+        shown = "" if flat[k] else f", z shown x{0.25 * lateral / ptp:.3g}"
+        plotter.add_text(f"{labels[k]}\nrms {np.std(fields[k]) * _UM:.3g} um{shown}",
+                         font_size=9)
         plotter.set_background("white")
         plotter.camera_position = "iso"
     return save_screenshot(plotter, path)
