@@ -178,7 +178,7 @@ def plot_correlations(mech, path) -> Path:
     allc = np.concatenate([v for d in (mech.c_td, mech.c_bu, mech.c_chromosome) for v in d.values()])
     low = np.nanmin(allc) if np.isfinite(allc).any() else 0.0
     axes[0].set_ylim(min(0.8, low - 0.05), 1.01)
-    axes[0].legend(fontsize=8, loc="lower right")
+    axes[-1].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))  # off the bars
     fig.suptitle(f"correlation with the complete profile ({mech.kernel} kernel)", fontsize=10)
     return save_figure(fig, path)
 
