@@ -253,6 +253,9 @@ def study_figures(summary, outdir) -> list:
         per_d(a2, "separation_star_mean", f"{key}_std")
         a2.set_xlabel("d/$\\sigma$")
         a2.set_ylabel(f"std of {label}")
+        fig.suptitle(f"{label} against the mean-plane separation, mean and scatter over the "
+                     f"surfaces (m = {m_max}; thesis Fig. {14 if name == 'vp_vs_separation' else 15})",
+                     fontsize=10)
         paths.append(save_figure(fig, outdir / f"{name}.png"))
 
     fig, (a1, a2) = new_figure(1, 2, figsize=(10, 4))
@@ -260,6 +263,8 @@ def study_figures(summary, outdir) -> list:
     per_d(a2, "separation_star_mean", "m2_star_mean")
     a1.set_xlabel("d/$\\sigma$"), a1.set_ylabel("m$_0$* = m$_0$/m$_{00}$")
     a2.set_xlabel("d/$\\sigma$"), a2.set_ylabel("m$_2$* = m$_2$/m$_{20}$")
+    fig.suptitle(f"spectral moments of the gap against the separation (m = {m_max}; "
+                 f"thesis Fig. 19)", fontsize=10)
     paths.append(save_figure(fig, outdir / "moments.png"))
 
     fig, axes = new_figure(2, 2, figsize=(10, 8))
@@ -270,6 +275,8 @@ def study_figures(summary, outdir) -> list:
     for ax, xl, yl in ((axes[0, 0], "m$_0$*", "V$_p$*"), (axes[0, 1], "m$_2$*", "V$_p$*"),
                        (axes[1, 0], "m$_0$*", "$\\bar V_p$*"), (axes[1, 1], "m$_2$*", "$\\bar V_p$*")):
         ax.set_xlabel(xl), ax.set_ylabel(yl)
+    fig.suptitle(f"percolating and trapped volume against the gap's moments (m = {m_max}; "
+                 f"thesis Fig. 20-21)", fontsize=10)
     paths.append(save_figure(fig, outdir / "vp_vs_moments.png"))
 
     ds = sorted({c["D"] for c in curves})
@@ -286,6 +293,8 @@ def study_figures(summary, outdir) -> list:
         axes[0, j].legend(fontsize=7)
     axes[0, 0].set_ylabel("V$_p$*")
     axes[1, 0].set_ylabel("$\\bar V_p$*")
+    fig.suptitle("percolating and trapped volume against the free volume, per D and "
+                 "resolution m (thesis Fig. 22)", fontsize=10)
     paths.append(save_figure(fig, outdir / "volumes_vs_vstar.png"))
 
     fig, (a1, a2) = new_figure(1, 2, figsize=(10, 4))
@@ -297,6 +306,11 @@ def study_figures(summary, outdir) -> list:
     a1.set_xlabel("m"), a1.set_ylabel("g = dV$_p$*/dV*  (Eq. 2.17)")
     a2.set_xlabel("m"), a2.set_ylabel("$\\beta$:  $\\bar V_p$* = (V*)$^\\beta$")
     a1.legend(fontsize=8), a2.legend(fontsize=8)
+    from matplotlib.ticker import MaxNLocator
+    for ax in (a1, a2):                # m is an integer
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    fig.suptitle("fits of Eq. 2.17 per D against the resolution m (thesis Fig. 24)",
+                 fontsize=10)
     paths.append(save_figure(fig, outdir / "fits_g_beta.png"))
 
     fig, ax = new_figure(figsize=(6, 4.5))
