@@ -127,9 +127,9 @@ class AdhesionLaw:
         H_ii E*/dx; :data:`SQUARE_CELL_COMPLIANCE` on a surface, 3-7 on a profile,
         growing as log n) in ``ndim`` dimensions.
 
-        * exponential: 0.9 c (1.0 on a surface). The cell's stiffness E*/(c dx) must
-          exceed the law's peak stiffness sigma0/rho = (pi/4) E*/zone: zone >= (pi/4) c
-          dx, with a margin. Measured (round 2, session 22): the pull-off of Maugis'
+        * exponential: c / 1.12 (:data:`PROCESS_ZONE_CELLS` = 1.0 on a square cell of a
+          surface). The cell's stiffness E*/(c dx) must exceed the law's peak stiffness
+          sigma0/rho = (pi/4) E*/zone: zone >= (pi/4) c dx = 0.79 c dx, with a margin. Measured (round 2, session 22): the pull-off of Maugis'
           sphere 1.25 % off its grid limit at 1.0 cell, branches that retrace (hysteresis
           < 1e-5 of the pull-off); Johnson's sinusoid (a profile, c = 3.3-5.9) +0.5 % at
           2 cells and 2 % hysteresis, +0.1 % and none at 4.
@@ -149,7 +149,7 @@ class AdhesionLaw:
         """
         c = float(cell_compliance)
         if self.kind == "exp":
-            return 0.9 * c
+            return PROCESS_ZONE_CELLS / SQUARE_CELL_COMPLIANCE * c
         if ndim >= 2:
             return 2.7 * c
         return max(3.2, 0.6 / max(self.smoothing, 0.05)) * c
