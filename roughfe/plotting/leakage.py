@@ -106,12 +106,16 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
                        f"red: trapped ({n_t}){legend}", path, size)
 
 
-def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="cells"):
+def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="cells",
+                 clim=None):
     """Fluid pressure per cell (``at="cells"``, FV) or at the cell corners (``"nodes"``,
-    Q1 FE); NaN where undetermined is grey."""
+    Q1 FE); NaN where undetermined is grey. ``clim`` (Pa, low and high): the colour range,
+    with pressures above it in magenta (the sealed pockets of a coupled solve, whose
+    pressure can be many times the inlet's and set the whole scale)."""
     if not load_render_backend():
         return _render_elsewhere("pressure_map", {"pressure": pressure}, size=list(size),
-                                 path=str(path), title=title, at=at)
+                                 path=str(path), title=title, at=at,
+                                 clim=None if clim is None else [float(c) for c in clim])
     p = np.asarray(pressure, float)
     if at == "cells":
         img = _image(p.shape, size)
@@ -120,9 +124,14 @@ def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="ce
         img = _image((p.shape[0] - 1, p.shape[1] - 1), size)
         img.point_data["p (Pa)"] = p.ravel(order="F")
     pl = offscreen_plotter(window_size=(900, 900))
+    extra = {}
+    if clim is not None and np.nanmax(p) > clim[1]:
+        extra = {"clim": [float(c) for c in clim], "above_color": "magenta"}
+        title += f"\nmagenta: above {clim[1]:.3g} Pa (sealed pockets, up to {np.nanmax(p):.3g} Pa)"
     pl.add_mesh(img, scalars="p (Pa)", cmap="viridis", nan_color="grey", lighting=False,
                 scalar_bar_args={"vertical": True, "title": "p (Pa)", "fmt": "%.3g",
-                                 "position_x": 0.85, "position_y": 0.1, "height": 0.7})
+                                 "position_x": 0.85, "position_y": 0.1, "height": 0.7},
+                **extra)
     return _finish(pl, title, path, size)
 
 
