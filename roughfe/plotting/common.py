@@ -48,6 +48,12 @@ def offscreen_plotter(window_size=(1000, 800), **kwargs):
     return pv.Plotter(off_screen=True, window_size=list(window_size), **kwargs)
 
 
+def add_triad(plotter):
+    """The x, y, z orientation marker in the lower-left corner of a 3D render (an axes
+    actor with captions; unlike the cube axes' tick labels it is safe beside dolfinx)."""
+    plotter.add_axes(xlabel="x", ylabel="y", zlabel="z", line_width=2, color="black")
+
+
 def save_screenshot(plotter, path) -> Path:
     """Render ``plotter`` to a PNG atomically and close it; return the path."""
     path = Path(path)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import (block_centres, block_means, block_sums, decimation_note,
+from .common import (add_triad, block_centres, block_means, block_sums, decimation_note,
                      new_figure, offscreen_plotter, render_blocks, save_figure,
                      save_screenshot)
 
@@ -236,5 +236,6 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     plotter.add_text(label.strip(), position="upper_left", font_size=10)
     plotter.set_background("white")
     plotter.camera_position = "iso"
+    add_triad(plotter)
     plotter.camera.zoom(1.0)    # the nearest corner clear of the colour bar
     return save_screenshot(plotter, path)

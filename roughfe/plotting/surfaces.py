@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import (block_centres, block_means, decimation_note, new_figure,
+from .common import (add_triad, block_centres, block_means, decimation_note, new_figure,
                      offscreen_plotter, render_blocks, save_figure, save_screenshot)
 
 UM = 1e6   # metres -> micrometres
@@ -59,6 +59,7 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
     plotter.add_text(label.strip(), position="upper_left", font_size=11)
     plotter.set_background("white")
     plotter.camera_position = "iso"
+    add_triad(plotter)
     # the corner nearest the colour bar clear of it (1.35 put it under the bar; a long
     # surface lies along the view's diagonal and fits at the same zoom)
     plotter.camera.zoom(1.0)
