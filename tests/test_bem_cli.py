@@ -108,10 +108,11 @@ def test_contact_cli_adhesion_unload_pull_off(tmp_path):
     out = tmp_path / "adh"
     w = 2.83e-4
     assert main(["contact", str(path), "--E", "0.91", "--nu", "0.3", "--adhesion", "md",
-                 "--work-of-adhesion", str(w), "--range", "0.0486", "--delta", "-0.002",
-                 "0.004", "--unload", "-o", str(out)]) == 0
+                 "--work-of-adhesion", str(w), "--range", "0.0486", "--smoothing", "0.2",
+                 "--delta", "-0.002", "0.004", "--unload", "-o", str(out)]) == 0
     doc = json.loads((out / "results.json").read_text())
     assert doc["inputs"]["adhesion"]["law"] == "md"
+    assert doc["inputs"]["adhesion"]["smoothing"] == 0.2
     assert doc["inputs"]["tol"] == 1e-5
     steps = doc["steps"]
     assert [s["unloading"] for s in steps[:2]] == [False, False]
@@ -139,6 +140,11 @@ def test_contact_cli_adhesion_unload_pull_off(tmp_path):
       "1e3"], "displacement control"),
     (["--adhesion", "exp", "--work-of-adhesion", "0.1", "--range", "1e-9",
       "--coarse-correction", "off"], "--coarse-correction does not apply with --adhesion"),
+    (["--adhesion", "exp", "--work-of-adhesion", "0.1", "--range", "1e-9", "--smoothing",
+      "0.5"], "--smoothing is the ramp of the Maugis-Dugdale law"),
+    (["--adhesion", "md", "--work-of-adhesion", "0.1", "--range", "1e-9", "--smoothing",
+      "1.5"], "--smoothing must be in [0, 1), got 1.5"),
+    (["--smoothing", "0.5"], "need --adhesion"),
 ])
 def test_contact_cli_adhesion_bad_input(tmp_path, capsys, extra, message):
     path = _sphere_file(tmp_path, n=8)

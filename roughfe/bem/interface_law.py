@@ -245,6 +245,14 @@ def check_resolution(law: AdhesionLaw, e_star: float, spacing,
     if r["resolved"]:
         return True
     zone, dx, need = r["process_zone"], r["grid_spacing"], r["threshold_cells"]
+    # a Maugis-Dugdale law on a profile is set by its ramp: a wider one resolves sooner
+    wider = (AdhesionLaw("md", law.work, law.range, smoothing=0.5)
+             if law.kind == "md" and law.smoothing < 0.5 else None)
+    easier = (None if wider is None else
+              wider.resolution_cells(r["cell_compliance"], np.size(spacing)))
+    hint = (f", or the ramp smoothing 0.5 (smoothing=, roughfe --smoothing; needs "
+            f"{easier:.2g} spacings)"
+            if easier is not None and easier < 0.9 * need else "")
     warnings.warn(
         f"the {law.kind} adhesion law (w = {law.work:.3g} J/m^2, range {law.range:.3g} m, "
         f"sigma0 = {law.max_traction:.3g} Pa) has a process zone (pi/4) E* w / sigma0^2 = "
@@ -252,6 +260,6 @@ def check_resolution(law: AdhesionLaw, e_star: float, spacing,
         f"grid needs at least {need:.2g}): each cell then acts as a bistable spring "
         f"of its own, and the pull-off and the hysteresis depend on the grid and on the "
         f"continuation's steps. Resolve it: a grid spacing <= "
-        f"{zone / need:.3g} m, or the same work of adhesion over a longer range",
+        f"{zone / need:.3g} m, or the same work of adhesion over a longer range{hint}",
         ResolutionWarning, stacklevel=3)
     return False

@@ -196,7 +196,8 @@ def material_from_args(args):
 
 # -- adhesion --------------------------------------------------------------------------------
 def add_adhesion_options(parser) -> None:
-    """``--adhesion md|exp``, ``--work-of-adhesion W`` (J/m^2), ``--range R`` (m)."""
+    """``--adhesion md|exp``, ``--work-of-adhesion W`` (J/m^2), ``--range R`` (m),
+    ``--smoothing S`` (md)."""
     group = parser.add_argument_group("adhesion (roughfe.bem.adhesion; displacement control)")
     group.add_argument("--adhesion", choices=("md", "exp"), default=None,
                        help="interface law: Maugis-Dugdale (constant attraction w/R up to the "
@@ -205,6 +206,10 @@ def add_adhesion_options(parser) -> None:
                        help="work of adhesion w in J/m^2 (with --adhesion)")
     group.add_argument("--range", type=positive_float, default=None, metavar="R",
                        help="range of the attraction in m: h0 (md) or rho (exp)")
+    group.add_argument("--smoothing", type=float, default=None, metavar="S",
+                       help="md only: relative width of the traction ramp about h0, 0 <= S "
+                            "< 1 (default 0.05; a wider ramp is resolved by coarser grids, "
+                            "see the ResolutionWarning)")
 
 
 def adhesion_from_args(args):
@@ -212,14 +217,23 @@ def adhesion_from_args(args):
     from ..bem.adhesion import AdhesionLaw
     from ..errors import InputError
     given = [args.work_of_adhesion is not None, args.range is not None]
+    smoothing = getattr(args, "smoothing", None)
     if args.adhesion is None:
-        if any(given):
-            raise InputError("--work-of-adhesion and --range need --adhesion md|exp")
+        if any(given) or smoothing is not None:
+            raise InputError("--work-of-adhesion, --range and --smoothing need --adhesion "
+                             "md|exp")
         return None
     if not all(given):
         raise InputError(f"--adhesion {args.adhesion} needs --work-of-adhesion W (J/m^2) and "
                          "--range R (m), both finite and > 0")
-    return AdhesionLaw(args.adhesion, args.work_of_adhesion, args.range)
+    if smoothing is None:
+        return AdhesionLaw(args.adhesion, args.work_of_adhesion, args.range)
+    if args.adhesion != "md":
+        raise InputError("--smoothing is the ramp of the Maugis-Dugdale law: it needs "
+                         "--adhesion md")
+    if not 0.0 <= smoothing < 1.0:
+        raise InputError(f"--smoothing must be in [0, 1), got {smoothing!r}")
+    return AdhesionLaw("md", args.work_of_adhesion, args.range, smoothing=smoothing)
 
 
 # -- contact physics: adhesion, hardness, unloading ----------------------------------------
