@@ -183,9 +183,10 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
             title=f"coupled free-volume network, {tag}", widest_path=widest,
             junctions=[con.position for con in lk.constrictions.values()
                        if con.position is not None]))
-        written.append(figs.pressure_map(
-            r.fluid_pressure, surface.size, out / "figures" / f"step_{k:03d}_fluid_pressure.png",
-            title=f"fluid pressure (Pa), two-way coupled\n{tag}", at="cells",
+        written.append(figs.pressure_map(   # contact cells grey, as on the one-way maps
+            np.where(r.contact.contact, np.nan, r.fluid_pressure), surface.size,
+            out / "figures" / f"step_{k:03d}_fluid_pressure.png",
+            title=f"fluid pressure (Pa), two-way coupled, contact grey\n{tag}", at="cells",
             clim=(min(p_in, p_out), max(p_in, p_out))))     # pockets above: magenta
     if not args.no_figures:
         written.append(figs.steps_figure([s for s in steps if s.get("area_fraction") is not None],
