@@ -142,7 +142,9 @@ def westergaard_case(outdir: Path, n=513, wavelength=1e-3, amplitude=1e-6):
             pairs.append((f"p/p* = {ratio[-1]:.2f}", rf.pressure, ref_f.pressure(x)))
     fplot.plot_westergaard(np.array(ratio), {"FEM-VI": err_fem, "BEM (spectral)": err_bem},
                            x, pairs, outdir / "bem_vs_fem_westergaard.png")
-    fplot.render_deformed_mesh(fem.results[4].fields, outdir / "bem_vs_fem_westergaard_mesh.png")
+    fplot.render_deformed_mesh(fem.results[4].fields, outdir / "bem_vs_fem_westergaard_mesh.png",
+                               title=f"Westergaard sinusoid, FEM-VI at p/p* = {ratio[4]:.2f} "
+                                     f"(p = {fem.results[4].mean_pressure:.3g} Pa)")
     max_err = float(np.max(np.abs(err_fem)))
     return {"rows": rows, "max_width_error_fem": max_err,
             "max_width_error_bem": float(np.max(np.abs(err_bem))),
@@ -289,7 +291,9 @@ def profile_case(name, surf, outdir: Path, n_steps=12):
                        "color": c, "style": "points"})
     fplot.plot_pressures(vi.results[0].x, series, outdir / f"bem_vs_fem_{name}_pressure.png",
                          title=f"{name}: pressure at three loads")
-    fplot.render_deformed_mesh(vi.results[keep[0]].fields, outdir / f"bem_vs_fem_{name}_mesh.png")
+    fplot.render_deformed_mesh(vi.results[keep[0]].fields, outdir / f"bem_vs_fem_{name}_mesh.png",
+                               title=f"{name}, FEM-VI at p = "
+                                     f"{vi.results[keep[0]].mean_pressure:.3g} Pa")
     table = [(float(bem.mean_pressure[k]), int(n_bem[k]), int(vi.n_contact[k]),
               int(node_flips[k]), float(bem.area_fraction[k]), float(vi.area_fraction[k]),
               float(sub_bem[k]), float(sub_vi[k]), float(pen.area_fraction[k]),

@@ -106,7 +106,7 @@ def plot_westergaard(p_star_ratio, width_errors, x, pressure_pairs, path) -> Pat
 
 
 def render_deformed_mesh(fields, path, *, magnification=None, top_fraction=0.35,
-                         window_size=(1400, 700)) -> Path:
+                         window_size=(1400, 700), title=None) -> Path:
     """pyvista off-screen picture of the deformed FEM mesh coloured by sigma_yy.
 
     Parameters
@@ -121,7 +121,10 @@ def render_deformed_mesh(fields, path, *, magnification=None, top_fraction=0.35,
         body width.
     top_fraction : float
         Only cells within ``top_fraction * W`` of the top are shown (the stresses of a
-        rough contact are confined near the surface).
+        rough contact are confined near the surface); the caption says so, with the
+        body's depth.
+    title : str, optional
+        First caption line (e.g. the load of the state shown).
 
     Debian's dolfinx and the vtk wheel cannot render in one process when dolfinx was
     loaded first (vtk aborts in its std::regex): then the picture is rendered by a fresh
@@ -130,19 +133,20 @@ def render_deformed_mesh(fields, path, *, magnification=None, top_fraction=0.35,
     path = Path(path)
     arrays = {k: np.asarray(fields[k]) for k in ("points", "cells", "displacement", "stress_yy")}
     if load_render_backend():
-        return _render(arrays, path, magnification, top_fraction, window_size)
+        return _render(arrays, path, magnification, top_fraction, window_size, title)
     render_in_fresh_process(__name__, "_render_arrays", arrays, path=str(path),
                             magnification=magnification, top_fraction=top_fraction,
-                            window_size=list(window_size))
+                            window_size=list(window_size), title=title)
     return path
 
 
-def _render_arrays(*, path, magnification, top_fraction, window_size, **fields) -> Path:
+def _render_arrays(*, path, magnification, top_fraction, window_size, title=None,
+                   **fields) -> Path:
     """:func:`_render` with the fields as keyword arrays (the fresh-process entry point)."""
-    return _render(fields, Path(path), magnification, top_fraction, tuple(window_size))
+    return _render(fields, Path(path), magnification, top_fraction, tuple(window_size), title)
 
 
-def _render(fields, path, magnification, top_fraction, window_size) -> Path:
+def _render(fields, path, magnification, top_fraction, window_size, title=None) -> Path:
     plotter = offscreen_plotter(window_size=window_size)
     import pyvista as pv
 
@@ -169,8 +173,11 @@ def _render(fields, path, magnification, top_fraction, window_size) -> Path:
     plotter.add_mesh(grid, scalars=name, cmap="viridis", clim=(lo, 0.0),
                      show_edges=cells.shape[0] < 6000,                # edges hide fine meshes
                      edge_color="grey", line_width=0.2, scalar_bar_args={"title": name})
-    plotter.add_text(f"deformed mesh, displacements x{magnification:.3g}; coordinates / W",
-                     font_size=10)
+    depth = float(np.ptp(pts[:, 1])) / width
+    caption = (f"deformed mesh, the top {top_fraction:g} W of a body {depth:.3g} W deep "
+               f"(W = {width:.3g} m); displacements x{magnification:.3g}; x right, y up, "
+               f"coordinates / W")
+    plotter.add_text(caption if not title else f"{title}\n{caption}", font_size=10)
     plotter.view_xy()
     plotter.reset_camera()
     plotter.camera.zoom(1.6)
