@@ -230,6 +230,10 @@ def plot_psds(named, path, title="") -> "Path":
         if lines:
             q, a = np.asarray(lines, float).T
             ax.loglog(q, a ** 2 / (4 * dq), "rs", ms=4, label="chromosomes")
+        # Eq. 3.5 takes wavelengths down to one node spacing: the last chromosomes lie
+        # beyond the nodes' Nyquist wavenumber and are aliased on them (docs/theory/05)
+        ax.axvline(np.pi / max(surf.spacing), color="0.5", ls=":", lw=1,
+                   label="Nyquist pi/dx")
         ax.set_xlabel("q (rad/m)")
         ax.set_ylabel("C (m^3)")
         ax.set_title(name)
