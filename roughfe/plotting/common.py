@@ -48,6 +48,13 @@ def offscreen_plotter(window_size=(1000, 800), **kwargs):
     return pv.Plotter(off_screen=True, window_size=list(window_size), **kwargs)
 
 
+def side_bar(title, x=0.88, y=0.15):
+    """``scalar_bar_args`` of a vertical colour bar at the right edge of a render, its
+    lower end at ``y`` (window fraction), labels to 3 significant digits."""
+    return {"title": title, "vertical": True, "position_x": x, "position_y": y,
+            "height": 0.7, "fmt": "%.3g"}
+
+
 def add_triad(plotter):
     """The x, y, z orientation marker in the lower-left corner of a 3D render (an axes
     actor with captions; unlike the cube axes' tick labels it is safe beside dolfinx)."""

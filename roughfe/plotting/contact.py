@@ -8,7 +8,7 @@ import numpy as np
 
 from .common import (add_triad, block_centres, block_means, block_sums, decimation_note,
                      new_figure, offscreen_plotter, render_blocks, save_figure,
-                     save_screenshot)
+                     save_screenshot, side_bar)
 
 UM = 1e6
 MPA = 1e-6
@@ -228,9 +228,7 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     plotter = offscreen_plotter(window_size=window_size)
     plotter.add_mesh(grid, scalars="pressure (MPa)", cmap="plasma", smooth_shading=True,
                      nan_color="lightgrey",
-                     scalar_bar_args={"title": "pressure (MPa)", "vertical": True,
-                                      "position_x": 0.88, "position_y": 0.15,
-                                      "height": 0.7, "fmt": "%.3g"})
+                     scalar_bar_args=side_bar("pressure (MPa)"))
     label = (title or "") + (f"\n{_state_label(result)} (free area grey), vertical "
                              f"x{exaggeration:.3g}" + decimation_note(h.shape, z.shape))
     plotter.add_text(label.strip(), position="upper_left", font_size=10)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .._runtime import load_render_backend, render_in_fresh_process
-from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
+from .common import new_figure, offscreen_plotter, save_figure, save_screenshot, side_bar
 
 UM = 1e6
 
@@ -129,8 +129,7 @@ def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="ce
         extra = {"clim": [float(c) for c in clim], "above_color": "magenta"}
         title += f"\nmagenta: above {clim[1]:.3g} Pa (sealed pockets, up to {np.nanmax(p):.3g} Pa)"
     pl.add_mesh(img, scalars="p (Pa)", cmap="viridis", nan_color="grey", lighting=False,
-                scalar_bar_args={"vertical": True, "title": "p (Pa)", "fmt": "%.3g",
-                                 "position_x": 0.85, "position_y": 0.1, "height": 0.7},
+                scalar_bar_args=side_bar("p (Pa)", x=0.85, y=0.1),
                 **extra)
     return _finish(pl, title, path, size)
 
@@ -149,8 +148,7 @@ def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
     img.cell_data["log10 |q|"] = _cells(np.log10(np.maximum(q, floor)))
     pl = offscreen_plotter(window_size=(900, 900))
     pl.add_mesh(img, scalars="log10 |q|", cmap="inferno", lighting=False,
-                scalar_bar_args={"vertical": True, "title": "log10 q, m^2/s", "fmt": "%.3g",
-                                 "position_x": 0.85, "position_y": 0.1, "height": 0.7})
+                scalar_bar_args=side_bar("log10 q, m^2/s", x=0.85, y=0.1))
     return _finish(pl, title, path, size)
 
 

@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from .common import (add_triad, block_centres, block_means, decimation_note, new_figure,
-                     offscreen_plotter, render_blocks, save_figure, save_screenshot)
+                     offscreen_plotter, render_blocks, save_figure, save_screenshot,
+                     side_bar)
 
 UM = 1e6   # metres -> micrometres
 
@@ -50,9 +51,7 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
     grid["h - mean h (um)"] = h.ravel(order="F")
     plotter = offscreen_plotter(window_size=window_size)
     plotter.add_mesh(grid, scalars="h - mean h (um)", cmap=cmap, smooth_shading=True,
-                     scalar_bar_args={"title": "h - mean h (um)", "vertical": True,
-                                      "position_x": 0.88, "position_y": 0.15,
-                                      "height": 0.7, "fmt": "%.3g"})
+                     scalar_bar_args=side_bar("h - mean h (um)"))
     label = title or ""
     label += (f"\n{surface.size[0] * UM:.4g} um x {surface.size[1] * UM:.4g} um, "
               f"vertical exaggeration x{exaggeration:.3g}" + decimation_note(surface.shape, h.shape))
