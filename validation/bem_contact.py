@@ -170,7 +170,8 @@ def main(outdir: Path, quick: bool = False) -> bool:
     if tam is None:                            # said, not dropped from the table
         targets.append(Target(labels["tamaas"], f"<= {fraction(TARGETS['tamaas'])}",
                               "not run", None, "--quick leaves Tamaas out (the full "
-                              "validation runs it)" if quick else "tamaas not importable"))
+                              "validation runs it)" if quick else "tamaas not importable (`make validate` "
+                              "installs it: the bench extra)"))
     write_json(outdir / "bem_contact.json", {"name": "bem_contact", "quick": quick,
                                              "targets": [t.to_dict() for t in targets],
                                              "westergaard": w, "hertz": h, "line": line,
