@@ -108,9 +108,19 @@ def check_real_array(name, value, ndim=None, unit="m"):
     """Return ``value`` as a float ndarray (not copied when it already is one) or raise
     :class:`InputError` naming what is wrong: complex or non-numeric entries, a number of
     axes not in ``ndim`` (an int or a tuple of ints; None: any), non-finite entries
-    (their count and the first one's index)."""
+    (their count and the first one's index), masked entries (the values under a mask
+    are not data)."""
     import numpy as np
 
+    if np.ma.isMaskedArray(value) and np.ma.getmaskarray(value).any():
+        # np.asarray would keep the values under the mask (a topography's undefined points)
+        raise InputError(
+            f"{name} is a masked array with {int(np.ma.getmaskarray(value).sum())} masked "
+            f"(undefined) point(s), first at index "
+            f"{tuple(int(i) for i in np.argwhere(np.ma.getmaskarray(value))[0])}; fill them "
+            f"first (load_surface interpolates a file's undefined points)")
+    if np.ma.isMaskedArray(value):
+        value = np.ma.getdata(value)
     if np.iscomplexobj(value):     # np.asarray(..., float) would drop the imaginary part
         raise InputError(f"{name} must be real numbers ({unit}), got a complex array")
     try:

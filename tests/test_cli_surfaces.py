@@ -18,6 +18,7 @@ def _nonblank(png):
 @pytest.mark.parametrize("model, extra", [
     ("rmd", ["--m", "5", "--D", "2.4"]),
     ("rmd", ["--m", "8", "--D", "1.4", "--profile"]),
+    ("rmd", ["--m", "6", "--profile"]),        # a profile's default D (1.3), not 2.3's
     ("wm", ["--n", "512", "--hurst", "0.6"]),
     ("mwm", ["--n", "48", "--ridges", "4", "--rms-height", "2e-6"]),
     ("spectral", ["--n", "64", "--hurst", "0.7", "--rms-slope", "0.2"]),
@@ -31,6 +32,8 @@ def test_generate_writes_a_loadable_npz(tmp_path, model, extra):
         assert rms_height(s) == pytest.approx(2e-6, rel=1e-12)
     if model == "rmd" and "--profile" not in extra:
         assert s.shape == (33, 33)
+    if extra == ["--m", "6", "--profile"]:
+        assert s.ndim == 1 and s.metadata["fractal_dimension"] == pytest.approx(1.3)
     again = tmp_path / "again.npz"
     main(["generate", model, *extra, "--seed", "11", "--no-figures", "-o", str(again)])
     np.testing.assert_array_equal(load_surface(again).heights, s.heights)   # reproducible

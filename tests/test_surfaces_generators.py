@@ -206,3 +206,37 @@ def test_surface_rejects_bad_input(heights, size, words):
         Surface(heights, size)
     for w in words:
         assert w in str(info.value)
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: wm_profile(64, 1e-4, 0.5, k_range=(0, 100000), rng=1), "beyond the grid's Nyquist"),
+    (lambda: wm_profile(64, 1e-4, 0.5, k_range=(-3000, 0), rng=1), "lost in round-off"),
+    (lambda: wm_profile(64, 1e-4, 0.5, k_range=(1.5, 3), rng=1), "two integers"),
+    (lambda: wm_profile(64, 1e-4, 0.5, gamma="x", rng=1), "gamma"),
+    (lambda: mwm_surface(32, 1e-4, 0.5, n_range=(1,), rng=1), "n_range must be two integers"),
+    (lambda: mwm_surface(32, 1e-4, 0.5, wavelength=1e-9, rng=1), "Nyquist"),
+    (lambda: mwm_surface(32, 1e-4, 0.5, ridges=2, angles=[0, np.nan], rng=1), "angles"),
+    (lambda: mwm_surface(32, 1e-4, 0.5, ridges=2, angles=[0], rng=1), "M = 2 ridge angles"),
+])
+def test_wm_generators_refuse_ranges_they_cannot_realise(make, match):
+    """Waves beyond the grid's Nyquist wavenumber (aliased), waves so long their amplitude
+    is lost in round-off, and malformed ranges or angles: a clear InputError each (they
+    gave overflow warnings, a flat profile, aliasing or unpacking errors)."""
+    with pytest.raises(InputError, match=match):
+        make()
+
+
+def test_plane_detrend_of_a_periodic_surface_removes_the_mean_only():
+    """A periodic surface has zero mean slope: its least-squares plane is a spurious tilt
+    whose removal put a step at the edges (+47 % rms slope by spectral derivatives)."""
+    s = spectral_surface(128, 1e-4, 0.8, rms_height=1e-6, rng=2)
+    d = s.detrended("plane")
+    assert d.periodic
+    np.testing.assert_allclose(d.heights, s.heights - s.heights.mean(), rtol=0, atol=1e-20)
+    assert rms_slope(d) == pytest.approx(rms_slope(s), rel=1e-12)
+    window = Surface(s.heights[:100, :90], (1e-4 * 100 / 128, 1e-4 * 90 / 128))
+    flat = window.detrended("plane").heights          # a non-periodic window: the plane
+    xs, ys = np.meshgrid(np.arange(100), np.arange(90), indexing="ij")
+    a = np.column_stack([np.ones(flat.size), xs.ravel(), ys.ravel()])
+    assert np.all(np.abs(a.T @ flat.ravel()) < 1e-12 * (np.abs(a.T) @ np.abs(flat.ravel())))
+

@@ -114,3 +114,27 @@ def test_multichannel_choice(topographies_dir):
         load_surface(path, channel=9)
     with pytest.raises(InputError, match="no channel named"):
         load_surface(path, channel="Nope")
+
+
+@pytest.mark.parametrize("name, keep", [("sur-2.sur", 0.25), ("opd-1.opd", 0.25),
+                                        ("di-1.di", 0.25), ("di-1.di", 0.001)])
+def test_truncated_instrument_file_is_a_file_format_error(topographies_dir, tmp_path, name,
+                                                         keep):
+    """A truncated file: the reader's own failure (a reshape, a short buffer, an index)
+    becomes a FileFormatError naming the file, not a traceback from SurfaceTopography."""
+    data = (topographies_dir / name).read_bytes()
+    cut = tmp_path / name
+    cut.write_bytes(data[:max(int(len(data) * keep), 600)])
+    with pytest.raises(FileFormatError, match=name.replace(".", r"\.")):
+        load_surface(cut)
+
+
+def test_masked_heights_are_refused_not_unmasked():
+    """The values under a mask (a topography's undefined points) are not heights."""
+    h = np.ma.masked_array(np.arange(12.0).reshape(3, 4), mask=False)
+    h[1, 2] = np.ma.masked
+    with pytest.raises(InputError, match=r"masked array with 1 masked .* index \(1, 2\)"):
+        Surface(h, (3e-6, 4e-6))
+    s = Surface(np.ma.masked_array(np.ones((3, 4)), mask=False), (3e-6, 4e-6))
+    assert type(s.heights) is np.ndarray      # no mask set: the data
+

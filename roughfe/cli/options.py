@@ -154,8 +154,8 @@ def add_detrend_option(parser, default: str = DEFAULT_DETREND) -> None:
     parser.add_argument(
         "--detrend", choices=DETRENDS, default=default,
         help="remove nothing, the mean height, or the least-squares plane before the "
-             "analysis (measured topographies usually need 'plane'; a plane fit breaks "
-             "the periodicity of a periodic surface)")
+             "analysis (measured topographies usually need 'plane'; on a periodic surface "
+             "'plane' removes the mean only: its mean slope is zero)")
 
 
 # -- material ------------------------------------------------------------------------------

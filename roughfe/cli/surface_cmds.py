@@ -69,9 +69,11 @@ def _info(args) -> int:
 # -- generate --------------------------------------------------------------------------
 def _make_rmd(a):
     from ..surfaces.rmd import rmd_profile, rmd_surface
-    if a.profile:
-        return rmd_profile(a.m, a.D, a.length, rng=a.seed, rms_height=a.rms_height)
-    return rmd_surface(a.m, a.D, a.length, rng=a.seed, rms_height=a.rms_height)
+    if a.profile:      # the default D is the surface's; a profile's is one less
+        return rmd_profile(a.m, 1.3 if a.D is None else a.D, a.length, rng=a.seed,
+                           rms_height=a.rms_height)
+    return rmd_surface(a.m, 2.3 if a.D is None else a.D, a.length, rng=a.seed,
+                       rms_height=a.rms_height)
 
 
 def _make_wm(a):
@@ -157,8 +159,9 @@ def _register_generate(sub):
     m = common("rmd", "Random Midpoint Displacement surface (thesis Sec. 2.1.1), (2^m+1)^2 grid",
                _make_rmd)
     m.add_argument("--m", type=positive_int, default=7, help="refinement levels: (2^m+1)^2 points")
-    m.add_argument("--D", type=float, default=2.3,
-                   help="fractal dimension, in (2, 3) for a surface, (1, 2) for a profile")
+    m.add_argument("--D", type=float, default=None,
+                   help="fractal dimension, in (2, 3) for a surface (default 2.3), (1, 2) "
+                        "for a profile (default 1.3): the same Hurst exponent 0.7")
     m.add_argument("--length", type=positive_float, default=1e-4,
                    help="thesis L end to end (m); size = (2^m+1) L / 2^m")
     m.add_argument("--profile", action="store_true", help="a 1D profile instead of a surface")

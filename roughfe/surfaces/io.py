@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FileFormatError, InputError
+from ..errors import FileFormatError, InputError, RoughfeError
 from ..writers import atomic_path, to_jsonable
 from .surface import Surface
 
@@ -223,6 +223,22 @@ def _check_reader_matches_suffix(path, reader):
                               f"SurfaceTopography's {fmt!r} reader instead)")
 
 
+def _unreadable(path, exc) -> str:
+    """Why no reader opened ``path``: the error of the reader its suffix names (a
+    truncated ``.di``), else SurfaceTopography's whole list of tried readers."""
+    from SurfaceTopography.IO import readers
+
+    suffix = path.suffix.lower().lstrip(".")
+    named = [r for r in readers if r.format() == suffix]
+    if named:
+        try:
+            named[0](str(path))
+        except Exception as own:  # noqa: BLE001 - the reader's own words
+            return (f"{path} is not a readable .{suffix} file (SurfaceTopography's "
+                    f"{suffix!r} reader: {type(own).__name__}: {own}); damaged or truncated?")
+    return f"{path}: no reader recognises this file ({exc})"
+
+
 def _read_instrument(path, size, periodic, channel):
     try:
         from SurfaceTopography import open_topography
@@ -233,8 +249,19 @@ def _read_instrument(path, size, periodic, channel):
     try:
         reader = open_topography(str(path))
     except Exception as exc:      # ST raises many types for unknown formats
-        raise FileFormatError(f"{path}: no reader recognises this file ({exc})") from None
+        raise FileFormatError(_unreadable(path, exc)) from None
     _check_reader_matches_suffix(path, reader)
+    try:
+        return _instrument_surface(reader, path, size, periodic, channel)
+    except RoughfeError:           # ours: already says what is wrong
+        raise
+    except Exception as exc:       # the reader's own failure on the data (a truncated file)
+        raise FileFormatError(
+            f"{path}: SurfaceTopography's {reader.format()!r} reader failed on this file's "
+            f"data; is it damaged or truncated? ({type(exc).__name__}: {exc})") from None
+
+
+def _instrument_surface(reader, path, size, periodic, channel):
     ch = _choose_channel(reader, channel, path)
     if ch.dim not in (1, 2):
         raise FileFormatError(f"{path}: channel {ch.name!r} has dimension {ch.dim}, not 1 or 2")

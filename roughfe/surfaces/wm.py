@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive, check_in_open_interval, check_int
+from ..errors import (InputError, check_finite_positive, check_in_open_interval, check_int,
+                      check_real_array)
 from .surface import Surface
 
 
@@ -105,10 +106,49 @@ def _grid(n, length, ndim):
 
 
 def _check_gamma_hurst(gamma, hurst):
-    gamma = float(gamma)
+    try:
+        gamma = float(gamma)
+    except (TypeError, ValueError):
+        raise InputError(f"gamma (frequency density) must be a number > 1, "
+                         f"got {gamma!r}") from None
     if not (np.isfinite(gamma) and gamma > 1):
         raise InputError(f"gamma (frequency density) must be > 1, got {gamma!r}")
     return gamma, check_in_open_interval("hurst H", hurst, 0.0, 1.0)
+
+
+def _int_pair(name, value, lower="first", upper="second"):
+    """``(a, b)`` as two integers with ``a <= b``, or an :class:`InputError`."""
+    try:
+        a, b = value
+        pair = int(a), int(b)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be two integers ({lower}, {upper}), "
+                         f"got {value!r}") from None
+    if any(int(v) != float(v) for v in value):
+        raise InputError(f"{name} must be two integers ({lower}, {upper}), got {value!r}")
+    if pair[1] < pair[0]:
+        raise InputError(f"{name} must satisfy {lower} <= {upper}, got {pair}")
+    return pair
+
+
+#: longest wave of a truncated WM sum, in profile lengths: a longer one is a constant
+#: over the grid whose huge amplitude the subtraction cos(phi) - cos(...) loses in round-off
+MAX_WAVE_LENGTHS = 1e6
+
+
+def _check_band(name, q_low, q_high, n, length):
+    """The wavenumbers of a WM sum on a grid of ``n`` points over ``length``: none beyond
+    the Nyquist wavenumber ``pi n / L`` (aliased on the nodes), none longer than
+    :data:`MAX_WAVE_LENGTHS` profile lengths."""
+    nyquist = np.pi * n / length
+    if not q_high <= nyquist * (1 + 1e-9):
+        raise InputError(f"{name} reaches the wavenumber {q_high:.4g} rad/m, beyond the "
+                         f"grid's Nyquist wavenumber pi n / L = {nyquist:.4g} rad/m (aliased "
+                         f"on the nodes): shorten the range or refine the grid")
+    if not q_low >= 2 * np.pi / (MAX_WAVE_LENGTHS * length):
+        raise InputError(f"{name} starts at a wavelength {2 * np.pi / q_low:.4g} m, more "
+                         f"than {MAX_WAVE_LENGTHS:.0e} times the length L = {length:.4g} m "
+                         f"(a constant over the grid, lost in round-off)")
 
 
 def wm_profile(n, length, hurst, gamma=1.5, amplitude=1e-6, q0=None, k_range=None, rng=None):
@@ -138,6 +178,8 @@ def wm_profile(n, length, hurst, gamma=1.5, amplitude=1e-6, q0=None, k_range=Non
     k_range : (int, int), optional
         ``(k1, k2)``; default: all ``k`` with ``2 pi / L <= q0 gamma**k <= pi n / L``
         (from the profile length to the Nyquist wavenumber, Majumdar & Bhushan 1991).
+        A range beyond the Nyquist wavenumber (aliased) or starting more than
+        :data:`MAX_WAVE_LENGTHS` lengths long is refused.
     rng : Generator or int, optional
         Source of the phases ``phi_k ~ U[0, 2 pi)``; the seed is recorded.
 
@@ -156,9 +198,14 @@ def wm_profile(n, length, hurst, gamma=1.5, amplitude=1e-6, q0=None, k_range=Non
         k1 = int(np.ceil(np.log(2 * np.pi / length / q0) / np.log(gamma) - 1e-9))
         k2 = int(np.floor(np.log(np.pi * n / length / q0) / np.log(gamma) + 1e-9))
     else:
-        k1, k2 = (int(k) for k in k_range)
+        k1, k2 = _int_pair("k_range", k_range, "k1", "k2")
     if k2 < k1:
-        raise InputError(f"k_range must satisfy k1 <= k2, got ({k1}, {k2})")
+        raise InputError(f"k_range must satisfy k1 <= k2, got ({k1}, {k2}): no wave lies "
+                         f"between the profile length and the Nyquist wavenumber for this "
+                         f"q0 = {q0:.4g} rad/m")
+    with np.errstate(all="ignore"):                # gamma**k over/underflows: refused
+        _check_band(f"k_range ({k1}, {k2})", q0 * np.power(gamma, float(k1)),
+                    q0 * np.power(gamma, float(k2)), n, length)
     gen, seed = resolve_rng(rng)
     k = np.arange(k1, k2 + 1)
     phases = gen.uniform(0, 2 * np.pi, k.size)
@@ -181,9 +228,7 @@ def mwm_coefficients(hurst, gamma, wavelength, n_range, ridges, amplitude=1.0, a
     wavelength = check_finite_positive("wavelength lambda (m)", wavelength)
     if isinstance(ridges, bool) or not isinstance(ridges, (int, np.integer)) or ridges < 1:
         raise InputError(f"ridges M must be an integer >= 1, got {ridges!r}")
-    n_s, n_f = (int(v) for v in n_range)
-    if n_f < n_s:
-        raise InputError(f"n_range must satisfy n_s <= n_f, got ({n_s}, {n_f})")
+    n_s, n_f = _int_pair("n_range", n_range, "n_s", "n_f")
     alpha = np.ones(ridges) if anisotropy is None else np.asarray(anisotropy, float).ravel()
     if alpha.size != ridges or not np.all(np.isfinite(alpha)) or np.any(alpha <= 0):
         raise InputError(f"anisotropy must hold M = {ridges} positive factors a_m, got {anisotropy!r}")
@@ -216,7 +261,7 @@ def mwm_surface(n, length, hurst, gamma=1.5, wavelength=None, n_range=None, ridg
         ``lambda`` (m), the longest wave (``n = 1``); default ``L``.
     n_range : (int, int), optional
         ``(n_s, n_f)``; default from ``1`` to the last ``n`` with ``q_n <= pi n / L``
-        (Nyquist).
+        (Nyquist). A range beyond Nyquist (aliased) is refused.
     ridges : int
         Number of ridges ``M``.
     amplitude : float
@@ -244,13 +289,18 @@ def mwm_surface(n, length, hurst, gamma=1.5, wavelength=None, n_range=None, ridg
                                / np.log(gamma) + 1e-9))
         n_range = (1, max(n_f, 1))
     amps, q = mwm_coefficients(hurst, gamma, wavelength, n_range, ridges, amplitude, anisotropy)
+    _check_band(f"n_range {tuple(int(v) for v in n_range)} with wavelength "
+                f"{wavelength:.4g} m", q[0], q[-1], n, length)
     gen, seed = resolve_rng(rng)
     if angles is None:
         theta = np.pi * np.arange(1, ridges + 1) / ridges
     elif isinstance(angles, str) and angles == "random":
         theta = gen.uniform(0, np.pi, ridges)
     else:
-        theta = np.asarray(angles, dtype=float).ravel()
+        theta = check_real_array("angles (ridge angles theta_m)", angles, unit="rad").ravel()
+        if theta.size != ridges:
+            raise InputError(f"angles must hold M = {ridges} ridge angles (rad), got "
+                             f"{theta.size}")
     phases = gen.uniform(0, 2 * np.pi, amps.shape)
     h = wm_series((x, y), amps, q, phases, angles=theta)
     meta = {"generator": "mwm", "equation": "thesis Eq. (2.2)/(3.17)", "hurst": hurst,
