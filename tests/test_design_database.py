@@ -174,3 +174,27 @@ def test_genome_entry_task_rows_are_byte_identical_to_the_recorded_ones(tmp_path
     assert row[6] == ref["p_max"]
     with pytest.raises(InputError, match="unknown database setting"):
         db.genome_entry_task(1.7, 0.9, 11, label="r-2", n_node=64)
+
+
+def test_micro_chromosomes_are_those_the_window_realises(tmp_path):
+    """An extended genome whose phases start below the database's window (lambda1 = 10 L:
+    the window shows n = 6..16 of its 1..44): macro and micro are the realised ones, so
+    the design model built from the entry is the stored realisation (micro was numbered
+    from the genome's first phase column, 1..6, none of them realised)."""
+    from roughfe.genomics.design.model import entry_design
+    from roughfe.genomics.genome import random_genome
+    from roughfe.genomics.periodic import realization
+    from roughfe.study import build_genome_db, extend_genome_db
+
+    tiny = db.DatabaseSettings(n_nodes=64, n_steps=6)
+    path = tmp_path / "g.sqlite"
+    build_genome_db(path, tiny, limit=1, workers=1, progress=False)
+    g = random_genome(1.0, 0.8, 1.5, 10 * tiny.length, 1, 44, rng=1)
+    assert g.held_range(tiny.length, tiny.n_nodes) == (6, 16)
+    extend_genome_db(path, [g], labels=["long"], workers=1, progress=False)
+    e = db.load_entries(path, labels_=["long"])[0]
+    assert sorted(e.macro + e.micro) == list(range(6, 17)) and len(e.corr_k) == 11
+    design = entry_design(e, tiny)
+    stored = realization(g, tiny.length, tiny.n_nodes)
+    np.testing.assert_allclose(design.surface().heights, stored.heights,
+                               atol=1e-12 * np.abs(stored.heights).max())

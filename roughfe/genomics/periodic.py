@@ -135,6 +135,15 @@ def check_dim(dim) -> int:
     return int(dim)
 
 
+def realized_chromosomes(genome: Genome, length, n_nodes, dim=1) -> np.ndarray:
+    """The chromosome numbers n a :func:`realization` sums by default: the held part of
+    Eq. (3.5)'s range (dim 1) or of the periodic range (dim 2)."""
+    if dim == 1:
+        return np.arange(genome.held_range(length, n_nodes)[0],
+                         genome.held_range(length, n_nodes)[1] + 1)
+    return _held(genome, length, n_nodes)
+
+
 def realization(genome: Genome, length, n_nodes, dim=1, chromosomes=None) -> Surface:
     """The one realisation of databases and designs: a profile (:func:`realize`, dim 1) or
     the periodic surface of this module (dim 2), optionally of some chromosomes only."""

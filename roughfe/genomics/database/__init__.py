@@ -13,11 +13,13 @@ Layout (schema version :data:`SCHEMA_VERSION`, stdlib :mod:`sqlite3`)
 ``genomes``
     one row per genome: ``label`` (unique; ``"i-k"`` = Sobol pair i, phase vector k),
     ``source`` (``sobol`` or ``extend``), the scalar genes (``n_ridges`` = M: 1 for
-    profiles, the ridges of a surface genome, whose angles and anisotropy are in its
-    ``genome_json``), ``genome_json`` (the
+    Sobol profiles, the genome's own M for an extended one, the ridges of a surface
+    genome, whose angles and anisotropy are in its ``genome_json``), ``genome_json`` (the
     versioned Genome JSON of :mod:`roughfe.genomics.genome`), ``p_max`` (Pa, at A as
     stored), ``curve_json`` (K(p), A(p) of the realisation), ``chromosome_curves_json``,
-    ``corr_k_json`` / ``corr_a_json`` (c_n of Alg. 2, in the order n = n_s..n_f),
+    ``corr_k_json`` / ``corr_a_json`` (c_n of Alg. 2, in the order of the chromosomes
+    the window realises: n = n_s..n_f of Eq. 3.5 (or the periodic range) that the
+    genome holds, :func:`roughfe.genomics.periodic.realized_chromosomes`),
     ``macro_json`` (chromosome indices n with c_n > threshold) and ``created_utc``.
 
 Profiles (dim 1) are the thesis realisations (N nodes spanning L, non-periodic BEM);

@@ -48,8 +48,9 @@ class DatabaseEntry:
     """One genome of the database with its stored responses (read-only view of a row).
 
     ``curve`` is the realisation's K(p)/A(p) at the stored amplitude gene; ``macro`` and
-    ``micro`` are 0-based chromosome column indices (Alg. 2); ``corr_k``/``corr_a`` the
-    c_n of every chromosome.
+    ``micro`` are chromosome numbers n (Alg. 2) of the chromosomes realised at the
+    database's L and N (:func:`roughfe.genomics.periodic.realized_chromosomes`), in the
+    order of ``corr_k``/``corr_a``, the c_n of each.
     """
 
     label: str
@@ -244,13 +245,21 @@ def extend_tasks(con, genomes, labels_=None) -> list:
             for lab, d in zip(labels_, dicts)]
 
 
-def _entry(row) -> DatabaseEntry:
+def _entry(row, settings: DatabaseSettings) -> DatabaseEntry:
+    from ..genome import Genome
+    from ..periodic import realized_chromosomes
     (label, source, gamma, hurst, genome_json, p_max, curve_json, chrom_json, ck, ca,
      macro) = row
     genome = json.loads(genome_json)
     ck, macro = np.asarray(json.loads(ck)), tuple(json.loads(macro))
-    n_s = int(genome.get("n_first", 1))
-    micro = tuple(n for n in range(n_s, n_s + ck.size) if n not in set(macro))
+    # the chromosomes realised at the database's window (not the genome's first phase
+    # column: an extended genome may hold phases below the window)
+    ns = realized_chromosomes(Genome.from_dict(genome), settings.length, settings.n_nodes,
+                              settings.dim)
+    if ns.size != ck.size:
+        raise FileFormatError(f"genome {label!r}: {ck.size} stored c_n for the {ns.size} "
+                              f"chromosomes {ns[0]}..{ns[-1]} its window realises")
+    micro = tuple(int(n) for n in ns if n not in set(macro))
     return DatabaseEntry(label=label, source=source, genome=genome,
                          p_max=float(p_max), curve=ResponseCurve.from_dict(json.loads(curve_json)),
                          chromosome_curves=tuple(ResponseCurve.from_dict(c)
@@ -275,12 +284,13 @@ def load_entries(path, *, labels_=None, where=None, params=()) -> list:
         elif where:
             sql += f" WHERE {where}"
         rows = con.execute(sql + " ORDER BY id", params).fetchall()
+        settings = read_settings(con) if rows else None
     finally:
         con.close()
     if not rows:
         raise InputError(f"the genome database {path} holds no genomes"
                          + (f" matching {labels_ or where!r}" if (labels_ or where) else ""))
-    return [_entry(r) for r in rows]
+    return [_entry(r, settings) for r in rows]
 
 
 def summary_table(path) -> list:
