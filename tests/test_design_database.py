@@ -198,3 +198,17 @@ def test_micro_chromosomes_are_those_the_window_realises(tmp_path):
     stored = realization(g, tiny.length, tiny.n_nodes)
     np.testing.assert_allclose(design.surface().heights, stored.heights,
                                atol=1e-12 * np.abs(stored.heights).max())
+
+
+@pytest.mark.parametrize("nu", [float("nan"), 0.7, -1.0])
+def test_db_build_refuses_a_bad_poisson_ratio_before_creating_the_file(tmp_path, nu):
+    """A bad --nu was stored in a new database's settings before any task ran: every
+    later build with it failed, every other nu clashed with the stored NaN."""
+    from roughfe.cli import main
+
+    with pytest.raises(InputError, match=r"Poisson's ratio\) must lie in \(-1, 0.5\]"):
+        db.DatabaseSettings(poisson=nu)
+    path = tmp_path / "y.sqlite"
+    assert main(["db", "build", str(path), "--nu", str(nu), "--limit", "1", "--nodes", "32",
+                 "--workers", "1"]) == 2
+    assert not path.exists()

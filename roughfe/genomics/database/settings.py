@@ -7,6 +7,7 @@ from dataclasses import asdict, dataclass, fields, replace
 import numpy as np
 
 from ...errors import InputError
+from ...model import Material
 
 
 @dataclass(frozen=True)
@@ -62,6 +63,8 @@ class DatabaseSettings:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"{name} must be finite and > 0, got {v!r}")
+        # Poisson's ratio in (-1, 0.5], checked before a database stores the settings
+        Material(self.youngs_modulus, self.poisson)
         if int(self.n_nodes) < 16:
             raise InputError(f"n_nodes must be >= 16, got {self.n_nodes!r}")
         if int(self.n_steps) < 3:
