@@ -11,7 +11,7 @@ from scipy.optimize import least_squares
 from ...errors import InputError, check_int
 from ...surfaces.wm import resolve_rng
 from ..genome import Genome, profile_heights
-from .acquisitions import acquisitions_from_surfaces, check_controls
+from .acquisitions import Acquisition, acquisitions_from_surfaces, check_controls
 from .genes import (H_SEARCH, amplitude_genes, peak_slope_H, phases_with_sums,
                     ridge_likelihood, variance_amplitude)
 from .lattice import (comb_periods, design_matrix, fit_lattice, label_q1, lattice_from_period,
@@ -126,7 +126,10 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     gamma, lam1 = math.exp(lg), 2 * math.pi / math.exp(lq1)
     n, mat = design_matrix(lq1, lg, acqs, ranges, weights)
     coef = solve_linear(mat, rhs)
-    cvec = coef[0::2] + 1j * coef[1::2]
+    cvec = coef[0:2 * n.size:2] + 1j * coef[1:2 * n.size:2]
+    # the acquisitions' height offsets (their heights at x = 0 off the genome's zero)
+    offsets = coef[2 * n.size:]
+    acqs = [Acquisition(a.x, a.z - off, a.length) for a, off in zip(acqs, offsets)]
     amps, thetas = np.abs(cvec), np.angle(cvec)
 
     # 5. genes
@@ -188,6 +191,6 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         ranges=ranges, lengths=np.array([a.length for a in acqs]), rms_errors=rms,
         x=[a.x for a in acqs], heights=[a.z for a in acqs], fitted=fitted, zd_x=zd_x, zd=zd,
         zd_fit=zd_fit, spectra=spectra, gamma_psd=gamma_psd, H_psd=peak_slope_H(spectra, lq1, lg),
-        M_loglik=loglik, A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1),
+        M_loglik=loglik, offsets=offsets, A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1),
                                                gamma, lam1, H),
         seed=int(seed), elapsed=time.perf_counter() - t0)

@@ -35,7 +35,8 @@ class SequencingResult:
     rms_errors : ndarray
         rms(Z_i - Z_i^seq) / rms(Z_i) per acquisition (relative, -).
     x, heights, fitted : list of ndarray
-        Nodes (m), measured and sequenced heights (m) per acquisition.
+        Nodes (m), measured heights less their fitted offset and sequenced heights (m)
+        per acquisition.
     zd_x, zd, zd_fit : ndarray
         Z_d = Z_1 - Z_2 at the common nodes of the two coarsest acquisitions and its
         sequenced counterpart (m); empty when they share no node.
@@ -46,6 +47,10 @@ class SequencingResult:
         comparison with the fit and the maximum-likelihood H.
     M_loglik : ndarray
         Log-likelihood of M = 2..20 (flat-ish: M is weakly identifiable).
+    offsets : ndarray
+        Height offset of each acquisition (m, coarsest first): the constant fitted with
+        the chromosomes, its height at x = 0 off the genome's zero (Eq. 3.1: Z(0) = 0),
+        e.g. the mean a mean-removed profile lost; ``heights`` are the data less it.
     A0 : float
         Amplitude from the height variance of the coarsest acquisition (Eq. 3.13), for
         comparison with the maximum-likelihood A.
@@ -74,6 +79,7 @@ class SequencingResult:
     gamma_psd: float
     H_psd: float
     M_loglik: np.ndarray
+    offsets: np.ndarray = field(default_factory=lambda: np.zeros(0))
     A0: float = float("nan")
     seed: Optional[int] = None
     elapsed: float = 0.0
@@ -88,7 +94,7 @@ class SequencingResult:
         return {"success": bool(self.success), "message": self.message, "nit": int(self.nit),
                 "genes": {"A": g.A, "H": g.H, "gamma": g.gamma, "lambda1": g.lambda1, "M": g.M},
                 "lengths": self.lengths.tolist(), "ranges": [list(r) for r in self.ranges],
-                "rms_errors": self.rms_errors.tolist(),
+                "rms_errors": self.rms_errors.tolist(), "offsets": self.offsets.tolist(),
                 "zd_rms": float(np.sqrt(np.mean(self.zd ** 2))) if self.zd.size else None,
                 "zd_rms_error": (float(np.sqrt(np.mean((self.zd - self.zd_fit) ** 2))
                                        / max(np.sqrt(np.mean(self.zd ** 2)), 1e-300))
