@@ -212,3 +212,30 @@ def test_db_build_refuses_a_bad_poisson_ratio_before_creating_the_file(tmp_path,
     assert main(["db", "build", str(path), "--nu", str(nu), "--limit", "1", "--nodes", "32",
                  "--workers", "1"]) == 2
     assert not path.exists()
+
+
+def test_extend_checks_labels_and_genomes_before_running(tmp_path):
+    """A label of the Sobol form i-k took the place of the design's genome i-k (a later
+    build skipped it as present); a genome the window cannot realise only showed as a
+    failed task ("rerun the same command to retry"). Both are InputErrors now, before
+    any task runs, and nothing is added."""
+    from roughfe.genomics.genome import random_genome
+    from roughfe.study import build_genome_db, extend_genome_db
+
+    tiny = db.DatabaseSettings(n_nodes=64, n_steps=6)
+    path = tmp_path / "g.sqlite"
+    build_genome_db(path, tiny, limit=1, workers=1, progress=False)
+    good = db.make_genome(1.7, 0.9, 11, tiny)
+    with pytest.raises(InputError, match=r"\['2-1'\] have the form i-k of the Sobol"):
+        extend_genome_db(path, [good], labels=["2-1"], progress=False)
+    beyond = random_genome(1.0, 0.8, 1.5, tiny.length, 1, 61, rng=1, n_first=40)
+    with pytest.raises(InputError, match=r"genome 1 of 1 cannot join .* holds only 40\.\.61"):
+        extend_genome_db(path, [beyond], progress=False)
+    surface = db.DatabaseSettings(n_nodes=32, n_steps=4, dim=2, top_fraction=0.8)
+    spath = tmp_path / "s.sqlite"
+    con = db.connect(spath, create=True)
+    db.write_settings(con, surface)
+    con.close()
+    with pytest.raises(InputError, match="no ridge angles"):
+        extend_genome_db(spath, [good], progress=False)
+    assert [e.label for e in db.load_entries(path)] == ["1-1"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import os
+import re
 import sqlite3
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -219,12 +220,22 @@ def extend_tasks(con, genomes, labels_=None) -> list:
     ``genomes`` are Genome objects or Genome JSON dicts (e.g. sequenced ones); labels
     default to ``"x-<k>"`` with k counting on from the database's size, past any label
     already there. The database must hold settings already (an empty database is an
-    error: build it first); a label given twice, or already present, is an error.
+    error: build it first); a label given twice, already present, or of the Sobol
+    design's form ``i-k`` is an error, and so is a genome the database's window cannot
+    realise (checked here, before any task runs).
     """
-    read_settings(con)
+    from .task import genome_entry_inputs
+    settings = read_settings(con)
     dicts = [g if isinstance(g, dict) else g.to_dict() for g in genomes]
     if not dicts:
         raise InputError("no genomes given to add to the database")
+    for k, d in enumerate(dicts):
+        try:
+            genome_entry_inputs(genome_json=d, **settings.to_dict())
+        except (InputError, FileFormatError) as exc:
+            raise InputError(f"genome {k + 1} of {len(dicts)} cannot join this database "
+                             f"(L = {settings.length:g} m, N = {settings.n_nodes}, dim "
+                             f"{settings.dim}): {exc}") from None
     have = set(labels(con))
     if labels_ is None:
         labels_, k = [], len(have)
@@ -238,6 +249,11 @@ def extend_tasks(con, genomes, labels_=None) -> list:
     if twice:
         raise InputError(f"label(s) given more than once: {twice}; every genome needs its "
                          f"own label")
+    sobol = sorted(lab for lab in labels_ if re.fullmatch(r"\d+-\d+", str(lab)))
+    if sobol:
+        raise InputError(f"label(s) {sobol} have the form i-k of the Sobol design's genomes "
+                         f"(pair i, phase vector k), which a later 'db build' adds; choose "
+                         f"another label")
     clash = sorted(set(labels_) & have)
     if clash:
         raise InputError(f"labels already in the database: {clash}")

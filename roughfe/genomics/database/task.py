@@ -64,11 +64,23 @@ def genome_entry_inputs(gamma=None, hurst=None, phases=None, *, amplitude=1.0, l
     analyses that run it (:mod:`roughfe.study.analyses`)."""
     settings = settings_from(settings)
     if genome_json is not None:
-        return settings, Genome.from_dict(genome_json)
+        return settings, _fits_window(Genome.from_dict(genome_json), settings)
     if gamma is None or hurst is None or phases is None:
         raise InputError("genome_entry_task needs gamma, hurst and phases, or genome_json")
     return settings, make_genome(gamma, hurst, phases, settings, amplitude=amplitude,
                                  lambda1=lambda1, angles=angles, anisotropy=anisotropy)
+
+
+def _fits_window(genome: Genome, settings: DatabaseSettings) -> Genome:
+    """``genome`` when the database's window can realise it: a surface database (dim 2)
+    needs ridge angles, and the window must show chromosomes the genome holds
+    (InputError naming what is missing otherwise)."""
+    from ..periodic import realized_chromosomes
+    if settings.dim == 2 and genome.angles is None:
+        raise InputError("a surface database (dim 2) takes surface genomes: this genome has "
+                         "no ridge angles (a profile genome)")
+    realized_chromosomes(genome, settings.length, settings.n_nodes, settings.dim)
+    return genome
 
 
 def _with_metadata(genome, **facts):
