@@ -335,8 +335,9 @@ def register(sub):
     p.add_argument("genome", metavar="GENOME.json", help="roughfe-genome JSON file")
     _length_or_scale(p, required=False)      # required, unless the genome is a design part
     p.add_argument("--nodes", type=positive_int, default=None,
-                   help="number of nodes N (spacing L/(N-1)); default 512, or the design's "
-                        "for a part of a design")
+                   help="number of nodes N (spacing L/(N-1)); default the genome's own "
+                        "(metadata n_nodes: a design part's or a sequenced genome's "
+                        "acquisitions'), else 512")
     p.add_argument("--chromosomes", type=positive_int, nargs="+",
                    help="sum only these chromosome indices (default: those of Eq. 3.5, or "
                         "the part's own for a part of a design)")
