@@ -97,6 +97,30 @@ def test_vi_and_penalty_agree():
     assert vi[-1].n_contact > vi[0].n_contact >= 1
 
 
+def test_penalty_agrees_with_vi_under_load_control():
+    """Load control (each step re-solved from the previous solution at a smaller imposed
+    approach, so the first Newton step unloads the body) and full contact: the penalty
+    Newton stopped after 1 iteration with DIVERGED_DTOL (PETSc's default divergence test,
+    |F| > 1e4 |F(x_0)|). Now it gives the VI's pressures (measured 1e-6: the penalty
+    penetration p / (k E / dx)), and response(n_steps) up to full contact as well."""
+    from roughfe.model import Loading
+    from roughfe.response import response
+    surf = cosine_half_period(33)
+    pm = mesh_profile(surf)
+    p_star = np.pi * MAT.E_star * G / LAM
+    loads = np.array([0.1, 0.5, 0.9]) * p_star
+    vi, pen = (fem_contact_sweep(pm, MAT, pressures=loads, options=FemSolverOptions(method=m))
+               for m in ("vi", "penalty"))
+    full_vi, full_pen = (response(surf, MAT, Loading(n_steps=3), method="fem", solver=m)
+                         for m in ("vi", "penalty"))
+    assert np.allclose(pen.mean_pressure, loads, rtol=1e-5)
+    for a, b in zip(vi.results + full_vi.results, pen.results + full_pen.results):
+        assert b.mean_pressure == pytest.approx(a.mean_pressure, rel=1e-5)
+        assert np.max(np.abs(a.pressure - b.pressure)) < 1e-4 * a.pressure.max()
+        assert np.sum(a.contact != b.contact) <= 1
+    assert full_pen.delta[-1] == pytest.approx(G, rel=1e-3)          # full contact
+
+
 @pytest.mark.parametrize("formulation", ["flat", "profile"])
 def test_uniform_layer_compliance_exact(formulation):
     """A flat punch on a roller-supported layer is uniaxial strain: p = M Delta / H_d

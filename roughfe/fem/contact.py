@@ -28,7 +28,8 @@ with the contact traction t from one of two solvers:
   with the nodal (2-point Gauss-Lobatto-Legendre) rule. For P1 elements that rule makes
   the term diagonal, ``kappa w_i <u_y,i - g_i>_+`` with trapezoidal weights w_i (dx, and
   dx/2 at the ends), which is what is assembled here (no form recompilation per step).
-  Newton (SNES ``newtonls``, line search ``basic``) with the exact generalized Jacobian.
+  Newton (SNES ``newtonls``, line search ``basic``, no divergence test) with the exact
+  generalized Jacobian.
 
 Everything is solved in non-dimensional units (coordinates / W, displacements / height
 range, E = 1): the SNES VI active-set test uses absolute tolerances, and displacements of
@@ -245,8 +246,13 @@ class _ContactProblem:
         snes.setJacobian(self._jacobian, J, J)
         snes.setTolerances(rtol=opt.rtol, atol=opt.atol, max_it=int(opt.max_it))
         snes.setConvergenceHistory(reset=True)       # |F(x_0)| of each solve: the tolerance
+        # no divergence test (PETSc's default stops at |F| > 1e4 |F(x_0)|): a step started
+        # from the previous solution at a smaller approach unloads the body in its first
+        # Newton step, a residual jump far beyond that, and the penalty Newton then
+        # converges (load control and full contact stopped with DIVERGED_DTOL)
         defaults = {"snes_type": "vinewtonrsls" if opt.method == "vi" else "newtonls",
-                    "snes_linesearch_type": "basic", **LU_MUMPS}
+                    "snes_linesearch_type": "basic", "snes_divergence_tolerance": -1,
+                    **LU_MUMPS}
         petsc = {**defaults, **dict(opt.petsc_options or {})}
         # the linear-solver options (ksp_*, pc_*) serve the SNES's inner solves and the
         # incremental-stiffness solve alike (MUMPS LU by default; e.g. CG + hypre)
