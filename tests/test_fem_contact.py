@@ -121,6 +121,51 @@ def test_penalty_agrees_with_vi_under_load_control():
     assert full_pen.delta[-1] == pytest.approx(G, rel=1e-3)          # full contact
 
 
+def test_jacobian_and_stiffness_solve_free_their_petsc_objects():
+    """The penalty Jacobian (every Newton step) and the incremental stiffness (every load
+    step) created work vectors and dropped them undestroyed: petsc4py only queues a
+    dropped object of a non-self communicator for PETSc.garbage_cleanup(), so memory grew
+    with every solve. Every Vec and Mat they create is now destroyed (a subclass of
+    PETSc.Mat records what is created from the stiffness matrix: its copies are of the
+    same class). A memory (RSS) test would need thousands of calls to rise above the
+    allocator's noise."""
+    from petsc4py import PETSc
+    from roughfe.fem.contact import _ContactProblem
+
+    made = []
+
+    class Recording(PETSc.Mat):
+        def createVecLeft(self):
+            made.append(super().createVecLeft())
+            return made[-1]
+
+        def createVecs(self, side=None):
+            vecs = super().createVecs(side)
+            made.extend(vecs if isinstance(vecs, tuple) else [vecs])
+            return vecs
+
+        def duplicate(self, copy=False):
+            made.append(super().duplicate(copy))
+            return made[-1]
+
+    problem = _ContactProblem(mesh_profile(cosine_half_period(17), growth=0.3), MAT,
+                              FemSolverOptions(method="penalty"))
+    try:
+        K = Recording()
+        problem.K.convert(out=K)
+        problem.K.destroy()
+        problem.K = K
+        problem.bound = problem.gap0 - 0.5                 # half the top nodes penetrate
+        J = K.duplicate(copy=True)
+        problem._jacobian(None, problem.x, J, J)
+        J.destroy()
+        assert problem._incremental_stiffness(problem.gap0 < 0.5) > 0
+        assert len(made) >= 5
+        assert [type(obj).__name__ for obj in made if obj.handle] == []
+    finally:
+        problem.destroy()
+
+
 @pytest.mark.parametrize("formulation", ["flat", "profile"])
 def test_uniform_layer_compliance_exact(formulation):
     """A flat punch on a roller-supported layer is uniaxial strain: p = M Delta / H_d

@@ -231,9 +231,13 @@ class _ContactProblem:
             self.K.copy(J, structure=J.Structure.SAME_NONZERO_PATTERN)
             active = (x.array_r[self.top_dofs] > self.bound).astype(float)
             d = J.createVecLeft()
-            d.set(0.0)
-            d.array[self.top_dofs] = self.kappa * self.weights * active
-            J.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
+            try:        # petsc4py queues a dropped Vec of a non-self comm for a
+                        # PETSc.garbage_cleanup() nobody calls: once per Newton step
+                d.set(0.0)
+                d.array[self.top_dofs] = self.kappa * self.weights * active
+                J.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
+            finally:
+                d.destroy()
             J.assemble()
 
     def _make_snes(self):
@@ -351,22 +355,26 @@ class _ContactProblem:
             return 0.0
         rstart = self.K.getOwnershipRange()[0]
         J = self.K.duplicate(copy=True)
-        du, b = J.createVecs()
-        du.set(0.0)
-        b.set(0.0)
-        du.array[rows] = -1.0
-        J.zeroRowsColumns((rows + rstart).astype(PETSc.IntType), diag=1.0, x=du, b=b)
+        du, b = self.K.createVecs()
         ksp = PETSc.KSP().create(comm)
-        ksp.setOperators(J)
-        apply_options(ksp, unique_prefix("stiffness"), self.ksp_options)
-        ksp.solve(b, du)
-        reason = ksp.getConvergedReason()
-        ksp.destroy()
-        J.destroy()
-        if reason <= 0:
-            raise NoConvergenceError(f"incremental stiffness: KSP failed with reason {reason}")
-        self.K.mult(du, b)
-        return comm.tompi4py().allreduce(float(-b.array_r[self.top_dofs].sum()))
+        try:            # (see _jacobian) once per load step
+            du.set(0.0)
+            b.set(0.0)
+            du.array[rows] = -1.0
+            J.zeroRowsColumns((rows + rstart).astype(PETSc.IntType), diag=1.0, x=du, b=b)
+            ksp.setOperators(J)
+            apply_options(ksp, unique_prefix("stiffness"), self.ksp_options)
+            ksp.solve(b, du)
+            reason = ksp.getConvergedReason()
+            if reason <= 0:
+                raise NoConvergenceError(
+                    f"incremental stiffness: KSP failed with reason {reason}")
+            self.K.mult(du, b)
+            local = float(-b.array_r[self.top_dofs].sum())
+        finally:
+            for obj in (ksp, J, du, b):
+                obj.destroy()
+        return comm.tompi4py().allreduce(local)
 
     def _gather(self, local):
         """Top-vertex values of all ranks, ordered by profile sample."""
