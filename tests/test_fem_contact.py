@@ -341,6 +341,26 @@ def test_full_contact_approach_is_the_least_full_contact_load(westergaard_mesh):
         fem_contact_sweep(westergaard_mesh, MAT, [0.5 * G, 1.2 * G])
 
 
+def test_stiffness_beyond_full_contact_is_infinite_as_the_bem():
+    """Beyond the full-contact load the half-plane approach no longer grows: the periodic
+    BEM returns K = inf. The FEM returned 1 / (1/k_applied - H_d/M) of a round-off
+    difference, -1e26..-3e28 Pa/m, and the penalty's load control, reading that negative
+    K as no contact, ran off to 4x the load (NoConvergenceError)."""
+    from roughfe.bem import solve_contact
+    surf = cosine_half_period(33)
+    pm = mesh_profile(surf)
+    load = 1.5 * np.pi * MAT.E_star * G / LAM                      # 1.5 p*
+    bem = solve_contact(mirrored_profile(surf), MAT, mean_pressure=load, kernel="spectral")
+    assert bem.stiffness == np.inf and bem.area_fraction == 1.0
+    for method in ("vi", "penalty"):
+        r = fem_contact_sweep(pm, MAT, pressures=[load],
+                              options=FemSolverOptions(method=method)).results[0]
+        assert r.mean_pressure == pytest.approx(load, rel=1e-6)
+        assert r.area_fraction == 1.0 and r.stiffness == np.inf, (method, r.stiffness)
+        # the penalty penetrates by p / (k E / dx) = 8e-6 G
+        assert r.delta == pytest.approx(bem.delta, rel=2e-5)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("pc", ["hypre", "gamg"])
 def test_iterative_inner_solver_gives_the_direct_solution(westergaard_mesh, pc):

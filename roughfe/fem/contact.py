@@ -309,6 +309,10 @@ class _ContactProblem:
             if abs(err) <= tol:
                 self.last_pressure = r.mean_pressure
                 return r
+            if np.isinf(r.stiffness):      # full contact: Delta is fixed, whatever the load
+                raise NoConvergenceError(
+                    f"FEM contact: the half-plane approach {target:.6g} m was not reached: "
+                    f"full contact at {r.delta:.6g} m, which no load changes", result=r)
             applied = applied + err * (1.0 + r.stiffness * compliance)
             if self.traction is None:          # dry: never above first contact
                 applied = max(applied, 0.0)
@@ -417,8 +421,14 @@ class _ContactProblem:
         mean_h = float(np.sum(w * h)) / W
         mean_gap = float(np.sum(w * gap)) / W
         sigma = self.rms_height
-        k_applied = self._incremental_stiffness(contact[self.sample]) * mat.E / W
-        stiffness = 1.0 / (1.0 / k_applied - compliance) if k_applied > 0 else 0.0
+        if contact.all():
+            # full contact: the top moves with the obstacle, k_applied = M / H_d, and
+            # Delta no longer grows with the load: K = inf, as the periodic BEM's (the
+            # difference 1/k_applied - compliance is round-off: K was +-1e28)
+            stiffness = float("inf")
+        else:
+            k_applied = self._incremental_stiffness(contact[self.sample]) * mat.E / W
+            stiffness = 1.0 / (1.0 / k_applied - compliance) if k_applied > 0 else 0.0
         return ContactResult(
             x=pm.x.copy(), pressure=np.maximum(force, 0.0) / w, displacement=disp, gap=gap,
             contact=contact, delta=delta, delta_applied=delta_applied,
