@@ -361,6 +361,29 @@ def test_stiffness_beyond_full_contact_is_infinite_as_the_bem():
         assert r.delta == pytest.approx(bem.delta, rel=2e-5)
 
 
+def test_near_incompressible_body_warns_with_the_measured_locking_error():
+    """P1 triangles lock as nu -> 1/2: the FEM's pressure came out too high with no word
+    (+8 % at nu = 0.49 on 33 nodes, +26 % at 0.499 on 65). Above nu = 0.45 a
+    ResolutionWarning names the error measured at that nu, and the error is in its range."""
+    import warnings
+    from roughfe.bem import solve_contact
+    from roughfe.errors import ResolutionWarning
+    surf = cosine_half_period(33)
+    pm = mesh_profile(surf)
+    deltas = np.array([0.3, 0.7]) * G
+    soft = Material(E=1e9, nu=0.49)
+    with pytest.warns(ResolutionWarning, match=r"nu = 0.49 > 0.45: the P1 displacement FEM "
+                      r"locks.* p \+3.4..8.1 %, K .* at nu = 0.49.*method='bem'"):
+        fem = fem_contact_sweep(pm, soft, deltas)
+    bem = [solve_contact(mirrored_profile(surf), soft, delta=d, kernel="spectral")
+           for d in deltas]
+    error = fem.mean_pressure / [b.mean_pressure for b in bem] - 1      # measured 8.1, 6.4 %
+    assert np.all((0.0335 <= error) & (error < 0.0815)), error       # the range, rounded
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ResolutionWarning)
+        fem_contact_sweep(pm, MAT, deltas[:1])                             # nu = 0.3
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("pc", ["hypre", "gamg"])
 def test_iterative_inner_solver_gives_the_direct_solution(westergaard_mesh, pc):

@@ -1,0 +1,66 @@
+"""Where the FEM body stops being the BEM's elastic half-plane: measured limits.
+
+An approximation of :mod:`roughfe.fem.contact` that does not go away with the mesh size dx:
+
+* **Volumetric locking.** P1 (constant-strain) displacement triangles cannot deform at
+  constant volume, so as nu -> 1/2 (lambda / mu -> inf) the body is too stiff. Refining
+  helps only slowly (at nu = 0.499 the error fell from +33..42 % to +16..19 % from 33 to
+  257 top nodes); the cure, a mixed u-p or enriched (MINI) element with the nodal
+  contact of the top vertices kept, is not implemented. Above
+  :data:`LOCKING_NU` a :class:`~roughfe.errors.ResolutionWarning` names the measured error;
+  nu >= 0.5 is refused (:func:`roughfe.fem.contact._check_material`).
+
+Measured (the tables below): a cosine half period (lambda = 1 mm, g = 1 um, W =
+lambda/2; E = 1 GPa; growth 0.1, depth 2 W), FEM-VI against the periodic BEM of the
+mirrored profile at the half-plane approaches Delta = 0.3, 0.7 g (33, 65, 129 and 257 top
+nodes). ``p``: mean pressure, ``K``: stiffness dp/dDelta, FEM / BEM - 1.
+"""
+from __future__ import annotations
+
+import warnings
+
+from ..errors import ResolutionWarning
+
+#: Poisson's ratio above which volumetric locking is warned about: at 0.45 the FEM-BEM
+#: difference is about twice that at nu = 0.3 (+0.9..2.1 % against +0.4..0.9 %).
+LOCKING_NU = 0.45
+#: nu, then the measured p and K errors (ranges over the meshes and loads).
+LOCKING_ERRORS = ((0.3, "+0.4..0.9 %", "+0.4..0.9 %"),
+                  (0.45, "+0.9..2.1 %", "-0.5..+2.7 %"),
+                  (0.46, "+1.1..2.5 %", "-0.3..+3.3 %"),
+                  (0.47, "+1.4..3.1 %", "+0.1..4.4 %"),
+                  (0.49, "+3.4..8.1 %", "-2.9..+10 %"),
+                  (0.499, "+16..42 %", "+13..25 %"),
+                  (0.49999, "+46..111 %", "+44..98 %"))
+
+
+def _measured(row, name="", unit=""):
+    """``"p <error>, K <error> at <name><value><unit>"`` of a row of a table."""
+    return f"p {row[1]}, K {row[2]} at {name}{row[0]:g}{unit}"
+
+
+def _bracket(table, value, name="", unit=""):
+    """The errors of ``table`` measured at ``value``, or at the rows on either side of it,
+    or "more than" those of the last row it lies beyond (the worse end of each table)."""
+    lower = [r for r in table if r[0] <= value]
+    upper = [r for r in table if r[0] >= value]
+    if lower and upper:
+        if lower[-1] is upper[0]:
+            return _measured(upper[0], name, unit)
+        return (f"between {_measured(lower[-1], name, unit)} and "
+                f"{_measured(upper[0], name, unit)}")
+    return f"more than {_measured(lower[-1] if lower else upper[0], name, unit)}"
+
+
+def warn_locking(nu: float, stacklevel: int = 3) -> None:
+    """ResolutionWarning when ``nu`` > :data:`LOCKING_NU`, naming the errors measured at
+    that nu or the tabulated ones on either side (:data:`LOCKING_ERRORS`)."""
+    if nu <= LOCKING_NU:
+        return
+    warnings.warn(
+        f"nu = {nu!r} > {LOCKING_NU}: the P1 displacement FEM locks volumetrically and "
+        f"overestimates the pressure; against the BEM on a cosine (33-257 top nodes) it "
+        f"was off by {_bracket(LOCKING_ERRORS, nu, 'nu = ')} (the discretisation error: "
+        f"{_measured(LOCKING_ERRORS[0], 'nu = ')}); a finer mesh helps little; "
+        f"use method='bem' (any nu < 0.5) for a near-incompressible body",
+        ResolutionWarning, stacklevel=stacklevel)
