@@ -169,10 +169,13 @@ def test_jacobian_and_stiffness_solve_free_their_petsc_objects():
 @pytest.mark.parametrize("formulation", ["flat", "profile"])
 def test_uniform_layer_compliance_exact(formulation):
     """A flat punch on a roller-supported layer is uniaxial strain: p = M Delta / H_d
-    exactly, so the half-plane delta = 0, uniform pressure and sigma_yy = -p in every cell."""
+    exactly, so the half-plane delta = 0, uniform pressure and sigma_yy = -p in every cell.
+    (A layer of 0.7 W is no half-plane: the warning says so, yet a uniform load is exact.)"""
+    from roughfe.errors import ResolutionWarning
     n, L = 17, 1e-3
     flat = Surface(np.zeros(n), n * L / (n - 1))
-    pm = mesh_profile(flat, depth=0.7e-3, growth=0.3, formulation=formulation)
+    with pytest.warns(ResolutionWarning, match="depth = 0.0007 m = 0.7 W is shallower"):
+        pm = mesh_profile(flat, depth=0.7e-3, growth=0.3, formulation=formulation)
     delta = 2e-6
     r = fem_solve_contact(pm, MAT, applied_delta=delta, keep_fields=True)
     M = MAT.E * 0.7 / (1.3 * 0.4)
@@ -186,6 +189,7 @@ def test_uniform_layer_compliance_exact(formulation):
     assert np.allclose(r.fields["stress_yy"], -p, rtol=1e-8)
 
 
+@pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 @pytest.mark.parametrize("formulation", ["flat", "profile"])
 def test_facet_tags_on_the_right_edges(formulation):
     surf = random_profile(33, seed=1)
@@ -244,6 +248,7 @@ def test_mirrored_profile_and_bad_input():
         fem_solve_contact("profile.msh", Material(E=1e9, nu=0.3), 1e-7)
 
 
+@pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 def test_mesh_files_for_inspection(tmp_path):
     """.msh keeps gmsh's physical groups; the XDMF holds the same triangles in metres."""
     meshio = pytest.importorskip("meshio")
@@ -382,6 +387,34 @@ def test_near_incompressible_body_warns_with_the_measured_locking_error():
     with warnings.catch_warnings():
         warnings.simplefilter("error", ResolutionWarning)
         fem_contact_sweep(pm, MAT, deltas[:1])                             # nu = 0.3
+
+
+def test_shallow_body_warns_and_a_body_thinner_than_dx_is_refused():
+    """A body of depth W/2 on its roller bottom is stiffer than the half-plane: the FEM's
+    pressure came out 18..40 % above the BEM's with no word. Below 2 W a ResolutionWarning
+    names the error measured at that depth, and the error is in its range. A body thinner
+    than dx (depth 1e-4 dx: slivers, then DIVERGED_MAX_IT) is an InputError."""
+    import warnings
+    from roughfe.bem import solve_contact
+    from roughfe.errors import ResolutionWarning
+    surf = cosine_half_period(33)
+    W, dx = LAM / 2, surf.spacing[0]
+    with pytest.warns(ResolutionWarning, match=r"depth = 0.00025 m = 0.5 W is shallower than "
+                      r"the 2 W .* p \+18..40 %, K \+18..48 % at 0.5 W"):
+        pm = mesh_profile(surf, depth=0.5 * W)
+    deltas = np.array([0.3, 0.7]) * G
+    fem = fem_contact_sweep(pm, MAT, deltas)
+    bem = [solve_contact(mirrored_profile(surf), MAT, delta=d, kernel="spectral")
+           for d in deltas]
+    error = fem.mean_pressure / [b.mean_pressure for b in bem] - 1      # measured 27, 40 %
+    assert np.all((0.175 <= error) & (error < 0.405)), error
+    for formulation, depth in (("flat", 1e-4 * dx), ("profile", G + 0.5 * dx)):
+        with pytest.raises(InputError, match=r"depth = .* m leaves a body .* thick, less "
+                           r"than the top element size dx = 1.56e-05 m.* give depth >= dx"):
+            mesh_profile(surf, depth=depth, formulation=formulation)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ResolutionWarning)
+        mesh_profile(surf, depth=2 * W)                                    # the default
 
 
 @pytest.mark.slow

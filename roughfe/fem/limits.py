@@ -1,6 +1,6 @@
 """Where the FEM body stops being the BEM's elastic half-plane: measured limits.
 
-An approximation of :mod:`roughfe.fem.contact` that does not go away with the mesh size dx:
+Two approximations of :mod:`roughfe.fem.contact` do not go away with the mesh size dx:
 
 * **Volumetric locking.** P1 (constant-strain) displacement triangles cannot deform at
   constant volume, so as nu -> 1/2 (lambda / mu -> inf) the body is too stiff. Refining
@@ -9,17 +9,24 @@ An approximation of :mod:`roughfe.fem.contact` that does not go away with the me
   contact of the top vertices kept, is not implemented. Above
   :data:`LOCKING_NU` a :class:`~roughfe.errors.ResolutionWarning` names the measured error;
   nu >= 0.5 is refused (:func:`roughfe.fem.contact._check_material`).
+* **Finite depth.** The body of depth H_d stands on rollers. The uniform part of the load
+  is corrected exactly (the layer compliance H_d / M), but the non-uniform part decays as
+  exp(-pi y / W) for the longest mode of the mirrored profile (period 2 W), so a shallow
+  body is stiffer than the half-plane. Below :data:`HALF_PLANE_DEPTH` W a
+  ResolutionWarning names the measured error; a body thinner than the top element size dx
+  cannot be meshed with triangles of that size and is refused (:class:`InputError`).
 
 Measured (the tables below): a cosine half period (lambda = 1 mm, g = 1 um, W =
-lambda/2; E = 1 GPa; growth 0.1, depth 2 W), FEM-VI against the periodic BEM of the
-mirrored profile at the half-plane approaches Delta = 0.3, 0.7 g (33, 65, 129 and 257 top
-nodes). ``p``: mean pressure, ``K``: stiffness dp/dDelta, FEM / BEM - 1.
+lambda/2; growth 0.1), FEM-VI against the periodic BEM of the mirrored profile at the
+half-plane approaches Delta = 0.3, 0.7 g (nu: E = 1 GPa, depth 2 W; 33, 65, 129 and 257 top
+nodes) and 0.1, 0.3, 0.7 g (depth: E = 210 GPa, nu = 0.3; 33, 65 and 129 top nodes).
+``p``: mean pressure, ``K``: stiffness dp/dDelta, FEM / BEM - 1.
 """
 from __future__ import annotations
 
 import warnings
 
-from ..errors import ResolutionWarning
+from ..errors import InputError, ResolutionWarning
 
 #: Poisson's ratio above which volumetric locking is warned about: at 0.45 the FEM-BEM
 #: difference is about twice that at nu = 0.3 (+0.9..2.1 % against +0.4..0.9 %).
@@ -32,6 +39,15 @@ LOCKING_ERRORS = ((0.3, "+0.4..0.9 %", "+0.4..0.9 %"),
                   (0.49, "+3.4..8.1 %", "-2.9..+10 %"),
                   (0.499, "+16..42 %", "+13..25 %"),
                   (0.49999, "+46..111 %", "+44..98 %"))
+#: The depth (in W) of a body that is the half-plane to the discretisation error: at 2 W
+#: the difference to the BEM equals that at 3 W and 4 W to 0.1 % (the default depth).
+HALF_PLANE_DEPTH = 2.0
+#: depth / W, then the measured p and K errors (ranges over the meshes and loads).
+DEPTH_ERRORS = ((0.25, "+67..159 %", "+65..216 %"),
+                (0.5, "+18..40 %", "+18..48 %"),
+                (1.0, "+1.8..3.3 %", "+1.8..3.0 %"),
+                (1.5, "+0.5..1.2 %", "+0.6..0.9 %"),
+                (2.0, "+0.4..1.2 %", "+0.5..0.9 %"))
 
 
 def _measured(row, name="", unit=""):
@@ -64,3 +80,40 @@ def warn_locking(nu: float, stacklevel: int = 3) -> None:
         f"{_measured(LOCKING_ERRORS[0], 'nu = ')}); a finer mesh helps little; "
         f"use method='bem' (any nu < 0.5) for a near-incompressible body",
         ResolutionWarning, stacklevel=stacklevel)
+
+
+def check_depth(depth: float, width: float, dx: float, thinnest: float) -> None:
+    """Refuse a body thinner than the top element size; warn below 2 W.
+
+    Parameters
+    ----------
+    depth, width, dx : float
+        H_d, W = (n-1) dx and dx (m).
+    thinnest : float
+        The least thickness of the body (m): ``depth`` for the flat top, ``depth + min
+        top(x)`` for the profile top.
+
+    Raises
+    ------
+    InputError
+        ``thinnest < dx``: triangles of size dx do not fit (gmsh makes one layer of
+        slivers of aspect dx / thickness; at depth = 1e-4 dx the SNES stopped with
+        DIVERGED_MAX_IT).
+    """
+    if thinnest < dx:
+        raise InputError(
+            f"depth = {depth:.3g} m leaves a body {thinnest:.3g} m thick, less than the top "
+            f"element size dx = {dx:.3g} m: it cannot be meshed with triangles of that size "
+            f"(slivers of aspect {dx / thinnest:.3g}); give depth >= dx, and >= "
+            f"{HALF_PLANE_DEPTH:g} W = {HALF_PLANE_DEPTH * width:.3g} m (the default) for "
+            f"the BEM's half-plane")
+    d = depth / width
+    if d >= HALF_PLANE_DEPTH:
+        return
+    warnings.warn(
+        f"depth = {depth:.3g} m = {d:.3g} W is shallower than the {HALF_PLANE_DEPTH:g} W = "
+        f"{HALF_PLANE_DEPTH * width:.3g} m of a half-plane (W = (n-1) dx = {width:.3g} m): "
+        f"the roller bottom stiffens the body; against the BEM on a cosine (33-129 top "
+        f"nodes) the FEM was off by {_bracket(DEPTH_ERRORS, d, unit=' W')} (the "
+        f"discretisation error: {_measured(DEPTH_ERRORS[-1], unit=' W')}); omit depth for "
+        f"the default {HALF_PLANE_DEPTH:g} W", ResolutionWarning, stacklevel=3)
