@@ -36,6 +36,8 @@ LONG_MODULES = {
 def _layer(parts):
     """Layer index of a module given its path parts below roughfe/."""
     head = parts[0].removesuffix(".py")
+    if head == "__main__":             # python -m roughfe: the command line's entry point
+        head = "cli"
     if head in BASE:
         return -1, head
     if head not in ORDER:

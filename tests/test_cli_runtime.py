@@ -82,3 +82,11 @@ def test_public_render_backend_call_orders_vtk_before_dolfinx():
                          env=headless_environment(dict(os.environ)), timeout=180)
     assert out.returncode == 0, out.stderr[-2000:]
     assert "rendered" in out.stdout
+
+
+def test_python_dash_m_roughfe_is_the_command(tmp_path):
+    """``python -m roughfe`` runs the roughfe command (it said "No module named
+    roughfe.__main__"; three reviewers tried it first)."""
+    proc = subprocess.run([sys.executable, "-m", "roughfe", "--version"], capture_output=True,
+                          text=True, timeout=120, cwd=tmp_path)
+    assert proc.returncode == 0 and proc.stdout.startswith("roughfe "), proc.stderr
