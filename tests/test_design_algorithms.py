@@ -69,6 +69,21 @@ def test_methods_improve_and_scores_reproduce_from_the_saved_design(entries, tar
     assert d.surface().shape == (SETTINGS.n_nodes,)
 
 
+@pytest.mark.parametrize("method", ["gco", "cco"])
+def test_cross_over_takes_a_pair_of_genomes_once(entries, targets, method):
+    """GCO/CCO: a genome in both U1 and U2 gave the pairs (a, b) and (b, a), the same
+    profile (a sum; both sets give the same part of a genome), and the duplicate took
+    one of the three GCMMA starts. On y_t2 the sets are {3, 5, 0} and {0, 3, 5}: 6
+    unordered pairs (3 genomes alone, 3 crossed), not 9, and no start twice."""
+    t2 = targets[1]
+    none = de.GcmmaOptions(n_it_cross=0, n_it_micro=0)        # GCMMA 0 only
+    r = de.run_design(method, entries, [t2], SETTINGS, pbar=0.5 * t2.p_max, options=none,
+                      n_best=3, max_set=3)
+    pairs = [frozenset(c.origin.split("+")) for c in r.candidates]
+    assert len(set(pairs)) == len(pairs) == 3
+    assert r.n_cross == 6
+
+
 def test_success_fails_when_eq42_rescaling_is_not_exact(entries, targets):
     """success is a criterion: with an elastic-plastic response (hardness H_p) a profile's
     curve does not stretch exactly with its amplitude (Eq. 4.2 assumes linearity), so the

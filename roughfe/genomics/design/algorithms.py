@@ -229,14 +229,26 @@ def sog(entries, target: Target, settings: DatabaseSettings, *, evaluate=None,
 
 
 def _cross(entries, by_label, objective, settings, evaluate, sets, parts_of, n_best, max_set):
-    """Steps 5-12 of Algs. 5-7: every pair of U1 x U2, rescaled (Eq. 4.2), scored."""
+    """Steps 5-12 of Algs. 5 and 6: every pair of U1 x U2, rescaled (Eq. 4.2), scored.
+
+    Departure from the thesis: Steps 5-11 run over the ordered pairs (i1, i2) of U1 x U2,
+    but a genome in both U1 and U2 gives (a, b) and (b, a), which are the same profile
+    (the cross-over is a sum, Step 6, and both sets contribute the same part of a genome:
+    all chromosomes in GCO, the macro-scale ones in CCO), so the duplicate took one of
+    the three GCMMA starts of Step 12 and one BEM sweep. Here each unordered pair is
+    crossed once, as (a, b) with a taken from U1. (a, a), the genome alone at its Eq.
+    (4.2) amplitude, is kept as in the thesis. M-CCO (Alg. 7) crosses the macro
+    chromosomes of U1 with the micro ones of U2, so its ordered pairs are distinct."""
     u1, u2 = (s[:max_set] if max_set else s for s in sets)
-    pool = []
+    pool, seen = [], set()
     for i1 in u1:
         for i2 in u2:
+            if frozenset((i1, i2)) in seen:
+                continue
+            seen.add(frozenset((i1, i2)))
             e1, e2 = entries[i1], entries[i2]
-            d1 = entry_design(e1, settings, objective.p_max / e1.p_max, parts_of[0](e1))
-            d2 = entry_design(e2, settings, objective.p_max / e2.p_max, parts_of[1](e2))
+            d1 = entry_design(e1, settings, objective.p_max / e1.p_max, parts_of(e1))
+            d2 = entry_design(e2, settings, objective.p_max / e2.p_max, parts_of(e2))
             d = combine(d1, d2)
             curve = evaluate(d)
             pool.append((objective(curve), d, curve, f"{e1.label}+{e2.label}"))
@@ -264,7 +276,7 @@ def _two_range_cross_over(method, entries, target, pbar, settings, evaluate, opt
     objective = Objective((target,))
     (s1, s2), sets, passed = _two_range_sets(entries, target, pbar)
     starts, n_cross, n_above = _cross(entries, by_label, objective, settings, evaluate, sets,
-                                      (chromosomes, chromosomes), n_best, max_set)
+                                      chromosomes, n_best, max_set)
     cands = _optimise_candidates(starts, objective, evaluate, options, options.n_it_cross,
                                  n_it_micro, by_label, settings, stage1=stage1)
     return _result(method, cands, objective, pbar, {"s1": s1.tolist(), "s2": s2.tolist()},
@@ -278,7 +290,8 @@ def gco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, eva
 
     U1/U2: genomes with s > 0.95 on [0, pbar] / [pbar, p_max^t] (the 3 best of a range
     if none passes; at most ``max_set`` per set, None = all as in the thesis); every
-    pair U1 x U2 is summed (each at its Eq. 4.2 amplitude), rescaled and scored; the
+    pair U1 x U2 is summed (each at its Eq. 4.2 amplitude; a pair of two genomes once,
+    whichever set each came from: see :func:`_cross`), rescaled and scored; the
     ``n_best`` best go through GCMMA on their macro phases (Alg. 2 on the new genome),
     then their micro phases.
     """
