@@ -77,3 +77,38 @@ def test_target_y_t2_shape_and_bad_inputs(tmp_path):
         t.check_pbar(2.5)
     with pytest.raises(InputError, match="quantity"):
         Target([0.1, 0.2], [1.0, 2.0], quantity="E")
+
+
+def test_target_csv_header_is_a_line_of_names_not_a_line_number(tmp_path):
+    """Header detection used the line number: a headerless file with a UTF-8 BOM, or a
+    first row with a typo, silently lost its first row, and a header after two comment
+    lines was refused. Now only names are a header, and every bad row is an error
+    naming its line and content."""
+    from roughfe.errors import FileFormatError
+    rows = "1e7,1e11\n2e7,1.1e11\n3e7,1.2e11\n"
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes(b"\xef\xbb\xbf" + rows.encode())
+    t = read_target_csv(bom)
+    np.testing.assert_array_equal(t.pressure, [1e7, 2e7, 3e7])
+    bom_header = tmp_path / "bom_header.csv"
+    bom_header.write_bytes(b"\xef\xbb\xbfpressure_Pa,value\n" + rows.encode())
+    assert read_target_csv(bom_header).pressure.size == 3
+    comments = tmp_path / "comments.csv"
+    comments.write_text("# my target\n# made by hand\npressure_Pa,value\n" + rows)
+    np.testing.assert_array_equal(read_target_csv(comments).values, [1e11, 1.1e11, 1.2e11])
+    typo = tmp_path / "typo.csv"
+    typo.write_text("1e7,1e11x\n2e7,1.1e11\n3e7,1.2e11\n")
+    with pytest.raises(FileFormatError, match=r"line 1 .*'1e7,1e11x'"):
+        read_target_csv(typo)
+    late = tmp_path / "late.csv"
+    late.write_text("pressure_Pa,value\n" + rows + "p,K\n")
+    with pytest.raises(FileFormatError, match=r"line 5 .*'p,K'"):
+        read_target_csv(late)
+    second = tmp_path / "second.csv"
+    second.write_text("pressure_Pa,value\nin Pa,in Pa/m\n" + rows)
+    with pytest.raises(FileFormatError, match="line 2"):
+        read_target_csv(second)
+    latin = tmp_path / "latin.csv"
+    latin.write_bytes(b"# \xb5m\n" + rows.encode())
+    with pytest.raises(FileFormatError, match="UTF-8"):
+        read_target_csv(latin)

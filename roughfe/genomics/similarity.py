@@ -316,35 +316,67 @@ def linear_then_flat_target(p_max: float, pbar: float, plateau: float, n_points:
                                          "start": None if start is None else float(start)})
 
 
+def _float_or_none(text):
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def _said(line):
+    """The quantity a comment line names (as :func:`write_target_csv` writes it), or None."""
+    return next((q for q, (label, _) in QUANTITY_LABELS.items() if label in line), None)
+
+
+def _target_lines(path):
+    """``(line number, raw text, stripped cells)`` of the lines of a target CSV that are
+    neither blank nor comments, and the quantity the first naming comment says."""
+    lines, said = [], None
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as fh:
+            for k, row in enumerate(csv.reader(fh), 1):
+                cells = [c.strip() for c in row]
+                if not any(cells):
+                    continue
+                if cells[0].startswith("#"):
+                    said = said or _said(",".join(row))
+                else:
+                    lines.append((k, ",".join(row), cells))
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise FileFormatError(f"{path} is not a UTF-8 CSV text file of 'pressure,value' rows "
+                              f"({exc})") from None
+    return lines, said
+
+
 def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> Target:
     """Read a target from a CSV file with two columns: pressure (Pa), value (K in Pa/m or A).
 
-    Lines starting with ``#`` and a non-numeric header line are skipped. The quantity is
-    the one the file's ``# name: <label> (unit) vs pressure (Pa)`` comment names (as
-    :func:`write_target_csv` writes it); ``quantity`` ("K" or "A") must then agree with
-    it (an area target read as a stiffness was a silent, meaningless objective), and is
-    taken as given for a file that names none (``default`` when None).
+    The file is UTF-8 (a byte-order mark is skipped). Blank lines and lines starting with
+    ``#`` are skipped anywhere; one header line of non-numeric names may precede the
+    first data row (a line with a number in it is data: ``1e7,1e11x`` is an error, not a
+    header); every other line must be two numbers, else the error names the line and
+    its content. The quantity is the one the file's ``# name: <label> (unit) vs pressure
+    (Pa)`` comment names (as :func:`write_target_csv` writes it); ``quantity`` ("K" or
+    "A") must then agree with it (an area target read as a stiffness was a silent,
+    meaningless objective), and is taken as given for a file that names none
+    (``default`` when None).
     """
     path = Path(path)
     if not path.is_file():
         raise InputError(f"target file {path} does not exist")
     if quantity is not None:
         _check_quantity(quantity)
-    rows, said = [], None
-    with path.open(newline="") as fh:
-        for k, row in enumerate(csv.reader(fh)):
-            if not row or row[0].lstrip().startswith("#"):
-                line = ",".join(row)
-                for q, (label, _) in QUANTITY_LABELS.items():
-                    if said is None and label in line:
-                        said = q
-                continue
-            try:
-                rows.append([float(row[0]), float(row[1])])
-            except (ValueError, IndexError):
-                if rows or k > 1:
-                    raise FileFormatError(f"{path}: line {k + 1} is not 'pressure,value': "
-                                          f"{row!r}") from None
+    lines, said = _target_lines(path)
+    rows = []
+    for i, (k, text, cells) in enumerate(lines):
+        values = [_float_or_none(c) for c in cells]
+        if i == 0 and all(v is None for v in values):
+            continue                                    # the header: names only
+        if len(values) < 2 or None in values[:2]:
+            raise FileFormatError(f"{path}: line {k} is not a row 'pressure,value' of two "
+                                  f"comma-separated numbers: {text!r} (one header line of "
+                                  f"names may precede the first row)")
+        rows.append(values[:2])
     if not rows:
         raise FileFormatError(f"{path}: no 'pressure,value' rows found")
     if said is not None and quantity is not None and said != quantity:
