@@ -112,3 +112,35 @@ def test_target_csv_header_is_a_line_of_names_not_a_line_number(tmp_path):
     latin.write_bytes(b"# \xb5m\n" + rows.encode())
     with pytest.raises(FileFormatError, match="UTF-8"):
         read_target_csv(latin)
+
+
+def test_target_csv_contents_are_checked(tmp_path):
+    """A header 'value,pressure_Pa' was read as pressure,value (values as pressures); a
+    third column was silently dropped; an area target in percent (5-60) was accepted.
+    Now the header must name the pressure first, rows hold two values, and 0 < A <= 1."""
+    from roughfe.errors import FileFormatError
+
+    def target(name, text, quantity=None):
+        path = tmp_path / name
+        path.write_text(text)
+        return read_target_csv(path, quantity)
+
+    with pytest.raises(FileFormatError, match=r"line 1: the header 'value,pressure_Pa' does "
+                                              r"not name the pressure first \(swapped"):
+        target("swapped.csv", "value,pressure_Pa\n1e11,1e7\n1.1e11,2e7\n")
+    with pytest.raises(FileFormatError, match=r"'x,y' does not name the pressure first"):
+        target("xy.csv", "x,y\n1e7,1e11\n2e7,1.1e11\n")
+    with pytest.raises(FileFormatError, match=r"'pressure_Pa,K,A' names 3 column"):
+        target("three.csv", "pressure_Pa,K,A\n1e7,1e11,0.01\n2e7,1.1e11,0.02\n")
+    with pytest.raises(FileFormatError, match=r"line 1 .*'1e7,1e11,0.01'"):
+        target("three_bare.csv", "1e7,1e11,0.01\n2e7,1.1e11,0.02\n")   # no header
+    with pytest.raises(InputError, match=r"0 < A <= 1 .*value 5.0 at p = 10000000.0 Pa.*"
+                                         r"not percent"):
+        target("percent.csv", "pressure_Pa,value\n1e7,5\n2e7,20\n3e7,60\n", "A")
+    with pytest.raises(InputError, match="0 < A <= 1"):
+        Target([1.0, 2.0], [0.5, 1.5], "A")
+    # accepted: pressure-first names with units, a trailing comma, A up to 1
+    for header in ("p,K", "p [Pa],K [Pa/m]", "Pressure (Pa),stiffness", "mean_pressure,value"):
+        assert target("ok.csv", f"{header}\n1e7,1e11\n2e7,1.1e11\n").pressure.size == 2
+    assert target("trail.csv", "pressure_Pa,value,\n1e7,1e11,\n2e7,1.1e11,\n").values[1] == 1.1e11
+    assert target("full.csv", "p,A\n1e7,0.5\n2e7,1\n", "A").values[-1] == 1.0

@@ -26,6 +26,7 @@ range without a new BEM solution (:meth:`ResponseCurve.rescaled`);
 from __future__ import annotations
 
 import csv
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
@@ -147,7 +148,8 @@ class Target:
         Mean contact pressures (Pa), >= 0; sorted on construction.
     values : array_like
         Target K (Pa/m) or A (-) at those pressures: finite and >= 0; where p > 0 it
-        must be > 0 because Eq. (4.1) divides by it. Points at p = 0 are dropped.
+        must be > 0 because Eq. (4.1) divides by it, and an area fraction A <= 1.
+        Points at p = 0 are dropped.
     quantity : {"K", "A"}
     name : str
         Label used in reports (e.g. ``"y_t1"``).
@@ -188,6 +190,11 @@ class Target:
             i = int(np.flatnonzero(zero)[0])
             raise InputError(f"target values must be > 0 where p > 0 (Eq. 4.1 divides by them): "
                              f"value {y[i]!r} at p = {p[i]!r} Pa")
+        if self.quantity == "A" and np.any(y > 1):
+            i = int(np.flatnonzero(y > 1)[0])
+            raise InputError(f"an area target holds fractions 0 < A <= 1 (A = A_r/A_n): value "
+                             f"{y[i]!r} at p = {p[i]!r} Pa; give fractions, not percent "
+                             f"(e.g. 0.05 for 5 %)")
         order = np.argsort(p, kind="stable")
         p, y = p[order], y[order]
         if np.any(np.diff(p) == 0):
@@ -348,14 +355,37 @@ def _target_lines(path):
     return lines, said
 
 
+def _is_pressure_name(name) -> bool:
+    """A header name that says pressure: ``p``, ``pressure``, ``mean pressure``, with any
+    unit or suffix after a non-letter (``pressure_Pa``, ``p [Pa]``, ``p_mean``)."""
+    return re.match(r"(mean[ _-]?)?(p|pressure)(?![a-z])", name.lower()) is not None
+
+
+def _check_header(path, k, text, cells):
+    """A header must name two columns, the pressure first (the reader takes columns by
+    position: a file written value first was read with its values as pressures)."""
+    if len(cells) != 2:
+        raise FileFormatError(f"{path}: line {k}: the header {text!r} names {len(cells)} "
+                              f"column(s); a target has two, comma-separated: pressure (Pa) "
+                              f"then value (e.g. 'pressure_Pa,value')")
+    if not _is_pressure_name(cells[0]) or _is_pressure_name(cells[1]):
+        swapped = " (swapped? put the pressure first)" if _is_pressure_name(cells[1]) else ""
+        raise FileFormatError(f"{path}: line {k}: the header {text!r} does not name the "
+                              f"pressure first{swapped}; the columns are pressure (Pa) then "
+                              f"value, e.g. 'pressure_Pa,value' or 'p,K'")
+
+
 def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> Target:
     """Read a target from a CSV file with two columns: pressure (Pa), value (K in Pa/m or A).
 
     The file is UTF-8 (a byte-order mark is skipped). Blank lines and lines starting with
     ``#`` are skipped anywhere; one header line of non-numeric names may precede the
     first data row (a line with a number in it is data: ``1e7,1e11x`` is an error, not a
-    header); every other line must be two numbers, else the error names the line and
-    its content. The quantity is the one the file's ``# name: <label> (unit) vs pressure
+    header), and it must name two columns, the pressure first (``pressure_Pa,value``,
+    ``p,K``, ``p [Pa],A``); every other line must be two numbers (empty cells after them,
+    a trailing comma, are ignored; a third value is an error), else the error names the
+    line and its content. An area target must be a fraction, 0 < A <= 1 (:class:`Target`).
+    The quantity is the one the file's ``# name: <label> (unit) vs pressure
     (Pa)`` comment names (as :func:`write_target_csv` writes it); ``quantity`` ("K" or
     "A") must then agree with it (an area target read as a stiffness was a silent,
     meaningless objective), and is taken as given for a file that names none
@@ -369,14 +399,17 @@ def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> 
     lines, said = _target_lines(path)
     rows = []
     for i, (k, text, cells) in enumerate(lines):
+        while not cells[-1]:                            # a trailing comma: no column
+            cells = cells[:-1]
         values = [_float_or_none(c) for c in cells]
         if i == 0 and all(v is None for v in values):
-            continue                                    # the header: names only
-        if len(values) < 2 or None in values[:2]:
+            _check_header(path, k, text, cells)         # the header: names only
+            continue
+        if len(values) != 2 or None in values:
             raise FileFormatError(f"{path}: line {k} is not a row 'pressure,value' of two "
                                   f"comma-separated numbers: {text!r} (one header line of "
                                   f"names may precede the first row)")
-        rows.append(values[:2])
+        rows.append(values)
     if not rows:
         raise FileFormatError(f"{path}: no 'pressure,value' rows found")
     if said is not None and quantity is not None and said != quantity:
