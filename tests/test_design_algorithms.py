@@ -104,6 +104,21 @@ def test_success_fails_when_eq42_rescaling_is_not_exact(entries, targets):
     assert elastic.success and elastic.best.rescore_error <= 1e-9
 
 
+def test_success_tolerance_is_relative_to_large_scores(entries, targets):
+    """A target 1e9 times too soft scores s ~ -1e9; the fresh sweep of the saved design
+    reproduces it to round-off (1e-15 relative, ~1e-6 absolute), which the absolute
+    tolerance 1e-6 called a failure blaming non-linearity. Relative beyond |s| = 1."""
+    t1 = targets[0]
+    soft = Target(t1.pressure, 1e-9 * t1.values, "K")
+    r = de.sog(entries, soft, SETTINGS, n_best=1,
+               options=de.GcmmaOptions(n_it_sog=1, n_it_micro=0, gradient="fd"))
+    assert r.best.scores[0] < -1e8 and r.best.rescore_error > 1e-6
+    assert r.best.rescore_error < 1e-14 * abs(r.best.scores[0])
+    assert r.success and "NOT a success" not in r.message
+    assert de.algorithms.rescore_tolerance([0.5]) == de.algorithms.RESCORE_TOL
+    assert de.algorithms.rescore_tolerance([-2e9]) == 2e9 * de.algorithms.RESCORE_TOL
+
+
 def test_bad_inputs_are_clear(entries, targets):
     t1, t2, t3, _ = targets
     with pytest.raises(InputError, match="pbar"):

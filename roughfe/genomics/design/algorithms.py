@@ -37,7 +37,9 @@ METHODS = ("sog", "gco", "cco", "mcco")
 #: as a match (thesis: 0.95)
 SELECTION = 0.95
 #: largest difference allowed between a candidate's reported scores (its curve stretched
-#: by Eq. 4.2) and a fresh BEM sweep of the saved, rescaled design: the success criterion
+#: by Eq. 4.2) and a fresh BEM sweep of the saved, rescaled design, relative to the
+#: scores' magnitude when that is above 1 (a poor score such as s = -1e9 carries
+#: round-off of 1e-15 relative, 1e-6 absolute): the success criterion
 RESCORE_TOL = 1e-6
 REFERENCES = ("Borri C. (2019) Surface roughness genomics, PhD thesis, IMT Lucca, Ch. 4",
               "Svanberg K. (2002) SIAM J. Optim. 12(2):555-573 (GCMMA)")
@@ -80,7 +82,8 @@ class DesignResult:
 
     ``success`` is a criterion, not a flag: every candidate's scores (and strict scores,
     when searched) are finite, and a fresh BEM sweep of each saved (Eq. 4.2-rescaled)
-    design gives its reported scores within :data:`RESCORE_TOL`. The second fails when
+    design gives its reported scores within :data:`RESCORE_TOL` times ``max(1, |s|)``
+    (:func:`rescore_tolerance`). The second fails when
     the response is not linear in the heights (e.g. an elastic-plastic evaluator): Eq.
     (4.2) then no longer rescales a curve exactly, and the reported design would not
     have the reported score.
@@ -147,17 +150,24 @@ def _finish(design, s_stages, objective, evaluate, macro, micro, origin):
                      origin, rescore_error=err)
 
 
+def rescore_tolerance(scores) -> float:
+    """The difference allowed between reported ``scores`` and a fresh sweep's:
+    :data:`RESCORE_TOL` absolute for scores up to 1 in magnitude, relative beyond."""
+    return RESCORE_TOL * max(1.0, float(np.max(np.abs(scores))))
+
+
 def _success(cands) -> tuple:
     """``(success, message suffix)`` of the criterion of :class:`DesignResult`."""
     bad = [c.origin for c in cands
            if not np.all(np.isfinite(np.concatenate([c.scores, c.at_targets])))]
     if bad:
         return False, f"; NOT a success: non-finite score of {', '.join(bad)}"
-    worst = max(cands, key=lambda c: c.rescore_error)
-    if not worst.rescore_error <= RESCORE_TOL:
+    worst = max(cands, key=lambda c: c.rescore_error / rescore_tolerance(c.scores))
+    tol = rescore_tolerance(worst.scores)
+    if not worst.rescore_error <= tol:
         return False, (f"; NOT a success: a fresh BEM sweep of the saved design {worst.origin} "
                        f"differs from its reported score by {worst.rescore_error:.2e} > "
-                       f"{RESCORE_TOL:g} (the response is not linear in the heights, so the "
+                       f"{tol:.2e} (the response is not linear in the heights, so the "
                        f"Eq. 4.2 rescaling is not exact)")
     return True, ""
 
