@@ -115,3 +115,21 @@ def test_design_command_reports_bad_input(tmp_path, capsys):
                      "--global", "cmaes", flag, value, "-o", str(tmp_path / "o")]) == 2
         assert why in capsys.readouterr().err
     np.testing.assert_equal((tmp_path / "o").exists(), False)
+
+
+def test_design_command_exits_1_when_the_design_is_not_a_success(tmp_path, monkeypatch,
+                                                                   capsys):
+    """docs/guide/02: exit 1 = the command ran but a check was missed. A design whose
+    success criterion failed exited 0. Forced here by a negative tolerance."""
+    from roughfe.genomics.design import algorithms
+    from roughfe.study import build_genome_db
+    path = tmp_path / "db.sqlite"
+    build_genome_db(path, db.DatabaseSettings(n_nodes=64, n_steps=6), limit=2, workers=1,
+                    progress=False)
+    monkeypatch.setattr(algorithms, "RESCORE_TOL", -1.0)
+    out = tmp_path / "o"
+    assert main(["design", "--db", str(path), "--target", "y_t1", "--method", "sog",
+                 "--iterations", "1", "--no-figures", "-o", str(out)]) == 1
+    captured = capsys.readouterr()
+    assert "NOT a success" in captured.out and "NOT a success" in captured.err
+    assert json.loads((out / "result.json").read_text())["success"] is False

@@ -5,6 +5,7 @@ y_t1, y_t2, y_t3, or the K(p), A(p) of a given (measured) surface, as CSV for a 
 settings."""
 from __future__ import annotations
 
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -117,6 +118,10 @@ def _run(args) -> int:
     print("best design solved at the target pressures (no interpolation): "
           + " ".join(f"{s:.4f}" for s in strict))
     print(f"{result.nit} BEM sweeps in {result.elapsed:.1f} s; wrote {paths['design'].parent}/")
+    if not result.success:      # exit 1: the command ran, its check failed (docs/guide/02)
+        print("the design is NOT a success (its criterion, in the message above, failed); "
+              "the result is written", file=sys.stderr)
+        return 1
     return 0
 
 
