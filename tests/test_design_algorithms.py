@@ -119,6 +119,28 @@ def test_success_tolerance_is_relative_to_large_scores(entries, targets):
     assert de.algorithms.rescore_tolerance([-2e9]) == 2e9 * de.algorithms.RESCORE_TOL
 
 
+@pytest.mark.parametrize("method", ["sog", "cco"])
+def test_reported_sweeps_are_every_bem_sweep_run(entries, targets, method, monkeypatch):
+    """nit counts BEM sweeps. CCO's exact Jacobian ran one uncounted sweep per gene
+    column (H, gamma, lambda, part amplitudes: forward differences) besides the one it
+    counted, so it reported about half its sweeps (reviewer: 45 of 93)."""
+    import roughfe.genomics.design.sensitivities as sens
+    import roughfe.genomics.macro_micro as mm
+    calls = {"n": 0}
+    real = mm.profile_sweep
+
+    def counted(*a, **k):
+        calls["n"] += 1
+        return real(*a, **k)
+    monkeypatch.setattr(mm, "profile_sweep", counted)
+    monkeypatch.setattr(sens, "profile_sweep", counted)
+    t1 = targets[0]
+    r = de.run_design(method, entries, [t1], SETTINGS, pbar=0.5 * t1.p_max, n_best=1,
+                      **({} if method == "sog" else {"max_set": 2}),
+                      options=de.GcmmaOptions(n_it_sog=1, n_it_cross=1, n_it_micro=1))
+    assert calls["n"] > 10 and r.nit == calls["n"]
+
+
 def test_bad_inputs_are_clear(entries, targets):
     t1, t2, t3, _ = targets
     with pytest.raises(InputError, match="pbar"):

@@ -13,7 +13,8 @@ from .model import Design
 from .objective import Objective
 
 
-def residual_jacobian(design: Design, keys, objective: Objective, settings: DatabaseSettings):
+def residual_jacobian(design: Design, keys, objective: Objective, settings: DatabaseSettings,
+                      evaluate=None):
     """Residuals r = (y_t - y)/y_t (as :meth:`Objective.residuals`) and their exact
     derivatives with respect to the phase variables ``keys`` on the fixed contact sets.
 
@@ -37,8 +38,10 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     goes through the Eq. (4.2) rescaling ``eta = p_max^t / p_n`` and the linear
     interpolation at the target pressures. Gene variables (``(part, name)`` keys) get
     forward differences. One BEM sweep plus n_t solves with H_cc replace the n + 1
-    sweeps of finite differences; the derivative ignores contact-set changes, as any
-    derivative of this piecewise-smooth map must.
+    sweeps of finite differences; each gene variable costs one more sweep (its forward
+    difference). ``evaluate`` (an :class:`~.objective.Evaluator`), when given, counts
+    every sweep run here on its ``n_sweeps``. The derivative ignores contact-set
+    changes, as any derivative of this piecewise-smooth map must.
 
     Checked against central differences (issue 14; tests in
     ``tests/test_design_algorithms.py`` and ``tests/test_surface_database.py``): on the
@@ -67,6 +70,7 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     n_nodes = h.size
     opts = settings.response_options()
     sweep = profile_sweep(surf, **opts)
+    _count(evaluate)
     p = np.asarray(sweep.mean_pressure, float)
     if np.any(p <= 0):
         raise InputError("a loading step without contact: no sensitivities (use finite "
@@ -132,6 +136,12 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
             v[col] += step
             c2 = profile_response(design.with_phases(keys, v).surface(),
                                   **settings.response_options())
+            _count(evaluate)
             jac[:, col] = (objective.residuals(c2) - r) / step
     return r, jac
 
+
+def _count(evaluate):
+    """One BEM sweep more on ``evaluate.n_sweeps`` (nothing without an evaluator)."""
+    if evaluate is not None:
+        evaluate.n_sweeps += 1

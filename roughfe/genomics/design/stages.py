@@ -121,9 +121,8 @@ def optimise_phases(design: Design, keys, objective: Objective, evaluate: Evalua
     jacobian = None
     if options.gradient == "exact":
         def jacobian(x):
-            evaluate.n_sweeps += 1
             return residual_jacobian(design.with_phases(keys, x), keys, objective,
-                                     evaluate.settings)[1]
+                                     evaluate.settings, evaluate)[1]
     res = gcmma(lambda x: objective.residuals(designed(x)), phi0, lo, hi, form="minimax",
                 score=score, n_it=n_it, eps=options.eps, jacobian=jacobian,
                 label="GCMMA min-max")
