@@ -50,3 +50,19 @@ def test_bad_input_is_refused():
             ipop_cmaes(f, *args)
     with pytest.raises(InputError, match="values"):
         ipop_cmaes(lambda X: np.zeros(2), np.zeros(3), 0.5, 100)
+
+
+def test_a_nan_start_counts_as_the_worst_and_the_stop_reasons_are_reported():
+    """A NaN value at x0 was kept as the best (NaN > NaN is never true): the run returned
+    x0 and NaN whatever it found. Now x0's value is mapped to -inf as every later
+    non-finite one; each run says why it stopped (converged on tol_x, stalled, budget)."""
+    f, centre = rotated_ellipsoid(3, cond=10)
+
+    def nan_at_zero(X):
+        return np.where(np.all(X == 0, axis=1), np.nan, f(X))
+    r = ipop_cmaes(nan_at_zero, np.zeros(3), 0.5, 2000, rng=1)
+    assert r.fun0 == -np.inf and r.fun > -1e-8 and np.allclose(r.x, centre, atol=1e-3)
+    assert r.stops[0] == "converged" and len(r.stops) == r.n_runs
+    assert "stopped at the budget" in r.message and "converged" in r.message
+    cut = ipop_cmaes(f, np.zeros(3), 0.5, 40, rng=1)
+    assert cut.stops == ("budget",) and "7 budget" in cut.message

@@ -38,3 +38,18 @@ def test_bad_input_is_refused():
     for kw in ({"n_eval": 0}, {"n_eval": 5, "sigma": 0.0}):
         with pytest.raises(InputError, match="n_eval"):
             one_plus_one_es(staircase, np.full(5, 0.5), **kw)
+
+
+def test_a_nan_start_counts_as_the_worst():
+    """A NaN start value froze the run (every comparison with NaN is false): it returned
+    the start. Non-finite values, alone or in a tuple, now count as -inf; the run says it
+    stopped at its budget (there is no convergence test)."""
+    start = np.full(5, 0.5)
+
+    def nan_at_start(u):
+        return np.nan if np.all(u == start) else staircase(u)
+    r = one_plus_one_es(nan_at_start, start, 800, rng=3)
+    assert r.fun0 == -np.inf and r.fun == 0.0 and not np.allclose(r.x, start)
+    lex = one_plus_one_es(lambda u: (nan_at_start(u), 0.0), start, 200, rng=3)
+    assert lex.fun0 == (-np.inf, 0.0) and lex.fun[0] > -np.inf
+    assert "stopped at the budget of 800 evaluations" in r.message

@@ -113,3 +113,26 @@ def test_design_stage_reproduces_the_former_loops(name, formulation, gradient):
     assert ev.n_sweeps == ref["sweeps"]
     assert s > res.fun0 + 0.1                     # the stage improves the start (0.68 -> 0.86)
     assert objective(de.Evaluator(settings)(d2)) == pytest.approx(s, rel=1e-12)
+
+
+def test_success_says_converged_or_stopped_at_the_budget():
+    """success was hard-coded True. A run converges when an outer step moves no variable
+    by more than xtol (unit box) and stops there; else it stops at its budget n_it with
+    success False; a model function not finite at the start stops the run at once (a NaN
+    start score compared false with every later one, so no point was ever kept)."""
+    resid, _, _, dr, x0, lo, hi = _problem()
+    worst = lambda r: 1 - np.max(np.abs(r))            # noqa: E731
+    jac = lambda x: (resid(x), -dr)                    # noqa: E731
+    short = gcmma_minimax(resid, worst, x0, lo, hi, n_it=2, jacobian=jac)
+    assert not short.success and "stopped at the budget n_it = 2" in short.message
+    long = gcmma_minimax(resid, worst, x0, lo, hi, n_it=200, jacobian=jac)
+    assert long.success and "converged" in long.message and long.nit < 200
+    assert long.fun > 1 - 1e-9
+    calls = []
+
+    def nan_at_start(x):
+        calls.append(x)
+        return [np.nan if len(calls) == 1 else 0.5]
+    r = gcmma(nan_at_start, x0, lo, hi, form="square", n_it=5)
+    assert not r.success and "not finite at the start" in r.message
+    assert r.fun == -np.inf and r.nit == 0 and len(calls) == 1

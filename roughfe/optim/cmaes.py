@@ -14,7 +14,9 @@ the largest axis of C falls below ``tol_x``, when the best value has not risen f
 with twice the population (Auger A., Hansen N. (2005) A restart CMA evolution strategy
 with increasing population size, CEC 2005, 1769-1776), until ``n_eval`` evaluations
 are spent. The best point over all runs is returned with the curve of the best value
-against the evaluations spent.
+against the evaluations spent, and why each run stopped (``stops``: "converged" on
+``tol_x``, "stalled", or "budget" when the evaluations left could not pay for another
+generation). A value that is not finite (x0's too) counts as -inf, the worst.
 """
 from __future__ import annotations
 
@@ -29,10 +31,13 @@ from ..errors import InputError
 
 @dataclass(frozen=True)
 class CmaResult:
-    """Best point ``x`` and value ``fun`` over all runs; ``fun0`` the value of ``x0``;
-    ``nfev`` evaluations, ``n_runs`` runs (restarts + 1), ``popsizes`` the population of
-    each run, and ``history``: rows (evaluations spent, best value so far) after every
-    generation."""
+    """Best point ``x`` and value ``fun`` over all runs; ``fun0`` the value of ``x0``
+    (-inf if not finite); ``nfev`` evaluations, ``n_runs`` runs (restarts + 1),
+    ``popsizes`` the population of each run, ``history``: rows (evaluations spent, best
+    value so far) after every generation; ``stops``: why each run stopped ("converged":
+    sigma times the largest axis of C below ``tol_x``; "stalled": no rise of the run's
+    best for ``10 + 30 n / lambda`` generations; "budget": the evaluations left could not
+    pay for its next generation), and ``message`` saying so."""
 
     x: np.ndarray
     fun: float
@@ -41,11 +46,19 @@ class CmaResult:
     n_runs: int
     popsizes: tuple
     history: np.ndarray
+    stops: tuple = ()
+    message: str = ""
+
+
+def _finite_or_worst(f):
+    """Values with every non-finite one (NaN, +-inf) replaced by -inf, the worst."""
+    f = np.asarray(f, dtype=float)
+    return np.where(np.isfinite(f), f, -np.inf)
 
 
 def _run(fun, x0, sigma0, lam, budget, rng, tol_x, best, history, spent):
     """One CMA-ES run of population ``lam`` from ``x0``; updates ``best`` = [x, f] and
-    ``history`` in place and returns the evaluations it spent."""
+    ``history`` in place and returns the evaluations it spent and why it stopped."""
     n = x0.size
     mu = lam // 2
     w = math.log(mu + 0.5) - np.log(np.arange(1, mu + 1))
@@ -69,7 +82,7 @@ def _run(fun, x0, sigma0, lam, budget, rng, tol_x, best, history, spent):
         f = np.asarray(fun(X), dtype=float)
         if f.shape != (lam,):
             raise InputError(f"the objective must return {lam} values, got shape {f.shape}")
-        f = np.where(np.isfinite(f), f, -np.inf)
+        f = _finite_or_worst(f)
         used += lam
         g += 1
         order = np.argsort(-f, kind="stable")
@@ -90,9 +103,11 @@ def _run(fun, x0, sigma0, lam, budget, rng, tol_x, best, history, spent):
              + cmu * (ys.T * w) @ ys)
         C = 0.5 * (C + C.T)
         sigma *= math.exp(cs / ds * (np.linalg.norm(ps) / chi - 1))
-        if sigma * float(D.max()) < tol_x or stall >= stall_limit:
-            break
-    return used
+        if sigma * float(D.max()) < tol_x:
+            return used, "converged"
+        if stall >= stall_limit:
+            return used, "stalled"
+    return used, "budget"
 
 
 def ipop_cmaes(fun: Callable[[np.ndarray], np.ndarray], x0, sigma0: float, n_eval: int, *,
@@ -110,10 +125,17 @@ def ipop_cmaes(fun: Callable[[np.ndarray], np.ndarray], x0, sigma0: float, n_eva
     rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
     lam = int(popsize) or 4 + int(3 * math.log(x0.size))
     lam = max(lam, 4)
-    f0 = float(np.asarray(fun(x0[None, :]), dtype=float)[0])
-    best, history, spent, sizes = [x0.copy(), f0], [(1, f0)], 1, []
+    f0 = float(_finite_or_worst(np.asarray(fun(x0[None, :]), dtype=float)[:1])[0])
+    best, history, spent, sizes, stops = [x0.copy(), f0], [(1, f0)], 1, [], []
     while spent + lam <= n_eval:
         sizes.append(lam)
-        spent += _run(fun, x0, sigma0, lam, n_eval - spent, rng, tol_x, best, history, spent)
+        used, why = _run(fun, x0, sigma0, lam, n_eval - spent, rng, tol_x, best, history,
+                         spent)
+        spent += used
+        stops.append(why)
         lam = min(2 * lam, int(max_popsize))
-    return CmaResult(best[0], best[1], f0, spent, len(sizes), tuple(sizes), np.array(history))
+    runs = ", ".join(f"{k} {w}" for k, w in zip(sizes, stops)) or "none"
+    message = (f"IPOP-CMA-ES: {spent} of {int(n_eval)} evaluations, stopped at the budget "
+               f"(too few left for a run of population {lam}); runs by population: {runs}")
+    return CmaResult(best[0], best[1], f0, spent, len(sizes), tuple(sizes), np.array(history),
+                     tuple(stops), message)

@@ -8,7 +8,13 @@ objective (a count of contact nodes has no gradient to follow); when the step co
 below ``restart_below`` it is reset to ``sigma`` (a restart from the current parent).
 
 ``fun`` may return a tuple: values are then compared lexicographically, so a second,
-smooth measure breaks the ties of the first without ever trading it away.
+smooth measure breaks the ties of the first without ever trading it away. A value that
+is not finite (NaN, +-inf; in a tuple, each such element) counts as -inf, the worst,
+the start's too (a NaN start compared false with everything and froze the run).
+
+There is no convergence test: a run always stops at its budget of ``n_eval``
+evaluations (``EsResult.message`` says so, with the step resets, each a local
+convergence of the step).
 
 Reference: Rechenberg I. (1973) Evolutionsstrategie, Frommann-Holzboog; Beyer H.-G.,
 Schwefel H.-P. (2002) Natural Computing 1:3-52 (the (1+1)-ES and the 1/5 rule).
@@ -26,8 +32,9 @@ from ..errors import InputError
 @dataclass(frozen=True)
 class EsResult:
     """Best point of a (1+1)-ES run: ``x`` (unit box), its value ``fun`` (as returned by
-    the objective), the start value ``fun0``, ``nfev`` evaluations, ``n_improved``
-    strict improvements and ``n_restarts`` step resets."""
+    the objective, non-finite values as -inf), the start value ``fun0``, ``nfev``
+    evaluations, ``n_improved`` strict improvements, ``n_restarts`` step resets and
+    ``message``, why the run stopped (always the budget: see the module notes)."""
 
     x: np.ndarray
     fun: Any
@@ -35,6 +42,15 @@ class EsResult:
     nfev: int
     n_improved: int
     n_restarts: int
+    message: str = ""
+
+
+def _finite_or_worst(v):
+    """``v`` with a non-finite number (alone or in a tuple) replaced by -inf."""
+    if isinstance(v, tuple):
+        return tuple(_finite_or_worst(x) for x in v)
+    v = float(v)
+    return v if np.isfinite(v) else -np.inf
 
 
 def one_plus_one_es(fun: Callable[[np.ndarray], Any], u0, n_eval: int, *, sigma: float = 0.3,
@@ -46,11 +62,11 @@ def one_plus_one_es(fun: Callable[[np.ndarray], Any], u0, n_eval: int, *, sigma:
         raise InputError(f"n_eval >= 1, sigma > 0 and a non-empty 1D start needed, got "
                          f"{n_eval!r}, {sigma!r}, shape {u.shape}")
     rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
-    f = f0 = fun(u)
+    f = f0 = _finite_or_worst(fun(u))
     step, n_up, n_restart = float(sigma), 0, 0
     for _ in range(int(n_eval) - 1):
         v = np.clip(u + step * rng.standard_normal(u.size), 0.0, 1.0)
-        fv = fun(v)
+        fv = _finite_or_worst(fun(v))
         if fv >= f:                         # ties accepted: move along a plateau
             n_up += fv > f
             u, f, step = v, fv, step * 1.5
@@ -59,4 +75,6 @@ def one_plus_one_es(fun: Callable[[np.ndarray], Any], u0, n_eval: int, *, sigma:
         if step < restart_below:
             step, n_restart = float(sigma), n_restart + 1
         step = min(step, max_step)
-    return EsResult(u, f, f0, int(n_eval), int(n_up), n_restart)
+    return EsResult(u, f, f0, int(n_eval), int(n_up), n_restart,
+                    f"(1+1)-ES: stopped at the budget of {int(n_eval)} evaluations (no "
+                    f"convergence test; {n_restart} step resets), {int(n_up)} improvements")

@@ -18,7 +18,14 @@ MMA subproblem are offered, both "maximise a similarity score s <= 1":
     own derivative, at the cost of the same ``n + 1`` evaluations as the gradient of s.
 
 The best point ever evaluated is returned (GCMMA is not monotone on a non-smooth
-objective). :func:`gcmma_maximize` and :func:`gcmma_minimax` are the two forms with the
+objective). A run stops converged when an outer step moves no variable by more than
+``xtol`` (unit-box units; ``success`` True), else after ``n_it`` outer iterations (the
+budget: ``success`` False, the message says which). Svanberg's test is the KKT residual
+of the original problem; it needs the derivatives at the last iterate, n + 1 more
+evaluations with forward differences, so the step is tested instead. A score that is
+not finite counts as -inf (never the best); a model function that is not finite at the
+start or at an iterate stops the run there (the subproblem cannot be built from it;
+``success`` False). :func:`gcmma_maximize` and :func:`gcmma_minimax` are the two forms with the
 call signatures used by :mod:`roughfe.genomics.design`.
 """
 from __future__ import annotations
@@ -51,7 +58,9 @@ class GcmmaResult:
     nfev : int
         Evaluations of the model function (forward differences included).
     success, message
-        scipy-like report.
+        scipy-like report: ``success`` is True when the run converged (the last outer
+        step moved no variable by more than ``xtol`` in the unit box), False when it
+        stopped at the budget ``n_it`` or at a non-finite model function.
     njev : int
         Calls of the user's ``jacobian`` (0 with forward differences).
     """
@@ -102,7 +111,7 @@ def _minimax_form(n, n_y):
 def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: str,
           score: Optional[Callable[[np.ndarray], float]] = None, n_it: int = 5,
           eps: float = 0.02, jacobian: Optional[Callable] = None, y0=None,
-          max_inner: int = 5, label: str = "GCMMA") -> GcmmaResult:
+          max_inner: int = 5, label: str = "GCMMA", xtol: float = 1e-9) -> GcmmaResult:
     """Run ``n_it`` outer GCMMA iterations on ``fun`` in the box [lower, upper].
 
     Parameters
@@ -118,7 +127,7 @@ def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: st
         ``y -> s`` reported and maximised (best point kept). Default: ``y[0]`` (square),
         ``1 - max |y|`` (minimax).
     n_it : int
-        Outer iterations.
+        Outer iterations at most (the budget).
     eps : float
         Forward-difference step in unit-box units when ``jacobian`` is None.
     jacobian : callable, optional
@@ -129,6 +138,8 @@ def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: st
         Inner (conservativity) iterations per outer iteration.
     label : str
         Prefix of the message.
+    xtol : float
+        Converged when an outer step moves no variable by more than ``xtol`` (unit box).
 
     Returns
     -------
@@ -166,13 +177,25 @@ def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: st
             dy[:, j] = (y_of(up) - y) / step
         return dy
 
+    def score_of(y):
+        s = float(score(y))
+        return s if np.isfinite(s) else -np.inf
+
+    def result(best_u, best_s, s0, history, it, converged, why):
+        return GcmmaResult(lo + best_u.ravel() * width, best_s, x0, s0, tuple(history), it,
+                           count["nfev"], converged, f"{label}: {it} outer iterations, {why}, "
+                           f"best s = {best_s:.6f} (start {s0:.6f})", count["njev"])
+
     u = ((x0 - lo) / width).reshape(n, 1)
     y = y_of(u) if y0 is None else np.atleast_1d(np.asarray(y0, float))
     make = _square_form if form == "square" else _minimax_form
     m, a, c, d, values, derivatives = make(n, y.size)
     a0 = 1.0
-    s0 = float(score(y))
+    s0 = score_of(y)
     best_u, best_s, history = u.copy(), s0, [s0]
+    if not np.all(np.isfinite(y)):
+        return result(u, s0, s0, history, 0, False, "stopped: the model function is not "
+                      "finite at the start")
     xmin, xmax = np.zeros((n, 1)), np.ones((n, 1))
     low, upp = xmin.copy(), xmax.copy()
     xold1, xold2 = u.copy(), u.copy()
@@ -180,7 +203,7 @@ def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: st
         1e-6 * np.ones((m, 1)), 1e-7
     f0val, fval = values(y)
     df0dx, dfdx = derivatives(y, dy_of(u, y))
-    it = 0
+    it, why, converged = 0, f"stopped at the budget n_it = {int(n_it)}", False
     for it in range(1, int(n_it) + 1):
         low, upp, raa0, raa = asymp(it, n, u, xold1, xold2, xmin, xmax, low, upp, raa0, raa,
                                     raa0eps, raaeps, df0dx, dfdx)
@@ -201,17 +224,23 @@ def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: st
             y_new = y_of(xmma)
             f0new, fnew = values(y_new)
             conserv = concheck(m, epsimin, f0app, f0new, fapp, fnew)
+        step = float(np.max(np.abs(np.clip(xmma, 0.0, 1.0) - u)))
         xold2, xold1, u, y = xold1, u, np.clip(xmma, 0.0, 1.0), y_new
-        s = float(score(y))
+        s = score_of(y)
         history.append(s)
         if s > best_s:
             best_u, best_s = u.copy(), s
+        if not np.all(np.isfinite(y)):
+            why = "stopped: the model function is not finite at the last iterate"
+            break
+        if step <= xtol:
+            why, converged = f"converged (step {step:.1e} <= xtol = {xtol:g})", True
+            break
+        why = f"stopped at the budget n_it = {int(n_it)} (last step {step:.1e} > xtol)"
         if it < n_it:
             f0val, fval = f0new, fnew
             df0dx, dfdx = derivatives(y, dy_of(u, y))
-    return GcmmaResult(lo + best_u.ravel() * width, best_s, x0, s0, tuple(history), it,
-                       count["nfev"], True, f"{label}: {it} outer iterations, best s = "
-                       f"{best_s:.6f} (start {s0:.6f})", count["njev"])
+    return result(best_u, best_s, s0, history, it, converged, why)
 
 
 def gcmma_maximize(fun: Callable[[np.ndarray], float], x0, lower, upper, *, n_it: int = 5,
