@@ -133,3 +133,43 @@ def test_design_command_exits_1_when_the_design_is_not_a_success(tmp_path, monke
     captured = capsys.readouterr()
     assert "NOT a success" in captured.out and "NOT a success" in captured.err
     assert json.loads((out / "result.json").read_text())["success"] is False
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--method", "sog", "--pbar", "1e6"], "--pbar needs --method gco or cco"),
+    (["--method", "mcco", "--second-target", "y_t3", "--pbar", "1e6"], "--pbar needs"),
+    (["--method", "sog", "--search-starts", "2"], "--search-starts needs --search"),
+    (["--method", "sog", "--search-amplitudes"], "--search-amplitudes needs --search"),
+    (["--method", "sog", "--global-eval", "50"], "--global-eval needs --global cmaes"),
+    (["--method", "sog", "--global-rounds", "2"], "--global-rounds needs --global cmaes"),
+    (["--method", "sog", "--global-score", "min"], "--global-score needs --global cmaes"),
+    (["--method", "sog", "--global-waves"], "--global-waves needs --global cmaes"),
+    (["--method", "sog", "--spectrum-starts", "1"], "--spectrum-starts needs --match-spectrum"),
+    (["--method", "sog", "--formulation", "thesis", "--gradient", "exact"],
+     "--gradient exact needs --formulation minimax"),
+    (["--method", "sog", "--eps", "0.01"], "--eps needs finite differences"),
+    (["--method", "sog", "--pool", "4"], "--pool needs --method mcco"),
+    (["--method", "sog", "--second-target", "y_t3"], "--second-target needs --method mcco")])
+def test_design_command_refuses_options_that_would_be_ignored(tmp_path, capsys, extra,
+                                                              message):
+    """Each of these options was silently ignored where it means nothing (--gradient exact
+    with the thesis form ran finite differences): refused before the database is read."""
+    assert main(["design", "--db", str(tmp_path / "none.sqlite"), "--target", "y_t1",
+                 *extra, "-o", str(tmp_path / "o")]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_design_option_defaults_are_kept():
+    """Options parsed as None (to tell 'not given' apart) get their former defaults."""
+    from roughfe.cli import build_parser
+    from roughfe.cli.design_cmd import _check_options
+    for form, gradient in (("minimax", "exact"), ("thesis", "fd")):
+        args = build_parser("design").parse_args(
+            ["design", "--db", "x", "--target", "y_t1", "--method", "gco", "--pbar", "1",
+             "--formulation", form, "-o", "o"])
+        _check_options(args)
+        assert (args.gradient, args.eps, args.search_starts, args.search_amplitudes,
+                args.spectrum_starts, args.pool, args.global_eval, args.global_score,
+                args.global_waves) == (gradient, 0.02, 1, "part", 3, 0, 20000, "strict",
+                                       False)

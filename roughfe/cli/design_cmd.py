@@ -44,6 +44,49 @@ def _target(spec, quantity, settings, cache, default):
     return read_target_csv(spec, quantity, default=default)
 
 
+def _dependent_options(args):
+    """Rows ``(dest, flag, default, what it needs, whether args have it)`` of the options
+    that mean something only with another option or method: given without it, each was
+    silently ignored (e.g. ``--gradient exact`` with ``--formulation thesis`` ran finite
+    differences)."""
+    fd = args.gradient == "fd" or args.formulation == "thesis"
+    gcmma_fd = "finite differences (--gradient fd or --formulation thesis)"
+    rows = [("pbar", "--pbar", None, "--method gco or cco (Algs. 5 and 6 split the target "
+             "there)", args.method in ("gco", "cco")),
+            ("second_target", "--second-target", None, "--method mcco", args.method == "mcco"),
+            ("pool", "--pool", 0, "--method mcco", args.method == "mcco"),
+            ("eps", "--eps", 0.02, gcmma_fd, fd),
+            ("search_starts", "--search-starts", 1, "--search SWEEPS", bool(args.search)),
+            ("search_amplitudes", "--search-amplitudes", "part", "--search SWEEPS",
+             bool(args.search)),
+            ("spectrum_starts", "--spectrum-starts", 3, "--match-spectrum SURFACE",
+             bool(args.match_spectrum)),
+            ("match_directions", "--match-directions", False, "--match-spectrum SURFACE",
+             bool(args.match_spectrum))]
+    globals_ = [(flag, default) for flag, _, default, _, _ in GLOBAL_FLAGS]
+    globals_ += [("--global-score", "strict"), ("--global-waves", False)]
+    rows += [(flag[2:].replace("-", "_"), flag, default, "--global cmaes",
+              bool(args.global_search)) for flag, default in globals_]
+    return rows
+
+
+def _check_options(args):
+    """Refuse an option given where it means nothing (:func:`_dependent_options`), then
+    set the defaults of those not given (parsed as None to tell "not given" apart)."""
+    from ..errors import InputError
+    if args.gradient == "exact" and args.formulation == "thesis":
+        raise InputError("--gradient exact needs --formulation minimax: the thesis form "
+                         "(1 - s)^2 takes forward differences (--gradient fd)")
+    args.gradient = args.gradient or ("fd" if args.formulation == "thesis" else "exact")
+    for dest, flag, default, needs, present in _dependent_options(args):
+        value = getattr(args, dest)
+        if value is not None and value is not False and not present:
+            raise InputError(f"{flag} needs {needs}; it was given without, where it means "
+                             f"nothing")
+        if value is None:
+            setattr(args, dest, default)
+
+
 def _run(args) -> int:
     from ..errors import InputError
     from ..genomics.database import load_entries, read_settings
@@ -51,6 +94,7 @@ def _run(args) -> int:
                                    rescore_at_target_pressures, run_design,
                                    search_at_target_pressures, search_global,
                                    write_design_result)
+    _check_options(args)            # before the database is read
     global_options = GlobalSearchOptions(
         method=args.global_search or "cmaes", n_eval=args.global_eval,
         popsize=args.global_popsize, amplitudes=args.global_amplitudes,
@@ -67,16 +111,10 @@ def _run(args) -> int:
                                "A"))
     if args.method == "mcco" and len(targets) == 2 and targets[0].quantity == "A":
         targets.reverse()
-    if args.method != "mcco" and args.second_target:
-        raise InputError("--second-target is used by --method mcco only")
     options = GcmmaOptions(bound=args.bound, formulation=args.formulation, eps=args.eps,
                            gradient=args.gradient,
                            **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
                               if args.iterations else {}))
-    if args.match_directions and not args.match_spectrum:
-        raise InputError("--match-directions needs --match-spectrum SURFACE")
-    if args.pool and args.method != "mcco":
-        raise InputError("--pool is used by --method mcco only")
     extra = ({"pool": args.pool, "swap": True, "weights": (0.5, 1.0, 2.0)} if args.pool else {})
     with output_folder_of(args, "design") as out:
         result = run_design(args.method, entries, targets, settings, pbar=args.pbar,
@@ -181,10 +219,13 @@ def register(sub):
                    help="phase box: +-10%% of the start value (thesis) or of 2 pi")
     g.add_argument("--formulation", choices=("minimax", "thesis"), default="minimax",
                    help="min-max form with residual Jacobian, or (1-s)^2 with its gradient")
-    g.add_argument("--gradient", choices=("exact", "fd"), default="exact",
-                   help="exact sensitivities on the fixed contact sets, or finite differences")
-    g.add_argument("--eps", type=positive_float, default=0.02,
-                   help="finite-difference step in units of the phase box (--gradient fd)")
+    g.add_argument("--gradient", choices=("exact", "fd"), default=None,
+                   help="exact sensitivities on the fixed contact sets (default with "
+                        "minimax), or finite differences (default and only choice with "
+                        "--formulation thesis)")
+    g.add_argument("--eps", type=positive_float, default=None,
+                   help="finite-difference step in units of the phase box (finite "
+                        "differences only; default 0.02)")
     g.add_argument("--refine", type=nonnegative_int, default=0, metavar="ROUNDS",
                    help="extra stage beyond the thesis: ROUNDS x 15 GCMMA iterations on all "
                         "phases, box (+-10%% of 2 pi) re-centred each round (0: off)")
@@ -192,10 +233,10 @@ def register(sub):
                    help="extra stage beyond the thesis, after --refine: a (1+1) evolution "
                         "strategy on all phases and part weights maximising the score solved "
                         "at the target pressures, SWEEPS BEM sweeps per candidate (0: off)")
-    g.add_argument("--search-starts", type=positive_int, default=1, metavar="K",
+    g.add_argument("--search-starts", type=positive_int, default=None, metavar="K",
                    help="--search: K independent runs per candidate (deterministic seeds), "
                         "the best kept")
-    g.add_argument("--search-amplitudes", nargs="?", const="chromosome", default="part",
+    g.add_argument("--search-amplitudes", nargs="?", const="chromosome", default=None,
                    choices=("part", "chromosome", "wave"), metavar="KIND",
                    help="--search amplitude variables (+-30%%): part (each part's weight, "
                         "default), chromosome (every chromosome's; the value when the option "
@@ -205,9 +246,9 @@ def register(sub):
                         "--global-amplitudes, on the score at the target pressures (batched "
                         "BEM, profiles and surfaces; beyond the thesis)")
     for flag, kind, default, metavar, text in GLOBAL_FLAGS:
-        g.add_argument(flag, type=kind, default=default, metavar=metavar,
-                       help="--global: " + text)
-    g.add_argument("--global-score", default="strict", metavar="{strict,min}",
+        g.add_argument(flag, type=kind, default=None, metavar=metavar,
+                       help=f"--global: {text} (default {default})")
+    g.add_argument("--global-score", default=None, metavar="{strict,min}",
                    help="--global: maximise f at the target pressures (strict, default) or "
                         "min(strict f, interpolated f) (min: the thesis scoring on the "
                         "design's own approaches too; checked by GlobalSearchOptions)")
@@ -219,14 +260,14 @@ def register(sub):
                         "--search: set every chromosome's amplitude to the band rms of this "
                         "(measured) topography, prepared as 'design-targets --surface' "
                         "does by default (plane removed, mirrored, database spacing)")
-    g.add_argument("--spectrum-starts", type=nonnegative_int, default=3, metavar="K",
+    g.add_argument("--spectrum-starts", type=nonnegative_int, default=None, metavar="K",
                    help="--match-spectrum: also start from the K best database genomes, "
                         "spectrum matched")
     g.add_argument("--match-directions", action="store_true",
                    help="--match-spectrum per wave: every (ridge, chromosome) wave gets the "
                         "rms of the target's modes nearest to it in log q and direction "
                         "(default: one rms per chromosome)")
-    p.add_argument("--pool", type=nonnegative_int, default=0, metavar="K",
+    p.add_argument("--pool", type=nonnegative_int, default=None, metavar="K",
                    help="mcco, beyond the thesis: start pool of the K best genomes of each "
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "
                         "(0: the thesis sets)")
