@@ -141,6 +141,27 @@ def test_reported_sweeps_are_every_bem_sweep_run(entries, targets, method, monke
     assert calls["n"] > 10 and r.nit == calls["n"]
 
 
+def test_cco_stage_2_is_stage_1_copied_and_the_part_fallbacks_are_documented(entries,
+                                                                           targets):
+    """The cco docstring said "stage 2 repeats stage 1"; the code copies stage 1's score
+    (the thesis' fictitious "GCMMA 2" of CCO, Sec. 4.3.1), and the fallback parts of a
+    genome without macro- (CCO, M-CCO) or micro-scale chromosomes (M-CCO) were written
+    inline, undocumented: one documented helper each now."""
+    al = de.algorithms
+    assert "repeats" not in de.cco.__doc__ and "copied" in de.cco.__doc__
+    assert "fictitious" in de.cco.__doc__ and "fictitious" in al.__doc__
+    e = entries[0]
+    n = e.macro + e.micro
+    only_micro, only_macro = replace(e, macro=(), micro=n), replace(e, macro=n, micro=())
+    assert al._macro_part(only_micro) == n[:1] and al._micro_part(only_macro) == n[-1:]
+    assert al._macro_part(e) == e.macro or not e.macro
+    for f in (al._macro_part, al._micro_part):
+        assert "Beyond the thesis" in f.__doc__
+    t1 = targets[0]
+    r = de.cco(entries, t1, 0.5 * t1.p_max, SETTINGS, options=FAST, n_best=1, max_set=2)
+    assert r.best.stages[2] == r.best.stages[1]
+
+
 def test_bad_inputs_are_clear(entries, targets):
     t1, t2, t3, _ = targets
     with pytest.raises(InputError, match="pbar"):

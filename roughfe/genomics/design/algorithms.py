@@ -5,9 +5,9 @@
   :mod:`roughfe.genomics.similarity`), so scoring needs no new BEM solution.
 * :func:`sog` (Alg. 4), :func:`gco` (Alg. 5), :func:`cco` (Alg. 6), :func:`mcco` (Alg. 7),
   each with the stages of Sec. 4.3.1: "GCMMA 0" (selection/cross-over), "GCMMA 1"
-  (GCMMA on the macro-scale phases; all phases for CCO) and "GCMMA 2" (GCMMA on the
-  micro-scale phases; CCO repeats stage 1); :func:`refine` is an optional "GCMMA 3"
-  beyond the thesis.
+  (GCMMA on the macro-scale phases; all genes for CCO) and "GCMMA 2" (GCMMA on the
+  micro-scale phases; for CCO not run: its score is stage 1's, copied, the thesis'
+  "fictitious step"); :func:`refine` is an optional "GCMMA 3" beyond the thesis.
 * Alg. 2 on a cross-over (Alg. 5 Step 13) needs the K_n(p) of every chromosome of the
   new genome: a chromosome of a part is the parent's chromosome times a positive factor,
   whose curve is the parent's stretched in p (Eq. 4.2), and c_n rescales it anyway, so
@@ -267,6 +267,22 @@ def _cross(entries, by_label, objective, settings, evaluate, sets, parts_of, n_b
     return starts, len(pool), sum(1 for t in pool if t[0] > SELECTION)
 
 
+def _macro_part(e: DatabaseEntry) -> tuple:
+    """The macro-scale chromosomes of a database genome (Alg. 2): its part in CCO's U1
+    and U2 (Alg. 6 Steps 3-4) and in M-CCO's U1 (Alg. 7 Step 3). Beyond the thesis,
+    which assumes every selected genome has some: a genome whose chromosomes are all
+    micro-scale (no c_n above the threshold) gives its first micro-scale chromosome, the
+    longest wave, so that it is crossed at all rather than as an empty part."""
+    return e.macro or e.micro[:1]
+
+
+def _micro_part(e: DatabaseEntry) -> tuple:
+    """The micro-scale chromosomes of a database genome (Alg. 2): its part in M-CCO's U2
+    (Alg. 7 Step 4). Beyond the thesis: a genome whose chromosomes are all macro-scale
+    gives its last macro-scale chromosome, the shortest wave, rather than an empty part."""
+    return e.micro or e.macro[-1:]
+
+
 def _two_range_sets(entries, target, pbar, threshold=SELECTION, fallback=3):
     r1, r2 = split_ranges(target, pbar)
     s1, s2 = score_database(entries, target, r1), score_database(entries, target, r2)
@@ -312,11 +328,15 @@ def gco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, eva
 def cco(entries, target: Target, pbar: float, settings: DatabaseSettings, *, evaluate=None,
         options: GcmmaOptions = GcmmaOptions(), n_best: int = 3, max_set: Optional[int] = 8
         ) -> DesignResult:
-    """Chromosomes Cross-Over (Alg. 6): as GCO with the macro-scale chromosomes only;
-    GCMMA on all genes of the new genome (phases, and with ``options.cco_genes`` also H,
-    gamma, lambda and the part amplitudes; stage 1); stage 2 repeats stage 1 (Sec. 4.3.1)."""
+    """Chromosomes Cross-Over (Alg. 6): as GCO with the macro-scale chromosomes only
+    (:func:`_macro_part`, with its fallback for a genome without any); GCMMA on all
+    genes of the new genome (phases, and with ``options.cco_genes`` also H, gamma,
+    lambda and the part amplitudes; stage 1). Stage 2 is not run: its score is stage
+    1's, copied, as the thesis' fictitious "GCMMA 2" of CCO (Sec. 4.3.1: "the GCMMA is
+    not applied again for the CCO ... whose value of the similarity score coincides with
+    GCMMA 1")."""
     return _two_range_cross_over("cco", entries, target, pbar, settings, evaluate, options,
-                                 n_best, max_set, lambda e: e.macro or e.micro[:1], 0, "all")
+                                 n_best, max_set, _macro_part, 0, "all")
 
 
 def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings, *,
@@ -326,7 +346,9 @@ def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings
     """Mixed Chromosomes Cross-Over (Alg. 7) for a K(p) target and an A(p) target.
 
     U1: macro chromosomes of genomes with s(y_t1, K) > 0.95; U2: micro chromosomes of
-    genomes with s(y_t3, A) > 0.95 (the 3 best if none passes); every pair summed,
+    genomes with s(y_t3, A) > 0.95 (the 3 best if none passes; a genome without macro-
+    or micro-scale chromosomes gives the nearest of the other scale:
+    :func:`_macro_part`, :func:`_micro_part`); every pair summed,
     rescaled, scored with f = s_K * s_A; the ``n_best`` best get GCMMA on their macro
     phases, then on their micro phases, objective f.
 
@@ -365,10 +387,9 @@ def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings
     found = []
     for i1, i2 in pairs:
         e1, e2 = entries[i1], entries[i2]
-        d1 = entry_design(e1, settings, objective.p_max / e1.p_max, e1.macro or e1.micro[:1])
+        d1 = entry_design(e1, settings, objective.p_max / e1.p_max, _macro_part(e1))
         for w in ws:
-            d2 = entry_design(e2, settings, w * objective.p_max / e2.p_max,
-                              e2.micro or e2.macro[-1:])
+            d2 = entry_design(e2, settings, w * objective.p_max / e2.p_max, _micro_part(e2))
             d = combine(d1, d2)
             curve = evaluate(d)
             tag = f"{e1.label}+{e2.label}" + ("" if w == 1.0 else f" (micro x{w:g})")
