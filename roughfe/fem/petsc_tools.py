@@ -282,10 +282,21 @@ class KrylovSolver:
         ksp.solve(b, x)
         nit = int(ksp.getIterationNumber())
         kept = keep
-        if keep and ksp.getConvergedReason() == PETSc.KSP.ConvergedReason.DIVERGED_MAX_IT:
-            # the kept hierarchy no longer fits: build one on this matrix, go on from x
+        failed = ksp.getConvergedReason()
+        if keep and failed < 0:
+            # the kept hierarchy no longer fits (a cell of the Reynolds film opening or
+            # closing changes its conductance by ~1e9 on the same pattern): build one on
+            # this matrix. After a stall (DIVERGED_MAX_IT) go on from x; after any other
+            # failure (DIVERGED_DTOL, an indefinite preconditioner) x is garbage: restart
+            # from the caller's start
             pc.setReusePreconditioner(False)
-            ksp.setInitialGuessNonzero(True)
+            if failed != PETSc.KSP.ConvergedReason.DIVERGED_MAX_IT:
+                if x0 is not None:
+                    x.setArray(np.asarray(x0, dtype=PETSc.ScalarType))
+                else:
+                    x.set(0.0)
+            ksp.setInitialGuessNonzero(
+                x0 is not None or failed == PETSc.KSP.ConvergedReason.DIVERGED_MAX_IT)
             ksp.setTolerances(max_it=self._max_it)
             t1 -= time.process_time()
             pc.setUp()                         # (the KSP counts itself set up)
@@ -305,7 +316,7 @@ class KrylovSolver:
                    f"residual norm {ksp.getResidualNorm():.3e}, "
                    f"set-up {t1 - t0:.3g} s + solve {t2 - t1:.3g} s CPU"
                    + (", kept preconditioner" if keep else
-                      ", preconditioner rebuilt after the kept one stalled" if kept else ""))
+                      ", preconditioner rebuilt after the kept one failed" if kept else ""))
         out = x.array.copy()
         x.destroy()
         b.destroy()
