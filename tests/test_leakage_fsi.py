@@ -349,3 +349,15 @@ def test_a_kept_preconditioner_that_diverges_is_rebuilt():
                               periodic=s.periodic)
     assert r.leak_rate == pytest.approx(fresh.leak_rate, rel=1e-8)
     assert r.contact_load_fraction + r.fluid_load_fraction == pytest.approx(1.0, abs=1e-8)
+
+
+def test_a_sweep_goes_on_after_a_lift_off_step(surface):
+    """A lift-off at a low external pressure does not mean lift-off at higher ones: the
+    sweep stopped there (`roughfe leak --fsi` wrote 1 of 3 steps, exit 0). The steps
+    after it start from first contact and equal independent solves."""
+    steps = coupled_sweep(surface, MAT, [1e7, 6e7, 1e8], p_in=5e7, p_out=0.0)
+    assert [r.state for r in steps] == ["lift-off", "contact", "contact"]
+    alone = coupled_leakage(surface, MAT, 6e7, p_in=5e7, p_out=0.0)
+    assert steps[1].leak_rate == pytest.approx(alone.leak_rate, rel=1e-6)
+    assert steps[1].contact.area_fraction == alone.contact.area_fraction
+    assert steps[2].contact.area_fraction > steps[1].contact.area_fraction

@@ -189,8 +189,7 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
             title=f"fluid pressure (Pa), two-way coupled, contact grey\n{tag}", at="cells",
             clim=(min(p_in, p_out), max(p_in, p_out))))     # pockets above: magenta
     if not args.no_figures:
-        written.append(figs.steps_figure([s for s in steps if s.get("area_fraction") is not None],
-                                         out / "figures" / "steps.png"))
+        written.append(figs.steps_figure(steps, out / "figures" / "steps.png"))
     return sweep, steps, written
 
 

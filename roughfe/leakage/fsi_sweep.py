@@ -16,7 +16,9 @@ from .fsi import coupled_leakage
 
 def coupled_sweep(surface: Surface, material, external_pressures, **kwargs) -> tuple:
     """:func:`coupled_leakage` over increasing external pressures (Pa), each step's fluid
-    state the trapped-fluid reference of the next. Stops after a lift-off step.
+    state the trapped-fluid reference of the next. A lift-off step (the fluid carries the
+    whole load: the gap is open everywhere) traps nothing, so the next step starts from
+    first contact (no reference); a larger external pressure can close the contact again.
 
     Returns a tuple of :class:`CoupledResult`.
     """
@@ -34,9 +36,7 @@ def coupled_sweep(surface: Surface, material, external_pressures, **kwargs) -> t
             r = coupled_leakage(surface, material, p, **kwargs, history=replace(
                 history, pressure=np.zeros_like(history.pressure)))
         out.append(r)
-        if r.state == "lift-off":
-            break
-        history = r.fluid_state
+        history = None if r.state == "lift-off" else r.fluid_state
     return tuple(out)
 
 

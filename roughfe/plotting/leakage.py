@@ -157,7 +157,11 @@ def steps_figure(steps, path):
     with ``persson_leak_rate`` in the records also Lorenz & Persson's critical-junction
     estimate beside the Reynolds leak rates, and with ``leak_rate_one_way`` (``--fsi``)
     the one-way leak rate beside the coupled one and a third panel of load shares.
-    Sealed steps (Q = 0) are marked on the axis, not dropped."""
+    Sealed steps (Q = 0) are marked on the axis, not dropped; steps without a contact
+    area (a coupled lift-off) are named below the leak rates."""
+    skipped = [s.get("external_pressure", np.nan) for s in steps
+               if s.get("area_fraction") is None]
+    steps = [s for s in steps if s.get("area_fraction") is not None]
     a = np.array([s["area_fraction"] for s in steps], float)
     coupled = any(s.get("leak_rate_one_way") is not None for s in steps)
     fig, axes = new_figure(1, 3 if coupled else 2, figsize=(15 if coupled else 10, 4))
@@ -175,6 +179,14 @@ def steps_figure(steps, path):
                 sealed |= np.array([v is not None and v <= 0 for v in q])
     for x in a[sealed]:
         ax1.axvline(x, color="0.6", lw=0.8, ls="--")
+    if sealed.size and sealed.all():               # no positive rate: an empty log axis
+        ax1.text(0.5, 0.5, "every step sealed: Q = 0", transform=ax1.transAxes,
+                 ha="center", va="center")
+        ax1.set_yticks([])
+    if skipped:
+        ax1.annotate(f"lift-off (not shown, no contact): p_ext = "
+                     f"{', '.join(f'{p:.3g}' for p in skipped)} Pa", (0.01, 0.01),
+                     xycoords="axes fraction", fontsize=7, color="0.3")
     ax1.set_xlabel("A* = A_r / A_n")
     ax1.set_ylabel("leak rate Q (m$^3$/s)")
     ax1.set_title("leak rate" + (" (dashed lines: sealed steps, Q = 0)" if sealed.any() else ""),
@@ -186,8 +198,9 @@ def steps_figure(steps, path):
         vals = [s.get(key) for s in steps]
         if all(v is not None for v in vals):
             vols[label] = np.array(vals, float)
-    for label, vals in vols.items():
-        ax2.plot(a, vals, "o-", label=label)
+    for k, (label, vals) in enumerate(vols.items()):   # V* wide below: V* = V_p* + trapped
+        ax2.plot(a, vals, "o-", label=label, **({"lw": 4, "ms": 9, "alpha": 0.45} if k == 0
+                                                else {}))
     positive = [v[v > 0] for v in vols.values() if np.any(v > 0)]
     if positive and max(v.max() for v in positive) > 100 * min(v.min() for v in positive):
         ax2.set_yscale("log")      # the trapped volume is decades below the free one
