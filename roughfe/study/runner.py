@@ -183,9 +183,8 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     tasks = spec.tasks()
     _check_tasks(spec.analysis, tasks)
     outdir = spec.output
-    fresh = not Path(outdir).exists()
-    try:
-        with store.study_lock(outdir):
+    with store.study_lock(outdir) as created:
+        try:
             store.write_study(outdir, spec, tasks, __version__)
             keys = [t.key for t in tasks]
             done = store.done_keys(outdir)
@@ -202,12 +201,14 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
                     _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
                            n_cached=n_cached, commit=code_commit())
             store.write_index(outdir, keys)
-    except InputError:
-        # a run refused before any task finished (e.g. an executor that cannot start)
-        # leaves no study folder behind: the command wrote nothing
-        if fresh and Path(outdir).is_dir() and not store.done_keys(outdir):
-            shutil.rmtree(outdir, ignore_errors=True)
-        raise
+        except InputError:
+            # a run refused before any task finished (e.g. an executor that cannot start)
+            # leaves no study folder behind: the command wrote nothing. Only a folder that
+            # this process made, and only while it holds the lock: a run started at the
+            # same moment that lost the lock never touches the winner's folder.
+            if created and not store.done_keys(outdir):
+                shutil.rmtree(outdir, ignore_errors=True)
+            raise
     summary = StudySummary(n_tasks=len(tasks), n_cached=n_cached, n_done=counts["done"],
                            n_failed=counts["failed"], n_retries=counts["retries"],
                            wall_s=time.perf_counter() - t_start, task_s=counts["task_s"],

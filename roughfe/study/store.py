@@ -48,6 +48,10 @@ def study_lock(outdir):
 
     A folder that holds files but no ``study.json`` is not a study folder: it is refused
     (InputError), so a study never mixes its files into another command's output.
+
+    Yields True when this call made the folder (``mkdir`` succeeded here, not in another
+    process started at the same moment): only such a caller, holding the lock, may remove
+    the folder again (a refused run leaves nothing behind).
     """
     outdir = Path(outdir)
     if outdir.exists() and not outdir.is_dir():
@@ -57,9 +61,16 @@ def study_lock(outdir):
         if other:
             raise InputError(f"study output {outdir} holds files but is not a study folder (no "
                              f"study.json; e.g. {other[0]!r}); choose a new or empty folder")
-    outdir.mkdir(parents=True, exist_ok=True)
+    try:
+        outdir.parent.mkdir(parents=True, exist_ok=True)
+        outdir.mkdir()
+        created = True
+    except FileExistsError:
+        created = False
+    except OSError as exc:
+        raise InputError(f"cannot create the study folder {outdir}: {exc.strerror}") from None
     with folder_lock(outdir, "`roughfe study run`"):
-        yield
+        yield created
 
 
 #: files derived from the results by ``collect``: stale once a run changes the results
