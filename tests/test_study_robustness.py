@@ -15,7 +15,8 @@ from roughfe.study import runner, store
 
 def _spec(outdir, grid=None, **fixed):
     return spec_from_mapping({
-        "study": {"name": "r", "analysis": "selftest", "output": str(outdir), "seed": 3},
+        "study": {"name": "r", "analysis": "selftest", "output": str(outdir), "seed": 3,
+                  "seed_from": ["x"]},
         "grid": grid or {"x": [0.5, 1.5]}, "fixed": fixed})
 
 
@@ -50,3 +51,37 @@ def test_a_refused_run_removes_the_folder_it_made(tmp_path):
     with pytest.raises(InputError, match="executor must be one of"):
         run_study(_spec(spec.output, n_records=2), executor="slurm", progress=False)
     assert json.loads((spec.output / "index.json").read_text())["n_done"] == 2
+
+
+def test_a_changed_analysis_default_gives_new_task_keys(tmp_path, monkeypatch):
+    """The key covers the parameters as the task runs them: a default that changes
+    (contact_sweep's E and nu did, with no version bump) makes new keys, so a resumed
+    study does not reuse results of the other physics; a value written in the spec that
+    equals the default (outside seed_from) is the same task as leaving it out."""
+    from roughfe.study.analyses import selftest_task
+
+    spec = _spec(tmp_path / "d")
+    assert [t.key for t in spec.tasks()] == [t.key for t in _spec(spec.output, y=0.0).tasks()]
+    assert run_study(spec, workers=1, progress=False).n_done == 2
+    monkeypatch.setattr(selftest_task, "__kwdefaults__",
+                        {**selftest_task.__kwdefaults__, "y": 0.5})
+    again = run_study(spec, workers=1, progress=False)
+    assert (again.n_cached, again.n_done) == (0, 2)
+    assert json.loads((spec.output / "study.json").read_text())["key_format"] == 2
+
+
+def test_a_folder_of_the_old_key_format_is_recognised_and_said(tmp_path):
+    """A study folder written before the key format was recorded is named as such by
+    status and by the run that recomputes its tasks (not silently)."""
+    from roughfe.study import study_status
+
+    spec = _spec(tmp_path / "old")
+    run_study(spec, workers=1, progress=False)
+    path = spec.output / "study.json"
+    data = json.loads(path.read_text())
+    del data["key_format"]
+    path.write_text(json.dumps(data))
+    assert "written with task key format 1" in study_status(spec.output).describe()
+    with pytest.warns(UserWarning, match=r"key format 1, which hashed only the parameters"):
+        run_study(spec, workers=1, progress=False)
+    assert "key format" not in study_status(spec.output).describe()

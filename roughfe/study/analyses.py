@@ -16,6 +16,8 @@ A task function is called as ``function(**params, seed=seed)`` and returns one J
 record (a dict) or a list of them; each record becomes one row of the collected table,
 next to the task's parameters and seed. Bump ``version`` when an analysis changes its
 results: the version is part of each task's content key, so old results are not reused.
+The key also holds every parameter as the task runs it, the function's defaults
+included (:func:`parameter_defaults`), so changing a default needs no version bump.
 """
 from __future__ import annotations
 
@@ -30,6 +32,7 @@ import numpy as np
 from ..errors import InputError
 from ..genomics.database.settings import THESIS_SETTINGS as _THESIS
 from ..model import DEFAULT_E, DEFAULT_NU
+from ..writers import to_jsonable
 
 
 @dataclass(frozen=True)
@@ -103,6 +106,20 @@ def resolve(name: str, what: str = "target"):
         return getattr(module, attr)
     except AttributeError:
         raise InputError(f"analysis {name!r}: {module_name} has no function {attr!r}") from None
+
+
+def parameter_defaults(name: str) -> dict:
+    """The keyword defaults of analysis ``name``'s task function (``seed`` aside), as
+    JSON values: what a task runs with for each parameter its spec does not give.
+
+    They are part of every task key (:meth:`roughfe.study.StudySpec.tasks`): a default
+    that changes (say E) gives new keys, so results computed with the old one are not
+    reused, and a value written in the spec that equals the default gives the same key
+    as leaving it out.
+    """
+    sig = inspect.signature(resolve(name))
+    return {p: to_jsonable(v.default) for p, v in sig.parameters.items()
+            if p != "seed" and v.default is not inspect.Parameter.empty}
 
 
 def check_parameters(name: str, params) -> None:

@@ -15,6 +15,7 @@ import subprocess
 import sys
 import time
 import traceback
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -185,11 +186,15 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     outdir = spec.output
     with store.study_lock(outdir) as created:
         try:
+            found = store.recorded_key_format(outdir)
             store.write_study(outdir, spec, tasks, __version__)
             keys = [t.key for t in tasks]
             done = store.done_keys(outdir)
             todo = [t for t in tasks if t.key not in done]
             n_cached = len(tasks) - len(todo)
+            note = store.old_keys_note(outdir, found, len(todo))
+            if note:
+                warnings.warn(note, stacklevel=2)
             counts = collections.Counter()
             description = "nothing to run"
             if todo:

@@ -27,8 +27,11 @@ grid or fixed table is used as given instead. A grid parameter named ``replica``
 labels the rows: it is not passed to the analysis.
 
 Each task is stored under a content key: SHA-256 of the canonical JSON of the analysis,
-its version, the roughfe version, the parameters and the seed. Identical work always
-gets the same key, on any machine and with any executor.
+its version, the roughfe version, the parameters as the task runs them (the spec's values
+over the analysis' defaults) and the seed. Identical work always gets the same key, on
+any machine and with any executor, and a changed default gives new keys. Up to key
+format 1 only the spec's values were hashed (a changed default reused old results);
+:data:`KEY_FORMAT` is recorded in ``study.json``.
 """
 from __future__ import annotations
 
@@ -47,6 +50,9 @@ from .. import __version__
 from ..errors import InputError
 from ..frozen import freeze_containers
 
+#: The task-key scheme, recorded in ``study.json``: 2 hashes the resolved parameters
+#: (defaults included); 1 (no record) hashed the spec's values only.
+KEY_FORMAT = 2
 SECTIONS = {"study", "grid", "fixed"}
 RUNNER_ONLY = ("replica",)  # parameters that select seeds but are not passed to the analysis
 STUDY_KEYS = {"name", "analysis", "output", "seed", "seed_from", "max_attempts"}
@@ -114,7 +120,8 @@ class Task:
     seed : int
         The task's seed (derived, or the ``seed`` parameter when one is given).
     key : str
-        Content key (SHA-256 hex) under which the result is stored.
+        Content key (SHA-256 hex) under which the result is stored: the analysis, its
+        version, the roughfe version, ``params`` over the analysis' defaults, the seed.
     """
 
     index: int
@@ -214,9 +221,10 @@ class StudySpec:
 
     def tasks(self) -> list[Task]:
         """All tasks, in cartesian-product order of the grid (last parameter fastest)."""
-        from .analyses import ANALYSES
+        from .analyses import ANALYSES, parameter_defaults
 
         version = ANALYSES[self.analysis].version
+        defaults = parameter_defaults(self.analysis)
         names = list(self.grid)
         out = []
         for index, combo in enumerate(itertools.product(*self.grid.values())):
@@ -229,7 +237,8 @@ class StudySpec:
                 chosen = names + list(self.fixed) if self.seed_from is None else self.seed_from
                 seed = derive_seed(self.seed, self.analysis, {k: params[k] for k in chosen})
             key = sha256_hex({"analysis": self.analysis, "analysis_version": version,
-                              "code_version": __version__, "params": params, "seed": seed})
+                              "code_version": __version__, "params": {**defaults, **params},
+                              "seed": seed})
             out.append(Task(index=index, params=params, seed=seed, key=key))
         return out
 

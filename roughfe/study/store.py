@@ -27,7 +27,7 @@ from pathlib import Path
 
 from ..errors import FileFormatError, InputError
 from ..writers import folder_lock, write_json, write_text
-from .spec import canonical_json, spec_from_mapping
+from .spec import KEY_FORMAT, canonical_json, spec_from_mapping
 
 
 def study_file(outdir) -> Path:
@@ -84,9 +84,34 @@ def write_study(outdir, spec, tasks, code_version):
     for name in TABLE_FILES:
         (Path(outdir) / name).unlink(missing_ok=True)
     write_json(study_file(outdir), {
-        "spec": spec.to_dict(), "code_version": code_version, "n_tasks": len(tasks),
+        "spec": spec.to_dict(), "code_version": code_version, "key_format": KEY_FORMAT,
+        "n_tasks": len(tasks),
         "tasks": [{"index": t.index, "key": t.key, "params": dict(t.params), "seed": t.seed}
                   for t in tasks]})
+
+
+def recorded_key_format(outdir):
+    """The task-key format of the ``study.json`` in ``outdir`` (1 when none is recorded:
+    written before roughfe recorded it), or None without a readable ``study.json``."""
+    try:
+        data = json.loads(study_file(outdir).read_text())
+    except (OSError, ValueError):
+        return None
+    return data.get("key_format", 1) if isinstance(data, dict) else None
+
+
+def old_keys_note(outdir, found, n_rerun=None) -> str:
+    """A note when the study folder ``outdir`` holds results under the task keys of an
+    older format ``found`` (empty otherwise): what changed, and what a run does."""
+    if found is None or found >= KEY_FORMAT:
+        return ""
+    what = ("the next `roughfe study run` computes its tasks once more under the new keys"
+            if n_rerun is None else
+            f"this run computes {n_rerun} task(s) that have no result under the new keys")
+    return (f"{outdir} was written with task key format {found}, which hashed only the "
+            f"parameters written in the spec, not the analysis' defaults (a changed default "
+            f"reused old results); roughfe now uses key format {KEY_FORMAT}: {what}; the "
+            f"old result files stay in {Path(outdir) / 'results'}, unused")
 
 
 def read_study(outdir) -> dict:
@@ -174,6 +199,8 @@ class StudyStatus:
         CPU time in seconds of each finished task (its cost on an idle core).
     commits : tuple of str
         The distinct code commits (provenance) of the finished results.
+    note : str
+        Said about the folder as a whole (results under an older task-key format).
     """
 
     name: str
@@ -186,6 +213,7 @@ class StudyStatus:
     cost_s: tuple
     cpu_s: tuple = ()
     commits: tuple = ()
+    note: str = ""
 
     def describe(self) -> str:
         """Human-readable multi-line summary."""
@@ -205,6 +233,8 @@ class StudyStatus:
                          "analysis version or use a new output folder after a physics change")
         for index, params, error in self.failures:
             lines.append(f"  failed task {index} {canonical_json(params)}: {error}")
+        if self.note:
+            lines.append(f"note: {self.note}")
         return "\n".join(lines)
 
 
@@ -237,7 +267,8 @@ def study_status(outdir) -> StudyStatus:
                        n_done=n_done, n_failed=n_failed,
                        n_missing=len(data["tasks"]) - n_done - n_failed,
                        failures=tuple(failures), cost_s=tuple(costs), cpu_s=tuple(cpus),
-                       commits=tuple(sorted(commits)))
+                       commits=tuple(sorted(commits)),
+                       note=old_keys_note(outdir, data.get("key_format", 1)))
 
 
 def _cell(value):
