@@ -85,3 +85,33 @@ def test_a_folder_of_the_old_key_format_is_recognised_and_said(tmp_path):
     with pytest.warns(UserWarning, match=r"key format 1, which hashed only the parameters"):
         run_study(spec, workers=1, progress=False)
     assert "key format" not in study_status(spec.output).describe()
+
+
+def test_genome_db_tasks_sharing_a_seed_are_distinct_genomes(tmp_path):
+    """seed_from = ["replica"] with two gamma: one seed, two genomes. Both are inserted
+    (they shared the label genome-<seed> and the database kept one, exit 0); two tasks
+    that do make one label are refused, naming them, and nothing is inserted."""
+    gdb = pytest.importorskip("roughfe.genomics.database")
+    from roughfe.cli import main as cli_main
+    from roughfe.study import genome_db_to_sqlite
+
+    out = tmp_path / "g"
+    spec = spec_from_mapping({
+        "study": {"analysis": "genome_db", "output": str(out), "seed": 3,
+                  "seed_from": ["replica"]},
+        "grid": {"gamma": [1.5, 1.8], "replica": [0]},
+        "fixed": {"hurst": 0.6, "n_nodes": 64, "n_steps": 3}})
+    assert run_study(spec, workers=1, progress=False).complete
+    db = tmp_path / "g.sqlite"
+    assert cli_main(["study", "collect", str(out), "--no-parquet", "--genome-db",
+                     str(db)]) == 0
+    seed = spec.tasks()[0].seed
+    assert sorted(e.label for e in gdb.load_entries(db)) == [
+        f"genome-{seed}-gamma1.5-hurst0.6", f"genome-{seed}-gamma1.8-hurst0.6"]
+    for path in (out / "results").glob("*.json"):    # as a label given in [fixed] would
+        record = json.loads(path.read_text())
+        record["records"][0]["label"] = "same"
+        path.write_text(json.dumps(record))
+    with pytest.raises(InputError, match="both made the genome label 'same'"):
+        genome_db_to_sqlite(out, tmp_path / "other.sqlite")
+    assert not (tmp_path / "other.sqlite").exists()

@@ -72,7 +72,7 @@ ANALYSES = {
         "leakage of one surface over approach steps (thesis Sec. 2.4)",
         "roughfe.leakage.study:leakage_inputs"),
     "genome_db": Analysis(
-        "roughfe.study.analyses:genome_db_task", "1",
+        "roughfe.study.analyses:genome_db_task", "2",   # 2: labels name the genes
         "one entry of the genome database: WM genome, Alg. 2 macro/micro, BEM sweep "
         "(roughfe.genomics.database.genome_entry_task)",
         "roughfe.study.analyses:genome_db_inputs"),
@@ -295,7 +295,9 @@ def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=Non
     """One genome-database entry: the study seed draws the WM phases.
 
     Calls :func:`roughfe.genomics.database.genome_entry_task` with ``phases=seed`` and
-    ``label`` (default ``"genome-<seed>"``); ``E`` (Pa) and ``nu`` (-) are the material
+    ``label`` (default :func:`genome_label`: the seed and the genes, so that tasks that
+    share a seed through ``seed_from`` but differ in a gene are distinct genomes of a
+    database); ``E`` (Pa) and ``nu`` (-) are the material
     (default: the one CLI default :data:`roughfe.model.DEFAULT_E`, 210 MPa, nu = 0; the
     thesis database used E = 1 MPa: give ``E = 1e6``). The full entry (genome, curves,
     chromosome curves, correlations) is stored in the task's result file; the table
@@ -309,9 +311,25 @@ def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=Non
     from ..genomics.database import genome_entry_task
 
     return genome_entry_task(
-        gamma, hurst, seed, label=label if label is not None else f"genome-{seed}",
+        gamma, hurst, seed,
+        label=label if label is not None else genome_label(seed, gamma, hurst, amplitude,
+                                                            lambda1),
         source="study", amplitude=amplitude, lambda1=lambda1, length=length, n_nodes=n_nodes,
         youngs_modulus=E, poisson=nu, n_steps=n_steps, threshold=threshold, kernel=kernel)
+
+
+def genome_label(seed, gamma, hurst, amplitude=1.0, lambda1=None) -> str:
+    """The default database label of a ``genome_db`` task: ``genome-<seed>-gamma<g>-
+    hurst<H>``, with ``-amplitude<A>`` and ``-lambda1<l>`` where they are not the defaults
+    (1 and None). One label per genome: the seed draws the phases, the rest are genes.
+    (Up to analysis version 1 it was ``genome-<seed>``, and tasks sharing a seed shared
+    a label: the database kept one of them.)"""
+    label = f"genome-{seed}-gamma{gamma!r}-hurst{hurst!r}"
+    if amplitude != 1.0:
+        label += f"-amplitude{amplitude!r}"
+    if lambda1 is not None:
+        label += f"-lambda1{lambda1!r}"
+    return label
 
 
 def genome_db_inputs(*, gamma, hurst, amplitude, lambda1, label, length, n_nodes, E, nu,

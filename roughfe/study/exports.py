@@ -18,8 +18,9 @@ def genome_db_to_sqlite(outdir, db_path) -> int:
 
     One transaction: labels already in the database are skipped (existing genomes are
     kept), so running it again after the study has progressed adds only the new
-    genomes; entries with other settings than the database's are refused and nothing
-    is inserted. A new database takes the settings of the first entry.
+    genomes; entries with other settings than the database's, or two tasks of the study
+    with one label, are refused and nothing is inserted. A new database takes the
+    settings of the first entry.
 
     Returns
     -------
@@ -33,11 +34,21 @@ def genome_db_to_sqlite(outdir, db_path) -> int:
     if analysis not in GENOME_ANALYSES:
         raise InputError(f"{outdir} holds a {analysis!r} study; only {GENOME_ANALYSES} "
                          "studies can fill a genome database")
-    entries = []
+    entries, made_by = [], {}
     for task in data["tasks"]:
         result = store.read_result(outdir, task["key"])
-        if result is not None:
-            entries.extend(result["records"])
+        if result is None:
+            continue
+        for record in result["records"]:
+            other = made_by.setdefault(record["label"], task)
+            if other is not task:
+                raise InputError(
+                    f"tasks {other['index']} {other['params']} and {task['index']} "
+                    f"{task['params']} of the study in {outdir} both made the genome label "
+                    f"{record['label']!r}; a database holds one genome per label, so nothing "
+                    "was inserted: give each task its own label (or leave 'label' out: "
+                    "genome_db labels name the seed and the genes)")
+        entries.extend(result["records"])
     if not entries:
         raise InputError(f"the study in {outdir} has no finished genome yet")
     con = gdb.connect(db_path, create=True)
