@@ -115,3 +115,20 @@ def test_genome_db_tasks_sharing_a_seed_are_distinct_genomes(tmp_path):
     with pytest.raises(InputError, match="both made the genome label 'same'"):
         genome_db_to_sqlite(out, tmp_path / "other.sqlite")
     assert not (tmp_path / "other.sqlite").exists()
+
+
+@pytest.mark.timeout(60)
+def test_a_missing_dask_scheduler_file_is_a_clear_error_not_a_hang(tmp_path):
+    """--scheduler typo.json: distributed waited forever for the file, holding the
+    study's lock; a file without an address ended in an AssertionError."""
+    pytest.importorskip("distributed")
+    from roughfe.study import make_executor
+
+    spec = _spec(tmp_path / "s")
+    with pytest.raises(InputError, match="scheduler file '.*typo.json' does not exist"):
+        run_study(spec, executor="dask", scheduler=str(tmp_path / "typo.json"),
+                  progress=False)
+    assert not spec.output.exists()
+    (tmp_path / "bad.json").write_text('{"id": "Scheduler-1"}')
+    with pytest.raises(InputError, match="holds no 'address'"):
+        make_executor("dask", scheduler=str(tmp_path / "bad.json"))

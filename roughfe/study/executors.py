@@ -22,6 +22,7 @@ No engine is home-made:
 from __future__ import annotations
 
 import concurrent.futures as cf
+import json
 import multiprocessing
 import os
 import threading
@@ -133,12 +134,37 @@ class LocalExecutor(_Base):
         self._pool.shutdown(wait=True, cancel_futures=True)
 
 
+def _scheduler_address(scheduler) -> str:
+    """The address of the dask scheduler ``scheduler``: an address as given, or the one a
+    scheduler file (``*.json``, from ``dask scheduler --scheduler-file``) holds. The file
+    is read here: ``distributed.Client`` would wait forever for a missing one (holding
+    the study's lock) and fails with an AssertionError on one without an address."""
+    text = str(scheduler)
+    if not text.endswith(".json"):
+        return text
+    try:
+        with open(text) as fh:
+            data = json.load(fh)
+    except FileNotFoundError:
+        raise InputError(f"the dask scheduler file {text!r} does not exist; start the "
+                         f"scheduler first (`dask scheduler --scheduler-file {text}`) or give "
+                         "its address, e.g. tcp://host:8786") from None
+    except (OSError, ValueError) as exc:
+        raise InputError(f"cannot read the dask scheduler file {text!r}: {exc}") from None
+    address = data.get("address") if isinstance(data, dict) else None
+    if not isinstance(address, str) or not address:
+        raise InputError(f"{text!r} is not a dask scheduler file: it holds no 'address' "
+                         "of a scheduler (a JSON object with 'address': 'tcp://host:port')")
+    return address
+
+
 class DaskExecutor(_Base):
     """dask.distributed: a running scheduler at ``scheduler``, or a LocalCluster."""
 
     name = "dask"
 
     def __init__(self, workers=None, scheduler=None):
+        address = _scheduler_address(scheduler) if scheduler else None
         try:
             import distributed
         except ImportError:
@@ -148,13 +174,11 @@ class DaskExecutor(_Base):
         workers = _check_workers(workers)
         self._cluster = None
         if scheduler:
-            where = ({"scheduler_file": str(scheduler)} if str(scheduler).endswith(".json")
-                     else {"address": scheduler})
             try:
-                self._client = distributed.Client(**where, timeout="30s")
-            except (OSError, TimeoutError) as exc:
-                raise InputError(
-                    f"cannot reach the dask scheduler at {scheduler!r}: {exc}") from None
+                self._client = distributed.Client(address, timeout="30s")
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise InputError(f"cannot reach the dask scheduler at {address!r}: "
+                                 f"{exc}") from None
             self.n_workers = max(1, len(self._client.scheduler_info()["workers"]))
         else:
             self.n_workers = workers or available_cores()
