@@ -132,3 +132,56 @@ def test_a_missing_dask_scheduler_file_is_a_clear_error_not_a_hang(tmp_path):
     (tmp_path / "bad.json").write_text('{"id": "Scheduler-1"}')
     with pytest.raises(InputError, match="holds no 'address'"):
         make_executor("dask", scheduler=str(tmp_path / "bad.json"))
+
+
+def _broken_pyarrow(tmp_path, monkeypatch):
+    """A pyarrow that is found but does not import (as one built for numpy 2 under
+    numpy 1.24 does)."""
+    import sys
+
+    fake = tmp_path / "site" / "pyarrow"
+    fake.mkdir(parents=True)
+    (fake / "__init__.py").write_text(
+        'raise ImportError("pyarrow requires NumPy 2.0 or newer, found 1.24.2")\n')
+    for name in [m for m in sys.modules if m == "pyarrow" or m.startswith("pyarrow.")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.syspath_prepend(str(tmp_path / "site"))
+
+
+def test_collect_writes_the_csv_when_pyarrow_is_found_but_does_not_import(
+        tmp_path, monkeypatch, capsys):
+    from roughfe.cli import main as cli_main
+
+    spec = _spec(tmp_path / "c")
+    run_study(spec, workers=1, progress=False)
+    _broken_pyarrow(tmp_path, monkeypatch)
+    assert cli_main(["study", "collect", str(spec.output)]) == 0
+    out = capsys.readouterr().out
+    assert "Parquet not written: pyarrow is installed but cannot be imported here " \
+           "(ImportError: pyarrow requires NumPy 2.0 or newer, found 1.24.2)" in out
+    assert (spec.output / "table.csv").is_file()
+    assert not (spec.output / "table.parquet").exists()
+
+
+def test_a_column_of_numbers_and_lists_is_text_in_parquet(tmp_path):
+    """A record field that is a list in one task and a number in another: the Parquet
+    column is JSON text, as in the CSV (pyarrow raised ArrowTypeError)."""
+    from roughfe.study import collect
+    from roughfe.study.store import _parquet_column
+
+    assert _parquet_column([[1, 2], 3, None, "a"]) == ["[1,2]", "3", None, "a"]
+    assert _parquet_column([1, 2.5, None]) == [1, 2.5, None]
+    assert _parquet_column([[1], [2.5]]) == ["[1]", "[2.5]"]
+    pytest.importorskip("pyarrow")
+    import pandas as pd
+
+    spec = _spec(tmp_path / "m")
+    run_study(spec, workers=1, progress=False)
+    path = sorted((spec.output / "results").glob("*.json"))[0]
+    record = json.loads(path.read_text())
+    record["records"][0]["f"] = [1.0, 2.0]
+    path.write_text(json.dumps(record))
+    paths, n_rows, missing, note = collect(spec.output)
+    assert note == "" and spec.output / "table.parquet" in paths
+    column = pd.read_parquet(spec.output / "table.parquet")["f"].tolist()
+    assert "[1.0,2.0]" in column and all(isinstance(v, str) for v in column)

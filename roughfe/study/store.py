@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import contextlib
 import csv
-import importlib.util
 import io
 import json
 import os
@@ -330,16 +329,46 @@ def _collect(outdir, parquet):
     paths = [write_text(outdir / "table.csv", buf.getvalue())]
     note = ""
     if parquet:
-        if importlib.util.find_spec("pyarrow") is None:
-            note = "Parquet not written: pyarrow is not installed (pip install pyarrow)"
-        else:
-            import pandas as pd
-
-            from ..writers import atomic_path
-
-            frame = pd.DataFrame([{c: None if r.get(c) is None else _cell(r[c]) for c in columns}
-                                  for r in rows], columns=columns)
-            with atomic_path(outdir / "table.parquet") as tmp:
-                frame.to_parquet(tmp, index=False)
+        note = _write_parquet(outdir / "table.parquet", columns, rows)
+        if not note:
             paths.append(outdir / "table.parquet")
     return paths, len(rows), missing, note
+
+
+def _parquet_column(values) -> list:
+    """One column for Parquet: lists and tables as JSON text (as in the CSV); a column
+    whose values are of several kinds (numbers, booleans, text) all as text, since an
+    Arrow column has one type (numbers beside a list raised ArrowTypeError)."""
+    def kind(v):
+        return "bool" if isinstance(v, bool) else "number" if isinstance(v, (int, float)) \
+            else "text"
+    kinds = {kind(v) for v in values if v is not None}
+    if len(kinds) > 1:
+        return [None if v is None else v if isinstance(v, str) else canonical_json(v)
+                for v in values]
+    return [None if v is None else _cell(v) for v in values]
+
+
+def _write_parquet(path, columns, rows) -> str:
+    """Write the table as Parquet (atomically); return why it was not written, or ""."""
+    try:
+        import pyarrow
+    except ModuleNotFoundError as exc:
+        if exc.name != "pyarrow":   # pyarrow is there, one of its imports is not
+            return f"Parquet not written: pyarrow cannot be imported here: {exc}"
+        return "Parquet not written: pyarrow is not installed (pip install pyarrow)"
+    except Exception as exc:        # found but broken, e.g. built for another numpy
+        return (f"Parquet not written: pyarrow is installed but cannot be imported here "
+                f"({type(exc).__name__}: {exc})")
+    import pandas as pd
+
+    from ..writers import atomic_path
+
+    frame = pd.DataFrame({c: _parquet_column([r.get(c) for r in rows]) for c in columns},
+                         columns=columns)
+    try:
+        with atomic_path(path) as tmp:
+            frame.to_parquet(tmp, index=False, engine="pyarrow")
+    except (pyarrow.ArrowException, TypeError, ValueError) as exc:
+        return f"Parquet not written: {type(exc).__name__}: {exc}"
+    return ""
