@@ -50,7 +50,7 @@ def test_a_refused_run_removes_the_folder_it_made(tmp_path):
     run_study(spec, workers=1, progress=False)
     with pytest.raises(InputError, match="executor must be one of"):
         run_study(_spec(spec.output, n_records=2), executor="slurm", progress=False)
-    assert json.loads((spec.output / "index.json").read_text())["n_done"] == 2
+    assert len(list((spec.output / "results").glob("*.json"))) == 2
 
 
 def test_a_changed_analysis_default_gives_new_task_keys(tmp_path, monkeypatch):
@@ -185,3 +185,71 @@ def test_a_column_of_numbers_and_lists_is_text_in_parquet(tmp_path):
     assert note == "" and spec.output / "table.parquet" in paths
     column = pd.read_parquet(spec.output / "table.parquet")["f"].tolist()
     assert "[1.0,2.0]" in column and all(isinstance(v, str) for v in column)
+
+
+class _Killed(BaseException):
+    """Stands for kill -9 in the middle of a run (no clean-up code runs after it)."""
+
+
+def _killed_executor(*args, **kwargs):
+    raise _Killed
+
+
+def test_a_killed_run_leaves_no_whole_study_file_of_an_earlier_state(tmp_path, monkeypatch):
+    """A completed 2-task study, collected, then extended to 4 tasks and killed before a
+    task finished: index.json said 2/2 done beside a 4-task study.json, and table.csv was
+    gone only because of an earlier fix. Now the index describes the 4 tasks at once."""
+    from roughfe.study import collect
+
+    spec = _spec(tmp_path / "k")
+    run_study(spec, workers=1, progress=False)
+    collect(spec.output, parquet=False)
+    monkeypatch.setattr(runner, "make_executor", _killed_executor)
+    with pytest.raises(_Killed):
+        run_study(_spec(spec.output, grid={"x": [0.5, 1.5, 2.5, 3.5]}), progress=False)
+    index = json.loads((spec.output / "index.json").read_text())
+    assert (index["n_tasks"], index["n_done"]) == (4, 2)
+    assert not (spec.output / "table.csv").exists()
+
+
+def test_status_rebuilds_a_stale_index(tmp_path):
+    from roughfe.study import study_status
+
+    spec = _spec(tmp_path / "i")
+    run_study(spec, workers=1, progress=False)
+    index = json.loads((spec.output / "index.json").read_text())
+    (spec.output / "index.json").write_text(json.dumps({"n_tasks": 20, "n_done": 20}))
+    assert study_status(spec.output).n_done == 2
+    assert json.loads((spec.output / "index.json").read_text()) == index
+    (spec.output / "index.json").unlink()
+    study_status(spec.output)
+    assert json.loads((spec.output / "index.json").read_text()) == index
+
+
+def test_a_killed_leak_study_leaves_no_summary_of_an_earlier_run(tmp_path, monkeypatch):
+    """leak-study completed, rerun with more D and killed: its summary.json (and
+    figures) described the earlier study beside the larger, unfinished one."""
+    pytest.importorskip("roughfe.leakage.study")
+    from roughfe.cli import main as cli_main
+
+    out = tmp_path / "leak"
+    args = ["leak-study", "--m", "2", "--surfaces", "1", "--steps", "2", "--workers", "1",
+            "--no-figures", "--quiet", "-o", str(out)]
+    assert cli_main([*args, "--D", "2.3"]) == 0
+    assert (out / "summary.json").is_file()
+    (out / "figures").mkdir()          # as the figures of the earlier run
+    monkeypatch.setattr(runner, "make_executor", _killed_executor)
+    with pytest.raises(_Killed):
+        cli_main([*args, "--D", "2.3", "2.7"])
+    assert not (out / "summary.json").exists() and not (out / "figures").exists()
+    assert json.loads((out / "index.json").read_text())["n_tasks"] == 2
+    # a plain `study run` of the folder (the spec extended again) removes them as well
+    monkeypatch.undo()
+    assert cli_main([*args, "--D", "2.3"]) == 0 and (out / "summary.json").is_file()
+    spec = spec_from_mapping(json.loads((out / "study.json").read_text())["spec"])
+    monkeypatch.setattr(runner, "make_executor", _killed_executor)
+    with pytest.raises(_Killed):
+        run_study(spec_from_mapping({**spec.to_dict(), "grid": {**spec.to_dict()["grid"],
+                                                                "D": [2.3, 2.9]}}),
+                  progress=False)
+    assert not (out / "summary.json").exists()

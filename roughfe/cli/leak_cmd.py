@@ -280,6 +280,7 @@ def _leak_study(args) -> int:
     from ..leakage.study import study_grid, summarise
     from ..plotting import leakage as figs
     from ..study import run_study, spec_from_mapping, table_rows
+    from ..study.store import study_lock
 
     out = Path(args.output)
     fixed = {"n_steps": args.steps, "L": args.length, "E": args.E, "nu": args.nu,
@@ -290,17 +291,21 @@ def _leak_study(args) -> int:
         "study": {"name": "leakage-sec2.4", "analysis": "leakage", "output": str(out),
                   "seed": args.seed, "seed_from": ["replica"]},
         "grid": study_grid(args.D, args.m, args.surfaces), "fixed": fixed})
+    # summary.json and figures/ describe the whole study: the run removes them when it
+    # starts (a run killed before they are rewritten leaves none of an earlier state)
     summary = run_study(spec, executor=args.executor, workers=args.workers,
                         scheduler=args.scheduler, progress=show_progress(args),
-                        log=log_of(args))
-    _, rows, missing = table_rows(out)
-    if not rows:
-        raise InputError(f"no task of the study in {out} finished; see `roughfe study status {out}`")
-    result = summarise(rows)
-    write_json(out / "summary.json", result)
-    # the figures are this summary's: an earlier run's never stand beside it
-    shutil.rmtree(out / "figures", ignore_errors=True)
-    paths = [] if args.no_figures else figs.study_figures(result, out / "figures")
+                        log=log_of(args), derived=("summary.json", "figures"))
+    with study_lock(out, "`roughfe leak-study`"):      # no run changes the results meanwhile
+        _, rows, missing = table_rows(out)
+        if not rows:
+            raise InputError(f"no task of the study in {out} finished; "
+                             f"see `roughfe study status {out}`")
+        result = summarise(rows)
+        # the figures are this summary's: an earlier run's never stand beside it
+        shutil.rmtree(out / "figures", ignore_errors=True)
+        paths = [] if args.no_figures else figs.study_figures(result, out / "figures")
+        write_json(out / "summary.json", result)                # last: the study is complete
     perc = result["percolation"]
     print(f"{len(rows)} step records from {spec.n_tasks - missing} surfaces; "
           f"network and Reynolds percolation disagree in {perc['n_disagree']}/{perc['n_compared']}")

@@ -158,7 +158,7 @@ def _check_tasks(analysis: str, tasks) -> None:
 
 
 def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=True,
-              log=None) -> StudySummary:
+              log=None, derived=()) -> StudySummary:
     """Run every missing task of ``spec`` and store the results in ``spec.output``.
 
     Parameters
@@ -173,6 +173,11 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
         Show a tqdm bar (done/failed counts, ETA) on stderr.
     log : callable, optional
         Receives one-line messages (e.g. ``print``).
+    derived : sequence of str
+        Names of files or folders in ``spec.output`` that the caller writes from the
+        results after the run (``leak-study``: ``summary.json``, ``figures``): removed
+        when the run starts, as the tables of ``collect`` are, and recorded in
+        ``study.json`` so that every later run removes them too.
 
     Returns
     -------
@@ -187,8 +192,9 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     with store.study_lock(outdir) as created:
         try:
             found = store.recorded_key_format(outdir)
-            store.write_study(outdir, spec, tasks, __version__)
+            store.write_study(outdir, spec, tasks, __version__, derived)
             keys = [t.key for t in tasks]
+            store.write_index(outdir, keys)     # the index of the new task list, at once
             done = store.done_keys(outdir)
             todo = [t for t in tasks if t.key not in done]
             n_cached = len(tasks) - len(todo)

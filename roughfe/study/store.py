@@ -10,8 +10,11 @@
     OUTDIR/.lock               held (flock) by the running driver
 
 The result files are the truth: a task is done if and only if ``results/<key>.json``
-exists (atomic rename, so it is complete). ``index.json`` is a convenience summary that
-may lag by a few seconds after a crash; ``status`` and ``run`` rebuild it from the files.
+exists (atomic rename, so it is complete). ``index.json`` is a convenience summary: a
+run rewrites it when it starts, every few seconds and at its end, and ``status``
+rebuilds it from the files when it is missing or stale (a run killed between two
+writes). The files that describe the whole study (the tables, a wrapper's summary) are
+removed when a run starts (:func:`write_study`) and written again by their command.
 """
 from __future__ import annotations
 
@@ -20,6 +23,7 @@ import csv
 import io
 import json
 import os
+import shutil
 import statistics
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,7 +46,7 @@ def failure_path(outdir, key) -> Path:
 
 
 @contextlib.contextmanager
-def study_lock(outdir):
+def study_lock(outdir, holder="`roughfe study run`"):
     """Hold an exclusive lock on ``OUTDIR/.lock`` (released by the OS if the driver dies).
 
     A folder that holds files but no ``study.json`` is not a study folder: it is refused
@@ -50,7 +54,8 @@ def study_lock(outdir):
 
     Yields True when this call made the folder (``mkdir`` succeeded here, not in another
     process started at the same moment): only such a caller, holding the lock, may remove
-    the folder again (a refused run leaves nothing behind).
+    the folder again (a refused run leaves nothing behind). ``holder`` names the command
+    holding the lock.
     """
     outdir = Path(outdir)
     if outdir.exists() and not outdir.is_dir():
@@ -68,23 +73,57 @@ def study_lock(outdir):
         created = False
     except OSError as exc:
         raise InputError(f"cannot create the study folder {outdir}: {exc.strerror}") from None
-    with folder_lock(outdir, "`roughfe study run`"):
+    with folder_lock(outdir, holder):
         yield created
 
 
 #: files derived from the results by ``collect``: stale once a run changes the results
 TABLE_FILES = ("table.csv", "table.parquet")
+#: what a study folder is made of: never removed as a derived file
+_OWN = frozenset({"", ".", "..", "study.json", "index.json", "results", "failures", ".lock"})
 
 
-def write_study(outdir, spec, tasks, code_version):
-    """Write ``study.json``: the spec and the task list (index, key, params, seed); the
-    tables of an earlier ``collect`` (:data:`TABLE_FILES`) are removed, since they
-    describe an earlier state of the study (``collect`` writes them again)."""
-    for name in TABLE_FILES:
-        (Path(outdir) / name).unlink(missing_ok=True)
+def _raw_study(outdir):
+    """The mapping in ``study.json`` as it is (no checks), or None when unreadable."""
+    try:
+        data = json.loads(study_file(outdir).read_text())
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def _derived_names(names) -> list:
+    """Plain names of files or folders inside the study folder (nothing else is ever
+    removed as derived: no path, none of the study's own files)."""
+    if not isinstance(names, (list, tuple)):
+        return []
+    return sorted({n for n in names
+                   if isinstance(n, str) and Path(n).name == n and n not in _OWN})
+
+
+def write_study(outdir, spec, tasks, code_version, derived=()):
+    """Start a run: remove what describes the whole study and write ``study.json``.
+
+    Removed: the tables of an earlier ``collect`` (:data:`TABLE_FILES`) and the files or
+    folders ``derived`` that a command wrapping the runner writes from the results
+    (``leak-study``: ``summary.json``, ``figures``), both those given now and those
+    recorded by earlier runs. They describe an earlier state of the study: a run killed
+    before it rewrites them must not leave them beside the new task list. The caller
+    rewrites ``index.json`` next (:func:`write_index`). ``study.json`` records the spec,
+    the task list (index, key, params, seed), the key format and ``derived``.
+    """
+    outdir = Path(outdir)
+    recorded = (_raw_study(outdir) or {}).get("derived")
+    derived = _derived_names([*(recorded if isinstance(recorded, list) else []), *derived])
+    for name in (*TABLE_FILES, *derived):
+        path = outdir / name
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path)
+        else:
+            path.unlink(missing_ok=True)
     write_json(study_file(outdir), {
         "spec": spec.to_dict(), "code_version": code_version, "key_format": KEY_FORMAT,
-        "n_tasks": len(tasks),
+        "derived": derived, "n_tasks": len(tasks),
         "tasks": [{"index": t.index, "key": t.key, "params": dict(t.params), "seed": t.seed}
                   for t in tasks]})
 
@@ -92,11 +131,8 @@ def write_study(outdir, spec, tasks, code_version):
 def recorded_key_format(outdir):
     """The task-key format of the ``study.json`` in ``outdir`` (1 when none is recorded:
     written before roughfe recorded it), or None without a readable ``study.json``."""
-    try:
-        data = json.loads(study_file(outdir).read_text())
-    except (OSError, ValueError):
-        return None
-    return data.get("key_format", 1) if isinstance(data, dict) else None
+    data = _raw_study(outdir)
+    return None if data is None else data.get("key_format", 1)
 
 
 def old_keys_note(outdir, found, n_rerun=None) -> str:
@@ -169,15 +205,32 @@ def clear_failure(outdir, key):
         os.unlink(failure_path(outdir, key))
 
 
+def _index(keys_in_order, done, failed) -> dict:
+    """The content of ``index.json``."""
+    failed = failed - done
+    return {"n_tasks": len(keys_in_order),
+            "n_done": sum(k in done for k in keys_in_order),
+            "n_failed": sum(k in failed for k in keys_in_order),
+            "done": [k for k in keys_in_order if k in done],
+            "failed": [k for k in keys_in_order if k in failed]}
+
+
 def write_index(outdir, keys_in_order):
     """Rewrite ``index.json`` from the result and failure files."""
-    done, failed = done_keys(outdir), failed_keys(outdir) - done_keys(outdir)
-    write_json(Path(outdir) / "index.json", {
-        "n_tasks": len(keys_in_order),
-        "n_done": sum(k in done for k in keys_in_order),
-        "n_failed": sum(k in failed for k in keys_in_order),
-        "done": [k for k in keys_in_order if k in done],
-        "failed": [k for k in keys_in_order if k in failed]})
+    write_json(Path(outdir) / "index.json",
+               _index(keys_in_order, done_keys(outdir), failed_keys(outdir)))
+
+
+def _refresh_index(outdir, index: dict) -> None:
+    """Rewrite a missing or stale ``index.json`` (``status``), unless a run holds the
+    folder (it rewrites the index itself) or the folder is read-only."""
+    path = Path(outdir) / "index.json"
+    with contextlib.suppress(OSError, ValueError):
+        if json.loads(path.read_text()) == index:
+            return
+    with contextlib.suppress(InputError, OSError):
+        with folder_lock(outdir, "`roughfe study status`"):
+            write_json(path, index)
 
 
 @dataclass(frozen=True)
@@ -261,6 +314,7 @@ def study_status(outdir) -> StudyStatus:
             except (FileNotFoundError, json.JSONDecodeError, KeyError, IndexError):
                 error = "?"
             failures.append((t["index"], t["params"], error))
+    _refresh_index(outdir, _index([t["key"] for t in data["tasks"]], done, failed))
     spec = data["spec"]["study"]
     return StudyStatus(name=spec["name"], analysis=spec["analysis"], n_tasks=len(data["tasks"]),
                        n_done=n_done, n_failed=n_failed,
