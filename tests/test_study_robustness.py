@@ -191,7 +191,7 @@ class _Killed(BaseException):
     """Stands for kill -9 in the middle of a run (no clean-up code runs after it)."""
 
 
-def _killed_executor(*args, **kwargs):
+def _killed_while_running(*args, **kwargs):
     raise _Killed
 
 
@@ -204,7 +204,7 @@ def test_a_killed_run_leaves_no_whole_study_file_of_an_earlier_state(tmp_path, m
     spec = _spec(tmp_path / "k")
     run_study(spec, workers=1, progress=False)
     collect(spec.output, parquet=False)
-    monkeypatch.setattr(runner, "make_executor", _killed_executor)
+    monkeypatch.setattr(runner, "_drive", _killed_while_running)
     with pytest.raises(_Killed):
         run_study(_spec(spec.output, grid={"x": [0.5, 1.5, 2.5, 3.5]}), progress=False)
     index = json.loads((spec.output / "index.json").read_text())
@@ -238,7 +238,7 @@ def test_a_killed_leak_study_leaves_no_summary_of_an_earlier_run(tmp_path, monke
     assert cli_main([*args, "--D", "2.3"]) == 0
     assert (out / "summary.json").is_file()
     (out / "figures").mkdir()          # as the figures of the earlier run
-    monkeypatch.setattr(runner, "make_executor", _killed_executor)
+    monkeypatch.setattr(runner, "_drive", _killed_while_running)
     with pytest.raises(_Killed):
         cli_main([*args, "--D", "2.3", "2.7"])
     assert not (out / "summary.json").exists() and not (out / "figures").exists()
@@ -247,9 +247,25 @@ def test_a_killed_leak_study_leaves_no_summary_of_an_earlier_run(tmp_path, monke
     monkeypatch.undo()
     assert cli_main([*args, "--D", "2.3"]) == 0 and (out / "summary.json").is_file()
     spec = spec_from_mapping(json.loads((out / "study.json").read_text())["spec"])
-    monkeypatch.setattr(runner, "make_executor", _killed_executor)
+    monkeypatch.setattr(runner, "_drive", _killed_while_running)
     with pytest.raises(_Killed):
         run_study(spec_from_mapping({**spec.to_dict(), "grid": {**spec.to_dict()["grid"],
                                                                 "D": [2.3, 2.9]}}),
                   progress=False)
     assert not (out / "summary.json").exists()
+
+
+def test_a_run_refused_at_executor_start_leaves_the_folder_as_it_was(tmp_path):
+    """The executor starts before anything is written: a typo of the executor (or a
+    scheduler that cannot be reached) did remove the collected table and rewrite
+    study.json with a task list that was never run."""
+    from roughfe.study import collect
+
+    spec = _spec(tmp_path / "f")
+    run_study(spec, workers=1, progress=False)
+    collect(spec.output, parquet=False)
+    before = {p.name: p.read_bytes() for p in spec.output.iterdir() if p.is_file()}
+    with pytest.raises(InputError, match="executor must be one of"):
+        run_study(_spec(spec.output, grid={"x": [0.5, 1.5, 2.5]}), executor="slurm",
+                  progress=False)
+    assert {p.name: p.read_bytes() for p in spec.output.iterdir() if p.is_file()} == before

@@ -8,6 +8,8 @@ where it stopped and ends with the same table as an uninterrupted run.
 from __future__ import annotations
 
 import collections
+import contextlib
+import dataclasses
 import os
 import shutil
 import socket
@@ -191,27 +193,8 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     outdir = spec.output
     with store.study_lock(outdir) as created:
         try:
-            found = store.recorded_key_format(outdir)
-            store.write_study(outdir, spec, tasks, __version__, derived)
-            keys = [t.key for t in tasks]
-            store.write_index(outdir, keys)     # the index of the new task list, at once
-            done = store.done_keys(outdir)
-            todo = [t for t in tasks if t.key not in done]
-            n_cached = len(tasks) - len(todo)
-            note = store.old_keys_note(outdir, found, len(todo))
-            if note:
-                warnings.warn(note, stacklevel=2)
-            counts = collections.Counter()
-            description = "nothing to run"
-            if todo:
-                log(f"study {spec.name!r}: {len(tasks)} tasks, {n_cached} already done, "
-                    f"{len(todo)} to run")
-                with make_executor(executor, workers=workers, scheduler=scheduler) as ex:
-                    description = ex.describe()
-                    log(description)
-                    _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
-                           n_cached=n_cached, commit=code_commit())
-            store.write_index(outdir, keys)
+            summary = _run_locked(spec, tasks, derived, log, progress,
+                                  (executor, workers, scheduler))
         except InputError:
             # a run refused before any task finished (e.g. an executor that cannot start)
             # leaves no study folder behind: the command wrote nothing. Only a folder that
@@ -220,12 +203,46 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
             if created and not store.done_keys(outdir):
                 shutil.rmtree(outdir, ignore_errors=True)
             raise
-    summary = StudySummary(n_tasks=len(tasks), n_cached=n_cached, n_done=counts["done"],
-                           n_failed=counts["failed"], n_retries=counts["retries"],
-                           wall_s=time.perf_counter() - t_start, task_s=counts["task_s"],
-                           task_cpu_s=counts["task_cpu_s"], executor=description)
+    summary = dataclasses.replace(summary, wall_s=time.perf_counter() - t_start)
     log(summary.describe())
     return summary
+
+
+def _run_locked(spec, tasks, derived, log, progress, how) -> StudySummary:
+    """The body of :func:`run_study`, under the study's lock (``how``: executor kind,
+    workers, scheduler). The executor is started before anything is written, so a run
+    refused there (an executor that cannot start) leaves an existing folder as it was."""
+    outdir = spec.output
+    found = store.recorded_key_format(outdir)
+    keys = [t.key for t in tasks]
+    done = store.done_keys(outdir)
+    todo = [t for t in tasks if t.key not in done]
+    n_cached = len(tasks) - len(todo)
+    counts = collections.Counter()
+    description = "nothing to run"
+    if todo:
+        log(f"study {spec.name!r}: {len(tasks)} tasks, {n_cached} already done, "
+            f"{len(todo)} to run")
+    with contextlib.ExitStack() as stack:
+        ex = None
+        if todo:
+            kind, workers, scheduler = how
+            ex = stack.enter_context(make_executor(kind, workers=workers, scheduler=scheduler))
+            description = ex.describe()
+        store.write_study(outdir, spec, tasks, __version__, derived)
+        store.write_index(outdir, keys)          # the index of the new task list, at once
+        note = store.old_keys_note(outdir, found, len(todo))
+        if note:
+            warnings.warn(note, stacklevel=3)
+        if ex is not None:
+            log(description)
+            _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
+                   n_cached=n_cached, commit=code_commit())
+    store.write_index(outdir, keys)
+    return StudySummary(n_tasks=len(tasks), n_cached=n_cached, n_done=counts["done"],
+                        n_failed=counts["failed"], n_retries=counts["retries"], wall_s=0.0,
+                        task_s=counts["task_s"], task_cpu_s=counts["task_cpu_s"],
+                        executor=description)
 
 
 def _drive(spec, ex, todo, keys, counts, progress, *, n_total, n_cached, commit=None):
