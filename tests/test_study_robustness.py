@@ -269,3 +269,65 @@ def test_a_run_refused_at_executor_start_leaves_the_folder_as_it_was(tmp_path):
         run_study(_spec(spec.output, grid={"x": [0.5, 1.5, 2.5]}), executor="slurm",
                   progress=False)
     assert {p.name: p.read_bytes() for p in spec.output.iterdir() if p.is_file()} == before
+
+
+@pytest.mark.parametrize("study, words", [
+    ({"analysis": "selftest", "output": 5}, "output must be a folder name (a string), got int 5"),
+    ({"analysis": "selftest", "output": ""}, "output must name a folder, got ''"),
+    ({"analysis": ["selftest"], "output": "o", "name": "n"},
+     "analysis must be the name of an analysis (a string), got list ['selftest']"),
+    ({"analysis": {"a": 1}, "output": "o", "name": "n"}, "got dict {'a': 1}"),
+    ({"analysis": 5, "output": "o"}, "analysis must be the name of an analysis (a string), "
+                                     "got int 5"),
+])
+def test_bad_spec_values_are_input_errors_naming_them(study, words, tmp_path):
+    """They were raw TypeErrors (Path(5), an unhashable list), an error about [study] name
+    for analysis = 5, or "" silently became the working directory."""
+    with pytest.raises(InputError) as info:
+        spec_from_mapping({"study": study, "grid": {"x": [1.0]}})
+    assert words in str(info.value)
+
+
+def test_a_spec_file_that_is_not_utf8_is_an_input_error(tmp_path, capsys):
+    from roughfe.cli import main as cli_main
+    from roughfe.study import load_spec
+
+    path = tmp_path / "latin1.toml"
+    path.write_bytes('[study]\nname = "caf\u00e9"\nanalysis = "selftest"\noutput = "o"\n'
+                     .encode("latin-1"))
+    with pytest.raises(InputError, match=r"is not UTF-8 text .* byte 0xe9 at offset 19"):
+        load_spec(path)
+    assert cli_main(["study", "run", str(path)]) == 2
+    assert "Traceback" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda d: d.pop("tasks"), "'tasks' (the task list) must be a list"),
+    (lambda d: d.update(tasks={"a": 1}), "'tasks' (the task list) must be a list"),
+    (lambda d: d["tasks"][1].pop("key"), "tasks[1] needs 'key' (str), got None"),
+    (lambda d: d["tasks"][0].update(key="../../etc/passwd"), "a key is 64 hex digits"),
+    (lambda d: d["tasks"][0].update(params=[1]), "tasks[0] needs 'params' (dict)"),
+    (lambda d: d.update(spec=None), "'spec' (the study spec) must be an object"),
+    (lambda d: d["spec"].update(study={"analysis": "nope", "output": "o"}),
+     "holds a spec that is not valid: [study] analysis 'nope' is unknown"),
+    (lambda d: d.update(key_format="2"), "'key_format' must be an integer"),
+])
+def test_a_hand_broken_study_json_is_a_file_format_error(edit, words, tmp_path, capsys):
+    """status and collect said KeyError 'tasks' or TypeError with a traceback."""
+    from roughfe.cli import main as cli_main
+    from roughfe.errors import FileFormatError
+    from roughfe.study import study_status
+
+    spec = _spec(tmp_path / "b")
+    run_study(spec, workers=1, progress=False)
+    path = spec.output / "study.json"
+    data = json.loads(path.read_text())
+    edit(data)
+    path.write_text(json.dumps(data))
+    with pytest.raises(FileFormatError) as info:
+        study_status(spec.output)
+    assert str(path) in str(info.value) and words in str(info.value)
+    for action in ("status", "collect"):
+        assert cli_main(["study", action, str(spec.output)]) == 2
+        err = capsys.readouterr().err
+        assert "error:" in err and "Traceback" not in err

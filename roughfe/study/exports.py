@@ -30,7 +30,7 @@ def genome_db_to_sqlite(outdir, db_path) -> int:
     from ..genomics import database as gdb
 
     data = store.read_study(outdir)
-    analysis = data["spec"]["study"]["analysis"]
+    analysis = data["spec_obj"].analysis
     if analysis not in GENOME_ANALYSES:
         raise InputError(f"{outdir} holds a {analysis!r} study; only {GENOME_ANALYSES} "
                          "studies can fill a genome database")

@@ -40,6 +40,7 @@ import inspect
 import itertools
 import json
 import math
+import os
 import tomllib
 import warnings
 from dataclasses import dataclass, field
@@ -159,13 +160,21 @@ class StudySpec:
     def __post_init__(self):
         from .analyses import ANALYSES  # the registry of names (no analysis is imported)
 
-        if not isinstance(self.name, str) or not self.name:
-            raise InputError(f"[study] name must be a non-empty string, got {self.name!r}")
+        if not isinstance(self.analysis, str):
+            raise InputError(f"[study] analysis must be the name of an analysis (a string), "
+                             f"got {type(self.analysis).__name__} {self.analysis!r}; "
+                             f"choose from {sorted(ANALYSES)}")
         if self.analysis not in ANALYSES:
             raise InputError(f"[study] analysis {self.analysis!r} is unknown; "
                              f"choose from {sorted(ANALYSES)}")
-        if not str(self.output):
-            raise InputError("[study] output must name a folder, got an empty string")
+        if not isinstance(self.name, str) or not self.name:
+            raise InputError(f"[study] name must be a non-empty string, got {self.name!r}")
+        if not isinstance(self.output, (str, os.PathLike)):
+            raise InputError(f"[study] output must be a folder name (a string), got "
+                             f"{type(self.output).__name__} {self.output!r}")
+        if not str(self.output).strip():
+            raise InputError(f"[study] output must name a folder, got {str(self.output)!r} "
+                             "(the results would be written into the working directory)")
         object.__setattr__(self, "output", Path(self.output))
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise InputError(f"[study] seed must be an integer >= 0, got {self.seed!r}")
@@ -256,7 +265,7 @@ def _current_names(analysis: str, section: str, table: Mapping) -> dict:
         return table
     from .analyses import ANALYSES, resolve
 
-    if analysis not in ANALYSES:
+    if not isinstance(analysis, str) or analysis not in ANALYSES:
         return table  # StudySpec reports the unknown analysis
     accepted = inspect.signature(resolve(analysis)).parameters
     for key in old:
@@ -303,7 +312,7 @@ def spec_from_mapping(data: Mapping[str, Any], *, output=None) -> StudySpec:
     return StudySpec(
         name=study.get("name", study["analysis"]),
         analysis=study["analysis"],
-        output=Path(output if output is not None else study["output"]),
+        output=output if output is not None else study["output"],   # checked there
         grid=grid,
         fixed=fixed,
         seed=study.get("seed", 0),
@@ -316,9 +325,15 @@ def load_spec(path, *, output=None) -> StudySpec:
     """Read and validate a study spec from a TOML file."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise InputError(f"study spec {path} does not exist") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"study spec {path} is not UTF-8 text (TOML files are UTF-8): byte "
+                         f"0x{exc.object[exc.start]:02x} at offset {exc.start}; save it as "
+                         "UTF-8") from None
+    except OSError as exc:
+        raise InputError(f"cannot read study spec {path}: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"study spec {path} is not valid TOML: {exc}") from None
     return spec_from_mapping(data, output=output)

@@ -132,7 +132,8 @@ def recorded_key_format(outdir):
     """The task-key format of the ``study.json`` in ``outdir`` (1 when none is recorded:
     written before roughfe recorded it), or None without a readable ``study.json``."""
     data = _raw_study(outdir)
-    return None if data is None else data.get("key_format", 1)
+    found = None if data is None else data.get("key_format", 1)
+    return found if isinstance(found, int) else None
 
 
 def old_keys_note(outdir, found, n_rerun=None) -> str:
@@ -150,17 +151,50 @@ def old_keys_note(outdir, found, n_rerun=None) -> str:
 
 
 def read_study(outdir) -> dict:
-    """Read ``study.json`` of a study folder."""
+    """Read ``study.json`` of a study folder, checked: FileFormatError naming the file
+    and what is wrong in it when it is not what ``roughfe study run`` writes."""
     path = study_file(outdir)
     if not path.is_file():
         raise InputError(f"{outdir} is not a study folder: {path} is missing "
                          "(run `roughfe study run SPEC.toml` first)")
     try:
-        data = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise FileFormatError(f"{path} is not valid JSON: {exc}") from None
-    data["spec_obj"] = spec_from_mapping(data["spec"])
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (ValueError, OSError) as exc:     # JSON and UTF-8 errors are ValueErrors
+        raise FileFormatError(f"{path} cannot be read as JSON: {exc}") from None
+    _check_study_data(path, data)
+    try:
+        data["spec_obj"] = spec_from_mapping(data["spec"])
+    except InputError as exc:
+        raise FileFormatError(f"{path} holds a spec that is not valid: {exc}") from None
     return data
+
+
+#: the fields of a task in ``study.json`` and their JSON types
+_TASK_FIELDS = {"index": int, "key": str, "params": dict, "seed": int}
+
+
+def _check_study_data(path, data) -> None:
+    """Raise FileFormatError unless ``data`` has the layout of :func:`write_study`."""
+    def refuse(what):
+        raise FileFormatError(f"{path} is not a study file as roughfe writes it: {what}; "
+                              "rerun `roughfe study run SPEC.toml` to write it again")
+    if not isinstance(data, dict):
+        refuse(f"a JSON object is expected, it holds a {type(data).__name__}")
+    if not isinstance(data.get("spec"), dict):
+        refuse(f"'spec' (the study spec) must be an object, got {data.get('spec')!r:.80}")
+    if not isinstance(data.get("key_format", 1), int):
+        refuse(f"'key_format' must be an integer, got {data['key_format']!r:.80}")
+    if not isinstance(data.get("tasks"), list):
+        refuse(f"'tasks' (the task list) must be a list, got {data.get('tasks')!r:.80}")
+    for i, task in enumerate(data["tasks"]):
+        if not isinstance(task, dict):
+            refuse(f"tasks[{i}] must be an object, got {task!r:.80}")
+        for name, kind in _TASK_FIELDS.items():
+            value = task.get(name)
+            if not isinstance(value, kind) or isinstance(value, bool):
+                refuse(f"tasks[{i}] needs {name!r} ({kind.__name__}), got {value!r:.80}")
+        if not (len(task["key"]) == 64 and all(c in "0123456789abcdef" for c in task["key"])):
+            refuse(f"tasks[{i}] has the key {task['key']!r:.80}; a key is 64 hex digits")
 
 
 def read_result(outdir, key):
@@ -315,8 +349,8 @@ def study_status(outdir) -> StudyStatus:
                 error = "?"
             failures.append((t["index"], t["params"], error))
     _refresh_index(outdir, _index([t["key"] for t in data["tasks"]], done, failed))
-    spec = data["spec"]["study"]
-    return StudyStatus(name=spec["name"], analysis=spec["analysis"], n_tasks=len(data["tasks"]),
+    spec = data["spec_obj"]
+    return StudyStatus(name=spec.name, analysis=spec.analysis, n_tasks=len(data["tasks"]),
                        n_done=n_done, n_failed=n_failed,
                        n_missing=len(data["tasks"]) - n_done - n_failed,
                        failures=tuple(failures), cost_s=tuple(costs), cpu_s=tuple(cpus),
