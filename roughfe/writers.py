@@ -1,8 +1,9 @@
 """Every file roughfe writes goes through here: atomic, umask-honouring, JSON-safe.
 
-* :func:`atomic_path` -- write to a temporary file beside the target, then rename it
-  (``os.replace`` is atomic on POSIX within one file system): an interrupted run never
-  leaves a half-written file. The file gets the mode a plain ``open()`` would give
+* :func:`atomic_path` -- write to a temporary file beside the target, ``fsync`` it, then
+  rename it (``os.replace`` is atomic on POSIX within one file system) and ``fsync`` the
+  folder: an interrupted run, or a power loss, never leaves a half-written or empty file
+  under the target's name. The file gets the mode a plain ``open()`` would give
   (``0o666 & ~umask``: 0644 under umask 022), not ``mkstemp``'s private 0600.
 * :func:`to_jsonable` -- the ONE JSON rule of the package: numpy scalars and arrays
   become numbers and lists, paths strings, and non-finite floats (NaN, +-inf) ``null``.
@@ -53,7 +54,9 @@ def atomic_path(path, suffix=None):
 
     Use it for writers that want a file name (``np.savez``, ``h5py.File``, matplotlib
     ``savefig``, pyvista ``screenshot``). On an exception the temporary file is removed
-    and ``path`` is left untouched. The final file has mode ``0o666 & ~umask``.
+    and ``path`` is left untouched. The final file has mode ``0o666 & ~umask``; it is
+    ``fsync``-ed before the rename and its folder after it, so that after a power loss
+    ``path`` holds the old content or the new, never an empty or partial file.
 
     Parameters
     ----------
@@ -78,12 +81,33 @@ def atomic_path(path, suffix=None):
     os.close(fd)
     try:
         yield Path(tmp)
+        _fsync(tmp)            # the data on disk before the name: never an empty renamed file
         os.chmod(tmp, 0o666 & ~current_umask())
         os.replace(tmp, path)
+        _fsync(path.parent, os.O_DIRECTORY)     # and the rename itself
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+def _fsync(path, flags=0):
+    """``fsync`` the file or folder ``path``: its content (or, for a folder, its entries)
+    reaches the disk before we go on. A folder whose file system refuses it is left as is
+    (the file's own fsync, which must work, is what matters most)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | flags)
+    except OSError:
+        if flags:
+            return
+        raise
+    try:
+        os.fsync(fd)
+    except OSError:
+        if not flags:
+            raise
+    finally:
+        os.close(fd)
 
 
 # -- the one JSON rule -----------------------------------------------------------------

@@ -331,3 +331,44 @@ def test_a_hand_broken_study_json_is_a_file_format_error(edit, words, tmp_path, 
         assert cli_main(["study", action, str(spec.output)]) == 2
         err = capsys.readouterr().err
         assert "error:" in err and "Traceback" not in err
+
+
+def test_an_unreadable_result_is_not_done_and_runs_again(tmp_path):
+    """An empty results/<key>.json (as a power loss could leave) counted as done
+    forever: run said nothing to run, status n/n done exit 0, collect 1 missing."""
+    from roughfe.cli import main as cli_main
+    from roughfe.study import study_status
+
+    spec = _spec(tmp_path / "u")
+    run_study(spec, workers=1, progress=False)
+    key = spec.tasks()[1].key
+    (spec.output / "results" / f"{key}.json").write_text("")
+    status = study_status(spec.output)
+    assert (status.n_done, status.n_missing, status.unreadable) == (1, 1, (1,))
+    assert "1 result file(s) cannot be read (tasks 1)" in status.describe()
+    assert cli_main(["study", "status", str(spec.output)]) == 1
+    with pytest.warns(UserWarning, match=rf"could not be read .*{key}\.json.* run again"):
+        again = run_study(spec, workers=1, progress=False)
+    assert (again.n_cached, again.n_done) == (1, 1)
+    assert (spec.output / "results" / f"{key}.json.unreadable").read_text() == ""
+    assert study_status(spec.output).n_done == 2
+
+
+def test_atomic_files_are_fsynced_before_the_rename(tmp_path, monkeypatch):
+    """Without an fsync a power loss after the rename can leave an empty file under the
+    target's name (a result that then looked done)."""
+    import os
+
+    from roughfe import writers
+
+    events = []
+    real_fsync, real_replace = os.fsync, os.replace
+    monkeypatch.setattr(writers.os, "fsync", lambda fd: (events.append(
+        ("fsync", os.readlink(f"/proc/self/fd/{fd}"))), real_fsync(fd))[1])
+    monkeypatch.setattr(writers.os, "replace", lambda a, b: (events.append(
+        ("replace", str(b))), real_replace(a, b))[1])
+    writers.write_json(tmp_path / "r.json", {"a": 1})
+    kinds = [kind for kind, _ in events]
+    assert kinds == ["fsync", "replace", "fsync"], events
+    assert events[0][1].startswith(str(tmp_path / ".roughfe-")) and \
+        events[2][1] == str(tmp_path)

@@ -216,6 +216,8 @@ def _run_locked(spec, tasks, derived, log, progress, how) -> StudySummary:
     found = store.recorded_key_format(outdir)
     keys = [t.key for t in tasks]
     done = store.done_keys(outdir)
+    unreadable = [k for k in keys if k in done and store.read_result(outdir, k) is None]
+    done -= set(unreadable)                        # an unreadable result is not done
     todo = [t for t in tasks if t.key not in done]
     n_cached = len(tasks) - len(todo)
     counts = collections.Counter()
@@ -229,6 +231,8 @@ def _run_locked(spec, tasks, derived, log, progress, how) -> StudySummary:
             kind, workers, scheduler = how
             ex = stack.enter_context(make_executor(kind, workers=workers, scheduler=scheduler))
             description = ex.describe()
+        if unreadable:
+            warnings.warn(store.set_aside(outdir, unreadable), stacklevel=3)
         store.write_study(outdir, spec, tasks, __version__, derived)
         store.write_index(outdir, keys)          # the index of the new task list, at once
         note = store.old_keys_note(outdir, found, len(todo))

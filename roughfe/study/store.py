@@ -198,11 +198,31 @@ def _check_study_data(path, data) -> None:
 
 
 def read_result(outdir, key):
-    """The stored result of task ``key``, or None if it is not (completely) there."""
+    """The stored result of task ``key``, or None if it is not there or cannot be read
+    (empty, cut short, or not what the runner writes: a JSON object of that key with a
+    list of records)."""
     try:
-        return json.loads(result_path(outdir, key).read_text())
-    except (FileNotFoundError, json.JSONDecodeError):
+        data = json.loads(result_path(outdir, key).read_text(encoding="utf-8"))
+    except (OSError, ValueError):          # missing, unreadable; JSON or UTF-8 errors
         return None
+    if not isinstance(data, dict) or data.get("key", key) != key \
+            or not isinstance(data.get("records"), list) \
+            or not all(isinstance(r, dict) for r in data["records"]):
+        return None
+    return data
+
+
+def set_aside(outdir, keys) -> str:
+    """Rename the unreadable result files of ``keys`` to ``<key>.json.unreadable`` (kept
+    for a look; no longer a result); return a message saying so, or ""."""
+    for key in keys:
+        path = result_path(outdir, key)
+        os.replace(path, path.with_name(path.name + ".unreadable"))
+    if not keys:
+        return ""
+    return (f"{len(keys)} result file(s) in {Path(outdir) / 'results'} could not be read "
+            f"(empty, cut short or not a result, e.g. {keys[0]}.json): renamed to "
+            "*.json.unreadable; their tasks run again")
 
 
 def done_keys(outdir) -> set:
@@ -287,6 +307,9 @@ class StudyStatus:
         The distinct code commits (provenance) of the finished results.
     note : str
         Said about the folder as a whole (results under an older task-key format).
+    unreadable : tuple of int
+        Indices of the tasks whose result file cannot be read (counted missing: the
+        next run runs them again).
     """
 
     name: str
@@ -300,6 +323,7 @@ class StudyStatus:
     cpu_s: tuple = ()
     commits: tuple = ()
     note: str = ""
+    unreadable: tuple = ()
 
     def describe(self) -> str:
         """Human-readable multi-line summary."""
@@ -319,6 +343,11 @@ class StudyStatus:
                          "analysis version or use a new output folder after a physics change")
         for index, params, error in self.failures:
             lines.append(f"  failed task {index} {canonical_json(params)}: {error}")
+        if self.unreadable:
+            lines.append(f"{len(self.unreadable)} result file(s) cannot be read (tasks "
+                         f"{', '.join(map(str, self.unreadable[:10]))}"
+                         f"{', ...' if len(self.unreadable) > 10 else ''}): counted missing; "
+                         "`roughfe study run` runs them again")
         if self.note:
             lines.append(f"note: {self.note}")
         return "\n".join(lines)
@@ -327,14 +356,19 @@ class StudyStatus:
 def study_status(outdir) -> StudyStatus:
     """Status of the study in ``outdir`` from its files."""
     data = read_study(outdir)
-    done, failed = done_keys(outdir), failed_keys(outdir)
+    files, failed = done_keys(outdir), failed_keys(outdir)
+    results = {t["key"]: read_result(outdir, t["key"]) for t in data["tasks"]
+               if t["key"] in files}
+    unreadable = tuple(t["index"] for t in data["tasks"] if t["key"] in results
+                       and results[t["key"]] is None)
+    done = {key for key, result in results.items() if result is not None}
     failures, costs, cpus, commits = [], [], [], set()
     n_done = n_failed = 0
     for t in data["tasks"]:
         if t["key"] in done:
             n_done += 1
-            result = read_result(outdir, t["key"])
-            if result is not None and "elapsed_s" in result:
+            result = results[t["key"]]
+            if "elapsed_s" in result:
                 costs.append(float(result["elapsed_s"]))
                 if "cpu_s" in result:
                     cpus.append(float(result["cpu_s"]))
@@ -354,7 +388,7 @@ def study_status(outdir) -> StudyStatus:
                        n_done=n_done, n_failed=n_failed,
                        n_missing=len(data["tasks"]) - n_done - n_failed,
                        failures=tuple(failures), cost_s=tuple(costs), cpu_s=tuple(cpus),
-                       commits=tuple(sorted(commits)),
+                       commits=tuple(sorted(commits)), unreadable=unreadable,
                        note=old_keys_note(outdir, data.get("key_format", 1)))
 
 
