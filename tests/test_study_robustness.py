@@ -167,7 +167,7 @@ def test_a_column_of_numbers_and_lists_is_text_in_parquet(tmp_path):
     """A record field that is a list in one task and a number in another: the Parquet
     column is JSON text, as in the CSV (pyarrow raised ArrowTypeError)."""
     from roughfe.study import collect
-    from roughfe.study.store import _parquet_column
+    from roughfe.study.tables import _parquet_column
 
     assert _parquet_column([[1, 2], 3, None, "a"]) == ["[1,2]", "3", None, "a"]
     assert _parquet_column([1, 2.5, None]) == [1, 2.5, None]

@@ -22,7 +22,8 @@ from .exports import genome_db_to_sqlite
 from .genome_db import GenomeDbRun, build_genome_db, extend_genome_db
 from .runner import StudySummary, execute_task, run_study
 from .spec import StudySpec, Task, derive_seed, load_spec, spec_from_mapping
-from .store import StudyStatus, collect, study_status, table_rows
+from .store import StudyStatus, study_status
+from .tables import collect, table_rows
 
 __all__ = [
     "ANALYSES", "Analysis", "EXECUTORS", "GenomeDbRun", "StudySpec", "StudyStatus",
