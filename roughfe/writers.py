@@ -191,18 +191,26 @@ def folder_lock(folder, holder: str):
     """Hold an exclusive ``flock`` on ``folder/.lock`` or raise :class:`InputError`.
 
     The OS releases the lock when the process dies, so a killed run never blocks the
-    next one. ``holder`` names the command in the error message.
+    next one. ``holder`` names the command: the holder writes it and its pid into the
+    lock file, and a refused command names the one that holds the lock (``holder``
+    itself when the file does not say).
     """
     import fcntl
 
     folder = Path(folder)
     lock = folder / LOCK_FILE
-    with open(lock, "w") as fh:
+    with open(lock, "a+") as fh:       # not "w": the holder's record stays while refused
         try:
             fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            raise InputError(f"another {holder} is writing to {folder} (it holds {lock}); "
-                             "wait for it or choose another output folder") from None
+            fh.seek(0)
+            held_by = fh.read(300).strip()
+            raise InputError(f"another {held_by or holder} is writing to {folder} (it holds "
+                             f"{lock}); wait for it or choose another output folder") from None
+        fh.seek(0)
+        fh.truncate()
+        fh.write(f"{holder} (pid {os.getpid()})\n")
+        fh.flush()
         try:
             yield
         finally:

@@ -264,11 +264,15 @@ def test_a_run_refused_at_executor_start_leaves_the_folder_as_it_was(tmp_path):
     spec = _spec(tmp_path / "f")
     run_study(spec, workers=1, progress=False)
     collect(spec.output, parquet=False)
-    before = {p.name: p.read_bytes() for p in spec.output.iterdir() if p.is_file()}
+    def files():     # the lock file aside: it names whoever holds (held) the lock
+        return {p.name: p.read_bytes() for p in spec.output.iterdir()
+                if p.is_file() and p.name != ".lock"}
+
+    before = files()
     with pytest.raises(InputError, match="executor must be one of"):
         run_study(_spec(spec.output, grid={"x": [0.5, 1.5, 2.5]}), executor="slurm",
                   progress=False)
-    assert {p.name: p.read_bytes() for p in spec.output.iterdir() if p.is_file()} == before
+    assert files() == before
 
 
 @pytest.mark.parametrize("study, words", [
@@ -372,3 +376,24 @@ def test_atomic_files_are_fsynced_before_the_rename(tmp_path, monkeypatch):
     assert kinds == ["fsync", "replace", "fsync"], events
     assert events[0][1].startswith(str(tmp_path / ".roughfe-")) and \
         events[2][1] == str(tmp_path)
+
+
+def test_the_commit_warning_keeps_dirty_and_a_refusal_names_the_holder(tmp_path):
+    """The warning printed '(1819729b9141, 1819729b9141)' for a commit and its +dirty
+    state; a collect holding the lock was called 'another `roughfe study run`'."""
+    from roughfe.study import study_status
+    from roughfe.writers import folder_lock
+
+    spec = _spec(tmp_path / "c")
+    run_study(spec, workers=1, progress=False)
+    for path, commit in zip(sorted((spec.output / "results").glob("*.json")),
+                            ["1819729b9141" + "0" * 28, "1819729b9141" + "0" * 28 + "+dirty"]):
+        record = json.loads(path.read_text())
+        record["code_commit"] = commit
+        path.write_text(json.dumps(record))
+    assert "2 different code commits (1819729b9141, 1819729b9141+dirty)" in \
+        study_status(spec.output).describe()
+    with folder_lock(spec.output, "`roughfe study collect`"):
+        with pytest.raises(InputError, match=r"another `roughfe study collect` \(pid \d+\) is "
+                                             "writing to"):
+            run_study(spec, progress=False)

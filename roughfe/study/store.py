@@ -338,7 +338,7 @@ class StudyStatus:
                          f"total {sum(self.cpu_s):.4g} s (the cost on an idle core)")
         if len(self.commits) > 1:
             lines.append(f"warning: the results come from {len(self.commits)} different code "
-                         f"commits ({', '.join(c[:12] for c in self.commits)}); bump the "
+                         f"commits ({', '.join(map(_short_commit, self.commits))}); bump the "
                          "analysis version or use a new output folder after a physics change")
         for index, params, error in self.failures:
             lines.append(f"  failed task {index} {canonical_json(params)}: {error}")
@@ -350,6 +350,13 @@ class StudyStatus:
         if self.note:
             lines.append(f"note: {self.note}")
         return "\n".join(lines)
+
+
+def _short_commit(commit: str) -> str:
+    """A commit as ``git log --oneline`` shows it, with ``+dirty`` kept (``abc+dirty`` and
+    ``abc`` are two states of the code)."""
+    head, plus, rest = commit.partition("+")
+    return head[:12] + plus + rest
 
 
 def study_status(outdir) -> StudyStatus:

@@ -60,7 +60,7 @@ def collect(outdir, *, parquet=True):
     """
     outdir = Path(outdir)
     read_study(outdir)                        # a study folder, or a one-line error
-    with folder_lock(outdir, "`roughfe study run` (or collect)"):   # not under a run
+    with folder_lock(outdir, "`roughfe study collect`"):   # not under a run
         return _collect(outdir, parquet)
 
 
