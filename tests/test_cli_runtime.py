@@ -90,3 +90,24 @@ def test_python_dash_m_roughfe_is_the_command(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "roughfe", "--version"], capture_output=True,
                           text=True, timeout=120, cwd=tmp_path)
     assert proc.returncode == 0 and proc.stdout.startswith("roughfe "), proc.stderr
+
+
+def test_a_reader_leaving_the_pipe_stops_the_command_quietly(tmp_path):
+    """`roughfe ... | head -1`: the reader closes the pipe; the command stopped with
+    "error: Broken pipe" and exit 2, now quietly with SIGPIPE's 141."""
+    from roughfe.surfaces import Surface
+    from roughfe.surfaces.io import save_surface
+    path = save_surface(Surface(np.random.default_rng(0).normal(size=(16, 16)) * 1e-6, 1e-4,
+                                periodic=True), tmp_path / "s.npz")
+    script = ("import sys\nfrom roughfe.cli import main\n"
+              "import roughfe.cli.surface_cmds as S\n"
+              "def chatty(args):\n"
+              "    for k in range(200000):\n"
+              "        print('line', k)\n"
+              "S._info = chatty\n"
+              "sys.exit(main(sys.argv[1:]))\n")
+    proc = subprocess.run(f"{sys.executable} -c \"{script}\" info {path} | head -1; "
+                          f"exit ${{PIPESTATUS[0]}}", shell=True, executable="/bin/bash",
+                          capture_output=True, text=True, timeout=120)
+    assert proc.stdout == "line 0\n" and proc.returncode == 141, proc.stderr
+    assert "error" not in proc.stderr and "Exception" not in proc.stderr, proc.stderr

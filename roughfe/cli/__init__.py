@@ -77,7 +77,8 @@ def _warning_printer(name, show):
 
 def main(argv=None) -> int:
     """Run ``roughfe ARGV``; return the exit code (0 ok, 1 targets/checks missed, 2 bad
-    input: one line ``roughfe CMD: error: ...`` on stderr, nothing written). The
+    input: one line ``roughfe CMD: error: ...`` on stderr, nothing written; 130
+    interrupted; 141 the reader of stdout left, as with SIGPIPE). The
     library's warnings are printed as one line ``roughfe CMD: warning: ...``."""
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command_of(argv))
@@ -106,6 +107,12 @@ def main(argv=None) -> int:
         message = str(exc)
     except MemoryError as exc:
         message = f"not enough memory ({exc or 'allocation failed'})"
+    except BrokenPipeError:       # the reader of stdout left (`| head`): stop quietly, as
+        try:                      # a command killed by SIGPIPE would (exit 128 + 13)
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):     # stdout without a file descriptor (a test)
+            pass
+        return 141
     except OSError as exc:
         message = f"{exc.strerror or exc}" + (f": {exc.filename}" if exc.filename else "")
     except KeyboardInterrupt:
