@@ -18,9 +18,11 @@ MMA subproblem are offered, both "maximise a similarity score s <= 1":
     own derivative, at the cost of the same ``n + 1`` evaluations as the gradient of s.
 
 The best point ever evaluated is returned (GCMMA is not monotone on a non-smooth
-objective). A run stops converged when an outer step moves no variable by more than
-``xtol`` (unit-box units; ``success`` True), else after ``n_it`` outer iterations (the
-budget: ``success`` False, the message says which). Svanberg's test is the KKT residual
+objective). A run takes its ``n_it`` outer iterations (the thesis' fixed budgets; a stop
+at the first small step changed the thesis stages' results: a step of zero is not a
+fixed point of MMA, whose asymptotes move on) and is called converged (``success``
+True) when its last step moved no variable by more than ``xtol`` (unit-box units), else
+it stopped at the budget (``success`` False, the message says which). Svanberg's test is the KKT residual
 of the original problem; it needs the derivatives at the last iterate, n + 1 more
 evaluations with forward differences, so the step is tested instead. A score that is
 not finite counts as -inf (never the best); a model function that is not finite at the
@@ -139,7 +141,8 @@ def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: st
     label : str
         Prefix of the message.
     xtol : float
-        Converged when an outer step moves no variable by more than ``xtol`` (unit box).
+        Called converged when the last outer step moved no variable by more than ``xtol``
+        (unit box); the run takes its ``n_it`` iterations all the same.
 
     Returns
     -------
@@ -233,10 +236,9 @@ def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: st
         if not np.all(np.isfinite(y)):
             why = "stopped: the model function is not finite at the last iterate"
             break
-        if step <= xtol:
-            why, converged = f"converged (step {step:.1e} <= xtol = {xtol:g})", True
-            break
-        why = f"stopped at the budget n_it = {int(n_it)} (last step {step:.1e} > xtol)"
+        converged = step <= xtol
+        why = (f"converged (last step {step:.1e} <= xtol = {xtol:g})" if converged else
+               f"stopped at the budget n_it = {int(n_it)} (last step {step:.1e} > xtol)")
         if it < n_it:
             f0val, fval = f0new, fnew
             df0dx, dfdx = derivatives(y, dy_of(u, y))
