@@ -182,6 +182,9 @@ def write_text(path, text):
 OWNER_FILE = ".roughfe-output.json"
 #: Present (and visible) while a run is writing the folder or after it failed/was killed.
 UNFINISHED_FILE = "UNFINISHED"
+#: Sub-folder holding an earlier run's output while a new run writes: restored when the
+#: new run fails or is interrupted, removed when it completes
+PREVIOUS_DIR = ".roughfe-previous"
 #: flock-ed by the run writing the folder (released by the OS if the process dies).
 LOCK_FILE = ".lock"
 
@@ -228,7 +231,8 @@ def _read_owner(folder: Path):
 def _relative_files(folder: Path) -> list:
     """Every file below ``folder`` (relative, sorted) but the lock and the owner record."""
     return sorted(str(p.relative_to(folder)) for p in folder.rglob("*")
-                  if not p.is_dir() and p.name not in (LOCK_FILE, OWNER_FILE))
+                  if not p.is_dir() and p.name not in (LOCK_FILE, OWNER_FILE)
+                  and PREVIOUS_DIR not in p.relative_to(folder).parts)
 
 
 def _added_files(folder: Path, owner) -> list:
@@ -251,14 +255,38 @@ def _refuse_to_clear(folder: Path):
                          "choose a dedicated output folder")
 
 
-def _clear(folder: Path):
+def _clear(folder: Path, keep=(LOCK_FILE,)):
     for entry in folder.iterdir():
-        if entry.name == LOCK_FILE:
+        if entry.name in keep:
             continue
         if entry.is_dir() and not entry.is_symlink():
             shutil.rmtree(entry)
         else:
             entry.unlink()
+
+
+def _set_aside(folder: Path) -> bool:
+    """Move an earlier run's output into ``folder/PREVIOUS_DIR`` (a killed run's leftover
+    there is dropped first: its folder was marked unfinished); True when there was any."""
+    previous = folder / PREVIOUS_DIR
+    if previous.exists():
+        shutil.rmtree(previous)
+    entries = [e for e in folder.iterdir() if e.name != LOCK_FILE]
+    if not entries:
+        return False
+    previous.mkdir()
+    for entry in entries:
+        os.rename(entry, previous / entry.name)
+    return True
+
+
+def _restore(folder: Path) -> None:
+    """Drop what the failed run wrote and put the earlier output back."""
+    previous = folder / PREVIOUS_DIR
+    _clear(folder, keep=(LOCK_FILE, PREVIOUS_DIR))
+    for entry in previous.iterdir():
+        os.rename(entry, folder / entry.name)
+    previous.rmdir()
 
 
 class OutputFolder:
@@ -274,13 +302,16 @@ class OutputFolder:
     ``with OutputFolder(...) as out:`` then takes the folder for the writes:
 
     * it is locked (:func:`folder_lock`) until the block ends;
-    * its old content is removed (no file of two runs ever sits side by side; stale
-      temporary files of a killed run go with it);
+    * its old content is set aside in ``.roughfe-previous`` (no file of two runs ever
+      sits side by side; stale temporary files of a killed run go with it);
     * ``UNFINISHED`` exists and ``.roughfe-output.json`` says ``"status": "running"``
-      until the block returns normally; then ``UNFINISHED`` is removed and the status
-      is ``"complete"``. A killed run never leaves a folder that looks complete. When
-      the block raises, a folder this run created is removed again (nothing written);
-      an older folder keeps ``UNFINISHED`` and ``"status": "failed"`` with the error.
+      until the block returns normally; then ``UNFINISHED`` and the old content are
+      removed and the status is ``"complete"``. A killed run never leaves a folder that
+      looks complete (its ``.roughfe-previous`` goes with the next run). When the block
+      raises (a bad value found during the work, a solver failure, Ctrl-C), a folder
+      this run created is removed again and an older folder gets its old content back
+      (an earlier complete output survives a failed rerun); a folder that was empty
+      keeps ``UNFINISHED`` and ``"status": "failed"`` with the error.
     """
 
     def __init__(self, folder, command: str, *, overwrite: bool = False):
@@ -329,7 +360,7 @@ class OutputFolder:
             raise InputError(f"cannot create output folder {folder}: {exc.strerror}") from None
         self._lock = contextlib.ExitStack()
         self._lock.enter_context(folder_lock(folder, f"`roughfe {self.command}`"))
-        _clear(folder)
+        self._kept = _set_aside(folder)
         self._record = {"command": self.command, "status": "running", "pid": os.getpid(),
                         "started": self._started, "writing": _now()}
         write_text(folder / UNFINISHED_FILE,
@@ -343,6 +374,8 @@ class OutputFolder:
         folder = self.path
         try:
             if kind is None:
+                if self._kept:
+                    shutil.rmtree(folder / PREVIOUS_DIR)
                 (folder / UNFINISHED_FILE).unlink()
                 write_json(folder / OWNER_FILE, {
                     **self._record, "status": "complete", "finished": _now(),
@@ -350,6 +383,8 @@ class OutputFolder:
                     "files": _relative_files(folder)})
             elif self._created:
                 shutil.rmtree(folder, ignore_errors=True)
+            elif self._kept:
+                _restore(folder)
             else:
                 with contextlib.suppress(Exception):
                     write_json(folder / OWNER_FILE, {**self._record, "status": "failed",

@@ -273,3 +273,22 @@ def test_demo_contact_results_carry_persson_like_roughfe_contact(tmp_path):
     steps = doc["steps"]
     assert all(0 < s["persson_area_fraction"] < 1 for s in steps if s["mean_pressure"] > 0)
     assert "A* Persson" in text
+
+
+def test_a_mistake_in_a_rerun_keeps_the_finished_output(tmp_path, capsys):
+    """`roughfe leak` took the folder before its own checks: a rerun with --fsi (which
+    refuses the default --direction both) left UNFINISHED and nothing else of the
+    finished leak output. The earlier output is now restored, byte for byte."""
+    from roughfe.surfaces import Surface
+    from roughfe.surfaces.io import save_surface
+    h = np.random.default_rng(1).normal(size=(16, 16)) * 1e-7
+    path = save_surface(Surface(h, 1e-4, periodic=True), tmp_path / "s.npz")
+    out = tmp_path / "L"
+    assert main(["leak", str(path), "--delta", "1e-7", "--no-figures", "-o", str(out)]) == 0
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*")
+              if p.is_file() and p.name != ".lock"}
+    assert main(["leak", str(path), "--fsi", "--pressure", "1e7", "--no-figures",
+                 "-o", str(out)]) == 2
+    after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*")
+             if p.is_file() and p.name != ".lock"}
+    assert after == before and not (out / "UNFINISHED").exists()

@@ -103,6 +103,8 @@ def test_output_folder_contract(tmp_path):
 
 
 def test_a_failed_run_never_looks_complete_and_a_fresh_folder_is_removed(tmp_path):
+    """A failed run: a folder it created is removed, an earlier output is restored, an
+    empty folder is marked unfinished."""
     out = tmp_path / "new"
     with pytest.raises(ValueError):
         with OutputFolder(out, "contact"):
@@ -110,12 +112,24 @@ def test_a_failed_run_never_looks_complete_and_a_fresh_folder_is_removed(tmp_pat
     assert not out.exists()                                   # nothing written
     with OutputFolder(out, "contact") as d:
         write_text(d / "results.json", "{}")
+    before = {f: (out / f).read_bytes() for f in _files(out) if f != ".lock"}
+    for error in (ValueError("a bad value found during the work"), KeyboardInterrupt()):
+        with pytest.raises(type(error)):
+            with OutputFolder(out, "contact") as d:
+                assert not (d / "results.json").exists()          # never two runs' files
+                write_text(d / "fields.h5", "partial")
+                raise error
+        # the earlier complete output is back, byte for byte (it was wiped: a mistake in
+        # a rerun's command destroyed a finished result)
+        assert {f: (out / f).read_bytes() for f in _files(out) if f != ".lock"} == before
+    empty = tmp_path / "empty"
+    empty.mkdir()
     with pytest.raises(ValueError):
-        with OutputFolder(out, "contact") as d:
+        with OutputFolder(empty, "contact") as d:
             write_text(d / "fields.h5", "partial")
             raise ValueError("killed")
-    assert (out / UNFINISHED_FILE).exists()
-    assert json.loads((out / OWNER_FILE).read_text())["status"] == "failed"
+    assert (empty / UNFINISHED_FILE).exists()
+    assert json.loads((empty / OWNER_FILE).read_text())["status"] == "failed"
 
 
 def test_a_killed_run_leaves_unfinished_and_the_next_run_cleans_its_temporaries(tmp_path):
