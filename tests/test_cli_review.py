@@ -91,6 +91,14 @@ def test_generate_keeps_its_figure_with_its_surface(tmp_path, capsys):
     assert main(["generate", "spectral", "--n", "32", "--seed", "2", "--overwrite",
                  "--no-figures", "-o", str(out)]) == 0
     assert not out.with_suffix(".png").exists()
+    # ... but a picture roughfe did not draw for the replaced surface stays (scan.png
+    # beside a scan.npz of other data was removed as "the figure of the surface")
+    scan = tmp_path / "scan.npz"
+    np.savez(scan, a=0)
+    (tmp_path / "scan.png").write_bytes(b"photo")
+    assert main(["generate", "spectral", "--n", "16", "--no-figures", "--overwrite",
+                 "-o", str(scan)]) == 0
+    assert (tmp_path / "scan.png").read_bytes() == b"photo"
 
 
 def test_unreadable_npz_files_say_what_is_wrong(tmp_path, surface64, capsys):

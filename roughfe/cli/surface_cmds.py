@@ -109,13 +109,25 @@ def _grid_points(a) -> tuple:
     return (a.n,) if a.model == "wm" or getattr(a, "profile", False) else (a.n, a.n)
 
 
+def _figure_of(path):
+    """The figure file named in the metadata of the roughfe surface at ``path`` (None
+    when it is not one or names none)."""
+    from ..surfaces.io import load_surface
+    try:
+        return load_surface(path).metadata.get("figure")
+    except Exception:  # noqa: BLE001 - any file that is not a readable roughfe surface
+        return None
+
+
 def _generate(args) -> int:
     from ..surfaces.io import save_surface
     from ..surfaces.stats import rms_height
     from ..writers import output_file
     out = output_file_of(args, suffixes=(".npz",))
     png = out.with_suffix(".png")          # the figure of this surface, beside it
-    replaced = out.exists()                # (with --overwrite)
+    # with --overwrite: the replaced surface's own figure (its metadata names it) goes,
+    # a picture of the same name that roughfe did not draw for it stays
+    stale = out.exists() and png.is_file() and _figure_of(out) == png.name
     if not args.no_figures:
         output_file(png, overwrite=args.overwrite)
     shape = _grid_points(args)
@@ -123,10 +135,12 @@ def _generate(args) -> int:
     surface = args.make(args)
     if args.rms_height is not None and args.model in ("wm", "mwm"):
         surface = surface.scaled(args.rms_height / rms_height(surface))
+    if not args.no_figures:
+        surface = surface.with_heights(surface.heights, figure=png.name)
     save_surface(surface, out)
     print(f"wrote {out}: {surface!r}, rms height {rms_height(surface) * 1e6:.4g} um, "
           f"seed {surface.metadata.get('seed')}")
-    if args.no_figures and replaced and png.is_file():
+    if args.no_figures and stale:
         png.unlink()      # the old surface's picture must not stand beside the new one
         print(f"removed {png} (the figure of the surface this file replaced)")
     if not args.no_figures:
