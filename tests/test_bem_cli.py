@@ -41,6 +41,13 @@ def test_contact_cli_writes_results_fields_and_figures(tmp_path):
         # the stored pressure integrates to the recorded load
         assert f["pressure"][2].mean() * 24e-6 ** 2 == pytest.approx(steps[2]["load"], rel=1e-12)
         assert np.all(f["gap"][...] >= 0)
+        # self-contained: each frame's response and the material beside the fields
+        np.testing.assert_array_equal(f["area_fraction"][...],
+                                      [s["area_fraction"] for s in steps])
+        np.testing.assert_array_equal(f["area_fraction"][...],
+                                      f["contact"][...].mean(axis=(1, 2)))
+        np.testing.assert_array_equal(f["mean_gap"][...], [s["mean_gap"] for s in steps])
+        assert f["stiffness"].attrs["unit"] == "Pa/m" and f.attrs["e_star_Pa"] > 0
     assert (out / "contact_area_stiffness.png").stat().st_size > 0
     assert (out / "contact_render.png").stat().st_size > 0
 

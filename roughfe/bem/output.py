@@ -53,7 +53,10 @@ def write_results_json(path, sweep: SweepResult, inputs: dict):
 
 def write_fields_h5(path, sweep: SweepResult, compression: str = "gzip"):
     """Write pressure and gap of every step to HDF5 (``frame`` first axis), atomically
-    (FEM: the values at the top vertices)."""
+    (FEM: the values at the top vertices), with each frame's ``delta``, ``mean_pressure``,
+    ``stiffness`` (Pa/m; inf at full periodic contact, NaN where not computed),
+    ``area_fraction``, ``mean_gap`` and ``unloading`` flag, and the material's ``e_star_Pa``
+    as an attribute."""
     import h5py  # Debian's h5py; imported here so the package works without it
 
     res = sweep.results
@@ -77,4 +80,14 @@ def write_fields_h5(path, sweep: SweepResult, compression: str = "gzip"):
             ds.attrs["unit"] = "m"
             ds = f.create_dataset("mean_pressure", data=np.array([r.mean_pressure for r in res]))
             ds.attrs["unit"] = "Pa"
+            # self-contained: the material and the response of every frame beside the
+            # fields (results.json holds the same numbers with Persson's theory)
+            f.attrs["e_star_Pa"] = float(sweep.e_star)
+            for name, unit in (("stiffness", "Pa/m"), ("area_fraction", "1"),
+                               ("mean_gap", "m")):
+                ds = f.create_dataset(name, data=np.asarray(getattr(sweep, name), float))
+                ds.attrs["unit"] = unit
+            if getattr(sweep, "unloading", None) is not None:
+                ds = f.create_dataset("unloading", data=np.asarray(sweep.unloading, float))
+                ds.attrs["unit"] = "1 on the unloading branch, 0 on loading"
     return path
