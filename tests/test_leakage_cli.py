@@ -51,6 +51,12 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
         path = f["widest_path_x"]
         assert path[0, 0] == 0 and path[-1, 0] == s.shape[0] - 1
         assert f["gap"][path[:, 0], path[:, 1]].min() == pytest.approx(steps[0]["critical_gap"])
+        # readable without results.json: the grid and every array's unit
+        np.testing.assert_allclose(f["size_m"], s.size)
+        np.testing.assert_allclose(f["spacing_m"], s.spacing)
+        units = json.loads(str(f["units"]))
+        assert units["gap"] == "m" and units["flux_x"].startswith("m^2/s")
+        assert set(units) == set(f.files) - {"units"}
     for name in ("step_000_network.png", "step_001_pressure_x.png", "step_000_flux_x.png",
                  "steps.png"):
         assert (out / "figures" / name).stat().st_size > 5000

@@ -88,7 +88,29 @@ def _fluid_pressures(args):
     return dp, 0.0
 
 
-def _save_fields(path, contact, leak):
+#: units of the arrays of fields/step_NNN.npz (key prefix -> unit), stored in the file
+FIELD_UNITS = {"gap": "m", "contact": "1", "pressure_contact": "Pa", "fluid_pressure": "Pa",
+               "flux": "m^2/s (volume flux per unit width, per cell: x, y components)",
+               "percolating": "1", "trapped": "1", "pockets": "pocket label (0: none)",
+               "widest_path": "cell indices (n, 2)", "parent_channel": "cell indices",
+               "size_m": "m", "spacing_m": "m"}
+
+
+def _write_step_npz(path, arrays: dict, surface) -> Path:
+    """One step's fields, with the grid (``size_m``, ``spacing_m``) and ``units`` (a JSON
+    object: array name -> unit) so that the file is read without results.json."""
+    import json
+    arrays = {**arrays, "size_m": np.asarray(surface.size, float),
+              "spacing_m": np.asarray(surface.spacing, float)}
+    units = {k: next((u for pre, u in FIELD_UNITS.items() if k.startswith(pre)), "")
+             for k in arrays}
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, units=np.array(json.dumps(units)), **arrays)
+    return path
+
+
+def _save_fields(path, contact, leak, surface):
     arrays = {"gap": contact.gap, "contact": contact.contact, "pressure_contact": contact.pressure,
               "percolating": leak.network.percolating, "trapped": leak.network.trapped}
     for d, net in leak.network.directions.items():
@@ -99,10 +121,7 @@ def _save_fields(path, contact, leak):
     for d, con in leak.constrictions.items():
         arrays[f"widest_path_{d}"] = con.path          # (n, 2) cell indices
         arrays[f"parent_channel_{d}"] = con.channel
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
-    return path
+    return _write_step_npz(path, arrays, surface)
 
 
 def _leak(args) -> int:
@@ -165,10 +184,7 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
                           percolating=lk.network.percolating, trapped=lk.network.trapped)
             for d, con in lk.constrictions.items():
                 arrays[f"widest_path_{d}"] = con.path
-        path = out / "fields" / f"step_{k:03d}.npz"
-        with atomic_path(path) as tmp:
-            with open(tmp, "wb") as fh:
-                np.savez_compressed(fh, **arrays)
+        path = _write_step_npz(out / "fields" / f"step_{k:03d}.npz", arrays, surface)
         written.append(path)
         if args.no_figures or r.contact is None:
             continue
@@ -250,7 +266,7 @@ def _leak_run(args, surface, material, out):
               "references": list(sweep.leakages[0].references)}
     written = []
     for k, (c, lk) in enumerate(zip(sweep.contacts, sweep.leakages)):
-        written.append(_save_fields(out / "fields" / f"step_{k:03d}.npz", c, lk))
+        written.append(_save_fields(out / "fields" / f"step_{k:03d}.npz", c, lk, surface))
         if args.no_figures:
             continue
         tag = f"step {k}: A*={c.area_fraction:.3f}, p={c.mean_pressure:.3g} Pa"
