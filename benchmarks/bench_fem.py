@@ -121,17 +121,35 @@ def main(ms) -> int:
     return 0
 
 
+def target_row(rows, big=None):
+    """Issue 16 sec. 4's row: the largest profile whose MUMPS VI step took < STEP_LIMIT s
+    CPU. The number is a measurement (nodes); the verdict says whether any measured
+    profile was solvable within the limit (NOT met when none was, or none succeeded: it
+    was then left out, and the summary read "not measured")."""
+    ok = [r for r in rows if r["solver"] == "mumps" and r["ok"]]
+    within = [r for r in ok if r["step_cpu_s"] < STEP_LIMIT]
+    if not within:
+        fastest = min((r["step_cpu_s"] for r in ok), default=None)
+        return {"name": f"largest profile with a MUMPS VI step < {STEP_LIMIT:g} s CPU "
+                        f"(nodes): none of {len(ok)} measured"
+                        + (f" (fastest step {fastest:.3g} s)" if ok else ""),
+                "value": None, "target": f"a step < {STEP_LIMIT:g} s", "met": False}
+    best = max(within, key=lambda r: r["nodes"])
+    beyond = min((r for r in ok if r["nodes"] > best["nodes"]), key=lambda r: r["nodes"],
+                 default=None)
+    extra = (f"; extrapolated limit {big['extrapolated_nodes']:.0f} nodes"
+             if big and big.get("extrapolated_nodes") else "")
+    return {"name": f"largest profile with a MUMPS VI step < {STEP_LIMIT:g} s CPU (nodes; "
+                    f"its step {best['step_cpu_s']:.3g} s"
+                    + (f", the next measured, {beyond['nodes']} nodes, "
+                       f"{beyond['step_cpu_s']:.3g} s" if beyond else
+                       ", the largest measured: larger ones were not run") + extra + ")",
+            "value": best["nodes"], "target": f"a step < {STEP_LIMIT:g} s", "met": True}
+
+
 def _write(rows, big=None):
-    """The report so far; the target row once the power law is fitted (``big``)."""
-    targets = []
-    if big and big["largest_measured_nodes"]:
-        step = max(r["step_cpu_s"] for r in rows if r["solver"] == "mumps" and r["ok"]
-                   and r["nodes"] == big["largest_measured_nodes"])
-        targets.append({"name": f"MUMPS VI step of the largest measured profile below "
-                                f"{STEP_LIMIT:g} s ({big['largest_measured_nodes']} nodes; "
-                                f"extrapolated limit {big['extrapolated_nodes']:.0f} nodes), "
-                                f"CPU s", "value": step, "target": f"< {STEP_LIMIT:g}",
-                        "met": bool(step < STEP_LIMIT)})
+    """The report so far with its target row (:func:`target_row`)."""
+    targets = [target_row(rows, big)] if rows else []
     write_report(OUT, "bench_fem", targets, rows,
                  {"step_cpu_s": "s (process CPU time)", "step_wall_s": "s (elapsed)",
                   "mesh_cpu_s": "s", "assembly_cpu_s": "s", "peak_rss_mb": "MB"},

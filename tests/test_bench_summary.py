@@ -217,3 +217,22 @@ def test_a_benchmark_that_ran_and_wrote_nothing_is_not_reported_as_not_run(tmp_p
     assert rows["bench_z"]["status"] == "not measured"
     assert "ran (exit code 1) and wrote no report" in rows["bench_z"]["note"]
     assert rows["bench_y"]["status"] == "not run"           # this one never ran
+
+
+def test_fem_row_says_not_met_when_no_profile_steps_within_the_limit():
+    """bench_fem picked the largest profile whose step took < 30 s and then checked
+    `step < 30` on it: never NOT met, and no row at all (summary "not measured") when no
+    step was that fast. The row is now always written and judged on what was measured."""
+    fem = _module("bench_fem")
+
+    def rows(*steps):
+        return [{"solver": "mumps", "ok": True, "nodes": 2 ** (8 + k) + 1, "dofs": 1000 * 2 ** k,
+                 "step_cpu_s": t} for k, t in enumerate(steps)]
+    slow = fem.target_row(rows(31.0, 70.0, 160.0))
+    assert slow["met"] is False and "none of 3" in slow["name"] and slow["value"] is None
+    fast = fem.target_row(rows(29.0, 70.0, 160.0))
+    assert fast["met"] is True and fast["value"] == 257 and "513 nodes, 70 s" in fast["name"]
+    top = fem.target_row(rows(1.0, 2.0))
+    assert top["value"] == 513 and "larger ones were not run" in top["name"]
+    assert fem.target_row([])["met"] is False
+    assert "MUMPS VI step" in slow["name"] and "MUMPS VI step" in fast["name"]   # summary key
