@@ -62,9 +62,11 @@ def run_one(script: Path, args, env) -> dict:
     proc = subprocess.Popen([sys.executable, str(script), *args], cwd=HERE, env=env)
     _, status, usage = os.wait4(proc.pid, 0)
     proc.returncode = os.waitstatus_to_exitcode(status)
+    from summary import owner_of  # benchmarks/summary.py
     folder = Path(env["ROUGHFE_BENCH_OUTPUT"])
+    # its own reports only (bench_bem_growth.json, written just before, is not bench_bem's)
     wrote = sorted(p.name for p in folder.glob(f"{script.stem}*.json")
-                   if p.stat().st_mtime >= clock0 - 1)
+                   if owner_of(p.stem, PLAN) == script.stem and p.stat().st_mtime >= clock0 - 1)
     return {"script": script.stem, "args": " ".join(args), "exit_code": proc.returncode,
             "wrote": wrote,
             "wall_s": time.perf_counter() - t0, "cpu_s": usage.ru_utime + usage.ru_stime,

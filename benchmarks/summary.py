@@ -138,15 +138,23 @@ def read_reports(folder: Path, expected=EXPECTED) -> dict:
     belongs to the benchmark of its name, else to the longest expected benchmark name it
     extends (``bench_bem_8192.json`` to ``bench_bem``, ``bench_bem_growth.json`` to
     ``bench_bem_growth`` itself)."""
-    names = sorted({e[1] for e in expected}, key=len, reverse=True)
+    names = {e[1] for e in expected}
     reports = {}
     for path in sorted(Path(folder).glob("*.json")):
         if path.stem == "run_all":
             continue
-        stem = path.stem if path.stem in names else next(
-            (b for b in names if path.stem.startswith(b + "_")), path.stem)
-        reports.setdefault(stem, []).append((path, *_load(path)))
+        reports.setdefault(owner_of(path.stem, names), []).append((path, *_load(path)))
     return reports
+
+
+def owner_of(file_stem: str, benchmarks) -> str:
+    """The benchmark a report file belongs to: the one of its name, else the longest
+    benchmark name it extends (``bench_bem_8192`` -> ``bench_bem``, ``bench_bem_growth``
+    -> ``bench_bem_growth`` itself when that is a benchmark), else its own name."""
+    if file_stem in benchmarks:
+        return file_stem
+    return next((b for b in sorted(benchmarks, key=len, reverse=True)
+                 if file_stem.startswith(b + "_")), file_stem)
 
 
 def _targets(data) -> list:

@@ -236,3 +236,21 @@ def test_fem_row_says_not_met_when_no_profile_steps_within_the_limit():
     assert top["value"] == 513 and "larger ones were not run" in top["name"]
     assert fem.target_row([])["met"] is False
     assert "MUMPS VI step" in slow["name"] and "MUMPS VI step" in fast["name"]   # summary key
+
+
+def test_a_crashed_benchmark_is_not_credited_with_a_neighbours_report(tmp_path, monkeypatch):
+    """run_all credited bench_bem with bench_bem_growth.json (written a second before by
+    the benchmark run just before it): a crashed bench_bem looked as if it had written
+    its report, and an old bench_bem.json then showed last run's verdicts as current."""
+    import os
+    monkeypatch.syspath_prepend(str(BENCH))
+    run_all = _module("run_all")
+    (tmp_path / "bench_bem_growth.json").write_text("{}")
+    stub = tmp_path / "bench_bem.py"
+    stub.write_text("import sys\nsys.exit(1)\n")
+    rec = run_all.run_one(stub, [], dict(os.environ, ROUGHFE_BENCH_OUTPUT=str(tmp_path)))
+    assert rec["exit_code"] == 1 and rec["wrote"] == []
+    stub.write_text("import os, pathlib\npathlib.Path(os.environ['ROUGHFE_BENCH_OUTPUT'], "
+                    "'bench_bem_8192.json').write_text('{}')\n")
+    rec = run_all.run_one(stub, [], dict(os.environ, ROUGHFE_BENCH_OUTPUT=str(tmp_path)))
+    assert rec["wrote"] == ["bench_bem_8192.json"]
