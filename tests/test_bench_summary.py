@@ -254,3 +254,16 @@ def test_a_crashed_benchmark_is_not_credited_with_a_neighbours_report(tmp_path, 
                     "'bench_bem_8192.json').write_text('{}')\n")
     rec = run_all.run_one(stub, [], dict(os.environ, ROUGHFE_BENCH_OUTPUT=str(tmp_path)))
     assert rec["wrote"] == ["bench_bem_8192.json"]
+
+
+def test_bem_growth_is_judged_only_between_sizes_of_one_solver(monkeypatch):
+    """bench_bem judged 512^2 -> 1024^2 (plain PCG, then the two-level solver): 147 -> 87
+    iterations read 0.59x, "met". Pairs across the switch are skipped with the reason."""
+    monkeypatch.syspath_prepend(str(BENCH))
+    bem = _module("bench_bem")
+    by_n = {n: {"cold_nit": k} for n, k in ((256, 120), (512, 147), (1024, 87), (2048, 110))}
+    targets, skipped = bem.growth_targets(by_n, 1024)
+    judged = {t["name"]: t for t in targets}
+    assert set(judged) == {"iteration growth 256^2 -> 512^2", "iteration growth 1024^2 -> 2048^2"}
+    assert judged["iteration growth 1024^2 -> 2048^2"]["met"] is False      # 1.26x
+    assert [s["name"] for s in skipped] == ["iteration growth 512^2 -> 1024^2"]
