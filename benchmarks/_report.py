@@ -9,6 +9,7 @@ folder, so that a smoke run never overwrites the full run's JSON.
 """
 import datetime
 import os
+import sys
 import resource
 import time
 from pathlib import Path
@@ -19,6 +20,12 @@ from roughfe.writers import write_json
 LOAD_AT_START = os.getloadavg()[0]
 _IMPORTED = time.perf_counter()
 
+
+
+def megabytes(ru_maxrss: float) -> float:
+    """MB (1e6 bytes, the unit of the issue's GB limits) of a ``ru_maxrss`` (KiB on
+    Linux). The benchmarks divided by 1024 (MiB) and called it MB until session 23."""
+    return float(ru_maxrss) * 1024 / 1e6
 
 def output_path(path) -> Path:
     """``path`` itself, or its file name in ``$ROUGHFE_BENCH_OUTPUT`` when that is set."""
@@ -49,7 +56,7 @@ def process_figures() -> dict:
             "cpus": os.cpu_count(),
             "cpu_s": me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime,
             "wall_s": _wall_since_start(),
-            "peak_rss_mb": max(me.ru_maxrss, kids.ru_maxrss) / 1024.0}   # KiB on Linux
+            "peak_rss_mb": megabytes(max(me.ru_maxrss, kids.ru_maxrss))}
 
 
 def write_report(path, name, targets, cases, units, extra=None, skipped=()):
@@ -59,11 +66,15 @@ def write_report(path, name, targets, cases, units, extra=None, skipped=()):
     the measured records; ``units``: field -> unit; ``extra`` (a dict) adds the benchmark's
     own keys (e.g. a fitted law, its settings); ``skipped``: records ``name, reason`` of
     the cases this run left out (shown in the summary table, never silently dropped).
+    The report records the script's arguments and ``reduced`` (``--quick``, or a run of
+    ``run_all.py --quick``): the summary marks the rows of a reduced run as such.
     Returns the path written.
     """
     path = output_path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    write_json(path, {"benchmark": name, **process_figures(), "targets": targets,
+    reduced = "--quick" in sys.argv[1:] or os.environ.get("ROUGHFE_BENCH_REDUCED") == "1"
+    write_json(path, {"benchmark": name, **process_figures(), "argv": sys.argv[1:],
+                      "reduced": reduced, "targets": targets,
                       "skipped": list(skipped), "cases": cases, "units": units,
                       **(extra or {})})
     for t in targets:

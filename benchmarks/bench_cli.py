@@ -87,7 +87,8 @@ def child(mode, argv):
             sys.stdout = saved
     usage = resource.getrusage(resource.RUSAGE_SELF)
     rec.update(exit_code=code, process_cpu_s=usage.ru_utime + usage.ru_stime,
-               peak_rss_mb=usage.ru_maxrss / 1024.0, end_clock=time.time())
+               peak_rss_mb=usage.ru_maxrss * 1024 / 1e6,   # MB = 1e6 B (_report.megabytes)
+               end_clock=time.time())
     print(json.dumps(rec))
 
 

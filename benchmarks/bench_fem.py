@@ -17,7 +17,7 @@ Timings are process CPU seconds (the machine is shared; wall time is printed bes
 the iterative solvers are stopped at the first size whose step exceeds ``ITERATIVE_CAP``
 CPU seconds. The largest profile solvable in < 30 s per step is read from the measured
 MUMPS rows and extrapolated with the fitted power law t = a dofs^b.
-Run: ``.venv/bin/python benchmarks/bench_fem.py [M ...]`` (default m = 8..13); writes
+Run: ``.venv/bin/python benchmarks/bench_fem.py [M ...]`` (default m = 8..13; `make bench` runs m = 8..14, 16385 nodes); writes
 ``benchmarks/output/bench_fem.json`` through ``benchmarks/_report.write_report`` (target
 row: the MUMPS step of the largest measured profile below 30 s CPU).
 """
@@ -36,7 +36,7 @@ from roughfe.fem import mesh_profile
 from roughfe.fem.contact import FemSolverOptions, _ContactProblem
 from roughfe.surfaces.rmd import rmd_profile
 
-from _report import write_report  # benchmarks/_report.py
+from _report import megabytes, write_report  # benchmarks/_report.py
 
 MATERIAL = Material(E=210e9, nu=0.3)
 SOLVERS = {"mumps": {},
@@ -73,7 +73,7 @@ def one_size(m: int, solvers) -> list:
             problem.destroy()
         except Exception as exc:          # PETSc errors and non-convergence are reported
             row.update(ok=False, error=f"{type(exc).__name__}: {str(exc).splitlines()[0][:200]}")
-        row["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+        row["peak_rss_mb"] = megabytes(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
         rows.append(row)
         print(f"{m:>3} {row['nodes']:>6} {row.get('dofs', 0):>8} {name:>9} "
               + (f"{row['step_cpu_s']:>8.2f} {row['step_wall_s']:>8.2f} {row['snes_iterations']:>4} "

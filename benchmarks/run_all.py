@@ -62,6 +62,7 @@ def run_one(script: Path, args, env) -> dict:
     proc = subprocess.Popen([sys.executable, str(script), *args], cwd=HERE, env=env)
     _, status, usage = os.wait4(proc.pid, 0)
     proc.returncode = os.waitstatus_to_exitcode(status)
+    from _report import megabytes  # benchmarks/_report.py
     from summary import owner_of  # benchmarks/summary.py
     folder = Path(env["ROUGHFE_BENCH_OUTPUT"])
     # its own reports only (bench_bem_growth.json, written just before, is not bench_bem's)
@@ -71,7 +72,7 @@ def run_one(script: Path, args, env) -> dict:
             "wrote": wrote,
             "wall_s": time.perf_counter() - t0, "cpu_s": usage.ru_utime + usage.ru_stime,
             "user_s": usage.ru_utime, "system_s": usage.ru_stime,
-            "peak_rss_mb": usage.ru_maxrss / 1024.0, "load_average_start": load0,
+            "peak_rss_mb": megabytes(usage.ru_maxrss), "load_average_start": load0,
             "load_average_end": os.getloadavg()[0]}
 
 
@@ -86,7 +87,8 @@ def main(argv=None) -> int:
     from summary import write_summary  # benchmarks/summary.py
 
     output = HERE / ("output-quick" if args.quick else "output")
-    env = dict(os.environ, ROUGHFE_BENCH_OUTPUT=str(output))
+    env = dict(os.environ, ROUGHFE_BENCH_OUTPUT=str(output),
+               ROUGHFE_BENCH_REDUCED="1" if args.quick else "0")
     found = {s.stem for s in HERE.glob("bench_*.py")}
     unplanned = sorted(found - set(PLAN))
     if unplanned:

@@ -158,10 +158,18 @@ def owner_of(file_stem: str, benchmarks) -> str:
 
 
 def _targets(data) -> list:
-    """A report's target rows in the table's columns (``docs/generate.target_rows``)."""
+    """A report's target rows in the table's columns (``docs/generate.target_rows``); the
+    rows of a reduced run (``--quick``) say so in their note."""
+    reduced = isinstance(data, dict) and data.get("reduced") is True
     return [{"target": t["name"], "limit": t.get("target"), "measured": t.get("value"),
-             "unit": t.get("unit"), "status": t["status"], "note": t.get("note")}
+             "unit": t.get("unit"), "status": t["status"],
+             "note": "; ".join(x for x in (REDUCED_NOTE if reduced else None, t.get("note"))
+                               if x)}
             for t in (GEN.target_rows(data) if isinstance(data, dict) else [])]
+
+
+#: the note of every row of a reduced run
+REDUCED_NOTE = "reduced run (--quick): a smaller case than the target's"
 
 
 def _runs(folder: Path) -> list:
@@ -245,6 +253,11 @@ def summary_markdown(folder, title="Benchmark summary") -> str:
              "of the benchmark on the machine's cores: a time measured at a load above the "
              "number of cores is inflated (CPU times much less than wall times).", "",
              ", ".join(f"{n} {s.strip('*')}" for s, n in counts.items()) + ".", ""]
+    n_reduced = sum(REDUCED_NOTE in (r.get("note") or "") for r in rows)
+    if n_reduced:
+        lines += [f"**{n_reduced} of these rows are of reduced runs (`--quick`, `make "
+                  "bench-quick`)**: they judge smaller cases than the targets name, for "
+                  "smoke use; the targets' verdicts are those of `make bench`.", ""]
     lines += _table(rows, COLUMNS) + [""]
     skipped = []
     for stem, files in sorted(read_reports(folder).items()):

@@ -267,3 +267,20 @@ def test_bem_growth_is_judged_only_between_sizes_of_one_solver(monkeypatch):
     assert set(judged) == {"iteration growth 256^2 -> 512^2", "iteration growth 1024^2 -> 2048^2"}
     assert judged["iteration growth 1024^2 -> 2048^2"]["met"] is False      # 1.26x
     assert [s["name"] for s in skipped] == ["iteration growth 512^2 -> 1024^2"]
+
+
+def test_rows_of_a_reduced_run_say_so(tmp_path, summary, monkeypatch):
+    """A script's own --quick wrote over the full run's report, and the summary showed its
+    reduced rows under the full-size targets with nothing saying so."""
+    rep = _module("_report")
+    monkeypatch.setenv("ROUGHFE_BENCH_OUTPUT", str(tmp_path))
+    monkeypatch.setattr("sys.argv", ["bench_x.py", "--quick"])
+    rep.write_report(tmp_path / "bench_x.json", "bench_x",
+                     [{"name": "iteration growth 256^2 -> 512^2", "value": 1.1,
+                       "target": "<= 1.15", "met": True}], [], {})
+    data = json.loads((tmp_path / "bench_x.json").read_text())
+    assert data["reduced"] is True and data["argv"] == ["--quick"]
+    rows = summary.summary_rows(tmp_path, EXPECTED)
+    growth = [r for r in rows if r["target"].startswith("iteration growth")][0]
+    assert growth["status"] == "met" and summary.REDUCED_NOTE in growth["note"]
+    assert "rows are of reduced runs" in summary.summary_markdown(tmp_path)
