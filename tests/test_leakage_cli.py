@@ -34,6 +34,7 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
     steps = res["steps"]
     assert len(steps) == 2 and STEP_KEYS <= set(steps[0])
     assert steps[0]["percolates_y"] is None            # not analysed
+    assert "stiffness" not in steps[0]                 # not computed: no null read as inf
     # more load: more contact, less free volume, smaller leak rate
     assert steps[1]["area_fraction"] > steps[0]["area_fraction"]
     assert steps[1]["free_volume_star"] < steps[0]["free_volume_star"]

@@ -235,10 +235,14 @@ class LeakageSweep:
         return all(c.success for c in self.contacts) and all(lk.success for lk in self.leakages)
 
     def records(self) -> list:
-        """One JSON-safe dict per step: contact scalars + :meth:`LeakageResult.record`."""
+        """One JSON-safe dict per step: contact scalars + :meth:`LeakageResult.record`.
+        No ``stiffness``: the leakage sweep does not compute it (a null there read as the
+        infinite stiffness of full contact, which results.json writes as null)."""
         out = []
         for k, (c, lk) in enumerate(zip(self.contacts, self.leakages)):
-            rec = {"step": k, **c.scalars(),
+            scalars = c.scalars()
+            scalars.pop("stiffness", None)
+            rec = {"step": k, **scalars,
                    "separation_star": float(c.mean_plane_separation / c.rms_height),
                    "contact_success": bool(c.success)}
             rec.update(lk.record())       # the network's free volume replaces the BEM one
