@@ -50,15 +50,14 @@ Steps (:func:`sequence_surfaces`)
    fit better than the noise allows (measured, 512^2 pair, 1 % noise, seeds 0-4: 4.4-32.5 s
    CPU before, 0.9-2.6 s after, the same genes).
 5. Genes: b_mn, phi_mn from the coefficients; (ln G, H, ln alpha) by least squares on
-   ln b_mn weighted by b_mn^2; A from G (Eq. 3.1).
+   ln b_mn weighted by b_mn^2; A from G (Eq. 3.1) (:mod:`.surface_result`, with the
+   misfits and the result).
 Undefined points (NaN) of a measured acquisition are left out of every step.
 """
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
-from typing import Optional
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -68,6 +67,8 @@ from .acquisitions import check_controls
 from .lattice import comb_periods, label_q1, lattice_from_period
 from .surface_data import (ANGLE_TOL, GridModel, SurfaceAcquisition, cluster_angles,
                            surface_acquisitions, surface_peaks)
+from .surface_result import (SurfaceSequencingResult, failure, genes_from_fit,
+                             plane_free_misfits)
 
 
 #: nodes (over all acquisitions) used by the nonlinear fit; the final solve uses every node
@@ -233,113 +234,6 @@ def _add_missing_ridges(model, full, p, ranges, sol, done, max_new=8):
     return p, ranges, sol, nit
 
 
-# -- step 5: genes --------------------------------------------------------------------------------
-def _genes(p, sol, ranges):
-    """Genome genes from the fitted coefficients (see the module notes)."""
-    nn, mm = sol["nn"], sol["mm"]
-    w = nn.size
-    u, v = sol["coef"][:w], sol["coef"][w:2 * w]
-    theta = np.asarray(p[2:], float)
-    flip = np.floor(theta / np.pi).astype(int) % 2 == 1     # theta in [pi, 2 pi) mod 2 pi
-    theta = np.mod(theta, np.pi)
-    v = np.where(flip[mm], -v, v)
-    order = np.argsort(theta)                     # ridges listed by angle in [0, pi)
-    rank = np.empty_like(order)
-    rank[order] = np.arange(order.size)
-    theta, mm = theta[order], rank[mm]
-    b = np.hypot(u, v)
-    phi = np.arctan2(v, -u)
-    n = np.unique(nn)
-    M = theta.size
-    phases = np.zeros((M, n.size))
-    phases[mm, nn - n[0]] = phi
-    amp = np.zeros((M, n.size))
-    amp[mm, nn - n[0]] = b
-    gamma = math.exp(p[1])
-    lam1 = 2 * math.pi / math.exp(p[0])
-    # ln b = ln G + (1 - n) H ln gamma + ln alpha_m, sum ln alpha_m = 0, weights b^2
-    good = b > 0
-    rows = np.flatnonzero(good)
-    mat = np.zeros((rows.size, 2 + M))
-    mat[:, 0] = 1.0
-    mat[:, 1] = (1.0 - nn[rows]) * math.log(gamma)
-    mat[np.arange(rows.size), 2 + mm[rows]] = 1.0
-    rhs = np.log(b[rows])
-    wts = b[rows] / b[rows].max()
-    # gauge: replace ln alpha_M by -sum of the others
-    red = mat[:, :2 + M - 1].copy()
-    red[:, 2:] -= mat[:, [2 + M - 1]]
-    sol_g, *_ = np.linalg.lstsq(red * wts[:, None], rhs * wts, rcond=None)
-    ln_g, hurst = sol_g[0], sol_g[1]
-    ln_alpha = np.append(sol_g[2:], -np.sum(sol_g[2:]))
-    prefactor = math.exp(ln_g)
-    a_gene = prefactor / (math.sqrt(math.log(gamma) / M) * (2 * math.pi / lam1) ** (-hurst))
-    return dict(A=a_gene, H=float(hurst), gamma=gamma, lambda1=lam1, phases=phases,
-                n_first=int(n[0]), angles=theta, anisotropy=np.exp(ln_alpha), amplitudes=amp)
-
-
-@dataclass(frozen=True, eq=False)
-class SurfaceSequencingResult:
-    """Sequenced surface genome and its quality report (OptimizeResult-like).
-
-    Attributes
-    ----------
-    genome : Genome or None
-        The band-limited genome (None when no WM lattice was found).
-    success : bool
-        True when every acquisition is reproduced within ``rms_tolerance``.
-    message : str
-    nit : int
-        Residual evaluations of the nonlinear fit.
-    ranges : list of (int, int)
-        Eq. 3.5 chromosome range per acquisition, coarsest first.
-    lengths, rms_errors : ndarray
-        Observation lengths (m) and relative rms misfits per acquisition: the rms misfit
-        over ``signal_rms``.
-    amplitudes : ndarray (M, n_c)
-        Fitted wave amplitudes b_mn (m).
-    peaks : list of SurfacePeaks
-    elapsed : float
-    signal_rms : ndarray or None
-        Rms height of each acquisition about its best plane (m), the part the waves must
-        reproduce (the model's plane per acquisition takes the rest); None without a fit.
-    """
-
-    genome: Optional[Genome]
-    success: bool
-    message: str
-    nit: int
-    ranges: list
-    lengths: np.ndarray
-    rms_errors: np.ndarray
-    amplitudes: np.ndarray
-    peaks: list
-    elapsed: float = 0.0
-    references: tuple = field(default=("thesis Sec. 3.3.2, Eq. 3.17 (projected form)",))
-    signal_rms: Optional[np.ndarray] = None
-
-    def report(self) -> dict:
-        g = self.genome
-        genes = None if g is None else {
-            "A": g.A, "H": g.H, "gamma": g.gamma, "lambda1": g.lambda1, "M": g.M,
-            "angles_deg": np.degrees(g.angles).tolist(), "anisotropy": g.anisotropy.tolist(),
-            "n_first": g.n_first, "n_last": g.n_last}
-        return {"success": bool(self.success), "message": self.message, "nit": int(self.nit),
-                "genes": genes, "lengths": self.lengths.tolist(),
-                "ranges": [list(r) for r in self.ranges],
-                "rms_errors": [float(e) for e in self.rms_errors],
-                "signal_rms_m": (None if self.signal_rms is None
-                                 else [float(v) for v in self.signal_rms]),
-                "elapsed_s": self.elapsed}
-
-
-def _failure(message, acqs, peaks, t0):
-    return SurfaceSequencingResult(
-        genome=None, success=False, message=message, nit=0, ranges=[],
-        lengths=np.array([a.length for a in acqs]), rms_errors=np.full(len(acqs), np.inf),
-        amplitudes=np.zeros((0, 0)), peaks=peaks, elapsed=time.perf_counter() - t0)
-
-
 def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
                       n_restarts=3) -> SurfaceSequencingResult:
     """Sequence the genome of a 2D MWM surface from one or more nested acquisitions.
@@ -366,12 +260,12 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     q = np.concatenate([pk.magnitude for pk in peaks])
     ang = np.concatenate([pk.angle for pk in peaks])
     if q.size < 4:
-        return _failure(f"only {q.size} spectral peaks: the spectrum is not a discrete WM "
+        return failure(f"only {q.size} spectral peaks: the spectrum is not a discrete WM "
                         f"spectrum", acqs, peaks, t0)
     centres, labels, sizes = cluster_angles(ang, q ** 2)
     ridges = np.flatnonzero(sizes >= 2)
     if ridges.size == 0:
-        return _failure("no direction holds two or more spectral peaks: no MWM ridges found",
+        return failure("no direction holds two or more spectral peaks: no MWM ridges found",
                         acqs, peaks, t0)
     in_ridge = np.isin(labels, ridges)
     log_q = np.log(q[in_ridge])
@@ -440,34 +334,19 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         if best[0] <= tiny:
             break
     if best is None:
-        return _failure("no gamma candidate gave a lattice fit", acqs, peaks, t0)
+        return failure("no gamma candidate gave a lattice fit", acqs, peaks, t0)
     _, p, ranges, _, _ = best
     sol = full.solve(p, ranges, exact=True)
-    g = _genes(p, sol, ranges)
+    g = genes_from_fit(p, sol, ranges)
     if not 0.0 < g["H"] <= 3.0:        # a Genome would refuse it with a message about
-        return _failure(               # an H the user never gave: a failed sequencing
+        return failure(               # an H the user never gave: a failed sequencing
             f"the fitted wave amplitudes grow or decay with an exponent H = {g['H']:.3g}, "
             f"outside (0, 3] (gamma = {math.exp(p[1]):.4g}): not a WM surface", acqs,
             peaks, t0)
     genome = Genome(A=g["A"], H=g["H"], gamma=g["gamma"], lambda1=g["lambda1"],
                     phases=g["phases"], n_first=g["n_first"], angles=g["angles"],
                     anisotropy=g["anisotropy"], metadata={"source": "sequence_surfaces"})
-    errs, signal = [], []
-    fitted = full.z - sol["resid"]
-    for k in range(len(acqs)):
-        rows = full.block == k
-        # relative to the heights without their best plane: the model fits a plane per
-        # acquisition, so a misfit over the variance about the mean let a tilt pass a fit
-        # that explained nothing else (10 % noise read 9.9 %, with a tilt of 100 rms 0.34 %)
-        grid = full.grids[k]
-        xx, yy = np.meshgrid(grid["x"], grid["y"], indexing="ij")
-        ok = grid["ok"]
-        plane = np.column_stack([np.ones(int(ok.sum())), xx[ok], yy[ok]])
-        zk = full.z[rows] - plane @ np.linalg.lstsq(plane, full.z[rows], rcond=None)[0]
-        signal.append(float(np.sqrt(np.mean(zk ** 2))))
-        errs.append(float(np.sqrt(np.mean((full.z[rows] - fitted[rows]) ** 2)))
-                    / max(signal[-1], 1e-300))
-    errs = np.array(errs)
+    errs, signal = plane_free_misfits(full, sol["resid"])
     ok = bool(np.all(errs <= rms_tolerance))
     msg = (f"M = {genome.M} ridges, gamma = {genome.gamma:.6g}, chromosomes "
            f"{genome.n_first}..{genome.n_last}; relative rms misfit "
@@ -478,4 +357,4 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         genome=genome, success=ok, message=msg, nit=nit, ranges=[tuple(r) for r in ranges],
         lengths=np.array([a.length for a in acqs]), rms_errors=errs,
         amplitudes=g["amplitudes"], peaks=peaks, elapsed=time.perf_counter() - t0,
-        signal_rms=np.array(signal))
+        signal_rms=signal)
