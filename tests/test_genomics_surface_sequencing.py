@@ -77,9 +77,13 @@ def test_one_percent_white_noise(seed):
     assert np.degrees(np.abs(s.angles - g.angles)).max() < 0.5
     assert s.gamma == pytest.approx(g.gamma, rel=5e-3)
     # the misfit is over the heights about their plane (the model's plane takes the rest):
-    # the noise, 1 % of the rms about the mean, is that share of signal_rms
+    # the noise, 1 % of the rms about the mean, is that share of signal_rms. The fit
+    # (every wave its own amplitude) is at the noise level; the genome (amplitudes on its
+    # power law) measured 0.99-1.40 x the noise (seeds 0-4, 11)
     noise = np.array([0.01 * a.heights.std() for a in acq]) / r.signal_rms
-    assert np.all((r.rms_errors > 0.8 * noise) & (r.rms_errors < 1.2 * noise)), r.rms_errors
+    fit = r.fit_rms_errors
+    assert np.all((fit > 0.8 * noise) & (fit < 1.2 * noise)), fit
+    assert np.all((r.rms_errors > 0.8 * noise) & (r.rms_errors < 1.5 * noise)), r.rms_errors
     assert r.success
 
 
@@ -237,7 +241,9 @@ def test_the_noise_floor_ends_the_search(seed, monkeypatch):
     assert np.degrees(np.abs(s.angles - g.angles)).max() < 0.5
     assert s.gamma == pytest.approx(g.gamma, rel=5e-3)
     noise = np.array([0.01 * a.heights.std() for a in acq]) / r.signal_rms
-    assert np.all((r.rms_errors > 0.8 * noise) & (r.rms_errors < 1.2 * noise)), r.rms_errors
+    fit = r.fit_rms_errors
+    assert np.all((fit > 0.8 * noise) & (fit < 1.2 * noise)), fit
+    assert np.all((r.rms_errors > 0.8 * noise) & (r.rms_errors < 1.5 * noise)), r.rms_errors
     if seed < 2:
         monkeypatch.setattr(seq, "NOISE_FLOOR_FACTOR", 0.0)
         full = sequence_surfaces(noisy)
@@ -315,3 +321,63 @@ def test_an_overfit_of_a_measured_profile_is_not_a_genome(topographies_dir):
     r = sequence_profiles(acq)
     assert not r.success and "not a genome" in r.message
     assert np.all(r.rms_errors < 0.05)            # the overfit itself: a tiny misfit
+
+
+def _own_misfits(genome, acq):
+    """Relative rms misfit of ``realize_surface(genome)`` on each acquisition, both about
+    their best plane (the sequencer fits a plane per acquisition)."""
+    out = []
+    for a in acq:
+        n = a.shape[0]
+        xx, yy = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+        plane = np.column_stack([np.ones(n * n), xx.ravel(), yy.ravel()])
+
+        def about_plane(f):
+            return f.ravel() - plane @ np.linalg.lstsq(plane, f.ravel(), rcond=None)[0]
+        d = a.heights - realize_surface(genome, a.metadata["length"], n).heights
+        out.append(np.sqrt(np.mean(about_plane(d) ** 2) / np.mean(about_plane(a.heights) ** 2)))
+    return np.array(out)
+
+
+def _sub_lattice_case():
+    from roughfe.genomics.genome import random_genome
+    g = random_genome(1e-3, 0.8, 1.8, 1.3e-3, 3, 30, rng=np.random.default_rng(3),
+                      angles=[0, np.pi / 2, 2.2], anisotropy=[1.2, 0.9, 1 / 1.08])
+    return g, [realize_surface(g, 1e-3, N), realize_surface(g, 4e-4, N)]
+
+
+@pytest.mark.parametrize("case", ["pair", "one window"])
+def test_a_sub_lattice_fit_is_refitted_on_its_lattice(case):
+    """The direct fits settled on gamma^(1/2) (pair) and gamma^(1/4) (one window of seed
+    1), which reproduce the data to 1e-11 and 1e-6 with k - 1 of every k chromosomes
+    empty; the genome on that lattice (amplitudes on its power law: A x1.41 and x36)
+    misfits its own windows by 94 % and 45 %, and success was True. Now the lattice the
+    fit stands for is found: the true genome, and the reported misfit is the genome's."""
+    if case == "pair":
+        g, acq = _sub_lattice_case()
+    else:
+        g, acq, _ = resolvable_surface_genome(1, length=L1, n_nodes=N)
+        acq = acq[:1]
+    r = sequence_surfaces(acq)
+    assert r.success, r.message
+    assert r.genome.gamma == pytest.approx(g.gamma, rel=1e-10)
+    assert r.genome.A == pytest.approx(g.A, rel=1e-8)
+    np.testing.assert_allclose(r.rms_errors, _own_misfits(r.genome, acq), rtol=0.05,
+                               atol=1e-13)
+    assert np.all(r.rms_errors < 1e-10)
+
+
+def test_the_reported_misfit_is_the_returned_genomes(monkeypatch):
+    """Without the refit on the coarser lattice the sub-lattice genome comes back: its
+    rms_errors (and success) are those of the genome realised on the acquisitions (94 %,
+    82 %), not of the fit with every wave its own amplitude (1e-11, kept as
+    fit_rms_errors)."""
+    import roughfe.genomics.sequencing.surface as seq
+    monkeypatch.setattr(seq, "_coarser_lattices", lambda *args, **kw: [])
+    g, acq = _sub_lattice_case()
+    r = sequence_surfaces(acq)
+    assert r.genome.gamma == pytest.approx(np.sqrt(g.gamma), rel=1e-6)
+    assert np.all(r.fit_rms_errors < 1e-9)
+    np.testing.assert_allclose(r.rms_errors, _own_misfits(r.genome, acq), rtol=1e-6)
+    assert r.rms_errors.min() > 0.5 and not r.success
+    assert "misfit of the genome 0.937, 0.817" in r.message

@@ -1,7 +1,9 @@
 """Step 5 and the report of 2D MWM sequencing: the genes from the fitted wave
 coefficients, the misfit per acquisition and the result.
 
-See :mod:`roughfe.genomics.sequencing.surface` for the model and the conventions.
+See :mod:`roughfe.genomics.sequencing.surface` for the model and the conventions. Beyond
+the thesis: its sequencing (Sec. 3.3.1) is of profiles, whose amplitudes it never checks
+against the genome's power law; here the misfit reported is the returned genome's.
 """
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ from typing import Optional
 
 import numpy as np
 
+from ...surfaces.wm import wm_series
 from ..genome import Genome
 
 
@@ -68,15 +71,16 @@ class SurfaceSequencingResult:
     genome : Genome or None
         The band-limited genome (None when no WM lattice was found).
     success : bool
-        True when every acquisition is reproduced within ``rms_tolerance``.
+        True when the genome reproduces every acquisition within ``rms_tolerance``.
     message : str
     nit : int
         Residual evaluations of the nonlinear fit.
     ranges : list of (int, int)
         Eq. 3.5 chromosome range per acquisition, coarsest first.
     lengths, rms_errors : ndarray
-        Observation lengths (m) and relative rms misfits per acquisition: the rms misfit
-        over ``signal_rms``.
+        Observation lengths (m) and relative rms misfits per acquisition of the returned
+        genome realised on the acquisition's nodes (about the best plane, as the fit
+        takes a plane per acquisition) over ``signal_rms``.
     amplitudes : ndarray (M, n_c)
         Fitted wave amplitudes b_mn (m).
     peaks : list of SurfacePeaks
@@ -84,6 +88,10 @@ class SurfaceSequencingResult:
     signal_rms : ndarray or None
         Rms height of each acquisition about its best plane (m), the part the waves must
         reproduce (the model's plane per acquisition takes the rest); None without a fit.
+    fit_rms_errors : ndarray or None
+        The same misfits of the fit, every wave (m, n) with its own amplitude b_mn; the
+        genome's ``rms_errors`` are larger where the amplitudes are off the power law
+        G gamma^((1-n)H) alpha_m the genome imposes.
     """
 
     genome: Optional[Genome]
@@ -98,6 +106,7 @@ class SurfaceSequencingResult:
     elapsed: float = 0.0
     references: tuple = field(default=("thesis Sec. 3.3.2, Eq. 3.17 (projected form)",))
     signal_rms: Optional[np.ndarray] = None
+    fit_rms_errors: Optional[np.ndarray] = None
 
     def report(self) -> dict:
         g = self.genome
@@ -111,6 +120,8 @@ class SurfaceSequencingResult:
                 "rms_errors": [float(e) for e in self.rms_errors],
                 "signal_rms_m": (None if self.signal_rms is None
                                  else [float(v) for v in self.signal_rms]),
+                "fit_rms_errors": (None if self.fit_rms_errors is None
+                                   else [float(e) for e in self.fit_rms_errors]),
                 "elapsed_s": self.elapsed}
 
 
@@ -121,13 +132,30 @@ def failure(message, acqs, peaks, t0):
         amplitudes=np.zeros((0, 0)), peaks=peaks, elapsed=time.perf_counter() - t0)
 
 
+def genome_residual(genome, full):
+    """Heights minus the genome's realisation on the valid nodes of every acquisition of
+    ``full`` (a GridModel of all nodes), in its row order: the chromosomes of Eq. 3.5 at
+    each acquisition that the genome holds, as :func:`~roughfe.genomics.genome.realize_surface`
+    sums them, at the acquisition's own node coordinates."""
+    out = []
+    for k, (a, grid) in enumerate(zip(full.acqs, full.grids)):
+        lo, hi = genome.held_range(a.length, full.n_nodes)
+        n = np.arange(lo, hi + 1)
+        amps = genome.wave_amplitude(n)[None, :] * genome.anisotropy[:, None]
+        z = wm_series((grid["x"][:, None], grid["y"][None, :]), amps, genome.wavenumber(n),
+                      genome.phase_columns(n), genome.angles)
+        out.append(full.z[full.block == k] - z[grid["ok"]])
+    return np.concatenate(out)
+
+
 def plane_free_misfits(full, resid):
     """Relative rms misfits and signal rms per acquisition of ``full`` (a GridModel of all
-    nodes) for the residual ``resid`` on its rows: the rms residual over the rms height
-    about the acquisition's best plane. Relative to the heights without their best plane:
-    the model fits a plane per acquisition, so a misfit over the variance about the mean
-    let a tilt pass a fit that explained nothing else (10 % noise read 9.9 %, with a tilt
-    of 100 rms 0.34 %)."""
+    nodes) for the residual ``resid`` on its rows: the rms of the residual about its best
+    plane over the rms height about the acquisition's best plane (the model fits a plane
+    per acquisition, so a fit's residual has none and a genome's is taken without its
+    plane). Relative to the heights without their best plane: a misfit over the variance
+    about the mean let a tilt pass a fit that explained nothing else (10 % noise read
+    9.9 %, with a tilt of 100 rms 0.34 %)."""
     errs, signal = [], []
     for k in range(len(full.acqs)):
         rows = full.block == k
@@ -135,7 +163,10 @@ def plane_free_misfits(full, resid):
         xx, yy = np.meshgrid(grid["x"], grid["y"], indexing="ij")
         ok = grid["ok"]
         plane = np.column_stack([np.ones(int(ok.sum())), xx[ok], yy[ok]])
-        zk = full.z[rows] - plane @ np.linalg.lstsq(plane, full.z[rows], rcond=None)[0]
-        signal.append(float(np.sqrt(np.mean(zk ** 2))))
-        errs.append(float(np.sqrt(np.mean(resid[rows] ** 2))) / max(signal[-1], 1e-300))
+
+        def about_plane(f):
+            return f - plane @ np.linalg.lstsq(plane, f, rcond=None)[0]
+        signal.append(float(np.sqrt(np.mean(about_plane(full.z[rows]) ** 2))))
+        errs.append(float(np.sqrt(np.mean(about_plane(resid[rows]) ** 2)))
+                    / max(signal[-1], 1e-300))
     return np.array(errs), np.array(signal)
