@@ -381,3 +381,22 @@ def test_the_reported_misfit_is_the_returned_genomes(monkeypatch):
     np.testing.assert_allclose(r.rms_errors, _own_misfits(r.genome, acq), rtol=1e-6)
     assert r.rms_errors.min() > 0.5 and not r.success
     assert "misfit of the genome 0.937, 0.817" in r.message
+
+
+@pytest.mark.parametrize("seed, n_nodes, gamma, n_ridges, windows",
+                         [(4, 32, 1.6, 2, 2), (10, 48, 1.8, 3, 1)])
+def test_a_ridge_left_empty_by_the_completion_is_dropped(seed, n_nodes, gamma, n_ridges,
+                                                         windows):
+    """A ridge added from the residual takes over the waves of a ridge fitted at a wrong
+    angle (44.2 deg next to the true 45.6; 127.1 next to 137.4), which then holds none.
+    It was kept: M = 3 for 2 (4 for 3), its alpha 1e-9 and, as the alphas have a product
+    of 1, the others x 1e4, A x 4.5e-5 (x 6e-4), success True. Now dropped: the genes."""
+    g, acq, _ = resolvable_surface_genome(seed, length=L1, n_nodes=n_nodes, gamma=gamma,
+                                          n_ridges=n_ridges)
+    r = sequence_surfaces(acq[:windows])
+    s = r.genome
+    assert r.success, r.message
+    assert s.M == g.M
+    np.testing.assert_allclose(s.angles, g.angles, atol=1e-9)
+    np.testing.assert_allclose(s.anisotropy, g.anisotropy, rtol=1e-8)
+    assert s.A == pytest.approx(g.A, rel=1e-8)

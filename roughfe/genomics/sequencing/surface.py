@@ -346,11 +346,9 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
             return out
         return (alt if score(alt) < score(out) else out)[:4] + (out[4] + len(trial) + alt[4],)
 
-    def attempt(p0, continuation):
-        """Fit from p0 and drop merged or empty ridges, then :func:`settle`:
-        (cost, p, ranges, sol, nit)."""
-        p, ranges, nit = _fit(model, p0, continuation=continuation)
-        sol = model.solve(p, ranges)
+    def prune(p, ranges, sol, nit):
+        """Drop merged ridges and ridges with no lattice waves (:func:`_weak_ridges`) and
+        refit: (cost, p, ranges, sol, nit)."""
         p = _merge_duplicate_ridges(p)
         weak = _weak_ridges(sol, p.size - 2) if p.size == sol["mm"].max() + 3 else []
         if len(weak) and len(weak) < p.size - 2 or p.size != sol["mm"].max() + 3:
@@ -359,13 +357,20 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
                                 continuation=False)
             nit += k
             sol = model.solve(p, ranges)
-        return settle((float(sol["resid"] @ sol["resid"]), p, ranges, sol, nit))
+        return float(sol["resid"] @ sol["resid"]), p, ranges, sol, nit
+
+    def attempt(p0, continuation):
+        """Fit from p0, :func:`prune`, then :func:`settle`: (cost, p, ranges, sol, nit)."""
+        p, ranges, nit = _fit(model, p0, continuation=continuation)
+        return settle(prune(p, ranges, model.solve(p, ranges), nit))
 
     def complete(out):
         """Add the ridges the first clustering missed (best lattice only), then
-        :func:`settle`."""
+        :func:`prune` (an added ridge can take over the waves of a ridge found at a wrong
+        angle, which then holds none: kept, it came out with alpha ~ 1e-9 and, as the
+        alphas have a product of 1, the others x 1e4 and A x 1e-4) and :func:`settle`."""
         p, ranges, sol, k = _add_missing_ridges(model, full, out[1], out[2], out[3], tiny)
-        return settle((float(sol["resid"] @ sol["resid"]), p, ranges, sol, out[4] + k))
+        return settle(prune(p, ranges, sol, out[4] + k))
 
     starts = []
     for period, ref in zip(periods, refs):
