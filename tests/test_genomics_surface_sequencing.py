@@ -77,13 +77,11 @@ def test_one_percent_white_noise(seed):
     assert np.degrees(np.abs(s.angles - g.angles)).max() < 0.5
     assert s.gamma == pytest.approx(g.gamma, rel=5e-3)
     # the misfit is over the heights about their plane (the model's plane takes the rest):
-    # the noise, 1 % of the rms about the mean, is that share of signal_rms. The fit
-    # (every wave its own amplitude) is at the noise level; the genome (amplitudes on its
-    # power law) measured 0.99-1.40 x the noise (seeds 0-4, 11)
+    # the noise, 1 % of the rms about the mean, is that share of signal_rms; both the fit
+    # (every wave its own amplitude) and the genome (amplitudes on its power law)
     noise = np.array([0.01 * a.heights.std() for a in acq]) / r.signal_rms
-    fit = r.fit_rms_errors
-    assert np.all((fit > 0.8 * noise) & (fit < 1.2 * noise)), fit
-    assert np.all((r.rms_errors > 0.8 * noise) & (r.rms_errors < 1.5 * noise)), r.rms_errors
+    for e in (r.fit_rms_errors, r.rms_errors):
+        assert np.all((e > 0.8 * noise) & (e < 1.2 * noise)), e
     assert r.success
 
 
@@ -241,9 +239,8 @@ def test_the_noise_floor_ends_the_search(seed, monkeypatch):
     assert np.degrees(np.abs(s.angles - g.angles)).max() < 0.5
     assert s.gamma == pytest.approx(g.gamma, rel=5e-3)
     noise = np.array([0.01 * a.heights.std() for a in acq]) / r.signal_rms
-    fit = r.fit_rms_errors
-    assert np.all((fit > 0.8 * noise) & (fit < 1.2 * noise)), fit
-    assert np.all((r.rms_errors > 0.8 * noise) & (r.rms_errors < 1.5 * noise)), r.rms_errors
+    for e in (r.fit_rms_errors, r.rms_errors):
+        assert np.all((e > 0.8 * noise) & (e < 1.2 * noise)), e
     if seed < 2:
         monkeypatch.setattr(seq, "NOISE_FLOOR_FACTOR", 0.0)
         full = sequence_surfaces(noisy)
@@ -370,8 +367,8 @@ def test_a_sub_lattice_fit_is_refitted_on_its_lattice(case):
 def test_the_reported_misfit_is_the_returned_genomes(monkeypatch):
     """Without the refit on the coarser lattice the sub-lattice genome comes back: its
     rms_errors (and success) are those of the genome realised on the acquisitions (94 %,
-    82 %), not of the fit with every wave its own amplitude (1e-11, kept as
-    fit_rms_errors)."""
+    82 %; 47 %, 50 % with the genes of least height misfit), not of the fit with every
+    wave its own amplitude (1e-11, kept as fit_rms_errors)."""
     import roughfe.genomics.sequencing.surface as seq
     monkeypatch.setattr(seq, "_coarser_lattices", lambda *args, **kw: [])
     g, acq = _sub_lattice_case()
@@ -379,8 +376,8 @@ def test_the_reported_misfit_is_the_returned_genomes(monkeypatch):
     assert r.genome.gamma == pytest.approx(np.sqrt(g.gamma), rel=1e-6)
     assert np.all(r.fit_rms_errors < 1e-9)
     np.testing.assert_allclose(r.rms_errors, _own_misfits(r.genome, acq), rtol=1e-6)
-    assert r.rms_errors.min() > 0.5 and not r.success
-    assert "misfit of the genome 0.937, 0.817" in r.message
+    assert r.rms_errors.min() > 0.3 and not r.success
+    assert f"misfit of the genome {r.rms_errors[0]:.3g}, {r.rms_errors[1]:.3g}" in r.message
 
 
 @pytest.mark.parametrize("seed, n_nodes, gamma, n_ridges, windows",
@@ -400,3 +397,19 @@ def test_a_ridge_left_empty_by_the_completion_is_dropped(seed, n_nodes, gamma, n
     np.testing.assert_allclose(s.angles, g.angles, atol=1e-9)
     np.testing.assert_allclose(s.anisotropy, g.anisotropy, rtol=1e-8)
     assert s.A == pytest.approx(g.A, rel=1e-8)
+
+
+def test_the_genes_minimise_the_genomes_height_misfit():
+    """1 % noise, seed 4: the genes from the fit of ln b_mn (weighted by b_mn^2) gave A
+    6.5 % and H 0.0072 off and a genome misfitting its windows by 1.31 / 1.40 x the noise
+    (the long waves, nearly collinear with each other and the plane near the window
+    length, are poorly set by the heights and weighed most); refined to the least height
+    misfit with the fitted phases: A 1.5 %, H 0.0017, 1.05 / 1.03 x."""
+    g, acq, rng = _genome(4)
+    noisy = [a.with_heights(a.heights + 0.01 * a.heights.std() * rng.normal(size=a.shape))
+             for a in acq]
+    r = sequence_surfaces(noisy)
+    noise = np.array([0.01 * a.heights.std() for a in acq]) / r.signal_rms
+    assert np.all(r.rms_errors < 1.1 * noise), r.rms_errors / noise
+    assert r.genome.A == pytest.approx(g.A, rel=0.03)
+    assert r.genome.H == pytest.approx(g.H, abs=0.003)

@@ -56,8 +56,9 @@ Steps (:func:`sequence_surfaces`)
    chromosome may be a sub-lattice gamma^(1/k) fit: it is also tried on the coarser
    lattices (:func:`_coarser_lattices`), the lower BIC wins.
 5. Genes: b_mn, phi_mn from the coefficients; (ln G, H, ln alpha) by least squares on
-   ln b_mn weighted by b_mn^2; A from G (Eq. 3.1) (:mod:`.surface_result`, with the
-   misfits and the result).
+   ln b_mn weighted by b_mn^2, refined to the least height misfit of the genome with the
+   fitted phases; A from G (Eq. 3.1) (:mod:`.surface_result`, with the misfits and the
+   result).
 Undefined points (NaN) of a measured acquisition are left out of every step. The misfit
 reported (``rms_errors``, ``success``) is that of the returned genome realised on the
 acquisitions, not of the fit (every wave its own amplitude, ``fit_rms_errors``).

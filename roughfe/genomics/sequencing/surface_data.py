@@ -375,7 +375,8 @@ class GridModel:
         evaluated on the grid, and one step of iterative refinement (``exact``: two)
         restores the accuracy of a backward-stable solver: noise-free data are fitted to
         round-off (relative cost ~1e-29, not the ~1e-20 floor of the plain normal
-        equations), which the fit's "reproduced to round-off" test needs.
+        equations), which the fit's "reproduced to round-off" test needs. ``gram``: the
+        Gram matrix A^T A of the design (real layout), for the genes' height misfit.
         """
         nn, mm, q, theta_w = self._waves(p, ranges, cap)
         w = nn.size
@@ -406,7 +407,7 @@ class GridModel:
             res = residual(coef)
         resid = np.concatenate([r[g["ok"]] for r, g in zip(res, self.grids)])
         return dict(nn=nn, mm=mm, q=q, theta_w=theta_w, coef=coef, resid=resid, fac=fac,
-                    lsq=lsq)
+                    lsq=lsq, gram=gram * np.outer(norm, norm))
 
     def jacobian(self, p, sol):
         """Kaufman's variable-projection Jacobian d(resid)/d(p) ~ -(I - P) (dA/dp) c for
