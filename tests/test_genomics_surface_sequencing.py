@@ -413,3 +413,17 @@ def test_the_genes_minimise_the_genomes_height_misfit():
     assert np.all(r.rms_errors < 1.1 * noise), r.rms_errors / noise
     assert r.genome.A == pytest.approx(g.A, rel=0.03)
     assert r.genome.H == pytest.approx(g.H, abs=0.003)
+
+
+def test_the_refit_on_a_coarser_lattice_is_not_refitted_again(monkeypatch):
+    """The refit from a coarser start can converge back to the finer lattice, which was
+    then offered its coarser lattices again, without end (RecursionError: N = 64, seed 1,
+    3 % undefined points and a plane). Here every fit is taken for a sub-lattice and its
+    "coarser" start is its own lattice: one refit each, the genome as without."""
+    import roughfe.genomics.sequencing.surface as seq
+    monkeypatch.setattr(seq, "_every_chromosome_present", lambda *args, **kw: False)
+    monkeypatch.setattr(seq, "_coarser_lattices", lambda p, *args, **kw: [p.copy()])
+    g, acq, _ = _genome(5)
+    r = sequence_surfaces(acq)
+    assert r.success and r.genome.M == g.M
+    assert r.genome.gamma == pytest.approx(g.gamma, rel=1e-10)

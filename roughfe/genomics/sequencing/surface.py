@@ -328,8 +328,10 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     def settle(out):
         """A fit within the tolerance with an empty chromosome may stand for a coarser
         lattice (a sub-lattice fit): the best-scoring start of :func:`_coarser_lattices`
-        is fitted and the lower BIC of the two is kept. (Poor fits are left alone: among
-        them the BIC is a lottery, measured 1 seed in 100 turned from right to wrong.)"""
+        is fitted (not settled again: every k is offered at once, and the refit can
+        converge back to the finer lattice) and the lower BIC of the two is kept. (Poor
+        fits are left alone: among them the BIC is a lottery, measured 1 seed in 100
+        turned from right to wrong.)"""
         if out[0] > good or _every_chromosome_present(out[3], noise=noise_amplitude):
             return out
         trial = []
@@ -342,7 +344,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         if not trial:
             return out
         try:
-            alt = attempt(min(trial, key=score)[1], False)
+            alt = attempt(min(trial, key=score)[1], False, coarsen=False)
         except (np.linalg.LinAlgError, ValueError):
             return out
         return (alt if score(alt) < score(out) else out)[:4] + (out[4] + len(trial) + alt[4],)
@@ -360,10 +362,12 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
             sol = model.solve(p, ranges)
         return float(sol["resid"] @ sol["resid"]), p, ranges, sol, nit
 
-    def attempt(p0, continuation):
-        """Fit from p0, :func:`prune`, then :func:`settle`: (cost, p, ranges, sol, nit)."""
+    def attempt(p0, continuation, coarsen=True):
+        """Fit from p0, :func:`prune`, then (``coarsen``) :func:`settle`:
+        (cost, p, ranges, sol, nit)."""
         p, ranges, nit = _fit(model, p0, continuation=continuation)
-        return settle(prune(p, ranges, model.solve(p, ranges), nit))
+        out = prune(p, ranges, model.solve(p, ranges), nit)
+        return settle(out) if coarsen else out
 
     def complete(out):
         """Add the ridges the first clustering missed (best lattice only), then
