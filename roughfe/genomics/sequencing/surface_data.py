@@ -10,6 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 import scipy.linalg
+import scipy.sparse
+import scipy.sparse.linalg
 from scipy.ndimage import maximum_filter
 from scipy.signal.windows import blackmanharris
 
@@ -146,12 +148,54 @@ def _parabola_offset(lm, l0, lp):
     return np.where(den < 0, 0.5 * (lm - lp) / np.where(den < 0, den, -1.0), 0.0)
 
 
+def harmonic_fill(z):
+    """``z`` (N x N, NaN = undefined) with every undefined node set to the mean of its
+    grid neighbours (the discrete harmonic fill: a sparse Laplace solve with the defined
+    nodes as boundary values; an isolated node gets the mean of its 4 neighbours). The
+    interpolation the file readers use (SurfaceTopography's ``interpolate_undefined_data``),
+    solved directly: 1000x faster at 512^2.
+
+    For the periodogram only: undefined nodes set to zero act as impulsive noise of about
+    sqrt(fraction) of the rms height (17 % at 3 % undefined), which raised the noise floor
+    and dropped the peaks of a WM surface (measured, 3 % undefined, seeds 0-49: 14 of 50
+    at N = 48 and 6 of 50 at N = 64 failed with "only k spectral peaks" or similar). The
+    fit leaves the undefined nodes out (:class:`GridModel`)."""
+    bad = ~np.isfinite(z)
+    out = np.where(bad, 0.0, z)
+    if not bad.any():
+        return out
+    idx = np.full(z.shape, -1)
+    idx[bad] = np.arange(int(bad.sum()))
+    rows, cols, vals = [], [], []
+    diag = np.zeros(int(bad.sum()))
+    rhs = np.zeros(int(bad.sum()))
+    bi, bj = np.nonzero(bad)
+    for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+        ni, nj = bi + di, bj + dj
+        inside = (ni >= 0) & (ni < z.shape[0]) & (nj >= 0) & (nj < z.shape[1])
+        k, ni, nj = idx[bi[inside], bj[inside]], ni[inside], nj[inside]
+        diag[k] += 1.0
+        other = idx[ni, nj]
+        unknown = other >= 0
+        rows.append(k[unknown])
+        cols.append(other[unknown])
+        rhs[k[~unknown]] += out[ni[~unknown], nj[~unknown]]
+    mat = scipy.sparse.coo_matrix(
+        (np.r_[diag, -np.ones(sum(r.size for r in rows))],
+         (np.r_[np.arange(diag.size), np.concatenate(rows)],
+          np.r_[np.arange(diag.size), np.concatenate(cols)])), shape=(diag.size,) * 2)
+    out[bad] = scipy.sparse.linalg.spsolve(mat.tocsc(), rhs)
+    return out
+
+
 def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
     """Peaks of the Blackman-Harris windowed, zero-padded periodogram (half plane q_y >= 0).
 
     A peak is a local maximum over +-3 original bins whose power exceeds both
     ``dynamic_range`` times the largest peak and 30 times the median power (the noise
-    floor); sub-bin positions by a parabola in log power along each axis.
+    floor); sub-bin positions by a parabola in log power along each axis. Undefined nodes
+    are filled by :func:`harmonic_fill` first (set to zero they were impulsive noise that
+    lifted the median and hid peaks).
 
     ``noise_variance``: the variance sigma^2 (m^2) of white noise on the heights, from the
     plateau of the periodogram above half the Nyquist wavenumber (|k_x| or |k_y|): there a
@@ -159,12 +203,14 @@ def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
     so the median bin is noise. A bin of white noise is complex Gaussian with mean power
     sigma^2 sum(w^2) (the window over the defined nodes; the zero padding adds nothing),
     exponentially distributed: sigma^2 = median / (ln 2 sum(w^2)). On noise-free data it
-    is the side-lobe and round-off level.
+    is the side-lobe and round-off level; with undefined nodes it includes the error of the
+    fill there (white too: impulses at scattered nodes), which the caller must not take
+    for noise.
     """
     n = acq.z.shape[0]
     d = acq.x[1] - acq.x[0]
     ok = acq.valid
-    z = np.where(ok, acq.z - acq.z[ok].mean(), 0.0)
+    z = harmonic_fill(acq.z - acq.z[ok].mean())
     w1 = blackmanharris(n)
     window = np.outer(w1, w1)
     spec = scipy.fft.rfft2(z * window, s=(PAD * n, PAD * n))
@@ -384,7 +430,7 @@ class GridModel:
         fac = [self._factors(k, q, theta_w, (nn >= ns) & (nn <= nf))
                for k, (ns, nf) in enumerate(ranges)]
         gram = sum(self._gram(k, fx, fy, w, n_cols) for k, (fx, fy) in enumerate(fac))
-        norm = np.sqrt(np.diag(gram))
+        norm = np.sqrt(np.clip(np.diag(gram), 0.0, None))    # round-off: undefined nodes
         norm[norm == 0] = 1.0
         gram = gram / np.outer(norm, norm)
         gram[np.diag_indices_from(gram)] += 1e-13 * n_cols        # two ridges merging
