@@ -154,7 +154,8 @@ def test_separable_grid_model_equals_the_dense_design():
     the coefficients of a dense least-squares fit of the explicit cos/sin/plane design, and
     its variable-projection Jacobian at the true lattice (zero residual, where Kaufman's
     form is exact) equals central finite differences of the residual."""
-    from roughfe.genomics.sequencing.surface_data import GridModel, surface_acquisitions
+    from roughfe.genomics.sequencing.surface_data import surface_acquisitions
+    from roughfe.genomics.sequencing.surface_grid import GridModel
     g, (a1, a2), rng = _genome(5)
     bad = rng.random(a1.shape) < 0.05
     acqs = surface_acquisitions([a1, a2], valid=[~bad, None])
@@ -195,7 +196,8 @@ def test_an_exact_sub_lattice_is_told_from_the_lattice():
     chromosomes come out empty); the sequencer stops at the first exact candidate only
     when every chromosome carries a wave, which tells the lattice from a sub-lattice."""
     from roughfe.genomics.sequencing.surface import _every_chromosome_present
-    from roughfe.genomics.sequencing.surface_data import GridModel, surface_acquisitions
+    from roughfe.genomics.sequencing.surface_data import surface_acquisitions
+    from roughfe.genomics.sequencing.surface_grid import GridModel
     g, acq, _ = _genome(5)
     model = GridModel(surface_acquisitions(acq), N)
     true = model.ranges(np.log(2 * np.pi / g.lambda1), np.log(g.gamma))
@@ -255,8 +257,8 @@ def test_a_noisy_sub_lattice_holds_noise_only_in_its_extra_chromosomes():
     which the presence test measured against the noise floor tells apart."""
     from roughfe.genomics.sequencing.surface import (NOISE_FLOOR_FACTOR, _every_chromosome_present,
                                                      _noise_floor)
-    from roughfe.genomics.sequencing.surface_data import (GridModel, surface_acquisitions,
-                                                          surface_peaks)
+    from roughfe.genomics.sequencing.surface_data import surface_acquisitions, surface_peaks
+    from roughfe.genomics.sequencing.surface_grid import GridModel
     g, acq, rng = _genome(5)
     noisy = surface_acquisitions(
         [a.with_heights(a.heights + 0.01 * a.heights.std() * rng.normal(size=a.shape))

@@ -46,7 +46,7 @@ Steps (:func:`sequence_surfaces`)
    (m, n) wave plus a plane per acquisition (which absorbs a removed mean plane);
    (ln q1, ln gamma, theta_1..theta_M) are refined by Levenberg-Marquardt with the
    Kaufman Jacobian, in continuation over the highest chromosome fitted; every product
-   is separable on the tensor grids of the acquisitions (:class:`.surface_data.GridModel`);
+   is separable on the tensor grids of the acquisitions (:class:`.surface_grid.GridModel`);
    among the gamma candidates the lowest BIC wins (:func:`_bic`). The search stops at the
    first candidate that fits the data to round-off or down to its white-noise floor (the
    noise variance read from the periodogram's high-q plateau, :func:`_noise_floor`) with
@@ -74,8 +74,9 @@ from scipy.optimize import least_squares
 from ..genome import Genome
 from .acquisitions import check_controls
 from .lattice import comb_periods, label_q1, lattice_from_period
-from .surface_data import (ANGLE_TOL, GridModel, SurfaceAcquisition, cluster_angles,
+from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles,
                            surface_acquisitions, surface_peaks)
+from .surface_grid import GridModel
 from .surface_result import (SurfaceSequencingResult, failure, genes_from_fit,
                              genome_residual, plane_free_misfits)
 
