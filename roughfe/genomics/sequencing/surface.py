@@ -74,7 +74,7 @@ from scipy.optimize import least_squares
 from ..genome import Genome
 from .acquisitions import check_controls
 from .lattice import comb_periods, label_q1, lattice_from_period
-from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles,
+from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, noise_variance,
                            surface_acquisitions, surface_peaks)
 from .surface_grid import GridModel
 from .surface_result import (SurfaceSequencingResult, failure, genes_from_fit,
@@ -198,13 +198,14 @@ def _coarser_lattices(p, sol, coarse_length, k_max=6, gamma_max=4.0):
     return starts
 
 
-def _noise_floor(model, peaks):
+def _noise_floor(model, variances):
     """The white-noise floor of a fit on ``model``: ``(cost, amplitude)``, the residual sum
-    of squares (m^2) the noise alone leaves (sigma_k^2 per row of acquisition k, from the
-    periodogram plateau of :func:`~.surface_data.surface_peaks`) and the standard error
-    (m) of a wave amplitude fitted to it, sigma sqrt(2 / rows) with the largest sigma and
-    the fewest rows of an acquisition (the strictest test of a chromosome's presence)."""
-    var = np.array([pk.noise_variance for pk in peaks])
+    of squares (m^2) the noise alone leaves (``variances``: sigma_k^2 per row of
+    acquisition k, from the periodogram plateau of :func:`~.surface_data.surface_peaks`)
+    and the standard error (m) of a wave amplitude fitted to it, sigma sqrt(2 / rows) with
+    the largest sigma and the fewest rows of an acquisition (the strictest test of a
+    chromosome's presence)."""
+    var = np.asarray(variances, float)
     rows = np.bincount(model.block, minlength=var.size)
     return (float(var @ rows),
             float(np.sqrt(var.max() * 2.0 / max(int(rows[rows > 0].min()), 1))))
@@ -248,12 +249,12 @@ def _add_missing_ridges(model, full, p, ranges, sol, done, max_new=8):
     """Greedy completion: a direction that holds the strongest peaks of the residual's
     periodogram becomes a new ridge when the refit halves the residual (ridges with one
     detected peak, or close to a stronger one, are missed by the first clustering).
-    Nothing is tried once the residual sum of squares is at most ``done`` (round-off or
-    the noise floor: no refit can halve it there)."""
+    Nothing is tried once ``done(cost, p, ranges, sol)`` (the residual sum of squares at
+    round-off or the noise floor: no refit can halve it there)."""
     nit = 0
     cost = float(sol["resid"] @ sol["resid"])
     for _ in range(max_new):
-        if cost <= done:
+        if done(cost, p, ranges, sol):
             break
         peaks = [surface_peaks(a) for a in _residual_acquisitions(full, p, ranges)]
         ang = np.concatenate([pk.angle for pk in peaks])
@@ -319,8 +320,26 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     full = GridModel(acqs, n_nodes)
     # fitted to round-off, or down to the white-noise floor of the data (measured data,
     # noise): no other gamma candidate, continuation or added ridge can do better
-    noise_cost, noise_amplitude = _noise_floor(model, peaks)
-    tiny = max(1e-24 * float(model.z @ model.z), NOISE_FLOOR_FACTOR * noise_cost)
+    noise_cost, noise_amplitude = _noise_floor(model, [pk.noise_variance for pk in peaks])
+    round_off = 1e-24 * float(model.z @ model.z)
+    tiny = max(round_off, NOISE_FLOOR_FACTOR * noise_cost)
+    holes = not all(a.valid.all() for a in acqs)
+
+    def at_floor(cost, p, ranges, sol):
+        """True when a fit's cost is at round-off or the noise floor. With undefined
+        nodes the periodogram's plateau holds the error of their harmonic fill too (white,
+        like noise): it let a fit stop at a 3 % misfit of noise-free data. The floor is
+        then read again with the undefined nodes filled by this fit's own heights, whose
+        error there is the fit's misfit on a few per cent of the nodes: it cannot pass
+        for noise."""
+        if cost <= round_off or (cost <= tiny and not holes):
+            return True
+        if cost > tiny:
+            return False
+        filled = [SurfaceAcquisition(a.x, a.y, np.where(a.valid, a.z, h), a.length)
+                  for a, h in zip(acqs, full.heights(p, ranges, sol["coef"]))]
+        floor = _noise_floor(model, [noise_variance(a) for a in filled])[0]
+        return cost <= NOISE_FLOOR_FACTOR * floor
     good = max(tiny, rms_tolerance ** 2 * float(model.z @ model.z))   # within the tolerance
 
     def score(out):
@@ -375,7 +394,8 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         :func:`prune` (an added ridge can take over the waves of a ridge found at a wrong
         angle, which then holds none: kept, it came out with alpha ~ 1e-9 and, as the
         alphas have a product of 1, the others x 1e4 and A x 1e-4) and :func:`settle`."""
-        p, ranges, sol, k = _add_missing_ridges(model, full, out[1], out[2], out[3], tiny)
+        p, ranges, sol, k = _add_missing_ridges(model, full, out[1], out[2], out[3],
+                                                at_floor)
         return settle(prune(p, ranges, sol, out[4] + k))
 
     starts = []
@@ -396,8 +416,8 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
                 outs.append(attempt(p0, continuation))
             except (np.linalg.LinAlgError, ValueError):
                 continue
-            if outs[-1][0] <= tiny and _every_chromosome_present(outs[-1][3],
-                                                                 noise=noise_amplitude):
+            if (_every_chromosome_present(outs[-1][3], noise=noise_amplitude)
+                    and at_floor(*outs[-1][:4])):
                 break        # exact (or at the noise floor), and not a sub-lattice
         nit += sum(o[4] for o in outs)
         if not outs:
@@ -407,7 +427,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         nit += top[4] - first[4]
         if best is None or score(top) < score(best):
             best = top
-        if best[0] <= tiny:
+        if at_floor(*best[:4]):
             break
     if best is None:
         return failure("no gamma candidate gave a lattice fit", acqs, peaks, t0)

@@ -186,6 +186,28 @@ def harmonic_fill(z):
     return out
 
 
+def _periodogram(acq: SurfaceAcquisition):
+    """(power, noise variance) of :func:`surface_peaks`: the windowed, zero-padded
+    periodogram of the heights about their mean (undefined nodes filled) and the white-noise
+    variance (m^2) read from its plateau."""
+    n = acq.z.shape[0]
+    ok = acq.valid
+    z = harmonic_fill(acq.z - acq.z[ok].mean())
+    w1 = blackmanharris(n)
+    window = np.outer(w1, w1)
+    power = np.abs(scipy.fft.rfft2(z * window, s=(PAD * n, PAD * n))) ** 2
+    m_pad = PAD * n
+    high_x = np.abs(np.fft.fftfreq(m_pad)) >= 0.25         # above half the Nyquist wavenumber
+    high_y = np.arange(power.shape[1]) >= m_pad // 4
+    return power, float(np.median(power[high_x[:, None] | high_y[None, :]])) / (
+        math.log(2.0) * float(np.sum(window[ok] ** 2)))
+
+
+def noise_variance(acq: SurfaceAcquisition) -> float:
+    """The white-noise variance (m^2) of :func:`surface_peaks` alone (no peak search)."""
+    return _periodogram(acq)[1]
+
+
 def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
     """Peaks of the Blackman-Harris windowed, zero-padded periodogram (half plane q_y >= 0).
 
@@ -207,17 +229,8 @@ def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
     """
     n = acq.z.shape[0]
     d = acq.x[1] - acq.x[0]
-    ok = acq.valid
-    z = harmonic_fill(acq.z - acq.z[ok].mean())
-    w1 = blackmanharris(n)
-    window = np.outer(w1, w1)
-    spec = scipy.fft.rfft2(z * window, s=(PAD * n, PAD * n))
-    power = np.abs(spec) ** 2
+    power, noise = _periodogram(acq)
     m_pad = PAD * n
-    high_x = np.abs(np.fft.fftfreq(m_pad)) >= 0.25         # above half the Nyquist wavenumber
-    high_y = np.arange(power.shape[1]) >= m_pad // 4
-    noise = float(np.median(power[high_x[:, None] | high_y[None, :]])) / (
-        math.log(2.0) * float(np.sum(window[ok] ** 2)))
     size = 2 * 3 * PAD + 1
     is_max = power == maximum_filter(power, size=size, mode="wrap")
     floor = 30.0 * float(np.median(power))

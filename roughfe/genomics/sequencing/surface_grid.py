@@ -163,6 +163,15 @@ class GridModel:
         return dict(nn=nn, mm=mm, q=q, theta_w=theta_w, coef=coef, resid=resid, fac=fac,
                     lsq=lsq, gram=gram * np.outer(norm, norm))
 
+    def heights(self, p, ranges, coef):
+        """The model's heights (waves and planes) for the coefficients ``coef`` (real
+        layout, as :meth:`solve` returns them at ``p``, ``ranges``) on every node of each
+        acquisition's grid, undefined nodes included: one array per acquisition."""
+        nn, _, q, theta_w = self._waves(p, ranges, None)
+        return [self._evaluate(*self._factors(k, q, theta_w, (nn >= ns) & (nn <= nf)),
+                               self._weights(k, coef, nn.size))
+                for k, (ns, nf) in enumerate(ranges)]
+
     def jacobian(self, p, sol):
         """Kaufman's variable-projection Jacobian d(resid)/d(p) ~ -(I - P) (dA/dp) c for
         p = (ln q1, ln gamma, theta_1..theta_M), evaluated on the grid by separable products:
