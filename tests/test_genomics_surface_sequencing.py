@@ -465,3 +465,27 @@ def test_the_fill_error_is_not_taken_for_noise():
     assert r.genome.gamma == pytest.approx(g.gamma, rel=1e-10)
     assert r.genome.A == pytest.approx(g.A, rel=1e-8)
     assert np.all(r.rms_errors < 1e-10)
+
+
+def test_a_sequenced_surface_genome_realises_as_its_surface(tmp_path, capsys):
+    """`genome realize` on a sequenced 2D genome wrote a 512-point profile by Eq. 3.1 that
+    ignored the ridge angles, and the sequencer stored no n_nodes for --nodes' default.
+    Now the N x N window of Eq. 3.17 the sequencer models, N of the acquisitions: the
+    acquisition itself."""
+    from roughfe.cli import main
+    from roughfe.surfaces.io import load_surface, save_surface
+    g, (a1, a2), _ = _genome(7)
+    p1, p2 = save_surface(a1, tmp_path / "a1.npz"), save_surface(a2, tmp_path / "a2.npz")
+    assert main(["genome", "sequence", str(p1), str(p2), "--no-figures",
+                 "-o", str(tmp_path / "seq")]) == 0
+    genome = str(tmp_path / "seq" / "genome.json")
+    assert main(["genome", "realize", genome, "--length", str(L1),
+                 "-o", str(tmp_path / "r.npz")]) == 0
+    assert "realised surface L = 0.001 m, N = 48" in capsys.readouterr().out
+    r = load_surface(tmp_path / "r.npz")
+    assert r.shape == (N, N) and not r.periodic
+    np.testing.assert_allclose(r.heights, a1.heights, atol=1e-10 * np.abs(a1.heights).max())
+    assert main(["genome", "realize", genome, "--length", str(L1), "--chromosomes", "2",
+                 "-o", str(tmp_path / "c.npz")]) == 2
+    assert "a surface genome (ridge angles) is realised with the Eq. 3.5" in \
+        capsys.readouterr().err

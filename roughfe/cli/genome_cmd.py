@@ -36,7 +36,7 @@ def _example(args) -> int:
 
 def _realize(args) -> int:
     from ..errors import InputError
-    from ..genomics.genome import load_genome, realize
+    from ..genomics.genome import load_genome, realize, realize_surface
     from ..genomics.periodic import realization
     from ..surfaces.io import save_surface
     g = load_genome(args.genome)
@@ -56,11 +56,22 @@ def _realize(args) -> int:
             raise InputError("--scale is for profiles; this genome is a part of a periodic "
                              "surface design: give --length (default: the design's)")
         s = realization(g, length, nodes, 2, chromosomes)
+    elif g.angles is not None:
+        # a surface genome (ridge angles: sequenced from 2D acquisitions, or made with
+        # angles): the non-periodic N x N window of Eq. 3.17 the sequencer models; its
+        # profile by Eq. 3.1 would ignore the angles (no line of that surface)
+        if args.chromosomes:
+            raise InputError(f"--chromosomes {' '.join(map(str, args.chromosomes))}: a "
+                             f"surface genome (ridge angles) is realised with the Eq. 3.5 "
+                             f"chromosomes it holds; --chromosomes is for profiles and parts "
+                             f"of a design")
+        s = realize_surface(g, g.length_of(args.scale) if args.scale else length, nodes)
     else:
         s = realize(g, length=length, scale=args.scale, n_nodes=nodes, chromosomes=chromosomes)
     save_surface(s, out)
     m = s.metadata
-    print(f"realised {'periodic surface ' if s.ndim == 2 else ''}L = {m['length']:.6g} m, "
+    kind = {1: "", 2: "surface " if not s.periodic else "periodic surface "}[s.ndim]
+    print(f"realised {kind}L = {m['length']:.6g} m, "
           f"N = {m['n_nodes']}, chromosomes "
           f"{m['chromosomes'][0]}..{m['chromosomes'][-1]} (Eq. 3.5: n_s = {m['n_s']}, n_f = {m['n_f']}) "
           f"-> {out}")
@@ -328,10 +339,15 @@ def register(sub):
                    help="last chromosome with a phase (22 covers the 100x scale)")
     p.set_defaults(func=_example)
 
-    p = gs.add_parser("realize", help="realise a genome as a profile (Eq. 3.1, 3.5)",
+    p = gs.add_parser("realize", help="realise a genome as a profile (Eq. 3.1, 3.5) or, "
+                                      "with ridge angles, a 2D surface (Eq. 3.17)",
                       description="Realise a roughfe-genome JSON as a profile of N nodes over "
                                   "L (Eq. 3.1 with the chromosomes of Eq. 3.5) and save it as "
-                                  "a roughfe .npz surface.")
+                                  "a roughfe .npz surface. A genome with ridge angles (e.g. "
+                                  "sequenced from 2D acquisitions) is realised as the N x N "
+                                  "window of Eq. 3.17 (projected plane waves; beyond the "
+                                  "thesis), a part of a periodic surface design as its "
+                                  "periodic surface.")
     p.add_argument("genome", metavar="GENOME.json", help="roughfe-genome JSON file")
     _length_or_scale(p, required=False)      # required, unless the genome is a design part
     p.add_argument("--nodes", type=positive_int, default=None,
@@ -341,7 +357,7 @@ def register(sub):
     p.add_argument("--chromosomes", type=positive_int, nargs="+",
                    help="sum only these chromosome indices (default: those of Eq. 3.5, or "
                         "the part's own for a part of a design)")
-    add_output_file(p, "profile .npz to write (roughfe surface format)")
+    add_output_file(p, "profile or surface .npz to write (roughfe surface format)")
     p.set_defaults(func=_realize)
 
     p = gs.add_parser("sequence", help="sequence a genome from nested acquisitions (profiles or 2D surfaces)",

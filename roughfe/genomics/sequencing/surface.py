@@ -441,7 +441,9 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
             peaks, t0)
     genome = Genome(A=g["A"], H=g["H"], gamma=g["gamma"], lambda1=g["lambda1"],
                     phases=g["phases"], n_first=g["n_first"], angles=g["angles"],
-                    anisotropy=g["anisotropy"], metadata={"source": "sequence_surfaces"})
+                    anisotropy=g["anisotropy"],
+                    metadata={"source": "sequence_surfaces", "n_nodes": n_nodes,
+                              "lengths": [a.length for a in acqs]})
     # the misfit of the returned genome (its amplitudes on the power law of its lattice),
     # not of the fit (every wave its own amplitude): the two agree for a WM surface and
     # differ where the genes do not describe the fitted waves (a sub-lattice fit: 1e-11
