@@ -1,6 +1,7 @@
 """Targets of a measured (non-periodic) window for surface design (issue 15 Sec. 3): the
 evenly mirrored window is the periodic interface the designs are; the window alone on a
 half-space adds its own bulk compliance in series (1/K_window ~ 1/K_periodic + C)."""
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -161,3 +162,29 @@ def test_profile_target_defaults_to_the_profile_databases_own_setting():
     np.testing.assert_allclose(curve.stiffness, own.stiffness, rtol=1e-12)
     _, _, mirrored = surface_targets(profile, settings, detrend="none", boundary="periodic")
     assert mirrored.stiffness[-1] > 10 * own.stiffness[-1]
+
+
+def test_a_surface_database_refuses_a_profile_target(tmp_path, capsys):
+    """`design-targets --db <dim-2 db> --surface profile.npz` wrote targets of a 1D profile
+    (a line contact) for periodic 2D designs, with no error; `design --match-spectrum`
+    refused the same file. Both now say so (target_surface, which both read)."""
+    from roughfe.cli import main
+    from roughfe.genomics.database.store import connect, write_settings
+    from roughfe.genomics.design.targets import target_surface
+    from roughfe.surfaces.io import save_surface
+    path = tmp_path / "s.sqlite"
+    settings = db.DatabaseSettings(length=1e-4, n_nodes=16, dim=2)
+    con = connect(path, create=True)
+    write_settings(con, settings)
+    con.commit()
+    con.close()
+    x = np.linspace(0.0, 1e-4, 64)
+    profile = save_surface(Surface(1e-7 * np.sin(2 * np.pi * 3 * x / 1e-4), 1e-4),
+                           tmp_path / "profile.npz")
+    message = "surface database \\(dim 2, designs are periodic 2D surfaces\\): its target " \
+              "must be a 2D surface, got a profile of 64 points"
+    assert main(["design-targets", "--db", str(path), "--surface", str(profile),
+                 "-o", str(tmp_path / "t")]) == 2
+    assert re.search(message, capsys.readouterr().err)
+    with pytest.raises(InputError, match=message):
+        target_surface(Surface(np.ones(64), 1e-4), settings)

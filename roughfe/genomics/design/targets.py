@@ -313,6 +313,13 @@ def target_surface(surface, settings: DatabaseSettings, *, detrend="plane",
     boundary = _boundary(boundary, settings)
     if resolution not in TARGET_RESOLUTIONS:
         raise InputError(f"resolution must be one of {TARGET_RESOLUTIONS}, got {resolution!r}")
+    if settings.dim == 2 and surface.ndim != 2:
+        # as spectrum_matched: a surface database designs periodic 2D surfaces, whose K(p)
+        # and A(p) a profile's (a line contact per unit length) cannot be compared with
+        raise InputError(f"the database is a surface database (dim 2, designs are periodic "
+                         f"2D surfaces): its target must be a 2D surface, got a profile of "
+                         f"{surface.shape[0]} points (targets of a profile need a profile "
+                         f"database, dim 1)")
     surf = surface.detrended(detrend) if detrend != "none" else surface
     if boundary == "periodic" and not surf.periodic:
         surf = surf.mirrored()
