@@ -411,3 +411,28 @@ def test_global_search_with_the_modulation_variable(surface_db):
     assert "short-wave modulation +-0.5" in out.message
     with pytest.raises(InputError, match="modulation <= 2"):
         search_global(res, SETTINGS, n_eval=4, modulation=3.0)
+
+
+def test_a_wave_at_the_nyquist_wavenumber_is_its_node_sampling():
+    """Documented, not changed (roughfe.genomics.periodic): the periodic range keeps
+    q_n = pi/delta, and a wave on the lattice vector (N/2, 0) is (-1)^i a cos(phi) on the
+    nodes (amplitude a |cos phi|: rms 5e-24 m at phi = pi/2, not a/sqrt 2); every wave,
+    on Nyquist-row vectors or not, is its exact node sampling."""
+    L, N = 1e-3, 32
+    g = Genome(A=1e-3, H=0.8, gamma=2.0, lambda1=L, phases=np.full((1, 6), np.pi / 2),
+               angles=[0.0])
+    assert periodic_chromosome_range(2.0, L, L, N) == (1, 5)      # q_5 = pi / delta
+    assert np.std(periodic_heights(g, L, N, [5])) < 1e-20
+    rng = np.random.default_rng(0)
+    g = Genome(A=1e-3, H=0.8, gamma=2.0, lambda1=L, phases=rng.uniform(0, 2 * np.pi, (4, 6)),
+               angles=[0.0, np.pi / 2, 0.3, 1.2], anisotropy=[1.0, 0.8, 1.1, 1 / 0.88])
+    n = np.arange(1, 6)
+    k, l_ = lattice_wavevectors(g, n, L)
+    assert (16, 0) in zip(k[:, -1], l_[:, -1]) and (0, 16) in zip(k[:, -1], l_[:, -1])
+    i, j = np.meshgrid(np.arange(N), np.arange(N), indexing="ij")
+    a = g.wave_amplitude(n)[None, :] * g.anisotropy[:, None]
+    phi = g.phase_columns(n)
+    direct = sum(a[m, c] * (np.cos(phi[m, c]) - np.cos(2 * np.pi * (k[m, c] * i + l_[m, c] * j)
+                                                         / N + phi[m, c]))
+                 for m in range(4) for c in range(n.size))
+    np.testing.assert_allclose(periodic_heights(g, L, N), direct, atol=1e-12 * np.abs(direct).max())

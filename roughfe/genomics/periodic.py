@@ -28,6 +28,18 @@ Nyquist wavenumber), i.e. ``n_s = ceil(log_gamma(lambda1 / L)) + 1`` and
 ``n_f = floor(log_gamma(lambda1 / (2 delta))) + 1`` (Eq. 3.5 keeps wavelengths down to
 delta, beyond Nyquist; on a periodic grid those alias onto other lattice vectors, so they
 are left out). Sums are built in Fourier space (one inverse FFT), exact on the nodes.
+
+The Nyquist wavenumber itself is in the range, and kept: a wave whose lattice vector is
+(N/2, 0), (0, N/2) or (N/2, N/2) (e.g. the chromosome q_n = pi/delta of a ridge along an
+axis) is on the nodes (-1)^i cos(phi) a, its sine part invisible there, so its realised
+amplitude is a |cos phi| (gamma = 2, lambda1 = L, theta = 0, N = 32, phi = pi/2: the last
+chromosome realises as rms 5e-24 m, not a/sqrt 2; a chromosome alone can then be flat).
+That is the exact node sampling of the wave, which is what the BEM solves, and what the
+profile realisation does too: Eq. 3.5 (:mod:`roughfe.genomics.genome`) keeps chromosomes
+down to wavelength delta and evaluates them exactly at the nodes, aliased, and a profile
+wave at q = pi/delta is (-1)^j a cos(phi) on its nodes likewise. Leaving the Nyquist
+chromosome out would drop node content of the surface; waves on other Nyquist-row
+vectors (N/2, l != 0) keep both parts.
 """
 from __future__ import annotations
 
