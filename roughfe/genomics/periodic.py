@@ -151,8 +151,8 @@ def realized_chromosomes(genome: Genome, length, n_nodes, dim=1) -> np.ndarray:
     """The chromosome numbers n a :func:`realization` sums by default: the held part of
     Eq. (3.5)'s range (dim 1) or of the periodic range (dim 2)."""
     if dim == 1:
-        return np.arange(genome.held_range(length, n_nodes)[0],
-                         genome.held_range(length, n_nodes)[1] + 1)
+        lo, hi = genome.held_range(length, n_nodes)
+        return np.arange(lo, hi + 1)
     return _held(genome, length, n_nodes)
 
 
