@@ -14,7 +14,6 @@ figures.
 """
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -318,8 +317,6 @@ def _leak_study(args) -> int:
             raise InputError(f"no task of the study in {out} finished; "
                              f"see `roughfe study status {out}`")
         result = summarise(rows)
-        # the figures are this summary's: an earlier run's never stand beside it
-        shutil.rmtree(out / "figures", ignore_errors=True)
         paths = [] if args.no_figures else figs.study_figures(result, out / "figures")
         write_json(out / "summary.json", result)                # last: the study is complete
     perc = result["percolation"]

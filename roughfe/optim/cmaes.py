@@ -27,6 +27,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError
+from .values import finite_or_worst
 
 
 @dataclass(frozen=True)
@@ -48,12 +49,6 @@ class CmaResult:
     history: np.ndarray
     stops: tuple = ()
     message: str = ""
-
-
-def _finite_or_worst(f):
-    """Values with every non-finite one (NaN, +-inf) replaced by -inf, the worst."""
-    f = np.asarray(f, dtype=float)
-    return np.where(np.isfinite(f), f, -np.inf)
 
 
 def _run(fun, x0, sigma0, lam, budget, rng, tol_x, best, history, spent):
@@ -82,7 +77,7 @@ def _run(fun, x0, sigma0, lam, budget, rng, tol_x, best, history, spent):
         f = np.asarray(fun(X), dtype=float)
         if f.shape != (lam,):
             raise InputError(f"the objective must return {lam} values, got shape {f.shape}")
-        f = _finite_or_worst(f)
+        f = finite_or_worst(f)
         used += lam
         g += 1
         order = np.argsort(-f, kind="stable")
@@ -125,7 +120,7 @@ def ipop_cmaes(fun: Callable[[np.ndarray], np.ndarray], x0, sigma0: float, n_eva
     rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
     lam = int(popsize) or 4 + int(3 * math.log(x0.size))
     lam = max(lam, 4)
-    f0 = float(_finite_or_worst(np.asarray(fun(x0[None, :]), dtype=float)[:1])[0])
+    f0 = float(finite_or_worst(np.asarray(fun(x0[None, :]), dtype=float)[:1])[0])
     best, history, spent, sizes, stops = [x0.copy(), f0], [(1, f0)], 1, [], []
     while spent + lam <= n_eval:
         sizes.append(lam)

@@ -27,6 +27,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import InputError
+from .values import finite_or_worst
 
 
 @dataclass(frozen=True)
@@ -45,14 +46,6 @@ class EsResult:
     message: str = ""
 
 
-def _finite_or_worst(v):
-    """``v`` with a non-finite number (alone or in a tuple) replaced by -inf."""
-    if isinstance(v, tuple):
-        return tuple(_finite_or_worst(x) for x in v)
-    v = float(v)
-    return v if np.isfinite(v) else -np.inf
-
-
 def one_plus_one_es(fun: Callable[[np.ndarray], Any], u0, n_eval: int, *, sigma: float = 0.3,
                     rng=None, restart_below: float = 2e-3, max_step: float = 0.5) -> EsResult:
     """Maximise ``fun`` on [0, 1]^n from ``u0`` with at most ``n_eval`` evaluations
@@ -62,11 +55,11 @@ def one_plus_one_es(fun: Callable[[np.ndarray], Any], u0, n_eval: int, *, sigma:
         raise InputError(f"n_eval >= 1, sigma > 0 and a non-empty 1D start needed, got "
                          f"{n_eval!r}, {sigma!r}, shape {u.shape}")
     rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
-    f = f0 = _finite_or_worst(fun(u))
+    f = f0 = finite_or_worst(fun(u))
     step, n_up, n_restart = float(sigma), 0, 0
     for _ in range(int(n_eval) - 1):
         v = np.clip(u + step * rng.standard_normal(u.size), 0.0, 1.0)
-        fv = _finite_or_worst(fun(v))
+        fv = finite_or_worst(fun(v))
         if fv >= f:                         # ties accepted: move along a plateau
             n_up += fv > f
             u, f, step = v, fv, step * 1.5

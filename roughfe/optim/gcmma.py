@@ -38,6 +38,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from ..errors import InputError
+from .values import finite_or_worst
 
 FORMS = ("square", "minimax")
 REFERENCES = ("Svanberg K. (2002) SIAM J. Optim. 12(2):555-573 (GCMMA)",)
@@ -181,8 +182,7 @@ def gcmma(fun: Callable[[np.ndarray], np.ndarray], x0, lower, upper, *, form: st
         return dy
 
     def score_of(y):
-        s = float(score(y))
-        return s if np.isfinite(s) else -np.inf
+        return finite_or_worst(float(score(y)))
 
     def result(best_u, best_s, s0, history, it, converged, why):
         return GcmmaResult(lo + best_u.ravel() * width, best_s, x0, s0, tuple(history), it,
