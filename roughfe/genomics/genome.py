@@ -495,6 +495,22 @@ def realize(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, scale=None,
     return Surface(z, n_nodes * delta, periodic=False, metadata=meta)
 
 
+def surface_heights(genome: Genome, length, n_nodes, x, y):
+    """``(z, n)``: heights (m) of a genome with ridge angles on the grid ``x`` (axis 0)
+    by ``y`` (axis 1) (m), summing the chromosomes ``n`` of Eq. (3.5) at a window of
+    ``length`` with ``n_nodes`` nodes that the genome holds, each ridge scaled by its
+    anisotropy factor. The one sum of :func:`realize_surface` and of the 2D sequencer's
+    misfit (each acquisition at its own node coordinates)."""
+    n = np.arange(*np.add(genome.held_range(length, n_nodes), (0, 1)))
+    phases = genome.phase_columns(n)
+    amps = np.broadcast_to(genome.wave_amplitude(n), phases.shape)
+    if genome.anisotropy is not None:
+        amps = amps * genome.anisotropy[:, None]
+    z = wm_series((np.asarray(x)[:, None], np.asarray(y)[None, :]), amps,
+                  genome.wavenumber(n), phases, genome.angles)
+    return z, n
+
+
 def realize_surface(genome: Genome, length, n_nodes=DEFAULT_NODES) -> Surface:
     """Realise a genome with ridge ``angles`` as a 2D surface (Eq. 3.17, projected form).
 
@@ -507,13 +523,8 @@ def realize_surface(genome: Genome, length, n_nodes=DEFAULT_NODES) -> Surface:
         raise InputError("realize_surface needs a genome with ridge angles (one per row of phases)")
     n_nodes = _check_nodes(n_nodes)
     n_s, n_f = genome.chromosome_range(length, n_nodes)
-    n = np.arange(*np.add(genome.held_range(length, n_nodes), (0, 1)))
-    phases = genome.phase_columns(n)
-    amps = np.broadcast_to(genome.wave_amplitude(n), phases.shape)
-    if genome.anisotropy is not None:
-        amps = amps * genome.anisotropy[:, None]
     x = node_coordinates(length, n_nodes)
-    z = wm_series((x[:, None], x[None, :]), amps, genome.wavenumber(n), phases, genome.angles)
+    z, n = surface_heights(genome, length, n_nodes, x, x)
     delta = length / (n_nodes - 1)
     meta = {"generator": "genome", "length": float(length), "n_nodes": n_nodes,
             "x0": float(x[0]), "n_s": n_s, "n_f": n_f, "chromosomes": [int(i) for i in n]}

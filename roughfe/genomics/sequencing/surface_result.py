@@ -15,8 +15,7 @@ from typing import Optional
 import numpy as np
 from scipy.optimize import least_squares
 
-from ...surfaces.wm import wm_series
-from ..genome import Genome
+from ..genome import Genome, surface_heights
 
 
 def _wave_gram(gram, n_waves):
@@ -184,11 +183,7 @@ def genome_residual(genome, full):
     sums them, at the acquisition's own node coordinates."""
     out = []
     for k, (a, grid) in enumerate(zip(full.acqs, full.grids)):
-        lo, hi = genome.held_range(a.length, full.n_nodes)
-        n = np.arange(lo, hi + 1)
-        amps = genome.wave_amplitude(n)[None, :] * genome.anisotropy[:, None]
-        z = wm_series((grid["x"][:, None], grid["y"][None, :]), amps, genome.wavenumber(n),
-                      genome.phase_columns(n), genome.angles)
+        z, _ = surface_heights(genome, a.length, full.n_nodes, grid["x"], grid["y"])
         out.append(full.z[full.block == k] - z[grid["ok"]])
     return np.concatenate(out)
 
