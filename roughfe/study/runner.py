@@ -215,9 +215,9 @@ def _run_locked(spec, tasks, derived, log, progress, how) -> StudySummary:
     outdir = spec.output
     found = store.recorded_key_format(outdir)
     keys = [t.key for t in tasks]
-    done = store.done_keys(outdir)
-    unreadable = [k for k in keys if k in done and store.read_result(outdir, k) is None]
-    done -= set(unreadable)                        # an unreadable result is not done
+    readable, unreadable = store.stored_results(outdir, keys)
+    done = set(readable)                           # an unreadable result is not done
+    del readable                                   # (held no longer than needed)
     todo = [t for t in tasks if t.key not in done]
     n_cached = len(tasks) - len(todo)
     counts = collections.Counter()

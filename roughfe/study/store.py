@@ -211,6 +211,24 @@ def read_result(outdir, key):
     return data
 
 
+def stored_results(outdir, keys) -> tuple:
+    """The results of the tasks ``keys`` that have a result file: ``(readable,
+    unreadable)``, a mapping key -> result for the files :func:`read_result` can read and
+    the list of keys (in the order given) whose file it cannot. The one answer to "done
+    and readable" for ``study run`` (what to skip, what to set aside) and ``study status``
+    (what to count)."""
+    files = done_keys(outdir)
+    readable, unreadable = {}, []
+    for key in keys:
+        if key in files:
+            result = read_result(outdir, key)
+            if result is None:
+                unreadable.append(key)
+            else:
+                readable[key] = result
+    return readable, unreadable
+
+
 def set_aside(outdir, keys) -> str:
     """Rename the unreadable result files of ``keys`` to ``<key>.json.unreadable`` (kept
     for a look; no longer a result); return a message saying so, or ""."""
@@ -362,12 +380,10 @@ def _short_commit(commit: str) -> str:
 def study_status(outdir) -> StudyStatus:
     """Status of the study in ``outdir`` from its files."""
     data = read_study(outdir)
-    files, failed = done_keys(outdir), failed_keys(outdir)
-    results = {t["key"]: read_result(outdir, t["key"]) for t in data["tasks"]
-               if t["key"] in files}
-    unreadable = tuple(t["index"] for t in data["tasks"] if t["key"] in results
-                       and results[t["key"]] is None)
-    done = {key for key, result in results.items() if result is not None}
+    failed = failed_keys(outdir)
+    results, bad = stored_results(outdir, [t["key"] for t in data["tasks"]])
+    unreadable = tuple(t["index"] for t in data["tasks"] if t["key"] in set(bad))
+    done = set(results)
     failures, costs, cpus, commits = [], [], [], set()
     n_done = n_failed = 0
     for t in data["tasks"]:
