@@ -23,8 +23,7 @@ import numpy as np
 import scipy.fft
 
 from ..caching import MB, bytes_bounded_cache
-from ..errors import (InputError, NoConvergenceError, check_in_open_interval,
-                      check_instance, check_int)
+from ..errors import InputError, NoConvergenceError, check_instance, check_int
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
@@ -34,7 +33,7 @@ from .approach import MAX_START_AREA, approach_by_load, approach_start
 from .periodic import periodic_bounded_displacement, periodic_gap_control
 from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
 from .contact_checks import (_check_coarse_correction, _check_hardness, _check_surface,
-                             _check_target)
+                             _check_target, _check_tol)
 from .deflation import BlockDeflation
 from .padded_deflation import PaddedBlockDeflation
 from .pk import polonsky_keer
@@ -334,7 +333,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     _check_surface(surface)
     check_instance("material", material, Material, "a roughfe.model.Material")
     delta, mean_pressure = _check_target(delta, mean_pressure)
-    tol = check_in_open_interval("tol (relative KKT residual)", tol, 0.0, 1.0)
+    tol = _check_tol(tol)
     if max_iter is not None:
         max_iter = check_int("max_iter (None: the solver's default)", max_iter, 1)
     hardness, plastic = _check_hardness(hardness, mean_pressure, plastic_displacement,
