@@ -255,7 +255,8 @@ STEP_SCALARS = ("delta", "load", "mean_pressure", "area_fraction", "contact_area
 
 #: Keys of every per-step record of :meth:`SweepResult.to_records` (results.json);
 #: optional numeric fields that a method sets follow them.
-RECORD_KEYS = ("delta", "load", "mean_pressure", "area_fraction", "n_contact", "stiffness",
+RECORD_KEYS = ("delta", "load", "mean_pressure", "area_fraction", "contact_area",
+               "n_contact", "stiffness",
                "stiffness_fd", "mean_gap", "mean_plane_separation", "free_volume",
                "free_volume_star", "iterations", "residual")
 

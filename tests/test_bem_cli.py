@@ -27,7 +27,8 @@ def test_contact_cli_writes_results_fields_and_figures(tmp_path):
         1e9 / 0.91)
     steps = doc["steps"]
     assert len(steps) == 4
-    assert set(steps[0]) == {"delta", "load", "mean_pressure", "area_fraction", "n_contact",
+    assert set(steps[0]) == {"delta", "load", "mean_pressure", "area_fraction", "contact_area",
+                             "n_contact",
                              "stiffness", "stiffness_fd", "mean_gap", "mean_plane_separation",
                              "free_volume", "free_volume_star", "iterations", "residual",
                              "persson_area_fraction", "persson_mean_gap"}

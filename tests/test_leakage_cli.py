@@ -35,6 +35,10 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
     assert len(steps) == 2 and STEP_KEYS <= set(steps[0])
     assert steps[0]["percolates_y"] is None            # not analysed
     assert "stiffness" not in steps[0]                 # not computed: no null read as inf
+    # the contact scalars under the names of contact's records (leak wrote "nit")
+    from roughfe.model import RECORD_KEYS
+    assert set(RECORD_KEYS) - {"stiffness", "stiffness_fd"} <= set(steps[0])
+    assert "nit" not in steps[0] and steps[0]["iterations"] >= 1
     # more load: more contact, less free volume, smaller leak rate
     assert steps[1]["area_fraction"] > steps[0]["area_fraction"]
     assert steps[1]["free_volume_star"] < steps[0]["free_volume_star"]

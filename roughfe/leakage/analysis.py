@@ -242,6 +242,7 @@ class LeakageSweep:
         for k, (c, lk) in enumerate(zip(self.contacts, self.leakages)):
             scalars = c.scalars()
             scalars.pop("stiffness", None)
+            scalars["iterations"] = scalars.pop("nit")    # the name of contact's records
             rec = {"step": k, **scalars,
                    "separation_star": float(c.mean_plane_separation / c.rms_height),
                    "contact_success": bool(c.success)}

@@ -63,6 +63,7 @@ class CoupledSweep:
             rec = {"step": k}
             if r.contact is not None:
                 rec.update(r.contact.scalars())
+                rec["iterations"] = rec.pop("nit")        # the name of contact's records
                 rec["separation_star"] = float(r.contact.mean_plane_separation / sigma)
             if lk is not None:
                 rec.update(lk.record())
