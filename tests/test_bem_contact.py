@@ -591,3 +591,40 @@ def test_the_smallest_tolerance_allowed_is_reached():
     s = spectral_surface(128, 1e-3, 0.8, rms_slope=0.1, rng=3)
     r = solve_contact(s, Material(E=1e6, nu=0.0), mean_pressure=5e3, tol=TOL_FLOOR)
     assert r.success and r.residual <= TOL_FLOOR
+
+
+@pytest.mark.parametrize("n", [256, 512])
+def test_dense_load_control_converges_just_below_full_contact(n):
+    """Westergaard's sinusoid at 1 - 1e-1 ... 1 - 1e-7 of p*: the dense solver's Newton
+    loop in Delta swapped between two adjacent floats (one ulp moves the load by more
+    than 1e-12 there) until it ran out of iterations and reported the load error as a
+    'KKT residual' of 2e-12 beside a tolerance of 1e-10 (10 of 25 loads failed at 512
+    points). It now stops there and lets the rescaling and the KKT test decide: A*
+    follows Westergaard and the PK solver."""
+    x = np.arange(n) / n
+    s = Surface(1e-6 * np.cos(2 * np.pi * x), (1e-4,), periodic=True)
+    pstar = np.pi * MAT.E_star * 1e-6 / 1e-4
+    for f in 1 - np.logspace(-1, -7, 13):
+        r = solve_contact(s, MAT, mean_pressure=f * pstar)
+        assert r.solver == "dense" and r.success
+        rp = solve_contact(s, MAT, mean_pressure=f * pstar, solver="pk")
+        assert r.area_fraction == pytest.approx(rp.area_fraction, abs=1e-12)
+        a_exact = 2 / np.pi * np.arcsin(np.sqrt(f))     # Westergaard: p/p* = sin^2(pi a/L)
+        assert r.area_fraction == pytest.approx(a_exact, abs=2.0 / n)
+
+
+def test_unload_needs_increasing_loads_and_targets_are_numbers():
+    """--unload with loads 3, 2, 1 um flagged the unloading steps as loading and the
+    reloading as unloading; a bool delta was read as 1 m and a string parsed."""
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=3)
+    with pytest.raises(InputError, match=r"increasing approaches, got \[3e-06, 2e-06"):
+        contact_sweep(s, MAT, deltas=[3e-6, 2e-6, 1e-6], unload=True)
+    with pytest.raises(InputError, match="increasing mean pressures"):
+        contact_sweep(s, MAT, pressures=[2e6, 2e6], unload=True)
+    sw = contact_sweep(s, MAT, deltas=[1e-6, 2e-6], unload=True)
+    assert [r.unloading for r in sw.results] == [False, False, True]
+    for bad in (True, "1e-6"):
+        with pytest.raises(InputError, match="delta must be a number"):
+            solve_contact(s, MAT, delta=bad)
+    with pytest.raises(InputError, match="mean_pressure must be a number"):
+        solve_contact(s, MAT, mean_pressure="1e6")

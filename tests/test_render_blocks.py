@@ -63,3 +63,20 @@ def test_the_deformed_surface_puts_every_contact_point_on_the_flat():
     assert _shown_step([0.1, 0.4, 1.0]) == 1
     assert _shown_step([0.1, 0.4, 0.4, 0.2, 0.0]) == 2
     assert _shown_step([1.0, 1.0]) == 1
+
+
+def test_a_render_without_contact_has_a_finite_colour_range(tmp_path):
+    # delta = 0 on a surface touching at one point: no block in contact; the all-NaN
+    # pressure gave a colour bar labelled "nan" and vtk's "All-NaN axis" warning
+    import warnings
+
+    from roughfe.bem import Material, solve_contact
+    from roughfe.plotting.contact import render_contact
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=3)
+    r = solve_contact(s, Material(1e9, 0.0), delta=0.0)
+    assert r.n_contact <= 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        path = render_contact(s.heights, r, tmp_path / "r.png", title="t", window_size=(400, 300))
+    assert path.stat().st_size > 5000

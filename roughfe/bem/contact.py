@@ -142,15 +142,17 @@ def _choose_solver(n_points: int, op: InfluenceOperator, solver: str,
         return "dense" if n_points <= DENSE_MAX_POINTS else "pk"
     if bounded and solver == "dense":
         raise InputError("solver 'dense' (block principal pivoting) has no hardness bound; "
-                         "use solver='nnls' (bounded least squares, non-periodic kernels) or "
-                         "'pk'")
+                         "use solver='pk', or solver='nnls' (bounded least squares) on a "
+                         "non-periodic kernel")
     if solver in ("dense", "nnls") and n_points > 8192:
         raise InputError(f"solver {solver!r} would build a dense {n_points} x {n_points} "
                          f"matrix ({8 * n_points ** 2 / 1e9:.1f} GB); use solver='pk' above "
                          f"8192 points")
     if solver == "nnls" and op.periodic:
         raise InputError("solver 'nnls' (Cholesky + Lawson-Hanson) needs a positive definite "
-                         "operator: not the periodic one (its mean mode is free); use 'dense'")
+                         "operator: not the periodic one (its mean mode is free); use "
+                         + ("solver='pk' (with a hardness the one solver of a periodic "
+                            "surface)" if bounded else "solver='dense' or solver='pk'"))
     return solver
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, check_finite_positive, check_in_open_interval, check_instance
+from ..model import _check_delta, _check_pressure
 from ..surfaces.surface import Surface
 from .coarse_start import COARSE_START_MIN
 
@@ -33,18 +34,13 @@ def _check_tol(tol) -> float:
 
 
 def _check_target(delta, mean_pressure):
+    """The one target of a solve (the checks of :class:`roughfe.model.Loading`: a bool or a
+    string is refused, not read as 1 m or parsed)."""
     if (delta is None) == (mean_pressure is None):
         raise InputError("give exactly one of delta (approach, m) or mean_pressure (Pa)")
     if delta is not None:
-        try:
-            d = float(delta)
-        except (TypeError, ValueError):
-            raise InputError(f"delta must be a number of metres >= 0, got {delta!r}") from None
-        if not (np.isfinite(d) and d >= 0):
-            raise InputError(f"delta (approach from first contact, m) must be finite and "
-                             f">= 0, got {delta!r}")
-        return d, None
-    return None, check_finite_positive("mean_pressure (Pa)", mean_pressure)
+        return _check_delta("delta", delta), None
+    return None, _check_pressure("mean_pressure", mean_pressure)
 
 
 def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):

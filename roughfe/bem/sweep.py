@@ -114,6 +114,13 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
         deltas = getattr(loading, loading.kind)
     key = "mean_pressure" if loading.controls_pressure else "delta"
     steps = [(float(v), False) for v in deltas]
+    if unload and np.any(np.diff(np.asarray(deltas, dtype=float)) <= 0):
+        # the branch below the highest step: given 3, 2, 1 um the unloading steps were
+        # flagged as loading and the reloading 1 -> 3 um as unloading
+        raise InputError(f"unload appends the unloading branch (the steps in reverse order "
+                         f"below the highest one): give the loading branch, increasing "
+                         f"{'mean pressures' if key == 'mean_pressure' else 'approaches'}, "
+                         f"got {[float(v) for v in deltas]}")
     if unload:
         steps += [(float(v), True) for v in deltas[-2::-1]]
     branch = unload or hardness is not None

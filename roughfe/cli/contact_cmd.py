@@ -160,6 +160,10 @@ def _run(args) -> int:
 
 #: the solver's keyword phrases in its InputErrors -> this command's flags
 _FLAGS = (("solver='pk'", "--solver pk"), ("solver 'dense'", "--solver dense"),
+          ("solver='dense'", "--solver dense"), ("solver='nnls'", "--solver nnls"),
+          ("solver 'nnls'", "--solver nnls"),
+          ("impose a mean_pressure", "impose a mean pressure (--pressure)"),
+          ("unload appends", "--unload appends"),
           ("coarse_correction=True", "--coarse-correction on"),
           ("load control (mean_pressure)", "load control (--pressure)"),
           ("kernel 'spectral'", "--kernel spectral"),

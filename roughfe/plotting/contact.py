@@ -226,8 +226,10 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     pressure = np.where(in_contact, p_sum / n_contact * MPA, np.nan)
     grid["pressure (MPa)"] = pressure.ravel(order="F")
     plotter = offscreen_plotter(window_size=window_size)
+    # no block in contact: a fixed range (an all-NaN one labelled the bar "nan" and made
+    # vtk warn "All-NaN axis encountered")
     plotter.add_mesh(grid, scalars="pressure (MPa)", cmap="plasma", smooth_shading=True,
-                     nan_color="lightgrey",
+                     nan_color="lightgrey", clim=None if in_contact.any() else (0.0, 1.0),
                      scalar_bar_args=side_bar("pressure (MPa)"))
     label = (title or "") + (f"\n{_state_label(result)} (free area grey), vertical "
                              f"x{exaggeration:.3g}" + decimation_note(h.shape, z.shape))
