@@ -10,13 +10,21 @@ top-level key ``"targets"``: a list of rows::
      "target": str,      the criterion as text, e.g. "<= 1 %"
      "measured": str,    the measured value as text, e.g. "0.42 %"
      "value": float|null the measured value as a number (SI or a fraction), if any
-     "met": bool|null,   null: not checked (a row reported beside the targets, e.g. a
-                         number fixed by construction, or a script not run by --quick)
+     "met": bool|null,   null: not checked, either a row reported beside the targets
+                         (:func:`reported`: e.g. a number fixed by construction) or a
+                         target the run did not check (:func:`skipped`)
      "reason": str}      why it is (not) met, or what it measures; "" when obvious
 
-and ``roughfe validate`` writes ``<outdir>/summary.json``: ``{"validations": {name: {"met":
-bool|null, "targets": [rows], "not_run": [scripts]}}, "all_met": bool, "not_run": [...]}``.
-The documentation pages are generated from these files; no number is typed by hand.
+A target that the run was to check but did not (an optional tool missing, a case or a
+script that ``--quick`` leaves out) is a :func:`skipped` row: ``met`` null, ``measured``
+"not run" and a name ending in ``": not run"`` (:data:`NOT_RUN`), which
+:func:`is_skipped` recognises; ``roughfe validate`` prints it, lists it under ``not_run``
+and never calls such a run "all met". A :func:`reported` row is not counted.
+
+``roughfe validate`` writes ``<outdir>/summary.json`` (see :mod:`roughfe.cli.validate_cmd`):
+``{"validations": {name: {"met": bool|null, "targets": [rows], "not_run": [...]}},
+"all_met": bool, "not_run": [...]}``. The documentation pages are generated from these
+files; no number is typed by hand.
 
 Richardson extrapolation
 ------------------------
@@ -86,6 +94,25 @@ def reported(row: Target, why: str) -> Target:
                   row.value)
 
 
+#: The end of the name of a :func:`skipped` row.
+NOT_RUN = ": not run"
+
+
+def skipped(name: str, target: str, why: str) -> Target:
+    """The row of a target the run was to check and did not (``met`` None, ``measured``
+    "not run", the name ``name + ": not run"``): counted as not run by ``roughfe
+    validate``, never as met. ``why``: what was missing and how to run it."""
+    return Target(f"{name}{NOT_RUN}", target, "not run", None, why)
+
+
+def is_skipped(row) -> bool:
+    """True for a :func:`skipped` row (a :class:`Target` or its dict); False for a
+    :func:`reported` one."""
+    met, name = ((row.get("met"), row.get("name")) if isinstance(row, dict)
+                 else (row.met, row.name))
+    return met is None and str(name or "").endswith(NOT_RUN)
+
+
 def within(name: str, value: float, limit: float, reason: str = "") -> Target:
     """A target ``|value| <= limit`` for a relative quantity (fractions, in % or, below
     1e-4, in scientific notation: :func:`fraction`)."""
@@ -98,7 +125,8 @@ def targets_markdown(rows) -> str:
     """The rows as a Markdown table (target | criterion | measured | status | reason)."""
     lines = ["| target | criterion | measured | status | reason |", "|---|---|---|---|---|"]
     for t in rows:
-        status = "not checked" if t.met is None else "met" if t.met else "**NOT met**"
+        status = ("**not run**" if is_skipped(t) else "not checked" if t.met is None
+                  else "met" if t.met else "**NOT met**")
         lines.append(f"| {t.name} | {t.target} | {t.measured} | {status} | {t.reason} |")
     return "\n".join(lines) + "\n"
 

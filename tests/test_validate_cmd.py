@@ -108,3 +108,85 @@ def test_validate_owns_its_folder_and_reports_every_study(studies, capsys, monke
     assert main(["validate", "good", "-o", str(out)]) == 0
     assert json.loads((out / "summary.json").read_text())["quick"] is False
     assert json.loads((out / "alpha.json").read_text())["targets"][0]["reason"] == "full"
+
+
+SKIPS = '''"""Stand-in study with a met target, a row reported beside the targets and a target
+that did not run (an optional tool missing)."""
+import json
+
+
+def main(outdir):
+    (outdir / "delta.json").write_text(json.dumps({"targets": [
+        {"name": "delta: z", "target": "<= 1", "measured": "0.5", "value": 0.5,
+         "met": True, "reason": ""},
+        {"name": "delta: cost", "target": "reported", "measured": "3 s", "value": 3.0,
+         "met": None, "reason": "cost: reported, not a target"},
+        {"name": "delta: vs the other code: not run", "target": "<= 1 %",
+         "measured": "not run", "value": None, "met": None,
+         "reason": "the other code is not importable"}]}))
+    return True
+'''
+
+
+def test_a_target_that_did_not_run_is_named_and_never_all_met(studies, capsys,
+                                                                monkeypatch):
+    """A skipped target row (roughfe.validation.skipped) is printed as not run, listed in
+    summary.json's not_run and makes all_met false (exit 0: nothing is NOT met); a row
+    reported beside the targets is neither. Before, the run said "all validation targets
+    met" and all_met was true."""
+    (studies / "validation" / "delta.py").write_text(SKIPS)
+    monkeypatch.setattr(validate_cmd, "VALIDATIONS", {"skips": ("delta",)})
+    out = studies / "skips"
+    assert main(["validate", "skips", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "all validation targets met" not in text
+    assert "not run: delta: vs the other code (the other code is not importable)" in text
+    assert "not run: delta: delta: vs the other code" in text.splitlines()[-1]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["not_run"] == ["delta: delta: vs the other code"]
+    assert summary["validations"]["skips"]["met"] is True and not summary["all_met"]
+
+
+def _script(name):
+    """A real script of validation/ (its cases are replaced by the test)."""
+    return validate_cmd._load(name)
+
+
+def test_bem_validation_without_tamaas_says_the_tamaas_target_did_not_run(
+        tmp_path, capsys, monkeypatch):
+    """validation/bem_contact.py with tamaas not importable (its cases replaced by
+    instant stand-ins): the Tamaas row is a skipped target, so `validate bem` names it
+    and summary.json is not all met (it said "all validation targets met", all_met true)."""
+    bem = _script("bem_contact")
+    row = {"n": 1024, "s": 1, "A": 0.5, "A_ref": 0.5, "width_err": 1e-4,
+           "edge_width_err": 1e-5, "gap_err": 1e-5, "nit": 3, "solver": "pk",
+           "radius_err": 1e-4, "load_err": 1e-4, "peak_err": 1e-4, "stiffness_err": 1e-4,
+           "time_s": 0.1, "seed": 0, "periodic": True, "max_rel_diff": 1e-12, "nit_pk": 3}
+    for case, n in (("westergaard_cases", 1024), ("hertz_cases", 256),
+                    ("line_cases", 2048), ("solver_cases", 32)):
+        monkeypatch.setattr(bem, case, lambda *a, n=n: [{**row, "n": n}])
+    monkeypatch.setattr(bem, "tamaas_case", lambda: None)
+    monkeypatch.setattr(bem, "_figure", lambda w, path: path)
+    monkeypatch.setattr(validate_cmd, "_load", lambda script: bem)
+    out = tmp_path / "bem"
+    assert main(["validate", "bem", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "all validation targets met" not in text
+    assert "not run: A* and mean gap vs Tamaas" in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert not summary["all_met"]
+    assert summary["not_run"] == ["bem_contact: A* and mean gap vs Tamaas 2.8 (256^2)"]
+    assert "**not run**" in (out / "bem_contact.md").read_text()
+
+
+def test_fem_validation_without_mpirun_keeps_the_mpi_target_as_not_run():
+    """validation/bem_vs_fem.py: with no mpirun the MPI comparison is a skipped row (it
+    was dropped from the targets, so nothing said the check had not run)."""
+    from roughfe.validation import is_skipped
+    bem_vs_fem = _script("bem_vs_fem")
+    west = {"max_width_error_fem": 1e-3, "max_width_error_bem": 1e-3, "n_nodes": 129}
+    rows = bem_vs_fem.target_rows(west, {}, {"ok": None, "note": "mpirun not found"})
+    assert [r.name for r in rows if is_skipped(r)] == [
+        "FEM-VI: 2 MPI ranks vs serial (p, A*, K): not run"]
+    ran = bem_vs_fem.target_rows(west, {}, {"ok": True, "max_rel_diff": 1e-12})
+    assert not any(is_skipped(r) for r in ran) and all(r.met for r in ran)

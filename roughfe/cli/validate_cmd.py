@@ -7,7 +7,12 @@ figures and ``<outdir>/<script>.json`` whose ``"targets"`` rows follow the schem
 ``--quick`` runs the reduced cases of the scripts that have them (``make validate-quick``,
 CI): same kinds of targets, smaller problems. A script without a reduced case
 (:data:`NOT_QUICK`) is reported as a row with ``"met": null`` ("not run"), and a
-validation none of whose scripts ran has ``"met": null``: never "met". They are readable
+validation none of whose scripts ran has ``"met": null``: never "met". A target a script
+was to check and did not (an optional tool such as Tamaas or ``mpirun`` missing, a case
+``--quick`` leaves out) is its :func:`roughfe.validation.skipped` row: printed as "not
+run", listed in ``not_run`` (``"script: target"``; a whole script by its name) and
+``all_met`` false; the exit code is 1 only for a target NOT met. A row merely reported
+beside the targets (:func:`roughfe.validation.reported`) is not counted. They are readable
 physics scripts that compare roughfe with analytic solutions, FEM and the literature;
 they need the repository checkout (they are not installed modules).
 
@@ -28,7 +33,7 @@ from pathlib import Path
 
 from .. import progress
 from ..errors import InputError
-from ..validation import Target
+from ..validation import NOT_RUN, Target, is_skipped, skipped
 from ..writers import write_json
 from .options import add_output_folder, output_folder_of
 
@@ -81,18 +86,22 @@ def _targets(outdir: Path, script: str, ok: bool) -> list:
 
 def run_validation(name: str, outdir: Path, quick: bool = False) -> dict:
     """Run the scripts of validation ``name``; ``{"met": bool or None, "targets": [rows],
-    "not_run": [scripts], ...}`` (``met`` None when no script ran)."""
+    "not_run": [...], ...}``: ``met`` None when no script ran, else whether every target
+    that ran is met; ``not_run`` names each script not run and each skipped target row
+    (:func:`roughfe.validation.is_skipped`) as ``"script: target"``."""
     if name not in VALIDATIONS:
         raise InputError(f"unknown validation {name!r}; choose from {sorted(VALIDATIONS)} or 'all'")
     out = {"met": True, "targets": [], "seconds": {}, "cpu_seconds": {}, "not_run": []}
+    ran = 0
     for script in VALIDATIONS[name]:
         if quick and script in NOT_QUICK:
             out["not_run"].append(script)
-            out["targets"].append(Target(
-                f"{script}: not run", "its targets", "not run", None,
+            out["targets"].append(skipped(
+                script, "its targets",
                 f"no reduced case: `roughfe validate {name}` (without --quick) runs it"
             ).to_dict())
             continue
+        ran += 1
         module = _load(script)
         takes_quick = "quick" in inspect.signature(module.main).parameters
         t0, c0 = time.perf_counter(), _cpu_seconds()
@@ -110,7 +119,9 @@ def run_validation(name: str, outdir: Path, quick: bool = False) -> dict:
         out["cpu_seconds"][script] = _cpu_seconds() - c0
         out["met"] = out["met"] and ok
         out["targets"] += rows
-    if len(out["not_run"]) == len(VALIDATIONS[name]):
+        out["not_run"] += [f"{script}: {r['name'][:-len(NOT_RUN)]}" for r in rows
+                           if is_skipped(r)]
+    if not ran:
         out["met"] = None                       # nothing was checked
     return out
 
@@ -145,8 +156,8 @@ def _run(args) -> int:
                 print(f"   {script}: {summary[name]['seconds'][script]:.0f} s wall, "
                       f"{summary[name]['cpu_seconds'][script]:.0f} s CPU", flush=True)
             for t in summary[name]["targets"]:
-                if t["met"] is None and t.get("name", "").endswith(": not run"):
-                    print(f"   not run: {t['name'][:-len(': not run')]} ({t.get('reason')})")
+                if is_skipped(t):
+                    print(f"   not run: {t['name'][:-len(NOT_RUN)]} ({t.get('reason')})")
                 elif t["met"] is None:
                     continue                            # reported beside the targets
                 elif not t["met"]:
@@ -165,10 +176,11 @@ def _run(args) -> int:
     elif not ran:
         print(f"nothing validated: no reduced case in {', '.join(not_run)} (run without "
               f"--quick)")
-    elif not_run:
-        print(f"all targets met of the studies that ran; not run (no reduced case): "
-              f"{', '.join(not_run)}")
-    else:
+    if failed and not_run:
+        print(f"not run either: {'; '.join(not_run)}")
+    elif not_run and ran:
+        print(f"all targets met of those that ran; not run: {'; '.join(not_run)}")
+    elif not failed and ran:
         print("all validation targets met")
     return 1 if failed else 0
 
