@@ -190,3 +190,40 @@ def test_fem_validation_without_mpirun_keeps_the_mpi_target_as_not_run():
         "FEM-VI: 2 MPI ranks vs serial (p, A*, K): not run"]
     ran = bem_vs_fem.target_rows(west, {}, {"ok": True, "max_rel_diff": 1e-12})
     assert not any(is_skipped(r) for r in ran) and all(r.met for r in ran)
+
+
+def test_the_database_cost_row_is_reported_not_met():
+    """validation/surface_genomics.py: the database cost has no criterion; its row was
+    "met" by a hard-coded True (met even for a NaN cost). It is reported (met null,
+    roughfe.validation.reported) and counts neither way."""
+    from roughfe.validation import is_skipped
+    genomics = _script("surface_genomics")
+    rows = genomics._targets(
+        rec=[{"M_exact": True, "gene_error": 0.0, "phase_error_rad": 0.0,
+              "angle_error_rad": 0.0, "rms_error": 0.0}],
+        noise=[{"noise": 0.01, "angle_error_deg": 0.1, "gamma_error": 1e-3,
+                "M_exact": True, "misfit_over_noise": 1.0}],
+        mech={"a.x3p": {"sum_error": 0.0, "c_td_last": 1.0, "partition": True}},
+        designs=[], db_info={"n_nodes": 16, "cpu_per_genome_s": float("nan"), "computed": 0},
+        x3p={"window": {"series_deviation_max": 0.01, "K_range": [1.0, 2.0],
+                        "compliance_m_per_Pa": 1e-9}})
+    cost = [r for r in rows if r.name.startswith("surface database cost per genome")]
+    assert len(cost) == 1 and cost[0].met is None and not is_skipped(cost[0])
+    assert "reported, not a target" in cost[0].reason
+
+
+def test_no_validation_row_is_met_by_a_constant():
+    """No target row of validation/*.py is built with met = True (or False) typed in: a
+    verdict must come from a measured value (a number with no criterion is reported)."""
+    import ast
+    bad = []
+    for path in sorted(validate_cmd._validation_dir().glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not (isinstance(node, ast.Call) and getattr(node.func, "id", "") in
+                    ("Target", "_row")):
+                continue
+            met = node.args[3] if len(node.args) > 3 else next(
+                (k.value for k in node.keywords if k.arg == "met"), None)
+            if isinstance(met, ast.Constant) and isinstance(met.value, bool):
+                bad.append(f"{path.name}:{node.lineno}")
+    assert not bad, f"rows with a constant met: {bad}"

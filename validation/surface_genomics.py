@@ -62,7 +62,7 @@ from roughfe.errors import InputError
 from roughfe.model import DEFAULT_E
 from roughfe.surfaces import Surface
 from roughfe.surfaces.io import load_surface, save_surface, topographies_folder
-from roughfe.validation import Target, percent, targets_markdown
+from roughfe.validation import Target, percent, reported, targets_markdown
 from roughfe.writers import write_json, write_text
 
 TOPOGRAPHIES = topographies_folder()
@@ -430,7 +430,7 @@ def main(outdir: Path, quick: bool = False) -> bool:
                            "x3p-2", target_surface(measured, settings), long=long("x3p-2"),
                            quick=quick)
     rows = _targets(rec, noise, mech, designs, db_info, x3p_info)
-    ok = all(r.met for r in rows)
+    ok = all(r.met for r in rows if r.met is not None)
     report = {"targets": [r.to_dict() for r in rows], "quick": quick, "recovery": rec,
               "noise": noise, "measured_mechanics": mech, "database": db_info,
               "settings": settings.to_dict(), "designs": designs,
@@ -477,12 +477,11 @@ def _targets(rec, noise, mech, designs, db_info, x3p):
     rows.append(_row("measured files: TD sum of all bands = complete, Alg. 2 partitions",
                      "c_n = 1, macro + micro = all bands", f"min c = {c:.12f}, partition "
                      f"{part}", abs(c - 1) < 1e-12 and part, value=c))
-    rows.append(_row(f"surface database cost per genome ({db_info['n_nodes']}^2, M = 3, "
-                     "10 steps)",
-                     "reported", f"{db_info['cpu_per_genome_s']:.1f} s CPU "
-                     f"({db_info['computed']} computed)", True,
-                     "computed this run; 0 computed means the database was reused",
-                     db_info["cpu_per_genome_s"]))
+    rows.append(reported(Target(
+        f"surface database cost per genome ({db_info['n_nodes']}^2, M = 3, 10 steps)",
+        "reported", f"{db_info['cpu_per_genome_s']:.1f} s CPU ({db_info['computed']} "
+        "computed)", None, "computed this run; 0 computed means the database was reused",
+        db_info["cpu_per_genome_s"]), "a cost, no criterion"))
     w = x3p["window"]
     rows.append(_row("x3p-2 window alone (non-periodic): 1/K = 1/K_periodic + C (window bulk "
                      "compliance)", "within 10 % beyond step 1",
