@@ -183,7 +183,8 @@ OWNER_FILE = ".roughfe-output.json"
 #: Present (and visible) while a run is writing the folder or after it failed/was killed.
 UNFINISHED_FILE = "UNFINISHED"
 #: Sub-folder holding an earlier run's output while a new run writes: restored when the
-#: new run fails or is interrupted, removed when it completes
+#: new run fails or is interrupted (left there with ``keep_partial``), removed when it
+#: completes
 PREVIOUS_DIR = ".roughfe-previous"
 #: flock-ed by the run writing the folder (released by the OS if the process dies).
 LOCK_FILE = ".lock"
@@ -311,13 +312,21 @@ class OutputFolder:
       raises (a bad value found during the work, a solver failure, Ctrl-C), a folder
       this run created is removed again and an older folder gets its old content back
       (an earlier complete output survives a failed rerun); a folder that was empty
-      keeps ``UNFINISHED`` and ``"status": "failed"`` with the error.
+      keeps ``UNFINISHED`` and ``"status": "failed"`` with the error (``"interrupted"``
+      for Ctrl-C, KeyboardInterrupt).
+    * ``keep_partial=True`` (``roughfe validate``, whose studies each finish a report):
+      when the block raises, what the run wrote stays, with ``UNFINISHED`` and
+      ``"status": "interrupted"`` (Ctrl-C) or ``"failed"`` with the error; an older
+      run's files stay set aside in ``.roughfe-previous`` (never beside the new ones;
+      the next run drops them, as after a kill).
     """
 
-    def __init__(self, folder, command: str, *, overwrite: bool = False):
+    def __init__(self, folder, command: str, *, overwrite: bool = False,
+                 keep_partial: bool = False):
         self.path = Path(folder)
         self.command = command
         self.overwrite = overwrite
+        self.keep_partial = keep_partial
         self._check(self.path)
         # the command's work starts here (checked before the computation), not when the
         # folder is taken for the writes
@@ -381,14 +390,17 @@ class OutputFolder:
                     **self._record, "status": "complete", "finished": _now(),
                     "elapsed_s": time.perf_counter() - self._t0,
                     "files": _relative_files(folder)})
+            elif self.keep_partial or not (self._created or self._kept):
+                with contextlib.suppress(Exception):   # UNFINISHED stays
+                    write_json(folder / OWNER_FILE, {
+                        **self._record, "status": "interrupted" if issubclass(
+                            kind, KeyboardInterrupt) else "failed",
+                        "error": f"{kind.__name__}: {exc}", "stopped": _now(),
+                        "elapsed_s": time.perf_counter() - self._t0})
             elif self._created:
                 shutil.rmtree(folder, ignore_errors=True)
-            elif self._kept:
-                _restore(folder)
             else:
-                with contextlib.suppress(Exception):
-                    write_json(folder / OWNER_FILE, {**self._record, "status": "failed",
-                                                     "error": f"{kind.__name__}: {exc}"})
+                _restore(folder)
         finally:
             self._lock.close()  # releases the flock (after a removed folder: harmless)
         return False
@@ -420,9 +432,10 @@ def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
-def output_folder(folder, command: str, *, overwrite: bool = False) -> OutputFolder:
+def output_folder(folder, command: str, *, overwrite: bool = False,
+                  keep_partial: bool = False) -> OutputFolder:
     """:class:`OutputFolder` (checked now; ``with`` it to write)."""
-    return OutputFolder(folder, command, overwrite=overwrite)
+    return OutputFolder(folder, command, overwrite=overwrite, keep_partial=keep_partial)
 
 
 def output_file(path, *, overwrite: bool = False, suffixes=None) -> Path:

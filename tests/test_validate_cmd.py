@@ -227,3 +227,24 @@ def test_no_validation_row_is_met_by_a_constant():
             if isinstance(met, ast.Constant) and isinstance(met.value, bool):
                 bad.append(f"{path.name}:{node.lineno}")
     assert not bad, f"rows with a constant met: {bad}"
+
+
+CTRL_C = '''"""Stand-in study the user interrupts (Ctrl-C)."""
+
+
+def main(outdir):
+    raise KeyboardInterrupt()
+'''
+
+
+def test_ctrl_c_keeps_the_reports_already_finished(studies, capsys, monkeypatch):
+    """Ctrl-C during `validate all`: exit 130, the finished study's report stays with
+    UNFINISHED and the status "interrupted" (the folder the run had created was removed,
+    finished reports and all)."""
+    (studies / "validation" / "stop.py").write_text(CTRL_C)
+    monkeypatch.setattr(validate_cmd, "VALIDATIONS", {"good": ("alpha",), "stop": ("stop",)})
+    out = studies / "interrupted"
+    assert main(["validate", "all", "-o", str(out)]) == 130
+    assert json.loads((out / "alpha.json").read_text())["targets"][0]["met"]
+    assert (out / "UNFINISHED").is_file()
+    assert json.loads((out / ".roughfe-output.json").read_text())["status"] == "interrupted"

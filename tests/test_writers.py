@@ -167,3 +167,34 @@ def test_study_lock_uses_the_same_lock(tmp_path):
     with study_lock(tmp_path / "s"):
         with pytest.raises(InputError, match="is writing to"):
             OutputFolder(tmp_path / "s", "study")
+
+
+def test_keep_partial_keeps_what_a_stopped_run_wrote(tmp_path):
+    """keep_partial (roughfe validate): a run that is interrupted or fails keeps its
+    finished files, marked unfinished, with the status saying why; an older run's files
+    stay set aside in .roughfe-previous, never beside the new ones. Without it the same
+    Ctrl-C removed a folder the run had created."""
+    out = tmp_path / "new"
+    with pytest.raises(KeyboardInterrupt):
+        with OutputFolder(out, "validate all", keep_partial=True) as d:
+            write_text(d / "bem_contact.json", "{}")
+            raise KeyboardInterrupt()
+    assert (out / "bem_contact.json").is_file() and (out / UNFINISHED_FILE).is_file()
+    record = json.loads((out / OWNER_FILE).read_text())
+    assert record["status"] == "interrupted" and record["elapsed_s"] >= 0
+    # an older complete output: the new partial files stay, the old ones only set aside
+    with OutputFolder(out, "validate all") as d:
+        write_text(d / "old_report.md", "old")
+    with pytest.raises(ValueError):
+        with OutputFolder(out, "validate all", keep_partial=True) as d:
+            write_text(d / "bem_contact.json", "new")
+            raise ValueError("harness bug")
+    visible = [f for f in _files(out) if not f.startswith(".roughfe-previous")]
+    assert "old_report.md" not in visible and (out / "bem_contact.json").read_text() == "new"
+    assert (out / ".roughfe-previous" / "old_report.md").read_text() == "old"
+    record = json.loads((out / OWNER_FILE).read_text())
+    assert record["status"] == "failed" and "harness bug" in record["error"]
+    # the next run of the same command takes the folder and drops the set-aside files
+    with OutputFolder(out, "validate all", keep_partial=True) as d:
+        write_text(d / "summary.json", "{}")
+    assert _files(out) == [".lock", ".roughfe-output.json", "summary.json"]

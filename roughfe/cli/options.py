@@ -287,10 +287,11 @@ def add_output_file(parser, help: str, required: bool = True) -> None:
     parser.add_argument("--overwrite", action="store_true", help="replace an existing file")
 
 
-def output_folder_of(args, command: str):
+def output_folder_of(args, command: str, *, keep_partial: bool = False):
     """:func:`roughfe.writers.output_folder` for ``args.output`` (context manager)."""
     from ..writers import output_folder
-    return output_folder(args.output, command, overwrite=getattr(args, "overwrite", False))
+    return output_folder(args.output, command, overwrite=getattr(args, "overwrite", False),
+                         keep_partial=keep_partial)
 
 
 def output_file_of(args, suffixes=None):

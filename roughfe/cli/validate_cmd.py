@@ -21,7 +21,10 @@ locked, ``UNFINISHED`` while the studies run, refused when it holds files that a
 earlier output of the same ``roughfe validate NAME`` (``--overwrite`` to replace them),
 the previous run's files removed first. A study that raises is reported as a failed
 target row (with the error) and the others still run, so a crash late in ``make
-validate`` does not lose the reports already written.
+validate`` does not lose the reports already written; Ctrl-C or an error of the harness
+keeps them too (``keep_partial``: ``UNFINISHED`` stays and ``.roughfe-output.json`` says
+``"interrupted"`` or ``"failed"``; an older run's files stay set aside in
+``.roughfe-previous``, never beside the new ones), and so does a kill (SIGKILL).
 """
 from __future__ import annotations
 
@@ -148,7 +151,7 @@ def _script_doc(name: str) -> str:
 def _run(args) -> int:
     names = list(VALIDATIONS) if args.name == "all" else [args.name]
     summary = {}
-    with output_folder_of(args, f"validate {args.name}") as outdir:
+    with output_folder_of(args, f"validate {args.name}", keep_partial=True) as outdir:
         for name in progress.iterate(names, "validations"):
             print(f"== validation {name}{' (quick)' if args.quick else ''}", flush=True)
             summary[name] = run_validation(name, outdir, quick=args.quick)
