@@ -6,7 +6,9 @@
 * ``docs/api/cli_reference.md``: ``roughfe ... --help`` of every command and subcommand.
 * ``docs/validation/generated/<script>.md``: one page per ``validation/<script>.py``,
   from ``validation/output/<script>.json`` (and ``<script>*.json``): its targets as a
-  table with a met / NOT met column, its scalars and every table of records in it.
+  table with a met / NOT met / not run column, its scalars and every table of records in
+  it; a page from a run that did not finish (``summary.json`` ``"complete": false`` or
+  ``UNFINISHED``) says so under its title.
 * ``docs/benchmarks/generated/<script>.md``: the same for ``benchmarks/bench_*.py`` and
   ``benchmarks/output/<script>*.json``.
 * ``docs/benchmarks/summary.md``: the one table of every speed and memory target of the
@@ -177,11 +179,13 @@ def target_rows(data) -> list:
     read as they are, with no value column.
     """
     if isinstance(data.get("targets"), list) and all(isinstance(t, dict) for t in data["targets"]):
+        from roughfe.validation import is_skipped
         rows = []
         for t in data["targets"]:
             row = {"name": t.get("name", "?"), "value": t.get("value"), "target": t.get("target")}
             row.update({k: v for k, v in t.items() if k not in ("name", "value", "target", "met")})
-            row["status"] = STATUS.get(t.get("met"), "not checked")
+            row["status"] = ("**not run**" if is_skipped(t)
+                             else STATUS.get(t.get("met"), "not checked"))
             rows.append(row)
         return rows
     thresholds = {}
@@ -207,10 +211,30 @@ def target_rows(data) -> list:
     return rows
 
 
-def result_page(title: str, source: Path, data, command: str) -> str:
-    """A Markdown page for one result JSON: targets, scalars, then every table in it."""
+def incomplete_run(folder: Path) -> str:
+    """A note for the pages of ``folder`` when the run that wrote it did not finish: its
+    ``summary.json`` (``roughfe validate``) says ``"complete": false``, or ``UNFINISHED``
+    is there (a run killed or interrupted); "" otherwise."""
+    pending = None
+    try:
+        summary = json.loads((folder / "summary.json").read_text())
+        if isinstance(summary, dict) and summary.get("complete") is False:
+            pending = summary.get("pending") or []
+    except (OSError, ValueError):
+        pass
+    if pending is None and not (folder / "UNFINISHED").exists():
+        return ""
+    return (f"**Incomplete run**: the run that wrote `{_rel(folder)}` did not finish"
+            + (f" (not done: {', '.join(map(str, pending))})" if pending else "")
+            + "; this page shows what it had written.")
+
+
+def result_page(title: str, source: Path, data, command: str, note: str = "") -> str:
+    """A Markdown page for one result JSON: targets, scalars, then every table in it
+    (``note``, e.g. :func:`incomplete_run`, under the title)."""
     rel = _rel(source)
     lines = [GENERATED_MARK.format(source=rel), "", f"# {title}", ""]
+    lines += [note, ""] if note else []
     lines += [f"From `{rel}`, written by `{command}`. Numbers are shown to 4 significant "
               "digits; n/a is a non-finite value (JSON null).", ""]
     targets = target_rows(data) if isinstance(data, dict) else []
@@ -292,7 +316,7 @@ def write_results(scripts, output: Path, outdir: Path, kind: str, commands,
             pages[f"{stem}.md"] = missing_page(f"{kind}: {stem}", output / f"{stem}.json", command)
             report.append((stem, "missing"))
             continue
-        parts = []
+        parts, note = [], incomplete_run(folder)
         for path in found:
             try:
                 data = json.loads(path.read_text())
@@ -300,7 +324,7 @@ def write_results(scripts, output: Path, outdir: Path, kind: str, commands,
                 parts.append(f"# {kind}: {path.stem}\n\n**Unreadable** `{path.name}`: {exc}\n")
                 continue
             title = data.get("title", path.stem) if isinstance(data, dict) else path.stem
-            parts.append(result_page(f"{kind}: {title}", path, data, command))
+            parts.append(result_page(f"{kind}: {title}", path, data, command, note))
         pages[f"{stem}.md"] = "\n".join(parts)
         report.append((stem, f"{len(found)} file(s)"))
     for stale in outdir.glob("*.md"):

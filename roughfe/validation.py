@@ -22,9 +22,10 @@ script that ``--quick`` leaves out) is a :func:`skipped` row: ``met`` null, ``me
 and never calls such a run "all met". A :func:`reported` row is not counted.
 
 ``roughfe validate`` writes ``<outdir>/summary.json`` (see :mod:`roughfe.cli.validate_cmd`):
-``{"validations": {name: {"met": bool|null, "targets": [rows], "not_run": [...]}},
-"all_met": bool, "not_run": [...]}``. The documentation pages are generated from these
-files; no number is typed by hand.
+``{"planned": [names], "complete": bool, "pending": [names], "validations": {name:
+{"met": bool|null, "targets": [rows], "not_run": [...]}}, "all_met": bool, "not_run":
+[...]}``; ``all_met`` is true only for a complete run with every target run and met. The
+documentation pages are generated from these files; no number is typed by hand.
 
 Richardson extrapolation
 ------------------------

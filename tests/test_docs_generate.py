@@ -91,6 +91,23 @@ def test_a_page_takes_its_own_variants_not_another_scripts_results(gen, tmp_path
     assert page["bench_x"].count("| pad |") == 0
 
 
+def test_a_page_from_an_incomplete_validation_run_says_so(gen, tmp_path):
+    """summary.json of a killed `roughfe validate` run ("complete": false): every page
+    from that folder says the run did not finish and what was not done; a skipped
+    target row is shown as not run, not as "not checked"."""
+    alpha = {"targets": [{"name": "w", "met": True},
+                         {"name": "vs Tamaas: not run", "met": None, "measured": "not run"}]}
+    page = _pages(gen, tmp_path, {"alpha": alpha})["alpha"]
+    assert "Incomplete run" not in page and "| vs Tamaas: not run | **not run** |" in page
+    (tmp_path / "output" / "summary.json").write_text(json.dumps(
+        {"planned": ["bem", "fem"], "complete": False, "pending": ["fem"],
+         "validations": {}, "all_met": False, "not_run": []}))
+    scripts, output, pages = (tmp_path / d for d in ("validation", "output", "pages"))
+    gen.write_results(sorted(scripts.glob("*.py")), output, pages, "Validation", {})
+    page = (pages / "alpha.md").read_text()
+    assert "**Incomplete run**" in page and "not done: fem" in page
+
+
 def test_missing_json_says_so_and_shows_no_numbers(gen, tmp_path):
     page = _pages(gen, tmp_path, {"gamma": None})["gamma"]
     assert "Not run yet" in page and "gamma.json" in page

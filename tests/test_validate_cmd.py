@@ -248,3 +248,32 @@ def test_ctrl_c_keeps_the_reports_already_finished(studies, capsys, monkeypatch)
     assert json.loads((out / "alpha.json").read_text())["targets"][0]["met"]
     assert (out / "UNFINISHED").is_file()
     assert json.loads((out / ".roughfe-output.json").read_text())["status"] == "interrupted"
+
+
+PROBE = '''"""Stand-in study that reads summary.json while it runs: what a kill would leave."""
+import json
+
+
+def main(outdir):
+    seen = json.loads((outdir / "summary.json").read_text())
+    (outdir / "probe.json").write_text(json.dumps({"seen": seen, "targets": [
+        {"name": "probe: p", "target": "<= 1", "measured": "0", "value": 0.0, "met": True,
+         "reason": ""}]}))
+    return True
+'''
+
+
+def test_a_killed_run_never_leaves_an_all_met_summary(studies, monkeypatch):
+    """summary.json while the second of two validations runs (what SIGKILL leaves): the
+    planned list, complete false, all_met false (it read {"all_met": true} with only the
+    first study in it); at the end complete and all met."""
+    (studies / "validation" / "probe.py").write_text(PROBE)
+    monkeypatch.setattr(validate_cmd, "VALIDATIONS", {"good": ("alpha",), "probe": ("probe",)})
+    out = studies / "killed"
+    assert main(["validate", "all", "-o", str(out)]) == 0
+    seen = json.loads((out / "probe.json").read_text())["seen"]
+    assert seen["all_met"] is False and seen["complete"] is False
+    assert seen["planned"] == ["good", "probe"] and seen["pending"] == ["probe"]
+    assert list(seen["validations"]) == ["good"] and seen["validations"]["good"]["met"]
+    final = json.loads((out / "summary.json").read_text())
+    assert final["complete"] and final["all_met"] and final["pending"] == []

@@ -16,6 +16,10 @@ beside the targets (:func:`roughfe.validation.reported`) is not counted. They ar
 physics scripts that compare roughfe with analytic solutions, FEM and the literature;
 they need the repository checkout (they are not installed modules).
 
+``summary.json`` is written before the first study and after every one: it lists the
+``planned`` validations and says ``"complete": false`` until the last one is done, so a
+killed run never leaves a summary that reads "all met" (:func:`summary_record`).
+
 ``OUTDIR`` is owned like every output folder (:class:`roughfe.writers.OutputFolder`):
 locked, ``UNFINISHED`` while the studies run, refused when it holds files that are not an
 earlier output of the same ``roughfe validate NAME`` (``--overwrite`` to replace them),
@@ -148,10 +152,27 @@ def _script_doc(name: str) -> str:
         return "(validation script not found: run from a roughfe checkout)"
 
 
+def summary_record(planned: list, summary: dict, quick: bool) -> dict:
+    """The content of ``summary.json``: the ``planned`` validations, those done so far
+    (``validations``, in order) and ``pending``; ``complete`` once every planned one is
+    done; ``not_run`` (scripts and skipped targets); ``all_met`` only for a complete run
+    in which every target ran and is met (a killed run's summary is never all met)."""
+    failed = [n for n, v in summary.items() if v["met"] is False]
+    not_run = [s for v in summary.values() for s in v["not_run"]]
+    complete = all(n in summary for n in planned)
+    return {"planned": list(planned), "complete": complete,
+            "pending": [n for n in planned if n not in summary], "validations": summary,
+            "quick": bool(quick), "all_met": complete and not failed and not not_run,
+            "not_run": not_run}
+
+
 def _run(args) -> int:
     names = list(VALIDATIONS) if args.name == "all" else [args.name]
     summary = {}
     with output_folder_of(args, f"validate {args.name}", keep_partial=True) as outdir:
+        # before the first study and after every one: a killed run's summary says what
+        # it had planned and that it is not complete
+        write_json(outdir / "summary.json", summary_record(names, summary, args.quick))
         for name in progress.iterate(names, "validations"):
             print(f"== validation {name}{' (quick)' if args.quick else ''}", flush=True)
             summary[name] = run_validation(name, outdir, quick=args.quick)
@@ -166,13 +187,9 @@ def _run(args) -> int:
                 elif not t["met"]:
                     print(f"   NOT met: {t.get('name')}: {t.get('measured', t.get('value'))} "
                           f"(target {t.get('target')})")
-            failed = [n for n, v in summary.items() if v["met"] is False]
-            not_run = [s for v in summary.values() for s in v["not_run"]]
-            # after every study, so that a killed run still has the finished ones
-            write_json(outdir / "summary.json", {"validations": summary,
-                                                 "quick": bool(args.quick),
-                                                 "all_met": not failed and not not_run,
-                                                 "not_run": not_run})
+            write_json(outdir / "summary.json", summary_record(names, summary, args.quick))
+    failed = [n for n, v in summary.items() if v["met"] is False]
+    not_run = [s for v in summary.values() for s in v["not_run"]]
     ran = [n for n, v in summary.items() if v["met"] is not None]
     if failed:
         print(f"targets missed in: {', '.join(failed)}")
