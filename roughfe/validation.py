@@ -122,6 +122,18 @@ def within(name: str, value: float, limit: float, reason: str = "") -> Target:
                   met=bool(np.isfinite(v) and abs(v) <= limit), reason=reason, value=v)
 
 
+def report_title(title: str, quick: bool = False, reduced: str = "") -> str:
+    """The first line of a validation report ``<script>.md``: ``# title``; for the
+    reduced case (``quick``, ``roughfe validate --quick``) the line says so, and the next
+    one says what is reduced (``reduced``, e.g. "3 seeds instead of 20") and that the
+    full case runs without ``--quick``. Ends with a newline."""
+    if not quick:
+        return f"# {title}\n"
+    return (f"# {title}: reduced case (`--quick`)\n\n"
+            f"Reduced case{': ' + reduced if reduced else ''}. The numbers below are not "
+            "those of the full validation, which `roughfe validate` without `--quick` runs.\n")
+
+
 def targets_markdown(rows) -> str:
     """The rows as a Markdown table (target | criterion | measured | status | reason)."""
     lines = ["| target | criterion | measured | status | reason |", "|---|---|---|---|---|"]

@@ -277,3 +277,39 @@ def test_a_killed_run_never_leaves_an_all_met_summary(studies, monkeypatch):
     assert list(seen["validations"]) == ["good"] and seen["validations"]["good"]["met"]
     final = json.loads((out / "summary.json").read_text())
     assert final["complete"] and final["all_met"] and final["pending"] == []
+
+
+def test_a_quick_report_says_in_its_first_line_that_it_is_the_reduced_case():
+    """roughfe.validation.report_title: the first line of every report written with
+    quick=True says it is the reduced case (the quick reports of fsi, leakage and
+    sequencing never said so), and every script with a reduced case uses it."""
+    import ast
+    from roughfe.validation import report_title
+    full = report_title("Leakage", False)
+    quick = report_title("Leakage", True, "one seed")
+    assert full == "# Leakage\n" and "reduced" not in full
+    assert "reduced case" in quick.splitlines()[0] and "one seed" in quick
+    missing = []
+    for path in sorted(validate_cmd._validation_dir().glob("*.py")):
+        tree = ast.parse(path.read_text())
+        main_ = next((n for n in tree.body if isinstance(n, ast.FunctionDef)
+                      and n.name == "main"), None)
+        if main_ is None or "quick" not in [a.arg for a in main_.args.args]:
+            continue
+        if not any(isinstance(n, ast.Call) and getattr(n.func, "id", "") == "report_title"
+                   for n in ast.walk(tree)):
+            missing.append(path.name)
+    assert not missing, f"reports with a reduced case that do not say so: {missing}"
+
+
+def test_the_reduced_sequencing_report_leaves_out_what_it_did_not_compute():
+    """validation/genomics_sequencing.py in quick mode wrote the headings (iii) and (iv)
+    with nothing under them and named mechanics_*.png figures it had not written."""
+    seq = _script("genomics_sequencing")
+    assert seq.measured_section({}) == [] and seq.mechanics_section({}) == []
+    mech = {"strip": {"sweeps": 3, "time_s": 1.0, "c_td": {"K": [0.5, 1.0]},
+                      "c_bu": {"K": [0.2, 1.0]}}}
+    text = "\n".join(seq.mechanics_section(mech))
+    assert "## (iv)" in text and "mechanics_correlations_*.png" in text
+    text = "\n".join(seq.measured_section({"plu-1.plu": {"skipped": "not found"}}))
+    assert "## (iii)" in text and "plu-1.plu: skipped" in text

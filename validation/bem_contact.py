@@ -22,7 +22,7 @@ from roughfe.bem import Material, solve_contact
 from roughfe.reference import hertz_cylinder, hertz_sphere, westergaard
 from roughfe.surfaces import Surface
 from roughfe.surfaces.spectral import spectral_surface
-from roughfe.validation import fraction, skipped, targets_markdown, within
+from roughfe.validation import fraction, report_title, skipped, targets_markdown, within
 from roughfe.writers import write_json, write_text
 
 MAT = Material(1.0e9, 0.3)
@@ -184,7 +184,8 @@ def main(outdir: Path, quick: bool = False) -> bool:
             f"{r[k]:.3g}" if isinstance(r[k], float) else str(r[k]) for k in keys) + " |"
             for r in rows)
 
-    md = ("# BEM contact validation\n\n"
+    md = (report_title("BEM contact validation", quick, "Westergaard to 1024 points, Hertz "
+                       "to 256^2, one solver seed, no Tamaas") + "\n"
           "## Westergaard (periodic profile)\n\n" + table(w, ["n", "s", "A", "A_ref",
                                                               "width_err", "edge_width_err", "gap_err", "nit",
                                                               "solver"])

@@ -28,7 +28,7 @@ from roughfe.genomics.similarity import write_target_csv
 from roughfe.model import Material
 from roughfe.plotting import design as dplot
 from roughfe.study import build_genome_db
-from roughfe.validation import Target, reported, targets_markdown
+from roughfe.validation import Target, report_title, reported, targets_markdown
 from roughfe.writers import write_json, write_text
 
 GOALS = {"s_yt1": 0.98, "f_multi": 0.9, "reproducible": 1e-6}
@@ -358,8 +358,11 @@ def quick_case(outdir: Path) -> bool:
     rows = [reported(t, monotone) if ">= best start" in t.name else t for t in rows]
     write_json(outdir / "design_study.json", {"name": "design_study", "quick": True,
                                               "targets": [t.to_dict() for t in rows]})
-    write_text(outdir / "design_study.md", "# Roughness design (quick)\n\n"
-               + targets_markdown(rows))
+    write_text(outdir / "design_study.md", report_title(
+        "Roughness design", True, "one design stage on a 6-genome database (128 nodes, 12 "
+        "loads): SOG for y_t1 with one GCMMA iteration per stage, the search at the target "
+        "pressures (2 starts x 8 sweeps) and the global search (60 evaluations)") + "\n"
+        + targets_markdown(rows))
     return all(t.met for t in rows if t.met is not None)
 
 
