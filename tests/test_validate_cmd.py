@@ -313,3 +313,13 @@ def test_the_reduced_sequencing_report_leaves_out_what_it_did_not_compute():
     assert "## (iv)" in text and "mechanics_correlations_*.png" in text
     text = "\n".join(seq.measured_section({"plu-1.plu": {"skipped": "not found"}}))
     assert "## (iii)" in text and "plu-1.plu: skipped" in text
+
+
+def test_the_leakage_figure_names_the_surface_it_used():
+    """validation/leakage_flow.py typed "RMD m=7, D=2.3" as the FE-vs-FV figure title
+    while the quick run used m = 6: the title, like the section headings, is built from
+    the values used (rmd_label)."""
+    leak = _script("leakage_flow")
+    assert leak.rmd_label(6) == f"RMD m = 6, D = {leak.ROUGH_D:g}"
+    source = (validate_cmd._validation_dir() / "leakage_flow.py").read_text()
+    assert "RMD m=7" not in source and 'set_title(f"{rmd_label(m_rough)}' in source

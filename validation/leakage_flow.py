@@ -37,6 +37,8 @@ from roughfe.validation import Target, report_title, within
 from roughfe.writers import write_json, write_text
 
 MU, DP, H, L = 1.0e-3, 1.0e3, 1.0e-6, 1.0e-4
+#: fractal dimension D of the RMD surfaces of the rough BEM gaps, (3) and (3b)
+ROUGH_D = 2.3
 TARGETS = {"exact": 1e-8, "order_low": 1.8, "order_high": 2.2, "richardson": 1e-4,
            "balance": 1e-8}
 
@@ -86,7 +88,7 @@ def convergence(ns=(32, 64, 128, 256)):
 def refinement(m=6, seed=2, fractions=(0.2, 0.35), factors=(1, 2, 4, 8)):
     """FE and FV leak rates of BEM gaps refined by r x r sub-cells (section 3b)."""
     rows = []
-    s = rmd_surface(m, 2.3, L, rng=seed)
+    s = rmd_surface(m, ROUGH_D, L, rng=seed)
     for f in fractions:
         c = solve_contact(s, Material(1e9, 0.3), delta=f * np.ptp(s.heights),
                           compute_stiffness=False)
@@ -105,7 +107,7 @@ def refinement(m=6, seed=2, fractions=(0.2, 0.35), factors=(1, 2, 4, 8)):
 def rough_cases(m=7, seeds=(1, 2, 3), fractions=(1 / 6, 2 / 6, 3 / 6)):
     rows = []
     for seed in seeds:
-        s = rmd_surface(m, 2.3, L, rng=seed)
+        s = rmd_surface(m, ROUGH_D, L, rng=seed)
         for f in fractions:
             c = solve_contact(s, Material(1e9, 0.3), delta=f * np.ptp(s.heights),
                               compute_stiffness=False)
@@ -129,18 +131,26 @@ def rough_cases(m=7, seeds=(1, 2, 3), fractions=(1 / 6, 2 / 6, 3 / 6)):
     return rows
 
 
+def rmd_label(m: int) -> str:
+    """The rough surfaces of (3)/(3b) in words, from the values used: "RMD m = 7, D = 2.3"."""
+    return f"RMD m = {m}, D = {ROUGH_D:g}"
+
+
 def main(outdir: Path, quick: bool = False) -> bool:
     """All cases; ``quick``: exact flows at 64^2, convergence n = 32..128, one rough RMD
     m = 6 surface, the Sec. 2.4 study for D = 2.3, m = 3..4, one seed (same targets)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    m_rough, m_refine = (6, 5) if quick else (7, 6)    # RMD levels of (3) and (3b)
     if quick:
-        ex, conv, rough = exact_cases(64), convergence((32, 64, 128)), rough_cases(6, (1,))
-        refine = refinement(5, fractions=(0.35,), factors=(1, 2))
+        ex, conv = exact_cases(64), convergence((32, 64, 128))
+        rough = rough_cases(m_rough, (1,))
+        refine = refinement(m_refine, fractions=(0.35,), factors=(1, 2))
         grid = [(2.3, m, seed) for m in (3, 4) for seed in (101,)]
     else:
-        ex, conv, rough, refine = exact_cases(), convergence(), rough_cases(), refinement()
+        ex, conv, rough = exact_cases(), convergence(), rough_cases(m_rough)
+        refine = refinement(m_refine)
         grid = [(D, m, seed) for D in (2.1, 2.3, 2.5, 2.7, 2.9) for m in (3, 4, 5, 6)
                 for seed in (101, 102)]
     records = [r for D, m, seed in grid for r in leakage_task(D, m, seed)]
@@ -166,7 +176,7 @@ def main(outdir: Path, quick: bool = False) -> bool:
     ax.loglog(lim, lim, "k:")
     ax.set_xlabel("Q finite volumes (m$^3$/s)")
     ax.set_ylabel("Q Q1 finite elements (m$^3$/s)")
-    ax.set_title("RMD m=7, D=2.3: BEM gaps")
+    ax.set_title(f"{rmd_label(m_rough)}: BEM gaps")
     save_figure(fig, outdir / "leakage_fe_vs_fv.png")
 
     bal = [r["balance"] for r in rough if r["balance"] is not None]
@@ -200,9 +210,9 @@ def main(outdir: Path, quick: bool = False) -> bool:
     rows += [Target(k, "holds", "yes" if v else "no", bool(v)) for k, v in checks.items()
              if k not in {t.name for t in rows}]
     lines = [report_title("Leakage: Reynolds FV (default) and FE cross-check validation",
-                          quick, "exact flows at 64^2, convergence n = 32..128, one rough "
-                          "RMD m = 6 surface, the Sec. 2.4 study for D = 2.3, m = 3..4, one "
-                          "seed"),
+                          quick, f"exact flows at 64^2, convergence n = 32..128, one rough "
+                          f"{rmd_label(m_rough)} surface, the Sec. 2.4 study for D = 2.3, "
+                          "m = 3..4, one seed"),
              f"Total time {elapsed:.0f} s (shared 2-core machine: timings inflated).", "",
              f"## (1) Exact discrete solutions, {64 if quick else 256}^2", "",
              "| case | relative error |", "|---|---|",
@@ -213,7 +223,7 @@ def main(outdir: Path, quick: bool = False) -> bool:
              "", f"Observed orders: FE {conv['order_fe']:.3f}, FV {conv['order_fv']:.3f}; "
                  f"Richardson limits differ by {conv['limit_agreement']:.2e}.",
              "", "![convergence](leakage_convergence.png)", "",
-             f"## (3) Rough BEM gaps (RMD m = {6 if quick else 7}, D = 2.3)", "",
+             f"## (3) Rough BEM gaps ({rmd_label(m_rough)})", "",
              "| seed | Delta* | dir | A* | Q FE | Q FV | FE/FV | perc. network / Q1 | nit | FE s |",
              "|---|---|---|---|---|---|---|---|---|---|",
              *[f"| {r['seed']} | {r['delta_star']:.3f} | {r['direction']} | {r['area_fraction']:.3f} "
@@ -226,8 +236,7 @@ def main(outdir: Path, quick: bool = False) -> bool:
                   "two-point FV does not; both converge to the same limit on smooth gaps)."
                   if ratio.size else "no percolating case"),
              "", "![FE vs FV](leakage_fe_vs_fv.png)", "",
-             f"## (3b) Rough BEM gaps refined by r x r sub-cells (RMD m = {5 if quick else 6}, "
-             "D = 2.3)", "",
+             f"## (3b) Rough BEM gaps refined by r x r sub-cells ({rmd_label(m_refine)})", "",
              "| Delta* | A* | r | n | Q FV | Q FE | FE/FV - 1 |", "|---|---|---|---|---|---|---|",
              *[f"| {r['delta_star']} | {r['area_fraction']:.3f} | {r['r']} | {r['n']} | "
                f"{r['q_fv']:.4e} | {r['q_fe']:.4e} | "
