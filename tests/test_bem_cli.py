@@ -269,3 +269,30 @@ def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path, caps
     # (the reported Delta is the equilibrium's own: adhesion may close the last step
     # fully, at Delta = max h - mean h, below the imposed approach's 3/4 of it)
     assert np.all(np.diff([st["load"] for st in steps]) > 0)
+
+
+def _narrow_band_adhesive_run(tmp_path, capsys):
+    """A narrow-band periodic cell (32^2, H = 0.8, 10 nm rms, q_s / q_r = 4) under a
+    resolved Maugis-Dugdale law (w = 4.52e-5 J/m^2, range 10 nm: process zone 7.4 cells)
+    loaded in 4 steps: the results.json and the screen."""
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=4 * np.pi / 1e-5,
+                         q_short=16 * np.pi / 1e-5, rng=3)
+    path = save_surface(s, tmp_path / "narrow.npz")
+    out = tmp_path / "adh"
+    assert main(["contact", str(path), "--E", "1e6", "--nu", "0.5", "--adhesion", "md",
+                 "--work-of-adhesion", "4.52e-5", "--range", "1e-8", "--steps", "4",
+                 "--no-figures", "-o", str(out)]) == 0
+    return json.loads((out / "results.json").read_text()), capsys.readouterr().out
+
+
+def test_contact_cli_adhesive_steps_get_no_non_adhesive_persson_theory(tmp_path, capsys):
+    # Persson's theory is non-adhesive: at the net (repulsive minus attractive) load of an
+    # adhesive state it predicts nothing (here the last step, p = 1.2 kPa > 0, has
+    # A* = 0.42 where the non-adhesive theory gave 0.073). Until round 2 session 24 every
+    # step with p > 0 got persson_area_fraction / persson_mean_gap unlabelled.
+    doc, _ = _narrow_band_adhesive_run(tmp_path, capsys)
+    steps = doc["steps"]
+    assert any(st["mean_pressure"] > 0 for st in steps)
+    assert not any(k.startswith("persson_") for st in steps for k in st)
+    assert doc["derived"]["persson"]["adhesion"] == "not in the theory"

@@ -184,6 +184,10 @@ def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
     assert res["cell_compliance"] == pytest.approx(1.11, abs=0.02)
     assert res["threshold_cells"] == pytest.approx(2.7 * res["cell_compliance"], rel=1e-12)
     assert "adhesion_resolution" not in el["inputs"]
+    # the (non-adhesive) Persson theory beside the elastic steps only, not the adhesive ones
+    assert all(st["persson_leak_rate"] is not None for st in el["steps"])
+    assert not any(k.startswith("persson_") for st in adh["steps"] for k in st)
+    assert adh["persson"]["adhesion"] == "not in the theory"
     for other in (adh, hard):
         for e, o in zip(el["steps"], other["steps"]):
             assert o["delta"] == pytest.approx(e["delta"], rel=1e-6)

@@ -211,6 +211,17 @@ def test_beside_adds_the_theory_to_step_records(surface):
     assert doc["persson"]["u0"] == pytest.approx(r.u0)
 
 
+def test_beside_evaluates_no_theory_for_adhesive_steps(surface):
+    # the theory is non-adhesive: at the net mean pressure of an adhesive state (repulsive
+    # minus attractive load) it is no prediction, so an adhesive run gets none and says why
+    steps = [{"mean_pressure": -50.0, "x": 1}, {"mean_pressure": 80.0, "x": 2}]
+    doc = beside(surface, E_STAR, steps, pressure_drop=1e5, viscosity=1e-3, adhesive=True)
+    assert doc["steps"] == steps and doc["steps"][1] is not steps[1]
+    assert not any(k.startswith("persson_") for st in doc["steps"] for k in st)
+    assert doc["persson"]["adhesion"] == "not in the theory"
+    assert "kappa" not in doc["persson"] and "u0" not in doc["persson"]
+
+
 def test_beside_direction_uses_the_geometry_factor_of_that_direction():
     # transpose symmetry: flow along y on Z is flow along x on Z.T (the radially averaged
     # PSD is the same; only width/length along the pressure drop changes: Lx/Ly for y)

@@ -4,7 +4,8 @@ Runs one warm-started BEM contact sweep (:func:`roughfe.response.response`) and 
 ``results.json``, ``fields.h5`` and the figures (A(p), K(p), mean gap, with Persson's
 theory beside the BEM curves; a 3D render of the last step for surfaces, a profile plot
 for profiles). Each step record carries ``persson_area_fraction`` and
-``persson_mean_gap`` (:func:`roughfe.theory.beside`).
+``persson_mean_gap`` (:func:`roughfe.theory.beside`), except with ``--adhesion``: the
+theory is non-adhesive, so an adhesive run has none (``derived.persson`` says so).
 """
 from __future__ import annotations
 
@@ -105,7 +106,7 @@ def _run(args) -> int:
               "hardness": args.hardness, "unload": args.unload,
               "detrend": args.detrend,
               "metadata": dict(surface.metadata)}
-    doc = contact_document(sweep, surface, material, inputs)
+    doc = contact_document(sweep, surface, material, inputs, adhesive=adhesive is not None)
     if adhesive is not None:
         doc["inputs"]["adhesion"] = law.describe()
         doc["derived"]["pull_off_force"] = adhesive.pull_off_force
@@ -205,14 +206,16 @@ def _adhesive_sweep(args, surface, material, law, tol):
 THESIS_FIG7 = {"A_star": 0.25, "P_star": 0.56, "h_s": 6.72e-6}
 
 
-def contact_document(sweep, surface, material, inputs: dict) -> dict:
+def contact_document(sweep, surface, material, inputs: dict, *, adhesive=False) -> dict:
     """results.json of a contact sweep (the one builder of ``roughfe contact`` and of the
     demo): :func:`~roughfe.bem.output.sweep_document` with the surface's grid in its
-    inputs and Persson's theory beside every step (``persson_*`` keys, ``derived.persson``)."""
+    inputs and Persson's theory beside every step (``persson_*`` keys, ``derived.persson``);
+    for an ``adhesive`` sweep no step gets the (non-adhesive) theory and
+    ``derived.persson`` says so (:data:`roughfe.theory.beside.NOT_ADHESIVE`)."""
     doc = sweep_document(sweep, {"surface": inputs.get("surface"),
                                  "shape": list(surface.shape), "size": list(surface.size),
                                  "periodic": surface.periodic, **inputs})
-    theory = beside(surface, material.E_star, doc["steps"])
+    theory = beside(surface, material.E_star, doc["steps"], adhesive=adhesive)
     doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
     return doc
 

@@ -259,7 +259,8 @@ def _leak_run(args, surface, material, out):
     check_small_strain(args, surface, [c.delta for c in sweep.contacts], material,
                        [c.mean_pressure for c in sweep.contacts])
     theory = beside(surface, material.E_star, sweep.records(), pressure_drop=dp,
-                    viscosity=args.mu, direction=args.direction)
+                    viscosity=args.mu, direction=args.direction,
+                    adhesive=physics["adhesion"] is not None)
     steps = theory["steps"]
     inputs = {**base, "reynolds": not args.no_reynolds,
               "references": list(sweep.leakages[0].references)}

@@ -1,6 +1,12 @@
 """Persson's theory beside the steps of a simulation (the ``persson_*`` keys of
 results.json): A*(p) and u(p) of :mod:`roughfe.theory.persson` and the critical-junction
-leak rate of :mod:`roughfe.theory.junction` at each step's mean pressure (SI)."""
+leak rate of :mod:`roughfe.theory.junction` at each step's mean pressure (SI).
+
+The theory is non-adhesive: its A*(p) and u(p) belong to a repulsive load p. In an
+adhesive run the net mean pressure is the repulsive load less the attraction (a tensile
+net load can hold a contact of A* = 0.2), so the theory at that load is not a prediction
+of the adhesive contact, and ``beside(..., adhesive=True)`` evaluates none
+(:data:`NOT_ADHESIVE`; docs/theory/07_adhesion_persson.md)."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,9 +15,18 @@ from ..errors import InputError
 from .junction import _geometry_factor, critical_junction
 from .persson import GAMMA_DEFAULT, PERCOLATION_THRESHOLD, REFERENCES, _spectrum, persson
 
+#: ``"persson"`` of an adhesive run: no step gets ``persson_*`` keys, and this says why
+NOT_ADHESIVE = {
+    "adhesion": "not in the theory",
+    "note": "Persson's A*(p), u(p) and critical junction here are non-adhesive: at the "
+            "net (repulsive minus attractive) mean pressure of an adhesive step they are "
+            "not a prediction of that contact, so no step carries persson_* values "
+            "(docs/theory/07_adhesion_persson.md)",
+}
+
 
 def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, direction="x",
-           gamma=GAMMA_DEFAULT) -> dict:
+           gamma=GAMMA_DEFAULT, adhesive=False) -> dict:
     """Persson's theory at the mean pressure of each simulation step (results.json).
 
     Parameters
@@ -29,6 +44,9 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         simulated ``leak_rate`` of ``roughfe leak --direction both``).
     gamma : float
         As in :func:`persson`.
+    adhesive : bool
+        The steps are states of an adhesive contact: the (non-adhesive) theory is not
+        evaluated; ``"steps"`` are plain copies and ``"persson"`` is :data:`NOT_ADHESIVE`.
 
     Returns
     -------
@@ -42,6 +60,8 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     psd = _spectrum(source)
     if direction not in ("x", "y", "both"):
         raise InputError(f"direction must be 'x', 'y' or 'both', got {direction!r}")
+    if adhesive:
+        return {"steps": [dict(s) for s in steps], "persson": dict(NOT_ADHESIVE)}
     dirs = ("x", "y") if direction == "both" else (direction,)
     factors = {d: _geometry_factor(source, d) for d in dirs}
     pressures = [s.get("mean_pressure") for s in steps]
