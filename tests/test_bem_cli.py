@@ -296,3 +296,14 @@ def test_contact_cli_adhesive_steps_get_no_non_adhesive_persson_theory(tmp_path,
     assert any(st["mean_pressure"] > 0 for st in steps)
     assert not any(k.startswith("persson_") for st in steps for k in st)
     assert doc["derived"]["persson"]["adhesion"] == "not in the theory"
+
+
+def test_contact_cli_says_when_pastewka_robbins_is_outside_its_domain(tmp_path, capsys):
+    # Delta_r / g0 = 0.14 here, above the criterion's 0.1: its verdict ("not sticky",
+    # while the loading branch holds contact at tensile loads) was printed as Eq. 10's
+    # prediction with no caveat until round 2 session 24
+    doc, out = _narrow_band_adhesive_run(tmp_path, capsys)
+    st = doc["derived"]["stickiness"]
+    assert st["range_over_edge_gap"] > 0.1 and st["in_domain"] is False
+    assert (f"outside its domain: Delta_r/g0 = {st['range_over_edge_gap']:.2g} > 0.1"
+            in out)

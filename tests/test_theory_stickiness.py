@@ -121,6 +121,25 @@ def test_profile_uses_the_strip_edge():
     assert r.criterion == pytest.approx(1 / r.stickiness, rel=1e-12)
 
 
+def test_the_verdict_states_the_domain_and_which_criterion():
+    # Eq. (10) holds for Delta_r / g0 < 0.1 (Monti, Sanner & Pastewka 2021): a verdict
+    # outside says so; a profile's criterion is our strip analogue, not the paper's
+    s = _surface()
+    g0 = 1e-9 / pastewka_robbins(s, 1.33e6, 1e-4, 1e-9).range_over_edge_gap
+    inside = pastewka_robbins(s, 1.33e6, 1e-4, 0.06 * g0)
+    outside = pastewka_robbins(s, 1.33e6, 1e-4, 0.18 * g0)
+    assert inside.in_domain is True and outside.in_domain is False
+    assert outside.describe()["in_domain"] is False
+    assert "outside" not in inside.verdict() and "(Eq. 10, sticky if < 1)" in inside.verdict()
+    assert "outside its domain: Delta_r/g0 = 0.18 > 0.1" in outside.verdict()
+    x = np.arange(256) / 256
+    prof = Surface(1e-8 * np.cos(2 * np.pi * 8 * x), 1e-5, periodic=True)
+    r = pastewka_robbins(prof, 1e6, 1e-4, 5e-9)
+    assert r.in_domain is None
+    assert "(strip analogue (not published), sticky if < 1)" in r.verdict()
+    assert "Eq. 10" not in r.verdict()
+
+
 @pytest.mark.parametrize("args, match", [((1e6, 0.0, 1e-9), "work of adhesion"),
                                          ((1e6, 1e-3, float("nan")), "range"),
                                          ((-1.0, 1e-3, 1e-9), "E"),

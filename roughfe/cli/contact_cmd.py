@@ -116,8 +116,8 @@ def _run(args) -> int:
         # the process zone against the grid (the ResolutionWarning's numbers, kept)
         doc["derived"]["resolution"] = adhesive.resolution
         doc["derived"]["units"].update(process_zone="m", grid_spacing="m")
-        doc["derived"]["stickiness"] = pastewka_robbins(surface, material.E_star, law.work,
-                                                        law.range).describe()
+        stickiness = pastewka_robbins(surface, material.E_star, law.work, law.range)
+        doc["derived"]["stickiness"] = stickiness.describe()
     with folder as out:
         write_fields_h5(out / "fields.h5", sweep)
         if not args.no_figures:
@@ -148,13 +148,10 @@ def _run(args) -> int:
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.4f} "
               f"{k} {s['mean_gap']:12.4e} {s['iterations']:5d}")
     if adhesive is not None:
-        st = doc["derived"]["stickiness"]
         pull = (f"pull-off force {adhesive.pull_off_force:.4e} "
                 f"({'detached' if adhesive.detached else 'NOT detached: a bound'})"
                 if args.unload else "pull-off force not traced (--unload traces it)")
-        print(f"{pull}; "
-              f"Pastewka-Robbins C = {st['criterion']:.3g} (Eq. 10, sticky if < 1) "
-              f"({'sticky' if st['sticky'] else 'not sticky'})")
+        print(f"{pull}; {stickiness.verdict()}")
     print(f"wrote {out / 'results.json'}, {out / 'fields.h5'}")
     return 0
 

@@ -81,6 +81,9 @@ KAPPA_REP = 2.0
 #: Gap-opening coefficient c_d of Eq. (1) and perimeter-over-area factor n_d, per dimension.
 EDGE_COEFFICIENT = {2: 2.0 * np.sqrt(2.0), 1: 16.0 * np.sqrt(2.0) / (3.0 * np.pi)}
 PERIMETER_FACTOR = {2: 2.0, 1: 1.0}
+#: Upper limit of Delta_r / g0 for the criterion's assumptions (Monti, Sanner & Pastewka
+#: 2021; the authors' group's examples): above it the verdict is outside its domain
+RANGE_OVER_EDGE_GAP_LIMIT = 0.1
 
 REFERENCES = (
     "Pastewka L., Robbins M.O. (2014) Proc. Natl. Acad. Sci. USA 111:3298-3303, Eq. (10) "
@@ -108,6 +111,13 @@ class Stickiness:
     published : bool
         True for a surface (Eq. (10) of the paper); False for a profile (our strip
         analogue, Eq. (2) with c_1, n_1: the paper has no 1D criterion).
+    in_domain : bool or None
+        Surface: ``range_over_edge_gap < RANGE_OVER_EDGE_GAP_LIMIT`` (0.1), the stated
+        domain of Eq. (10); outside it the verdict is not a prediction (measured on a
+        narrow band: Eq. (10) underestimates the stickiness 6.5x there, docs/theory/07).
+        The other domain condition there, a wide self-affine band, is not known from a
+        surface alone and not checked. None for a profile: the strip analogue has no
+        stated domain.
     kappa_ratio : float
         Mean-field ``kappa / kappa_rep = 1 / (1 - S)`` (-), negative when sticky.
     rms_slope, rms_curvature : float
@@ -142,6 +152,7 @@ class Stickiness:
     stickiness: float
     sticky: bool
     published: bool
+    in_domain: bool | None
     kappa_ratio: float
     rms_slope: float
     rms_curvature: float
@@ -167,6 +178,17 @@ class Stickiness:
                         "repulsive_pressure": "Pa", "adhesion_length": "m",
                         "work": "J/m^2", "range": "m", "e_star": "Pa"}
         return out
+
+    def verdict(self) -> str:
+        """One line: C, which criterion (Eq. (10) or the strip analogue), the verdict and,
+        outside the criterion's domain, that and why."""
+        which = "Eq. 10" if self.published else "strip analogue (not published)"
+        text = (f"Pastewka-Robbins C = {self.criterion:.3g} ({which}, sticky if < 1) "
+                f"({'sticky' if self.sticky else 'not sticky'}")
+        if self.in_domain is False:
+            text += (f"; outside its domain: Delta_r/g0 = {self.range_over_edge_gap:.2g} "
+                     f"> {RANGE_OVER_EDGE_GAP_LIMIT:g}")
+        return text + ")"
 
 
 def published_criterion(slope, curvature, adhesion_length, interaction_range,
@@ -311,14 +333,16 @@ def pastewka_robbins(surface: Surface, e_star, work, interaction_range, *,
     c = published_criterion(slope, curv, l_a, dr, kappa_rep) if published else 1.0 / s
     s = 1.0 / c
     d_rep = 4.0 * slope / curv
+    edge = float(dr / (16.0 / 3.0 * slope * slope / curv))
     return Stickiness(criterion=float(c), stickiness=float(s), sticky=bool(c < 1.0),
                       published=published,
+                      in_domain=bool(edge < RANGE_OVER_EDGE_GAP_LIMIT) if published else None,
                       kappa_ratio=float(1.0 / (1.0 - s)) if s != 1.0 else float("inf"),
                       rms_slope=slope, rms_curvature=curv, contact_diameter=float(d_rep),
                       ring_width=float(ring), ring_over_half_width=float(2.0 * ring / d_rep),
                       attractive_over_repulsive=float(
                           PERIMETER_FACTOR[dim] * 2.0 * ring / d_rep),
-                      range_over_edge_gap=float(dr / (16.0 / 3.0 * slope * slope / curv)),
+                      range_over_edge_gap=edge,
                       tabor_parameter=float((l_a * l_a / curv) ** (1.0 / 3.0) / dr),
                       repulsive_pressure=float(slope * e_star / kappa_rep),
                       adhesion_length=l_a, kappa_rep=kappa_rep, work=work, range=dr,
