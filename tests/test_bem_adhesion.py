@@ -168,6 +168,34 @@ def test_periodic_full_contact_approach_is_refused():
         solve_adhesive(s, Material(1e9, 0.3), AdhesionLaw("exp", 0.01, 1e-6), delta=top)
 
 
+@pytest.mark.parametrize("spring", [float("nan"), -1.0, 0.0, float("inf"), "1e9"])
+def test_the_mean_gap_spring_must_be_finite_and_positive(spring):
+    # nan returned a NaN residual with no NoConvergenceError, -1 a "converged" state at
+    # another approach, 0 a ZeroDivisionError (until round 2 session 24)
+    s = spectral_surface(16, 1e-4, 0.8, rms_height=1e-7, rng=1)
+    with pytest.raises(InputError, match="spring .* must be"):
+        solve_adhesive(s, Material(1e9, 0.3), AdhesionLaw("exp", 0.01, 1e-6), delta=0.0,
+                       spring=spring)
+
+
+def test_the_mean_gap_spring_is_refused_on_a_non_periodic_kernel():
+    # the DC-FFT operator has no mean-gap spring: a spring given there was ignored
+    with pytest.raises(InputError, match="periodic kernel 'spectral' only"):
+        solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=0.1 * D_SCALE, spring=1.0)
+
+
+def test_a_residual_that_is_not_a_number_is_not_converged(monkeypatch):
+    # the convergence tests read "not r <= tol": "r > tol" is False for NaN, and a NaN
+    # residual came back as a result with no NoConvergenceError
+    from roughfe.bem import adhesive_energy
+    monkeypatch.setattr(adhesive_energy.AdhesiveEnergy, "residual",
+                        lambda self, x: float("nan"))
+    s = spectral_surface(16, 1e-4, 0.8, rms_height=1e-7, rng=1)
+    with pytest.raises(NoConvergenceError, match="residual nan"):
+        solve_adhesive(s, Material(1e9, 0.3), AdhesionLaw("exp", 0.01, 1e-6), delta=0.0,
+                       max_iter=50)
+
+
 def _johnson_difference(n, h0, delta):
     """(p - p_Johnson(a)) / p* for the adhesive sinusoid (Johnson 1995, JKR-type, plane
     strain): h = D cos(2 pi x / l), Johnson's alpha = 0.5, Maugis-Dugdale law with range

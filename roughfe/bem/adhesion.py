@@ -68,7 +68,8 @@ import numpy as np
 import scipy.optimize
 
 from ..errors import (InputError, NoConvergenceError, ResolutionWarning,
-                      check_in_open_interval, check_instance, check_int)
+                      check_finite_positive, check_in_open_interval, check_instance,
+                      check_int)
 from ..model import ContactResult, Loading, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
@@ -131,7 +132,9 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     max_iter : int
         Iterations (CG and L-BFGS-B together).
     spring : float, optional
-        Periodic only: stiffness k0 (Pa/m) of the spring imposing the mean gap.
+        Periodic only: stiffness k0 (Pa/m, finite and > 0) of the spring imposing the
+        mean gap; default 10x the stiffest elastic mode. Refused with a non-periodic
+        kernel, which has no such spring.
     unloading : bool
         The branch stored in the result (``ContactResult.unloading``).
     cell_average : bool
@@ -168,6 +171,13 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     max_iter = check_int("max_iter", max_iter, 1)
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
+    if spring is not None:
+        if not op.periodic:
+            raise InputError(f"spring (the mean-gap spring, Pa/m) applies to the periodic "
+                             f"kernel 'spectral' only; kernel {kernel!r} has none: leave "
+                             f"it None (got spring={spring!r})")
+        spring = check_finite_positive("spring (stiffness of the mean-gap spring, Pa/m)",
+                                       spring)
     check_resolution(law, material.E_star, surface.spacing,
                      cell_compliance(surface, material.E_star, kernel))
     h = surface.heights
@@ -191,11 +201,11 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     for _ in range(MAX_SPREAD_PASSES):
         x, k, r, message = _minimise(energy, x, tol, int(max_iter) - nit, solver)
         nit += k
-        if not averaged or r > tol or not _update_spread(energy, x, law):
+        if not averaged or not r <= tol or not _update_spread(energy, x, law):
             break
     out = _adhesive_result(surface, material, op, law, energy, x, d, r, tol, nit,
                            bool(unloading), solver)
-    if r > tol:
+    if not r <= tol:          # (a NaN residual is not converged)
         raise NoConvergenceError(
             f"adhesive solver ({solver}) did not converge: traction residual {r:.3e} "
             f"(relative to {scale:.3e} Pa) after {nit} iterations ({message}), tolerance "
