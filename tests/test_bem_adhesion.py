@@ -504,6 +504,18 @@ def test_adhesive_sweep_default_approaches():
         adhesive_sweep(s, mat, law, n_steps=0)
 
 
+def test_adhesive_sweep_refuses_approaches_that_do_not_increase():
+    # the continuation labels every given approach a loading step and retraces them in
+    # reverse to unload: given decreasing, the separating steps were labelled loading and
+    # the "unloading" branch went back up (until round 2 session 24)
+    s = spectral_surface(16, 1e-5, 0.8, rms_height=1e-8, rng=3)
+    mat, law = Material(1e6, 0.5), AdhesionLaw("exp", 1e-3, 1e-7)
+    for deltas in ([3e-9, 2e-9, 1e-9], [1e-9, 1e-9], [1e-9, 3e-9, 2e-9]):
+        with pytest.raises(InputError, match="must be strictly increasing") as info:
+            adhesive_sweep(s, mat, law, deltas, unload=True)
+        assert str(deltas[1]) in str(info.value)
+
+
 def test_the_adhesive_rules_speak_each_front_end_s_words():
     """One function holds the rules; the library and the command line get the same
     message in their own vocabulary."""
@@ -516,7 +528,9 @@ def test_the_adhesive_rules_speak_each_front_end_s_words():
              ({"coarse_correction": False}, "coarse_correction does not apply",
               "--coarse-correction does not apply"),
              ({"pressure_control": True}, "give approaches (delta, deltas, n_steps), not mean",
-              "give --delta or --steps, not --pressure")]
+              "give --delta or --steps, not --pressure"),
+             ({"deltas": [3e-8, 2e-8]}, "deltas (the approaches of the adhesion loading",
+              "--delta (the approaches of the --adhesion loading")]
     for kwargs, library, cli in cases:
         with pytest.raises(InputError) as info:
             check_adhesive_run(**kwargs)

@@ -153,6 +153,9 @@ def test_contact_cli_adhesion_unload_pull_off(tmp_path):
     (["--adhesion", "md", "--work-of-adhesion", "0.1", "--range", "1e-9", "--smoothing",
       "1.5"], "--smoothing must be in [0, 1), got 1.5"),
     (["--smoothing", "0.5"], "need --adhesion"),
+    (["--adhesion", "md", "--work-of-adhesion", "0.1", "--range", "1e-9", "--delta", "3e-8",
+      "2e-8", "--unload"], "--delta (the approaches of the --adhesion loading branch, m) "
+                           "must be strictly increasing"),
 ])
 def test_contact_cli_adhesion_bad_input(tmp_path, capsys, extra, message):
     path = _sphere_file(tmp_path, n=8)

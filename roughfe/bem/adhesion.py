@@ -76,6 +76,7 @@ from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
 from .adhesive_cg import adhesive_pcg
 from .adhesive_energy import AdhesiveEnergy
+from .adhesive_rules import check_adhesive_run
 from .adhesive_start import continued_start, elastic_start
 from .interface_law import LAWS, AdhesionLaw, check_resolution, resolution
 
@@ -349,7 +350,8 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     Parameters
     ----------
     deltas : sequence of float, optional
-        Increasing approaches (m) of the loading branch.
+        Strictly increasing approaches (m) of the loading branch (``unload`` traces the
+        unloading branch; approaches in another order are refused).
     n_steps : int, optional
         Instead of ``deltas``: that many equispaced approaches, k / n of the
         peak-to-valley height, or with a periodic kernel k / (n + 1) of max h - mean h
@@ -384,6 +386,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)):
         raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "
                          f"got {deltas!r}")
+    check_adhesive_run(deltas=deltas)
     grid = (law, material.E_star, surface.spacing,
             cell_compliance(surface, material.E_star, kernel))
     check_resolution(*grid)   # once for the sweep

@@ -50,7 +50,9 @@ def register(subparsers) -> None:
     load.add_argument("--pressure", type=positive_float, nargs="+", metavar="P",
                       help="mean pressures (Pa), solved in the order given")
     load.add_argument("--delta", type=float, nargs="+", metavar="D",
-                      help="approaches from first contact (m), solved in the order given")
+                      help="approaches from first contact (m), solved in the order given; "
+                           "with --adhesion strictly increasing (the loading branch; "
+                           "--unload traces the unloading one)")
     add_contact_physics_options(p)
     num = p.add_argument_group("numerics")
     num.add_argument("--kernel", default="auto", choices=("auto",) + KERNELS,

@@ -344,7 +344,8 @@ def register(sub):
     add_detrend_option(p)
     load = p.add_argument_group("loading (exactly one)").add_mutually_exclusive_group(required=True)
     load.add_argument("--delta", type=float, nargs="+", metavar="M",
-                      help="approaches Delta from first contact, in m (one step each)")
+                      help="approaches Delta from first contact, in m (one step each; "
+                           "with --adhesion strictly increasing)")
     load.add_argument("--pressure", type=positive_float, nargs="+", metavar="PA",
                       help="mean contact pressures in Pa (one step each)")
     _add_fluid_material(p)

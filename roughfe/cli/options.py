@@ -258,7 +258,8 @@ def contact_physics_from_args(args) -> dict:
     law = adhesion_from_args(args)
     if law is not None:
         from ..bem.adhesive_rules import check_adhesive_run
-        check_adhesive_run(hardness=args.hardness, words=ADHESION_WORDS)
+        check_adhesive_run(hardness=args.hardness, deltas=getattr(args, "delta", None),
+                           words=ADHESION_WORDS)
     return {"adhesion": law, "hardness": args.hardness, "unload": bool(args.unload)}
 
 
@@ -266,7 +267,8 @@ def contact_physics_from_args(args) -> dict:
 #: :func:`roughfe.bem.adhesive_rules.check_adhesive_run`
 ADHESION_WORDS = {"hardness": "--hardness", "adhesion": "--adhesion", "solver": "--solver",
                   "coarse_correction": "--coarse-correction",
-                  "approaches": "--delta or --steps", "mean pressures": "--pressure"}
+                  "approaches": "--delta or --steps", "mean pressures": "--pressure",
+                  "deltas": "--delta", "unload": "--unload"}
 
 
 # -- outputs and runs ----------------------------------------------------------------------
