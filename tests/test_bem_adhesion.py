@@ -148,6 +148,24 @@ def test_bad_adhesion_parameters(args, match):
         AdhesionLaw(*args)
 
 
+@pytest.mark.parametrize("smoothing", ["x", None, float("nan"), -0.1, 1.0])
+def test_bad_smoothing_is_an_input_error(smoothing):
+    # "x" was a ValueError and None a TypeError from float()
+    with pytest.raises(InputError, match="smoothing"):
+        AdhesionLaw("md", 0.05, 1e-9, smoothing=smoothing)
+
+
+def test_bad_initial_state_and_approaches_are_input_errors():
+    # initial="abc" was an AttributeError, deltas=["a"] a ValueError from numpy
+    s = spectral_surface(16, 1e-5, 0.8, rms_height=1e-8, rng=3)
+    mat, law = Material(1e6, 0.5), AdhesionLaw("exp", 1e-3, 1e-7)
+    with pytest.raises(InputError, match="initial must be a ContactResult"):
+        solve_adhesive(s, mat, law, delta=1e-9, initial="abc")
+    for deltas in (["a"], [[1e-9], [2e-9, 3e-9]]):
+        with pytest.raises(InputError, match="deltas must be a non-empty sequence"):
+            adhesive_sweep(s, mat, law, deltas)
+
+
 def test_bad_approach():
     with pytest.raises(InputError, match="delta"):
         solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=float("nan"))

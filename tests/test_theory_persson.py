@@ -184,6 +184,25 @@ def test_mean_separation_checks_its_spectrum(q, power, match):
         mean_separation(np.array(q), np.array(power), E_STAR, 1e6)
 
 
+@pytest.mark.parametrize("q_min", [np.nan, -1.0, np.inf, None])
+def test_mean_separation_checks_q_min(q_min):
+    # q > nan is False everywhere: u = 0, a closed gap, came back without a word
+    with pytest.raises(InputError, match="q_min"):
+        mean_separation(np.array([1.0, 2.0]), np.array([1.0, 1.0]), E_STAR, 1e6, q_min=q_min)
+
+
+@pytest.mark.parametrize("steps, match", [
+    ([{"mean_pressure": "abc"}], r"steps\[0\]\['mean_pressure'\] must be a number"),
+    ([{"mean_pressure": 1e6}, {"mean_pressure": [1e6]}], r"steps\[1\]"),
+    ([{"mean_pressure": True}], "must be a number"),
+    ([1e6], r"steps\[0\] must be a step record"),
+])
+def test_beside_checks_its_step_records(surface, steps, match):
+    for adhesive in (False, True):
+        with pytest.raises(InputError, match=match):
+            beside(surface, E_STAR, steps, adhesive=adhesive)
+
+
 def test_bad_input_critical_junction(surface):
     prof = spectral_profile(64, 1e-3, 0.7, rms_height=1e-6, rng=1)
     with pytest.raises(InputError, match="2D"):

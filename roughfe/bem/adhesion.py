@@ -191,6 +191,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     scale = max(law.max_traction, 0.5 * material.E_star * rms_slope(surface))
     energy = AdhesiveEnergy(op, law, c, spring, scale)
     if initial is not None:
+        check_instance("initial", initial, ContactResult,
+                       "a ContactResult of a previous adhesive solve (or None)")
         x0 = continued_start(initial, d, op, energy)
     else:
         x0 = elastic_start(surface, material, op, d, c, energy)
@@ -382,7 +384,11 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
         deltas = default_deltas(surface, n_steps + periodic, periodic)[:n_steps]
     elif n_steps is not None:
         raise InputError(f"give deltas or n_steps, not both (got n_steps={n_steps!r})")
-    deltas = np.atleast_1d(np.asarray(deltas, float))
+    try:
+        deltas = np.atleast_1d(np.asarray(deltas, float))
+    except (TypeError, ValueError):
+        raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "
+                         f"got {deltas!r}") from None
     if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)):
         raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "
                          f"got {deltas!r}")

@@ -46,7 +46,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, ResolutionWarning, check_finite_positive
+from ..errors import (InputError, ResolutionWarning, check_finite_nonnegative,
+                      check_finite_positive)
 
 LAWS = ("md", "exp")
 
@@ -91,9 +92,11 @@ class AdhesionLaw:
             "work of adhesion w (J/m^2)", self.work))
         object.__setattr__(self, "range", check_finite_positive(
             "range of adhesion (m)", self.range))
-        s = float(self.smoothing)
-        if not 0.0 <= s < 1.0:
+        s = check_finite_nonnegative("smoothing (the Maugis-Dugdale ramp, a fraction of "
+                                     "the range in [0, 1))", self.smoothing)
+        if not s < 1.0:
             raise InputError(f"smoothing must be in [0, 1), got {self.smoothing!r}")
+        object.__setattr__(self, "smoothing", s)
 
     @property
     def max_traction(self) -> float:

@@ -9,6 +9,9 @@ of the adhesive contact, and ``beside(..., adhesive=True)`` evaluates none
 (:data:`NOT_ADHESIVE`; docs/theory/07_adhesion_persson.md)."""
 from __future__ import annotations
 
+import numbers
+from collections.abc import Mapping
+
 import numpy as np
 
 from ..errors import InputError
@@ -60,11 +63,11 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     psd = _spectrum(source)
     if direction not in ("x", "y", "both"):
         raise InputError(f"direction must be 'x', 'y' or 'both', got {direction!r}")
-    if adhesive:
-        return {"steps": [dict(s) for s in steps], "persson": dict(NOT_ADHESIVE)}
     dirs = ("x", "y") if direction == "both" else (direction,)
     factors = {d: _geometry_factor(source, d) for d in dirs}
-    pressures = [s.get("mean_pressure") for s in steps]
+    pressures = [_pressure_of(k, s) for k, s in enumerate(steps)]
+    if adhesive:
+        return {"steps": [dict(s) for s in steps], "persson": dict(NOT_ADHESIVE)}
     ok = [p is not None and np.isfinite(p) and p > 0 for p in pressures]
     theory = persson(psd, e_star, [p for p, k in zip(pressures, ok) if k] or [1.0],
                      gamma=gamma)
@@ -91,3 +94,18 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     if pressure_drop is not None:
         info["percolation_threshold"] = PERCOLATION_THRESHOLD
     return {"steps": out, "persson": info}
+
+
+def _pressure_of(k, step):
+    """The mean pressure (Pa) of the step record ``steps[k]``: None when it has none, a
+    float when it is a real number (NaN and p <= 0 get no theory), else an InputError."""
+    if not isinstance(step, Mapping):
+        raise InputError(f"steps[{k}] must be a step record (a dict with 'mean_pressure' in "
+                         f"Pa), got {type(step).__name__}")
+    p = step.get("mean_pressure")
+    if p is None:
+        return None
+    if isinstance(p, (bool, str, bytes)) or not isinstance(p, numbers.Real):
+        raise InputError(f"steps[{k}]['mean_pressure'] must be a number (Pa) or None, got "
+                         f"{p!r}")
+    return float(p)

@@ -68,7 +68,8 @@ from functools import lru_cache
 import numpy as np
 import scipy.special
 
-from ..errors import InputError, check_finite_positive, check_in_open_interval
+from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
+                      check_in_open_interval)
 from ..surfaces.stats import PowerSpectrum, power_spectrum
 from ..surfaces.surface import Surface
 
@@ -204,6 +205,7 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
     e = check_finite_positive("e_star (Pa)", e_star)
     gamma = check_in_open_interval("gamma", gamma, 0.0, 1.0 + 1e-12)
     p = _pressures(mean_pressure)
+    q_min = check_finite_nonnegative("q_min (rad/m)", q_min)
     q, power = np.asarray(q, float), np.asarray(power, float)
     if q.ndim != 1 or q.shape != power.shape:
         raise InputError(f"q and power must be 1D arrays of the same length, got shapes "
