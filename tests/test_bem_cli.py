@@ -75,7 +75,7 @@ def test_contact_cli_draws_persson_beside_the_bem(tmp_path):
         # measured 1.17-1.32: the BEM kappa ~ 2 against Persson's sqrt(8/pi) = 1.6 (known:
         # Hyun et al. 2004, Prodanov et al. 2014), closing towards full contact
         assert 1.05 < st["area_fraction"] / st["persson_area_fraction"] < 1.4
-        # mean gap: measured 0.90-1.03 (docs/theory/adhesion-persson.md)
+        # mean gap: measured 0.90-1.03 (docs/theory/07_adhesion_persson.md)
         assert 0.8 < st["mean_gap"] / st["persson_mean_gap"] < 1.2
     assert (out / "contact_area_stiffness.png").stat().st_size > 0
 

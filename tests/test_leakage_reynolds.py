@@ -289,7 +289,7 @@ def test_refined_piecewise_constant_gap_fe_and_fv_bracket_one_limit():
     # continuum problem is unchanged, only the discretisation is refined. The FV scheme
     # (no corner flow) converges from below, the Q1 FE (corner nodes conduct) from
     # above; their difference shrinks (slowly: the corner conductance of Q1 decays like
-    # a spreading resistance, see docs/theory/leakage.md)
+    # a spreading resistance, see docs/theory/04_leakage.md)
     rng = np.random.default_rng(3)
     g0 = np.maximum(rng.standard_normal((12, 12)) + 1.0, 0.0) * H
     fv, fe = [], []

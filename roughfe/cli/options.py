@@ -1,4 +1,4 @@
-"""The one option vocabulary of the ``roughfe`` command (docs/usage/cli.md).
+"""The one option vocabulary of the ``roughfe`` command (docs/guide/02_command_line.md).
 
 Every subcommand builds its options from these helpers, so a name means the same thing
 everywhere:

@@ -21,7 +21,7 @@ face-connected, the connectivity of the default finite-volume Reynolds scheme):
   the gap stays below ``channel_factor * u_c`` (default 2: where the local conductance
   ``h^3`` is within a factor 8 of the junction's); ``parent_channel_length`` is its length
   along the path (m). The thesis names these two sizes as future work without a
-  definition; these are ours, stated here and in docs/theory/leakage.md.
+  definition; these are ours, stated here and in docs/theory/04b_leakage_ii.md.
 * ``leak_rate_junction`` = ``(W/L) u_c^3 dp / (12 mu)``: Lorenz & Persson's (2009)
   critical-junction formula (Eq. 5 there) with the *measured* ``u_c``, beside the
   Reynolds leak rate and beside the PSD-based estimate of

@@ -10,7 +10,7 @@ Two discretisations of one equation, chosen by ``scheme``:
   corners, gap constant per cell): two open cells touching at a corner share a pressure
   node and exchange fluid, so on rough gaps near the percolation threshold it leaks more
   than the FV scheme; on smooth (or refined) gap fields both converge at second order to
-  the same leak rate (docs/theory/leakage.md).
+  the same leak rate (docs/theory/04_leakage.md).
 
 Both solve with CG + BoomerAMG and return the leak rate, the hydraulic aperture and the
 pressure and flux fields as a frozen :class:`ReynoldsResult`. The flux per unit width is

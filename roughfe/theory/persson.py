@@ -55,7 +55,7 @@ pressures ``u = u0 ln(p_ref / p)``, i.e. ``p ~ exp(-u / u0)``, with
 
 (:attr:`PerssonResult.u0`). Persson (2007) writes ``u0 ~ gamma h_rms``; that is an
 order-of-magnitude statement (the ratio u0 / (gamma h_rms) depends on the spectrum, see
-docs/theory/adhesion-persson.md); Eq. (3) is what the theory gives.
+docs/theory/07_adhesion_persson.md); Eq. (3) is what the theory gives.
 
 The critical junction of Lorenz & Persson is in :mod:`roughfe.theory.junction`, the
 theory beside a simulation's steps in :mod:`roughfe.theory.beside`.
