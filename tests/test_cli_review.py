@@ -281,6 +281,22 @@ def test_demo_contact_results_carry_persson_like_roughfe_contact(tmp_path):
     steps = doc["steps"]
     assert all(0 < s["persson_area_fraction"] < 1 for s in steps if s["mean_pressure"] > 0)
     assert "A* Persson" in text
+    # one gbar on the page, Persson's (derived.persson.rms_gradient, the PSD's), and the
+    # page's numbers reproduce from it: the last row's "A* Persson" is erf(sqrt2 p/(E* gbar))
+    # and kappa = A* E* gbar / p. Until round 2 session 24 the kappa sentence used the
+    # finite-difference rms slope (0.109 against the column's 0.130)
+    import re
+    from scipy.special import erf
+    gbar = doc["derived"]["persson"]["rms_gradient"]
+    shown = [float(g) for g in re.findall(r"gbar = (\d\.\d+)", text)]
+    assert len(shown) == 2 and all(g == pytest.approx(gbar, abs=5e-5) for g in shown)
+    e_star = doc["inputs"]["E_star"]
+    row = [c.strip() for c in text.split("| A* Persson |")[1].split("\n\n")[0]
+           .strip().splitlines()[-1].strip("|").split("|")]
+    p, a, a_persson = float(row[1]) * 1e6, float(row[2]), float(row[3])
+    assert erf(np.sqrt(2) * p / (e_star * shown[0])) == pytest.approx(a_persson, abs=1e-4)
+    kappa = float(re.search(r"A\* / \(p/\(E\* gbar\)\) = (\d+\.\d+)", text).group(1))
+    assert kappa == pytest.approx(a * e_star * shown[1] / p, abs=0.01)
 
 
 def test_a_mistake_in_a_rerun_keeps_the_finished_output(tmp_path, capsys):

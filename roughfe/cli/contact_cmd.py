@@ -251,10 +251,14 @@ def section_contact(outdir: Path, context: dict) -> str:
                             title="RMD D = 2.3, m = 7 at Delta = h_s")
     thesis_kernel = solve_contact(surface, material, delta=last.delta, kernel="thesis",
                                   initial=last.pressure)
-    sigma, gbar, length = sweep.rms_height, sweep.rms_slope, surface.size[0]
+    # one gbar on the page: Persson's (the rms gradient of the Hann-windowed PSD, which
+    # his A* column uses), in the kappa sentence too; the statistics table's rms slope
+    # (forward differences) is named beside it with why it is lower
+    sigma, length = sweep.rms_height, surface.size[0]
+    gbar = doc["derived"]["persson"]["rms_gradient"]
     p_star = sweep.load_star[-1]
     p_star_t = thesis_kernel.mean_pressure * length / (material.E_star * sigma)
-    kappa = last.area_fraction / sweep.pressure_star[-1]
+    kappa = last.area_fraction * material.E_star * gbar / last.mean_pressure
     picks = sorted(set(range(0, len(sweep.results), 4)) | {len(sweep.results) - 1})
     rows = "\n".join(
         f"| {r.delta * 1e6:.3f} | {r.mean_pressure * 1e-6:.4g} | {r.area_fraction:.4f} | "
@@ -283,8 +287,13 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"sweep (shared 2-core machine). Files: `contact/results.json`, `contact/fields.h5`.\n\n"
         "| Delta (um) | p (MPa) | A* | A* Persson | P* = pL/(E* sigma) | K (MPa/um) | "
         "mean gap (um) | V* | iterations |\n|---|---|---|---|---|---|---|---|---|\n" + rows
-        + "\n\n(Persson's A* = erf(sqrt 2 p/(E* gbar)) of the surface's PSD, beside every step "
-        "of `contact/results.json` as in `roughfe contact`; docs/theory/07.)\n\n"
+        + f"\n\n(Persson's A* = erf(sqrt 2 p/(E* gbar)) with gbar = {gbar:.4f}, the rms "
+        f"gradient of the surface's Hann-windowed PSD (`derived.persson.rms_gradient`), "
+        f"beside every step of `contact/results.json` as in `roughfe contact`; docs/theory/07. "
+        f"The rms slope {sweep.rms_slope:.4f} of the statistics table is from forward "
+        f"differences, which weigh a Fourier mode of wavenumber q by (2 sin(q dx/2)/dx)^2 "
+        f"instead of q^2, less at the short wavelengths that carry most of this surface's "
+        f"slope; this page uses the PSD's gbar throughout.)\n\n"
         f"**At Delta = h_s:** A* = {last.area_fraction:.3f} (thesis 0.25), "
         f"P* = {p_star:.2f} (thesis 0.56); with the thesis kernel Eq. 2.4 instead of Love's: "
         f"A* = {thesis_kernel.area_fraction:.3f}, P* = {p_star_t:.2f}.\n\n"
@@ -295,7 +304,8 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"{p_star / THESIS_FIG7['P_star']:.0f}x the thesis value, which neither the "
         f"realisation (P* = {p_lo:.1f}-{p_hi:.1f} over seeds 1-5), nor E vs E* (10 %), nor "
         f"the kernel (Love vs Eq. 2.4, above) explains. Our numbers obey the standard "
-        f"checks: with the rms slope gbar = {gbar:.3f}, A* / (p/(E* gbar)) = {kappa:.2f}, within the range "
+        f"checks: with Persson's gbar = {gbar:.4f} (above), A* / (p/(E* gbar)) = "
+        f"{kappa:.2f}, within the range "
         f"1.6-2.5 of rough-contact theory and simulations (Persson; Hyun et al. 2004; "
         f"Yastrebov et al. 2015). Since A* = kappa p/(E* gbar), P* = (A*/kappa) gbar L/sigma: "
         f"the thesis pair (A* = 0.25, P* = 0.56) needs gbar L/sigma = {needed:.1f}, while this "
