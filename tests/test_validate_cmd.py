@@ -323,3 +323,11 @@ def test_the_leakage_figure_names_the_surface_it_used():
     assert leak.rmd_label(6) == f"RMD m = 6, D = {leak.ROUGH_D:g}"
     source = (validate_cmd._validation_dir() / "leakage_flow.py").read_text()
     assert "RMD m=7" not in source and 'set_title(f"{rmd_label(m_rough)}' in source
+
+
+def test_the_one_line_help_is_the_first_sentence_not_the_first_line():
+    # "Roughness design study (thesis Chapter 4): macro/micro roughness of the Table 1
+    # case," was cut at the docstring's first line break
+    from roughfe.cli.validate_cmd import _first_sentence
+    doc = "Genome sequencing (thesis Sec. 3.3-3.4): Table 1\nrecovery over seeds. Then more.\n\nX."
+    assert _first_sentence(doc) == "Genome sequencing (thesis Sec. 3.3-3.4): Table 1 recovery over seeds"

@@ -166,6 +166,15 @@ def summary_record(planned: list, summary: dict, quick: bool) -> dict:
             "not_run": not_run}
 
 
+def _first_sentence(doc: str) -> str:
+    """The first sentence of a docstring (its first paragraph up to a '. ' before a capital), on one
+    line: the one-line help of ``roughfe validate --help`` (the first line cut it
+    mid-sentence where a script wraps its first sentence)."""
+    import re
+    text = " ".join(doc.split("\n\n", 1)[0].split())
+    return re.split(r"\.\s+(?=[A-Z])", text, maxsplit=1)[0].rstrip(".")
+
+
 def _run(args) -> int:
     names = list(VALIDATIONS) if args.name == "all" else [args.name]
     summary = {}
@@ -217,7 +226,7 @@ def register(sub):
     for name in [*VALIDATIONS, "all"]:
         doc = ("every validation in turn: " + ", ".join(VALIDATIONS) if name == "all"
                else _script_doc(name))
-        v = names.add_parser(name, help=doc.splitlines()[0] if doc else name, description=doc)
+        v = names.add_parser(name, help=_first_sentence(doc) or name, description=doc)
         add_output_folder(v, "report folder (every study writes its <script>.md/.json and "
                              "figures there, and summary.json)", required=False,
                           default="validation/output")
