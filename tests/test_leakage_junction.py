@@ -103,3 +103,41 @@ def test_sealed_field_and_record():
         critical_constriction(g, (UM, UM), channel_factor=0.5)
     with pytest.raises(InputError, match="spacing must be the cell size"):
         critical_constriction(g, UM)                              # was a TypeError
+
+
+def test_the_unsuffixed_junction_leak_rate_is_the_mean_over_directions():
+    """A gap that is open along y only (a closed row across x): the unsuffixed junction
+    leak rate was the x direction's, 0 ('sealed'), beside leak_rate = the mean of 0 and
+    a positive Q_y. It is now the mean over the directions, as leak_rate."""
+    g = np.full((16, 12), 1e-6)
+    g[8, :] = 0.0                        # a closed row: no flow along x, open along y
+    r = analyse_leakage(g, g == 0, (1e-6, 1e-6), mu=1e-3, pressure_drop=1e3).record()
+    assert r["leak_rate_critical_junction_x"] == 0.0 and r["leak_rate_critical_junction_y"] > 0
+    assert r["leak_rate_critical_junction"] == pytest.approx(
+        0.5 * r["leak_rate_critical_junction_y"], rel=1e-12)
+    assert r["leak_rate"] == pytest.approx(0.5 * r["leak_rate_y"], rel=1e-12)
+    # parallel plates: the junction formula is exact, as is the Reynolds flux
+    assert r["leak_rate_critical_junction_y"] == pytest.approx(r["leak_rate_y"], rel=1e-6)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"mu": 0.0, "reynolds": False}, "mu"), ({"pressure_drop": -5.0, "reynolds": False}, "pressure_drop"),
+    ({"pressure_drop": float("nan"), "reynolds": False}, "pressure_drop")])
+def test_fluid_data_are_checked_without_reynolds_too(kwargs, words):
+    # mu = 0 was a ZeroDivisionError in record(); a negative drop a negative junction
+    # leak rate (the study path wrote it)
+    g = np.full((8, 8), 1e-6)
+    with pytest.raises(InputError, match=words):
+        analyse_leakage(g, None, (1e-6, 1e-6), **kwargs)
+
+
+def test_empty_and_clipped_negative_gaps_are_refused():
+    with pytest.raises(InputError, match="shape"):
+        critical_constriction(np.zeros((0, 5)), (1e-6, 1e-6))
+    from roughfe.leakage.network import free_volume_network
+    with pytest.raises(InputError, match="shape"):
+        free_volume_network(np.zeros((0, 5)), None, (1e-6, 1e-6))
+    g = np.full((6, 6), 1e-6)
+    g[3, :] = -5e-6                      # interpenetrating: became a 1 nm film with h_min
+    with pytest.raises(InputError, match="finite and >= 0"):
+        reynolds_flow(g, (1e-6, 1e-6), h_min=1e-9)

@@ -419,3 +419,12 @@ def test_initial_pressure_changes_the_iterations_not_the_solution(direction):
     assert again.nit <= 1 and again.leak_rate == pytest.approx(cold.leak_rate, rel=1e-8)
     with pytest.raises(InputError, match="initial pressure has shape"):
         solve_reynolds_fv(g2, (DX, DX), initial=old.pressure.T, **kw)
+
+
+@pytest.mark.parametrize("kwargs", [{"mu": -1e-3}, {"mu": 0.0}, {"flow_length": -1e-3},
+                                    {"width": 0.0}])
+def test_hydraulic_aperture_checks_its_fluid_and_geometry(kwargs):
+    # mu = -1e-3 returned a negative aperture, mu = 0 returned 0
+    args = dict(mu=1e-3, pressure_drop=1.0, flow_length=1e-3, width=1e-3) | kwargs
+    with pytest.raises(InputError):
+        hydraulic_aperture(1e-12, **args)

@@ -13,7 +13,7 @@ from typing import Mapping, Optional
 import numpy as np
 
 from .. import progress
-from ..errors import InputError, check_instance
+from ..errors import InputError, check_finite_nonnegative, check_finite_positive, check_instance
 from ..frozen import FrozenMapping
 from ..model import ContactResult
 from .junction import CriticalConstriction, critical_constriction
@@ -97,6 +97,10 @@ class LeakageResult:
         """JSON-safe scalars: percolation flags, volumes, leak rates per direction.
 
         ``percolates_<d>`` is the network verdict (its corner rule);
+        ``leak_rate_critical_junction`` (unsuffixed) is the mean of the per-direction
+        junction leak rates, as ``leak_rate``; the unsuffixed ``critical_gap``,
+        ``critical_position``, ``critical_width`` and ``parent_channel_length`` are the
+        first analysed direction's junction (``_x``/``_y`` keys for each);
         ``percolates_reynolds_<d>`` the one of the Reynolds scheme (FV: face neighbours;
         FE: Q1 corner conduction); ``leak_rate`` and
         ``hydraulic_aperture`` are means over the solved directions.
@@ -133,11 +137,16 @@ class LeakageResult:
                 None if con is None else con.leak_rate_junction(
                     mu=self.mu, pressure_drop=self.pressure_drop,
                     length=self.size[0 if d == "x" else 1], width=self.size[1 if d == "x" else 0]))
-        # the first analysed direction's constriction, unsuffixed (results.json contract)
+        # unsuffixed: the junction leak rate as leak_rate, the mean over the analysed
+        # directions (the first direction's alone read "sealed", 0, beside a positive Q
+        # that flowed along y); the geometry of the first direction's junction
         first = self.directions[0]
         for key in ("critical_gap", "critical_position", "critical_width",
-                    "parent_channel_length", "leak_rate_critical_junction"):
+                    "parent_channel_length"):
             rec[key] = rec[f"{key}_{first}"]
+        rates = [rec[f"leak_rate_critical_junction_{d}"] for d in self.directions]
+        rec["leak_rate_critical_junction"] = (
+            None if any(q is None for q in rates) else float(np.mean(rates)))
         return rec
 
 
@@ -185,6 +194,10 @@ def analyse_leakage(gap, contact, spacing, *, direction="both", periodic: bool =
         PETSc options for the Reynolds solve.
     """
     dirs = _direction_list(direction)
+    # checked whether or not Reynolds runs: the junction leak rate takes them too (mu = 0
+    # was a ZeroDivisionError in record(), a negative drop a negative leak rate)
+    mu = check_finite_positive("mu (Pa s)", mu)
+    pressure_drop = check_finite_nonnegative("pressure_drop (Pa)", pressure_drop)
     g = np.asarray(gap, dtype=float)
     net = free_volume_network(g, contact, spacing, directions=dirs, periodic=periodic,
                               sigma=sigma, gap_tol=gap_tol, corner_rule=corner_rule)

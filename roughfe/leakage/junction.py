@@ -36,7 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import breadth_first_order
 
-from ..errors import InputError, check_spacing
+from ..errors import InputError, check_finite_nonnegative, check_finite_positive, check_spacing
 from .finite_volume import components_reaching
 
 
@@ -84,6 +84,10 @@ class CriticalConstriction:
 
         ``length`` and ``width`` are the domain's size along and across the flow (m).
         """
+        mu = check_finite_positive("mu (Pa s)", mu)
+        pressure_drop = check_finite_nonnegative("pressure_drop (Pa)", pressure_drop)
+        length = check_finite_positive("length (m)", length)
+        width = check_finite_positive("width (m)", width)
         if not self.percolates:
             return 0.0
         return float(width / length * self.critical_gap ** 3 * pressure_drop / (12.0 * mu))
@@ -148,8 +152,9 @@ def critical_constriction(gap, spacing, *, direction: str = "x", periodic: bool 
     CriticalConstriction
     """
     g = np.asarray(gap, dtype=float)
-    if g.ndim != 2 or not np.all(np.isfinite(g)) or g.min() < 0:
-        raise InputError("gap must be a finite 2D array of metres >= 0")
+    if g.ndim != 2 or min(g.shape) < 1 or not np.all(np.isfinite(g)) or g.min() < 0:
+        raise InputError(f"gap must be a finite 2D array (nx, ny) of metres >= 0, got shape "
+                         f"{g.shape}")
     if direction not in ("x", "y"):
         raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
     dx, dy = check_spacing(spacing)

@@ -402,7 +402,7 @@ def free_volume_network(gap, contact, spacing, *, directions: Sequence[str] = ("
     NetworkResult
     """
     g = np.asarray(gap, dtype=float)
-    if g.ndim != 2:
+    if g.ndim != 2 or min(g.shape) < 1:
         raise InputError(f"gap must be a 2D array (nx, ny) of metres, got shape {g.shape}")
     if not np.all(np.isfinite(g)) or g.min() < 0:
         raise InputError("gap must be finite and >= 0 (m); got min "

@@ -25,7 +25,7 @@ from typing import Mapping, Optional
 import numpy as np
 
 from ..errors import InputError, check_finite_nonnegative, check_finite_positive
-from ..fem.reynolds import solve_reynolds_fe
+from ..fem.reynolds import check_reynolds_data, solve_reynolds_fe
 from .finite_volume import solve_reynolds_fv
 
 SCHEMES = ("fv", "fe")
@@ -100,6 +100,9 @@ def hydraulic_aperture(leak_rate: float, *, mu: float, pressure_drop: float,
     ``Q <= 0``.
     """
     dp = check_finite_positive("pressure_drop", pressure_drop)
+    mu = check_finite_positive("mu (Pa s)", mu)
+    flow_length = check_finite_positive("flow_length (m)", flow_length)
+    width = check_finite_positive("width (m)", width)
     return float(np.cbrt(max(leak_rate, 0.0) * 12.0 * mu * flow_length / (width * dp)))
 
 
@@ -172,7 +175,9 @@ def reynolds_flow(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         raise InputError("pressure_drop is 0 and there is no wall velocity: nothing drives the flow")
     if scheme not in SCHEMES:
         raise InputError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
-    g = np.asarray(gap, dtype=float)
+    # the gap as given is checked before the h_min clip (a negative, interpenetrating
+    # gap became a conducting film of h_min)
+    g = check_reynolds_data(gap, spacing, mu, p_out + dp, p_out, direction, wall_velocity)[0]
     h_min = check_finite_nonnegative("h_min (m)", h_min)
     h = np.maximum(g, h_min) if h_min > 0 else g
     if scheme == "fv":

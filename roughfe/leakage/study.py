@@ -146,8 +146,9 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     check_finite_positive("mu (Pa s)", mu)
     if not isinstance(reynolds, (bool, np.bool_)):
         raise InputError(f"reynolds must be true or false, got {reynolds!r}")
-    if reynolds:      # the Reynolds solve's own rule (no wall velocity here: > 0)
-        check_finite_positive("pressure_drop (Pa)", pressure_drop)
+    # the Reynolds solve's own rule (no wall velocity here: > 0), and the junction leak
+    # rate's without Reynolds too (a negative drop gave negative junction leak rates)
+    check_finite_positive("pressure_drop (Pa)", pressure_drop)
     _direction_list(direction)
     check_kernel_name(kernel)
     return Material(E, nu)
