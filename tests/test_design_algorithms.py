@@ -46,6 +46,15 @@ def test_alg3_recovers_a_database_genome_at_another_amplitude(entries):
     r = de.sog(entries, t, SETTINGS, options=FAST, n_best=1)
     assert r.best.origin == "1-2" and r.best.stages[0] == pytest.approx(1.0, abs=1e-6)
     assert r.best.scores[0] == pytest.approx(1.0, abs=1e-6)
+    assert "NOT matched" not in r.message
+    # a target no database genome can match (K falling with p): the design is still a
+    # sound computation (success), and the message says the target is not matched
+    # (success True at s = -23.7 read as a verdict)
+    falling = Target(c.pressure, c.stiffness[::-1].copy(), "K")
+    bad = de.sog(entries, falling, SETTINGS, options=FAST, n_best=1)
+    from roughfe.genomics.design.algorithms import SELECTION
+    assert bad.success and de.combined_score(bad.best.scores) < SELECTION
+    assert "the target is NOT matched" in bad.message
 
 
 @pytest.mark.parametrize("method", ["gco", "cco", "mcco"])

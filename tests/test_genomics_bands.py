@@ -8,6 +8,7 @@ from roughfe.genomics.macro_micro import profile_response
 from roughfe.genomics.band_mechanics import band_macro_micro, band_mechanics
 from roughfe.genomics.bands import band_chromosomes, band_leakage, genome_q1
 from roughfe.genomics.genome import node_coordinates, random_genome, realize_surface
+from roughfe.genomics.mechanics import ChromosomeMechanics
 from roughfe.surfaces.io import load_surface
 from roughfe.surfaces.spectral import spectral_profile, spectral_surface
 from roughfe.surfaces.surface import Surface
@@ -106,6 +107,8 @@ def test_profiles_decompose_too():
 @pytest.mark.parametrize("kwargs, match", [
     (dict(gamma=1.0), "gamma"), (dict(gamma="x"), "gamma"), (dict(detrend="cubic"), "detrend"),
     (dict(transform="wavelet"), "transform"), (dict(q1=-1.0), "q1"),
+    # 1.0001 made 1000s of (mostly empty) bands before any check
+    (dict(gamma=1.0001), "more than the .* distinct wavenumbers"),
 ])
 def test_bad_band_input(kwargs, match):
     s = Surface(np.random.default_rng(0).normal(size=(16, 16)), 1e-3)
@@ -171,10 +174,25 @@ def test_band_mechanics_of_a_periodic_surface():
     bad = band_mechanics(b, youngs_modulus=1e9, n_steps=6, response=flaky)
     assert not bad.success and f"c {int(b.indices[1])}" in bad.message
     assert bad.chromosome_curves[1] is None and np.isnan(bad.c_chromosome["K"][1])
+    # Alg. 2 does not count the failed band as a flat micro one (it holds energy)
+    assert bad.failed_chromosomes == (int(b.indices[1]),) and b.energy[1] > 0
+    split = band_macro_micro(bad, threshold=0.95)
+    assert int(b.indices[1]) not in split.micro + split.macro and not split.success
+    assert "NOT classified" in split.message
+    assert ChromosomeMechanics.from_dict(bad.to_dict()).failed_chromosomes == bad.failed_chromosomes
+    # a failed bottom-up sum is named by the band it ends at (bu key k ends at
+    # indices[-1 - k]; it was labelled indices[k])
+    bu = b.partial_sums("bu")
+
+    def flaky_bu(surf):
+        if np.array_equal(surf.heights, bu[2]):
+            raise NoConvergenceError("KKT residual 1e-3 > tol")
+        return profile_response(surf, youngs_modulus=1e9, n_steps=6)
+    bad_bu = band_mechanics(b, youngs_modulus=1e9, n_steps=6, response=flaky_bu)
+    assert f"(bu {int(b.indices[-3])})" in bad_bu.message
     # the material under the one vocabulary E/nu; files with the old keys still read
     assert (d["E"], d["nu"]) == (1e9, 0.0) and "youngs_modulus" not in d
     import json
-    from roughfe.genomics.mechanics import ChromosomeMechanics
     old = json.loads(json.dumps(d))
     old["youngs_modulus"], old["poisson"] = old.pop("E"), old.pop("nu")
     for data in (d, old):
@@ -212,3 +230,33 @@ def test_genome_chromosomes_command(tmp_path, capsys):
                  str(tmp_path / "bad")]) == 2
     assert "gamma" in capsys.readouterr().err
     assert not (tmp_path / "bad").exists()
+    # a band sweep that does not converge: exit 1 (it exited 0 with the band counted as
+    # a flat micro band) and macro_micro.json says success false
+    import roughfe.genomics.band_mechanics as bm
+    real, seen = bm.profile_response, []
+
+    def flaky(surf, **kw):
+        seen.append(1)
+        if len(seen) == 3:
+            raise NoConvergenceError("simulated")
+        return real(surf, **kw)
+    bm.profile_response = flaky
+    try:
+        assert main(["genome", "chromosomes", str(path), "--gamma", "2", "--steps", "4",
+                     "--E", "1e9", "--no-figures", "-o", str(tmp_path / "fail")]) == 1
+    finally:
+        bm.profile_response = real
+    mm = json.loads((tmp_path / "fail" / "macro_micro.json").read_text())
+    assert mm["success"] is False and "NOT classified" in mm["message"]
+
+
+def test_band_edges_checks_its_range():
+    # (10, 1) returned [] silently; NaN raised "cannot convert float NaN to integer"; 0 a
+    # ZeroDivisionError
+    from roughfe.genomics.bands import band_edges
+    for q_min, q_max, match in [(10.0, 1.0, "below q_min"), (float("nan"), 1.0, "q_min"),
+                                (0.0, 1.0, "q_min")]:
+        with pytest.raises(InputError, match=match):
+            band_edges(q_min, q_max, 2.0)
+    e = band_edges(1.0, 8.0, 2.0)
+    assert e[0] == 1.0 and e[-1] >= 8.0

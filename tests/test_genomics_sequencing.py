@@ -1,5 +1,6 @@
 """Sequencing (Sec. 3.3.1): exact recovery of the identifiable genes of the Table 1 genome,
 M-free maximum likelihood of A and H, quality report on non-WM data, clear input errors."""
+import json
 import re
 
 import numpy as np
@@ -147,3 +148,16 @@ def test_profiles_with_height_offsets_are_sequenced_exactly(table1):
     np.testing.assert_allclose(res.offsets, [-s.heights.mean() for s in by_length],
                                atol=1e-9 * max(abs(s.heights).max() for s in acq))
     assert exact.offsets.shape == (3,) and np.all(np.abs(exact.offsets) < 1e-12)
+
+
+@pytest.mark.slow
+def test_genome_natural_strict_exits_1_when_the_quality_check_fails(topographies_dir, tmp_path):
+    # `genome natural` exited 0 after "FAILED quality check" and had no --strict (unlike
+    # `genome sequence`); plu-1's row is not WM-like (rms errors 22-28 %)
+    from roughfe.cli import main
+    args = ["genome", "natural", str(topographies_dir / "plu-1.plu"), "--nodes", "128",
+            "--kernels", "--no-figures"]
+    assert main(args + ["-o", str(tmp_path / "a")]) == 0
+    assert main(args + ["--strict", "-o", str(tmp_path / "b")]) == 1
+    report = json.loads(next((tmp_path / "b").glob("*_report.json")).read_text())
+    assert report["sequencing"]["success"] is False

@@ -182,6 +182,7 @@ def _mechanics(args) -> int:
     g = load_genome(args.genome)
     material = material_from_args(args)
     length = args.length if args.length is not None else g.length_of(args.scale)
+    ok = True
     with output_folder_of(args, "genome mechanics") as out:
         for kernel in args.kernels:
             mech = chromosome_mechanics(g, length=length, n_nodes=args.nodes,
@@ -195,11 +196,12 @@ def _mechanics(args) -> int:
                 gp.plot_td_bu(mech, out / f"td_bu_K_{kernel}.png", "K")
                 gp.plot_correlations(mech, out / f"correlations_{kernel}.png")
             write_json(out / f"mechanics_{kernel}.json", mech.to_dict())
+            ok = ok and mech.success
             print(f"{kernel} kernel: {mech.message}, {mech.elapsed:.1f} s")
             print("  c_n TD (K): " + " ".join(f"{v:.3f}" for v in mech.c_td["K"]))
             print("  c_n BU (K): " + " ".join(f"{v:.3f}" for v in mech.c_bu["K"]))
     print(f"curves, c_n and figures -> {out}")
-    return 0
+    return 0 if ok else 1          # a BEM sweep that did not converge: a check missed
 
 
 def _natural(args) -> int:
@@ -232,7 +234,7 @@ def _natural(args) -> int:
         d = v["difference"]
         print(f"  {k} kernel: A(p) differs by up to {100 * d['A']:.3g} %, K(p) by {100 * d['K']:.3g} %")
     print(f"outputs -> {out}")
-    return 0
+    return 0 if res.success or not args.strict else 1
 
 
 def _chromosomes(args) -> int:
@@ -263,7 +265,8 @@ def _chromosomes(args) -> int:
             write_json(out / "macro_micro.json", {
                 "threshold": split.threshold, "macro": list(split.macro),
                 "micro": list(split.micro), "c_n_K": split.corr_k, "c_n_A": split.corr_a,
-                "chromosomes": split.chromosomes, "message": split.message})
+                "chromosomes": split.chromosomes, "success": split.success,
+                "message": split.message})
         if not args.no_figures:
             from ..plotting import bands as bp
             paths = [bp.render_band_sums(bands, out / "td.png", "td"),
@@ -285,7 +288,7 @@ def _chromosomes(args) -> int:
         if mech is not None:
             print(f"  {mech.message}; macro bands {list(split.macro)}, micro {list(split.micro)}")
         print(f"outputs -> {out}")
-    return 0
+    return 0 if mech is None or (mech.success and split.success) else 1
 
 
 def _validity(args) -> int:
@@ -409,6 +412,8 @@ def register(sub):
     _add_response_options(p, "*", "BEM kernels for A(p), K(p) (none: sequencing only)")
     p.add_argument("--tolerance", type=positive_float, default=0.05,
                    help="relative rms error below which a profile counts as WM-like")
+    p.add_argument("--strict", action="store_true",
+                   help="exit 1 when the quality check fails (as genome sequence)")
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_natural)

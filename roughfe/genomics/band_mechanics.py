@@ -82,8 +82,11 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
     def sums(kind, first_key):
         out = [curves[first_key]] + [curves[(kind, k)] for k in range(1, n_c - 1)]
         return tuple(out + [complete]) if n_c > 1 else (complete,)
-    ok, why = sweep_report(failed, lambda key: key if isinstance(key, str)
-                           else f"{key[0]} {int(bands.indices[key[1]])}")
+    # a TD key k is the sum ending at band indices[k]; a BU key k the sum ending at
+    # indices[-1 - k] (it was labelled indices[k]: "bu 4" for the sum ending at band 7)
+    ok, why = sweep_report(failed, lambda key: key if isinstance(key, str) else
+                           f"bu {int(bands.indices[-1 - key[1]])}" if key[0] == "bu" else
+                           f"{key[0]} {int(bands.indices[key[1]])}")
     td_curves = sums("td", ("c", 0))
     bu_curves = sums("bu", ("c", n_c - 1))
     return ChromosomeMechanics(
@@ -93,20 +96,31 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
         bu_curves=bu_curves, c_chromosome=correlations(complete, c_curves),
         c_td=correlations(complete, td_curves), c_bu=correlations(complete, bu_curves),
         success=ok, message=f"{done} BEM sweeps of {n_steps} steps ({n_c} bands){why}", nit=done,
-        elapsed=time.perf_counter() - t0, references=REFERENCES)
+        elapsed=time.perf_counter() - t0, references=REFERENCES,
+        failed_chromosomes=tuple(int(bands.indices[key[1]]) for key in failed
+                                 if not isinstance(key, str) and key[0] == "c"))
 
 
 def band_macro_micro(mech: ChromosomeMechanics, threshold: float = 0.95,
                      axis: str = "steps") -> MacroMicroResult:
     """Alg. 2 on band chromosomes: macro = bands whose K(p) correlates with the complete
-    K(p) by c_n > ``threshold``; empty/flat bands count as micro (c_n undefined)."""
+    K(p) by c_n > ``threshold``; empty/flat bands count as micro (c_n undefined). A band
+    whose sweep did not converge (``mech.failed_chromosomes``) is in neither: it is not
+    classified and ``success`` is False (it was counted as a flat micro band, 31 % of
+    <h^2> in a measured case)."""
     keep = [k for k, c in enumerate(mech.chromosome_curves) if c is not None]
     res = classify(mech.complete, [mech.chromosome_curves[k] for k in keep],
                    mech.indices[keep], threshold, axis)
-    flat = tuple(int(mech.indices[k]) for k, c in enumerate(mech.chromosome_curves) if c is None)
-    if not flat:
+    failed = tuple(sorted(int(n) for n in mech.failed_chromosomes))
+    flat = tuple(int(mech.indices[k]) for k, c in enumerate(mech.chromosome_curves)
+                 if c is None and int(mech.indices[k]) not in failed)
+    if not flat and not failed:
         return res
+    message = res.message + (f" ({len(flat)} flat bands counted as micro)" if flat else "")
+    if failed:
+        message += (f"; band(s) {', '.join(map(str, failed))} NOT classified: their BEM "
+                    f"sweep did not converge")
     return MacroMicroResult(res.chromosomes, res.curve, res.chromosome_curves, res.corr_k,
                             res.corr_a, res.threshold, res.macro,
-                            tuple(sorted(res.micro + flat)), res.success,
-                            res.message + f" ({len(flat)} flat bands counted as micro)", res.nit)
+                            tuple(sorted(res.micro + flat)), res.success and not failed,
+                            message, res.nit)

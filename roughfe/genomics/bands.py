@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
-from ..errors import InputError, check_finite_positive, check_instance
+from ..errors import InputError, check_finite_positive, check_instance, check_memory
 from ..surfaces.stats import angular_wavevectors
 from ..surfaces.surface import Surface
 
@@ -192,6 +192,10 @@ def band_edges(q_min: float, q_max: float, gamma: float, q1=None) -> np.ndarray:
     up, so band 1 always contains the longest wave of the grid.
     """
     gamma = _check_gamma(gamma)
+    q_min = check_finite_positive("q_min (rad/m)", q_min)
+    q_max = check_finite_positive("q_max (rad/m)", q_max)
+    if q_max < q_min:
+        raise InputError(f"q_max = {q_max:g} rad/m is below q_min = {q_min:g} rad/m")
     q1 = q_min if q1 is None else check_finite_positive("q1 (lower band edge, rad/m)", q1)
     k0 = int(np.floor(np.log(q_min / q1) / np.log(gamma) + _EDGE_SLACK))
     start = q1 * gamma ** k0
@@ -248,6 +252,15 @@ def band_chromosomes(surface: Surface, gamma: float = DEFAULT_GAMMA, *, q1=None,
                              + _EDGE_SLACK).astype(np.int64)
     n_c = edges.size - 1
     np.clip(band, -1, n_c - 1, out=band)
+    # before the n_c x grid array is made: gamma = 1.0001 made 37808 bands of a 32^2 grid
+    # (430 not empty), 1.001 asked 13.6 GiB for a 563 x 484 file
+    shells = np.unique(qmag[nonzero]).size
+    if n_c > shells:
+        raise InputError(f"gamma = {gamma:g} makes {n_c} bands, more than the {shells} "
+                         f"distinct wavenumbers of this {' x '.join(map(str, h.shape))} grid "
+                         f"(most bands would be empty): choose a larger gamma")
+    check_memory(f"{n_c} band chromosomes of a {' x '.join(map(str, h.shape))} grid",
+                 2.0 * 8.0 * n_c * h.size)
     forward, inverse = _transform_pair(transform)
     spectrum = forward(h)
     chrom = np.empty((n_c,) + h.shape)

@@ -102,6 +102,9 @@ class ChromosomeMechanics:
         has curve None and c_n NaN, and the message names it.
     elapsed : float
         Wall time (s).
+    failed_chromosomes : tuple of int
+        Chromosomes n whose own sweep did not converge (curve None like a flat one's;
+        Alg. 2 must not count them as flat micro chromosomes).
     """
 
     length: float
@@ -121,6 +124,7 @@ class ChromosomeMechanics:
     nit: int
     elapsed: float = 0.0
     references: tuple = field(default=("thesis Sec. 3.4.1, Fig. 36-39",))
+    failed_chromosomes: tuple = ()
 
     def __post_init__(self):
         freeze_containers(self)
@@ -138,7 +142,8 @@ class ChromosomeMechanics:
                 "td": curves(self.td_curves), "bu": curves(self.bu_curves),
                 "c_chromosome": to_jsonable(self.c_chromosome), "c_td": to_jsonable(self.c_td),
                 "c_bu": to_jsonable(self.c_bu), "success": self.success, "message": self.message,
-                "nit": self.nit, "elapsed_s": self.elapsed}
+                "nit": self.nit, "elapsed_s": self.elapsed,
+                "failed_chromosomes": [int(n) for n in self.failed_chromosomes]}
 
     @classmethod
     def from_dict(cls, d) -> "ChromosomeMechanics":
@@ -165,7 +170,8 @@ class ChromosomeMechanics:
                    c_chromosome=coefficients(d.get("c_chromosome", {})),
                    c_td=coefficients(d.get("c_td", {})), c_bu=coefficients(d.get("c_bu", {})),
                    success=bool(d.get("success", True)), message=d.get("message", ""),
-                   nit=int(d.get("nit", 0)), elapsed=float(d.get("elapsed_s", 0.0)))
+                   nit=int(d.get("nit", 0)), elapsed=float(d.get("elapsed_s", 0.0)),
+                   failed_chromosomes=tuple(int(n) for n in d.get("failed_chromosomes", ())))
 
 
 def sweep_fields(fields: dict, surface_of, response, label=None, workers: int = 1):
@@ -310,4 +316,6 @@ def chromosome_mechanics(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, 
         c_chromosome=correlations(complete, chrom), c_td=correlations(complete, td_c),
         c_bu=correlations(complete, bu_c), success=ok,
         message=f"{nit} BEM sweeps ({kernel} kernel, {n_steps} steps each){why}", nit=nit,
-        elapsed=time.perf_counter() - t0)
+        elapsed=time.perf_counter() - t0,
+        failed_chromosomes=tuple(int(td.indices[0]) + key[1] for key in failed
+                                 if key[0] == "c"))

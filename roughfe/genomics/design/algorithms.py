@@ -86,7 +86,8 @@ class DesignResult:
     (:func:`rescore_tolerance`). The second fails when
     the response is not linear in the heights (e.g. an elastic-plastic evaluator): Eq.
     (4.2) then no longer rescales a curve exactly, and the reported design would not
-    have the reported score.
+    have the reported score. It does not say the target is matched: the message says
+    "the target is NOT matched" when the best combined s is not above :data:`SELECTION`.
     """
 
     method: str
@@ -201,10 +202,15 @@ def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, ent
 def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evaluate, t0):
     best = cands[0]
     ok, why = _success(cands)
-    msg = (f"{method}: best {best.origin} s = {combined_score(best.scores):.4f} "
+    s_best = combined_score(best.scores)
+    # success is the soundness of the computation (finite, reproducible scores), not the
+    # match: say so when the best design is no match (s = -23.7 read as a success)
+    miss = (f"; the target is NOT matched (s = {s_best:.4g} <= {SELECTION}, the selection "
+            f"value of Alg. 3)" if not s_best > SELECTION else "")
+    msg = (f"{method}: best {best.origin} s = {s_best:.4f} "
            f"(stages {', '.join(f'{s:.4f}' for s in best.stages)})"
            + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used")
-           + why)
+           + miss + why)
     return DesignResult(method, cands, objective, pbar, dbs, n_cross, n_above, passed, ok, msg,
                         evaluate.n_sweeps, time.perf_counter() - t0)
 
