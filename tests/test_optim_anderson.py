@@ -25,7 +25,7 @@ def test_anderson_reaches_the_exact_fixed_point_faster_than_picard():
     assert len(fp.residuals) == fp.iterations + 1
 
 
-def test_a_rejected_iterate_falls_back_to_the_plain_one_then_stops():
+def test_a_refused_iterate_is_damped_before_the_loop_stops():
     G, exact = _linear_map()
     calls = []
 
@@ -43,5 +43,24 @@ def test_a_rejected_iterate_falls_back_to_the_plain_one_then_stops():
             raise RejectedIterate()
         return G(x)
 
-    stop = anderson_fixed_point(always, np.zeros(exact.size), tol=1e-10, max_iter=200)
-    assert stop.status == "rejected" and stop.iterations == 1 and not stop.converged
+    # the full step, then beta r / 2^j for j = 1 .. backoff (j = 0 is the full step)
+    stop = anderson_fixed_point(always, np.zeros(exact.size), tol=1e-10, max_iter=200,
+                                backoff=3)
+    assert stop.status == "rejected" and stop.iterations == 4 and not stop.converged
+    assert np.all(stop.x == 0)                    # the last accepted iterate
+
+
+def test_one_refused_full_step_does_not_stop_the_loop():
+    # G(x) = 1.9 - 0.9 x (fixed point 1) refuses x > 1.5: the first full step from 0 is
+    # G(0) = 1.9; the plain iterate G(x_0) that the loop fell back to is the same point,
+    # so it stopped "rejected" after one step. The half step 0.95 is accepted.
+    def G(x):
+        if np.any(x > 1.5):
+            raise RejectedIterate()
+        return 1.9 - 0.9 * x
+
+    fp = anderson_fixed_point(G, np.zeros(3), tol=1e-12, max_iter=20)
+    assert fp.converged and np.allclose(fp.x, 1.0, rtol=0, atol=1e-10)
+    damped = anderson_fixed_point(G, np.zeros(3), tol=1e-12, max_iter=200, memory=0,
+                                  relaxation=0.5)
+    assert damped.converged and np.allclose(damped.x, 1.0, rtol=0, atol=1e-10)

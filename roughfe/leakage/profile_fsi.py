@@ -38,9 +38,17 @@ docs/theory/03_fem_validation.md):
 Before closure (``min g > 0``) the contact is inactive and the state is ``"open"``. In 1D
 any contact closes the channel (no contact islands can be by-passed): the leak rate is
 then 0 and the pocket pressures depend on the trapped fluid, which this 1D model does not
-follow. An iterate whose gap closes is refused (the plain iterate is tried); if that
-closes too the result has ``state = "closed"``, ``leak_rate = 0`` and the last body
-solution, without a converged fluid pressure.
+follow. An iterate whose gap closes is refused, and the Anderson loop tries damped steps
+towards it (:mod:`roughfe.optim.anderson`). If every one of them closes too, the closed
+state is reported only when it is self-consistent: the body under that state's own fluid
+pressure (``p_in`` before the first closed sample, ``p_out`` after the last, their mean
+between) closes the channel again. Then the result has ``state = "closed"``,
+``leak_rate = 0`` and that body solution, without a converged fluid pressure; otherwise
+NoConvergenceError (neither state holds). A one-way state that is closed is checked the
+same way and, if its own pressure opens the channel, the iteration starts from that
+pressure. Lift-off (load control) likewise. Until round 2, session 24 one refused full
+step gave "closed": the reversed wavy channel of ``validation/fsi_fem.py`` at
+``Delta = -2 um`` read ``q = 0`` where it is open (throat 0.85 um, q = -5.7e-6 m^2/s).
 
 Two controls
 ------------
@@ -57,7 +65,8 @@ Two controls
   The mean fluid pressure of an open channel lies between ``(p_in + p_out)/2`` (wide open:
   linear pressure) and its value at closure (the pressure on the throat's far side); a
   ``p_ext`` above that range needs contact: ``state = "closed"``; below it the fluid lifts
-  the body off: ``state = "lift-off"`` (no equilibrium: ``leak_rate`` and the gaps None).
+  the body off: ``state = "lift-off"`` (no equilibrium: ``leak_rate`` and the gaps None),
+  both reported only when self-consistent (above).
   If the mean pressure is not monotone in ``Delta`` the balance takes one of its roots.
 """
 from __future__ import annotations
@@ -284,7 +293,9 @@ def coupled_channel(profile: Surface, material: Material, approach: Optional[flo
     InputError
         Bad input (named).
     NoConvergenceError
-        The coupled residual did not reach ``tol``; ``result`` holds the last state.
+        The coupled residual did not reach ``tol``, or the iteration stopped at a closed
+        (lift-off) state that its own fluid pressure does not keep closed (lifted off);
+        ``result`` holds the last state.
     """
     check_instance("profile", profile, Surface, "a roughfe Surface")
     check_instance("material", material, Material, "a roughfe.model.Material")
@@ -349,18 +360,55 @@ def coupled_channel(profile: Surface, material: Material, approach: Optional[flo
             raise _Closed()
         return flow.pressure
 
+    def own_pressure(one_way, it, residual, residuals):
+        """G at the fluid pressure of the last, refused evaluation (a closed channel or
+        lift-off; the evaluation kept in ``last``): its value if accepted, None if refused
+        into the same state (which is then self-consistent); NoConvergenceError if
+        refused into the other one."""
+        refused = last["state"]
+        try:
+            return G(last["flow"].pressure)
+        except RejectedIterate:
+            if last["state"] == refused:
+                return None
+            raise NoConvergenceError(
+                f"channel fluid-structure coupling ({method}): a {refused} state gives "
+                f"{last['state']} under its own fluid pressure",
+                result=_result(method, last, p_ext, mu, one_way, it + 1, residual,
+                               residuals)) from None
+
     with contextlib.closing(body):
         x = np.zeros(n)
+        extra = 0
         try:
             gx = G(x)
+            one_way = last["flow"].leak_rate
         except RejectedIterate:
             one_way = None if last["state"] == "lift-off" else last["flow"].leak_rate
-            return _result(method, last, p_ext, mu, one_way, 0, float("nan"), ())
-        one_way = last["flow"].leak_rate
+            # the one-way state refused: the coupled one if its own fluid pressure keeps
+            # it, else the iteration starts from that pressure
+            x, extra = last["flow"].pressure, 1
+            gx = own_pressure(one_way, 0, float("nan"), ())
+            if gx is None:
+                return _result(method, last, p_ext, mu, one_way, extra, float("nan"), ())
         fp = anderson_fixed_point(G, x, gx, tol=tol, max_iter=max_iter, memory=anderson,
                                   relaxation=relaxation)
-        out = _result(method, last, p_ext, mu, one_way, fp.iterations, fp.residual,
-                      fp.residuals)
+        it = fp.iterations + extra
+        if fp.status == "rejected":
+            # every damped step from the last accepted iterate was refused: that state only
+            # if its own fluid pressure gives it again (until round 2, session 24 a channel
+            # was reported closed after one refused full step, where it is open)
+            refused = last["state"]
+            if own_pressure(one_way, it, fp.residual, fp.residuals) is not None:
+                raise NoConvergenceError(
+                    f"channel fluid-structure coupling ({method}): every damped step from "
+                    f"the iterate at relative residual {fp.residual:.3e} is {refused}, but "
+                    f"the {refused} state's own fluid pressure does not keep it {refused} "
+                    f"(try a smaller relaxation)",
+                    result=_result(method, last, p_ext, mu, one_way, it + 1, fp.residual,
+                                   fp.residuals))
+            it += 1
+        out = _result(method, last, p_ext, mu, one_way, it, fp.residual, fp.residuals)
     if fp.status == "max_iter":
         raise NoConvergenceError(
             f"channel fluid-structure coupling ({method}): relative residual "

@@ -9,8 +9,15 @@ with the residuals ``r_k = G(x_k) - x_k`` and the differences ``dR``, ``dX`` of 
 ``m = 0`` is the relaxed Picard iteration ``x + beta r``. The residual is
 ``||G(x) - x|| / ||G(x)||`` (2-norms). ``G`` may refuse an iterate by raising
 :class:`RejectedIterate` (e.g. an extrapolated fluid pressure that would lift the body
-off): the plain iterate ``G(x_k)`` is taken instead and the memory cleared; if ``G``
-refuses that too, the iteration stops with ``status = "rejected"``.
+off, or close a channel): the memory is cleared and ``G`` is tried on the damped steps
+``x_k + beta r_k / 2^j``, ``j = 0 .. backoff`` (the first one it accepts is taken); if
+``G`` refuses all of them, the iteration stops with ``status = "rejected"`` at the last
+accepted iterate. A refusal is then a property of ``G`` near ``x_k``, not of the one
+full step ``G(x_k)``: until round 2, session 24 only the plain iterate ``G(x_k)`` was
+tried, which on the first iteration is the refused point itself (``x_1 = x_0 + r_0``),
+so one refused Picard step stopped the loop (a channel reported closed with q = 0 where
+the damped iteration finds it open, docs/theory/04c_profile_fsi.md). The caller decides
+whether the refused state is one (a closed channel, lift-off) or raises.
 
 Used by the fluid-structure couplings of :mod:`roughfe.leakage.fsi` (surfaces) and
 :mod:`roughfe.leakage.profile_fsi` (profiles, BEM and FEM bodies): one loop for all.
@@ -40,9 +47,10 @@ class FixedPoint:
     x, gx : ndarray
         Last iterate and ``G(x)``.
     status : {"converged", "max_iter", "rejected"}
-        Residual <= tol; iteration limit reached; ``G`` refused the plain iterate.
+        Residual <= tol; iteration limit reached; ``G`` refused every damped step from
+        the last accepted iterate ``x`` (module docstring).
     iterations : int
-        Evaluations of ``G`` after the first.
+        Evaluations of ``G`` after the first (refused ones included).
     residual : float
         Last relative residual.
     residuals : tuple of float
@@ -75,7 +83,8 @@ def check_options(tol, max_iter, memory, relaxation) -> tuple:
 
 def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
                          tol: float = 1e-8, max_iter: int = 60, memory: int = 5,
-                         relaxation: float = 1.0, floor: float = 0.0) -> FixedPoint:
+                         relaxation: float = 1.0, floor: float = 0.0,
+                         backoff: int = 4) -> FixedPoint:
     """Solve ``x = G(x)`` from ``x0`` (module docstring).
 
     Parameters
@@ -98,6 +107,8 @@ def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
         The residual is ``||G(x) - x|| / max(||G(x)||, floor)``: a norm below which the
         iterate counts as small (the caller's scale of x; 0: purely relative, which asks
         digits of a field that is noise next to the scale the problem resolves).
+    backoff : int
+        Halvings of the damped step ``beta r`` tried after a refused iterate (>= 0).
 
     Returns
     -------
@@ -105,6 +116,7 @@ def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
         Never raises on non-convergence: the caller reads ``status`` and raises its own
         :class:`~roughfe.errors.NoConvergenceError` with its partial result.
     """
+    backoff = check_int("backoff (step halvings after a refused iterate)", backoff, 0)
     x = np.asarray(x0, dtype=float)
     gx = G(x) if gx0 is None else np.asarray(gx0, dtype=float)
     hist_x: list = []
@@ -137,9 +149,28 @@ def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
         except RejectedIterate:
             hist_x.clear()
             hist_r.clear()
-            try:
-                x, gx = gx, G(gx)
-            except RejectedIterate:
+            evaluations, step = _damped_step(G, x, r, x_new, relaxation, backoff)
+            it += evaluations
+            if step is None:
                 status = "rejected"
+            else:
+                x, gx = step
     return FixedPoint(x=x, gx=gx, status=status, iterations=it, residual=residuals[-1],
                       residuals=tuple(residuals))
+
+
+def _damped_step(G, x, r, refused, relaxation, backoff) -> tuple:
+    """The first of ``x + relaxation r / 2^j`` (``j = 0 .. backoff``; ``refused`` itself
+    skipped) that ``G`` accepts: ``(evaluations, (x_j, G(x_j)))``, or
+    ``(evaluations, None)`` when it refuses all of them."""
+    evaluations = 0
+    for j in range(backoff + 1):
+        trial = x + (relaxation / 2.0 ** j) * r
+        if np.array_equal(trial, refused):
+            continue
+        evaluations += 1
+        try:
+            return evaluations, (trial, G(trial))
+        except RejectedIterate:
+            pass
+    return evaluations, None
