@@ -17,7 +17,7 @@ from roughfe.bem.contact import surface_displacement
 from roughfe.errors import InputError, NoConvergenceError
 from roughfe.leakage.finite_volume import solve_reynolds_fv
 from roughfe.leakage.fsi import coupled_leakage
-from roughfe.leakage.fsi_sweep import coupled_sweep
+from roughfe.leakage.fsi_sweep import coupled_leakage_sweep, coupled_sweep
 from roughfe.model import Material
 from roughfe.surfaces import Surface
 from roughfe.surfaces.spectral import spectral_surface
@@ -81,6 +81,25 @@ def test_coupled_state_is_a_fixed_point_and_leaks_more(surface, flowing):
     assert r.leak_rate > 0 and r.one_way_leak_rate == 0.0
     rec = r.record()
     assert rec["coupled_iterations"] == r.coupled_iterations and rec["fsi_state"] == "contact"
+
+
+def test_coupled_records_use_the_one_way_contact_scalars(surface):
+    """``delta`` of the coupled records was the approach of the internal dry problem on the
+    shifted heights h - H p_f (2.424 um beside an approach of 2.586 um, measured)."""
+    sweep = coupled_leakage_sweep(surface, MAT, [P_EXT], p_in=2e7, p_out=0.0)
+    rec, r = sweep.records()[0], sweep.results[0]
+    h, sigma = surface.heights, float(np.std(surface.heights))
+    # Eq. 2.5 with the total traction p_c + p_f on the half-space: g = u + max h - h - Delta
+    u = surface_displacement(surface, MAT, r.contact.pressure + r.fluid_pressure)
+    assert np.allclose(r.contact.gap, u + h.max() - h - rec["delta"], rtol=0,
+                       atol=1e-6 * sigma)                        # measured 3e-14 m
+    # the one-way records' definitions (zero mean displacement of the periodic half-space)
+    assert rec["delta"] == pytest.approx(h.max() - h.mean() - rec["mean_gap"], rel=1e-9)
+    assert rec["mean_plane_separation"] == pytest.approx(h.max() - h.mean() - rec["delta"],
+                                                         rel=1e-12)
+    assert rec["free_volume_star"] == pytest.approx(rec["mean_gap"] / sigma, rel=1e-12)
+    assert rec["separation_star"] == pytest.approx(rec["mean_plane_separation"] / sigma,
+                                                   rel=1e-12)
 
 
 def test_reversed_flow_is_the_mirror_image(surface, flowing):

@@ -128,9 +128,16 @@ class CoupledResult:
     ----------
     state : {"contact", "lift-off"}
     contact : roughfe.model.ContactResult or None
-        The final contact solve (of the shifted heights): its ``gap`` and ``contact`` are
-        the coupled ones, its ``pressure`` the *solid* contact pressure ``p_c`` on top of
-        the fluid pressure (Pa). None at lift-off.
+        The final contact solve (of the shifted heights ``h - H p_f``): its ``gap`` and
+        ``contact`` are the coupled ones, its ``pressure`` the *solid* contact pressure
+        ``p_c`` on top of the fluid pressure (Pa); its ``delta``,
+        ``mean_plane_separation`` and ``free_volume_star`` are those of the shifted
+        heights (use :attr:`approach`). None at lift-off.
+    approach : float or None
+        Approach ``Delta`` of the rigid surface from first contact of the undeformed
+        surfaces (m), the one-way contact's ``delta``: ``contact.delta - (max(h - H p_f)
+        - max h)`` (periodic: ``max h - mean h - mean gap``, zero mean displacement).
+        None at lift-off.
     flow : FVSolution or None
         Reynolds solution on the coupled gap (absolute pressures).
     fluid_pressure : ndarray
@@ -173,6 +180,7 @@ class CoupledResult:
 
     state: str
     contact: Optional[object]
+    approach: Optional[float]
     flow: Optional[FVSolution]
     fluid_pressure: np.ndarray
     external_pressure: float
@@ -323,6 +331,8 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
             raise _LiftOff()
         shifted = Surface(h - surface_displacement(surface, material, x, kernel),
                           surface.size, surface.periodic)
+        # the approach of the shifted heights' contact is Delta + max(h - H p_f) - max h
+        shift = float(shifted.heights.max() - h.max())
         c = solve_contact(shifted, material, mean_pressure=p_contact, kernel=kernel,
                           tol=contact_tol, compute_stiffness=False,
                           initial=last["contact"].pressure)
@@ -334,7 +344,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
             lab = frozen.labels
             p_pocket = frozen.pressure if newton is None else newton(x, gap, c, p_ext)
             y = np.where(lab >= 0, p_pocket[np.maximum(lab, 0)], y)
-        last.update(contact=c, gap=gap)
+        last.update(contact=c, gap=gap, shift=shift)
         return y
 
     def _flow(gap):
@@ -347,7 +357,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         # step's fluid pressure (pocket pressures near their solution), else from 0
         dry = solve_contact(surface, material, mean_pressure=p_ext, kernel=kernel, tol=contact_tol,
                             compute_stiffness=False)
-        last["contact"] = dry
+        last.update(contact=dry, shift=0.0)
         one_way = _flow(np.where(dry.contact, 0.0, dry.gap)).leak_rate
         x = (np.array(history.pressure, dtype=float) if history is not None
              and history.pressure.mean() < p_ext else np.zeros(h.shape))
@@ -417,7 +427,8 @@ def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residu
         p_f = np.broadcast_to(ramp.reshape([-1 if a == axis else 1 for a in range(fluid.ndim)]),
                               fluid.shape).copy()
         return CoupledResult(
-            state=state, contact=None, flow=None, fluid_pressure=p_f, leak_rate=None,
+            state=state, contact=None, approach=None, flow=None, fluid_pressure=p_f,
+            leak_rate=None,
             fluid_load_fraction=float(p_f.mean() / p_ext), contact_load_fraction=0.0,
             trapped_load_fraction=0.0,
             pocket_volume=0.0, pocket_pressures=(), pocket_volumes=(),
@@ -436,7 +447,8 @@ def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residu
         pocket_v = (np.bincount(lab[in_pocket], gap[in_pocket], n) * cell)[order]
     nxt = last.get("next")
     return CoupledResult(
-        state=state, contact=c, flow=sol, fluid_pressure=fluid, leak_rate=sol.leak_rate,
+        state=state, contact=c, approach=float(c.delta - last["shift"]), flow=sol,
+        fluid_pressure=fluid, leak_rate=sol.leak_rate,
         fluid_load_fraction=float(fluid.mean() / p_ext),
         contact_load_fraction=float(c.pressure.mean() / p_ext),
         trapped_load_fraction=float(fluid[in_pocket].sum() / fluid.size / p_ext),
