@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from roughfe.leakage.fsi_sweep import coupled_sweep
-from roughfe.leakage.pockets import Pockets, transfer
+from roughfe.leakage.pockets import Pockets, transfer, wet_components
 from roughfe.model import Material
 from roughfe.surfaces import Surface
 from roughfe.surfaces.spectral import spectral_surface
@@ -32,6 +32,31 @@ def _grid():
     labels = np.full(gap.shape, -1)
     labels[2:6, 2:6] = 0
     return gap, Pockets(labels=labels, volume=np.array([3e-20]), pressure=np.array([2e6]))
+
+
+def test_no_pocket_left_is_the_flowing_labelling():
+    # the held cells all joined the flow: every cell wet and reaching inlet and outlet
+    lab, connected = wet_components(np.ones((4, 4)), 0.1, axis=0, periodic=False,
+                                    hold=np.eye(4, dtype=bool))
+    assert np.all(lab == 0) and list(connected) == [True]
+    # the only pocket squeezed shut (every cell in contact) while the channel flows
+    gap, prev = _grid()
+    gap[2:6, 2:6] = 0.0
+    lab, connected = wet_components(gap, H_REG, axis=0, periodic=False,
+                                    hold=prev.labels >= 0)
+    assert np.array_equal(lab >= 0, gap > H_REG) and connected.all()
+    # ... keeps its cells and liquid (module docstring: a pocket on no wet cell)
+    nxt, counts = transfer(prev, gap, np.zeros(gap.shape), CELL, H_REG, axis=0,
+                           periodic=False)
+    assert nxt.n == 1 and np.array_equal(nxt.labels, prev.labels)
+    assert nxt.volume[0] == prev.volume[0] and counts["kept"] == 1
+    # the CLI case (`roughfe leak --fsi --pressure 1e7 5e6`, exit 1 with nothing written):
+    # on unloading the only pocket reopens to the flow
+    surface = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=4)
+    steps = coupled_sweep(surface, Material(1e9, 0.3), [1e7, 5e6], p_in=5e6, p_out=0.0)
+    assert [r.state for r in steps] == ["contact", "contact"]
+    assert steps[0].fluid_state.pockets.n == 1 and steps[1].pockets_released == 1
+    assert steps[1].fluid_state.pockets.n == 0 and steps[1].pockets_settled
 
 
 def test_thin_cells_stay_in_their_pocket_until_they_close():

@@ -109,13 +109,17 @@ def wet_components(gap, h_reg, *, axis, periodic, hold=None):
     the previous pockets) stays wet while it is open (gap > 0) and not part of a component
     that reaches inlet or outlet through cells thicker than the film: the hysteresis of
     the module docstring. The flowing components are those of the plain criterion; held
-    cells count only in a component with a wet cell."""
+    cells count only in a component with a wet cell. When no cell outside the flow is
+    wet or held open (the last pocket squeezed shut or reopened to the flow) the result
+    is the flowing labelling (until round 2, session 24: an IndexError)."""
     wet = gap > h_reg
     lab, connected = _components(wet, axis, periodic)
     if hold is None or not np.any(hold):
         return lab, connected
     flowing = (lab >= 0) & connected[np.maximum(lab, 0)]
     inner = (wet | (np.asarray(hold, bool) & (gap > 0))) & ~flowing
+    if not inner.any():     # the held cells closed or joined the flow: no pocket left
+        return lab, connected
     lab2, conn2 = _components(inner, axis, periodic)
     # held cells only count with a wet cell of their component (no pocket of thin cells)
     some_wet = np.bincount(lab2[inner & wet], minlength=conn2.size) > 0
