@@ -59,6 +59,22 @@ def test_no_pocket_left_is_the_flowing_labelling():
     assert steps[1].fluid_state.pockets.n == 0 and steps[1].pockets_settled
 
 
+def test_a_pocket_squeezed_shut_loses_its_liquid_under_the_pressure_law():
+    gap, prev = _grid()
+    gap[2:6, 2:6] = 0.0                      # every cell of the pocket in solid contact
+    kept, counts = transfer(prev, gap, np.zeros(gap.shape), CELL, H_REG, axis=0,
+                            periodic=False)                     # volume law: kept
+    assert kept.n == 1 and counts["kept"] == 1 and counts["squeezed"] == 0
+    lost, counts = transfer(prev, gap, np.zeros(gap.shape), CELL, H_REG, axis=0,
+                            periodic=False, bulk_modulus=0.0)   # pressure law (K -> 0)
+    assert lost.n == 0 and np.all(lost.labels < 0) and counts["squeezed"] == 1
+    # a thin cell still open: collapsed below the film, not shut; it keeps its liquid
+    gap[3, 3] = 0.5 * H_REG
+    thin, counts = transfer(prev, gap, np.zeros(gap.shape), CELL, H_REG, axis=0,
+                            periodic=False, bulk_modulus=0.0)
+    assert thin.n == 1 and counts["kept"] == 1
+
+
 def test_thin_cells_stay_in_their_pocket_until_they_close():
     gap, prev = _grid()
     gap[2, 2] = 0.5 * H_REG          # pocket cell thinner than the film: stays
@@ -73,7 +89,7 @@ def test_thin_cells_stay_in_their_pocket_until_they_close():
     expect[2:6, 2:6] = True
     expect[5, 5] = False
     assert nxt.n == 1 and np.array_equal(nxt.labels >= 0, expect)
-    assert cnt == {"new": 0, "released": 0, "merged": 0, "kept": 0}
+    assert cnt == {"new": 0, "released": 0, "merged": 0, "kept": 0, "squeezed": 0}
     assert nxt.volume[0] == pytest.approx(prev.volume[0], rel=1e-14)
     assert nxt.pressure[0] == pytest.approx(prev.pressure[0], rel=1e-14)
     # without the history the thin cells are not wet: the bridge splits the pocket
@@ -151,7 +167,9 @@ def test_pocket_cells_settle_on_the_64_sweep_to_60_mpa(kw):
     rs = coupled_sweep(s, Material(1e9, 0.3), [1e7, 2e7, 3e7, 6e7], p_in=5e6, p_out=0.0,
                        **kw)
     last = rs[-1]
-    assert len(last.pocket_pressures) > 100
+    # pressure law: 81 pockets hold liquid (121 were reported while 40 squeezed shut kept
+    # theirs); the others 100+
+    assert len(last.pocket_pressures) > (50 if kw.get("trapped") == "pressure" else 100)
     for r in rs:
         assert r.state == "contact" and r.residual <= 1e-8
         assert r.pockets_settled and r.pocket_passes <= 2
@@ -163,3 +181,8 @@ def test_pocket_cells_settle_on_the_64_sweep_to_60_mpa(kw):
                             axis=0, periodic=True)
         assert again.same_cells(r.fluid_state.pockets)
         assert r.contact_load_fraction + r.fluid_load_fraction == pytest.approx(1.0, abs=1e-8)
+        if kw.get("trapped") == "pressure":
+            # a pocket squeezed shut keeps no liquid under the pressure law: no pocket of
+            # zero volume carries fluid load (9 did at 10 -> 30 MPa, 12 % of the trapped
+            # load)
+            assert min(r.pocket_volumes) > 0

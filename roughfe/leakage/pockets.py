@@ -53,7 +53,10 @@ state is its drained state (volume, and gap-weighted mean film pressure), i.e. t
 is placed at the end of the load step (a finer load path moves it closer to the true
 closure load; measured in docs/theory/04b_leakage_ii.md). A previous pocket that
 overlaps no wet cell (every cell closed or thinner than ``h_reg``) keeps its cells and
-fluid. Every case is a defined state.
+fluid, except under the ``"pressure"`` law (``bulk_modulus = 0``, ``K -> 0``) when every
+cell is closed: a pocket squeezed shut keeps no liquid there (until round 2, session 24
+it kept its label and closure pressure and carried fluid load on solid contact: 64^2,
+10 -> 30 MPa, 9 such pockets, 12 % of the trapped load). Every case is a defined state.
 """
 from __future__ import annotations
 
@@ -199,12 +202,14 @@ def transfer(previous: Pockets, gap, fluid, cell_area, h_reg, *, axis, periodic,
         Flow axis.
     periodic : bool
     bulk_modulus : float
-        Of the merge rule (inf: incompressible).
+        Of the merge rule (inf: incompressible); 0 is the ``"pressure"`` law, under which a
+        pocket squeezed shut loses its liquid (module docstring).
 
     Returns
     -------
     (Pockets, dict)
-        The current pockets and counts ``{"new", "released", "merged", "kept"}``.
+        The current pockets and counts ``{"new", "released", "merged", "kept",
+        "squeezed"}`` (kept: on no wet cell; squeezed: shut and dropped, ``K = 0``).
     """
     lab, connected = wet_components(gap, h_reg, axis=axis, periodic=periodic,
                                     hold=previous.labels >= 0)
@@ -213,11 +218,14 @@ def transfer(previous: Pockets, gap, fluid, cell_area, h_reg, *, axis, periodic,
     vol_cell = gap * cell_area
     shares = {}                         # component -> list of (volume, pressure)
     kept_cells, kept = [], []
-    released = merged = 0
+    released = merged = squeezed = 0
     for i in range(previous.n):
         cells = previous.labels == i
         comp = lab[cells]
         on = comp >= 0
+        if not on.any() and bulk_modulus == 0 and not np.any(gap[cells] > 0):
+            squeezed += 1               # shut under the "pressure" law: its liquid is lost
+            continue
         if not on.any():                # collapsed below the film: keeps cells and fluid
             kept_cells.append(cells)
             kept.append((previous.volume[i], previous.pressure[i]))
@@ -257,7 +265,7 @@ def transfer(previous: Pockets, gap, fluid, cell_area, h_reg, *, axis, periodic,
     return (Pockets(labels=labels, volume=np.array(volume, float),
                     pressure=np.array(pressure, float)),
             {"new": new, "released": int(released), "merged": int(merged),
-             "kept": len(kept)})
+             "kept": len(kept), "squeezed": squeezed})
 
 
 def penny_compliance(area, e_star):
