@@ -75,6 +75,19 @@ def test_a_pocket_squeezed_shut_loses_its_liquid_under_the_pressure_law():
     assert thin.n == 1 and counts["kept"] == 1
 
 
+def test_a_cavity_opening_among_contact_spots_counts_as_new():
+    # pockets_new: every pocket with no liquid of the previous state, also a cavity that
+    # opens in solid contact on unloading (documented; transfer does not see the old gap)
+    gap, prev = _grid()
+    gap[3, 0] = 10 * H_REG                   # a cell opening inside the contact
+    nxt, cnt = transfer(prev, gap, np.full(gap.shape, 1e6), CELL, H_REG, axis=0,
+                        periodic=False)
+    assert nxt.n == 2 and cnt["new"] == 1 and cnt["kept"] == 0
+    k = nxt.labels[3, 0]
+    assert nxt.volume[k] == pytest.approx(10 * H_REG * CELL, rel=1e-14)   # drained state
+    assert nxt.pressure[k] == 1e6
+
+
 def test_thin_cells_stay_in_their_pocket_until_they_close():
     gap, prev = _grid()
     gap[2, 2] = 0.5 * H_REG          # pocket cell thinner than the film: stays

@@ -78,9 +78,10 @@ alike, and at its fixed point the pocket volumes are exact.
 The pocket cells are frozen during one fixed-point solve (a pass) so that ``G`` is a
 continuous map; after the pass the pockets of the coupled gap are found again
 (:func:`roughfe.leakage.pockets.transfer`: merge, split, reopening, new pockets closing
-at this load), and the pass is repeated with them until the cells no longer change
-(``pockets_settled``; membership rules: :mod:`roughfe.leakage.pockets`), else they stop
-after ``max_passes`` or when a layout already solved in this step comes back (a cycle).
+or cavities opening at this load), and the pass is repeated with them until the cells
+no longer change (``pockets_settled``; membership rules: :mod:`roughfe.leakage.pockets`),
+else they stop after ``max_passes`` or when a layout already solved in this step comes
+back (a cycle).
 Why round 2's first ``"pressure"`` model stalled in sweeps: docs/theory/04b_leakage_ii.md.
 """
 from __future__ import annotations
@@ -165,8 +166,11 @@ class CoupledResult:
     pocket_pressures, pocket_volumes : tuple of float
         Pressure (Pa) and fluid volume (m^3) of each pocket, largest pocket first.
     pockets_new, pockets_released, pockets_merged, pocket_passes : int
-        Pockets closed in this step, reopened to inlet/outlet, merges; fixed-point solves
-        with frozen pocket cells.
+        Pockets that hold no liquid of the previous state (sealed off from the flowing
+        film in this step, or, on unloading, cavities opened in this step among contact
+        spots: both start from their drained state), pockets reopened to inlet/outlet,
+        merges (each summed over the passes); fixed-point solves with frozen pocket
+        cells.
     pockets_settled : bool
         The pocket cells of the last pass are those of its solution.
     coupled_iterations : int

@@ -48,8 +48,10 @@ to the current gap volume of the overlap. Shares that reach a component connecte
 inlet or outlet are released (the pocket reopened: its fluid joins the flow); shares
 reaching one pocket merge (``V_c`` summed at a common ``P_c``, the volume-weighted mean:
 ``V_c = sum V_i exp((P_i - P_c)/K)``, exact for the law above); a pocket split in two gives
-each part its share. A component with no share closed in the current step: its closure
-state is its drained state (volume, and gap-weighted mean film pressure), i.e. the closure
+each part its share. A component with no share is new in the current step: sealed off
+from the flowing film, or (on unloading) a cavity opened among contact spots, counted
+alike as ``"new"`` (``transfer`` does not see the previous gap); its closure state is
+its drained state (volume, and gap-weighted mean film pressure), i.e. the closure
 is placed at the end of the load step (a finer load path moves it closer to the true
 closure load; measured in docs/theory/04b_leakage_ii.md). A previous pocket that
 overlaps no wet cell (every cell closed or thinner than ``h_reg``) keeps its cells and
@@ -209,7 +211,8 @@ def transfer(previous: Pockets, gap, fluid, cell_area, h_reg, *, axis, periodic,
     -------
     (Pockets, dict)
         The current pockets and counts ``{"new", "released", "merged", "kept",
-        "squeezed"}`` (kept: on no wet cell; squeezed: shut and dropped, ``K = 0``).
+        "squeezed"}``: new, no share of ``previous`` (sealed off or opened); kept, on
+        no wet cell; squeezed, shut and dropped (``K = 0``).
     """
     lab, connected = wet_components(gap, h_reg, axis=axis, periodic=periodic,
                                     hold=previous.labels >= 0)
@@ -250,7 +253,7 @@ def transfer(previous: Pockets, gap, fluid, cell_area, h_reg, *, axis, periodic,
             v, p = np.array(shares[c]).T
             merged += v.size > 1
             vc, pc = _merge(v, p, bulk_modulus)
-        else:                           # closed in this step: its drained state
+        else:                           # new in this step: its drained state
             new += 1
             vc = float(vol_cell[cells].sum())
             g = vol_cell[cells]
