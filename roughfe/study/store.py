@@ -243,18 +243,19 @@ def set_aside(outdir, keys) -> str:
 
 
 def done_keys(outdir) -> set:
-    """Keys with a result file (the truth about what is done)."""
+    """Keys with a result file (the truth about what is done); a writer's temporary file
+    (hidden, ``.roughfe-*.tmp.json``: a run killed while writing leaves one) is none."""
     folder = Path(outdir) / "results"
     if not folder.is_dir():
         return set()
-    return {p.stem for p in folder.glob("*.json")}
+    return {p.stem for p in folder.glob("*.json") if not p.name.startswith(".")}
 
 
 def failed_keys(outdir) -> set:
     folder = Path(outdir) / "failures"
     if not folder.is_dir():
         return set()
-    return {p.stem for p in folder.glob("*.json")}
+    return {p.stem for p in folder.glob("*.json") if not p.name.startswith(".")}
 
 
 def record_failure(outdir, task, attempt: dict) -> int:
