@@ -18,6 +18,11 @@ thesis reports. What is loose in Eq. (3.8) is the phase: arccos returns theta in
 which is right only when g2 >= 0 (about half of the random draws); the correct phase is
 theta_n = atan2(g2, g1), used here. :func:`validity_monte_carlo` measures both.
 
+With ridge amplitude factors alpha_m (a genome with ``anisotropy``, Eq. 3.17-3.18) the
+waves are weighted and so are the phasors: g1 = sum_m alpha_m cos(phi_m),
+g2 = sum_m alpha_m sin(phi_m), K_n e^{i theta_n} = G sum_m alpha_m e^{i phi_m}; the
+chromosome is still exactly one cosine.
+
 Consequence for sequencing: a profile determines only K_n and theta_n per chromosome,
 never the individual phi_{m,n} nor M (see ``roughfe.genomics.sequencing``).
 """
@@ -34,17 +39,24 @@ from .genome import DEFAULT_NODES, Genome, chromosome_heights, node_coordinates
 def reduced_chromosome(genome: Genome, n):
     """K_n (m) and theta_n (rad) of the single-cosine form of chromosome(s) n, Eq. (3.8).
 
-    ``K_n = G sqrt(M + 2 g3)`` and ``theta_n = atan2(g2, g1)`` (the sign-correct version of
-    the thesis's ``arccos(g1 / sqrt(M + 2 g3))``). Returns two arrays of len(n).
+    ``K_n e^{i theta_n} = G sum_m alpha_m e^{i phi_mn}``, i.e. ``K_n = G |g1 + i g2|``
+    and ``theta_n = atan2(g2, g1)`` with ``g1 = sum_m alpha_m cos(phi_mn)``,
+    ``g2 = sum_m alpha_m sin(phi_mn)``: the ridge amplitude factors alpha_m of the genome
+    (``Genome.anisotropy``, Eq. 3.17-3.18; 1 when absent) weight the phasors as they
+    weight the waves of :func:`~roughfe.genomics.genome.chromosome_heights`. For alpha = 1
+    this is the thesis's ``K_n = G sqrt(M + 2 g3)`` with the sign-correct phase (the thesis
+    has ``arccos(g1 / sqrt(M + 2 g3))``). Returns two arrays of len(n).
     """
     phi = genome.phase_columns(np.atleast_1d(n))
-    g1 = np.cos(phi).sum(axis=0)
-    g2 = np.sin(phi).sum(axis=0)
+    alpha = np.ones(phi.shape[0]) if genome.anisotropy is None else genome.anisotropy
+    g1 = alpha @ np.cos(phi)
+    g2 = alpha @ np.sin(phi)
     return genome.prefactor * np.hypot(g1, g2), np.arctan2(g2, g1)
 
 
 def reduced_chromosome_heights(genome: Genome, x, n):
-    """C_n(x) from the reduced form Eq. (3.7) with theta_{n,1} = theta_{n,2} (m), shape (len(n), P)."""
+    """C_n(x) from the reduced form Eq. (3.7) with theta_{n,1} = theta_{n,2} (m), shape
+    (len(n), P); the ridge factors alpha_m are included (:func:`reduced_chromosome`)."""
     n = np.atleast_1d(np.asarray(n, dtype=int))
     k, theta = reduced_chromosome(genome, n)
     amp = k * genome.gamma ** ((1.0 - n) * genome.H)
