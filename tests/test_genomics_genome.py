@@ -5,7 +5,8 @@ import pytest
 from roughfe.errors import FileFormatError, InputError
 from roughfe.genomics.genome import (Genome, chromosome_heights, chromosome_range, load_genome,
                                      node_coordinates, observation_coordinates, profile_heights,
-                                     realize, save_genome, table1_genome)
+                                     random_genome, realize, save_genome, table1_genome)
+from roughfe.genomics.periodic import realization
 
 
 def test_table1_index_ranges_from_eq_3_5():
@@ -98,3 +99,27 @@ def test_surface_realisation_with_ridges_along_x_repeats_the_profile():
     prof = realize(g2, length=1e-3, n_nodes=64).heights
     np.testing.assert_allclose(surf.heights, np.repeat(prof[:, None], 64, axis=1),
                                atol=1e-12 * np.abs(prof).max())
+
+
+@pytest.mark.parametrize("chromosomes, words", [
+    ([1.5], ["chromosomes[0]", "integer", "1.5"]),      # used to be truncated to chromosome 1
+    ([2, 3.0], ["chromosomes[1]", "3.0"]),
+    ([0, 2], ["chromosomes[0]", ">= 1", "0"]),
+    ([], ["at least one"]),
+])
+def test_realize_refuses_chromosome_indices_it_would_truncate(chromosomes, words):
+    g = table1_genome(rng=0)
+    with pytest.raises(InputError) as info:
+        realize(g, scale="10x", n_nodes=64, chromosomes=chromosomes)
+    for w in words:
+        assert w in str(info.value)
+    # the periodic surface realisation checks them the same way
+    g2 = random_genome(1, .75, 1.5, 1e-3, 4, 22, rng=0, angles=[0, .5, 1, 2])
+    with pytest.raises(InputError) as info:
+        realization(g2, 1e-3, 64, dim=2, chromosomes=chromosomes)
+    for w in words:
+        assert w in str(info.value)
+    # integer indices (Python or numpy) still select exactly those chromosomes
+    s = realize(g, scale="10x", n_nodes=64, chromosomes=np.array([3, 1]))
+    assert s.metadata["chromosomes"] == [1, 3]
+    assert realization(g2, 1e-3, 64, dim=2, chromosomes=[3, 1]).metadata["chromosomes"] == [1, 3]

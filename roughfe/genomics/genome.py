@@ -443,6 +443,17 @@ def profile_heights(genome: Genome, x, n):
     return wm_series(np.asarray(x, dtype=float), amps, genome.wavenumber(n), phases)
 
 
+def chromosome_indices(chromosomes) -> np.ndarray:
+    """The distinct chromosome indices n (sorted int array) named by ``chromosomes`` (an
+    index or a sequence of them); :class:`InputError` for none, or for an index that is not
+    an integer >= 1 (1.5 is refused, not truncated to 1)."""
+    items = np.ravel(np.asarray(chromosomes, dtype=object))
+    if items.size == 0:
+        raise InputError("chromosomes must name at least one chromosome index")
+    return np.unique([check_int(f"chromosomes[{k}] (a chromosome index n)", v, 1)
+                      for k, v in enumerate(items)])
+
+
 def realize(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, scale=None,
             chromosomes=None) -> Surface:
     """Realise a genome as a profile at observation length ``length`` (Eq. 3.1, 3.5).
@@ -458,8 +469,9 @@ def realize(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, scale=None,
         Named scale: L = lambda1, lambda1/2, lambda1/10 (Table 1 convention).
     chromosomes : sequence of int, optional
         Sum only these chromosome indices (a single chromosome, a top-down or bottom-up
-        partial sum, Sec. 3.2.2). Default: the chromosomes n_s..n_f of Eq. (3.5) that
-        the genome holds (:meth:`Genome.held_range`: none beyond its phase matrix).
+        partial sum, Sec. 3.2.2), integers >= 1 (:func:`chromosome_indices`). Default:
+        the chromosomes n_s..n_f of Eq. (3.5) that the genome holds
+        (:meth:`Genome.held_range`: none beyond its phase matrix).
 
     Returns
     -------
@@ -477,9 +489,7 @@ def realize(genome: Genome, length=None, n_nodes=DEFAULT_NODES, *, scale=None,
     if chromosomes is None:
         idx = np.arange(*np.add(genome.held_range(length, n_nodes), (0, 1)))
     else:
-        idx = np.unique(np.atleast_1d(np.asarray(chromosomes, dtype=int)))
-        if idx.size == 0:
-            raise InputError("chromosomes must name at least one chromosome index")
+        idx = chromosome_indices(chromosomes)
     x = node_coordinates(length, n_nodes)
     z = profile_heights(genome, x, idx)
     delta = length / (n_nodes - 1)

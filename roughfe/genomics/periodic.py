@@ -49,7 +49,7 @@ import numpy as np
 
 from ..errors import InputError, check_finite_positive
 from ..surfaces.surface import Surface
-from .genome import Genome, realize
+from .genome import Genome, chromosome_indices, realize
 
 _TOL = 1e-9
 
@@ -129,7 +129,7 @@ def realize_periodic_surface(genome: Genome, length, n_nodes, chromosomes=None) 
     n_s, n_f = periodic_chromosome_range(genome.gamma, genome.lambda1, length, n_nodes)
     if chromosomes is None:
         chromosomes = _held(genome, length, n_nodes)
-    n = np.unique(np.atleast_1d(np.asarray(chromosomes, dtype=int)))
+    n = chromosome_indices(chromosomes)
     z = periodic_heights(genome, length, n_nodes, n)
     meta = {"generator": "genome (periodic)", "length": float(length), "n_nodes": int(n_nodes),
             "x0": 0.0, "n_s": n_s, "n_f": n_f, "chromosomes": [int(i) for i in n]}
