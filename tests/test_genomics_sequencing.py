@@ -161,3 +161,13 @@ def test_genome_natural_strict_exits_1_when_the_quality_check_fails(topographies
     assert main(args + ["--strict", "-o", str(tmp_path / "b")]) == 1
     report = json.loads(next((tmp_path / "b").glob("*_report.json")).read_text())
     assert report["sequencing"]["success"] is False
+
+
+def test_too_few_peaks_is_an_error_not_a_guessed_lattice():
+    """With fewer than 3 PSD peaks gamma = 1.5 (Table 1's own value) was assumed, and on
+    Table 1 data the "sequencing" succeeded because the guess was the answer, with
+    success True beside the message "the spectrum is not a discrete WM spectrum"."""
+    g = table1_genome(rng=1)
+    acq = [realize(g, scale=s, n_nodes=32) for s in ("10x", "20x")]
+    with pytest.raises(InputError, match=r"only 2 PSD peaks.*at least 3.*more\s+nodes"):
+        sequence_profiles(acq)

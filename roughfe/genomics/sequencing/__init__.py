@@ -44,7 +44,9 @@ Steps (:func:`sequence_profiles`)
    located to sub-bin precision by a parabola in log PSD.
 2. gamma (Eq. 3.6): the peaks of all acquisitions lie on one lattice
    ln q_n = ln q_1 + (n-1) ln gamma; ln gamma is the period of a comb fitted to the peak
-   abscissae (largest period with near-maximal coherence), refined by regression.
+   abscissae (largest period with near-maximal coherence), refined by regression. Fewer
+   than 3 peaks over all acquisitions: an InputError (no lattice can be read from them;
+   more nodes or acquisitions are needed).
 3. lambda1 so that n_s = 1 for the coarsest acquisition (Eq. 3.5): lambda1 in [L_1, gamma L_1).
 4. Variable projection with continuation in the highest chromosome index (the basin of
    ln gamma shrinks like 1/n), restarts from the best comb periods; the lattice label is

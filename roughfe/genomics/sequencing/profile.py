@@ -51,6 +51,12 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     Returns
     -------
     SequencingResult
+
+    Raises
+    ------
+    InputError
+        Fewer than 3 PSD peaks over all acquisitions (too few to read a lattice from), or
+        no admissible lattice (gamma in (1, 10]).
     """
     t0 = time.perf_counter()
     rms_tolerance, n_restarts = check_controls(rms_tolerance, n_restarts)
@@ -67,10 +73,12 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     log_q = np.concatenate([np.log(s.peak_q) for s in spectra])
     messages = []
     if log_q.size < 3:
-        messages.append(f"only {log_q.size} PSD peaks found: the spectrum is not a discrete WM spectrum")
-        periods, refs = np.array([math.log(1.5)]), np.array([math.log(2 * math.pi / acqs[0].length)])
-    else:
-        periods, _, refs = comb_periods(log_q, n_best=n_restarts)
+        raise InputError(
+            f"only {log_q.size} PSD peaks found in the {len(acqs)} acquisitions; the lattice "
+            f"ln q_n = ln q_1 + (n-1) ln gamma (Eq. 3.6) needs at least 3: the spectrum is "
+            f"not a discrete WM spectrum, or its chromosomes are not resolved (give more "
+            f"nodes than N = {n_nodes}, or more acquisitions)")
+    periods, _, refs = comb_periods(log_q, n_best=n_restarts)
     bins = np.concatenate([s.peak_q / (s.q[1] - s.q[0]) for s in spectra])
     groups = np.concatenate([np.full(s.peak_q.size, i) for i, s in enumerate(spectra)])
     gamma_psd = float(math.exp(periods[0]))
@@ -79,10 +87,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     best = None
     nit = 0
     for period, ref in zip(periods, refs):
-        if log_q.size >= 3:
-            lq1, lg = lattice_from_period(log_q, period, ref, acqs[0].length, bins, groups)
-        else:
-            lq1, lg = label_q1(ref, period, acqs[0].length), period
+        lq1, lg = lattice_from_period(log_q, period, ref, acqs[0].length, bins, groups)
         if not (math.log(1.0 + 1e-3) < lg < math.log(10.0)):
             continue
         p, k = fit_lattice(lq1, lg, acqs, n_nodes, weights, rhs)
