@@ -8,7 +8,7 @@ import pytest
 
 from roughfe.errors import InputError
 from roughfe.genomics.chromosomes import reduced_chromosome
-from roughfe.genomics.genome import realize, table1_genome
+from roughfe.genomics.genome import random_genome, realize, table1_genome
 from roughfe.genomics.sequencing import (amplitude_genes, phases_with_sums, ridge_likelihood,
                                          sequence_profiles)
 from roughfe.surfaces.surface import Surface
@@ -161,6 +161,49 @@ def test_genome_natural_strict_exits_1_when_the_quality_check_fails(topographies
     assert main(args + ["--strict", "-o", str(tmp_path / "b")]) == 1
     report = json.loads(next((tmp_path / "b").glob("*_report.json")).read_text())
     assert report["sequencing"]["success"] is False
+
+
+def _random_case(seed, n_nodes=64):
+    """The random genomes of the round-1 measurement (gamma 1.2-2, H 0.5-1.2, M 1-9)."""
+    rng = np.random.default_rng(100 + seed)
+    gamma, H, M = rng.uniform(1.2, 2.0), rng.uniform(0.5, 1.2), int(rng.integers(1, 10))
+    g = random_genome(1.0, H, gamma, 1e-3, M, 60, rng=seed)
+    return g, [realize(g, length=L, n_nodes=n_nodes) for L in (1e-3, 5e-4)]
+
+
+@pytest.mark.parametrize("case", ["random-10", "random-17", "random-35", "table1-N40-1"])
+def test_a_sub_lattice_fit_is_refitted_on_the_coarser_lattice(case):
+    """A lattice gamma^(1/k) holds the genome's lattice as every k-th chromosome and fits
+    WM data exactly too: these came out as sqrt(gamma) or gamma^(1/3) with rms 1e-15 and
+    success True, every k-th chromosome holding the real amplitude, the others round-off
+    (Table 1 at N = 40, seed 1: gamma = sqrt(1.5), rms 8e-4). Now the genome's lattice,
+    exactly, and every sequenced chromosome carries a wave."""
+    if case.startswith("random"):
+        g, acq = _random_case(int(case.split("-")[1]))
+    else:
+        g = table1_genome(rng=1)
+        acq = [realize(g, scale=s, n_nodes=40) for s in ("10x", "20x")]
+    res = sequence_profiles(acq)
+    assert res.success, res.message
+    assert abs(res.genome.gamma / g.gamma - 1) < 1e-9
+    assert abs(res.genome.lambda1 / g.lambda1 - 1) < 1e-9
+    assert np.all(res.rms_errors < 1e-12)
+    assert res.amplitudes.min() > 1e-6 * res.amplitudes.max()
+
+
+def test_a_noisy_profile_is_sequenced_on_its_own_lattice():
+    """Table 1, N = 128, 0.1 % white noise (seed 5): with noise the comb offers only
+    sub-multiples of ln gamma and the fit on sqrt(1.5) (success True, H 1.01) was kept; the
+    coarser lattice is now tried and the BIC keeps gamma = 1.5, misfit at the noise."""
+    g = table1_genome(rng=5)
+    rng = np.random.default_rng(5)
+    acq = [realize(g, scale=s, n_nodes=128) for s in ("10x", "20x")]
+    noisy = [a.with_heights(a.heights + 1e-3 * a.heights.std() * rng.standard_normal(a.shape))
+             for a in acq]
+    res = sequence_profiles(noisy)
+    assert res.success, res.message
+    assert abs(res.genome.gamma / 1.5 - 1) < 1e-4               # measured 7e-6
+    assert np.all(res.rms_errors < 1.5e-3)                      # the noise: 1e-3
 
 
 def test_too_few_peaks_is_an_error_not_a_guessed_lattice():

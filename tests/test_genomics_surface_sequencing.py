@@ -372,7 +372,7 @@ def test_the_reported_misfit_is_the_returned_genomes(monkeypatch):
     82 %; 47 %, 50 % with the genes of least height misfit), not of the fit with every
     wave its own amplitude (1e-11, kept as fit_rms_errors)."""
     import roughfe.genomics.sequencing.surface as seq
-    monkeypatch.setattr(seq, "_coarser_lattices", lambda *args, **kw: [])
+    monkeypatch.setattr(seq, "coarser_lattices", lambda *args, **kw: [])
     g, acq = _sub_lattice_case()
     r = sequence_surfaces(acq)
     assert r.genome.gamma == pytest.approx(np.sqrt(g.gamma), rel=1e-6)
@@ -424,7 +424,7 @@ def test_the_refit_on_a_coarser_lattice_is_not_refitted_again(monkeypatch):
     "coarser" start is its own lattice: one refit each, the genome as without."""
     import roughfe.genomics.sequencing.surface as seq
     monkeypatch.setattr(seq, "_every_chromosome_present", lambda *args, **kw: False)
-    monkeypatch.setattr(seq, "_coarser_lattices", lambda p, *args, **kw: [p.copy()])
+    monkeypatch.setattr(seq, "coarser_lattices", lambda p, *args, **kw: [p.copy()])
     g, acq, _ = _genome(5)
     r = sequence_surfaces(acq)
     assert r.success and r.genome.M == g.M

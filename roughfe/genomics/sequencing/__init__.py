@@ -50,7 +50,12 @@ Steps (:func:`sequence_profiles`)
 3. lambda1 so that n_s = 1 for the coarsest acquisition (Eq. 3.5): lambda1 in [L_1, gamma L_1).
 4. Variable projection with continuation in the highest chromosome index (the basin of
    ln gamma shrinks like 1/n), restarts from the best comb periods; the lattice label is
-   finally chosen among the shifts compatible with step 3 by the residual.
+   finally chosen among the shifts compatible with step 3 by the Bayesian information
+   criterion (BIC). A lattice gamma^(1/k) holds the data's lattice as every k-th
+   chromosome and fits as well (the others empty, or holding noise), and with noise the
+   comb offers only such sub-lattices: a fit within ``rms_tolerance`` is therefore also
+   tried on its coarser lattices gamma^k (k = 2..24, as the 2D sequencer does) and the
+   lower BIC wins.
 5. Genes A, H (maximum likelihood on c_n, M-free), M, phases; Z_d = Z_1 - Z_2 at the
    common nodes; relative rms errors of the realisations of the sequenced genome; a
    quality report (success is False, with a message, when the relative rms error of any

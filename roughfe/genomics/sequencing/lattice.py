@@ -101,6 +101,46 @@ def label_q1(log_q_any, period, coarse_length):
     return log_q_any + math.floor((top - log_q_any) / period + 1e-9) * period
 
 
+def coarser_lattices(p, n0, coarse_length, k_max=6, gamma_max=4.0):
+    """Starts (ln q1, k ln gamma, *rest) of every lattice that holds the lattice
+    ``p = (ln q1, ln gamma, *rest)`` as every k-th chromosome, k = 2..``k_max``
+    (gamma^k <= ``gamma_max``, the top of the comb's search), through each of its first k
+    chromosomes from ``n0`` (the first chromosome of the fit); q1 labelled by
+    :func:`label_q1` (``rest``: the ridge angles of a surface fit, kept).
+
+    A fit on a sub-lattice gamma^(1/k) of the data's lattice reproduces the data as well
+    (to round-off, or down to the noise) with k - 1 of every k chromosomes empty, or
+    holding noise only; a Genome forces its amplitudes onto the power law of its own
+    lattice and puts waves back into them (measured, 2D: a fit to 1e-11 whose genome
+    misfits its windows by 94 %). Which chromosomes are empty is not reliable near the
+    window length (long waves of neighbouring chromosomes nearly collinear: all present
+    in an exact gamma^(1/4) fit of one 48^2 window), so every (k, offset) is offered; the
+    callers rank them by the cost of one linear solve.
+    """
+    starts = []
+    for k in range(2, k_max + 1):
+        if k * p[1] > math.log(gamma_max):
+            break
+        for r in range(k):
+            log_q = p[0] + (n0 + r - 1) * p[1]
+            starts.append(np.concatenate([[label_q1(log_q, k * p[1], coarse_length),
+                                           k * p[1]], p[2:]]))
+    return starts
+
+
+def bic(cost, rows, unknowns, floor):
+    """Bayesian information criterion of a least-squares fit (lower is better):
+    rows ln(cost / rows) + unknowns ln(rows), ``cost`` the residual sum of squares floored
+    at ``floor`` (round-off: two exact fits tie and the one with fewer unknowns wins).
+
+    The lowest cost alone would not do: a lattice gamma^(1/k) holds the data's lattice as
+    every k-th chromosome, so it fits exactly too, and with noise a little better (its
+    extra waves fit noise); its extra coefficients lower the cost by about their share
+    of the rows, the penalty ln(rows) per unknown keeps the data's lattice.
+    """
+    return rows * math.log(max(cost, floor) / rows) + unknowns * math.log(rows)
+
+
 # -- step 4: variable projection -----------------------------------------------------------
 def lattice_ranges(log_q1, log_gamma, acqs, n_nodes):
     lam1 = 2 * math.pi / math.exp(log_q1)
@@ -208,12 +248,13 @@ def _continuation(p, first, hi, acqs, ranges, weights, rhs, budget):
     return p, nit
 
 
-def fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600):
+def fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600, continuation=True):
     """Variable projection with continuation in the highest chromosome index.
 
     First a local fit of the full model from the PSD estimate (enough when the refined
-    peaks place every chromosome within the basin). Otherwise the continuation starts at
-    the last chromosome with <= 30 periods in the coarsest
+    peaks place every chromosome within the basin; all that is done with
+    ``continuation=False``, for a start known to be in the basin). Otherwise the
+    continuation starts at the last chromosome with <= 30 periods in the coarsest
     window (:func:`_first_cap`) -- starting lower lets the unresolved longest waves drag
     gamma away -- and adds one chromosome per step (each step shrinks the error enough
     for the next one). It is run from the PSD estimate and, unless that already fits
@@ -237,6 +278,8 @@ def fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600):
                         x_scale=np.array([1e-4, 1e-4]), diff_step=1e-10, max_nfev=40,
                         xtol=1e-15, ftol=1e-15, gtol=1e-15)
     nit = res.nfev + 2 * (res.njev or 0)
+    if not continuation:
+        return (res.x if res.x[1] > 0 else p0), nit
     if res.x[1] > 0 and final_cost(res.x) < 1e-20:
         return res.x, nit                 # the refined PSD lattice is already in the basin
     p_a, k = _continuation(p0, first, hi, acqs, ranges, weights, rhs, budget)

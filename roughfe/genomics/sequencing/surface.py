@@ -54,7 +54,7 @@ Steps (:func:`sequence_surfaces`)
    fit better than the noise allows (measured, 512^2 pair, 1 % noise, seeds 0-4: 4.4-32.5 s
    CPU before, 0.9-2.6 s after, the same genes). A fit within the tolerance with an empty
    chromosome may be a sub-lattice gamma^(1/k) fit: it is also tried on the coarser
-   lattices (:func:`_coarser_lattices`), the lower BIC wins.
+   lattices (:func:`~.lattice.coarser_lattices`), the lower BIC wins.
 5. Genes: b_mn, phi_mn from the coefficients; (ln G, H, ln alpha) by least squares on
    ln b_mn weighted by b_mn^2, refined to the least height misfit of the genome with the
    fitted phases; A from G (Eq. 3.1) (:mod:`.surface_result`, with the misfits and the
@@ -73,7 +73,7 @@ from scipy.optimize import least_squares
 
 from ..genome import Genome
 from .acquisitions import check_controls
-from .lattice import comb_periods, label_q1, lattice_from_period
+from .lattice import bic, coarser_lattices, comb_periods, label_q1, lattice_from_period
 from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, noise_variance,
                            surface_acquisitions, surface_peaks)
 from .surface_grid import GridModel
@@ -137,19 +137,13 @@ def _fit(model, p0, budget=60, continuation=True):
 
 
 def _bic(model, cost, sol, p):
-    """Bayesian information criterion of a fit (lower is better): rows ln(cost / rows) +
-    unknowns ln(rows), unknowns = the wave and plane coefficients and the lattice.
-
-    The lowest cost alone would not do: a lattice gamma^(1/k) holds the true lattice as
-    every k-th chromosome, so with noise it always fits a little better (its extra waves
-    fit noise: measured, 1 % noise, gamma = 1.6: gamma^(1/3) won with the misfit at the
-    noise level, H and A wrong). Its 2 M n_c (k - 1) extra coefficients lower the cost by
-    about that share of rows; the penalty ln(rows) per unknown keeps the true lattice.
-    """
-    rows = model.z.size
+    """Bayesian information criterion (:func:`~.lattice.bic`, lower is better) of a fit,
+    unknowns = the wave and plane coefficients and the lattice. (Measured, 1 % noise,
+    gamma = 1.6: by the lowest cost gamma^(1/3) won with the misfit at the noise level, H
+    and A wrong.)"""
     unknowns = 2 * sol["nn"].size + 3 * len(model.acqs) + len(p)
     floor = 1e-300 + 1e-32 * float(model.z @ model.z)      # round-off: costs are equal
-    return rows * math.log(max(cost, floor) / rows) + unknowns * math.log(rows)
+    return bic(cost, model.z.size, unknowns, floor)
 
 
 def _chromosome_presence(sol, ratio=1e-6, noise=0.0):
@@ -171,31 +165,6 @@ def _every_chromosome_present(sol, ratio=1e-6, noise=0.0):
     every k chromosomes empty, or holding noise only, so the remaining gamma candidates
     need not be tried."""
     return bool(_chromosome_presence(sol, ratio, noise)[1].all())
-
-
-def _coarser_lattices(p, sol, coarse_length, k_max=6, gamma_max=4.0):
-    """Starts (ln q1, k ln gamma, theta) of every lattice that holds the fit's lattice
-    gamma as every k-th chromosome, k = 2..``k_max`` (gamma^k <= ``gamma_max``, the top
-    of the comb's search), through each of its first k chromosomes.
-
-    A fit on a sub-lattice gamma^(1/k) of the data's lattice reproduces the data as well
-    (to round-off, or down to the noise floor) with k - 1 of every k chromosomes empty;
-    a Genome forces its amplitudes onto the power law of its own lattice and puts waves
-    back into them (measured: a fit to 1e-11 whose genome misfits its windows by 94 %).
-    Which chromosomes are empty is not reliable near the window length (long waves of
-    neighbouring chromosomes nearly collinear: all present in an exact gamma^(1/4) fit of
-    one 48^2 window), so every (k, offset) is offered; the caller ranks them by the cost
-    of one linear solve."""
-    n0 = int(sol["nn"].min())
-    starts = []
-    for k in range(2, k_max + 1):
-        if k * p[1] > math.log(gamma_max):
-            break
-        for r in range(k):
-            log_q = p[0] + (n0 + r - 1) * p[1]
-            starts.append(np.concatenate([[label_q1(log_q, k * p[1], coarse_length),
-                                           k * p[1]], p[2:]]))
-    return starts
 
 
 def _noise_floor(model, variances):
@@ -347,15 +316,16 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
 
     def settle(out):
         """A fit within the tolerance with an empty chromosome may stand for a coarser
-        lattice (a sub-lattice fit): the best-scoring start of :func:`_coarser_lattices`
-        is fitted (not settled again: every k is offered at once, and the refit can
-        converge back to the finer lattice) and the lower BIC of the two is kept. (Poor
+        lattice (a sub-lattice fit): the best-scoring start of
+        :func:`~.lattice.coarser_lattices` is fitted (not settled again: every k is
+        offered at once, and the refit can converge back to the finer lattice) and the
+        lower BIC of the two is kept. (Poor
         fits are left alone: among them the BIC is a lottery, measured 1 seed in 100
         turned from right to wrong.)"""
         if out[0] > good or _every_chromosome_present(out[3], noise=noise_amplitude):
             return out
         trial = []
-        for start in _coarser_lattices(out[1], out[3], acqs[0].length):
+        for start in coarser_lattices(out[1], int(out[3]["nn"].min()), acqs[0].length):
             try:
                 sol = model.solve(start, model.ranges(start[0], start[1]))
             except np.linalg.LinAlgError:
