@@ -36,6 +36,13 @@ class ResolutionWarning(UserWarning):
     and what to change)."""
 
 
+class WindowStiffnessWarning(RuntimeWarning):
+    """The contact stiffness of a finite non-periodic window (a measured topography) is
+    mostly the bulk stiffness of the loaded window (a flat-punch property of its size)
+    in series with the rough interface, not a property of the roughness
+    (:func:`roughfe.bem.window.window_report`)."""
+
+
 def _number(value):
     """``value``, or a TypeError for text and bools, which ``float()`` would take ("2.3" in
     a study spec ran, under a key of its own, beside 2.3)."""

@@ -7,7 +7,11 @@ BEM or the FEM (:func:`roughfe.response.response`).
   per step with the keys :data:`roughfe.model.RECORD_KEYS` in SI units, followed by the
   optional numbers a method sets (FEM: ``delta_applied``, ``layer_compliance``), see
   :meth:`SweepResult.to_records`; ``derived`` holds the method, the sweep-level
-  dimensionless curves, the units and the references.
+  dimensionless curves, the units and the references, and for a non-periodic BEM sweep
+  (a measured window) the window's bulk compliance ``window_compliance`` C (m/Pa),
+  ``bulk_share`` C p/Delta and ``stiffness_compliance`` K C per step
+  (:func:`roughfe.bem.window.window_report`, which warns when K C > 0.5 at the largest
+  load: K is then mostly the window's flat-punch bulk stiffness).
 * ``fields.h5``: datasets ``pressure`` (Pa) and ``gap`` (m) of shape
   ``(frame, *grid)``, ``contact`` (bool) and ``delta`` (m) per frame, with the grid
   size/spacing as attributes (the "frame" layout of Tamaas/ContactMechanics dumps).
@@ -20,6 +24,7 @@ import numpy as np
 
 from ..writers import atomic_path, write_json
 from ..model import SweepResult
+from .window import window_report
 
 #: Units of the step records (dimensionless keys are absent).
 UNITS = {"delta": "m", "load": "N (surface) or N/m (profile)", "mean_pressure": "Pa",
@@ -29,8 +34,10 @@ UNITS = {"delta": "m", "load": "N (surface) or N/m (profile)", "mean_pressure": 
 
 
 def sweep_document(sweep: SweepResult, inputs: dict) -> dict:
-    """The JSON document of a sweep: inputs, per-step records and derived curves."""
-    return {
+    """The JSON document of a sweep: inputs, per-step records and derived curves (with
+    the window's bulk compliance when the sweep is a non-periodic BEM one)."""
+    window = window_report(sweep)
+    doc = {
         "inputs": dict(inputs),
         "steps": sweep.to_records(),
         "derived": {
@@ -44,6 +51,10 @@ def sweep_document(sweep: SweepResult, inputs: dict) -> dict:
             "references": list(sweep.results[0].references),
         },
     }
+    if window:
+        doc["derived"].update(window)
+        doc["derived"]["units"]["window_compliance"] = "m/Pa"
+    return doc
 
 
 def write_results_json(path, sweep: SweepResult, inputs: dict):

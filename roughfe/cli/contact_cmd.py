@@ -127,7 +127,8 @@ def _run(args) -> int:
                                             render_contact)
             plot_area_stiffness(doc["steps"], out / "contact_area_stiffness.png",
                                 title=f"{Path(args.surface).name}, E* = {material.E_star:.4g} Pa",
-                                rms_height=sweep.rms_height)
+                                rms_height=sweep.rms_height,
+                                window_compliance=doc["derived"].get("window_compliance"))
             if adhesive is not None:
                 from ..plotting.contact import plot_adhesion
                 plot_adhesion(doc["steps"], out / "adhesion_load_approach.png",
@@ -149,6 +150,14 @@ def _run(args) -> int:
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.4f} "
               f"{k} {s['mean_gap']:12.4e} {s['iterations']:5d}")
+    window = doc["derived"].get("window_compliance")
+    if window is not None:     # a measured (non-periodic) window: K includes its bulk
+        share = sorted({round(v, 2) for v in doc["derived"]["bulk_share"] if v is not None})
+        print(f"non-periodic window: bulk compliance C = {window:.4e} m/Pa (1/C = "
+              f"{1 / window:.4e} Pa/m); bulk deflection C p / Delta = "
+              + ("-" if not share else f"{share[0]:.2f}" if len(share) == 1 else
+                 f"{share[0]:.2f}..{share[-1]:.2f}")
+              + " (derived.window_compliance, bulk_share in results.json)")
     if adhesive is not None:
         pull = (f"pull-off force {adhesive.pull_off_force:.4e} "
                 f"({'detached' if adhesive.detached else 'NOT detached: a bound'})"
@@ -245,7 +254,8 @@ def section_contact(outdir: Path, context: dict) -> str:
     write_fields_h5(sub / "fields.h5", sweep)
     fig = plot_area_stiffness(doc["steps"], sub / "contact_area_stiffness.png",
                               title="RMD D = 2.3, m = 7: A(p), K(p), V*(d/sigma)",
-                              rms_height=sweep.rms_height)
+                              rms_height=sweep.rms_height,
+                              window_compliance=doc["derived"].get("window_compliance"))
     last = sweep.results[-1]
     render = render_contact(surface.heights, last, sub / "contact_render.png",
                             title="RMD D = 2.3, m = 7 at Delta = h_s")

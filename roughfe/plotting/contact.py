@@ -25,11 +25,13 @@ def _theory(steps, key):
     return np.array([np.nan if s.get(key) is None else s[key] for s in steps], float)
 
 
-def plot_area_stiffness(steps, path, title=None, rms_height=None):
+def plot_area_stiffness(steps, path, title=None, rms_height=None, window_compliance=None):
     """A*(p), K(p) (exact incremental and central finite differences) and the mean gap
     u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8). Records
     with ``persson_area_fraction`` / ``persson_mean_gap`` (:func:`roughfe.theory.beside`)
-    get Persson's curves drawn beside the BEM points.
+    get Persson's curves drawn beside the BEM points. With the ``window_compliance`` C
+    (m/Pa) of a non-periodic window, the K panel marks the window's bulk stiffness 1/C,
+    the ceiling K approaches whatever the roughness (:mod:`roughfe.bem.window`).
 
     Parameters
     ----------
@@ -39,6 +41,8 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None):
         PNG to write.
     rms_height : float, optional
         sigma (m) for the free-volume panel.
+    window_compliance : float, optional
+        C (m/Pa) of a non-periodic window (``results.json["derived"]``).
     """
     p = _column(steps, "mean_pressure") * MPA
     a = _column(steps, "area_fraction")
@@ -96,6 +100,9 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None):
         ok3 = ok & on & np.isfinite(kfd) & (kfd > 0)
         if ok3.any():
             ax2.loglog(p[ok3], kfd[ok3], "x" + ls, ms=5, label="finite differences" + tag)
+    if window_compliance and ax2.get_legend_handles_labels()[0]:
+        ax2.axhline(MPA * 1e-6 / window_compliance, color="0.4", ls="--", lw=1,
+                    label="window bulk 1/C (K is in series with it)")
     ax2.set_xlabel("mean pressure p (MPa)")
     ax2.set_ylabel("K = dp/dDelta (MPa/um)")
     ax2.set_title("contact stiffness K(p), Eq. 2.7")

@@ -8,6 +8,7 @@ import numpy as np
 from ...bem.batch import solve_batch
 from ...bem.batch_exact import batch_sweep, solve_batch_exact
 from ...bem.operators import influence_operator
+from ...bem.window import window_compliance  # noqa: F401 (re-export: its home is bem)
 from ...errors import InputError, NoConvergenceError
 from ...model import Loading, Material, central_differences
 from ...response import response
@@ -336,21 +337,6 @@ def target_surface(surface, settings: DatabaseSettings, *, detrend="plane",
                 f"use a database of finer spacing")
         surf = surf.resampled(points)
     return surf
-
-
-def window_compliance(surface, youngs_modulus, poisson=0.0) -> float:
-    """Mean surface displacement per unit uniform pressure over a non-periodic window
-    (m/Pa): ``C = mean(H 1)`` with the window's non-periodic BEM operator (Love's
-    rectangle kernel for a surface, the strip kernel for a profile), E* = E/(1 - nu^2).
-
-    It is the bulk compliance the ``"window"`` targets of :func:`surface_targets` add in
-    series with the rough interface; for a rectangle of area A_n it is ~0.9
-    sqrt(A_n)/E* (x3p-2: 5.6e-13 m/Pa at E* = 210 MPa, 0.90 sqrt(A_n)/E*).
-    """
-    mat = Material(youngs_modulus, poisson)
-    kernel = "love" if surface.ndim == 2 else "strip"
-    op = influence_operator(surface.shape, surface.size, mat.E_star, kernel)
-    return float(np.mean(op.apply(np.ones(surface.shape))))
 
 
 def thesis_targets(settings: DatabaseSettings, response=None, *, pbar2_fraction=0.53 / 1.6):
