@@ -121,7 +121,9 @@ def test_info_of_a_tiny_grid_has_no_numpy_warnings(tmp_path, capsys):
         warnings.simplefilter("error")
         assert main(["info", str(path), "--size", "1e-3"]) == 0
     out = capsys.readouterr()
-    assert "warning" not in out.err and "rms curvature" in out.out
+    # the one warning is roughfe's own: this 2 x 2 grid is 97 % tilt (--detrend plane)
+    other = [line for line in out.err.splitlines() if "--detrend mean keeps the tilt" not in line]
+    assert not any("warning" in line for line in other) and "rms curvature" in out.out
 
 
 def test_a_channel_without_height_unit_is_refused_by_name(topographies_dir, capsys):

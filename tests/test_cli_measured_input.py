@@ -1,0 +1,55 @@
+"""What the commands say about the measured surface they read: a tilt left by the default
+``--detrend mean``, filled undefined points, the channel of a multi-channel file."""
+import re
+
+import numpy as np
+import pytest
+
+from roughfe.cli import main
+from roughfe.surfaces import Surface
+from roughfe.surfaces.io import save_surface
+from roughfe.surfaces.spectral import spectral_surface
+from roughfe.surfaces.stats import rms_height
+
+
+def _tilted(tmp_path, slope, periodic=False, name="tilted.npz"):
+    rough = spectral_surface(32, 1e-4, 0.8, rms_height=1e-7, rng=5)
+    x = np.arange(32) * rough.spacing[0]
+    heights = rough.heights + slope * x[:, None]
+    surface = Surface(heights, rough.size, periodic=periodic)
+    return save_surface(surface, tmp_path / name), surface
+
+
+def test_detrend_mean_on_a_tilted_window_warns_with_both_rms_heights(tmp_path, capsys):
+    """plu-1 read with the default --detrend mean was a tilted plane without a word: rms
+    2.834 um with the mean removed, 18.3 nm with the plane removed (the plane is 99.996 %
+    of the variance); roughfe contact at 9.4 kPa gave A* 0.0069 instead of 0.037."""
+    path, surface = _tilted(tmp_path, 0.02)
+    assert main(["info", str(path)]) == 0
+    err = capsys.readouterr().err
+    assert err.count("warning: --detrend mean keeps the tilt") == 1 and "--detrend plane" in err
+    shown = [float(v) for v in re.findall(r"rms height ([\d.e+-]+) m with the mean removed, "
+                                          r"([\d.e+-]+) m with the plane removed", err)[0]]
+    assert shown[0] == pytest.approx(rms_height(surface), rel=1e-3)
+    assert shown[1] == pytest.approx(rms_height(surface.detrended("plane")), rel=1e-3)
+    share = float(re.search(r"carries ([\d.]+) %", err).group(1)) / 100
+    assert share == pytest.approx(1 - (shown[1] / shown[0]) ** 2, abs=1e-3) and share > 0.5
+    # the same file with the plane removed, and a tilt that is not most of the variance
+    assert main(["info", str(path), "--detrend", "plane"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    small, _ = _tilted(tmp_path, 1e-4, name="small.npz")
+    assert main(["info", str(small)]) == 0
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_a_periodic_surface_has_no_tilt_to_warn_of(tmp_path, capsys):
+    path, _ = _tilted(tmp_path, 0.02, periodic=True)
+    assert main(["info", str(path)]) == 0
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_contact_on_a_tilted_window_warns(tmp_path, capsys):
+    path, _ = _tilted(tmp_path, 0.02)
+    assert main(["contact", str(path), "--pressure", "1e5", "--no-figures", "-o",
+                 str(tmp_path / "out")]) == 0
+    assert capsys.readouterr().err.count("--detrend mean keeps the tilt") == 1
