@@ -53,3 +53,32 @@ def test_contact_on_a_tilted_window_warns(tmp_path, capsys):
     assert main(["contact", str(path), "--pressure", "1e5", "--no-figures", "-o",
                  str(tmp_path / "out")]) == 0
     assert capsys.readouterr().err.count("--detrend mean keeps the tilt") == 1
+
+
+def test_info_names_the_channel_read_and_the_filled_points(topographies_dir, capsys):
+    """`info` said neither which of di-1's two 'Height' channels it read nor that opd-1
+    had 116 undefined points filled (only --json's metadata did)."""
+    di = topographies_dir / "di-1.di"
+    assert main(["info", str(di), "--channel", "1", "--detrend", "plane"]) == 0
+    out = capsys.readouterr().out
+    assert "channel 1 'Height' (Retrace); the file has 4: 0 'Height' (Trace)" in out
+    assert main(["info", str(di), "--channel", "Height"]) == 2
+    err = capsys.readouterr().err
+    assert "2 channels are named 'Height'" in err and "1 'Height' (Retrace)" in err
+    assert main(["info", str(topographies_dir / "opd-1.opd")]) == 0
+    out = capsys.readouterr().out
+    assert "116 undefined points filled (harmonic interpolation)" in out
+    assert "channel 0 'Raw'" in out and "the file has" not in out
+
+
+def test_contact_and_leak_say_how_many_points_were_filled(tmp_path, capsys):
+    rough = spectral_surface(32, 1e-4, 0.8, rms_height=1e-7, rng=5)
+    filled = Surface(rough.heights, rough.size, periodic=True,
+                     metadata={"filled_points": 7})
+    path = save_surface(filled, tmp_path / "filled.npz")
+    assert main(["contact", str(path), "--pressure", "1e5", "--no-figures", "-o",
+                 str(tmp_path / "c")]) == 0
+    assert "7 undefined points filled (harmonic interpolation)" in capsys.readouterr().out
+    assert main(["leak", str(path), "--pressure", "1e6", "--no-figures", "-o",
+                 str(tmp_path / "l")]) == 0
+    assert "7 undefined points filled (harmonic interpolation)" in capsys.readouterr().out

@@ -106,10 +106,17 @@ def test_multichannel_choice(topographies_dir):
     path = topographies_dir / "di-1.di"
     first = load_surface(path)
     second = load_surface(path, channel=1)
-    by_name = load_surface(path, channel="Height")
+    by_index = load_surface(path, channel="0")
     assert second.metadata["channel"]["index"] == 1
-    np.testing.assert_array_equal(by_name.heights, first.heights)
+    np.testing.assert_array_equal(by_index.heights, first.heights)
     assert not np.array_equal(first.heights, second.heights)
+    # trace (rms 9.95 nm) and retrace (114 nm) are both 'Height': the name took the
+    # first without a word until round 2, session 24; now it is refused with the list
+    with pytest.raises(InputError, match=r"2 channels are named 'Height'.*give the channel "
+                                         r"index.*0 'Height' \(Trace\), 1 'Height' "
+                                         r"\(Retrace\), 2 'Phase'"):
+        load_surface(path, channel="Height")
+    assert first.metadata["channels"][:2] == ["0 'Height' (Trace)", "1 'Height' (Retrace)"]
     with pytest.raises(InputError, match="out of range"):
         load_surface(path, channel=9)
     with pytest.raises(InputError, match="no channel named"):

@@ -25,7 +25,7 @@ from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_o
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, check_small_strain, contact_physics_from_args,
                       fmt_or_dash, material_from_args, output_folder_of, positive_float,
-                      positive_int, surface_from_args, unit_fraction)
+                      positive_int, print_surface_notes, surface_from_args, unit_fraction)
 
 DEFAULT_STEPS = Loading.DEFAULT_STEPS
 #: --coarse-correction -> solve_contact(coarse_correction=)
@@ -143,6 +143,7 @@ def _run(args) -> int:
                 plot_profile_state(surface.heights, last, out / "contact_profile.png",
                                    title=Path(args.surface).name)
         write_json(out / "results.json", doc)  # last: the run is complete
+    print_surface_notes(args, surface)
     print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} {'K (Pa/m)':>12s} {'gap (m)':>12s} "
           f"{'nit':>5s}")
     for s, k in zip(sweep.to_records(), sweep.stiffness):

@@ -26,8 +26,8 @@ from .options import (add_contact_physics_options, add_detrend_option, add_mater
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, check_small_strain, contact_physics_from_args,
                       material_from_args, nonnegative_int, output_folder_of, positive_float,
-                      fmt_or_dash, log_of, positive_int, show_progress,
-                      surface_from_args)
+                      fmt_or_dash, log_of, positive_int, print_surface_notes,
+                      show_progress, surface_from_args)
 
 
 def _add_fluid_material(p, fsi=True):
@@ -128,6 +128,7 @@ def _leak(args) -> int:
     material = material_from_args(args)
     with output_folder_of(args, "leak") as out:
         sweep, steps, written = _leak_run(args, surface, material, out)
+    print_surface_notes(args, surface)
     if args.fsi:
         print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>7} {'fluid':>6} {'trap':>6} "
               f"{'iter':>5} "

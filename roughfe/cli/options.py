@@ -131,7 +131,9 @@ def add_surface_options(parser, positional: bool = True) -> None:
         help="treat the heights as non-periodic")
     group.add_argument(
         "--channel", default=None,
-        help="channel index or name of a multi-channel instrument file (default: the first)")
+        help="channel index or name of a multi-channel instrument file (default: the "
+             "first); a name that several channels share is refused (give the index; "
+             "`roughfe info` names the channel read and lists the file's channels)")
 
 
 def surface_from_args(args):
@@ -151,6 +153,33 @@ def surface_from_args(args):
     if detrend == "mean" and not surface.periodic:
         _warn_tilt(args, surface)
     return surface if detrend == "none" else surface.detrended(detrend)
+
+
+def surface_notes(surface, channel: bool = False) -> list:
+    """Console lines on what an instrument file gave: with ``channel`` the channel read
+    (and, of a multi-channel file, all of its channels), and the undefined points that
+    the reader filled (``metadata["filled_points"]``; opd-1: 116), which only
+    ``--json``/results.json said until round 2, session 24."""
+    meta = surface.metadata
+    lines = []
+    read = meta.get("channel")
+    if channel and isinstance(read, dict):
+        every = list(meta.get("channels") or [])
+        label = next((c for c in every if c.split(" ", 1)[0] == str(read["index"])),
+                     f"{read['index']} {read['name']!r}")
+        lines.append(f"channel {label}" + (f"; the file has {len(every)}: "
+                                           f"{', '.join(every)} (--channel INDEX)"
+                                           if len(every) > 1 else ""))
+    if meta.get("filled_points"):
+        lines.append(f"{int(meta['filled_points'])} undefined points filled (harmonic "
+                     f"interpolation)")
+    return lines
+
+
+def print_surface_notes(args, surface, channel: bool = False) -> None:
+    """Print :func:`surface_notes` on stdout, each as ``SURFACE: note``."""
+    for note in surface_notes(surface, channel):
+        print(f"{args.surface}: {note}")
 
 
 def _warn_tilt(args, surface) -> None:

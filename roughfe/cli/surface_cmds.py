@@ -6,7 +6,7 @@ import numpy as np
 from ..errors import check_memory
 from .options import (add_detrend_option, add_output_file, add_run_options,
                       add_surface_options, nonnegative_int, output_file_of, positive_float,
-                      positive_int, surface_from_args)
+                      positive_int, print_surface_notes, surface_from_args)
 
 # (key, label, unit, scale) rows of the info table
 _TABLE = (
@@ -62,6 +62,7 @@ def _info(args) -> int:
                             "metadata": dict(surface.metadata)}))
     else:
         print(f"{args.surface}: {surface!r}")
+        print_surface_notes(args, surface, channel=True)
         print(format_table(stats))
     return 0
 

@@ -22,7 +22,9 @@ False.
 
 Instrument files are converted to SI: lengths and heights are rescaled from the unit
 stored in the file to metres. Missing (undefined) points are filled by SurfaceTopography's
-harmonic interpolation and their number recorded in ``metadata["filled_points"]``.
+harmonic interpolation and their number recorded in ``metadata["filled_points"]``; the
+channel read in ``metadata["channel"]`` and the file's channels in
+``metadata["channels"]``.
 """
 from __future__ import annotations
 
@@ -193,20 +195,37 @@ def _read_text(path, size, periodic, channel):
 
 
 # -- SurfaceTopography (instrument files) ---------------------------------------------
+def channel_label(channel) -> str:
+    """``0 'Height'`` for a SurfaceTopography channel, with the scan direction where the
+    file gives one (``0 'Height' (Trace)``: a .di file holds trace and retrace heights
+    under one name)."""
+    raw = (channel.info or {}).get("raw_metadata")
+    direction = raw.get("line direction") if isinstance(raw, dict) else None
+    return f"{channel.index} {channel.name!r}" + (f" ({direction})" if direction else "")
+
+
 def _choose_channel(reader, channel, path):
     channels = reader.channels
+    listed = ", ".join(channel_label(c) for c in channels)
     if channel is None:
         return reader.default_channel
     if isinstance(channel, str) and not channel.lstrip("-").isdigit():
         named = [c for c in channels if c.name == channel]
         if not named:
-            raise InputError(f"{path}: no channel named {channel!r}; channels are "
-                             f"{[c.name for c in channels]}")
+            raise InputError(f"{path}: no channel named {channel!r}; channels (index name) "
+                             f"are {listed}")
+        if len(named) > 1:
+            # di-1: trace (rms 9.95 nm) and retrace (114 nm) are both 'Height'; the
+            # name took the first without a word until round 2, session 24
+            raise InputError(f"{path}: {len(named)} channels are named {channel!r} "
+                             f"({', '.join(channel_label(c) for c in named)}): give the "
+                             f"channel index (channel=N, --channel N); channels (index "
+                             f"name) are {listed}")
         return named[0]
     index = int(channel)
     if not 0 <= index < len(channels):
         raise InputError(f"{path}: channel index {index} out of range 0..{len(channels) - 1} "
-                         f"(channels {[c.name for c in channels]})")
+                         f"(channels (index name) {listed})")
     return channels[index]
 
 
@@ -298,6 +317,7 @@ def _instrument_surface(reader, path, size, periodic, channel):
     metadata = {
         "source": str(path), "reader": type(reader).__name__,
         "channel": {"index": int(ch.index), "name": str(ch.name)},
+        "channels": [channel_label(c) for c in reader.channels],
         "unit_in_file": unit, "filled_points": filled,
         "instrument": json_safe(info.get("instrument", {})),
     }
@@ -337,7 +357,10 @@ def load_surface(path, size=None, periodic=None, channel=None) -> Surface:
         Overrides the periodic flag (default: the file's flag, False for plain matrices).
     channel : int or str, optional
         Channel index or name of a multi-channel instrument file (default: the file's
-        default channel, usually the first height channel).
+        default channel, usually the first height channel). A name that several channels
+        share (di-1: trace and retrace 'Height') is refused: give the index. The channel
+        read is ``metadata["channel"]``, every channel of the file (index, name and the
+        scan direction where the file gives one) ``metadata["channels"]``.
 
     Returns
     -------
