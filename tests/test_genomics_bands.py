@@ -221,6 +221,18 @@ def test_genome_chromosomes_command(tmp_path, capsys):
     assert data["q_bounds"].size == data["chromosomes"].shape[0] + 1
     mech = json.loads((out / "mechanics.json").read_text())
     assert mech["td"][-1] == mech["complete"] == mech["bu"][-1]
+    # units in the files (none until round 2, session 24), as leak's fields/step_NNN.npz
+    units = json.loads(str(data["units"]))
+    assert set(units) == set(data.files) - {"units"}
+    assert units["chromosomes"] == units["surface"] == "m" and units["q_bounds"] == "rad/m"
+    assert mech["units"]["E"] == "Pa" and mech["units"]["length"] == "m"
+    assert mech["units"]["pressure"].startswith("Pa ") and mech["units"]["stiffness"].startswith(
+        "Pa/m")
+    numbers = {k for k, v in mech.items() if isinstance(v, (int, float, list, dict))
+               and not isinstance(v, bool)} - {"complete", "chromosomes", "td", "bu",
+                                               "failed_chromosomes", "units"}
+    assert numbers <= set(mech["units"])
+    assert set(mech["complete"]) <= set(mech["units"])
     mm = json.loads((out / "macro_micro.json").read_text())
     assert sorted(mm["macro"] + mm["micro"]) == mech["indices"]
     for fig in ("td", "bu", "chromosomes", "energy", "curves", "correlations"):

@@ -40,6 +40,30 @@ def test_lattice_and_chromosomes_are_recovered_exactly(table1):
     np.testing.assert_allclose(res.zd_fit, res.zd, atol=1e-9 * np.abs(res.zd).max())
 
 
+def _numbers_without_unit(report):
+    """Keys of ``report`` (and of its genes) holding numbers that ``units`` does not name."""
+    def numeric(v):
+        return (isinstance(v, (int, float)) and not isinstance(v, bool)) or (
+            isinstance(v, list) and any(numeric(x) for x in v))
+    flat = {**report, **(report.get("genes") or {})}
+    return sorted(k for k, v in flat.items()
+                  if numeric(v) and k not in report["units"] and k != "seed")
+
+
+def test_reports_say_the_unit_of_every_number(table1):
+    """report.json of `genome sequence` and the `genome natural` report (lengths, offsets,
+    zd_rms in m) carried no units until round 2, session 24."""
+    from roughfe.genomics.natural import NaturalResult
+    _, acq, res = table1
+    report = json.loads(json.dumps(res.report()))
+    assert _numbers_without_unit(report) == []
+    assert report["units"]["lengths"] == "m" and report["units"]["offsets"] == "m"
+    assert report["units"]["zd_rms"] == "m" and report["units"]["A"] == "m^(1-H)"
+    natural = NaturalResult(tuple(acq), res, {}, res.success, res.message, res.nit).report()
+    assert natural["sequencing"]["units"] == report["units"]
+    assert set(natural["units"]) >= {"measured_points", "curve_differences"}
+
+
 def test_A_and_H_are_the_ml_estimate_of_the_true_chromosomes(table1):
     g, _, res = table1
     k, _ = reduced_chromosome(g, res.n)

@@ -6,6 +6,7 @@ its outputs (atomically) and prints a summary; figures come from
 """
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -17,6 +18,12 @@ from .options import (add_detrend_option, add_material_options, add_output_file,
 
 from ..genomics.genome import SCALES
 from ..genomics.natural import DEFAULT_FRACTIONS
+
+#: units of the arrays of chromosomes.npz (``genome chromosomes``), stored in the file as
+#: ``units`` (a JSON object, as `leak`'s fields/step_NNN.npz); "1": dimensionless
+CHROMOSOMES_UNITS = {"chromosomes": "m", "surface": "m", "q_bounds": "rad/m",
+                     "indices": "1 (chromosome numbers n)", "energy": "m^2 (mean square)",
+                     "size": "m", "gamma": "1", "transform": "", "detrend": ""}
 
 
 def _print_genome(g, prefix="  "):
@@ -259,7 +266,8 @@ def _chromosomes(args) -> int:
                                 surface=bands.surface.heights, q_bounds=bands.q_bounds,
                                 indices=bands.indices, energy=bands.energy,
                                 size=np.asarray(bands.surface.size), gamma=bands.gamma,
-                                transform=bands.transform, detrend=bands.detrend)
+                                transform=bands.transform, detrend=bands.detrend,
+                                units=np.array(json.dumps(CHROMOSOMES_UNITS)))
         if mech is not None:
             write_json(out / "mechanics.json", mech.to_dict())
             write_json(out / "macro_micro.json", {

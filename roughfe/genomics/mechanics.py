@@ -77,6 +77,16 @@ def curve_difference(reference: ResponseCurve, other: ResponseCurve) -> dict:
     return out
 
 
+#: Units of the numbers of :meth:`ChromosomeMechanics.to_dict` (mechanics.json); the
+#: curves (``complete``, ``chromosomes``, ``td``, ``bu``) hold ``pressure``, ``stiffness``
+#: and ``area_fraction``; "1": dimensionless
+MECHANICS_UNITS = {"length": "m", "E": "Pa", "nu": "1", "indices": "1 (chromosome numbers n)",
+                   "pressure": "Pa (mean contact pressure)",
+                   "stiffness": "Pa/m (K = dp/dDelta)", "area_fraction": "1 (A*)",
+                   "c_chromosome": "1 (correlation c_n)", "c_td": "1 (correlation c_n)",
+                   "c_bu": "1 (correlation c_n)", "nit": "1 (BEM sweeps)", "elapsed_s": "s"}
+
+
 @dataclass(frozen=True, eq=False)
 class ChromosomeMechanics:
     """Contact curves of a realisation, its chromosomes and TD/BU partial sums.
@@ -132,7 +142,9 @@ class ChromosomeMechanics:
     def to_dict(self) -> dict:
         """JSON-safe curves and coefficients; the material under the one vocabulary of the
         package, ``E`` (Pa) and ``nu`` (-) (files before issue 15 wrote ``youngs_modulus``
-        and ``poisson``: :meth:`from_dict` reads both)."""
+        and ``poisson``: :meth:`from_dict` reads both); ``units`` names the unit of every
+        number (:data:`MECHANICS_UNITS`; the curves' keys ``pressure``, ``stiffness``,
+        ``area_fraction``)."""
         def curves(cs):
             return [None if c is None else c.to_dict() for c in cs]
 
@@ -143,7 +155,8 @@ class ChromosomeMechanics:
                 "c_chromosome": to_jsonable(self.c_chromosome), "c_td": to_jsonable(self.c_td),
                 "c_bu": to_jsonable(self.c_bu), "success": self.success, "message": self.message,
                 "nit": self.nit, "elapsed_s": self.elapsed,
-                "failed_chromosomes": [int(n) for n in self.failed_chromosomes]}
+                "failed_chromosomes": [int(n) for n in self.failed_chromosomes],
+                "units": dict(MECHANICS_UNITS)}
 
     @classmethod
     def from_dict(cls, d) -> "ChromosomeMechanics":

@@ -129,9 +129,15 @@ class NaturalResult:
         freeze_containers(self)
 
     def report(self) -> dict:
+        """JSON-safe report (*_report.json of `genome natural`): the sequencing report
+        (with its own ``units``), the measured samples per acquisition and the relative
+        A(p), K(p) differences per kernel; ``units`` names the units of this level."""
         out = {"sequencing": self.sequencing.report(),
                "measured_points": [a.metadata.get("measured_points") for a in self.acquisitions],
-               "curve_differences": {k: v["difference"] for k, v in self.curves.items()}}
+               "curve_differences": {k: v["difference"] for k, v in self.curves.items()},
+               "units": {"measured_points": "1 (samples)",
+                         "curve_differences": "1 (relative difference, A and K)",
+                         "sequencing": "see sequencing.units"}}
         return out
 
 

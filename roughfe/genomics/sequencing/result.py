@@ -11,6 +11,17 @@ from ...frozen import freeze_containers
 from ..genome import Genome
 
 
+#: Units of :meth:`SequencingResult.report` (report.json of `genome sequence`, the
+#: ``sequencing`` part of `genome natural`'s *_report.json); "1": dimensionless
+REPORT_UNITS = {"A": "m^(1-H)", "H": "1", "gamma": "1", "lambda1": "m",
+                "M": "1 (number of ridges)", "lengths": "m",
+                "ranges": "1 (chromosome numbers n_s, n_f)",
+                "rms_errors": "1 (relative: rms(Z - Z_seq) / rms(Z))", "offsets": "m",
+                "zd_rms": "m", "zd_rms_error": "1 (relative)", "gamma_psd": "1",
+                "H_psd": "1", "A0_variance": "m^(1-H)", "M_loglik": "1 (log-likelihood)",
+                "nit": "1 (residual evaluations)", "elapsed_s": "s"}
+
+
 @dataclass(frozen=True, eq=False)
 class SequencingResult:
     """Sequenced genome and its quality report (scipy OptimizeResult-like).
@@ -89,7 +100,8 @@ class SequencingResult:
         freeze_containers(self)
 
     def report(self) -> dict:
-        """JSON-safe summary (genes, rms errors, ranges, diagnostics)."""
+        """JSON-safe summary (genes, rms errors, ranges, diagnostics), with ``units`` (the
+        unit of every number, :data:`REPORT_UNITS`)."""
         g = self.genome
         return {"success": bool(self.success), "message": self.message, "nit": int(self.nit),
                 "genes": {"A": g.A, "H": g.H, "gamma": g.gamma, "lambda1": g.lambda1, "M": g.M},
@@ -101,4 +113,4 @@ class SequencingResult:
                                  if self.zd.size else None),
                 "gamma_psd": self.gamma_psd, "H_psd": self.H_psd, "A0_variance": self.A0,
                 "M_loglik": to_jsonable(self.M_loglik),
-                "seed": self.seed, "elapsed_s": self.elapsed}
+                "seed": self.seed, "elapsed_s": self.elapsed, "units": dict(REPORT_UNITS)}

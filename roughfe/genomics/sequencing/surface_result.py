@@ -16,6 +16,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..genome import Genome, surface_heights
+from .result import REPORT_UNITS
 
 
 def _wave_gram(gram, n_waves):
@@ -153,20 +154,27 @@ class SurfaceSequencingResult:
     fit_rms_errors: Optional[np.ndarray] = None
 
     def report(self) -> dict:
+        """JSON-safe summary (report.json of `genome sequence` on surfaces), with
+        ``units`` for the keys it holds."""
         g = self.genome
         genes = None if g is None else {
             "A": g.A, "H": g.H, "gamma": g.gamma, "lambda1": g.lambda1, "M": g.M,
             "angles_deg": np.degrees(g.angles).tolist(), "anisotropy": g.anisotropy.tolist(),
             "n_first": g.n_first, "n_last": g.n_last}
-        return {"success": bool(self.success), "message": self.message, "nit": int(self.nit),
-                "genes": genes, "lengths": self.lengths.tolist(),
-                "ranges": [list(r) for r in self.ranges],
-                "rms_errors": [float(e) for e in self.rms_errors],
-                "signal_rms_m": (None if self.signal_rms is None
-                                 else [float(v) for v in self.signal_rms]),
-                "fit_rms_errors": (None if self.fit_rms_errors is None
-                                   else [float(e) for e in self.fit_rms_errors]),
-                "elapsed_s": self.elapsed}
+        out = {"success": bool(self.success), "message": self.message, "nit": int(self.nit),
+               "genes": genes, "lengths": self.lengths.tolist(),
+               "ranges": [list(r) for r in self.ranges],
+               "rms_errors": [float(e) for e in self.rms_errors],
+               "signal_rms_m": (None if self.signal_rms is None
+                                else [float(v) for v in self.signal_rms]),
+               "fit_rms_errors": (None if self.fit_rms_errors is None
+                                  else [float(e) for e in self.fit_rms_errors]),
+               "elapsed_s": self.elapsed}
+        units = {**REPORT_UNITS, "angles_deg": "deg", "anisotropy": "1",
+                 "n_first": "1 (chromosome number)", "n_last": "1 (chromosome number)",
+                 "signal_rms_m": "m", "fit_rms_errors": "1 (relative)"}
+        out["units"] = {k: u for k, u in units.items() if k in out or k in (genes or {})}
+        return out
 
 
 def failure(message, acqs, peaks, t0):
