@@ -276,8 +276,12 @@ def test_collect_waits_for_no_run(tmp_path):
 
 
 def test_demo_contact_results_carry_persson_like_roughfe_contact(tmp_path):
+    import warnings
+
     from roughfe.cli.contact_cmd import section_contact
-    text = section_contact(tmp_path, {})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        text = section_contact(tmp_path, {})
     doc = json.loads((tmp_path / "contact" / "results.json").read_text())
     assert {"shape", "size", "periodic"} <= set(doc["inputs"]) and "persson" in doc["derived"]
     steps = doc["steps"]
@@ -299,6 +303,11 @@ def test_demo_contact_results_carry_persson_like_roughfe_contact(tmp_path):
     assert erf(np.sqrt(2) * p / (e_star * shown[0])) == pytest.approx(a_persson, abs=1e-4)
     kappa = float(re.search(r"A\* / \(p/\(E\* gbar\)\) = (\d+\.\d+)", text).group(1))
     assert kappa == pytest.approx(a * e_star * shown[1] / p, abs=0.01)
+    # the page says what K of this non-periodic window is, with the numbers of its file
+    # (the contact command warns; the demo page explains instead)
+    kc = float(re.search(r"K C = (\d+\.\d+) at the largest load", text).group(1))
+    assert kc == pytest.approx(doc["derived"]["stiffness_compliance"][-1], abs=0.01)
+    assert kc > 0.5
 
 
 def test_a_mistake_in_a_rerun_keeps_the_finished_output(tmp_path, capsys):
