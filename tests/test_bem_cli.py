@@ -229,10 +229,7 @@ def test_cli_prints_the_library_s_warnings_as_one_line(tmp_path, capsys):
     # library's ResolutionWarning reaches the user as "roughfe contact: warning: ...",
     # not as a Python file:line with a source line
     from roughfe.surfaces.io import save_surface
-    from roughfe.surfaces.spectral import spectral_surface
-    s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=4 * np.pi / 1e-5,
-                         q_short=16 * np.pi / 1e-5, rng=3)
-    path = save_surface(s, tmp_path / "periodic.npz")
+    path = save_surface(_narrow_band_cell(), tmp_path / "periodic.npz")
     assert main(["contact", str(path), "--E", "1e6", "--nu", "0.5", "--adhesion", "exp",
                  "--work-of-adhesion", "0.02", "--range", "2e-9", "--steps", "1",
                  "--no-figures", "-o", str(tmp_path / "adh")]) == 0
@@ -249,16 +246,20 @@ def test_cli_prints_the_library_s_warnings_as_one_line(tmp_path, capsys):
     assert not res["resolved"] and res["process_zone_cells"] == pytest.approx(zone * 32 / 1e-5)
 
 
+def _narrow_band_cell():
+    """A narrow-band periodic cell: 32^2, L = 10 um, H = 0.8, 10 nm rms, q_s / q_r = 4."""
+    from roughfe.surfaces.spectral import spectral_surface
+    return spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=4 * np.pi / 1e-5,
+                            q_short=16 * np.pi / 1e-5, rng=3)
+
+
 def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path, capsys):
     # the default approaches of --adhesion on a periodic surface stop short of full
     # contact (max h - mean h), where the adhesive state is not defined by the approach
     # and the solver refuses it: until round 2 session 13 the last default step did
     # (a weak law whose process zone, 10 um, spans 34 grid spacings: resolved)
     from roughfe.surfaces.io import save_surface
-    from roughfe.surfaces.spectral import spectral_surface
-    s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=4 * np.pi / 1e-5,
-                         q_short=16 * np.pi / 1e-5, rng=3)
-    path = save_surface(s, tmp_path / "periodic.npz")
+    path = save_surface(_narrow_band_cell(), tmp_path / "periodic.npz")
     out = tmp_path / "adh"
     assert main(["contact", str(path), "--E", "1e6", "--nu", "0.5", "--adhesion", "exp",
                  "--work-of-adhesion", "1e-3", "--range", "1e-7", "--steps", "3",
@@ -278,10 +279,7 @@ def _narrow_band_adhesive_run(tmp_path, capsys):
     """A narrow-band periodic cell (32^2, H = 0.8, 10 nm rms, q_s / q_r = 4) under a
     resolved Maugis-Dugdale law (w = 4.52e-5 J/m^2, range 10 nm: process zone 7.4 cells)
     loaded in 4 steps: the results.json and the screen."""
-    from roughfe.surfaces.spectral import spectral_surface
-    s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=4 * np.pi / 1e-5,
-                         q_short=16 * np.pi / 1e-5, rng=3)
-    path = save_surface(s, tmp_path / "narrow.npz")
+    path = save_surface(_narrow_band_cell(), tmp_path / "narrow.npz")
     out = tmp_path / "adh"
     assert main(["contact", str(path), "--E", "1e6", "--nu", "0.5", "--adhesion", "md",
                  "--work-of-adhesion", "4.52e-5", "--range", "1e-8", "--steps", "4",
