@@ -293,11 +293,7 @@ class ContactResult(Frozen):
     mean_gap : float
         Mean of the gap over the nominal area (m).
     mean_plane_separation : float
-        d (m), the separation of the rough surface's mean plane from the (deformed)
-        flat: max h - mean h - Delta on a periodic surface (zero mean displacement; = the
-        mean gap, Betti), max h - mean h - Delta + mean(u) on a non-periodic BEM window
-        (= the mean gap; the undeformed flat's separation would include the window's
-        mean bulk deflection, :func:`roughfe.bem.window.mean_plane_separation`).
+        d = max h - mean h - Delta (m).
     free_volume : float
         V = gap integrated over the nominal area (Eq. 2.8): m^3, or m^2 per unit depth
         for profiles (= mean_gap * A_n).

@@ -74,7 +74,6 @@ from ..model import ContactResult, Loading, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
-from .window import mean_plane_separation
 from .adhesive_cg import adhesive_pcg
 from .adhesive_energy import AdhesiveEnergy
 from .adhesive_rules import check_adhesive_run
@@ -294,7 +293,7 @@ def _adhesive_result(surface, material, op, law, energy, x, delta, resid, tol, n
         pressure=p, displacement=disp, gap=g, contact=contact, delta=delta,
         load=pm * surface.nominal_area, mean_pressure=pm, area_fraction=nc / n,
         contact_area=nc * surface.cell_area, n_contact=nc, mean_gap=mean_gap,
-        mean_plane_separation=mean_plane_separation(h, delta, disp, op.periodic),
+        mean_plane_separation=float(h.max() - h.mean() - delta),
         free_volume=float(g.sum()) * surface.cell_area,
         free_volume_star=mean_gap / sigma if sigma > 0 else float("nan"),
         stiffness=float("nan"),

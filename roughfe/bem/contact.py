@@ -8,12 +8,9 @@ u = H p (m) of the half-space surface points away from the rough surface; the ga
 
     g = u + max(h) - h - Delta >= 0,      p g = 0.
 
-The mean plane separation d is the distance between the mean plane of the rough surface
-and the (deformed) flat, as in Greenwood-Williamson and Paggi & He 2015:
-max(h) - mean(h) - Delta with the periodic kernel (mean(u) = 0, so d equals the mean
-gap), max(h) - mean(h) - Delta + mean(u) on a non-periodic window, whose mean bulk
-deflection the undeformed flat's separation would include
-(:func:`roughfe.bem.window.mean_plane_separation`).
+The mean plane separation is d = max(h) - mean(h) - Delta (the distance between the
+undeformed flat and the mean plane of the rough surface, as in Greenwood-Williamson
+and Paggi & He 2015); with the periodic kernel mean(u) = 0, so d equals the mean gap.
 """
 from __future__ import annotations
 
@@ -30,20 +27,24 @@ from ..errors import InputError, NoConvergenceError, check_instance, check_int
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
-from .operators import WORKERS, InfluenceOperator, _irfftn_owned, influence_operator
+from .operators import (WORKERS, InfluenceOperator, _irfftn_owned, check_kernel_name,
+                        influence_operator)
 from .approach import MAX_START_AREA, approach_by_load, approach_start
 from .periodic import periodic_bounded_displacement, periodic_gap_control
 from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
 from .contact_checks import (_check_coarse_correction, _check_hardness, _check_surface,
-                             _check_target, _check_tol, _choose_kernel, _choose_solver)
-from .contact_checks import DENSE_MAX_POINTS, SOLVERS, check_solver_name  # noqa: F401
-from .window import mean_plane_separation
+                             _check_target, _check_tol)
 from .deflation import BlockDeflation
 from .padded_deflation import PaddedBlockDeflation
 from .pk import polonsky_keer
 from .solvers import SolverOutput, dense_solve
 from .stiffness import exact_stiffness
 
+SOLVERS = ("auto", "dense", "nnls", "pk")
+#: largest number of grid points solved with the dense solvers by ``solver="auto"``
+#: (measured: a 20-step sweep of a 512-point profile takes the same time with both, at
+#: 1024 points pk is 3x faster, at 2048 15x)
+DENSE_MAX_POINTS = 512
 #: a contact point with p within max(YIELD_RTOL, min(100 tol, YIELD_BAND_MAX)) of the
 #: hardness is at yield (no stiffness): pressures are exact to ~1e-8 of max p at tol
 #: 1e-10, and an elastic reload to the previous peak load comes out just below H_p. The
@@ -113,6 +114,46 @@ def _dense(op: InfluenceOperator) -> np.ndarray:
     H = op.dense()
     _read_only(H)
     return H
+
+
+def check_solver_name(solver: str) -> str:
+    """Return ``solver`` or raise :class:`InputError` unless it is one of :data:`SOLVERS`."""
+    if solver not in SOLVERS:
+        raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    return solver
+
+
+def _choose_kernel(surface: Surface, kernel: str) -> str:
+    if check_kernel_name(kernel) == "auto":
+        if surface.periodic:
+            return "spectral"
+        return "strip" if surface.ndim == 1 else "love"
+    if kernel == "spectral" and not surface.periodic:
+        raise InputError("kernel 'spectral' is periodic and needs a periodic surface "
+                         "(Surface(..., periodic=True)); use 'strip'/'love' otherwise")
+    return kernel
+
+
+def _choose_solver(n_points: int, op: InfluenceOperator, solver: str,
+                   bounded: bool = False) -> str:
+    if check_solver_name(solver) == "auto":
+        if bounded:   # the dense bounded path is BVLS, which needs a definite operator
+            return "nnls" if n_points <= DENSE_MAX_POINTS and not op.periodic else "pk"
+        return "dense" if n_points <= DENSE_MAX_POINTS else "pk"
+    if bounded and solver == "dense":
+        raise InputError("solver 'dense' (block principal pivoting) has no hardness bound; "
+                         "use solver='pk', or solver='nnls' (bounded least squares) on a "
+                         "non-periodic kernel")
+    if solver in ("dense", "nnls") and n_points > 8192:
+        raise InputError(f"solver {solver!r} would build a dense {n_points} x {n_points} "
+                         f"matrix ({8 * n_points ** 2 / 1e9:.1f} GB); use solver='pk' above "
+                         f"8192 points")
+    if solver == "nnls" and op.periodic:
+        raise InputError("solver 'nnls' (Cholesky + Lawson-Hanson) needs a positive definite "
+                         "operator: not the periodic one (its mean mode is free); use "
+                         + ("solver='pk' (with a hardness the one solver of a periodic "
+                            "surface)" if bounded else "solver='dense' or solver='pk'"))
+    return solver
 
 
 #: elastic surface solves (load-controlled, or non-periodic) whose FFT grid has lo^2 to
@@ -427,7 +468,7 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
         pressure=p, displacement=u, gap=gap, contact=contact, delta=float(d),
         load=pm * A, mean_pressure=pm, area_fraction=nc / n,
         contact_area=nc * surface.cell_area, n_contact=nc, mean_gap=mean_gap,
-        mean_plane_separation=mean_plane_separation(h, d, u, op.periodic, plastic),
+        mean_plane_separation=float(h.max() - h.mean() - d),
         free_volume=float(gap[gap > 0].sum()) * surface.cell_area,
         free_volume_star=mean_gap / sigma, stiffness=K,
         message=("full contact" if nc == n else "converged") + f" ({out.solver})",

@@ -1,5 +1,5 @@
 """Input checks of :func:`roughfe.bem.solve_contact`: what was wrong, which value, what is
-allowed (InputError), and its choice of kernel and solver for ``"auto"``."""
+allowed (InputError)."""
 from __future__ import annotations
 
 import numpy as np
@@ -8,13 +8,6 @@ from ..errors import InputError, check_finite_positive, check_in_open_interval, 
 from ..model import _check_delta, _check_pressure
 from ..surfaces.surface import Surface
 from .coarse_start import COARSE_START_MIN
-from .operators import check_kernel_name
-
-SOLVERS = ("auto", "dense", "nnls", "pk")
-#: largest number of grid points solved with the dense solvers by ``solver="auto"``
-#: (measured: a 20-step sweep of a 512-point profile takes the same time with both, at
-#: 1024 points pk is 3x faster, at 2048 15x)
-DENSE_MAX_POINTS = 512
 
 #: the smallest relative KKT residual a solve may be asked for: 100 float64 epsilons. The
 #: residual of u = H p in double precision stops near 2e-15 (measured: 4.0e-15 at 64^2,
@@ -96,43 +89,3 @@ def _check_coarse_correction(value, op, solver, mean_pressure, hardness, two_lev
         raise InputError(f"coarse_correction=True (the two-level correction of the "
                          f"Polonsky-Keer CG) needs {why}")
     return True
-
-
-def check_solver_name(solver: str) -> str:
-    """Return ``solver`` or raise :class:`InputError` unless it is one of :data:`SOLVERS`."""
-    if solver not in SOLVERS:
-        raise InputError(f"solver must be one of {SOLVERS}, got {solver!r}")
-    return solver
-
-
-def _choose_kernel(surface: Surface, kernel: str) -> str:
-    if check_kernel_name(kernel) == "auto":
-        if surface.periodic:
-            return "spectral"
-        return "strip" if surface.ndim == 1 else "love"
-    if kernel == "spectral" and not surface.periodic:
-        raise InputError("kernel 'spectral' is periodic and needs a periodic surface "
-                         "(Surface(..., periodic=True)); use 'strip'/'love' otherwise")
-    return kernel
-
-
-def _choose_solver(n_points: int, op: InfluenceOperator, solver: str,
-                   bounded: bool = False) -> str:
-    if check_solver_name(solver) == "auto":
-        if bounded:   # the dense bounded path is BVLS, which needs a definite operator
-            return "nnls" if n_points <= DENSE_MAX_POINTS and not op.periodic else "pk"
-        return "dense" if n_points <= DENSE_MAX_POINTS else "pk"
-    if bounded and solver == "dense":
-        raise InputError("solver 'dense' (block principal pivoting) has no hardness bound; "
-                         "use solver='pk', or solver='nnls' (bounded least squares) on a "
-                         "non-periodic kernel")
-    if solver in ("dense", "nnls") and n_points > 8192:
-        raise InputError(f"solver {solver!r} would build a dense {n_points} x {n_points} "
-                         f"matrix ({8 * n_points ** 2 / 1e9:.1f} GB); use solver='pk' above "
-                         f"8192 points")
-    if solver == "nnls" and op.periodic:
-        raise InputError("solver 'nnls' (Cholesky + Lawson-Hanson) needs a positive definite "
-                         "operator: not the periodic one (its mean mode is free); use "
-                         + ("solver='pk' (with a hardness the one solver of a periodic "
-                            "surface)" if bounded else "solver='dense' or solver='pk'"))
-    return solver

@@ -1,6 +1,5 @@
 """What a finite, non-periodic window (a measured topography) adds to its BEM contact
-results: the bulk compliance of the loaded window, and the mean plane separation of its
-deformed surface (SI units).
+results: the bulk compliance of the loaded window (SI units).
 
 A non-periodic BEM solve presses the window alone into a half-space. The half-space
 then deflects as a whole under the window's load, like a flat punch of the window's
@@ -16,11 +15,8 @@ and the approach Delta = (rough interface closure) + (bulk deflection ~ C p). So
   correct for the window problem, and a property of the window's size, not of its
   roughness, wherever K C is of order one. :func:`window_report` says so (a
   :class:`~roughfe.errors.WindowStiffnessWarning`).
-* the undeformed flat's separation from the mean plane, max h - mean h - Delta,
-  includes the mean bulk deflection: :func:`mean_plane_separation` gives the deformed
-  one's (= the mean gap), for the elastic and the adhesive BEM alike.
 
-A periodic surface has neither effect: its kernel has zero mean displacement.
+A periodic surface has no such compliance: its kernel has zero mean displacement.
 """
 from __future__ import annotations
 
@@ -62,41 +58,6 @@ def window_compliance(surface, youngs_modulus, poisson=0.0, kernel="auto") -> fl
     if kernel == "auto":
         kernel = "love" if surface.ndim == 2 else "strip"
     return _mean_deflection(surface.shape, surface.size, mat.E_star, kernel)
-
-
-def mean_plane_separation(heights, delta, displacement, periodic, plastic=None) -> float:
-    """d (m): the separation between the mean plane of the rough surface and the
-    indenting flat (thesis Sec. 2.2; Greenwood-Williamson; Paggi & He 2015, Eq. 2.8),
-    applied to the deformed flat, whose surface sits at u (+ u_pl) below its undeformed
-    position max h - Delta:
-
-        d = max h - mean h - Delta + mean(u + u_pl)       (= the mean gap).
-
-    Periodic (``periodic=True``): d = max h - mean h - Delta, unchanged; the periodic
-    kernel has zero mean displacement, so the deformed and undeformed planes coincide
-    and d equals the mean gap (Betti). Non-periodic: the undeformed plane's
-    separation max h - mean h - Delta includes the window's mean bulk deflection
-    (~C p, :func:`window_compliance`) and goes negative while every gap is >= 0
-    (x3p-2 at 3 MPa: -1.53 um = -19.8 sigma beside a mean gap of +24 nm); the deformed
-    plane's is the separation the definition means.
-
-    Parameters
-    ----------
-    heights : ndarray
-        h (m) of the rough surface.
-    delta : float
-        Approach Delta (m) from first contact.
-    displacement : ndarray
-        u (m) of the elastic surface on the grid (unused when ``periodic``).
-    periodic : bool
-    plastic : ndarray, optional
-        The permanent displacement u_pl (m) after the step (BEM with a hardness).
-    """
-    d = float(np.max(heights) - np.mean(heights) - delta)
-    if periodic:
-        return d
-    return d + float(np.mean(displacement)) + (0.0 if plastic is None
-                                               else float(np.mean(plastic)))
 
 
 def window_report(sweep) -> dict:

@@ -61,7 +61,7 @@ class CoupledSweep:
         The contact scalars mean what the one-way records' keys mean: ``delta`` is the
         approach of the rigid surface from first contact of the undeformed surfaces
         (:attr:`CoupledResult.approach`), ``mean_plane_separation`` is ``max h - mean h -
-        delta`` (non-periodic: of the deformed flat, ``+ mean(u)``, = the mean gap) and ``free_volume_star`` is ``mean_gap / sigma`` with the heights ``h``
+        delta`` and ``free_volume_star`` is ``mean_gap / sigma`` with the heights ``h``
         of the surface, not those of the internal dry problem on ``h - H p_f`` (until
         round 2, session 24 they were copied from it: 32^2, p_ext 30 MPa, p_in 20 MPa,
         delta 2.424 um where the approach is 2.586 um)."""
@@ -73,11 +73,7 @@ class CoupledSweep:
             if r.contact is not None:
                 rec.update(r.contact.scalars())
                 rec["iterations"] = rec.pop("nit")        # the name of contact's records
-                # periodic: max h - mean h - approach; non-periodic: that of the deformed
-                # flat, which the internal solve's is (h - H p_f moves max h - Delta and
-                # mean h by the same H p_f terms): roughfe.bem.window.mean_plane_separation
-                separation = (float(h.max() - h.mean() - r.approach) if self.surface.periodic
-                              else r.contact.mean_plane_separation)
+                separation = float(h.max() - h.mean() - r.approach)
                 rec.update(delta=r.approach, mean_plane_separation=separation,
                            free_volume_star=float(r.contact.mean_gap / sigma),
                            separation_star=separation / sigma)

@@ -27,9 +27,7 @@ def _theory(steps, key):
 
 def plot_area_stiffness(steps, path, title=None, rms_height=None, window_compliance=None):
     """A*(p), K(p) (exact incremental and central finite differences) and the mean gap
-    u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8; d is the
-    deformed flat's separation, so V* = d/sigma = mean gap/sigma for the BEM, periodic or
-    not, and the FEM: the panel checks the identity, roughfe.bem.window). Records
+    u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8). Records
     with ``persson_area_fraction`` / ``persson_mean_gap`` (:func:`roughfe.theory.beside`)
     get Persson's curves drawn beside the BEM points. With the ``window_compliance`` C
     (m/Pa) of a non-periodic window, the K panel marks the window's bulk stiffness 1/C,
