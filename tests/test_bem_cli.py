@@ -32,6 +32,9 @@ def test_contact_cli_writes_results_fields_and_figures(tmp_path):
                              "stiffness", "stiffness_fd", "mean_gap", "mean_plane_separation",
                              "free_volume", "free_volume_star", "iterations", "residual",
                              "persson_area_fraction", "persson_mean_gap"}
+    # every dimensional record key has its unit (contact_area had none: read as a fraction)
+    units = doc["derived"]["units"]
+    assert units["contact_area"].startswith("m^2") and units["mean_gap"] == "m"
     # the last approach is the peak-to-valley height, loads increase
     assert steps[-1]["delta"] == pytest.approx(np.ptp(_bump().heights))
     assert all(a["load"] < b["load"] for a, b in zip(steps, steps[1:]))

@@ -79,3 +79,32 @@ def test_contact_cli_says_what_k_is_on_a_window(window, tmp_path, capsys):
     assert "bulk compliance C =" in captured.out
     d = json.loads((out / "results.json").read_text())["derived"]
     assert d["window_compliance"] > 0 and len(d["bulk_share"]) == 2
+
+
+def test_the_separation_of_a_window_is_the_thesis_undeformed_plane(window):
+    """d = max h - mean h - Delta (thesis Sec. 2.2.3): on a window pressed into a
+    half-space it holds the window's bulk deflection and goes negative under load, while
+    the mean gap (the deformed plane's separation) stays positive; the two differ by the
+    mean displacement. (A change that made d the mean gap was withdrawn in round 2,
+    session 24: the thesis reads V* against d/sigma as two quantities, Figs. 8 and 19.)"""
+    sweep = contact_sweep(window, MAT, pressures=[1e5, 1e7])
+    h = window.heights
+    for r in sweep.results:
+        assert r.mean_plane_separation == pytest.approx(h.max() - h.mean() - r.delta, rel=1e-12)
+        assert r.mean_gap - r.mean_plane_separation == pytest.approx(
+            float(np.mean(r.displacement)), rel=1e-8)
+    assert sweep.results[-1].mean_plane_separation < 0 < sweep.results[-1].mean_gap
+
+
+def test_a_profile_window_is_warned_without_surface_facts():
+    """The warning gave a profile the 3D facts C ~ 0.9 sqrt(A_n)/E* and a flat punch's
+    K C ~ 1.08 (sqrt(A_n) means nothing for a profile; the strip kernel's C depends on its
+    reference length)."""
+    from roughfe.surfaces.spectral import spectral_profile
+    prof = spectral_profile(256, 1e-4, 0.8, rms_height=1e-7, rng=3)
+    prof = Surface(prof.heights, prof.size, periodic=False)
+    sweep = contact_sweep(prof, MAT, pressures=[1e6, 3e7])
+    _, caught = _document(sweep)
+    assert len(caught) == 1
+    text = str(caught[0].message)
+    assert "sqrt(A_n)" not in text and "flat punch" not in text and "reference length" in text

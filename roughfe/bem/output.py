@@ -28,6 +28,7 @@ from .window import window_report
 
 #: Units of the step records (dimensionless keys are absent).
 UNITS = {"delta": "m", "load": "N (surface) or N/m (profile)", "mean_pressure": "Pa",
+         "contact_area": "m^2 (surface) or m (profile)",
          "stiffness": "Pa/m", "stiffness_fd": "Pa/m", "mean_gap": "m",
          "mean_plane_separation": "m", "free_volume": "m^3 (surface) or m^2 (profile)",
          "delta_applied": "m", "layer_compliance": "m/Pa"}

@@ -79,13 +79,19 @@ def window_report(sweep) -> dict:
     if ok.any():
         top = int(np.flatnonzero(ok)[np.argmax(p[ok])])
         if kc[top] > WINDOW_STIFFNESS_SHARE:
+            # the 3D facts (C ~ 0.9 sqrt(A_n)/E*, a flat punch's K C ~ 1.08) are not a
+            # profile's: the strip kernel's C depends on its reference length
+            facts = (" (~0.9 sqrt(A_n)/E*)", " (a rigid flat punch of the window's size "
+                     "has K C ~ 1.08)") if len(r0.pressure.shape) == 2 else (
+                " (the strip kernel's, which depends on its reference length, the "
+                "profile's)", "")
             warnings.warn(
                 f"K is the bulk stiffness of the measured window in series with the "
                 f"interface (1/K ~ 1/K_interface + C), not a property of the roughness; "
                 f"here K C = {kc[top]:.3g} at p = {p[top]:.3g} Pa, with the window "
-                f"compliance C = {c:.3g} m/Pa (~0.9 sqrt(A_n)/E*) and the window's bulk "
-                f"deflection C p = {share[top]:.2g} of the approach (a rigid flat punch of "
-                f"the window's size has K C ~ 1.08). The interface's own K(p) is that of "
+                f"compliance C = {c:.3g} m/Pa{facts[0]} and the window's bulk "
+                f"deflection C p = {share[top]:.2g} of the approach{facts[1]}. "
+                f"The interface's own K(p) is that of "
                 f"a periodic surface, e.g. the evenly mirrored window (Surface.mirrored(), "
                 f"roughfe design-targets --boundary periodic); C is written to "
                 f"results.json (derived.window_compliance)", WindowStiffnessWarning,
