@@ -143,7 +143,7 @@ def test_directional_spectrum_matching_recovers_every_wave_amplitude():
         assert (err < 1e-12) == ok, (directional, err)
 
 
-def test_profile_target_defaults_to_the_profile_databases_own_setting():
+def test_profile_target_defaults_to_the_profile_databases_own_setting(tmp_path):
     """On a profile database the designs are non-periodic profiles on the strip kernel:
     the default boundary of a profile target is then the window itself, and a design's
     own profile is its own target exactly. The old default ("periodic": the mirrored
@@ -162,6 +162,13 @@ def test_profile_target_defaults_to_the_profile_databases_own_setting():
     np.testing.assert_allclose(curve.stiffness, own.stiffness, rtol=1e-12)
     _, _, mirrored = surface_targets(profile, settings, detrend="none", boundary="periodic")
     assert mirrored.stiffness[-1] > 10 * own.stiffness[-1]
+    # the CSV says how the target was made (K 10x apart between the two boundaries, and
+    # the file said neither) and still reads back with its quantity
+    from roughfe.genomics.similarity import read_target_csv, write_target_csv
+    path = write_target_csv(tmp_path / "tk.csv", tk)
+    assert "# solved with boundary window, resolution design, detrend none" in path.read_text()
+    back = read_target_csv(path)
+    assert back.quantity == "K" and np.array_equal(back.values, tk.values)
 
 
 def test_a_surface_database_refuses_a_profile_target(tmp_path, capsys):

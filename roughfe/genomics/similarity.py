@@ -425,7 +425,12 @@ def write_target_csv(path, target: Target):
     """Write ``target`` as 'pressure_Pa,value' CSV atomically (readable by :func:`read_target_csv`)."""
     from ..writers import write_text
     unit = QUANTITY_LABELS[target.quantity][1]
-    lines = [f"# {target.name}: {QUANTITY_LABELS[target.quantity][0]} ({unit}) vs pressure (Pa)",
-             "pressure_Pa,value"]
+    lines = [f"# {target.name}: {QUANTITY_LABELS[target.quantity][0]} ({unit}) vs pressure (Pa)"]
+    meta = target.metadata or {}
+    if "boundary" in meta:      # how a surface target was made (K differs 10x between them)
+        lines.append(f"# solved with boundary {meta['boundary']}, resolution "
+                     f"{meta.get('resolution')}, detrend {meta.get('detrend')} on a "
+                     f"{' x '.join(map(str, meta.get('solved_shape', ())))} grid")
+    lines.append("pressure_Pa,value")
     lines += [f"{p:.17g},{y:.17g}" for p, y in zip(target.pressure, target.values)]
     return write_text(path, "\n".join(lines) + "\n")
