@@ -213,7 +213,7 @@ def add_detrend_option(parser, default: str = DEFAULT_DETREND) -> None:
         help="remove nothing, the mean height, or the least-squares plane before the "
              "analysis (measured topographies usually need 'plane'; on a periodic surface "
              "'plane' removes the mean only: its mean slope is zero); 'mean' on a "
-             "non-periodic surface whose plane carries more than 95 % of the height "
+             "non-periodic surface whose plane carries more than 95 %% of the height "
              "variance warns")
 
 
