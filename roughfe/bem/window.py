@@ -11,7 +11,8 @@ and the approach Delta = (rough interface closure) + (bulk deflection ~ C p). So
 
 * ``stiffness`` K = dp/dDelta is that of the interface in series with the window's bulk,
   1/K ~ 1/K_interface + C (docs/theory/02_bem_contact.md, measured on the five instrument
-  files: K C = 1.02-1.09 once A* >~ 0.1, C p/Delta = 0.70-0.99 of the approach): it is
+  files: K C = 0.87-1.09 at A* = 0.12-0.85, 1.02-1.09 from A* ~ 0.2; C p/Delta up to
+  0.71-1.05 of the approach): it is
   correct for the window problem, and a property of the window's size, not of its
   roughness, wherever K C is of order one. :func:`window_report` says so (a
   :class:`~roughfe.errors.WindowStiffnessWarning`).
