@@ -155,15 +155,16 @@ def _script_doc(name: str) -> str:
 def summary_record(planned: list, summary: dict, quick: bool) -> dict:
     """The content of ``summary.json``: the ``planned`` validations, those done so far
     (``validations``, in order) and ``pending``; ``complete`` once every planned one is
-    done; ``not_run`` (scripts and skipped targets); ``all_met`` only for a complete run
-    in which every target ran and is met (a killed run's summary is never all met)."""
+    done; ``failed`` (validations with a target NOT met); ``not_run`` (scripts and skipped
+    targets); ``all_met`` only for a complete run in which every target ran and is met (a
+    killed run's summary is never all met). Also what :func:`_run` prints at the end."""
     failed = [n for n, v in summary.items() if v["met"] is False]
     not_run = [s for v in summary.values() for s in v["not_run"]]
     complete = all(n in summary for n in planned)
     return {"planned": list(planned), "complete": complete,
             "pending": [n for n in planned if n not in summary], "validations": summary,
             "quick": bool(quick), "all_met": complete and not failed and not not_run,
-            "not_run": not_run}
+            "failed": failed, "not_run": not_run}
 
 
 def _first_sentence(doc: str) -> str:
@@ -197,8 +198,8 @@ def _run(args) -> int:
                     print(f"   NOT met: {t.get('name')}: {t.get('measured', t.get('value'))} "
                           f"(target {t.get('target')})")
             write_json(outdir / "summary.json", summary_record(names, summary, args.quick))
-    failed = [n for n, v in summary.items() if v["met"] is False]
-    not_run = [s for v in summary.values() for s in v["not_run"]]
+    record = summary_record(names, summary, args.quick)
+    failed, not_run = record["failed"], record["not_run"]
     ran = [n for n, v in summary.items() if v["met"] is not None]
     if failed:
         print(f"targets missed in: {', '.join(failed)}")
