@@ -64,9 +64,10 @@ def check_finite_positive(name, value):
 
 
 def check_finite_nonnegative(name, value):
-    """Return ``float(value)`` or raise :class:`InputError` unless it is finite and >= 0."""
+    """Return ``float(value)`` or raise :class:`InputError` unless it is finite and >= 0 (a
+    number: not a string such as "0.5", not a bool)."""
     try:
-        v = None if isinstance(value, bool) else float(value)
+        v = float(_number(value))
     except (TypeError, ValueError):
         v = None
     if v is None or not (0.0 <= v < float("inf")):

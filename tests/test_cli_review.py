@@ -241,6 +241,17 @@ def test_numbers_given_as_text_are_refused():
     assert check_finite_positive("L", np.float32(2.0)) == 2.0
 
 
+def test_nonnegative_numbers_given_as_text_are_refused():
+    # check_finite_nonnegative took "0.5" (float() does): an adhesive law's smoothing
+    # given as text ran as 0.5
+    from roughfe.errors import InputError, check_finite_nonnegative
+    for bad in ("0.5", b"0", True, -1.0, float("nan")):
+        with pytest.raises(InputError, match="must be a finite number >= 0"):
+            check_finite_nonnegative("smoothing", bad)
+    assert check_finite_nonnegative("smoothing", np.float32(0.5)) == 0.5
+    assert check_finite_nonnegative("smoothing", 0) == 0.0
+
+
 def test_a_study_run_never_leaves_an_earlier_table_beside_new_results(tmp_path, capsys):
     # table.csv of a collect after a partial run stayed, stale, once the run completed
     from roughfe.study import collect
