@@ -30,7 +30,10 @@ def test_partial_sums_end_at_the_complete_profile(genome):
     # a single chromosome is one cosine: its first contact is one point, area grows smoothly
     c1 = mech.chromosome_curves[0]
     assert np.all(np.diff(c1.area_fraction) >= 0) and np.all(np.diff(c1.pressure) > 0)
-    assert mech.nit == 1 + 2 + 2 * 12
+    # TD_1 is C_1 and TD_12 the complete profile, bit for bit: swept once each (27 sweeps
+    # until round 2, session 25)
+    assert mech.td_curves[0] is mech.chromosome_curves[0] and mech.td_curves[-1] is mech.complete
+    assert mech.nit == 1 + 2 + 2 * 12 - 2
 
 
 def test_a_band_limited_genome_has_the_mechanics_of_its_realisation():
@@ -103,3 +106,27 @@ def test_a_chromosome_whose_waves_cancel_is_micro():
     assert not is_flat(c3) and is_flat(c3, np.abs(total).max())
     r = macro_micro(g, settings)
     assert 3 in r.micro and r.corr_k[2] == 0.0
+
+
+def test_identical_fields_are_swept_once():
+    # a partial sum across an empty band equals the sum before it bit for bit; it was
+    # swept again (44 sweeps for 42 distinct fields on one profile)
+    from roughfe.errors import NoConvergenceError
+    from roughfe.genomics.mechanics import sweep_fields
+    from roughfe.genomics.similarity import ResponseCurve
+    rng = np.random.default_rng(3)
+    z, z1, z2 = (rng.normal(size=64) for _ in range(3))
+    calls = []
+
+    def response(heights):
+        calls.append(heights.copy())
+        if np.array_equal(heights, z2):
+            raise NoConvergenceError("KKT residual 1e-3 > tol")
+        k = float(np.ptp(heights))
+        return ResponseCurve(np.array([1.0, 2.0]), np.array([k, 2 * k]), np.array([0.1, 0.2]))
+    fields = {"complete": z, "a": z1, "b": z1.copy(), "c": z1 + 0.0, "d": z2, "e": z2.copy()}
+    curves, failed, n = sweep_fields(fields, lambda h: h, response)
+    assert n == len(calls) == 3
+    assert curves["b"] is curves["a"] and curves["c"] is curves["a"]
+    assert curves["d"] is None and curves["e"] is None and set(failed) == {"d", "e"}
+    assert curves["complete"].stiffness[0] == pytest.approx(np.ptp(z))
