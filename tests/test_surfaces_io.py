@@ -82,6 +82,48 @@ def test_bad_files(tmp_path):
         load_surface(tmp_path / "junk.xyz9")
 
 
+def _raw_float64(path):
+    np.random.default_rng(0).standard_normal((256, 256)).tofile(path)   # 2 * 512^2 bytes
+
+
+@pytest.mark.parametrize("name, write, reader", [
+    ("heights.raw", _raw_float64, "'hgt'"),                     # read as 512 x 512, 5.12e8 m
+    ("x.json", lambda p: p.write_text("abcdefgh"), "'hgt'"),    # read as a 2 x 2 grid
+    ("r.bin", lambda p: p.write_bytes(np.random.default_rng(1).bytes(2 * 128 ** 2)), "'hgt'"),
+    ("table.foo", lambda p: p.write_text("1 2 3\n4 5 6\n7 8 9\n"), "'xyz'"),
+])
+def test_unknown_suffix_is_not_read_by_a_reader_without_signature(tmp_path, name, write,
+                                                                  reader):
+    """SurfaceTopography's SRTM reader takes any file of 2 n^2 bytes, its text readers any
+    table of numbers: under a suffix no format claims, they are refused (until round 2,
+    session 25 each of these files was a surface and ``roughfe info`` exited 0)."""
+    path = tmp_path / name
+    write(path)
+    with pytest.raises(FileFormatError) as info:
+        load_surface(path, size=1e-4)
+    message = str(info.value)
+    assert name in message and reader in message and "no file signature" in message
+    assert ".npy .txt" in message and ".x3p" in message      # the formats accepted
+
+
+def test_suffix_of_another_format_is_refused(tmp_path):
+    """.spm is a suffix of SurfaceTopography's DI reader (not its format name): 8 bytes of
+    text there are not a readable .spm, not an SRTM grid."""
+    (tmp_path / "scan.spm").write_text("abcdefgh")
+    with pytest.raises(FileFormatError, match=r"scan\.spm is not a readable \.spm file.*'hgt'"):
+        load_surface(tmp_path / "scan.spm")
+
+
+@pytest.mark.parametrize("name, renamed", [("x3p-2.x3p", "scan.foo"), ("di-1.di", "scan.006")])
+def test_signed_instrument_file_reads_under_any_suffix(topographies_dir, tmp_path, name,
+                                                       renamed):
+    """Readers that recognise a file by its signature (an x3p zip, a Bruker header) still
+    read it under a suffix no format claims (Bruker numbers its files .000, .001, ...)."""
+    (tmp_path / renamed).write_bytes((topographies_dir / name).read_bytes())
+    np.testing.assert_array_equal(load_surface(tmp_path / renamed).heights,
+                                  load_surface(topographies_dir / name).heights)
+
+
 def test_reader_table_is_ordered_with_fallback_last():
     assert READERS[0][0] == (".npz",)
     assert READERS[-1][0] is None and all(r[0] is not None for r in READERS[:-1])

@@ -3,7 +3,11 @@
 All readers live in one ordered table, :data:`READERS` (STYLE.md habit 3): the first
 entry whose suffixes match the file name reads it; SurfaceTopography's
 ``open_topography`` is the last entry and the fallback for every other suffix (it reads
-30+ instrument formats: ``.x3p .sur .opd .plu .di .datx .xyz ...``).
+30+ instrument formats: ``.x3p .sur .opd .plu .di .datx .xyz ...``). SurfaceTopography
+picks its reader by content: under a suffix one of its formats claims, only that format's
+reader is accepted; under any other suffix (``.raw .bin .json``, none) the readers that
+check no file signature (:data:`NO_SIGNATURE`: SRTM ``.hgt``, any file of 2 n^2 bytes;
+``.asc``/``.xyz``, any table of numbers) are refused with a :class:`FileFormatError`.
 
 Native format (``.npz``, ``format = "roughfe-surface"``, ``version = 1``)
 ------------------------------------------------------------------------
@@ -229,17 +233,42 @@ def _choose_channel(reader, channel, path):
     return channels[index]
 
 
+#: SurfaceTopography readers that check no file signature, with what they accept: under
+#: a suffix no format claims they read anything of the right length or characters
+#: (8 bytes of text in x.json as a 2 x 2 grid, 256^2 float64 values in heights.raw as a
+#: 512 x 512 surface of 5.12e8 m, until round 2, session 25)
+NO_SIGNATURE = {"hgt": "an SRTM .hgt grid is any file of 2 n^2 bytes",
+                "asc": "any table of numbers", "xyz": "any table of numbers"}
+
+
+def _claims(reader, suffix) -> bool:
+    return suffix == reader.format() or suffix in reader.file_extensions()
+
+
 def _check_reader_matches_suffix(path, reader):
-    """SurfaceTopography picks its reader by content: a damaged ``.x3p`` can be taken for
-    another format (8 bytes of text read as a 2 x 2 SRTM ``.hgt`` grid). When the suffix
-    names a format SurfaceTopography knows, the reader must be that format's."""
+    """SurfaceTopography picks its reader by content, whatever the suffix. When the suffix
+    is one SurfaceTopography maps, the reader must be one that claims it (a damaged
+    ``.x3p`` is not read as an SRTM ``.hgt`` grid). When no reader claims the suffix,
+    only a reader that recognises the content by a file signature is trusted: the readers
+    of :data:`NO_SIGNATURE` are refused there."""
     from SurfaceTopography.IO import readers
 
     suffix = path.suffix.lower().lstrip(".")
     fmt = reader.format()
-    if suffix != fmt and suffix in {r.format() for r in readers}:
+    if _claims(reader, suffix):
+        return
+    if any(_claims(r, suffix) for r in readers):
         raise FileFormatError(f"{path} is not a readable .{suffix} file (its content matches "
                               f"SurfaceTopography's {fmt!r} reader instead)")
+    if fmt in NO_SIGNATURE:
+        ours = {s.lstrip(".") for suffixes, _, _ in READERS if suffixes for s in suffixes}
+        known = sorted({e for r in readers for e in (r.format(), *r.file_extensions())} - ours)
+        raise FileFormatError(
+            f"{path}: its suffix {path.suffix or '(none)'!r} names no format, and "
+            f"SurfaceTopography's {fmt!r} reader took its content, which checks no file "
+            f"signature ({NO_SIGNATURE[fmt]}). Give the file its format's suffix: roughfe "
+            f".npz, a plain height matrix .npy .txt .csv .dat (metres, with --size/size=), "
+            f"or an instrument file ." + " .".join(known))
 
 
 def _unreadable(path, exc) -> str:
