@@ -95,3 +95,22 @@ def test_contact_and_leak_say_how_many_points_were_filled(tmp_path, capsys):
     assert main(["leak", str(path), "--pressure", "1e6", "--no-figures", "-o",
                  str(tmp_path / "l")]) == 0
     assert "7 undefined points filled (harmonic interpolation)" in capsys.readouterr().out
+
+
+def test_a_file_without_unit_is_said_to_be_read_as_metres(tmp_path, capsys, topographies_dir):
+    """An .xyz table gives no unit: its values are taken as metres, which only --json's
+    metadata said ("m (assumed: the file gives no unit)") until round 2, session 25."""
+    rough = spectral_surface(16, 1.6e-5, 0.8, rms_height=1e-7, rng=3)
+    x = np.arange(16) * rough.spacing[0]
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    path = tmp_path / "scan.xyz"
+    np.savetxt(path, np.column_stack([X.ravel(), Y.ravel(), rough.heights.ravel()]))
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert (f"{path}: the file gives no unit; heights and lengths taken as metres" in out
+            and "rescale" in out and "--size" in out)
+    assert main(["contact", str(path), "--pressure", "1e5", "--no-figures", "-o",
+                 str(tmp_path / "c")]) == 0
+    assert "the file gives no unit" in capsys.readouterr().out
+    assert main(["info", str(topographies_dir / "x3p-2.x3p")]) == 0     # unit 'm' in file
+    assert "gives no unit" not in capsys.readouterr().out

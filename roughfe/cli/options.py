@@ -163,7 +163,12 @@ def surface_notes(surface, channel: bool = False) -> list:
     """Console lines on what an instrument file gave: with ``channel`` the channel read
     (and, of a multi-channel file, all of its channels), and the undefined points that
     the reader filled (``metadata["filled_points"]``; opd-1: 116), which only
-    ``--json``/results.json said until round 2, session 24."""
+    ``--json``/results.json said until round 2, session 24, and that the file gives no
+    unit, so that its heights and lengths were taken as metres (``metadata
+    ["unit_in_file"]`` is :data:`~roughfe.surfaces.io.ASSUMED_UNIT`; only ``--json``
+    said so until round 2, session 25)."""
+    from ..surfaces.io import ASSUMED_UNIT
+
     meta = surface.metadata
     lines = []
     read = meta.get("channel")
@@ -177,6 +182,11 @@ def surface_notes(surface, channel: bool = False) -> list:
     if meta.get("filled_points"):
         lines.append(f"{int(meta['filled_points'])} undefined points filled (harmonic "
                      f"interpolation)")
+    if meta.get("unit_in_file") == ASSUMED_UNIT:
+        lines.append("the file gives no unit; heights and lengths taken as metres (in "
+                     "another unit: rescale the file's values to metres, e.g. save the "
+                     "heights as .npy in metres and give --size LX [LY]; --size alone "
+                     "sets the lengths, not the heights)")
     return lines
 
 

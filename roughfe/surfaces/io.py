@@ -25,7 +25,9 @@ metres): the physical ``size`` must be given explicitly, and ``periodic`` defaul
 False.
 
 Instrument files are converted to SI: lengths and heights are rescaled from the unit
-stored in the file to metres. Missing (undefined) points are filled by SurfaceTopography's
+stored in the file to metres. A file that gives no unit (an ``.xyz`` or ``.asc`` table
+of numbers) is read as metres, lengths and heights alike: ``metadata["unit_in_file"]``
+is then :data:`ASSUMED_UNIT`, and the command line prints a note saying so. Missing (undefined) points are filled by SurfaceTopography's
 harmonic interpolation and their number recorded in ``metadata["filled_points"]``; the
 channel read in ``metadata["channel"]`` and the file's channels in
 ``metadata["channels"]``.
@@ -46,6 +48,8 @@ from .surface import Surface
 
 NATIVE_FORMAT = "roughfe-surface"
 NATIVE_VERSION = 1
+#: ``metadata["unit_in_file"]`` of an instrument file that gives no unit: read as metres
+ASSUMED_UNIT = "m (assumed: the file gives no unit)"
 
 
 # -- JSON-safe metadata ------------------------------------------------------------------
@@ -333,7 +337,7 @@ def _instrument_surface(reader, path, size, periodic, channel):
         unit = ch.unit[0]
     if unit is None:
         kwargs["unit"] = "m"
-        unit = "m (assumed: the file gives no unit)"
+        unit = ASSUMED_UNIT
     topo = reader.topography(**kwargs)
     filled = 0
     if topo.has_undefined_data:
@@ -378,7 +382,9 @@ def load_surface(path, size=None, periodic=None, channel=None) -> Surface:
     ----------
     path : str or Path
         ``.npz`` (native), ``.npy``/``.txt``/``.csv``/``.dat`` (plain height matrix in
-        metres, axis 0 = x) or any instrument file SurfaceTopography reads.
+        metres, axis 0 = x) or any instrument file SurfaceTopography reads (converted
+        to metres; one that gives no unit is read as metres, ``metadata["unit_in_file"]
+        == ASSUMED_UNIT``).
     size : float or (float, float), optional
         Physical size in metres (``n * spacing`` per axis). Required for plain matrices
         and for instrument files without a size; otherwise it overrides the file's size.
