@@ -39,6 +39,39 @@ def test_generate_writes_a_loadable_npz(tmp_path, model, extra):
     np.testing.assert_array_equal(load_surface(again).heights, s.heights)   # reproducible
 
 
+def _regenerate(surface):
+    """The surface that the library makes from ``surface``'s own metadata."""
+    from roughfe.surfaces.wm import mwm_surface, wm_profile
+    m = surface.metadata
+    if m["generator"] == "wm":
+        return wm_profile(surface.shape[0], surface.size[0], m["hurst"], gamma=m["gamma"],
+                          amplitude=m["amplitude_A"], q0=m["q0"], k_range=m["k_range"],
+                          rng=m["seed"])
+    return mwm_surface(surface.shape[0], surface.size[0], m["hurst"], gamma=m["gamma"],
+                       wavelength=m["wavelength"], n_range=m["n_range"], ridges=m["ridges"],
+                       amplitude=m["amplitude_A"], anisotropy=m["anisotropy"],
+                       angles=m["angles"], rng=m["seed"])
+
+
+@pytest.mark.parametrize("model, extra", [
+    ("wm", ["--n", "512"]),
+    ("mwm", ["--n", "48", "--ridges", "4", "--anisotropy", "0.9", "1", "1.1", "1"]),
+])
+def test_rescaled_wm_metadata_regenerates_its_heights(tmp_path, model, extra):
+    """--rms-height rescales the heights; Eq. (2.1) and (3.17) are linear in A, so the
+    stored amplitude_A must be the effective one (it kept the A before the rescaling,
+    a factor 17.6 off for wm --n 512 --seed 1 --rms-height 2e-6)."""
+    out = tmp_path / f"{model}.npz"
+    assert main(["generate", model, *extra, "--seed", "1", "--rms-height", "2e-6",
+                 "--no-figures", "-o", str(out)]) == 0
+    s = load_surface(out)
+    assert rms_height(s) == pytest.approx(2e-6, rel=1e-12)
+    assert s.metadata["rms_height_target"] == 2e-6
+    again = _regenerate(s)
+    np.testing.assert_allclose(again.heights, s.heights, rtol=0,
+                               atol=1e-12 * np.abs(s.heights).max())   # round-off of A * factor
+
+
 def test_generate_png_and_info(tmp_path, capsys):
     out = tmp_path / "s.npz"
     assert main(["generate", "spectral", "--n", "32", "--seed", "1", "-o", str(out)]) == 0

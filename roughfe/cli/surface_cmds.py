@@ -120,6 +120,19 @@ def _figure_of(path):
         return None
 
 
+def _rescaled_wm(surface, target):
+    """A WM profile or MWM surface rescaled to the rms height ``target`` (m), with its
+    metadata's ``amplitude_A`` the effective one: the heights of Eq. (2.1) and Eq. (3.17)
+    are linear in A, so the stored A regenerates the stored heights (it kept the A before
+    the rescaling until round 2, session 25: a factor 17.6 off for ``generate wm --n 512
+    --seed 1 --rms-height 2e-6``); ``rms_height_target`` records the target as
+    :func:`~roughfe.surfaces.rmd.rmd_surface` does."""
+    from ..surfaces.stats import rms_height
+    factor = target / rms_height(surface)
+    return surface.with_heights(surface.heights * factor, rms_height_target=float(target),
+                                amplitude_A=surface.metadata["amplitude_A"] * factor)
+
+
 def _generate(args) -> int:
     from ..surfaces.io import save_surface
     from ..surfaces.stats import rms_height
@@ -135,7 +148,7 @@ def _generate(args) -> int:
     check_memory(f"a {' x '.join(map(str, shape))} grid", 8.0 * float(np.prod(shape)))
     surface = args.make(args)
     if args.rms_height is not None and args.model in ("wm", "mwm"):
-        surface = surface.scaled(args.rms_height / rms_height(surface))
+        surface = _rescaled_wm(surface, args.rms_height)
     if not args.no_figures:
         surface = surface.with_heights(surface.heights, figure=png.name)
     save_surface(surface, out)
