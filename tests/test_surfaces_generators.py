@@ -182,6 +182,15 @@ def test_spectral_is_real_hermitian_and_band_limited():
     (lambda: spectral_surface(32, (1e-4, 1e-4, 1e-4), 0.5, rms_height=1e-6),
      ["size", "one entry per axis"]),
     (lambda: wm_profile(100.0, 1e-3, 0.5), ["n", "integer", "100.0"]),
+    # text where a number belongs: a bare ValueError from float() until round 2, session 25
+    (lambda: spectral_surface(32, 1e-4, 0.5, rms_height=1e-6, q_long="a"), ["q_long", "'a'"]),
+    (lambda: spectral_surface(32, 1e-4, 0.5, rms_height=1e-6, q_long=-1.0), ["q_long", "-1"]),
+    (lambda: wm_profile(64, 1e-4, 0.5, q0="a"), ["q0", "'a'"]),
+    (lambda: mwm_surface(32, 1e-4, 0.5, ridges=2, anisotropy=["a", "b"]),
+     ["anisotropy", "numeric"]),
+    (lambda: mwm_surface(32, 1e-4, 0.5, ridges=2, anisotropy=[1.0, np.nan]),
+     ["anisotropy", "finite"]),
+    (lambda: mwm_coefficients(0.5, 1.5, 1e-4, (1, 3), 2, amplitude="a"), ["amplitude", "'a'"]),
 ])
 def test_generators_reject_bad_input(call, words):
     with pytest.raises(ValueError) as info:

@@ -25,7 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive, check_in_open_interval, check_int
+from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
+                      check_in_open_interval, check_int)
 from .stats import angular_wavevectors, periodic_moment
 from .surface import Surface, _as_size
 from .wm import resolve_rng
@@ -69,7 +70,7 @@ def _synthesise(ndim, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_s
     q_nyq = min(np.pi * nn / s for nn, s in zip(shape, size))
     q_roll = q_min if q_roll is None else check_finite_positive("q_roll (rad/m)", q_roll)
     q_short = q_nyq if q_short is None else check_finite_positive("q_short (rad/m)", q_short)
-    q_long = 0.0 if q_long is None else float(q_long)
+    q_long = 0.0 if q_long is None else check_finite_nonnegative("q_long (rad/m)", q_long)
     if not (0 <= q_long <= q_roll < q_short):
         raise InputError(f"wavenumbers must satisfy 0 <= q_long <= q_roll < q_short (rad/m), got "
                          f"q_long={q_long!r}, q_roll={q_roll!r}, q_short={q_short!r}")

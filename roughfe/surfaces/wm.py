@@ -191,9 +191,7 @@ def wm_profile(n, length, hurst, gamma=1.5, amplitude=1e-6, q0=None, k_range=Non
     (x,), length = _grid(n, length, 1)
     gamma, hurst = _check_gamma_hurst(gamma, hurst)
     amplitude = check_finite_positive("amplitude A (m)", amplitude)
-    q0 = 2 * np.pi / length if q0 is None else float(q0)
-    if not (np.isfinite(q0) and q0 > 0):
-        raise InputError(f"q0 must be > 0 (rad/m), got {q0!r}")
+    q0 = 2 * np.pi / length if q0 is None else check_finite_positive("q0 (rad/m)", q0)
     if k_range is None:
         k1 = int(np.ceil(np.log(2 * np.pi / length / q0) / np.log(gamma) - 1e-9))
         k2 = int(np.floor(np.log(np.pi * n / length / q0) / np.log(gamma) + 1e-9))
@@ -229,12 +227,14 @@ def mwm_coefficients(hurst, gamma, wavelength, n_range, ridges, amplitude=1.0, a
     if isinstance(ridges, bool) or not isinstance(ridges, (int, np.integer)) or ridges < 1:
         raise InputError(f"ridges M must be an integer >= 1, got {ridges!r}")
     n_s, n_f = _int_pair("n_range", n_range, "n_s", "n_f")
-    alpha = np.ones(ridges) if anisotropy is None else np.asarray(anisotropy, float).ravel()
-    if alpha.size != ridges or not np.all(np.isfinite(alpha)) or np.any(alpha <= 0):
+    amplitude = check_finite_positive("amplitude A (m^(1-H))", amplitude)
+    alpha = np.ones(ridges) if anisotropy is None else check_real_array(
+        "anisotropy (factors a_m)", anisotropy, unit="-").ravel()
+    if alpha.size != ridges or np.any(alpha <= 0):
         raise InputError(f"anisotropy must hold M = {ridges} positive factors a_m, got {anisotropy!r}")
     nn = np.arange(n_s, n_f + 1)
     q_base = 2 * np.pi / wavelength
-    scale = float(amplitude) * np.sqrt(np.log10(gamma) / ridges) * q_base ** (-hurst)
+    scale = amplitude * np.sqrt(np.log10(gamma) / ridges) * q_base ** (-hurst)
     amps = scale * alpha[:, None] * gamma ** ((1 - nn) * hurst)[None, :]
     return amps, q_base * gamma ** (nn - 1.0)
 
