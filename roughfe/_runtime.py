@@ -31,6 +31,24 @@ HEADLESS = {"MPLBACKEND": "Agg", "VTK_DEFAULT_OPENGL_WINDOW": "vtkEGLRenderWindo
             "PYVISTA_OFF_SCREEN": "true"}
 
 
+#: PETSc option that leaves the process's signals to Python: without it the first import of
+#: petsc4py (dolfinx, the FV Reynolds solver) installs PETSc's handlers, and a reader that
+#: leaves (``roughfe leak ... | head``) ended the command in an MPI abort banner with exit
+#: 59 instead of Python's BrokenPipeError (exit 141, nothing on stderr)
+PETSC_KEEP_SIGNALS = "-no_signal_handler"
+
+
+def python_signals_for_petsc(env=None) -> dict:
+    """Append :data:`PETSC_KEEP_SIGNALS` to ``PETSC_OPTIONS`` in ``env`` (default
+    ``os.environ``) unless it is there. Effective only before PETSc is initialised (the
+    command line calls it first); a user's own PETSC_OPTIONS are kept."""
+    env = os.environ if env is None else env
+    options = env.get("PETSC_OPTIONS", "")
+    if PETSC_KEEP_SIGNALS not in options.split():
+        env["PETSC_OPTIONS"] = f"{options} {PETSC_KEEP_SIGNALS}".strip()
+    return env
+
+
 def headless_environment(env=None) -> dict:
     """Put the :data:`HEADLESS` defaults into ``env`` (default ``os.environ``) unless set."""
     env = os.environ if env is None else env

@@ -111,3 +111,28 @@ def test_a_reader_leaving_the_pipe_stops_the_command_quietly(tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert proc.stdout == "line 0\n" and proc.returncode == 141, proc.stderr
     assert "error" not in proc.stderr and "Exception" not in proc.stderr, proc.stderr
+
+
+def test_a_reader_leaving_a_command_that_loaded_petsc_is_still_141(tmp_path):
+    """`roughfe leak ... | true`: the FV Reynolds solve imports petsc4py, whose signal
+    handlers took SIGPIPE from Python: exit 59 and an MPI abort banner on stderr. The
+    command line leaves the signals to Python (PETSc's -no_signal_handler)."""
+    from roughfe.surfaces import spectral_surface
+    from roughfe.surfaces.io import save_surface
+    path = save_surface(spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=1),
+                        tmp_path / "s.npz")
+    env = {k: v for k, v in __import__("os").environ.items() if k != "PETSC_OPTIONS"}
+    proc = subprocess.run(f"{sys.executable} -m roughfe leak {path} --pressure 1e7 "
+                          f"--no-figures -o {tmp_path / 'out'} | true; exit ${{PIPESTATUS[0]}}",
+                          shell=True, executable="/bin/bash", capture_output=True, text=True,
+                          timeout=300, env=env, cwd=tmp_path)
+    assert proc.returncode == 141, proc.stderr[-2000:]
+    assert "PETSC ERROR" not in proc.stderr and "MPI_ABORT" not in proc.stderr, proc.stderr
+
+
+def test_python_signals_for_petsc_keeps_the_users_options():
+    from roughfe._runtime import python_signals_for_petsc
+    env = python_signals_for_petsc({"PETSC_OPTIONS": "-log_view"})
+    assert env["PETSC_OPTIONS"].split() == ["-log_view", "-no_signal_handler"]
+    assert python_signals_for_petsc(dict(env))["PETSC_OPTIONS"] == env["PETSC_OPTIONS"]
+    assert python_signals_for_petsc({})["PETSC_OPTIONS"] == "-no_signal_handler"

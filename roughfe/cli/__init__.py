@@ -86,6 +86,8 @@ def main(argv=None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a parse error (one line, exit 2)
         return int(exc.code or 0)
+    from .._runtime import python_signals_for_petsc
+    python_signals_for_petsc()   # a closed stdout is exit 141, not PETSc's abort (exit 59)
     if getattr(args, "renders_with_dolfinx", False) and not getattr(args, "no_figures", False):
         from .._runtime import load_render_backend
         load_render_backend()  # vtk before dolfinx: this command solves with dolfinx and draws
