@@ -338,3 +338,12 @@ def test_a_mistake_in_a_rerun_keeps_the_finished_output(tmp_path, capsys):
     after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*")
              if p.is_file() and p.name != ".lock"}
     assert after == before and not (out / "UNFINISHED").exists()
+
+
+def test_study_run_prints_its_summary_once(tmp_path, capsys):
+    # run_study logs the summary (stderr) and the command printed it again (stdout)
+    spec = tmp_path / "s.toml"
+    spec.write_text('[study]\nanalysis = "selftest"\n[grid]\nx = [0.5]\n')
+    assert main(["study", "run", str(spec), "--workers", "1", "-o", str(tmp_path / "o")]) == 0
+    both = capsys.readouterr()
+    assert (both.out + both.err).count("1 tasks: 0 already done, 1 computed") == 1

@@ -78,3 +78,16 @@ def test_parts_of_a_design_realise_their_share_by_default(tmp_path, dim, n_nodes
         total = total + s.heights
     ref = design.surface().heights
     np.testing.assert_allclose(total, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+
+
+def test_genome_mechanics_without_figures_does_not_say_it_wrote_figures(tmp_path, capsys):
+    g = tmp_path / "g.json"
+    assert main(["genome", "example", "-o", str(g), "--seed", "3"]) == 0
+    capsys.readouterr()
+    mech = tmp_path / "mech"
+    assert main(["genome", "mechanics", str(g), "--nodes", "32", "--kernels", "strip",
+                 "--steps", "3", "--max-chromosomes", "1", "--no-figures", "-o",
+                 str(mech)]) == 0
+    out = capsys.readouterr().out
+    assert f"curves, c_n -> {mech}" in out and "figures" not in out
+    assert not list(mech.glob("*.png"))

@@ -207,7 +207,7 @@ def _mechanics(args) -> int:
             print(f"{kernel} kernel: {mech.message}, {mech.elapsed:.1f} s")
             print("  c_n TD (K): " + " ".join(f"{v:.3f}" for v in mech.c_td["K"]))
             print("  c_n BU (K): " + " ".join(f"{v:.3f}" for v in mech.c_bu["K"]))
-    print(f"curves, c_n and figures -> {out}")
+    print(f"curves, c_n{'' if args.no_figures else ' and figures'} -> {out}")
     return 0 if ok else 1          # a BEM sweep that did not converge: a check missed
 
 

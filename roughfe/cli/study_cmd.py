@@ -20,8 +20,7 @@ def _run(args) -> int:
     summary = run_study(spec, executor=args.executor, workers=args.workers,
                         scheduler=args.scheduler, progress=show_progress(args),
                         log=log_of(args))
-    if not args.quiet:
-        print(summary.describe())
+    if not args.quiet:            # the summary line itself is run_study's last log line
         print(f"results in {spec.output}; `roughfe study status {spec.output}` lists "
               f"failures, `roughfe study collect {spec.output}` writes the table")
     return 0 if summary.complete else 1
