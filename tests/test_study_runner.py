@@ -316,3 +316,25 @@ def test_a_temporary_file_left_by_a_killed_writer_is_no_result(tmp_path):
         (tmp_path / sub / "abc.json").write_text("{}")
         (tmp_path / sub / ".roughfe-15jb_9h0.tmp.json").write_text("{")
     assert done_keys(tmp_path) == {"abc"} == failed_keys(tmp_path)
+
+
+@pytest.mark.parametrize("study, fixed, names", [
+    ({"seed_from": ["x"]}, {}, r"replica.*seed_from = \['x'\].*Add 'replica' to seed_from"),
+    ({}, {"seed": 5}, r"replica.*parameter 'seed'.*Drop 'seed'"),
+    ({"seed_from": ["x", "replica"]}, {"seed": 5}, r"replica.*parameter 'seed'"),
+])
+def test_replicas_that_cannot_select_the_seed_are_refused(study, fixed, names):
+    """``replica`` only selects the seed: with a seed_from without it, or a fixed seed,
+    three replicas were three task keys of one surface (spread 0). Such a spec is refused;
+    one replica, or replica in seed_from, gives one distinct seed per replica."""
+    layout = {"study": {"analysis": "selftest", "output": "o", **study},
+              "grid": {"x": [0.5], "replica": [0, 1, 2]}, "fixed": fixed}
+    with pytest.raises(InputError, match=names):
+        spec_from_mapping(layout)
+    layout["study"].pop("seed_from", None)
+    layout["fixed"].pop("seed", None)
+    for seed_from in (None, ["x", "replica"]):
+        spec = spec_from_mapping({**layout, "study": {**layout["study"], "seed_from": seed_from}})
+        assert len({t.seed for t in spec.tasks()}) == 3
+    spec_from_mapping({**layout, "grid": {"x": [0.5], "replica": [0]},
+                       "study": {**layout["study"], "seed_from": ["x"]}})

@@ -24,7 +24,9 @@ parameter out of ``seed_from`` keeps the same random surface across its values, 
 the same realisation refined over resolutions ``m``. A parameter named ``seed`` in the
 grid or fixed table is used as given instead. A grid parameter named ``replica``
 (e.g. ``replica = [0, 1, ..., 19]`` for 20 surfaces per point) only selects the seed and
-labels the rows: it is not passed to the analysis.
+labels the rows: it is not passed to the analysis. So a grid of several replicas needs
+``replica`` in ``seed_from`` (when ``seed_from`` is given) and no ``seed`` parameter; a
+spec without them is refused (its replicas would all run the same surface).
 
 Each task is stored under a content key: SHA-256 of the canonical JSON of the analysis,
 its version, the roughfe version, the parameters as the task runs them (the spec's values
@@ -106,6 +108,26 @@ def _check_name(where: str, name: str):
         raise InputError(f"{where}: parameter name {name!r} must be a Python identifier "
                          "(letters, digits, underscores; not starting with a digit)")
     return name
+
+
+def _check_replica(grid: Mapping, fixed: Mapping, seed_from) -> None:
+    """Refuse a ``replica`` grid that cannot select the seed.
+
+    ``replica`` is not passed to the analysis: it only selects the seed. With a ``seed``
+    parameter (used as given) or a ``seed_from`` without ``replica``, its values would be
+    distinct tasks of one surface (identical "replicas", spread 0).
+    """
+    if len(grid.get("replica", ())) < 2:
+        return
+    if "seed" in grid or "seed" in fixed:
+        raise InputError("[grid] replica only selects the seed, but a parameter 'seed' gives "
+                         "the seed as is: every replica would run the same surface. Drop "
+                         "'seed' (the study's [study] seed and seed_from derive one per "
+                         "replica) or drop 'replica'")
+    if seed_from is not None and "replica" not in seed_from:
+        raise InputError(f"[grid] replica only selects the seed, but [study] seed_from = "
+                         f"{list(seed_from)} leaves it out: every replica would run the "
+                         f"same surface. Add 'replica' to seed_from, or drop 'replica'")
 
 
 @dataclass(frozen=True)
@@ -213,6 +235,7 @@ class StudySpec:
                 raise InputError(f"[study] seed_from names {unknown} that are not parameters; "
                                  f"the parameters are {names}")
             object.__setattr__(self, "seed_from", tuple(self.seed_from))
+        _check_replica(grid, fixed, self.seed_from)
 
     @property
     def n_tasks(self) -> int:
