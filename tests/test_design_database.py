@@ -239,3 +239,22 @@ def test_extend_checks_labels_and_genomes_before_running(tmp_path):
     with pytest.raises(InputError, match="no ridge angles"):
         extend_genome_db(spath, [good], progress=False)
     assert [e.label for e in db.load_entries(path)] == ["1-1"]
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("n_nodes", 64.7, r"n_nodes must be an integer >= 16, got 64.7"),
+    ("n_steps", 5.9, r"n_steps must be an integer >= 3, got 5.9"),
+    ("n_nodes", "abc", r"n_nodes must be an integer >= 16, got 'abc'"),
+    ("n_nodes", True, r"n_nodes must be an integer"),
+    ("length", "1e-3", r"length \(m\) must be a positive number, got '1e-3'"),
+    ("youngs_modulus", "1e6", r"youngs_modulus \(Pa\) must be a positive number"),
+    ("threshold", "0.9", r"threshold must be a number in \(0.0, 1.0\), got '0.9'"),
+    ("top_fraction", "0.8", r"top_fraction must be a positive number"),
+])
+def test_settings_refuse_non_integers_and_numbers_given_as_text(field, value, message):
+    """n_nodes = 64.7 ran at N = 64 (int() truncated it) while the task's parameters said
+    64.7; text such as "abc" or "0.9" was a ValueError or TypeError traceback. Each is an
+    InputError naming the setting; integral values are kept exactly."""
+    with pytest.raises(InputError, match=message):
+        db.settings_from({field: value})
+    assert db.settings_from({"n_nodes": np.int64(64), "n_steps": 5}).n_nodes == 64

@@ -83,11 +83,11 @@ def test_a_bad_value_anywhere_in_the_grid_refuses_the_study_before_any_task(tmp_
     ("leakage", {"D": 2.3, "m": 3, "direction": "z"}, "direction must be"),
     ("leakage", {"D": 1.5, "m": 3}, "D (fractal dimension)"),
     ("leakage", {"D": 2.3, "m": 3, "pressure_drop": 0.0}, "pressure_drop"),
-    ("genome_db", {"gamma": 1.5, "hurst": 0.7, "n_nodes": 8}, "n_nodes must be >= 16"),
+    ("genome_db", {"gamma": 1.5, "hurst": 0.7, "n_nodes": 8}, "n_nodes must be an integer >= 16"),
     ("genome_db", {"gamma": 1.5, "hurst": 0.7, "E": 0.0}, "youngs_modulus"),
     ("genome_entry", {"entry": {"label": "a"}}, "needs gamma, hurst and phases"),
     ("genome_entry", {"entry": {"label": "a", "gamma": 1.5, "hurst": 0.7, "phases": 1},
-                      "threshold": 1.5}, "threshold must lie in (0, 1)"),
+                      "threshold": 1.5}, "threshold must lie in the open interval (0.0, 1.0)"),
 ])
 def test_the_input_checks_of_the_analyses_name_the_bad_value(name, params, words):
     pytest.importorskip("roughfe.leakage.study")

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields, replace
 
-import numpy as np
-
-from ...errors import InputError
+from ...errors import InputError, check_finite_positive, check_in_open_interval, check_int
 from ...model import Material
+from ..periodic import check_dim
 
 
 @dataclass(frozen=True)
@@ -59,30 +58,24 @@ class DatabaseSettings:
     top_fraction: float = 1.0
 
     def __post_init__(self):
-        for name in ("length", "youngs_modulus"):
-            v = getattr(self, name)
-            if not (np.isfinite(v) and v > 0):
-                raise InputError(f"{name} must be finite and > 0, got {v!r}")
+        """Check every field (InputError naming it): numbers given as text or bools, and
+        a non-integer n_nodes or n_steps (64.7 ran as 64), are refused, not truncated."""
+        check_finite_positive("length (m)", self.length)
+        check_finite_positive("youngs_modulus (Pa)", self.youngs_modulus)
         # Poisson's ratio in (-1, 0.5], checked before a database stores the settings
         Material(self.youngs_modulus, self.poisson)
-        if int(self.n_nodes) < 16:
-            raise InputError(f"n_nodes must be >= 16, got {self.n_nodes!r}")
-        if int(self.n_steps) < 3:
-            raise InputError(f"n_steps must be >= 3, got {self.n_steps!r}")
+        object.__setattr__(self, "n_nodes", check_int("n_nodes", self.n_nodes, 16))
+        object.__setattr__(self, "n_steps", check_int("n_steps", self.n_steps, 3))
         if self.correlation not in ("steps", "pressure"):
             raise InputError(f"correlation must be 'steps' or 'pressure', got {self.correlation!r}")
         if self.stiffness not in ("fd", "exact"):
             raise InputError(f"stiffness must be 'fd' or 'exact', got {self.stiffness!r}")
-        if not (0.0 < self.threshold < 1.0):
-            raise InputError(f"threshold must lie in (0, 1), got {self.threshold!r}")
-        if self.dim not in (1, 2):
-            raise InputError(f"dim must be 1 (profiles) or 2 (periodic surfaces), got {self.dim!r}")
-        if not (np.isfinite(self.top_fraction) and 0.0 < self.top_fraction <= 1.0):
+        check_in_open_interval("threshold", self.threshold, 0.0, 1.0)
+        object.__setattr__(self, "dim", check_dim(self.dim))
+        top = check_finite_positive("top_fraction", self.top_fraction)
+        if top > 1.0:
             raise InputError(f"top_fraction must lie in (0, 1], got {self.top_fraction!r}")
-        object.__setattr__(self, "n_nodes", int(self.n_nodes))
-        object.__setattr__(self, "dim", int(self.dim))
-        object.__setattr__(self, "top_fraction", float(self.top_fraction))
-        object.__setattr__(self, "n_steps", int(self.n_steps))
+        object.__setattr__(self, "top_fraction", top)
 
     def to_dict(self) -> dict:
         """The fields as a dict; a thesis profile database (dim 1, top_fraction 1) omits
