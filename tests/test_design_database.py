@@ -258,3 +258,19 @@ def test_settings_refuse_non_integers_and_numbers_given_as_text(field, value, me
     with pytest.raises(InputError, match=message):
         db.settings_from({field: value})
     assert db.settings_from({"n_nodes": np.int64(64), "n_steps": 5}).n_nodes == 64
+
+
+def test_an_unknown_kernel_is_refused_before_any_task(tmp_path):
+    """kernel = "foo" in a genome_db study passed the pre-check and failed every task
+    on the workers; the settings now check the kernel name, so the study is refused
+    before anything is written."""
+    from roughfe.study import run_study, spec_from_mapping
+
+    with pytest.raises(InputError, match=r"kernel must be 'auto' or one of .*'foo'"):
+        db.DatabaseSettings(kernel="foo")
+    spec = spec_from_mapping({"study": {"analysis": "genome_db", "output": str(tmp_path / "o")},
+                              "grid": {"gamma": [1.5], "hurst": [0.5]},
+                              "fixed": {"n_nodes": 32, "kernel": "foo"}})
+    with pytest.raises(InputError, match=r"kernel must be 'auto'"):
+        run_study(spec, progress=False)
+    assert not (tmp_path / "o").exists()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields, replace
 
+from ...bem.operators import check_kernel_name
 from ...errors import InputError, check_finite_positive, check_in_open_interval, check_int
 from ...model import Material
 from ..periodic import check_dim
@@ -28,7 +29,8 @@ class DatabaseSettings:
     threshold : float
         c_n above which a chromosome is macro-scale (Alg. 2); thesis 0.95.
     kernel : str
-        BEM influence kernel passed to :func:`roughfe.bem.contact_sweep`.
+        BEM influence kernel passed to :func:`roughfe.bem.contact_sweep`: "auto" or one of
+        :data:`roughfe.bem.operators.KERNELS`.
     stiffness : {"fd", "exact"}
         How K(p) is taken from the sweep (see :func:`roughfe.genomics.macro_micro.profile_response`).
     correlation : {"steps", "pressure"}
@@ -70,6 +72,7 @@ class DatabaseSettings:
             raise InputError(f"correlation must be 'steps' or 'pressure', got {self.correlation!r}")
         if self.stiffness not in ("fd", "exact"):
             raise InputError(f"stiffness must be 'fd' or 'exact', got {self.stiffness!r}")
+        check_kernel_name(self.kernel)
         check_in_open_interval("threshold", self.threshold, 0.0, 1.0)
         object.__setattr__(self, "dim", check_dim(self.dim))
         top = check_finite_positive("top_fraction", self.top_fraction)
