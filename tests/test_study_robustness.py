@@ -397,3 +397,36 @@ def test_the_commit_warning_keeps_dirty_and_a_refusal_names_the_holder(tmp_path)
         with pytest.raises(InputError, match=r"another `roughfe study collect` \(pid \d+\) is "
                                              "writing to"):
             run_study(spec, progress=False)
+
+
+def test_a_refused_db_build_or_import_leaves_no_new_database_file(tmp_path):
+    """A refused `db build` (a design the task check refuses: H up to 4 > 3; the mpi
+    executor outside mpirun) and a refused `collect --genome-db` (entries of two
+    settings) left a new file with the settings/design and 0 genomes, which then refused
+    the corrected command ("the database was built with ..."). A refused call removes
+    the file it made; an existing database is left as it was."""
+    pytest.importorskip("roughfe.genomics.database")
+    from roughfe.cli import main as cli_main
+    from roughfe.study import genome_db_to_sqlite
+
+    path = tmp_path / "e.sqlite"
+    small = ["--nodes", "32", "--steps", "3", "--workers", "1"]
+    assert cli_main(["db", "build", str(path), "--hurst-range", "0.5", "4", "--limit", "12",
+                     *small]) == 2
+    assert not path.exists()
+    assert cli_main(["db", "build", str(path), "--limit", "1", "--executor", "mpi",
+                     *small]) == 2
+    assert not path.exists()
+    assert cli_main(["db", "build", str(path), "--limit", "1", *small]) == 0   # corrected
+    before = path.read_bytes()
+    assert cli_main(["db", "build", str(path), "--limit", "2", "--executor", "mpi",
+                     *small]) == 2
+    assert path.read_bytes() == before
+    out = tmp_path / "g"
+    spec = spec_from_mapping({"study": {"analysis": "genome_db", "output": str(out)},
+                              "grid": {"n_nodes": [32, 48]},
+                              "fixed": {"gamma": 1.5, "hurst": 0.6, "n_steps": 3}})
+    assert run_study(spec, workers=1, progress=False).complete
+    with pytest.raises(InputError, match="settings"):
+        genome_db_to_sqlite(out, tmp_path / "c.sqlite")
+    assert not (tmp_path / "c.sqlite").exists()

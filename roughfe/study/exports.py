@@ -19,8 +19,8 @@ def genome_db_to_sqlite(outdir, db_path) -> int:
     One transaction: labels already in the database are skipped (existing genomes are
     kept), so running it again after the study has progressed adds only the new
     genomes; entries with other settings than the database's, or two tasks of the study
-    with one label, are refused and nothing is inserted. A new database takes the
-    settings of the first entry.
+    with one label, are refused and nothing is inserted (a database file this call
+    created is removed again). A new database takes the settings of the first entry.
 
     Returns
     -------
@@ -51,9 +51,10 @@ def genome_db_to_sqlite(outdir, db_path) -> int:
         entries.extend(result["records"])
     if not entries:
         raise InputError(f"the study in {outdir} has no finished genome yet")
-    con = gdb.connect(db_path, create=True)
-    try:
-        gdb.write_settings(con, gdb.DatabaseSettings.from_dict(entries[0]["settings"]))
-        return gdb.insert_records(con, entries)
-    finally:
-        con.close()
+    with gdb.new_file_removed_on_error(db_path):   # a refused import leaves no new file
+        con = gdb.connect(db_path, create=True)
+        try:
+            gdb.write_settings(con, gdb.DatabaseSettings.from_dict(entries[0]["settings"]))
+            return gdb.insert_records(con, entries)
+        finally:
+            con.close()

@@ -94,6 +94,8 @@ def build_genome_db(db_path, settings=None, design=None, *, limit=None, executor
     ----------
     db_path : path-like
         SQLite file; created when missing. Its genomes are kept; only missing labels run.
+        A file this call created is removed again when the call fails before a genome
+        is in it (a task check, the executor or an interrupt refused the build).
     settings, design : DatabaseSettings, SobolDesign, optional
         Defaults: the thesis settings and design. Must match what the file stores
         (checked before any task runs; InputError otherwise).
@@ -109,14 +111,16 @@ def build_genome_db(db_path, settings=None, design=None, *, limit=None, executor
     settings = gdb.DatabaseSettings() if settings is None else settings
     design = gdb.SobolDesign() if design is None else design
     tasks = gdb.sobol_tasks(design, limit)
-    con = gdb.connect(db_path, create=True)
-    try:
-        gdb.write_settings(con, settings)
-        gdb.write_design(con, design)
-    finally:
-        con.close()
-    return _run(db_path, tasks, settings, "db build", executor=executor, workers=workers,
-                scheduler=scheduler, study_dir=study_dir, progress=progress, log=log)
+    with gdb.new_file_removed_on_error(db_path):   # a refused build leaves no new file
+        con = gdb.connect(db_path, create=True)
+        try:
+            gdb.write_settings(con, settings)
+            gdb.write_design(con, design)
+        finally:
+            con.close()
+        return _run(db_path, tasks, settings, "db build", executor=executor,
+                    workers=workers, scheduler=scheduler, study_dir=study_dir,
+                    progress=progress, log=log)
 
 
 def extend_genome_db(db_path, genomes, *, labels=None, executor="local", workers=None,

@@ -7,6 +7,7 @@ import json
 import os
 import re
 import sqlite3
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -106,6 +107,41 @@ def connect(path, *, create=False) -> sqlite3.Connection:
         con.close()
         raise FileFormatError(f"{path} is not a roughfe genome database: {exc}") from None
     return con
+
+
+@contextmanager
+def new_file_removed_on_error(path):
+    """Run the block; when it raises, remove the database file ``path`` if the block
+    created it (it did not exist before) and it holds no genome yet.
+
+    A refused ``db build`` or ``study collect --genome-db`` (a design value the tasks
+    refuse, an executor that does not start, entries of other settings) left a new file
+    with only the settings and design, which then refused the corrected command ("the
+    database was built with ..."). A refused call removes what it made.
+    """
+    path = Path(path)
+    existed = path.exists()
+    try:
+        yield
+    except BaseException:
+        if not existed and path.is_file() and _n_genomes(path) == 0:
+            path.unlink()
+        raise
+
+
+def _n_genomes(path: Path):
+    """Genomes in the database file ``path`` (0 for an empty file; None when it cannot be
+    read as a genome database)."""
+    if path.stat().st_size == 0:
+        return 0
+    try:
+        con = _connect_read_only(path)
+    except (FileFormatError, sqlite3.Error):
+        return None
+    try:
+        return con.execute("SELECT COUNT(*) FROM genomes").fetchone()[0]
+    finally:
+        con.close()
 
 
 def _connect_read_only(path: Path) -> sqlite3.Connection:
