@@ -274,3 +274,18 @@ def test_an_unknown_kernel_is_refused_before_any_task(tmp_path):
     with pytest.raises(InputError, match=r"kernel must be 'auto'"):
         run_study(spec, progress=False)
     assert not (tmp_path / "o").exists()
+
+
+def test_db_build_on_a_folder_is_an_input_error(tmp_path, capsys):
+    """`db build adir` (a folder) was a sqlite3.OperationalError traceback ("unable to
+    open database file"); it is the InputError of `db list adir`, and the folder stays."""
+    from roughfe.cli import main
+
+    folder = tmp_path / "adir"
+    folder.mkdir()
+    for command in ("build", "list"):
+        assert main(["db", command, str(folder)]) == 2
+        assert "does not exist (it is a folder)" in capsys.readouterr().err
+    with pytest.raises(InputError, match="it is a folder"):
+        db.connect(folder, create=True)
+    assert folder.is_dir()

@@ -80,13 +80,14 @@ def connect(path, *, create=False) -> sqlite3.Connection:
 
     Without ``create`` the file is opened read-only and must already hold roughfe's
     tables: a foreign or empty SQLite file is reported (FileFormatError), never written.
+    A folder is an InputError in both modes.
     """
     path = Path(path)
+    if path.is_dir() or not (create or path.is_file()):
+        raise InputError(f"genome database {path} does not exist"
+                         + (" (it is a folder)" if path.is_dir() else
+                            " (build it with 'roughfe db build')"))
     if not create:
-        if not path.is_file():
-            raise InputError(f"genome database {path} does not exist"
-                             + (" (it is a folder)" if path.is_dir() else
-                                " (build it with 'roughfe db build')"))
         return _connect_read_only(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     try:       # created by us with 0666 & ~umask (SQLite's own default is 0644)
