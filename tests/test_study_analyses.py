@@ -78,6 +78,10 @@ def test_a_bad_value_anywhere_in_the_grid_refuses_the_study_before_any_task(tmp_
     ("contact_sweep", {"nu": 0.6}, "nu"),
     ("contact_sweep", {"n_steps": 0}, "n_steps"),
     ("contact_sweep", {"m": 14}, "1 <= m <= 13"),
+    # spectral m had no upper bound: m = 40 passed and numpy refused "array is too big"
+    # on the worker (m = 16 asks for 34 GB of heights)
+    ("contact_sweep", {"generator": "spectral", "m": 40}, "1 <= m <= 13 (grid 2**m points"),
+    ("contact_sweep", {"generator": "spectral", "m": 2.0}, "must be an integer"),
     ("leakage", {"D": 2.3, "m": 20}, "1 <= m <= 13"),
     ("leakage", {"D": 2.3, "m": 3, "mu": -1.0}, "mu (Pa s)"),
     ("leakage", {"D": 2.3, "m": 3, "direction": "z"}, "direction must be"),
