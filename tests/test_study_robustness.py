@@ -430,3 +430,25 @@ def test_a_refused_db_build_or_import_leaves_no_new_database_file(tmp_path):
     with pytest.raises(InputError, match="settings"):
         genome_db_to_sqlite(out, tmp_path / "c.sqlite")
     assert not (tmp_path / "c.sqlite").exists()
+
+
+def test_collect_of_tasks_with_two_settings_names_the_setting(tmp_path):
+    """A genome_db grid over n_nodes without 'label' (seed_from without n_nodes: one
+    label per gamma) was refused as a label collision advising "leave 'label' out",
+    which it was. The refusal now says one database holds one set of settings and names
+    the differing setting; nothing is written."""
+    pytest.importorskip("roughfe.genomics.database")
+    from roughfe.study import genome_db_to_sqlite
+
+    out = tmp_path / "g"
+    spec = spec_from_mapping({"study": {"analysis": "genome_db", "output": str(out),
+                                        "seed_from": ["gamma"]},
+                              "grid": {"n_nodes": [32, 48]},
+                              "fixed": {"gamma": 1.5, "hurst": 0.6, "n_steps": 3}})
+    assert run_study(spec, workers=1, progress=False).complete
+    with pytest.raises(InputError) as info:
+        genome_db_to_sqlite(out, tmp_path / "c.sqlite")
+    message = str(info.value)
+    assert "n_nodes (32 vs 48)" in message and "one set of settings" in message
+    assert "leave 'label' out" not in message
+    assert not (tmp_path / "c.sqlite").exists()
