@@ -289,3 +289,25 @@ def test_db_build_on_a_folder_is_an_input_error(tmp_path, capsys):
     with pytest.raises(InputError, match="it is a folder"):
         db.connect(folder, create=True)
     assert folder.is_dir()
+
+
+def test_a_profile_database_refuses_a_surface_genome(tmp_path):
+    """A 2-ridge genome with angles (from a --dim 2 database) joined a profile database
+    through `db extend` and was realised as a profile with its angles ignored, while a
+    surface database refused a profile genome. Both directions are refused, naming the
+    dims, before any task runs."""
+    from roughfe.study import extend_genome_db
+
+    surface = db.DatabaseSettings(n_nodes=32, n_steps=4, dim=2, top_fraction=0.8)
+    genome = db.make_genome(1.7, 0.9, 11, surface, angles=[0.3, 1.2])
+    path = tmp_path / "p.sqlite"
+    con = db.connect(path, create=True)
+    db.write_settings(con, db.DatabaseSettings(n_nodes=64, n_steps=6))
+    con.close()
+    with pytest.raises(InputError, match=r"profile database \(dim 1\).* 2 ridge\(s\) with "
+                                         r"angles \(a surface genome, dim 2\)"):
+        extend_genome_db(path, [genome], progress=False)
+    con = db.connect(path)
+    assert db.labels(con) == []
+    con.close()
+    assert not (tmp_path / "p.sqlite.study").exists()

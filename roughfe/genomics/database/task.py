@@ -73,12 +73,17 @@ def genome_entry_inputs(gamma=None, hurst=None, phases=None, *, amplitude=1.0, l
 
 def _fits_window(genome: Genome, settings: DatabaseSettings) -> Genome:
     """``genome`` when the database's window can realise it: a surface database (dim 2)
-    needs ridge angles, and the window must show chromosomes the genome holds
-    (InputError naming what is missing otherwise)."""
+    needs ridge angles, a profile database (dim 1) takes no genome with ridge angles
+    (its realisation would ignore them), and the window must show chromosomes the genome
+    holds (InputError naming what is missing otherwise)."""
     from ..periodic import realized_chromosomes
     if settings.dim == 2 and genome.angles is None:
         raise InputError("a surface database (dim 2) takes surface genomes: this genome has "
                          "no ridge angles (a profile genome)")
+    if settings.dim == 1 and genome.angles is not None:
+        raise InputError(f"a profile database (dim 1) takes profile genomes: this genome has "
+                         f"{genome.M} ridge(s) with angles (a surface genome, dim 2), which "
+                         "a profile would ignore; add it to a surface database (--dim 2)")
     realized_chromosomes(genome, settings.length, settings.n_nodes, settings.dim)
     return genome
 
