@@ -248,6 +248,47 @@ def test_mirrored_profile_and_bad_input():
         fem_solve_contact("profile.msh", Material(E=1e9, nu=0.3), 1e-7)
 
 
+@pytest.mark.parametrize("method", ["vi", "penalty"])
+def test_petsc_options_refused_or_never_read_are_input_errors(method):
+    """A key PETSc never reads ({"snes_typo_option": 1}, {"ksp_typ": "cg"}) was dropped
+    without a word (the options were deleted right after setFromOptions, so PETSc's
+    unused-option report never fired); a value PETSc refuses was a bare
+    petsc4py.PETSc.Error. Both are InputErrors naming the key (and the value), and the
+    options database is left as it was."""
+    from petsc4py import PETSc
+
+    pm = mesh_profile(cosine_half_period(17), growth=0.3)
+    before = PETSc.Options().getAll()
+    for petsc, words in (({"snes_typo_option": 1}, r"\['snes_typo_option'\] .*never read"),
+                         ({"ksp_typ": "cg"}, r"\['ksp_typ'\] .*never read"),
+                         ({"ksp_rtol": 1e-12}, r"\['ksp_rtol'\] .*never read"),  # preonly
+                         ({"snes_type": "foo"}, r"snes_type='foo' .*SNES type foo"),
+                         ({"pc_type": "bogus"}, r"pc_type='bogus' .*PC type bogus"),
+                         ({"snes_max_it": "abc"}, r"snes_max_it='abc' .*no integer value")):
+        with pytest.raises(InputError, match=words):
+            fem_solve_contact(pm, MAT, 0.3 * G,
+                              options=FemSolverOptions(method=method, petsc_options=petsc))
+    assert PETSc.Options().getAll() == before
+
+
+def test_mumps_options_reach_every_factorization():
+    """The mat_mumps_* keys of FemSolverOptions (documented) are read by PETSc when MUMPS
+    factorizes, after setFromOptions, and were deleted before: ICNTL(14) stayed at its
+    default 20 %. It is now the value given, also at the second load step."""
+    from roughfe.fem.contact import _ContactProblem
+
+    problem = _ContactProblem(mesh_profile(cosine_half_period(17), growth=0.3), MAT,
+                              FemSolverOptions(method="penalty",
+                                               petsc_options={"mat_mumps_icntl_14": 77}))
+    try:
+        for delta in (0.2 * G, 0.4 * G):
+            problem.solve(delta)
+            factor = problem.snes.getKSP().getPC().getFactorMatrix()
+            assert factor.getMumpsIcntl(14) == 77
+    finally:
+        problem.destroy()
+
+
 @pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 def test_mesh_files_for_inspection(tmp_path):
     """.msh keeps gmsh's physical groups; the XDMF holds the same triangles in metres."""

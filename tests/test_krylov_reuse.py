@@ -70,3 +70,32 @@ def test_stalled_hierarchy_is_rebuilt_and_new_size_accepted():
         assert ok and solver.setups == 3
         assert nit == ksp_solve(small, bs, name="t", options=REYNOLDS_FV)[1]
         assert np.allclose(small @ x, bs, atol=1e-8 * np.abs(bs).max())
+
+
+def test_petsc_options_refused_misspelled_or_read_at_set_up():
+    """The Reynolds KSP options: a value PETSc refuses was a bare petsc4py.PETSc.Error, a
+    misspelled key was dropped without a word (the options were deleted right after
+    setFromOptions, so PETSc's own unused-option report never fired), and the MUMPS keys,
+    which PETSc reads at the factorization, never reached MUMPS. Now the first two are
+    InputErrors naming the key, ICNTL(14) of the factor is the value given, and the
+    options database is left as it was."""
+    from petsc4py import PETSc
+
+    from roughfe.errors import InputError
+    from roughfe.fem.petsc_tools import LU_MUMPS
+
+    before = PETSc.Options().getAll()
+    A, b = diffusion(8, np.ones(64)), np.ones(64)
+    with pytest.raises(InputError, match=r"ksp_type='foo' .*KSP type foo"):
+        ksp_solve(A, b, name="reynolds", options={"ksp_type": "foo"})
+    with pytest.raises(InputError, match=r"\['ksp_typ'\] .*never read"):
+        ksp_solve(A, b, name="reynolds", options={"ksp_typ": "cg"})
+    with pytest.raises(InputError, match=r"ksp_rtol='x1' .*no numeric value"):
+        ksp_solve(A, b, name="reynolds", options={"ksp_rtol": "x1"})
+    # a default that the caller's pc_type leaves unread (pc_hypre_type) is no error
+    assert ksp_solve(A, b, name="t", options={"pc_type": "gamg"})[2]
+    with KrylovSolver("t", {**LU_MUMPS, "mat_mumps_icntl_14": 77}) as solver:
+        x, nit, ok, message = solver.solve(A, b)
+        assert ok and np.allclose(A @ x, b)
+        assert solver._ksp.getPC().getFactorMatrix().getMumpsIcntl(14) == 77
+    assert PETSc.Options().getAll() == before

@@ -62,7 +62,7 @@ from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
 from .limits import warn_locking
 from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
-from .petsc_tools import (LU_MUMPS, apply_options, check_snes, fresh_pc_on_resize,
+from .petsc_tools import (LU_MUMPS, PrefixedOptions, check_snes, fresh_pc_on_resize,
                           unique_prefix)
 
 Method = Literal["vi", "penalty"]
@@ -114,7 +114,11 @@ class FemSolverOptions:
         ``{"snes_linesearch_type": "bt"}``. The linear-solver keys (``ksp_*``, ``pc_*``,
         ``mat_mumps_*``; default MUMPS LU) apply to the SNES's inner solves and to the
         incremental-stiffness solve, e.g. ``{"ksp_type": "cg", "pc_type": "hypre",
-        "ksp_rtol": 1e-12}`` (see ``benchmarks/bench_fem.py`` for their cost).
+        "ksp_rtol": 1e-12}`` (see ``benchmarks/bench_fem.py`` for their cost). A value
+        PETSc refuses (``{"snes_type": "foo"}``) raises InputError when the solver is
+        built, a key PETSc never reads (a misspelling, or ``ksp_rtol`` with the default
+        ``ksp_type preonly``) after the first solve
+        (:class:`roughfe.fem.petsc_tools.PrefixedOptions`).
     """
 
     method: Method = "vi"
@@ -266,12 +270,19 @@ class _ContactProblem:
         # incremental-stiffness solve alike (MUMPS LU by default; e.g. CG + hypre)
         self.ksp_options = {k: v for k, v in petsc.items() if k.startswith(_KSP_PREFIXES)}
         prefix = unique_prefix(opt.method)
-        apply_options(snes, prefix, {k: v for k, v in petsc.items()
-                                     if k not in self.ksp_options})
+        what = f"the FEM contact solver ({opt.method})"
+        self._options = [PrefixedOptions(
+            snes, prefix, {k: v for k, v in petsc.items() if k not in self.ksp_options},
+            what, checked=opt.petsc_options or {})]
         ksp = snes.getKSP()
-        apply_options(ksp, prefix, self.ksp_options)
+        try:
+            self._options.append(PrefixedOptions(ksp, prefix, self.ksp_options, what,
+                                                 checked=opt.petsc_options or {}))
+        except InputError:
+            self._options[0].release()
+            raise
         if opt.method == "vi" and self.ksp_options.get("pc_type") == "gamg":
-            fresh_pc_on_resize(ksp, self.ksp_options)      # the reduced system changes size
+            fresh_pc_on_resize(ksp, self._options[1])      # the reduced system changes size
         self.lower = self.x.duplicate()
         self.upper = self.x.duplicate()
         self.lower.set(-PETSc.INFINITY)
@@ -282,6 +293,8 @@ class _ContactProblem:
         """Free the PETSc objects (nothing of this problem outlives its sweep)."""
         for obj in (self.snes, self.K, self.x, self.y, self.r, self.lower, self.upper):
             obj.destroy()
+        for options in self._options:
+            options.release()
 
     # -- one load step ----------------------------------------------------------------
     def solve(self, delta: float, keep_fields: bool = False) -> ContactResult:
@@ -291,6 +304,8 @@ class _ContactProblem:
             self.upper.array[self.top_dofs] = self.bound
             self.snes.setVariableBounds(self.lower, self.upper)
         self.snes.solve(None, self.x)
+        for options in self._options:          # (once, after the first set-up)
+            options.check_used()
         what = (f"FEM contact ({self.options.method}, {self.pmesh.formulation}) at "
                 f"imposed delta = {float(delta):.6g} m")
         nit = check_snes(self.snes, what)
@@ -365,13 +380,16 @@ class _ContactProblem:
         J = self.K.duplicate(copy=True)
         du, b = self.K.createVecs()
         ksp = PETSc.KSP().create(comm)
+        options = None
         try:            # (see _jacobian) once per load step
             du.set(0.0)
             b.set(0.0)
             du.array[rows] = -1.0
             J.zeroRowsColumns((rows + rstart).astype(PETSc.IntType), diag=1.0, x=du, b=b)
             ksp.setOperators(J)
-            apply_options(ksp, unique_prefix("stiffness"), self.ksp_options)
+            # (the same keys as the SNES's linear solver, which checked them)
+            options = PrefixedOptions(ksp, unique_prefix("stiffness"), self.ksp_options,
+                                      "the incremental-stiffness solve", checked=())
             ksp.solve(b, du)
             reason = ksp.getConvergedReason()
             if reason <= 0:
@@ -382,6 +400,8 @@ class _ContactProblem:
         finally:
             for obj in (ksp, J, du, b):
                 obj.destroy()
+            if options is not None:
+                options.release()
         return comm.tompi4py().allreduce(local)
 
     def _gather(self, local):

@@ -7,8 +7,10 @@ solve ends with a check of the converged reason that raises
 """
 from __future__ import annotations
 
+import functools
 import itertools
 import os
+import re
 import sys
 import tempfile
 import time
@@ -17,7 +19,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ..errors import NoConvergenceError
+from ..errors import InputError, NoConvergenceError
 
 _COUNTER = itertools.count()
 
@@ -48,24 +50,114 @@ def unique_prefix(name: str) -> str:
     return f"roughfe_{name}_{next(_COUNTER)}_"
 
 
-def apply_options(obj, prefix: str, options: Mapping | None) -> None:
-    """Set ``options`` under ``prefix``, call ``obj.setFromOptions()``, remove them again.
+@functools.cache
+def _petsc_options_used():
+    """PETSc's ``PetscOptionsUsed(options, name, &used)`` through ctypes (petsc4py 3.18
+    wraps no query of the used flag); the symbol is found through the loaded petsc4py
+    extension, which links the PETSc library."""
+    import ctypes
 
-    ``obj`` is a PETSc SNES, KSP or similar. Values are converted to strings; ``None``
-    means a flag without value. The global options database is left as it was.
-    """
     from petsc4py import PETSc
 
-    options = dict(options or {})
-    db = PETSc.Options()
-    obj.setOptionsPrefix(prefix)
-    for key, value in options.items():
-        db.setValue(f"{prefix}{key}", "" if value is None else str(value))
-    try:
-        obj.setFromOptions()
-    finally:
-        for key in options:
-            db.delValue(f"{prefix}{key}")
+    used = ctypes.CDLL(PETSc.__file__).PetscOptionsUsed
+    used.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
+    used.restype = ctypes.c_int
+    return used
+
+
+def option_used(name: str) -> bool:
+    """Whether PETSc has read the option ``name`` (with its prefix, without the leading
+    ``-``) from the global options database (PETSc marks an option used when any object
+    queries it)."""
+    import ctypes
+
+    flag = ctypes.c_int(0)
+    if _petsc_options_used()(None, name.encode(), ctypes.byref(flag)) != 0:
+        raise RuntimeError(f"PetscOptionsUsed failed for the option {name!r}")
+    return bool(flag.value)
+
+
+def _refused_message(options: Mapping, what: str, exc) -> str:
+    """InputError text for a PETSc error of ``setFromOptions``: the option(s) whose value
+    PETSc's last message line names (else all of them) and that line."""
+    lines = [line.split("] ", 1)[-1].strip() for line in str(exc).splitlines()]
+    reason = next((line for line in reversed(lines) if line), str(exc))
+    bad = {k: v for k, v in options.items()
+           if v and re.search(rf"(?<![\w.-]){re.escape(v)}(?![\w.-])", reason)} or options
+    given = ", ".join(f"{k}={v!r}" for k, v in bad.items())
+    return f"PETSc refused the option(s) {given} of {what}: {reason}"
+
+
+class PrefixedOptions:
+    """PETSc options of one solver object, held in the global options database under a
+    unique prefix for the object's life (STYLE.md habit 8).
+
+    ``obj`` (a PETSc SNES, KSP, PC) gets ``prefix`` and reads them in
+    ``setFromOptions()``; they stay in the database until :meth:`release` because PETSc
+    reads some only at set-up (the MUMPS ``mat_mumps_*`` keys at every factorization,
+    the multigrid levels' ``mg_levels_*``): removed right after ``setFromOptions`` they
+    were dropped without a word. Values are converted to strings; ``None`` means a flag
+    without value. A value PETSc refuses (an unknown type, text for a number) raises
+    :class:`~roughfe.errors.InputError` naming the option and its value; after the
+    object's first solve, :meth:`check_used` raises one naming the ``checked`` options
+    PETSc never read (a misspelled key, or one the chosen types do not use, e.g.
+    ``ksp_rtol`` with ``ksp_type preonly``).
+
+    Parameters
+    ----------
+    obj : petsc4py object with ``setOptionsPrefix`` and ``setFromOptions``
+    prefix : str
+        From :func:`unique_prefix`.
+    options : mapping or None
+        Option names without prefix -> values.
+    what : str
+        The solver's name in messages.
+    checked : iterable of str, optional
+        The keys :meth:`check_used` requires to be read (default all; the caller's own
+        keys, not defaults that a caller's choice of type may leave unused).
+    """
+
+    def __init__(self, obj, prefix: str, options: Mapping | None, what: str,
+                 checked=None):
+        from petsc4py import PETSc
+
+        self.prefix, self.what = prefix, what
+        self.options = {str(k): "" if v is None else str(v)
+                        for k, v in dict(options or {}).items()}
+        self.checked = list(self.options if checked is None else checked)
+        self._db = PETSc.Options()
+        obj.setOptionsPrefix(prefix)
+        for key, value in self.options.items():
+            self._db.setValue(f"{prefix}{key}", value)
+        try:
+            obj.setFromOptions()
+        except PETSc.Error as exc:
+            message = _refused_message(self.options, what, exc)
+            self.release()
+            raise InputError(message) from None
+
+    def check_used(self) -> None:
+        """Raise InputError naming the checked options PETSc has not read (call after the
+        object's first solve, when everything read at set-up has been read)."""
+        unused = [k for k in self.checked
+                  if k in self.options and not option_used(f"{self.prefix}{k}")]
+        self.checked = []                      # once
+        if unused:
+            raise InputError(
+                f"PETSc option(s) {unused} of {self.what} were never read by PETSc: "
+                f"misspelled, or not used by the chosen solver types (e.g. ksp_rtol with "
+                f"ksp_type preonly); given {dict(self.options)}")
+
+    def set(self, key: str, value) -> None:
+        """Hold ``key`` = ``value`` instead (e.g. a type the caller set by hand)."""
+        self.options[key] = "" if value is None else str(value)
+        self._db.setValue(f"{self.prefix}{key}", self.options[key])
+
+    def release(self) -> None:
+        """Remove the options from the database (idempotent)."""
+        for key in self.options:
+            self._db.delValue(f"{self.prefix}{key}")
+        self.options = {}
 
 
 def reason_name(cls, reason: int) -> str:
@@ -108,7 +200,7 @@ class FreshOnResize:
 
     def __init__(self, options: Mapping):
         self.options = dict(options)
-        self.inner = None
+        self.inner = self.inner_options = None
         self.size = None
 
     def setUp(self, pc):                       # noqa: N802 (petsc4py's name)
@@ -116,11 +208,12 @@ class FreshOnResize:
 
         A, P = pc.getOperators()
         if self.inner is None or P.getSize() != self.size:
-            if self.inner is not None:
-                self.inner.destroy()
+            self.destroy(pc)
             self.inner = PETSc.PC().create(pc.getComm())
             self.inner.setOperators(A, P)
-            apply_options(self.inner, unique_prefix("inner"), self.options)
+            # (the keys were checked on the outer KSP, which read them as its own pc_*)
+            self.inner_options = PrefixedOptions(self.inner, unique_prefix("inner"),
+                                                 self.options, "the rebuilt preconditioner")
             self.size = P.getSize()
         else:
             self.inner.setOperators(A, P)
@@ -132,16 +225,23 @@ class FreshOnResize:
     def destroy(self, pc):
         if self.inner is not None:
             self.inner.destroy()
-            self.inner = None
+            self.inner_options.release()
+            self.inner = self.inner_options = None
 
 
-def fresh_pc_on_resize(ksp, options: Mapping) -> None:
+def fresh_pc_on_resize(ksp, options: PrefixedOptions) -> None:
     """Give ``ksp`` a :class:`FreshOnResize` preconditioner built from the ``pc_*`` keys of
-    ``options`` (the KSP's own ``ksp_*`` options stay as they are)."""
+    its ``options`` (the KSP's own ``ksp_*`` options stay as they are).
+
+    The held ``pc_type`` becomes ``python`` as well: the VI solver resets its KSP from the
+    options database whenever the active set changes (``KSPResetFromOptions``), which
+    would otherwise turn the PC back into the inner type.
+    """
     pc = ksp.getPC()
+    inner = {k: v for k, v in options.options.items() if k.startswith("pc_")}
     pc.setType("python")
-    pc.setPythonContext(FreshOnResize({k: v for k, v in options.items()
-                                       if k.startswith("pc_")}))
+    pc.setPythonContext(FreshOnResize(inner))
+    options.set("pc_type", "python")
 
 
 #: CG + BoomerAMG (hypre): the default for the symmetric positive definite Reynolds
@@ -203,11 +303,16 @@ class KrylovSolver:
     name : str
         Options prefix stem and the name in messages.
     options : mapping, optional
-        PETSc options overriding :data:`CG_AMG`.
+        PETSc options overriding ``defaults``; a value PETSc refuses raises InputError,
+        and so does, after the first solve, a key PETSc never read (a misspelling, or a
+        key the chosen types do not use; :class:`PrefixedOptions`).
     reuse_preconditioner : bool
         Keep the preconditioner across solves with an unchanged sparsity pattern.
     reuse_min_it : int
         Iterations always allowed with a kept preconditioner before it is rebuilt.
+    defaults : mapping
+        The solver's own options (default :data:`CG_AMG`), not checked for use (a
+        ``pc_type`` in ``options`` leaves e.g. ``pc_hypre_type`` unread).
 
     Attributes
     ----------
@@ -216,7 +321,8 @@ class KrylovSolver:
     """
 
     def __init__(self, name: str, options: Mapping | None = None, *,
-                 reuse_preconditioner: bool = False, reuse_min_it: int = REUSE_MIN_IT):
+                 reuse_preconditioner: bool = False, reuse_min_it: int = REUSE_MIN_IT,
+                 defaults: Mapping = CG_AMG):
         from petsc4py import PETSc
 
         self.name = name
@@ -225,7 +331,14 @@ class KrylovSolver:
         self.setups = 0
         self._cap = self.reuse_min_it
         self._ksp = PETSc.KSP().create(PETSc.COMM_SELF)
-        apply_options(self._ksp, unique_prefix(name), {**CG_AMG, **dict(options or {})})
+        options = dict(options or {})
+        try:
+            self._options = PrefixedOptions(self._ksp, unique_prefix(name),
+                                            {**defaults, **options}, f"the {name} KSP",
+                                            checked=options)
+        except InputError:
+            self._ksp.destroy()
+            raise
         self._max_it = self._ksp.getTolerances()[3]
         self._A = self._own = self._pattern = None
 
@@ -239,6 +352,7 @@ class KrylovSolver:
         """Destroy the KSP (and the last matrix if the solver owns it)."""
         self._release()
         self._ksp.destroy()
+        self._options.release()
 
     def _release(self):
         if self._own and self._A is not None:
@@ -280,6 +394,7 @@ class KrylovSolver:
         ksp.setUp()
         t1 = time.process_time()
         ksp.solve(b, x)
+        self._options.check_used()             # (after the first set-up; then a no-op)
         nit = int(ksp.getIterationNumber())
         kept = keep
         failed = ksp.getConvergedReason()

@@ -56,7 +56,7 @@ from scipy import ndimage
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
-from ..fem.petsc_tools import KrylovSolver, petsc_aij_csr
+from ..fem.petsc_tools import CG_AMG, KrylovSolver, petsc_aij_csr
 from ..fem.reynolds import check_reynolds_data
 
 #: PETSc options of the finite-volume Reynolds solve, over
@@ -355,8 +355,8 @@ def reynolds_fv_solver(petsc_options: Optional[Mapping] = None, *,
     (:class:`roughfe.fem.petsc_tools.KrylovSolver`). Close it after use (a context
     manager).
     """
-    return KrylovSolver("reynolds_fv", {**REYNOLDS_FV, **dict(petsc_options or {})},
-                        reuse_preconditioner=reuse)
+    return KrylovSolver("reynolds_fv", petsc_options, reuse_preconditioner=reuse,
+                        defaults={**CG_AMG, **REYNOLDS_FV})
 
 
 def _diagonal(T_l, T_t, T_in, T_out, wrap):
