@@ -289,6 +289,28 @@ def test_mumps_options_reach_every_factorization():
         problem.destroy()
 
 
+def test_fluid_loaded_body_refuses_a_non_finite_approach_and_recovers_from_a_failure():
+    """FluidLoadedBody.solve(p, inf) ran the SNES on an infinite bound, left NaN in its
+    solution vector, and every later valid solve failed (DIVERGED_FNORM_NAN); nan was
+    reported as a NoConvergenceError. A non-finite approach is now an InputError, and a
+    failed solve restarts the next one from the undeformed body: its result is the fresh
+    one's. NaN guesses of load control are refused too."""
+    from roughfe.fem import FluidLoadedBody
+
+    pm = mesh_profile(cosine_half_period(33), growth=0.3)
+    zero = np.zeros(pm.heights.size)
+    with FluidLoadedBody(pm, MAT) as body:
+        fresh = body.solve(zero, 0.5 * G).mean_pressure
+        for bad in (np.inf, np.nan, "1e-7"):
+            with pytest.raises(InputError, match="approach"):
+                body.solve(zero, bad)
+        with pytest.raises(NoConvergenceError, match="DIVERGED_FNORM_NAN"):
+            body.problem.solve(np.inf)             # (internal: a failed SNES solve)
+        assert body.solve(zero, 0.5 * G).mean_pressure == pytest.approx(fresh, rel=1e-6)
+    with pytest.raises(InputError, match="guesses"):
+        fem_contact_sweep(pm, MAT, pressures=[1e5], guesses=[np.nan])
+
+
 @pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 def test_mesh_files_for_inspection(tmp_path):
     """.msh keeps gmsh's physical groups; the XDMF holds the same triangles in metres."""

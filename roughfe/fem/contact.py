@@ -55,7 +55,7 @@ from typing import Literal, Mapping
 import numpy as np
 
 from ..errors import (InputError, NoConvergenceError, check_finite_nonnegative,
-                      check_finite_positive, check_instance, check_int)
+                      check_finite_positive, check_instance, check_int, check_real_array)
 from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
@@ -303,12 +303,18 @@ class _ContactProblem:
         if self.options.method == "vi":
             self.upper.array[self.top_dofs] = self.bound
             self.snes.setVariableBounds(self.lower, self.upper)
-        self.snes.solve(None, self.x)
-        for options in self._options:          # (once, after the first set-up)
-            options.check_used()
         what = (f"FEM contact ({self.options.method}, {self.pmesh.formulation}) at "
                 f"imposed delta = {float(delta):.6g} m")
-        nit = check_snes(self.snes, what)
+        try:
+            self.snes.solve(None, self.x)
+            for options in self._options:      # (once, after the first set-up)
+                options.check_used()
+            nit = check_snes(self.snes, what)
+        except Exception:
+            # the next solve starts from the undeformed body, not from a failed iterate
+            # (NaN after an infinite approach made every later solve DIVERGED_FNORM_NAN)
+            self.x.set(0.0)
+            raise
         return self._result(float(delta), nit, what, keep_fields)
 
     def solve_half_plane(self, target: float, keep_fields: bool = False) -> ContactResult:
@@ -663,7 +669,7 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     if name == "pressures" and guesses is None:
         guesses = _applied_guesses(pmesh, material, values)
     elif guesses is not None:
-        guesses = np.asarray(guesses, dtype=float).ravel()
+        guesses = check_real_array("guesses (imposed approaches)", guesses).ravel()
         if name != "pressures" or guesses.shape != values.shape:
             raise InputError(f"guesses (m) go with pressures, one per load; got {guesses!r}")
 

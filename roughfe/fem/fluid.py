@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_in_open_interval
 from ..model import ContactResult, Material
 from .contact import FemSolverOptions, _check_material, _ContactProblem
 from .mesh import FACET_TAGS, ProfileMesh
@@ -109,11 +109,12 @@ class FluidLoadedBody:
 
     def solve(self, pressure, approach: float, keep_fields: bool = False) -> ContactResult:
         """Contact of the body under the fluid ``pressure`` (Pa, nodal) at the half-plane
-        approach ``approach`` (m; negative: a clearance before first contact).
+        approach ``approach`` (m, finite; negative: a clearance before first contact).
 
         Returns the :class:`~roughfe.model.ContactResult` of the contact problem: its
         ``gap`` and ``displacement`` include the fluid's deformation (zero trapezoidal
         mean), ``pressure``/``load``/``mean_pressure`` are the solid contact's only.
         """
+        approach = check_in_open_interval("approach (m)", approach, -np.inf, np.inf)
         self.load_vector(pressure)
-        return self.problem.solve_half_plane(float(approach), keep_fields)
+        return self.problem.solve_half_plane(approach, keep_fields)
