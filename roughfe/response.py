@@ -65,7 +65,9 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         default tolerance is its traction residual 1e-5). FEM: mesh ``depth``, ``growth``,
         ``formulation``, ``size_max`` (:func:`roughfe.fem.mesh_profile`); ``solver``
         (``"vi"`` or ``"penalty"``), ``penalty_factor``, ``rtol``, ``atol``, ``max_it``,
-        ``petsc_options`` (:class:`roughfe.fem.FemSolverOptions`); ``keep_fields``.
+        ``petsc_options`` (:class:`roughfe.fem.FemSolverOptions`); ``keep_fields``
+        (the index or indices in ``[-n, n)`` of the steps whose full fields are kept,
+        :func:`roughfe.fem.fem_contact_sweep`).
 
     Returns
     -------

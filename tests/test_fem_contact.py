@@ -311,6 +311,29 @@ def test_fluid_loaded_body_refuses_a_non_finite_approach_and_recovers_from_a_fai
         fem_contact_sweep(pm, MAT, pressures=[1e5], guesses=[np.nan])
 
 
+def test_keep_fields_names_steps_in_range():
+    """keep_fields=(5,) of a 2-step sweep silently kept step 1 (5 % 2), and a lone index
+    through response(keep_fields=5) was a TypeError. Indices in [-n, n) (a lone int too)
+    keep those steps; anything else is an InputError."""
+    from roughfe.model import Loading
+    from roughfe.response import response
+
+    prof = cosine_half_period(17)
+    pm = mesh_profile(prof, growth=0.3)
+    deltas = [0.2 * G, 0.4 * G]
+    for keep, kept in (((1,), [False, True]), (-2, [True, False]),
+                       (np.int64(1), [False, True]), ((), [False, False])):
+        r = fem_contact_sweep(pm, MAT, deltas, keep_fields=keep)
+        assert [c.fields is not None for c in r.results] == kept
+    for bad in ((5,), (-3,), 2, (0.5,), True, "all"):
+        with pytest.raises(InputError, match="keep_fields"):
+            fem_contact_sweep(pm, MAT, deltas, keep_fields=bad)
+    one = response(prof, MAT, Loading(delta=0.3 * G), method="fem", growth=0.3, keep_fields=0)
+    assert one.results[0].fields is not None
+    with pytest.raises(InputError, match="keep_fields"):
+        response(prof, MAT, Loading(delta=0.3 * G), method="fem", growth=0.3, keep_fields=5)
+
+
 @pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 def test_mesh_files_for_inspection(tmp_path):
     """.msh keeps gmsh's physical groups; the XDMF holds the same triangles in metres."""

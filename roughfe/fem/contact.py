@@ -627,8 +627,9 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
         With ``pressures``: imposed approaches (m) to start each step's Newton from
         instead of the BEM's, e.g. ``delta_applied`` of a coarser mesh of the same body.
     options : FemSolverOptions, optional
-    keep_fields : iterable of int
-        Indices of the steps whose full fields (mesh, displacement, sigma_yy) are kept.
+    keep_fields : int or iterable of int
+        Indices of the steps whose full fields (mesh, displacement, sigma_yy) are kept,
+        in ``[-n, n)`` for ``n`` steps (negative: from the end); others are an InputError.
 
     Raises
     ------
@@ -655,7 +656,7 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
         raise InputError(f"pressures must be > 0 (Pa), got {values!r}")
     if np.any(np.diff(values) <= 0):
         raise InputError(f"{name} must be strictly increasing (load stepping)")
-    keep = {int(k) % values.size for k in keep_fields}
+    keep = _kept_steps(keep_fields, values.size)
     full = None
     if name == "deltas":
         full = _full_contact(pmesh, material)
@@ -694,6 +695,25 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     finally:
         problem.destroy()
     return SweepResult.from_results(results, rms_slope=problem.rms_slope, length=pmesh.width)
+
+
+def _kept_steps(keep_fields, n: int) -> set:
+    """The step indices in ``[0, n)`` named by ``keep_fields`` (an int or an iterable of
+    ints in ``[-n, n)``, negative from the end); an InputError otherwise (5 of 2 steps
+    was silently step 1)."""
+    single = isinstance(keep_fields, (int, np.integer)) and not isinstance(keep_fields, bool)
+    try:
+        items = list([keep_fields] if single else keep_fields)
+    except TypeError:
+        raise InputError(f"keep_fields must be a step index or an iterable of step "
+                         f"indices, got {keep_fields!r}") from None
+    name = f"keep_fields index (one of the {n} steps, -{n} <= k < {n})"
+    kept = set()
+    for k in items:
+        if check_int(name, k, -n) >= n:
+            raise InputError(f"{name} must be < {n}, got {k!r}")
+        kept.add(int(k) % n)
+    return kept
 
 
 def _full_contact(pmesh: ProfileMesh, material: Material):
