@@ -115,6 +115,7 @@ def _adhesive_response(surface, material, loading, options) -> SweepResult:
 
 
 def _fem_response(surface, material, loading, options) -> SweepResult:
+    from .bem.contact_checks import _check_surface
     from .bem.sweep import default_deltas
     from .fem import FemSolverOptions, fem_contact_sweep, mesh_profile, mirrored_profile
 
@@ -122,6 +123,7 @@ def _fem_response(surface, material, loading, options) -> SweepResult:
     if surface.ndim != 1:
         raise InputError(f"method='fem' needs a 1D profile (plane strain), got a surface of "
                          f"shape {surface.shape}")
+    _check_surface(surface)            # the BEM's words (n_steps gave no approaches)
     if loading.controls_pressure:
         raise InputError(f"method='fem' imposes approaches (delta, deltas, n_steps); got "
                          f"{loading.kind}: use method='bem' for load control")

@@ -209,6 +209,22 @@ def test_optional_field_is_one_line():
 
 
 @pytest.mark.fem
+def test_flat_profile_is_refused_by_both_methods_in_the_same_words():
+    """A flat profile with Loading(n_steps=3) and method="fem" got all-zero default
+    approaches and "deltas must be strictly increasing"; it is now the BEM's "the surface
+    is flat" for every loading of both methods."""
+    pytest.importorskip("dolfinx")
+    flat = Surface(np.zeros(33), 1e-3)
+    for loading in (Loading(n_steps=3), Loading(delta=1e-7)):
+        messages = []
+        for method in ("bem", "fem"):
+            with pytest.raises(InputError, match="the surface is flat") as err:
+                response(flat, MAT, loading, method=method)
+            messages.append(str(err.value))
+        assert messages[0] == messages[1]
+
+
+@pytest.mark.fem
 def test_fem_fields_are_an_immutable_mapping():
     pytest.importorskip("dolfinx")
     prof = cosine_half_period(17)
