@@ -334,6 +334,33 @@ def test_keep_fields_names_steps_in_range():
         response(prof, MAT, Loading(delta=0.3 * G), method="fem", growth=0.3, keep_fields=5)
 
 
+def test_fluid_loaded_body_checks_its_arguments_and_refuses_use_after_close():
+    """A dict of options was "AttributeError: 'dict' object has no attribute
+    'penalty_factor'" (also through coupled_channel(fem_options={...})), a pmesh that is
+    not a ProfileMesh was not checked, and a solve after close() was "'NoneType' object
+    has no attribute 'localForm'". They are InputErrors naming the argument, as in
+    fem_contact_sweep (one check for both)."""
+    from roughfe.fem import FluidLoadedBody
+    from roughfe.leakage.profile_fsi import coupled_channel
+
+    prof = cosine_half_period(17)
+    pm = mesh_profile(prof, growth=0.3)
+    with pytest.raises(InputError, match="options must be a roughfe.fem.FemSolverOptions, "
+                                         "got dict"):
+        FluidLoadedBody(pm, MAT, {"method": "penalty"})
+    with pytest.raises(InputError, match="pmesh must be a roughfe.fem.ProfileMesh"):
+        FluidLoadedBody(prof, MAT)
+    with pytest.raises(InputError, match="options must be a roughfe.fem.FemSolverOptions"):
+        coupled_channel(prof, MAT, -1e-6, p_in=2e6, p_out=1e5, method="fem", growth=0.3,
+                        fem_options={"method": "penalty"})
+    body = FluidLoadedBody(pm, MAT)
+    assert body.solve(np.zeros(17), 0.5 * G).mean_pressure > 0
+    body.close()
+    body.close()                                   # twice is harmless
+    with pytest.raises(InputError, match="closed"):
+        body.solve(np.zeros(17), 0.5 * G)
+
+
 @pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 def test_mesh_files_for_inspection(tmp_path):
     """.msh keeps gmsh's physical groups; the XDMF holds the same triangles in metres."""

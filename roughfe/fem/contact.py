@@ -84,17 +84,6 @@ def p_wave_modulus(material: Material) -> float:
     return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 
 
-def _check_material(material) -> Material:
-    """``material``, or an InputError for nu >= 0.5; a ResolutionWarning (volumetric
-    locking, the measured error) above :data:`roughfe.fem.limits.LOCKING_NU` = 0.45."""
-    check_instance("material", material, Material, "a roughfe.model.Material")
-    if material.nu >= 0.5:
-        raise InputError(f"the P1 displacement FEM needs nu < 0.5 (it locks when incompressible), "
-                         f"got nu = {material.nu!r}")
-    warn_locking(material.nu, stacklevel=4)
-    return material
-
-
 @dataclass(frozen=True)
 class FemSolverOptions:
     """Numerical options of the FEM contact solvers (physical data live elsewhere).
@@ -137,6 +126,22 @@ class FemSolverOptions:
         check_int("max_it (SNES iterations per step)", self.max_it, 1)
         if self.petsc_options is not None:
             object.__setattr__(self, "petsc_options", FrozenMapping(self.petsc_options))
+
+
+def _check_body(pmesh, material, options) -> tuple:
+    """``(material, options)`` of a FEM body, checked: ``pmesh`` a ProfileMesh, ``material``
+    a Material with nu < 0.5 (a ResolutionWarning, volumetric locking with the measured
+    error, above :data:`roughfe.fem.limits.LOCKING_NU` = 0.45), ``options`` a
+    FemSolverOptions (None: the defaults); an InputError naming the argument otherwise."""
+    check_instance("pmesh", pmesh, ProfileMesh, "a roughfe.fem.ProfileMesh (mesh_profile)")
+    check_instance("material", material, Material, "a roughfe.model.Material")
+    if material.nu >= 0.5:
+        raise InputError(f"the P1 displacement FEM needs nu < 0.5 (it locks when incompressible), "
+                         f"got nu = {material.nu!r}")
+    warn_locking(material.nu, stacklevel=4)
+    options = FemSolverOptions() if options is None else options
+    check_instance("options", options, FemSolverOptions, "a roughfe.fem.FemSolverOptions")
+    return material, options
 
 
 #: The FEM returns the one result types of :mod:`roughfe.model`; these names are aliases
@@ -637,10 +642,7 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
         Naming the SNES converged reason of the failed step; ``result`` holds the list
         of the steps solved before it.
     """
-    check_instance("pmesh", pmesh, ProfileMesh, "a roughfe.fem.ProfileMesh (mesh_profile)")
-    material = _check_material(material)
-    options = FemSolverOptions() if options is None else options
-    check_instance("options", options, FemSolverOptions, "a roughfe.fem.FemSolverOptions")
+    material, options = _check_body(pmesh, material, options)
     given = {k: v for k, v in (("deltas", deltas), ("applied_deltas", applied_deltas),
                                ("pressures", pressures)) if v is not None}
     if len(given) != 1:

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import InputError, check_in_open_interval
 from ..model import ContactResult, Material
-from .contact import FemSolverOptions, _check_material, _ContactProblem
+from .contact import FemSolverOptions, _check_body, _ContactProblem
 from .mesh import FACET_TAGS, ProfileMesh
 
 
@@ -42,6 +42,12 @@ class FluidLoadedBody:
     material : roughfe.model.Material
     options : FemSolverOptions, optional
         Contact solver options (default: VI, MUMPS).
+
+    Raises
+    ------
+    InputError
+        A ``pmesh``, ``material`` or ``options`` of the wrong type (e.g. a dict of
+        options), nu >= 0.5; a solve after :meth:`close`.
     """
 
     def __init__(self, pmesh: ProfileMesh, material: Material,
@@ -50,8 +56,7 @@ class FluidLoadedBody:
         from dolfinx import fem
         from dolfinx.fem.petsc import create_vector
 
-        self.problem = _ContactProblem(pmesh, _check_material(material),
-                                       FemSolverOptions() if options is None else options)
+        self.problem = _ContactProblem(pmesh, *_check_body(pmesh, material, options))
         self.pmesh = pmesh
         mesh = pmesh.mesh
         fdim = mesh.topology.dim - 1
@@ -89,6 +94,9 @@ class FluidLoadedBody:
         from dolfinx.fem.petsc import assemble_vector, set_bc
         from petsc4py import PETSc
 
+        if self._vec is None:
+            raise InputError("this FluidLoadedBody is closed (its PETSc objects are freed): "
+                             "make a new one")
         p = np.asarray(pressure, dtype=float)
         if p.shape != self.pmesh.heights.shape or not np.all(np.isfinite(p)):
             raise InputError(f"the fluid pressure must be finite, one value per profile "

@@ -8,7 +8,7 @@ Two approximations of :mod:`roughfe.fem.contact` do not go away with the mesh si
   257 top nodes); the cure, a mixed u-p or enriched (MINI) element with the nodal
   contact of the top vertices kept, is not implemented. Above
   :data:`LOCKING_NU` a :class:`~roughfe.errors.ResolutionWarning` names the measured error;
-  nu >= 0.5 is refused (:func:`roughfe.fem.contact._check_material`).
+  nu >= 0.5 is refused (:func:`roughfe.fem.contact._check_body`).
 * **Finite depth.** The body of depth H_d stands on rollers. The uniform part of the load
   is corrected exactly (the layer compliance H_d / M), but the non-uniform part decays as
   exp(-pi y / W) for the longest mode of the mirrored profile (period 2 W), so a shallow
