@@ -383,6 +383,27 @@ def test_mesh_files_for_inspection(tmp_path):
     assert area[yc < -0.8e-3].mean() > 20 * area[yc > -0.05e-3].mean()
 
 
+def test_mesh_profile_refuses_bad_growth_and_output_paths(tmp_path):
+    """growth="a" was a bare ValueError, write_to=<an existing file> a FileExistsError,
+    name="" gmsh's "Unknown output file format", and name="../escape" wrote beside the
+    folder. They are InputErrors now, raised before gmsh runs and before anything is
+    written."""
+    s = cosine_half_period(17)
+    for growth in ("a", float("nan"), 0.0, 1.5):
+        with pytest.raises(InputError, match="growth"):
+            mesh_profile(s, growth=growth)
+    (tmp_path / "afile").write_text("mine")
+    with pytest.raises(InputError, match="write_to must be a folder"):
+        mesh_profile(s, write_to=tmp_path / "afile")
+    with pytest.raises(InputError, match="is not a folder"):
+        mesh_profile(s, write_to=tmp_path / "afile" / "sub")
+    for name in ("", "../escape", "a/b", 3):
+        with pytest.raises(InputError, match="name .* must be a non-empty name without '/'"):
+            mesh_profile(s, write_to=tmp_path / "m", name=name)
+    assert (tmp_path / "afile").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
 def test_contact_length_is_continuous_when_a_node_changes_state():
     """A node that closes (gap -> 0+) and then carries a pressure (p -> 0+) moves the
     sub-element edge continuously to that node; the node count jumps by dx there."""

@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import InputError, check_finite_positive, check_instance
 from ..surfaces import Surface
 from ..frozen import FrozenMapping
-from ..writers import atomic_path
+from ..writers import atomic_path, output_file
 from .limits import check_depth
 from .petsc_tools import ensure_jit_cache
 
@@ -118,10 +118,11 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
     size_max : float, optional
         Largest element size (m); default ``W / 4``.
     write_to : path, optional
-        Folder (e.g. ``meshes/``) where ``<name>.msh`` (gmsh) and ``<name>.xdmf`` (meshio,
-        inline XML data) are written atomically for inspection.
+        Folder (e.g. ``meshes/``, created if missing) where ``<name>.msh`` (gmsh) and
+        ``<name>.xdmf`` (meshio, inline XML data) are written atomically for inspection;
+        an existing file or a folder that cannot be created is an InputError.
     name : str
-        File stem for ``write_to``.
+        File stem for ``write_to``: not empty, no ``/``.
     comm : MPI communicator, optional
         Default ``MPI.COMM_WORLD``; gmsh runs on rank 0 and dolfinx distributes the mesh.
     """
@@ -133,8 +134,9 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
     surface = _check_profile(surface)
     if formulation not in FORMULATIONS:
         raise InputError(f"formulation must be one of {FORMULATIONS}, got {formulation!r}")
-    if not (0.0 < float(growth) <= 1.0):
+    if check_finite_positive("growth", growth) > 1.0:
         raise InputError(f"growth must lie in (0, 1], got {growth!r}")
+    folder = None if write_to is None else _check_output(write_to, name)
     comm = MPI.COMM_WORLD if comm is None else comm
     h = np.asarray(surface.heights, dtype=float)
     n = h.size
@@ -187,8 +189,8 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
                 gmsh.option.setNumber(opt, 0)
             gmsh.option.setNumber("Mesh.Algorithm", 6)       # Frontal-Delaunay
             gmsh.model.mesh.generate(2)
-            if write_to is not None:
-                files = _write_mesh_files(Path(write_to), name, scale)
+            if folder is not None:
+                files = _write_mesh_files(folder, name, scale)
         mesh, cell_tags, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
     finally:
         gmsh.finalize()
@@ -200,6 +202,22 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
     return ProfileMesh(mesh, cell_tags, facet_tags, h_ro, x, float(width), float(depth),
                        float(dx), float(growth), float(scale), formulation, int(n_cells),
                        FrozenMapping(files))
+
+
+def _check_output(write_to, name) -> Path:
+    """The folder ``write_to`` of the mesh files, checked: ``name`` a non-empty file stem
+    without ``/``, ``<name>.msh`` and ``<name>.xdmf`` writable there (the folder exists or
+    can be created; :func:`roughfe.writers.output_file`); an InputError otherwise."""
+    if not isinstance(name, str) or not name.strip() or "/" in name or "\0" in name:
+        raise InputError(f"name (the file stem of the mesh files) must be a non-empty "
+                         f"name without '/', got {name!r}")
+    folder = Path(write_to)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"write_to must be a folder for {name}.msh and {name}.xdmf, got "
+                         f"the existing file {str(folder)!r}")
+    for suffix in (".msh", ".xdmf"):
+        output_file(folder / f"{name}{suffix}", overwrite=True)
+    return folder
 
 
 def _write_mesh_files(folder: Path, name: str, scale: float) -> dict:
