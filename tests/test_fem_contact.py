@@ -363,7 +363,8 @@ def test_fluid_loaded_body_checks_its_arguments_and_refuses_use_after_close():
 
 @pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 def test_mesh_files_for_inspection(tmp_path):
-    """.msh keeps gmsh's physical groups; the XDMF holds the same triangles in metres."""
+    """.msh keeps gmsh's physical groups; it and the XDMF hold the same triangles in
+    metres."""
     meshio = pytest.importorskip("meshio")
     surf = random_profile(33, seed=3)
     pm = mesh_profile(surf, depth=1e-3, growth=0.2, write_to=tmp_path, name="r33")
@@ -376,6 +377,16 @@ def test_mesh_files_for_inspection(tmp_path):
     assert used[:, 1].min() == pytest.approx(-1e-3, rel=1e-12)
     msh = meshio.read(pm.files["msh"])
     assert set(msh.field_data) >= {"top", "bottom", "left", "right", "body"}
+    # the .msh is in metres as well (it was in units of W, x in [0, 1]): the same
+    # vertices and triangles as the XDMF; the solver's mesh stays in units of W
+    assert np.allclose(msh.points[:, :2], m.points[:, :2], rtol=0, atol=1e-12 * pm.width)
+    assert np.array_equal(msh.cells_dict["triangle"], tri)
+    assert msh.points[:, 0].max() == pytest.approx(pm.width, rel=1e-12)
+    assert pm.mesh.geometry.x[:, 0].max() == pytest.approx(1.0, rel=1e-12)
+    lines = msh.cells_dict["line"]
+    top = lines[msh.cell_data_dict["gmsh:physical"]["line"] == FACET_TAGS["top"]]
+    assert np.allclose(np.sort(msh.points[np.unique(top), 0]), pm.x, rtol=0,
+                       atol=1e-12 * pm.width)
     # element size grows with depth: the bottom triangles are much larger than the top ones
     area = 0.5 * np.abs(np.cross(m.points[tri[:, 1], :2] - m.points[tri[:, 0], :2],
                                  m.points[tri[:, 2], :2] - m.points[tri[:, 0], :2]))

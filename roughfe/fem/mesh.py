@@ -118,9 +118,10 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
     size_max : float, optional
         Largest element size (m); default ``W / 4``.
     write_to : path, optional
-        Folder (e.g. ``meshes/``, created if missing) where ``<name>.msh`` (gmsh) and
-        ``<name>.xdmf`` (meshio, inline XML data) are written atomically for inspection;
-        an existing file or a folder that cannot be created is an InputError.
+        Folder (e.g. ``meshes/``, created if missing) where ``<name>.msh`` (gmsh, with the
+        physical groups) and ``<name>.xdmf`` (meshio, inline XML data) are written
+        atomically for inspection, both in metres (the solver's mesh stays in units of
+        W); an existing file or a folder that cannot be created is an InputError.
     name : str
         File stem for ``write_to``: not empty, no ``/``.
     comm : MPI communicator, optional
@@ -189,9 +190,9 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
                 gmsh.option.setNumber(opt, 0)
             gmsh.option.setNumber("Mesh.Algorithm", 6)       # Frontal-Delaunay
             gmsh.model.mesh.generate(2)
-            if folder is not None:
-                files = _write_mesh_files(folder, name, scale)
         mesh, cell_tags, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+        if comm.rank == 0 and folder is not None:
+            files = _write_mesh_files(folder, name, scale)     # (rescales the gmsh model)
     finally:
         gmsh.finalize()
     files = comm.bcast(files, root=0)
@@ -221,19 +222,28 @@ def _check_output(write_to, name) -> Path:
 
 
 def _write_mesh_files(folder: Path, name: str, scale: float) -> dict:
-    """Write the current gmsh model as ``.msh`` and, in metres, as XDMF (meshio)."""
+    """Write the current gmsh model in metres as ``.msh`` (gmsh) and XDMF (meshio).
+
+    The model is built in units of ``scale`` (= W); its geometry and its mesh nodes are
+    scaled by ``scale`` in place first (gmsh 4.8 has no mesh.affineTransform: node by
+    node), so call this after the dolfinx mesh has been made from the model.
+    """
     import gmsh
     import meshio
 
-    folder.mkdir(parents=True, exist_ok=True)
+    gmsh.model.geo.dilate(gmsh.model.getEntities(0), 0.0, 0.0, 0.0, scale, scale, scale)
+    gmsh.model.geo.synchronize()                      # the .msh entities' bounding boxes
+    node_tags, coords, _ = gmsh.model.mesh.getNodes()
+    coords = coords.reshape(-1, 3) * scale
+    for tag, xyz in zip(node_tags.tolist(), coords.tolist()):
+        gmsh.model.mesh.setNode(tag, xyz, [])
     msh = folder / f"{name}.msh"
     with atomic_path(msh) as tmp:
         gmsh.write(str(tmp))
-    node_tags, coords, _ = gmsh.model.mesh.getNodes()
     _, nodes = gmsh.model.mesh.getElementsByType(2)           # 3-node triangles
     index = np.empty(int(node_tags.max()) + 1, dtype=np.int64)
     index[node_tags.astype(np.int64)] = np.arange(node_tags.size)
-    points = coords.reshape(-1, 3)[:, :2] * scale
+    points = coords[:, :2]
     cells = index[nodes.astype(np.int64)].reshape(-1, 3)
     xdmf = folder / f"{name}.xdmf"
     with atomic_path(xdmf) as tmp:
