@@ -55,6 +55,17 @@ def test_alg3_recovers_a_database_genome_at_another_amplitude(entries):
     from roughfe.genomics.design.algorithms import SELECTION
     assert bad.success and de.combined_score(bad.best.scores) < SELECTION
     assert "the target is NOT matched" in bad.message
+    # an extra stage moves the verdict to its own best: a refine that lifted s from 0.932 to
+    # 0.9806 followed "the target is NOT matched (s = 0.932 ...)" (make validate, design)
+    import time
+    from types import SimpleNamespace
+
+    from roughfe.genomics.design.algorithms import _extended
+    none = SimpleNamespace(n_sweeps=0)
+    lifted = _extended(bad, r.candidates, none, time.perf_counter(), "; extra stage")
+    assert "NOT matched" not in lifted.message and lifted.message.endswith("; extra stage")
+    dropped = _extended(r, bad.candidates, none, time.perf_counter(), "; extra stage")
+    assert dropped.message.index("; extra stage") < dropped.message.index("NOT matched")
 
 
 @pytest.mark.parametrize("method", ["gco", "cco", "mcco"])

@@ -199,14 +199,19 @@ def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, ent
     return tuple(out)
 
 
+def _miss_note(s_best: float) -> str:
+    """The message's verdict on the match. ``success`` is the soundness of the computation
+    (finite, reproducible scores), not the match: say so when the best design is no match
+    (s = -23.7 read as a success)."""
+    return (f"; the target is NOT matched (s = {s_best:.4g} <= {SELECTION}, the selection "
+            f"value of Alg. 3)" if not s_best > SELECTION else "")
+
+
 def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evaluate, t0):
     best = cands[0]
     ok, why = _success(cands)
     s_best = combined_score(best.scores)
-    # success is the soundness of the computation (finite, reproducible scores), not the
-    # match: say so when the best design is no match (s = -23.7 read as a success)
-    miss = (f"; the target is NOT matched (s = {s_best:.4g} <= {SELECTION}, the selection "
-            f"value of Alg. 3)" if not s_best > SELECTION else "")
+    miss = _miss_note(s_best)
     msg = (f"{method}: best {best.origin} s = {s_best:.4f} "
            f"(stages {', '.join(f'{s:.4f}' for s in best.stages)})"
            + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used")
@@ -439,12 +444,16 @@ def refine(result: DesignResult, settings: DatabaseSettings, *, rounds: int = 3,
 
 
 def _extended(result, out, evaluate, t0, note):
-    """``result`` with the candidates ``out`` of an extra stage, its sweeps and time added
-    and the success criterion re-applied to the new candidates."""
+    """``result`` with the candidates ``out`` of an extra stage, its sweeps and time added,
+    the success criterion re-applied to the new candidates and the match verdict moved to
+    the end, on the new best (a stage that lifted s from 0.932 to 0.9806 followed "the
+    target is NOT matched (s = 0.932 ...)")."""
     ok, why = _success(out)
+    before = result.message.replace(_miss_note(combined_score(result.candidates[0].scores)), "")
     return replace(result, candidates=tuple(out), nit=result.nit + evaluate.n_sweeps,
                    elapsed=result.elapsed + time.perf_counter() - t0,
-                   success=result.success and ok, message=result.message + note + why)
+                   success=result.success and ok,
+                   message=before + note + _miss_note(combined_score(out[0].scores)) + why)
 
 
 def _at_targets(design, objective, settings, evaluate):
