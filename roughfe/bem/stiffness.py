@@ -124,10 +124,14 @@ def unit_load_rate(op, contact, tol=1e-8, max_iter=2000):
 def exact_stiffness(op, solver, contact, w, scale) -> float:
     """Exact incremental stiffness K = dp/dDelta (Pa/m, Eq. 2.7) of the contact set: the
     mean of :func:`pressure_rate`; at Delta = 0 the touching point(s) (gap w <= 1e-12
-    scale); ``inf`` at full contact of a periodic surface."""
+    scale); 0 when nothing touches (a separated state: the end of an unloading branch
+    after plastic flow, whose recess lifts the surface off the flat); ``inf`` at full
+    contact of a periodic surface."""
     c = contact
     if not c.any():
         c = w <= 1e-12 * scale          # Delta = 0: the touching point(s)
+        if not c.any():                 # separated: no point responds (every solver)
+            return 0.0
     if op.periodic and c.all():
         return float("inf")
     return float(pressure_rate(op, solver, c, tol=STIFFNESS_TOL)[1].sum()) / c.size
