@@ -166,3 +166,38 @@ def test_the_elastic_state_of_a_hardness_solve(rough, monkeypatch):
     assert np.array_equal(a.contact, b.contact)
     assert np.array_equal(a.pressure >= hp, b.pressure >= hp)
     assert np.abs(a.pressure - b.pressure).max() <= 1e-7 * hp
+
+
+def test_unloading_off_the_recessed_surface_is_no_contact(rough, monkeypatch):
+    """Unloading after plastic flow: the recessed heights h - u_pl first touch the flat at
+    Delta_0 = max h - max(h - u_pl) > 0. At or below it there is no contact and no load,
+    exactly (as at Delta <= 0 without a recess), with no iteration; it went to load
+    control, whose secant halved P for 20000 iterations and then fell back with a
+    RuntimeWarning (35 s for a 4-step 256^2 unloading sweep; reviewer, session 25).
+    Just above it the load path, started from the recessed heights, agrees with the
+    gap-variable CG."""
+    import warnings
+    h = rough.heights
+    hp = 0.3 * MAT.E_star
+    top = solve_contact(rough, MAT, delta=0.6 * (h.max() - h.mean()), hardness=hp,
+                        compute_stiffness=False)
+    up = top.plastic_displacement
+    first = float(h.max() - (h - up).max())
+    assert top.plastic_area_fraction > 0.01 and first > 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for d in (0.5 * first, first):
+            r = solve_contact(rough, MAT, delta=d, hardness=hp, plastic_displacement=up)
+            assert r.nit == 0 and r.n_contact == 0 and r.mean_pressure == 0.0
+            assert r.gap.min() >= 0 and np.array_equal(r.plastic_displacement, up)
+        assert r.gap.min() <= 1e-12 * float(np.ptp(h))     # at Delta_0 the top touches
+        assert r.stiffness > 0                               # ... and responds
+        d = first + 0.05 * float(h.std())
+        a = solve_contact(rough, MAT, delta=d, hardness=hp, plastic_displacement=up,
+                          compute_stiffness=False)
+    _gap_variable(monkeypatch)
+    b = solve_contact(rough, MAT, delta=d, hardness=hp, plastic_displacement=up,
+                      compute_stiffness=False)
+    assert 0 < a.area_fraction < 0.1 and a.plastic_area_fraction == 0.0
+    assert np.array_equal(a.contact, b.contact)
+    assert np.abs(a.pressure - b.pressure).max() <= 1e-7 * a.pressure.max()

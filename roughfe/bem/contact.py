@@ -215,9 +215,9 @@ def _elastic_approach(surface, material, op, h, hmax, scale, delta, tol, max_ite
     tolerance: a 2D surface through load control (:mod:`roughfe.bem.approach`, ``tol``)
     where the load has an estimate; otherwise, or when that solve does not converge
     (with a RuntimeWarning), the gap-variable CG (:func:`periodic_gap_control`, which
-    accepts a primal residual of 10 ``tol``)."""
-    start = (approach_start(surface, material, delta, initial, coarse_correction)
-             if surface.ndim == 2 else None)
+    accepts a primal residual of 10 ``tol``). ``surface``: the (recessed) heights h."""
+    start = (approach_start(surface, material, delta - (hmax - float(h.max())), initial,
+                            coarse_correction) if surface.ndim == 2 else None)
     spent = 0                  # iterations of a load-controlled attempt that fell back
     if start is not None:
         p0, deflation = start[0], _deflation(op, None, None, coarse_correction, start[0])
@@ -359,10 +359,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                              f"{int(np.count_nonzero(~np.isfinite(initial)))} non-finite value(s)")
 
     out = None
-    if delta is not None and delta <= 0:
-        # the flat at or above the highest point (of the heights before any plastic recess,
-        # which only lowers them): no contact and no load, exactly. A warm step there went
-        # to load control, whose secant never reaches P = 0 (20000 iterations)
+    if delta is not None and delta <= hmax - float(h.max()):
+        # the flat at or above the top of the (recessed) heights: p = 0, no contact, exactly
         out = SolverOutput(np.zeros(h.shape), np.zeros(h.shape), delta, 0, 0.0, solver)
     # the gap-variable CG accepts a primal residual of 10 tol (its dual reaches tol)
     periodic_delta = solver == "pk" and op.periodic and delta is not None
@@ -388,7 +386,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 out = SolverOutput(p, h - h.mean(), delta_full, 0, 0.0, "closed form")
             del p0            # not kept through the iterative solve (one field)
     if out is None:
-        elastic = functools.partial(_elastic_approach, surface, material, op, h, hmax,
+        recessed = surface if plastic is None else Surface(h, surface.size, True)
+        elastic = functools.partial(_elastic_approach, recessed, material, op, h, hmax,
                                     scale, delta, tol, max_iter, coarse_correction)
         if gap_control:
             out, tolerance = elastic(initial)
