@@ -189,6 +189,12 @@ def test_contact_cli_hardness_load_unload_cycle(tmp_path, capsys):
     assert steps[0]["plastic_area_fraction"] == 0.0 < steps[1]["plastic_area_fraction"]
     # back at 1 MPa the flattened crest carries the load on a wider contact
     assert steps[2]["area_fraction"] > steps[0]["area_fraction"]
+    # Persson's elastic theory beside the elastic step only, not beside the plastic one
+    # nor the unloading step on the flattened crest; derived.persson says why
+    assert steps[0]["persson_area_fraction"] > 0
+    assert steps[1]["persson_area_fraction"] is None is steps[2]["persson_area_fraction"]
+    assert steps[2]["persson_mean_gap"] is None
+    assert doc["derived"]["persson"]["plastic_steps"] == [1, 2]
     h5py = pytest.importorskip("h5py")
     with h5py.File(out / "fields.h5", "r") as f:
         up = f["plastic_displacement"][:]

@@ -196,6 +196,11 @@ def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
             assert o["mean_pressure"] < e["mean_pressure"]
     assert any(st["adhesive_area_fraction"] > 0 for st in adh["steps"])
     assert max(st["plastic_area_fraction"] for st in hard["steps"]) > 0
+    # nor beside the plastic steps and those after them (the elastic theory; session 25)
+    flowed = [k for k, st in enumerate(hard["steps"]) if st["plastic_area_fraction"] > 0]
+    assert hard["persson"]["plastic_steps"] == list(range(flowed[0], len(hard["steps"])))
+    assert all(st["persson_leak_rate"] is None and st["persson_area_fraction"] is None
+               for st in hard["steps"][flowed[0]:])
     # --unload: the loading steps in reverse; the plastic set keeps the gap smaller than
     # on loading at the same approach
     unl = [st for st in hard["steps"] if st["unloading"]]

@@ -241,6 +241,34 @@ def test_beside_evaluates_no_theory_for_adhesive_steps(surface):
     assert "kappa" not in doc["persson"] and "u0" not in doc["persson"]
 
 
+def test_beside_evaluates_no_elastic_theory_from_the_first_plastic_step_on(surface):
+    # the theory is elastic: a step with plastic flow, and every later one (on the surface
+    # recessed by the plastic displacement: the unloading branch), is not the elastic
+    # contact of this PSD. Until the review of session 25 a hardness run got it beside
+    # every step (A* 0.606, 0.595 of it plastic, beside Persson's 0.058)
+    gbar = stats.rms_slope(surface)
+    p = [0.02 * E_STAR * gbar, 0.05 * E_STAR * gbar, 0.02 * E_STAR * gbar]
+    steps = [{"mean_pressure": p[0], "plastic_area_fraction": 0.0},
+             {"mean_pressure": p[1], "plastic_area_fraction": 0.1},
+             {"mean_pressure": p[2], "plastic_area_fraction": 0.0, "unloading": True}]
+    doc = beside(surface, E_STAR, steps, pressure_drop=1e5, viscosity=1e-3)
+    first = doc["steps"][0]
+    assert first["persson_area_fraction"] == persson(surface, E_STAR, p[0]).area_fraction[0]
+    assert first["persson_leak_rate"] > 0
+    for st in doc["steps"][1:]:
+        assert all(st[k] is None for k in st if k.startswith("persson_"))
+        assert {"persson_area_fraction", "persson_mean_gap", "persson_leak_rate"} <= set(st)
+    assert doc["persson"]["plasticity"] == "not in the theory"
+    assert doc["persson"]["plastic_steps"] == [1, 2] and "elastic" in doc["persson"]["note"]
+    # an elastic run of a hardness (no flow anywhere, also when unloading) keeps it all
+    elastic = [dict(st, plastic_area_fraction=0.0) for st in steps]
+    doc = beside(surface, E_STAR, elastic)
+    assert all(st["persson_area_fraction"] > 0 for st in doc["steps"])
+    assert "plasticity" not in doc["persson"]
+    with pytest.raises(InputError, match=r"steps\[1\]\['plastic_area_fraction'\]"):
+        beside(surface, E_STAR, [steps[0], dict(steps[1], plastic_area_fraction="yes")])
+
+
 def test_beside_direction_uses_the_geometry_factor_of_that_direction():
     # transpose symmetry: flow along y on Z is flow along x on Z.T (the radially averaged
     # PSD is the same; only width/length along the pressure drop changes: Lx/Ly for y)

@@ -5,7 +5,9 @@ Runs one warm-started BEM contact sweep (:func:`roughfe.response.response`) and 
 theory beside the BEM curves; a 3D render of the last step for surfaces, a profile plot
 for profiles). Each step record carries ``persson_area_fraction`` and
 ``persson_mean_gap`` (:func:`roughfe.theory.beside`), except with ``--adhesion``: the
-theory is non-adhesive, so an adhesive run has none (``derived.persson`` says so).
+theory is non-adhesive, so an adhesive run has none (``derived.persson`` says so); with
+``--hardness`` the theory is elastic, so from the first step with plastic flow on the
+values are None (``derived.persson`` says so and lists those steps).
 """
 from __future__ import annotations
 
@@ -220,7 +222,8 @@ def contact_document(sweep, surface, material, inputs: dict, *, adhesive=False) 
     demo): :func:`~roughfe.bem.output.sweep_document` with the surface's grid in its
     inputs and Persson's theory beside every step (``persson_*`` keys, ``derived.persson``);
     for an ``adhesive`` sweep no step gets the (non-adhesive) theory and
-    ``derived.persson`` says so (:data:`roughfe.theory.beside.NOT_ADHESIVE`)."""
+    ``derived.persson`` says so (:data:`roughfe.theory.beside.NOT_ADHESIVE`), nor does a
+    step with plastic flow or one after it (:data:`roughfe.theory.beside.NOT_PLASTIC`)."""
     doc = sweep_document(sweep, {"surface": inputs.get("surface"),
                                  "shape": list(surface.shape), "size": list(surface.size),
                                  "periodic": surface.periodic, **inputs})

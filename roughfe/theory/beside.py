@@ -6,7 +6,12 @@ The theory is non-adhesive: its A*(p) and u(p) belong to a repulsive load p. In 
 adhesive run the net mean pressure is the repulsive load less the attraction (a tensile
 net load can hold a contact of A* = 0.2), so the theory at that load is not a prediction
 of the adhesive contact, and ``beside(..., adhesive=True)`` evaluates none
-(:data:`NOT_ADHESIVE`; docs/theory/07_adhesion_persson.md)."""
+(:data:`NOT_ADHESIVE`; docs/theory/07_adhesion_persson.md).
+
+It is elastic as well: a step with plastic flow (a hardness run, ``plastic_area_fraction``
+> 0) and every step after it, on a surface recessed by the plastic displacement (the
+unloading branch), are not the elastic contact of the surface's PSD, so those steps get
+None and ``"persson"`` says why (:data:`NOT_PLASTIC`)."""
 from __future__ import annotations
 
 import numbers
@@ -27,6 +32,17 @@ NOT_ADHESIVE = {
             "(docs/theory/07_adhesion_persson.md)",
 }
 
+#: added to ``"persson"`` when a step had plastic flow; ``plastic_steps`` lists the steps
+#: left without persson_* values (None)
+NOT_PLASTIC = {
+    "plasticity": "not in the theory",
+    "note": "Persson's A*(p), u(p) and critical junction here are elastic: a step with "
+            "plastic flow (plastic_area_fraction > 0), and every step after it (on the "
+            "surface recessed by the plastic displacement, e.g. the unloading branch), "
+            "is not the elastic contact of this PSD, so its persson_* values are None "
+            "(docs/theory/07_adhesion_persson.md)",
+}
+
 
 def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, direction="x",
            gamma=GAMMA_DEFAULT, adhesive=False) -> dict:
@@ -38,7 +54,9 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     e_star : float
         E* (Pa).
     steps : list of dict
-        Step records with ``mean_pressure`` (Pa).
+        Step records with ``mean_pressure`` (Pa), in the order of the load path; with a
+        hardness also ``plastic_area_fraction`` (-): from the first step where it is > 0
+        on, no step gets the (elastic) theory (:data:`NOT_PLASTIC`).
     pressure_drop, viscosity : float, optional
         Delta P (Pa) and eta (Pa s): add the critical-junction leak rate (surfaces).
     direction : {"x", "y", "both"}
@@ -57,18 +75,22 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         ``"steps"``: copies of ``steps`` with ``persson_area_fraction`` (-),
         ``persson_mean_gap`` (m) and, with ``pressure_drop``, ``persson_leak_rate_<d>``
         per direction and ``persson_leak_rate`` (their mean; m^3/s) added; steps with no
-        positive finite pressure get None (no theory at zero load). ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
-        percolation threshold, units, references).
+        positive finite pressure (no theory at zero load) and plastic ones get None.
+        ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
+        percolation threshold, units, references), with :data:`NOT_PLASTIC` and
+        ``plastic_steps`` (their indices) when steps were left out as plastic.
     """
     psd = _spectrum(source)
     if direction not in ("x", "y", "both"):
         raise InputError(f"direction must be 'x', 'y' or 'both', got {direction!r}")
     dirs = ("x", "y") if direction == "both" else (direction,)
     factors = {d: _geometry_factor(source, d) for d in dirs}
-    pressures = [_pressure_of(k, s) for k, s in enumerate(steps)]
+    pressures = [_number_of(k, s, "mean_pressure", "(Pa)") for k, s in enumerate(steps)]
     if adhesive:
         return {"steps": [dict(s) for s in steps], "persson": dict(NOT_ADHESIVE)}
-    ok = [p is not None and np.isfinite(p) and p > 0 for p in pressures]
+    plastic = _plastic_from(steps)
+    ok = [p is not None and np.isfinite(p) and p > 0 and not pl
+          for p, pl in zip(pressures, plastic)]
     theory = persson(psd, e_star, [p for p, k in zip(pressures, ok) if k] or [1.0],
                      gamma=gamma)
     out, j = [], 0
@@ -93,19 +115,32 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
             "references": list(REFERENCES)}
     if pressure_drop is not None:
         info["percolation_threshold"] = PERCOLATION_THRESHOLD
+    if any(plastic):
+        info.update(NOT_PLASTIC, plastic_steps=[k for k, pl in enumerate(plastic) if pl])
     return {"steps": out, "persson": info}
 
 
-def _pressure_of(k, step):
-    """The mean pressure (Pa) of the step record ``steps[k]``: None when it has none, a
-    float when it is a real number (NaN and p <= 0 get no theory), else an InputError."""
+def _plastic_from(steps):
+    """Per step (in path order): it or an earlier one had plastic flow
+    (``plastic_area_fraction`` > 0), so it is not the elastic contact of the surface."""
+    out, flowed = [], False
+    for k, step in enumerate(steps):
+        fraction = _number_of(k, step, "plastic_area_fraction", "(-)")
+        flowed = flowed or (fraction is not None and fraction > 0)
+        out.append(flowed)
+    return out
+
+
+def _number_of(k, step, key, unit):
+    """The value of ``key`` (in ``unit``) of the step record ``steps[k]``: None when it
+    has none, a float when it is a real number (for the mean pressure: NaN and p <= 0 get
+    no theory), else an InputError."""
     if not isinstance(step, Mapping):
         raise InputError(f"steps[{k}] must be a step record (a dict with 'mean_pressure' in "
                          f"Pa), got {type(step).__name__}")
-    p = step.get("mean_pressure")
+    p = step.get(key)
     if p is None:
         return None
     if isinstance(p, (bool, str, bytes)) or not isinstance(p, numbers.Real):
-        raise InputError(f"steps[{k}]['mean_pressure'] must be a number (Pa) or None, got "
-                         f"{p!r}")
+        raise InputError(f"steps[{k}][{key!r}] must be a number {unit} or None, got {p!r}")
     return float(p)
