@@ -424,9 +424,13 @@ class ContactResult(Frozen):
 
 
 def central_differences(x, y, branch=None):
-    """dy/dx: (y[i+1] - y[i-1]) / (x[i+1] - x[i-1]) inside, one-sided at the ends; NaN
-    where the spacing is zero to round-off (1e-12 of max |x|: e.g. repeated full-contact
-    steps) or fewer than 2 points.
+    """dy/dx along the curve y(x): the points ordered by x, then (y[i+1] - y[i-1]) /
+    (x[i+1] - x[i-1]) between neighbours on the curve inside, one-sided at the ends,
+    returned in the order given; NaN where the spacing is zero to round-off (1e-12 of
+    max |x|: e.g. repeated full-contact steps) or fewer than 2 points. (Until session 25
+    the neighbours were those in the order given: loads solved as 3e5, 1e4, 1e5, 3e4,
+    2e5 Pa read K = 7.3e11, 1.9e11, 6.6e11 Pa/m at 1e4, 1e5, 3e4 Pa where the exact K
+    is 1.0e11, 5.3e11, 2.7e11.)
 
     ``branch`` (optional, one flag per point, e.g. 1 on an unloading branch): the
     differences are taken within each run of equal flags, never across the turn of a
@@ -451,11 +455,13 @@ def central_differences(x, y, branch=None):
         return out
     if x.size < 2:
         return out
+    order = np.argsort(x, kind="stable")      # along the curve; scattered back below
+    xs, ys = x[order], y[order]
     tiny = 1e-12 * float(np.max(np.abs(x)))
     with np.errstate(divide="ignore", invalid="ignore"):
-        dx = np.concatenate([[x[1] - x[0]], x[2:] - x[:-2], [x[-1] - x[-2]]])
-        dy = np.concatenate([[y[1] - y[0]], y[2:] - y[:-2], [y[-1] - y[-2]]])
-        out = np.where(np.abs(dx) > tiny, dy / dx, np.nan)
+        dx = np.concatenate([[xs[1] - xs[0]], xs[2:] - xs[:-2], [xs[-1] - xs[-2]]])
+        dy = np.concatenate([[ys[1] - ys[0]], ys[2:] - ys[:-2], [ys[-1] - ys[-2]]])
+        out[order] = np.where(np.abs(dx) > tiny, dy / dx, np.nan)
     out[~np.isfinite(out)] = np.nan
     return out
 
@@ -479,8 +485,9 @@ class SweepResult(Frozen):
     n_contact : ndarray (int)
         Contact points per step.
     stiffness_fd : ndarray
-        K by central finite differences of mean_pressure over delta (Pa/m); agrees with
-        the exact ``stiffness`` away from contact-set changes.
+        K by central finite differences of mean_pressure over delta along the curve
+        (each branch's steps ordered by delta, whatever the solve order; Pa/m); agrees
+        with the exact ``stiffness`` away from contact-set changes.
     load_star : ndarray
         P* = p L / (E* sigma), the thesis' dimensionless load (L = size along x: the
         grid length for the BEM, the body width W for the FEM).

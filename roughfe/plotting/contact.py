@@ -25,8 +25,16 @@ def _theory(steps, key):
     return np.array([np.nan if s.get(key) is None else s[key] for s in steps], float)
 
 
+def _along(x, mask):
+    """Indices of the points in ``mask`` ordered by ``x``: a branch's line drawn along
+    its curve (loads given out of order were joined in solve order, zig-zagging)."""
+    idx = np.flatnonzero(mask)
+    return idx[np.argsort(x[idx], kind="stable")]
+
+
 def plot_area_stiffness(steps, path, title=None, rms_height=None, window_compliance=None):
-    """A*(p), K(p) (exact incremental and central finite differences) and the mean gap
+    """A*(p), K(p) (exact incremental and central finite differences along p(Delta), each
+    branch's lines drawn in order of p whatever the order of the steps) and the mean gap
     u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8). Records
     with ``persson_area_fraction`` / ``persson_mean_gap`` (:func:`roughfe.theory.beside`)
     get Persson's curves drawn beside the BEM points. With the ``window_compliance`` C
@@ -59,7 +67,8 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
         d = _column(steps, "mean_plane_separation") / rms_height
         v = _column(steps, "free_volume_star")
         for on, mk, tag, ls in branches:
-            axes[3].plot(d[on], v[on], mk + ls, ms=4, label="BEM" + tag)
+            i = _along(d, on)
+            axes[3].plot(d[i], v[i], mk + ls, ms=4, label="BEM" + tag)
         axes[3].set_xlabel("d / sigma")
         axes[3].set_ylabel("V* = V / (A_n sigma)")
         axes[3].set_title("free volume V*(d/sigma), Eq. 2.8")
@@ -94,11 +103,11 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     ax1.set_title("contact area A(p)")
     ax1.grid(True, which="both", alpha=0.3)
     for on, mk, tag, ls in branches:
-        ok2 = ok & on & np.isfinite(k) & (k > 0)
-        if ok2.any():
+        ok2 = _along(p, ok & on & np.isfinite(k) & (k > 0))
+        if ok2.size:
             ax2.loglog(p[ok2], k[ok2], mk + ls, ms=4, label="exact, H_cc x = 1" + tag)
-        ok3 = ok & on & np.isfinite(kfd) & (kfd > 0)
-        if ok3.any():
+        ok3 = _along(p, ok & on & np.isfinite(kfd) & (kfd > 0))
+        if ok3.size:
             ax2.loglog(p[ok3], kfd[ok3], "x" + ls, ms=5, label="finite differences" + tag)
     if window_compliance and ax2.get_legend_handles_labels()[0]:
         ax2.axhline(MPA * 1e-6 / window_compliance, color="0.4", ls="--", lw=1,
