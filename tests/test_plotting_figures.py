@@ -46,3 +46,69 @@ def test_stiffness_lines_follow_the_curve_when_loads_come_out_of_order(drawn):
     for label in ("exact, H_cc x = 1", "finite differences"):
         x = _lines(fig.axes[1])[label].get_xdata()
         assert sorted(x) == list(x) and len(x) == 5
+
+
+# -- design PSD figure ---------------------------------------------------------------------
+def _three_ridge_design():
+    """A periodic 2D design (64 x 64, L = 100 um) of one genome with three ridges at 0, 90
+    and 45 deg and anisotropy factors 0.5, 1, 2: chromosomes n = 1..3 at q_n L / 2 pi = 4,
+    8, 16, each wave on its own lattice vector, no two in one annulus of another n."""
+    from roughfe.genomics.design.model import Design, DesignPart
+    from roughfe.genomics.genome import random_genome
+    L = 1e-4
+    g = random_genome(1e-6, 0.8, 2.0, L / 4, 3, 3, rng=1,
+                      angles=[0.0, np.pi / 2, np.pi / 4], anisotropy=[0.5, 1.0, 2.0])
+    return Design((DesignPart(g, (1, 2, 3), 1.0, "a"),), 1.0, L, 64, dim=2)
+
+
+def test_spectrum_lines_carry_the_mean_square_each_chromosome_realises():
+    """a_n is the rms-equivalent amplitude of the ridges' waves: a_n^2 / 2 is the mean
+    square chromosome n adds to the surface, each ridge scaled by its anisotropy factor
+    (left out until session 25: sqrt(M), 1.7x here)."""
+    d = _three_ridge_design()
+    for n, (q, a) in zip((1, 2, 3), d.spectrum_lines()):
+        var = d.chromosome_surface(0, n).heights.var()
+        assert a ** 2 / 2 / var == pytest.approx(1.0, rel=1e-9)    # (m^2 ~ 1e-21: ratios)
+
+
+def test_surface_psd_figure_markers_sit_on_the_annulus_averaged_fft_psd(drawn):
+    """A surface design's PSD is a density per d^2q (m^4): a chromosome's mean square
+    a^2/2 is spread over its annulus 2 pi q dq, which is what the annulus average of the
+    FFT PSD reports. The markers took the profile formula a^2/(4 dq) (m^3), 1e4-1e5
+    above the line, the axis read m^3 and the legend 'Hann' for an unwindowed periodic
+    surface."""
+    from roughfe.plotting import design as design_plot
+    from roughfe.surfaces.stats import power_spectrum
+    d = _three_ridge_design()
+    s = d.surface()
+    fig = drawn(design_plot, "plot_psds", {"sog": (s, d.spectrum_lines())})
+    ax = fig.axes[0]
+    lines = _lines(ax)
+    ps = power_spectrum(s)
+    assert ps.window == "none" and ax.get_ylabel() == "C (m^4)"
+    assert "Hann" not in " ".join(lines) and "FFT (no window, annulus mean)" in lines
+    q, marker = lines["chromosomes"].get_xdata(), lines["chromosomes"].get_ydata()
+    fft = ps.C[[int(np.argmin(np.abs(ps.q - qi))) for qi in q]]
+    # the annulus holds N_bin lattice points of area (2 pi / L)^2, about 2 pi q dq; the
+    # counts differ (measured marker / FFT 1.27, 0.95, 1.11: 20 points at k = 4, not 25)
+    assert np.all(np.abs(np.log(marker / fft)) < np.log(1.4))
+
+
+def test_profile_psd_figure_markers_equal_the_psd_of_one_cosine(drawn):
+    """A profile's C is per dq, two-sided: a cosine of amplitude a on the lattice puts
+    a^2/4 on +-q, C = a^2 / (4 dq) (m^3); a non-periodic profile's PSD is Hann-windowed."""
+    from roughfe.plotting import design as design_plot
+    from roughfe.surfaces import Surface
+    L, n, k, a = 1e-4, 256, 12, 2e-7
+    x = np.arange(n) * L / n
+    cos = Surface(a * np.cos(2 * np.pi * k * x / L), L, periodic=True)
+    q = 2 * np.pi * k / L
+    fig = drawn(design_plot, "plot_psds", {"periodic": (cos, [(q, a)]),
+                                           "window": (Surface(cos.heights, L), [(q, a)])})
+    (ax1, ax2) = fig.axes
+    fft = _lines(ax1)["FFT (no window)"]
+    at_q = fft.get_ydata()[int(np.argmin(np.abs(fft.get_xdata() - q)))]
+    assert _lines(ax1)["chromosomes"].get_ydata()[0] / at_q == pytest.approx(1.0, rel=1e-9)
+    assert at_q / (a ** 2 / (4 * 2 * np.pi / L)) == pytest.approx(1.0, rel=1e-9)
+    assert ax1.get_ylabel() == ax2.get_ylabel() == "C (m^3)"
+    assert "FFT (Hann)" in _lines(ax2)

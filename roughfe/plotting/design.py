@@ -215,27 +215,43 @@ def plot_profiles(named_surfaces, path, title="") -> "Path":
     return save_figure(fig, path)
 
 
+def chromosome_psd(surface, q, a):
+    """C (two-sided, the convention of :mod:`roughfe.surfaces.stats`) at which the
+    chromosomes of rms-equivalent amplitude ``a`` (m) at ``q`` (rad/m) stand beside the
+    FFT PSD of ``surface``: the mean square a^2/2 of one chromosome spread over the
+    q-space its PSD value stands for (the ``weight`` of :func:`power_spectrum`): a
+    profile's 2 dq (C = a^2 / (4 dq), m^3), a surface's annulus 2 pi q dq (C = a^2 /
+    (4 pi q dq), m^4; the isotropic density, matched by the annulus average of the FFT
+    PSD), dq = 2 pi / L with L the longest side (the annulus width). (Until session 25
+    a surface's markers took the profile formula, in m^3: 1e4-1e5 above its PSD.)"""
+    q, a = np.asarray(q, float), np.asarray(a, float)
+    dq = 2 * np.pi / max(surface.size)
+    return a ** 2 / (4 * dq) if surface.ndim == 1 else a ** 2 / (4 * np.pi * q * dq)
+
+
 def plot_psds(named, path, title="") -> "Path":
-    """Figs. 62/66/70: log10 PSD of each designed profile (FFT, line) and the discrete
-    spectrum of its chromosomes (markers at q_n: C = a_n^2 / (4 dq), the value whose
-    weight 2 dq (:func:`power_spectrum`) gives the mean square a_n^2/2 of one cosine).
+    """Figs. 62/66/70: log10 PSD of each designed profile or surface (FFT, line: a
+    surface's annulus average; Hann-windowed for non-periodic data, as
+    :func:`power_spectrum` reports) and the discrete spectrum of its chromosomes
+    (markers at q_n, :func:`chromosome_psd`).
 
     ``named``: name -> (Surface, list of (q_n (rad/m), a_n (m))).
     """
     fig, axes = new_figure(1, len(named), figsize=(4.5 * len(named), 3.6), squeeze=False)
     for ax, (name, (surf, lines)) in zip(axes[0], named.items()):
         ps = power_spectrum(surf)
-        ax.loglog(ps.q, ps.C, "k-", lw=0.8, label="FFT (Hann)")
-        dq = 2 * np.pi / surf.size[0]
+        how = "no window" if ps.window == "none" else ps.window.capitalize()
+        ax.loglog(ps.q, ps.C, "k-", lw=0.8,
+                  label=f"FFT ({how}{', annulus mean' if surf.ndim == 2 else ''})")
         if lines:
             q, a = np.asarray(lines, float).T
-            ax.loglog(q, a ** 2 / (4 * dq), "rs", ms=4, label="chromosomes")
+            ax.loglog(q, chromosome_psd(surf, q, a), "rs", ms=4, label="chromosomes")
         # Eq. 3.5 takes wavelengths down to one node spacing: the last chromosomes lie
         # beyond the nodes' Nyquist wavenumber and are aliased on them (docs/theory/05)
         ax.axvline(np.pi / max(surf.spacing), color="0.5", ls=":", lw=1,
                    label="Nyquist pi/dx")
         ax.set_xlabel("q (rad/m)")
-        ax.set_ylabel("C (m^3)")
+        ax.set_ylabel(f"C (m^{surf.ndim + 2})")
         ax.set_title(name)
         ax.legend(fontsize=7)
     fig.suptitle(title)
