@@ -48,6 +48,30 @@ def test_stiffness_lines_follow_the_curve_when_loads_come_out_of_order(drawn):
         assert sorted(x) == list(x) and len(x) == 5
 
 
+
+def test_an_unloading_branch_detached_at_every_step_is_a_note_not_an_empty_entry(drawn):
+    """``roughfe contact ns.npz --hardness 2e6 --unload``: every unloading step detaches
+    (p = 0, A* = 0), none is drawn on the log axes; the A(p) and u(p) legends listed
+    'BEM (unloading)' with no point. Now the panels say so; a branch with points keeps
+    its entry."""
+    p = np.array([1e5, 2e5, 4e5, 0.0, 0.0, 0.0])
+    recs = _records(p, np.linspace(1, 6, 6) * 1e-7, p * 1e6, unloading=[0, 0, 0, 1, 1, 1])
+    for r in recs[3:]:
+        r.update(area_fraction=0.0, stiffness=0.0, stiffness_fd=None)
+    fig = drawn(contact_plot, "plot_area_stiffness", recs, rms_height=1e-7)
+    for ax in fig.axes[:3]:
+        legend = ax.get_legend()
+        assert [t.get_text() for t in legend.get_texts()][:1] in (["BEM"], ["exact, H_cc x = 1"])
+        assert not any("unloading" in t.get_text() for t in legend.get_texts())
+        assert legend.get_title().get_text() == "unloading: detached at every step"
+    # the V* panel draws every step, detached ones too: both branches, no note
+    assert "BEM (unloading)" in _lines(fig.axes[3])
+    back = _records(np.array([1e5, 2e5, 4e5, 2e5]), np.array([1, 2, 3, 2.5]) * 1e-7,
+                    np.full(4, 1e11), unloading=[0, 0, 0, 1])
+    fig = drawn(contact_plot, "plot_area_stiffness", back)
+    assert "BEM (unloading)" in _lines(fig.axes[0])
+    assert not fig.axes[0].get_legend().get_title().get_text()
+
 # -- design PSD figure ---------------------------------------------------------------------
 def _three_ridge_design():
     """A periodic 2D design (64 x 64, L = 100 um) of one genome with three ridges at 0, 90

@@ -32,6 +32,26 @@ def _along(x, mask):
     return idx[np.argsort(x[idx], kind="stable")]
 
 
+def _branch_note(a, ok, unl):
+    """What the log panels say of an unloading branch none of whose steps they draw
+    (every step detached, or tensile), else None (until session 25 the branch was listed
+    in the legend with no point)."""
+    if not unl.any() or (ok & unl).any():
+        return None
+    if np.all(a[unl] == 0):
+        return "unloading: detached at every step"
+    return "unloading: no step in compression with contact"
+
+
+def _legend(ax, note):
+    """The panel's legend (if it has labelled lines), ``note`` as its title, or the note
+    alone in the lower left corner."""
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=8, title=note, title_fontsize=8)
+    elif note:
+        ax.text(0.03, 0.03, note, transform=ax.transAxes, fontsize=8)
+
+
 def plot_area_stiffness(steps, path, title=None, rms_height=None, window_compliance=None):
     """A*(p), K(p) (exact incremental and central finite differences along p(Delta), each
     branch's lines drawn in order of p whatever the order of the steps) and the mean gap
@@ -83,17 +103,19 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     gap = _column(steps, "mean_gap") * UM
     theory = ok & ~unl                 # Persson's theory has no branch: drawn once
     order = np.argsort(p[theory])
-    for on, mk, tag, _ in branches:
-        ax1.loglog(p[ok & on], a[ok & on], mk, ms=4, label="BEM" + tag)
+    for on, mk, tag, _ in branches:     # a branch with no point gets no legend entry
+        if (ok & on).any():
+            ax1.loglog(p[ok & on], a[ok & on], mk, ms=4, label="BEM" + tag)
         okg = ok & on & (gap > 0)
-        ax3.semilogx(p[okg], gap[okg], mk, ms=4, label="BEM" + tag)
+        if okg.any():
+            ax3.semilogx(p[okg], gap[okg], mk, ms=4, label="BEM" + tag)
     if a_th is not None:
         ax1.loglog(p[theory][order], a_th[theory][order], "-", label="Persson (2001)")
     if u_th is not None:
         ax3.semilogx(p[theory][order], u_th[theory][order] * UM, "-", label="Persson (2007)")
+    note = _branch_note(a, ok, unl)
     for ax in (ax1, ax3):
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize=8)
+        _legend(ax, note)
     ax3.set_xlabel("mean pressure p (MPa)")
     ax3.set_ylabel("mean gap (um)")
     ax3.set_title("mean interfacial separation u(p)")
@@ -116,8 +138,7 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     ax2.set_ylabel("K = dp/dDelta (MPa/um)")
     ax2.set_title("contact stiffness K(p), Eq. 2.7")
     ax2.grid(True, which="both", alpha=0.3)
-    if ax2.get_legend_handles_labels()[0]:
-        ax2.legend(fontsize=8)
+    _legend(ax2, note)
     if title:
         fig.suptitle(title)
     return save_figure(fig, path)
