@@ -136,3 +136,28 @@ def test_profile_psd_figure_markers_equal_the_psd_of_one_cosine(drawn):
     assert at_q / (a ** 2 / (4 * 2 * np.pi / L)) == pytest.approx(1.0, rel=1e-9)
     assert ax1.get_ylabel() == ax2.get_ylabel() == "C (m^3)"
     assert "FFT (Hann)" in _lines(ax2)
+
+
+# -- leakage maps -------------------------------------------------------------------------
+def test_the_caption_of_a_tall_leakage_map_leaves_its_top_rows_visible(tmp_path):
+    """A 64 x 256 um map fills the square window's height: the four-line caption of a
+    network map (title, colour key, legend, orientation) covered its top rows. The
+    caption now has its own band: every dark (text) pixel lies above the map's top row.
+    One gap everywhere, all cells percolating: the map is one colour."""
+    from matplotlib.image import imread
+    from roughfe.plotting.leakage import network_map
+    shape = (64, 256)
+    path = network_map(np.full(shape, 1e-6), np.ones(shape, bool), np.zeros(shape, bool),
+                       (64e-6, 256e-6), tmp_path / "net.png",
+                       title="free-volume network, step 1: A*=0.056, p=3.45e+05 Pa",
+                       widest_path=np.arange(np.prod(shape)).reshape(shape) == 0)
+    rgb = imread(path)[..., :3]
+    colour = rgb[rgb.shape[0] // 2, rgb.shape[1] // 2]          # the map, mid-window
+    in_map = np.flatnonzero(np.all(np.abs(rgb - colour) < 0.02, axis=-1).any(axis=1))
+    text = np.flatnonzero(np.all(rgb < 0.35, axis=-1).any(axis=1))
+    assert text.size and in_map.size and text.max() < in_map.min()
+    # the map is shown whole: its height 4x its width, as the domain
+    cols = np.flatnonzero(np.all(np.abs(rgb - colour) < 0.02, axis=-1).any(axis=0))
+    height, width = in_map.max() - in_map.min() + 1, cols.max() - cols.min() + 1
+    assert height / width == pytest.approx(4.0, rel=0.02)
+

@@ -38,15 +38,59 @@ def _cells(a):
         a.transpose(1, 0, *range(2, a.ndim)).reshape(a.shape[0] * a.shape[1], *a.shape[2:])
 
 
-def _finish(plotter, title, path, size):
+#: Caption font (pixels) and the margin (pixels) kept around the caption and the map.
+_CAPTION_PX, _MARGIN_PX = 20, 12
+#: Left edge of a map's colour bar (window fraction); the map is fitted left of it.
+_BAR_X = 0.85
+
+
+def _caption(plotter, text):
+    """``text`` centred at the top edge of the window; returns its height (pixels),
+    measured by vtk's text renderer."""
+    from vtkmodules.vtkRenderingCore import vtkTextRenderer
+    width, height = plotter.window_size
+    actor = plotter.add_text(text, position=(width / 2, height - _MARGIN_PX), font_size=10)
+    prop = actor.GetTextProperty()
+    prop.SetFontSize(_CAPTION_PX)
+    prop.SetJustificationToCentered()
+    prop.SetVerticalJustificationToTop()
+    box = [0, 0, 0, 0]
+    vtkTextRenderer().GetBoundingBox(prop, text, box, plotter.render_window.GetDPI())
+    return box[3] - box[2] + 1
+
+
+def _fit_below(plotter, size, top, right):
+    """Parallel view from above that shows the map (``size`` m) whole in the window below
+    its top ``top`` pixels and left of the fraction ``right`` of its width (the colour
+    bar), centred there with a margin."""
+    width, height = plotter.window_size
+    lx, ly = size[0] * UM, size[1] * UM
+    free_w, free_h = right * width - 2 * _MARGIN_PX, height - top - 2 * _MARGIN_PX
+    px = min(free_w / lx, free_h / ly)                    # pixels per um
+    # the map's centre at the centre of the free box; the focal point is the window's
+    fx = lx / 2 - (right * width / 2 - width / 2) / px
+    fy = ly / 2 - ((height - top) / 2 - height / 2) / px
+    plotter.enable_parallel_projection()
+    cam = plotter.camera
+    cam.focal_point = (fx, fy, 0.0)
+    cam.position = (fx, fy, max(lx, ly) * 4.0)
+    cam.up = (0.0, 1.0, 0.0)
+    cam.parallel_scale = height / (2 * px)
+    plotter.renderer.reset_camera_clipping_range()
+
+
+def _finish(plotter, title, path, size, right=1.0):
+    """Caption, view and screenshot of a map. The caption (the title wrapped, the
+    orientation and the size) has its own band at the top and the map is fitted below
+    it, left of ``right`` (the colour bar's left edge, a fraction of the width): on a
+    tall map (64 x 256 um) the caption covered the top rows until session 25."""
     # no cube-axes labels: vtk's label formatting aborts (std::bad_alloc in its regex)
     # in processes that also loaded dolfinx; the size goes into the caption instead
     # long titles (a coupled step's tag) wrapped: centred text is clipped at both ends
     text = "\n".join(textwrap.fill(line, 80) for line in title.split("\n"))
-    plotter.add_text(f"{text}\nx to the right, y up; {size[0] * UM:.4g} x {size[1] * UM:.4g} um",
-                     font_size=10, position="upper_edge")
-    plotter.view_xy()
-    plotter.camera.zoom(0.9)
+    top = _caption(plotter, f"{text}\nx to the right, y up; {size[0] * UM:.4g} x "
+                            f"{size[1] * UM:.4g} um")
+    _fit_below(plotter, size, top + 2 * _MARGIN_PX, right)
     return save_screenshot(plotter, path)
 
 
@@ -129,9 +173,9 @@ def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="ce
         extra = {"clim": [float(c) for c in clim], "above_color": "magenta"}
         title += f"\nmagenta: above {clim[1]:.3g} Pa (sealed pockets, up to {np.nanmax(p):.3g} Pa)"
     pl.add_mesh(img, scalars="p (Pa)", cmap="viridis", nan_color="grey", lighting=False,
-                scalar_bar_args=side_bar("p (Pa)", x=0.85, y=0.1),
+                scalar_bar_args=side_bar("p (Pa)", x=_BAR_X, y=0.1),
                 **extra)
-    return _finish(pl, title, path, size)
+    return _finish(pl, title, path, size, right=_BAR_X - 0.01)
 
 
 def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
@@ -148,8 +192,8 @@ def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
     img.cell_data["log10 |q|"] = _cells(np.log10(np.maximum(q, floor)))
     pl = offscreen_plotter(window_size=(900, 900))
     pl.add_mesh(img, scalars="log10 |q|", cmap="inferno", lighting=False,
-                scalar_bar_args=side_bar("log10 q, m^2/s", x=0.85, y=0.1))
-    return _finish(pl, title, path, size)
+                scalar_bar_args=side_bar("log10 q, m^2/s", x=_BAR_X, y=0.1))
+    return _finish(pl, title, path, size, right=_BAR_X - 0.01)
 
 
 def steps_figure(steps, path):
