@@ -161,3 +161,38 @@ def test_the_caption_of_a_tall_leakage_map_leaves_its_top_rows_visible(tmp_path)
     height, width = in_map.max() - in_map.min() + 1, cols.max() - cols.min() + 1
     assert height / width == pytest.approx(4.0, rel=0.02)
 
+
+# -- design curves title -------------------------------------------------------------------
+def _design_result(score, success=True):
+    """The parts of a DesignResult the curves figure reads (one K target)."""
+    from types import SimpleNamespace
+    from roughfe.genomics.similarity import Target
+    p = np.geomspace(2e6, 2.5e8, 8)
+    target = Target(p, 1e3 * p, "K", "y_t1")
+    curve = SimpleNamespace(pressure=p, stiffness=1.1e3 * p, area_fraction=p / 3e8)
+    best = SimpleNamespace(origin="2-1", scores=(score,), curve=curve)
+    message = (f"sog: best 2-1 s = {score:.4f} (stages -0.2848, 0.6208, 0.6208); the target "
+               f"is NOT matched (s = {score:.4f} <= 0.95, the selection value of Alg. 3)")
+    return SimpleNamespace(method="sog", best=best, success=success, message=message,
+                           objective=SimpleNamespace(targets=(target,)))
+
+
+def _inside(fig, text):
+    fig.canvas.draw()
+    box, frame = text.get_window_extent(), fig.bbox
+    return frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+
+
+def test_design_curves_title_is_whole_and_keeps_the_verdict(drawn):
+    """``roughfe design`` titled curves.png with the 136-character result.message, centred
+    on an 11 in figure and clipped at both ends: the verdict ('NOT matched') was lost.
+    The title is now one short line (method, origin, s, verdict) and a long title wraps."""
+    from roughfe.plotting import design as design_plot
+    result = _design_result(0.6208)
+    title = design_plot.design_title(result)
+    assert title == "sog: best 2-1, s = 0.6208; target NOT matched (s <= 0.95)"
+    assert design_plot.design_title(_design_result(0.97)).endswith("; target matched")
+    assert "NOT a success" in design_plot.design_title(_design_result(0.97, success=False))
+    for t in (title, result.message):
+        fig = drawn(design_plot, "plot_design_curves", [result], title=t)
+        assert _inside(fig, fig._suptitle) and "NOT matched" in fig._suptitle.get_text()

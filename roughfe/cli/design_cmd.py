@@ -135,10 +135,10 @@ def _run(args) -> int:
         if args.global_search:
             result = search_global(result, settings, global_options)
         if not args.no_figures:
-            from ..plotting.design import (plot_design_curves, plot_profiles, plot_psds,
-                                           plot_stages)
+            from ..plotting.design import (design_title, plot_design_curves, plot_profiles,
+                                           plot_psds, plot_stages)
             best = result.best.design
-            plot_design_curves([result], out / "curves.png", title=result.message)
+            plot_design_curves([result], out / "curves.png", title=design_title(result))
             plot_stages([result], out / "stages.png")
             plot_profiles({result.method: best.surface()}, out / "profile.png")  # 2D: a map
             plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")

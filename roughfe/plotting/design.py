@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
+import textwrap
+
 from ..genomics.design import combined_score
+from ..genomics.design.algorithms import SELECTION
 from ..surfaces.stats import power_spectrum
 from .common import new_figure, save_figure
 
@@ -118,8 +121,20 @@ def plot_database_curves(entries, targets, path) -> "Path":
     return save_figure(fig, path)
 
 
+def design_title(result) -> str:
+    """A figure title a line long: method, best origin, combined s and the verdict on the
+    match (not above :data:`SELECTION`: NOT matched), and NOT a success when the result's
+    criterion failed. The full ``result.message`` (136 characters and more, clipped at
+    both ends as a title until session 25) is in result.json and printed."""
+    s = combined_score(result.best.scores)
+    verdict = "target matched" if s > SELECTION else f"target NOT matched (s <= {SELECTION})"
+    return (f"{result.method}: best {result.best.origin}, s = {s:.4f}; {verdict}"
+            + ("" if result.success else "; NOT a success (see result.json)"))
+
+
 def plot_design_curves(results, path, title="") -> "Path":
-    """Figs. 60/64/68: K(p) and A(p) of the best design of each result vs the targets."""
+    """Figs. 60/64/68: K(p) and A(p) of the best design of each result vs the targets;
+    ``title`` (e.g. :func:`design_title`) wrapped to the figure's width."""
     results = list(results)
     fig, axes = new_figure(1, 2, figsize=(11, 4))
     for t in results[0].objective.targets:
@@ -143,7 +158,7 @@ def plot_design_curves(results, path, title="") -> "Path":
     axes[1].set_ylabel("A = A_r/A_n")
     axes[0].legend(fontsize=8)
     axes[1].legend(fontsize=8)
-    fig.suptitle(title)
+    fig.suptitle(textwrap.fill(title, 100))
     return save_figure(fig, path)
 
 
