@@ -244,6 +244,11 @@ def chromosome_psd(surface, q, a):
     return a ** 2 / (4 * dq) if surface.ndim == 1 else a ** 2 / (4 * np.pi * q * dq)
 
 
+#: PSD values below this fraction of the largest are round-off (float64 power of an exact
+#: zero): left out of the PSD figure
+ROUND_OFF = 1e-20
+
+
 def plot_psds(named, path, title="") -> "Path":
     """Figs. 62/66/70: log10 PSD of each designed profile or surface (FFT, line: a
     surface's annulus average; Hann-windowed for non-periodic data, as
@@ -256,7 +261,10 @@ def plot_psds(named, path, title="") -> "Path":
     for ax, (name, (surf, lines)) in zip(axes[0], named.items()):
         ps = power_spectrum(surf)
         how = "no window" if ps.window == "none" else ps.window.capitalize()
-        ax.loglog(ps.q, ps.C, "k-", lw=0.8,
+        # bins without power (empty annuli of a band-limited design: round-off ~1e-48)
+        # are gaps, not points that stretch the log axis over 30 decades
+        c = np.where(ps.C > ROUND_OFF * np.max(ps.C), ps.C, np.nan)
+        ax.loglog(ps.q, c, "k-", lw=0.8,
                   label=f"FFT ({how}{', annulus mean' if surf.ndim == 2 else ''})")
         if lines:
             q, a = np.asarray(lines, float).T
