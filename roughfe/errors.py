@@ -43,6 +43,14 @@ class WindowStiffnessWarning(RuntimeWarning):
     (:func:`roughfe.bem.window.window_report`)."""
 
 
+class FlowImbalanceWarning(RuntimeWarning):
+    """The inlet and outlet flows of a Reynolds solve differ by more than
+    :data:`roughfe.leakage.reynolds.FLOW_IMBALANCE_TOL` of the leak rate: near the
+    percolation threshold the drop across the boundary faces of a large open reservoir
+    is below the round-off of the pressure drop (the message says what the leak rate
+    rests on)."""
+
+
 def _number(value):
     """``value``, or a TypeError for text and bools, which ``float()`` would take ("2.3" in
     a study spec ran, under a key of its own, beside 2.3)."""

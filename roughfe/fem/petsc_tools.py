@@ -339,7 +339,7 @@ class KrylovSolver:
         except InputError:
             self._ksp.destroy()
             raise
-        self._max_it = self._ksp.getTolerances()[3]
+        self._rtol, _, _, self._max_it = self._ksp.getTolerances()
         self._A = self._own = self._pattern = None
 
     def __enter__(self):
@@ -359,37 +359,52 @@ class KrylovSolver:
             self._A.destroy()
         self._A = None
 
-    def solve(self, matrix, rhs, x0=None, *, own: bool = False):
+    @property
+    def rtol(self) -> float:
+        """The relative tolerance of a solve (its options' ``ksp_rtol``)."""
+        return self._rtol
+
+    def solve(self, matrix, rhs, x0=None, *, own: bool = False, rtol: float | None = None):
         """Solve ``A x = b``; see :func:`ksp_solve` for the arguments and the return value.
 
         ``own=True`` hands the PETSc matrix to the solver, which destroys it when the next
         matrix arrives or at :meth:`close` (a scipy matrix is always copied and owned).
+        ``rtol`` replaces the relative tolerance for this solve only. The matrix of the
+        previous solve again (unchanged, e.g. a continuation from its answer to a tighter
+        ``rtol``) keeps its preconditioner and its owner.
         """
         from petsc4py import PETSc
 
+        same = matrix is self._A
         if not isinstance(matrix, PETSc.Mat):
             matrix, own = petsc_aij(matrix), True
         pattern = None
-        if self.reuse:
+        if self.reuse and not same:
             indptr, indices, _ = matrix.getValuesCSR()
             pattern = (matrix.getSize(), indptr, indices)
-        keep = (self.reuse and self._pattern is not None and pattern[0] == self._pattern[0]
-                and np.array_equal(pattern[1], self._pattern[1])
-                and np.array_equal(pattern[2], self._pattern[2]))
+        keep = same or (self.reuse and self._pattern is not None
+                        and pattern[0] == self._pattern[0]
+                        and np.array_equal(pattern[1], self._pattern[1])
+                        and np.array_equal(pattern[2], self._pattern[2]))
         ksp, pc = self._ksp, self._ksp.getPC()
-        if self._A is not None and matrix.getSize() != self._A.getSize():
-            ksp.reset()                        # PETSc refuses new sizes on a used KSP
-        pc.setReusePreconditioner(keep)
-        ksp.setOperators(matrix)
-        self._release()
-        self._A, self._own = matrix, own
+        if not same:
+            if self._A is not None and matrix.getSize() != self._A.getSize():
+                ksp.reset()                    # PETSc refuses new sizes on a used KSP
+            pc.setReusePreconditioner(keep)
+            ksp.setOperators(matrix)
+            self._release()
+            self._A, self._own = matrix, own
         b = matrix.createVecLeft()
         b.setArray(np.asarray(rhs, dtype=PETSc.ScalarType))
         x = matrix.createVecRight()
+        if ksp.getType() == "preonly":         # a direct solve: no start (PETSc refuses one)
+            x0 = None
         if x0 is not None:
             x.setArray(np.asarray(x0, dtype=PETSc.ScalarType))
         ksp.setInitialGuessNonzero(x0 is not None)
-        ksp.setTolerances(max_it=min(self._cap, self._max_it) if keep else self._max_it)
+        ksp.setTolerances(rtol=self._rtol if rtol is None else float(rtol),
+                          max_it=min(self._cap, self._max_it) if keep and not same
+                          else self._max_it)
         t0 = time.process_time()
         ksp.setUp()
         t1 = time.process_time()
@@ -398,7 +413,7 @@ class KrylovSolver:
         nit = int(ksp.getIterationNumber())
         kept = keep
         failed = ksp.getConvergedReason()
-        if keep and failed < 0:
+        if keep and not same and failed < 0:
             # the kept hierarchy no longer fits (a cell of the Reynolds film opening or
             # closing changes its conductance by ~1e9 on the same pattern): build one on
             # this matrix. After a stall (DIVERGED_MAX_IT) go on from x; after any other
@@ -455,7 +470,7 @@ def ksp_solve(matrix, rhs, *, name: str, options: Mapping | None = None, x0=None
         Initial guess (a nonzero start of the Krylov iteration). The stopping test stays
         PETSc's default, relative to the norm of the (preconditioned) right-hand side,
         not to the initial residual: the same accuracy as from x = 0, in fewer
-        iterations when ``x0`` is close.
+        iterations when ``x0`` is close. Ignored by ``ksp_type preonly`` (a direct solve).
 
     Returns
     -------

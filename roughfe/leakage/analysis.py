@@ -102,7 +102,9 @@ class LeakageResult:
         ``critical_position``, ``critical_width`` and ``parent_channel_length`` are the
         first analysed direction's junction (``_x``/``_y`` keys for each);
         ``percolates_reynolds_<d>`` the one of the Reynolds scheme (FV: face neighbours;
-        FE: Q1 corner conduction); ``leak_rate`` and
+        FE: Q1 corner conduction); ``flow_imbalance_<d>`` its
+        ``|inlet - outlet| / |leak rate|`` (above 1e-6 a boundary flow is round-off,
+        :attr:`~roughfe.leakage.reynolds.ReynoldsResult.flow_imbalance`); ``leak_rate`` and
         ``hydraulic_aperture`` are means over the solved directions.
         """
         net = self.network
@@ -122,11 +124,10 @@ class LeakageResult:
             rec[f"leak_rate_{d}"] = None if flow is None else flow.leak_rate
             rec[f"hydraulic_aperture_{d}"] = None if flow is None else flow.hydraulic_aperture
             rec[f"percolates_reynolds_{d}"] = None if flow is None else flow.percolates
-            # relative inlet/outlet mismatch; None without through-flow (both ~round-off)
+            # |inlet - outlet| / |leak rate| (ReynoldsResult.flow_imbalance; a
+            # FlowImbalanceWarning above 1e-6); None without through-flow (both ~round-off)
             rec[f"flow_imbalance_{d}"] = (
-                None if flow is None or not flow.percolates
-                else abs(flow.inlet_flow - flow.outlet_flow)
-                / max(abs(flow.inlet_flow), abs(flow.outlet_flow), 1e-300))
+                None if flow is None or not flow.percolates else flow.flow_imbalance)
             rec[f"reynolds_nit_{d}"] = None if flow is None else flow.nit
             con = self.constrictions.get(d)
             for key, val in (con.record() if con is not None else
