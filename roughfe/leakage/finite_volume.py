@@ -14,8 +14,10 @@ One pressure per grid cell (the BEM grid: sample ``gap[i, j]`` is the centre of 
 * the inlet and outlet pressures act on the boundary faces, half a cell from the first
   and last centres (``T = w / (l/2) * k``); the sides parallel to the flow are walls
   (no flux) or periodic;
-* the Couette term ``h U / 2`` of Eq. 2.11 crosses a face with the mean gap of the two
-  cells when both are open (boundary faces: the gap of the boundary cell).
+* the Couette term ``h U / 2`` of Eq. 2.11 crosses a face between two open cells with
+  the gap of their two half-cells in series, ``(h_a^-2 + h_b^-2) / (h_a^-3 + h_b^-3)``
+  (:func:`_series_gap`; exact for strips in series), a boundary face with the gap of its
+  cell.
 
 Cells are *connected* (live) when they belong to a face-connected open component that
 reaches the inlet or the outlet (components labelled by ``scipy.ndimage.label``, merged
