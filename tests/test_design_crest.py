@@ -44,7 +44,7 @@ def test_crest_step_keeps_every_wave_amplitude_and_lowers_z_max():
     z = d.surface().heights
     spec = np.abs(np.fft.fft2(z))
     peak = (spec.sum() - spec[0, 0]) / z.size                          # sum over all modes
-    assert _z_max(d) == pytest.approx(peak / z.std(), rel=1e-12)     # all crests at (0, 0)
+    assert _z_max(d) == pytest.approx(peak / z.std(), rel=1e-12, abs=0)  # all crests at 0
     # an even field stays even under clipping (a fixed point): move every phase a little
     d = d.with_phases(keys, d.phase_values(keys) +
                       np.random.default_rng(1).uniform(-0.3, 0.3, len(keys)))
@@ -58,7 +58,11 @@ def test_crest_step_keeps_every_wave_amplitude_and_lowers_z_max():
         assert a.weight == b.weight
     before, after = _mode_moduli(d, modes), _mode_moduli(out, modes)
     np.testing.assert_allclose(after, before, rtol=1e-12, atol=1e-12 * before.max())
-    assert out.surface().heights.std() == pytest.approx(z.std(), rel=1e-12)
+    # the rms of the field the step started from (the phase move changes it where two
+    # waves share a mode: 0.26 %; this compared with the aligned start's 1.296e-10 m and
+    # passed only through pytest.approx's default abs = 1e-12)
+    rms = d.surface().heights.std()
+    assert out.surface().heights.std() == pytest.approx(rms, rel=1e-12, abs=0)
 
 
 def test_crest_phases_realise_the_projected_field():

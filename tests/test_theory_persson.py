@@ -100,15 +100,20 @@ def test_mean_gap_matches_a_direct_quadrature_of_yang_persson():
                             * np.exp(-(wq * np.exp(lp) / E_STAR) ** 2))
             return scipy.integrate.quad(f, np.log(p), top, limit=200)[0]
         g = lambda lq: np.exp(lq) ** 3 * c0 * np.exp(lq) ** (-2 * (1 + h)) * w(np.exp(lq)) * inner(np.exp(lq))
-        return np.sqrt(np.pi) * scipy.integrate.quad(g, np.log(q0), np.log(q1), limit=200,
-                                                     epsrel=1e-7)[0]
+        # in pieces: one quad over ln q missed the steep rise next to q0 at light loads
+        # (0.47 % low at p = 1e-3 E* gbar; the test passed only through pytest.approx's
+        # default abs = 1e-12 on gaps of 3e-18 m)
+        edges = np.log(np.geomspace(q0 * (1 + 1e-9), q1, 40))
+        return np.sqrt(np.pi) * sum(scipy.integrate.quad(g, lo, hi, limit=200, epsrel=1e-9)[0]
+                                    for lo, hi in zip(edges[:-1], edges[1:]))
 
     gbar = np.sqrt(2 * np.pi * c0 * (q1 ** a - q0 ** a) / a)
     for x in (1e-3, 0.1, 0.5):
         p = x * E_STAR * gbar
         ours = persson(psd, E_STAR, p, gamma=gamma).mean_gap[0]
-        # 2e-3: the 1/sqrt(q - q0) singularity of w at q0 in the first of 6000 log bins
-        assert ours == pytest.approx(u_quad(p), rel=2e-3)
+        # 5e-4: the 1/sqrt(q - q0) singularity of w at q0 in the first of 6000 log bins
+        # (measured 1.3e-4, 6e-6, 4e-7 at the three loads)
+        assert ours == pytest.approx(u_quad(p), rel=5e-4, abs=0)
 
 
 def test_log_law_at_intermediate_pressures(surface):
