@@ -32,10 +32,21 @@ Discretisation
   identified with the first one through a restriction matrix ``P`` (``K_r = P^T K P``),
   which also removes the Dirichlet and pinned unknowns. The reduced matrix is SPD; it
   is solved with CG + BoomerAMG (hypre) by default.
-* Leak rate by the consistent (weak-form) flux: with the full residual
-  ``r = K p - b`` and ``w`` linear from 1 on the inlet to 0 on the outlet,
-  ``Q = w . r`` (m^3/s), which is exact for the discrete problem; the inlet and outlet
-  sums of ``r`` are returned too (they agree to the solver tolerance).
+* The unknown is ``x = p - p_out`` (``K`` annihilates constants; the Dirichlet lift is
+  ``p_in - p_out`` on the inlet, 0 on the outlet), ``p_out`` is added afterwards.
+* Leak rate without wall motion: the viscous dissipation over the drop,
+  ``Q = x^T K x / (p_in - p_out) = int h^3/(12 mu) |grad x|^2 dx / (p_in - p_out)``
+  (m^3/s), summed cell by cell from nodal differences (:func:`q1_dissipation`). For the
+  discrete solution it equals the consistent (weak-form) flux ``w . r`` (``r = K x - b``
+  the full residual, ``w`` linear from 1 on the inlet to 0 on the outlet) and the inlet
+  sum of ``r``, but no term cancels another: near the percolation threshold ``K x`` at an
+  inlet vertex of a large open reservoir is a difference far below the round-off of the
+  drop (a 64^2 wall closed but for one pinhole cell of gap 1e-11 m, dp = 1 Pa: ``w . r``
+  gave -2.8e-28 m^3/s for 8.3e-32). Its error is second order in the solver's; where
+  that is not enough the CG goes on to a tighter tolerance (:mod:`roughfe.fem.dissipation`,
+  shared with the finite volumes). With wall motion ``Q = w . r`` (from ``x``); the inlet
+  and outlet sums of ``r`` are returned too (near the percolation threshold the one by
+  the large reservoir is round-off).
 
 Cells should be (nearly) square, as BEM grids are: for an aspect ratio above sqrt(2)
 the Q1 stiffness has positive off-diagonal entries, and the discrete pressure may then
@@ -62,7 +73,8 @@ from scipy.sparse.csgraph import connected_components
 
 from ..errors import (InputError, NoConvergenceError, check_finite_nonnegative,
                       check_finite_positive, check_spacing)
-from .petsc_tools import CG_AMG, ksp_solve, petsc_aij
+from .dissipation import solve_for_dissipation
+from .petsc_tools import CG_AMG, KrylovSolver, petsc_aij
 
 DEFAULT_PETSC_OPTIONS = CG_AMG
 
@@ -81,10 +93,13 @@ class ReynoldsFESolution:
     connected : ndarray of bool, shape (nx+1, ny+1)
         Vertices connected to the inlet or the outlet through open cells.
     residual : ndarray, shape (nx+1, ny+1)
-        Nodal flux residual ``K p - b`` in m^3/s (non-zero on inlet/outlet only).
+        Nodal flux residual ``K (p - p_out) - b`` in m^3/s (non-zero on inlet/outlet
+        only, up to the solver tolerance).
     flow_rate : float
-        Consistent leak rate ``Q`` in m^3/s (positive from inlet to outlet); exactly 0
-        when inlet and outlet are not connected and there is no wall velocity.
+        Leak rate ``Q`` in m^3/s (positive from inlet to outlet): the viscous dissipation
+        over the drop without wall motion, the consistent flux ``w . r`` with it (module
+        docstring); exactly 0 when inlet and outlet are not connected and there is no
+        wall velocity.
     inlet_flow, outlet_flow : float
         Flow in through the inlet and out through the outlet (m^3/s).
     percolates : bool
@@ -231,6 +246,35 @@ def vertex_components(open_cells: np.ndarray, *, periodic_axis: Optional[int] = 
     return labels.reshape(nx + 1, ny + 1)
 
 
+def q1_dissipation(x, conductance, spacing) -> float:
+    """Viscous dissipation ``int k |grad x|^2 dA`` of a Q1 field on the grid (W for ``x``
+    in Pa): ``x^T K x`` with ``K`` the stiffness of :func:`solve_reynolds_fe`, summed cell
+    by cell from nodal differences only (no absolute value enters, so nothing cancels).
+
+    On a ``dx x dy`` cell of conductance ``k``, with ``d0, d1`` the differences of ``x``
+    along axis 0 on its two edges at ``y = 0, dy`` and ``e0, e1`` those along axis 1 at
+    ``x = 0, dx``, the bilinear field gives exactly
+    ``k [(dy/dx) (d0^2 + d0 d1 + d1^2) + (dx/dy) (e0^2 + e0 e1 + e1^2)] / 3``
+    (each bracket >= (d0^2 + d1^2) / 2).
+
+    Parameters
+    ----------
+    x : ndarray, shape (nx+1, ny+1)
+        Nodal values (e.g. ``p - p_out``, Pa).
+    conductance : ndarray, shape (nx, ny)
+        ``k = h^3 / (12 mu)`` per cell (m^3/(Pa s)).
+    spacing : (float, float)
+        ``(dx, dy)`` in m.
+    """
+    dx, dy = spacing
+    total = 0.0
+    for ratio, d, k in ((dy / dx, np.diff(x, axis=0), conductance),
+                        (dx / dy, np.diff(x, axis=1).T, conductance.T)):
+        d0, d1 = d[:, :-1], d[:, 1:]           # the two opposite edges of each cell
+        total += ratio * float(np.sum(k * (d0 * d0 + d0 * d1 + d1 * d1)))
+    return total / 3.0
+
+
 def check_reynolds_data(gap, spacing, mu, p_in, p_out, direction, wall_velocity):
     """The data of the Reynolds problem (Eq. 2.12) as both discretisations take them
     (this Q1 solver and :func:`roughfe.leakage.finite_volume.solve_reynolds_fv`),
@@ -312,7 +356,8 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     K.assemble()
     nv = (nx + 1) * (ny + 1)
     b_dof = np.zeros(nv)
-    if np.any(u != 0.0):
+    moving = bool(np.any(u != 0.0))
+    if moving:
         bvec = fem_petsc.assemble_vector(space.L)
         b_dof = bvec.array.copy()                            # dolfinx dof order
         bvec.destroy()
@@ -351,18 +396,20 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     red = np.full(nv, -1, dtype=np.int64)
     red[free_master] = np.arange(n_red)
     red_of_vertex = np.where(fixed_v, -1, red[master])
-    # pinned vertices of floating components take p_out (their level is arbitrary)
-    p_fixed = np.where(inlet, p_in, p_out)
-
     # restriction P: dof (dolfinx numbering) -> reduced unknown
     dofs = space.dof_of_vertex
     keep = red_of_vertex >= 0
     P = sp.csr_matrix((np.ones(int(keep.sum())), (dofs[keep], red_of_vertex[keep])),
                       shape=(nv, max(n_red, 1)))
-    # Dirichlet/pinned lift, in dof order
+    # unknown x = p - p_out (K annihilates constants): the Dirichlet lift is the drop on the
+    # inlet, 0 on the outlet and on the pinned vertices (their level is arbitrary)
+    drop = p_in - p_out
     lift = np.zeros(nv)
-    fixed_all = ~keep
-    lift[dofs[fixed_all]] = p_fixed[fixed_all]
+    lift[dofs[inlet]] = drop
+    k = h**3 / (12.0 * mu)
+
+    def dissipation(x_dof):
+        return q1_dissipation(x_dof[dofs].reshape(vshape), k, (dx, dy)), x_dof
 
     Kl = K.createVecLeft()
     Kl.setArray(lift)
@@ -370,35 +417,41 @@ def solve_reynolds_fe(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     K.mult(Kl, Klift)
     rhs_full = b_dof - Klift.array
 
-    p_dof = lift.copy()
     nit, success, message = 0, True, "nothing to solve: every pressure unknown is fixed"
+    power, x_dof = dissipation(lift)
     if n_red > 0:
+        # a dissipation leak rate goes on to rtol sqrt(rtol / R) (roughfe.fem.dissipation)
+        energy = percolates and not moving and drop != 0.0
         Pm = petsc_aij(P)
         Kr = K.PtAP(Pm)
-        x, nit, success, message = ksp_solve(Kr, P.T @ rhs_full, name="reynolds",
-                                             options=petsc_options)
-        p_dof = lift + P @ x
-        for obj in (Kr, Pm):
-            obj.destroy()
-    # full residual r = K p - b (flux into the domain at inlet/outlet vertices)
-    Kl.setArray(p_dof)
+        Pm.destroy()
+        with KrylovSolver("reynolds", petsc_options) as solver:
+            _, nit, success, message, power, x_dof = solve_for_dissipation(
+                solver, Kr, P.T @ rhs_full, own=True, scale=power if energy else None,
+                evaluate=lambda xr: dissipation(lift + P @ xr))
+    # full residual r = K x - b (flux into the domain at inlet/outlet vertices)
+    Kl.setArray(x_dof)
     K.mult(Kl, Klift)
     r_dof = Klift.array - b_dof
     for obj in (Kl, Klift, K):
         obj.destroy()
 
-    p = p_dof[dofs]                      # structured vertex order
+    x = x_dof[dofs]                      # structured vertex order
     r = r_dof[dofs]
     if not success:
         raise NoConvergenceError(f"Reynolds solve: {message}")
-    w = 1.0 - coord.ravel() / n_flow     # linear weight, 1 at inlet, 0 at outlet
-    q = float(w @ r)
-    if not percolates and not np.any(u != 0.0):
+    if not percolates and not moving:
         # inlet and outlet lie in different components of the open network: no through
         # flow, exactly (the computed sum is round-off, ~1e-30 m^3/s)
         q = 0.0
+    elif not moving:
+        q = power / drop if drop != 0.0 else 0.0   # Q dp = x^T K x: no cancellation
+    else:
+        w = 1.0 - coord.ravel() / n_flow           # linear weight, 1 at inlet, 0 at outlet
+        q = float(w @ r)
     q_in = float(r[inlet].sum())
     q_out = float(-r[outlet].sum())
+    p = x + p_out
     p_out_field = np.where(connected, p, np.nan).reshape(vshape)
     return ReynoldsFESolution(
         pressure=p_out_field, pressure_pinned=p.reshape(vshape),

@@ -40,9 +40,10 @@ included; summing the cell balances, it equals the inlet and the outlet flow of 
 discrete solution): no term cancels another, and its error is second order in the
 solver's, an upper bound ~ rtol^2 R with ``R = sum(T_in) (p_in - p_out) / Q``. Where
 rtol R > 1 the solve goes on from its answer to rtol sqrt(rtol / R) (not below
-:data:`RTOL_FLOOR`). The boundary flows are computed from ``x`` too, but across each
-inlet face ``p_in - p`` is ~1/R of the drop, round-off once R nears 1e16: near the
-percolation threshold, where the open reservoirs conduct ``(h / u_c)^3`` ~ 1e8-1e15 times
+:data:`~roughfe.fem.dissipation.RTOL_FLOOR`; :mod:`roughfe.fem.dissipation`, the
+continuation of both schemes). The boundary flows are computed from ``x`` too, but
+across each inlet face ``p_in - p`` is ~1/R of the drop, round-off once R nears 1e16:
+near the percolation threshold, where the open reservoirs conduct ``(h / u_c)^3`` ~ 1e8-1e15 times
 more than the junction (a 64^2 pinhole wall of gap 1e-11 m: inlet flow -3.6e-30, exact Q
 8.3e-32 m^3/s; :attr:`roughfe.leakage.reynolds.ReynoldsResult.flow_imbalance`). With wall
 motion the leak rate is the mean of the inlet and outlet flows, and that floor is its
@@ -56,6 +57,7 @@ elements of :mod:`roughfe.fem.reynolds` converge to the same limit).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Mapping, Optional
 
@@ -65,6 +67,7 @@ from scipy import ndimage
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..fem.dissipation import solve_for_dissipation
 from ..fem.petsc_tools import CG_AMG, KrylovSolver, petsc_aij_csr
 from ..fem.reynolds import check_reynolds_data
 
@@ -77,11 +80,6 @@ from ..fem.reynolds import check_reynolds_data
 REYNOLDS_FV = {"pc_hypre_boomeramg_relax_type_down": "SOR/Jacobi",
                "pc_hypre_boomeramg_relax_type_up": "backward-SOR/Jacobi",
                "pc_hypre_boomeramg_no_CF": None}
-
-#: Tightest relative tolerance a solve is continued to for the leak rate near the
-#: percolation threshold (module docstring): on a 64^2 pinhole wall the leak rate is the
-#: same at 1e-14 and 1e-17, the round-off floor.
-RTOL_FLOOR = 1e-15
 
 
 @dataclass(frozen=True, eq=False)
@@ -299,7 +297,8 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     drop = p_in - p_out
     energy = percolates and ul == 0.0 and ut == 0.0 and drop != 0.0
     nit, success, message = 0, True, "nothing to solve: no open cell reaches inlet or outlet"
-    faces = (T_l, T_t, T_in, T_out, drop, wrap)
+    flows = functools.partial(_pressure_flows, live=live, T_l=T_l, T_t=T_t, T_in=T_in,
+                              T_out=T_out, drop=drop, wrap=wrap, out=rhs)
     if live.any():
         M = _live_system(T_l, T_t, _diagonal(T_l, T_t, T_in, T_out, wrap), live, wrap)
         x0 = None
@@ -310,24 +309,14 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         if one_shot:
             solver = reynolds_fv_solver(petsc_options, reuse=False)
         try:
-            b = rhs[live]
-            x, nit, success, message = solver.solve(M, b, x0, own=True)
-            x_grid, fl, ft, power = _pressure_flows(x, live, *faces, out=rhs)
-            rtol = solver.rtol
-            for _ in range(2):                 # 2: the first R may be low (Q too high)
-                ratio = drop * drop * float(T_in.sum()) / power if power > 0 else np.inf
-                if not (success and energy and rtol > RTOL_FLOOR and rtol * ratio > 1.0):
-                    break
-                rtol = max(np.sqrt(rtol / ratio), RTOL_FLOOR)
-                x, more, success, message = solver.solve(M, b, x, rtol=rtol)
-                nit += more
-                message += f"; continued to rtol {rtol:.1e} for the leak rate: {nit} in all"
-                x_grid, fl, ft, power = _pressure_flows(x, live, *faces, out=rhs)
+            _, nit, success, message, power, (x_grid, fl, ft) = solve_for_dissipation(
+                solver, M, rhs[live], x0, own=True, evaluate=flows,
+                scale=drop * drop * float(T_in.sum()) if energy else None)
         finally:
             if one_shot:
                 solver.close()
     else:
-        x_grid, fl, ft, power = _pressure_flows(np.zeros(0), live, *faces, out=rhs)
+        power, (x_grid, fl, ft) = flows(np.zeros(0))
     if not success:
         raise NoConvergenceError(f"Reynolds finite-volume solve: {message}")
     # Couette face flows on top of the pressure-driven ones
@@ -386,7 +375,7 @@ def _pressure_flows(x, live, T_l, T_t, T_in, T_out, drop, wrap, *, out):
     """Pressure-driven face flows (m^3/s, along +axis) from the live unknowns
     ``x = p - p_out`` itself (p_out is added to the pressure only afterwards: near the
     percolation threshold the drop across an outlet face is far below the round-off of an
-    absolute pressure). Returns ``(x_grid, fl, ft, power)``: ``x`` on the grid ``out``
+    absolute pressure). Returns ``(power, (x_grid, fl, ft))``: ``x`` on the grid ``out``
     (0 outside the live cells); ``fl[i]`` enters row i (``fl[0]`` inlet, ``fl[-1]``
     outlet), ``ft[:, j]`` column j (``ft[:, 0]``, ``ft[:, -1]``: the seam face, or a wall:
     0); ``power = sum T (x_a - x_b)^2`` over every face (W), the viscous dissipation."""
@@ -399,7 +388,7 @@ def _pressure_flows(x, live, T_l, T_t, T_in, T_out, drop, wrap, *, out):
         (out[:-1], out[1:], T_l, fl[1:-1]), (drop, out[0], T_in, fl[0]),
         (out[-1], 0.0, T_out, fl[-1]), (out[:, :-1], out[:, 1:], T_t[:, :nt - 1], ft[:, 1:-1]))
         + (((out[:, -1], out[:, 0], T_t[:, -1], ft[:, -1]),) if wrap else ()))
-    return out, fl, ft, power
+    return power, (out, fl, ft)
 
 
 def _face_flows(x_a, x_b, T, out) -> float:

@@ -49,9 +49,10 @@ class ReynoldsResult:
     scheme : {"fv", "fe"}
         Discretisation (see the module docstring).
     leak_rate : float
-        Volumetric leak rate ``Q`` in m^3/s: "fv" the viscous dissipation over the drop
-        without wall motion (no round-off cancellation; docs/theory/04b_leakage_ii.md),
-        else the mean of the boundary flows; "fe" the consistent weak-form flux.
+        Volumetric leak rate ``Q`` in m^3/s: without wall motion the viscous dissipation
+        over the drop, both schemes (no round-off cancellation;
+        docs/theory/04b_leakage_ii.md); with it "fv" the mean of the boundary flows, "fe"
+        the consistent weak-form flux.
     hydraulic_aperture : float or None
         ``h_eff = (12 mu Q L_flow / (W dp))^(1/3)`` in m: the parallel-plate gap with the
         same leak rate (0 when nothing flows; None without a pressure drop).
@@ -102,9 +103,9 @@ class ReynoldsResult:
         """``|inlet_flow - outlet_flow| / |leak_rate|``; None when the leak rate is 0.
 
         Above :data:`FLOW_IMBALANCE_TOL` the boundary flows (and the flux field by the
-        large-conductance boundary) are at the round-off of the pressure drop; the FV leak
-        rate without wall motion does not rest on them, any other is uncertain by about
-        this fraction."""
+        large-conductance boundary) are at the round-off of the pressure drop; the leak
+        rate without wall motion (either scheme) does not rest on them, one with a sliding
+        wall is uncertain by about this fraction."""
         if self.leak_rate == 0.0:
             return None
         return abs(self.inlet_flow - self.outlet_flow) / abs(self.leak_rate)
@@ -228,7 +229,7 @@ def reynolds_flow(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         nit=sol.nit)
     imbalance = result.flow_imbalance
     if imbalance is not None and imbalance > FLOW_IMBALANCE_TOL:
-        dissipation = scheme == "fv" and not np.any(np.asarray(wall_velocity, float) != 0)
+        dissipation = not np.any(np.asarray(wall_velocity, float) != 0)   # both schemes
         warnings.warn(FlowImbalanceWarning(
             f"Reynolds flow along {direction} ({scheme}): inlet flow {result.inlet_flow:.3e} "
             f"and outlet flow {result.outlet_flow:.3e} m^3/s differ by {imbalance:.1e} of "
