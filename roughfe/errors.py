@@ -120,12 +120,13 @@ def check_spacing(spacing, ndim=2):
     return tuple(check_finite_positive(f"spacing[{k}] (m)", v) for k, v in enumerate(values))
 
 
-def check_real_array(name, value, ndim=None, unit="m"):
+def check_real_array(name, value, ndim=None, unit="m", allow_nan=False):
     """Return ``value`` as a float ndarray (not copied when it already is one) or raise
     :class:`InputError` naming what is wrong: complex or non-numeric entries, a number of
     axes not in ``ndim`` (an int or a tuple of ints; None: any), non-finite entries
-    (their count and the first one's index), masked entries (the values under a mask
-    are not data)."""
+    (their count and the first one's index; with ``allow_nan`` NaN is allowed, where the
+    caller documents it as "no value", and only infinities are refused), masked entries
+    (the values under a mask are not data)."""
     import numpy as np
 
     if np.ma.isMaskedArray(value) and np.ma.getmaskarray(value).any():
@@ -148,7 +149,7 @@ def check_real_array(name, value, ndim=None, unit="m"):
     if allowed is not None and a.ndim not in allowed:
         axes = " or ".join(f"{k}D" for k in allowed)
         raise InputError(f"{name} must be a {axes} array, got shape {a.shape}")
-    bad = ~np.isfinite(a)
+    bad = np.isinf(a) if allow_nan else ~np.isfinite(a)
     if bad.any():
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
         raise InputError(f"{name} must be finite: {int(bad.sum())} non-finite value(s), "

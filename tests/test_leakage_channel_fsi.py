@@ -82,7 +82,7 @@ def test_a_closed_channel_carries_nothing():
 
 @pytest.mark.parametrize("gap, dx, kw, words", [
     ([1e-6, -1e-9, 1e-6], 1e-5, {}, "finite and >= 0"),
-    ([1e-6, np.nan, 1e-6], 1e-5, {}, "finite and >= 0"),
+    ([1e-6, np.nan, 1e-6], 1e-5, {}, "must be finite: 1 non-finite"),
     ([1e-6], 1e-5, {}, "at least 2 samples"),
     ([1e-6, 1e-6], 0.0, {}, "spacing"),
     ([1e-6, 1e-6], 1e-5, {"mu": -1.0}, "mu"),

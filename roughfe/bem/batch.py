@@ -92,9 +92,9 @@ class BatchOperator:
 
 
 def _rows(x, B, name):
-    x = np.asarray(x, dtype=float)
+    x = check_real_array(name, x, (0, 1), unit="Pa" if name == "mean_pressure" else "m")
     x = np.broadcast_to(x, (B,)) if x.ndim == 0 else x
-    if x.shape != (B,) or not np.all(np.isfinite(x)) or np.any(x < 0):
+    if x.shape != (B,) or np.any(x < 0):
         raise InputError(f"{name} must be finite and >= 0, one value per row ({B}), got "
                          f"shape {x.shape}")
     return x
@@ -150,8 +150,8 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
     else:
         dl = _rows(delta, B, "delta")
     if initial is not None:        # pressures or a BatchState (its pressures)
-        p = np.clip(np.array(getattr(initial, "pressure", initial), dtype=float).reshape(shape),
-                    0.0, None)
+        p = np.clip(check_real_array("initial pressure", getattr(initial, "pressure", initial),
+                                     unit="Pa").reshape(shape), 0.0, None)
     elif load:
         p = np.broadcast_to(col(pm), shape).copy()
     else:

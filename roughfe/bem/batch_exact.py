@@ -150,7 +150,8 @@ def solve_batch_exact(op: InfluenceOperator, heights, *, delta=None, mean_pressu
     if isinstance(initial, BatchState) and initial.pivots is not None:
         F, *cached = (a.copy() for a in initial.pivots)
     elif initial is not None:
-        F = np.asarray(getattr(initial, "pressure", initial), dtype=float).reshape(B, n) > 0
+        F = check_real_array("initial pressure", getattr(initial, "pressure", initial),
+                             unit="Pa").reshape(B, n) > 0
     elif load:
         F = c >= 0
     else:

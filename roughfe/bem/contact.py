@@ -23,7 +23,7 @@ import numpy as np
 import scipy.fft
 
 from ..caching import MB, bytes_bounded_cache
-from ..errors import InputError, NoConvergenceError, check_instance, check_int
+from ..errors import InputError, NoConvergenceError, check_instance, check_int, check_real_array
 from ..surfaces.stats import rms_height
 from ..surfaces.surface import Surface
 from ..model import ContactResult, Material
@@ -351,12 +351,9 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         h = h - plastic   # the recessed elastic surface acts as lowered rigid heights
     scale = float(np.ptp(surface.heights))
     if initial is not None:
-        initial = np.asarray(initial, dtype=float)
+        initial = check_real_array("initial pressure", initial, unit="Pa")
         if initial.shape != h.shape:
             raise InputError(f"initial pressure has shape {initial.shape}, expected {h.shape}")
-        if not np.all(np.isfinite(initial)):
-            raise InputError(f"initial pressure must be finite (Pa): "
-                             f"{int(np.count_nonzero(~np.isfinite(initial)))} non-finite value(s)")
 
     out = None
     if delta is not None and delta <= hmax - float(h.max()):
@@ -490,9 +487,9 @@ def surface_displacement(surface: Surface, material: Material, traction,
     :mod:`roughfe.leakage.fsi`).
     """
     _check_surface(surface)
-    t = np.asarray(traction, dtype=float)
-    if t.shape != surface.heights.shape or not np.all(np.isfinite(t)):
-        raise InputError(f"traction must be finite with the surface's shape "
+    t = check_real_array("traction", traction, unit="Pa")
+    if t.shape != surface.heights.shape:
+        raise InputError(f"traction must have the surface's shape "
                          f"{surface.heights.shape} (Pa), got shape {t.shape}")
     op = _operator(surface.shape, surface.size, material.E_star,
                    _choose_kernel(surface, kernel))

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive, check_in_open_interval, check_instance
+from ..errors import (InputError, check_finite_positive, check_in_open_interval, check_instance,
+                      check_real_array)
 from ..model import _check_delta, _check_pressure
 from ..surfaces.surface import Surface
 from .coarse_start import COARSE_START_MIN
@@ -58,11 +59,11 @@ def _check_hardness(hardness, mean_pressure, plastic_displacement, shape):
         raise InputError(f"mean_pressure = {mean_pressure:.6g} Pa must be below the hardness "
                          f"{hp:.6g} Pa (at p = hardness every point is plastic)")
     if plastic_displacement is not None:
-        up = np.asarray(plastic_displacement, dtype=float)
+        up = check_real_array("plastic_displacement", plastic_displacement)
         if up.shape != shape:
             raise InputError(f"plastic_displacement has shape {up.shape}, expected {shape}")
-        if not np.all(np.isfinite(up)) or float(up.min()) < 0:
-            raise InputError("plastic_displacement (m) must be finite and >= 0")
+        if float(up.min()) < 0:
+            raise InputError("plastic_displacement (m) must be >= 0")
         plastic_displacement = up
     return hp, plastic_displacement
 

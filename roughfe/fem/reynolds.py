@@ -72,7 +72,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import (InputError, NoConvergenceError, check_finite_nonnegative,
-                      check_finite_positive, check_spacing)
+                      check_finite_positive, check_real_array, check_spacing)
 from .dissipation import solve_for_dissipation
 from .petsc_tools import CG_AMG, KrylovSolver, petsc_aij
 
@@ -285,20 +285,19 @@ def check_reynolds_data(gap, spacing, mu, p_in, p_out, direction, wall_velocity)
     array of two components in m/s. ``p_in`` and ``p_out`` (Pa) must be finite and
     ``direction`` one of ``"x"``, ``"y"``.
     """
-    gap = np.asarray(gap, dtype=float)
-    if gap.ndim != 2 or min(gap.shape) < 1:
+    gap = check_real_array("gap", gap, 2)     # refuses masked and complex gaps
+    if min(gap.shape) < 1:
         raise InputError(f"gap must be a 2D array (nx, ny) of metres, got shape {gap.shape}")
-    if not np.all(np.isfinite(gap)) or gap.min() < 0:
-        raise InputError(f"gap must be finite and >= 0 (m), got min {np.nanmin(gap)!r} "
-                         f"and {int((~np.isfinite(gap)).sum())} non-finite value(s)")
+    if gap.min() < 0:
+        raise InputError(f"gap must be finite and >= 0 (m), got min {gap.min()!r}")
     if direction not in ("x", "y"):
         raise InputError(f"direction must be 'x' or 'y', got {direction!r}")
     mu = check_finite_positive("mu", mu)
     dx, dy = check_spacing(spacing)
     if not (np.isfinite(p_in) and np.isfinite(p_out)):
         raise InputError(f"p_in and p_out must be finite (Pa), got {p_in!r}, {p_out!r}")
-    u = np.asarray(wall_velocity, dtype=float).reshape(-1)
-    if u.size != 2 or not np.all(np.isfinite(u)):
+    u = check_real_array("wall_velocity", wall_velocity, unit="m/s").reshape(-1)
+    if u.size != 2:
         raise InputError(f"wall_velocity must be two finite numbers (m/s), got {wall_velocity!r}")
     return gap, (dx, dy), mu, u
 

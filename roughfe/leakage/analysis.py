@@ -13,7 +13,8 @@ from typing import Mapping, Optional
 import numpy as np
 
 from .. import progress
-from ..errors import InputError, check_finite_nonnegative, check_finite_positive, check_instance
+from ..errors import (InputError, check_finite_nonnegative, check_finite_positive, check_instance,
+                      check_real_array)
 from ..frozen import FrozenMapping
 from ..model import ContactResult
 from .junction import CriticalConstriction, critical_constriction
@@ -199,7 +200,7 @@ def analyse_leakage(gap, contact, spacing, *, direction="both", periodic: bool =
     # was a ZeroDivisionError in record(), a negative drop a negative leak rate)
     mu = check_finite_positive("mu (Pa s)", mu)
     pressure_drop = check_finite_nonnegative("pressure_drop (Pa)", pressure_drop)
-    g = np.asarray(gap, dtype=float)
+    g = check_real_array("gap", gap, 2)     # a masked or complex gap is refused, not read
     net = free_volume_network(g, contact, spacing, directions=dirs, periodic=periodic,
                               sigma=sigma, gap_tol=gap_tol, corner_rule=corner_rule)
     flows = {}

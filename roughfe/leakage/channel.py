@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive
+from ..errors import InputError, check_finite_positive, check_real_array
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,12 +112,12 @@ def channel_flow(gap, spacing: float, *, p_in: float, p_out: float,
     -------
     ChannelFlow
     """
-    g = np.asarray(gap, dtype=float)
-    if g.ndim != 1 or g.size < 2:
+    g = check_real_array("the channel gap", gap, 1)
+    if g.size < 2:
         raise InputError(f"the channel gap must be a 1D array of at least 2 samples (m), "
                          f"got shape {g.shape}")
-    if not np.all(np.isfinite(g)) or np.any(g < 0):
-        bad = g[~(np.isfinite(g) & (g >= 0))][0]
+    if np.any(g < 0):
+        bad = g[g < 0][0]
         raise InputError(f"the channel gap must be finite and >= 0 (m), got {bad!r}")
     dx = check_finite_positive("spacing", spacing)
     mu = check_finite_positive("mu", mu)

@@ -66,7 +66,7 @@ import scipy.sparse as sp
 from scipy import ndimage
 from scipy.sparse.csgraph import connected_components
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive
+from ..errors import InputError, NoConvergenceError, check_finite_positive, check_real_array
 from ..fem.dissipation import solve_for_dissipation
 from ..fem.petsc_tools import CG_AMG, KrylovSolver, petsc_aij_csr
 from ..fem.reynolds import check_reynolds_data
@@ -232,7 +232,7 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     if solver is not None and petsc_options:
         raise InputError("give petsc_options to reynolds_fv_solver, not beside a solver")
     if initial is not None:
-        initial = np.asarray(initial, dtype=float)
+        initial = check_real_array("initial pressure", initial, unit="Pa", allow_nan=True)
         if initial.shape != g.shape:
             raise InputError(f"initial pressure has shape {initial.shape}, the gap {g.shape}")
     if direction == "y":                       # work with the flow along axis 0

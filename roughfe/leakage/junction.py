@@ -36,7 +36,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import breadth_first_order
 
-from ..errors import InputError, check_finite_nonnegative, check_finite_positive, check_spacing
+from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
+                      check_real_array, check_spacing)
 from .finite_volume import components_reaching
 
 
@@ -151,8 +152,8 @@ def critical_constriction(gap, spacing, *, direction: str = "x", periodic: bool 
     -------
     CriticalConstriction
     """
-    g = np.asarray(gap, dtype=float)
-    if g.ndim != 2 or min(g.shape) < 1 or not np.all(np.isfinite(g)) or g.min() < 0:
+    g = check_real_array("gap", gap, 2)
+    if min(g.shape) < 1 or g.min() < 0:
         raise InputError(f"gap must be a finite 2D array (nx, ny) of metres >= 0, got shape "
                          f"{g.shape}")
     if direction not in ("x", "y"):

@@ -70,7 +70,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
-                      check_spacing)
+                      check_real_array, check_spacing)
 from ..frozen import FrozenMapping
 
 _AXES = {"x": 0, "y": 1}
@@ -300,7 +300,7 @@ def directional_network(open_cells, gap, spacing, direction: str = "x", *,
         raise InputError(f"corner_rule must be one of {CORNER_RULES}, got {corner_rule!r}")
     axis = _AXES[direction]
     o = np.asarray(open_cells, dtype=bool)
-    g = np.asarray(gap, dtype=float)
+    g = check_real_array("gap", gap, 2)
     g = np.where(o, g, 0.0)                      # closed cells have w = 0 (Fig. 13)
     if axis == 1:
         o, g = o.T, g.T
@@ -401,12 +401,10 @@ def free_volume_network(gap, contact, spacing, *, directions: Sequence[str] = ("
     -------
     NetworkResult
     """
-    g = np.asarray(gap, dtype=float)
-    if g.ndim != 2 or min(g.shape) < 1:
-        raise InputError(f"gap must be a 2D array (nx, ny) of metres, got shape {g.shape}")
-    if not np.all(np.isfinite(g)) or g.min() < 0:
-        raise InputError("gap must be finite and >= 0 (m); got min "
-                         f"{np.nanmin(g)!r} and {int((~np.isfinite(g)).sum())} non-finite value(s)")
+    g = check_real_array("gap", gap, 2)       # refuses masked and complex gaps
+    if min(g.shape) < 1 or g.min() < 0:
+        raise InputError(f"gap must be a non-empty 2D array (nx, ny) of metres >= 0, got "
+                         f"shape {g.shape}" + (f", min {g.min()!r}" if g.size else ""))
     dx, dy = check_spacing(spacing)
     gap_tol = check_finite_nonnegative("gap_tol (m)", gap_tol)
     min_hydraulic_diameter = check_finite_nonnegative("min_hydraulic_diameter (m)",

@@ -195,13 +195,14 @@ def reynolds_flow(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     dp = float(pressure_drop)
     if not (np.isfinite(dp) and dp >= 0):
         raise InputError(f"pressure_drop must be finite and >= 0 (Pa), got {pressure_drop!r}")
-    if dp == 0 and not np.any(np.asarray(wall_velocity, float) != 0):
-        raise InputError("pressure_drop is 0 and there is no wall velocity: nothing drives the flow")
     if scheme not in SCHEMES:
         raise InputError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
     # the gap as given is checked before the h_min clip (a negative, interpenetrating
-    # gap became a conducting film of h_min)
-    g = check_reynolds_data(gap, spacing, mu, p_out + dp, p_out, direction, wall_velocity)[0]
+    # gap became a conducting film of h_min); a masked or complex gap is refused
+    g, _, _, u = check_reynolds_data(gap, spacing, mu, p_out + dp, p_out, direction,
+                                     wall_velocity)
+    if dp == 0 and not np.any(u != 0):
+        raise InputError("pressure_drop is 0 and there is no wall velocity: nothing drives the flow")
     h_min = check_finite_nonnegative("h_min (m)", h_min)
     h = np.maximum(g, h_min) if h_min > 0 else g
     if scheme == "fv":
@@ -229,7 +230,7 @@ def reynolds_flow(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         nit=sol.nit)
     imbalance = result.flow_imbalance
     if imbalance is not None and imbalance > FLOW_IMBALANCE_TOL:
-        dissipation = not np.any(np.asarray(wall_velocity, float) != 0)   # both schemes
+        dissipation = not np.any(u != 0)          # both schemes
         warnings.warn(FlowImbalanceWarning(
             f"Reynolds flow along {direction} ({scheme}): inlet flow {result.inlet_flow:.3e} "
             f"and outlet flow {result.outlet_flow:.3e} m^3/s differ by {imbalance:.1e} of "

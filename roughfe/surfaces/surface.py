@@ -113,8 +113,9 @@ class Surface:
 
     # -- derived surfaces -----------------------------------------------------------
     def with_heights(self, heights, **metadata) -> "Surface":
-        """A new surface on the same grid with other heights (metadata updated)."""
-        heights = np.asarray(heights, dtype=float)
+        """A new surface on the same grid with other heights (metadata updated); masked or
+        complex heights are an InputError, as in :class:`Surface`."""
+        heights = check_real_array("heights", heights)
         if heights.shape != self.shape:
             raise InputError(f"new heights have shape {heights.shape}, expected {self.shape}")
         return Surface(heights, self.size, self.periodic, {**self.metadata, **metadata})

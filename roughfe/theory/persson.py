@@ -69,7 +69,7 @@ import numpy as np
 import scipy.special
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
-                      check_in_open_interval)
+                      check_in_open_interval, check_real_array)
 from ..surfaces.stats import PowerSpectrum, power_spectrum
 from ..surfaces.surface import Surface
 
@@ -95,12 +95,8 @@ def _spectrum(source) -> PowerSpectrum:
 
 
 def _pressures(mean_pressure):
-    try:
-        p = np.atleast_1d(np.asarray(mean_pressure, dtype=float))
-    except (TypeError, ValueError):
-        raise InputError(f"mean_pressure must be numbers (Pa), got {mean_pressure!r}") from None
-    bad = ~(np.isfinite(p) & (p > 0))
-    if p.ndim != 1 or p.size == 0 or bad.any():
+    p = np.atleast_1d(check_real_array("mean_pressure", mean_pressure, unit="Pa"))
+    if p.ndim != 1 or p.size == 0 or np.any(p <= 0):
         raise InputError(f"mean_pressure must be finite and > 0 (Pa), got {mean_pressure!r}")
     return p
 
@@ -206,15 +202,15 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
     gamma = check_in_open_interval("gamma", gamma, 0.0, 1.0 + 1e-12)
     p = _pressures(mean_pressure)
     q_min = check_finite_nonnegative("q_min (rad/m)", q_min)
-    q, power = np.asarray(q, float), np.asarray(power, float)
+    q = check_real_array("q (wavenumbers)", q, unit="rad/m")
+    power = check_real_array("power", power, unit="m^2")
     if q.ndim != 1 or q.shape != power.shape:
         raise InputError(f"q and power must be 1D arrays of the same length, got shapes "
                          f"{q.shape} and {power.shape}")
-    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(power))) \
-            or q.min(initial=0.0) < 0 or power.min(initial=0.0) < 0 or np.any(np.diff(q) < 0):
+    if q.min(initial=0.0) < 0 or power.min(initial=0.0) < 0 or np.any(np.diff(q) < 0):
         raise InputError("q (rad/m) must be finite, >= 0 and increasing, and power (m^2) "
                          "finite and >= 0")
-    q2 = q * q if q2 is None else np.asarray(q2, float)
+    q2 = q * q if q2 is None else check_real_array("q2", q2, unit="rad^2/m^2")
     if q2.shape != q.shape:
         raise InputError(f"q2 must have the shape of q {q.shape}, got {q2.shape}")
     sel = q > q_min
