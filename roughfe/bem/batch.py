@@ -85,7 +85,7 @@ class BatchOperator:
         self.inverse = op.inverse_spectrum()
 
     def apply(self, p):
-        return self.op.apply(p, workers=WORKERS)
+        return self.op.apply_unchecked(p, workers=WORKERS)
 
     def precondition(self, g):
         return self.op.precondition(g, self.inverse, workers=WORKERS)

@@ -201,10 +201,10 @@ def _pk(op, h, hmax, scale, tol, max_iter, initial, own, deflation, **target):
     """The Polonsky-Keer CG on ``op`` for the heights ``h`` (max ``hmax``): the float32
     products and preconditioner of its direction, the split line search with a
     ``deflation``; ``target``: delta or mean_pressure (and hardness, approach)."""
-    return polonsky_keer(op.apply, h, scale, initial=initial, diagonal=op.diagonal, tol=tol,
-                         precond=_cg_preconditioner(op), overwrite_initial=own,
+    return polonsky_keer(op.apply_unchecked, h, scale, initial=initial, diagonal=op.diagonal,
+                         tol=tol, precond=_cg_preconditioner(op), overwrite_initial=own,
                          max_iter=max_iter or 20000, offset=-hmax,
-                         apply_single=functools.partial(op.apply, single=True),
+                         apply_single=functools.partial(op.apply_unchecked, single=True),
                          deflation=deflation,
                          split=None if deflation is None else op.split_product, **target)
 

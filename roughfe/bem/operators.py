@@ -56,7 +56,7 @@ from typing import Optional
 import numpy as np
 import scipy.fft
 
-from ..errors import InputError
+from ..errors import InputError, check_real_array
 from .fft import (WORKERS, FFTWorkspace, _backward, _convolve, _copy, _forward,  # noqa: F401
                   _irfftn_owned, _multiply, _pocketfft, _spectral_energy, fast_length)
 from ..reference import uniform_cell_displacement_grid, uniform_strip_displacement
@@ -133,17 +133,33 @@ class InfluenceOperator:
         return _KERNEL_REFERENCES[self.name]
 
     def apply(self, p, single=False, out=None, work=None, workers=None):
-        """Displacement u = H p (m) of the pressure ``p`` (Pa, array of ``shape``, or a
-        stack ``(..., *shape)`` of them: one product over the trailing axes).
+        """Displacement u = H p (m) of the pressure ``p`` (Pa, array_like of ``shape``, or
+        a stack ``(..., *shape)`` of them: one product over the trailing axes).
 
-        ``single``: in single precision (``p`` rounded to float32, float32 result,
-        relative error ~1e-7 of max |u|; half the FFT work), for iterates far from
-        convergence (:func:`roughfe.bem.pk.polonsky_keer`). ``out`` (an array of
-        ``p``'s shape and the result's dtype) receives the result; with an
-        :class:`FFTWorkspace` ``work`` a periodic product allocates nothing.
+        ``p`` is taken as float64 (a float32 ``p`` too: single precision only with
+        ``single``); its trailing axes must be ``shape`` (an InputError otherwise: the
+        FFT would zero-pad a smaller grid and crop a larger one without a word), and
+        masked or complex arrays are refused. ``single``: in single precision (``p``
+        rounded to float32, float32 result, relative error ~1e-7 of max |u|; half the
+        FFT work), for iterates far from convergence (:func:`roughfe.bem.pk.polonsky_keer`).
+        ``out`` (an array of ``p``'s shape and the result's dtype) receives the result;
+        with an :class:`FFTWorkspace` ``work`` a periodic product allocates nothing.
         ``workers``: threads per FFT (default ``WORKERS``; the batched solvers of
-        :mod:`roughfe.bem.batch` take 1).
+        :mod:`roughfe.bem.batch` take 1). The solvers call :meth:`apply_unchecked`.
         """
+        if np.ma.isMaskedArray(p) or np.iscomplexobj(p):
+            p = check_real_array("pressure p", p, unit="Pa")   # names the mask / complex
+        p = np.asarray(p) if single else np.asarray(p, dtype=float)
+        if p.shape[max(p.ndim - len(self.shape), 0):] != self.shape:
+            raise InputError(f"the pressure's trailing axes must be the operator's grid "
+                             f"{self.shape} (a stack (..., {', '.join(map(str, self.shape))}) "
+                             f"allowed), got shape {p.shape}")
+        return self.apply_unchecked(p, single, out, work, workers)
+
+    def apply_unchecked(self, p, single=False, out=None, work=None, workers=None):
+        """:meth:`apply` without its input checks, for the solvers' inner loops: ``p``
+        must be an ndarray whose trailing axes are ``shape`` (a smaller one would be
+        zero-padded, a larger one cropped) and a float32 ``p`` gives a float32 result."""
         if single and p.dtype != np.float32:
             if out is not None and work is not None and self.periodic:
                 _copy(out, p)                     # the float32 input, in out

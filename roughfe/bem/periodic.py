@@ -33,7 +33,7 @@ def periodic_bounded_displacement(op, h, hmax, scale, delta, initial, tol, max_i
         if float(elastic.pressure.max()) <= hardness:
             return elastic
         initial = elastic.pressure
-    return polonsky_keer(op.apply, h, scale, delta=delta, initial=initial,
+    return polonsky_keer(op.apply_unchecked, h, scale, delta=delta, initial=initial,
                          diagonal=op.diagonal, precond=precond, tol=tol,
                          max_iter=max_iter, offset=-hmax, hardness=hardness)
 

@@ -82,7 +82,7 @@ def unit_load_rate(op, contact, tol=1e-8, max_iter=2000):
 
     def apply_free(xF):
         grid[c] = xF
-        return op.apply(grid.reshape(shape), out=out, work=work).reshape(-1)[c]
+        return op.apply_unchecked(grid.reshape(shape), out=out, work=work).reshape(-1)[c]
 
     y = np.full(nc, 1.0 / nc)
     u = apply_free(y)
@@ -211,7 +211,7 @@ def load_controlled_gap_response(result: ContactResult, tractions, *,
     for t in tractions:
         t = np.asarray(t, dtype=float).reshape(c.shape)
         ht = np.asarray(op.apply(t)).reshape(c.shape)
-        a, _ = restricted_cg(op.apply, c, ht, precond=precond, tol=1e-10)
+        a, _ = restricted_cg(op.apply_unchecked, c, ht, precond=precond, tol=1e-10)
         dD = (a.sum() - t.sum()) / b.sum()
         dp = np.where(c, dD * b - a, 0.0)
         dg = np.asarray(op.apply(dp + t)).reshape(c.shape) - dD
