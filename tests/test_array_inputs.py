@@ -7,6 +7,8 @@ column of 1 mm samples under its mask leaked 2.6e-9 m^3/s instead of 6.3e-16. Ev
 entry point routes its arrays through :func:`roughfe.errors.check_real_array`, as
 :class:`~roughfe.surfaces.Surface` does.
 """
+import functools
+
 import numpy as np
 import pytest
 
@@ -14,6 +16,7 @@ from roughfe.bem import solve_contact
 from roughfe.bem.batch import solve_batch
 from roughfe.bem.contact import surface_displacement
 from roughfe.bem.operators import influence_operator
+from roughfe.bem.stiffness import load_controlled_gap_response
 from roughfe.errors import InputError
 from roughfe.leakage import (analyse_leakage, channel_flow, critical_constriction,
                              directional_network, finite_volume_leak_rate,
@@ -49,6 +52,12 @@ MATERIAL = Material(1e9, 0.3)
 PRESSURE = np.full(SURFACE.shape, 1e6)
 Q, POWER = np.linspace(1e4, 1e6, 16), np.full(16, 1e-14)
 
+
+@functools.cache
+def _contact():
+    return solve_contact(SURFACE, MATERIAL, mean_pressure=1e7)
+
+
 # name -> a call of the entry point with its array argument replaced by ``a``
 CALLS = {
     "reynolds_flow": lambda a: reynolds_flow(a, SPACING),
@@ -70,6 +79,7 @@ CALLS = {
         mean_pressure=a[:1, N // 2] * 1e12 + 1e6),
     "solve_contact plastic_displacement": lambda a: solve_contact(
         SURFACE, MATERIAL, mean_pressure=1e6, hardness=1e8, plastic_displacement=a * 1e-3),
+    "load_controlled_gap_response": lambda a: load_controlled_gap_response(_contact(), [a]),
     "mean_separation power": lambda a: mean_separation(Q, a[0, :16] * 1e-8, 1e9, 1e6),
     "persson mean_pressure": lambda a: persson(SURFACE, 1e9, a[0] * 1e12 + 1.0),
 }

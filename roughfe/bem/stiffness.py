@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, NoConvergenceError
+from ..errors import InputError, NoConvergenceError, check_real_array
 from ..model import ContactResult
 from .directions import _descent_guard
 from .fft import FFTWorkspace
@@ -209,11 +209,14 @@ def load_controlled_gap_response(result: ContactResult, tractions, *,
     precond = _cg_preconditioner(op)
     out = []
     for t in tractions:
-        t = np.asarray(t, dtype=float).reshape(c.shape)
-        ht = np.asarray(op.apply(t)).reshape(c.shape)
+        t = check_real_array("traction pattern", t, unit="Pa")
+        if t.shape != c.shape:
+            raise InputError(f"a traction pattern must have the surface's shape {c.shape}, "
+                             f"got {t.shape}")
+        ht = np.asarray(op.apply_unchecked(t)).reshape(c.shape)
         a, _ = restricted_cg(op.apply_unchecked, c, ht, precond=precond, tol=1e-10)
         dD = (a.sum() - t.sum()) / b.sum()
         dp = np.where(c, dD * b - a, 0.0)
-        dg = np.asarray(op.apply(dp + t)).reshape(c.shape) - dD
+        dg = np.asarray(op.apply_unchecked(dp + t)).reshape(c.shape) - dD
         out.append(np.where(c, 0.0, dg))
     return np.array(out).reshape((len(out),) + c.shape)
