@@ -575,3 +575,24 @@ def test_iterative_inner_solver_gives_the_direct_solution(westergaard_mesh, pc):
         petsc_options={"ksp_type": "cg", "pc_type": pc, "ksp_rtol": 1e-13}))
     for key in ("mean_pressure", "area_fraction", "stiffness"):
         assert np.allclose(getattr(cg, key), getattr(direct, key), rtol=1e-6, atol=0), key
+
+
+def test_the_dimensionless_answer_does_not_depend_on_the_unit_of_length():
+    """One 65-point profile at dx = 1 m, 1 mm and 1 pm (heights and approaches scaled with
+    dx): the same mesh in units of W and the same p/E*, area fraction, K dx/E* and mean
+    gap/dx. The mesh was built from x / W = i dx / ((n-1) dx), whose last bit depends on
+    dx, and gmsh turned the 1-ulp differences into different interior meshes: p/E*
+    0.0418401343 at dx = 1 m and 0.0418419674 at 1 mm (4.4e-5 apart, K 5e-5)."""
+    base = random_profile(65, seed=4)
+    h0 = base.heights / base.spacing[0]             # heights in units of dx
+    meshes, answers = [], []
+    for dx in (1.0, 1e-3, 1e-12):
+        pm = mesh_profile(Surface(h0 * dx, 65 * dx), growth=0.1)
+        deltas = np.array([0.1, 0.3, 0.5]) * np.ptp(h0) * dx
+        res = fem_contact_sweep(pm, MAT, applied_deltas=deltas).results
+        meshes.append(pm.mesh.geometry.x)
+        answers.append(np.array([[r.mean_pressure / r.e_star, r.area_fraction,
+                                  r.stiffness * dx / r.e_star, r.mean_gap / dx] for r in res]))
+    for x, a in zip(meshes[1:], answers[1:]):
+        assert x.shape == meshes[0].shape and np.array_equal(x, meshes[0])
+        np.testing.assert_allclose(a, answers[0], rtol=1e-12, atol=0)

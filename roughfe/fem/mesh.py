@@ -17,8 +17,11 @@ on the contact width, 0.1 gives <= 0.7 %%, 0.03 gives <= 0.14 %%.
 
 The mesh is built in non-dimensional coordinates ``x / W`` (the length scale is stored
 in :attr:`ProfileMesh.length_scale`), which keeps the VI solver's absolute tolerances
-meaningful. Physical groups (facet tags): top = 1, bottom = 2, left = 3, right = 4; the
-domain is cell tag 1.
+meaningful. They are unit-free: ``x_i / W = i / (n-1)``, ``dx / W = 1 / (n-1)``, and the
+default depth and ``size_max`` are 2 and 1/4 exactly, so one profile gives the same mesh
+and the same dimensionless answer at any dx (``i dx / ((n-1) dx)`` rounds with dx, and
+gmsh turned those 1-ulp differences into other interior meshes). Physical groups (facet
+tags): top = 1, bottom = 2, left = 3, right = 4; the domain is cell tag 1.
 """
 from __future__ import annotations
 
@@ -147,6 +150,12 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
     size_max = width / 4 if size_max is None else check_finite_positive("size_max", size_max)
     size_max = max(size_max, dx)
     scale = width
+    # the mesh's coordinates in units of W, unit-free: x / W and dx / W from the sample
+    # index (i dx / ((n-1) dx) rounds with dx, and gmsh made a different interior mesh of
+    # the same profile from the 1-ulp differences: p/E* 4.4e-5 apart at dx = 1 m and 1 mm)
+    xs, d = np.arange(n) / (n - 1), 1.0 / (n - 1)
+    H = depth / width                   # 2 exactly by default
+    smax = d if size_max <= dx else size_max / width
     x = np.arange(n) * dx
     top_y = np.zeros(n) if formulation == "flat" else h - h.mean()
     if formulation == "profile" and -depth >= top_y.min():
@@ -160,9 +169,9 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
         gmsh.model.add(name)
         if comm.rank == 0:
             geo = gmsh.model.geo
-            xs, ys, d, H = x / scale, top_y / scale, dx / scale, depth / scale
-            p_bl = geo.addPoint(0.0, -H, 0.0, size_max / scale)
-            p_br = geo.addPoint(1.0, -H, 0.0, size_max / scale)
+            ys = top_y / scale
+            p_bl = geo.addPoint(0.0, -H, 0.0, smax)
+            p_br = geo.addPoint(1.0, -H, 0.0, smax)
             top_pts = [geo.addPoint(float(xi), float(yi), 0.0, d) for xi, yi in zip(xs, ys)]
             bottom = geo.addLine(p_bl, p_br)
             right = geo.addLine(p_br, top_pts[-1])
@@ -181,7 +190,7 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
             gmsh.model.setPhysicalName(2, DOMAIN_TAG, "body")
             field = gmsh.model.mesh.field.add("MathEval")
             ytop = float(ys.max())
-            size = f"Min({d!r} + {float(growth)!r} * ({ytop!r} - y), {size_max / scale!r})"
+            size = f"Min({d!r} + {float(growth)!r} * ({ytop!r} - y), {smax!r})"
             gmsh.model.mesh.field.setString(field, "F", size)
             gmsh.model.mesh.field.setAsBackgroundMesh(field)
             for opt in ("Mesh.CharacteristicLengthExtendFromBoundary",
