@@ -317,3 +317,15 @@ def test_contact_cli_says_when_pastewka_robbins_is_outside_its_domain(tmp_path, 
     assert st["range_over_edge_gap"] > 0.1 and st["in_domain"] is False
     assert (f"outside its domain: Delta_r/g0 = {st['range_over_edge_gap']:.2g} > 0.1"
             in out)
+
+
+def test_contact_cli_completes_on_a_two_row_window(tmp_path):
+    # Persson's theory has no PSD of a non-periodic 2 x N window (Hann): the run writes
+    # its results without it (it failed after the whole solve, rc 2, nothing written)
+    path = tmp_path / "two.npy"
+    np.save(path, 1e-6 * np.random.default_rng(1).standard_normal((2, 64)))
+    assert main(["contact", str(path), "--size", "1e-4", "--steps", "3", "-o",
+                 str(tmp_path / "out"), "--no-figures", "--quiet"]) == 0
+    doc = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert len(doc["steps"]) == 3 and all(st["area_fraction"] > 0 for st in doc["steps"])
+    assert doc["derived"]["persson"]["theory"] == "not evaluated on this grid"

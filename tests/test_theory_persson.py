@@ -297,3 +297,22 @@ def test_beside_direction_uses_the_geometry_factor_of_that_direction():
         0.5 * (along_x["persson_leak_rate"] + along_y["persson_leak_rate"]), rel=1e-12)
     with pytest.raises(InputError, match="direction"):
         beside(s, E_STAR, steps, direction="z", **kw)
+
+
+def test_beside_evaluates_no_theory_where_the_grid_has_no_psd():
+    """A non-periodic 2 x N surface has no Hann-windowed PSD: beside leaves the theory out
+    and says why, so `roughfe contact` / `roughfe leak` on such a strip complete (they
+    failed after the whole solve, rc 2 and nothing written, with advice to use
+    window='none' that the CLI does not take)."""
+    rng = np.random.default_rng(0)
+    strip = Surface(1e-6 * rng.standard_normal((2, 64)), (1e-4 / 32, 1e-4), periodic=False)
+    steps = [{"mean_pressure": 1e6, "x": 1}, {"mean_pressure": 2e6, "x": 2}]
+    doc = beside(strip, E_STAR, steps, pressure_drop=1e5, viscosity=1e-3, direction="both")
+    assert doc["steps"] == steps and doc["steps"][0] is not steps[0]
+    assert not any(k.startswith("persson_") for st in doc["steps"] for k in st)
+    assert doc["persson"]["theory"] == "not evaluated on this grid"
+    assert doc["persson"]["grid"] == [2, 64] and "Hann" in doc["persson"]["note"]
+    # the periodic strip has a PSD (no window) and keeps the theory
+    periodic = Surface(strip.heights, strip.size, periodic=True)
+    assert beside(periodic, E_STAR, steps)["steps"][0]["persson_area_fraction"] > 0
+

@@ -11,7 +11,12 @@ of the adhesive contact, and ``beside(..., adhesive=True)`` evaluates none
 It is elastic as well: a step with plastic flow (a hardness run, ``plastic_area_fraction``
 > 0) and every step after it, on a surface recessed by the plastic displacement (the
 unloading branch), are not the elastic contact of the surface's PSD, so those steps get
-None and ``"persson"`` says why (:data:`NOT_PLASTIC`)."""
+None and ``"persson"`` says why (:data:`NOT_PLASTIC`).
+
+It needs the surface's PSD: a non-periodic surface's is taken with a Hann window, which
+is zero on a side of fewer than 3 points, so on such a grid (a 2 x N strip) no step gets
+the theory and ``"persson"`` says why (:data:`NOT_EVALUATED`); the simulation's own
+results are written as usual."""
 from __future__ import annotations
 
 import numbers
@@ -20,6 +25,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import InputError
+from ..surfaces.surface import Surface
 from .junction import _geometry_factor, critical_junction
 from .persson import GAMMA_DEFAULT, PERCOLATION_THRESHOLD, REFERENCES, _spectrum, persson
 
@@ -41,6 +47,16 @@ NOT_PLASTIC = {
             "surface recessed by the plastic displacement, e.g. the unloading branch), "
             "is not the elastic contact of this PSD, so its persson_* values are None "
             "(docs/theory/07_adhesion_persson.md)",
+}
+
+
+#: ``"persson"`` of a grid whose PSD cannot be taken (``grid`` is added: its shape); no
+#: step gets ``persson_*`` keys
+NOT_EVALUATED = {
+    "theory": "not evaluated on this grid",
+    "note": "Persson's theory takes the surface's power spectrum; a non-periodic surface's "
+            "is taken with a Hann window, which is zero on a side of fewer than 3 points, "
+            "so this grid has none and no step carries persson_* values",
 }
 
 
@@ -68,6 +84,8 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     adhesive : bool
         The steps are states of an adhesive contact: the (non-adhesive) theory is not
         evaluated; ``"steps"`` are plain copies and ``"persson"`` is :data:`NOT_ADHESIVE`.
+        So are they, with ``"persson"`` :data:`NOT_EVALUATED`, for a non-periodic surface
+        with fewer than 3 points on a side (no Hann-windowed PSD).
 
     Returns
     -------
@@ -80,7 +98,7 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         percolation threshold, units, references), with :data:`NOT_PLASTIC` and
         ``plastic_steps`` (their indices) when steps were left out as plastic.
     """
-    psd = _spectrum(source)
+    psd = None if _no_spectrum(source) else _spectrum(source)
     if direction not in ("x", "y", "both"):
         raise InputError(f"direction must be 'x', 'y' or 'both', got {direction!r}")
     dirs = ("x", "y") if direction == "both" else (direction,)
@@ -88,6 +106,9 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     pressures = [_number_of(k, s, "mean_pressure", "(Pa)") for k, s in enumerate(steps)]
     if adhesive:
         return {"steps": [dict(s) for s in steps], "persson": dict(NOT_ADHESIVE)}
+    if psd is None:
+        return {"steps": [dict(s) for s in steps],
+                "persson": dict(NOT_EVALUATED, grid=list(source.shape))}
     plastic = _plastic_from(steps)
     ok = [p is not None and np.isfinite(p) and p > 0 and not pl
           for p, pl in zip(pressures, plastic)]
@@ -118,6 +139,12 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     if any(plastic):
         info.update(NOT_PLASTIC, plastic_steps=[k for k, pl in enumerate(plastic) if pl])
     return {"steps": out, "persson": info}
+
+
+def _no_spectrum(source) -> bool:
+    """The source is a non-periodic surface too narrow for the Hann window of its PSD
+    (:func:`roughfe.surfaces.stats.power_spectrum`: fewer than 3 points on a side)."""
+    return isinstance(source, Surface) and not source.periodic and min(source.shape) < 3
 
 
 def _plastic_from(steps):
