@@ -125,7 +125,8 @@ class Surface:
         return self.with_heights(self.heights * float(factor))
 
     def detrended(self, mode: str = "mean") -> "Surface":
-        """Remove the mean (``"mean"``) or the least-squares plane/line (``"plane"``).
+        """Remove the mean (``"mean"``) or the least-squares plane/line (``"plane"``; fitted
+        on coordinates centred and divided by the size, so the same at any unit of length).
 
         On a periodic surface ``"plane"`` removes the mean only (metadata ``detrend =
         "plane (periodic: mean)"``): the mean slope of a periodic surface is zero exactly
@@ -138,7 +139,11 @@ class Surface:
             return self.with_heights(h - h.mean(), detrend=(
                 "mean" if mode == "mean" else "plane (periodic: mean)"))
         if mode == "plane":
-            coords = np.meshgrid(*self.coordinates(), indexing="ij")
+            # centred and in units of the size: the columns of the fit are O(1) at any
+            # scale (on raw coordinates lstsq's rcond cut the tilt columns of a window
+            # below ~1e-11 m, ~1e-9 m at 1024^2, and kept the tilt)
+            coords = np.meshgrid(*((c - c.mean()) / length for c, length
+                                   in zip(self.coordinates(), self.size)), indexing="ij")
             a = np.column_stack([np.ones(h.size)] + [c.ravel() for c in coords])
             coef, *_ = np.linalg.lstsq(a, h.ravel(), rcond=None)
             return self.with_heights(h - (a @ coef).reshape(h.shape), detrend="plane")
