@@ -24,7 +24,10 @@ reaches the inlet or the outlet (components labelled by ``scipy.ndimage.label``,
 across the periodic seam); the pressure of every other open cell (pockets ringed by
 contact: trapped fluid) is not determined by the inlet/outlet data and is NaN. Only the
 live cells are unknowns: closed cells and pockets never enter the linear system (at high
-A* most of the grid). The unknown is ``p - p_out``, so the solver tolerance is relative to
+A* most of the grid); without wall motion neither do the components reaching one side
+only, which carry no flow: their pressure is p_in or p_out exactly. (Near the threshold
+they hang reservoirs on a side through junctions ~1e17 times weaker, below the round-off
+of a diagonal: BoomerAMG then broke down, DIVERGED_INDEFINITE_PC/MAT.) The unknown is ``p - p_out``, so the solver tolerance is relative to
 the pressure drop (and the Couette flow), never to the absolute pressure level. The
 symmetric positive definite system is assembled with array operations straight into CSR
 (no loop over cells, no COO duplicates) and solved with CG + BoomerAMG (PETSc, through
@@ -248,16 +251,23 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
 
     lab, t_in_lab, t_out_lab = components_reaching(is_open, periodic=periodic)
     live = np.append(t_in_lab | t_out_lab, False)[lab]      # label -1 (closed): False
-    del lab
     percolates = bool((t_in_lab & t_out_lab).any())
+    # without wall motion a component reaching one side only carries no flow: p = p_in
+    # (inlet) or p_out exactly, no unknown (module docstring); `solve` masks the system
+    inlet_only = None
+    solve = live
+    if ul == 0.0 and ut == 0.0:
+        solve = np.append(t_in_lab & t_out_lab, False)[lab]
+        inlet_only = np.append(t_in_lab & ~t_out_lab, False)[lab]
+    del lab
 
     # face transmissibilities (m^3/(Pa s)); T_t[:, j] joins columns j and j + 1 (with wrap,
     # the last column is the seam face); faces outside the live components carry nothing
-    T_l = _harmonic(k[:-1], k[1:], dt / dl, live[:-1])
+    T_l = _harmonic(k[:-1], k[1:], dt / dl, solve[:-1])
     T_t = np.empty((nl, nt if wrap else nt - 1))
-    _harmonic(k[:, :-1], k[:, 1:], dl / dt, live[:, :-1], out=T_t[:, :nt - 1])
+    _harmonic(k[:, :-1], k[:, 1:], dl / dt, solve[:, :-1], out=T_t[:, :nt - 1])
     if wrap:
-        _harmonic(k[:, -1:], k[:, :1], dl / dt, live[:, -1:], out=T_t[:, -1:])
+        _harmonic(k[:, -1:], k[:, :1], dl / dt, solve[:, -1:], out=T_t[:, -1:])
     # Couette face flows (m^3/s, along +axis; None without wall motion along that axis)
     C_l = C_t = None
     if ul:
@@ -270,8 +280,8 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         T_t, wrap = T_t[:, :1] + T_t[:, 1:], False
         if C_t is not None:
             C_t = C_t[:, :1] - C_t[:, 1:]
-    T_in = dt / (0.5 * dl) * k[0] * live[0]
-    T_out = dt / (0.5 * dl) * k[-1] * live[-1]
+    T_in = dt / (0.5 * dl) * k[0] * solve[0]
+    T_out = dt / (0.5 * dl) * k[-1] * solve[-1]
     del k
     C_in = 0.5 * g[0] * ul * dt * live[0]
     C_out = 0.5 * g[-1] * ul * dt * live[-1]
@@ -292,25 +302,26 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         if wrap:
             rhs[:, 0] += C_t[:, -1]
 
-    # unknowns on the live cells only: closed cells and pockets do not enter the system;
+    # unknowns on the `solve` cells only: closed cells and pockets do not enter the system;
     # a dissipation leak rate (energy) goes on to rtol sqrt(rtol / R) (module docstring)
     drop = p_in - p_out
     energy = percolates and ul == 0.0 and ut == 0.0 and drop != 0.0
-    nit, success, message = 0, True, "nothing to solve: no open cell reaches inlet or outlet"
-    flows = functools.partial(_pressure_flows, live=live, T_l=T_l, T_t=T_t, T_in=T_in,
+    nit, success, message = 0, True, ("nothing to solve: no open component reaches both "
+                                      "inlet and outlet")
+    flows = functools.partial(_pressure_flows, live=solve, T_l=T_l, T_t=T_t, T_in=T_in,
                               T_out=T_out, drop=drop, wrap=wrap, out=rhs)
-    if live.any():
-        M = _live_system(T_l, T_t, _diagonal(T_l, T_t, T_in, T_out, wrap), live, wrap)
+    if solve.any():
+        M = _live_system(T_l, T_t, _diagonal(T_l, T_t, T_in, T_out, wrap), solve, wrap)
         x0 = None
         if initial is not None:                # unknown p - p_out; NaN (pockets) -> 0
-            x0 = initial[live] - p_out
+            x0 = initial[solve] - p_out
             x0[~np.isfinite(x0)] = 0.0
         one_shot = solver is None
         if one_shot:
             solver = reynolds_fv_solver(petsc_options, reuse=False)
         try:
             _, nit, success, message, power, (x_grid, fl, ft) = solve_for_dissipation(
-                solver, M, rhs[live], x0, own=True, evaluate=flows,
+                solver, M, rhs[solve], x0, own=True, evaluate=flows,
                 scale=drop * drop * float(T_in.sum()) if energy else None)
         finally:
             if one_shot:
@@ -336,6 +347,8 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     else:
         leak = 0.5 * (q_in + q_out)            # wall motion: the mean of the boundary flows
     p = x_grid
+    if inlet_only is not None:
+        p[inlet_only] = drop
     p += p_out
 
     # cell-centre flux per unit width: mean of the two opposite face flows
