@@ -572,6 +572,22 @@ def test_fe_leak_rate_is_the_dissipation_of_the_discrete_solution():
             assert abs(cg.leak_rate / fv.leak_rate - 1) > 1e-3
 
 
+def _threshold_gap(seed, mean_pressure, quantile):
+    """BEM gap of a 64^2 spectral surface near the percolation threshold (A* 0.4-0.5) with
+    the contact-edge cells below the ``quantile`` of their gaps set to 1e-12 m (the residual
+    gap BEM leaves on real topographies): ``(surface, gap)``."""
+    from scipy import ndimage
+
+    from roughfe.bem import Material, solve_contact
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=seed)
+    g = solve_contact(s, Material(1e9, 0.3), mean_pressure=mean_pressure).gap.copy()
+    edge = (g > 0) & ndimage.binary_dilation(g == 0)
+    g[edge & (g <= np.quantile(g[edge], quantile))] = 1e-12
+    assert 0.4 < np.mean(g == 0) < 0.5
+    return s, g
+
+
 def test_one_sided_components_are_exact_at_the_threshold_and_match_lu():
     """BEM contact of a 64^2 spectral surface at A* = 0.44 with its contact-edge cells at a
     residual gap of 1e-12 m (as BEM leaves on real topographies): reservoirs hang on the
@@ -580,16 +596,8 @@ def test_one_sided_components_are_exact_at_the_threshold_and_match_lu():
     DIVERGED_INDEFINITE_MAT on the components reaching one side only (they carry no flow
     without wall motion: p = p_in or p_out exactly, now no unknowns); along x those
     components had moved the leak rate 2 % off the LU solve's. Both now match MUMPS LU."""
-    from scipy import ndimage
-
-    from roughfe.bem import Material, solve_contact
     from roughfe.leakage.finite_volume import components_reaching, solve_reynolds_fv
-    from roughfe.surfaces.spectral import spectral_surface
-    s = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=12)
-    g = solve_contact(s, Material(1e9, 0.3), mean_pressure=6e7).gap.copy()
-    edge = (g > 0) & ndimage.binary_dilation(g == 0)
-    g[edge & (g <= np.quantile(g[edge], 0.1))] = 1e-12
-    assert 0.4 < np.mean(g == 0) < 0.5
+    s, g = _threshold_gap(12, 6e7, 0.1)
     lu = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
     p_in, p_out = 3e5 + DP, 3e5
     kw = dict(mu=MU, p_in=p_in, p_out=p_out)
@@ -605,3 +613,33 @@ def test_one_sided_components_are_exact_at_the_threshold_and_match_lu():
         ok = lab >= 0
         assert np.all(p[ok & (t_in & ~t_out)[np.maximum(lab, 0)]] == p_in)
         assert np.all(p[ok & (t_out & ~t_in)[np.maximum(lab, 0)]] == p_out)
+
+
+def test_krylov_breakdown_at_the_threshold_is_solved_by_mumps_lu(monkeypatch):
+    """A percolating film with dead-end reservoirs hanging on it through 1e-12 m junctions
+    (64^2 BEM gap, A* = 0.45): CG + BoomerAMG stops with DIVERGED_INDEFINITE_PC after 14
+    iterations along x (it raised NoConvergenceError); the same matrix is now solved by
+    MUMPS LU and the message says so. Ordinary systems never take the fallback, a stall
+    (DIVERGED_MAX_IT) still raises, and so does a breakdown above the size bound."""
+    from roughfe.errors import NoConvergenceError
+    from roughfe.fem import dissipation
+    from roughfe.leakage.finite_volume import solve_reynolds_fv
+    s, g = _threshold_gap(5, 5.05e7, 0.5)
+    lu = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+    direct = solve_reynolds_fv(g, s.spacing, petsc_options=lu)
+    r = solve_reynolds_fv(g, s.spacing)
+    assert r.success and r.percolates and direct.leak_rate > 0
+    assert r.leak_rate == approx(direct.leak_rate, rel=1e-6)
+    assert "cg/hypre broke down (DIVERGED_INDEFINITE" in r.message
+    assert "solved by MUMPS LU" in r.message
+    rng = np.random.default_rng(4)
+    ordinary = np.maximum(rng.standard_normal((24, 20)) + 0.5, 0.0) * H
+    cg = solve_reynolds_fv(ordinary, (DX, DX), mu=MU, p_in=DP, p_out=0.0)
+    assert cg.percolates and cg.nit > 1 and "MUMPS" not in cg.message
+    assert cg.message.startswith("KSP cg/hypre CONVERGED_RTOL")
+    with pytest.raises(NoConvergenceError, match="DIVERGED_MAX_IT"):
+        solve_reynolds_fv(ordinary, (DX, DX), mu=MU, p_in=DP, p_out=0.0,
+                          petsc_options={"ksp_max_it": 1})
+    monkeypatch.setattr(dissipation, "DIRECT_MAX_UNKNOWNS", 100)
+    with pytest.raises(NoConvergenceError, match="no MUMPS LU fallback"):
+        solve_reynolds_fv(g, s.spacing)

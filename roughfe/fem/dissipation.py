@@ -22,10 +22,50 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from ..errors import available_memory
+
 #: Tightest relative tolerance a solve is continued to for the leak rate near the
 #: percolation threshold: on a 64^2 pinhole wall the leak rate is the same at 1e-14 and
 #: 1e-17, the round-off floor.
 RTOL_FLOOR = 1e-15
+
+#: Most unknowns a broken-down Krylov solve is redone by MUMPS LU for (a 1024^2 grid).
+DIRECT_MAX_UNKNOWNS = 2 ** 20
+
+#: Memory a MUMPS LU solve is assumed to need per unknown (B): measured 0.7 kB per unknown
+#: in all (peak RSS 249 MB, 65 MB before) on a 512^2 five-point Reynolds system; x3 for
+#: the n log n fill growth up to :data:`DIRECT_MAX_UNKNOWNS` and a margin.
+DIRECT_BYTES_PER_UNKNOWN = 2048
+
+
+def _solve(solver, matrix, rhs, x0=None, *, own: bool = False, rtol=None):
+    """``solver.solve``; a breakdown redone by MUMPS LU if small enough (module docstring).
+
+    Returns
+    -------
+    (ndarray, int, bool, str, str, bool)
+        Solution, Krylov iterations, converged flag, Krylov report, what the fallback did
+        (``""``: not needed) and whether the solution is the direct one.
+    """
+    from petsc4py import PETSc
+
+    from .petsc_tools import LU_MUMPS, KrylovSolver, reason_name
+
+    x, nit, success, message = solver.solve(matrix, rhs, x0, own=own, rtol=rtol)
+    if (success or solver.reason == PETSc.KSP.ConvergedReason.DIVERGED_MAX_IT
+            or solver.types.startswith("preonly/")):
+        return x, nit, success, message, "", False
+    n = len(rhs)
+    broke = (f"; {solver.types} broke down "
+             f"({reason_name(PETSc.KSP.ConvergedReason, solver.reason)})")
+    if n > DIRECT_MAX_UNKNOWNS or n * DIRECT_BYTES_PER_UNKNOWN > available_memory():
+        return x, nit, False, message, (
+            f"{broke}; no MUMPS LU fallback for {n} unknowns (at most "
+            f"{DIRECT_MAX_UNKNOWNS} and {DIRECT_BYTES_PER_UNKNOWN} B each of the available "
+            f"memory)"), False
+    with KrylovSolver(f"{solver.name}_lu", defaults=LU_MUMPS) as direct:
+        x, _, success, report = direct.solve(matrix, rhs)
+    return x, nit, success, message, f"{broke}; solved by MUMPS LU: {report}", True
 
 
 def solve_for_dissipation(solver, matrix, rhs, x0=None, *, own: bool = False,
@@ -50,18 +90,19 @@ def solve_for_dissipation(solver, matrix, rhs, x0=None, *, own: bool = False,
     Returns
     -------
     (ndarray, int, bool, str, float, object)
-        Solution, iterations in all, converged flag, report, ``D(x)`` and ``data``.
+        Solution, Krylov iterations in all, converged flag, report (naming a MUMPS LU
+        fallback after a breakdown), ``D(x)`` and ``data``.
     """
-    x, nit, success, message = solver.solve(matrix, rhs, x0, own=own)
+    x, nit, success, message, fallback, direct = _solve(solver, matrix, rhs, x0, own=own)
     power, data = evaluate(x)
     rtol = solver.rtol
     for _ in range(2 if scale is not None else 0):   # 2: the first R may be low (Q high)
         ratio = scale / power if power > 0 else np.inf
-        if not (success and rtol > RTOL_FLOOR and rtol * ratio > 1.0):
+        if direct or not (success and rtol > RTOL_FLOOR and rtol * ratio > 1.0):
             break
         rtol = max(np.sqrt(rtol / ratio), RTOL_FLOOR)
-        x, more, success, message = solver.solve(matrix, rhs, x, rtol=rtol)
+        x, more, success, message, fallback, direct = _solve(solver, matrix, rhs, x, rtol=rtol)
         nit += more
         message += f"; continued to rtol {rtol:.1e} for the leak rate: {nit} in all"
         power, data = evaluate(x)
-    return x, nit, success, message, power, data
+    return x, nit, success, message + fallback, power, data

@@ -318,6 +318,8 @@ class KrylovSolver:
     ----------
     setups : int
         Preconditioner set-ups so far.
+    reason : int
+        PETSc converged reason of the last solve (``PETSc.KSP.ConvergedReason``; 0 before).
     """
 
     def __init__(self, name: str, options: Mapping | None = None, *,
@@ -328,7 +330,7 @@ class KrylovSolver:
         self.name = name
         self.reuse = bool(reuse_preconditioner)
         self.reuse_min_it = int(reuse_min_it)
-        self.setups = 0
+        self.setups = self.reason = 0
         self._cap = self.reuse_min_it
         self._ksp = PETSc.KSP().create(PETSc.COMM_SELF)
         options = dict(options or {})
@@ -358,6 +360,11 @@ class KrylovSolver:
         if self._own and self._A is not None:
             self._A.destroy()
         self._A = None
+
+    @property
+    def types(self) -> str:
+        """KSP and PC type, e.g. ``"cg/hypre"`` (``"preonly/lu"``: a direct solve)."""
+        return f"{self._ksp.getType()}/{self._ksp.getPC().getType()}"
 
     @property
     def rtol(self) -> float:
@@ -440,7 +447,7 @@ class KrylovSolver:
             self.setups += 1
             self._pattern = pattern
             self._cap = max((built if kept else nit) + 2, self.reuse_min_it)
-        reason = ksp.getConvergedReason()
+        reason = self.reason = int(ksp.getConvergedReason())
         message = (f"KSP {ksp.getType()}/{pc.getType()} "
                    f"{reason_name(PETSc.KSP.ConvergedReason, reason)} in {nit} iterations, "
                    f"residual norm {ksp.getResidualNorm():.3e}, "
