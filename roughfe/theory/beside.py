@@ -39,7 +39,7 @@ NOT_ADHESIVE = {
 }
 
 #: added to ``"persson"`` when a step had plastic flow; ``plastic_steps`` lists the steps
-#: left without persson_* values (None)
+#: left without ``persson_*`` values (None)
 NOT_PLASTIC = {
     "plasticity": "not in the theory",
     "note": "Persson's A*(p), u(p) and critical junction here are elastic: a step with "
