@@ -16,8 +16,8 @@ def test_rmd_grid_and_size_convention(m):
     n = 2 ** m + 1
     assert s.shape == (n, n)
     # the thesis L spans the nodes end to end: spacing L / 2**m, size = n * spacing
-    assert s.spacing == pytest.approx((1e-4 / 2 ** m,) * 2, rel=1e-12)
-    assert s.size == pytest.approx((n * 1e-4 / 2 ** m,) * 2, rel=1e-12)
+    assert s.spacing == pytest.approx((1e-4 / 2 ** m,) * 2, rel=1e-12, abs=0)
+    assert s.size == pytest.approx((n * 1e-4 / 2 ** m,) * 2, rel=1e-12, abs=0)
     assert not s.periodic
     assert s.metadata["seed"] == 0 and s.metadata["fractal_dimension"] == 2.4
 
@@ -30,7 +30,7 @@ def test_rmd_reproducible_and_seed_dependent():
 
 def test_rmd_rms_target():
     s = rmd_surface(6, 2.5, 1e-4, rng=1, rms_height=2e-6)
-    assert rms_height(s) == pytest.approx(2e-6, rel=1e-12)
+    assert rms_height(s) == pytest.approx(2e-6, rel=1e-12, abs=0)
     assert abs(s.heights.mean()) < 1e-18
 
 
@@ -72,7 +72,7 @@ def test_wm_psd_peaks_and_amplitude_ratio():
     peaks = np.sort(np.argsort(energy)[-8:])
     q_expected = 2 * np.pi / length * gamma ** np.arange(1, 9)
     np.testing.assert_allclose(psd.q[peaks], q_expected, rtol=1e-12)
-    assert energy[peaks].sum() == pytest.approx(energy.sum(), rel=1e-9)   # nothing else
+    assert energy[peaks].sum() == pytest.approx(energy.sum(), rel=1e-9, abs=0)   # nothing else
     np.testing.assert_allclose(psd.C[peaks][1:] / psd.C[peaks][:-1], gamma ** (-2 * hurst),
                                rtol=1e-8)
     # absolute level: a wave A gamma**(-H k) cos(...) holds mean square a**2 / 2
@@ -111,7 +111,8 @@ def test_mwm_peaks_at_qn_with_eq_317_amplitudes():
     ratio = power[k[1:], 0] / power[k[:-1], 0]
     np.testing.assert_allclose(ratio, gamma ** (-2 * hurst), rtol=1e-9)
     # log in Eq. 2.2 is base 10
-    assert amps[0, 0] == pytest.approx(3e-6 * np.sqrt(np.log10(2) / 2) * (2 * np.pi / length) ** -hurst)
+    a0 = 3e-6 * np.sqrt(np.log10(2) / 2) * (2 * np.pi / length) ** -hurst
+    assert amps[0, 0] == pytest.approx(a0, rel=1e-6, abs=0)
 
 
 def test_mwm_anisotropy_scales_ridges():
@@ -242,7 +243,7 @@ def test_plane_detrend_of_a_periodic_surface_removes_the_mean_only():
     d = s.detrended("plane")
     assert d.periodic
     np.testing.assert_allclose(d.heights, s.heights - s.heights.mean(), rtol=0, atol=1e-20)
-    assert rms_slope(d) == pytest.approx(rms_slope(s), rel=1e-12)
+    assert rms_slope(d) == pytest.approx(rms_slope(s), rel=1e-12, abs=0)
     window = Surface(s.heights[:100, :90], (1e-4 * 100 / 128, 1e-4 * 90 / 128))
     flat = window.detrended("plane").heights          # a non-periodic window: the plane
     xs, ys = np.meshgrid(np.arange(100), np.arange(90), indexing="ij")
