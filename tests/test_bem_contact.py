@@ -47,7 +47,7 @@ def test_westergaard_half_width_and_mean_gap(s):
     assert abs(r.area_fraction - ref.area_fraction) <= 2 / 1024
     assert r.mean_gap == pytest.approx(ref.mean_gap, rel=5e-3)
     # periodic convention: mean displacement zero, so d equals the mean gap
-    assert r.mean_plane_separation == pytest.approx(r.mean_gap, rel=1e-9)
+    assert r.mean_plane_separation == pytest.approx(r.mean_gap, rel=1e-9, abs=0)
     assert r.mean_pressure == pytest.approx(ref.mean_pressure, rel=1e-12)
     # the pressure field itself, away from the square-root edges
     x = surf.coordinates()[0]
@@ -115,7 +115,7 @@ def test_dense_and_matrix_free_agree(periodic, kernel, shape):
         assert 0 < a.area_fraction < 1
         assert np.array_equal(a.contact, b.contact)
         assert np.max(np.abs(a.pressure - b.pressure)) <= 1e-8 * a.pressure.max()
-        assert b.delta == pytest.approx(a.delta, rel=1e-8)
+        assert b.delta == pytest.approx(a.delta, rel=1e-8, abs=0)
         assert b.stiffness == pytest.approx(a.stiffness, rel=1e-6)
 
 
@@ -132,7 +132,7 @@ def test_load_and_displacement_control_give_the_same_state():
     b = solve_contact(surf, MAT, delta=a.delta)
     assert b.mean_pressure == pytest.approx(1e6, rel=1e-7)
     assert np.array_equal(a.contact, b.contact)
-    assert b.mean_gap == pytest.approx(a.mean_gap, rel=1e-8)
+    assert b.mean_gap == pytest.approx(a.mean_gap, rel=1e-8, abs=0)
 
 
 def test_dense_load_control_warm_started_far_below_the_load():
@@ -199,9 +199,10 @@ def test_sweep_stiffness_exact_vs_finite_differences_and_records():
                              "free_volume", "free_volume_star", "iterations", "residual"]
     # V = mean gap * A_n, the free volume of Eq. 2.8
     r = sweep.results[5]
-    assert r.free_volume == pytest.approx(r.mean_gap * 1e-4, rel=1e-12)
+    assert r.free_volume == pytest.approx(r.mean_gap * 1e-4, rel=1e-12, abs=0)
     # the record's contact area is A* A_n (m^2), as leak's records carry it
-    assert recs[5]["contact_area"] == pytest.approx(recs[5]["area_fraction"] * 1e-4, rel=1e-12)
+    assert recs[5]["contact_area"] == pytest.approx(recs[5]["area_fraction"] * 1e-4, rel=1e-12,
+                                                    abs=0)
 
 
 def test_composite_modulus_has_the_squares():
@@ -404,7 +405,8 @@ def test_thesis_kernel_is_a_boussinesq_line_of_punches():
     n, L, E = 256, 1e-3, 2e9
     op = influence_operator((n,), (L,), E, "thesis")
     dx = L / n
-    assert op.diagonal == pytest.approx(dx / E, rel=1e-14)   # punch: F/(E* delta), F = p dx^2
+    # punch: F/(E* delta), F = p dx^2
+    assert op.diagonal == pytest.approx(dx / E, rel=1e-14, abs=0)
     r = np.arange(50, 200) * dx
     # far field: the 3D point load u = F / (pi E* r), not the 2D logarithm
     assert np.allclose(op.kernel[50:200] * np.pi * E * r / dx ** 2, 1.0, rtol=2e-5)
@@ -600,7 +602,7 @@ def test_a_patch_pressed_far_beyond_its_roughness_converges_to_the_dense_answer(
         dense = solve_contact(s, mat, mean_pressure=p, tol=1e-10, solver="dense")
         assert pk.solver == "pk" and pk.nit < 100 and pk.area_fraction == 1.0
         assert np.max(np.abs(pk.pressure - dense.pressure)) < 1e-9 * p
-        assert pk.delta == pytest.approx(dense.delta, rel=1e-12)
+        assert pk.delta == pytest.approx(dense.delta, rel=1e-12, abs=0)
         assert pk.delta > 500 * np.ptp(s.heights)
 
 
