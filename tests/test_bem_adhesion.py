@@ -50,7 +50,7 @@ def test_laws_store_the_work_of_adhesion(kind):
     t = law.traction(g)
     # phi(0) = -w, phi(inf) = 0, phi' = traction, int traction dg = w (the md ramp is
     # symmetric about h0, so w = sigma0 h0 holds exactly)
-    assert law.potential(0.0) == pytest.approx(-0.05, rel=1e-12)
+    assert law.potential(0.0) == pytest.approx(-0.05, rel=1e-12, abs=0)
     assert law.potential(30e-9) == pytest.approx(0.0, abs=1e-12 * 0.05)
     assert np.sum(0.5 * (t[1:] + t[:-1]) * np.diff(g)) == pytest.approx(0.05, rel=1e-6)
     dphi = np.gradient(law.potential(g), g)
@@ -262,7 +262,7 @@ def test_cell_averaged_law_keeps_the_work_and_locates_the_zone_end():
     for delta in (0.0, 0.1e-9, 0.4e-9, 2e-9):          # the last one capped at h0
         spread = np.full(g.shape, delta)
         phi, t = law.evaluate(g, spread)
-        assert phi[0] == pytest.approx(-0.05, rel=1e-12) and phi[-1] == 0.0
+        assert phi[0] == pytest.approx(-0.05, rel=1e-12, abs=0) and phi[-1] == 0.0
         assert np.sum(0.5 * (t[1:] + t[:-1]) * np.diff(g)) == pytest.approx(0.05, rel=1e-5)
         # brute-force average of the sharp-ish law over a uniform gap distribution
         if 0 < delta < 1e-9:
@@ -435,7 +435,7 @@ def test_an_unresolved_process_zone_is_a_warning_that_names_the_lengths():
     s, mat = _peel_case()
     law = AdhesionLaw("exp", 0.02, 2e-9)
     assert law.process_zone(mat.E_star) == pytest.approx(
-        np.pi / 4 * mat.E_star * 0.02 / 1e7 ** 2, rel=1e-14)
+        np.pi / 4 * mat.E_star * 0.02 / 1e7 ** 2, rel=1e-14, abs=0)
     top = float(s.heights.max() - s.heights.mean())
     with pytest.warns(ResolutionWarning, match=r"process zone .* 2\.09e-10 m, 0\.00067 of "
                                                r"the grid spacing 3\.13e-07 m"):
@@ -449,7 +449,7 @@ def test_an_unresolved_process_zone_is_a_warning_that_names_the_lengths():
                              max_unload_steps=1).resolution
     # once for the sweep, not at each of its solves (the CLI printed it twice)
     assert sum(issubclass(w.category, ResolutionWarning) for w in record) == 1
-    assert not res["resolved"] and res["grid_spacing"] == pytest.approx(1e-5 / 32)
+    assert not res["resolved"] and res["grid_spacing"] == pytest.approx(1e-5 / 32, rel=1e-6, abs=0)
     assert res["process_zone_cells"] == pytest.approx(6.7e-4, rel=1e-2)
     assert adhesive_sweep(s, mat, RESOLVED_EXP, [0.3 * top]).resolution["resolved"]
 

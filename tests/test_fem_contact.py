@@ -41,7 +41,7 @@ def test_westergaard_width_and_mean_gap(westergaard_mesh):
     targets = np.array([0.2, 0.5, 0.8]) * G          # half-plane approaches (full contact: G)
     sweep = fem_contact_sweep(pm, MAT, targets)
     res = sweep.results
-    assert np.allclose(sweep.delta, targets, rtol=1e-8)
+    assert np.allclose(sweep.delta, targets, rtol=1e-8, atol=0)
     for r in res:
         ref = westergaard(G, LAM, MAT.E_star, r.mean_pressure)
         a = contact_edge(r.x, r.gap, r.contact)
@@ -209,11 +209,11 @@ def test_facet_tags_on_the_right_edges(formulation):
             expect = np.broadcast_to(top_y, (33,))[np.rint(xi).astype(int)]
             assert np.allclose(pts[..., 1], expect, atol=1e-12)
         elif name == "bottom":
-            assert np.allclose(pts[..., 1], -1.5e-3)
+            assert np.allclose(pts[..., 1], -1.5e-3, rtol=0, atol=1e-12 * pm.width)
         elif name == "left":
-            assert np.allclose(pts[..., 0], 0.0)
+            assert np.allclose(pts[..., 0], 0.0, rtol=0, atol=1e-12 * pm.width)
         else:
-            assert np.allclose(pts[..., 0], pm.width)
+            assert np.allclose(pts[..., 0], pm.width, rtol=0, atol=1e-12 * pm.width)
     # tags are disjoint and cover exactly the exterior facets
     assert np.unique(ft.indices).size == ft.indices.size
 
