@@ -42,8 +42,8 @@ def test_published_equation_10_by_hand():
     # Pastewka & Robbins Eq. (10): C = (dr h' / (kappa l_a)) (h' d_rep / (4 dr))^(2/3),
     # d_rep = 4 h'/h''. h' = 0.1, h'' = 1e7 /m, dr = l_a = 1 nm, kappa = 2:
     # C = 0.05 (0.01 / (1e7 1e-9))^(2/3) = 0.05; kappa = 4 halves it.
-    assert published_criterion(0.1, 1e7, 1e-9, 1e-9) == pytest.approx(0.05, rel=1e-14)
-    assert published_criterion(0.1, 1e7, 1e-9, 1e-9, 4.0) == pytest.approx(0.025, rel=1e-14)
+    assert published_criterion(0.1, 1e7, 1e-9, 1e-9) == pytest.approx(0.05, rel=1e-14, abs=0)
+    assert published_criterion(0.1, 1e7, 1e-9, 1e-9, 4.0) == pytest.approx(0.025, rel=1e-14, abs=0)
 
 
 def test_derived_ring_argument_equals_equation_10_at_kappa_2():
@@ -66,23 +66,23 @@ def test_closed_form_and_scaling():
     closed = dr * h1 / (2 * w / e_star) * (h1 * h1 / (h2 * dr)) ** (2 / 3)
     assert r.published and r.dimension == 2
     assert r.criterion == pytest.approx(closed, rel=1e-12)
-    assert r.stickiness == pytest.approx(1 / closed, rel=1e-12)
+    assert r.stickiness == pytest.approx(1 / closed, rel=1e-12, abs=0)
     assert r.kappa_ratio == pytest.approx(1 / (1 - r.stickiness), rel=1e-12)
     assert r.attractive_over_repulsive == pytest.approx(
-        PERIMETER_FACTOR[2] * r.ring_over_half_width, rel=1e-12)
-    assert r.range_over_edge_gap == pytest.approx(dr * 3 * h2 / (16 * h1 * h1), rel=1e-12)
+        PERIMETER_FACTOR[2] * r.ring_over_half_width, rel=1e-12, abs=0)
+    assert r.range_over_edge_gap == pytest.approx(dr * 3 * h2 / (16 * h1 * h1), rel=1e-12, abs=0)
     assert r.tabor_parameter == pytest.approx((w * w / e_star ** 2 / h2) ** (1 / 3) / dr,
-                                              rel=1e-12)
+                                              rel=1e-12, abs=0)
     # linear in w; Delta_r^(-1/3); heights x lambda -> lambda^(-5/3) (h_rms itself does not
     # enter, only slopes and curvatures); w and E* only as l_a = w / E*
     assert pastewka_robbins(s, e_star, 3 * w, dr).stickiness == pytest.approx(
         3 * r.stickiness, rel=1e-12)
     assert pastewka_robbins(s, e_star, w, 8 * dr).stickiness == pytest.approx(
-        r.stickiness / 2, rel=1e-12)
+        r.stickiness / 2, rel=1e-12, abs=0)
     assert pastewka_robbins(_surface(2.0), e_star, w, dr).stickiness == pytest.approx(
         r.stickiness * 2 ** (-5 / 3), rel=1e-9)
     assert pastewka_robbins(s, 2 * e_star, 2 * w, dr).stickiness == pytest.approx(
-        r.stickiness, rel=1e-12)
+        r.stickiness, rel=1e-12, abs=0)
     # the verdict flips at C = 1
     w1 = w * r.criterion
     assert not pastewka_robbins(s, e_star, 0.99 * w1, dr).sticky
@@ -116,8 +116,10 @@ def test_profile_uses_the_strip_edge():
     r = pastewka_robbins(prof, 1e6, 1e-4, 5e-9)
     a = 2 * r.rms_slope / r.rms_curvature
     d = (5e-9 * np.sqrt(a) / (EDGE_COEFFICIENT[1] * r.rms_slope / 2)) ** (2 / 3)
-    assert r.dimension == 1 and not r.published and r.ring_width == pytest.approx(d, rel=1e-12)
-    assert r.stickiness == pytest.approx((1e-4 / 5e-9) / r.repulsive_pressure * d / a, rel=1e-12)
+    assert r.dimension == 1 and not r.published
+    assert r.ring_width == pytest.approx(d, rel=1e-12, abs=0)
+    assert r.stickiness == pytest.approx((1e-4 / 5e-9) / r.repulsive_pressure * d / a, rel=1e-12,
+                                         abs=0)
     assert r.criterion == pytest.approx(1 / r.stickiness, rel=1e-12)
 
 
@@ -177,7 +179,7 @@ def test_load_balance_on_a_hertz_contact_is_the_exact_ring():
         assert lb.attractive_fraction * (8 * a) ** 2 == pytest.approx(ring, rel=0.04)
         assert lb.threshold_work == pytest.approx(dr * load / ring, rel=0.04)
         assert lb.attractive_over_repulsive == pytest.approx(
-            lb.attractive_fraction / res.area_fraction, rel=1e-12)
+            lb.attractive_fraction / res.area_fraction, rel=1e-12, abs=0)
     with pytest.raises(InputError, match="range"):
         load_balance(res, -1.0)
     with pytest.raises(InputError, match="below the range"):
