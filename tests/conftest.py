@@ -1,6 +1,11 @@
-"""Shared test set-up: headless rendering and the location of the shared test data."""
+"""Shared test set-up: headless rendering, the location of the shared test data, and a
+guard that refuses pytest.approx comparisons decided by its default ``abs = 1e-12``."""
+import math
+from decimal import Decimal
+from numbers import Complex
 from pathlib import Path
 
+import _pytest.python_api
 import pytest
 
 # Headless figures in every test process, and vtk loaded before any test module imports
@@ -13,6 +18,37 @@ from roughfe.surfaces.io import topographies_folder  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 TOPOGRAPHIES = topographies_folder()
+
+SWAMPED = "pytest.approx's default abs=1e-12 swamps rel for this SI value; give abs explicitly"
+
+
+def _refuse_default_abs(eq):
+    """``ApproxScalar.__eq__`` that raises where pytest.approx's default ``abs = 1e-12``,
+    not ``rel``, would decide the comparison. pytest keeps that abs when ``rel`` is given,
+    and roughfe works in SI units: leak rates (1e-14 m^3/s), pocket volumes (1e-19 m^3),
+    compliances (1e-13 m/Pa) and mean squares (1e-12 m^2) lie below it, so
+    ``approx(x, rel=1e-9)`` passed for any error (three such passes hid wrong
+    expectations). Refused: ``abs`` not given, a non-zero finite expected value, and
+    1e-12 > rel |expected| (rel defaults to 1e-6). Give ``abs=0`` for a relative
+    comparison, or an abs scaled to the quantity where the expected value can be 0."""
+    api = _pytest.python_api
+
+    def guarded(self, actual):
+        expected = self.expected
+        if (self.abs is None and isinstance(expected, (Complex, Decimal))
+                and api._as_numpy_array(actual) is None):     # arrays: per element
+            size = float(abs(expected))
+            rel = float(self.DEFAULT_RELATIVE_TOLERANCE if self.rel is None else self.rel)
+            default_abs = float(self.DEFAULT_ABSOLUTE_TOLERANCE)
+            if 0 < size < math.inf and default_abs > rel * size:
+                raise AssertionError(f"{SWAMPED} (expected {expected!r}, rel {rel:g}, "
+                                     f"actual {actual!r})")
+        return eq(self, actual)
+    return guarded
+
+
+_pytest.python_api.ApproxScalar.__eq__ = _refuse_default_abs(
+    _pytest.python_api.ApproxScalar.__eq__)
 
 
 @pytest.fixture(scope="session")
