@@ -676,3 +676,14 @@ def test_krylov_breakdown_at_the_threshold_is_solved_by_mumps_lu(monkeypatch):
     monkeypatch.setattr(dissipation, "DIRECT_MAX_UNKNOWNS", 100)
     with pytest.raises(NoConvergenceError, match="no MUMPS LU fallback"):
         solve_reynolds_fv(g, s.spacing)
+
+
+def test_a_direct_solve_of_the_caller_is_not_continued():
+    # a user's preonly/LU solver went through the tolerance continuation: the same
+    # factors solved again, and the message reported "continued to rtol 8.3e-15"
+    from roughfe.leakage.finite_volume import solve_reynolds_fv
+    g, conductance = _pinhole_wall(1e-11)
+    lu = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+    r = solve_reynolds_fv(g, (DX, DX), mu=MU, p_in=1.0, p_out=0.0, petsc_options=lu)
+    assert r.leak_rate == approx(conductance, rel=1e-6, abs=0)
+    assert "continued" not in r.message and r.nit == 1

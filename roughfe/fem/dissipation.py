@@ -45,15 +45,18 @@ def _solve(solver, matrix, rhs, x0=None, *, own: bool = False, rtol=None):
     -------
     (ndarray, int, bool, str, str, bool)
         Solution, Krylov iterations, converged flag, Krylov report, what the fallback did
-        (``""``: not needed) and whether the solution is the direct one.
+        (``""``: not needed) and whether the solution is a direct one (the fallback's or
+        the caller's own ``preonly`` solver: no continuation, a tolerance means nothing
+        there).
     """
     from petsc4py import PETSc
 
     from .petsc_tools import LU_MUMPS, KrylovSolver, reason_name
 
     x, nit, success, message = solver.solve(matrix, rhs, x0, own=own, rtol=rtol)
-    if (success or solver.reason == PETSc.KSP.ConvergedReason.DIVERGED_MAX_IT
-            or solver.types.startswith("preonly/")):
+    if solver.types.startswith("preonly/"):       # the caller's own direct solve
+        return x, nit, success, message, "", True
+    if success or solver.reason == PETSc.KSP.ConvergedReason.DIVERGED_MAX_IT:
         return x, nit, success, message, "", False
     n = len(rhs)
     broke = (f"; {solver.types} broke down "
