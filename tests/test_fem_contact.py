@@ -361,6 +361,35 @@ def test_fluid_loaded_body_checks_its_arguments_and_refuses_use_after_close():
         body.solve(np.zeros(17), 0.5 * G)
 
 
+@pytest.mark.parametrize("method", ["vi", "penalty"])
+def test_option_check_waits_for_the_first_newton_step(method):
+    """A step without contact (delta = 0: the crest just touches) converges in 0 Newton
+    iterations and sets up no linear solver, so MUMPS has not read mat_mumps_icntl_14
+    yet: the check of unread options ran there and refused the valid key as "never
+    read". It now runs after the first step that takes a Newton iteration: the key
+    reaches the factorization of the contact step, a sweep without any contact never
+    refuses, and a misspelled key is still refused at the first contact step."""
+    from roughfe.fem.contact import _ContactProblem
+
+    pm = mesh_profile(cosine_half_period(17), growth=0.3)
+    fem_solve_contact(pm, MAT, applied_delta=0.0, options=FemSolverOptions(
+        method=method, petsc_options={"mat_mumps_icntl_14": 50}))
+    for petsc in ({"mat_mumps_icntl_14": 50}, {"mat_mumps_icntl_14": 50, "ksp_typo": 1}):
+        problem = _ContactProblem(pm, MAT, FemSolverOptions(method=method,
+                                                            petsc_options=petsc))
+        try:
+            assert problem.solve(0.0).mean_pressure == 0.0
+            if "ksp_typo" in petsc:
+                with pytest.raises(InputError, match=r"\['ksp_typo'\] .*never read"):
+                    problem.solve(0.4 * G)
+            else:
+                assert problem.solve(0.4 * G).mean_pressure > 0.0
+                factor = problem.snes.getKSP().getPC().getFactorMatrix()
+                assert factor.getMumpsIcntl(14) == 50
+        finally:
+            problem.destroy()
+
+
 @pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 def test_mesh_files_for_inspection(tmp_path):
     """.msh keeps gmsh's physical groups; it and the XDMF hold the same triangles in

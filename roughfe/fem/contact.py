@@ -106,7 +106,8 @@ class FemSolverOptions:
         "ksp_rtol": 1e-12}`` (see ``benchmarks/bench_fem.py`` for their cost). A value
         PETSc refuses (``{"snes_type": "foo"}``) raises InputError when the solver is
         built, a key PETSc never reads (a misspelling, or ``ksp_rtol`` with the default
-        ``ksp_type preonly``) after the first solve
+        ``ksp_type preonly``) after the first solve that takes a Newton step (steps
+        without contact take none and set up no linear solver)
         (:class:`roughfe.fem.petsc_tools.PrefixedOptions`).
     """
 
@@ -312,8 +313,11 @@ class _ContactProblem:
                 f"imposed delta = {float(delta):.6g} m")
         try:
             self.snes.solve(None, self.x)
-            for options in self._options:      # (once, after the first set-up)
-                options.check_used()
+            if self.snes.getIterationNumber() > 0:
+                # once, after the first Newton step: a step without contact converges
+                # in 0 iterations, before the linear solver (mat_mumps_*, mg_*) is set up
+                for options in self._options:
+                    options.check_used()
             nit = check_snes(self.snes, what)
         except Exception:
             # the next solve starts from the undeformed body, not from a failed iterate
