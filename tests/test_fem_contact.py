@@ -390,6 +390,32 @@ def test_option_check_waits_for_the_first_newton_step(method):
             problem.destroy()
 
 
+def test_multigrid_options_reach_the_rebuilt_gamg_of_the_vi():
+    """With the VI and GAMG the preconditioner is rebuilt by FreshOnResize, which was
+    given only the pc_* keys: mg_levels_* / mg_coarse_* never reached the GAMG and were
+    refused as "never read" (the penalty method accepted them). Now every non-ksp_* key
+    reaches the inner GAMG (its level smoothers take mg_levels_ksp_max_it = 3, the
+    coarse solve mg_coarse_pc_type = lu), and a misspelled mg_ key is still refused."""
+    from roughfe.fem.contact import _ContactProblem
+
+    pm = mesh_profile(cosine_half_period(17), growth=0.3)
+    base = {"ksp_type": "cg", "pc_type": "gamg", "ksp_rtol": 1e-12}
+    good = {**base, "mg_levels_ksp_max_it": 3, "mg_coarse_pc_type": "lu"}
+    problem = _ContactProblem(pm, MAT, FemSolverOptions(method="vi", petsc_options=good))
+    try:
+        assert problem.solve(0.4 * G).mean_pressure > 0.0
+        gamg = problem.snes.getKSP().getPC().getPythonContext().inner
+        levels = gamg.getMGLevels()
+        assert levels > 1
+        assert all(gamg.getMGSmoother(i).getTolerances()[3] == 3 for i in range(1, levels))
+        assert gamg.getMGCoarseSolve().getPC().getType() == "lu"
+    finally:
+        problem.destroy()
+    with pytest.raises(InputError, match=r"\['mg_levels_ksp_max_itt'\] .*never read"):
+        fem_solve_contact(pm, MAT, 0.4 * G, options=FemSolverOptions(
+            method="vi", petsc_options={**base, "mg_levels_ksp_max_itt": 3}))
+
+
 @pytest.mark.filterwarnings("ignore:depth = .* is shallower:roughfe.errors.ResolutionWarning")
 def test_mesh_files_for_inspection(tmp_path):
     """.msh keeps gmsh's physical groups; it and the XDMF hold the same triangles in

@@ -67,7 +67,7 @@ from .petsc_tools import (LU_MUMPS, PrefixedOptions, check_snes, fresh_pc_on_res
 
 Method = Literal["vi", "penalty"]
 METHODS = ("vi", "penalty")
-_KSP_PREFIXES = ("ksp_", "pc_", "mat_mumps_")
+_KSP_PREFIXES = ("ksp_", "pc_", "mg_", "mat_")
 #: Load control: relative tolerance on the mean pressure of a step.
 LOAD_RTOL = 1e-6
 REFERENCES = ("Benson S.J., Munson T.S. (2006) Optim. Methods Softw. 21:155-168 (SNES VI)",
@@ -101,7 +101,7 @@ class FemSolverOptions:
     petsc_options : mapping, optional
         Extra PETSc options (without prefix) overriding the defaults, e.g.
         ``{"snes_linesearch_type": "bt"}``. The linear-solver keys (``ksp_*``, ``pc_*``,
-        ``mat_mumps_*``; default MUMPS LU) apply to the SNES's inner solves and to the
+        ``mg_*``, ``mat_*``; default MUMPS LU) apply to the SNES's inner solves and to the
         incremental-stiffness solve, e.g. ``{"ksp_type": "cg", "pc_type": "hypre",
         "ksp_rtol": 1e-12}`` (see ``benchmarks/bench_fem.py`` for their cost). A value
         PETSc refuses (``{"snes_type": "foo"}``) raises InputError when the solver is

@@ -194,12 +194,16 @@ class FreshOnResize:
     size changes with the contact set; PETSc 3.18's GAMG then re-uses its coarse levels
     on the new size and stops with error 60 ("Cannot change local size of Amat after use",
     PCSetUp_GAMG -> KSPSetOperators of a level). Here the inner PC (configured by
-    ``options``, the ``pc_*`` keys) is destroyed and created anew when the size changes and
-    set up as usual otherwise. Install with :func:`fresh_pc_on_resize`.
+    ``options``: the ``pc_*``, ``mg_*``, ``mat_*`` keys) is destroyed and created anew when
+    the size changes and set up as usual otherwise. After each set-up, every key the inner
+    PC read is marked read under ``outer_prefix`` too, so the outer KSP's
+    :meth:`PrefixedOptions.check_used` refuses only keys nobody read. Install with
+    :func:`fresh_pc_on_resize`.
     """
 
-    def __init__(self, options: Mapping):
+    def __init__(self, options: Mapping, outer_prefix: str = ""):
         self.options = dict(options)
+        self.outer_prefix = outer_prefix
         self.inner = self.inner_options = None
         self.size = None
 
@@ -211,13 +215,15 @@ class FreshOnResize:
             self.destroy(pc)
             self.inner = PETSc.PC().create(pc.getComm())
             self.inner.setOperators(A, P)
-            # (the keys were checked on the outer KSP, which read them as its own pc_*)
             self.inner_options = PrefixedOptions(self.inner, unique_prefix("inner"),
                                                  self.options, "the rebuilt preconditioner")
             self.size = P.getSize()
         else:
             self.inner.setOperators(A, P)
         self.inner.setUp()
+        for key in self.options:              # (mg_* and mat_* are read at set-up)
+            if option_used(f"{self.inner_options.prefix}{key}"):   # hasName marks it read
+                PETSc.Options().hasName(f"{self.outer_prefix}{key}")
 
     def apply(self, pc, x, y):
         self.inner.apply(x, y)
@@ -230,17 +236,18 @@ class FreshOnResize:
 
 
 def fresh_pc_on_resize(ksp, options: PrefixedOptions) -> None:
-    """Give ``ksp`` a :class:`FreshOnResize` preconditioner built from the ``pc_*`` keys of
-    its ``options`` (the KSP's own ``ksp_*`` options stay as they are).
+    """Give ``ksp`` a :class:`FreshOnResize` preconditioner built from every key of its
+    ``options`` but the KSP's own ``ksp_*`` (``pc_*``, the multigrid levels' ``mg_*``,
+    ``mat_*``); those the inner PC reads count as read by ``options``.
 
     The held ``pc_type`` becomes ``python`` as well: the VI solver resets its KSP from the
     options database whenever the active set changes (``KSPResetFromOptions``), which
     would otherwise turn the PC back into the inner type.
     """
     pc = ksp.getPC()
-    inner = {k: v for k, v in options.options.items() if k.startswith("pc_")}
+    inner = {k: v for k, v in options.options.items() if not k.startswith("ksp_")}
     pc.setType("python")
-    pc.setPythonContext(FreshOnResize(inner))
+    pc.setPythonContext(FreshOnResize(inner, options.prefix))
     options.set("pc_type", "python")
 
 
