@@ -67,13 +67,18 @@ def angular_wavevectors(shape, size):
     return tuple(out)
 
 
+#: points per side a Hann window needs (it is zero on both ends of a side of 2)
+HANN_MIN_POINTS = 3
+
+
 def _window(name, shape):
     if name is None or name == "none":
         return None
     if name != "hann":
         raise InputError(f"window must be None, 'none' or 'hann', got {name!r}")
-    if min(shape) < 3:
-        raise InputError(f"a Hann window needs at least 3 points per side (it is zero on 2), "
+    if min(shape) < HANN_MIN_POINTS:
+        raise InputError(f"a Hann window needs at least {HANN_MIN_POINTS} points per side "
+                         f"(it is zero on 2), "
                          f"got shape {tuple(shape)}; use window='none'")
     w = np.ones(shape)
     for axis, n in enumerate(shape):

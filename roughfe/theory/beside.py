@@ -25,6 +25,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import InputError
+from ..surfaces.stats import HANN_MIN_POINTS
 from ..surfaces.surface import Surface
 from .junction import _geometry_factor, critical_junction
 from .persson import GAMMA_DEFAULT, PERCOLATION_THRESHOLD, REFERENCES, _spectrum, persson
@@ -144,7 +145,8 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
 def _no_spectrum(source) -> bool:
     """The source is a non-periodic surface too narrow for the Hann window of its PSD
     (:func:`roughfe.surfaces.stats.power_spectrum`: fewer than 3 points on a side)."""
-    return isinstance(source, Surface) and not source.periodic and min(source.shape) < 3
+    return (isinstance(source, Surface) and not source.periodic
+            and min(source.shape) < HANN_MIN_POINTS)
 
 
 def _plastic_from(steps):
