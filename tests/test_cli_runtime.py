@@ -113,6 +113,23 @@ def test_a_reader_leaving_the_pipe_stops_the_command_quietly(tmp_path):
     assert "error" not in proc.stderr and "Exception" not in proc.stderr, proc.stderr
 
 
+def test_help_into_a_closed_pipe_is_141_without_a_traceback(tmp_path):
+    """`roughfe contact --help | true`: argparse's print_help met the closed pipe before
+    main's handler (a BrokenPipeError traceback, exit 1). The read end is closed before
+    the command starts, so the write fails every time (no race with the reader)."""
+    import os
+    read, write = os.pipe()
+    os.close(read)
+    try:
+        proc = subprocess.run([sys.executable, "-m", "roughfe", "contact", "--help"],
+                              stdout=write, stderr=subprocess.PIPE, text=True, timeout=120,
+                              cwd=tmp_path)
+    finally:
+        os.close(write)
+    assert proc.returncode == 141, proc.stderr
+    assert "Traceback" not in proc.stderr and "Error" not in proc.stderr, proc.stderr
+
+
 def test_a_reader_leaving_a_command_that_loaded_petsc_is_still_141(tmp_path):
     """`roughfe leak ... | true`: the FV Reynolds solve imports petsc4py, whose signal
     handlers took SIGPIPE from Python: exit 59 and an MPI abort banner on stderr. The

@@ -75,6 +75,17 @@ def _warning_printer(name, show):
     return printer
 
 
+def _reader_left() -> int:
+    """The reader of stdout left (``| head``): stop quietly, as a command killed by SIGPIPE
+    would (exit 128 + 13); stdout goes to /dev/null so that the interpreter's final flush
+    does not print a traceback."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):     # stdout without a file descriptor (a test)
+        pass
+    return 141
+
+
 def main(argv=None) -> int:
     """Run ``roughfe ARGV``; return the exit code (0 ok, 1 targets/checks missed, 2 bad
     input: one line ``roughfe CMD: error: ...`` on stderr, nothing written; 130
@@ -86,6 +97,8 @@ def main(argv=None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a parse error (one line, exit 2)
         return int(exc.code or 0)
+    except BrokenPipeError:    # `roughfe CMD --help | head`
+        return _reader_left()
     from .._runtime import python_signals_for_petsc
     python_signals_for_petsc()   # a closed stdout is exit 141, not PETSc's abort (exit 59)
     if getattr(args, "renders_with_dolfinx", False) and not getattr(args, "no_figures", False):
@@ -109,12 +122,8 @@ def main(argv=None) -> int:
         message = str(exc)
     except MemoryError as exc:
         message = f"not enough memory ({exc or 'allocation failed'})"
-    except BrokenPipeError:       # the reader of stdout left (`| head`): stop quietly, as
-        try:                      # a command killed by SIGPIPE would (exit 128 + 13)
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        except (OSError, ValueError):     # stdout without a file descriptor (a test)
-            pass
-        return 141
+    except BrokenPipeError:       # the reader of stdout left (`| head`)
+        return _reader_left()
     except OSError as exc:
         message = f"{exc.strerror or exc}" + (f": {exc.filename}" if exc.filename else "")
     except KeyboardInterrupt:
