@@ -4,7 +4,8 @@
 #   bash tools/bootstrap.sh [EXTRAS]      EXTRAS defaults to "io,design,study,test"
 #
 # Idempotent and fast when nothing changed: a stamp in .venv records the hash of the
-# files that define the environment; when it matches, nothing is done.
+# files that define the environment and the extras installed; when the hash matches and
+# the extras asked for are among those installed, nothing is done.
 #
 # Facts measured on Debian 12 that shape this script:
 #  * dolfinx 0.5.2, petsc4py, mpi4py, gmsh, h5py, meshio and scipy come from Debian
@@ -38,11 +39,22 @@ if [ -n "$missing" ]; then
 fi
 
 # the checkout's path is part of the stamp: the editable install maps `roughfe` to one
-# checkout, so a venv shared with (or moved from) another checkout is re-pointed here
-stamp_value="$(cat pyproject.toml tools/bootstrap.sh tools/constraints.txt | sha256sum | cut -c1-16)-$EXTRAS-$(pwd)"
-if [ -x "$VENV/bin/python" ] && [ -f "$VENV/.roughfe-stamp" ] && [ "$(cat "$VENV/.roughfe-stamp")" = "$stamp_value" ]; then
-  exit 0
+# checkout, so a venv shared with (or moved from) another checkout is re-pointed here.
+# The stamp's second line lists the extras installed: a call asking for a subset of them
+# (make test after make bench) does nothing, and a call asking for more installs the union,
+# so that two targets with different extras never undo each other's install.
+stamp_value="$(cat pyproject.toml tools/bootstrap.sh tools/constraints.txt | sha256sum | cut -c1-16)-$(pwd)"
+stamp="$VENV/.roughfe-stamp"
+installed=""
+if [ -x "$VENV/bin/python" ] && [ -f "$stamp" ] && [ "$(head -n 1 "$stamp")" = "$stamp_value" ]; then
+  installed="$(sed -n 2p "$stamp")"
+  new=""
+  for e in ${EXTRAS//,/ }; do
+    case ",$installed," in *,"$e",*) ;; *) new="$new $e" ;; esac
+  done
+  [ -z "$new" ] && exit 0
 fi
+EXTRAS="$(echo "$installed,$EXTRAS" | tr ',' '\n' | sed '/^$/d' | sort -u | paste -sd, -)"
 
 if [ ! -x "$VENV/bin/python" ]; then
   echo "[bootstrap] creating $VENV from /usr/bin/python3 (--system-site-packages)"
@@ -61,4 +73,4 @@ assert numpy.__version__ == "1.24.2", numpy.__version__
 assert h5py.__file__.startswith("/usr/lib/python3/dist-packages"), h5py.__file__
 print(f"[bootstrap] ok: numpy {numpy.__version__}, dolfinx {dolfinx.__version__}, h5py from Debian")
 PY
-echo "$stamp_value" > "$VENV/.roughfe-stamp"
+printf '%s\n%s\n' "$stamp_value" "$EXTRAS" > "$stamp"
