@@ -3,7 +3,7 @@
 #   make test   installs what is missing, runs the test suite
 #   make validate-quick   the reduced validation cases (CI, a few minutes); make validate: all
 #   make docs   builds the documentation (docs/_build/html)
-#   make bench-quick   the benchmarks at reduced sizes (< 3 min); make bench: all, full size
+#   make bench-quick   the benchmarks at reduced sizes (4-5 min); make bench: all, full size
 VENV   := .venv
 PY     := $(VENV)/bin/python
 # vtk renders off-screen through EGL; this silences its X11 warning.
@@ -21,10 +21,10 @@ env:
 
 # make test is the CI command and runs EVERY test, slow ones included: the suite is the
 # physics coverage (analytic solutions, FEM vs BEM, studies end to end) and takes 2-3 min
-# on 2 cores with -n 2 (measured: see docs/validation/fem-convergence.md). The 25 slowest
-# are printed so that a new outlier is seen. make test-fast leaves out the tests marked
-# @pytest.mark.slow (end-to-end CLI runs and studies, each several seconds) for the
-# edit-test loop; it is not a substitute for make test.
+# on 2 cores with -n 2 (measured: docs/validation/fem-convergence.md, "Speed of make
+# test"). The 25 slowest are printed so that a new outlier is seen. make test-fast leaves
+# out the tests marked @pytest.mark.slow (end-to-end CLI runs and studies, each several
+# seconds) for the edit-test loop; it is not a substitute for make test.
 test: env
 	$(PY) -m pytest -q -p no:cacheprovider -n $(JOBS) --durations=25
 
@@ -47,9 +47,10 @@ validate-quick: env
 	$(PY) -m roughfe.cli validate all --quick -o validation/output-quick
 
 # make bench: every benchmark at full size (8192^2 BEM, 4096^2 Reynolds, Tamaas up to
-# 512^2; over an hour on 2 cores, ~4.6 GB peak), JSON in benchmarks/output and the one
-# table of every speed/memory target in benchmarks/output/SUMMARY.md. make bench-quick:
-# reduced sizes (< 3 min) into benchmarks/output-quick, for smoke use.
+# 512^2; over an hour on 2 cores, ~6.3 GB peak in the 4096^2 Reynolds solve), JSON in
+# benchmarks/output and the one table of every speed/memory target in
+# benchmarks/output/SUMMARY.md. make bench-quick:
+# reduced sizes (4-5 min on 2 cores) into benchmarks/output-quick, for smoke use.
 bench: env
 	@bash tools/bootstrap.sh io,design,study,test,bench
 	$(PY) benchmarks/run_all.py
