@@ -522,6 +522,41 @@ def test_adhesive_sweep_default_approaches():
         adhesive_sweep(s, mat, law, n_steps=0)
 
 
+def test_every_sweep_argument_is_checked_before_the_first_solve(monkeypatch):
+    # A periodic approach reaching max h - mean h was refused by the solve of that step,
+    # unload_growth after the loading branch, max_unload_steps after the loading branch
+    # and its retrace: `roughfe contact --delta ... 3.3e-8 --unload` solved every earlier
+    # step before it failed (found by a reviewer, session 26). Now adhesive_sweep checks
+    # them first: no solve runs.
+    from roughfe.bem import adhesion
+
+    def solved(*args, **kwargs):
+        raise AssertionError("solve_adhesive ran before the arguments were checked")
+
+    monkeypatch.setattr(adhesion, "solve_adhesive", solved)
+    s = spectral_surface(16, 1e-5, 0.8, rms_height=1e-8, rng=3)
+    mat, law = Material(1e6, 0.5), AdhesionLaw("exp", 1e-3, 1e-7)
+    top = float(s.heights.max() - s.heights.mean())
+    below = np.array([0.2, 0.5, 0.8]) * top
+    for deltas, kwargs, match in (
+            ([0.2 * top, 0.5 * top, top], {}, r"delta = .* reaches max h - mean h = .*full "
+                                              r"contact"),
+            ([0.2 * top, 1.5 * top], {"unload": True}, "full contact"),
+            (below, {"unload": True, "unload_growth": 0.5}, "unload_growth must be a finite "
+                                                            "factor >= 1, got 0.5"),
+            (below, {"unload": True, "unload_growth": float("nan")}, "unload_growth"),
+            (below, {"unload": True, "unload_growth": "x"}, "unload_growth"),
+            (below, {"unload": True, "max_unload_steps": -1}, "max_unload_steps must be an "
+                                                              "integer >= 0, got -1"),
+            (below, {"unload": True, "max_unload_steps": 2.5}, "max_unload_steps")):
+        with pytest.raises(InputError, match=match):
+            adhesive_sweep(s, mat, law, deltas, **kwargs)
+    # the full-contact rule is the periodic kernel's: on the Love kernel (peak-to-valley
+    # approaches) the same approaches pass the check and reach the solver
+    with pytest.raises(AssertionError, match="solve_adhesive ran"):
+        adhesive_sweep(s, mat, law, [0.2 * top, top], kernel="love")
+
+
 def test_adhesive_sweep_refuses_approaches_that_do_not_increase():
     # the continuation labels every given approach a loading step and retraces them in
     # reverse to unload: given decreasing, the separating steps were labelled loading and

@@ -105,6 +105,34 @@ def _check(surface, material, law, delta):
     return d
 
 
+def _check_below_full_contact(surface, periodic, delta):
+    """Raise :class:`InputError` when the approach ``delta`` (m; the largest of a sweep)
+    reaches max h - mean h on a ``periodic`` kernel: with zero mean displacement that is
+    full contact, where the adhesive state is not defined by the approach."""
+    h = surface.heights
+    top = float(h.max() - h.mean())
+    if periodic and delta >= top:
+        raise InputError(f"delta = {delta:.6g} m reaches max h - mean h = {top:.6g} m: on a "
+                         f"periodic surface (zero mean displacement) that is full contact, "
+                         f"where the adhesive state is not defined by the approach; stay "
+                         f"below it")
+
+
+def _check_unloading(unload_growth, max_unload_steps, n_loading):
+    """``(growth, extra)`` of :func:`adhesive_sweep`'s unloading controls, or
+    :class:`InputError`: ``unload_growth`` a finite factor >= 1, ``max_unload_steps`` an
+    integer >= 0 (None: 4 x the ``n_loading`` loading steps)."""
+    try:
+        growth = float(unload_growth)
+    except (TypeError, ValueError):
+        growth = float("nan")
+    if not (np.isfinite(growth) and growth >= 1.0):
+        raise InputError(f"unload_growth must be a finite factor >= 1, got {unload_growth!r}")
+    extra = 4 * n_loading if max_unload_steps is None else check_int(
+        "max_unload_steps", max_unload_steps, 0)
+    return growth, extra
+
+
 def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, delta,
                    kernel: str = "auto", initial=None, tol: float = 1e-5,
                    max_iter: int = 20000, spring=None, unloading: bool = False,
@@ -181,12 +209,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
                                        spring)
     check_resolution(law, material.E_star, surface.spacing,
                      cell_compliance(surface, material.E_star, kernel))
+    _check_below_full_contact(surface, op.periodic, d)
     h = surface.heights
-    if op.periodic and d >= float(h.max() - h.mean()):
-        raise InputError(f"delta = {d:.6g} m reaches max h - mean h = "
-                         f"{float(h.max() - h.mean()):.6g} m: on a periodic surface (zero mean "
-                         f"displacement) that is full contact, where the adhesive state is "
-                         f"not defined by the approach; stay below it")
     c = float(h.max()) - h - d
     scale = max(law.max_traction, 0.5 * material.E_star * rms_slope(surface))
     energy = AdhesiveEnergy(op, law, c, spring, scale)
@@ -393,6 +417,9 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
         raise InputError(f"deltas must be a non-empty sequence of finite approaches (m), "
                          f"got {deltas!r}")
     check_adhesive_run(deltas=deltas)
+    growth, extra = _check_unloading(unload_growth, max_unload_steps, deltas.size)
+    op = _operator(surface.shape, surface.size, material.E_star, _choose_kernel(surface, kernel))
+    _check_below_full_contact(surface, op.periodic, float(deltas.max()))
     grid = (law, material.E_star, surface.spacing,
             cell_compliance(surface, material.E_star, kernel))
     check_resolution(*grid)   # once for the sweep
@@ -404,9 +431,6 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
             prev = solve_adhesive(surface, material, law, delta=d, kernel=kernel, initial=prev,
                                   tol=tol, max_iter=max_iter, unloading=False)
             results.append(prev)
-        growth = float(unload_growth)
-        if not (np.isfinite(growth) and growth >= 1.0):
-            raise InputError(f"unload_growth must be a finite factor >= 1, got {unload_growth!r}")
         pull, detached = float("nan"), False
         if unload:
             step = float(deltas[-1] - deltas[-2]) if deltas.size > 1 else float(abs(deltas[0]))
@@ -426,8 +450,6 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
             for d in deltas[-2::-1]:              # the loading approaches in reverse
                 prev = unload_to(d)
             d, h = float(deltas[0]), step
-            extra = 4 * deltas.size if max_unload_steps is None else check_int(
-                "max_unload_steps", max_unload_steps, 0)
             for _ in range(extra):
                 low = min(loads) if loads else float("inf")
                 d -= h
