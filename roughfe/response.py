@@ -101,10 +101,11 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
 
 def _adhesive_response(surface, material, loading, options) -> SweepResult:
     """``response(..., adhesion=law)``: the adhesive continuation in the approach."""
-    from .bem.adhesion import adhesive_sweep
+    from .bem.adhesion import adhesive_sweep, check_adhesive_objects
     from .bem.adhesive_rules import check_adhesive_run
 
     law = options.pop("adhesion")
+    check_adhesive_objects(surface, material, law, law_name="adhesion")
     check_adhesive_run(hardness=options.get("hardness"), solver=options.get("solver", "auto"),
                        coarse_correction=options.get("coarse_correction"),
                        pressure_control=loading.controls_pressure)

@@ -166,6 +166,33 @@ def test_bad_initial_state_and_approaches_are_input_errors():
             adhesive_sweep(s, mat, law, deltas)
 
 
+def test_wrong_argument_types_are_input_errors_that_name_the_argument():
+    # adhesive_sweep and response(..., adhesion=) gave an AttributeError ("'str' object
+    # has no attribute 'process_zone'") for a law given by name, a missing material or a
+    # heights array (found by a reviewer, session 26); they check the types first, with
+    # solve_adhesive's check and in each function's own names
+    from roughfe.model import Loading
+    from roughfe.response import response
+    s = spectral_surface(16, 1e-5, 0.8, rms_height=1e-8, rng=3)
+    mat, law = Material(1e6, 0.5), AdhesionLaw("exp", 1e-3, 1e-7)
+    for call, message in (
+            (lambda: adhesive_sweep(s, mat, "md", [0.0, 1e-9]),
+             "law must be an AdhesionLaw, got str"),
+            (lambda: adhesive_sweep(s, None, law, [0.0, 1e-9]),
+             "material must be a roughfe.model.Material, got NoneType"),
+            (lambda: adhesive_sweep(s.heights, mat, law, [0.0, 1e-9]),
+             "surface must be a roughfe Surface, got ndarray"),
+            (lambda: adhesive_sweep(s.heights, mat, law, n_steps=2),
+             "surface must be a roughfe Surface, got ndarray"),
+            (lambda: response(s, mat, Loading(n_steps=2), adhesion="md"),
+             "adhesion must be an AdhesionLaw, got str"),
+            (lambda: response(s, mat, Loading(n_steps=2), adhesion={"kind": "md"}),
+             "adhesion must be an AdhesionLaw, got dict")):
+        with pytest.raises(InputError) as info:
+            call()
+        assert str(info.value) == message
+
+
 def test_bad_approach():
     with pytest.raises(InputError, match="delta"):
         solve_adhesive(sphere(16, 0.2), MAT, md_law(1.0), delta=float("nan"))

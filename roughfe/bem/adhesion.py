@@ -81,7 +81,7 @@ from .adhesive_start import continued_start, elastic_start
 from .interface_law import LAWS, AdhesionLaw, check_resolution, resolution
 
 __all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "cell_compliance",
-           "solve_adhesive"]
+           "check_adhesive_objects", "solve_adhesive"]
 
 REFERENCES = (
     "Maugis D. (1992) J. Colloid Interface Sci. 150:243-269 (Maugis-Dugdale law)",
@@ -92,10 +92,17 @@ REFERENCES = (
 )
 
 
-def _check(surface, material, law, delta):
+def check_adhesive_objects(surface, material, law, law_name="law"):
+    """Raise :class:`InputError` unless ``surface``, ``material`` and ``law`` (called
+    ``law_name`` in the message: ``adhesion`` for :func:`roughfe.response.response`) are a
+    :class:`Surface`, a :class:`Material` and an :class:`AdhesionLaw`."""
     check_instance("surface", surface, Surface, "a roughfe Surface")
     check_instance("material", material, Material, "a roughfe.model.Material")
-    check_instance("law", law, AdhesionLaw, "an AdhesionLaw")
+    check_instance(law_name, law, AdhesionLaw, "an AdhesionLaw")
+
+
+def _check(surface, material, law, delta):
+    check_adhesive_objects(surface, material, law)
     try:
         d = float(delta)
     except (TypeError, ValueError):
@@ -401,6 +408,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
         the step fixed. Must be >= 1.
     Other parameters as in :func:`solve_adhesive`.
     """
+    check_adhesive_objects(surface, material, law)
     if deltas is None:
         from .sweep import default_deltas
         n_steps = Loading(n_steps=n_steps).n_steps     # checked, default 20
