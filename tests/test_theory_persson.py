@@ -189,6 +189,49 @@ def test_mean_separation_checks_its_spectrum(q, power, match):
         mean_separation(np.array(q), np.array(power), E_STAR, 1e6)
 
 
+def test_mean_separation_leaves_out_the_values_without_power():
+    # q = q0 (1..64) with no power below 4 q0: m(q) = 0 there, w = inf, and u(p) came
+    # back NaN (0 * inf; found by a reviewer, session 26). The values without power add
+    # nothing to Eq. (2): u is that of the spectrum without them, and persson() (which
+    # always left them out) on the same PSD agrees. No power anywhere: a clear error.
+    q0 = 1e5
+    q = q0 * np.arange(1.0, 65.0)
+    power = np.where(q < 4 * q0, 0.0, 1e-13 * (q / (4 * q0)) ** -4.6)      # m^2
+    p = np.array([1e5, 1e6])
+    u = mean_separation(q, power, E_STAR, p)
+    kept = power > 0
+    ref = mean_separation(q[kept], power[kept], E_STAR, p)
+    assert np.all(np.isfinite(u)) and np.all(u > 0)
+    np.testing.assert_allclose(u, ref, rtol=1e-14, atol=0)
+    assert np.all(np.diff(u) < 0)                      # more pressure, smaller gap
+    psd = PowerSpectrum(q=q, C=power, weight=np.ones_like(q), ndim=1, window="none")
+    np.testing.assert_allclose(persson(psd, E_STAR, p).mean_gap, u, rtol=1e-14, atol=0)
+    with pytest.raises(InputError, match="zero everywhere"):
+        mean_separation(q, 0.0 * power, E_STAR, p)
+
+
+def test_j_function_checks_its_domain():
+    # J(y) = (2/sqrt(pi)) int_y^inf exp(-x^2) [gamma + 3 (1 - gamma) erf(x)^2] dx / x is
+    # defined for y >= 0 (J(-1) returned J(1) = 0.814, J being evaluated on y^2) and
+    # gamma in (0, 1], where S = gamma + (1 - gamma) P^2 lies between gamma and 1
+    # (gamma = 5 gave J(0.5) = -0.80, a negative separation)
+    from roughfe.theory.persson import j_function
+    y = np.array([0.1, 0.5, 2.0])
+    # gamma = 1: J = E1(y^2) / sqrt(pi) exactly
+    np.testing.assert_allclose(j_function(y, 1.0), scipy.special.exp1(y ** 2) / np.sqrt(np.pi),
+                               rtol=1e-14, atol=0)
+    assert j_function(0.0) == np.inf
+    with pytest.raises(InputError, match=r"y \(w p / E\*\) must be >= 0, got -1.0"):
+        j_function(-1.0)
+    with pytest.raises(InputError, match="must be finite"):
+        j_function([0.5, np.nan])
+    for gamma in (5, 0.0, -0.1, 1.5, np.nan, "0.45"):
+        with pytest.raises(InputError, match=r"gamma .* must lie in \(0, 1\]"):
+            j_function(0.5, gamma)
+        with pytest.raises(InputError, match=r"gamma .* must lie in \(0, 1\]"):
+            mean_separation(np.array([1.0, 2.0]), np.array([1.0, 1.0]), E_STAR, 1e6, gamma)
+
+
 @pytest.mark.parametrize("q_min", [np.nan, -1.0, np.inf, None])
 def test_mean_separation_checks_q_min(q_min):
     # q > nan is False everywhere: u = 0, a closed gap, came back without a word

@@ -69,7 +69,7 @@ import numpy as np
 import scipy.special
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
-                      check_in_open_interval, check_real_array)
+                      check_real_array)
 from ..surfaces.stats import PowerSpectrum, power_spectrum
 from ..surfaces.surface import Surface
 
@@ -105,12 +105,32 @@ def _arrays(psd: PowerSpectrum):
     """``(q, q2, power)`` of the PSD's values with power: q (rad/m), the power-weighted
     mean |q|^2 of each value's modes (:attr:`PowerSpectrum.q2`; exact gradient moments
     of a binned surface spectrum), |h~|^2 per value (m^2)."""
-    q = np.asarray(psd.q, float)
     power = np.asarray(psd.C, float) * np.asarray(psd.weight, float)     # |h~|^2 per value
+    return _with_power(np.asarray(psd.q, float), np.asarray(psd.q_squared, float), power)
+
+
+def _with_power(q, q2, power):
+    """``(q, q2, power)`` of the values with power > 0 only: a value without power adds
+    nothing to Eq. (2) but, below the first with power, has m(q) = 0 and so w = inf (its
+    0 * inf term made u(p) NaN); :class:`InputError` when no value has power."""
     keep = power > 0
     if not keep.any():
         raise InputError("the PSD is zero everywhere: a flat surface has no Persson theory")
-    return q[keep], np.asarray(psd.q_squared, float)[keep], power[keep]
+    return q[keep], q2[keep], power[keep]
+
+
+def _check_gamma(gamma) -> float:
+    """``gamma`` of Persson's elastic-energy factor ``S = gamma + (1 - gamma) P^2``
+    (Persson 2007), in (0, 1]: S lies between gamma at small contact and 1 at full
+    contact, and J(y) of Eq. (2) is positive; otherwise :class:`InputError`."""
+    try:
+        g = float(gamma) if not isinstance(gamma, (str, bytes, bool)) else float("nan")
+    except (TypeError, ValueError):
+        g = float("nan")
+    if not 0.0 < g <= 1.0:
+        raise InputError(f"gamma (Persson's elastic-energy factor S = gamma + (1 - gamma) "
+                         f"P^2) must lie in (0, 1], got {gamma!r}")
+    return g
 
 
 def _cumulative_gradient(q2, power):
@@ -136,12 +156,22 @@ def _erf2_table():
 
 
 def j_function(y, gamma=GAMMA_DEFAULT):
-    """``J(y)`` of Eq. (2) (dimensionless), y > 0.
+    """``J(y)`` of Eq. (2) (dimensionless) for y = w p / E* >= 0 (J(0) = inf: the
+    integral diverges at its lower end) and gamma in (0, 1] (:func:`_check_gamma`).
 
     ``J = (2/sqrt(pi)) [gamma E1(y^2)/2 + 3 (1 - gamma) K(y)]`` with the exponential
     integral E1 and the tabulated ``K`` (:func:`_erf2_table`).
+
+    Raises
+    ------
+    InputError
+        y not finite or < 0 (J was evaluated on y^2 and returned J(|y|)), gamma outside
+        (0, 1] (gamma = 5 gave J < 0).
     """
-    y = np.asarray(y, float)
+    gamma = _check_gamma(gamma)
+    y = check_real_array("y (w p / E*)", y, unit="-")
+    if np.any(y < 0):
+        raise InputError(f"y (w p / E*) must be >= 0, got {float(y.min())!r}")
     x, k = _erf2_table()
     kk = np.interp(y, x, k, right=0.0)
     return (2 / np.sqrt(np.pi)) * (0.5 * gamma * scipy.special.exp1(y ** 2)
@@ -180,7 +210,9 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
     q : array
         Wavenumbers |q| of the PSD values (rad/m), increasing.
     power : array
-        ``C * weight`` per value: the mean-square height each carries (m^2).
+        ``C * weight`` per value: the mean-square height each carries (m^2), >= 0; the
+        values without power are left out (as by :func:`persson`: they add nothing to
+        Eq. (2)), and a spectrum without any is an :class:`InputError`.
     e_star : float
         E* (Pa).
     mean_pressure : float or array
@@ -199,7 +231,7 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
         u(p) for each pressure (m).
     """
     e = check_finite_positive("e_star (Pa)", e_star)
-    gamma = check_in_open_interval("gamma", gamma, 0.0, 1.0 + 1e-12)
+    gamma = _check_gamma(gamma)
     p = _pressures(mean_pressure)
     q_min = check_finite_nonnegative("q_min (rad/m)", q_min)
     q = check_real_array("q (wavenumbers)", q, unit="rad/m")
@@ -213,6 +245,7 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
     q2 = q * q if q2 is None else check_real_array("q2", q2, unit="rad^2/m^2")
     if q2.shape != q.shape:
         raise InputError(f"q2 must have the shape of q {q.shape}, got {q2.shape}")
+    q, q2, power = _with_power(q, q2, power)
     sel = q > q_min
     q, q2, power = q[sel], q2[sel], power[sel]
     if q.size == 0:
