@@ -211,8 +211,11 @@ def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra, message", [
+    # in leak's own words (it said "give approaches (delta, deltas, n_steps), not mean
+    # pressures", the library's keywords, until session 26)
     (["--adhesion", "md", "--work-of-adhesion", "1", "--range", "1e-7", "--pressure", "1e6"],
-     "displacement control"),
+     "roughfe leak: error: --adhesion runs in displacement control (the load-approach curve "
+     "has unstable parts): give --delta, not --pressure"),
     (["--hardness", "1e6", "--adhesion", "exp", "--work-of-adhesion", "1", "--range", "1e-7",
       "--delta", "1e-7"], "not supported"),
     (["--fsi", "--direction", "x", "--hardness", "1e6", "--pressure", "1e6"], "--fsi"),

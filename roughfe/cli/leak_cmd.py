@@ -22,7 +22,7 @@ from ..bem.interface_law import resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
-from .options import (add_contact_physics_options, add_detrend_option, add_material_options,
+from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, check_small_strain, contact_physics_from_args,
                       material_from_args, nonnegative_int, output_folder_of, positive_float,
@@ -209,6 +209,11 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
     return sweep, steps, written
 
 
+#: leak's words in the messages of :func:`roughfe.bem.adhesive_rules.check_adhesive_run`
+#: (its approaches are --delta only: it has no --steps)
+LEAK_ADHESION_WORDS = {**ADHESION_WORDS, "approaches": "--delta"}
+
+
 def _leak_run(args, surface, material, out):
     """Solve and write every file of ``roughfe leak`` into ``out``; results.json last."""
     from ..leakage import leakage_sweep
@@ -217,6 +222,10 @@ def _leak_run(args, surface, material, out):
 
     p_in, p_out = _fluid_pressures(args)
     physics = contact_physics_from_args(args)
+    if physics["adhesion"] is not None and not args.fsi:   # (--fsi refuses --adhesion itself)
+        from ..bem.adhesive_rules import check_adhesive_run
+        check_adhesive_run(pressure_control=args.pressure is not None,
+                           words=LEAK_ADHESION_WORDS)
     for flag, value in (("--bulk-modulus", args.bulk_modulus),
                         ("--trapped-fluid", args.trapped_fluid)):
         if value is not None and not args.fsi:
