@@ -168,8 +168,9 @@ class Loading:
         One imposed mean pressure p > 0 over the nominal area (Pa), Eq. 2.6.
     n_steps : int, optional
         A sweep of ``n_steps`` equispaced approaches up to the peak-to-valley height
-        (up to max h - mean h, i.e. full contact, for periodic problems), as in the
-        thesis. The default when nothing is given: ``Loading()`` is 20 steps.
+        (up to max h - mean h, i.e. full contact, for periodic problems; with adhesion
+        k / (n_steps + 1) of it, k = 1..n_steps: :func:`~roughfe.bem.adhesion.adhesive_sweep`),
+        as in the thesis. The default when nothing is given: ``Loading()`` is 20 steps.
     deltas : sequence of float, optional
         A sweep over these approaches (m), solved in the order given.
     pressures : sequence of float, optional

@@ -285,6 +285,18 @@ def test_contact_cli_adhesion_default_steps_on_a_periodic_surface(tmp_path, caps
     assert np.all(np.diff([st["load"] for st in steps]) > 0)
 
 
+def test_contact_help_says_where_the_default_approaches_stop(capsys, monkeypatch):
+    # --steps said "up to full contact for periodic surfaces", also with --adhesion, whose
+    # approaches stop at N/(N+1) of max h - mean h (adhesive_sweep; found by a reviewer,
+    # session 26)
+    monkeypatch.setenv("COLUMNS", "2000")              # one line per option, no wrapping
+    assert main(["contact", "--help"]) == 0
+    text = capsys.readouterr().out
+    assert ("N equispaced approaches k/N (k = 1..N) of the peak-to-valley height, on a "
+            "periodic surface of max h - mean h (full contact); with --adhesion on a "
+            "periodic surface k/(N+1) of max h - mean h (full contact left out") in text
+
+
 def _narrow_band_adhesive_run(tmp_path, capsys):
     """A narrow-band periodic cell (32^2, H = 0.8, 10 nm rms, q_s / q_r = 4) under a
     resolved Maugis-Dugdale law (w = 4.52e-5 J/m^2, range 10 nm: process zone 7.4 cells)

@@ -46,9 +46,11 @@ def register(subparsers) -> None:
     add_material_options(p)
     load = p.add_argument_group("loading (one of; default --steps 20)").add_mutually_exclusive_group()
     load.add_argument("--steps", type=positive_int, default=None, metavar="N",
-                      help=f"N equispaced approaches up to the peak-to-valley height (up to "
-                           f"full contact for periodic surfaces); {DEFAULT_STEPS} if no "
-                           "loading is given")
+                      help=f"N equispaced approaches k/N (k = 1..N) of the peak-to-valley "
+                           f"height, on a periodic surface of max h - mean h (full contact); "
+                           f"with --adhesion on a periodic surface k/(N+1) of max h - mean h "
+                           f"(full contact left out: the adhesive state is not defined by "
+                           f"the approach there); {DEFAULT_STEPS} if no loading is given")
     load.add_argument("--pressure", type=positive_float, nargs="+", metavar="P",
                       help="mean pressures (Pa), solved in the order given")
     load.add_argument("--delta", type=float, nargs="+", metavar="D",
