@@ -365,14 +365,18 @@ def test_unloading_steps_grow_past_the_pull_off_until_separation():
         adhesive_sweep(s, mat, law, deltas, unload=True, unload_growth=0.5)
 
 
-def test_pull_off_is_a_property_of_the_contact_not_of_the_step():
-    # The quasi-static pull-off of a resolved law is a property of the contact, not of
-    # the continuation. Here the most tensile state of the unloading branch is its start,
-    # the largest approach (-80.65 kPa), whatever the step: the pull-off is the same at
-    # 3, 5 and 9 loading points to the solver's tolerance. Until round 2, session 21 the
-    # branch's loads left that start out, and the pull-off read -77.57, -78.94, -79.74
-    # kPa, creeping towards it as the step shrank (taken then for first-order
-    # convergence). Below the tensile strength sigma0 = w / rho.
+def test_pull_off_is_that_of_the_load_path_independent_of_the_step():
+    """The quasi-static pull-off of a resolved law is that of the load path: independent
+    of the step size, dependent on the maximum approach (the preload dependence of a
+    displacement-controlled experiment)."""
+    # Loaded to 0.6 of max h - mean h, the most tensile state of the unloading branch is
+    # its start, the largest approach (-80.65 kPa), whatever the step: the pull-off is
+    # the same at 3, 5 and 9 loading points to the solver's tolerance. Until round 2,
+    # session 21 the branch's loads left that start out, and the pull-off read -77.57,
+    # -78.94, -79.74 kPa, creeping towards it as the step shrank (taken then for
+    # first-order convergence). Below the tensile strength sigma0 = w / rho. Loaded to
+    # 0.2, 0.4 and 0.8 of it instead, the pull-off is -76.15, -78.12 and -83.25 kPa:
+    # deeper loading, more tension (docs/theory/07_adhesion_persson.md).
     s, mat = _peel_case()
     top = float(s.heights.max() - s.heights.mean())
     runs = [adhesive_sweep(s, mat, RESOLVED_EXP, np.linspace(0.1, 0.6, k) * top,
@@ -383,6 +387,13 @@ def test_pull_off_is_a_property_of_the_contact_not_of_the_step():
         branch = r.sweep.mean_pressure[k - 1:]          # from the largest approach on
         assert r.pull_off_pressure == branch.min() and r.detached
     assert -RESOLVED_EXP.max_traction < pull[0] < 0
+
+    def pull_off_to(depth):
+        return adhesive_sweep(s, mat, RESOLVED_EXP, np.linspace(0.1, depth, 3) * top,
+                              unload=True, max_unload_steps=200).pull_off_pressure
+
+    by_depth = [pull_off_to(0.2), pull_off_to(0.4), pull[0], pull_off_to(0.8)]
+    assert np.all(np.diff(by_depth) < -1e-2 * abs(pull[0]))   # far beyond the step's 1e-5
     # max_unload_steps = 0: no solve beyond the loading range (it meant the default)
     none = adhesive_sweep(s, mat, RESOLVED_EXP, np.linspace(0.1, 0.6, 3) * top,
                           unload=True, max_unload_steps=0)

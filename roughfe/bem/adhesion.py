@@ -347,7 +347,8 @@ class AdhesiveSweep:
         ``unloading`` (and ``sweep.unloading`` the per-step branch, 1.0 on unloading).
     pull_off_force : float
         Most tensile load of the unloading branch (N for surfaces, N/m for profiles;
-        negative), NaN without unloading.
+        negative), NaN without unloading: that of this load path (independent of the
+        step, more tensile the larger the largest loading approach).
     pull_off_pressure : float
         The same as a mean pressure (Pa).
     detached : bool
