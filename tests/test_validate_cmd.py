@@ -203,13 +203,40 @@ def test_the_database_cost_row_is_reported_not_met():
               "angle_error_rad": 0.0, "rms_error": 0.0}],
         noise=[{"noise": 0.01, "angle_error_deg": 0.1, "gamma_error": 1e-3,
                 "M_exact": True, "misfit_over_noise": 1.0}],
-        mech={"a.x3p": {"sum_error": 0.0, "c_td_last": 1.0, "partition": True}},
+        mech={"a.x3p": {"sum_error": 0.0, "c_td_last": 1.0, "partition": True,
+                        "td_last_K_deviation": 0.0, "td_last_A_deviation": 0.0}},
         designs=[], db_info={"n_nodes": 16, "cpu_per_genome_s": float("nan"), "computed": 0},
         x3p={"window": {"series_deviation_max": 0.01, "K_range": [1.0, 2.0],
                         "compliance_m_per_Pa": 1e-9}})
     cost = [r for r in rows if r.name.startswith("surface database cost per genome")]
     assert len(cost) == 1 and cost[0].met is None and not is_skipped(cost[0])
     assert "reported, not a target" in cost[0].reason
+
+
+def test_the_sum_of_all_bands_row_can_fail():
+    """validation/surface_genomics.py: the TD sum of all bands is its own sweep (it was the
+    complete surface's curve, c_n = 1 by construction). The row fails on a sum whose K is
+    off by a factor (c stays 1), on a failed sweep (NaN; min() had skipped it) and on c."""
+    genomics = _script("surface_genomics")
+
+    def row(*files):
+        mech = {f"{i}.x3p": {"sum_error": 2e-16, "c_td_last": c, "partition": True,
+                             "td_last_K_deviation": dk, "td_last_A_deviation": 0.0}
+                for i, (c, dk) in enumerate(files)}
+        rows = genomics._targets(
+            rec=[], noise=[{"noise": 0.01, "angle_error_deg": 0.1, "gamma_error": 1e-3,
+                            "M_exact": True, "misfit_over_noise": 1.0}],
+            mech=mech, designs=[], db_info={"n_nodes": 16, "cpu_per_genome_s": 1.0,
+                                            "computed": 0},
+            x3p={"window": {"series_deviation_max": 0.01, "K_range": [1.0, 2.0],
+                            "compliance_m_per_Pa": 1e-9}})
+        return next(r for r in rows if r.name.startswith("measured files: TD sum"))
+    honest = (1.0 - 1.1e-16, 3.2e-10)          # x3p-2 at 47^2, 8 steps (measured)
+    assert row(honest, honest).met
+    assert not row(honest, (1.0, 1e-3)).met                 # K off by 0.1 %, c = 1
+    assert not row((float("nan"), float("nan")), honest).met
+    assert not row(honest, (1.0 - 1e-9, 3.2e-10)).met
+    assert not row().met                                      # no file measured
 
 
 def test_no_validation_row_is_met_by_a_constant():
