@@ -41,8 +41,10 @@ leak rate and the throat (minimum) gap test the coupled elasticity. Under load c
 (`balanced`) the mean gap is an output and tests it too.
 
 Targets (met / NOT met): per case, the FEM and BEM leak-rate limits agree within 1 % and
-the leak rates within 1 % at the finest r; the mean gaps within 1 % at every r (position
-control) or their limits and finest values within 1 % (load control).
+the leak rates within 1 % at the finest r; under load control (`balanced`) also the
+mean-gap limits and the finest mean gaps within 1 %. Under position control the worst
+mean-gap difference over r is reported against 1 %, not gated (met / NOT met): Delta
+fixes it in both methods (above), so no elasticity error could move it.
 """
 from __future__ import annotations
 
