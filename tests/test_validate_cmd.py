@@ -276,6 +276,34 @@ def test_design_quick_case_docstring_gates_only_its_targets():
     assert "gain over the best start is reported, not a target" in doc
 
 
+def test_the_mpi_row_needs_two_ranks(monkeypatch):
+    """validation/bem_vs_fem.mpi_case: when `mpirun -n 2` starts two singletons (each
+    COMM_WORLD of size 1) both runs are serial and equal by construction: not met (it was
+    met with a difference of 0)."""
+    import json
+    import subprocess
+    from types import SimpleNamespace
+    bem_vs_fem = _script("bem_vs_fem")
+    seen, launched = [], {"size": 1}       # COMM_WORLD.size of a run under mpirun -n 2
+
+    def run(cmd, **kw):
+        seen.append(cmd)
+        line = json.dumps({"p": [1.0, 2.0], "A": [0.1, 0.2], "K": [3.0, 4.0],
+                           "ranks": launched["size"] if "-n" in cmd else 1})
+        return SimpleNamespace(returncode=0, stdout=line + "\n", stderr="")
+    monkeypatch.setattr(bem_vs_fem.shutil, "which", lambda name: "/usr/bin/mpirun")
+    monkeypatch.setattr(subprocess, "run", run)
+    single = bem_vs_fem.mpi_case()
+    assert single["ok"] is False and "not a parallel run" in single["note"]
+    assert "-n" in seen[-1] and "2" in seen[-1]
+    launched["size"] = 2
+    two = bem_vs_fem.mpi_case()
+    assert two["ok"] is True and two["max_rel_diff"] == 0.0
+    row = bem_vs_fem.target_rows({"max_width_error_fem": 1e-3, "max_width_error_bem": 1e-3,
+                                  "n_nodes": 129}, {}, single)[-1]
+    assert row.met is False and "not a parallel run" in row.reason
+
+
 def test_no_validation_row_is_met_by_a_constant():
     """No target row of validation/*.py is built with met = True (or False) typed in: a
     verdict must come from a measured value (a number with no criterion is reported)."""

@@ -334,7 +334,11 @@ if MPI.COMM_WORLD.rank == 0:
 
 
 def mpi_case():
-    """Run the same small FEM sweep serially and with ``mpirun -n 2``; max relative diff."""
+    """Run the same small FEM sweep serially and with ``mpirun -n 2``; max relative diff.
+
+    Each run reports its ``MPI.COMM_WORLD.size``: a launcher that starts two singletons
+    (an mpi4py built against another MPI) gives two serial runs, equal to the serial one
+    by construction; such a run does not count as the check (not met, said why)."""
     mpirun = shutil.which("mpirun")
     if mpirun is None:
         return {"ok": None, "note": "mpirun not found on PATH: the MPI check did not run "
@@ -352,6 +356,10 @@ def mpi_case():
         if proc.returncode != 0 or not lines:
             return {"ok": False, "note": f"{ranks} rank(s) failed: {proc.stderr[-500:]}"}
         out[ranks] = json.loads(lines[-1])
+        if out[ranks].get("ranks") != ranks:
+            return {"ok": False, "note": f"mpirun -n {ranks} ran on {out[ranks].get('ranks')} "
+                                         f"rank(s): not a parallel run (mpi4py and mpirun "
+                                         f"of different MPIs?)", "serial": out.get(1)}
     diff = max(float(np.max(_rel(out[2][k], out[1][k]))) for k in ("p", "A", "K"))
     return {"ok": diff < 1e-8, "max_rel_diff": diff, "serial": out[1], "two_ranks": out[2]}
 
