@@ -23,7 +23,7 @@ from roughfe.bem import contact_sweep
 from roughfe.genomics import database as db
 from roughfe.genomics import design as de
 from roughfe.genomics.genome import realize, table1_genome
-from roughfe.genomics.macro_micro import macro_micro
+from roughfe.genomics.macro_micro import macro_micro, top_approach
 from roughfe.genomics.similarity import write_target_csv
 from roughfe.model import Material
 from roughfe.plotting import design as dplot
@@ -62,27 +62,42 @@ def strict_scores_from_file(design_json: Path, targets, settings) -> list:
 
 
 def strict_scores_from_dict(design_dict: dict, targets, settings) -> list:
-    """Independent check of a strict score of a saved design (its JSON object): solve the
-    profile at the targets' own pressures with :func:`roughfe.bem.contact_sweep` (one
-    approach to the peak-valley height for p_max, Eq. 4.2 factor eta, then load control
-    at ``p_t / eta``), A = contact nodes / N, K by central differences, Eq. (4.1) --
-    each written out here, not through the design package."""
-    design = de.Design.from_dict(design_dict)
-    surf = design.surface()
+    """Independent check of a strict score of a saved design (its JSON object):
+    :func:`strict_scores_of_surface` of its realisation."""
+    return strict_scores_of_surface(de.Design.from_dict(design_dict).surface(), targets,
+                                    settings)
+
+
+def strict_scores_of_surface(surf, targets, settings) -> list:
+    """Independent check of a strict score (Eq. 4.1 at the targets' own pressures) of a
+    saved design's heights, profile or surface: solve them with
+    :func:`roughfe.bem.contact_sweep` (one approach to the database's last approach for
+    p_max -- the peak-valley height of a profile, ``top_fraction`` of full contact of a
+    periodic surface, :func:`~roughfe.genomics.macro_micro.top_approach` -- Eq. 4.2
+    factor eta, then load control at ``p_t / eta``), A = contact nodes / nodes, K by
+    central differences, Eq. (4.1) -- each written out here, not through the design
+    package (its :func:`~roughfe.genomics.design.score_at_target_pressures` is what is
+    checked; the BEM solver is the same)."""
     mat = Material(settings.youngs_modulus, settings.poisson)
-    top = contact_sweep(surf, mat, deltas=(float(np.ptp(surf.heights)),), kernel=settings.kernel,
-                        compute_stiffness=False)
+    top = contact_sweep(surf, mat, deltas=(top_approach(surf, settings.kernel,
+                                                        settings.top_fraction),),
+                        kernel=settings.kernel, compute_stiffness=False)
     eta = targets[0].p_max / top.results[-1].mean_pressure
     p_t = np.unique(np.concatenate([t.pressure for t in targets]))
     sw = contact_sweep(surf, mat, pressures=tuple(p_t / eta), kernel=settings.kernel,
                        compute_stiffness=False)
-    p = np.array([r.mean_pressure for r in sw.results]) * eta
-    if not np.allclose(p, p_t, rtol=1e-6):
-        raise RuntimeError(f"load control missed the target pressures: {p} vs {p_t} Pa")
+    solved = np.array([r.mean_pressure for r in sw.results])
+    if not np.allclose(solved * eta, p_t, rtol=1e-6):
+        raise RuntimeError(f"load control missed the target pressures: {solved * eta} vs "
+                           f"{p_t} Pa")
+    # K of the surface solved (Eq. 4.2 stretches p by eta and leaves K = dp/dDelta as it
+    # is: heights x eta give p x eta at Delta x eta); it was differenced on p x eta, K x
+    # eta, unseen while the designs checked had eta = 1 to round-off (Eq. 4.2-rescaled)
     dl = np.array([r.delta for r in sw.results])
-    k = np.empty_like(p)
-    k[1:-1] = (p[2:] - p[:-2]) / (dl[2:] - dl[:-2])
-    k[0], k[-1] = (p[1] - p[0]) / (dl[1] - dl[0]), (p[-1] - p[-2]) / (dl[-1] - dl[-2])
+    k = np.empty_like(solved)
+    k[1:-1] = (solved[2:] - solved[:-2]) / (dl[2:] - dl[:-2])
+    k[0] = (solved[1] - solved[0]) / (dl[1] - dl[0])
+    k[-1] = (solved[-1] - solved[-2]) / (dl[-1] - dl[-2])
     a = np.array([np.count_nonzero(r.contact) for r in sw.results]) / surf.heights.size
     out = []
     for t in targets:

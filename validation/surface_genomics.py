@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import json
 import resource
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -54,7 +55,7 @@ from roughfe.genomics.bands import band_chromosomes
 from roughfe.genomics.mechanics import curve_difference
 from roughfe.genomics.design import (Design, GcmmaOptions, GlobalSearchOptions,
                                      combined_score, match_spectrum,
-                                     run_design, score_at_target_pressures,
+                                     run_design,
                                      search_at_target_pressures, search_global,
                                      surface_targets, target_surface, thesis_targets,
                                      window_compliance)
@@ -66,6 +67,9 @@ from roughfe.surfaces import Surface
 from roughfe.surfaces.io import load_surface, save_surface, topographies_folder
 from roughfe.validation import Target, percent, report_title, reported, targets_markdown
 from roughfe.writers import write_json, write_text
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from design_study import strict_scores_of_surface  # noqa: E402
 
 TOPOGRAPHIES = topographies_folder()
 MEASURED = ("x3p-2.x3p", "sur-2.sur", "opd-1.opd", "plu-1.plu", "di-1.di")
@@ -388,7 +392,9 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
                 surface=None, long=None, quick=False):
     """SOG/GCO/CCO on K, M-CCO on K and A (:func:`design_chain` each, ``search`` sweeps
     per candidate or ``long[method]`` where given), every design saved and re-scored by
-    an independent BEM run of its saved heights."""
+    an independent BEM run of its saved heights (``design_study.strict_scores_of_surface``:
+    contact_sweep, Eq. 4.2, K, A and Eq. 4.1 written out, not through the design
+    package)."""
     rows = []
     for method in ("sog", "gco", "cco", "mcco"):
         targets = [targets_k, target_a] if method == "mcco" else [targets_k]
@@ -401,9 +407,11 @@ def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, ta
         saved = outdir / f"surface_design_{tag}_{method}"
         write_json(saved.with_suffix(".json"), best.design.to_dict())
         save_surface(best.design.surface(), saved.with_suffix(".npz"))
-        # independent: the saved heights (not the design) read back and solved afresh
+        # independent: the saved heights (not the design) read back and scored by the
+        # hand-written Eq. 4.1 of design_study (it was score_at_target_pressures, the
+        # function that gave best.at_targets, on the same heights: 0.0 by construction)
         heights = load_surface(saved.with_suffix(".npz"))
-        independent = score_at_target_pressures(heights, targets, settings)
+        independent = strict_scores_of_surface(heights, targets, settings)
         again = Design.from_dict(json.loads(saved.with_suffix(".json").read_text()))
         assert np.array_equal(again.surface().heights, heights.heights)
         rows.append({"target": tag, "method": method, "origin": best.origin,
