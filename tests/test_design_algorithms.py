@@ -63,9 +63,25 @@ def test_alg3_recovers_a_database_genome_at_another_amplitude(entries):
     from roughfe.genomics.design.algorithms import _extended
     none = SimpleNamespace(n_sweeps=0)
     lifted = _extended(bad, r.candidates, none, time.perf_counter(), "; extra stage")
-    assert "NOT matched" not in lifted.message and lifted.message.endswith("; extra stage")
+    assert "NOT matched" not in lifted.message
+    assert lifted.message.index("; extra stage") < lifted.message.index("target is matched")
     dropped = _extended(r, bad.candidates, none, time.perf_counter(), "; extra stage")
     assert dropped.message.index("; extra stage") < dropped.message.index("NOT matched")
+    # the verdict is decided by the scores solved at the target pressures where the design
+    # has them, and says so: after a search stage the message said "f at p_t = 0.9634;
+    # the target is NOT matched (s = 0.908 ...)" by the interpolated s
+    solved = [replace(c, at_targets=(0.9634,)) for c in bad.candidates]
+    searched = _extended(bad, solved, none, time.perf_counter(), "; search")
+    assert searched.message.endswith("; search; the target is matched (s = 0.9634 > 0.95, "
+                                     "the selection value of Alg. 3; decided by the score "
+                                     "solved at the target pressures)")
+    assert "interpolated from the design's own n_t approaches)" in bad.message
+    again = de.with_solved_scores(r, (0.5,))      # roughfe design solves the best there
+    assert again.best.at_targets == (0.5,) and again.candidates[1:] == r.candidates[1:]
+    assert again.message == r.message.replace(
+        "matched (s = 1 > 0.95", "NOT matched (s = 0.5 <= 0.95").replace(
+        "interpolated from the design's own n_t approaches", "solved at the target pressures")
+    assert de.result_to_dict(again, SETTINGS)["matched"] is False
 
 
 @pytest.mark.parametrize("method", ["gco", "cco", "mcco"])
@@ -124,13 +140,13 @@ def test_success_fails_when_eq42_rescaling_is_not_exact(entries, targets):
     assert elastic.success and elastic.best.rescore_error <= 1e-9
 
 
-@pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")   # MMA's subproblem at |s| ~ 1e9
+@pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")   # MMA's subproblem at |s| ~ 1e10
 def test_success_tolerance_is_relative_to_large_scores(entries, targets):
-    """A target 1e9 times too soft scores s ~ -1e9; the fresh sweep of the saved design
-    reproduces it to round-off (1e-15 relative, ~1e-6 absolute), which the absolute
+    """A target 1e10 times too soft scores s ~ -1e10; the fresh sweep of the saved design
+    reproduces it to round-off (1e-15 relative, ~1e-5 absolute), which the absolute
     tolerance 1e-6 called a failure blaming non-linearity. Relative beyond |s| = 1."""
     t1 = targets[0]
-    soft = Target(t1.pressure, 1e-9 * t1.values, "K")
+    soft = Target(t1.pressure, 1e-10 * t1.values, "K")
     r = de.sog(entries, soft, SETTINGS, n_best=1,
                options=de.GcmmaOptions(n_it_sog=1, n_it_micro=0, gradient="fd"))
     assert r.best.scores[0] < -1e8 and r.best.rescore_error > 1e-6
@@ -215,11 +231,18 @@ def test_exact_sensitivities_equal_finite_differences_on_fixed_contact_sets(stif
     other = db.make_genome(1.5, 0.9, 8, settings)     # target pressures off the curve's nodes
     c = de.Evaluator(settings)(de.Design((de.DesignPart(other, tuple(range(
         other.n_first, other.n_last + 1))),), 1.0, settings.length, settings.n_nodes))
-    obj = de.Objective((Target(c.pressure, c.stiffness, "K"),
-                        Target(c.pressure[:-1], c.area_fraction[:-1], "A")))
+    # and one point of each target below the design's first (rescaled) pressure, where
+    # the curve is read from (0, 0) (similarity.from_origin): its derivative moves with p_1
+    low = 0.3 * c.pressure[0]
+    obj = de.Objective((Target(np.r_[low, c.pressure], np.r_[0.3 * c.stiffness[0],
+                                                            c.stiffness], "K"),
+                        Target(np.r_[low, c.pressure[:-1]], np.r_[0.3 * c.area_fraction[0],
+                                                                 c.area_fraction[:-1]], "A")))
     keys = d.keys([[1, 2, 4]])
     r, jac = de.residual_jacobian(d, keys, obj, settings)
     ev = de.Evaluator(settings)
+    design_p1 = ev(d).to_target_range(obj.p_max).pressure[0]
+    assert low < design_p1
     np.testing.assert_allclose(r, obj.residuals(ev(d)), atol=1e-12)
     v = d.phase_values(keys)
     for col in range(len(keys)):

@@ -47,7 +47,14 @@ def test_db_and_design_commands(tmp_path, capsys):
                  "--method", "sog", "--iterations", "1", "--no-figures", "-o",
                  str(plain)]) == 0
     printed = capsys.readouterr().out.split("(no interpolation): ")[1].split()[0]
-    saved = json.loads((plain / "result.json").read_text())["candidates"][0]
+    whole = json.loads((plain / "result.json").read_text())
+    saved = whole["candidates"][0]
+    # the verdict is decided by those solved scores, in the message and result.json alike
+    # (the message's was the interpolated s while the command printed the solved one)
+    s_solved = saved["scores_at_target_pressures"][0]
+    assert whole["matched"] is (s_solved > 0.95)
+    assert "decided by the score solved at the target pressures" in whole["message"]
+    assert f"s = {s_solved:.4g} {'>' if s_solved > 0.95 else '<='} 0.95" in whole["message"]
     assert len(saved["scores_at_target_pressures"]) == 1
     assert f"{saved['scores_at_target_pressures'][0]:.4f}" == printed
     plain_design = de.Design.from_dict(json.loads((plain / "design.json").read_text()))

@@ -144,3 +144,23 @@ def test_target_csv_contents_are_checked(tmp_path):
         assert target("ok.csv", f"{header}\n1e7,1e11\n2e7,1.1e11\n").pressure.size == 2
     assert target("trail.csv", "pressure_Pa,value,\n1e7,1e11,\n2e7,1.1e11,\n").values[1] == 1.1e11
     assert target("full.csv", "p,A\n1e7,0.5\n2e7,1\n", "A").values[-1] == 1.0
+
+
+def test_a_curve_is_read_from_zero_load_below_its_first_pressure():
+    """K(p) and A(p) of a rough surface vanish at p = 0 (no contact): below a curve's
+    first computed pressure p_1 it is read linearly from (0, 0), for both quantities, by
+    the score, the objective and the figures alike (similarity.from_origin). The clamp of
+    np.interp held the first value there (here 20 where the chord gives 10)."""
+    from roughfe.genomics.design import Objective
+    c = ResponseCurve([2.0, 3.0, 4.0], [20.0, 30.0, 36.0], [0.2, 0.3, 0.5])
+    np.testing.assert_allclose(c.at([0.0, 1.0, 2.5, 5.0], "K"), [0.0, 10.0, 25.0, 36.0])
+    np.testing.assert_allclose(c.at([1.0, 3.5], "A"), [0.1, 0.4])
+    for q, y1 in (("K", 10.0), ("A", 0.1)):       # on the chord through the origin: s = 1
+        t = Target([1.0, 2.0, 4.0], [y1, c.values(q)[0], c.values(q)[-1]], q)
+        assert similarity(t, c) == pytest.approx(1.0, abs=1e-14)
+    t = Target([1.0, 4.0], [8.0, 36.0], "K")     # the design reads 10 at p = 1: 25 % too stiff
+    assert similarity(t, c) == pytest.approx(0.75, abs=1e-14)
+    np.testing.assert_allclose(Objective((t,)).residuals(c), [-0.25, 0.0], atol=1e-14)
+    p, k = c.points("K")
+    np.testing.assert_array_equal(p, [0.0, 2.0, 3.0, 4.0])
+    np.testing.assert_array_equal(k, [0.0, 20.0, 30.0, 36.0])

@@ -2,7 +2,9 @@
 former genomics/design.py gave (recorded in tests/data/genomics_refactor_reference.json
 before the split): the thesis (1 - s)^2 form and Svanberg's min-max form, with forward
 differences and with user derivatives, on an analytic problem and on a GCMMA design stage
-(BEM sweeps of a 64-node profile)."""
+(BEM sweeps of a 64-node profile). The three design-stage entries were re-recorded in
+session 26, when the objective began to read a curve from (0, 0) below its first
+pressure (similarity.from_origin): a change of the objective, not of the driver."""
 import json
 from pathlib import Path
 
@@ -111,7 +113,7 @@ def test_design_stage_reproduces_the_former_loops(name, formulation, gradient):
     ref = REF["gcmma"][name]
     _check(res, ref, x=d2.phase_values(keys), jacobian_counted=formulation == "minimax")
     assert ev.n_sweeps == ref["sweeps"]
-    assert s > res.fun0 + 0.1                     # the stage improves the start (0.68 -> 0.86)
+    assert s > res.fun0 + 0.1                     # the stage improves the start (0.58 -> 0.85)
     assert objective(de.Evaluator(settings)(d2)) == pytest.approx(s, rel=1e-12, abs=0)
 
 

@@ -167,14 +167,15 @@ def test_the_caption_of_a_tall_leakage_map_leaves_its_top_rows_visible(tmp_path)
 
 
 # -- design curves title -------------------------------------------------------------------
-def _design_result(score, success=True):
-    """The parts of a DesignResult the curves figure reads (one K target)."""
+def _design_result(score, success=True, solved=()):
+    """The parts of a DesignResult the curves figure reads (one K target; ``solved``:
+    the best design's scores at the target pressures)."""
     from types import SimpleNamespace
-    from roughfe.genomics.similarity import Target
+    from roughfe.genomics.similarity import ResponseCurve, Target
     p = np.geomspace(2e6, 2.5e8, 8)
     target = Target(p, 1e3 * p, "K", "y_t1")
-    curve = SimpleNamespace(pressure=p, stiffness=1.1e3 * p, area_fraction=p / 3e8)
-    best = SimpleNamespace(origin="2-1", scores=(score,), curve=curve)
+    curve = ResponseCurve(p, 1.1e3 * p, p / 3e8)
+    best = SimpleNamespace(origin="2-1", scores=(score,), curve=curve, at_targets=solved)
     message = (f"sog: best 2-1 s = {score:.4f} (stages -0.2848, 0.6208, 0.6208); the target "
                f"is NOT matched (s = {score:.4f} <= 0.95, the selection value of Alg. 3)")
     return SimpleNamespace(method="sog", best=best, success=success, message=message,
@@ -194,9 +195,15 @@ def test_design_curves_title_is_whole_and_keeps_the_verdict(drawn):
     from roughfe.plotting import design as design_plot
     result = _design_result(0.6208)
     title = design_plot.design_title(result)
-    assert title == "sog: best 2-1, s = 0.6208; target NOT matched (s <= 0.95)"
-    assert design_plot.design_title(_design_result(0.97)).endswith("; target matched")
+    assert title == ("sog: best 2-1; target NOT matched: s = 0.6208 <= 0.95 (interpolated "
+                     "from the design's own n_t approaches)")
+    assert "; target matched: s = 0.9700 > 0.95" in design_plot.design_title(
+        _design_result(0.97))
     assert "NOT a success" in design_plot.design_title(_design_result(0.97, success=False))
+    # solved at the target pressures (roughfe design always, the search stages): those
+    # scores decide, as in the message (a title said NOT matched by the interpolated s)
+    assert design_plot.design_title(_design_result(0.908, solved=(0.9634,))).endswith(
+        "target matched: s = 0.9634 > 0.95 (solved at the target pressures)")
     for t in (title, result.message):
         fig = drawn(design_plot, "plot_design_curves", [result], title=t)
         assert _inside(fig, fig._suptitle) and "NOT matched" in fig._suptitle.get_text()

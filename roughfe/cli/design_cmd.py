@@ -6,7 +6,6 @@ settings."""
 from __future__ import annotations
 
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 from .options import (add_output_folder, add_run_options, nonnegative_float, nonnegative_int,
@@ -93,7 +92,7 @@ def _run(args) -> int:
     from ..genomics.design import (GcmmaOptions, GlobalSearchOptions, refine,
                                    rescore_at_target_pressures, run_design,
                                    search_at_target_pressures, search_global,
-                                   write_design_result)
+                                   with_solved_scores, write_design_result)
     _check_options(args)            # before the database is read
     global_options = GlobalSearchOptions(
         method=args.global_search or "cmaes", n_eval=args.global_eval,
@@ -134,6 +133,10 @@ def _run(args) -> int:
                                                 amplitudes=args.search_amplitudes)
         if args.global_search:
             result = search_global(result, settings, global_options)
+        if not result.best.at_targets:   # solved at the target pressures: the verdict's
+            result = with_solved_scores(result, rescore_at_target_pressures(
+                result.best.design, targets, settings))
+        strict = result.best.at_targets
         if not args.no_figures:
             from ..plotting.design import (design_title, plot_design_curves, plot_profiles,
                                            plot_psds, plot_stages)
@@ -142,11 +145,6 @@ def _run(args) -> int:
             plot_stages([result], out / "stages.png")
             plot_profiles({result.method: best.surface()}, out / "profile.png")  # 2D: a map
             plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
-        strict = tuple(result.best.at_targets) or tuple(
-            rescore_at_target_pressures(result.best.design, targets, settings))
-        if not result.best.at_targets:      # saved with the design, not only printed
-            result = replace(result, candidates=(replace(result.best, at_targets=strict),)
-                             + tuple(result.candidates[1:]))
         paths = write_design_result(result, settings, out)
     print(result.message)
     for k, c in enumerate(result.candidates, 1):

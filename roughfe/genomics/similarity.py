@@ -101,6 +101,19 @@ class ResponseCurve:
         """``K`` (Pa/m) or ``A`` (-) along the curve."""
         return self.stiffness if _check_quantity(quantity) == "K" else self.area_fraction
 
+    def points(self, quantity: Quantity):
+        """``(p, y)``: the points the curve of ``quantity`` is read between, the origin
+        ``(0, 0)`` first (:func:`from_origin`); what :meth:`at` interpolates and the
+        design figures draw."""
+        return from_origin(self.pressure, self.values(quantity))
+
+    def at(self, pressure, quantity: Quantity) -> np.ndarray:
+        """``K`` (Pa/m) or ``A`` (-) at the pressures ``pressure`` (Pa, >= 0): linear in p
+        between the points of :meth:`points`, so below the first computed pressure p_1
+        the value rises linearly from ``(0, 0)`` (:func:`from_origin`); above p_max the
+        last value (after Eq. 4.2 a curve and its target share p_max)."""
+        return np.interp(pressure, *self.points(quantity))
+
     def rescaled(self, factor: float) -> "ResponseCurve":
         """The curve of the same profile with heights times ``factor`` (Eq. 4.2 scaling law).
 
@@ -122,6 +135,28 @@ class ResponseCurve:
     @classmethod
     def from_dict(cls, d) -> "ResponseCurve":
         return cls(d["pressure"], d["stiffness"], d["area_fraction"])
+
+
+def from_origin(pressure, *values):
+    """``pressure`` and each of ``values`` with the point of zero load prepended: a 0 (a
+    zero row for arrays of derivatives) before the first entry along axis 0.
+
+    The one rule by which a response curve is read below its first computed pressure
+    p_1 > 0 (the score Eq. 4.1, :meth:`Objective.residuals` and its exact Jacobian, and
+    the design figures): both K(p) and A(p) of a rough surface vanish at p = 0 -- no
+    contact, no real area, no stiffness (a Hertzian asperity: A ~ p^(2/3), K ~ p^(1/3);
+    a plane-strain profile: K -> 0 logarithmically) -- so between p = 0 and p_1 the
+    curve is interpolated linearly from (0, 0). Until session 26 the first value was
+    held constant there (the clamp of ``np.interp``): a design's K at p_1 = 17.7 MPa was
+    read at a target point of 14.3 MPa (error -9.2 %, +12.0 % on the chord). The chord
+    lies below a concave curve (one asperity's K ~ p^(1/3), A ~ p^(2/3)), so it is a
+    rule, not a model of first contact: a target point below p_1 is read at the sweep's
+    resolution, and more steps n_t move p_1 down. Arrays of shape (n, ...) (Pa; Pa/m,
+    -, or their derivatives) in, (n + 1, ...) out.
+    """
+    lead = [np.concatenate([np.zeros((1,) + np.shape(v)[1:]), np.asarray(v, dtype=float)])
+            for v in (pressure, *values)]
+    return tuple(lead)
 
 
 def amplitude_factor(p_max_target: float, p_max_i: float) -> float:
@@ -261,8 +296,9 @@ def similarity(target: Target, curve: ResponseCurve, p_range=(0.0, np.inf), *,
     Notes
     -----
     The infinity norm is taken over the target's own points inside ``p_range``; y_i is
-    interpolated linearly in p on the curve (after rescaling the two share p_max, and
-    below the curve's first pressure the first value is used).
+    :meth:`ResponseCurve.at` those pressures: linear in p on the curve, and below the
+    curve's first pressure linear from (0, 0), since K and A vanish at p = 0
+    (:func:`from_origin`; after rescaling the two share p_max).
     """
     if rescale:
         curve = curve.to_target_range(target.p_max)
@@ -272,7 +308,7 @@ def similarity(target: Target, curve: ResponseCurve, p_range=(0.0, np.inf), *,
         raise InputError(f"no target point lies in the pressure range [{lo:.6g}, {hi:.6g}] Pa "
                          f"(target spans {target.pressure[0]:.6g} .. {target.p_max:.6g} Pa)")
     p, yt = target.pressure[sel], target.values[sel]
-    yi = np.interp(p, curve.pressure, curve.values(target.quantity))
+    yi = curve.at(p, target.quantity)
     return float(1.0 - np.max(np.abs((yt - yi) / yt)))
 
 

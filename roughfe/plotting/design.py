@@ -7,8 +7,7 @@ import numpy as np
 
 import textwrap
 
-from ..genomics.design import combined_score
-from ..genomics.design.algorithms import SELECTION
+from ..genomics.design import combined_score, verdict
 from ..surfaces.stats import power_spectrum
 from .common import new_figure, save_figure
 
@@ -100,13 +99,14 @@ def plot_map_summary(rows, path, n_max=None) -> "Path":
 
 
 def plot_database_curves(entries, targets, path) -> "Path":
-    """Fig. 57/67: K(p), A(p) of every database genome rescaled (Eq. 4.2) and the targets."""
+    """Fig. 57/67: K(p), A(p) of every database genome rescaled (Eq. 4.2) and the targets;
+    each curve drawn from (0, 0), as the score reads it (:meth:`ResponseCurve.points`)."""
     p_max = targets[0].p_max
     fig, axes = new_figure(1, 2, figsize=(11, 4))
     for e in entries:
         c = e.curve.to_target_range(p_max)
-        axes[0].plot(c.pressure, c.stiffness, color="0.7", lw=0.7)
-        axes[1].plot(c.pressure, c.area_fraction, color="0.7", lw=0.7)
+        axes[0].plot(*c.points("K"), color="0.7", lw=0.7)
+        axes[1].plot(*c.points("A"), color="0.7", lw=0.7)
     colors = ("r", "k", "m")
     for t, col in zip(targets, colors):
         ax = axes[0] if t.quantity == "K" else axes[1]
@@ -122,19 +122,20 @@ def plot_database_curves(entries, targets, path) -> "Path":
 
 
 def design_title(result) -> str:
-    """A figure title a line long: method, best origin, combined s and the verdict on the
-    match (not above :data:`SELECTION`: NOT matched), and NOT a success when the result's
-    criterion failed. The full ``result.message`` (136 characters and more, clipped at
-    both ends as a title until session 25) is in result.json and printed."""
-    s = combined_score(result.best.scores)
-    verdict = "target matched" if s > SELECTION else f"target NOT matched (s <= {SELECTION})"
-    return (f"{result.method}: best {result.best.origin}, s = {s:.4f}; {verdict}"
+    """A figure title a line long: method, best origin and the verdict on the match with
+    the scores that decided it (:func:`~roughfe.genomics.design.verdict`, the message's
+    own), and NOT a success when the result's criterion failed. The full
+    ``result.message`` (136 characters and more, clipped at both ends as a title until
+    session 25) is in result.json and printed."""
+    return (f"{result.method}: best {result.best.origin}; {verdict(result.best).short()}"
             + ("" if result.success else "; NOT a success (see result.json)"))
 
 
 def plot_design_curves(results, path, title="") -> "Path":
     """Figs. 60/64/68: K(p) and A(p) of the best design of each result vs the targets;
-    ``title`` (e.g. :func:`design_title`) wrapped to the figure's width."""
+    ``title`` (e.g. :func:`design_title`) wrapped to the figure's width. A design's
+    curve is drawn as the score reads it (:meth:`ResponseCurve.points`): its computed
+    steps (marked) and, below the first, the line from (0, 0)."""
     results = list(results)
     fig, axes = new_figure(1, 2, figsize=(11, 4))
     for t in results[0].objective.targets:
@@ -150,8 +151,9 @@ def plot_design_curves(results, path, title="") -> "Path":
             labels.append(f"{r.method} s={', '.join(own)}" if own else r.method)
         if len(targets) > 1:
             labels[0] += f" (product {combined_score(r.best.scores):.3f})"
-        axes[0].plot(c.pressure, c.stiffness, "--" + m, ms=4, label=labels[0])
-        axes[1].plot(c.pressure, c.area_fraction, "--" + m, ms=4, label=labels[1])
+        for ax, quantity, label in zip(axes, ("K", "A"), labels):  # from (0, 0), unmarked
+            ax.plot(*c.points(quantity), "--" + m, ms=4, markevery=slice(1, None),
+                    label=label)
     axes[0].set_xlabel("p (Pa)")
     axes[0].set_ylabel("K (Pa/m)")
     axes[1].set_xlabel("p (Pa)")

@@ -5,7 +5,8 @@ Modules, by idea (see ``docs/theory/genomics-layout.md``):
 * :mod:`.model` -- :class:`Design`/:class:`DesignPart` (a sum of chromosome sets of
   genomes, Eq. 3.2, with the Eq. 4.2 factors) and their JSON;
 * :mod:`.objective` -- :class:`Objective` (Eq. 4.1 after Eq. 4.2; f = s_1 s_2 of
-  Alg. 7), :func:`combined_score` and the counted BEM :class:`Evaluator`;
+  Alg. 7), :func:`combined_score`, the :func:`verdict` on a match and the counted BEM
+  :class:`Evaluator`;
 * :mod:`.sensitivities` -- exact residual derivatives on the fixed contact sets;
 * :mod:`.stages` -- one GCMMA stage (Sec. 4.3.1) through the one driver
   :func:`roughfe.optim.gcmma.gcmma`, its options and the phase box;
@@ -29,13 +30,13 @@ Every public name is importable from ``roughfe.genomics.design``.
 """
 from ...optim.gcmma import GcmmaResult, gcmma_maximize, gcmma_minimax
 from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, mcco, refine,
-                         run_design, score_database, sog)
+                         run_design, score_database, sog, with_solved_scores)
 from .io import result_to_dict, write_design_result
 from .crest import clipped_phases, crest_phases, wave_modes
 from .modulation import MODULATION_CUT, crest_roughness, modulated_heights, wave_split
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
                     entry_design)
-from .objective import Evaluator, Objective, combined_score
+from .objective import SELECTION, Evaluator, Objective, Verdict, combined_score, verdict
 from .search import (AMPLITUDE_VARIABLES, GLOBAL_METHODS, GLOBAL_SCORES, GlobalSearchOptions,
                      search_at_target_pressures, search_global)
 from .sensitivities import residual_jacobian
@@ -58,6 +59,7 @@ __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "
            "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",
            "combine", "entry_design", "Evaluator", "Objective", "combined_score",
+           "SELECTION", "Verdict", "verdict", "with_solved_scores",
            "residual_jacobian", "FORMULATIONS", "GcmmaOptions", "optimise_phases",
            "phase_bounds", "Y_T1_GENES", "Y_T1_SURFACE_GENES", "rescore",
            "rescore_at_target_pressures", "score_at_target_pressures", "surface_targets",

@@ -28,14 +28,11 @@ from ..database import DatabaseEntry, DatabaseSettings
 from ..macro_micro import classify
 from ..similarity import ResponseCurve, Target, similarity, split_ranges
 from .model import Design, combine, entry_design
-from .objective import Evaluator, Objective, combined_score
+from .objective import SELECTION, Evaluator, Objective, combined_score, verdict
 from .stages import GcmmaOptions, optimise_phases
 from .targets import rescore_at_target_pressures
 
 METHODS = ("sog", "gco", "cco", "mcco")
-#: similarity above which a database genome (Algs. 5-7 Step 2-3) or a cross-over counts
-#: as a match (thesis: 0.95)
-SELECTION = 0.95
 #: largest difference allowed between a candidate's reported scores (its curve stretched
 #: by Eq. 4.2) and a fresh BEM sweep of the saved, rescaled design, relative to the
 #: scores' magnitude when that is above 1 (a poor score such as s = -1e9 carries
@@ -86,8 +83,9 @@ class DesignResult:
     (:func:`rescore_tolerance`). The second fails when
     the response is not linear in the heights (e.g. an elastic-plastic evaluator): Eq.
     (4.2) then no longer rescales a curve exactly, and the reported design would not
-    have the reported score. It does not say the target is matched: the message says
-    "the target is NOT matched" when the best combined s is not above :data:`SELECTION`.
+    have the reported score. It does not say the target is matched: the message states
+    the verdict on the match (:func:`~.objective.verdict`: by the best candidate's scores
+    solved at the target pressures when it has them, else by its interpolated ones).
     """
 
     method: str
@@ -199,19 +197,28 @@ def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, ent
     return tuple(out)
 
 
-def _miss_note(s_best: float) -> str:
-    """The message's verdict on the match. ``success`` is the soundness of the computation
-    (finite, reproducible scores), not the match: say so when the best design is no match
-    (s = -23.7 read as a success)."""
-    return (f"; the target is NOT matched (s = {s_best:.4g} <= {SELECTION}, the selection "
-            f"value of Alg. 3)" if not s_best > SELECTION else "")
+def _verdict_note(candidate) -> str:
+    """The message's verdict on the match (:func:`~.objective.verdict`). ``success`` is
+    the soundness of the computation (finite, reproducible scores), not the match: say
+    so when the best design is no match (s = -23.7 read as a success)."""
+    return "; " + verdict(candidate).note()
+
+
+def with_solved_scores(result: DesignResult, scores) -> DesignResult:
+    """``result`` with its best candidate's scores solved at the target pressures
+    (``scores``, :func:`rescore_at_target_pressures`) and the verdict of its message
+    re-decided by them (``roughfe design`` solves the best design there)."""
+    best = replace(result.best, at_targets=tuple(float(s) for s in scores))
+    return replace(result, candidates=(best,) + tuple(result.candidates[1:]),
+                   message=result.message.replace(_verdict_note(result.best),
+                                                  _verdict_note(best)))
 
 
 def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evaluate, t0):
     best = cands[0]
     ok, why = _success(cands)
     s_best = combined_score(best.scores)
-    miss = _miss_note(s_best)
+    miss = _verdict_note(best)
     msg = (f"{method}: best {best.origin} s = {s_best:.4f} "
            f"(stages {', '.join(f'{s:.4f}' for s in best.stages)})"
            + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used")
@@ -447,13 +454,15 @@ def _extended(result, out, evaluate, t0, note):
     """``result`` with the candidates ``out`` of an extra stage, its sweeps and time added,
     the success criterion re-applied to the new candidates and the match verdict moved to
     the end, on the new best (a stage that lifted s from 0.932 to 0.9806 followed "the
-    target is NOT matched (s = 0.932 ...)")."""
+    target is NOT matched (s = 0.932 ...)"); after a search stage it is decided by the
+    scores solved at the target pressures (it said NOT matched by the interpolated
+    s = 0.908 after "f at p_t = 0.9634")."""
     ok, why = _success(out)
-    before = result.message.replace(_miss_note(combined_score(result.candidates[0].scores)), "")
+    before = result.message.replace(_verdict_note(result.best), "")
     return replace(result, candidates=tuple(out), nit=result.nit + evaluate.n_sweeps,
                    elapsed=result.elapsed + time.perf_counter() - t0,
                    success=result.success and ok,
-                   message=before + note + _miss_note(combined_score(out[0].scores)) + why)
+                   message=before + note + _verdict_note(out[0]) + why)
 
 
 def _at_targets(design, objective, settings, evaluate):

@@ -10,14 +10,19 @@ from ...writers import write_json, write_text
 from ..database import DatabaseSettings
 from ..genome import save_genome
 from .algorithms import DesignResult
-from .objective import combined_score
+from .objective import combined_score, verdict
 
 
 def result_to_dict(result: DesignResult, settings: DatabaseSettings) -> dict:
-    """JSON-safe report of a design run: candidates, scores per stage, targets, settings."""
+    """JSON-safe report of a design run: candidates, scores per stage, targets, settings,
+    and the verdict on the best design's match (:func:`~.objective.verdict`, as the
+    message states it): ``matched`` and ``matched_by`` (which scores decided it)."""
+    v = verdict(result.best)
     return {
         "format": "roughfe-design-result", "version": 1, "method": result.method,
-        "message": result.message, "success": result.success, "nit_bem_sweeps": result.nit,
+        "message": result.message, "success": result.success,
+        "matched": v.matched, "matched_by": f"scores {v.source}: {list(v.scores)}",
+        "nit_bem_sweeps": result.nit,
         "elapsed_s": result.elapsed, "pbar": result.pbar, "n_cross": result.n_cross,
         "n_cross_above_0.95": result.n_cross_above,
         "selection_passed": result.selection_passed,

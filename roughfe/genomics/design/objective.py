@@ -63,14 +63,62 @@ class Objective:
 
     def residuals(self, curve: ResponseCurve) -> np.ndarray:
         """Relative errors (y_t - y_i)/y_t at every target point in ``p_range`` (all
-        targets stacked); ``s = 1 - max |r|`` for one target (Eq. 4.1)."""
+        targets stacked); ``s = 1 - max |r|`` for one target (Eq. 4.1). The curve is
+        read as :func:`similarity` reads it (:meth:`ResponseCurve.at`: from (0, 0) below
+        its first pressure)."""
         c = curve.to_target_range(self.p_max)
         out = []
         for t in self.targets:
             sel = (t.pressure >= self.p_range[0]) & (t.pressure <= self.p_range[1])
-            yi = np.interp(t.pressure[sel], c.pressure, c.values(t.quantity))
+            yi = c.at(t.pressure[sel], t.quantity)
             out.append((t.values[sel] - yi) / t.values[sel])
         return np.concatenate(out)
+
+
+#: similarity above which a database genome (Algs. 5-7 Step 2-3) or a cross-over counts
+#: as a match (thesis: 0.95), and a design matches its target (:func:`verdict`)
+SELECTION = 0.95
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Whether a design matches its targets (:func:`verdict`), with the scores that
+    decided it and where they come from: ``solved`` True when the design was solved at
+    the target pressures (:func:`~.targets.rescore_at_target_pressures`), False when its
+    curve on its own n_t approaches was interpolated there (Eq. 4.1 after Eq. 4.2)."""
+
+    matched: bool
+    scores: tuple
+    solved: bool
+
+    @property
+    def source(self) -> str:
+        return ("solved at the target pressures" if self.solved else
+                "interpolated from the design's own n_t approaches")
+
+    def note(self) -> str:
+        """The verdict as the design message states it."""
+        s = combined_score(self.scores)
+        return (f"the target is {'' if self.matched else 'NOT '}matched (s = {s:.4g} "
+                f"{'>' if self.matched else '<='} {SELECTION}, the selection value of Alg. "
+                f"3; decided by the score {self.source})")
+
+    def short(self) -> str:
+        """The verdict in a figure title."""
+        s = combined_score(self.scores)
+        return (f"target {'' if self.matched else 'NOT '}matched: s = {s:.4f} "
+                f"{'>' if self.matched else '<='} {SELECTION} ({self.source})")
+
+
+def verdict(candidate) -> Verdict:
+    """The one verdict on a design candidate's match, for the message, result.json and
+    the figure title alike: decided by its scores solved at the target pressures
+    (``candidate.at_targets``) when it has them -- the search stages and ``roughfe
+    design`` solve the best design there -- else by its interpolated ``scores``; matched
+    when the combined s (:func:`combined_score`) is above :data:`SELECTION`."""
+    solved = len(candidate.at_targets) > 0
+    scores = tuple(float(s) for s in (candidate.at_targets if solved else candidate.scores))
+    return Verdict(combined_score(scores) > SELECTION, scores, solved)
 
 
 def combined_score(scores) -> float:
