@@ -306,6 +306,31 @@ def test_mcco_when_one_genome_tops_both_rankings(entries):
     assert r.best.stages[0] == pytest.approx(1.0, abs=1e-6)
 
 
+def test_mcco_verdict_is_per_target(entries):
+    """M-CCO is matched when every target's s is above 0.95, not when the product f is:
+    targets K and A of genome 1-2 x 1.03 score 0.9709 each (f = 0.9427), which was called
+    "NOT matched (s = 0.9427 <= 0.95)". The message, result.json and the figure title
+    name each target's score."""
+    from roughfe.plotting.design import design_title
+    e = next(x for x in entries if x.label == "1-2")
+    c = e.curve
+    tk = Target(c.pressure, 1.03 * c.stiffness, "K", "tK")
+    ta = Target(c.pressure, 1.03 * c.area_fraction, "A", "tA")
+    r = de.mcco([e], tk, ta, SETTINGS, options=FAST, n_best=1)
+    assert r.best.scores == pytest.approx((1 - 0.03 / 1.03,) * 2, abs=1e-4)
+    assert de.combined_score(r.best.scores) < 0.95
+    note = ("the targets are matched (s(tK) = 0.9709 > 0.95, s(tA) = 0.9709 > 0.95: each "
+            "target's s must exceed 0.95")
+    assert note in r.message and "NOT matched" not in r.message
+    assert r.message.startswith("mcco: best 1-2+1-2 f = s_1 s_2 = 0.942")
+    assert de.result_to_dict(r, SETTINGS)["matched"] is True
+    assert "targets matched: s(tK) = 0.9709 > 0.95, s(tA) = 0.9709 > 0.95" in design_title(r)
+    # one target below 0.95 is no match, whatever the other
+    low = de.with_solved_scores(r, (0.99, 0.94))
+    assert "the targets are NOT matched (s(tK) = 0.99 > 0.95, s(tA) = 0.94 <= 0.95" in \
+        low.message and de.result_to_dict(low, SETTINGS)["matched"] is False
+
+
 def _design_study():
     spec = importlib.util.spec_from_file_location(
         "design_study", Path(__file__).resolve().parents[1] / "validation" / "design_study.py")

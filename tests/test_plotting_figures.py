@@ -197,7 +197,7 @@ def test_design_curves_title_is_whole_and_keeps_the_verdict(drawn):
     title = design_plot.design_title(result)
     assert title == ("sog: best 2-1; target NOT matched: s = 0.6208 <= 0.95 (interpolated "
                      "from the design's own n_t approaches)")
-    assert "; target matched: s = 0.9700 > 0.95" in design_plot.design_title(
+    assert "; target matched: s = 0.97 > 0.95" in design_plot.design_title(
         _design_result(0.97))
     assert "NOT a success" in design_plot.design_title(_design_result(0.97, success=False))
     # solved at the target pressures (roughfe design always, the search stages): those

@@ -127,7 +127,8 @@ def design_title(result) -> str:
     own), and NOT a success when the result's criterion failed. The full
     ``result.message`` (136 characters and more, clipped at both ends as a title until
     session 25) is in result.json and printed."""
-    return (f"{result.method}: best {result.best.origin}; {verdict(result.best).short()}"
+    v = verdict(result.best, result.objective.targets)
+    return (f"{result.method}: best {result.best.origin}; {v.short()}"
             + ("" if result.success else "; NOT a success (see result.json)"))
 
 

@@ -197,11 +197,11 @@ def _optimise_candidates(starts, objective, evaluate, options, n_it1, n_it2, ent
     return tuple(out)
 
 
-def _verdict_note(candidate) -> str:
+def _verdict_note(candidate, objective) -> str:
     """The message's verdict on the match (:func:`~.objective.verdict`). ``success`` is
     the soundness of the computation (finite, reproducible scores), not the match: say
     so when the best design is no match (s = -23.7 read as a success)."""
-    return "; " + verdict(candidate).note()
+    return "; " + verdict(candidate, objective.targets).note()
 
 
 def with_solved_scores(result: DesignResult, scores) -> DesignResult:
@@ -210,16 +210,18 @@ def with_solved_scores(result: DesignResult, scores) -> DesignResult:
     re-decided by them (``roughfe design`` solves the best design there)."""
     best = replace(result.best, at_targets=tuple(float(s) for s in scores))
     return replace(result, candidates=(best,) + tuple(result.candidates[1:]),
-                   message=result.message.replace(_verdict_note(result.best),
-                                                  _verdict_note(best)))
+                   message=result.message.replace(
+                       _verdict_note(result.best, result.objective),
+                       _verdict_note(best, result.objective)))
 
 
 def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evaluate, t0):
     best = cands[0]
     ok, why = _success(cands)
     s_best = combined_score(best.scores)
-    miss = _verdict_note(best)
-    msg = (f"{method}: best {best.origin} s = {s_best:.4f} "
+    miss = _verdict_note(best, objective)
+    f_or_s = "f = s_1 s_2" if len(objective.targets) > 1 else "s"      # Alg. 7 Step 10
+    msg = (f"{method}: best {best.origin} {f_or_s} = {s_best:.4f} "
            f"(stages {', '.join(f'{s:.4f}' for s in best.stages)})"
            + ("" if passed else "; no genome passed the 0.95 selection, the best ones were used")
            + miss + why)
@@ -458,11 +460,11 @@ def _extended(result, out, evaluate, t0, note):
     scores solved at the target pressures (it said NOT matched by the interpolated
     s = 0.908 after "f at p_t = 0.9634")."""
     ok, why = _success(out)
-    before = result.message.replace(_verdict_note(result.best), "")
+    before = result.message.replace(_verdict_note(result.best, result.objective), "")
     return replace(result, candidates=tuple(out), nit=result.nit + evaluate.n_sweeps,
                    elapsed=result.elapsed + time.perf_counter() - t0,
                    success=result.success and ok,
-                   message=before + note + _verdict_note(out[0]) + why)
+                   message=before + note + _verdict_note(out[0], result.objective) + why)
 
 
 def _at_targets(design, objective, settings, evaluate):

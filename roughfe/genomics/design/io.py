@@ -17,11 +17,12 @@ def result_to_dict(result: DesignResult, settings: DatabaseSettings) -> dict:
     """JSON-safe report of a design run: candidates, scores per stage, targets, settings,
     and the verdict on the best design's match (:func:`~.objective.verdict`, as the
     message states it): ``matched`` and ``matched_by`` (which scores decided it)."""
-    v = verdict(result.best)
+    v = verdict(result.best, result.objective.targets)
+    by = ", ".join(f"{n} {sc!r}" for n, sc in zip(v.names, v.scores))
     return {
         "format": "roughfe-design-result", "version": 1, "method": result.method,
         "message": result.message, "success": result.success,
-        "matched": v.matched, "matched_by": f"scores {v.source}: {list(v.scores)}",
+        "matched": v.matched, "matched_by": f"scores {v.source}: {by}",
         "nit_bem_sweeps": result.nit,
         "elapsed_s": result.elapsed, "pbar": result.pbar, "n_cross": result.n_cross,
         "n_cross_above_0.95": result.n_cross_above,
