@@ -60,6 +60,19 @@ def test_db_and_design_commands(tmp_path, capsys):
     plain_design = de.Design.from_dict(json.loads((plain / "design.json").read_text()))
     assert de.rescore_at_target_pressures(plain_design, [target], settings) == pytest.approx(
         saved["scores_at_target_pressures"], abs=1e-7)
+    # a curve cut short (a genome's own K(p), 7 of 10 points): --target-p-top gives its
+    # pressure at Delta = peak-valley amplitude (Eq. 4.2's p_max^t), and the genome is
+    # recovered (without it the genome scores 0.658 on the reviewer's database)
+    e = db.load_entries(path)[0]
+    from roughfe.genomics.similarity import write_target_csv
+    cut = write_target_csv(tmp_path / "cut.csv", Target(e.curve.pressure[:7],
+                                                        e.curve.stiffness[:7], "K", "cut"))
+    assert main(["design", "--db", str(path), "--target", str(cut), "--target-p-top",
+                 repr(e.p_max), "--method", "sog", "--iterations", "1", "--no-figures", "-o",
+                 str(tmp_path / "cut")]) == 0
+    rep = json.loads((tmp_path / "cut" / "result.json").read_text())
+    assert rep["targets"][0]["p_top"] == e.p_max
+    assert rep["candidates"][0]["score"] == pytest.approx(1.0, abs=1e-9)
     # the global stage with chromosome amplitudes as variables: bounded, strict scores
     # of the saved design reproduced
     amp = tmp_path / "sog_amp"

@@ -164,3 +164,25 @@ def test_a_curve_is_read_from_zero_load_below_its_first_pressure():
     p, k = c.points("K")
     np.testing.assert_array_equal(p, [0.0, 2.0, 3.0, 4.0])
     np.testing.assert_array_equal(k, [0.0, 20.0, 30.0, 36.0])
+
+
+def test_the_last_target_pressure_is_eq42s_p_max_unless_p_top_says_otherwise():
+    """Eq. (4.2) takes the target's last pressure as its pressure at Delta = peak-valley
+    amplitude: a curve cut short is stretched onto the wrong range and its own profile
+    no longer matches it (measured on a database genome: 7 of 10 points, s = 0.658).
+    ``p_top`` gives that pressure; the cut curve then scores 1 against its profile."""
+    c = _curve()
+    cut = Target(c.pressure[:7], c.stiffness[:7], "K")
+    assert cut.p_max == c.pressure[6] and similarity(cut, c) < 0.9
+    told = Target(c.pressure[:7], c.stiffness[:7], "K", p_top=c.p_max)
+    assert told.p_max == c.p_max
+    assert similarity(told, c) == pytest.approx(1.0, abs=1e-14)
+    assert similarity(told, c.rescaled(3.0)) == pytest.approx(1.0, abs=1e-14)  # any amplitude
+    assert Target.from_dict(told.to_dict()).p_top == c.p_max
+    assert "p_top" not in cut.to_dict()                      # files of before: unchanged
+    assert told.check_pbar(0.5) == 0.5
+    with pytest.raises(InputError, match="pbar must lie inside"):
+        told.check_pbar(0.8)                                  # beyond the last point
+    for bad in (0.5, np.inf, "x"):
+        with pytest.raises(InputError, match=r"p_top .* >= its last pressure 0\.7"):
+            Target(c.pressure[:7], c.stiffness[:7], "K", p_top=bad)

@@ -6,6 +6,7 @@ settings."""
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from .options import (add_output_folder, add_run_options, nonnegative_float, nonnegative_int,
@@ -110,6 +111,8 @@ def _run(args) -> int:
                                "A"))
     if args.method == "mcco" and len(targets) == 2 and targets[0].quantity == "A":
         targets.reverse()
+    if args.target_p_top is not None:       # Eq. 4.2's p_max^t beyond the last points
+        targets = [replace(t, p_top=args.target_p_top) for t in targets]
     options = GcmmaOptions(bound=args.bound, formulation=args.formulation, eps=args.eps,
                            gradient=args.gradient,
                            **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
@@ -196,7 +199,17 @@ def register(sub):
                                    "profile.npz, curves.csv, stages.csv and the figures.")
     p.add_argument("--db", required=True, help="SQLite genome database ('roughfe db build')")
     p.add_argument("--target", required=True,
-                   help="CSV 'pressure_Pa,value' or a thesis target y_t1|y_t2|y_t3")
+                   help="CSV 'pressure_Pa,value' or a thesis target y_t1|y_t2|y_t3. Its LAST "
+                        "pressure is taken as the pressure at the approach Delta = "
+                        "peak-valley amplitude (p_max^t of the amplitude rescaling Eq. 4.2, "
+                        "the thesis convention): a measured curve that stops earlier is not "
+                        "recovered, even by the genome that produced it, unless "
+                        "--target-p-top gives that pressure")
+    p.add_argument("--target-p-top", type=positive_float, default=None, metavar="PA",
+                   help="the targets' pressure (Pa) at the approach Delta = peak-valley "
+                        "amplitude, p_max^t of Eq. 4.2, when their points stop earlier "
+                        "(>= the last target pressure; both targets of mcco, one loading; "
+                        "default: the last pressure of --target)")
     p.add_argument("--quantity", choices=("K", "A"), default=None,
                    help="what the target CSV holds: stiffness K (Pa/m) or area fraction A "
                         "(default: what the file's comment says, as design-targets writes "

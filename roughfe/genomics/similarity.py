@@ -29,7 +29,7 @@ import csv
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Literal, Optional
 
 import numpy as np
 
@@ -162,6 +162,15 @@ def from_origin(pressure, *values):
 def amplitude_factor(p_max_target: float, p_max_i: float) -> float:
     """Factor ``p_max^t / p_max^i`` of Eq. (4.2): multiply the amplitude gene A_i by it.
 
+    Both are pressures at the approach Delta = peak-valley amplitude (thesis convention;
+    a periodic surface: the database's top approach,
+    :func:`~roughfe.genomics.macro_micro.top_approach`): p_max^i is the profile's last
+    sweep step, p_max^t the target's :attr:`Target.p_max`, i.e. its LAST pressure unless
+    :attr:`Target.p_top` says otherwise. A measured curve
+    that stops before that approach is stretched onto the wrong range: even the genome
+    that produced it is not recovered (its own K(p) cut to the first 7 of 10 points
+    scores s = 0.658), unless its pressure at that approach is given as ``p_top``.
+
     Parameters
     ----------
     p_max_target, p_max_i : float
@@ -190,6 +199,10 @@ class Target:
         Label used in reports (e.g. ``"y_t1"``).
     metadata : dict
         JSON-safe provenance (how the target was made).
+    p_top : float, optional
+        The target's pressure (Pa) at the approach Delta = peak-valley amplitude, p_max^t
+        of Eq. (4.2), when its points stop earlier; >= the last pressure. Default: the
+        last pressure (the thesis convention, :func:`amplitude_factor`).
     """
 
     pressure: np.ndarray
@@ -197,6 +210,7 @@ class Target:
     quantity: str = "K"
     name: str = "target"
     metadata: dict = field(default_factory=dict)
+    p_top: Optional[float] = None
 
     def __post_init__(self):
         _check_quantity(self.quantity)
@@ -237,11 +251,18 @@ class Target:
         object.__setattr__(self, "pressure", _readonly(p))
         object.__setattr__(self, "values", _readonly(y))
         object.__setattr__(self, "metadata", FrozenMapping(self.metadata or {}))
+        if self.p_top is not None:
+            top = _float_or_none(self.p_top)
+            if top is None or not (np.isfinite(top) and top >= p[-1]):
+                raise InputError(f"p_top (the target's pressure at Delta = peak-valley "
+                                 f"amplitude, Eq. 4.2) must be finite and >= its last "
+                                 f"pressure {p[-1]!r} Pa, got {self.p_top!r}")
+            object.__setattr__(self, "p_top", top)
 
     @property
     def p_max(self) -> float:
-        """Largest target pressure p_max^t (Pa)."""
-        return float(self.pressure[-1])
+        """p_max^t of Eq. (4.2) (Pa): :attr:`p_top` if given, else the last pressure."""
+        return float(self.pressure[-1]) if self.p_top is None else self.p_top
 
     def check_pbar(self, pbar: float) -> float:
         """Return ``pbar`` if it splits the target range ``(p_min, p_max)`` into two parts."""
@@ -249,7 +270,7 @@ class Target:
             v = float(pbar)
         except (TypeError, ValueError):
             raise InputError(f"pbar must be a pressure in Pa, got {pbar!r}") from None
-        lo, hi = float(self.pressure[0]), self.p_max
+        lo, hi = float(self.pressure[0]), float(self.pressure[-1])
         if not (lo < v < hi):
             raise InputError(f"pbar must lie inside the target pressure range ({lo:.6g}, {hi:.6g}) "
                              f"Pa so that [0, pbar] and [pbar, p_max] both hold target points; "
@@ -258,12 +279,13 @@ class Target:
 
     def to_dict(self) -> dict:
         return {"name": self.name, "quantity": self.quantity, "pressure": self.pressure.tolist(),
-                "values": self.values.tolist(), "metadata": self.metadata}
+                "values": self.values.tolist(), "metadata": self.metadata,
+                **({} if self.p_top is None else {"p_top": self.p_top})}
 
     @classmethod
     def from_dict(cls, d) -> "Target":
         return cls(d["pressure"], d["values"], d.get("quantity", "K"), d.get("name", "target"),
-                   d.get("metadata", {}))
+                   d.get("metadata", {}), d.get("p_top"))
 
     @classmethod
     def from_curve(cls, curve: ResponseCurve, quantity: Quantity = "K", name="target",
@@ -306,7 +328,8 @@ def similarity(target: Target, curve: ResponseCurve, p_range=(0.0, np.inf), *,
     sel = (target.pressure >= lo) & (target.pressure <= hi)
     if not sel.any():
         raise InputError(f"no target point lies in the pressure range [{lo:.6g}, {hi:.6g}] Pa "
-                         f"(target spans {target.pressure[0]:.6g} .. {target.p_max:.6g} Pa)")
+                         f"(target spans {target.pressure[0]:.6g} .. {target.pressure[-1]:.6g} "
+                         f"Pa)")
     p, yt = target.pressure[sel], target.values[sel]
     yi = curve.at(p, target.quantity)
     return float(1.0 - np.max(np.abs((yt - yi) / yt)))
@@ -362,7 +385,7 @@ def linear_then_flat_target(p_max: float, pbar: float, plateau: float, n_points:
 def _float_or_none(text):
     try:
         return float(text)
-    except ValueError:
+    except (TypeError, ValueError):
         return None
 
 
