@@ -64,7 +64,7 @@ def test_db_and_design_commands(tmp_path, capsys):
     # pressure at Delta = peak-valley amplitude (Eq. 4.2's p_max^t), and the genome is
     # recovered (without it the genome scores 0.658 on the reviewer's database)
     e = db.load_entries(path)[0]
-    from roughfe.genomics.similarity import write_target_csv
+    from roughfe.genomics.target_csv import write_target_csv
     cut = write_target_csv(tmp_path / "cut.csv", Target(e.curve.pressure[:7],
                                                         e.curve.stiffness[:7], "K", "cut"))
     assert main(["design", "--db", str(path), "--target", str(cut), "--target-p-top",

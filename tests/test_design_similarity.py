@@ -4,8 +4,8 @@ import pytest
 
 from roughfe.errors import InputError
 from roughfe.genomics.similarity import (ResponseCurve, Target, amplitude_factor,
-                                         linear_then_flat_target, read_target_csv, similarity,
-                                         split_ranges, write_target_csv)
+                                         linear_then_flat_target, similarity, split_ranges)
+from roughfe.genomics.target_csv import read_target_csv, write_target_csv
 
 
 def _curve(scale=1.0, k0=2.0):
@@ -60,8 +60,9 @@ def test_target_y_t2_shape_and_bad_inputs(tmp_path):
                                                        "y_t3"))
     assert read_target_csv(area).quantity == "A" and back.quantity == "K"
     assert read_target_csv(area, "A").quantity == "A"
-    with pytest.raises(InputError, match=r"holds contact area fraction .* \(A\), not "
-                                         r"normal contact stiffness .*--quantity A"):
+    with pytest.raises(InputError, match=r"its comment says contact area fraction .* \(A\) "
+                                         r"but --quantity K says normal contact stiffness .*"
+                                         r"--quantity A or none"):
         read_target_csv(area, "K")
     plain = tmp_path / "plain.csv"
     plain.write_text("pressure_Pa,value\n1e5,0.1\n2e5,0.2\n")
@@ -144,6 +145,36 @@ def test_target_csv_contents_are_checked(tmp_path):
         assert target("ok.csv", f"{header}\n1e7,1e11\n2e7,1.1e11\n").pressure.size == 2
     assert target("trail.csv", "pressure_Pa,value,\n1e7,1e11,\n2e7,1.1e11,\n").values[1] == 1.1e11
     assert target("full.csv", "p,A\n1e7,0.5\n2e7,1\n", "A").values[-1] == 1.0
+
+
+def test_target_csv_header_names_the_quantity(tmp_path):
+    """A header 'p [Pa],A' (a valid header, listed in read_target_csv's docstring) was read
+    as K: the quantity came only from a # comment, --quantity or the default K. Now the
+    value column's name says it, and a conflict with --quantity or the comment is an
+    InputError naming both."""
+    from roughfe.errors import FileFormatError
+    rows = "1e7,0.01\n2e7,0.02\n"
+
+    def read(header, quantity=None, comment=""):
+        path = tmp_path / "t.csv"
+        path.write_text(comment + header + "\n" + rows)
+        return read_target_csv(path, quantity).quantity
+
+    for header, q in (("p [Pa],A", "A"), ("p,A*", "A"), ("pressure,area_fraction", "A"),
+                      ("p,a", "A"), ("p,A_r/A_n", "A"), ("p,K", "K"), ("p [Pa],K [Pa/m]", "K"),
+                      ("p,K_Pa_per_m", "K"), ("Pressure (Pa),stiffness", "K"),
+                      ("pressure_Pa,value", "K"), ("p,amplitude", "K")):     # K: the default
+        assert read(header) == q, header
+    assert read("p [Pa],A", "A") == "A" and read("pressure_Pa,value", "A") == "A"
+    with pytest.raises(InputError, match=r"the header 'p \[Pa\],A' says contact area fraction "
+                                         r".*\(A\) but --quantity K says normal contact "
+                                         r"stiffness .*\(K\)"):
+        read("p [Pa],A", "K")
+    with pytest.raises(InputError, match=r"its comment says normal contact stiffness .*\(K\) "
+                                         r"but the header 'p,A' says contact area fraction"):
+        read("p,A", comment="# t: normal contact stiffness K = dp/dDelta (Pa/m) vs pressure\n")
+    with pytest.raises(FileFormatError, match="names both stiffness K and area A"):
+        read("p,K or area")
 
 
 def test_a_curve_is_read_from_zero_load_below_its_first_pressure():

@@ -164,7 +164,7 @@ def test_profile_target_defaults_to_the_profile_databases_own_setting(tmp_path):
     assert mirrored.stiffness[-1] > 10 * own.stiffness[-1]
     # the CSV says how the target was made (K 10x apart between the two boundaries, and
     # the file said neither) and still reads back with its quantity
-    from roughfe.genomics.similarity import read_target_csv, write_target_csv
+    from roughfe.genomics.target_csv import read_target_csv, write_target_csv
     path = write_target_csv(tmp_path / "tk.csv", tk)
     assert "# solved with boundary window, resolution design, detrend none" in path.read_text()
     back = read_target_csv(path)

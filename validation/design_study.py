@@ -24,7 +24,7 @@ from roughfe.genomics import database as db
 from roughfe.genomics import design as de
 from roughfe.genomics.genome import realize, table1_genome
 from roughfe.genomics.macro_micro import macro_micro, top_approach
-from roughfe.genomics.similarity import write_target_csv
+from roughfe.genomics.target_csv import write_target_csv
 from roughfe.model import Material
 from roughfe.plotting import design as dplot
 from roughfe.study import build_genome_db

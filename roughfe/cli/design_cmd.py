@@ -35,7 +35,7 @@ GLOBAL_FLAGS = (
 
 def _target(spec, quantity, settings, cache, default):
     from ..genomics.design import thesis_targets
-    from ..genomics.similarity import read_target_csv
+    from ..genomics.target_csv import read_target_csv
     if spec in BUILTIN and not Path(spec).exists():
         if "t" not in cache:
             cache["t"] = thesis_targets(settings)
@@ -167,7 +167,7 @@ def _run(args) -> int:
 def _targets(args) -> int:
     from ..genomics.database import read_settings
     from ..genomics.design import surface_targets, thesis_targets
-    from ..genomics.similarity import write_target_csv
+    from ..genomics.target_csv import write_target_csv
     settings = read_settings(args.db)
     if args.surface:
         from ..surfaces.io import load_surface
@@ -212,13 +212,14 @@ def register(sub):
                         "default: the last pressure of --target)")
     p.add_argument("--quantity", choices=("K", "A"), default=None,
                    help="what the target CSV holds: stiffness K (Pa/m) or area fraction A "
-                        "(default: what the file's comment says, as design-targets writes "
-                        "it; else K)")
+                        "(default: what the file says, in its comment as design-targets "
+                        "writes it or its header's value column, e.g. 'p,A'; else K; a "
+                        "disagreement is an error)")
     p.add_argument("--second-target", default=None,
                    help="M-CCO: the second target (CSV or y_t3), usually A(p)")
     p.add_argument("--second-quantity", choices=("K", "A"), default=None,
-                   help="what the second target CSV holds (default: what its comment "
-                        "says; else A)")
+                   help="what the second target CSV holds (default: what its comment or "
+                        "header says; else A)")
     p.add_argument("--method", choices=("sog", "gco", "cco", "mcco"), required=True,
                    help="Alg. 4 (sog), 5 (gco), 6 (cco) or 7 (mcco)")
     p.add_argument("--pbar", type=positive_float, default=None,

@@ -22,18 +22,17 @@ curves of the original one stretched along the pressure axis,
 Choosing ``eta = p_max^t / p_max^i`` (Eq. 4.2) puts the profile on the target's pressure
 range without a new BEM solution (:meth:`ResponseCurve.rescaled`);
 ``tests/test_design_bem.py`` checks it against an independent BEM run.
+
+Target CSV files: :mod:`roughfe.genomics.target_csv`.
 """
 from __future__ import annotations
 
-import csv
-import re
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Literal, Optional
 
 import numpy as np
 
-from ..errors import FileFormatError, InputError
+from ..errors import InputError
 from ..frozen import FrozenMapping
 
 Quantity = Literal["K", "A"]
@@ -387,109 +386,3 @@ def _float_or_none(text):
         return float(text)
     except (TypeError, ValueError):
         return None
-
-
-def _said(line):
-    """The quantity a comment line names (as :func:`write_target_csv` writes it), or None."""
-    return next((q for q, (label, _) in QUANTITY_LABELS.items() if label in line), None)
-
-
-def _target_lines(path):
-    """``(line number, raw text, stripped cells)`` of the lines of a target CSV that are
-    neither blank nor comments, and the quantity the first naming comment says."""
-    lines, said = [], None
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as fh:
-            for k, row in enumerate(csv.reader(fh), 1):
-                cells = [c.strip() for c in row]
-                if not any(cells):
-                    continue
-                if cells[0].startswith("#"):
-                    said = said or _said(",".join(row))
-                else:
-                    lines.append((k, ",".join(row), cells))
-    except (UnicodeDecodeError, csv.Error) as exc:
-        raise FileFormatError(f"{path} is not a UTF-8 CSV text file of 'pressure,value' rows "
-                              f"({exc})") from None
-    return lines, said
-
-
-def _is_pressure_name(name) -> bool:
-    """A header name that says pressure: ``p``, ``pressure``, ``mean pressure``, with any
-    unit or suffix after a non-letter (``pressure_Pa``, ``p [Pa]``, ``p_mean``)."""
-    return re.match(r"(mean[ _-]?)?(p|pressure)(?![a-z])", name.lower()) is not None
-
-
-def _check_header(path, k, text, cells):
-    """A header must name two columns, the pressure first (the reader takes columns by
-    position: a file written value first was read with its values as pressures)."""
-    if len(cells) != 2:
-        raise FileFormatError(f"{path}: line {k}: the header {text!r} names {len(cells)} "
-                              f"column(s); a target has two, comma-separated: pressure (Pa) "
-                              f"then value (e.g. 'pressure_Pa,value')")
-    if not _is_pressure_name(cells[0]) or _is_pressure_name(cells[1]):
-        swapped = " (swapped? put the pressure first)" if _is_pressure_name(cells[1]) else ""
-        raise FileFormatError(f"{path}: line {k}: the header {text!r} does not name the "
-                              f"pressure first{swapped}; the columns are pressure (Pa) then "
-                              f"value, e.g. 'pressure_Pa,value' or 'p,K'")
-
-
-def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> Target:
-    """Read a target from a CSV file with two columns: pressure (Pa), value (K in Pa/m or A).
-
-    The file is UTF-8 (a byte-order mark is skipped). Blank lines and lines starting with
-    ``#`` are skipped anywhere; one header line of non-numeric names may precede the
-    first data row (a line with a number in it is data: ``1e7,1e11x`` is an error, not a
-    header), and it must name two columns, the pressure first (``pressure_Pa,value``,
-    ``p,K``, ``p [Pa],A``); every other line must be two numbers (empty cells after them,
-    a trailing comma, are ignored; a third value is an error), else the error names the
-    line and its content. An area target must be a fraction, 0 < A <= 1 (:class:`Target`).
-    The quantity is the one the file's ``# name: <label> (unit) vs pressure
-    (Pa)`` comment names (as :func:`write_target_csv` writes it); ``quantity`` ("K" or
-    "A") must then agree with it (an area target read as a stiffness was a silent,
-    meaningless objective), and is taken as given for a file that names none
-    (``default`` when None).
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"target file {path} does not exist")
-    if quantity is not None:
-        _check_quantity(quantity)
-    lines, said = _target_lines(path)
-    rows = []
-    for i, (k, text, cells) in enumerate(lines):
-        while not cells[-1]:                            # a trailing comma: no column
-            cells = cells[:-1]
-        values = [_float_or_none(c) for c in cells]
-        if i == 0 and all(v is None for v in values):
-            _check_header(path, k, text, cells)         # the header: names only
-            continue
-        if len(values) != 2 or None in values:
-            raise FileFormatError(f"{path}: line {k} is not a row 'pressure,value' of two "
-                                  f"comma-separated numbers: {text!r} (one header line of "
-                                  f"names may precede the first row)")
-        rows.append(values)
-    if not rows:
-        raise FileFormatError(f"{path}: no 'pressure,value' rows found")
-    if said is not None and quantity is not None and said != quantity:
-        raise InputError(f"{path} holds {QUANTITY_LABELS[said][0]} ({said}), not "
-                         f"{QUANTITY_LABELS[quantity][0]} ({quantity}); give the quantity "
-                         f"the file holds (--quantity {said}), or none")
-    a = np.asarray(rows)
-    return Target(a[:, 0], a[:, 1], said or quantity or default, name or path.stem,
-                  {"source": str(path)})
-
-
-def write_target_csv(path, target: Target):
-    """Write ``target`` as 'pressure_Pa,value' CSV atomically (readable by :func:`read_target_csv`)."""
-    from ..writers import write_text
-    unit = QUANTITY_LABELS[target.quantity][1]
-    lines = [f"# {target.name}: {QUANTITY_LABELS[target.quantity][0]} ({unit}) vs pressure (Pa)"]
-    meta = target.metadata or {}
-    if "boundary" in meta:      # how a surface target was made (K differs 10x between them)
-        lines.append(f"# solved with boundary {meta['boundary']}, resolution "
-                     f"{meta.get('resolution')}, detrend {meta.get('detrend')} on a "
-                     f"{' x '.join(map(str, meta.get('solved_shape', ())))} grid")
-    lines.append("pressure_Pa,value")
-    lines += [f"{p:.17g},{y:.17g}" for p, y in zip(target.pressure, target.values)]
-    return write_text(path, "\n".join(lines) + "\n")
