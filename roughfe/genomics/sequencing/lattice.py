@@ -128,6 +128,22 @@ def coarser_lattices(p, n0, coarse_length, k_max=6, gamma_max=4.0):
     return starts
 
 
+#: relative round-off of a least-squares fit: a residual sum of squares at or below
+#: ROUND_OFF times the energy of the data fitted (sum of z^2) is an exact fit, the
+#: definition of "exact" of both sequencers (:func:`round_off_cost`). The linear solves
+#: reach ~1e-29 relative (measured, 2D grid fit, N = 48): a floor below that (1e-32 was
+#: used) let round-off choose between two exact fits, sqrt(gamma) for gamma (3 of 136
+#: noise-free random surface genomes at N = 48)
+ROUND_OFF = 1e-24
+
+
+def round_off_cost(energy):
+    """The residual sum of squares (units of ``energy``, e.g. m^2) of a fit exact to
+    round-off, ``ROUND_OFF * energy`` (plus 1e-300, so that data of zero energy have a
+    positive floor): the floor of :func:`bic`, and the test of an exact fit."""
+    return 1e-300 + ROUND_OFF * float(energy)
+
+
 def bic(cost, rows, unknowns, floor):
     """Bayesian information criterion of a least-squares fit (lower is better):
     rows ln(cost / rows) + unknowns ln(rows), ``cost`` the residual sum of squares floored

@@ -15,7 +15,8 @@ from .acquisitions import Acquisition, acquisitions_from_surfaces, check_control
 from .genes import (H_SEARCH, amplitude_genes, peak_slope_H, phases_with_sums,
                     ridge_likelihood, variance_amplitude)
 from .lattice import (bic, coarser_lattices, comb_periods, design_matrix, fit_lattice, label_q1,
-                      lattice_from_period, lattice_ranges, solve_linear, vp_residual)
+                      lattice_from_period, lattice_ranges, round_off_cost, solve_linear,
+                      vp_residual)
 from .peaks import spectrum_peaks
 from .result import SequencingResult
 
@@ -43,10 +44,10 @@ def _labelled(p, acqs, n_nodes, weights, rhs):
     if not (1.0 < math.exp(p[1]) <= 10.0):
         return None
     base = label_q1(p[0], p[1], acqs[0].length)     # lambda1 in [L_1, gamma L_1)
-    # the misfit is floored at round-off (1e-24 of the data energy) so that two exact fits
-    # tie and the lattice with fewer chromosomes wins (a lattice of ratio sqrt(gamma)
-    # contains the gamma lattice and fits WM data exactly too)
-    floor = 1e-24 * float(rhs @ rhs)
+    # the misfit is floored at round-off (:func:`~.lattice.round_off_cost`) so that two
+    # exact fits tie and the lattice with fewer chromosomes wins (a lattice of ratio
+    # sqrt(gamma) contains the gamma lattice and fits WM data exactly too)
+    floor = round_off_cost(rhs @ rhs)
     best = None
     for shift in (0.0, -1.0, 1.0):
         cand = np.array([base + shift * p[1], p[1]])

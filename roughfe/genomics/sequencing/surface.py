@@ -73,7 +73,8 @@ from scipy.optimize import least_squares
 
 from ..genome import Genome
 from .acquisitions import check_controls
-from .lattice import bic, coarser_lattices, comb_periods, label_q1, lattice_from_period
+from .lattice import (bic, coarser_lattices, comb_periods, label_q1, lattice_from_period,
+                      round_off_cost)
 from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, noise_variance,
                            surface_acquisitions, surface_peaks)
 from .surface_grid import GridModel
@@ -142,8 +143,10 @@ def _bic(model, cost, sol, p):
     gamma = 1.6: by the lowest cost gamma^(1/3) won with the misfit at the noise level, H
     and A wrong.)"""
     unknowns = 2 * sol["nn"].size + 3 * len(model.acqs) + len(p)
-    floor = 1e-300 + 1e-32 * float(model.z @ model.z)      # round-off: costs are equal
-    return bic(cost, model.z.size, unknowns, floor)
+    # two fits exact to round-off (the sequencers' one definition) tie: the lattice with
+    # fewer unknowns wins (measured: a floor of 1e-32 z.z, below the ~1e-29 the solve
+    # reaches, let round-off pick sqrt(gamma) for gamma in 3 of 136 noise-free genomes)
+    return bic(cost, model.z.size, unknowns, round_off_cost(model.z @ model.z))
 
 
 def _chromosome_presence(sol, ratio=1e-6, noise=0.0):
@@ -290,8 +293,8 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     # fitted to round-off, or down to the white-noise floor of the data (measured data,
     # noise): no other gamma candidate, continuation or added ridge can do better
     noise_cost, noise_amplitude = _noise_floor(model, [pk.noise_variance for pk in peaks])
-    round_off = 1e-24 * float(model.z @ model.z)
-    tiny = max(round_off, NOISE_FLOOR_FACTOR * noise_cost)
+    exact = round_off_cost(model.z @ model.z)
+    tiny = max(exact, NOISE_FLOOR_FACTOR * noise_cost)
     holes = not all(a.valid.all() for a in acqs)
 
     def at_floor(cost, p, ranges, sol):
@@ -301,7 +304,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         then read again with the undefined nodes filled by this fit's own heights, whose
         error there is the fit's misfit on a few per cent of the nodes: it cannot pass
         for noise."""
-        if cost <= round_off or (cost <= tiny and not holes):
+        if cost <= exact or (cost <= tiny and not holes):
             return True
         if cost > tiny:
             return False
