@@ -201,29 +201,31 @@ def plot_measured_vs_sequenced(curves, path, title="") -> Path:
 
 
 def plot_sequenced_surfaces(result, surfaces, path) -> Path:
-    """Measured 2D acquisitions, the sequenced genome's realisations at the same windows
-    (:func:`~roughfe.genomics.genome.realize_surface`) and their difference (issue 15)."""
-    from ..genomics.genome import realize_surface
+    """Measured 2D acquisitions, the sequenced genome at the same nodes and their
+    difference (issue 15): the fields of
+    :func:`~roughfe.genomics.sequencing.surface_result.misfit_fields` (each about its best
+    plane, at the acquisitions' own coordinates), so that the difference panel is the
+    reported misfit."""
+    from ..genomics.sequencing.surface_result import misfit_fields
 
-    acq = sorted(surfaces, key=lambda s: -s.size[0])
-    fig, axes = new_figure(len(acq), 3, figsize=(11, 3.4 * len(acq)), squeeze=False)
-    for row, (s, length) in enumerate(zip(acq, result.lengths)):
-        fit = realize_surface(result.genome, float(length), s.shape[0]).heights
-        z = s.heights - s.heights.mean()
-        fit = fit - fit.mean()
-        ext = [0, s.size[0] * _MM, 0, s.size[1] * _MM]
-        lim = float(np.abs(z).max()) * _UM
+    fields = misfit_fields(result.genome, surfaces)
+    fig, axes = new_figure(len(fields), 3, figsize=(11, 3.4 * len(fields)), squeeze=False)
+    for row, (a, z, fit, diff) in enumerate(fields):
+        half = 0.5 * (a.x[1] - a.x[0])                  # the pixels centred on the nodes
+        ext = [(a.x[0] - half) * _MM, (a.x[-1] + half) * _MM,
+               (a.y[0] - half) * _MM, (a.y[-1] + half) * _MM]
+        lim = float(np.nanmax(np.abs(z))) * _UM
         for col, (data, name) in enumerate(((z, "measured"), (fit, "sequenced genome"),
-                                            (z - fit, "difference"))):
+                                            (diff, "difference"))):
             ax = axes[row, col]
             im = ax.imshow(data.T * _UM, origin="lower", extent=ext, cmap="RdBu_r",
                            vmin=-lim, vmax=lim)
-            ax.set_title(f"L = {length * _MM:.4g} mm: {name}"
+            ax.set_title(f"L = {a.length * _MM:.4g} mm: {name}"
                          + (f" (rms {100 * result.rms_errors[row]:.3g} %)" if col == 2 else ""),
                          fontsize=9)
             ax.set_xlabel("x (mm)")
             ax.set_ylabel("y (mm)")
-        fig.colorbar(im, ax=axes[row, :], label="z (um)", shrink=0.8)
+        fig.colorbar(im, ax=axes[row, :], label="z (um), best plane removed", shrink=0.8)
     g = result.genome
     fig.suptitle(f"sequenced surface genome: M = {g.M}, gamma = {g.gamma:.6g}, H = {g.H:.4g}, "
                  f"A = {g.A:.4g}", fontsize=10)

@@ -17,6 +17,7 @@ from scipy.optimize import least_squares
 
 from ..genome import Genome, surface_heights
 from .result import REPORT_UNITS
+from .surface_data import surface_acquisitions
 
 
 def _wave_gram(gram, n_waves):
@@ -196,6 +197,16 @@ def genome_residual(genome, full):
     return np.concatenate(out)
 
 
+def about_plane(x, y, ok, f):
+    """``f`` (m, the values on the nodes ``ok`` of the grid ``x`` by ``y``, in the order of
+    ``z[ok]``) minus its least-squares plane a + b x + c y: the part of a height field or
+    residual that a plane per acquisition (the fit's, or a removed mean plane) cannot
+    absorb."""
+    xx, yy = np.meshgrid(x, y, indexing="ij")
+    plane = np.column_stack([np.ones(int(ok.sum())), xx[ok], yy[ok]])
+    return f - plane @ np.linalg.lstsq(plane, f, rcond=None)[0]
+
+
 def plane_free_misfits(full, resid):
     """Relative rms misfits and signal rms per acquisition of ``full`` (a GridModel of all
     nodes) for the residual ``resid`` on its rows: the rms of the residual about its best
@@ -208,13 +219,28 @@ def plane_free_misfits(full, resid):
     for k in range(len(full.acqs)):
         rows = full.block == k
         grid = full.grids[k]
-        xx, yy = np.meshgrid(grid["x"], grid["y"], indexing="ij")
-        ok = grid["ok"]
-        plane = np.column_stack([np.ones(int(ok.sum())), xx[ok], yy[ok]])
-
-        def about_plane(f):
-            return f - plane @ np.linalg.lstsq(plane, f, rcond=None)[0]
-        signal.append(float(np.sqrt(np.mean(about_plane(full.z[rows]) ** 2))))
-        errs.append(float(np.sqrt(np.mean(about_plane(resid[rows]) ** 2)))
-                    / max(signal[-1], 1e-300))
+        fields = [about_plane(grid["x"], grid["y"], grid["ok"], f)
+                  for f in (full.z[rows], resid[rows])]
+        signal.append(float(np.sqrt(np.mean(fields[0] ** 2))))
+        errs.append(float(np.sqrt(np.mean(fields[1] ** 2))) / max(signal[-1], 1e-300))
     return np.array(errs), np.array(signal)
+
+
+def misfit_fields(genome, surfaces, valid=None):
+    """What the misfit of :func:`plane_free_misfits` compares, per acquisition (coarsest
+    first): ``(acquisition, measured, sequenced, difference)``, the measured heights and
+    the genome's (:func:`~roughfe.genomics.genome.surface_heights` at the acquisition's
+    own node coordinates, ``metadata["x0"]``/``"y0"`` honoured as by the sequencer), each
+    about its best plane, and ``measured - sequenced`` (the residual about its best
+    plane), in m on the N x N grid, NaN where undefined. The rms of ``difference`` over
+    that of ``measured`` is the relative misfit ``rms_errors`` of the sequencing."""
+    out = []
+    for a in surface_acquisitions(surfaces, valid):
+        model, _ = surface_heights(genome, a.length, a.z.shape[0], a.x, a.y)
+        fields = []
+        for f in (a.z, model):
+            g = np.full(a.z.shape, np.nan)
+            g[a.valid] = about_plane(a.x, a.y, a.valid, f[a.valid])
+            fields.append(g)
+        out.append((a, fields[0], fields[1], fields[0] - fields[1]))
+    return out
