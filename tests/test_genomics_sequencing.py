@@ -255,3 +255,19 @@ def test_a_clipping_m_is_reported_as_the_cause():
     assert "not WM-like" not in res.message
     assert "exceeds 0.05 with the clipped amplitudes" in res.message
     assert sequence_profiles(acq, M=8).rms_errors.max() < 1e-12
+
+
+def test_the_zd_error_is_none_when_zd_is_round_off():
+    """Windows L and L/1.1 at N = 256 show the same chromosomes: Z_d = Z_1 - Z_2 is
+    round-off (2.2e-19 m on heights of 7.3e-4 m rms), and the report gave a relative
+    error 2.66 (a ratio of two round-offs). Now None; a Z_d that carries signal keeps
+    its error (L and L/3.3: ~4e-15)."""
+    g = table1_genome(rng=0)
+    same = sequence_profiles([realize(g, length=1e-3, n_nodes=256),
+                              realize(g, length=1e-3 / 1.1, n_nodes=256)])
+    assert same.ranges[0] == same.ranges[1]
+    assert np.sqrt(np.mean(same.zd ** 2)) < 1e-15 * np.std(same.heights[0])
+    assert same.report()["zd_rms_error"] is None
+    other = sequence_profiles([realize(g, length=1e-3, n_nodes=256),
+                               realize(g, length=1e-3 / 3.3, n_nodes=256)])
+    assert other.report()["zd_rms_error"] < 1e-12

@@ -9,6 +9,7 @@ import numpy as np
 from ...writers import to_jsonable
 from ...frozen import freeze_containers
 from ..genome import Genome
+from .lattice import round_off_cost
 
 
 #: Units of :meth:`SequencingResult.report` (report.json of `genome sequence`, the
@@ -50,7 +51,8 @@ class SequencingResult:
         per acquisition.
     zd_x, zd, zd_fit : ndarray
         Z_d = Z_1 - Z_2 at the common nodes of the two coarsest acquisitions and its
-        sequenced counterpart (m); empty when they share no node.
+        sequenced counterpart (m); empty when they share no node. Their relative misfit,
+        :meth:`zd_rms_error`, is None when Z_d is round-off.
     spectra : list of SpectrumPeaks
     gamma_psd, H_psd : float
         gamma from the PSD peaks alone (comb, step 2) and H from the slope of the PSD
@@ -99,6 +101,20 @@ class SequencingResult:
     def __post_init__(self):
         freeze_containers(self)
 
+    def zd_rms_error(self) -> Optional[float]:
+        """rms(Z_d - Z_d^seq) / rms(Z_d) (relative, -), the report's ``zd_rms_error``; None
+        when there is no Z_d (no common nodes) or when Z_d is round-off of the heights
+        (mean Z_d^2 <= :func:`~.lattice.round_off_cost` of the coarsest acquisition's mean
+        square height: two windows that show the same chromosomes, e.g. L and L/1.1 at
+        N = 256, have Z_d ~ 2e-19 m on heights of 7e-4 m, and a ratio of two round-offs,
+        2.66, is no error)."""
+        if not self.zd.size:
+            return None
+        zd2 = float(np.mean(self.zd ** 2))
+        if zd2 <= round_off_cost(np.mean(self.heights[0] ** 2)):
+            return None
+        return float(np.sqrt(np.mean((self.zd - self.zd_fit) ** 2) / zd2))
+
     def report(self) -> dict:
         """JSON-safe summary (genes, rms errors, ranges, diagnostics), with ``units`` (the
         unit of every number, :data:`REPORT_UNITS`)."""
@@ -108,9 +124,7 @@ class SequencingResult:
                 "lengths": self.lengths.tolist(), "ranges": [list(r) for r in self.ranges],
                 "rms_errors": self.rms_errors.tolist(), "offsets": self.offsets.tolist(),
                 "zd_rms": float(np.sqrt(np.mean(self.zd ** 2))) if self.zd.size else None,
-                "zd_rms_error": (float(np.sqrt(np.mean((self.zd - self.zd_fit) ** 2))
-                                       / max(np.sqrt(np.mean(self.zd ** 2)), 1e-300))
-                                 if self.zd.size else None),
+                "zd_rms_error": self.zd_rms_error(),
                 "gamma_psd": self.gamma_psd, "H_psd": self.H_psd, "A0_variance": self.A0,
                 "M_loglik": to_jsonable(self.M_loglik),
                 "seed": self.seed, "elapsed_s": self.elapsed, "units": dict(REPORT_UNITS)}
