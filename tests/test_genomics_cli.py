@@ -91,3 +91,22 @@ def test_genome_mechanics_without_figures_does_not_say_it_wrote_figures(tmp_path
     out = capsys.readouterr().out
     assert f"curves, c_n -> {mech}" in out and "figures" not in out
     assert not list(mech.glob("*.png"))
+
+
+def test_realize_names_its_own_option_for_a_missing_chromosome(tmp_path, capsys):
+    """`genome realize --chromosomes 30` on the Table 1 example (phases for n = 1..22)
+    suggested `random_genome(n_max=...)`, a Python call. It names the command line's own
+    option now, and that option does give the chromosome."""
+    g = tmp_path / "g.json"
+    assert main(["genome", "example", "-o", str(g)]) == 0
+    out = tmp_path / "a.npz"
+    args = ["genome", "realize", str(g), "--scale", "10x", "--nodes", "64",
+            "--chromosomes", "3", "30", "-o", str(out)]
+    capsys.readouterr()
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "--chromosomes 30:" in err and "n = 1..22 only" in err
+    assert "`roughfe genome example --n-max 30 -o FILE`" in err
+    assert "random_genome" not in err
+    assert main(["genome", "example", "-o", str(g), "--n-max", "30", "--overwrite"]) == 0
+    assert main(args) == 0 and out.is_file()

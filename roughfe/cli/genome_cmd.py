@@ -41,6 +41,19 @@ def _example(args) -> int:
     return 0
 
 
+def _check_chromosomes(args, g):
+    """``--chromosomes`` within the phases the genome file holds, else an InputError that
+    names this command's options (the library's message names a Python call)."""
+    from ..errors import InputError
+    outside = [n for n in args.chromosomes or () if not g.n_first <= n <= g.n_last]
+    if outside:
+        raise InputError(
+            f"--chromosomes {' '.join(map(str, outside))}: {args.genome} holds phases for "
+            f"n = {g.n_first}..{g.n_last} only; give indices in that range, or a genome file "
+            f"with more chromosomes (the Table 1 example: `roughfe genome example --n-max "
+            f"{max(outside)} -o FILE`)")
+
+
 def _realize(args) -> int:
     from ..errors import InputError
     from ..genomics.genome import load_genome, realize, realize_surface
@@ -62,6 +75,7 @@ def _realize(args) -> int:
         if args.scale is not None:
             raise InputError("--scale is for profiles; this genome is a part of a periodic "
                              "surface design: give --length (default: the design's)")
+        _check_chromosomes(args, g)
         s = realization(g, length, nodes, 2, chromosomes)
     elif g.angles is not None:
         # a surface genome (ridge angles: sequenced from 2D acquisitions, or made with
@@ -74,6 +88,7 @@ def _realize(args) -> int:
                              f"of a design")
         s = realize_surface(g, g.length_of(args.scale) if args.scale else length, nodes)
     else:
+        _check_chromosomes(args, g)
         s = realize(g, length=length, scale=args.scale, n_nodes=nodes, chromosomes=chromosomes)
     save_surface(s, out)
     m = s.metadata
