@@ -19,6 +19,17 @@ def test_table1_index_ranges_from_eq_3_5():
         [(1, 16), (2, 18), (6, 22)]
 
 
+def test_the_eq_3_5_count_is_not_eq_3_4s_n_c():
+    """As chromosome_range's notes say: Eq. 3.4's n_c = floor(log_gamma(N - 1)) is 15 for
+    Table 1, Eq. 3.5 holds 16 / 17 / 17 chromosomes at 10x / 20x / 100x (floor + 1 or + 2),
+    so n_c is not "the same at any realization"."""
+    import math
+    assert math.floor(math.log(511) / math.log(1.5)) == 15
+    counts = [n_f - n_s + 1 for n_s, n_f in (chromosome_range(1.5, 1e-3, L, 512)
+                                            for L in (1e-3, 5e-4, 1e-4))]
+    assert counts == [16, 17, 17]
+
+
 def test_realisation_is_sum_of_chromosomes_and_vanishes_at_origin():
     g = table1_genome(rng=1)
     s = realize(g, scale="20x")

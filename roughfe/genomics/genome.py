@@ -386,6 +386,15 @@ def chromosome_range(gamma, lambda1, length, n_nodes=DEFAULT_NODES):
     (int, int)
         ``n_s = floor(log_gamma(lambda1/L)) + 1`` and
         ``n_f = floor(log_gamma(lambda1/delta)) + 1``.
+
+    Notes
+    -----
+    The count n_f - n_s + 1 is floor(log_gamma(N - 1)) + 1 or + 2 (by the fractional
+    parts of log_gamma(lambda1/L) and log_gamma(N - 1)), never Eq. (3.4)'s
+    n_c = floor(log_gamma(N - 1)): Table 1 (N = 512) has n_c = 15 by Eq. (3.4) and 16 /
+    17 / 17 chromosomes at 10x / 20x / 100x by Eq. (3.5). The thesis's claim that n_c
+    "will be the same at any realization" holds for neither equation's count across
+    windows; Eq. (3.5), the range used, is followed.
     """
     n_nodes = _check_nodes(n_nodes)
     length = check_finite_positive("length (observation length, m)", length)
