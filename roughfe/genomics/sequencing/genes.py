@@ -129,6 +129,14 @@ def peak_slope_H(spectra, log_q1, log_gamma):
     of amplitude c gives a periodogram peak C ~ c^2 L_i whatever its q, so the peaks
     fall as q_n^(-2H); one intercept per acquisition absorbs L_i. Peaks farther than 0.15
     lattice steps from the lattice (aliases, leakage) are ignored.
+
+    Two slips of the thesis around Eq. 3.11 are not followed: it writes
+    q_n = (2 pi / lambda) gamma^(1-n), the wrong sign of the exponent (q_n = 2 pi /
+    lambda_n = (2 pi / lambda1) gamma^(n-1) rad/m, Eq. 3.1-3.2, as used here), and it calls
+    the PSD "the square root of the FFT", while the PSD C (m^3 for a profile,
+    :func:`~roughfe.surfaces.stats.power_spectrum`) is the squared modulus |FFT|^2,
+    normalised (of the modulus, the peaks would fall as q^-H and this estimate would
+    read H/2).
     """
     lq, lc, which = [], [], []
     for i, sp in enumerate(spectra):
