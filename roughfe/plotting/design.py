@@ -136,7 +136,9 @@ def plot_design_curves(results, path, title="") -> "Path":
     """Figs. 60/64/68: K(p) and A(p) of the best design of each result vs the targets;
     ``title`` (e.g. :func:`design_title`) wrapped to the figure's width. A design's
     curve is drawn as the score reads it (:meth:`ResponseCurve.points`): its computed
-    steps (marked) and, below the first, the line from (0, 0)."""
+    steps (marked) and, below the first, the line from (0, 0). The legend's s is that
+    reading (Eq. 4.1 on the design's own steps); the title's verdict may be decided by the
+    score solved at the target pressures and says so."""
     results = list(results)
     fig, axes = new_figure(1, 2, figsize=(11, 4))
     for t in results[0].objective.targets:
@@ -149,7 +151,7 @@ def plot_design_curves(results, path, title="") -> "Path":
         for quantity in ("K", "A"):      # each panel: the scores of its own targets
             own = [f"{sc:.3f}" for t, sc in zip(targets, r.best.scores)
                    if t.quantity == quantity]
-            labels.append(f"{r.method} s={', '.join(own)}" if own else r.method)
+            labels.append(f"{r.method} s={', '.join(own)} on its steps" if own else r.method)
         if len(targets) > 1:
             labels[0] += f" (product {combined_score(r.best.scores):.3f})"
         for ax, quantity, label in zip(axes, ("K", "A"), labels):  # from (0, 0), unmarked
