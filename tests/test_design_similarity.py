@@ -163,7 +163,13 @@ def test_target_csv_header_names_the_quantity(tmp_path):
     for header, q in (("p [Pa],A", "A"), ("p,A*", "A"), ("pressure,area_fraction", "A"),
                       ("p,a", "A"), ("p,A_r/A_n", "A"), ("p,K", "K"), ("p [Pa],K [Pa/m]", "K"),
                       ("p,K_Pa_per_m", "K"), ("Pressure (Pa),stiffness", "K"),
-                      ("pressure_Pa,value", "K"), ("p,amplitude", "K")):     # K: the default
+                      ("pressure_Pa,value", "K"), ("p,amplitude", "K"),     # K: the default
+                      # "per unit area" qualifies K (was refused as naming both); Ar/An is
+                      # the usual area-fraction notation (was read as the default K)
+                      ("p,stiffness_per_unit_area_Pa_per_m", "K"),
+                      ("p,K (contact stiffness per area)", "K"),
+                      ("p,area-normalised stiffness", "K"), ("p,Ar/An", "A"), ("p,Ar", "A"),
+                      ("p,A_r/A_0", "A")):
         assert read(header) == q, header
     assert read("p [Pa],A", "A") == "A" and read("pressure_Pa,value", "A") == "A"
     with pytest.raises(InputError, match=r"the header 'p \[Pa\],A' says contact area fraction "
@@ -174,7 +180,7 @@ def test_target_csv_header_names_the_quantity(tmp_path):
                                          r"but the header 'p,A' says contact area fraction"):
         read("p,A", comment="# t: normal contact stiffness K = dp/dDelta (Pa/m) vs pressure\n")
     with pytest.raises(FileFormatError, match="names both stiffness K and area A"):
-        read("p,K or area")
+        read("p,A (stiffness)")
 
 
 def test_a_curve_is_read_from_zero_load_below_its_first_pressure():

@@ -45,17 +45,22 @@ def _is_pressure_name(name) -> bool:
 
 
 def _named_quantity(path, k, text, name):
-    """The quantity a header's value column names: K for ``K``/``k`` alone or before a
-    non-letter (``K [Pa/m]``, ``K_Pa_per_m``) or the word ``stiffness``; A for ``A``/``a``
-    so (``A``, ``A*``, ``A_r/A_n``) or the word ``area``; None for a neutral name
-    (``value``); a FileFormatError for a name that says both."""
+    """The quantity a header's value column names: K for a leading ``K``/``k`` token
+    (``K [Pa/m]``, ``K_Pa_per_m``) or the word ``stiffness`` anywhere (``stiffness per
+    unit area``: "per unit area" qualifies K, it does not name A); A for a leading
+    ``A``/``Ar``/``A_r`` token (``A``, ``A*``, ``Ar/An``, ``A_r/A_n``) or, without
+    ``stiffness``, the word ``area`` (``area_fraction``); None for a neutral name
+    (``value``); a FileFormatError for a name that says both (a leading A token beside
+    the word stiffness)."""
     low = name.lower()
-    named = {q for q, word in (("K", "stiffness"), ("A", "area"))
-             if re.match(rf"{q.lower()}(?![a-z])", low) or re.search(rf"(?<![a-z]){word}(?![a-z])", low)}
-    if len(named) > 1:
+    lead = re.match(r"(k|a(_?r)?)(?![a-z])", low)
+    lead = None if lead is None else ("K" if lead.group(0) == "k" else "A")
+    word = ("K" if re.search(r"(?<![a-z])stiffness(?![a-z])", low) else
+            "A" if re.search(r"(?<![a-z])area(?![a-z])", low) else None)
+    if lead == "A" and word == "K":
         raise FileFormatError(f"{path}: line {k}: the header {text!r} names both stiffness K "
                               f"and area A in its value column {name!r}; a target holds one")
-    return named.pop() if named else None
+    return lead or word
 
 
 def _check_header(path, k, text, cells):
