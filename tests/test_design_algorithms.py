@@ -306,6 +306,15 @@ def test_mcco_when_one_genome_tops_both_rankings(entries):
     assert r.best.stages[0] == pytest.approx(1.0, abs=1e-6)
 
 
+def test_verdict_prints_enough_digits_to_be_read_against_the_selection_value():
+    """0.95004 was printed "s = 0.95 > 0.95" and 0.94996 "s = 0.95 <= 0.95"."""
+    from roughfe.genomics.design.objective import Verdict
+    assert "s = 0.95004 > 0.95" in Verdict(True, (0.95004,), ("t",), True).note()
+    assert "s = 0.94996 <= 0.95" in Verdict(False, (0.94996,), ("t",), True).note()
+    assert "s = 0.95 <= 0.95" in Verdict(False, (0.95,), ("t",), True).note()
+    assert "s = 0.9709 > 0.95" in Verdict(True, (0.970912,), ("t",), True).note()
+
+
 def test_mcco_verdict_is_per_target(entries):
     """M-CCO is matched when every target's s is above 0.95, not when the product f is:
     targets K and A of genome 1-2 x 1.03 score 0.9709 each (f = 0.9427), which was called

@@ -80,6 +80,16 @@ class Objective:
 SELECTION = 0.95
 
 
+def _beside(s: float) -> str:
+    """``s`` with 4 significant digits, or as many as it takes to tell it from the
+    selection value (0.95004 is not printed "0.95 > 0.95")."""
+    for digits in (4, 6, 8, 12, 17):
+        text = f"{s:.{digits}g}"
+        if float(text) == s or float(text) != SELECTION and (float(text) > SELECTION) == (s > SELECTION):
+            return text
+    return text
+
+
 @dataclass(frozen=True)
 class Verdict:
     """Whether a design matches its targets (:func:`verdict`), with the scores that
@@ -100,7 +110,7 @@ class Verdict:
 
     def _each(self) -> str:
         """``s = 0.97 > 0.95`` (one target) or ``s(y_t1) = 0.97 > 0.95, s(y_t3) = ...``."""
-        return ", ".join(f"s{f'({n})' if len(self.names) > 1 else ''} = {s:.4g} "
+        return ", ".join(f"s{f'({n})' if len(self.names) > 1 else ''} = {_beside(s)} "
                          f"{'>' if s > SELECTION else '<='} {SELECTION}"
                          for n, s in zip(self.names, self.scores))
 
