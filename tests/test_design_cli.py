@@ -72,6 +72,13 @@ def test_db_and_design_commands(tmp_path, capsys):
                  str(tmp_path / "cut")]) == 0
     rep = json.loads((tmp_path / "cut" / "result.json").read_text())
     assert rep["targets"][0]["p_top"] == e.p_max
+    capsys.readouterr()       # a p_top below the curve's last point: in the option's words
+    assert main(["design", "--db", str(path), "--target", str(cut), "--target-p-top",
+                 repr(e.curve.pressure[3]), "--method", "sog", "--iterations", "1",
+                 "--no-figures", "-o", str(tmp_path / "cut_low")]) == 2
+    err = capsys.readouterr().err
+    assert "--target-p-top" in err and "for the target cut" in err, err
+    assert not (tmp_path / "cut_low").exists()
     assert rep["candidates"][0]["score"] == pytest.approx(1.0, abs=1e-9)
     # the global stage with chromosome amplitudes as variables: bounded, strict scores
     # of the saved design reproduced

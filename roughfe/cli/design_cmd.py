@@ -87,6 +87,16 @@ def _check_options(args):
             setattr(args, dest, default)
 
 
+def _with_p_top(target, p_top):
+    """``target`` with ``--target-p-top``; the Target's own check, in the option's words."""
+    from ..errors import InputError
+    try:
+        return replace(target, p_top=p_top)
+    except InputError as exc:
+        raise InputError(f"--target-p-top {p_top:g} for the target {target.name}: "
+                         f"{exc}") from None
+
+
 def _run(args) -> int:
     from ..errors import InputError
     from ..genomics.database import load_entries, read_settings
@@ -112,7 +122,7 @@ def _run(args) -> int:
     if args.method == "mcco" and len(targets) == 2 and targets[0].quantity == "A":
         targets.reverse()
     if args.target_p_top is not None:       # Eq. 4.2's p_max^t beyond the last points
-        targets = [replace(t, p_top=args.target_p_top) for t in targets]
+        targets = [_with_p_top(t, args.target_p_top) for t in targets]
     options = GcmmaOptions(bound=args.bound, formulation=args.formulation, eps=args.eps,
                            gradient=args.gradient,
                            **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
