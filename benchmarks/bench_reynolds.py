@@ -52,6 +52,23 @@ def _split(message):
     return (float(m.group(1)), float(m.group(2))) if m else (None, None)
 
 
+def _seconds(value) -> str:
+    """A 6-wide column of CPU seconds; "-" where the solver made no linear solve (a gap
+    whose open components do not reach both inlet and outlet: Q = 0 without a KSP, so its
+    report has no set-up/solve split)."""
+    return f"{'-':>6}" if value is None else f"{value:>6.2f}"
+
+
+def row_line(r) -> str:
+    """One printed table row of a case of :func:`one_size`."""
+    return (f"{r['n']:>5} {r['area_fraction']:>5.2f} {r['live_fraction']:>5.2f} "
+            f"{r['wall_s']:>7.1f} {r['cpu_s']:>6.2f} {r['system_cpu_s']:>5.2f} "
+            f"{_seconds(r['amg_setup_cpu_s'])} "
+            f"{_seconds(r['cg_solve_cpu_s'])} {r['nit']:>4} {r['leak_rate']:>10.4e} "
+            f"{r['balance']:>8.1e} {r['peak_memory_gb']:>5.2f} "
+            f"{r.get('junction_cpu_s', float('nan')):>8.2f}")
+
+
 def _cpu():
     """User and system CPU seconds of this process (the system part is mostly the kernel
     zeroing freshly touched pages: large first allocations)."""
@@ -119,12 +136,7 @@ def main(sizes, coupled_case=True):
     for n in sizes:
         for r in _child(str(n)):
             rows.append(r)
-            print(f"{n:>5} {r['area_fraction']:>5.2f} {r['live_fraction']:>5.2f} "
-                  f"{r['wall_s']:>7.1f} {r['cpu_s']:>6.2f} {r['system_cpu_s']:>5.2f} "
-                  f"{r['amg_setup_cpu_s']:>6.2f} "
-                  f"{r['cg_solve_cpu_s']:>6.2f} {r['nit']:>4} {r['leak_rate']:>10.4e} "
-                  f"{r['balance']:>8.1e} {r['peak_memory_gb']:>5.2f} "
-                  f"{r.get('junction_cpu_s', float('nan')):>8.2f}", flush=True)
+            print(row_line(r), flush=True)
     c = _child("coupled") if coupled_case else None
     if c is not None:
         print(f"coupled {COUPLED_N}^2: wall {c['wall_s']:.1f} s, cpu {c['cpu_s']:.1f} s, "
