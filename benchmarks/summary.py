@@ -11,12 +11,17 @@ gives one row per matching target with its value, limit, unit, verdict (the scri
 * ``met`` / ``NOT met``: as the script decided it against the stated limit;
 * ``not run``: the benchmark's JSON is missing (``make bench`` has not run it here);
 * ``not measured``: the JSON is there but has no such row (a reduced run, e.g.
-  ``--quick``, or a case left out): the reason from its ``skipped`` records;
+  ``--quick``, or a case left out): the reason from its ``skipped`` records; or the
+  benchmark ran (``run_all.json``) and wrote no report: its exit code;
 * ``not checked``: a row without a verdict.
 
-Target rows of the benchmarks that no expected entry claims are listed after them, so
-nothing measured is hidden. ``run_all.json`` adds the per-benchmark wall, CPU and peak
-memory of the run. No number in the table is typed by hand.
+When ``run_all.json`` lists a run of a benchmark, only the files that run wrote (its
+``wrote``) are read: a report of an earlier run left in the folder is ignored, and a
+row it would have given says so with its date. Target rows of the benchmarks that no
+expected entry claims are listed after them, so nothing measured is hidden, then the rows
+of ``run_all.json`` itself ("<script> wrote its report", NOT met for a crash).
+``run_all.json`` adds the per-benchmark wall, CPU and peak memory of the run. No number
+in the table is typed by hand.
 
 Run: ``python benchmarks/summary.py [FOLDER] [OUT.md]`` (defaults ``benchmarks/output``,
 ``FOLDER/SUMMARY.md``); ``make bench`` runs it last, ``make docs`` writes the same table to
@@ -133,18 +138,32 @@ def _run_facts(data: dict, path: Path) -> dict:
     return {"date (UTC)": date.replace("T", " ").replace("+00:00", ""), "load": load}
 
 
-def read_reports(folder: Path, expected=EXPECTED) -> dict:
-    """benchmark stem -> list of (path, data or None, error) of its JSON files: a file
-    belongs to the benchmark of its name, else to the longest expected benchmark name it
-    extends (``bench_bem_8192.json`` to ``bench_bem``, ``bench_bem_growth.json`` to
-    ``bench_bem_growth`` itself)."""
+def report_files(folder: Path, expected=EXPECTED) -> tuple:
+    """(current, older): benchmark stem -> paths of its JSON files. A file belongs to the
+    benchmark of its name, else to the longest benchmark name it extends
+    (``bench_bem_8192.json`` to ``bench_bem``, ``bench_bem_growth.json`` to
+    ``bench_bem_growth`` itself). The folder is never cleaned: when ``run_all.json`` lists
+    a run of a file's benchmark and no run wrote that file (its ``wrote`` lists), the file
+    is an older run's report and goes to ``older``, never read as this run's."""
+    runs = [r for r in _runs(folder) if isinstance(r.get("wrote"), list)]
+    listed = {r.get("script") for r in runs}
+    wrote = {name for r in runs for name in r["wrote"]}
     names = {e[1] for e in expected}
-    reports = {}
+    current, older = {}, {}
     for path in sorted(Path(folder).glob("*.json")):
         if path.stem == "run_all":
             continue
-        reports.setdefault(owner_of(path.stem, names), []).append((path, *_load(path)))
-    return reports
+        stem = owner_of(path.stem, names)
+        stale = stem in listed and path.name not in wrote
+        (older if stale else current).setdefault(stem, []).append(path)
+    return current, older
+
+
+def read_reports(folder: Path, expected=EXPECTED) -> dict:
+    """benchmark stem -> list of (path, data or None, error) of its current JSON files
+    (:func:`report_files`: an older run's report left in the folder is not among them)."""
+    current, _ = report_files(Path(folder), expected)
+    return {stem: [(path, *_load(path)) for path in paths] for stem, paths in current.items()}
 
 
 def owner_of(file_stem: str, benchmarks) -> str:
@@ -157,10 +176,11 @@ def owner_of(file_stem: str, benchmarks) -> str:
                  if file_stem.startswith(b + "_")), file_stem)
 
 
-def _targets(data) -> list:
+def _targets(data, reduced_note=True) -> list:
     """A report's target rows in the table's columns (``docs/generate.target_rows``); the
-    rows of a reduced run (``--quick``) say so in their note."""
-    reduced = isinstance(data, dict) and data.get("reduced") is True
+    rows of a reduced run (``--quick``) say so in their note (``reduced_note``: not those
+    of ``run_all.json``, whose rows judge whether a report was written, not a size)."""
+    reduced = reduced_note and isinstance(data, dict) and data.get("reduced") is True
     return [{"target": t["name"], "limit": t.get("target"), "measured": t.get("value"),
              "unit": t.get("unit"), "status": t["status"],
              "note": "; ".join(x for x in (REDUCED_NOTE if reduced else None, t.get("note"))
@@ -172,18 +192,32 @@ def _targets(data) -> list:
 REDUCED_NOTE = "reduced run (--quick): a smaller case than the target's"
 
 
+def _run_all(folder: Path):
+    """(path, data or None) of ``<folder>/run_all.json``."""
+    path = Path(folder) / "run_all.json"
+    data = _load(path)[0] if path.is_file() else None
+    return path, data if isinstance(data, dict) else None
+
+
 def _runs(folder: Path) -> list:
     """The per-script records of ``run_all.json`` (script, exit code, files written), or
     [] without it."""
-    path = folder / "run_all.json"
-    data = _load(path)[0] if path.is_file() else None
-    cases = data.get("cases") if isinstance(data, dict) else None
+    data = _run_all(folder)[1]
+    cases = data.get("cases") if data else None
     return [c for c in cases if isinstance(c, dict)] if isinstance(cases, list) else []
+
+
+def _older_note(paths) -> str:
+    """"; older report(s) of DATE ignored" for the reports of an earlier run, or ""."""
+    dates = [_run_facts(_load(p)[0] or {}, p)["date (UTC)"] for p in paths]
+    return (f"; older report{'s' if len(dates) > 1 else ''} of {', '.join(dates)} ignored"
+            if dates else "")
 
 
 def summary_rows(folder, expected=EXPECTED) -> list:
     """The rows of the table (dicts keyed by :data:`COLUMNS`), expected targets first."""
     reports = read_reports(Path(folder), expected)
+    older = report_files(Path(folder), expected)[1]
     runs = _runs(Path(folder))
     rows, claimed = [], set()
     for issue, stem, match, what, unit, skip_match in expected:
@@ -203,10 +237,13 @@ def summary_rows(folder, expected=EXPECTED) -> list:
             continue
         readable = [(p, d) for p, d, _ in files if d is not None]
         ran = [r for r in runs if r.get("script") == stem]
+        stale = _older_note(older.get(stem, []))
         if not files and ran:        # it ran and wrote no report: it crashed
+            codes = ", ".join(str(r.get("exit_code"))
+                              for r in [r for r in ran if not r.get("wrote")] or ran)
             rows.append({**base, "status": "not measured",
-                         "note": f"{stem} ran (exit code {ran[-1].get('exit_code')}) and "
-                                 f"wrote no report: see its output"})
+                         "note": f"{stem} ran (exit code {codes}) and wrote no report: "
+                                 f"see its output{stale}"})
         elif not files:
             rows.append({**base, "status": "not run",
                          "note": f"{stem}.json missing: run make bench"})
@@ -219,7 +256,7 @@ def summary_rows(folder, expected=EXPECTED) -> list:
                        if skip_match in str(s.get("name", ""))]
             path, data = readable[0]
             rows.append({**base, **_run_facts(data, path), "status": "not measured",
-                         "note": "; ".join(reasons) or "no such row in this run"})
+                         "note": ("; ".join(reasons) or "no such row in this run") + stale})
     for stem, files in sorted(reports.items()):
         for path, data, error in files:
             if data is None:
@@ -231,6 +268,10 @@ def summary_rows(folder, expected=EXPECTED) -> list:
                 if (path, k) not in claimed:
                     rows.append({"issue": "-", "benchmark": path.stem, **_run_facts(data, path),
                                  **t})
+    path, run = _run_all(Path(folder))
+    if run:                          # its rows "<script> wrote its report": a crash is NOT met
+        rows += [{"issue": "-", "benchmark": "run_all", **_run_facts(run, path), **t}
+                 for t in _targets(run, reduced_note=False)]
     return rows
 
 
@@ -239,10 +280,10 @@ def _table(rows, columns) -> list:
     return lines + ["| " + " | ".join(_cell(r.get(c)) for c in columns) + " |" for r in rows]
 
 
-def summary_markdown(folder, title="Benchmark summary") -> str:
+def summary_markdown(folder, title="Benchmark summary", expected=EXPECTED) -> str:
     """The Markdown page: the target table, what was skipped, and the run's own figures."""
     folder = Path(folder)
-    rows = summary_rows(folder)
+    rows = summary_rows(folder, expected)
     counts = {s: sum(r["status"] == s for r in rows)
               for s in ("met", "**NOT met**", "not measured", "not run", "not checked")}
     lines = [f"# {title}", "",
@@ -260,11 +301,11 @@ def summary_markdown(folder, title="Benchmark summary") -> str:
                   "smoke use; the targets' verdicts are those of `make bench`.", ""]
     lines += _table(rows, COLUMNS) + [""]
     skipped = []
-    for stem, files in sorted(read_reports(folder).items()):
+    for stem, files in sorted(read_reports(folder, expected).items()):
         for path, data, _ in files:
             skipped += [{"benchmark": path.stem, "skipped": s.get("name"),
                          "reason": s.get("reason")} for s in (data or {}).get("skipped") or []]
-    run, _ = _load(folder / "run_all.json") if (folder / "run_all.json").is_file() else (None, None)
+    run = _run_all(folder)[1]
     if run:
         skipped += [{"benchmark": s.get("name"), "skipped": "whole benchmark",
                      "reason": s.get("reason")} for s in run.get("skipped") or []]

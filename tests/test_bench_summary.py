@@ -284,3 +284,48 @@ def test_rows_of_a_reduced_run_say_so(tmp_path, summary, monkeypatch):
     growth = [r for r in rows if r["target"].startswith("iteration growth")][0]
     assert growth["status"] == "met" and summary.REDUCED_NOTE in growth["note"]
     assert "rows are of reduced runs" in summary.summary_markdown(tmp_path)
+
+
+def test_an_older_report_left_in_the_folder_is_not_read_as_this_runs(tmp_path, summary):
+    """The output folder is never cleaned: bench_y crashed in this run (run_all.json: exit
+    1, wrote []) and its report of an earlier run still gave the table's rows, "met" (only
+    the date told). run_all.json's own rows ("... wrote its report") were not shown."""
+    old = "2026-11-23T21:40:00+00:00"
+    _write(tmp_path, "bench_y", date=old, targets=[
+        {"name": "Reynolds 2048^2 CPU time (s)", "value": 8.8, "target": "< 10", "met": True},
+        {"name": "an unclaimed row", "value": 1.0, "target": "< 2", "met": True}])
+    _write(tmp_path, "bench_x_big", date=old, targets=[
+        {"name": "peak RSS 8192^2 (MB)", "value": 4406.0, "target": 4500.0, "met": True}],
+        skipped=[{"name": "old skip", "reason": "older run"}])
+    _write(tmp_path, "bench_x", date="2026-11-29T12:00:00+00:00", targets=[
+        {"name": "iteration growth 1024^2 -> 2048^2", "value": 1.1, "target": 1.15,
+         "met": True}])
+    _write(tmp_path, "run_all", date="2026-11-29T13:00:00+00:00", reduced=True, targets=[
+        {"name": "bench_x wrote its report", "value": 0, "target": "a JSON written",
+         "met": True},
+        {"name": "bench_y wrote its report", "value": 1, "target": "a JSON written",
+         "met": False}],
+        cases=[{"script": "bench_x", "args": "", "exit_code": 0, "wrote": ["bench_x.json"]},
+               {"script": "bench_y", "args": "", "exit_code": 1, "wrote": []}])
+    rows = summary.summary_rows(tmp_path, EXPECTED)
+    (rey,) = [r for r in rows if r["benchmark"] == "bench_y"]
+    assert rey["status"] == "not measured" and rey.get("measured") is None
+    assert rey["note"] == ("bench_y ran (exit code 1) and wrote no report: see its output; "
+                           "older report of 2026-11-23 21:40:00 ignored")
+    assert not [r for r in rows if "unclaimed" in r["target"] or "RSS" in r["target"]]
+    # bench_x ran and wrote bench_x.json only: its older bench_x_big.json is not read
+    (rss,) = [r for r in rows if r["target"] == "8192^2 in <= 4.5 GB"]
+    assert rss["status"] == "not measured"
+    assert rss["note"].endswith("; older report of 2026-11-23 21:40:00 ignored")
+    (growth,) = [r for r in rows if r["target"].startswith("iteration growth")]
+    assert growth["status"] == "met" and growth["date (UTC)"] == "2026-11-29 12:00:00"
+    # the run's own rows: a crash is a NOT met row of the table (not a reduced-size row)
+    run = {r["target"]: (r["status"], r["note"]) for r in rows if r["benchmark"] == "run_all"}
+    assert run == {"bench_x wrote its report": ("met", ""),
+                   "bench_y wrote its report": ("**NOT met**", "")}
+    text = summary.summary_markdown(tmp_path, expected=EXPECTED)
+    assert "old skip" not in text and "reduced runs" not in text
+    # without run_all.json nothing says which files are this run's: all are read
+    (tmp_path / "run_all.json").unlink()
+    rows = summary.summary_rows(tmp_path, EXPECTED)
+    assert {r["target"]: r["status"] for r in rows}["Reynolds 2048^2 CPU time (s)"] == "met"
