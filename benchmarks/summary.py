@@ -101,17 +101,21 @@ COLUMNS = ("issue", "target", "limit", "measured", "unit", "status", "date (UTC)
            "benchmark", "note")
 
 
-def _docs_generate():
-    """``docs/generate.py``, whose reading of a report's target rows (``target_rows``: the
-    script's ``met`` as met / **NOT met** / not checked) and cell format this table shares."""
-    spec = importlib.util.spec_from_file_location("docs_generate",
-                                                  HERE.parent / "docs" / "generate.py")
+def _module(path: Path, name: str):
+    """The module of the file ``path`` (loaded under ``name``)."""
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
-GEN = _docs_generate()
+#: ``docs/generate.py``, whose reading of a report's target rows (``target_rows``: the
+#: script's ``met`` as met / **NOT met** / not checked) and cell format this table shares
+GEN = _module(HERE.parent / "docs" / "generate.py", "docs_generate")
+#: every benchmark script, the stems of ``benchmarks/run_all.py``'s PLAN (one list of
+#: names): a report file belongs to the one of its name or the longest one it extends
+BENCHMARKS = tuple(s for s in _module(HERE / "run_all.py", "bench_run_all").PLAN
+                   if s.startswith("bench_"))
 
 
 def _cell(value) -> str:
@@ -141,14 +145,14 @@ def _run_facts(data: dict, path: Path) -> dict:
 def report_files(folder: Path, expected=EXPECTED) -> tuple:
     """(current, older): benchmark stem -> paths of its JSON files. A file belongs to the
     benchmark of its name, else to the longest benchmark name it extends
-    (``bench_bem_8192.json`` to ``bench_bem``, ``bench_bem_growth.json`` to
-    ``bench_bem_growth`` itself). The folder is never cleaned: when ``run_all.json`` lists
+    (:data:`BENCHMARKS` and the expected ones: ``bench_bem_8192.json`` to ``bench_bem``,
+    ``bench_bem_approach.json`` to ``bench_bem_approach`` itself). The folder is never cleaned: when ``run_all.json`` lists
     a run of a file's benchmark and no run wrote that file (its ``wrote`` lists), the file
     is an older run's report and goes to ``older``, never read as this run's."""
     runs = [r for r in _runs(folder) if isinstance(r.get("wrote"), list)]
     listed = {r.get("script") for r in runs}
     wrote = {name for r in runs for name in r["wrote"]}
-    names = {e[1] for e in expected}
+    names = set(BENCHMARKS) | {e[1] for e in expected}
     current, older = {}, {}
     for path in sorted(Path(folder).glob("*.json")):
         if path.stem == "run_all":

@@ -329,3 +329,29 @@ def test_an_older_report_left_in_the_folder_is_not_read_as_this_runs(tmp_path, s
     (tmp_path / "run_all.json").unlink()
     rows = summary.summary_rows(tmp_path, EXPECTED)
     assert {r["target"]: r["status"] for r in rows}["Reynolds 2048^2 CPU time (s)"] == "met"
+
+
+def test_a_benchmark_of_its_own_is_never_read_as_the_one_its_name_extends(tmp_path, summary):
+    """bench_bem_padding / _nonperiodic / _approach have no expected row, so their reports
+    were given to bench_bem by the prefix: with bench_bem crashed (exit 1, nothing
+    written) its rows read "not measured: no such row in this run" dated by
+    bench_bem_approach.json, and the crash note was lost. Every benchmark of run_all's PLAN
+    owns its own reports."""
+    row = {"name": "512^2, 3 cold approaches: CPU gap variable / load", "value": 0.5,
+           "target": "< 1", "met": True}
+    _write(tmp_path, "bench_bem_approach", date="2026-11-29T12:21:09+00:00", targets=[row])
+    _write(tmp_path, "run_all", targets=[], cases=[
+        {"script": "bench_bem_approach", "args": "", "exit_code": 0,
+         "wrote": ["bench_bem_approach.json"]},
+        {"script": "bench_bem", "args": "", "exit_code": 1, "wrote": []}])
+    assert set(summary.read_reports(tmp_path)) == {"bench_bem_approach"}
+    rows = summary.summary_rows(tmp_path)
+    bem = [r for r in rows if r["benchmark"] == "bench_bem"]
+    assert len(bem) == sum(e[1] == "bench_bem" for e in summary.EXPECTED)
+    for r in bem:
+        assert r["status"] == "not measured" and r.get("date (UTC)") is None
+        assert r["note"] == "bench_bem ran (exit code 1) and wrote no report: see its output"
+    (approach,) = [r for r in rows if r["benchmark"] == "bench_bem_approach"]
+    assert approach["status"] == "met" and approach["issue"] == "-"
+    assert {"bench_bem_padding", "bench_bem_nonperiodic", "bench_bem_approach"} <= set(
+        summary.BENCHMARKS)
