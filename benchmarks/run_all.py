@@ -55,19 +55,35 @@ NOT_IN_QUICK = {"bench_fsi": "the coupled 512^2 solve takes 15-35 s CPU per trap
                                        "global search take ~4-5 min CPU: make bench only"}
 
 
+def _stamps(folder: Path) -> dict:
+    """file name -> (inode, mtime in ns, size) of every report in ``folder``."""
+    stamps = {}
+    for path in folder.glob("*.json"):
+        try:
+            st = path.stat()
+        except OSError:                  # removed meanwhile
+            continue
+        stamps[path.name] = (st.st_ino, st.st_mtime_ns, st.st_size)
+    return stamps
+
+
 def run_one(script: Path, args, env) -> dict:
-    """Run one benchmark in a fresh interpreter; its figures from ``os.wait4``."""
-    load0, t0, clock0 = os.getloadavg()[0], time.perf_counter(), time.time()
+    """Run one benchmark in a fresh interpreter; its figures from ``os.wait4``. ``wrote``:
+    its own reports (``summary.owner_of``) that are new or changed (inode, mtime in ns or
+    size) against a listing taken before the start: a file written by an earlier run, even
+    a second before (bench_fsi then bench_fsi --steps), is not credited to this one."""
+    from summary import owner_of  # benchmarks/summary.py
+    folder = Path(env["ROUGHFE_BENCH_OUTPUT"])
+    before = _stamps(folder)
+    load0, t0 = os.getloadavg()[0], time.perf_counter()
     print(f"== {script.name} {' '.join(args)}", flush=True)
     proc = subprocess.Popen([sys.executable, str(script), *args], cwd=HERE, env=env)
     _, status, usage = os.wait4(proc.pid, 0)
     proc.returncode = os.waitstatus_to_exitcode(status)
     from _report import megabytes  # benchmarks/_report.py
-    from summary import owner_of  # benchmarks/summary.py
-    folder = Path(env["ROUGHFE_BENCH_OUTPUT"])
-    # its own reports only (bench_bem_growth.json, written just before, is not bench_bem's)
-    wrote = sorted(p.name for p in folder.glob(f"{script.stem}*.json")
-                   if owner_of(p.stem, PLAN) == script.stem and p.stat().st_mtime >= clock0 - 1)
+    wrote = sorted(name for name, stamp in _stamps(folder).items()
+                   if stamp != before.get(name)
+                   and owner_of(Path(name).stem, PLAN) == script.stem)
     return {"script": script.stem, "args": " ".join(args), "exit_code": proc.returncode,
             "wrote": wrote,
             "wall_s": time.perf_counter() - t0, "cpu_s": usage.ru_utime + usage.ru_stime,

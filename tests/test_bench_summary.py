@@ -355,3 +355,28 @@ def test_a_benchmark_of_its_own_is_never_read_as_the_one_its_name_extends(tmp_pa
     assert approach["status"] == "met" and approach["issue"] == "-"
     assert {"bench_bem_padding", "bench_bem_nonperiodic", "bench_bem_approach"} <= set(
         summary.BENCHMARKS)
+
+
+def test_a_crashed_second_run_is_not_credited_with_the_first_runs_report(tmp_path,
+                                                                         monkeypatch):
+    """bench_fsi runs twice (then with --steps); run_all counted any of its files with an
+    mtime >= the start - 1 s: the first run's bench_fsi.json, written < 1 s before, made
+    a crashed --steps run read "wrote its report" (met, make bench exit 0)."""
+    import os
+    monkeypatch.syspath_prepend(str(BENCH))
+    run_all = _module("run_all")
+    stub = tmp_path / "bench_fsi.py"
+    stub.write_text("import os, sys, pathlib\n"
+                    "if '--steps' in sys.argv:\n    sys.exit(1)\n"
+                    "pathlib.Path(os.environ['ROUGHFE_BENCH_OUTPUT'], 'bench_fsi.json')"
+                    ".write_text('{}')\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "bench_fsi_steps.json").write_text("{}")          # an older run's (2001)
+    os.utime(out / "bench_fsi_steps.json", (1e9, 1e9))
+    env = dict(os.environ, ROUGHFE_BENCH_OUTPUT=str(out))
+    assert run_all.run_one(stub, [], env)["wrote"] == ["bench_fsi.json"]
+    rec = run_all.run_one(stub, ["--steps"], env)
+    assert rec["exit_code"] == 1 and rec["wrote"] == []
+    # a report written again under the same name counts (the first run, repeated)
+    assert run_all.run_one(stub, [], env)["wrote"] == ["bench_fsi.json"]
