@@ -62,7 +62,8 @@ def process_figures() -> dict:
 def write_report(path, name, targets, cases, units, extra=None, skipped=()):
     """Write the JSON report atomically and print each target's value and verdict.
 
-    ``targets``: records ``name, value, target, met`` (and ``unit``, ``note``); ``cases``:
+    ``targets``: records ``name, value, target, met`` (and ``unit``, ``note``; ``met``
+    None: a value reported without a verdict, "not checked" in the summary); ``cases``:
     the measured records; ``units``: field -> unit; ``extra`` (a dict) adds the benchmark's
     own keys (e.g. a fitted law, its settings); ``skipped``: records ``name, reason`` of
     the cases this run left out (shown in the summary table, never silently dropped).
@@ -80,7 +81,8 @@ def write_report(path, name, targets, cases, units, extra=None, skipped=()):
     for t in targets:
         value = t["value"]
         shown = f"{value:.4g}" if isinstance(value, (int, float)) else str(value)
-        print(f"{'met' if t['met'] else 'NOT met':>8s}  {t['name']}: {shown} "
+        verdict = "not checked" if t["met"] is None else "met" if t["met"] else "NOT met"
+        print(f"{verdict:>8s}  {t['name']}: {shown} "
               f"(target {t['target']})")
     for s in skipped:
         print(f" skipped  {s['name']}: {s['reason']}")

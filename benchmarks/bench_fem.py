@@ -19,7 +19,8 @@ CPU seconds. The largest profile solvable in < 30 s per step is read from the me
 MUMPS rows and extrapolated with the fitted power law t = a dofs^b.
 Run: ``.venv/bin/python benchmarks/bench_fem.py [M ...]`` (default m = 8..13; `make bench` runs m = 8..14, 16385 nodes); writes
 ``benchmarks/output/bench_fem.json`` through ``benchmarks/_report.write_report`` (target
-row: the MUMPS step of the largest measured profile below 30 s CPU).
+row: the largest measured profile whose MUMPS step is below 30 s CPU, reported without a
+verdict: :func:`target_row`).
 """
 from __future__ import annotations
 
@@ -121,11 +122,19 @@ def main(ms) -> int:
     return 0
 
 
+#: the note of the issue 16 sec. 4 row: why it has no verdict, where to compare it
+REPORTED_NOTE = ("a measurement, not judged: any profile whose step is under the limit "
+                 "would meet a pass/fail form (257 nodes do); the previous measurements to "
+                 "compare it with are in docs/benchmarks/00_overview.md")
+
+
 def target_row(rows, big=None):
-    """Issue 16 sec. 4's row: the largest profile whose MUMPS VI step took < STEP_LIMIT s
-    CPU. The number is a measurement (nodes); the verdict says whether any measured
-    profile was solvable within the limit (NOT met when none was, or none succeeded: it
-    was then left out, and the summary read "not measured")."""
+    """Issue 16 sec. 4's row: the largest profile (nodes) whose MUMPS VI step took
+    < STEP_LIMIT s CPU. The issue asks for that number, a measurement: the row reports it
+    without a verdict (``met`` None, "not checked" in the summary; a verdict "met" held
+    whenever any profile was that fast, 257 nodes included). NOT met only when no
+    measured profile was solvable within the limit (or none succeeded): then there is no
+    such profile to report."""
     ok = [r for r in rows if r["solver"] == "mumps" and r["ok"]]
     within = [r for r in ok if r["step_cpu_s"] < STEP_LIMIT]
     if not within:
@@ -144,7 +153,8 @@ def target_row(rows, big=None):
                     + (f", the next measured, {beyond['nodes']} nodes, "
                        f"{beyond['step_cpu_s']:.3g} s" if beyond else
                        ", the largest measured: larger ones were not run") + extra + ")",
-            "value": best["nodes"], "target": f"a step < {STEP_LIMIT:g} s", "met": True}
+            "value": best["nodes"], "target": f"a step < {STEP_LIMIT:g} s", "met": None,
+            "unit": "nodes", "note": REPORTED_NOTE}
 
 
 def _write(rows, big=None):
