@@ -22,6 +22,48 @@ _IMPORTED = time.perf_counter()
 
 
 
+def script_args(doc: str, argv=None, *, flags=(), max_ints=None, words=None):
+    """The positional arguments and flags of a benchmark script without argparse:
+    ``(values, given)``, ``values`` the integers (or, with ``words``, the words of that
+    set) in order, ``given`` the set of ``flags`` present. ``-h``/``--help`` prints
+    ``doc`` (the script's docstring: its usage line is there) and exits 0; an unknown
+    flag, a value that is not an integer (or not one of ``words``) or more than
+    ``max_ints`` values exits 2 with a message naming it (was a ``ValueError`` traceback
+    from ``int('--help')``)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    script = Path(sys.argv[0]).name
+    if "-h" in argv or "--help" in argv:
+        print(doc.strip())
+        sys.exit(0)
+    given = {a for a in argv if a in flags}
+    values = []
+    for a in argv:
+        if a in flags:
+            continue
+        if words is not None:
+            if a not in words:
+                _usage_error(f"{script}: unknown argument {a!r}; allowed: "
+                             f"{', '.join(words)} (--help: usage)")
+            values.append(a)
+            continue
+        try:
+            values.append(int(a))
+        except ValueError:
+            _usage_error(f"{script}: expected integer arguments"
+                         f"{' or ' + ', '.join(flags) if flags else ''}, got {a!r} "
+                         f"(--help: usage)")
+    if max_ints is not None and len(values) > max_ints:
+        _usage_error(f"{script}: at most {max_ints} integer arguments, got {len(values)}: "
+                     f"{values} (--help: usage)")
+    return values, given
+
+
+def _usage_error(message: str):
+    """``message`` on stderr, exit status 2 (a command-line error, as argparse's)."""
+    print(message, file=sys.stderr)
+    raise SystemExit(2)
+
+
 def megabytes(ru_maxrss: float) -> float:
     """MB (1e6 bytes, the unit of the issue's GB limits) of a ``ru_maxrss`` (KiB on
     Linux). The benchmarks divided by 1024 (MiB) and called it MB until session 23."""

@@ -26,7 +26,7 @@ from roughfe.bem.adhesion import SOLVERS, AdhesionLaw, solve_adhesive
 from roughfe.model import Material
 from roughfe.surfaces.spectral import spectral_surface
 
-from _report import write_report  # benchmarks/_report.py
+from _report import script_args, write_report  # benchmarks/_report.py
 
 OUT = Path(__file__).resolve().parent / "output" / "bench_adhesion.json"
 
@@ -84,4 +84,4 @@ def main(sizes):
 
 
 if __name__ == "__main__":
-    sys.exit(main([int(a) for a in sys.argv[1:]] or [512]))
+    sys.exit(main(script_args(__doc__)[0] or [512]))

@@ -26,7 +26,7 @@ from roughfe.genomics.macro_micro import profile_response
 from roughfe.surfaces.io import load_surface, topographies_folder
 from roughfe.surfaces.surface import Surface
 
-from _report import write_report  # benchmarks/_report.py
+from _report import script_args, write_report  # benchmarks/_report.py
 
 DATA = topographies_folder() / "di-1.di"
 OUT = Path(__file__).resolve().parent / "output" / "bench_bands.json"
@@ -95,4 +95,4 @@ def main(n=256, workers=2):
 
 
 if __name__ == "__main__":
-    sys.exit(main(*(int(a) for a in sys.argv[1:3])))
+    sys.exit(main(*script_args(__doc__, max_ints=2)[0]))

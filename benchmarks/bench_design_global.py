@@ -24,7 +24,7 @@ from roughfe.genomics import database as gdb
 from roughfe.genomics import design as de
 from roughfe.study import build_genome_db
 
-from _report import write_report  # benchmarks/_report.py
+from _report import script_args, write_report  # benchmarks/_report.py
 
 OUT = Path(__file__).resolve().parent / "output" / "bench_design_global.json"
 GOAL = 0.9
@@ -78,5 +78,6 @@ def main(n_eval=100000, db_path=None):
 
 
 if __name__ == "__main__":
-    main(*(int(sys.argv[1]),) if len(sys.argv) > 1 else (),
-         **({"db_path": Path(sys.argv[2])} if len(sys.argv) > 2 else {}))
+    args = sys.argv[1:]
+    n_eval = script_args(__doc__, args[:1], max_ints=1)[0]    # [N_EVAL [DB]]: DB is a path
+    main(*n_eval, **({"db_path": Path(args[1])} if len(args) > 1 else {}))

@@ -37,7 +37,7 @@ from roughfe.fem import mesh_profile
 from roughfe.fem.contact import FemSolverOptions, _ContactProblem
 from roughfe.surfaces.rmd import rmd_profile
 
-from _report import megabytes, write_report  # benchmarks/_report.py
+from _report import megabytes, script_args, write_report  # benchmarks/_report.py
 
 MATERIAL = Material(E=210e9, nu=0.3)
 SOLVERS = {"mumps": {},
@@ -167,4 +167,4 @@ def _write(rows, big=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main([int(a) for a in sys.argv[1:]] or list(range(8, 14))))
+    sys.exit(main(script_args(__doc__)[0] or list(range(8, 14))))

@@ -24,7 +24,7 @@ import sys
 import time
 from pathlib import Path
 
-from _report import write_report  # benchmarks/_report.py
+from _report import script_args, write_report  # benchmarks/_report.py
 
 N, TARGET_S = 512, 60.0
 OUT = Path(__file__).resolve().parent / "output"
@@ -109,4 +109,5 @@ if __name__ == "__main__":
     if sys.argv[1:] == ["--steps"]:
         OUT.mkdir(exist_ok=True)
         sys.exit(closure_steps())
-    sys.exit(main(sys.argv[1:] or ["volume", "pressure", "film"]))
+    models = ("volume", "pressure", "film")
+    sys.exit(main(script_args(__doc__, words=models)[0] or list(models)))

@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from _report import megabytes, write_report  # benchmarks/_report.py
+from _report import megabytes, script_args, write_report  # benchmarks/_report.py
 
 OUT = Path(__file__).resolve().parent / "output"
 TARGETS = {2048: 10.0, 4096: 60.0}
@@ -181,5 +181,5 @@ if __name__ == "__main__":
         res = coupled() if sys.argv[2] == "coupled" else one_size(int(sys.argv[2]))
         print(json.dumps(res))
         sys.exit(0)
-    sys.exit(main([int(a) for a in sys.argv[1:] if a != "--no-coupled"]
-                  or [512, 1024, 2048, 4096], coupled_case="--no-coupled" not in sys.argv))
+    sizes, given = script_args(__doc__, flags=("--no-coupled",))
+    sys.exit(main(sizes or [512, 1024, 2048, 4096], coupled_case="--no-coupled" not in given))

@@ -21,7 +21,7 @@ import numpy as np
 from roughfe.genomics.sequencing import sequence_surfaces
 from roughfe.genomics.sequencing.surface_data import resolvable_surface_genome
 
-from _report import write_report  # benchmarks/_report.py
+from _report import script_args, write_report  # benchmarks/_report.py
 
 OUT = Path(__file__).resolve().parent / "output" / "bench_sequencing.json"
 TARGET_S = 10.0
@@ -87,4 +87,4 @@ def main(sizes):
 
 
 if __name__ == "__main__":
-    sys.exit(main([int(a) for a in sys.argv[1:]] or [128, 256, 512]))
+    sys.exit(main(script_args(__doc__)[0] or [128, 256, 512]))

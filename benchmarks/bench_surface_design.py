@@ -31,7 +31,7 @@ from roughfe.genomics import database as gdb
 from roughfe.genomics.design import combined_score, target_surface, thesis_targets
 from roughfe.surfaces.io import load_surface
 
-from _report import write_report  # benchmarks/_report.py
+from _report import script_args, write_report  # benchmarks/_report.py
 
 OUT = Path(__file__).resolve().parent / "output" / "bench_surface_design.json"
 STUDY = Path(__file__).resolve().parents[1] / "validation" / "surface_genomics.py"
@@ -97,5 +97,5 @@ def main(n_points=24, n_nodes=64, quick=False):
 
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a != "--quick"]
-    sys.exit(main(*(int(a) for a in args[:2]), quick="--quick" in sys.argv[1:]))
+    sizes, given = script_args(__doc__, flags=("--quick",), max_ints=2)
+    sys.exit(main(*sizes, quick="--quick" in given))
