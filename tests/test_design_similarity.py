@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from roughfe.errors import InputError
+from roughfe.errors import FileFormatError, InputError
 from roughfe.genomics.similarity import (ResponseCurve, Target, amplitude_factor,
                                          linear_then_flat_target, similarity, split_ranges)
 from roughfe.genomics.target_csv import read_target_csv, write_target_csv
@@ -223,3 +223,25 @@ def test_the_last_target_pressure_is_eq42s_p_max_unless_p_top_says_otherwise():
     for bad in (0.5, np.inf, "x"):
         with pytest.raises(InputError, match=r"p_top .* >= its last pressure 0\.7"):
             Target(c.pressure[:7], c.stiffness[:7], "K", p_top=bad)
+
+
+def test_target_csv_keeps_p_top(tmp_path):
+    """Eq. 4.2's p_max^t of a target that stops early (Target.p_top) is written as a
+    comment and read back (write_target_csv dropped it: the file read back was
+    stretched onto its last pressure, a different objective)."""
+    from dataclasses import replace
+    t = replace(linear_then_flat_target(p_max=2.0, pbar=0.5, plateau=4.0, n_points=20),
+                p_top=3.5)
+    back = read_target_csv(write_target_csv(tmp_path / "t.csv", t))
+    assert back.p_top == 3.5 and back.p_max == 3.5
+    np.testing.assert_array_equal(back.pressure, t.pressure)
+    plain = read_target_csv(write_target_csv(tmp_path / "p.csv", replace(t, p_top=None)))
+    assert plain.p_top is None and plain.p_max == t.pressure[-1]
+    bad = tmp_path / "bad.csv"
+    bad.write_text("# p_top: 3.5e6Pa\npressure_Pa,value\n1e5,0.1\n2e5,0.2\n")
+    with pytest.raises(FileFormatError, match=r"line 1: .* p_top '3.5e6Pa', not a number"):
+        read_target_csv(bad)
+    low = tmp_path / "low.csv"               # below the last pressure: Target's own check
+    low.write_text("# p_top: 1.5e5\npressure_Pa,value\n1e5,0.1\n2e5,0.2\n")
+    with pytest.raises(InputError, match="p_top"):
+        read_target_csv(low)

@@ -18,10 +18,27 @@ def _said(line):
     return next((q for q, (label, _) in QUANTITY_LABELS.items() if label in line), None)
 
 
+#: the comment that carries :attr:`Target.p_top` (Eq. 4.2's p_max^t, Pa)
+P_TOP_COMMENT = re.compile(r"#\s*p_top\s*[:=]\s*(\S+)")
+
+
+def _p_top(path, k, text):
+    """The p_top (Pa) of a ``# p_top: <number> Pa ...`` comment line, else None."""
+    m = P_TOP_COMMENT.match(text.strip())
+    if m is None:
+        return None
+    value = _float_or_none(m.group(1))
+    if value is None:
+        raise FileFormatError(f"{path}: line {k}: the comment {text.strip()!r} gives p_top "
+                              f"{m.group(1)!r}, not a number (Pa)")
+    return value
+
+
 def _target_lines(path):
     """``(line number, raw text, stripped cells)`` of the lines of a target CSV that are
-    neither blank nor comments, and the quantity the first naming comment says."""
-    lines, said = [], None
+    neither blank nor comments, the quantity the first naming comment says and the
+    ``p_top`` of a ``# p_top: ...`` comment (None without one)."""
+    lines, said, p_top = [], None, None
     try:
         with path.open(newline="", encoding="utf-8-sig") as fh:
             for k, row in enumerate(csv.reader(fh), 1):
@@ -29,13 +46,18 @@ def _target_lines(path):
                 if not any(cells):
                     continue
                 if cells[0].startswith("#"):
-                    said = said or _said(",".join(row))
+                    text = ",".join(row)
+                    top = _p_top(path, k, text)
+                    if top is not None:
+                        p_top = top
+                    else:
+                        said = said or _said(text)
                 else:
                     lines.append((k, ",".join(row), cells))
     except (UnicodeDecodeError, csv.Error) as exc:
         raise FileFormatError(f"{path} is not a UTF-8 CSV text file of 'pressure,value' rows "
                               f"({exc})") from None
-    return lines, said
+    return lines, said, p_top
 
 
 def _is_pressure_name(name) -> bool:
@@ -112,14 +134,16 @@ def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> 
     "A") must agree with it (an area target read as a stiffness was a silent,
     meaningless objective: a header ``p [Pa],A`` was read as K); an InputError names
     the two. ``quantity`` is taken as given for a file that names none (``default``
-    when None).
+    when None). A comment ``# p_top: <number> Pa`` gives the target's
+    :attr:`~roughfe.genomics.similarity.Target.p_top` (Eq. 4.2's p_max^t for a curve
+    that stops before Delta = peak-valley; ``roughfe design --target-p-top`` replaces it).
     """
     path = Path(path)
     if not path.is_file():
         raise InputError(f"target file {path} does not exist")
     if quantity is not None:
         _check_quantity(quantity)
-    lines, said = _target_lines(path)
+    lines, said, p_top = _target_lines(path)
     rows, header = [], None
     for i, (k, text, cells) in enumerate(lines):
         while not cells[-1]:                            # a trailing comma: no column
@@ -138,11 +162,15 @@ def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> 
     named = _agreed(path, [("its comment", said), header or ("", None)], quantity)
     a = np.asarray(rows)
     return Target(a[:, 0], a[:, 1], named or default, name or path.stem,
-                  {"source": str(path)})
+                  {"source": str(path)}, p_top=p_top)
 
 
 def write_target_csv(path, target: Target):
-    """Write ``target`` as 'pressure_Pa,value' CSV atomically (readable by :func:`read_target_csv`)."""
+    """Write ``target`` as 'pressure_Pa,value' CSV atomically (readable by
+    :func:`read_target_csv`): a comment naming the quantity and its unit, how a surface
+    target was solved, its :attr:`~roughfe.genomics.similarity.Target.p_top` (a
+    ``# p_top: <Pa>`` comment, read back; it was lost until session 27), the header and
+    the rows."""
     from ..writers import write_text
     unit = QUANTITY_LABELS[target.quantity][1]
     lines = [f"# {target.name}: {QUANTITY_LABELS[target.quantity][0]} ({unit}) vs pressure (Pa)"]
@@ -151,6 +179,9 @@ def write_target_csv(path, target: Target):
         lines.append(f"# solved with boundary {meta['boundary']}, resolution "
                      f"{meta.get('resolution')}, detrend {meta.get('detrend')} on a "
                      f"{' x '.join(map(str, meta.get('solved_shape', ())))} grid")
+    if target.p_top is not None:  # Eq. 4.2's p_max^t beyond the last row (read back)
+        lines.append(f"# p_top: {target.p_top:.17g} Pa (the target's pressure at Delta = "
+                     f"peak-valley, Eq. 4.2 p_max^t)")
     lines.append("pressure_Pa,value")
     lines += [f"{p:.17g},{y:.17g}" for p, y in zip(target.pressure, target.values)]
     return write_text(path, "\n".join(lines) + "\n")
