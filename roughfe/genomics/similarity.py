@@ -357,10 +357,14 @@ def linear_then_flat_target(p_max: float, pbar: float, plateau: float, n_points:
         (the n_t loading steps of the thesis).
     start : float, optional
         Value at the first pressure p_1. Default: the line through the origin,
-        ``y = plateau p / pbar``. A line through the origin asks for K -> 0 at p -> 0,
-        which no rough profile has (K jumps to a finite value at first contact); Eq.
-        (4.1) then scores every profile below 0 at p_1. The thesis' y_t2 (Fig. 57) is
-        "linear" without saying where it starts.
+        ``y = plateau p / pbar``. A line through the origin asks for K proportional to
+        p near p = 0. A rough profile's K does vanish at p = 0 (:func:`from_origin`), but
+        far more slowly than p (one plane-strain asperity: K ~ 1 / ln(1/p), up to
+        constants), and the first computed step of a discretised profile (one or a few
+        nodes in contact) already has a K of the order of its later values; Eq. (4.1)
+        then scores every profile below 0 at p_1. The thesis' y_t2 (Fig. 57) is
+        "linear" without saying where it starts. (Until session 27 this said K jumps to
+        a finite value at first contact, which is the discretisation, not the profile.)
     """
     if not (0 < pbar < p_max and np.isfinite(p_max)):
         raise InputError(f"need 0 < pbar < p_max, got pbar={pbar!r}, p_max={p_max!r}")
