@@ -232,7 +232,8 @@ def test_exact_sensitivities_equal_finite_differences_on_fixed_contact_sets(stif
     c = de.Evaluator(settings)(de.Design((de.DesignPart(other, tuple(range(
         other.n_first, other.n_last + 1))),), 1.0, settings.length, settings.n_nodes))
     # and one point of each target below the design's first (rescaled) pressure, where
-    # the curve is read from (0, 0) (similarity.from_origin): its derivative moves with p_1
+    # the curve is read by the power law from (0, 0) through its first two points
+    # (similarity.read_curve): its derivative moves with p_1, p_2, y_1, y_2
     low = 0.3 * c.pressure[0]
     obj = de.Objective((Target(np.r_[low, c.pressure], np.r_[0.3 * c.stiffness[0],
                                                             c.stiffness], "K"),

@@ -185,22 +185,54 @@ def test_target_csv_header_names_the_quantity(tmp_path):
 
 def test_a_curve_is_read_from_zero_load_below_its_first_pressure():
     """K(p) and A(p) of a rough surface vanish at p = 0 (no contact): below a curve's
-    first computed pressure p_1 it is read linearly from (0, 0), for both quantities, by
-    the score, the objective and the figures alike (similarity.from_origin). The clamp of
-    np.interp held the first value there (here 20 where the chord gives 10)."""
+    first computed pressure p_1 it is read by the power law through (0, 0) and its first
+    two points, y_1 (p / p_1)^alpha, alpha their log-slope clipped to [0, 1], by the
+    score, the objective and the figures alike (similarity.read_curve). Session 26 read
+    the chord (alpha = 1), before it np.interp's clamp (alpha = 0)."""
     from roughfe.genomics.design import Objective
-    c = ResponseCurve([2.0, 3.0, 4.0], [20.0, 30.0, 36.0], [0.2, 0.3, 0.5])
-    np.testing.assert_allclose(c.at([0.0, 1.0, 2.5, 5.0], "K"), [0.0, 10.0, 25.0, 36.0])
-    np.testing.assert_allclose(c.at([1.0, 3.5], "A"), [0.1, 0.4])
-    for q, y1 in (("K", 10.0), ("A", 0.1)):       # on the chord through the origin: s = 1
-        t = Target([1.0, 2.0, 4.0], [y1, c.values(q)[0], c.values(q)[-1]], q)
+    from roughfe.genomics.similarity import leading_exponent
+    # K nearly flat (alpha = ln(1.1)/ln 2), A linear (alpha = 1: the chord)
+    c = ResponseCurve([2.0, 4.0, 6.0], [20.0, 22.0, 24.0], [0.2, 0.4, 0.5])
+    alpha = np.log(1.1) / np.log(2.0)
+    assert leading_exponent(c.pressure, c.stiffness) == pytest.approx(alpha, rel=1e-14, abs=0)
+    np.testing.assert_allclose(c.at([0.0, 1.0, 3.0, 9.0], "K"),
+                               [0.0, 20.0 * 0.5 ** alpha, 21.0, 24.0], rtol=1e-14)
+    np.testing.assert_allclose(c.at([1.0, 5.0], "A"), [0.1, 0.45], rtol=1e-14)
+    for q in ("K", "A"):                      # a target on the read curve scores s = 1
+        t = Target([0.5, 1.0, 2.0, 6.0], c.at([0.5, 1.0, 2.0, 6.0], q), q)
         assert similarity(t, c) == pytest.approx(1.0, abs=1e-14)
-    t = Target([1.0, 4.0], [8.0, 36.0], "K")     # the design reads 10 at p = 1: 25 % too stiff
+    y1 = 20.0 * 0.5 ** alpha
+    t = Target([1.0, 6.0], [y1 / 1.25, 24.0], "K")   # the design reads y1: 25 % too stiff
     assert similarity(t, c) == pytest.approx(0.75, abs=1e-14)
     np.testing.assert_allclose(Objective((t,)).residuals(c), [-0.25, 0.0], atol=1e-14)
-    p, k = c.points("K")
-    np.testing.assert_array_equal(p, [0.0, 2.0, 3.0, 4.0])
-    np.testing.assert_array_equal(k, [0.0, 20.0, 30.0, 36.0])
+    # the exponent is clipped: a K that falls from p_1 to p_2 is held (alpha = 0), an A
+    # that rises faster than p is read on the chord (alpha = 1), as is a zero first value
+    d = ResponseCurve([2.0, 4.0], [30.0, 20.0], [0.01, 0.1])
+    np.testing.assert_allclose(d.at([1.0], "K"), [30.0], rtol=1e-14)
+    np.testing.assert_allclose(d.at([1.0], "A"), [0.005], rtol=1e-14)
+    assert leading_exponent([1.0, 2.0], [0.0, 1.0]) == 1.0
+    p, k = c.points("K")                      # the figures draw what is read
+    assert p[0] == 0.0 and k[0] == 0.0 and np.all(np.diff(p) > 0)
+    np.testing.assert_allclose(k, c.at(p, "K"), rtol=1e-14)
+    np.testing.assert_array_equal(p[-3:], c.pressure)
+
+
+def test_the_reading_rule_derivative_is_exact():
+    """read_curve's derivative with moving points (the design Jacobian's chain): against
+    central differences, below p_1 (the exponent moves), on a segment and above p_max."""
+    from roughfe.genomics.similarity import read_curve
+    rng = np.random.default_rng(3)
+    p0, y0 = np.array([1.0, 1.7, 2.5, 4.0]), np.array([5.0, 6.0, 6.5, 7.0])
+    dp, dy = rng.normal(size=(4, 2)), rng.normal(size=(4, 2))
+    q = np.array([0.2, 0.6, 1.2, 3.0, 5.0])
+    y, jac = read_curve(q, p0, y0, dp, dy)
+    np.testing.assert_allclose(y, read_curve(q, p0, y0), rtol=1e-15)
+    h = 1e-6
+    for m in range(2):
+        up = read_curve(q, p0 + h * dp[:, m], y0 + h * dy[:, m])
+        down = read_curve(q, p0 - h * dp[:, m], y0 - h * dy[:, m])
+        np.testing.assert_allclose(jac[:, m], (up - down) / (2 * h), rtol=1e-7, atol=1e-9)
+    assert np.all(np.abs(jac[:2]) > 1e-3)
 
 
 def test_the_last_target_pressure_is_eq42s_p_max_unless_p_top_says_otherwise():

@@ -4,7 +4,8 @@ before the split): the thesis (1 - s)^2 form and Svanberg's min-max form, with f
 differences and with user derivatives, on an analytic problem and on a GCMMA design stage
 (BEM sweeps of a 64-node profile). The three design-stage entries were re-recorded in
 session 26, when the objective began to read a curve from (0, 0) below its first
-pressure (similarity.from_origin): a change of the objective, not of the driver."""
+pressure, and in session 27, when that reading became the power law through the first
+two points (similarity.read_curve): changes of the objective, not of the driver."""
 import json
 from pathlib import Path
 

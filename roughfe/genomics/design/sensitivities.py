@@ -9,7 +9,7 @@ from ...errors import InputError
 from ..database import DatabaseSettings
 from ..macro_micro import (periodic_approach, profile_response, profile_sweep, sweep_curve,
                            top_approach)
-from ..similarity import from_origin
+from ..similarity import read_curve
 from .model import Design
 from .objective import Objective
 
@@ -37,8 +37,9 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     difference matrix D and ``delta = (max h - min h)/n_t``; the exact per-step K and
     A(p) depend only on the contact sets, so their derivatives vanish. The chain then
     goes through the Eq. (4.2) rescaling ``eta = p_max^t / p_n`` and the linear
-    interpolation at the target pressures (below the first rescaled pressure from the
-    fixed point (0, 0), :func:`~roughfe.genomics.similarity.from_origin`). Gene
+    interpolation at the target pressures (below the first rescaled pressure the power
+    law through (0, 0) and the first two points, whose exponent moves with them:
+    :func:`~roughfe.genomics.similarity.read_curve`). Gene
     variables (``(part, name)`` keys) get forward differences. One BEM sweep plus n_t
     solves with H_cc replace the n + 1 sweeps of finite differences; each gene variable costs one more sweep (its forward
     difference). ``evaluate`` (an :class:`~.objective.Evaluator`), when given, counts
@@ -111,22 +112,10 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     for t in objective.targets:
         sel = (t.pressure >= objective.p_range[0]) & (t.pressure <= objective.p_range[1])
         pt, yt = t.pressure[sel], t.values[sel]
-        # the curve read as Objective.residuals reads it: from (0, 0) below p_1
-        # (from_origin; the origin does not move with the phases: zero derivative rows)
-        pr0, yv, dpr0, dyv = from_origin(pr, curve.values(t.quantity), dpr,
-                                         dk if t.quantity == "K" else np.zeros_like(dp))
-        y = np.interp(pt, pr0, yv)
-        dy = np.empty((pt.size, len(keys)))
-        b = np.clip(np.searchsorted(pr0, pt), 1, n_t)
-        a_ = b - 1
-        for i, (ia, ib, q) in enumerate(zip(a_, b, pt)):
-            if q >= pr0[-1]:
-                dy[i] = dyv[-1]
-            else:
-                span = pr0[ib] - pr0[ia]
-                w = (q - pr0[ia]) / span
-                dw = (-dpr0[ia] * span - (q - pr0[ia]) * (dpr0[ib] - dpr0[ia])) / span ** 2
-                dy[i] = (1 - w) * dyv[ia] + w * dyv[ib] + (yv[ib] - yv[ia]) * dw
+        # the curve read as Objective.residuals reads it (read_curve: below p_1 the
+        # power law through (0, 0) and the first two points, whose exponent moves too)
+        y, dy = read_curve(pt, pr, curve.values(t.quantity), dpr,
+                           dk if t.quantity == "K" else np.zeros_like(dp))
         r_out.append((yt - y) / yt)
         j_out.append(-dy / yt[:, None])
     r, jac = np.concatenate(r_out), np.vstack(j_out)
