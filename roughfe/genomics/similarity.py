@@ -165,7 +165,9 @@ def read_curve(q, pressure, values, dpressure=None, dvalues=None):
     score Eq. (4.1), :meth:`Objective.residuals` and its exact Jacobian, and the design
     figures. Between computed points linear in p; above the last point the last value;
     below the first computed pressure p_1 the power law through (0, 0) and the first
-    two points, ``y = y_1 (q / p_1)^alpha`` (:func:`leading_exponent`, alpha in [0, 1]).
+    two points, ``y = y_1 (q / p_1)^alpha`` (:func:`leading_exponent`, alpha in [0, 1];
+    at alpha = 0, a curve that falls from p_1 to p_2, the first value held down to
+    q = 0: targets have no point at p = 0).
 
     Why: K(p) and A(p) of a rough surface vanish at p = 0 but not linearly -- one
     plane-strain asperity has A ~ p^(1/2) and K ~ 1/ln(1/p); many asperities bring A
