@@ -256,6 +256,22 @@ def test_exact_sensitivities_equal_finite_differences_on_fixed_contact_sets(stif
     assert np.abs(jac[:n_k]).max() > 1e-3 and np.abs(jac[n_k:]).max() > 1e-3
 
 
+def test_a_stage_that_changes_the_best_candidate_says_so(entries, targets):
+    """The message of an extended result starts with the best design before the stage;
+    when the stage leaves another candidate best (a global stage runs from the best by
+    the solved score, not by the interpolated one) the message names it."""
+    import time as _time
+    from roughfe.genomics.design.algorithms import _extended
+    r = de.run_design("sog", entries, [targets[0]], SETTINGS, options=FAST, n_best=2)
+    assert r.candidates[0].origin != r.candidates[1].origin
+    swapped = _extended(r, tuple(reversed(r.candidates)), de.Evaluator(SETTINGS),
+                        _time.perf_counter(), "; a stage")
+    assert swapped.message.startswith(r.message.split(";")[0])
+    assert f"; a stage; the best design is now from {r.candidates[1].origin}" in swapped.message
+    kept = _extended(r, r.candidates, de.Evaluator(SETTINGS), _time.perf_counter(), "; a stage")
+    assert "the best design is now" not in kept.message
+
+
 def test_refinement_stage_appends_a_reproducible_fourth_score(entries, targets):
     t1 = targets[0]
     r = de.run_design("sog", entries, [t1], SETTINGS, options=FAST, n_best=1)

@@ -461,10 +461,15 @@ def _extended(result, out, evaluate, t0, note):
     s = 0.908 after "f at p_t = 0.9634")."""
     ok, why = _success(out)
     before = result.message.replace(_verdict_note(result.best, result.objective), "")
+    # the message starts with the best design before this stage: say when another
+    # candidate is best after it (a global stage run from the best by the solved score)
+    moved = (f"; the best design is now from {out[0].origin}"
+             if out[0].origin != result.best.origin else "")
     return replace(result, candidates=tuple(out), nit=result.nit + evaluate.n_sweeps,
                    elapsed=result.elapsed + time.perf_counter() - t0,
                    success=result.success and ok,
-                   message=before + note + _verdict_note(out[0], result.objective) + why)
+                   message=(before + note + moved + _verdict_note(out[0], result.objective)
+                            + why))
 
 
 def _at_targets(design, objective, settings, evaluate):
