@@ -1,7 +1,9 @@
 """How well a response curve read below its first computed pressure p_1 predicts the
-solved K(p) and A(p) there: the power law of ``similarity.read_curve`` against its two
-limits, the chord from (0, 0) (alpha = 1, session 26) and the first value held
-(np.interp's clamp, alpha = 0, before it).
+solved K(p) and A(p) there: the first value held (``similarity.read_curve``, np.interp's
+clamp), the chord from (0, 0) (session 26) and the power law through (0, 0) and the
+first two points, ``y_1 (p / p_1)^alpha`` with alpha their log-slope clipped to [0, 1]
+(session 27's trial: the best reading, but the optimiser reached worse designs with it,
+docs/theory/06_design.md).
 
 Every genome of the design study's database (``roughfe validate design``: 60 genomes,
 N = 512 profiles; built here when no database is given, ~1-2 min) is solved at the
@@ -21,12 +23,18 @@ import numpy as np
 
 from roughfe.genomics import database as gdb
 from roughfe.genomics import design as de
-from roughfe.genomics.similarity import leading_exponent
 from roughfe.model import Loading, Material
 from roughfe.response import response
 from roughfe.study import build_genome_db
 
 FINE = np.linspace(0.05, 1.2, 47)
+
+
+def leading_exponent(p, y):
+    """alpha of the power-law reading: ln(y_2/y_1) / ln(p_2/p_1) clipped to [0, 1]."""
+    if not (y[0] > 0 and y[1] > 0):
+        return 1.0
+    return float(np.clip(np.log(y[1] / y[0]) / np.log(p[1] / p[0]), 0.0, 1.0))
 READ_AT = (0.25, 0.5, 0.75)
 
 

@@ -37,9 +37,8 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
     difference matrix D and ``delta = (max h - min h)/n_t``; the exact per-step K and
     A(p) depend only on the contact sets, so their derivatives vanish. The chain then
     goes through the Eq. (4.2) rescaling ``eta = p_max^t / p_n`` and the linear
-    interpolation at the target pressures (below the first rescaled pressure the power
-    law through (0, 0) and the first two points, whose exponent moves with them:
-    :func:`~roughfe.genomics.similarity.read_curve`). Gene
+    interpolation at the target pressures (below the first rescaled pressure the first
+    value held: :func:`~roughfe.genomics.similarity.read_curve`). Gene
     variables (``(part, name)`` keys) get forward differences. One BEM sweep plus n_t
     solves with H_cc replace the n + 1 sweeps of finite differences; each gene variable costs one more sweep (its forward
     difference). ``evaluate`` (an :class:`~.objective.Evaluator`), when given, counts
@@ -113,7 +112,7 @@ def residual_jacobian(design: Design, keys, objective: Objective, settings: Data
         sel = (t.pressure >= objective.p_range[0]) & (t.pressure <= objective.p_range[1])
         pt, yt = t.pressure[sel], t.values[sel]
         # the curve read as Objective.residuals reads it (read_curve: below p_1 the
-        # power law through (0, 0) and the first two points, whose exponent moves too)
+        # first value held, its derivative that of y_1)
         y, dy = read_curve(pt, pr, curve.values(t.quantity), dpr,
                            dk if t.quantity == "K" else np.zeros_like(dp))
         r_out.append((yt - y) / yt)
