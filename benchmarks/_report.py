@@ -33,7 +33,11 @@ def script_args(doc: str, argv=None, *, flags=(), max_ints=None, words=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     script = Path(sys.argv[0]).name
     if "-h" in argv or "--help" in argv:
-        print(doc.strip())
+        try:
+            print(doc.strip(), flush=True)
+        except BrokenPipeError:          # `--help | head`: quiet, as the roughfe CLI
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            sys.exit(141)
         sys.exit(0)
     given = {a for a in argv if a in flags}
     values = []

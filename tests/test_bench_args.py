@@ -59,3 +59,18 @@ def test_a_non_integer_size_exits_2_without_a_traceback():
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert "bench_bands.py: expected integer arguments, got 'big'" in run.stderr
+
+
+def test_help_into_a_closed_pipe_exits_141_quietly():
+    """`bench_bands.py --help | head -1`: the rest of the usage goes nowhere, no
+    BrokenPipeError traceback (as the roughfe CLI). The pipe is closed before the
+    script writes, so the case is deterministic."""
+    import os
+    r, w = os.pipe()
+    os.close(r)
+    try:
+        run = subprocess.run([sys.executable, str(BENCH / "bench_bands.py"), "--help"],
+                             stdout=w, stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(w)
+    assert run.returncode == 141 and "Traceback" not in run.stderr, run.stderr[-500:]
