@@ -28,6 +28,7 @@ from roughfe.response import response
 from roughfe.study import build_genome_db
 
 FINE = np.linspace(0.05, 1.2, 47)
+READ_AT = (0.25, 0.5, 0.75)
 
 
 def leading_exponent(p, y):
@@ -35,7 +36,6 @@ def leading_exponent(p, y):
     if not (y[0] > 0 and y[1] > 0):
         return 1.0
     return float(np.clip(np.log(y[1] / y[0]) / np.log(p[1] / p[0]), 0.0, 1.0))
-READ_AT = (0.25, 0.5, 0.75)
 
 
 def rule_errors(entries, settings):
