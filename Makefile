@@ -37,7 +37,9 @@ demo: env
 # Every validation study (tens of minutes to hours on 2 shared cores: the FEM refinement
 # study to r = 8 dominates); exits 1 while any target is NOT met (validation/output/summary.json).
 # It installs the "bench" extra (the peer, Tamaas) so that the BEM-vs-Tamaas row runs.
-validate: env
+# validate, bench, bench-quick and docs call the bootstrap once with their own extras
+# instead of depending on env: a fresh venv then runs pip once, not twice.
+validate:
 	@bash tools/bootstrap.sh io,design,study,test,bench
 	$(PY) -m roughfe.cli validate all -o validation/output
 
@@ -51,17 +53,17 @@ validate-quick: env
 # benchmarks/output and the one table of every speed/memory target in
 # benchmarks/output/SUMMARY.md. make bench-quick:
 # reduced sizes (4-5 min on 2 cores) into benchmarks/output-quick, for smoke use.
-bench: env
+bench:
 	@bash tools/bootstrap.sh io,design,study,test,bench
 	$(PY) benchmarks/run_all.py
 
-bench-quick: env
+bench-quick:
 	@bash tools/bootstrap.sh io,design,study,test,bench
 	$(PY) benchmarks/run_all.py --quick
 
 # HTML documentation in docs/_build/html (warnings are errors); the API, validation and
 # benchmark pages are generated first from the sources and the JSON of validate/bench.
-docs: env
+docs:
 	@bash tools/bootstrap.sh io,design,study,test,docs
 	$(PY) docs/generate.py
 	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html

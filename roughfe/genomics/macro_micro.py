@@ -30,7 +30,7 @@ from ..errors import InputError
 from ..model import Loading, Material, SweepResult
 from ..response import response as contact_response
 from ..surfaces.surface import Surface
-from .similarity import ResponseCurve
+from .similarity import ResponseCurve, read_curve
 
 
 STIFFNESS_KINDS = ("fd", "exact")
@@ -136,7 +136,9 @@ def correlation(reference: ResponseCurve, curve: ResponseCurve, quantity: str = 
 
     ``axis="steps"``: the values paired step by step (equal step counts needed; curves
     of different lengths fall back to the pressure axis). ``axis="pressure"``: ``curve``
-    rescaled to the reference p_max (Eq. 4.2) and interpolated at its pressures.
+    rescaled to the reference p_max (Eq. 4.2) and read at its pressures by the design's
+    rule (:func:`roughfe.genomics.similarity.read_curve`: linear between computed
+    points, the end values held beyond them).
     """
     if axis not in CORRELATION_AXES:
         raise InputError(f"axis must be one of {CORRELATION_AXES}, got {axis!r}")
@@ -145,7 +147,7 @@ def correlation(reference: ResponseCurve, curve: ResponseCurve, quantity: str = 
         y_n = curve.values(quantity)
     else:
         c = curve.to_target_range(reference.p_max)
-        y_n = np.interp(reference.pressure, c.pressure, c.values(quantity))
+        y_n = read_curve(reference.pressure, c.pressure, c.values(quantity))
     if np.ptp(y_r) == 0 or np.ptp(y_n) == 0:
         return 0.0
     return float(np.corrcoef(y_r, y_n)[0, 1])
