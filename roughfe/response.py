@@ -21,7 +21,8 @@ METHODS = ("bem", "fem")
 BEM_OPTIONS = ("kernel", "solver", "tol", "max_iter", "compute_stiffness", "hardness",
                "coarse_correction", "unload", "adhesion")
 FEM_MESH_OPTIONS = ("depth", "growth", "formulation", "size_max")
-FEM_SOLVER_OPTIONS = ("solver", "penalty_factor", "rtol", "atol", "max_it", "petsc_options")
+FEM_SOLVER_OPTIONS = ("solver", "penalty_factor", "rtol", "atol", "max_it", "petsc_options",
+                      "volumetric")
 FEM_OPTIONS = FEM_MESH_OPTIONS + FEM_SOLVER_OPTIONS + ("keep_fields",)
 
 
@@ -65,7 +66,7 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         default tolerance is its traction residual 1e-5). FEM: mesh ``depth``, ``growth``,
         ``formulation``, ``size_max`` (:func:`roughfe.fem.mesh_profile`); ``solver``
         (``"vi"`` or ``"penalty"``), ``penalty_factor``, ``rtol``, ``atol``, ``max_it``,
-        ``petsc_options`` (:class:`roughfe.fem.FemSolverOptions`); ``keep_fields``
+        ``petsc_options``, ``volumetric`` (:class:`roughfe.fem.FemSolverOptions`); ``keep_fields``
         (the index or indices in ``[-n, n)`` of the steps whose full fields are kept,
         :func:`roughfe.fem.fem_contact_sweep`).
 

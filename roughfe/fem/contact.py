@@ -60,6 +60,7 @@ from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
+from .elasticity import VOLUMETRIC, stiffness_matrix, volumetric_form
 from .limits import warn_locking
 from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
 from .petsc_tools import (LU_MUMPS, PrefixedOptions, check_snes, fresh_pc_on_resize,
@@ -109,6 +110,12 @@ class FemSolverOptions:
         ``ksp_type preonly``) after the first solve that takes a Newton step (steps
         without contact take none and set up no linear solver)
         (:class:`roughfe.fem.petsc_tools.PrefixedOptions`).
+    volumetric : {"auto", "element", "nodal"}
+        The volumetric term of the stiffness (:mod:`roughfe.fem.elasticity`):
+        ``"element"`` exact on the P1 triangles (locks as nu -> 1/2), ``"nodal"`` on the
+        nodal average of div u (no locking: +0.3..0.7 % against the BEM at nu = 0.499),
+        ``"auto"`` ``"nodal"`` above nu = 0.45 (:data:`roughfe.fem.limits.LOCKING_NU`),
+        ``"element"`` up to it.
     """
 
     method: Method = "vi"
@@ -117,10 +124,14 @@ class FemSolverOptions:
     atol: float = 1e-12
     max_it: int = 50
     petsc_options: Mapping | None = None
+    volumetric: str = "auto"
 
     def __post_init__(self):
         if self.method not in METHODS:
             raise InputError(f"method must be one of {METHODS}, got {self.method!r}")
+        if self.volumetric not in VOLUMETRIC:
+            raise InputError(f"volumetric must be one of {VOLUMETRIC}, got "
+                             f"{self.volumetric!r}")
         check_finite_positive("penalty_factor", self.penalty_factor)
         check_finite_positive("rtol (SNES relative tolerance)", self.rtol)
         check_finite_nonnegative("atol (SNES absolute tolerance)", self.atol)
@@ -131,17 +142,20 @@ class FemSolverOptions:
 
 def _check_body(pmesh, material, options) -> tuple:
     """``(material, options)`` of a FEM body, checked: ``pmesh`` a ProfileMesh, ``material``
-    a Material with nu < 0.5 (a ResolutionWarning, volumetric locking with the measured
-    error, above :data:`roughfe.fem.limits.LOCKING_NU` = 0.45), ``options`` a
+    a Material with nu < 0.5 (with ``volumetric="element"`` above
+    :data:`roughfe.fem.limits.LOCKING_NU` = 0.45 a ResolutionWarning, volumetric locking
+    with the measured error), ``options`` a
     FemSolverOptions (None: the defaults); an InputError naming the argument otherwise."""
     check_instance("pmesh", pmesh, ProfileMesh, "a roughfe.fem.ProfileMesh (mesh_profile)")
     check_instance("material", material, Material, "a roughfe.model.Material")
     if material.nu >= 0.5:
-        raise InputError(f"the P1 displacement FEM needs nu < 0.5 (it locks when incompressible), "
-                         f"got nu = {material.nu!r}")
-    warn_locking(material.nu, stacklevel=4)
+        raise InputError(f"the FEM body needs nu < 0.5 (its Lame lambda is infinite at 0.5; "
+                         f"below it the default nodal volumetric form does not lock), got "
+                         f"nu = {material.nu!r}")
     options = FemSolverOptions() if options is None else options
     check_instance("options", options, FemSolverOptions, "a roughfe.fem.FemSolverOptions")
+    if volumetric_form(options.volumetric, material.nu) == "element":
+        warn_locking(material.nu, stacklevel=4)
     return material, options
 
 
@@ -155,9 +169,7 @@ class _ContactProblem:
     """Assembled stiffness, top DOFs and one configured SNES (internal, per mesh+method)."""
 
     def __init__(self, pmesh: ProfileMesh, material: Material, options: FemSolverOptions):
-        import ufl
         from dolfinx import fem
-        from dolfinx.fem.petsc import assemble_matrix
         from petsc4py import PETSc
 
         self.pmesh, self.material, self.options = pmesh, material, options
@@ -165,20 +177,8 @@ class _ContactProblem:
         h = pmesh.heights
         # displacement unit: the height range (a flat profile -- a flat punch -- uses W/1000)
         self.u_ref = float(h.max() - h.min()) or 1e-3 * pmesh.width
-        nu = material.nu
         V = fem.VectorFunctionSpace(mesh, ("CG", 1))
         self.V = V
-        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-        lam = nu / ((1 + nu) * (1 - 2 * nu))          # Lame constants for E = 1
-        mu = 1.0 / (2 * (1 + nu))
-
-        def eps(w):
-            return ufl.sym(ufl.grad(w))
-
-        def sigma(w):
-            return lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2 * mu * eps(w)
-
-        a = fem.form(ufl.inner(sigma(u), eps(v)) * ufl.dx)
         fdim = mesh.topology.dim - 1
         ft = pmesh.facet_tags
         bcs = []
@@ -186,8 +186,8 @@ class _ContactProblem:
             facets = ft.find(FACET_TAGS[name])
             dofs = fem.locate_dofs_topological(V.sub(comp), fdim, facets)
             bcs.append(fem.dirichletbc(PETSc.ScalarType(0), dofs, V.sub(comp)))
-        self.K = assemble_matrix(a, bcs=bcs)
-        self.K.assemble()
+        self.volumetric = volumetric_form(options.volumetric, material.nu)
+        self.K = stiffness_matrix(V, material.nu, bcs, self.volumetric)
         self.bcs = bcs
 
         # owned top vertices -> profile sample index

@@ -2,13 +2,17 @@
 
 Two approximations of :mod:`roughfe.fem.contact` do not go away with the mesh size dx:
 
-* **Volumetric locking.** P1 (constant-strain) displacement triangles cannot deform at
-  constant volume, so as nu -> 1/2 (lambda / mu -> inf) the body is too stiff. Refining
-  helps only slowly (at nu = 0.499 the error fell from +33..42 % to +16..19 % from 33 to
-  257 top nodes); the cure, a mixed u-p or enriched (MINI) element with the nodal
-  contact of the top vertices kept, is not implemented. Above
-  :data:`LOCKING_NU` a :class:`~roughfe.errors.ResolutionWarning` names the measured error;
-  nu >= 0.5 is refused (:func:`roughfe.fem.contact._check_body`).
+* **Volumetric locking** of the ``"element"`` volumetric form
+  (:mod:`roughfe.fem.elasticity`). P1 (constant-strain) displacement triangles cannot
+  deform at constant volume, so as nu -> 1/2 (lambda / mu -> inf) the body is too stiff.
+  Refining helps only slowly (at nu = 0.499 the error fell from +33..42 % to +16..19 %
+  from 33 to 257 top nodes: :data:`LOCKING_ERRORS`). The cure (round 2, session 28) is
+  the ``"nodal"`` form, the volumetric term on the nodal average of div u, with the nodal
+  contact of the top vertices kept: :data:`NODAL_ERRORS`, +0.3..0.7 % up to nu =
+  0.49999. ``FemSolverOptions(volumetric="auto")`` (the default) takes it above
+  :data:`LOCKING_NU`; with ``volumetric="element"`` above it a
+  :class:`~roughfe.errors.ResolutionWarning` names the measured error. nu >= 0.5 is
+  refused (:func:`roughfe.fem.contact._check_body`).
 * **Finite depth.** The body of depth H_d stands on rollers. The uniform part of the load
   is corrected exactly (the layer compliance H_d / M), but the non-uniform part decays as
   exp(-pi y / W) for the longest mode of the mirrored profile (period 2 W), so a shallow
@@ -39,6 +43,14 @@ LOCKING_ERRORS = ((0.3, "+0.4..0.9 %", "+0.4..0.9 %"),
                   (0.49, "+3.4..8.1 %", "-2.9..+10 %"),
                   (0.499, "+16..42 %", "+13..25 %"),
                   (0.49999, "+46..111 %", "+44..98 %"))
+#: The same for the ``"nodal"`` volumetric form (:mod:`roughfe.fem.elasticity`; round 2,
+#: session 28): no locking, the error falls with the mesh at every nu (p at 257 nodes:
+#: +0.24 % at nu = 0.3, +0.32 % at 0.49999; the rest is the 2 W depth and the mesh).
+NODAL_ERRORS = ((0.3, "+0.24..0.48 %", "-0.03..+0.19 %"),
+                (0.45, "+0.28..0.54 %", "-0.33..+0.20 %"),
+                (0.49, "+0.30..0.61 %", "-0.01..+0.26 %"),
+                (0.499, "+0.32..0.66 %", "+0.28..0.44 %"),
+                (0.49999, "+0.32..0.67 %", "+0.30..0.63 %"))
 #: The depth (in W) of a body that is the half-plane to the discretisation error: at 2 W
 #: the difference to the BEM equals that at 3 W and 4 W to 0.1 % (the default depth).
 HALF_PLANE_DEPTH = 2.0
@@ -70,15 +82,17 @@ def _bracket(table, value, name="", unit=""):
 
 def warn_locking(nu: float, stacklevel: int = 3) -> None:
     """ResolutionWarning when ``nu`` > :data:`LOCKING_NU`, naming the errors measured at
-    that nu or the tabulated ones on either side (:data:`LOCKING_ERRORS`)."""
+    that nu or the tabulated ones on either side (:data:`LOCKING_ERRORS`); called for
+    the ``"element"`` volumetric form only."""
     if nu <= LOCKING_NU:
         return
     warnings.warn(
         f"nu = {nu!r} > {LOCKING_NU}: the P1 displacement FEM locks volumetrically and "
         f"overestimates the pressure; against the BEM on a cosine (33-257 top nodes) it "
         f"was off by {_bracket(LOCKING_ERRORS, nu, 'nu = ')} (the discretisation error: "
-        f"{_measured(LOCKING_ERRORS[0], 'nu = ')}); a finer mesh helps little; "
-        f"use method='bem' (any nu < 0.5) for a near-incompressible body",
+        f"{_measured(LOCKING_ERRORS[0], 'nu = ')}); a finer mesh helps little; use "
+        f"FemSolverOptions(volumetric='nodal') (the default 'auto' above {LOCKING_NU}: "
+        f"{_measured(NODAL_ERRORS[-1], 'nu = ')}) or method='bem'",
         ResolutionWarning, stacklevel=stacklevel)
 
 
