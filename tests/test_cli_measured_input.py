@@ -116,3 +116,43 @@ def test_a_file_without_unit_is_said_to_be_read_as_metres(tmp_path, capsys, topo
     assert "the file gives no unit" in capsys.readouterr().out
     assert main(["info", str(topographies_dir / "x3p-2.x3p")]) == 0     # unit 'm' in file
     assert "gives no unit" not in capsys.readouterr().out
+
+
+def test_contact_mirror_solves_the_mirrored_window(tmp_path, capsys):
+    """``contact --mirror`` solves the evenly mirrored window as a periodic surface: the
+    same records as the mirrored surface given directly, a pressure field with the
+    window's mirror symmetry, no window compliance, and a stiffer K than the window's
+    own (whose K includes the bulk compliance of a finite punch). A periodic surface is
+    refused."""
+    import h5py
+    import json
+    rough = spectral_surface(64, 1e-4, 0.8, rms_height=1e-7, rng=3)
+    window = Surface(rough.heights[:33, :33], (33 * rough.spacing[0],) * 2, periodic=False)
+    path = save_surface(window, tmp_path / "window.npz")
+    mirrored = save_surface(window.mirrored(), tmp_path / "mirrored.npz")
+    args = ["--E", "2e9", "--nu", "0.4", "--pressure", "2e6", "1e7", "--no-figures"]
+    assert main(["contact", str(path), "--mirror", *args, "-o", str(tmp_path / "m")]) == 0
+    assert main(["contact", str(mirrored), *args, "-o", str(tmp_path / "p")]) == 0
+    assert main(["contact", str(path), *args, "-o", str(tmp_path / "w")]) == 0
+    docs = {k: json.loads((tmp_path / k / "results.json").read_text()) for k in "mpw"}
+    assert docs["m"]["inputs"]["mirror"] is True and docs["p"]["inputs"]["mirror"] is False
+    assert docs["m"]["inputs"]["metadata"]["mirrored"] is True
+    # the same surface up to its mean (--detrend mean acts before --mirror: the mirrored
+    # window counts its interior twice), which the contact does not see
+    for key in ("area_fraction", "stiffness", "mean_gap"):
+        assert [s[key] for s in docs["m"]["steps"]] == pytest.approx(
+            [s[key] for s in docs["p"]["steps"]], rel=1e-9, abs=0)
+    assert "window_compliance" not in docs["m"]["derived"]
+    assert docs["w"]["derived"]["window_compliance"] > 0
+    with h5py.File(tmp_path / "m" / "fields.h5", "r") as f:
+        p = f["pressure"][-1]
+    assert p.shape == (64, 64)
+    # even about the window's edges: p[i] = p[64 - i] along each axis
+    back = np.roll(np.flip(p, axis=(0, 1)), 1, axis=(0, 1))
+    assert np.max(np.abs(back - p)) <= 1e-8 * p.max()
+    k_m = [s["stiffness"] for s in docs["m"]["steps"]]
+    k_w = [s["stiffness"] for s in docs["w"]["steps"]]
+    assert all(a > b for a, b in zip(k_m, k_w)), (k_m, k_w)
+    capsys.readouterr()
+    assert main(["contact", str(mirrored), "--mirror", *args, "-o", str(tmp_path / "x")]) == 2
+    assert "--mirror mirrors a non-periodic window" in capsys.readouterr().err

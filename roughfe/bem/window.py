@@ -93,8 +93,9 @@ def window_report(sweep) -> dict:
                 f"compliance C = {c:.3g} m/Pa{facts[0]} and the window's bulk "
                 f"deflection C p = {share[top]:.2g} of the approach{facts[1]}. "
                 f"The interface's own K(p) is that of "
-                f"a periodic surface, e.g. the evenly mirrored window (Surface.mirrored(), "
-                f"roughfe design-targets --boundary periodic); C is written to "
+                f"a periodic surface, e.g. the evenly mirrored window (roughfe contact "
+                f"--mirror, Surface.mirrored(), roughfe design-targets --boundary "
+                f"periodic); C is written to "
                 f"results.json (derived.window_compliance)", WindowStiffnessWarning,
                 stacklevel=2)
 

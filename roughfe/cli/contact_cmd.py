@@ -7,7 +7,10 @@ for profiles). Each step record carries ``persson_area_fraction`` and
 ``persson_mean_gap`` (:func:`roughfe.theory.beside`), except with ``--adhesion``: the
 theory is non-adhesive, so an adhesive run has none (``derived.persson`` says so); with
 ``--hardness`` the theory is elastic, so from the first step with plastic flow on the
-values are None (``derived.persson`` says so and lists those steps).
+values are None (``derived.persson`` says so and lists those steps). ``--mirror`` solves
+the evenly mirrored window of a non-periodic surface (:meth:`Surface.mirrored`) as a
+periodic one: a measured window's K is otherwise mostly its bulk compliance
+(``derived.window_compliance``).
 """
 from __future__ import annotations
 
@@ -43,6 +46,13 @@ def register(subparsers) -> None:
                     "last, OUTDIR/results.json (inputs and one record per step). SI units.")
     add_surface_options(p)
     add_detrend_option(p)
+    p.add_argument("--mirror", action="store_true",
+                   help="solve the evenly mirrored window (2 (n - 1) points per axis, "
+                        "periodic: Surface.mirrored) instead of the non-periodic window "
+                        "itself: K is then the interface stiffness of the mirrored "
+                        "periodic surface, without the window's bulk (flat-punch) "
+                        "compliance that dominates K of a measured window; 4x the points "
+                        "of a surface. A non-periodic SURFACE only; after --detrend")
     add_material_options(p)
     load = p.add_argument_group("loading (one of; default --steps 20)").add_mutually_exclusive_group()
     load.add_argument("--steps", type=positive_int, default=None, metavar="N",
@@ -83,6 +93,11 @@ def register(subparsers) -> None:
 
 def _run(args) -> int:
     surface = surface_from_args(args)
+    if args.mirror:
+        if surface.periodic:
+            raise InputError(f"--mirror mirrors a non-periodic window; {args.surface} is "
+                             f"read as periodic (drop --mirror, or give --non-periodic)")
+        surface = surface.mirrored()
     material = material_from_args(args)
     law = contact_physics_from_args(args)["adhesion"]
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
@@ -110,7 +125,7 @@ def _run(args) -> int:
               "coarse_correction": args.coarse_correction,
               "control": "pressure" if args.pressure else "delta",
               "hardness": args.hardness, "unload": args.unload,
-              "detrend": args.detrend,
+              "detrend": args.detrend, "mirror": args.mirror,
               "metadata": dict(surface.metadata)}
     doc = contact_document(sweep, surface, material, inputs, adhesive=adhesive is not None)
     if adhesive is not None:
