@@ -139,28 +139,29 @@ def _run(args) -> int:
         doc["derived"]["units"].update(process_zone="m", grid_spacing="m")
         stickiness = pastewka_robbins(surface, material.E_star, law.work, law.range)
         doc["derived"]["stickiness"] = stickiness.describe()
+    name = Path(args.surface).name + (" (mirrored)" if args.mirror else "")
     with folder as out:
         write_fields_h5(out / "fields.h5", sweep)
         if not args.no_figures:
             from ..plotting.contact import (plot_area_stiffness, plot_profile_state,
                                             render_contact)
             plot_area_stiffness(doc["steps"], out / "contact_area_stiffness.png",
-                                title=f"{Path(args.surface).name}, E* = {material.E_star:.4g} Pa",
+                                title=f"{name}, E* = {material.E_star:.4g} Pa",
                                 rms_height=sweep.rms_height,
                                 window_compliance=doc["derived"].get("window_compliance"))
             if adhesive is not None:
                 from ..plotting.contact import plot_adhesion
                 plot_adhesion(doc["steps"], out / "adhesion_load_approach.png",
                               pull_off_force=adhesive.pull_off_force,
-                              title=f"{Path(args.surface).name}, {law.kind}: w = {law.work:.3g} "
+                              title=f"{name}, {law.kind}: w = {law.work:.3g} "
                                     f"J/m^2, range {law.range:.3g} m")
             last = sweep.results[_shown_step(sweep.area_fraction)]
             if surface.ndim == 2:
                 render_contact(surface.heights, last, out / "contact_render.png",
-                               title=Path(args.surface).name)
+                               title=name)
             else:
                 plot_profile_state(surface.heights, last, out / "contact_profile.png",
-                                   title=Path(args.surface).name)
+                                   title=name)
         write_json(out / "results.json", doc)  # last: the run is complete
     print_surface_notes(args, surface)
     print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} {'K (Pa/m)':>12s} {'gap (m)':>12s} "
