@@ -599,9 +599,8 @@ def test_nodal_volumetric_form_does_not_lock(nu):
     """The volumetric term on the nodal average of div u (roughfe.fem.elasticity) against
     the periodic BEM of the mirrored cosine, a near-incompressible body: within 1 % in p
     and K on 33 top nodes (measured +0.5..0.7 %), closer on 65 (the discretisation error
-    falls), where the element-wise form is 16-111 % off (LOCKING_ERRORS). Both contact
-    solvers build on the same matrix; the penalty one agrees with the VI to its
-    penetration."""
+    falls), where the element-wise form is 16-111 % off (LOCKING_ERRORS). The penalty
+    solver builds on the same matrix and agrees with the VI to its penetration."""
     from roughfe.bem import solve_contact
     soft = Material(E=1e9, nu=nu)
     deltas = np.array([0.3, 0.7]) * G
@@ -616,12 +615,41 @@ def test_nodal_volumetric_form_does_not_lock(nu):
         assert np.all(np.abs(ep) < 0.01) and np.all(np.abs(ek) < 0.01), (n, ep, ek)
         errors.append(np.max(np.abs(ep)))
     assert errors[1] < errors[0]
+    penalty = fem_contact_sweep(mesh_profile(cosine_half_period(65)), soft, deltas,
+                                options=FemSolverOptions(method="penalty"))
+    assert np.allclose(penalty.mean_pressure, fem.mean_pressure, rtol=1e-4)
     from roughfe.errors import ResolutionWarning
     with pytest.warns(ResolutionWarning, match="locks volumetrically"):
         locked = fem_contact_sweep(mesh_profile(cosine_half_period(33)), soft, deltas[:1],
                                    options=FemSolverOptions(volumetric="element")).mean_pressure
     assert locked[0] > 1.15 * fem_contact_sweep(
         mesh_profile(cosine_half_period(33)), soft, deltas[:1]).mean_pressure[0]
+
+
+def test_nodal_form_stress_and_convergence_near_incompressibility():
+    """With the nodal form the kept sigma_yy is the form's own (lambda times the nodal
+    average of div u): at the top of a parabolic contact -sigma_yy / p is 1 within a few
+    per cent at nu = 0.499 (lambda times a triangle's own div u was up to 548x the peak
+    pressure at 0.49999). And the SNES absolute tolerance grows with the modulus: at nu =
+    0.499999 warm-started VI steps 1e-6 apart converge (they ran to DIVERGED_MAX_IT at
+    |F| ~ 1e-11 with the fixed 1e-12) and agree with the penalty solver."""
+    from roughfe.fem.elasticity import atol_scale
+    W, n = 1e-3, 129
+    x = np.arange(n) * W / (n - 1)
+    pm = mesh_profile(Surface(-G * (x / W) ** 2, n * W / (n - 1)))
+    r = fem_contact_sweep(pm, Material(E=1e9, nu=0.499), [0.06 * G], keep_fields=0).results[0]
+    pts, cells, s = r.fields["points"], r.fields["cells"], r.fields["stress_yy"]
+    cx = pts[cells, 0].mean(axis=1)
+    top = np.isclose(pts[cells, 1].max(axis=1), 0.0) & (cx < 0.5 * r.contact_area)
+    ratio = -s[top] / np.interp(cx[top], r.x, r.pressure)
+    assert top.sum() >= 20 and np.all(np.abs(ratio - 1) < 0.05), ratio
+    assert np.abs(s).max() < 1.05 * r.pressure.max()
+    assert atol_scale(0.3) == atol_scale(0.45) == 1.0 and atol_scale(0.499999) > 1e4
+    stiff = Material(E=1e9, nu=0.499999)
+    fine = 0.05 * G * (1 + np.arange(6) * 1e-6)
+    vi = fem_contact_sweep(pm, stiff, fine)
+    pen = fem_contact_sweep(pm, stiff, fine, options=FemSolverOptions(method="penalty"))
+    assert np.allclose(vi.mean_pressure, pen.mean_pressure, rtol=1e-4)
 
 
 def test_volumetric_forms_auto_choice_and_bad_value():
@@ -646,17 +674,20 @@ def test_volumetric_forms_auto_choice_and_bad_value():
     from dolfinx import fem
     from petsc4py import PETSc
     V = fem.VectorFunctionSpace(pm.mesh, ("CG", 1))
-    facets = pm.facet_tags.find(FACET_TAGS["bottom"])
-    dofs = fem.locate_dofs_topological(V.sub(1), 1, facets)
-    bc = fem.dirichletbc(PETSc.ScalarType(0), dofs, V.sub(1))
-    K = stiffness_matrix(V, 0.49, [bc], "nodal")
+    bcs = []
+    for name, comp in (("left", 0), ("right", 0), ("bottom", 1)):     # as _ContactProblem
+        dofs = fem.locate_dofs_topological(V.sub(comp), 1, pm.facet_tags.find(FACET_TAGS[name]))
+        bcs.append(fem.dirichletbc(PETSc.ScalarType(0), dofs, V.sub(comp)))
+    K = stiffness_matrix(V, 0.49, bcs, "nodal")
     try:
         dense = K.convert("dense").getDenseArray()
         assert np.allclose(dense, dense.T, atol=1e-12 * np.abs(dense).max())
-        held = bc.dof_indices()[0]
-        rows = dense[held]
-        assert np.array_equal(rows, np.eye(dense.shape[0])[held])
-        assert np.array_equal(dense[:, held], np.eye(dense.shape[0])[:, held])
+        held = np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs]))
+        eye = np.eye(dense.shape[0])
+        assert np.array_equal(dense[held], eye[held])
+        assert np.array_equal(dense[:, held], eye[:, held])
+        free = np.setdiff1d(np.arange(dense.shape[0]), held)
+        np.linalg.cholesky(dense[np.ix_(free, free)])        # positive definite there
     finally:
         K.destroy()
     with pytest.raises(InputError, match=r"volumetric must be one of \('auto', 'element', "

@@ -18,6 +18,10 @@ u_y = 0 on the bottom such that
     a(u, v) = integral_Omega sigma(u) : eps(v) dA = integral_top t . v ds  for all v,
     sigma(u) = lambda tr(eps(u)) I + 2 mu eps(u),   eps(u) = sym(grad u),
 
+(above nu = 0.45, by default, with tr(eps(u)) replaced by its nodal average in the
+lambda term: the locking-free form of :mod:`roughfe.fem.elasticity`, selected by
+``FemSolverOptions.volumetric``),
+
 with the contact traction t from one of two solvers:
 
 * ``"vi"``: PETSc SNES ``vinewtonrsls`` (reduced-space active set) with upper bounds
@@ -60,7 +64,8 @@ from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
-from .elasticity import VOLUMETRIC, stiffness_matrix, volumetric_form
+from .elasticity import (VOLUMETRIC, atol_scale, lame, nodal_average, stiffness_matrix,
+                         volumetric_form)
 from .limits import warn_locking
 from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
 from .petsc_tools import (LU_MUMPS, PrefixedOptions, check_snes, fresh_pc_on_resize,
@@ -96,7 +101,10 @@ class FemSolverOptions:
     penalty_factor : float
         k in kappa = k E / delta (1e3-1e4 recommended).
     rtol, atol : float
-        SNES relative / absolute residual tolerances (non-dimensional residual).
+        SNES relative / absolute residual tolerances (non-dimensional residual). Above
+        nu = 0.45 ``atol`` is scaled by (lambda + 2 mu) / its value at nu = 0.45
+        (:func:`roughfe.fem.elasticity.atol_scale`): the residual's round-off grows with
+        the modulus, and 1e-12 is below it near nu = 1/2.
     max_it : int
         SNES iteration limit per load step.
     petsc_options : mapping, optional
@@ -113,9 +121,11 @@ class FemSolverOptions:
     volumetric : {"auto", "element", "nodal"}
         The volumetric term of the stiffness (:mod:`roughfe.fem.elasticity`):
         ``"element"`` exact on the P1 triangles (locks as nu -> 1/2), ``"nodal"`` on the
-        nodal average of div u (no locking: +0.3..0.7 % against the BEM at nu = 0.499),
-        ``"auto"`` ``"nodal"`` above nu = 0.45 (:data:`roughfe.fem.limits.LOCKING_NU`),
-        ``"element"`` up to it.
+        nodal average of div u (no locking: +0.3..0.7 % against the BEM on a cosine up to
+        nu = 0.49999; softer, 1-4 % low, on measured lines of 257 nodes), ``"auto"``
+        ``"nodal"`` above nu = 0.45 (:data:`roughfe.fem.limits.LOCKING_NU`),
+        ``"element"`` up to it (results jump by ~1 % at that switch: fix one form for a
+        study across nu).
     """
 
     method: Method = "vi"
@@ -262,7 +272,8 @@ class _ContactProblem:
         J = self.K if opt.method == "vi" else self.K.duplicate(copy=True)
         snes.setFunction(self._residual, self.r)
         snes.setJacobian(self._jacobian, J, J)
-        snes.setTolerances(rtol=opt.rtol, atol=opt.atol, max_it=int(opt.max_it))
+        self.atol = opt.atol * atol_scale(self.material.nu)
+        snes.setTolerances(rtol=opt.rtol, atol=self.atol, max_it=int(opt.max_it))
         snes.setConvergenceHistory(reset=True)       # |F(x_0)| of each solve: the tolerance
         # no divergence test (PETSc's default stops at |F| > 1e4 |F(x_0)|): a step started
         # from the previous solution at a smaller approach unloads the body in its first
@@ -487,10 +498,11 @@ class _ContactProblem:
         """The SNES residual test of the last solve: max(atol, rtol * |F(x_0)|)."""
         norms = self.snes.getConvergenceHistory()[0]
         f0 = float(norms[0]) if len(norms) else float(self.snes.getFunctionNorm())
-        return max(self.options.atol, self.options.rtol * f0)
+        return max(self.atol, self.options.rtol * f0)
 
     def _fields(self):
-        """Vertices, triangles, displacement (m) and cell-wise sigma_yy (Pa), serial."""
+        """Vertices, triangles, displacement (m) and cell-wise sigma_yy (Pa) of the
+        body's volumetric form, serial."""
         pm, mat = self.pmesh, self.material
         if pm.mesh.comm.size > 1:
             return None
@@ -498,14 +510,22 @@ class _ContactProblem:
         cells = self.V.dofmap.list.array.reshape(-1, 3).astype(np.int64)
         disp = self.x.array_r.reshape(-1, 2) * self.u_ref
         return {"points": pts, "cells": cells, "displacement": disp,
-                "stress_yy": cell_stress_yy(pts, cells, disp, mat),
+                "stress_yy": cell_stress_yy(pts, cells, disp, mat, self.volumetric),
                 "formulation": pm.formulation}
 
 
-def cell_stress_yy(points, cells, displacement, material: Material):
-    """sigma_yy (Pa) of each linear triangle (constant strain), plane strain.
+def cell_stress_yy(points, cells, displacement, material: Material,
+                   volumetric: str = "element"):
+    """sigma_yy (Pa) of each linear triangle, plane strain, in the body's volumetric
+    form (:mod:`roughfe.fem.elasticity`).
 
-    sigma_yy = lambda (eps_xx + eps_yy) + 2 mu eps_yy from the exact P1 gradients.
+    ``"element"``: sigma_yy = lambda div u + 2 mu eps_yy from the exact P1 gradients
+    (constant per triangle). ``"nodal"``: lambda times the nodal average theta of div u
+    (the form's own volumetric strain; its mean over the triangle's three nodes) instead
+    of the triangle's div u. As nu -> 1/2 a triangle's own div u of the nodal form is
+    not small, only theta is: lambda div u was 548x the peak contact pressure at nu =
+    0.49999 (review, round 2, session 28), the nodal stress -sigma_yy / p = 1.00 +- 0.04
+    at the top.
     """
     p = points[cells]                                  # (C, 3, 2)
     u = displacement[cells]                            # (C, 3, 2)
@@ -513,10 +533,14 @@ def cell_stress_yy(points, cells, displacement, material: Material):
     jac = np.stack([d1, d2], axis=-1)                  # columns: edge vectors
     du = np.stack([u[:, 1] - u[:, 0], u[:, 2] - u[:, 0]], axis=-1)   # (C, 2 comps, 2 edges)
     grad = du @ np.linalg.inv(jac)                     # du_i/dx_j
-    E, nu = material.E, material.nu
-    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
-    mu = E / (2 * (1 + nu))
-    return lam * (grad[:, 0, 0] + grad[:, 1, 1]) + 2 * mu * grad[:, 1, 1]
+    lam, mu = (material.E * c for c in lame(material.nu))
+    div = grad[:, 0, 0] + grad[:, 1, 1]
+    if volumetric == "nodal":
+        areas = 0.5 * np.abs(np.linalg.det(jac))
+        div = nodal_average(cells, areas, div, len(points))[cells].mean(axis=1)
+    elif volumetric != "element":
+        raise InputError(f"volumetric must be 'element' or 'nodal', got {volumetric!r}")
+    return lam * div + 2 * mu * grad[:, 1, 1]
 
 
 def contact_edge(x, gap, contact):
@@ -619,7 +643,9 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     ----------
     pmesh : ProfileMesh
     material : roughfe.model.Material
-        E (Pa) and nu < 0.5 of the body (the obstacle is rigid). Above nu = 0.45 a
+        E (Pa) and nu < 0.5 of the body (the obstacle is rigid). Above nu = 0.45 the
+        default ``options.volumetric="auto"`` takes the nodal volumetric form (no
+        locking; :mod:`roughfe.fem.elasticity`); with ``"element"`` there a
         ResolutionWarning: the P1 elements lock, the pressure comes out too high (measured
         +3.4..8.1 % at nu = 0.49, +16..42 % at 0.499; :mod:`roughfe.fem.limits`).
     deltas : array_like, optional

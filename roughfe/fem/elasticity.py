@@ -20,18 +20,37 @@ The elastic energy density of plane strain (non-dimensional: E = 1) is
 
   which is a u-p mixed form (continuous P1 pressure, lumped pressure mass) with the
   pressure eliminated exactly, because M_L is diagonal. There are as many volumetric
-  constraints as nodes, about half the displacement unknowns, so the body does not lock.
-  The top vertices and their DOFs are the P1 ones, so the nodal contact of
-  :mod:`roughfe.fem.contact` is unchanged. Its matrix couples the neighbours of
-  neighbours (more non-zeros than ``"element"``). Measured against the periodic BEM
-  (:data:`roughfe.fem.limits.NODAL_ERRORS`): +0.3..0.7 % in p at nu = 0.499 and 0.49999,
-  where ``"element"`` is 16..111 % off.
+  constraints as nodes, about half the displacement unknowns, so the body does not lock
+  (a count, not a stability proof: the pair is not inf-sup stable, below). The top
+  vertices and their DOFs are the P1 ones, so the nodal contact of
+  :mod:`roughfe.fem.contact` is unchanged. The matrix couples the neighbours of
+  neighbours: 2.7x the non-zeros of ``"element"``.
+
+What was measured against the periodic BEM (round 2, session 28, and its review):
+
+* The Westergaard cosine (:data:`roughfe.fem.limits.NODAL_ERRORS`): +0.3..0.7 % in p up
+  to nu = 0.49999, where ``"element"`` is 16..111 % off.
+* Measured lines (``sur-2.sur``, 257 samples), whose contact patches are a few nodes
+  wide: the nodal body is **softer** (K_element - K_nodal is positive semidefinite: the
+  lumped projection never raises the volumetric energy), p 1-4 % low at nu = 0.46-0.49
+  (``"element"``: +2..5 % at 0.46, +8..17 % at 0.49), and 0.5-2.5 % low at nu = 0.3,
+  where ``"element"`` is within 0.6 %. It converges under refinement (nu = 0.46, one
+  line: -5.0, -3.5, -1.4 % at 129, 257, 513 nodes).
+* The pair is not inf-sup stable (the inf-sup constant falls with h, unlike a
+  Taylor-Hood pair): as nu -> 1/2 the nodal contact pressure carries a node-to-node
+  oscillation of 1-2 % of its peak on ~25 contact nodes (nu = 0.49999, 129 nodes),
+  which decreases with h. The mean pressure and K are not affected by it.
 
 ``"auto"`` (the default of :class:`roughfe.fem.FemSolverOptions`) takes ``"nodal"`` above
-:data:`roughfe.fem.limits.LOCKING_NU` and ``"element"`` up to it. Up to that nu the FEM
-validation's numbers are unchanged (they were measured with ``"element"``).
+:data:`roughfe.fem.limits.LOCKING_NU` = 0.45 and ``"element"`` up to it: there the
+element form is the more accurate one on rough lines, and the FEM validation's numbers
+(all at nu = 0.3) are unchanged. The switch makes results jump at 0.45 (cosine, 65
+nodes: p -0.75 %, K -1.9 % from nu = 0.45 to 0.450001): a study across nu should fix
+``volumetric`` to one form.
 """
 from __future__ import annotations
+
+import numpy as np
 
 from ..errors import InputError
 from .limits import LOCKING_NU
@@ -53,6 +72,29 @@ def volumetric_form(volumetric: str, nu: float) -> str:
 def lame(nu: float) -> tuple:
     """``(lambda, mu)`` of plane strain for E = 1 (module docstring)."""
     return nu / ((1 + nu) * (1 - 2 * nu)), 1.0 / (2 * (1 + nu))
+
+
+def atol_scale(nu: float) -> float:
+    """Factor on the SNES absolute tolerance of the body at ``nu``: the round-off of the
+    residual K u grows with the largest modulus lambda + 2 mu (E = 1), so an absolute
+    tolerance that the solver reaches at nu = 0.45 is below the round-off near nu = 1/2
+    (1e-12 at nu = 0.49999: a warm-started VI step ran to DIVERGED_MAX_IT at |F| ~ 3e-12,
+    review of round 2, session 28). ``(lambda + 2 mu)(nu) / (lambda + 2 mu)(0.45)``,
+    at least 1, so that nothing changes up to :data:`LOCKING_NU`."""
+    lam, mu = lame(nu)
+    lam0, mu0 = lame(LOCKING_NU)
+    return max(1.0, (lam + 2 * mu) / (lam0 + 2 * mu0))
+
+
+def nodal_average(cells, areas, values, n_nodes: int):
+    """The lumped L2 projection of a cell-wise constant field on continuous P1:
+    ``theta_i = sum_c values_c A_c / 3 / sum_c A_c / 3`` over the triangles ``c`` at node
+    ``i`` (``cells`` (C, 3) node indices, ``areas`` (C,), ``values`` (C,)); the nodal
+    form's div u (module docstring) when ``values`` is the cell div u."""
+    corner = np.repeat(np.asarray(areas, dtype=float) / 3.0, 3)
+    mass = np.bincount(cells.ravel(), corner, minlength=n_nodes)
+    weighted = np.bincount(cells.ravel(), corner * np.repeat(values, 3), minlength=n_nodes)
+    return weighted / np.where(mass > 0, mass, 1.0)
 
 
 def stiffness_matrix(V, nu: float, bcs, form: str):
@@ -80,25 +122,30 @@ def stiffness_matrix(V, nu: float, bcs, form: str):
         return K
     if form != "nodal":
         raise InputError(f"form must be 'element' or 'nodal', got {form!r}")
-    K_mu = assemble_matrix(fem.form(2 * mu * ufl.inner(eps(u), eps(v)) * ufl.dx), bcs=bcs)
-    K_mu.assemble()
     Q = fem.FunctionSpace(V.mesh, ("CG", 1))
     q = ufl.TestFunction(Q)
+    K_mu = assemble_matrix(fem.form(2 * mu * ufl.inner(eps(u), eps(v)) * ufl.dx), bcs=bcs)
     # B with the Dirichlet columns zeroed (the bcs act on V, the trial space), so that
     # B^T M_L^-1 B has zero rows and columns there and K keeps K_mu's unit diagonal
     B = assemble_matrix(fem.form(q * ufl.div(u) * ufl.dx), bcs=bcs)
-    B.assemble()
     areas = assemble_vector(fem.form(q * ufl.dx))
-    areas.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    areas.reciprocal()
-    scaled = B.copy()
+    scaled = K = None
     try:
+        K_mu.assemble()
+        B.assemble()
+        areas.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        areas.reciprocal()
+        scaled = B.copy()
         scaled.diagonalScale(L=areas)                         # M_L^-1 B
         K = B.transposeMatMult(scaled)                        # B^T M_L^-1 B
+        K.scale(lam)
+        K.axpy(1.0, K_mu, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    except Exception:
+        if K is not None:
+            K.destroy()
+        raise
     finally:
-        for obj in (scaled, B, areas):
-            obj.destroy()
-    K.scale(lam)
-    K.axpy(1.0, K_mu, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    K_mu.destroy()
+        for obj in (scaled, B, areas, K_mu):
+            if obj is not None:
+                obj.destroy()
     return K
