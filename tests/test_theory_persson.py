@@ -163,6 +163,24 @@ def test_critical_junction(surface):
     assert critical_junction(wide, E_STAR, 0.05 * E_STAR * gbar, dp, eta).geometry_factor == 2.0
 
 
+def test_critical_junction_below_threshold_at_the_first_wavenumber(surface):
+    """When A(q, p) is below A_c already at the first wavenumber (light loads), A crossed
+    A_c inside the first band: the junction carries p / A_c and all the roughness, so u_c
+    is Persson's u(p / A_c) and Q falls with the load. The junction was loaded by p /
+    A(q_0) before, with A(q_0) ~ p at light load: Q did not change over decades of p
+    (3.6e-24 m^3/s from 1 MPa to 1 GPa on di-1.di, a user's review)."""
+    gbar = stats.rms_slope(surface)
+    loads = np.array([1e-4, 1e-3, 1e-2]) * E_STAR * gbar
+    res = [critical_junction(surface, E_STAR, p, 1e5, 1e-3) for p in loads]
+    for p, r in zip(loads, res):
+        assert r.q_c == res[0].q_c < 2 * (2 * np.pi / 1e-3)     # the first wavenumber
+        assert r.area_fraction_c == 0.42 and r.pressure_c == pytest.approx(p / 0.42, rel=1e-14)
+        assert r.u_c == pytest.approx(persson(surface, E_STAR, p / 0.42).mean_gap[0],
+                                      rel=1e-12, abs=0)
+    q = [r.leak_rate for r in res]
+    assert q[0] > 1.05 * q[1] > 1.05 ** 2 * q[2], q
+
+
 @pytest.mark.parametrize("kwargs, match", [
     (dict(mean_pressure=-1.0), "mean_pressure"),
     (dict(mean_pressure=np.nan), "mean_pressure"),

@@ -45,7 +45,8 @@ class CriticalJunction:
         p (Pa).
     q_c : float
         Wavenumber at which A(q, p) falls to the percolation threshold (rad/m); NaN when
-        the contact still percolates at full magnification (sealed: u_c = Q = 0).
+        the contact still percolates at full magnification (sealed: u_c = Q = 0); the
+        first wavenumber (an upper bound) when A is below A_c already there.
     area_fraction_c : float
         A(q_c, p) (-).
     pressure_c : float
@@ -146,7 +147,18 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
                                 sealed=True, **common)
     k = int(below[0])
     if k == 0:
-        q_c, a_c = float(q[0]), float(a[0])
+        # A < A_c already at the first wavenumber: A(q) falls from 1 (no roughness
+        # resolved) to a[0] within the first band, so it crosses A_c there; the junction
+        # carries p / A_c and all the roughness lies below its scale. (Until round 2,
+        # session 28 the junction was loaded by p / a[0]: at light load a[0] ~ p, so
+        # p_c, u_c and Q stopped depending on p -- 3.6e-24 m^3/s from 1 MPa to 1 GPa on
+        # di-1, 200x below Reynolds.) q_c is reported as q[0], its upper bound.
+        q_c, a_c = float(q[0]), threshold
+        p_c = p / a_c
+        u_c = float(mean_separation(q, power, e, p_c, gamma, q2=q2)[0])
+        leak = geometry_factor * dp / eta * u_c ** 3 / 12.0
+        return CriticalJunction(q_c=q_c, area_fraction_c=a_c, pressure_c=p_c, u_c=u_c,
+                                leak_rate=leak, sealed=False, **common)
     else:   # log-linear interpolation of A(q) between the bracketing wavenumbers
         t = (a[k - 1] - threshold) / (a[k - 1] - a[k])
         q_c = float(np.exp(np.log(q[k - 1]) + t * (np.log(q[k]) - np.log(q[k - 1]))))
