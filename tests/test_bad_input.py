@@ -215,12 +215,26 @@ def test_a_legal_249_character_output_name_works(tmp_path, capsys):
 
 
 def test_a_strain_far_beyond_the_half_space_is_warned(tmp_path, capsys):
-    """Non-periodic 100 um patch at p = 1e12 Pa: Delta of centimetres, a warning (the
-    numbers are returned: the half-space model is solved as asked)."""
+    """Non-periodic 100 um patch at p = E*/2: Delta of tens of micrometres, a strain of
+    ~0.4, a warning (the numbers are returned: the half-space model is solved as asked).
+    A mean pressure above E* or an approach above the lateral size is refused before any
+    solve (a user's E in GPa, --E 210, ran 10 minutes to a NoConvergenceError; a 1 m
+    approach on a 0.5 um window ran without end)."""
     path = _surface(tmp_path, periodic=False, n=16)
-    assert main(["contact", str(path), "--E", "1e9", "--pressure", "1e12", "--tol", "1e-8",
+    assert main(["contact", str(path), "--E", "1e9", "--pressure", "5e8", "--tol", "1e-8",
                  "-o", str(tmp_path / "o"), "--no-figures"]) == 0
     err = capsys.readouterr().err
     assert "warning" in err and "not physical" in err
     delta = json.loads((tmp_path / "o" / "results.json").read_text())["steps"][0]["delta"]
-    assert 0.05 < delta < 0.15                                  # ~8 cm on a 100 um patch
+    assert 2e-5 < delta < 8e-5                                  # ~40 um on a 100 um patch
+    for cmd, extra, words in (
+            ("contact", ["--pressure", "1e12"], ["mean pressure 1e+12 Pa is 1e+03 x E* = 1e+09 Pa",
+                                                 "is --E in Pa?"]),
+            ("leak", ["--pressure", "1e6", "2e9"], ["mean pressure 2e+09 Pa is 2 x E*"]),
+            ("contact", ["--delta", "1"], ["approach 1 m is 1e+04 x the smallest lateral size "
+                                           "0.0001 m", "is --delta in metres?"])):
+        assert main([cmd, str(path), "--E", "1e9", *extra, "-o", str(tmp_path / "x"),
+                     "--no-figures"]) == 2
+        err = capsys.readouterr().err
+        assert all(w in err for w in words), err
+        assert not (tmp_path / "x").exists()

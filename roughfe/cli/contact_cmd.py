@@ -28,7 +28,8 @@ from ..theory import beside, pastewka_robbins
 from ..writers import write_json
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
-                      add_surface_options, check_small_strain, contact_physics_from_args,
+                      add_surface_options, check_load_magnitudes, check_small_strain,
+                      contact_physics_from_args,
                       fmt_or_dash, material_from_args, output_folder_of, positive_float,
                       positive_int, print_surface_notes, surface_from_args, unit_fraction)
 
@@ -99,6 +100,7 @@ def _run(args) -> int:
                              f"read as periodic (drop --mirror, or give --non-periodic)")
         surface = surface.mirrored()
     material = material_from_args(args)
+    check_load_magnitudes(surface, material, args.pressure, args.delta)
     law = contact_physics_from_args(args)["adhesion"]
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
     adhesive = None

@@ -24,7 +24,8 @@ from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
-                      add_surface_options, check_small_strain, contact_physics_from_args,
+                      add_surface_options, check_load_magnitudes, check_small_strain,
+                      contact_physics_from_args,
                       material_from_args, nonnegative_int, output_folder_of, positive_float,
                       fmt_or_dash, log_of, positive_int, print_surface_notes,
                       show_progress, surface_from_args)
@@ -221,6 +222,7 @@ def _leak_run(args, surface, material, out):
     from ..theory import beside
 
     p_in, p_out = _fluid_pressures(args)
+    check_load_magnitudes(surface, material, args.pressure, args.delta)
     physics = contact_physics_from_args(args)
     if physics["adhesion"] is not None and not args.fsi:   # (--fsi refuses --adhesion itself)
         from ..bem.adhesive_rules import check_adhesive_run

@@ -439,6 +439,33 @@ def warn(args, message: str) -> None:
 SMALL_STRAIN_LIMIT = 0.1
 
 
+def check_load_magnitudes(surface, material, pressures=None, deltas=None) -> None:
+    """Refuse, before any solve, loads that no elastic half-space can mean: a mean
+    pressure above E* (strains ~ p / E* >= 1: mostly E given in GPa or MPa as if in Pa)
+    and an approach larger than the surface's smallest lateral size (a strain above 1:
+    mostly a length in the wrong unit). Such a run took 10 minutes to a
+    NoConvergenceError (``--E 210`` at 100 MPa) or ran without end (``--delta 1`` on a
+    0.5 um window; a user's review, round 2, session 28). The milder case, an approach
+    above 10 % of the size, is warned of after the solve (:func:`check_small_strain`)."""
+    from ..errors import InputError
+
+    e_star = material.E_star
+    if pressures is not None and len(pressures):
+        p = max(float(v) for v in pressures)
+        if p > e_star:
+            raise InputError(
+                f"mean pressure {p:.4g} Pa is {p / e_star:.3g} x E* = {e_star:.4g} Pa (from "
+                f"E = {material.E:.4g} Pa, nu = {material.nu:g}): the elastic half-space "
+                f"needs p << E* (its strains are ~ p / E*); is --E in Pa?")
+    if deltas is not None and len(deltas):
+        d, length = max(abs(float(v)) for v in deltas), min(surface.size)
+        if d > length:
+            raise InputError(
+                f"approach {d:.4g} m is {d / length:.3g} x the smallest lateral size "
+                f"{length:.4g} m of the surface: a strain above 1, beyond the elastic "
+                f"half-space; is --delta in metres?")
+
+
 def check_small_strain(args, surface, deltas, material, pressures) -> None:
     """Warn when the largest approach exceeds 10 % of the smallest lateral size.
 
