@@ -258,6 +258,15 @@ def test_genome_chromosomes_command(tmp_path, capsys):
     assert main(["genome", "chromosomes", str(path), "--gamma", "20", "-o",
                  str(tmp_path / "bad")]) == 2
     assert "gamma" in capsys.readouterr().err
+    # two steps difference K(p) into one secant: every curve flat, every c_n 0, all bands
+    # "micro" and a success (a user's review); refused before the decomposition
+    for steps in ("1", "2"):
+        assert main(["genome", "chromosomes", str(path), "--steps", steps, "--E", "1e9",
+                     "-o", str(tmp_path / "two")]) == 2
+        assert "--steps must be 0 (the decomposition only) or >= 3" in capsys.readouterr().err
+    assert not (tmp_path / "two").exists()
+    with pytest.raises(InputError, match="n_steps must be >= 3"):
+        band_mechanics(band_chromosomes(s, 2.0), youngs_modulus=1e9, n_steps=2)
     assert not (tmp_path / "bad").exists()
     # a band sweep that does not converge: exit 1 (it exited 0 with the band counted as
     # a flat micro band) and macro_micro.json says success false

@@ -266,6 +266,12 @@ def _chromosomes(args) -> int:
     from ..genomics.band_mechanics import band_macro_micro, band_mechanics
     from ..genomics.bands import band_chromosomes
     from ..writers import atomic_path, write_json
+    from ..errors import InputError
+    if args.steps in (1, 2):
+        raise InputError(f"--steps must be 0 (the decomposition only) or >= 3, got "
+                         f"{args.steps}: K(p) is differenced over the steps, and "
+                         f"{args.steps} give(s) at most one secant (every curve flat, no "
+                         f"macro/micro split)")
     surface = surface_from_args(args)
     material = material_from_args(args)
     bands = band_chromosomes(surface, args.gamma, detrend=args.detrend)
@@ -457,7 +463,8 @@ def register(sub):
                    help="band ratio q_{n+1}/q_n (the genome's gamma when known)")
     add_material_options(p)
     p.add_argument("--steps", type=nonnegative_int, default=20,
-                   help="equal approaches per A(p), K(p) curve (0: decomposition only)")
+                   help="equal approaches per A(p), K(p) curve, >= 3 (K is differenced "
+                        "over them; 0: decomposition only)")
     p.add_argument("--threshold", type=unit_fraction, default=0.95,
                    help="Alg. 2: c_n of K(p) above which a band is macro-scale roughness "
                         "(checked before the sweeps)")

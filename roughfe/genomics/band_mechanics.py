@@ -60,8 +60,13 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
 
     Progress is reported through :func:`roughfe.progress.iterate` ("band sweeps").
     """
-    if int(n_steps) < 2:
-        raise InputError(f"n_steps must be >= 2 (a curve needs two points), got {n_steps!r}")
+    if int(n_steps) < 3:
+        # K(p) is the central difference over the steps (sweep_curve "fd"): two steps give
+        # one secant, every K curve flat, every c_n of Alg. 2 zero (all bands "micro",
+        # reported as a success: a user's review, round 2, session 28)
+        raise InputError(f"n_steps must be >= 3: K(p) is differenced over the steps, and "
+                         f"{n_steps!r} give(s) at most one secant (every K curve flat, c_n "
+                         f"undefined), got {n_steps!r}")
     if response is None:
         def response(s):
             return profile_response(s, youngs_modulus=youngs_modulus, poisson=poisson,

@@ -239,7 +239,7 @@ def band_chromosomes(surface: Surface, gamma: float = DEFAULT_GAMMA, *, q1=None,
         raise InputError("the surface is flat after detrending: it has no chromosomes")
     if detrend == "none" and abs(float(h.mean())) > 1e-9 * scale:
         raise InputError(f"the heights have a mean of {h.mean():.3g} m: the q = 0 mode belongs "
-                         "to no band; use detrend='mean' or 'plane'")
+                         "to no band; use detrend='mean' or 'plane' (CLI: --detrend mean or plane)")
     if detrend != "none":     # round-off of the detrending, so that the bands sum exactly
         surf = surf.with_heights(h - h.mean())
         h = surf.heights
