@@ -153,6 +153,8 @@ def test_contact_mirror_solves_the_mirrored_window(tmp_path, capsys):
     k_m = [s["stiffness"] for s in docs["m"]["steps"]]
     k_w = [s["stiffness"] for s in docs["w"]["steps"]]
     assert all(a > b for a, b in zip(k_m, k_w)), (k_m, k_w)
-    capsys.readouterr()
+    out = capsys.readouterr().out
+    assert out.count("--mirror: the fields and the load, contact area and contact count are "
+                     "of the mirrored period") == 1
     assert main(["contact", str(mirrored), "--mirror", *args, "-o", str(tmp_path / "x")]) == 2
     assert "--mirror mirrors a non-periodic window" in capsys.readouterr().err

@@ -171,8 +171,13 @@ def _run(args) -> int:
     for s, k in zip(sweep.to_records(), sweep.stiffness):
         # inf at full periodic contact; "-" where it was not computed (adhesion)
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
-        print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.4f} "
+        print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
               f"{k} {s['mean_gap']:12.4e} {s['iterations']:5d}")
+    if args.mirror:
+        print("--mirror: the fields and the load, contact area and contact count are of the "
+              "mirrored period (2 (n - 1) points per axis, "
+              f"{2 ** surface.ndim}x the window's area); p, A*, K and the gaps are the "
+              "window's")
     window = doc["derived"].get("window_compliance")
     if window is not None:     # a measured (non-periodic) window: K includes its bulk
         share = sorted({round(v, 2) for v in doc["derived"]["bulk_share"] if v is not None})

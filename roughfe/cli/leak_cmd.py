@@ -131,26 +131,26 @@ def _leak(args) -> int:
         sweep, steps, written = _leak_run(args, surface, material, out)
     print_surface_notes(args, surface)
     if args.fsi:
-        print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>7} {'fluid':>6} {'trap':>6} "
+        print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>8} {'fluid':>6} {'trap':>6} "
               f"{'iter':>5} "
               f"{'Q (m^3/s)':>11} {'Q one-way':>11} {'u_c (m)':>10}")
         for s in steps:
             print(f"{s['step']:>4} {s['external_pressure']:>11.4g} {s['fsi_state']:>8} "
-                  f"{fmt_or_dash(s.get('area_fraction'), '.4f'):>7} {s['fluid_load_fraction']:>6.3f} "
+                  f"{fmt_or_dash(s.get('area_fraction'), '.3g'):>8} {s['fluid_load_fraction']:>6.3f} "
                   f"{s['trapped_load_fraction']:>6.3f} "
                   f"{s['coupled_iterations']:>5} {fmt_or_dash(s['leak_rate'], '.4e'):>11} "
                   f"{fmt_or_dash(s['leak_rate_one_way'], '.4e'):>11} "
                   f"{fmt_or_dash(s.get('critical_gap'), '.3e'):>10}")
         print(f"wrote {len(written)} files in {out}")
         return 0 if sweep.success else 1
-    print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>7} {'Vp*':>9} {'Vnp*':>9} "
+    print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>8} {'Vp*':>9} {'Vnp*':>9} "
           f"{'perc x/y':>8} {'Q (m^3/s)':>11}")
     for s in steps:
         q = s["leak_rate"]
         print(f"{s['step']:>4} {s['delta']:>11.4e} {s['mean_pressure']:>10.4g} "
-              f"{s['area_fraction']:>7.4f} {s['percolating_volume_star'] or 0:>9.3e} "
+              f"{s['area_fraction']:>8.3g} {s['percolating_volume_star'] or 0:>9.3e} "
               f"{s['trapped_volume_star'] or 0:>9.3e} "
-              f"{str(s['percolates_x'])[0]}/{str(s['percolates_y'])[0]:>6} "
+              f"{str(s['percolates_x'])[0] + '/' + str(s['percolates_y'])[0]:>8} "
               f"{fmt_or_dash(q, '.4e'):>11}")
     print(f"wrote {len(written)} files in {out}")
     return 0 if sweep.success else 1
