@@ -158,3 +158,21 @@ def test_contact_mirror_solves_the_mirrored_window(tmp_path, capsys):
                      "of the mirrored period") == 1
     assert main(["contact", str(mirrored), "--mirror", *args, "-o", str(tmp_path / "x")]) == 2
     assert "--mirror mirrors a non-periodic window" in capsys.readouterr().err
+
+
+def test_heights_or_size_in_the_wrong_unit_are_warned(tmp_path, capsys, topographies_dir):
+    """A plain matrix of heights in um read as metres (rms slope ~1e6) and a --size in nm
+    given as if in metres were accepted without a word (a user's review): both are
+    warned, once; the measured files themselves (rms slope up to 0.77) are not."""
+    heights = np.random.default_rng(0).normal(size=(32, 32))         # "um", read as m
+    path = tmp_path / "h_um.csv"
+    np.savetxt(path, heights, delimiter=",")
+    assert main(["info", str(path), "--size", "1e-4"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("warning: rms slope") == 1 and "are the heights in metres" in err
+    di = topographies_dir / "di-1.di"
+    assert main(["info", str(di), "--size", "500"]) == 0
+    err = capsys.readouterr().err
+    assert "--size 500 x 500 m differs 1e+09x from the file's own size 5e-07 x 5e-07 m" in err
+    assert main(["info", str(di)]) == 0
+    assert "warning" not in capsys.readouterr().err

@@ -153,6 +153,7 @@ def surface_from_args(args):
     if size is not None and len(size) == 1:
         size = size[0]
     surface = load_surface(args.surface, size=size, periodic=args.periodic, channel=args.channel)
+    _warn_units(args, surface)
     detrend = getattr(args, "detrend", "none")
     if detrend == "mean" and not surface.periodic:
         _warn_tilt(args, surface)
@@ -194,6 +195,38 @@ def print_surface_notes(args, surface, channel: bool = False) -> None:
     """Print :func:`surface_notes` on stdout, each as ``SURFACE: note``."""
     for note in surface_notes(surface, channel):
         print(f"{args.surface}: {note}")
+
+
+#: rms slope above which the heights are said to be out of the half-space's range (and
+#: probably in another unit than metres: heights in um read as m give ~1e6)
+SLOPE_LIMIT = 1.0
+#: factor between --size and the size an instrument file states beyond which both are said
+SIZE_RATIO_LIMIT = 100.0
+
+
+def _warn_units(args, surface) -> None:
+    """Warn (stderr) of the two unit mistakes a review found accepted without a word: an
+    rms slope above :data:`SLOPE_LIMIT` (a plain matrix of heights in um read as m had
+    rms slope 1.3e6 and ran to a mean gap of 3 m), and a ``--size`` that differs from the
+    instrument file's own size by more than :data:`SIZE_RATIO_LIMIT` (``--size 500`` for
+    500 nm on an AFM file: a 500 m scan)."""
+    from ..surfaces.stats import rms_slope
+
+    in_file = surface.metadata.get("size_in_file")
+    if in_file:
+        ratio = max(max(a / b, b / a) for a, b in zip(surface.size, in_file) if a > 0 and b > 0)
+        if ratio > SIZE_RATIO_LIMIT:
+            warn(args, f"--size {' x '.join(f'{v:.4g}' for v in surface.size)} m differs "
+                       f"{ratio:.3g}x from the file's own size "
+                       f"{' x '.join(f'{v:.4g}' for v in in_file)} m: --size is in metres")
+    try:
+        slope = rms_slope(surface)
+    except Exception:       # noqa: BLE001 -- a flat or degenerate surface: no slope to judge
+        return
+    if slope > SLOPE_LIMIT:
+        warn(args, f"rms slope {slope:.3g} > {SLOPE_LIMIT:g}: beyond the small slopes of the "
+                   f"elastic half-space" + (" -- far beyond: are the heights in metres and "
+                                            "the size (--size) in metres?" if slope > 100 else ""))
 
 
 def _warn_tilt(args, surface) -> None:
