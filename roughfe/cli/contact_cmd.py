@@ -167,12 +167,13 @@ def _run(args) -> int:
         write_json(out / "results.json", doc)  # last: the run is complete
     print_surface_notes(args, surface)
     print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} {'K (Pa/m)':>12s} {'gap (m)':>12s} "
-          f"{'nit':>5s}")
-    for s, k in zip(sweep.to_records(), sweep.stiffness):
+          f"{'nit':>5s} {'A* Persson':>10s}")
+    for s, k, t in zip(sweep.to_records(), sweep.stiffness, doc["steps"]):
         # inf at full periodic contact; "-" where it was not computed (adhesion)
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
-              f"{k} {s['mean_gap']:12.4e} {s['iterations']:5d}")
+              f"{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
+              f"{fmt_or_dash(t.get('persson_area_fraction'), '.3g'):>10s}")
     if args.mirror:
         print("--mirror: the fields and the load, contact area and contact count are of the "
               "mirrored period (2 (n - 1) points per axis, "
