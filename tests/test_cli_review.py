@@ -36,7 +36,8 @@ def test_adhesive_contact_table_prints_no_stiffness_where_none_was_computed(
                  "--no-figures", "-o", str(tmp_path / "ad")]) == 0
     out = capsys.readouterr()
     rows = [line.split() for line in out.out.splitlines()[1:3]]
-    assert all(len(r) == 6 and r[3] == "-" for r in rows), out.out
+    # (the 7th column, Persson's A*, is "-" too: the theory is non-adhesive)
+    assert all(len(r) == 7 and r[3] == "-" and r[6] == "-" for r in rows), out.out
     # the unresolved law is said once for the run, not once per solve
     assert out.err.count("warning: the md adhesion law") == 1
     steps = json.loads((tmp_path / "ad" / "results.json").read_text())["steps"]
