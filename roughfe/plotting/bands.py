@@ -94,7 +94,9 @@ def plot_band_energy(bands, path) -> Path:
     share = bands.energy / bands.energy.sum()
     ax.bar(np.arange(bands.n_chromosomes), 100 * share, color="tab:blue")
     ax.set_xticks(np.arange(bands.n_chromosomes))
-    ax.set_xticklabels([f"{n}\n{c:.3g}" for n, c in zip(bands.indices, centre)], fontsize=7)
+    # rotated, 2 significant digits: 19 bands of di-1 ran together as "0.009290.00657..."
+    ax.set_xticklabels([f"{n}: {c:.2g}" for n, c in zip(bands.indices, centre)], fontsize=7,
+                       rotation=60, ha="right", rotation_mode="anchor")
     ax.set_xlabel("band n / centre wavelength (um)")
     ax.set_ylabel("share of <h^2> (%)")
     ax.set_title(f"variance budget of {bands.n_chromosomes} bands (gamma = {bands.gamma:.4g}, "
