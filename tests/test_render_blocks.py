@@ -8,7 +8,8 @@ from roughfe.plotting.common import (MAX_RENDER_POINTS, block_centres, block_mea
                                      render_blocks)
 
 
-@pytest.mark.parametrize("shape", [(2048, 2048), (1030, 700), (300, 5000), (17, 9)])
+@pytest.mark.parametrize("shape", [(2048, 2048), (1030, 700), (300, 5000), (17, 9),
+                                   (640, 480)])
 def test_blocks_conserve_sums_and_are_exact_on_planes(shape):
     rng = np.random.default_rng(0)
     a = rng.normal(size=shape)
@@ -25,6 +26,9 @@ def test_blocks_conserve_sums_and_are_exact_on_planes(shape):
                                rtol=1e-12, atol=1e-12)
     if max(shape) <= MAX_RENDER_POINTS:           # small grids are drawn point by point
         np.testing.assert_array_equal(block_means(a, blocks), a)
+    # square blocks: one step on every axis (640 x 480 was drawn as 2 x 1 blocks)
+    steps = {int(b[1] - b[0]) for b in blocks if len(b) > 1}
+    assert len(steps) <= 1
 
 
 def test_a_large_contact_render_is_drawn_from_blocks(tmp_path):

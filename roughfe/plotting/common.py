@@ -79,9 +79,12 @@ MAX_RENDER_POINTS = 512
 
 
 def render_blocks(shape, max_points=MAX_RENDER_POINTS) -> tuple:
-    """Start index of every display block per axis: blocks of ceil(n / max_points) points
-    (the last one may be shorter); one point per block when the axis fits."""
-    return tuple(np.arange(0, n, -(-n // max_points)) for n in shape)
+    """Start index of every display block per axis: square blocks of ceil(n / max_points)
+    points of the longest axis, the same on every axis (the last one may be shorter); one
+    point per block when every axis fits. (Until round 2, session 28 each axis had its
+    own factor: 640 x 480 points were drawn as 320 x 480 blocks of 2 x 1 points.)"""
+    step = max(-(-n // max_points) for n in shape)
+    return tuple(np.arange(0, n, step) for n in shape)
 
 
 def block_sums(a, blocks) -> np.ndarray:

@@ -263,13 +263,21 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     pressure = np.where(in_contact, p_sum / n_contact * MPA, np.nan)
     grid["pressure (MPa)"] = pressure.ravel(order="F")
     plotter = offscreen_plotter(window_size=window_size)
-    # no block in contact: a fixed range (an all-NaN one labelled the bar "nan" and made
-    # vtk warn "All-NaN axis encountered")
+    # the colour range ends at the 99th percentile of the contact pressures: contact
+    # pressures are heavy-tailed (max / median 16-20 on the measured files), and with the
+    # full range 72-77 % of the contact points fell in its lowest tenth, every patch one
+    # colour (a user's review). No block in contact: a fixed range (an all-NaN one
+    # labelled the bar "nan" and made vtk warn "All-NaN axis encountered").
+    shown = pressure[in_contact]
+    top = float(np.percentile(shown, 99)) if shown.size else 1.0
+    clipped = shown.size and float(shown.max()) > top > 0
     plotter.add_mesh(grid, scalars="pressure (MPa)", cmap="plasma", smooth_shading=True,
-                     nan_color="lightgrey", clim=None if in_contact.any() else (0.0, 1.0),
+                     nan_color="lightgrey", clim=(0.0, top if top > 0 else 1.0),
                      scalar_bar_args=side_bar("pressure (MPa)"))
     label = (title or "") + (f"\n{_state_label(result)} (free area grey), vertical "
-                             f"x{exaggeration:.3g}" + decimation_note(h.shape, z.shape))
+                             f"x{exaggeration:.3g}" + decimation_note(h.shape, z.shape)
+                             + (f"; colours to the 99th percentile, {top:.3g} MPa (max "
+                                f"{float(shown.max()):.3g})" if clipped else ""))
     plotter.add_text(label.strip(), position="upper_left", font_size=10)
     plotter.set_background("white")
     plotter.camera_position = "iso"
