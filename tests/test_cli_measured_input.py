@@ -176,3 +176,15 @@ def test_heights_or_size_in_the_wrong_unit_are_warned(tmp_path, capsys, topograp
     assert "--size 500 x 500 m differs 1e+09x from the file's own size 5e-07 x 5e-07 m" in err
     assert main(["info", str(di)]) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+def test_an_option_of_another_command_is_named_by_the_command(tmp_path, capsys):
+    """`roughfe leak ... --mirror` (an option of `contact`) was refused by the top parser,
+    "roughfe: error: unrecognized arguments: --mirror (see `roughfe --help`)": now the
+    command that did not know it says so and points at its own help."""
+    assert main(["leak", str(tmp_path / "s.npz"), "--mirror", "--pressure", "1e6",
+                 "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err == ("roughfe leak: error: unrecognized arguments: --mirror (see `roughfe leak "
+                   "--help`)\n")
+    assert not (tmp_path / "o").exists()

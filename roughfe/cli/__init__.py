@@ -94,11 +94,19 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command_of(argv))
     try:
-        args = parser.parse_args(argv)
+        args, extra = parser.parse_known_args(argv)
     except SystemExit as exc:  # --help, --version, or a parse error (one line, exit 2)
         return int(exc.code or 0)
     except BrokenPipeError:    # `roughfe CMD --help | head`
         return _reader_left()
+    if extra:    # said by the command that did not know them (argparse's top parser
+        # said "roughfe: ... (see `roughfe --help`)" for `roughfe leak ... --mirror`)
+        cmd = " ".join(["roughfe"] + [str(getattr(args, k)) for k in (
+            "command", "genome_command", "db_command", "study_command")
+            if getattr(args, k, None)])
+        print(f"{cmd}: error: unrecognized arguments: {' '.join(extra)} (see `{cmd} "
+              f"--help`)", file=sys.stderr)
+        return 2
     from .._runtime import python_signals_for_petsc
     python_signals_for_petsc()   # a closed stdout is exit 141, not PETSc's abort (exit 59)
     if getattr(args, "renders_with_dolfinx", False) and not getattr(args, "no_figures", False):
