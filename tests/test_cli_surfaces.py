@@ -81,6 +81,9 @@ def test_generate_png_and_info(tmp_path, capsys):
     info = json.loads(capsys.readouterr().out)
     assert info["statistics"]["rms_height"] == pytest.approx(1e-6, rel=1e-9, abs=0)
     assert info["statistics"]["periodic"] is True
+    # units of every dimensional number (none until round 2, session 28: m4 1e10 of what?)
+    assert info["units"]["rms_height"] == "m" and info["units"]["m4"] == "1/m^2"
+    assert set(info["statistics"]) - set(info["units"]) == {"ndim", "periodic", "hurst_success"}
     assert main(["info", str(out)]) == 0
     assert "rms height" in capsys.readouterr().out
 

@@ -28,6 +28,15 @@ _TABLE = (
 )
 
 
+#: SI units of the statistics in ``info --json`` ("1": dimensionless)
+STATISTICS_UNITS = {"shape": "points", "size": "m", "mean": "m", "rms_height": "m",
+                    "rms_slope": "1", "rms_curvature": "1/m", "peak_to_valley": "m",
+                    "skewness": "1", "kurtosis": "1", "m0": "m^2", "m2": "1", "m4": "1/m^2",
+                    "nayak_alpha": "1", "hurst": "1 (meaningful when hurst_success)",
+                    "fractal_dimension": "1 (meaningful when hurst_success)",
+                    "hurst_q_range": "rad/m"}
+
+
 def format_table(stats: dict) -> str:
     """Plain-text table of a ``SurfaceStatistics.as_dict()``."""
     lines = []
@@ -58,7 +67,8 @@ def _info(args) -> int:
     surface = surface_from_args(args)
     stats = surface_statistics(surface).as_dict()
     if args.json:
-        print(to_json_text({"file": str(args.surface), "statistics": stats,
+        units = {k: v for k, v in STATISTICS_UNITS.items() if k in stats}
+        print(to_json_text({"file": str(args.surface), "statistics": stats, "units": units,
                             "metadata": dict(surface.metadata)}))
     else:
         print(f"{args.surface}: {surface!r}")
