@@ -152,6 +152,10 @@ def _leak(args) -> int:
               f"{s['trapped_volume_star'] or 0:>9.3e} "
               f"{str(s['percolates_x'])[0] + '/' + str(s['percolates_y'])[0]:>8} "
               f"{fmt_or_dash(q, '.4e'):>11}")
+    p_in, p_out = _fluid_pressures(args)
+    along = "x and y (their mean)" if args.direction == "both" else args.direction
+    print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
+          f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is linear in both")
     print(f"wrote {len(written)} files in {out}")
     return 0 if sweep.success else 1
 
