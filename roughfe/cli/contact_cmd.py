@@ -26,10 +26,10 @@ from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
+from .plausibility import check_load_magnitudes, check_small_strain
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
-                      add_surface_options, check_load_magnitudes, check_small_strain,
-                      contact_physics_from_args,
+                      add_surface_options, contact_physics_from_args,
                       fmt_or_dash, material_from_args, output_folder_of, positive_float,
                       positive_int, print_surface_notes, surface_from_args, unit_fraction)
 

@@ -22,10 +22,10 @@ from ..bem.interface_law import resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
+from .plausibility import check_load_magnitudes, check_small_strain
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
-                      add_surface_options, check_load_magnitudes, check_small_strain,
-                      contact_physics_from_args,
+                      add_surface_options, contact_physics_from_args,
                       material_from_args, nonnegative_int, output_folder_of, positive_float,
                       fmt_or_dash, log_of, positive_int, print_surface_notes,
                       show_progress, surface_from_args)
