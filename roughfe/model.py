@@ -428,7 +428,10 @@ def central_differences(x, y, branch=None):
     """dy/dx along the curve y(x): the points ordered by x, then (y[i+1] - y[i-1]) /
     (x[i+1] - x[i-1]) between neighbours on the curve inside, one-sided at the ends,
     returned in the order given; NaN where the spacing is zero to round-off (1e-12 of
-    max |x|: e.g. repeated full-contact steps) or fewer than 2 points. (Until session 25
+    max |x|: e.g. repeated full-contact steps) and on a curve of fewer than 3 points: two
+    points give one secant, the derivative at neither (until round 2, session 29 both
+    points got it, and ``roughfe contact --pressure 1e7 1e8`` drew a flat K_fd beside an
+    exact K that rose 3.5x between them). (Until session 25
     the neighbours were those in the order given: loads solved as 3e5, 1e4, 1e5, 3e4,
     2e5 Pa read K = 7.3e11, 1.9e11, 6.6e11 Pa/m at 1e4, 1e5, 3e4 Pa where the exact K
     is 1.0e11, 5.3e11, 2.7e11.)
@@ -454,7 +457,7 @@ def central_differences(x, y, branch=None):
                 ext = np.concatenate([[run[0] - 1], run])
                 out[run] = central_differences(x[ext], y[ext])[1:]
         return out
-    if x.size < 2:
+    if x.size < 3:
         return out
     order = np.argsort(x, kind="stable")      # along the curve; scattered back below
     xs, ys = x[order], y[order]
@@ -487,8 +490,9 @@ class SweepResult(Frozen):
         Contact points per step.
     stiffness_fd : ndarray
         K by central finite differences of mean_pressure over delta along the curve
-        (each branch's steps ordered by delta, whatever the solve order; Pa/m); agrees
-        with the exact ``stiffness`` away from contact-set changes.
+        (each branch's steps ordered by delta, whatever the solve order; one-sided at
+        a branch's ends; NaN on a branch of fewer than 3 steps; Pa/m); agrees with the
+        exact ``stiffness`` away from contact-set changes where the steps are close.
     load_star : ndarray
         P* = p L / (E* sigma), the thesis' dimensionless load (L = size along x: the
         grid length for the BEM, the body width W for the FEM).

@@ -545,6 +545,11 @@ def test_finite_difference_stiffness_stays_on_its_branch():
     np.testing.assert_allclose(sw.stiffness_fd[4:], sw.stiffness_fd[2::-1], rtol=1e-6)
     # round-off spacing is no spacing: NaN, not a number from noise
     assert np.isnan(central_differences([1.0, 1.0 + 1e-17], [2.0, 3.0])).all()
+    # two points are one secant, the derivative at neither (round 2, session 29): NaN;
+    # from three points on, the inner point is the central difference of its neighbours
+    assert np.isnan(central_differences([1.0, 2.0], [1.0, 4.0])).all()
+    np.testing.assert_allclose(central_differences([1.0, 2.0, 3.0], [1.0, 4.0, 9.0]),
+                               [3.0, 4.0, 5.0], rtol=1e-15)
 
 
 def test_finite_difference_stiffness_is_taken_along_the_curve_whatever_the_load_order():

@@ -348,3 +348,35 @@ def test_study_run_prints_its_summary_once(tmp_path, capsys):
     assert main(["study", "run", str(spec), "--workers", "1", "-o", str(tmp_path / "o")]) == 0
     both = capsys.readouterr()
     assert (both.out + both.err).count("1 tasks: 0 already done, 1 computed") == 1
+
+
+def test_contact_warns_where_its_solution_leaves_the_model(tmp_path, capsys):
+    """A steep surface (rms slope 0.7: the AFM file di-1 has 0.77), a load whose local
+    pressure exceeds E* and a step whose contact rests on a few grid points were solved
+    without a word (a user's review, round 2, session 29). Each is now one warning line
+    that names its number; a gentle surface at a moderate load gets none of them."""
+    steep = tmp_path / "steep.npz"
+    assert main(["generate", "spectral", "--n", "64", "--seed", "3", "--rms-slope", "0.7",
+                 "--no-figures", "-o", str(steep)]) == 0
+    capsys.readouterr()
+    assert main(["contact", str(steep), "--E", "1e9", "--nu", "0.5", "--pressure", "1e5",
+                 "1e8", "--no-figures", "-o", str(tmp_path / "a")]) == 0
+    err = _error(capsys)
+    assert "warning: rms slope 0.7 > 0.5: the linear half-space assumes small slopes" in err
+    e_star = 1e9 / 0.75
+    import h5py
+    with h5py.File(tmp_path / "a" / "fields.h5", "r") as f:
+        peaks = f["pressure"][...].reshape(2, -1).max(axis=1)
+    ratio = max(peaks) / e_star
+    assert ratio > 1 and f"reaches {max(peaks):.3g} Pa = {ratio:.3g} E* (step 2)" in err
+    steps = json.loads((tmp_path / "a" / "results.json").read_text())["steps"]
+    n1 = steps[0]["n_contact"]
+    assert 0 < n1 < 32 and steps[1]["n_contact"] >= 32
+    assert f"step 1 has contact on only {n1} grid points (fewer than 32)" in err
+    gentle = tmp_path / "gentle.npz"
+    assert main(["generate", "spectral", "--n", "64", "--seed", "3", "--rms-slope", "0.1",
+                 "--no-figures", "-o", str(gentle)]) == 0
+    capsys.readouterr()
+    assert main(["contact", str(gentle), "--E", "1e9", "--nu", "0.5", "--pressure", "1e6",
+                 "--no-figures", "-o", str(tmp_path / "b")]) == 0
+    assert "warning" not in _error(capsys)

@@ -43,7 +43,7 @@ def test_stiffness_lines_follow_the_curve_when_loads_come_out_of_order(drawn):
     a zig-zag; each branch's line is drawn in order of p."""
     p = np.array([3e5, 1e4, 1e5, 3e4, 2e5])
     fig = drawn(contact_plot, "plot_area_stiffness", _records(p, p * 1e-12, p * 1e6))
-    for label in ("exact, H_cc x = 1", "finite differences"):
+    for label in ("exact, H_cc x = 1", "central differences"):
         x = _lines(fig.axes[1])[label].get_xdata()
         assert sorted(x) == list(x) and len(x) == 5
 

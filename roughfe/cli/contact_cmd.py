@@ -26,7 +26,7 @@ from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
-from .plausibility import check_load_magnitudes, check_small_strain
+from .plausibility import check_load_magnitudes, check_solution
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, contact_physics_from_args,
@@ -119,7 +119,7 @@ def _run(args) -> int:
     else:
         adhesive = _adhesive_sweep(args, surface, material, law, tol)
         sweep = adhesive.sweep
-    check_small_strain(args, surface, sweep.delta, material, sweep.mean_pressure)
+    check_solution(args, surface, sweep.results, material)
     r0 = sweep.results[0]
     inputs = {"surface": str(args.surface),
               "E": material.E, "nu": material.nu, "E_star": material.E_star,

@@ -22,7 +22,7 @@ from ..bem.interface_law import resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
-from .plausibility import check_load_magnitudes, check_small_strain
+from .plausibility import check_load_magnitudes, check_solution
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, contact_physics_from_args,
@@ -272,8 +272,7 @@ def _leak_run(args, surface, material, out):
     sweep = leakage_sweep(surface, material, deltas=args.delta, pressures=args.pressure,
                           direction=args.direction, mu=args.mu, pressure_drop=dp,
                           reynolds=not args.no_reynolds, contact_options=physics)
-    check_small_strain(args, surface, [c.delta for c in sweep.contacts], material,
-                       [c.mean_pressure for c in sweep.contacts])
+    check_solution(args, surface, sweep.contacts, material)
     theory = beside(surface, material.E_star, sweep.records(), pressure_drop=dp,
                     viscosity=args.mu, direction=args.direction,
                     adhesive=physics["adhesion"] is not None)

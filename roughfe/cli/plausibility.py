@@ -1,8 +1,10 @@
 """Physical plausibility of a command's input, checked or warned of by the commands that
 solve: heights and sizes in a wrong unit, an instrument tilt kept by ``--detrend mean``,
 loads beyond the elastic half-space (refused before the solve), and large strains
-(warned of after it). Split from :mod:`roughfe.cli.options` (round 2, session 28)."""
+(warned of after it, with the other limits of the model the solution reaches). Split from :mod:`roughfe.cli.options` (round 2, session 28)."""
 from __future__ import annotations
+
+import numpy as np
 
 from .options import warn
 
@@ -66,7 +68,7 @@ def warn_tilt(args, surface) -> None:
                    f"the longest wavelength of the roughness, use --detrend plane")
 
 
-#: Largest approach Delta / lateral size L before :func:`check_small_strain` warns.
+#: Largest approach Delta / lateral size L before :func:`check_solution` warns.
 SMALL_STRAIN_LIMIT = 0.1
 
 
@@ -77,7 +79,7 @@ def check_load_magnitudes(surface, material, pressures=None, deltas=None) -> Non
     mostly a length in the wrong unit). Such a run took 10 minutes to a
     NoConvergenceError (``--E 210`` at 100 MPa) or ran without end (``--delta 1`` on a
     0.5 um window; a user's review, round 2, session 28). The milder case, an approach
-    above 10 % of the size, is warned of after the solve (:func:`check_small_strain`)."""
+    above 10 % of the size, is warned of after the solve (:func:`check_solution`)."""
     from ..errors import InputError
 
     e_star = material.E_star
@@ -97,20 +99,58 @@ def check_load_magnitudes(surface, material, pressures=None, deltas=None) -> Non
                 f"half-space; is --delta in metres?")
 
 
-def check_small_strain(args, surface, deltas, material, pressures) -> None:
-    """Warn when the largest approach exceeds 10 % of the smallest lateral size.
+#: rms slope above which a solving command says the small-slope half-space is strained
+#: (up to :data:`SLOPE_LIMIT`, above which the unit warning speaks). The boundary-element
+#: half-space linearises the surface's geometry (the normal is taken along z and the
+#: heights as small against the lateral scales); the AFM file di-1 has 0.77.
+STEEP_SLOPE = 0.5
+#: fewest grid points in contact for which a step's A* and K are said to be resolved:
+#: fewer points form a handful of pixel-sized spots, whose area the grid cannot measure
+#: (Yastrebov et al. 2015 need tens of points per contact spot for A* within a few %)
+MIN_CONTACT_POINTS = 32
 
-    The half-space solution is linear elasticity: it assumes strains ~ Delta / L << 1.
-    A non-periodic patch of 100 um pressed to p = 1e12 Pa needs Delta ~ 8 cm, a strain
-    of 800 -- a number the solver returns but no material follows.
-    """
-    deltas = [float(d) for d in deltas]
-    if not deltas:
+
+def check_solution(args, surface, results, material) -> None:
+    """Warn (stderr, after the solve) where the solution leaves the model it was solved
+    in: an approach above :data:`SMALL_STRAIN_LIMIT` of the smallest lateral size (strains
+    ~ Delta / L), an rms slope above :data:`STEEP_SLOPE` (the linear half-space), a local
+    contact pressure above E* (local strains of order one: a hardness, ``--hardness``,
+    is the usual remedy) and steps whose contact rests on fewer than
+    :data:`MIN_CONTACT_POINTS` grid points (not resolved). ``results``: the steps'
+    ContactResults. The last three from a user's review (round 2, session 29: di-1 at
+    1 GPa reached 2.9 E* locally, and its 10 MPa step had 29 contact points)."""
+    from ..surfaces.stats import rms_slope
+
+    results = list(results)
+    if not results:
         return
-    d_max, length = max(deltas), min(surface.size)
+    e_star = material.E_star
+    d_max, length = max(float(r.delta) for r in results), min(surface.size)
     if d_max > SMALL_STRAIN_LIMIT * length:
-        p_max = max(float(p) for p in pressures)
+        p_max = max(float(r.mean_pressure) for r in results)
         warn(args, f"approach Delta = {d_max:.3g} m is {d_max / length:.3g} x the lateral size "
-                   f"{length:.3g} m (p = {p_max:.3g} Pa = {p_max / material.E_star:.3g} E*): "
+                   f"{length:.3g} m (p = {p_max:.3g} Pa = {p_max / e_star:.3g} E*): "
                    "far beyond the small strains of the elastic half-space; the result is not "
                    "physical")
+    try:
+        slope = rms_slope(surface)
+    except Exception:       # noqa: BLE001 -- a flat or degenerate surface: no slope to judge
+        slope = 0.0
+    if STEEP_SLOPE < slope <= SLOPE_LIMIT:      # above: warn_units has spoken
+        warn(args, f"rms slope {slope:.3g} > {STEEP_SLOPE:g}: the linear half-space assumes "
+                   f"small slopes (its geometry is linearised); read A* and K as that model's")
+    peak = max(float(np.max(r.pressure)) for r in results)
+    if peak > e_star:
+        k = max(range(len(results)), key=lambda i: float(np.max(results[i].pressure)))
+        warn(args, f"the local contact pressure reaches {peak:.3g} Pa = {peak / e_star:.3g} E* "
+                   f"(step {k + 1}): local strains of order one, beyond linear elasticity; "
+                   f"a real material yields first (--hardness)")
+    few = [(i + 1, int(r.n_contact)) for i, r in enumerate(results)
+           if 0 < int(r.n_contact) < MIN_CONTACT_POINTS]
+    if few:
+        more = ", ..." if len(few) > 6 else ""
+        warn(args, f"step{'s' if len(few) > 1 else ''} "
+                   f"{', '.join(str(i) for i, _ in few[:6])}{more} "
+                   f"{'have' if len(few) > 1 else 'has'} contact on only "
+                   f"{', '.join(str(n) for _, n in few[:6])}{more} grid points (fewer than "
+                   f"{MIN_CONTACT_POINTS}): A* and K there are not resolved by the grid")

@@ -130,7 +130,7 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
             ax2.loglog(p[ok2], k[ok2], mk + ls, ms=4, label="exact, H_cc x = 1" + tag)
         ok3 = _along(p, ok & on & np.isfinite(kfd) & (kfd > 0))
         if ok3.size:
-            ax2.loglog(p[ok3], kfd[ok3], "x" + ls, ms=5, label="finite differences" + tag)
+            ax2.loglog(p[ok3], kfd[ok3], "x" + ls, ms=5, label="central differences" + tag)
     if window_compliance and ax2.get_legend_handles_labels()[0]:
         ax2.axhline(MPA * 1e-6 / window_compliance, color="0.4", ls="--", lw=1,
                     label="window bulk 1/C (K is in series with it)")
