@@ -380,3 +380,31 @@ def test_contact_warns_where_its_solution_leaves_the_model(tmp_path, capsys):
     assert main(["contact", str(gentle), "--E", "1e9", "--nu", "0.5", "--pressure", "1e6",
                  "--no-figures", "-o", str(tmp_path / "b")]) == 0
     assert "warning" not in _error(capsys)
+
+
+def test_contact_table_names_its_theory_slope_plastic_share_and_every_file(
+        surface64, tmp_path, capsys):
+    """The screen says which slope "A* Persson" took (the PSD's rms gradient, which
+    differs up to 2x from the finite-difference slope of `roughfe info`), shows the
+    plastic share of A* with --hardness, and lists every file it wrote, figures included
+    (the PNGs were left out; a user's review, round 2, session 29)."""
+    from roughfe.surfaces import load_surface
+    from roughfe.surfaces.stats import rms_slope
+    out = tmp_path / "c"
+    assert main(["contact", str(surface64), "--E", "1e9", "--nu", "0.3", "--pressure",
+                 "1e6", "1e7", "--hardness", "3e7", "-o", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    doc = json.loads((out / "results.json").read_text())
+    head = next(i for i, line in enumerate(lines) if line.split()[:1] == ["delta"])
+    assert lines[head].split()[5] == "A*plastic"
+    for line, step in zip(lines[head + 1:head + 3], doc["steps"]):
+        assert float(line.split()[3]) == pytest.approx(step["plastic_area_fraction"],
+                                                       rel=5e-3)
+    assert doc["steps"][1]["plastic_area_fraction"] > 0
+    gbar = doc["derived"]["persson"]["rms_gradient"]
+    assert (f"A* Persson: Persson (2001) with gbar = {gbar:.3g}, the rms gradient of the "
+            f"surface's PSD; its rms slope by finite differences (roughfe info) is "
+            f"{rms_slope(load_surface(surface64)):.3g}") in lines
+    wrote = [line for line in lines if line.startswith("wrote ")]
+    assert wrote == ["wrote " + ", ".join(str(out / f) for f in (
+        "results.json", "fields.h5", "contact_area_stiffness.png", "contact_render.png"))]

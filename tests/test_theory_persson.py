@@ -377,3 +377,26 @@ def test_beside_evaluates_no_theory_where_the_grid_has_no_psd():
     periodic = Surface(strip.heights, strip.size, periodic=True)
     assert beside(periodic, E_STAR, steps)["steps"][0]["persson_area_fraction"] > 0
 
+
+
+def test_beside_says_when_the_heights_are_far_from_gaussian(surface):
+    """The theory's surface is Gaussian. A Gaussian surface gets its skewness and
+    kurtosis (near 0 and 3) and no note; the same surface with a few deep pits (sur-2 has
+    skewness -30: its BEM A* was 20-50x the theory's, a user's review) gets the
+    "non_gaussian" note, with its numbers, beside the theory it still evaluates."""
+    from roughfe.theory.beside import NON_GAUSSIAN
+    steps = [{"mean_pressure": 1e-3}]
+    info = beside(surface, 1.0, steps)["persson"]
+    assert abs(info["height_skewness"]) < 0.5 and abs(info["height_kurtosis"] - 3) < 0.5
+    assert "non_gaussian" not in info
+    h = surface.heights.copy()
+    sigma = float(np.std(h))
+    h.flat[::997] -= 60 * sigma                   # sparse deep pits
+    pitted = Surface(h, surface.size, periodic=surface.periodic)
+    out = beside(pitted, 1.0, steps)
+    info = out["persson"]
+    skew, kurt = stats.height_moments(pitted)
+    assert info["height_skewness"] == skew and info["height_kurtosis"] == kurt
+    assert abs(skew) > NON_GAUSSIAN["skewness"] or kurt > NON_GAUSSIAN["kurtosis"]
+    assert f"skewness {skew:.3g}, kurtosis {kurt:.3g}" in info["non_gaussian"]
+    assert out["steps"][0]["persson_area_fraction"] > 0

@@ -31,7 +31,8 @@ from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_o
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, contact_physics_from_args,
                       fmt_or_dash, material_from_args, output_folder_of, positive_float,
-                      positive_int, print_surface_notes, surface_from_args, unit_fraction)
+                      positive_int, print_surface_notes, surface_from_args, unit_fraction,
+                      warn)
 
 DEFAULT_STEPS = Loading.DEFAULT_STEPS
 #: --coarse-correction -> solve_contact(coarse_correction=)
@@ -144,6 +145,7 @@ def _run(args) -> int:
     name = Path(args.surface).name + (" (mirrored)" if args.mirror else "")
     with folder as out:
         write_fields_h5(out / "fields.h5", sweep)
+        written = [out / "results.json", out / "fields.h5"]
         if not args.no_figures:
             from ..plotting.contact import (plot_area_stiffness, plot_profile_state,
                                             render_contact)
@@ -164,16 +166,22 @@ def _run(args) -> int:
             else:
                 plot_profile_state(surface.heights, last, out / "contact_profile.png",
                                    title=name)
+            written += sorted(out.glob("*.png"))
         write_json(out / "results.json", doc)  # last: the run is complete
     print_surface_notes(args, surface)
-    print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} {'K (Pa/m)':>12s} {'gap (m)':>12s} "
-          f"{'nit':>5s} {'A* Persson':>10s}")
+    plastic = args.hardness is not None      # the plastic share of A* beside it
+    print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} "
+          + (f"{'A*plastic':>9s} " if plastic else "")
+          + f"{'K (Pa/m)':>12s} {'gap (m)':>12s} {'nit':>5s} {'A* Persson':>10s}")
     for s, k, t in zip(sweep.to_records(), sweep.stiffness, doc["steps"]):
         # inf at full periodic contact; "-" where it was not computed (adhesion)
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
+        pl = (f"{fmt_or_dash(t.get('plastic_area_fraction'), '.3g'):>9s} " if plastic
+              else "")
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
-              f"{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
+              f"{pl}{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
               f"{fmt_or_dash(t.get('persson_area_fraction'), '.3g'):>10s}")
+    _persson_line(args, surface, doc["derived"]["persson"])
     if args.mirror:
         print("--mirror: the fields and the load, contact area and contact count are of the "
               "mirrored period (2 (n - 1) points per axis, "
@@ -192,8 +200,25 @@ def _run(args) -> int:
                 f"({'detached' if adhesive.detached else 'NOT detached: a bound'})"
                 if args.unload else "pull-off force not traced (--unload traces it)")
         print(f"{pull}; {stickiness.verdict()}")
-    print(f"wrote {out / 'results.json'}, {out / 'fields.h5'}")
+    print(f"wrote {', '.join(str(w) for w in written)}")
     return 0
+
+
+def _persson_line(args, surface, persson: dict) -> None:
+    """Which slope the "A* Persson" column took (the PSD's rms gradient, which can differ
+    from the finite-difference rms slope of ``roughfe info``: 2x on sur-2, a user's
+    review), and a warning when the heights are far from Gaussian (the theory's
+    surface; :data:`roughfe.theory.beside.NON_GAUSSIAN`)."""
+    from ..surfaces.stats import rms_slope
+
+    if persson.get("rms_gradient") is None:
+        return
+    window = "" if surface.periodic else " (Hann-windowed)"
+    print(f"A* Persson: Persson (2001) with gbar = {persson['rms_gradient']:.3g}, the rms "
+          f"gradient of the surface's PSD{window}; its rms slope by finite differences "
+          f"(roughfe info) is {rms_slope(surface):.3g}")
+    if persson.get("non_gaussian"):
+        warn(args, persson["non_gaussian"])
 
 
 #: the solver's keyword phrases in its InputErrors -> this command's flags

@@ -462,12 +462,23 @@ class SurfaceStatistics:
         return to_jsonable(asdict(self))
 
 
+def height_moments(surface: Surface) -> tuple:
+    """Skewness and kurtosis of the heights about their mean (-; a Gaussian surface has
+    0 and 3), NaN for a flat surface."""
+    h = np.asarray(surface.heights, float)
+    dev = h - h.mean()
+    rq = float(np.sqrt(np.mean(dev ** 2)))
+    if not rq > 0:
+        return float("nan"), float("nan")
+    return float(np.mean(dev ** 3)) / rq ** 3, float(np.mean(dev ** 4)) / rq ** 4
+
+
 def surface_statistics(surface: Surface, q_range=None) -> SurfaceStatistics:
     """All statistics of this module for one surface (see the module docstring)."""
     _check_surface(surface)
     h = surface.heights
-    dev = h - h.mean()
     rq = rms_height(surface)
+    skewness, kurtosis = height_moments(surface)
     m0, m2, m4 = spectral_moments(surface)
     fit = fit_hurst(surface, q_range=q_range)
     return SurfaceStatistics(
@@ -475,8 +486,7 @@ def surface_statistics(surface: Surface, q_range=None) -> SurfaceStatistics:
         periodic=surface.periodic, mean=float(h.mean()), rms_height=rq,
         rms_slope=rms_slope(surface), rms_curvature=rms_curvature(surface),
         peak_to_valley=peak_to_valley(surface),
-        skewness=float(np.mean(dev ** 3) / rq ** 3) if rq > 0 else float("nan"),
-        kurtosis=float(np.mean(dev ** 4) / rq ** 4) if rq > 0 else float("nan"),
+        skewness=skewness, kurtosis=kurtosis,
         m0=m0, m2=m2, m4=m4, nayak_alpha=m0 * m4 / m2 ** 2 if m2 > 0 else float("nan"),
         hurst=fit.hurst, fractal_dimension=fit.fractal_dimension, hurst_q_range=fit.q_range,
         hurst_success=fit.success)
