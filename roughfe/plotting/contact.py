@@ -89,7 +89,11 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
         for on, mk, tag, ls in branches:
             i = _along(d, on)
             axes[3].plot(d[i], v[i], mk + ls, ms=4, label="BEM" + tag)
-        axes[3].set_xlabel("d / sigma")
+        # on a window d = max h - mean h - Delta carries the window's bulk deflection
+        # (part of Delta), so it goes below 0 under load (a user's review)
+        axes[3].set_xlabel("d / sigma" if not window_compliance else
+                           "d / sigma  (d = max h - mean h - Delta: with the window's\n"
+                           "bulk deflection in Delta, < 0 under load)")
         axes[3].set_ylabel("V* = V / (A_n sigma)")
         axes[3].set_title("free volume V*(d/sigma), Eq. 2.8")
         axes[3].grid(True, alpha=0.3)

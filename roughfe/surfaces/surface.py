@@ -198,5 +198,6 @@ class Surface:
 
     def __repr__(self):
         kind = "profile" if self.ndim == 1 else "surface"
-        return (f"Surface({kind}, shape={self.shape}, size={self.size} m, "
+        size = "(" + ", ".join(f"{v:.6g}" for v in self.size) + ("," if self.ndim == 1 else "")
+        return (f"Surface({kind}, shape={self.shape}, size={size}) m, "
                 f"periodic={self.periodic})")
