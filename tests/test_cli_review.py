@@ -368,11 +368,11 @@ def test_contact_warns_where_its_solution_leaves_the_model(tmp_path, capsys):
     with h5py.File(tmp_path / "a" / "fields.h5", "r") as f:
         peaks = f["pressure"][...].reshape(2, -1).max(axis=1)
     ratio = max(peaks) / e_star
-    assert ratio > 1 and f"reaches {max(peaks):.3g} Pa = {ratio:.3g} E* (step 2)" in err
+    assert ratio > 1 and f"reaches {max(peaks):.3g} Pa = {ratio:.3g} E* (step 1)" in err
     steps = json.loads((tmp_path / "a" / "results.json").read_text())["steps"]
     n1 = steps[0]["n_contact"]
     assert 0 < n1 < 32 and steps[1]["n_contact"] >= 32
-    assert f"step 1 has contact on only {n1} grid points (fewer than 32)" in err
+    assert f"step 0 has contact on only {n1} grid points (fewer than 32)" in err
     gentle = tmp_path / "gentle.npz"
     assert main(["generate", "spectral", "--n", "64", "--seed", "3", "--rms-slope", "0.1",
                  "--no-figures", "-o", str(gentle)]) == 0
@@ -402,9 +402,9 @@ def test_contact_table_names_its_theory_slope_plastic_share_and_every_file(
                                                        rel=5e-3)
     assert doc["steps"][1]["plastic_area_fraction"] > 0
     gbar = doc["derived"]["persson"]["rms_gradient"]
-    assert (f"A* Persson: Persson (2001) with gbar = {gbar:.3g}, the rms gradient of the "
-            f"surface's PSD; its rms slope by finite differences (roughfe info) is "
-            f"{rms_slope(load_surface(surface64)):.3g}") in lines
+    assert (f"Persson's theory beside the results (persson_* in results.json) takes gbar = "
+            f"{gbar:.3g}, the rms gradient of the surface's PSD; its rms slope by finite "
+            f"differences (roughfe info) is {rms_slope(load_surface(surface64)):.3g}") in lines
     wrote = [line for line in lines if line.startswith("wrote ")]
     assert wrote == ["wrote " + ", ".join(str(out / f) for f in (
         "results.json", "fields.h5", "contact_area_stiffness.png", "contact_render.png"))]

@@ -687,3 +687,33 @@ def test_a_direct_solve_of_the_caller_is_not_continued():
     r = solve_reynolds_fv(g, (DX, DX), mu=MU, p_in=1.0, p_out=0.0, petsc_options=lu)
     assert r.leak_rate == approx(conductance, rel=1e-6, abs=0)
     assert "continued" not in r.message and r.nit == 1
+
+
+def test_a_sweep_names_the_step_of_a_leakage_warning(monkeypatch):
+    """A Reynolds flow imbalance warned of inside a sweep said neither its step nor its
+    load (a user's review, round 2, session 29): ``leakage_sweep`` re-issues each step's
+    warnings, same category, with the step (from 0, as the records) and its p and Delta."""
+    import warnings
+
+    from roughfe.errors import FlowImbalanceWarning
+    from roughfe.leakage import analysis
+    from roughfe.model import Material
+    from roughfe.surfaces.spectral import spectral_surface
+
+    real = analysis.leakage_of_contact
+    calls = []
+
+    def warns_on_the_second(contact, **kw):
+        calls.append(contact)
+        if len(calls) == 2:
+            warnings.warn("inlet and outlet flows differ", FlowImbalanceWarning)
+        return real(contact, **kw)
+
+    monkeypatch.setattr(analysis, "leakage_of_contact", warns_on_the_second)
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=0)
+    with pytest.warns(FlowImbalanceWarning) as record:
+        sweep = analysis.leakage_sweep(s, Material(1e9, 0.3), pressures=[1e6, 1e7])
+    c = sweep.contacts[1]
+    assert [str(w.message) for w in record if w.category is FlowImbalanceWarning] == [
+        f"step 1 (p = {c.mean_pressure:.4g} Pa, Delta = {c.delta:.4g} m): inlet and outlet "
+        f"flows differ"]

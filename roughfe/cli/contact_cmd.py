@@ -26,13 +26,12 @@ from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
-from .plausibility import check_load_magnitudes, check_solution
+from .plausibility import check_load_magnitudes, check_solution, persson_basis
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, contact_physics_from_args,
                       fmt_or_dash, material_from_args, output_folder_of, positive_float,
-                      positive_int, print_surface_notes, surface_from_args, unit_fraction,
-                      warn)
+                      positive_int, print_surface_notes, surface_from_args, unit_fraction)
 
 DEFAULT_STEPS = Loading.DEFAULT_STEPS
 #: --coarse-correction -> solve_contact(coarse_correction=)
@@ -181,7 +180,7 @@ def _run(args) -> int:
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
               f"{pl}{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
               f"{fmt_or_dash(t.get('persson_area_fraction'), '.3g'):>10s}")
-    _persson_line(args, surface, doc["derived"]["persson"])
+    persson_basis(args, surface, doc["derived"]["persson"])
     if args.mirror:
         print("--mirror: the fields and the load, contact area and contact count are of the "
               "mirrored period (2 (n - 1) points per axis, "
@@ -202,23 +201,6 @@ def _run(args) -> int:
         print(f"{pull}; {stickiness.verdict()}")
     print(f"wrote {', '.join(str(w) for w in written)}")
     return 0
-
-
-def _persson_line(args, surface, persson: dict) -> None:
-    """Which slope the "A* Persson" column took (the PSD's rms gradient, which can differ
-    from the finite-difference rms slope of ``roughfe info``: 2x on sur-2, a user's
-    review), and a warning when the heights are far from Gaussian (the theory's
-    surface; :data:`roughfe.theory.beside.NON_GAUSSIAN`)."""
-    from ..surfaces.stats import rms_slope
-
-    if persson.get("rms_gradient") is None:
-        return
-    window = "" if surface.periodic else " (Hann-windowed)"
-    print(f"A* Persson: Persson (2001) with gbar = {persson['rms_gradient']:.3g}, the rms "
-          f"gradient of the surface's PSD{window}; its rms slope by finite differences "
-          f"(roughfe info) is {rms_slope(surface):.3g}")
-    if persson.get("non_gaussian"):
-        warn(args, persson["non_gaussian"])
 
 
 #: the solver's keyword phrases in its InputErrors -> this command's flags

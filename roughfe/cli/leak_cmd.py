@@ -22,7 +22,7 @@ from ..bem.interface_law import resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
-from .plausibility import check_load_magnitudes, check_solution
+from .plausibility import check_load_magnitudes, check_solution, persson_basis
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, contact_physics_from_args,
@@ -128,7 +128,7 @@ def _leak(args) -> int:
     surface = surface_from_args(args)
     material = material_from_args(args)
     with output_folder_of(args, "leak") as out:
-        sweep, steps, written = _leak_run(args, surface, material, out)
+        sweep, steps, written, persson = _leak_run(args, surface, material, out)
     print_surface_notes(args, surface)
     if args.fsi:
         print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>8} {'fluid':>6} {'trap':>6} "
@@ -141,6 +141,7 @@ def _leak(args) -> int:
                   f"{s['coupled_iterations']:>5} {fmt_or_dash(s['leak_rate'], '.4e'):>11} "
                   f"{fmt_or_dash(s['leak_rate_one_way'], '.4e'):>11} "
                   f"{fmt_or_dash(s.get('critical_gap'), '.3e'):>10}")
+        persson_basis(args, surface, persson)
         print(f"wrote {len(written)} files in {out}")
         return 0 if sweep.success else 1
     print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>8} {'Vp*':>9} {'Vnp*':>9} "
@@ -156,6 +157,7 @@ def _leak(args) -> int:
     along = "x and y (their mean)" if args.direction == "both" else args.direction
     print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
           f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is linear in both")
+    persson_basis(args, surface, persson)
     print(f"wrote {len(written)} files in {out}")
     return 0 if sweep.success else 1
 
@@ -267,7 +269,7 @@ def _leak_run(args, surface, material, out):
         steps = theory["steps"]
         written.append(write_json(out / "results.json", {"inputs": base, "steps": steps,
                                                           "persson": theory["persson"]}))
-        return sweep, steps, written
+        return sweep, steps, written, theory["persson"]
     dp = p_in - p_out
     sweep = leakage_sweep(surface, material, deltas=args.delta, pressures=args.pressure,
                           direction=args.direction, mu=args.mu, pressure_drop=dp,
@@ -304,7 +306,7 @@ def _leak_run(args, surface, material, out):
         written.append(figs.steps_figure(steps, out / "figures" / "steps.png"))
     written.append(write_json(out / "results.json", {"inputs": inputs, "steps": steps,
                                                       "persson": theory["persson"]}))
-    return sweep, steps, written
+    return sweep, steps, written, theory["persson"]
 
 
 def _leak_study(args) -> int:

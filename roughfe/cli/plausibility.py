@@ -117,7 +117,8 @@ def check_solution(args, surface, results, material) -> None:
     contact pressure above E* (local strains of order one: a hardness, ``--hardness``,
     is the usual remedy) and steps whose contact rests on fewer than
     :data:`MIN_CONTACT_POINTS` grid points (not resolved). ``results``: the steps'
-    ContactResults. The last three from a user's review (round 2, session 29: di-1 at
+    ContactResults; steps are numbered from 0, as in results.json, the ``leak`` table and
+    the fields' frames. The last three from a user's review (round 2, session 29: di-1 at
     1 GPa reached 2.9 E* locally, and its 10 MPa step had 29 contact points)."""
     from ..surfaces.stats import rms_slope
 
@@ -143,9 +144,9 @@ def check_solution(args, surface, results, material) -> None:
     if peak > e_star:
         k = max(range(len(results)), key=lambda i: float(np.max(results[i].pressure)))
         warn(args, f"the local contact pressure reaches {peak:.3g} Pa = {peak / e_star:.3g} E* "
-                   f"(step {k + 1}): local strains of order one, beyond linear elasticity; "
+                   f"(step {k}): local strains of order one, beyond linear elasticity; "
                    f"a real material yields first (--hardness)")
-    few = [(i + 1, int(r.n_contact)) for i, r in enumerate(results)
+    few = [(i, int(r.n_contact)) for i, r in enumerate(results)
            if 0 < int(r.n_contact) < MIN_CONTACT_POINTS]
     if few:
         more = ", ..." if len(few) > 6 else ""
@@ -154,3 +155,22 @@ def check_solution(args, surface, results, material) -> None:
                    f"{'have' if len(few) > 1 else 'has'} contact on only "
                    f"{', '.join(str(n) for _, n in few[:6])}{more} grid points (fewer than "
                    f"{MIN_CONTACT_POINTS}): A* and K there are not resolved by the grid")
+
+
+def persson_basis(args, surface, persson: dict) -> None:
+    """Say (stdout) which slope Persson's theory beside the results took -- the rms
+    gradient of the surface's PSD, which can differ from the finite-difference rms slope
+    of ``roughfe info`` (2x on sur-2: a user's review, round 2, session 29) -- and warn
+    when the heights are far from Gaussian, the theory's surface
+    (:data:`roughfe.theory.beside.NON_GAUSSIAN`). ``persson``: the ``"persson"`` block of
+    :func:`roughfe.theory.beside` (nothing is said without its ``rms_gradient``)."""
+    from ..surfaces.stats import rms_slope
+
+    if persson.get("rms_gradient") is None:
+        return
+    window = "" if surface.periodic else " (Hann-windowed)"
+    print(f"Persson's theory beside the results (persson_* in results.json) takes gbar = "
+          f"{persson['rms_gradient']:.3g}, the rms gradient of the surface's PSD{window}; "
+          f"its rms slope by finite differences (roughfe info) is {rms_slope(surface):.3g}")
+    if persson.get("non_gaussian"):
+        warn(args, persson["non_gaussian"])
