@@ -34,6 +34,9 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
     steps = res["steps"]
     assert len(steps) == 2 and STEP_KEYS <= set(steps[0])
     assert steps[0]["percolates_y"] is None            # not analysed
+    assert set(res["units"]) == set(steps[0])          # every key has its unit
+    for st in steps:     # the sealed part of the trapped (non-percolating) volume
+        assert 0 <= st["sealed_volume"] <= st["trapped_volume"]
     assert "stiffness" not in steps[0]                 # not computed: no null read as inf
     # the contact scalars under the names of contact's records (leak wrote "nit")
     from roughfe.model import RECORD_KEYS
@@ -52,6 +55,7 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
         assert f["gap"].shape == s.shape and f["fluid_pressure_x"].shape == s.shape
         assert f["flux_x"].shape == s.shape + (2,) and "flux_y" not in f
         assert not (f["percolating"] & f["trapped"]).any()
+        assert not (f["sealed"] & ~f["trapped"]).any()
         # the widest path runs inlet -> outlet through cells no narrower than u_c
         path = f["widest_path_x"]
         assert path[0, 0] == 0 and path[-1, 0] == s.shape[0] - 1
@@ -108,8 +112,12 @@ def test_leak_fsi_writes_coupled_steps(tmp_path, capsys):
             "--inlet-pressure", "1e6", "--outlet-pressure", "0", "--E", "2.1e8",
             "--no-figures", "--quiet", "-o", str(out)]
     assert main(argv) == 0
-    steps = json.loads((out / "results.json").read_text())["steps"]
+    doc = json.loads((out / "results.json").read_text())
+    steps = doc["steps"]
     assert len(steps) == 2 and FSI_KEYS <= set(steps[0])
+    # every key has its unit (there was none per key: a user's review, session 29)
+    assert set(doc["units"]) == set(steps[0])
+    assert doc["units"]["pocket_volume"] == "m^3" and doc["units"]["external_pressure"] == "Pa"
     for st in steps:
         assert st["fsi_state"] == "contact" and st["coupled_residual"] <= 1e-8
         # the fluid opens the contact: the coupled leak rate exceeds the one-way one

@@ -91,7 +91,8 @@ def _fluid_pressures(args):
 #: units of the arrays of fields/step_NNN.npz (key prefix -> unit), stored in the file
 FIELD_UNITS = {"gap": "m", "contact": "1", "pressure_contact": "Pa", "fluid_pressure": "Pa",
                "flux": "m^2/s (volume flux per unit width, per cell: x, y components)",
-               "percolating": "1", "trapped": "1", "pockets": "pocket label (0: none)",
+               "percolating": "1", "trapped": "1", "sealed": "1",
+               "pockets": "pocket label (0: none)",
                "widest_path": "cell indices (n, 2)", "parent_channel": "cell indices",
                "size_m": "m", "spacing_m": "m"}
 
@@ -112,7 +113,8 @@ def _write_step_npz(path, arrays: dict, surface) -> Path:
 
 def _save_fields(path, contact, leak, surface):
     arrays = {"gap": contact.gap, "contact": contact.contact, "pressure_contact": contact.pressure,
-              "percolating": leak.network.percolating, "trapped": leak.network.trapped}
+              "percolating": leak.network.percolating, "trapped": leak.network.trapped,
+              "sealed": leak.network.sealed}
     for d, net in leak.network.directions.items():
         arrays[f"percolating_{d}"] = net.percolating
     for d, flow in leak.flows.items():
@@ -145,16 +147,19 @@ def _leak(args) -> int:
         print(f"wrote {len(written)} files in {out}")
         return 0 if sweep.success else 1
     print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>8} {'Vp*':>9} {'Vnp*':>9} "
-          f"{'perc x/y':>8} {'Q (m^3/s)':>11}")
+          f"{'sealed*':>9} {'perc x/y':>8} {'Q (m^3/s)':>11}")
     for s in steps:
         q = s["leak_rate"]
         print(f"{s['step']:>4} {s['delta']:>11.4e} {s['mean_pressure']:>10.4g} "
               f"{s['area_fraction']:>8.3g} {s['percolating_volume_star'] or 0:>9.3e} "
-              f"{s['trapped_volume_star'] or 0:>9.3e} "
+              f"{s['trapped_volume_star'] or 0:>9.3e} {s['sealed_volume_star'] or 0:>9.3e} "
               f"{str(s['percolates_x'])[0] + '/' + str(s['percolates_y'])[0]:>8} "
               f"{fmt_or_dash(q, '.4e'):>11}")
     p_in, p_out = _fluid_pressures(args)
     along = "x and y (their mean)" if args.direction == "both" else args.direction
+    print("Vp*, Vnp*: percolating and trapped (non-percolating, Alg. 1) free volume / (A_n "
+          "sigma); sealed*: the part of Vnp* with no open path to inlet or outlet (the rest "
+          "are dead ends open to the flow)")
     print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
           f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is linear in both")
     persson_basis(args, surface, persson)
@@ -202,7 +207,7 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
             widest[con.path[:, 0], con.path[:, 1]] = True
         written.append(figs.network_map(
             r.contact.gap, lk.network.percolating, lk.network.trapped, surface.size,
-            out / "figures" / f"step_{k:03d}_network.png",
+            out / "figures" / f"step_{k:03d}_network.png", sealed=lk.network.sealed,
             title=f"coupled free-volume network, {tag}", widest_path=widest,
             junctions=[con.position for con in lk.constrictions.values()
                        if con.position is not None]))
@@ -219,6 +224,12 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
 #: leak's words in the messages of :func:`roughfe.bem.adhesive_rules.check_adhesive_run`
 #: (its approaches are --delta only: it has no --steps)
 LEAK_ADHESION_WORDS = {**ADHESION_WORDS, "approaches": "--delta"}
+
+
+def _units(steps) -> dict:
+    """results.json ``units``: the unit of every step key (:func:`record_units`)."""
+    from ..leakage.analysis import record_units
+    return record_units(dict.fromkeys(k for s in steps for k in s))
 
 
 def _leak_run(args, surface, material, out):
@@ -267,8 +278,9 @@ def _leak_run(args, surface, material, out):
                         pressure_drop=abs(p_in - p_out) or None, viscosity=args.mu,
                         direction=args.direction)
         steps = theory["steps"]
-        written.append(write_json(out / "results.json", {"inputs": base, "steps": steps,
-                                                          "persson": theory["persson"]}))
+        written.append(write_json(out / "results.json", {
+            "inputs": base, "steps": steps, "units": _units(steps),
+            "persson": theory["persson"]}))
         return sweep, steps, written, theory["persson"]
     dp = p_in - p_out
     sweep = leakage_sweep(surface, material, deltas=args.delta, pressures=args.pressure,
@@ -292,7 +304,8 @@ def _leak_run(args, surface, material, out):
             widest[con.path[:, 0], con.path[:, 1]] = True
         written.append(figs.network_map(
             c.gap, lk.network.percolating, lk.network.trapped, surface.size,
-            out / "figures" / f"step_{k:03d}_network.png", title=f"free-volume network, {tag}",
+            out / "figures" / f"step_{k:03d}_network.png", sealed=lk.network.sealed,
+            title=f"free-volume network, {tag}",
             widest_path=widest, junctions=[con.position for con in lk.constrictions.values()
                                            if con.position is not None]))
         for d, flow in lk.flows.items():
@@ -304,8 +317,9 @@ def _leak_run(args, surface, material, out):
                 title=f"flux magnitude (m^2/s), flow along {d}\nleak rate Q = {flow.leak_rate:.3e} m^3/s"))
     if not args.no_figures:
         written.append(figs.steps_figure(steps, out / "figures" / "steps.png"))
-    written.append(write_json(out / "results.json", {"inputs": inputs, "steps": steps,
-                                                      "persson": theory["persson"]}))
+    written.append(write_json(out / "results.json", {
+        "inputs": inputs, "steps": steps, "units": _units(steps),
+        "persson": theory["persson"]}))
     return sweep, steps, written, theory["persson"]
 
 

@@ -116,6 +116,10 @@ class LeakageResult:
             "free_volume_star": net.free_volume_star,
             "percolating_volume_star": net.percolating_volume_star,
             "trapped_volume_star": net.trapped_volume_star,
+            # the part of the trapped (non-percolating) volume that no open path joins to
+            # inlet or outlet; the rest are dead ends open to the flow
+            "sealed_volume": net.sealed_volume,
+            "sealed_volume_star": net.sealed_volume_star,
             "leak_rate": self.leak_rate,
             "hydraulic_aperture": self.hydraulic_aperture,
         }
@@ -317,3 +321,44 @@ def _leakage_of_step(k, contact, leak_kwargs):
                    f"{contact.delta:.4g} m): {w.message}")
         warnings.warn(message, w.category, stacklevel=2)
     return leak
+
+
+#: units of the step-record keys of ``roughfe leak`` (results.json ``units``), by name
+#: without its direction suffix (``_x``/``_y``); "1" dimensionless
+_RECORD_UNITS = {
+    "step": "index (from 0)", "delta": "m", "load": "N", "mean_pressure": "Pa",
+    "external_pressure": "Pa", "contact_area": "m^2", "n_contact": "count",
+    "mean_gap": "m", "mean_plane_separation": "m", "residual": "1 (relative KKT residual)",
+    "iterations": "count", "separation_star": "1 (d / sigma)", "contact_success": "bool",
+    "hydraulic_aperture": "m", "percolates": "bool", "percolates_reynolds": "bool",
+    "flow_imbalance": "1 (|inlet flow - outlet flow| / leak rate)", "reynolds_nit": "count",
+    "critical_position": "m (x, y of the junction centre)", "critical_width": "m",
+    "parent_channel_length": "m", "fsi_state": "label", "coupled_iterations": "count",
+    "stiffness": "Pa/m", "trapped_fluid": "label (pocket law)", "bulk_modulus": "Pa",
+    "leak_rate_coupled": "m^3/s", "pocket_pressures": "Pa (one per pocket)",
+    "pocket_volumes": "m^3 (one per pocket)", "pockets_new": "count",
+    "pockets_released": "count", "pockets_merged": "count", "pocket_passes": "count",
+    "pockets_settled": "bool", "coupled_residual": "1 (relative)",
+}
+
+
+def record_units(keys) -> dict:
+    """The unit of each step-record key in ``keys`` (SI; volumes ``*_volume`` m^3, their
+    ``*_volume_star`` V / (A_n sigma), sigma the rms height of the undeformed surface;
+    ``*_fraction`` 1, ``*_rate`` m^3/s, ``*_gap`` m, ``*_pressure`` Pa); keys of no known
+    kind are left out."""
+    out = {}
+    for key in keys:
+        base = key[:-2] if key.endswith(("_x", "_y")) else key
+        unit = _RECORD_UNITS.get(base)
+        if unit is None:
+            for suffix, u in (("_volume_star", "1 (V / (A_n sigma))"), ("_volume", "m^3"),
+                              ("_fraction", "1"), ("_rate", "m^3/s"),
+                              ("leak_rate_critical_junction", "m^3/s"), ("_gap", "m"),
+                              ("_pressure", "Pa"), ("_one_way", "m^3/s")):
+                if base.endswith(suffix):
+                    unit = u
+                    break
+        if unit is not None:
+            out[key] = unit
+    return out

@@ -65,14 +65,12 @@ from dataclasses import dataclass
 from typing import Mapping, Optional
 
 import numpy as np
-import scipy.sparse as sp
-from scipy import ndimage
-from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError, NoConvergenceError, check_finite_positive, check_real_array
 from ..fem.dissipation import solve_for_dissipation
 from ..fem.petsc_tools import CG_AMG, KrylovSolver, petsc_aij_csr
 from ..fem.reynolds import check_reynolds_data
+from .components import components_reaching
 
 #: PETSc options of the finite-volume Reynolds solve, over
 #: :data:`roughfe.fem.petsc_tools.CG_AMG` (CG + BoomerAMG, rtol 1e-10 of the preconditioned
@@ -147,45 +145,6 @@ def _series_gap(a, b, live):
         ia, ib = 1.0 / a, 1.0 / b
         h = (ia * ia + ib * ib) / (ia * ia * ia + ib * ib * ib)
     return np.where(ok, h, 0.0)
-
-
-def _open_components(open_cells: np.ndarray, periodic: bool):
-    """Face-connected components of the open cells (labels 0..k-1 per cell, -1 closed).
-
-    ``scipy.ndimage.label`` (4-connectivity) labels the grid; with periodic side walls the
-    components meeting across the seam (column -1 | column 0) are merged on the small
-    graph of labels."""
-    nl, nt = open_cells.shape
-    lab, nlab = ndimage.label(open_cells)      # 0: closed, 1..nlab
-    root = np.arange(nlab + 1)
-    if periodic and nt > 1:
-        seam = open_cells[:, -1] & open_cells[:, 0]
-        if seam.any():
-            a, b = lab[seam, -1], lab[seam, 0]
-            graph = sp.csr_matrix((np.ones(a.size, np.int8), (a, b)),
-                                  shape=(nlab + 1, nlab + 1))
-            _, root = connected_components(graph, directed=False)
-    # compact numbering without the closed label
-    used = np.zeros(int(root.max()) + 1, bool)
-    used[root[1:]] = True
-    new = np.cumsum(used) - 1
-    table = np.append(-1, new[root[1:]]).astype(np.int32 if nlab < 2**31 - 1 else np.int64)
-    return table[lab]
-
-
-def components_reaching(open_cells: np.ndarray, *, periodic: bool = False):
-    """Open components, and which of them touch the inlet (row 0) and the outlet (last row).
-
-    Flow along axis 0. Returns ``(labels, touches_in, touches_out)``: per-cell component
-    label (-1 closed) and boolean arrays indexed by label.
-    """
-    lab = _open_components(np.asarray(open_cells, bool), periodic)
-    nlab = int(lab.max()) + 1 if lab.size and lab.max() >= 0 else 0
-    touches_in = np.zeros(nlab, bool)
-    touches_out = np.zeros(nlab, bool)
-    touches_in[lab[0][lab[0] >= 0]] = True
-    touches_out[lab[-1][lab[-1] >= 0]] = True
-    return lab, touches_in, touches_out
 
 
 def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,

@@ -38,7 +38,7 @@ from scipy.sparse.csgraph import breadth_first_order
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
                       check_real_array, check_spacing)
-from .finite_volume import components_reaching
+from .components import components_reaching
 
 
 @dataclass(frozen=True, eq=False)

@@ -66,7 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .finite_volume import components_reaching
+from .components import components_reaching
 
 TRAPPED_MODELS = ("volume", "pressure", "film")
 SEALED = ("volume", "pressure")

@@ -95,10 +95,11 @@ def _finish(plotter, title, path, size, right=1.0):
 
 
 def network_map(gap, percolating, trapped, size, path, *, title="free-volume network",
-                widest_path=None, junctions=None):
+                widest_path=None, junctions=None, sealed=None):
     """Gap map with contact black, percolating cells white to blue (by gap) and trapped
-    cells red, like thesis Fig. 16-17; optionally the widest path (orange) and the
-    critical junctions (yellow discs).
+    cells red, like thesis Fig. 16-17; with ``sealed`` the trapped cells are split into
+    sealed (red: no open path to inlet or outlet) and dead ends open to the flow (pink);
+    optionally the widest path (orange) and the critical junctions (yellow discs).
 
     Parameters
     ----------
@@ -114,11 +115,14 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
         Cells of the widest inlet-outlet path(s) (:mod:`roughfe.leakage.junction`).
     junctions : sequence of (x, y), optional
         Junction centres in m.
+    sealed : ndarray of bool, optional
+        The sealed part of ``trapped`` (:attr:`roughfe.leakage.network.NetworkResult.sealed`).
     """
     if not load_render_backend():
         arrays = {"gap": gap, "percolating": percolating, "trapped": trapped}
-        if widest_path is not None:
-            arrays["widest_path"] = widest_path
+        for key, value in (("widest_path", widest_path), ("sealed", sealed)):
+            if value is not None:
+                arrays[key] = value
         return _render_elsewhere("network_map", arrays, size=list(size), path=str(path),
                                  title=title,
                                  junctions=None if junctions is None else
@@ -129,7 +133,10 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
     t = np.clip(g / gmax, 0.0, 1.0) if gmax > 0 else np.zeros_like(g)
     blue = np.stack([1.0 - 0.85 * t, 1.0 - 0.6 * t, np.ones_like(t)], axis=-1)
     rgb[percolating] = blue[percolating]
-    rgb[trapped] = (0.85, 0.1, 0.1)
+    trapped = np.asarray(trapped, bool)
+    sealed = trapped if sealed is None else trapped & np.asarray(sealed, bool)
+    rgb[trapped] = (1.0, 0.62, 0.72)            # dead ends open to the flow
+    rgb[sealed] = (0.85, 0.1, 0.1)
     legend = ""
     if widest_path is not None and np.any(widest_path):
         rgb[np.asarray(widest_path, bool)] = (1.0, 0.55, 0.0)
@@ -146,8 +153,11 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
         legend += ("  " if legend else "\n") + "yellow: critical junction"
     n_p, n_t, n_c = int(np.sum(percolating)), int(np.sum(trapped)), int(
         g.size - np.sum(percolating) - np.sum(trapped))
+    n_s = int(np.sum(sealed))
+    kinds = (f"red: trapped ({n_t})" if n_s == n_t else
+             f"red: sealed ({n_s})  pink: dead end ({n_t - n_s})")
     return _finish(pl, f"{title}\nblack: contact ({n_c})  white-blue: percolating ({n_p})  "
-                       f"red: trapped ({n_t}){legend}", path, size)
+                       f"{kinds}{legend}", path, size)
 
 
 def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="cells",
