@@ -46,8 +46,20 @@ def test_db_and_design_commands(tmp_path, capsys):
     assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "y_t1.csv"),
                  "--method", "sog", "--iterations", "1", "--no-figures", "-o",
                  str(plain)]) == 0
-    printed = capsys.readouterr().out.split("(no interpolation): ")[1].split()[0]
+    captured = capsys.readouterr()
+    printed = captured.out.split("(no interpolation): ")[1].split()[0]
     whole = json.loads((plain / "result.json").read_text())
+    # the thesis' y_t1 runs to 1.7 E*, and Eq. 4.2 scales the design's amplitude to it:
+    # both said, with their numbers (the tutorial's profile had rms slope 8.5 in silence;
+    # a user's review, round 2, session 29)
+    from roughfe.surfaces.io import load_surface
+    from roughfe.surfaces.stats import rms_slope
+    e_star = whole["settings"]["youngs_modulus"] / (1 - whole["settings"]["poisson"] ** 2)
+    p_top = Target.from_dict(whole["targets"][0]).p_max
+    slope = rms_slope(load_surface(plain / "profile.npz"))
+    assert p_top > e_star and slope > 0.5
+    assert f"p_max^t = {p_top:.4g} Pa is {p_top / e_star:.3g} x the database's E*" in captured.err
+    assert f"the designed surface has rms slope {slope:.3g}" in captured.err
     saved = whole["candidates"][0]
     # the verdict is decided by those solved scores, in the message and result.json alike
     # (the message's was the interpolated s while the command printed the solved one)
