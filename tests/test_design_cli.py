@@ -84,6 +84,16 @@ def test_db_and_design_commands(tmp_path, capsys):
                  str(tmp_path / "cut")]) == 0
     rep = json.loads((tmp_path / "cut" / "result.json").read_text())
     assert rep["targets"][0]["p_top"] == e.p_max
+    # --strict: exit 1 exactly when the target is NOT matched (a user's review: a script
+    # could not tell a miss from a match without reading result.json)
+    for goal, name in ((cut, "cut_strict"), (tmp_path / "t" / "y_t1.csv", "y_t1_strict")):
+        extra = ["--target-p-top", repr(e.p_max)] if goal == cut else []
+        rc = main(["design", "--db", str(path), "--target", str(goal), *extra, "--method",
+                   "sog", "--iterations", "1", "--no-figures", "--strict", "-o",
+                   str(tmp_path / name)])
+        matched = json.loads((tmp_path / name / "result.json").read_text())["matched"]
+        assert rc == (0 if matched else 1), (name, matched, rc)
+        assert matched is (goal == cut)        # the genome recovered; y_t1 missed (0.93)
     capsys.readouterr()       # a p_top below the curve's last point: in the option's words
     assert main(["design", "--db", str(path), "--target", str(cut), "--target-p-top",
                  repr(e.curve.pressure[3]), "--method", "sog", "--iterations", "1",

@@ -173,6 +173,12 @@ def _run(args) -> int:
         print("the design is NOT a success (its criterion, in the message above, failed); "
               "the result is written", file=sys.stderr)
         return 1
+    if args.strict:
+        from ..genomics.design.objective import verdict
+        if not verdict(result.best, result.objective.targets).matched:
+            print("--strict: the target is NOT matched (result.json 'matched'); the result "
+                  "is written", file=sys.stderr)
+            return 1
     return 0
 
 
@@ -241,7 +247,12 @@ def register(sub):
     p.add_argument("--method", choices=("sog", "gco", "cco", "mcco"), required=True,
                    help="Alg. 4 (sog), 5 (gco), 6 (cco) or 7 (mcco)")
     p.add_argument("--pbar", type=positive_float, default=None,
-                   help="threshold pressure (Pa) splitting [0, pbar] and [pbar, p_max] (gco, cco)")
+                   help="threshold pressure (Pa) splitting [0, pbar] and [pbar, p_max] (gco, "
+                        "cco; `roughfe design-targets` prints y_t2's)")
+    p.add_argument("--strict", action="store_true",
+                   help="exit 1 when the target is NOT matched (the verdict of result.json "
+                        "'matched', from the scores solved at the target pressures), as "
+                        "`genome sequence --strict`; the result is written all the same")
     g = p.add_argument_group("GCMMA options")
     g.add_argument("--iterations", type=positive_int, default=None,
                    help="outer GCMMA iterations of stage 1 (default: thesis, 5 sog / 3 others)")
