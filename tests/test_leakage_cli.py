@@ -276,3 +276,17 @@ def test_leak_direction_y_is_direction_x_of_the_transpose(tmp_path):
     assert a["leak_rate_y"] == pytest.approx(b["leak_rate_x"], rel=1e-6, abs=0)
     assert a["persson_leak_rate"] == pytest.approx(b["persson_leak_rate"], rel=1e-6, abs=0)
     assert a["persson_leak_rate_y"] == pytest.approx(b["persson_leak_rate_x"], rel=1e-6, abs=0)
+
+
+def test_leak_draws_the_maps_of_the_end_steps_unless_asked_for_all():
+    """The per-step maps took ~90 % of a leak sweep's run time (8 steps at 128^2: 47 s
+    against 4.6 s without figures; a user's review): by default only the first and last
+    steps get them, every step with --maps all, none with --no-figures."""
+    from argparse import Namespace
+
+    from roughfe.cli.leak_cmd import _maps_of
+    drawn = {m: [k for k in range(5) if _maps_of(Namespace(no_figures=False, maps=m), k, 5)]
+             for m in ("ends", "all")}
+    assert drawn == {"ends": [0, 4], "all": [0, 1, 2, 3, 4]}
+    assert _maps_of(Namespace(no_figures=False, maps="ends"), 0, 1)
+    assert not any(_maps_of(Namespace(no_figures=True, maps="all"), k, 5) for k in range(5))

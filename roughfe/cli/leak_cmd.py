@@ -146,17 +146,21 @@ def _leak(args) -> int:
         persson_basis(args, surface, persson)
         print(f"wrote {len(written)} files in {out}")
         return 0 if sweep.success else 1
+    # both directions: Q_x and Q_y side by side (their mean, results.json leak_rate, mixes
+    # two geometry factors W/L and can be neither: a user's review, round 2, session 29)
+    keys = ["leak_rate_x", "leak_rate_y"] if args.direction == "both" else ["leak_rate"]
+    heads = ["Q_x (m^3/s)", "Q_y (m^3/s)"] if args.direction == "both" else ["Q (m^3/s)"]
     print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>8} {'Vp*':>9} {'Vnp*':>9} "
-          f"{'sealed*':>9} {'perc x/y':>8} {'Q (m^3/s)':>11}")
+          f"{'sealed*':>9} {'perc x/y':>8} " + " ".join(f"{h:>11}" for h in heads))
     for s in steps:
-        q = s["leak_rate"]
         print(f"{s['step']:>4} {s['delta']:>11.4e} {s['mean_pressure']:>10.4g} "
               f"{s['area_fraction']:>8.3g} {s['percolating_volume_star'] or 0:>9.3e} "
               f"{s['trapped_volume_star'] or 0:>9.3e} {s['sealed_volume_star'] or 0:>9.3e} "
               f"{str(s['percolates_x'])[0] + '/' + str(s['percolates_y'])[0]:>8} "
-              f"{fmt_or_dash(q, '.4e'):>11}")
+              + " ".join(f"{fmt_or_dash(s[k], '.4e'):>11}" for k in keys))
     p_in, p_out = _fluid_pressures(args)
-    along = "x and y (their mean)" if args.direction == "both" else args.direction
+    along = ("x and y (results.json leak_rate is their mean)" if args.direction == "both"
+             else args.direction)
     print("Vp*, Vnp*: percolating and trapped (non-percolating, Alg. 1) free volume / (A_n "
           "sigma); sealed*: the part of Vnp* with no open path to inlet or outlet (the rest "
           "are dead ends open to the flow)")
@@ -198,7 +202,7 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
                 arrays[f"widest_path_{d}"] = con.path
         path = _write_step_npz(out / "fields" / f"step_{k:03d}.npz", arrays, surface)
         written.append(path)
-        if args.no_figures or r.contact is None:
+        if not _maps_of(args, k, len(sweep.results)) or r.contact is None:
             continue
         tag = (f"step {k}: p_ext={r.external_pressure:.3g} Pa, A*={r.contact.area_fraction:.3f}, "
                f"fluid load {r.fluid_load_fraction:.3f}")
@@ -224,6 +228,14 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
 #: leak's words in the messages of :func:`roughfe.bem.adhesive_rules.check_adhesive_run`
 #: (its approaches are --delta only: it has no --steps)
 LEAK_ADHESION_WORDS = {**ADHESION_WORDS, "approaches": "--delta"}
+
+
+def _maps_of(args, k, n) -> bool:
+    """Whether step ``k`` of ``n`` gets its maps (network, pressure, flux): every step with
+    ``--maps all``, else the first and the last (the maps took ~90 % of a sweep's run time:
+    47 s against 4.6 s without figures for 8 steps at 128^2; a user's review, round 2,
+    session 29). ``steps.png`` is drawn in any case, none with ``--no-figures``."""
+    return not args.no_figures and (args.maps == "all" or k in (0, n - 1))
 
 
 def _units(steps) -> dict:
@@ -296,7 +308,7 @@ def _leak_run(args, surface, material, out):
     written = []
     for k, (c, lk) in enumerate(zip(sweep.contacts, sweep.leakages)):
         written.append(_save_fields(out / "fields" / f"step_{k:03d}.npz", c, lk, surface))
-        if args.no_figures:
+        if not _maps_of(args, k, len(sweep.contacts)):
             continue
         tag = f"step {k}: A*={c.area_fraction:.3f}, p={c.mean_pressure:.3g} Pa"
         widest = np.zeros(c.gap.shape, bool)
@@ -387,6 +399,10 @@ def register(sub):
     _add_coupling_options(p)
     add_output_folder(p)
     add_run_options(p)
+    p.add_argument("--maps", choices=("ends", "all"), default="ends",
+                   help="the per-step maps (network, pressure, flux) of the first and the "
+                        "last step (ends) or of every step (all: about 1 s per map); "
+                        "figures/steps.png draws every step in any case")
     p.set_defaults(func=_leak, renders_with_dolfinx=True)
 
     s = sub.add_parser(

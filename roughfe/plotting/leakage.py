@@ -179,7 +179,10 @@ def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="ce
         img.point_data["p (Pa)"] = p.ravel(order="F")
     pl = offscreen_plotter(window_size=(900, 900))
     extra = {}
-    if clim is not None and np.nanmax(p) > clim[1]:
+    if not np.isfinite(p).any():      # no open cell with a pressure: all grey, said, and
+        extra = {"clim": [0.0, 1.0]}  # no "All-NaN axis" warning from the colour range
+        title += "\nno pressure: no open cell reaches the inlet or the outlet"
+    elif clim is not None and np.nanmax(p) > clim[1]:
         extra = {"clim": [float(c) for c in clim], "above_color": "magenta"}
         title += f"\nmagenta: above {clim[1]:.3g} Pa (sealed pockets, up to {np.nanmax(p):.3g} Pa)"
     pl.add_mesh(img, scalars="p (Pa)", cmap="viridis", nan_color="grey", lighting=False,
