@@ -408,3 +408,24 @@ def test_contact_table_names_its_theory_slope_plastic_share_and_every_file(
     wrote = [line for line in lines if line.startswith("wrote ")]
     assert wrote == ["wrote " + ", ".join(str(out / f) for f in (
         "results.json", "fields.h5", "contact_area_stiffness.png", "contact_render.png"))]
+
+
+def test_design_targets_says_when_its_surface_is_of_another_scale(capsys):
+    """A 79 um 2D window as the target of a 0.85 mm profile database gave s = 0.08 with no
+    word of why (a user's review): the dimension and the size ratio are said; a profile
+    of the database's length is not warned of."""
+    from argparse import Namespace
+
+    from roughfe.cli.plausibility import check_target_surface
+    from roughfe.genomics.database import DatabaseSettings
+    from roughfe.surfaces.spectral import spectral_profile, spectral_surface
+    settings = DatabaseSettings(length=8.4942e-4, n_nodes=128)
+    args = Namespace(command="design-targets")
+    check_target_surface(args, spectral_surface(32, 7.9e-5, 0.8, rms_height=1e-7, rng=0),
+                         settings)
+    err = capsys.readouterr().err
+    assert "a 2D surface gives targets to a profile database (dim 1)" in err
+    assert f"{8.4942e-4 / 7.9e-5:.3g}x shorter than the database length" in err
+    check_target_surface(args, spectral_profile(128, 8.4942e-4, 0.8, rms_height=1e-6, rng=0),
+                         settings)
+    assert capsys.readouterr().err == ""

@@ -190,6 +190,8 @@ def _targets(args) -> int:
     if args.surface:
         from ..surfaces.io import load_surface
         surface = load_surface(args.surface)
+        from .plausibility import check_target_surface
+        check_target_surface(args, surface, settings)
         name = Path(args.surface).stem.replace(" ", "_")
         tk, ta, curve = surface_targets(surface, settings, name=name, detrend=args.detrend,
                                         boundary=args.boundary, resolution=args.resolution)

@@ -201,3 +201,31 @@ def check_design(args, surface, targets, settings) -> None:
                    f"amplitude is rescaled by Eq. 4.2 to reach p_max^t): beyond the small "
                    f"slopes of the elastic half-space; its K(p) and A(p) are the linear "
                    f"model's")
+
+
+#: factor between a target surface's lateral size and the database length L beyond which
+#: ``design-targets --surface`` says the curves are of another scale
+TARGET_SIZE_RATIO = 2.0
+
+
+def check_target_surface(args, surface, settings) -> None:
+    """Warn (stderr) when ``design-targets --surface`` takes a surface that the database's
+    designs cannot be compared with at face value: a 2D surface for a profile database
+    (areal against line contact) and a lateral size more than :data:`TARGET_SIZE_RATIO`
+    from the database length L (K(p) depends on the size: the long wavelengths, and for
+    a non-periodic window its bulk compliance ~ 0.9 sqrt(A_n) / E*). A user's review
+    (round 2, session 29) designed for a 79 um window with a 0.85 mm profile database and
+    got s = 0.08 with no word of why."""
+    if settings.dim == 1 and surface.ndim == 2:
+        warn(args, "a 2D surface gives targets to a profile database (dim 1): its A(p) and "
+                   "K(p) are those of an areal contact, the designs' of a line contact; "
+                   "expect them to agree in shape at best (a surface database, dim 2, "
+                   "designs 2D surfaces)")
+    size = max(surface.size)
+    ratio = max(size / settings.length, settings.length / size)
+    if ratio > TARGET_SIZE_RATIO:
+        warn(args, f"the surface is {size:.4g} m across, {ratio:.3g}x "
+                   f"{'shorter' if size < settings.length else 'longer'} than the database "
+                   f"length L = {settings.length:.4g} m: K(p) depends on the size (the longest "
+                   f"wavelengths, and a window's bulk compliance ~ 0.9 sqrt(A_n) / E*), so the "
+                   f"designs of length L may not reach its curves")
