@@ -1,14 +1,16 @@
 """Finding the reader of an instrument file (roughfe.surfaces.probe): a cut file is
 "damaged or truncated", not what a reader without file signature makes of its bytes; the
 readers say nothing on the terminal while they are tried; a file none reads is one short
-line, with each reader's error in the exception's notes (a user's review)."""
+line, with each reader's error in the exception's notes; an .opd shorter than its header
+announces is read with a warning (a user's review)."""
 import logging
 import warnings
 
+import numpy as np
 import pytest
 
 from roughfe.cli import main
-from roughfe.errors import FileFormatError
+from roughfe.errors import FileFormatError, TruncatedFileWarning
 from roughfe.surfaces import load_surface
 
 
@@ -94,3 +96,16 @@ def test_a_file_no_reader_opens_is_one_short_line(tmp_path, capsys):
     with pytest.raises(FileFormatError, match=r"\(the file name has no suffix; known"):
         load_surface(tmp_path / "README")
 
+
+def test_an_opd_shorter_than_its_header_announces_warns(topographies_dir, tmp_path):
+    """Cut to 1.5 of its 4.0 MB, opd-1.opd still has its height block, and was read
+    without a word; its directory announces 4 020 870 bytes (exactly the whole file)."""
+    whole = topographies_dir / "opd-1.opd"
+    path = _cut(topographies_dir, tmp_path, "opd-1.opd", 1_500_000, stem="cut")
+    with pytest.warns(TruncatedFileWarning, match=r"cut\.opd is shorter than its header "
+                                                  r"announces \(1500000 of 4020870 bytes\)"):
+        cut = load_surface(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", TruncatedFileWarning)
+        full = load_surface(whole)
+    np.testing.assert_array_equal(cut.heights, full.heights)

@@ -11,6 +11,8 @@ could be); under any other suffix (``.raw .bin .json``, none) the readers that c
 file signature (:data:`.probe.NO_SIGNATURE`: SRTM ``.hgt``, any file of 2 n^2 bytes;
 ``.asc``/``.xyz``, any table of numbers) are refused with a :class:`FileFormatError`. A
 file none reads is refused in one line; each reader's error is in the exception's notes.
+An ``.opd`` shorter than its header announces is read with a
+:class:`~roughfe.errors.TruncatedFileWarning`.
 
 Native format (``.npz``, ``format = "roughfe-surface"``, ``version = 1``)
 ------------------------------------------------------------------------
@@ -47,7 +49,7 @@ import numpy as np
 
 from ..errors import FileFormatError, InputError, RoughfeError
 from ..writers import atomic_path, to_jsonable
-from .probe import open_instrument, quietly, quote_error
+from .probe import open_instrument, quietly, quote_error, warn_if_shorter_than_announced
 from .surface import Surface
 
 NATIVE_FORMAT = "roughfe-surface"
@@ -258,6 +260,7 @@ def _read_instrument(path, size, periodic, channel):
         raise FileFormatError(
             f"{path}: SurfaceTopography's {reader.format()!r} reader failed on this file's "
             f"data; is it damaged or truncated? ({quote_error(exc)})") from exc
+    warn_if_shorter_than_announced(path, reader.format())
     return surface
 
 

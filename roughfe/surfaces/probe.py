@@ -22,10 +22,11 @@ from __future__ import annotations
 import contextlib
 import io
 import logging
+import struct
 import warnings
 from pathlib import Path
 
-from ..errors import FileFormatError
+from ..errors import FileFormatError, TruncatedFileWarning
 
 #: SurfaceTopography readers that check no file signature, with what they accept: under
 #: a suffix no format claims they read anything of the right length or characters
@@ -155,3 +156,44 @@ def open_instrument(path):
             f"{_known_formats()}", tried, said)
     return reader
 
+
+# -- a file shorter than its header announces -------------------------------------------
+def _opd_announced_bytes(path):
+    """Bytes a Wyko OPD file announces: 2 header bytes, then its directory block and the
+    blocks it lists, back to back, each with its length in the directory (opd-1.opd:
+    4 020 870 bytes, exactly). None when the directory cannot be read."""
+    with open(path, "rb") as fh:
+        fh.read(2)
+
+        def length():
+            entry = fh.read(24)      # 16 bytes name, int16 type, int32 length, uint16 attr
+            if len(entry) < 24:
+                raise ValueError("short directory")
+            return struct.unpack("<hlH", entry[16:])[1]
+        try:
+            directory = length()
+            if directory <= 0 or directory % 24:
+                return None
+            return 2 + directory + sum(max(length(), 0) for _ in range(directory // 24 - 1))
+        except (ValueError, struct.error):
+            return None
+
+
+#: format -> the bytes its header announces (a reader of a cut file can succeed when the
+#: blocks it reads lie before the cut: an .opd cut to 1.5 of its 4.0 MB was read without
+#: a word); formats whose header gives no total are not checked
+ANNOUNCED_BYTES = {"opd": _opd_announced_bytes}
+
+
+def warn_if_shorter_than_announced(path, fmt) -> None:
+    """A :class:`~roughfe.errors.TruncatedFileWarning` when ``path`` (read by the
+    ``fmt`` reader) has fewer bytes than its header announces: the heights were read
+    whole (the reader found them), the blocks after the cut are missing."""
+    count = ANNOUNCED_BYTES.get(fmt)
+    announced = count(path) if count else None
+    size = Path(path).stat().st_size
+    if announced is not None and size < announced:
+        warnings.warn(TruncatedFileWarning(
+            f"{path} is shorter than its header announces ({size} of {announced} bytes): a "
+            f"truncated copy? Its heights lie before the cut and were read whole; the "
+            f"blocks after the cut (instrument metadata) are missing"), stacklevel=2)
