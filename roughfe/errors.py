@@ -36,6 +36,12 @@ class ResolutionWarning(UserWarning):
     and what to change)."""
 
 
+class TruncatedFileWarning(UserWarning):
+    """An instrument file has fewer bytes than its header announces, though the heights
+    were read (they lie before the cut): a truncated copy
+    (:func:`roughfe.surfaces.probe.warn_if_shorter_than_announced`)."""
+
+
 class WindowStiffnessWarning(RuntimeWarning):
     """The contact stiffness of a finite non-periodic window (a measured topography) is
     mostly the bulk stiffness of the loaded window (a flat-punch property of its size)

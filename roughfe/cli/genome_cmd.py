@@ -278,6 +278,11 @@ def _chromosomes(args) -> int:
     folder = output_folder_of(args, "genome chromosomes")
     mech = None
     if args.steps:
+        if not args.quiet:   # before the sweeps, which dominate the run time (a review)
+            from ..genomics.band_plan import plan_band_sweeps
+            plan = plan_band_sweeps(bands, youngs_modulus=material.E, poisson=material.nu,
+                                    n_steps=args.steps)
+            print(f"mechanics: {plan.summary()}", flush=True)
         mech = band_mechanics(bands, youngs_modulus=material.E, poisson=material.nu,
                               n_steps=args.steps)
         split = band_macro_micro(mech, threshold=args.threshold)
@@ -464,7 +469,10 @@ def register(sub):
     add_material_options(p)
     p.add_argument("--steps", type=nonnegative_int, default=20,
                    help="equal approaches per A(p), K(p) curve, >= 3 (K is differenced "
-                        "over them; 0: decomposition only)")
+                        "over them; 0: decomposition only). The BEM sweeps dominate the "
+                        "run time: about 3 per band (55 for the 19 bands of a 512 x 512 "
+                        "grid), each of STEPS solves on the whole grid; the number and a "
+                        "rough time estimate are printed before they start")
     p.add_argument("--threshold", type=unit_fraction, default=0.95,
                    help="Alg. 2: c_n of K(p) above which a band is macro-scale roughness "
                         "(checked before the sweeps)")

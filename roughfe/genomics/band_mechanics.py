@@ -34,6 +34,19 @@ from .similarity import ResponseCurve
 REFERENCES = BAND_REFERENCES + ("thesis Sec. 3.4.1, Fig. 36-39 and Alg. 2, on band chromosomes",)
 
 
+def band_fields(bands: BandChromosomes) -> dict:
+    """The height fields :func:`band_mechanics` sweeps: the complete surface, each
+    chromosome, TD sums 2..n_c (the last: the sum of all bands, swept as its own surface)
+    and BU sums 2..n_c-1 (TD_1 = C_1 and BU_1 = C_{n_c} are not repeated)."""
+    chrom, n_c = bands.chromosomes, bands.n_chromosomes
+    td, bu = bands.partial_sums("td"), bands.partial_sums("bu")
+    jobs = {"complete": bands.surface.heights}
+    jobs.update({("c", k): chrom[k] for k in range(n_c)})
+    jobs.update({("td", k): td[k] for k in range(1, n_c)})
+    jobs.update({("bu", k): bu[k] for k in range(1, n_c - 1)})
+    return jobs
+
+
 def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: float = 0.0,
                    n_steps: int = 20, kernel: str = "auto",
                    response: Optional[Callable[[Surface], ResponseCurve]] = None,
@@ -72,17 +85,9 @@ def band_mechanics(bands: BandChromosomes, *, youngs_modulus: float, poisson: fl
             return profile_response(s, youngs_modulus=youngs_modulus, poisson=poisson,
                                     n_steps=int(n_steps), kernel=kernel)
     t0 = time.perf_counter()
-    chrom = bands.chromosomes
-    td = bands.partial_sums("td")
-    bu = bands.partial_sums("bu")
     n_c = bands.n_chromosomes
-    # unique height fields: the complete surface, each chromosome, TD sums 2..n_c (the
-    # last: the sum of all bands, swept as its own surface) and BU sums 2..n_c-1
-    jobs = {"complete": bands.surface.heights}
-    jobs.update({("c", k): chrom[k] for k in range(n_c)})
-    jobs.update({("td", k): td[k] for k in range(1, n_c)})
-    jobs.update({("bu", k): bu[k] for k in range(1, n_c - 1)})
-    curves, failed, done = sweep_fields(jobs, bands.as_surface, response, "band sweeps",
+    curves, failed, done = sweep_fields(band_fields(bands), bands.as_surface, response,
+                                        "band sweeps",
                                         workers=workers)
     complete = curves["complete"]
     if complete is None:

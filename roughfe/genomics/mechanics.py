@@ -223,16 +223,8 @@ def sweep_fields(fields: dict, surface_of, response, label=None, workers: int = 
     if workers < 1:
         raise InputError(f"workers must be an integer >= 1, got {workers!r}")
     first = next(iter(fields), None)
-    scale = float(np.max(np.abs(fields[first]))) if first is not None else 0.0
-    curves = {key: None for key, z in fields.items() if is_flat(z, scale)}
-    # identical fields are swept once (a partial sum across an empty band equals the sum
-    # before it, bit for bit: 44 sweeps for 42 distinct fields on one profile)
-    same, seen = {}, {}
-    for key in fields:
-        if key not in curves:
-            z = np.ascontiguousarray(fields[key])
-            digest = hashlib.blake2b(z, digest_size=20).digest()
-            same[key] = seen.setdefault((z.shape, z.dtype.str, digest), key)
+    flat, same = distinct_fields(fields)
+    curves = {key: None for key in flat}
     todo = [key for key in same if same[key] == key]
     failed = {}
 
@@ -256,6 +248,25 @@ def sweep_fields(fields: dict, surface_of, response, label=None, workers: int = 
         if first_key in failed:
             failed[key] = failed[first_key]
     return {key: curves[key] for key in fields}, failed, len(todo)
+
+
+def distinct_fields(fields: dict) -> tuple:
+    """``(flat, same)`` of ``{key: heights}``: the keys of the flat fields (no contact
+    curve, judged against the largest height of the first field, the complete surface),
+    and ``{key: first key of the same field}`` for the others. Identical fields are swept
+    once (a partial sum across an empty band equals the sum before it, bit for bit: 44
+    sweeps for 42 distinct fields on one profile): :func:`sweep_fields` runs the keys
+    with ``same[key] == key``."""
+    first = next(iter(fields), None)
+    scale = float(np.max(np.abs(fields[first]))) if first is not None else 0.0
+    flat = [key for key, z in fields.items() if is_flat(z, scale)]
+    same, seen = {}, {}
+    for key in fields:
+        if key not in flat:
+            z = np.ascontiguousarray(fields[key])
+            digest = hashlib.blake2b(z, digest_size=20).digest()
+            same[key] = seen.setdefault((z.shape, z.dtype.str, digest), key)
+    return flat, same
 
 
 def sweep_report(failed: dict, names) -> tuple:

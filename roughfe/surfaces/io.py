@@ -1,13 +1,18 @@
 """Reading and writing rough surfaces: native ``.npz``, plain matrices, instrument files.
 
 All readers live in one ordered table, :data:`READERS` (STYLE.md habit 3): the first
-entry whose suffixes match the file name reads it; SurfaceTopography's
-``open_topography`` is the last entry and the fallback for every other suffix (it reads
-30+ instrument formats: ``.x3p .sur .opd .plu .di .datx .xyz ...``). SurfaceTopography
-picks its reader by content: under a suffix one of its formats claims, only that format's
-reader is accepted; under any other suffix (``.raw .bin .json``, none) the readers that
-check no file signature (:data:`NO_SIGNATURE`: SRTM ``.hgt``, any file of 2 n^2 bytes;
-``.asc``/``.xyz``, any table of numbers) are refused with a :class:`FileFormatError`.
+entry whose suffixes match the file name reads it; SurfaceTopography's readers are the
+last entry and the fallback for every other suffix (30+ instrument formats:
+``.x3p .sur .opd .plu .di .datx .xyz ...``), found by :func:`.probe.open_instrument`:
+SurfaceTopography picks its reader by content, tried quietly (the readers' prints, logs and
+warnings are not shown). Under a suffix one of its formats claims, only that format's
+reader is accepted (a cut ``.x3p`` is "damaged or truncated", whatever else its bytes
+could be); under any other suffix (``.raw .bin .json``, none) the readers that check no
+file signature (:data:`.probe.NO_SIGNATURE`: SRTM ``.hgt``, any file of 2 n^2 bytes;
+``.asc``/``.xyz``, any table of numbers) are refused with a :class:`FileFormatError`. A
+file none reads is refused in one line; each reader's error is in the exception's notes.
+An ``.opd`` shorter than its header announces is read with a
+:class:`~roughfe.errors.TruncatedFileWarning`.
 
 Native format (``.npz``, ``format = "roughfe-surface"``, ``version = 1``)
 ------------------------------------------------------------------------
@@ -44,6 +49,7 @@ import numpy as np
 
 from ..errors import FileFormatError, InputError, RoughfeError
 from ..writers import atomic_path, to_jsonable
+from .probe import open_instrument, quietly, quote_error, warn_if_shorter_than_announced
 from .surface import Surface
 
 NATIVE_FORMAT = "roughfe-surface"
@@ -237,80 +243,25 @@ def _choose_channel(reader, channel, path):
     return channels[index]
 
 
-#: SurfaceTopography readers that check no file signature, with what they accept: under
-#: a suffix no format claims they read anything of the right length or characters
-#: (8 bytes of text in x.json as a 2 x 2 grid, 256^2 float64 values in heights.raw as a
-#: 512 x 512 surface of 5.12e8 m, until round 2, session 25)
-NO_SIGNATURE = {"hgt": "an SRTM .hgt grid is any file of 2 n^2 bytes",
-                "asc": "any table of numbers", "xyz": "any table of numbers"}
-
-
-def _claims(reader, suffix) -> bool:
-    return suffix == reader.format() or suffix in reader.file_extensions()
-
-
-def _check_reader_matches_suffix(path, reader):
-    """SurfaceTopography picks its reader by content, whatever the suffix. When the suffix
-    is one SurfaceTopography maps, the reader must be one that claims it (a damaged
-    ``.x3p`` is not read as an SRTM ``.hgt`` grid). When no reader claims the suffix,
-    only a reader that recognises the content by a file signature is trusted: the readers
-    of :data:`NO_SIGNATURE` are refused there."""
-    from SurfaceTopography.IO import readers
-
-    suffix = path.suffix.lower().lstrip(".")
-    fmt = reader.format()
-    if _claims(reader, suffix):
-        return
-    if any(_claims(r, suffix) for r in readers):
-        raise FileFormatError(f"{path} is not a readable .{suffix} file (its content matches "
-                              f"SurfaceTopography's {fmt!r} reader instead)")
-    if fmt in NO_SIGNATURE:
-        ours = {s.lstrip(".") for suffixes, _, _ in READERS if suffixes for s in suffixes}
-        known = sorted({e for r in readers for e in (r.format(), *r.file_extensions())} - ours)
-        raise FileFormatError(
-            f"{path}: its suffix {path.suffix or '(none)'!r} names no format, and "
-            f"SurfaceTopography's {fmt!r} reader took its content, which checks no file "
-            f"signature ({NO_SIGNATURE[fmt]}). Give the file its format's suffix: roughfe "
-            f".npz, a plain height matrix .npy .txt .csv .dat (metres, with --size/size=), "
-            f"or an instrument file ." + " .".join(known))
-
-
-def _unreadable(path, exc) -> str:
-    """Why no reader opened ``path``: the error of the reader its suffix names (a
-    truncated ``.di``), else SurfaceTopography's whole list of tried readers."""
-    from SurfaceTopography.IO import readers
-
-    suffix = path.suffix.lower().lstrip(".")
-    named = [r for r in readers if r.format() == suffix]
-    if named:
-        try:
-            named[0](str(path))
-        except Exception as own:  # noqa: BLE001 - the reader's own words
-            return (f"{path} is not a readable .{suffix} file (SurfaceTopography's "
-                    f"{suffix!r} reader: {type(own).__name__}: {own}); damaged or truncated?")
-    return f"{path}: no reader recognises this file ({exc})"
-
-
 def _read_instrument(path, size, periodic, channel):
     try:
-        from SurfaceTopography import open_topography
+        import SurfaceTopography  # noqa: F401
     except ImportError:
         raise FileFormatError(
             f"{path}: reading instrument files needs SurfaceTopography (pip install "
             f"SurfaceTopography); it is not installed") from None
+    reader = open_instrument(path)         # quietly; one line when no reader fits
     try:
-        reader = open_topography(str(path))
-    except Exception as exc:      # ST raises many types for unknown formats
-        raise FileFormatError(_unreadable(path, exc)) from None
-    _check_reader_matches_suffix(path, reader)
-    try:
-        return _instrument_surface(reader, path, size, periodic, channel)
+        with quietly():                    # the readers' numpy warnings, prints, logs
+            surface = _instrument_surface(reader, path, size, periodic, channel)
     except RoughfeError:           # ours: already says what is wrong
         raise
     except Exception as exc:       # the reader's own failure on the data (a truncated file)
         raise FileFormatError(
             f"{path}: SurfaceTopography's {reader.format()!r} reader failed on this file's "
-            f"data; is it damaged or truncated? ({type(exc).__name__}: {exc})") from None
+            f"data; is it damaged or truncated? ({quote_error(exc)})") from exc
+    warn_if_shorter_than_announced(path, reader.format())
+    return surface
 
 
 def _instrument_surface(reader, path, size, periodic, channel):
