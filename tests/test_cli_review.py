@@ -429,3 +429,19 @@ def test_design_targets_says_when_its_surface_is_of_another_scale(capsys):
     check_target_surface(args, spectral_profile(128, 8.4942e-4, 0.8, rms_height=1e-6, rng=0),
                          settings)
     assert capsys.readouterr().err == ""
+
+
+def test_a_design_target_falling_with_load_is_warned_of(capsys):
+    """A K(p) target whose rows (1e6, 1e5, 1e8 Pa) were sorted so that K fell between 1e5
+    and 1e6 Pa was taken without a word (a user's review); a rising one is quiet."""
+    from argparse import Namespace
+
+    from roughfe.cli.plausibility import check_target_curve
+    from roughfe.genomics.similarity import Target
+    args = Namespace(command="design")
+    check_target_curve(args, Target([1e6, 1e5, 1e8], [1e10, 2e10, 5e10], "K", "unsorted"))
+    err = capsys.readouterr().err
+    assert ("target unsorted: K falls with the load at 1 of its 2 intervals (first from "
+            "2e+10 at p = 1e+05 Pa to 1e+10 at 1e+06 Pa") in err
+    check_target_curve(args, Target([1e5, 1e6, 1e8], [1e10, 2e10, 5e10], "K", "sorted"))
+    assert capsys.readouterr().err == ""

@@ -119,6 +119,9 @@ def _run(args) -> int:
     if args.second_target:
         targets.append(_target(args.second_target, args.second_quantity, settings, cache,
                                "A"))
+    from .plausibility import check_target_curve
+    for t in targets:
+        check_target_curve(args, t)
     if args.method == "mcco" and len(targets) == 2 and targets[0].quantity == "A":
         targets.reverse()
     if args.target_p_top is not None:       # Eq. 4.2's p_max^t beyond the last points

@@ -229,3 +229,21 @@ def check_target_surface(args, surface, settings) -> None:
                    f"length L = {settings.length:.4g} m: K(p) depends on the size (the longest "
                    f"wavelengths, and a window's bulk compliance ~ 0.9 sqrt(A_n) / E*), so the "
                    f"designs of length L may not reach its curves")
+
+
+def check_target_curve(args, target) -> None:
+    """Warn (stderr) when a design target's K(p) or A(p) falls with the load: the contact
+    stiffness and area of an elastic rough contact grow with it, so a falling curve is
+    mostly a file whose rows or columns are mixed up (a user's review, round 2, session
+    29: rows given as 1e6, 1e5, 1e8 Pa were sorted and K fell between 1e5 and 1e6)."""
+    p = np.asarray(target.pressure, float)
+    y = np.asarray(target.values, float)
+    falls = np.flatnonzero(np.diff(y) < 0)
+    if falls.size:
+        k = int(falls[0])
+        what = "K" if target.quantity == "K" else "A*"
+        warn(args, f"target {target.name}: {what} falls with the load at "
+                   f"{falls.size} of its {p.size - 1} intervals (first from {y[k]:.4g} at "
+                   f"p = {p[k]:.4g} Pa to {y[k + 1]:.4g} at {p[k + 1]:.4g} Pa; the rows are "
+                   f"read sorted by pressure): the {what} of an elastic rough contact grows "
+                   f"with the load; are the file's rows or columns right?")
