@@ -81,6 +81,8 @@ def test_leak_study_runs_resumes_and_summarises(tmp_path, capsys):
     assert main(argv) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["n_records"] == 2 * 2 * 6
+    # the settings the curves belong to (Q at this pressure drop and viscosity)
+    assert summary["settings"]["pressure_drop"] == 1.0 and summary["settings"]["mu"] == 1e-3
     assert {(f["D"], f["m"]) for f in summary["fits"]} == {(2.3, 3), (2.7, 3)}
     assert (out / "figures" / "fits_g_beta.png").stat().st_size > 5000
     assert capsys.readouterr().err == ""                          # --quiet is quiet

@@ -361,6 +361,10 @@ def _leak_study(args) -> int:
             raise InputError(f"no task of the study in {out} finished; "
                              f"see `roughfe study status {out}`")
         result = summarise(rows)
+        # the settings every curve belongs to (Q is at this pressure drop and viscosity;
+        # summary.json had none: a user's review, round 2, session 29)
+        result["settings"] = dict(fixed, units={"L": "m", "E": "Pa", "mu": "Pa s",
+                                                "pressure_drop": "Pa"})
         paths = [] if args.no_figures else figs.study_figures(result, out / "figures")
         write_json(out / "summary.json", result)                # last: the study is complete
     perc = result["percolation"]

@@ -396,7 +396,11 @@ def study_figures(summary, outdir) -> list:
         ax.plot(xs, np.where(ys > 0, ys, np.nan), "o-", label=f"D={D:g}")
     ax.set_yscale("log")
     ax.set_xlabel("A* = A$_r$/A$_n$")
-    ax.set_ylabel(f"leak rate Q (m$^3$/s), mean, m={m_max}")
+    given = summary.get("settings") or {}
+    at = (f"\nat $\\Delta P$ = {given['pressure_drop']:.3g} Pa, "
+          f"$\\mu$ = {given['mu']:.3g} Pa s" if "pressure_drop" in given and "mu" in given
+          else "")
+    ax.set_ylabel(f"leak rate Q (m$^3$/s), mean, m={m_max}{at}")
     ax.legend(fontsize=8)
     paths.append(save_figure(fig, outdir / "leak_rate_vs_area.png"))
     return paths
