@@ -298,3 +298,35 @@ def test_band_edges_checks_its_range():
             band_edges(q_min, q_max, 2.0)
     e = band_edges(1.0, 8.0, 2.0)
     assert e[0] == 1.0 and e[-1] >= 8.0
+
+
+def test_genome_chromosomes_window_mirror_and_undiscriminating_split(tmp_path, capsys):
+    """On a non-periodic window every band's K(p) is mostly the window's bulk stiffness
+    (a user's review: all bands macro or all micro with --steps): the command says so and
+    offers --mirror, which decomposes and solves the evenly mirrored window; a split with
+    every band on one side is warned of with the c_n range."""
+    import json
+
+    from roughfe.cli import main
+    from roughfe.surfaces.io import save_surface
+    from roughfe.surfaces.surface import Surface
+    s = spectral_surface(32, 1e-3, 0.8, rms_height=1e-6, rng=4)
+    window = Surface(s.heights[:17, :17], (1e-3 * 17 / 32,) * 2, periodic=False)
+    path = save_surface(window, tmp_path / "w.npz")
+    args = ["genome", "chromosomes", str(path), "--gamma", "2", "--steps", "3", "--E", "1e9",
+            "--no-figures"]
+    assert main(args + ["-o", str(tmp_path / "plain")]) in (0, 1)
+    err = capsys.readouterr().err
+    assert "is mostly the window's flat-punch bulk stiffness" in err and "--mirror" in err
+    assert main(args + ["--mirror", "-o", str(tmp_path / "mirrored")]) in (0, 1)
+    err = capsys.readouterr().err
+    assert "flat-punch" not in err
+    data = np.load(tmp_path / "mirrored" / "chromosomes.npz")
+    assert data["surface"].shape == (32, 32)                     # 2 (n - 1) per side
+    mm = json.loads((tmp_path / "mirrored" / "macro_micro.json").read_text())
+    one_side = not mm["macro"] or not mm["micro"]
+    assert ("the split does not discriminate here" in err) is one_side
+    periodic = save_surface(s, tmp_path / "p.npz")
+    assert main(["genome", "chromosomes", str(periodic), "--mirror", "--steps", "0",
+                 "-o", str(tmp_path / "bad")]) == 2
+    assert "--mirror mirrors a non-periodic window" in capsys.readouterr().err

@@ -14,7 +14,7 @@ from .options import (add_detrend_option, add_material_options, add_output_file,
                       add_output_folder, add_run_options, add_surface_options, at_least_two,
                       material_from_args, nonnegative_int, output_file_of,
                       output_folder_of, positive_float, positive_int, surface_from_args,
-                      unit_fraction)
+                      unit_fraction, warn)
 
 from ..genomics.genome import SCALES
 from ..genomics.natural import DEFAULT_FRACTIONS
@@ -273,6 +273,19 @@ def _chromosomes(args) -> int:
                          f"{args.steps} give(s) at most one secant (every curve flat, no "
                          f"macro/micro split)")
     surface = surface_from_args(args)
+    if args.mirror:
+        if surface.periodic:
+            raise InputError(f"--mirror mirrors a non-periodic window; {args.surface} is "
+                             f"read as periodic (drop --mirror, or give --non-periodic)")
+        # detrended before the mirror, as contact's --detrend then --mirror (the mirrored
+        # period's own plane is flat)
+        surface = (surface.detrended(args.detrend) if args.detrend != "none"
+                   else surface).mirrored()
+    elif args.steps and not surface.periodic:
+        warn(args, "the K(p) of a non-periodic window is mostly the window's flat-punch bulk "
+                   "stiffness (1/K ~ 1/K_interface + C, as `roughfe contact` says), the same "
+                   "for every band, so c_n of K compares bulk-dominated curves; --mirror "
+                   "solves the evenly mirrored window, whose K is the interface's")
     material = material_from_args(args)
     bands = band_chromosomes(surface, args.gamma, detrend=args.detrend)
     folder = output_folder_of(args, "genome chromosomes")
@@ -322,6 +335,14 @@ def _chromosomes(args) -> int:
         if mech is not None:
             print(f"  {mech.message}; macro bands {list(split.macro)}, micro {list(split.micro)}")
         print(f"outputs -> {out}")
+    if mech is not None and (not split.macro or not split.micro):
+        c = np.asarray(split.corr_k, float)
+        c = c[np.isfinite(c)]
+        side = "macro" if not split.micro else "micro"
+        warn(args, f"every band is {side} at --threshold {split.threshold:g} (c_n of K "
+                   + (f"{c.min():.4f} .. {c.max():.4f}" if c.size else "undefined")
+                   + f"): the split does not discriminate here; it depends on --steps and "
+                   f"--threshold (docs/theory/surface-genomics.md)")
     return 0 if mech is None or (mech.success and split.success) else 1
 
 
@@ -464,6 +485,11 @@ def register(sub):
                                   "macro_micro.json and figures.")
     add_surface_options(p)
     add_detrend_option(p, default="plane")    # band_chromosomes' (a tilt fills band 1)
+    p.add_argument("--mirror", action="store_true",
+                   help="decompose and solve the evenly mirrored window (periodic, "
+                        "Surface.mirrored, as `contact --mirror`): the K(p) of a "
+                        "non-periodic window is mostly its flat-punch bulk stiffness, the "
+                        "same for every band; 4x the points. A non-periodic SURFACE only")
     p.add_argument("--gamma", type=positive_float, default=2 ** 0.5,
                    help="band ratio q_{n+1}/q_n (the genome's gamma when known)")
     add_material_options(p)
