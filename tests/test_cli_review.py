@@ -445,3 +445,20 @@ def test_a_design_target_falling_with_load_is_warned_of(capsys):
             "2e+10 at p = 1e+05 Pa to 1e+10 at 1e+06 Pa") in err
     check_target_curve(args, Target([1e5, 1e6, 1e8], [1e10, 2e10, 5e10], "K", "sorted"))
     assert capsys.readouterr().err == ""
+
+
+def test_leak_warns_of_percolation_through_a_molecular_gap(capsys):
+    """A channel whose critical gap is 0.3 Angstrom was counted as open without a word (a
+    user's review: x3p-2 at 1 GPa); it is said, with its step and direction; a closed
+    direction and a nanometre-wide gap are not."""
+    from argparse import Namespace
+
+    from roughfe.cli.plausibility import check_critical_gaps
+    steps = [{"step": 0, "percolates_x": True, "critical_gap_x": 5e-9,
+              "percolates_y": True, "critical_gap_y": 2e-9},
+             {"step": 1, "percolates_x": True, "critical_gap_x": 3e-11,
+              "percolates_y": False, "critical_gap_y": None}]
+    check_critical_gaps(Namespace(command="leak"), steps)
+    err = capsys.readouterr().err
+    assert "step 1 (x: 3e-11 m) percolates through a critical gap below 1e-09 m" in err
+    assert err.count("warning") == 1

@@ -22,7 +22,8 @@ from ..bem.interface_law import resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
-from .plausibility import check_load_magnitudes, check_solution, persson_basis
+from .plausibility import (check_critical_gaps, check_load_magnitudes, check_solution,
+                           persson_basis)
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, contact_physics_from_args,
@@ -166,6 +167,7 @@ def _leak(args) -> int:
           "are dead ends open to the flow)")
     print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
           f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is linear in both")
+    check_critical_gaps(args, steps)
     persson_basis(args, surface, persson)
     print(f"wrote {len(written)} files in {out}")
     return 0 if sweep.success else 1

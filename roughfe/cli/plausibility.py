@@ -247,3 +247,27 @@ def check_target_curve(args, target) -> None:
                    f"p = {p[k]:.4g} Pa to {y[k + 1]:.4g} at {p[k + 1]:.4g} Pa; the rows are "
                    f"read sorted by pressure): the {what} of an elastic rough contact grows "
                    f"with the load; are the file's rows or columns right?")
+
+
+#: critical gap (m) below which a percolating channel is said to be of molecular size:
+#: the continuum Reynolds film (and a measured topography's height resolution) stop there
+MOLECULAR_GAP = 1e-9
+
+
+def check_critical_gaps(args, steps) -> None:
+    """Warn (stderr) of steps that percolate through a critical gap below
+    :data:`MOLECULAR_GAP`: a channel of 0.3 Angstrom counted as open (x3p-2 at 1 GPa; a
+    user's review, round 2, session 29) is closed for a seal, and the Reynolds equation
+    does not describe a film of that thickness. ``steps``: the leak records."""
+    thin = []
+    for s in steps:
+        for d in ("x", "y"):
+            gap = s.get(f"critical_gap_{d}")
+            if s.get(f"percolates_{d}") and gap is not None and 0 < gap < MOLECULAR_GAP:
+                thin.append(f"{s['step']} ({d}: {gap:.2g} m)")
+    if thin:
+        warn(args, f"step{'s' if len(thin) > 1 else ''} {', '.join(thin[:6])}"
+                   f"{', ...' if len(thin) > 6 else ''} percolate{'' if len(thin) > 1 else 's'} "
+                   f"through a critical gap below {MOLECULAR_GAP:g} m: a channel of molecular "
+                   f"size, beyond the continuum Reynolds film and most instruments' height "
+                   f"resolution; read it as closed for a seal")
