@@ -494,8 +494,7 @@ def run_design(method: str, entries, targets, settings: DatabaseSettings, *, pba
     if method == "sog":
         return sog(entries, targets[0], settings, evaluate=evaluate, options=options, **kw)
     if pbar is None:
-        raise InputError(f"{method} needs the threshold pressure pbar (Pa; --pbar on the "
-                         f"command line; `roughfe design-targets` prints y_t2's)")
+        raise InputError(f"{method} needs the threshold pressure pbar (Pa, --pbar)")
     fn = gco if method == "gco" else cco
     return fn(entries, targets[0], pbar, settings, evaluate=evaluate, options=options, **kw)
 
