@@ -158,7 +158,7 @@ def _run(args) -> int:
                                            plot_psds, plot_stages)
             best = result.best.design
             plot_design_curves([result], out / "curves.png", title=design_title(result))
-            plot_stages([result], out / "stages.png")
+            plot_stages([result], out / "stages.png", title=design_title(result))
             plot_profiles({result.method: best.surface()}, out / "profile.png")  # 2D: a map
             plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
         paths = write_design_result(result, settings, out)

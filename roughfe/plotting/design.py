@@ -170,17 +170,20 @@ def plot_design_curves(results, path, title="") -> "Path":
 def plot_stages(results, path, title="") -> "Path":
     """Figs. 58/63: similarity of every candidate at GCMMA 0, 1, 2 (and the optional
     refinement stage 3), per method."""
+    from ..genomics.design.objective import SELECTION
+
     fig, ax = new_figure(figsize=(6.4, 4))
     styles = {"sog": "k--", "gco": "r-", "cco": "b-.", "mcco": "m-"}
     for r in results:
         for k, (c, mk) in enumerate(zip(r.candidates, ("^", "o", "x"))):
             ax.plot(range(len(c.stages)), c.stages, styles.get(r.method, "g-"), marker=mk,
-                    label=f"{r.method.upper()} ({k + 1})")
+                    label=f"{r.method.upper()} ({k + 1}: {c.origin})")
     n = max(len(c.stages) for r in results for c in r.candidates)
+    ax.axhline(SELECTION, color="0.5", lw=1, ls=":", label=f"match: s > {SELECTION:g}")
     ax.set_xticks(range(n))
     ax.set_xticklabels(["GCMMA 0", "GCMMA 1", "GCMMA 2", "GCMMA 3\n(refined)"][:n])
-    ax.set_ylabel("similarity score s")
-    ax.set_title(title)
+    ax.set_ylabel("similarity score s (interpolated, Eq. 4.1)")
+    ax.set_title(title or "similarity of each candidate after each GCMMA stage")
     ax.legend(fontsize=7, ncol=2)
     return save_figure(fig, path)
 
