@@ -45,7 +45,7 @@ def test_the_summary_line_and_a_plan_without_estimate():
     assert none.summary().endswith(": time not estimated (the calibration sweep did not run)")
 
 
-def test_the_command_prints_the_plan_before_the_sweeps(tmp_path, capsys):
+def test_the_command_prints_the_plan_before_the_sweeps(tmp_path, capsys, monkeypatch):
     import roughfe.genomics.band_mechanics as bm
     path = save_surface(_surface(), tmp_path / "s.npz")
     said_before = []
@@ -54,12 +54,9 @@ def test_the_command_prints_the_plan_before_the_sweeps(tmp_path, capsys):
     def spy(*args, **kwargs):      # what was on stdout when the sweeps started
         said_before.append(capsys.readouterr().out)
         return real(*args, **kwargs)
-    bm.sweep_fields = spy
-    try:
-        assert main(["genome", "chromosomes", str(path), "--gamma", "2", "--steps", "4",
-                     "--E", "1e9", "--no-figures", "-o", str(tmp_path / "out")]) == 0
-    finally:
-        bm.sweep_fields = real
+    monkeypatch.setattr(bm, "sweep_fields", spy)
+    assert main(["genome", "chromosomes", str(path), "--gamma", "2", "--steps", "4",
+                 "--E", "1e9", "--no-figures", "-o", str(tmp_path / "out")]) == 0
     nit = json.loads((tmp_path / "out" / "mechanics.json").read_text())["nit"]
     assert said_before[0].startswith(f"mechanics: {nit} BEM sweeps of 4 steps on "
                                      f"32 x 32 points (2 at a time): roughly ")
