@@ -18,9 +18,6 @@
 #  * dolfinx sets RTLD_GLOBAL dlopen flags; a PyPI h5py imported after dolfinx fails
 #    ("Not a datatype"). SurfaceTopography declares h5py, so it is installed with
 #    --no-deps and its other requirements come from the "io" extra of pyproject.toml.
-#  * numba (Debian's python3-numba 0.56, which works with the pinned numpy) compiles the
-#    BEM's window kernel (roughfe/bem/edge_sweeps.py); without it the solver runs
-#    without the edge sweeps, with the same answers and a few more iterations.
 #  * The vtk wheel renders off-screen through EGL (libegl1) or OSMesa (libosmesa6);
 #    with neither it segfaults.
 set -euo pipefail
@@ -28,7 +25,7 @@ cd "$(dirname "$0")/.."
 EXTRAS="${1:-io,design,study,test}"
 VENV=.venv
 APT_PACKAGES="python3-dolfinx python3-petsc4py python3-mpi4py python3-gmsh python3-meshio \
-python3-h5py python3-scipy python3-numba python3-pytest python3-venv python3-pip libegl1 libosmesa6"
+python3-h5py python3-scipy python3-pytest python3-venv python3-pip libegl1 libosmesa6"
 
 missing=""
 for p in $APT_PACKAGES; do
