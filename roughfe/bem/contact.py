@@ -31,7 +31,6 @@ from .operators import (WORKERS, InfluenceOperator, _irfftn_owned, check_kernel_
                         influence_operator)
 from .approach import MAX_START_AREA, approach_by_load, approach_start
 from .periodic import periodic_bounded_displacement, periodic_gap_control
-from .edge_sweeps import edge_sweeps_for
 from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
 from .contact_checks import (_check_coarse_correction, _check_hardness, _check_surface,
                              _check_target, _check_tol)
@@ -403,9 +402,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 initial is not None or delta is None) else np.maximum(h - hmax + delta, 0),
                                    load=mean_pressure is not None)   # cold: h's contact
             out = _pk(op, h, hmax, scale, tol, max_iter, initial, own, deflation,
-                      delta=delta, mean_pressure=mean_pressure, hardness=hardness,
-                      edge_sweeps=edge_sweeps_for(op, deflation, load=delta is None,
-                                                  hardness=hardness, tol=tol))
+                      delta=delta, mean_pressure=mean_pressure, hardness=hardness)
         else:
             H = _dense(op)
             if initial is None:

@@ -40,7 +40,7 @@ def _single_until(approach, scale):
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
                   diagonal=1.0, precond=None, tol=1e-10, max_iter=10000, offset=0.0,
                   hardness=None, overwrite_initial=False, apply_single=None,
-                  deflation=None, split=None, approach=None, edge_sweeps=None):
+                  deflation=None, split=None, approach=None):
     """Polonsky & Keer (1999) constrained CG with FFT operator products, bounded form.
 
     Solves Eq. 2.5-2.6 for ``0 <= p <= hardness`` with the gap ``w = H p - b - offset -
@@ -143,14 +143,6 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     uniform displacement of S, and the CG restarts from there; a plain rescaling would
     make the gap on S as uneven as u itself (02b, session 17: 815 instead of 945
     iterations on a 1024^2 sweep).
-
-    ``edge_sweeps`` (load control, elastic; :func:`roughfe.bem.edge_sweeps.edge_sweeps_for`):
-    load-conserving window sweeps of the contact edges before the first iterations and
-    every few after (:class:`~roughfe.bem.edge_sweeps.EdgeSweeps`): the sweep's change
-    dp (in the full-grid buffer "y" of the two-level correction), one product H dp, the
-    exact step along it (clipped to [0, 1]), p rescaled to the load, then the CG
-    restarted. Each sweep counts as an iteration (``nit``) and
-    its product in ``n_products``.
 
     Returns a :class:`SolverOutput`.
     """
@@ -323,31 +315,6 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             u = None          # confirm on a freshly computed double-precision displacement
             confirm = True
             continue
-        if edge_sweeps is not None and edge_sweeps.due(it - 1 - edge_sweeps.count, res):
-            if us != 1.0:
-                u *= us
-                us = 1.0
-            fn = apply_single if single else apply      # as H_free's and H t's
-            y = buffer("y", np.float64)                  # edge_sweeps: dp in float64
-            if edge_sweeps.block is None:      # the window's block: H of a unit load
-                y.fill(0.0)
-                y[0] = 1.0
-                edge_sweeps.set_block(product(fn, y, y))
-            slope = edge_sweeps.changes(p, u, bf, y)
-            if slope is not None and slope < 0:
-                r = product(fn, y, buffer("r", np.float32 if single else np.float64))
-                curvature = edge_sweeps.curvature(y, r)
-                step = min(1.0, -slope / curvature) if curvature > 0 else 0.0
-                if step > 0:
-                    _axpy(p, step, y)
-                    np.maximum(p, 0.0, out=p)
-                    _rescale_to_load(p, target, upper)
-                    _axpy(u, step, r)
-                    edge_sweeps.made()
-                    exact, gz_old = False, 0.0
-                    S = par.flatnonzero(p)
-                    continue
-            edge_sweeps.missed()
         if watch is not None and watch.stalled(res):
             warnings.warn(f"Polonsky-Keer CG: the two-level correction made no progress "
                           f"(KKT residual {res:.2e}, not halved in {watch.window} "
