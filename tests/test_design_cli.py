@@ -24,6 +24,9 @@ def test_db_and_design_commands(tmp_path, capsys):
     assert main(["db", "map", str(path), "-o", str(tmp_path / "map")]) == 0
     assert (tmp_path / "map" / "genetic_map.png").stat().st_size > 1000
     assert main(["design-targets", "--db", str(path), "-o", str(tmp_path / "t")]) == 0
+    # the file says how its K was taken (a reviewer compared it with an exact K)
+    assert ("# K by central finite differences of p over the database's 10 approaches"
+            in (tmp_path / "t" / "y_t1.csv").read_text())
     out = tmp_path / "sog"
     assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "y_t1.csv"),
                  "--method", "sog", "--iterations", "1", "--search", "3", "--global", "cmaes",

@@ -110,3 +110,16 @@ def test_realize_names_its_own_option_for_a_missing_chromosome(tmp_path, capsys)
     assert "random_genome" not in err
     assert main(["genome", "example", "-o", str(g), "--n-max", "30", "--overwrite"]) == 0
     assert main(args) == 0 and out.is_file()
+
+
+def test_genome_mechanics_refuses_a_surface_genome(tmp_path, capsys):
+    """A genome with ridge angles ran `genome mechanics` on its Eq. 3.1 profile, which
+    ignores the angles (a user's review); it is refused with the commands that do it."""
+    from roughfe.genomics.genome import random_genome, save_genome
+    g = save_genome(random_genome(1, .75, 1.5, 1e-3, 4, 22, rng=0, angles=[0, .5, 1, 2]),
+                    tmp_path / "g2d.json")
+    assert main(["genome", "mechanics", str(g), "--length", "1e-3", "--nodes", "32",
+                 "--steps", "3", "-o", str(tmp_path / "m")]) == 2
+    err = capsys.readouterr().err
+    assert "is a surface genome (ridge angles)" in err and "genome chromosomes" in err
+    assert not (tmp_path / "m").exists()

@@ -219,6 +219,14 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
     save_surface(Surface(tsurf.heights, tsurf.size, periodic=True), tmp_path / "t.npz")
     assert main(["design-targets", "--db", str(path), "--surface", str(tmp_path / "t.npz"),
                  "--detrend", "mean", "-o", str(tmp_path / "t")]) == 0
+    # a plain matrix of the same heights with --size and --periodic (a review found no
+    # way to give its size: the message named a --size the command did not have)
+    np.save(tmp_path / "t.npy", tsurf.heights)
+    assert main(["design-targets", "--db", str(path), "--surface", str(tmp_path / "t.npy"),
+                 "--size", "1e-4", "--periodic", "--detrend", "mean", "-o",
+                 str(tmp_path / "t_npy")]) == 0
+    for name in ("t_K.csv", "t_A.csv"):
+        assert (tmp_path / "t_npy" / name).read_text() == (tmp_path / "t" / name).read_text()
     out = tmp_path / "d"
     assert main(["design", "--db", str(path), "--target", str(tmp_path / "t" / "t_K.csv"),
                  "--second-target", str(tmp_path / "t" / "t_A.csv"), "--method", "mcco",

@@ -9,7 +9,8 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .options import (add_output_folder, add_run_options, nonnegative_float, nonnegative_int,
+from .options import (add_output_folder, add_run_options, add_surface_options, surface_file,
+                      nonnegative_float, nonnegative_int,
                       output_folder_of, positive_float, positive_int)
 
 BUILTIN = ("y_t1", "y_t2", "y_t3")
@@ -138,8 +139,7 @@ def _run(args) -> int:
             result = refine(result, settings, rounds=args.refine)
         if args.match_spectrum:
             from ..genomics.design import match_spectrum, target_surface
-            from ..surfaces.io import load_surface
-            surface = target_surface(load_surface(args.match_spectrum), settings)
+            surface = target_surface(surface_file(args, args.match_spectrum), settings)
             result = match_spectrum(result, surface, settings, entries=entries,
                                     n_entries=args.spectrum_starts,
                                     directional=args.match_directions)
@@ -191,8 +191,7 @@ def _targets(args) -> int:
     from ..genomics.target_csv import write_target_csv
     settings = read_settings(args.db)
     if args.surface:
-        from ..surfaces.io import load_surface
-        surface = load_surface(args.surface)
+        surface = surface_file(args, args.surface)
         from .plausibility import check_target_surface
         check_target_surface(args, surface, settings)
         name = Path(args.surface).stem.replace(" ", "_")
@@ -317,6 +316,7 @@ def register(sub):
                    help="mcco, beyond the thesis: start pool of the K best genomes of each "
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "
                         "(0: the thesis sets)")
+    add_surface_options(p, positional=False)      # of --match-spectrum's file
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_run)
@@ -341,6 +341,7 @@ def register(sub):
                    help="a periodic target on a surface database: resampled onto the "
                         "database spacing L/N (the band the designs hold) or at the file's "
                         "own sampling")
+    add_surface_options(t, positional=False)      # of --surface's file
     add_output_folder(t)
     add_run_options(t, figures=False)
     t.set_defaults(func=_targets)

@@ -196,6 +196,13 @@ def _mechanics(args) -> int:
     from ..genomics.mechanics import chromosome_mechanics
     from ..writers import write_json
     g = load_genome(args.genome)
+    if g.angles is not None:
+        # its Eq. 3.1 profile would ignore the angles: no line of that surface (a review)
+        from ..errors import InputError
+        raise InputError(f"{args.genome} is a surface genome (ridge angles): `genome "
+                         f"mechanics` sweeps the chromosomes of an Eq. 3.1 profile, which "
+                         f"would ignore its angles; realise it (`roughfe genome realize`) "
+                         f"and take its band chromosomes (`roughfe genome chromosomes`)")
     material = material_from_args(args)
     length = args.length if args.length is not None else g.length_of(args.scale)
     ok = True

@@ -133,10 +133,9 @@ def add_surface_options(parser, positional: bool = True) -> None:
              "`roughfe info` names the channel read and lists the file's channels)")
 
 
-def surface_from_args(args):
-    """The :class:`~roughfe.surfaces.surface.Surface` named by ``args.surface`` with
-    ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
-    command has that option."""
+def surface_file(args, path):
+    """The surface file ``path`` with ``--size``/``--periodic``/``--channel`` applied (the
+    options of :func:`add_surface_options`)."""
     from ..errors import InputError
     from ..surfaces.io import load_surface
 
@@ -145,7 +144,14 @@ def surface_from_args(args):
         raise InputError(f"--size takes one or two lengths in metres, got {size}")
     if size is not None and len(size) == 1:
         size = size[0]
-    surface = load_surface(args.surface, size=size, periodic=args.periodic, channel=args.channel)
+    return load_surface(path, size=size, periodic=args.periodic, channel=args.channel)
+
+
+def surface_from_args(args):
+    """The :class:`~roughfe.surfaces.surface.Surface` named by ``args.surface`` with
+    ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
+    command has that option."""
+    surface = surface_file(args, args.surface)
     from .plausibility import warn_tilt, warn_units
     warn_units(args, surface)
     detrend = getattr(args, "detrend", "none")

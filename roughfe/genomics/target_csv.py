@@ -179,6 +179,12 @@ def write_target_csv(path, target: Target):
         lines.append(f"# solved with boundary {meta['boundary']}, resolution "
                      f"{meta.get('resolution')}, detrend {meta.get('detrend')} on a "
                      f"{' x '.join(map(str, meta.get('solved_shape', ())))} grid")
+    settings = meta.get("settings") or {}
+    if target.quantity == "K" and settings.get("stiffness") == "fd":
+        # how K was taken: a user compared it with `contact`'s exact K (25-60 % apart)
+        lines.append(f"# K by central finite differences of p over the database's "
+                     f"{settings.get('n_steps')} approaches (stiffness 'fd', the thesis' "
+                     f"Eq. 2.7 on coarse steps), not the exact K of the contact set")
     if target.p_top is not None:  # Eq. 4.2's p_max^t beyond the last row (read back)
         lines.append(f"# p_top: {target.p_top:.17g} Pa (the target's pressure at Delta = "
                      f"peak-valley, Eq. 4.2 p_max^t)")
