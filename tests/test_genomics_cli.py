@@ -88,9 +88,14 @@ def test_genome_mechanics_without_figures_does_not_say_it_wrote_figures(tmp_path
     assert main(["genome", "mechanics", str(g), "--nodes", "32", "--kernels", "strip",
                  "--steps", "3", "--max-chromosomes", "1", "--no-figures", "-o",
                  str(mech)]) == 0
-    out = capsys.readouterr().out
+    captured = capsys.readouterr()
+    out = captured.out
     assert f"curves, c_n -> {mech}" in out and "figures" not in out
     assert not list(mech.glob("*.png"))
+    # the Table 1 profile at 10x is steep (rms slope > 10) and swept beyond E*: said
+    # (a user's review found 49 E* in silence)
+    p_max = max(json.loads((mech / "mechanics_strip.json").read_text())["complete"]["pressure"])
+    assert p_max > 2.1e8 and f"mean pressure up to {p_max:.3g} Pa" in captured.err
 
 
 def test_realize_names_its_own_option_for_a_missing_chromosome(tmp_path, capsys):

@@ -205,6 +205,10 @@ def _mechanics(args) -> int:
                          f"and take its band chromosomes (`roughfe genome chromosomes`)")
     material = material_from_args(args)
     length = args.length if args.length is not None else g.length_of(args.scale)
+    from ..genomics.genome import realize
+    from ..surfaces.stats import rms_slope
+    from .plausibility import check_curve
+    slope = rms_slope(realize(g, length, args.nodes))
     ok = True
     with output_folder_of(args, "genome mechanics") as out:
         for kernel in args.kernels:
@@ -221,6 +225,8 @@ def _mechanics(args) -> int:
             write_json(out / f"mechanics_{kernel}.json", mech.to_dict())
             ok = ok and mech.success
             print(f"{kernel} kernel: {mech.message}, {mech.elapsed:.1f} s")
+            check_curve(args, f"{kernel} kernel, the complete profile", mech.complete.pressure,
+                        material.E_star, slope=slope)
             print("  c_n TD (K): " + " ".join(f"{v:.3f}" for v in mech.c_td["K"]))
             print("  c_n BU (K): " + " ".join(f"{v:.3f}" for v in mech.c_bu["K"]))
     print(f"curves, c_n{'' if args.no_figures else ' and figures'} -> {out}")

@@ -271,3 +271,21 @@ def check_critical_gaps(args, steps) -> None:
                    f"through a critical gap below {MOLECULAR_GAP:g} m: a channel of molecular "
                    f"size, beyond the continuum Reynolds film and most instruments' height "
                    f"resolution; read it as closed for a seal")
+
+
+def check_curve(args, what, pressure, e_star, slope=None) -> None:
+    """Warn (stderr) when a response curve computed without the per-step checks of
+    :func:`check_solution` (``genome mechanics``: a genome's profile swept to full
+    approach) runs beyond the elastic half-space: its largest mean pressure above E*, or
+    the surface's rms ``slope`` above :data:`STEEP_SLOPE` (a user's review, round 2,
+    session 29: a Table 1 profile at 10x, rms slope 27, swept to 49 E* in silence)."""
+    p = np.asarray(pressure, float)
+    p_max = float(np.nanmax(p)) if p.size else 0.0
+    beyond = []
+    if p_max > e_star:
+        beyond.append(f"mean pressure up to {p_max:.3g} Pa = {p_max / e_star:.3g} E*")
+    if slope is not None and slope > STEEP_SLOPE:
+        beyond.append(f"rms slope {slope:.3g}")
+    if beyond:
+        warn(args, f"{what}: {' and '.join(beyond)}, beyond the small strains and slopes of "
+                   f"the elastic half-space; the curves are the linear model's")
