@@ -31,8 +31,6 @@ def warn_units(args, surface) -> None:
     rms slope 1.3e6 and ran to a mean gap of 3 m), and a ``--size`` that differs from the
     instrument file's own size by more than :data:`SIZE_RATIO_LIMIT` (``--size 500`` for
     500 nm on an AFM file: a 500 m scan)."""
-    from ..surfaces.stats import rms_slope
-
     in_file = surface.metadata.get("size_in_file")
     if in_file:
         ratio = max(max(a / b, b / a) for a, b in zip(surface.size, in_file) if a > 0 and b > 0)
@@ -40,10 +38,7 @@ def warn_units(args, surface) -> None:
             warn(args, f"--size {' x '.join(f'{v:.4g}' for v in surface.size)} m differs "
                        f"{ratio:.3g}x from the file's own size "
                        f"{' x '.join(f'{v:.4g}' for v in in_file)} m: --size is in metres")
-    try:
-        slope = rms_slope(surface)
-    except Exception:       # noqa: BLE001 -- a flat or degenerate surface: no slope to judge
-        return
+    slope = _slope(surface)
     if slope > SLOPE_LIMIT:
         warn(args, f"rms slope {slope:.3g} > {SLOPE_LIMIT:g}: beyond the small slopes of the "
                    f"elastic half-space" + (" -- far beyond: are the heights in metres and "
@@ -120,8 +115,6 @@ def check_solution(args, surface, results, material) -> None:
     ContactResults; steps are numbered from 0, as in results.json, the ``leak`` table and
     the fields' frames. The last three from a user's review (round 2, session 29: di-1 at
     1 GPa reached 2.9 E* locally, and its 10 MPa step had 29 contact points)."""
-    from ..surfaces.stats import rms_slope
-
     results = list(results)
     if not results:
         return
@@ -133,10 +126,7 @@ def check_solution(args, surface, results, material) -> None:
                    f"{length:.3g} m (p = {p_max:.3g} Pa = {p_max / e_star:.3g} E*): "
                    "far beyond the small strains of the elastic half-space; the result is not "
                    "physical")
-    try:
-        slope = rms_slope(surface)
-    except Exception:       # noqa: BLE001 -- a flat or degenerate surface: no slope to judge
-        slope = 0.0
+    slope = _slope(surface)
     if STEEP_SLOPE < slope <= SLOPE_LIMIT:      # above: warn_units has spoken
         warn(args, f"rms slope {slope:.3g} > {STEEP_SLOPE:g}: the linear half-space assumes "
                    f"small slopes (its geometry is linearised); read A* and K as that model's")
@@ -164,16 +154,36 @@ def persson_basis(args, surface, persson: dict) -> None:
     when the heights are far from Gaussian, the theory's surface
     (:data:`roughfe.theory.beside.NON_GAUSSIAN`). ``persson``: the ``"persson"`` block of
     :func:`roughfe.theory.beside` (nothing is said without its ``rms_gradient``)."""
-    from ..surfaces.stats import rms_slope
-
     if persson.get("rms_gradient") is None:
         return
     window = "" if surface.periodic else " (Hann-windowed)"
     print(f"Persson's theory beside the results (persson_* in results.json) takes gbar = "
           f"{persson['rms_gradient']:.3g}, the rms gradient of the surface's PSD{window}; "
-          f"its rms slope by finite differences (roughfe info) is {rms_slope(surface):.3g}")
+          f"its rms slope by finite differences (roughfe info) is {_slope(surface):.3g}")
     if persson.get("non_gaussian"):
         warn(args, persson["non_gaussian"])
+
+
+def _slope(surface) -> float:
+    """The rms slope of ``surface`` (finite differences, as ``roughfe info``), 0 for a
+    flat or degenerate one (no slope to judge)."""
+    from ..surfaces.stats import rms_slope
+    try:
+        return float(rms_slope(surface))
+    except Exception:       # noqa: BLE001
+        return 0.0
+
+
+def check_target_pressure(args, targets, settings, why) -> None:
+    """Warn (stderr) when the largest pressure p_max^t of the design ``targets`` exceeds
+    the database's E* (``why``: what the run's numbers are then)."""
+    from ..model import Material
+    e_star = Material(settings.youngs_modulus, settings.poisson).E_star
+    p_top = max(float(t.p_max) for t in targets)
+    if p_top > e_star:
+        warn(args, f"the target's largest pressure p_max^t = {p_top:.4g} Pa is "
+                   f"{p_top / e_star:.3g} x the database's E* = {e_star:.4g} Pa: beyond the "
+                   f"small strains of the elastic half-space ({why})")
 
 
 def check_design(args, surface, targets, settings) -> None:
@@ -183,19 +193,9 @@ def check_design(args, surface, targets, settings) -> None:
     to reach p_max^t: the design tutorial's profile had rms slope 8.5 with the thesis'
     targets at 1.7 E*; a user's review, round 2, session 29). The design then matches
     the linear model's curves, which no material follows there."""
-    from ..surfaces.stats import rms_slope
-
-    e_star = settings.youngs_modulus / (1.0 - settings.poisson ** 2)
-    p_top = max(float(t.p_max) for t in targets)
-    if p_top > e_star:
-        warn(args, f"the target's largest pressure p_max^t = {p_top:.4g} Pa is "
-                   f"{p_top / e_star:.3g} x the database's E* = {e_star:.4g} Pa: beyond the "
-                   f"small strains of the elastic half-space (the model scales with E*: "
-                   f"the design matches p / E*, not a material's response)")
-    try:
-        slope = rms_slope(surface)
-    except Exception:       # noqa: BLE001 -- a flat design: no slope to judge
-        return
+    check_target_pressure(args, targets, settings, "the model scales with E*: the design "
+                                                   "matches p / E*, not a material's response")
+    slope = _slope(surface)
     if slope > STEEP_SLOPE:
         warn(args, f"the designed surface has rms slope {slope:.3g} (> {STEEP_SLOPE:g}; its "
                    f"amplitude is rescaled by Eq. 4.2 to reach p_max^t): beyond the small "
