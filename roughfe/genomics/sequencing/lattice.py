@@ -166,14 +166,11 @@ def lattice_ranges(log_q1, log_gamma, acqs, n_nodes):
 def design_matrix(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
     """The linear model of the stacked acquisitions (Eq. 3.12-3.16): for each chromosome
     n the columns ``1 - cos(q_n x)`` and ``sin(q_n x)`` (the real and imaginary parts of
-    its phasor sum), then per acquisition a constant and a linear column: its height
-    offset and tilt. The genome's profile is zero at x = 0 (Eq. 3.1); a measured or
-    mean-removed profile is not, and without the offsets the fit bends the chromosomes to
-    absorb it (mean-removed Table 1 profiles: gamma 1.14 for 1.5). A levelled profile
-    (its least-squares line removed, as every profilometer does) lost a line: without
-    the tilts the fit took gamma^(1/3) or gamma^(1/2) (a user's review, round 2, session
-    29; the 2D sequencer fits a plane per acquisition). Returns (n, matrix); the offsets
-    and then the tilts are the last ``2 len(acqs)`` unknowns."""
+    its phasor sum), then one constant column per acquisition: its height offset. The
+    genome's profile is zero at x = 0 (Eq. 3.1); a measured or mean-removed profile is
+    not, and without the offsets the fit bends the chromosomes to absorb it (mean-removed
+    Table 1 profiles: gamma 1.14 for 1.5). Returns (n, matrix); the offsets are the last
+    ``len(acqs)`` unknowns."""
     lo = min(r[0] for r in ranges)
     hi = max(r[1] for r in ranges) if n_cap is None else min(n_cap, max(r[1] for r in ranges))
     n = np.arange(lo, hi + 1)
@@ -182,11 +179,10 @@ def design_matrix(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
     for a, (ns, nf), w in zip(acqs, ranges, weights):
         on = (n >= ns) & (n <= nf)
         arg = np.multiply.outer(a.x, q)
-        m = np.zeros((a.x.size, 2 * n.size + 2 * len(acqs)))
+        m = np.zeros((a.x.size, 2 * n.size + len(acqs)))
         m[:, 0:2 * n.size:2] = np.where(on, 1.0 - np.cos(arg), 0.0)
         m[:, 1:2 * n.size:2] = np.where(on, np.sin(arg), 0.0)
         m[:, 2 * n.size + len(blocks)] = 1.0
-        m[:, 2 * n.size + len(acqs) + len(blocks)] = a.x
         blocks.append(m * w)
     return n, np.vstack(blocks)
 
