@@ -32,10 +32,8 @@ def _chromosomes(args) -> int:
         if surface.periodic:
             raise InputError(f"--mirror mirrors a non-periodic window; {args.surface} is "
                              f"read as periodic (drop --mirror, or give --non-periodic)")
-        # detrended before the mirror, as contact's --detrend then --mirror (the mirrored
-        # period's own plane is flat)
-        surface = (surface.detrended(args.detrend) if args.detrend != "none"
-                   else surface).mirrored()
+        # surface_from_args has applied --detrend: mirrored after it, as in `contact`
+        surface = surface.mirrored()
     elif args.steps and not surface.periodic:
         warn(args, "the K(p) of a non-periodic window is mostly the window's flat-punch bulk "
                    "stiffness (1/K ~ 1/K_interface + C, as `roughfe contact` says), the same "

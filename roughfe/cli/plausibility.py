@@ -130,9 +130,10 @@ def check_solution(args, surface, results, material) -> None:
     if STEEP_SLOPE < slope <= SLOPE_LIMIT:      # above: warn_units has spoken
         warn(args, f"rms slope {slope:.3g} > {STEEP_SLOPE:g}: the linear half-space assumes "
                    f"small slopes (its geometry is linearised); read A* and K as that model's")
-    peak = max(float(np.max(r.pressure)) for r in results)
+    peaks = [float(np.max(r.pressure)) for r in results]
+    k = int(np.argmax(peaks))
+    peak = peaks[k]
     if peak > e_star:
-        k = max(range(len(results)), key=lambda i: float(np.max(results[i].pressure)))
         warn(args, f"the local contact pressure reaches {peak:.3g} Pa = {peak / e_star:.3g} E* "
                    f"(step {k}): local strains of order one, beyond linear elasticity; "
                    f"a real material yields first (--hardness)")
