@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import json
 
-from .options import (material_from_args, output_folder_of, surface_from_args, warn)
+from .options import (material_from_args, mirrored_if_asked, output_folder_of,
+                      surface_from_args, warn)
 
 #: units of the arrays of chromosomes.npz (``genome chromosomes``), stored in the file as
 #: ``units`` (a JSON object, as `leak`'s fields/step_NNN.npz); "1": dimensionless
@@ -27,14 +28,8 @@ def _chromosomes(args) -> int:
                          f"{args.steps}: K(p) is differenced over the steps, and "
                          f"{args.steps} give(s) at most one secant (every curve flat, no "
                          f"macro/micro split)")
-    surface = surface_from_args(args)
-    if args.mirror:
-        if surface.periodic:
-            raise InputError(f"--mirror mirrors a non-periodic window; {args.surface} is "
-                             f"read as periodic (drop --mirror, or give --non-periodic)")
-        # surface_from_args has applied --detrend: mirrored after it, as in `contact`
-        surface = surface.mirrored()
-    elif args.steps and not surface.periodic:
+    surface = mirrored_if_asked(args, surface_from_args(args))
+    if args.steps and not surface.periodic:
         warn(args, "the K(p) of a non-periodic window is mostly the window's flat-punch bulk "
                    "stiffness (1/K ~ 1/K_interface + C, as `roughfe contact` says), the same "
                    "for every band, so c_n of K compares bulk-dominated curves; --mirror "

@@ -30,7 +30,8 @@ from .plausibility import check_load_magnitudes, check_solution, persson_basis
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, contact_physics_from_args,
-                      fmt_or_dash, material_from_args, output_folder_of, positive_float,
+                      fmt_or_dash, material_from_args, mirrored_if_asked,
+                      output_folder_of, positive_float,
                       positive_int, print_surface_notes, surface_from_args, unit_fraction)
 
 DEFAULT_STEPS = Loading.DEFAULT_STEPS
@@ -93,12 +94,7 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
-    surface = surface_from_args(args)
-    if args.mirror:
-        if surface.periodic:
-            raise InputError(f"--mirror mirrors a non-periodic window; {args.surface} is "
-                             f"read as periodic (drop --mirror, or give --non-periodic)")
-        surface = surface.mirrored()
+    surface = mirrored_if_asked(args, surface_from_args(args))
     material = material_from_args(args)
     check_load_magnitudes(surface, material, args.pressure, args.delta)
     law = contact_physics_from_args(args)["adhesion"]

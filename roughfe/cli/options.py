@@ -160,6 +160,19 @@ def surface_from_args(args):
     return surface if detrend == "none" else surface.detrended(detrend)
 
 
+def mirrored_if_asked(args, surface):
+    """``surface`` (as :func:`surface_from_args` gave it, detrended) evenly mirrored into a
+    periodic one when the command's ``--mirror`` is given (``contact``, ``genome
+    chromosomes``); a periodic surface cannot be mirrored."""
+    if not getattr(args, "mirror", False):
+        return surface
+    if surface.periodic:
+        from ..errors import InputError
+        raise InputError(f"--mirror mirrors a non-periodic window; {args.surface} is "
+                         f"read as periodic (drop --mirror, or give --non-periodic)")
+    return surface.mirrored()
+
+
 def surface_notes(surface, channel: bool = False) -> list:
     """Console lines on what an instrument file gave: with ``channel`` the channel read
     (and, of a multi-channel file, all of its channels), and the undefined points that
