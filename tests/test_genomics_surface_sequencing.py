@@ -540,3 +540,15 @@ def test_the_figure_draws_the_genome_at_the_acquisitions_own_nodes(tmp_path, mon
         z = np.asarray(panels[3 * row].images[0].get_array())
         diff = np.asarray(panels[3 * row + 2].images[0].get_array())
         assert np.sqrt(np.mean(diff ** 2)) < 1e-12 * np.sqrt(np.mean(z ** 2))
+
+
+@pytest.mark.parametrize("hurst, seed", [(0.3, 1), (0.8, 2)])
+def test_a_continuous_spectrum_fails_before_any_fit(hurst, seed):
+    """A periodic self-affine 256^2 surface: its periodogram has ~100 local maxima in
+    17-31 directions, and the lattice fit of all of them ran for more than 12 minutes
+    before it failed (a user's review). Its peaks lie on no geometric lattice (comb
+    coherence ~0.2, an MWM's is > 0.7): the failure is now told before any fit."""
+    s = spectral_surface(256, 1e-4, hurst, rms_height=1e-6, rng=seed)
+    r = sequence_surfaces([Surface(s.heights, 256 * 1e-4 / 255)])
+    assert not r.success and r.genome is None and r.nit == 0
+    assert "no geometric lattice" in r.message and "comb coherence 0." in r.message

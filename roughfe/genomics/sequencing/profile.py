@@ -8,6 +8,7 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
+from ... import progress
 from ...errors import InputError, check_int
 from ...surfaces.wm import resolve_rng
 from ..genome import Genome, profile_heights
@@ -160,7 +161,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     best = None
     nit = 0
     exact = 1e-20 * float(rhs @ rhs)
-    for period, ref in zip(periods, refs):
+    for period, ref in progress.iterate(list(zip(periods, refs)), "sequencing: lattice fits"):
         lq1, lg = lattice_from_period(log_q, period, ref, acqs[0].length, bins, groups)
         if not (math.log(1.0 + 1e-3) < lg < math.log(10.0)):
             continue
