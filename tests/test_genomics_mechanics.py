@@ -130,3 +130,21 @@ def test_identical_fields_are_swept_once():
     assert curves["b"] is curves["a"] and curves["c"] is curves["a"]
     assert curves["d"] is None and curves["e"] is None and set(failed) == {"d", "e"}
     assert curves["complete"].stiffness[0] == pytest.approx(np.ptp(z))
+
+
+def test_curves_on_disjoint_pressure_ranges_are_not_compared():
+    """Two curves sharing fewer than 2 pressures: the difference is undefined (NaN, with
+    the two ranges said), not an InputError after a sequencing had run; overlapping
+    curves compare on the shared range only."""
+    from roughfe.genomics.similarity import ResponseCurve
+    p = np.array([1e5, 2e5, 4e5])
+    ref = ResponseCurve(p, 1e12 * p / p[-1], 0.1 * p / p[-1])
+    far = ResponseCurve(1e4 * p, 1e12 * p / p[-1], 0.1 * p / p[-1])
+    d = curve_difference(ref, far)
+    assert np.isnan(d["K"]) and np.isnan(d["A"]) and d["n_points"] == 0
+    assert "1e+05..4e+05 Pa" in d["note"]
+    half = ResponseCurve(2 * p, 1e12 * p / p[-1], 0.1 * p / p[-1])   # shares 2e5, 4e5
+    d = curve_difference(ref, half)
+    assert d["n_points"] == 2 and "note" not in d
+    # at 2e5 and 4e5 Pa the other curve holds K 0.25e12 and 0.5e12 against 0.5e12, 1e12
+    assert d["K"] == pytest.approx(0.5, rel=1e-12, abs=0)

@@ -259,9 +259,8 @@ def test_a_clipping_m_is_reported_as_the_cause():
 
 def test_the_zd_error_is_none_when_zd_is_round_off():
     """Windows L and L/1.1 at N = 256 show the same chromosomes: Z_d = Z_1 - Z_2 is
-    round-off (2.2e-19 m on heights of 7.3e-4 m rms), and the report gave a relative
-    error 2.66 (a ratio of two round-offs). Now None; a Z_d that carries signal keeps
-    its error (L and L/3.3: ~4e-15)."""
+    round-off (2.2e-19 m on heights of 7.3e-4 m rms), and the report gave a relative error 2.66 (a ratio of two round-offs).
+    Now None; a Z_d that carries signal keeps its error (L and L/3.3: ~4e-15)."""
     g = table1_genome(rng=0)
     same = sequence_profiles([realize(g, length=1e-3, n_nodes=256),
                               realize(g, length=1e-3 / 1.1, n_nodes=256)])
@@ -271,3 +270,47 @@ def test_the_zd_error_is_none_when_zd_is_round_off():
     other = sequence_profiles([realize(g, length=1e-3, n_nodes=256),
                                realize(g, length=1e-3 / 3.3, n_nodes=256)])
     assert other.report()["zd_rms_error"] < 1e-12
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_levelled_profiles_are_sequenced_exactly(seed):
+    """Profilometers level their profiles (remove their least-squares line). The
+    profile model carried one offset per acquisition and took gamma^(1/3) for levelled
+    Table 1 profiles in 6 of 6 seeds (a user's review, round 2, session 29); a levelled
+    acquisition now gets its line back as unknowns, and they are sequenced as the raw
+    ones, the fitted tilts being the lines removed."""
+    from roughfe.surfaces.surface import Surface
+    g = table1_genome(rng=seed)
+    acqs, lines = [], []
+    for length in (1e-3, 0.5e-3):
+        s = realize(g, length=length, n_nodes=256)
+        x = s.coordinates()[0]          # the slope does not depend on the origin of x
+        slope, icpt = np.polyfit(x, s.heights, 1)
+        lines.append(slope)
+        acqs.append(Surface(s.heights - (slope * x + icpt), s.size, periodic=False,
+                            metadata=dict(s.metadata)))
+    res = sequence_profiles(acqs)
+    assert res.success and res.genome.gamma == pytest.approx(1.5, rel=1e-9, abs=0)
+    assert np.all(res.rms_errors < 1e-12)
+    # the tilt of each fitted line is minus the slope removed (x about the same origin)
+    np.testing.assert_allclose(res.tilts, -np.array(lines), rtol=1e-6)
+    # raw profiles fit no line: their tilts are zero and the genes the same
+    raw = sequence_profiles([realize(g, length=L, n_nodes=256) for L in (1e-3, 0.5e-3)])
+    assert np.all(raw.tilts == 0.0)
+    assert raw.genome.lambda1 == pytest.approx(res.genome.lambda1, rel=1e-9, abs=0)
+
+
+def test_a_levelled_profile_is_told_from_a_raw_one():
+    """The mark of levelling: a least-squares line of zero to round-off, also after a
+    float32 round trip; a raw window, a mean-removed one (still tilted) and a detrended
+    sub-window of a longer row (genome natural's acquisitions) are not levelled."""
+    from roughfe.genomics.sequencing.acquisitions import is_levelled
+    g = table1_genome(rng=1)
+    s = realize(g, length=1e-3, n_nodes=512)
+    x, z = s.coordinates()[0], s.heights
+    flat = z - np.polyval(np.polyfit(x, z, 1), x)
+    assert not is_levelled(x, z)
+    assert not is_levelled(x, z - z.mean())
+    assert is_levelled(x, flat)
+    assert is_levelled(x, flat.astype(np.float32).astype(float))
+    assert not is_levelled(x[100:300], flat[100:300])

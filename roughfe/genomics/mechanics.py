@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import math
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -64,11 +65,19 @@ def curve_difference(reference: ResponseCurve, other: ResponseCurve) -> dict:
     ``other`` is interpolated (linearly) at the reference pressures inside its own range;
     differences are |y_o - y_r| / max|y_r| (A and K normalised by their largest value, so
     a zero area at first contact does not blow up the ratio).
+
+    Curves whose pressure ranges share fewer than 2 reference pressures (e.g. a sequenced
+    profile of a measured row whose genome is not that row's, loaded to other pressures)
+    cannot be compared: K and A are then NaN and ``"note"`` says why (it was an
+    InputError, raised after the sequencing had run; a user's review).
     """
     p = reference.pressure
     inside = (p >= other.pressure[0]) & (p <= other.pressure[-1])
     if inside.sum() < 2:
-        raise InputError("the two response curves share fewer than 2 pressures")
+        return {"K": math.nan, "A": math.nan, "n_points": int(inside.sum()),
+                "note": (f"the curves share {int(inside.sum())} pressure(s): the reference "
+                         f"spans {p[0]:.4g}..{p[-1]:.4g} Pa, the other "
+                         f"{other.pressure[0]:.4g}..{other.pressure[-1]:.4g} Pa")}
     out = {}
     for q in ("K", "A"):
         yr = reference.values(q)[inside]
@@ -281,7 +290,8 @@ def sweep_report(failed: dict, names) -> tuple:
 
 def correlations(complete, curves):
     """``{"K": c_n, "A": c_n}``: Pearson c_n of each curve with the complete one (Alg. 2,
-    paired by loading step); NaN where a curve is None."""
+    paired by loading step); NaN where a curve is None or constant (an undefined correlation,
+    :func:`~roughfe.genomics.macro_micro.correlation`)."""
     out = {}
     for q in ("K", "A"):
         out[q] = np.array([np.nan if c is None else correlation(complete, c, q) for c in curves])

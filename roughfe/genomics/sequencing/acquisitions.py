@@ -10,16 +10,34 @@ from ...surfaces.surface import Surface
 from ..genome import observation_coordinates
 
 MIN_NODES = 32
+#: a profile is levelled when its own least-squares line (mean, and slope times L/2) is
+#: below this fraction of its rms height: zero to the round-off of float32 files, while
+#: a raw WM or measured window has a line of order its rms
+LEVELLED_TOLERANCE = 1e-6
 
 
 # -- data checks -------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class Acquisition:
-    """One acquisition: node abscissae x (m), heights z (m), observation length L = (N-1) dx."""
+    """One acquisition: node abscissae x (m), heights z (m), observation length L = (N-1) dx;
+    ``levelled``: its least-squares line was removed (:func:`is_levelled`), so the
+    sequencer fits the line back (:func:`~.lattice.design_matrix`)."""
 
     x: np.ndarray
     z: np.ndarray
     length: float
+    levelled: bool = False
+
+
+def is_levelled(x, z) -> bool:
+    """True when the heights ``z`` (m) at ``x`` (m) have a least-squares line of zero to
+    round-off (:data:`LEVELLED_TOLERANCE` of their rms): the mark a profilometer's
+    levelling leaves."""
+    xc = x - x.mean()
+    rms = float(np.sqrt(np.mean(z ** 2)))
+    slope = float(xc @ z) / float(xc @ xc)
+    return bool(abs(float(z.mean())) <= LEVELLED_TOLERANCE * rms
+                and abs(slope) * 0.5 * float(np.ptp(x)) <= LEVELLED_TOLERANCE * rms)
 
 
 def check_controls(rms_tolerance, n_restarts):
@@ -59,7 +77,8 @@ def acquisitions_from_surfaces(surfaces) -> list:
             raise InputError(f"acquisition {k} is flat (all heights equal {float(s.heights[0])!r} m): "
                              f"there is no roughness to sequence")
         x = observation_coordinates(s)
-        acq.append(Acquisition(x, np.asarray(s.heights, dtype=float), float((n - 1) * s.spacing[0])))
+        z = np.asarray(s.heights, dtype=float)
+        acq.append(Acquisition(x, z, float((n - 1) * s.spacing[0]), is_levelled(x, z)))
     acq.sort(key=lambda a: -a.length)
     for a, b in zip(acq, acq[1:]):
         if not b.length < a.length * (1 - 1e-9):

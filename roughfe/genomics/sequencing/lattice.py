@@ -163,26 +163,43 @@ def lattice_ranges(log_q1, log_gamma, acqs, n_nodes):
     return [chromosome_range(math.exp(log_gamma), lam1, a.length, n_nodes) for a in acqs]
 
 
+def line_columns(acqs) -> int:
+    """The unknowns of the acquisitions' lines in :func:`design_matrix`: an offset for
+    each, and a tilt for each levelled one (:attr:`.acquisitions.Acquisition.levelled`)."""
+    return len(acqs) + sum(bool(a.levelled) for a in acqs)
+
+
 def design_matrix(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
     """The linear model of the stacked acquisitions (Eq. 3.12-3.16): for each chromosome
     n the columns ``1 - cos(q_n x)`` and ``sin(q_n x)`` (the real and imaginary parts of
-    its phasor sum), then one constant column per acquisition: its height offset. The
-    genome's profile is zero at x = 0 (Eq. 3.1); a measured or mean-removed profile is
-    not, and without the offsets the fit bends the chromosomes to absorb it (mean-removed
-    Table 1 profiles: gamma 1.14 for 1.5). Returns (n, matrix); the offsets are the last
-    ``len(acqs)`` unknowns."""
+    its phasor sum), then a constant column per acquisition (its height offset), then a
+    linear column per *levelled* acquisition (its tilt).
+
+    The genome's profile is zero at x = 0 (Eq. 3.1); a measured or mean-removed profile
+    is not, and without the offsets the fit bends the chromosomes to absorb it
+    (mean-removed Table 1 profiles: gamma 1.14 for 1.5). A levelled profile (its
+    least-squares line removed, as profilometers do) lost a line: without a tilt the fit
+    took gamma^(1/3) or gamma^(1/2) (a user's review, round 2, session 29). The tilt is
+    fitted only where the data say a line was removed (its own least-squares line is zero
+    to round-off): a free tilt on every acquisition is nearly collinear with the longest
+    chromosome's sine over a window shorter than its wavelength, and on measured rows
+    (``genome natural``) it traded them into waves of 1e4 x the heights. Returns
+    (n, matrix); the last :func:`line_columns` unknowns are the offsets, then the tilts."""
     lo = min(r[0] for r in ranges)
     hi = max(r[1] for r in ranges) if n_cap is None else min(n_cap, max(r[1] for r in ranges))
     n = np.arange(lo, hi + 1)
     q = np.exp(log_q1 + (n - 1) * log_gamma)
+    tilt_col = np.cumsum([bool(a.levelled) for a in acqs]) - 1 + len(acqs)
     blocks = []
-    for a, (ns, nf), w in zip(acqs, ranges, weights):
+    for k, (a, (ns, nf), w) in enumerate(zip(acqs, ranges, weights)):
         on = (n >= ns) & (n <= nf)
         arg = np.multiply.outer(a.x, q)
-        m = np.zeros((a.x.size, 2 * n.size + len(acqs)))
+        m = np.zeros((a.x.size, 2 * n.size + line_columns(acqs)))
         m[:, 0:2 * n.size:2] = np.where(on, 1.0 - np.cos(arg), 0.0)
         m[:, 1:2 * n.size:2] = np.where(on, np.sin(arg), 0.0)
-        m[:, 2 * n.size + len(blocks)] = 1.0
+        m[:, 2 * n.size + k] = 1.0
+        if a.levelled:
+            m[:, 2 * n.size + tilt_col[k]] = a.x
         blocks.append(m * w)
     return n, np.vstack(blocks)
 

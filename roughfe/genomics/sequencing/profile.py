@@ -16,7 +16,7 @@ from .acquisitions import Acquisition, acquisitions_from_surfaces, check_control
 from .genes import (H_SEARCH, amplitude_genes, peak_slope_H, phases_with_sums,
                     ridge_likelihood, variance_amplitude)
 from .lattice import (bic, coarser_lattices, comb_periods, design_matrix, fit_lattice, label_q1,
-                      lattice_from_period, lattice_ranges, round_off_cost, solve_linear,
+                      lattice_from_period, line_columns, lattice_ranges, round_off_cost, solve_linear,
                       vp_residual)
 from .peaks import spectrum_peaks
 from .result import SequencingResult
@@ -62,7 +62,7 @@ def _labelled(p, acqs, n_nodes, weights, rhs):
         r = vp_residual(cand, acqs, ranges, weights, rhs, None)
         lo, hi = min(rr[0] for rr in ranges), max(rr[1] for rr in ranges)
         rss = float(r @ r)
-        cost = bic(rss, r.size, 2 * (hi - lo + 1) + len(acqs) + 2, floor)
+        cost = bic(rss, r.size, 2 * (hi - lo + 1) + line_columns(acqs) + 2, floor)
         if best is None or cost < best[0]:
             best = (cost, cand, ranges, rss)
     return best
@@ -190,9 +190,13 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     n, mat = design_matrix(lq1, lg, acqs, ranges, weights)
     coef = solve_linear(mat, rhs)
     cvec = coef[0:2 * n.size:2] + 1j * coef[1:2 * n.size:2]
-    # the acquisitions' height offsets (their heights at x = 0 off the genome's zero)
-    offsets = coef[2 * n.size:]
-    acqs = [Acquisition(a.x, a.z - off, a.length) for a, off in zip(acqs, offsets)]
+    # the acquisitions' height offsets (their heights at x = 0 off the genome's zero) and
+    # tilts (the line a levelled profile lost)
+    offsets = coef[2 * n.size:2 * n.size + len(acqs)]
+    tilts = np.zeros(len(acqs))
+    tilts[[a.levelled for a in acqs]] = coef[2 * n.size + len(acqs):]
+    acqs = [Acquisition(a.x, a.z - off - tilt * a.x, a.length)
+            for a, off, tilt in zip(acqs, offsets, tilts)]
     amps, thetas = np.abs(cvec), np.angle(cvec)
 
     # 5. genes
@@ -261,6 +265,6 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         ranges=ranges, lengths=np.array([a.length for a in acqs]), rms_errors=rms,
         x=[a.x for a in acqs], heights=[a.z for a in acqs], fitted=fitted, zd_x=zd_x, zd=zd,
         zd_fit=zd_fit, spectra=spectra, gamma_psd=gamma_psd, H_psd=peak_slope_H(spectra, lq1, lg),
-        M_loglik=loglik, offsets=offsets, A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1),
+        M_loglik=loglik, offsets=offsets, tilts=tilts, A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1),
                                                gamma, lam1, H),
         seed=int(seed), elapsed=time.perf_counter() - t0)

@@ -18,6 +18,7 @@ REPORT_UNITS = {"A": "m^(1-H)", "H": "1", "gamma": "1", "lambda1": "m",
                 "M": "1 (number of ridges)", "lengths": "m",
                 "ranges": "1 (chromosome numbers n_s, n_f)",
                 "rms_errors": "1 (relative: rms(Z - Z_seq) / rms(Z))", "offsets": "m",
+                "tilts": "1 (m/m)",
                 "zd_rms": "m", "zd_rms_error": "1 (relative)", "gamma_psd": "1",
                 "H_psd": "1", "A0_variance": "m^(1-H)", "M_loglik": "1 (log-likelihood)",
                 "nit": "1 (residual evaluations)", "elapsed_s": "s"}
@@ -64,6 +65,9 @@ class SequencingResult:
         Height offset of each acquisition (m, coarsest first): the constant fitted with
         the chromosomes, its height at x = 0 off the genome's zero (Eq. 3.1: Z(0) = 0),
         e.g. the mean a mean-removed profile lost; ``heights`` are the data less it.
+    tilts : ndarray
+        Slope of each acquisition's fitted line (m/m, coarsest first): the line a
+        levelled profile lost (``heights`` are the data less it too; round 2, session 29).
     A0 : float
         Amplitude from the height variance of the coarsest acquisition (Eq. 3.13), for
         comparison with the maximum-likelihood A.
@@ -93,6 +97,7 @@ class SequencingResult:
     H_psd: float
     M_loglik: np.ndarray
     offsets: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    tilts: np.ndarray = field(default_factory=lambda: np.zeros(0))
     A0: float = float("nan")
     seed: Optional[int] = None
     elapsed: float = 0.0
@@ -123,6 +128,7 @@ class SequencingResult:
                 "genes": {"A": g.A, "H": g.H, "gamma": g.gamma, "lambda1": g.lambda1, "M": g.M},
                 "lengths": self.lengths.tolist(), "ranges": [list(r) for r in self.ranges],
                 "rms_errors": self.rms_errors.tolist(), "offsets": self.offsets.tolist(),
+                "tilts": self.tilts.tolist(),
                 "zd_rms": float(np.sqrt(np.mean(self.zd ** 2))) if self.zd.size else None,
                 "zd_rms_error": self.zd_rms_error(),
                 "gamma_psd": self.gamma_psd, "H_psd": self.H_psd, "A0_variance": self.A0,
