@@ -30,6 +30,15 @@ class FileFormatError(RoughfeError, ValueError):
     """A file could not be read or does not follow the documented format."""
 
 
+class Terminated(KeyboardInterrupt):
+    """The process was asked to stop by SIGTERM (``kill PID``, a batch system's time
+    limit). The command line turns SIGTERM into this exception so that it stops as after
+    Ctrl-C (KeyboardInterrupt, of which it is a subclass): clean-up code runs, a study's
+    workers are stopped and its folder keeps ``UNFINISHED``, an output folder is left as
+    after Ctrl-C (:class:`roughfe.writers.OutputFolder`), and the command exits with 143
+    (128 + 15, what a shell reports for a process killed by SIGTERM) instead of 130."""
+
+
 class ResolutionWarning(UserWarning):
     """The input is valid but the grid does not resolve a length the physics needs: the
     result depends on the discretisation (the message says which length, by how much,

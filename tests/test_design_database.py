@@ -42,6 +42,21 @@ def test_alg2_classification_maths():
     assert r.corr_k[1] == pytest.approx(-1.0, abs=0.05)
 
 
+def test_a_constant_curve_has_an_undefined_correlation_and_is_micro():
+    """Pearson's c_n of a constant curve is 0/0: NaN, not the 0.0 ("uncorrelated") it
+    was; classify makes that chromosome micro, as any c_n not above the threshold."""
+    p = np.linspace(1.0, 2.0, 20)
+    full = ResponseCurve(p, p ** 0.7, p / 4)
+    flat_k = ResponseCurve(p, np.full(p.size, 3.0e9), p / 4)     # K constant, A rising
+    assert np.isnan(correlation(full, flat_k, "K"))
+    assert np.isnan(correlation(flat_k, full, "K"))              # a constant reference
+    assert correlation(full, flat_k, "A") == pytest.approx(1.0)   # A is defined
+    assert np.isnan(correlation(full, flat_k, "K", axis="pressure"))
+    r = classify(full, [full.rescaled(2.0), flat_k], [1, 2], threshold=0.95)
+    assert r.macro == (1,) and r.micro == (2,)
+    assert np.isnan(r.corr_k[1]) and r.corr_a[1] == pytest.approx(1.0)
+
+
 def test_eq_4_2_scaling_law_with_the_bem():
     """Heights x eta under displacement control: p x eta, K and A unchanged (linear elasticity)."""
     g = db.make_genome(1.6, 0.8, 7, SMALL)
@@ -137,6 +152,22 @@ def test_built_entry_matches_its_bem_curve_and_record_checks(tmp_path):
         assert db.labels(con) == ["1-1"]
     finally:
         con.close()
+    con = db.connect(path, create=True)
+    try:  # an undefined c_n (NaN: a constant curve) is stored as JSON null, read back NaN
+        undefined = [float("nan")] + list(e.corr_k[1:])
+        assert db.insert_records(con, [{
+            "label": "nan-1", "source": e.source, "genome": e.genome, "p_max": e.p_max,
+            "curve": e.curve.to_dict(),
+            "chromosome_curves": [c.to_dict() for c in e.chromosome_curves],
+            "corr_k": undefined, "corr_a": list(e.corr_a), "macro": list(e.macro),
+            "settings": SMALL.to_dict()}]) == 1
+        text = con.execute("SELECT corr_k_json FROM genomes WHERE label='nan-1'").fetchone()[0]
+        assert text.startswith("[null,") and "NaN" not in text
+    finally:
+        con.close()
+    back = db.load_entries(path, labels_=["nan-1"])[0]
+    assert back.corr_k.dtype == float and np.isnan(back.corr_k[0])
+    np.testing.assert_array_equal(back.corr_k[1:], e.corr_k[1:])
 
 
 def test_empty_missing_and_foreign_databases(tmp_path):

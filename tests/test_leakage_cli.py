@@ -158,6 +158,55 @@ def test_leak_fsi_writes_coupled_steps(tmp_path, capsys):
     assert "--bulk-modulus needs --fsi" in capsys.readouterr().err
 
 
+def _table_head(text):
+    return next(line for line in text.splitlines() if line.lstrip().startswith("step "))
+
+
+def test_leak_fsi_and_one_way_write_the_same_network_fields_and_columns(tmp_path, capsys):
+    """The coupled (--fsi) step files carry the one-way files' contact and network arrays,
+    the `sealed` mask included (they lacked it, and percolating_x and parent_channel_x:
+    a user's review), and both tables print the Vp*, Vnp*, sealed* and perc x/y columns
+    (the --fsi table had none of them)."""
+    from roughfe.cli import main
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=4)
+    path = save_surface(s, tmp_path / "s.npz")
+    common = ["leak", str(path), "--pressure", "1e6", "3e6", "--direction", "x", "--E", "2.1e8",
+              "--no-figures"]
+    fsi_out, plain_out = tmp_path / "fsi", tmp_path / "plain"
+    assert main(common + ["--fsi", "--inlet-pressure", "1e6", "--outlet-pressure", "0",
+                          "-o", str(fsi_out)]) == 0
+    fsi_text = capsys.readouterr().out
+    assert main(common + ["-o", str(plain_out)]) == 0
+    plain_text = capsys.readouterr().out
+    for text in (fsi_text, plain_text):
+        head = _table_head(text)
+        for column in ("A*", "Vp*", "Vnp*", "sealed*", "perc x/y", "Q (m^3/s)"):
+            assert f" {column}" in head, (column, head)
+        assert "sealed*: the part of Vnp* with no open path" in text
+    # the printed sealed* is the step's sealed_volume_star; x analysed, y not ("-", not "N")
+    steps = json.loads((fsi_out / "results.json").read_text())["steps"]
+    row = _table_head(fsi_text).split()
+    last = fsi_text.splitlines()[fsi_text.splitlines().index(_table_head(fsi_text)) + 2].split()
+    assert float(last[row.index("sealed*") - 1]) == pytest.approx(
+        steps[1]["sealed_volume_star"], rel=1e-3, abs=0)
+    assert "T/-" in last
+
+    flow_only = {"fluid_pressure_x", "flux_x"}             # the one-way Reynolds solve's
+    with np.load(plain_out / "fields" / "step_001.npz") as plain, \
+            np.load(fsi_out / "fields" / "step_001.npz") as fsi:
+        assert set(plain.files) - flow_only <= set(fsi.files)
+        units = json.loads(str(fsi["units"]))
+        assert units["sealed"] == "1" and set(units) == set(fsi.files) - {"units"}
+        sealed, trapped, gap = fsi["sealed"], fsi["trapped"], fsi["gap"]
+        assert sealed.dtype == bool and sealed.shape == s.shape
+        assert sealed.any() and not (sealed & ~trapped).any()
+        # the mask is the one of the step's sealed_volume (the gap over its cells)
+        dx, dy = fsi["spacing_m"]
+        assert gap[sealed].sum() * dx * dy == pytest.approx(steps[1]["sealed_volume"],
+                                                            rel=1e-12, abs=0)
+
+
 def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
     # roughfe leak accepts --adhesion/--hardness/--unload of roughfe contact (one option
     # vocabulary): at the same approaches adhesion pulls the body onto the surface and a

@@ -122,6 +122,32 @@ def test_surface_psd_figure_markers_sit_on_the_annulus_averaged_fft_psd(drawn):
     assert ax.get_ylim()[0] > 1e-20 * np.nanmax(line)
 
 
+def test_the_psd_figure_draws_the_target_spectrum_of_a_matched_design(drawn):
+    """`design --match-spectrum`: psd.png drew the design's spectrum alone. With
+    ``target`` the target surface's annulus-averaged PSD (the same estimator, m^4) is a
+    line of its own on every panel; a target of another dimension is refused (C(q) of a
+    profile, m^3, is not comparable)."""
+    from roughfe.errors import InputError
+    from roughfe.plotting import design as design_plot
+    from roughfe.surfaces import Surface
+    from roughfe.surfaces.stats import power_spectrum
+    d = _three_ridge_design()
+    s = d.surface()
+    target = s.scaled(2.0)
+    fig = drawn(design_plot, "plot_psds", {"a": (s, d.spectrum_lines()), "b": (s, [])},
+                target=target, target_label="target t.npz")
+    ps = power_spectrum(target)
+    for ax in fig.axes:
+        line = _lines(ax)["target t.npz"]
+        keep = ps.C > design_plot.ROUND_OFF * ps.C.max()   # empty annuli: gaps, as the design's
+        np.testing.assert_array_equal(line.get_xdata(), ps.q)
+        np.testing.assert_allclose(line.get_ydata()[keep], ps.C[keep], rtol=1e-12, atol=0)
+        assert np.isnan(line.get_ydata()[~keep]).all()
+    profile = Surface(target.heights[:, 0], target.size[0], periodic=True)
+    with pytest.raises(InputError, match="dimension"):
+        drawn(design_plot, "plot_psds", {"a": (s, [])}, target=profile)
+
+
 def test_profile_psd_figure_markers_equal_the_psd_of_one_cosine(drawn):
     """A profile's C is per dq, two-sided: a cosine of amplitude a on the lattice puts
     a^2/4 on +-q, C = a^2 / (4 dq) (m^3); a non-periodic profile's PSD is Hann-windowed."""

@@ -204,6 +204,53 @@ def test_kill_9_then_resume_gives_identical_table(tmp_path):
     assert again.n_done == 0 and again.n_cached == 16 and again.executor == "nothing to run"
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("signum, code, line", [
+    (signal.SIGTERM, 143, "roughfe study run: interrupted (SIGTERM)"),
+    (signal.SIGINT, 130, "roughfe study run: interrupted")])
+def test_sigterm_stops_a_study_as_ctrl_c_does(signum, code, line, tmp_path):
+    """`kill PID` (SIGTERM) to the driver alone, as Ctrl-C: one "interrupted" line,
+    exit 143 (130 for SIGINT), no traceback, no leaked semaphore (the resource tracker's
+    warning), no worker left, UNFINISHED kept with an index of what is done; a rerun
+    resumes and removes UNFINISHED. Before, SIGTERM killed the driver silently and the
+    resource tracker warned of 5 leaked semaphores."""
+    out = tmp_path / "stopped"
+    spec_path = _write_toml(tmp_path / "spec.toml", out, sleep=0.3)
+    proc = subprocess.Popen(
+        [PY, "-m", "roughfe.cli", "study", "run", str(spec_path), "--workers", "2",
+         "--quiet"], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 60
+    while len(_results(out)) < 2 and time.monotonic() < deadline:
+        assert proc.poll() is None, proc.stderr.read().decode()
+        time.sleep(0.02)
+    workers = _children(proc.pid)
+    assert workers, "the pool's worker processes"
+    t0 = time.monotonic()
+    os.kill(proc.pid, signum)              # the driver only, as `kill PID` would
+    _, err = proc.communicate(timeout=30)  # EOF: every holder of stderr (workers,
+    stopped_s = time.monotonic() - t0      # the resource tracker) has exited
+    err = err.decode()
+    assert proc.returncode == code, err
+    assert err.strip().splitlines()[-1] == line, err
+    assert "Traceback" not in err and "leaked" not in err, err
+    deadline = time.monotonic() + 5    # a worker that closed its files may still be exiting
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not any(_alive(p) for p in workers)
+    assert stopped_s < 10              # the running tasks are stopped, not waited for
+    n_done = len(_results(out))
+    assert 2 <= n_done < 16
+    assert (out / "UNFINISHED").is_file()
+    assert json.loads((out / "index.json").read_text())["n_done"] == n_done
+    status = study_status(out)
+    assert status.unfinished and "unfinished" in status.describe()
+    assert status.n_done == n_done and status.n_missing == 16 - n_done
+
+    resumed = run_study(load_spec(spec_path), executor="local", workers=2, progress=False)
+    assert resumed.complete and resumed.n_cached == n_done
+    assert not (out / "UNFINISHED").exists() and not study_status(out).unfinished
+
+
 def test_failing_task_is_recorded_retried_and_not_fatal(tmp_path):
     out = tmp_path / "fail"
     summary = run_study(_spec(out, fail_x=1.5), executor="local", workers=2, progress=False)

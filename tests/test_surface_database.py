@@ -197,13 +197,25 @@ def test_surface_database_bad_input():
         combine(one, two)
 
 
-def test_surface_db_and_design_commands(tmp_path, capsys):
+def test_surface_db_and_design_commands(tmp_path, capsys, monkeypatch):
     """db build --dim 2 through the study runner, design-targets of a surface file (its own
     BEM sweep), design on the surface database; the saved periodic heights re-scored by a
-    fresh BEM run give the reported scores."""
+    fresh BEM run give the reported scores. A surface design is saved as surface.npz and
+    surface.png (they were profile.*), and psd.png draws the --match-spectrum target's
+    spectrum beside the design's (it drew the design's alone)."""
     import json
 
+    import roughfe.plotting.design as design_plots
     from roughfe.cli import main
+
+    drawn = {}                                   # figure file -> its panels' legend labels
+    save = design_plots.save_figure
+
+    def recording_save(fig, path, *args, **kwargs):
+        drawn[path.name] = [[t.get_text() for t in ax.get_legend().get_texts()]
+                            for ax in fig.axes if ax.get_legend() is not None]
+        return save(fig, path, *args, **kwargs)
+    monkeypatch.setattr(design_plots, "save_figure", recording_save)
     from roughfe.surfaces import Surface
     from roughfe.surfaces.io import load_surface, save_surface
 
@@ -234,14 +246,19 @@ def test_surface_db_and_design_commands(tmp_path, capsys):
                  "--spectrum-starts", "1", "--match-directions", "--search", "3",
                  "--search-amplitudes", "wave", "--global", "cmaes", "--global-eval", "6",
                  "--global-amplitudes", "0.5", "--global-waves",
-                 "--no-figures", "-o", str(out)]) == 0
+                 "-o", str(out)]) == 0
     report = json.loads((out / "result.json").read_text())
     assert "wave amplitudes matched to the target spectrum" in report["message"]
     assert "wave weights" in report["message"] and "wave amplitudes x exp" in report["message"]
     design = Design.from_dict(json.loads((out / "design.json").read_text()))
     assert design.dim == 2
-    heights = load_surface(out / "profile.npz")
+    heights = load_surface(out / "surface.npz")
     assert heights.periodic and heights.shape == (16, 16)
+    assert (out / "surface.png").is_file() and (out / "psd.png").is_file()
+    assert not (out / "profile.npz").exists() and not (out / "profile.png").exists()
+    assert drawn["psd.png"] == [["FFT (no window, annulus mean)",
+                                 "target t.npz (--match-spectrum)", "chromosomes",
+                                 "Nyquist pi/dx"]]
     np.testing.assert_allclose(heights.heights, design.surface().heights, rtol=1e-12)
     targets = [Target.from_dict(t) for t in report["targets"]]
     assert rescore_at_target_pressures(design, targets, settings) == pytest.approx(

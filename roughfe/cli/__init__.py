@@ -16,11 +16,13 @@ from __future__ import annotations
 import contextlib
 import importlib
 import os
+import signal
 import sys
+import threading
 import warnings
 
 from .. import progress
-from ..errors import RoughfeError
+from ..errors import RoughfeError, Terminated
 from .options import ProgressBars, RoughfeParser, show_progress
 
 # module -> the commands it registers (explicit and ordered; no import-time magic)
@@ -86,11 +88,35 @@ def _reader_left() -> int:
     return 141
 
 
+def _raise_terminated(signum, frame):
+    """SIGTERM handler: stop as after Ctrl-C (:class:`~roughfe.errors.Terminated`). A
+    second SIGTERM during the clean-up ends the process at once (default action)."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    raise Terminated("SIGTERM")
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt():
+    """Turn SIGTERM (``kill PID``) into :class:`~roughfe.errors.Terminated` while the
+    command runs, so that it stops as after Ctrl-C: clean-up code runs (a study's worker
+    pool is shut down, no semaphore leaks; an output folder keeps ``UNFINISHED`` or gets
+    its earlier content back). Only in the main thread (signal handlers live there)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv=None) -> int:
     """Run ``roughfe ARGV``; return the exit code (0 ok, 1 targets/checks missed, 2 bad
     input: one line ``roughfe CMD: error: ...`` on stderr, nothing written; 130
-    interrupted; 141 the reader of stdout left, as with SIGPIPE). The
-    library's warnings are printed as one line ``roughfe CMD: warning: ...``."""
+    interrupted by Ctrl-C (SIGINT), 143 by SIGTERM (``kill PID``), either with one line
+    ``roughfe CMD: interrupted`` on stderr; 141 the reader of stdout left, as with
+    SIGPIPE). The library's warnings are printed as one line ``roughfe CMD: warning: ...``."""
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command_of(argv))
     try:
@@ -118,6 +144,7 @@ def main(argv=None) -> int:
     bars = ProgressBars() if show_progress(args) else None
     try:
         with contextlib.ExitStack() as stack:
+            stack.enter_context(_sigterm_as_interrupt())
             stack.enter_context(warnings.catch_warnings())   # restores showwarning
             warnings.showwarning = _warning_printer(name, warnings.showwarning)
             if quiet:
@@ -134,9 +161,11 @@ def main(argv=None) -> int:
         return _reader_left()
     except OSError as exc:
         message = f"{exc.strerror or exc}" + (f": {exc.filename}" if exc.filename else "")
-    except KeyboardInterrupt:
-        print(f"roughfe {name}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:       # Ctrl-C, or SIGTERM (Terminated)
+        terminated = isinstance(exc, Terminated)
+        print(f"roughfe {name}: interrupted{' (SIGTERM)' if terminated else ''}",
+              file=sys.stderr)
+        return 143 if terminated else 130
     finally:
         if quiet:
             quiet.close()

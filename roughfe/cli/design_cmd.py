@@ -137,9 +137,11 @@ def _run(args) -> int:
                             options=options, **extra)
         if args.refine:
             result = refine(result, settings, rounds=args.refine)
+        spectrum_target = None          # the surface whose spectrum psd.png draws beside
         if args.match_spectrum:
             from ..genomics.design import match_spectrum, target_surface
-            surface = target_surface(surface_file(args, args.match_spectrum), settings)
+            surface = spectrum_target = target_surface(surface_file(args, args.match_spectrum),
+                                                       settings)
             result = match_spectrum(result, surface, settings, entries=entries,
                                     n_entries=args.spectrum_starts,
                                     directional=args.match_directions)
@@ -159,8 +161,13 @@ def _run(args) -> int:
             best = result.best.design
             plot_design_curves([result], out / "curves.png", title=design_title(result))
             plot_stages([result], out / "stages.png", title=design_title(result))
-            plot_profiles({result.method: best.surface()}, out / "profile.png")  # 2D: a map
-            plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png")
+            from ..genomics.design import heights_name
+            plot_profiles({result.method: best.surface()},       # 2D: a map, surface.png
+                          out / f"{heights_name(best.dim)}.png")
+            plot_psds({result.method: (best.surface(), best.spectrum_lines())}, out / "psd.png",
+                      target=spectrum_target,
+                      target_label=f"target {Path(str(args.match_spectrum)).name} "
+                                   "(--match-spectrum)" if spectrum_target else "target")
         paths = write_design_result(result, settings, out)
     print(result.message)
     for k, c in enumerate(result.candidates, 1):
@@ -221,7 +228,9 @@ def register(sub):
                                    "Writes OUTDIR/result.json (scores, stages), design.json, "
                                    "genome.json (a roughfe-genome for 'genome realize'; for a "
                                    "design of several genomes one genome_partK.json per part), "
-                                   "profile.npz, curves.csv, stages.csv and the figures.")
+                                   "profile.npz (surface.npz for a surface database), "
+                                   "curves.csv, stages.csv and the figures (psd.png with the "
+                                   "--match-spectrum target's spectrum).")
     p.add_argument("--db", required=True, help="SQLite genome database ('roughfe db build')")
     p.add_argument("--target", required=True,
                    help="CSV 'pressure_Pa,value' or a thesis target y_t1|y_t2|y_t3. Its LAST "

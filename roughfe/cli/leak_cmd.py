@@ -112,19 +112,43 @@ def _write_step_npz(path, arrays: dict, surface) -> Path:
     return path
 
 
-def _save_fields(path, contact, leak, surface):
+def _contact_network_arrays(contact, leak) -> dict:
+    """The arrays of a step's contact and free-volume network, the same for the one-way
+    and the coupled (``--fsi``) sweep: gap, contact, contact pressure, the percolating,
+    trapped and sealed (:attr:`~roughfe.leakage.network.NetworkResult.sealed`) cells, the
+    percolating cells and the critical constriction of each analysed direction."""
+    net = leak.network
     arrays = {"gap": contact.gap, "contact": contact.contact, "pressure_contact": contact.pressure,
-              "percolating": leak.network.percolating, "trapped": leak.network.trapped,
-              "sealed": leak.network.sealed}
-    for d, net in leak.network.directions.items():
-        arrays[f"percolating_{d}"] = net.percolating
-    for d, flow in leak.flows.items():
-        arrays[f"fluid_pressure_{d}"] = flow.pressure
-        arrays[f"flux_{d}"] = flow.flux
+              "percolating": net.percolating, "trapped": net.trapped, "sealed": net.sealed}
+    for d, one in net.directions.items():
+        arrays[f"percolating_{d}"] = one.percolating
     for d, con in leak.constrictions.items():
         arrays[f"widest_path_{d}"] = con.path          # (n, 2) cell indices
         arrays[f"parent_channel_{d}"] = con.channel
+    return arrays
+
+
+def _save_fields(path, contact, leak, surface):
+    arrays = _contact_network_arrays(contact, leak)
+    for d, flow in leak.flows.items():
+        arrays[f"fluid_pressure_{d}"] = flow.pressure
+        arrays[f"flux_{d}"] = flow.flux
     return _write_step_npz(path, arrays, surface)
+
+
+#: the free-volume columns of both leak tables (one-way and --fsi): header, cells, footnote
+_VOLUME_HEAD = f"{'Vp*':>9} {'Vnp*':>9} {'sealed*':>9} {'perc x/y':>8}"
+_VOLUME_NOTE = ("Vp*, Vnp*: percolating and trapped (non-percolating, Alg. 1) free volume / "
+                "(A_n sigma); sealed*: the part of Vnp* with no open path to inlet or outlet "
+                "(the rest are dead ends open to the flow); perc x/y: the network percolates "
+                "along x / y (T, F; -: not analysed)")
+
+
+def _volume_cells(s) -> str:
+    """A step's cells under :data:`_VOLUME_HEAD` (``-`` where not computed)."""
+    perc = "/".join({True: "T", False: "F"}.get(s.get(f"percolates_{d}"), "-") for d in "xy")
+    return " ".join([*(f"{fmt_or_dash(s.get(k), '.3e'):>9}" for k in (
+        "percolating_volume_star", "trapped_volume_star", "sealed_volume_star")), f"{perc:>8}"])
 
 
 def _leak(args) -> int:
@@ -134,16 +158,18 @@ def _leak(args) -> int:
         sweep, steps, written, persson = _leak_run(args, surface, material, out)
     print_surface_notes(args, surface)
     if args.fsi:
-        print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>8} {'fluid':>6} {'trap':>6} "
-              f"{'iter':>5} "
+        print(f"{'step':>4} {'p_ext (Pa)':>11} {'state':>8} {'A*':>8} {_VOLUME_HEAD} "
+              f"{'fluid':>6} {'trap':>6} {'iter':>5} "
               f"{'Q (m^3/s)':>11} {'Q one-way':>11} {'u_c (m)':>10}")
         for s in steps:
             print(f"{s['step']:>4} {s['external_pressure']:>11.4g} {s['fsi_state']:>8} "
-                  f"{fmt_or_dash(s.get('area_fraction'), '.3g'):>8} {s['fluid_load_fraction']:>6.3f} "
-                  f"{s['trapped_load_fraction']:>6.3f} "
+                  f"{fmt_or_dash(s.get('area_fraction'), '.3g'):>8} {_volume_cells(s)} "
+                  f"{s['fluid_load_fraction']:>6.3f} {s['trapped_load_fraction']:>6.3f} "
                   f"{s['coupled_iterations']:>5} {fmt_or_dash(s['leak_rate'], '.4e'):>11} "
                   f"{fmt_or_dash(s['leak_rate_one_way'], '.4e'):>11} "
                   f"{fmt_or_dash(s.get('critical_gap'), '.3e'):>10}")
+        print(_VOLUME_NOTE + "; fluid, trap: the external load's share carried by the fluid "
+              "and by its trapped pockets")
         persson_basis(args, surface, persson)
         print(f"wrote {len(written)} files in {out}")
         return 0 if sweep.success else 1
@@ -151,20 +177,16 @@ def _leak(args) -> int:
     # two geometry factors W/L and can be neither: a user's review, round 2, session 29)
     keys = ["leak_rate_x", "leak_rate_y"] if args.direction == "both" else ["leak_rate"]
     heads = ["Q_x (m^3/s)", "Q_y (m^3/s)"] if args.direction == "both" else ["Q (m^3/s)"]
-    print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>8} {'Vp*':>9} {'Vnp*':>9} "
-          f"{'sealed*':>9} {'perc x/y':>8} " + " ".join(f"{h:>11}" for h in heads))
+    print(f"{'step':>4} {'delta (m)':>11} {'p (Pa)':>10} {'A*':>8} {_VOLUME_HEAD} "
+          + " ".join(f"{h:>11}" for h in heads))
     for s in steps:
         print(f"{s['step']:>4} {s['delta']:>11.4e} {s['mean_pressure']:>10.4g} "
-              f"{s['area_fraction']:>8.3g} {s['percolating_volume_star'] or 0:>9.3e} "
-              f"{s['trapped_volume_star'] or 0:>9.3e} {s['sealed_volume_star'] or 0:>9.3e} "
-              f"{str(s['percolates_x'])[0] + '/' + str(s['percolates_y'])[0]:>8} "
+              f"{s['area_fraction']:>8.3g} {_volume_cells(s)} "
               + " ".join(f"{fmt_or_dash(s[k], '.4e'):>11}" for k in keys))
     p_in, p_out = _fluid_pressures(args)
     along = ("x and y (results.json leak_rate is their mean)" if args.direction == "both"
              else args.direction)
-    print("Vp*, Vnp*: percolating and trapped (non-percolating, Alg. 1) free volume / (A_n "
-          "sigma); sealed*: the part of Vnp* with no open path to inlet or outlet (the rest "
-          "are dead ends open to the flow)")
+    print(_VOLUME_NOTE)
     print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
           f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is linear in both")
     check_critical_gaps(args, steps)
@@ -196,12 +218,8 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
     written = []
     for k, (r, lk) in enumerate(zip(sweep.results, sweep.leakages)):
         arrays = {"fluid_pressure": r.fluid_pressure, "pockets": r.fluid_state.pockets.labels}
-        if r.contact is not None:
-            arrays.update(gap=r.contact.gap, contact=r.contact.contact,
-                          pressure_contact=r.contact.pressure, flux=r.flow.flux,
-                          percolating=lk.network.percolating, trapped=lk.network.trapped)
-            for d, con in lk.constrictions.items():
-                arrays[f"widest_path_{d}"] = con.path
+        if r.contact is not None:      # the one-way sweep's contact and network arrays
+            arrays.update(_contact_network_arrays(r.contact, lk), flux=r.flow.flux)
         path = _write_step_npz(out / "fields" / f"step_{k:03d}.npz", arrays, surface)
         written.append(path)
         if not _maps_of(args, k, len(sweep.results)) or r.contact is None:

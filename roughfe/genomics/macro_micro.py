@@ -17,7 +17,9 @@ equal pressure as in the design score. Measured on the Table 1 genome (10x, seed
 "steps" puts the long wavelengths n <= 9 (all but n = 5 at 0.949) above 0.95 and the
 short ones lower, the pattern of Fig. 47; "pressure" gives c_n > 0.9 almost everywhere,
 because any two increasing K(p) curves correlate strongly at equal pressure. A constant
-K_n has no defined correlation and counts as c_n = 0 (micro).
+curve (K_n, or the complete profile's K) has no defined correlation: c_n is NaN
+(:func:`correlation`), which is never above the threshold, so the chromosome is micro;
+files and tables write it as null or "nan", not as a number.
 """
 from __future__ import annotations
 
@@ -139,6 +141,15 @@ def correlation(reference: ResponseCurve, curve: ResponseCurve, quantity: str = 
     rescaled to the reference p_max (Eq. 4.2) and read at its pressures by the design's
     rule (:func:`roughfe.genomics.similarity.read_curve`: linear between computed
     points, the end values held beyond them).
+
+    Returns
+    -------
+    float
+        c_n in [-1, 1]; NaN when either curve is constant (its standard deviation is 0:
+        the Pearson coefficient is 0/0, undefined). Earlier versions returned 0.0 here,
+        which read as "uncorrelated". NaN compares False with any
+        threshold (:func:`classify` makes the chromosome micro); a caller that needs a
+        number must test ``np.isfinite``.
     """
     if axis not in CORRELATION_AXES:
         raise InputError(f"axis must be one of {CORRELATION_AXES}, got {axis!r}")
@@ -149,7 +160,7 @@ def correlation(reference: ResponseCurve, curve: ResponseCurve, quantity: str = 
         c = curve.to_target_range(reference.p_max)
         y_n = read_curve(reference.pressure, c.pressure, c.values(quantity))
     if np.ptp(y_r) == 0 or np.ptp(y_n) == 0:
-        return 0.0
+        return float("nan")            # 0/0: a constant curve has no correlation
     return float(np.corrcoef(y_r, y_n)[0, 1])
 
 
@@ -166,7 +177,8 @@ class MacroMicroResult:
     chromosome_curves : tuple of ResponseCurve
         y_n of every chromosome (same order as ``chromosomes``).
     corr_k, corr_a : ndarray
-        c_n for K(p) (the classification) and for A(p) (reported, Fig. 47).
+        c_n for K(p) (the classification) and for A(p) (reported, Fig. 47); NaN where
+        a curve is constant (undefined, micro), 0 for a chromosome that is round-off.
     threshold : float
     macro, micro : tuple of int
         Chromosome indices with ``corr_k > threshold`` (Z_L) and the others (Z_S).
@@ -189,6 +201,9 @@ class MacroMicroResult:
 def classify(full: ResponseCurve, chromosome_curves, chromosomes, threshold: float = 0.95,
              axis: str = "steps", flat=None) -> MacroMicroResult:
     """Steps 4 and 6 of Alg. 2 from computed curves: c_n and the macro/micro split.
+
+    An undefined c_n (NaN: a constant curve, :func:`correlation`) is not above the
+    threshold: that chromosome is micro.
 
     ``flat`` (optional, one bool per chromosome): chromosomes whose realisation is
     round-off of the complete profile (waves that cancel) take c_n = 0, micro: Alg. 2

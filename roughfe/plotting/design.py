@@ -7,6 +7,7 @@ import numpy as np
 
 import textwrap
 
+from ..errors import InputError
 from ..genomics.design import combined_score, verdict
 from ..surfaces.stats import power_spectrum
 from .common import new_figure, save_figure
@@ -257,23 +258,39 @@ def chromosome_psd(surface, q, a):
 ROUND_OFF = 1e-20
 
 
-def plot_psds(named, path, title="") -> "Path":
+def _drawn_psd(surf):
+    """``(q, C, window name)`` of :func:`power_spectrum`; bins without power (empty
+    annuli of a band-limited design: round-off ~1e-48) are NaN, gaps rather than points
+    that stretch the log axis over 30 decades."""
+    ps = power_spectrum(surf)
+    how = "no window" if ps.window == "none" else ps.window.capitalize()
+    return ps.q, np.where(ps.C > ROUND_OFF * np.max(ps.C), ps.C, np.nan), how
+
+
+def plot_psds(named, path, title="", target=None, target_label="target") -> "Path":
     """Figs. 62/66/70: log10 PSD of each designed profile or surface (FFT, line: a
     surface's annulus average; Hann-windowed for non-periodic data, as
     :func:`power_spectrum` reports) and the discrete spectrum of its chromosomes
     (markers at q_n, :func:`chromosome_psd`).
 
-    ``named``: name -> (Surface, list of (q_n (rad/m), a_n (m))).
+    ``named``: name -> (Surface, list of (q_n (rad/m), a_n (m))). ``target``: a Surface
+    whose spectrum the design was matched to (``design --match-spectrum``: the target
+    surface as :func:`~roughfe.genomics.design.target_surface` prepares it), drawn on
+    every panel by the same estimator (C in m^4 for a surface), labelled
+    ``target_label``.
     """
+    if target is not None and any(s.ndim != target.ndim for s, _ in named.values()):
+        raise InputError(f"the target spectrum is of a {target.ndim}D height field, a design "
+                         f"here of another dimension: their C(q) have different units")
+    drawn_target = None if target is None else _drawn_psd(target)
     fig, axes = new_figure(1, len(named), figsize=(4.5 * len(named), 3.6), squeeze=False)
     for ax, (name, (surf, lines)) in zip(axes[0], named.items()):
-        ps = power_spectrum(surf)
-        how = "no window" if ps.window == "none" else ps.window.capitalize()
-        # bins without power (empty annuli of a band-limited design: round-off ~1e-48)
-        # are gaps, not points that stretch the log axis over 30 decades
-        c = np.where(ps.C > ROUND_OFF * np.max(ps.C), ps.C, np.nan)
-        ax.loglog(ps.q, c, "k-", lw=0.8,
+        q, c, how = _drawn_psd(surf)
+        ax.loglog(q, c, "k-", lw=0.8,
                   label=f"FFT ({how}{', annulus mean' if surf.ndim == 2 else ''})")
+        if drawn_target is not None:
+            ax.loglog(*drawn_target[:2], "-", color="tab:blue", lw=1.2, alpha=0.8,
+                      label=target_label)
         if lines:
             q, a = np.asarray(lines, float).T
             ax.loglog(q, chromosome_psd(surf, q, a), "rs", ms=4, label="chromosomes")

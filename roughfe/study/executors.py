@@ -2,7 +2,10 @@
 
 Each executor has ``submit(fn, *args) -> future`` (the future has ``result()``),
 ``completed()`` (an ``as_completed`` iterator to which futures can be added while
-iterating), ``n_workers``, ``name`` and ``shutdown()``; each is a context manager.
+iterating), ``n_workers``, ``name``, ``shutdown()`` and ``stop_workers()``; each is a
+context manager, which on KeyboardInterrupt (Ctrl-C, or SIGTERM turned into
+:class:`~roughfe.errors.Terminated` by the command line) stops the tasks in flight
+before it shuts down (the local pool terminates its workers instead of waiting).
 No engine is home-made:
 
 ``local``
@@ -22,6 +25,7 @@ No engine is home-made:
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import json
 import multiprocessing
 import os
@@ -90,9 +94,15 @@ class _Base:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, kind, exc, tb):
+        if kind is not None and issubclass(kind, KeyboardInterrupt):
+            self.stop_workers()         # Ctrl-C or SIGTERM: do not wait for running tasks
         self.shutdown()
         return False
+
+    def stop_workers(self):
+        """Stop the tasks in flight at once (an interrupted run); default: nothing (the
+        executor's ``shutdown`` cancels what has not started)."""
 
     def describe(self) -> str:
         """One line for logs: executor name and worker count."""
@@ -129,6 +139,19 @@ class LocalExecutor(_Base):
 
     def completed(self):
         return _FuturesCompletion()
+
+    def stop_workers(self):
+        """Terminate the worker processes (SIGTERM): their tasks are lost, not stored
+        (an interrupted study resumes them); the pool's own thread then sees them gone
+        and :meth:`shutdown` joins everything, so the pool's semaphores are released."""
+        terminate = getattr(self._pool, "terminate_workers", None)   # Python >= 3.14
+        if terminate is not None:
+            terminate()
+            return
+        processes = getattr(self._pool, "_processes", None) or {}  # CPython's pool before
+        for process in list(processes.values()):
+            with contextlib.suppress(OSError, ValueError):   # already gone
+                process.terminate()
 
     def shutdown(self):
         self._pool.shutdown(wait=True, cancel_futures=True)

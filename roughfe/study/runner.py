@@ -3,7 +3,9 @@
 The driver (this module) owns every file of the study folder; workers only compute and
 return JSON-safe records, so workers need no access to the study folder. A task whose
 ``results/<key>.json`` exists is skipped, hence a study killed at any moment resumes
-where it stopped and ends with the same table as an uninterrupted run.
+where it stopped and ends with the same table as an uninterrupted run. Ctrl-C or SIGTERM
+(``kill PID``; the command line exits 130 or 143) stops the workers, rewrites
+``index.json`` and leaves ``UNFINISHED`` in the folder (store.py) until a run returns.
 """
 from __future__ import annotations
 
@@ -235,14 +237,22 @@ def _run_locked(spec, tasks, derived, log, progress, how) -> StudySummary:
             warnings.warn(store.set_aside(outdir, unreadable), stacklevel=3)
         store.write_study(outdir, spec, tasks, __version__, derived)
         store.write_index(outdir, keys)          # the index of the new task list, at once
+        store.mark_unfinished(outdir, time.strftime("%Y-%m-%dT%H:%M:%S%z"))
         note = store.old_keys_note(outdir, found, len(todo))
         if note:
             warnings.warn(note, stacklevel=3)
         if ex is not None:
             log(description)
-            _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
-                   n_cached=n_cached, commit=code_commit())
+            try:
+                _drive(spec, ex, todo, keys, counts, progress, n_total=len(tasks),
+                       n_cached=n_cached, commit=code_commit())
+            except KeyboardInterrupt:
+                # Ctrl-C or SIGTERM (errors.Terminated): the index says what is done,
+                # UNFINISHED stays; leaving the block stops the workers (executors.py)
+                store.write_index(outdir, keys)
+                raise
     store.write_index(outdir, keys)
+    store.clear_unfinished(outdir)
     return StudySummary(n_tasks=len(tasks), n_cached=n_cached, n_done=counts["done"],
                         n_failed=counts["failed"], n_retries=counts["retries"], wall_s=0.0,
                         task_s=counts["task_s"], task_cpu_s=counts["task_cpu_s"],

@@ -8,6 +8,7 @@
     OUTDIR/failures/<key>.json one failing task: every attempt's error and traceback
     OUTDIR/table.csv           the tidy table written by ``collect`` (tables.py)
     OUTDIR/.lock               held (flock) by the running driver
+    OUTDIR/UNFINISHED          while a run works, and after it was interrupted or killed
 
 The result files are the truth: a task is done if and only if ``results/<key>.json``
 exists and can be read (an fsync-ed file renamed into place, so it is complete; one that
@@ -16,6 +17,10 @@ run rewrites it when it starts, every few seconds and at its end, and ``status``
 rebuilds it from the files when it is missing or stale (a run killed between two
 writes). The files that describe the whole study (the tables, a wrapper's summary) are
 removed when a run starts (:func:`write_study`) and written again by their command.
+``UNFINISHED`` (:data:`roughfe.writers.UNFINISHED_FILE`, the marker of every output folder
+being written) is written when a run starts and removed when it returns: a folder that
+holds it was left by a run that was interrupted (Ctrl-C, SIGTERM) or killed, or is being
+written now; ``study status`` says so and the next run removes it.
 """
 from __future__ import annotations
 
@@ -28,7 +33,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import FileFormatError, InputError
-from ..writers import folder_lock, write_json
+from ..writers import UNFINISHED_FILE, folder_lock, write_json, write_text
 from .spec import KEY_FORMAT, canonical_json, spec_from_mapping
 
 
@@ -79,7 +84,21 @@ def study_lock(outdir, holder="`roughfe study run`"):
 #: files derived from the results by ``collect``: stale once a run changes the results
 TABLE_FILES = ("table.csv", "table.parquet")
 #: what a study folder is made of: never removed as a derived file
-_OWN = frozenset({"", ".", "..", "study.json", "index.json", "results", "failures", ".lock"})
+_OWN = frozenset({"", ".", "..", "study.json", "index.json", "results", "failures", ".lock",
+                  UNFINISHED_FILE})
+
+
+def mark_unfinished(outdir, started: str) -> None:
+    """Write ``OUTDIR/UNFINISHED``: a run started at ``started`` (ISO time) is working."""
+    write_text(Path(outdir) / UNFINISHED_FILE,
+               f"A study run started {started} (pid {os.getpid()}) and has not finished: it "
+               "is running, or it was interrupted or killed, so tasks may be missing. Rerun "
+               "the same command to resume; `roughfe study status` lists what is done.\n")
+
+
+def clear_unfinished(outdir) -> None:
+    """Remove ``OUTDIR/UNFINISHED`` (a run returned: ``index.json`` says what is done)."""
+    (Path(outdir) / UNFINISHED_FILE).unlink(missing_ok=True)
 
 
 def _raw_study(outdir):
@@ -328,6 +347,9 @@ class StudyStatus:
     unreadable : tuple of int
         Indices of the tasks whose result file cannot be read (counted missing: the
         next run runs them again).
+    unfinished : bool
+        The folder holds ``UNFINISHED``: its last run was interrupted or killed (or is
+        running now).
     """
 
     name: str
@@ -342,11 +364,15 @@ class StudyStatus:
     commits: tuple = ()
     note: str = ""
     unreadable: tuple = ()
+    unfinished: bool = False
 
     def describe(self) -> str:
         """Human-readable multi-line summary."""
         lines = [f"study {self.name!r} (analysis {self.analysis}): {self.n_done}/{self.n_tasks} "
                  f"done, {self.n_failed} failed, {self.n_missing} missing"]
+        if self.unfinished:
+            lines.append("unfinished: the last run was interrupted or killed (or is still "
+                         "running); rerun the command that wrote the folder to resume")
         if self.cost_s:
             lines.append(f"cost per task: mean {statistics.fmean(self.cost_s):.3g} s, median "
                          f"{statistics.median(self.cost_s):.3g} s, max {max(self.cost_s):.3g} s "
@@ -412,4 +438,5 @@ def study_status(outdir) -> StudyStatus:
                        n_missing=len(data["tasks"]) - n_done - n_failed,
                        failures=tuple(failures), cost_s=tuple(costs), cpu_s=tuple(cpus),
                        commits=tuple(sorted(commits)), unreadable=unreadable,
+                       unfinished=(Path(outdir) / UNFINISHED_FILE).exists(),
                        note=old_keys_note(outdir, data.get("key_format", 1)))

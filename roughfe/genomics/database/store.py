@@ -15,6 +15,7 @@ import numpy as np
 
 from ...errors import FileFormatError, InputError
 from ...frozen import freeze_containers
+from ...writers import to_json_text
 from ..similarity import ResponseCurve
 from .settings import DatabaseSettings
 from .sobol import SobolDesign
@@ -52,7 +53,8 @@ class DatabaseEntry:
     ``curve`` is the realisation's K(p)/A(p) at the stored amplitude gene; ``macro`` and
     ``micro`` are chromosome numbers n (Alg. 2) of the chromosomes realised at the
     database's L and N (:func:`roughfe.genomics.periodic.realized_chromosomes`), in the
-    order of ``corr_k``/``corr_a``, the c_n of each.
+    order of ``corr_k``/``corr_a``, the c_n of each (NaN where undefined: a constant
+    curve, stored as JSON null).
     """
 
     label: str
@@ -215,8 +217,8 @@ def _insert_row(con, record: dict):
     row = (record["label"], record["source"], float(g["gamma"]), float(g["H"]), float(g["A"]),
            float(g["lambda1"]), int(g["M"]), len(record["corr_k"]), json.dumps(g),
            float(record["p_max"]), json.dumps(record["curve"]),
-           json.dumps(record["chromosome_curves"]), json.dumps(record["corr_k"]),
-           json.dumps(record["corr_a"]), json.dumps(record["macro"]), _now())
+           json.dumps(record["chromosome_curves"]), to_json_text(record["corr_k"], None),
+           to_json_text(record["corr_a"], None), json.dumps(record["macro"]), _now())
     con.execute("INSERT INTO genomes (label, source, gamma, hurst, amplitude, lambda1, "
                 "n_ridges, n_chromosomes, genome_json, p_max, curve_json, "
                 "chromosome_curves_json, corr_k_json, corr_a_json, macro_json, created_utc) "
@@ -304,7 +306,8 @@ def _entry(row, settings: DatabaseSettings) -> DatabaseEntry:
     (label, source, gamma, hurst, genome_json, p_max, curve_json, chrom_json, ck, ca,
      macro) = row
     genome = json.loads(genome_json)
-    ck, macro = np.asarray(json.loads(ck)), tuple(json.loads(macro))
+    # an undefined c_n (a constant curve) is stored null and read back NaN
+    ck, macro = np.asarray(json.loads(ck), dtype=float), tuple(json.loads(macro))
     # the chromosomes realised at the database's window (not the genome's first phase
     # column: an extended genome may hold phases below the window)
     ns = realized_chromosomes(Genome.from_dict(genome), settings.length, settings.n_nodes,
@@ -317,7 +320,8 @@ def _entry(row, settings: DatabaseSettings) -> DatabaseEntry:
                          p_max=float(p_max), curve=ResponseCurve.from_dict(json.loads(curve_json)),
                          chromosome_curves=tuple(ResponseCurve.from_dict(c)
                                                  for c in json.loads(chrom_json)),
-                         corr_k=ck, corr_a=np.asarray(json.loads(ca)), macro=macro, micro=micro,
+                         corr_k=ck, corr_a=np.asarray(json.loads(ca), dtype=float),
+                         macro=macro, micro=micro,
                          gamma=float(gamma), hurst=float(hurst))
 
 

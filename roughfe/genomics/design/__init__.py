@@ -31,7 +31,7 @@ Every public name is importable from ``roughfe.genomics.design``.
 from ...optim.gcmma import GcmmaResult, gcmma_maximize, gcmma_minimax
 from .algorithms import (METHODS, REFERENCES, Candidate, DesignResult, cco, gco, mcco, refine,
                          run_design, score_database, sog, with_solved_scores)
-from .io import result_to_dict, write_design_result
+from .io import heights_name, result_to_dict, write_design_result
 from .crest import clipped_phases, crest_phases, wave_modes
 from .modulation import MODULATION_CUT, crest_roughness, modulated_heights, wave_split
 from .model import (DESIGN_FORMAT, DESIGN_VERSION, GENE_VARIABLES, Design, DesignPart, combine,
@@ -56,7 +56,7 @@ __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "
            "match_spectrum", "spectrum_matched", "target_surface",
            "clipped_phases", "crest_phases", "wave_modes",
            "MODULATION_CUT", "crest_roughness", "modulated_heights", "wave_split",
-           "result_to_dict", "write_design_result",
+           "heights_name", "result_to_dict", "write_design_result",
            "DESIGN_FORMAT", "DESIGN_VERSION", "GENE_VARIABLES", "Design", "DesignPart",
            "combine", "entry_design", "Evaluator", "Objective", "combined_score",
            "SELECTION", "Verdict", "verdict", "with_solved_scores",

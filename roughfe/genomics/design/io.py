@@ -13,6 +13,13 @@ from .algorithms import DesignResult
 from .objective import combined_score, verdict
 
 
+def heights_name(dim: int) -> str:
+    """The stem of a design's heights file and figure: ``"profile"`` for a profile design
+    (dim 1: ``profile.npz``, ``profile.png``), ``"surface"`` for a surface design (dim 2:
+    ``surface.npz``, ``surface.png``; earlier versions named both ``profile.*``)."""
+    return "surface" if int(dim) == 2 else "profile"
+
+
 def result_to_dict(result: DesignResult, settings: DatabaseSettings) -> dict:
     """JSON-safe report of a design run: candidates, scores per stage, targets, settings,
     and the verdict on the best design's match (:func:`~.objective.verdict`, as the
@@ -45,9 +52,11 @@ def write_design_result(result: DesignResult, settings: DatabaseSettings, outdir
     Files: ``result.json`` (:func:`result_to_dict`), ``design.json`` (the best design,
     reloadable with :meth:`Design.from_dict`), ``genome.json`` (the roughfe-genome when
     the design is one genome; for several, ``genome_partK.json``: part K as a genome with
-    its weight and the overall scale in A), ``profile.npz`` (native
-    surface file of the designed profile), ``curves.csv`` (p, targets, K, A) and
-    ``stages.csv`` (similarity per candidate and GCMMA stage).
+    its weight and the overall scale in A), ``profile.npz`` (native surface file of the
+    designed profile; ``surface.npz`` for a surface design, :func:`heights_name`),
+    ``curves.csv`` (p, targets, K, A) and ``stages.csv`` (similarity per candidate and
+    GCMMA stage). The returned paths are keyed by file stem (``"profile"`` or
+    ``"surface"`` for the heights).
     """
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
@@ -61,7 +70,8 @@ def write_design_result(result: DesignResult, settings: DatabaseSettings, outdir
         for k in range(len(best.design.parts)):
             paths[f"genome_part{k + 1}"] = save_genome(best.design.part_genome(k),
                                                        out / f"genome_part{k + 1}.json")
-    paths["profile"] = save_surface(best.design.surface(), out / "profile.npz")
+    kind = heights_name(best.design.dim)
+    paths[kind] = save_surface(best.design.surface(), out / f"{kind}.npz")
     c = best.curve
     cols = ["pressure_Pa", "K_Pa_per_m", "A"]
     data = [c.pressure, c.stiffness, c.area_fraction]
