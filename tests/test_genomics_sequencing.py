@@ -314,3 +314,18 @@ def test_a_levelled_profile_is_told_from_a_raw_one():
     assert is_levelled(x, flat)
     assert is_levelled(x, flat.astype(np.float32).astype(float))
     assert not is_levelled(x[100:300], flat[100:300])
+
+
+def test_the_report_names_the_m_of_each_likelihood():
+    """report.json gave M_loglik without its M axis (a user's review): M_values now
+    says which M each log-likelihood is of, and the maximum-likelihood M is the genome's
+    (M not imposed) or, with M imposed, still listed."""
+    g = table1_genome(rng=2)
+    acqs = [realize(g, length=L, n_nodes=256) for L in (1e-3, 0.5e-3)]
+    rep = sequence_profiles(acqs, seed=1).report()
+    assert len(rep["M_values"]) == len(rep["M_loglik"]) and rep["M_values"][0] == 2
+    loglik = np.array([np.nan if v is None else v for v in rep["M_loglik"]])  # null: -inf
+    best = rep["M_values"][int(np.nanargmax(loglik))]
+    assert rep["genes"]["M"] == best
+    imposed = sequence_profiles(acqs, seed=1, M=7).report()
+    assert imposed["genes"]["M"] == 7 and imposed["M_values"] == rep["M_values"]

@@ -111,7 +111,10 @@ def _percent_or_undefined(e):
 
 
 def _print_sequencing(res):
-    print("sequenced genome:")
+    # a failed sequencing says so before its genes, which are then no genome of the data
+    print("sequenced genome:" if res.success else
+          "sequenced genome (FAILED quality check, see below: the genes are the best fit "
+          "found, not a genome of the data):")
     _print_genome(res.genome)
     for k, (L, r, e) in enumerate(zip(res.lengths, res.ranges, res.rms_errors)):
         print(f"  acquisition {k + 1}: L = {L:.6g} m, n = {r[0]}..{r[1]}, relative rms error "

@@ -48,7 +48,12 @@ def _resultant_samples(m, n_samples, rng):
     return np.hypot(np.cos(phi).sum(axis=1), np.sin(phi).sum(axis=1)) / math.sqrt(m)
 
 
-def ridge_likelihood(u, M_values=tuple(range(2, 21)), *, rng, n_samples=10000):
+#: the numbers of ridges M whose likelihood is computed (:func:`ridge_likelihood`; the
+#: thesis's range, Sec. 3.3.1)
+M_VALUES = tuple(range(2, 21))
+
+
+def ridge_likelihood(u, M_values=M_VALUES, *, rng, n_samples=10000):
     """Log-likelihood of M for normalised chromosome amplitudes u_n = |sum_m e^{i phi}| / sqrt(M).
 
     The density of the resultant of M random unit phasors is estimated by a histogram of

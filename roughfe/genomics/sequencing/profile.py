@@ -13,7 +13,7 @@ from ...errors import InputError, check_int
 from ...surfaces.wm import resolve_rng
 from ..genome import Genome, profile_heights
 from .acquisitions import Acquisition, acquisitions_from_surfaces, check_controls
-from .genes import (H_SEARCH, amplitude_genes, peak_slope_H, phases_with_sums,
+from .genes import (H_SEARCH, M_VALUES, amplitude_genes, peak_slope_H, phases_with_sums,
                     ridge_likelihood, variance_amplitude)
 from .lattice import (bic, coarser_lattices, comb_periods, design_matrix, fit_lattice, label_q1,
                       lattice_from_period, line_columns, lattice_ranges, round_off_cost, solve_linear,
@@ -201,7 +201,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
 
     # 5. genes
     A, H = amplitude_genes(n, amps, gamma, lam1)
-    m_values = tuple(range(2, 21))
+    m_values = M_VALUES
     g1 = Genome(A=A, H=H, gamma=gamma, lambda1=lam1, phases=np.zeros((1, n.size)), n_first=int(n[0]))
     unit = g1.prefactor * gamma ** ((1.0 - n) * H)       # G(M=1) gamma^((1-n)H)
     u = amps / unit                                     # = |sum_m e^{i phi}| / sqrt(M)

@@ -9,6 +9,7 @@ import numpy as np
 from ...writers import to_jsonable
 from ...frozen import freeze_containers
 from ..genome import Genome
+from .genes import M_VALUES
 from .lattice import round_off_cost
 
 
@@ -20,7 +21,8 @@ REPORT_UNITS = {"A": "m^(1-H)", "H": "1", "gamma": "1", "lambda1": "m",
                 "rms_errors": "1 (relative: rms(Z - Z_seq) / rms(Z))", "offsets": "m",
                 "tilts": "1 (m/m)",
                 "zd_rms": "m", "zd_rms_error": "1 (relative)", "gamma_psd": "1",
-                "H_psd": "1", "A0_variance": "m^(1-H)", "M_loglik": "1 (log-likelihood)",
+                "H_psd": "1", "A0_variance": "m^(1-H)", "M_loglik": "1 (log-likelihood, one per M_values)",
+                "M_values": "1 (number of ridges M of each M_loglik)",
                 "nit": "1 (residual evaluations)", "elapsed_s": "s"}
 
 
@@ -133,4 +135,5 @@ class SequencingResult:
                 "zd_rms_error": self.zd_rms_error(),
                 "gamma_psd": self.gamma_psd, "H_psd": self.H_psd, "A0_variance": self.A0,
                 "M_loglik": to_jsonable(self.M_loglik),
+                "M_values": list(M_VALUES[:len(self.M_loglik)]),
                 "seed": self.seed, "elapsed_s": self.elapsed, "units": dict(REPORT_UNITS)}

@@ -8,7 +8,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ...errors import InputError
-from .genes import variance_amplitude
+from .genes import M_VALUES, variance_amplitude
 from .result import SequencingResult
 
 
@@ -30,7 +30,7 @@ class ZdRidgeFit:
     nit: int
 
 
-def thesis_zd_fit(result: SequencingResult, M_values=tuple(range(2, 21)), *, seed=0,
+def thesis_zd_fit(result: SequencingResult, M_values=M_VALUES, *, seed=0,
                   n_starts=3) -> ZdRidgeFit:
     """Fit Z_d = Z_1 - Z_2 with the ridge model of Eq. (3.12)-(3.15) for each M (angles directly).
 
