@@ -128,3 +128,23 @@ def test_genome_mechanics_refuses_a_surface_genome(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "is a surface genome (ridge angles)" in err and "genome chromosomes" in err
     assert not (tmp_path / "m").exists()
+
+
+def test_a_band_limited_realisation_is_warned_of(tmp_path, capsys):
+    """A genome holds chromosomes over a finite band (a sequenced one: the band of its
+    data). Realised at a window whose Eq. 3.5 range reaches beyond it, the heights lack
+    those waves: said on stderr (it was silent; a user's review), not when the window
+    lies inside the band."""
+    g = tmp_path / "g.json"
+    assert main(["genome", "example", "-o", str(g), "--seed", "1", "--n-max", "10"]) == 0
+    capsys.readouterr()
+    assert main(["genome", "realize", str(g), "--scale", "10x", "--nodes", "128",
+                 "-o", str(tmp_path / "a.npz")]) == 0
+    err = capsys.readouterr().err
+    assert "band-limited realisation" in err and "holds only 1..10" in err
+    assert "chromosomes 11..12" in err          # Eq. 3.5 at L = lambda1, N = 128: 1..12
+    z = load_surface(tmp_path / "a.npz")
+    assert z.metadata["chromosomes"] == list(range(1, 11)) and z.metadata["n_f"] == 12
+    assert main(["genome", "realize", str(g), "--scale", "10x", "--nodes", "32",
+                 "-o", str(tmp_path / "b.npz")]) == 0
+    assert "band-limited" not in capsys.readouterr().err

@@ -14,7 +14,7 @@ from .options import (add_detrend_option, add_material_options, add_output_file,
                       add_output_folder, add_run_options, add_surface_options, at_least_two,
                       material_from_args, nonnegative_int, output_file_of,
                       output_folder_of, positive_float, positive_int, surface_from_args,
-                      unit_fraction)
+                      unit_fraction, warn)
 
 from ..genomics.genome import SCALES
 from ..genomics.natural import DEFAULT_FRACTIONS
@@ -91,6 +91,14 @@ def _realize(args) -> int:
           f"N = {m['n_nodes']}, chromosomes "
           f"{m['chromosomes'][0]}..{m['chromosomes'][-1]} (Eq. 3.5: n_s = {m['n_s']}, n_f = {m['n_f']}) "
           f"-> {out}")
+    held, wanted = m["chromosomes"], (m["n_s"], m["n_f"])
+    if not chromosomes and (held[0] > wanted[0] or held[-1] < wanted[1]):
+        warn(args, f"band-limited realisation: this window asks for chromosomes "
+                   f"{wanted[0]}..{wanted[1]} (Eq. 3.5) but the genome holds only "
+                   f"{g.n_first}..{g.n_last} (a sequenced genome holds the band of its data): "
+                   f"the realisation lacks the waves of chromosomes "
+                   + ", ".join(f"{a}..{b}" for a, b in ((wanted[0], held[0] - 1),
+                                                        (held[-1] + 1, wanted[1])) if a <= b))
     return 0
 
 
