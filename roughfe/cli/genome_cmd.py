@@ -391,9 +391,11 @@ def register(sub):
     p = gs.add_parser("natural", help="sequence the central row of a measured topography (Sec. 3.4.2)",
                       description="Sequence the central row of a measured topography (thesis "
                                   "Sec. 3.4.2): nested acquisitions, their genome and report, "
-                                  "and the measured vs sequenced A(p), K(p).")
+                                  "and the measured vs sequenced A(p), K(p). The row is "
+                                  "levelled by its own least-squares line (an instrument "
+                                  "tilt or a removed plane changes nothing), so there is no "
+                                  "--detrend.")
     add_surface_options(p)
-    add_detrend_option(p)
     p.add_argument("--fractions", type=positive_float, nargs="+", default=list(DEFAULT_FRACTIONS),
                    help="nested window lengths as fractions of the row")
     p.add_argument("--nodes", type=positive_int, default=512, help="nodes per acquisition")

@@ -36,7 +36,7 @@ from ..model import DEFAULT_E, DEFAULT_NU
 
 #: DEFAULT_E, DEFAULT_NU: the one default material, defined in :mod:`roughfe.model` (shared
 #: with the study analyses) and imported above.
-#: Default of --detrend in info, contact, leak and genome natural.
+#: Default of --detrend in info, contact and leak.
 DEFAULT_DETREND = "mean"
 DETRENDS = ("none", "mean", "plane")
 
