@@ -540,6 +540,11 @@ def test_the_figure_draws_the_genome_at_the_acquisitions_own_nodes(tmp_path, mon
         z = np.asarray(panels[3 * row].images[0].get_array())
         diff = np.asarray(panels[3 * row + 2].images[0].get_array())
         assert np.sqrt(np.mean(diff ** 2)) < 1e-12 * np.sqrt(np.mean(z ** 2))
+        # the difference on its own colour scale (on the heights' it was one flat colour)
+        assert panels[3 * row + 2].images[0].get_clim()[1] == pytest.approx(
+            np.abs(diff).max(), rel=1e-9, abs=0)
+        assert panels[3 * row].images[0].get_clim()[1] == pytest.approx(
+            np.abs(z).max(), rel=1e-9, abs=0)
 
 
 @pytest.mark.parametrize("hurst, seed", [(0.3, 1), (0.8, 2)])

@@ -215,17 +215,24 @@ def plot_sequenced_surfaces(result, surfaces, path) -> Path:
         ext = [(a.x[0] - half) * _MM, (a.x[-1] + half) * _MM,
                (a.y[0] - half) * _MM, (a.y[-1] + half) * _MM]
         lim = float(np.nanmax(np.abs(z))) * _UM
+        # the difference on its own scale: on the heights' scale a misfit of 1e-3 (or of
+        # round-off) is one flat colour (a user's review)
+        dlim = max(float(np.nanmax(np.abs(diff))) * _UM, 1e-300)
         for col, (data, name) in enumerate(((z, "measured"), (fit, "sequenced genome"),
                                             (diff, "difference"))):
             ax = axes[row, col]
+            top = dlim if col == 2 else lim
             im = ax.imshow(data.T * _UM, origin="lower", extent=ext, cmap="RdBu_r",
-                           vmin=-lim, vmax=lim)
+                           vmin=-top, vmax=top)
             ax.set_title(f"L = {a.length * _MM:.4g} mm: {name}"
-                         + (f" (rms {100 * result.rms_errors[row]:.3g} %)" if col == 2 else ""),
-                         fontsize=9)
+                         + (f"\n(own scale; rms {100 * result.rms_errors[row]:.3g} %)"
+                            if col == 2 else ""), fontsize=9)
             ax.set_xlabel("x (mm)")
             ax.set_ylabel("y (mm)")
-        fig.colorbar(im, ax=axes[row, :], label="z (um), best plane removed", shrink=0.8)
+            if col == 1:
+                fig.colorbar(im, ax=axes[row, :2], label="z (um), best plane removed",
+                             shrink=0.8)
+        fig.colorbar(im, ax=axes[row, 2], label="difference (um)", shrink=0.8)
     g = result.genome
     fig.suptitle(f"sequenced surface genome: M = {g.M}, gamma = {g.gamma:.6g}, H = {g.H:.4g}, "
                  f"A = {g.A:.4g}", fontsize=10)
