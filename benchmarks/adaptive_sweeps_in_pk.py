@@ -35,7 +35,6 @@ Usage (from the repository root; numba: Debian's python3-numba)::
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import sys
 import time
 from pathlib import Path
@@ -280,17 +279,8 @@ HOOK = """        if EDGE[0] is not None and res > EDGE[0].until:
 
 
 def hooked_pk():
-    """``roughfe.bem.pk`` with the hook (its own module; ``EDGE[0]`` the controller)."""
-    src = (ROOT / "roughfe" / "bem" / "pk.py").read_text()
-    anchor = "        if watch is not None and watch.stalled(res):\n"
-    assert src.count(anchor) == 1, "pk.py changed: put the hook in again"
-    src = src.replace(anchor, HOOK + anchor).replace(
-        "def polonsky_keer(", "EDGE = [None]\n\n\ndef polonsky_keer(", 1)
-    spec = importlib.util.spec_from_loader("roughfe.bem._pk_adaptive", loader=None)
-    mod = importlib.util.module_from_spec(spec)
-    mod.__package__ = "roughfe.bem"
-    exec(compile(src, "pk_adaptive", "exec"), mod.__dict__)
-    return mod
+    """``roughfe.bem.pk`` with this script's hook (``EDGE[0]`` the controller)."""
+    return edge.hooked_pk(HOOK, "pk_adaptive")
 
 
 _PK = []

@@ -288,18 +288,20 @@ HOOK = """        if EDGE[0] is not None and EDGE[0].due(it - 1 - EDGE[0].count,
 """
 
 
-def hooked_pk():
-    """``roughfe.bem.pk`` with the hook (a module of its own; ``EDGE[0]`` the sweeps)."""
+def hooked_pk(hook=None, name="pk_edge"):
+    """``roughfe.bem.pk`` with ``hook`` (default: this script's :data:`HOOK`) put in
+    before the stall test of its loop: a module of its own, ``EDGE[0]`` the sweeps (also
+    used by ``adaptive_sweeps_in_pk.py`` with its own hook)."""
     import importlib.util
     src = (ROOT / "roughfe" / "bem" / "pk.py").read_text()
     anchor = "        if watch is not None and watch.stalled(res):\n"
     assert src.count(anchor) == 1, "pk.py changed: put the hook in again"
-    src = src.replace(anchor, HOOK + anchor).replace(
+    src = src.replace(anchor, (HOOK if hook is None else hook) + anchor).replace(
         "def polonsky_keer(", "EDGE = [None]\n\n\ndef polonsky_keer(", 1)
-    spec = importlib.util.spec_from_loader("roughfe.bem._pk_edge", loader=None)
+    spec = importlib.util.spec_from_loader(f"roughfe.bem._{name}", loader=None)
     mod = importlib.util.module_from_spec(spec)
     mod.__package__ = "roughfe.bem"
-    exec(compile(src, "pk_edge", "exec"), mod.__dict__)
+    exec(compile(src, name, "exec"), mod.__dict__)
     return mod
 
 
