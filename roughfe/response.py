@@ -49,8 +49,9 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
     method : {"bem", "fem"}
         ``"bem"``: :func:`roughfe.bem.contact_sweep` (the production solver).
         ``"fem"``: :func:`roughfe.fem.fem_contact_sweep` on a gmsh body below the profile,
-        approaches only (``n_steps`` / ``delta`` / ``deltas``, strictly increasing):
-        Delta is the half-plane approach, the BEM's; ``n_steps`` gives the BEM's default
+        approaches (``n_steps`` / ``delta`` / ``deltas``) or mean pressures
+        (``mean_pressure`` / ``pressures``, load control to a relative 1e-6), strictly
+        increasing: Delta is the half-plane approach, the BEM's; ``n_steps`` gives the BEM's default
         approaches of the evenly mirrored profile, which the body with rollers solves
         (:func:`roughfe.fem.mirrored_profile`), up to full contact. The FEM solves that
         mirrored problem also for a periodic profile: compare it with
@@ -126,15 +127,13 @@ def _fem_response(surface, material, loading, options) -> SweepResult:
         raise InputError(f"method='fem' needs a 1D profile (plane strain), got a surface of "
                          f"shape {surface.shape}")
     _check_surface(surface)            # the BEM's words (n_steps gave no approaches)
-    if loading.controls_pressure:
-        raise InputError(f"method='fem' imposes approaches (delta, deltas, n_steps); got "
-                         f"{loading.kind}: use method='bem' for load control")
     if loading.kind == "n_steps":
-        deltas = default_deltas(mirrored_profile(surface), loading.n_steps, periodic=True)
+        imposed = {"deltas": default_deltas(mirrored_profile(surface), loading.n_steps,
+                                            periodic=True)}
     else:
-        deltas = loading.sweep_arguments()["deltas"]
+        imposed = loading.sweep_arguments()   # {"deltas": ...} or {"pressures": ...}
     mesh = mesh_profile(surface, **{k: options[k] for k in FEM_MESH_OPTIONS if k in options})
     solver = {("method" if k == "solver" else k): options[k]
               for k in FEM_SOLVER_OPTIONS if k in options}
-    return fem_contact_sweep(mesh, material, deltas, options=FemSolverOptions(**solver),
+    return fem_contact_sweep(mesh, material, **imposed, options=FemSolverOptions(**solver),
                              keep_fields=options.get("keep_fields", ()))

@@ -757,3 +757,24 @@ def test_the_dimensionless_answer_does_not_depend_on_the_unit_of_length():
     for x, a in zip(meshes[1:], answers[1:]):
         assert x.shape == meshes[0].shape and np.array_equal(x, meshes[0])
         np.testing.assert_allclose(a, answers[0], rtol=1e-12, atol=0)
+
+
+def test_response_takes_pressures_with_the_fem():
+    """response(method="fem") refused load control ("use method='bem'") while
+    fem_contact_sweep has it, and the FEM's own message for an approach beyond full
+    contact said "give pressures" (a user's review). Now Loading(pressures=...) is the
+    FEM's load control: the loads are met, the sweep is fem_contact_sweep's, and a load
+    above the mirrored profile's full-contact pressure is full contact."""
+    from roughfe.model import Loading
+    from roughfe.response import response
+    surf = cosine_half_period(33)
+    p_star = np.pi * MAT.E_star * G / LAM                # Westergaard: full contact
+    loads = np.array([0.2, 0.6, 1.5]) * p_star
+    got = response(surf, MAT, Loading(pressures=tuple(loads)), method="fem")
+    direct = fem_contact_sweep(mesh_profile(surf), MAT, pressures=loads)
+    assert np.allclose(got.mean_pressure, loads, rtol=1e-5)
+    np.testing.assert_array_equal(got.area_fraction, direct.area_fraction)
+    assert got.area_fraction[0] < got.area_fraction[1] < 1.0 == got.area_fraction[2]
+    one = response(surf, MAT, Loading(mean_pressure=0.6 * p_star), method="fem")
+    assert one.mean_pressure[0] == pytest.approx(0.6 * p_star, rel=1e-5)
+    assert one.area_fraction[0] == got.area_fraction[1]
