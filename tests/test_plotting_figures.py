@@ -43,7 +43,7 @@ def test_stiffness_lines_follow_the_curve_when_loads_come_out_of_order(drawn):
     a zig-zag; each branch's line is drawn in order of p."""
     p = np.array([3e5, 1e4, 1e5, 3e4, 2e5])
     fig = drawn(contact_plot, "plot_area_stiffness", _records(p, p * 1e-12, p * 1e6))
-    for label in ("exact, H_cc x = 1", "central differences"):
+    for label in ("exact (fixed contact set)", "central differences"):
         x = _lines(fig.axes[1])[label].get_xdata()
         assert sorted(x) == list(x) and len(x) == 5
 
@@ -61,7 +61,7 @@ def test_an_unloading_branch_detached_at_every_step_is_a_note_not_an_empty_entry
     fig = drawn(contact_plot, "plot_area_stiffness", recs, rms_height=1e-7)
     for ax in fig.axes[:3]:
         legend = ax.get_legend()
-        assert [t.get_text() for t in legend.get_texts()][:1] in (["BEM"], ["exact, H_cc x = 1"])
+        assert [t.get_text() for t in legend.get_texts()][:1] in (["BEM"], ["exact (fixed contact set)"])
         assert not any("unloading" in t.get_text() for t in legend.get_texts())
         assert legend.get_title().get_text() == "unloading: detached at every step"
     # the V* panel draws every step, detached ones too: both branches, no note

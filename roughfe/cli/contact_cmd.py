@@ -71,6 +71,14 @@ def register(subparsers) -> None:
                            "--unload traces the unloading one)")
     add_contact_physics_options(p)
     num = p.add_argument_group("numerics")
+    num.add_argument("--method", default="bem", choices=("bem", "fem"),
+                     help="bem: the boundary-element solver (production); fem: the dolfinx "
+                          "plane-strain FEM body meshed by gmsh below a PROFILE (the "
+                          "cross-validation solver, minutes instead of seconds). The FEM "
+                          "solves the evenly mirrored profile's problem: compare it with "
+                          "the BEM's --mirror. With fem: --steps, --pressure or --delta "
+                          "only (no --hardness, --adhesion, --unload, --kernel, --solver, "
+                          "--coarse-correction, --tol)")
     num.add_argument("--kernel", default="auto", choices=("auto",) + KERNELS,
                      help="influence operator: auto = spectral if periodic, else strip for "
                           "profiles and love for surfaces; 'thesis' = Eq. 2.4")
@@ -101,15 +109,15 @@ def _run(args) -> int:
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
     adhesive = None
     tol = args.tol if args.tol is not None else (1e-10 if law is None else 1e-5)
+    if args.method == "fem" and law is not None:
+        raise InputError("--method fem has no adhesion (--adhesion is the BEM's)")
     if law is None:
         loading = (Loading(pressures=args.pressure) if args.pressure else
                    Loading(deltas=args.delta) if args.delta else
                    Loading(n_steps=args.steps or DEFAULT_STEPS))
+        options = _method_options(args, tol)
         try:
-            sweep = response(surface, material, loading, kernel=args.kernel,
-                             solver=args.solver, tol=tol, unload=args.unload,
-                             hardness=args.hardness,
-                             coarse_correction=COARSE[args.coarse_correction])
+            sweep = response(surface, material, loading, method=args.method, **options)
         except InputError as exc:      # the solver's rules, said in this command's flags
             raise InputError(_in_flags(str(exc))) from None
     else:
@@ -119,7 +127,8 @@ def _run(args) -> int:
     r0 = sweep.results[0]
     inputs = {"surface": str(args.surface),
               "E": material.E, "nu": material.nu, "E_star": material.E_star,
-              "kernel": r0.kernel, "solver": r0.solver, "tol": tol,
+              "method": args.method, "kernel": r0.kernel, "solver": r0.solver,
+              "tol": tol if args.method == "bem" else None,
               "coarse_correction": args.coarse_correction,
               "control": "pressure" if args.pressure else "delta",
               "hardness": args.hardness, "unload": args.unload,
@@ -147,7 +156,8 @@ def _run(args) -> int:
             plot_area_stiffness(doc["steps"], out / "contact_area_stiffness.png",
                                 title=f"{name}, E* = {material.E_star:.4g} Pa",
                                 rms_height=sweep.rms_height,
-                                window_compliance=doc["derived"].get("window_compliance"))
+                                window_compliance=doc["derived"].get("window_compliance"),
+                                method=args.method.upper())
             if adhesive is not None:
                 from ..plotting.contact import plot_adhesion
                 plot_adhesion(doc["steps"], out / "adhesion_load_approach.png",
@@ -244,6 +254,24 @@ def _adhesive_sweep(args, surface, material, law, tol):
 
 # -- demo section (appended to roughfe.cli.demo_cmd.SECTIONS) ------------------------------
 THESIS_FIG7 = {"A_star": 0.25, "P_star": 0.56, "h_s": 6.72e-6}
+
+
+def _method_options(args, tol) -> dict:
+    """The solver options of ``response`` for ``--method``: the BEM's from the numerics
+    flags; none for the FEM, which refuses the BEM-only flags given (by name)."""
+    if args.method == "bem":
+        return dict(kernel=args.kernel, solver=args.solver, tol=tol, unload=args.unload,
+                    hardness=args.hardness, coarse_correction=COARSE[args.coarse_correction])
+    given = [flag for flag, on in (("--hardness", args.hardness is not None),
+                                   ("--unload", args.unload),
+                                   ("--kernel", args.kernel != "auto"),
+                                   ("--solver", args.solver != "auto"),
+                                   ("--coarse-correction", args.coarse_correction != "auto"),
+                                   ("--tol", args.tol is not None)) if on]
+    if given:
+        raise InputError(f"--method fem does not take {', '.join(given)} (BEM options; the "
+                         f"FEM is the frictionless elastic VI of roughfe.fem)")
+    return {}
 
 
 def contact_document(sweep, surface, material, inputs: dict, *, adhesive=False) -> dict:

@@ -52,7 +52,8 @@ def _legend(ax, note):
         ax.text(0.03, 0.03, note, transform=ax.transAxes, fontsize=8)
 
 
-def plot_area_stiffness(steps, path, title=None, rms_height=None, window_compliance=None):
+def plot_area_stiffness(steps, path, title=None, rms_height=None, window_compliance=None,
+                        method="BEM"):
     """A*(p), K(p) (exact incremental and central finite differences along p(Delta), each
     branch's lines drawn in order of p whatever the order of the steps) and the mean gap
     u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8). Records
@@ -60,6 +61,7 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     get Persson's curves drawn beside the BEM points. With the ``window_compliance`` C
     (m/Pa) of a non-periodic window, the K panel marks the window's bulk stiffness 1/C,
     the ceiling K approaches whatever the roughness (:mod:`roughfe.bem.window`).
+    ``method`` labels the solver's points ("BEM", or "FEM" for ``contact --method fem``).
 
     Parameters
     ----------
@@ -88,7 +90,7 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
         v = _column(steps, "free_volume_star")
         for on, mk, tag, ls in branches:
             i = _along(d, on)
-            axes[3].plot(d[i], v[i], mk + ls, ms=4, label="BEM" + tag)
+            axes[3].plot(d[i], v[i], mk + ls, ms=4, label=method + tag)
         # on a window d = max h - mean h - Delta carries the window's bulk deflection
         # (part of Delta), so it goes below 0 under load (a user's review)
         axes[3].set_xlabel("d / sigma" if not window_compliance else
@@ -109,10 +111,10 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     order = np.argsort(p[theory])
     for on, mk, tag, _ in branches:     # a branch with no point gets no legend entry
         if (ok & on).any():
-            ax1.loglog(p[ok & on], a[ok & on], mk, ms=4, label="BEM" + tag)
+            ax1.loglog(p[ok & on], a[ok & on], mk, ms=4, label=method + tag)
         okg = ok & on & (gap > 0)
         if okg.any():
-            ax3.semilogx(p[okg], gap[okg], mk, ms=4, label="BEM" + tag)
+            ax3.semilogx(p[okg], gap[okg], mk, ms=4, label=method + tag)
     if a_th is not None:
         ax1.loglog(p[theory][order], a_th[theory][order], "-", label="Persson (2001)")
     if u_th is not None:
@@ -131,7 +133,7 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     for on, mk, tag, ls in branches:
         ok2 = _along(p, ok & on & np.isfinite(k) & (k > 0))
         if ok2.size:
-            ax2.loglog(p[ok2], k[ok2], mk + ls, ms=4, label="exact, H_cc x = 1" + tag)
+            ax2.loglog(p[ok2], k[ok2], mk + ls, ms=4, label="exact (fixed contact set)" + tag)
         ok3 = _along(p, ok & on & np.isfinite(kfd) & (kfd > 0))
         if ok3.size:
             ax2.loglog(p[ok3], kfd[ok3], "x" + ls, ms=5, label="central differences" + tag)
