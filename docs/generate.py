@@ -240,9 +240,15 @@ def result_page(title: str, source: Path, data, command: str, note: str = "") ->
     targets = target_rows(data) if isinstance(data, dict) else []
     if targets:
         n_met = sum(r["status"] == "met" for r in targets)
+        n_skipped = sum(r["status"] == "**not run**" for r in targets)
         columns = [c for c in dict.fromkeys(k for r in targets for k in r)
                    if c in ("name", "status") or any(r.get(c) is not None for r in targets)]
-        lines += ["## Targets", "", f"{n_met} of {len(targets)} met.", ""]
+        # a row a quick run skips is neither met nor missed (a user's review: "1 of 2
+        # met" for one met row and one not run)
+        count = (f"{n_met} of {len(targets) - n_skipped} run met; {n_skipped} not run "
+                 f"(the full run, `make validate`, runs every row)." if n_skipped
+                 else f"{n_met} of {len(targets)} met.")
+        lines += ["## Targets", "", count, ""]
         lines += _table(targets, columns) + [""]
     if isinstance(data, dict):
         scalars = [{"quantity": k, "value": v} for k, v in data.items()
@@ -282,7 +288,7 @@ def _validation_commands():
         from roughfe.cli.validate_cmd import VALIDATIONS
     except Exception:  # the page still says how to run the script
         return {}
-    return {script: f"roughfe validate {name} -o OUTDIR"
+    return {script: f"roughfe validate {name}"
             for name, scripts in VALIDATIONS.items()
             for script in ((scripts,) if isinstance(scripts, str) else scripts)}
 
@@ -311,7 +317,9 @@ def write_results(scripts, output: Path, outdir: Path, kind: str, commands,
             if found:
                 break
         if found and folder is fallback:
-            command += f" --quick (reduced cases; found in {_rel(fallback)})"
+            command += f" --quick -o {_rel(fallback)} (reduced cases)"
+        elif command.startswith("roughfe validate"):   # the folder this page is read from
+            command += f" -o {_rel(output)}"
         if not found:
             pages[f"{stem}.md"] = missing_page(f"{kind}: {stem}", output / f"{stem}.json", command)
             report.append((stem, "missing"))

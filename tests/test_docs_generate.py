@@ -72,8 +72,23 @@ def test_quick_run_is_used_and_named_when_the_full_run_is_missing(gen, tmp_path)
     gen.write_results([scripts / "alpha.py"], full, pages, "Validation",
                       {"alpha": "roughfe validate alpha"}, fallback=quick)
     page = (pages / "alpha.md").read_text()
-    assert "roughfe validate alpha --quick" in page and "1 of 1 met." in page
+    assert f"roughfe validate alpha --quick -o {quick}" in page and "1 of 1 met." in page
     assert "| w | 0.002 | <= 1 % | 0.2 % |" in page
+    from roughfe.validation import NOT_RUN
+    # a row the quick run skips is counted apart, not as missed (a user's review)
+    (quick / "alpha.json").write_text(json.dumps(
+        {"targets": [{"name": "w", "value": 0.002, "target": 0.01, "met": True},
+                     {"name": "refined" + NOT_RUN, "value": None, "target": 0.01,
+                      "met": None}]}))
+    gen.write_results([scripts / "alpha.py"], full, pages, "Validation",
+                      {"alpha": "roughfe validate alpha"}, fallback=quick)
+    page = (pages / "alpha.md").read_text()
+    assert "1 of 1 run met; 1 not run" in page and "**not run**" in page
+    # the page of a missing run names the folder the page is read from
+    (quick / "alpha.json").unlink()
+    gen.write_results([scripts / "alpha.py"], full, pages, "Validation",
+                      {"alpha": "roughfe validate alpha"}, fallback=quick)
+    assert f"roughfe validate alpha -o {full}" in (pages / "alpha.md").read_text()
 
 
 def test_a_page_takes_its_own_variants_not_another_scripts_results(gen, tmp_path):

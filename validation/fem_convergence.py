@@ -1,4 +1,4 @@
-"""FEM vs BEM by convergence (issue 14 section 1): refinement study of both methods.
+"""FEM vs BEM by convergence: refinement study of both methods.
 
 Run: ``roughfe validate fem`` (with ``bem_vs_fem.py``) or ``python validation/fem_convergence.py
 OUTDIR [--profile NAME] [--resume]``; writes ``<outdir>/fem_convergence.md``,

@@ -1,4 +1,4 @@
-"""FEM vs BEM two-way fluid-structure coupling on a profile (issue 12 section 5).
+"""FEM vs BEM two-way fluid-structure coupling on a profile.
 
 Run: ``roughfe validate fsi`` or ``python validation/fsi_fem.py OUTDIR [--quick]``; writes
 ``<outdir>/fsi_fem.md``, ``fsi_fem.json`` and ``fsi_fem_<case>.png``.

@@ -1,4 +1,4 @@
-"""Surface genomics (issue 15): sequencing recovery over seeds, the noise table, chromosome
+"""Surface genomics: sequencing recovery over seeds, the noise table, chromosome
 mechanics of the measured files, and surface design scores from a 2D genome database.
 
 Run: ``roughfe validate surface-genomics`` (or ``make validate``); writes

@@ -14,6 +14,7 @@ periodic one: a measured window's K is otherwise mostly its bulk compliance
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -174,6 +175,8 @@ def _run(args) -> int:
             written += sorted(out.glob("*.png"))
         write_json(out / "results.json", doc)  # last: the run is complete
     print_surface_notes(args, surface)
+    print(f"{args.method.upper()}, E = {material.E:.4g} Pa, nu = {material.nu:g}, "
+          f"E* = E / (1 - nu^2) = {material.E_star:.4g} Pa (--E, --nu)")
     plastic = args.hardness is not None      # the plastic share of A* beside it
     print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} "
           + (f"{'A*plastic':>9s} " if plastic else "")
@@ -377,7 +380,7 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"{material.nu}, E* = {material.E_star:.4g} Pa; non-periodic Love kernel "
         f"(DC-FFT), {sweep.results[0].solver} solver, 20 approaches Delta up to h_s = "
         f"peak-to-valley = {np.ptp(surface.heights) * 1e6:.3f} um; {elapsed:.1f} s for the "
-        f"sweep (shared 2-core machine). Files: `contact/results.json`, `contact/fields.h5`.\n\n"
+        f"sweep ({os.cpu_count()} CPU(s) visible). Files: `contact/results.json`, `contact/fields.h5`.\n\n"
         "| Delta (um) | p (MPa) | A* | A* Persson | P* = pL/(E* sigma) | K (MPa/um) | "
         "mean gap (um) | V* | iterations |\n|---|---|---|---|---|---|---|---|---|\n" + rows
         + f"\n\n(Persson's A* = erf(sqrt 2 p/(E* gbar)) with gbar = {gbar:.4f}, the rms "
