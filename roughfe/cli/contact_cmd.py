@@ -27,7 +27,8 @@ from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
-from .plausibility import check_load_magnitudes, check_solution, persson_basis
+from .plausibility import (MIN_CONTACT_POINTS, check_load_magnitudes, check_solution,
+                           persson_basis)
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, contact_physics_from_args,
@@ -292,13 +293,20 @@ def contact_document(sweep, surface, material, inputs: dict, *, adhesive=False) 
     return doc
 
 
-def _window_sentence(derived: dict) -> str:
+def _window_sentence(derived: dict, mirrored=None) -> str:
     """What K of a non-periodic window is (docs/theory/02): its bulk compliance C and K C
-    at the largest load, or "" for a periodic sweep."""
+    at the largest load, and with ``mirrored`` (a ContactResult of the evenly mirrored
+    window at the largest load) the interface's own K beside it; "" for a periodic
+    sweep."""
     c = derived.get("window_compliance")
     kc = [v for v in derived.get("stiffness_compliance") or () if v is not None]
     if c is None or not kc:
         return ""
+    interface = "" if mirrored is None else (
+        f" At the largest load, p = {mirrored.mean_pressure * 1e-6:.4g} MPa, the evenly "
+        f"mirrored window (periodic: the rough interface alone, `roughfe contact --mirror`) "
+        f"has K = {mirrored.stiffness * 1e-12:.4g} MPa/um and A* = "
+        f"{mirrored.area_fraction:.4f}.")
     return (f"**K of this window.** The surface is a finite, non-periodic window pressed into "
             f"a half-space (the thesis' Fig. 7 setting), so the approach includes the "
             f"window's own bulk deflection: its compliance is C = {c:.3g} m/Pa (~0.9 "
@@ -306,7 +314,7 @@ def _window_sentence(derived: dict) -> str:
             f"of the window's size has K C ~ 1.08). The K column is therefore mostly the "
             f"window's flat-punch stiffness, not a property of the roughness; the rough "
             f"interface's own K(p) is that of a periodic surface (e.g. the evenly mirrored "
-            f"window), docs/theory/02.\n\n")
+            f"window), docs/theory/02.{interface}\n\n")
 
 
 def section_contact(outdir: Path, context: dict) -> str:
@@ -361,6 +369,8 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"{fmt_or_dash(doc['steps'][i].get('persson_area_fraction'), '.4f')} | "
         f"{sweep.load_star[i]:.3f} | {r.stiffness * 1e-12:.4g} | {r.mean_gap * 1e6:.4f} | "
         f"{r.free_volume_star:.3f} | {r.nit} |"
+        + (f" contact on {r.n_contact} points (< {MIN_CONTACT_POINTS}): not resolved |"
+           if 0 < r.n_contact < MIN_CONTACT_POINTS else " |")
         for i, r in ((i, sweep.results[i]) for i in picks))
     needed = THESIS_FIG7["P_star"] * kappa / THESIS_FIG7["A_star"]
     # realisation scatter: the same generator, seeds 1-5, at Delta = h_s
@@ -382,7 +392,8 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"peak-to-valley = {np.ptp(surface.heights) * 1e6:.3f} um; {elapsed:.1f} s for the "
         f"sweep ({os.cpu_count()} CPU(s) visible). Files: `contact/results.json`, `contact/fields.h5`.\n\n"
         "| Delta (um) | p (MPa) | A* | A* Persson | P* = pL/(E* sigma) | K (MPa/um) | "
-        "mean gap (um) | V* | iterations |\n|---|---|---|---|---|---|---|---|---|\n" + rows
+        "mean gap (um) | V* | iterations | note |\n|---|---|---|---|---|---|---|---|---|---|\n"
+        + rows
         + f"\n\n(Persson's A* = erf(sqrt 2 p/(E* gbar)) with gbar = {gbar:.4f}, the rms "
         f"gradient of the surface's Hann-windowed PSD (`derived.persson.rms_gradient`), "
         f"beside every step of `contact/results.json` as in `roughfe contact`; docs/theory/07. "
@@ -410,6 +421,7 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"differently from what Sec. 2.2.2 states: with the maximum height h_s in place of "
         f"sigma, pL/(E* h_s) = {p_star * sigma / np.ptp(surface.heights):.2f} here, close to "
         f"0.56. We report pL/(E* sigma) as written.\n\n"
-        + _window_sentence(doc["derived"]) +
+        + _window_sentence(doc["derived"], solve_contact(
+            surface.mirrored(), material, mean_pressure=last.mean_pressure)) +
         f"![A(p), K(p)]({fig.relative_to(outdir)})\n\n"
         f"![deformed surface coloured by pressure]({render.relative_to(outdir)})\n")
