@@ -466,3 +466,19 @@ def test_leak_warns_of_percolation_through_a_molecular_gap(capsys):
     err = capsys.readouterr().err
     assert "step 1 (x: 3e-11 m) percolates through a critical gap below 1e-09 m" in err
     assert err.count("warning") == 1
+
+
+def test_adhesive_contact_of_a_strip_is_written_without_a_stickiness(tmp_path, capsys):
+    """A 2 x N non-periodic strip has no rms curvature: the Pastewka-Robbins criterion
+    raised after the adhesive solve, which was then lost (exit 2, nothing written; a
+    user's review). Now the results are written and the criterion is said not evaluated."""
+    h = np.random.default_rng(0).normal(size=(2, 64)) * 1e-8
+    np.save(tmp_path / "strip.npy", h)
+    assert main(["contact", str(tmp_path / "strip.npy"), "--size", "1e-6", "3.2e-5",
+                 "--adhesion", "exp", "--work-of-adhesion", "0.01", "--range", "1e-8",
+                 "--steps", "2", "--no-figures", "-o", str(tmp_path / "s")]) == 0
+    assert "stickiness not evaluated" in capsys.readouterr().out
+    doc = json.loads((tmp_path / "s" / "results.json").read_text())
+    assert doc["derived"]["stickiness"]["evaluated"] is False
+    assert "curvature" in doc["derived"]["stickiness"]["why"]
+    assert all(s["mean_pressure"] is not None for s in doc["steps"])

@@ -84,3 +84,33 @@ def test_a_render_without_contact_has_a_finite_colour_range(tmp_path):
         warnings.simplefilter("error", RuntimeWarning)
         path = render_contact(s.heights, r, tmp_path / "r.png", title="t", window_size=(400, 300))
     assert path.stat().st_size > 5000
+
+
+def test_tensile_tractions_get_a_diverging_colour_range(tmp_path, monkeypatch):
+    """Adhesive contact carries tensile tractions (p < 0) inside the contact; the render's
+    range from 0 drew all of them as one flat colour (a user's review). A contact with
+    p < 0 gets a range symmetric about 0 on a diverging map; a compressive one keeps
+    (0, 99th percentile)."""
+    import dataclasses
+
+    import roughfe.plotting.contact as pc
+    from roughfe.bem import Material, solve_contact
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=3)
+    r = solve_contact(s, Material(1e9, 0.0), mean_pressure=5e6)
+    seen = []
+    make = pc.offscreen_plotter
+
+    def recording(**kw):
+        plotter = make(**kw)
+        add = plotter.add_mesh
+        plotter.add_mesh = lambda *a, **k: seen.append(k) or add(*a, **k)
+        return plotter
+    monkeypatch.setattr(pc, "offscreen_plotter", recording)
+    pc.render_contact(s.heights, r, tmp_path / "c.png", window_size=(300, 200))
+    tensile = dataclasses.replace(r, pressure=np.where(r.contact, r.pressure - 3e6, 0.0))
+    pc.render_contact(s.heights, tensile, tmp_path / "t.png", window_size=(300, 200))
+    (lo_c, hi_c), (lo_t, hi_t) = seen[0]["clim"], seen[1]["clim"]
+    assert lo_c == 0.0 and hi_c > 0 and seen[0]["cmap"] == "plasma"
+    assert lo_t == -hi_t and lo_t < 0 and seen[1]["cmap"] == "coolwarm"
+    assert -lo_t * 1e6 >= -np.percentile(tensile.pressure[tensile.contact], 1) * (1 - 1e-9)

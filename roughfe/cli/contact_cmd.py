@@ -146,8 +146,13 @@ def _run(args) -> int:
         # the process zone against the grid (the ResolutionWarning's numbers, kept)
         doc["derived"]["resolution"] = adhesive.resolution
         doc["derived"]["units"].update(process_zone="m", grid_spacing="m")
-        stickiness = pastewka_robbins(surface, material.E_star, law.work, law.range)
-        doc["derived"]["stickiness"] = stickiness.describe()
+        try:
+            stickiness = pastewka_robbins(surface, material.E_star, law.work, law.range)
+            doc["derived"]["stickiness"] = stickiness.describe()
+        except InputError as exc:   # e.g. a 2 x N strip: no curvature; the solve stands
+            stickiness = None       # (it raised after the solve and wrote nothing)
+            doc["derived"]["stickiness"] = {"theory": "Pastewka-Robbins (2014)",
+                                            "evaluated": False, "why": str(exc)}
     name = Path(args.surface).name + (" (mirrored)" if args.mirror else "")
     with folder as out:
         write_fields_h5(out / "fields.h5", sweep)
@@ -208,7 +213,9 @@ def _run(args) -> int:
         pull = (f"pull-off force {adhesive.pull_off_force:.4e} "
                 f"({'detached' if adhesive.detached else 'NOT detached: a bound'})"
                 if args.unload else "pull-off force not traced (--unload traces it)")
-        print(f"{pull}; {stickiness.verdict()}")
+        print(f"{pull}; " + (stickiness.verdict() if stickiness is not None else
+                             "Pastewka-Robbins stickiness not evaluated: "
+                             + doc["derived"]["stickiness"]["why"]))
     print(f"wrote {', '.join(str(w) for w in written)}")
     return 0
 

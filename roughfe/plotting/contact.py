@@ -277,13 +277,21 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     shown = pressure[in_contact]
     top = float(np.percentile(shown, 99)) if shown.size else 1.0
     clipped = shown.size and float(shown.max()) > top > 0
-    plotter.add_mesh(grid, scalars="pressure (MPa)", cmap="plasma", smooth_shading=True,
-                     nan_color="lightgrey", clim=(0.0, top if top > 0 else 1.0),
-                     scalar_bar_args=side_bar("pressure (MPa)"))
+    # adhesion: tensile tractions (p < 0) inside the contact, which a range from 0 drew
+    # as one flat colour (a user's review): then a diverging map centred on p = 0
+    low = float(np.percentile(shown, 1)) if shown.size else 0.0
+    if low < 0:
+        span = max(-low, top, 1e-300)
+        cmap, clim, bar = "coolwarm", (-span, span), "traction (MPa)"
+    else:
+        cmap, clim, bar = "plasma", (0.0, top if top > 0 else 1.0), "pressure (MPa)"
+    plotter.add_mesh(grid, scalars="pressure (MPa)", cmap=cmap, smooth_shading=True,
+                     nan_color="lightgrey", clim=clim, scalar_bar_args=side_bar(bar))
     label = (title or "") + (f"\n{_state_label(result)} (free area grey), vertical "
                              f"x{exaggeration:.3g}" + decimation_note(h.shape, z.shape)
                              + (f"; colours to the 99th percentile, {top:.3g} MPa (max "
-                                f"{float(shown.max()):.3g})" if clipped else ""))
+                                f"{float(shown.max()):.3g})" if clipped else "")
+                             + ("; traction < 0 (blue) is tensile" if low < 0 else ""))
     plotter.add_text(label.strip(), position="upper_left", font_size=10)
     plotter.set_background("white")
     plotter.camera_position = "iso"
