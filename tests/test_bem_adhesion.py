@@ -98,16 +98,16 @@ def test_dmt_limit_sphere_pull_off():
 
 @pytest.mark.slow
 def test_jkr_side_sphere_pull_off(jkr_side):
-    # lambda = 2: Maugis -1.535 pi w R. Measured -1.506 (-1.9 %) with the cell-averaged
-    # law (sampled at the cell centres it was -1.6 % here and -1.6 % to +4 % for other
-    # step paths: the zone end, inside one cell, was pinned by the grid). The continuation
-    # samples F(Delta) at steps of 0.2 Maugis units, so its pull-off errs on the JKR side
-    # of the minimum; tolerance 3 %. Far from the DMT value 2 and within 2 % of the JKR
-    # limit 1.5 (the Maugis curve and the refinement: validation/adhesion_maugis.py).
+    # lambda = 2: Maugis -1.535 pi w R. The continuation samples F(Delta) at steps of 0.2
+    # Maugis units; the most tensile sample read -1.506 (-1.9 %, on the JKR side of the
+    # minimum). Since round 2, session 30 the steps around it are bisected down to a
+    # quarter of the law's range (refine_pull_off): measured -1.5374 (+0.15 %), the rest
+    # the grid's (the cell-averaged law). Far from the DMT value 2, 2.3 % beyond the JKR
+    # limit 1.5 as Maugis' curve (validation/adhesion_maugis.py).
     ratio = jkr_side.pull_off_force / (np.pi * W * R)
     assert jkr_side.detached
-    assert ratio == pytest.approx(maugis_pull_off(2.0), rel=3e-2)
-    assert ratio == pytest.approx(-1.5, rel=2e-2)
+    assert ratio == pytest.approx(maugis_pull_off(2.0), rel=5e-3)
+    assert ratio == pytest.approx(-1.5, rel=3e-2)
 
 
 def test_loading_and_unloading_branches_differ(jkr_side):
@@ -701,3 +701,38 @@ def test_the_resolution_a_law_needs_depends_on_the_law_and_the_grid():
     sharp = AdhesionLaw("md", law.work, law.range, smoothing=0.0)
     assert sharp.resolution_cells(4.6, 1) == law.resolution_cells(4.6, 1) == pytest.approx(
         0.6 / 0.05 * 4.6)
+
+
+def test_the_pull_off_does_not_depend_on_the_unloading_step():
+    """A Maugis-Dugdale sphere (lambda = 2) traced at steps of 0.4 and 0.1 Maugis units:
+    the most tensile sample of the coarse branch read short of the fine one (the true
+    minimum lies between samples; a user's review measured 11 % on a coarser path). With
+    the steps around it bisected (refine_pull_off) both give Maugis' pull-off, and the
+    refined branch keeps its states in order of the approach."""
+    from roughfe.bem.adhesive_pull_off import refine_pull_off
+    law = md_law(2.0)
+    runs = {}
+    for name, count in (("coarse", 3), ("fine", 9)):
+        runs[name] = adhesive_sweep(sphere(64, 0.21), MAT, law,
+                                    np.linspace(-0.6, 0.2, count) * D_SCALE, unload=True,
+                                    max_unload_steps=12)
+    coarse, fine = (runs[k].pull_off_force / (np.pi * W * R) for k in ("coarse", "fine"))
+    assert coarse == pytest.approx(fine, rel=5e-3)
+    assert coarse == pytest.approx(maugis_pull_off(2.0), rel=1e-2)
+    recs = [r for r in runs["coarse"].records() if r["unloading"]]
+    assert all(a["delta"] > b["delta"] for a, b in zip(recs, recs[1:]))
+    # the bisection itself on a parabola F = (d - 0.3)^2 - 1 sampled at d = 1, 0.5, 0, -0.5
+    from types import SimpleNamespace
+    calls = []
+
+    def solve(d, initial):
+        calls.append((d, initial.delta))
+        return SimpleNamespace(delta=d, load=(d - 0.3) ** 2 - 1)
+    branch = [(d, SimpleNamespace(delta=d, load=(d - 0.3) ** 2 - 1)) for d in (1, 0.5, 0, -0.5)]
+    out = refine_pull_off(branch, solve, resolution=0.1)
+    ds = [d for d, _ in out]
+    assert ds == sorted(ds, reverse=True)
+    # the samples' minimum -0.96 (at 0.5) becomes the parabola's to within (h / 2)^2
+    assert -1.0 <= min(s.load for _, s in out) <= -1.0 + 0.05 ** 2
+    assert all(init > d for d, init in calls)       # each continued from the larger approach
+    assert len(calls) <= 2 * 4
