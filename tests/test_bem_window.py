@@ -110,3 +110,21 @@ def test_a_profile_window_is_warned_without_surface_facts():
     assert len(caught) == 1
     text = str(caught[0].message)
     assert "sqrt(A_n)" not in text and "flat punch" not in text and "reference length" in text
+
+
+def test_the_bulk_share_is_undefined_at_round_off_approaches_and_under_tension(window):
+    """C p / Delta of an adhesive branch unloaded to Delta = 2.1e-22 m (round-off of the
+    step arithmetic) printed -2e15, and under tension (p < 0) it is no share of anything
+    (a user's review): None there, C p / Delta elsewhere."""
+    from types import SimpleNamespace
+
+    from roughfe.bem.window import window_report
+    sweep = contact_sweep(window, MAT, pressures=[1e5, 1e6])
+    fake = SimpleNamespace(method="bem", results=sweep.results,
+                           delta=[sweep.delta[0], sweep.delta[1], 2.1e-22, 0.5 * sweep.delta[0]],
+                           mean_pressure=[1e5, 1e6, -3e3, -1e4],
+                           stiffness=[np.nan] * 4)
+    share = window_report(fake)["bulk_share"]
+    c = window_compliance(window, MAT.E, MAT.nu)
+    assert share[0] == pytest.approx(c * 1e5 / sweep.delta[0], rel=1e-12, abs=0)
+    assert share[2] is None and share[3] is None

@@ -52,6 +52,13 @@ def sweep_document(sweep: SweepResult, inputs: dict) -> dict:
             "references": list(sweep.results[0].references),
         },
     }
+    # two slopes live in one file: name which is which (a user's review: a user who
+    # plotted A* against this p/(E* slope) with Persson's curve got another curve than
+    # the persson_* columns, which take the PSD's rms gradient)
+    doc["derived"]["units"].update(
+        rms_height="m", rms_slope="1 (rms slope by finite differences of the heights)",
+        pressure_over_estar_rms_slope="1 (p / (E* rms_slope), rms_slope the finite-"
+        "difference one above; Persson's columns use persson.rms_gradient, the PSD's)")
     if window:
         doc["derived"].update(window)
         doc["derived"]["units"]["window_compliance"] = "m/Pa"

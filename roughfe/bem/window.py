@@ -65,16 +65,21 @@ def window_report(sweep) -> dict:
     """The window's bulk compliance beside a non-periodic BEM sweep ({} for a periodic
     or a FEM one): ``window_compliance`` C (m/Pa, the kernel of the solve) and per step
     ``bulk_share`` = C p/Delta (the share of the approach that is the window's bulk
-    deflection; None at Delta = 0) and ``stiffness_compliance`` K C (None where K is not
-    computed). Warns once (:class:`~roughfe.errors.WindowStiffnessWarning`) when K C >
+    deflection; None at Delta = 0 to round-off and for a tensile load) and
+    ``stiffness_compliance`` K C (None where K is not computed). Warns once
+    (:class:`~roughfe.errors.WindowStiffnessWarning`) when K C >
     :data:`WINDOW_STIFFNESS_SHARE` at the largest load with a computed K."""
     r0 = sweep.results[0]
     if sweep.method != "bem" or r0.periodic:
         return {}
     c = _mean_deflection(r0.pressure.shape, r0.size, r0.e_star, r0.kernel)
     p = np.asarray(sweep.mean_pressure, float)
+    d = np.asarray(sweep.delta, float)
+    # defined for a compressive load at an approach above round-off (an adhesive branch
+    # unloaded to Delta = 2e-22 m printed C p / Delta = -2e15; a user's review)
+    defined = (d > 1e-9 * float(np.max(np.abs(d), initial=0.0))) & (p > 0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        share = np.where(np.asarray(sweep.delta) > 0, c * p / np.asarray(sweep.delta), np.nan)
+        share = np.where(defined, c * p / d, np.nan)
     kc = np.asarray(sweep.stiffness, float) * c
     ok = np.isfinite(kc)
     if ok.any():
