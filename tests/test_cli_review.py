@@ -482,3 +482,26 @@ def test_adhesive_contact_of_a_strip_is_written_without_a_stickiness(tmp_path, c
     assert doc["derived"]["stickiness"]["evaluated"] is False
     assert "curvature" in doc["derived"]["stickiness"]["why"]
     assert all(s["mean_pressure"] is not None for s in doc["steps"])
+
+
+def test_the_adhesive_unloading_can_be_traced_further(tmp_path, capsys):
+    """An unloading branch that ends attached gave a pull-off "NOT detached: a bound"
+    with no way on the command line to trace further (a user's review): the message
+    names --max-unload-steps, which reaches the separation, and the flag is refused
+    without --adhesion --unload."""
+    from roughfe.surfaces.io import save_surface
+    from roughfe.surfaces.spectral import spectral_surface
+    s = spectral_surface(32, 1e-5, 0.8, rms_height=1e-8, q_roll=4 * np.pi / 1e-5,
+                         q_short=16 * np.pi / 1e-5, rng=3)
+    save_surface(s, tmp_path / "s.npz")
+    args = ["contact", str(tmp_path / "s.npz"), "--E", "1e6", "--nu", "0.5", "--adhesion",
+            "exp", "--work-of-adhesion", "0.01", "--range", "5e-8", "--steps", "2",
+            "--unload", "--no-figures"]
+    assert main(args + ["--max-unload-steps", "1", "-o", str(tmp_path / "a")]) == 0
+    assert "NOT detached: a bound; trace further with --max-unload-steps" in \
+        capsys.readouterr().out
+    assert main(args + ["--max-unload-steps", "16", "-o", str(tmp_path / "b")]) == 0
+    assert "(detached)" in capsys.readouterr().out
+    assert main(["contact", str(tmp_path / "s.npz"), "--steps", "2", "--max-unload-steps",
+                 "3", "-o", str(tmp_path / "c")]) == 2
+    assert "needs --adhesion and --unload" in capsys.readouterr().err

@@ -33,7 +33,7 @@ from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_o
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, contact_physics_from_args,
                       fmt_or_dash, material_from_args, mirrored_if_asked,
-                      output_folder_of, positive_float,
+                      nonnegative_int, output_folder_of, positive_float,
                       positive_int, print_surface_notes, surface_from_args, unit_fraction)
 
 DEFAULT_STEPS = Loading.DEFAULT_STEPS
@@ -72,6 +72,10 @@ def register(subparsers) -> None:
                            "with --adhesion strictly increasing (the loading branch; "
                            "--unload traces the unloading one)")
     add_contact_physics_options(p)
+    p.add_argument("--max-unload-steps", type=nonnegative_int, default=None, metavar="N",
+                   help="with --adhesion --unload: at most N solves beyond the loading "
+                        "range while tracing the unloading branch to separation (default "
+                        "4 x the loading steps; the steps grow once the load recovers)")
     num = p.add_argument_group("numerics")
     num.add_argument("--method", default="bem", choices=("bem", "fem"),
                      help="bem: the boundary-element solver (production); fem: the dolfinx "
@@ -111,6 +115,9 @@ def _run(args) -> int:
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
     adhesive = None
     tol = args.tol if args.tol is not None else (1e-10 if law is None else 1e-5)
+    if args.max_unload_steps is not None and (law is None or not args.unload):
+        raise InputError("--max-unload-steps bounds the adhesive unloading branch: it needs "
+                         "--adhesion and --unload")
     if args.method == "fem" and law is not None:
         raise InputError("--method fem has no adhesion (--adhesion is the BEM's)")
     if law is None:
@@ -211,7 +218,9 @@ def _run(args) -> int:
               + " (derived.window_compliance, bulk_share in results.json)")
     if adhesive is not None:
         pull = (f"pull-off force {adhesive.pull_off_force:.4e} "
-                f"({'detached' if adhesive.detached else 'NOT detached: a bound'})"
+                + ("(detached)" if adhesive.detached else
+                   "(NOT detached: a bound; trace further with --max-unload-steps N, "
+                   "more than the default 4 x the loading steps)")
                 if args.unload else "pull-off force not traced (--unload traces it)")
         print(f"{pull}; " + (stickiness.verdict() if stickiness is not None else
                              "Pastewka-Robbins stickiness not evaluated: "
@@ -260,7 +269,8 @@ def _adhesive_sweep(args, surface, material, law, tol):
         pressure_control=args.pressure is not None, words=ADHESION_WORDS)
     return adhesive_sweep(surface, material, law, args.delta,
                           n_steps=None if args.delta else args.steps,
-                          unload=args.unload, kernel=args.kernel, tol=tol)
+                          unload=args.unload, kernel=args.kernel, tol=tol,
+                          max_unload_steps=args.max_unload_steps)
 
 
 # -- demo section (appended to roughfe.cli.demo_cmd.SECTIONS) ------------------------------
