@@ -151,8 +151,6 @@ def test_response_rejects_what_a_method_can_not_do():
         response(surf, MAT, method="xfem")
     with pytest.raises(InputError, match="loading must be"):
         response(surf, MAT, {"delta": 1e-7})
-    with pytest.raises(InputError, match="load control"):
-        response(surf, MAT, Loading(mean_pressure=1e5), method="fem")
     with pytest.raises(InputError, match="1D profile"):
         response(Surface(np.ones((4, 4)), 1.0), MAT, method="fem")
 

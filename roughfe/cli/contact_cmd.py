@@ -3,8 +3,8 @@
 Runs one warm-started BEM contact sweep (:func:`roughfe.response.response`) and writes
 ``results.json``, ``fields.h5`` and the figures (A(p), K(p), mean gap, with Persson's
 theory beside the BEM curves; a 3D render of the last step for surfaces, a profile plot
-for profiles). Each step record carries ``persson_area_fraction`` and
-``persson_mean_gap`` (:func:`roughfe.theory.beside`), except with ``--adhesion``: the
+for profiles). Each step record carries ``persson_area_fraction``, ``persson_mean_gap``
+and ``persson_stiffness`` (:func:`roughfe.theory.beside`), except with ``--adhesion``: the
 theory is non-adhesive, so an adhesive run has none (``derived.persson`` says so); with
 ``--hardness`` the theory is elastic, so from the first step with plastic flow on the
 values are None (``derived.persson`` says so and lists those steps). ``--mirror`` solves

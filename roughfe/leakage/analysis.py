@@ -345,7 +345,8 @@ _RECORD_UNITS = {
 def record_units(keys) -> dict:
     """The unit of each step-record key in ``keys`` (SI; volumes ``*_volume`` m^3, their
     ``*_volume_star`` V / (A_n sigma), sigma the rms height of the undeformed surface;
-    ``*_fraction`` 1, ``*_rate`` m^3/s, ``*_gap`` m, ``*_pressure`` Pa); keys of no known
+    ``*_fraction`` 1, ``*_rate`` m^3/s, ``*_gap`` m, ``*_pressure`` Pa, ``*_stiffness``
+    Pa/m); keys of no known
     kind are left out."""
     out = {}
     for key in keys:
@@ -355,7 +356,8 @@ def record_units(keys) -> dict:
             for suffix, u in (("_volume_star", "1 (V / (A_n sigma))"), ("_volume", "m^3"),
                               ("_fraction", "1"), ("_rate", "m^3/s"),
                               ("leak_rate_critical_junction", "m^3/s"), ("_gap", "m"),
-                              ("_pressure", "Pa"), ("_one_way", "m^3/s")):
+                              ("_pressure", "Pa"), ("_one_way", "m^3/s"),
+                              ("_stiffness", "Pa/m")):
                 if base.endswith(suffix):
                     unit = u
                     break

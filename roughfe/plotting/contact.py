@@ -58,7 +58,8 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     branch's lines drawn in order of p whatever the order of the steps) and the mean gap
     u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8). Records
     with ``persson_area_fraction`` / ``persson_mean_gap`` (:func:`roughfe.theory.beside`)
-    get Persson's curves drawn beside the BEM points. With the ``window_compliance`` C
+    get Persson's curves drawn beside the BEM points (and ``persson_stiffness`` its K =
+    -dp/du in the K panel). With the ``window_compliance`` C
     (m/Pa) of a non-periodic window, the K panel marks the window's bulk stiffness 1/C,
     the ceiling K approaches whatever the roughness (:mod:`roughfe.bem.window`).
     ``method`` labels the solver's points ("BEM", or "FEM" for ``contact --method fem``).
@@ -137,6 +138,15 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
         ok3 = _along(p, ok & on & np.isfinite(kfd) & (kfd > 0))
         if ok3.size:
             ax2.loglog(p[ok3], kfd[ok3], "x" + ls, ms=5, label="central differences" + tag)
+    k_th = _theory(steps, "persson_stiffness")
+    # below full contact only: there K -> inf (the BEM's is inf, not drawn), and a
+    # theory point there squashed the panel's range by 6 decades
+    if k_th is not None and (theory & np.isfinite(k_th) & (a < 0.999)).any():
+        sel = theory & np.isfinite(k_th) & (a < 0.999)
+        by_p = np.argsort(p[sel])
+        ax2.loglog(p[sel][by_p], k_th[sel][by_p] * MPA * 1e-6, "-",
+                   label="Persson, -dp/du" + (" (interface only)" if window_compliance
+                                             else ""))
     if window_compliance and ax2.get_legend_handles_labels()[0]:
         ax2.axhline(MPA * 1e-6 / window_compliance, color="0.4", ls="--", lw=1,
                     label="window bulk 1/C (K is in series with it)")

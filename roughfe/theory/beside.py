@@ -100,7 +100,7 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     -------
     dict
         ``"steps"``: copies of ``steps`` with ``persson_area_fraction`` (-),
-        ``persson_mean_gap`` (m) and, with ``pressure_drop``, ``persson_leak_rate_<d>``
+        ``persson_mean_gap`` (m), ``persson_stiffness`` (Pa/m, K = -dp/du) and, with ``pressure_drop``, ``persson_leak_rate_<d>``
         per direction and ``persson_leak_rate`` (their mean; m^3/s) added; steps with no
         positive finite pressure (no theory at zero load) and plastic ones get None.
         ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
@@ -129,6 +129,7 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         rec = dict(step)
         rec["persson_area_fraction"] = float(theory.area_fraction[j]) if k else None
         rec["persson_mean_gap"] = float(theory.mean_gap[j]) if k else None
+        rec["persson_stiffness"] = float(theory.stiffness[j]) if k else None
         if pressure_drop is not None:
             # Q is linear in the geometry factor: one junction per step, scaled per direction
             unit = (critical_junction(psd, e_star, float(p), pressure_drop, viscosity,
@@ -142,6 +143,7 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         out.append(rec)
     info = {"gamma": theory.gamma, "kappa": theory.kappa, "rms_gradient": theory.rms_gradient,
             "u0": theory.u0, "units": {"persson_mean_gap": "m", "u0": "m",
+                                       "persson_stiffness": "Pa/m (K = -dp/du)",
                                        "persson_leak_rate": "m^3/s"},
             "references": list(REFERENCES)}
     if pressure_drop is not None:

@@ -57,6 +57,19 @@ pressures ``u = u0 ln(p_ref / p)``, i.e. ``p ~ exp(-u / u0)``, with
 order-of-magnitude statement (the ratio u0 / (gamma h_rms) depends on the spectrum, see
 docs/theory/07_adhesion_persson.md); Eq. (3) is what the theory gives.
 
+Normal contact stiffness (Persson 2007; Akarapu, Sharp & Robbins 2011)
+--------------------------------------------------------------------
+``K = -dp/du``: the derivative of Eq. (2), ``dJ/dy = -(2/sqrt(pi)) exp(-y^2) [gamma + 3
+(1 - gamma) erf(y)^2] / y`` with ``y = w p / E*``, gives
+
+    K(p) = p / D(p),                                                                 (4)
+    D(p) = (2/sqrt(pi)) sum_k (1/4) |q_k| C_k weight_k w_k exp(-y_k^2) [gamma + 3 (1 -
+           gamma) erf(y_k)^2],
+
+so ``K -> p / u0`` at small p (Eq. (3)). For a periodic surface the mean gap falls as
+the approach grows (u = const - Delta), and K is the BEM's dp/dDelta; for a
+non-periodic window the BEM's K also holds the window's bulk compliance.
+
 The critical junction of Lorenz & Persson is in :mod:`roughfe.theory.junction`, the
 theory beside a simulation's steps in :mod:`roughfe.theory.beside`.
 """
@@ -82,6 +95,7 @@ REFERENCES = (
     "Persson B.N.J. (2007) Phys. Rev. Lett. 99:125502 (u(p), gamma)",
     "Yang C., Persson B.N.J. (2008) J. Phys.: Condens. Matter 20:215214 (u(p), Eq. (2))",
     "Lorenz B., Persson B.N.J. (2009) Eur. Phys. J. E 31:159-167 (critical junction)",
+    "Akarapu S., Sharp T., Robbins M.O. (2011) Phys. Rev. Lett. 106:204301 (K = -dp/du)",
 )
 
 
@@ -255,6 +269,26 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
     return j_function(np.outer(p, w / e), gamma) @ weight
 
 
+def normal_stiffness(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q2=None):
+    """Persson's normal contact stiffness K(p) = -dp/du (Pa/m), Eq. (4): the derivative of
+    :func:`mean_separation` (same arguments, every |q|), ``p / u0`` at small p."""
+    e = check_finite_positive("e_star (Pa)", e_star)
+    gamma = _check_gamma(gamma)
+    p = _pressures(mean_pressure)
+    q = check_real_array("q (wavenumbers)", q, unit="rad/m")
+    power = check_real_array("power", power, unit="m^2")
+    q2 = q * q if q2 is None else check_real_array("q2", q2, unit="rad^2/m^2")
+    if q.ndim != 1 or q.shape != power.shape or q2.shape != q.shape:
+        raise InputError(f"q, power and q2 must be 1D arrays of one length, got shapes "
+                         f"{q.shape}, {power.shape} and {q2.shape}")
+    q, q2, power = _with_power(q, q2, power)
+    w = np.sqrt(2.0 / _cumulative_gradient(q2, power))
+    weight = 0.25 * q * power * w
+    y = np.outer(p, w / e)
+    kernel = np.exp(-y ** 2) * (gamma + 3 * (1 - gamma) * scipy.special.erf(y) ** 2)
+    return p / ((2 / np.sqrt(np.pi)) * (kernel @ weight))
+
+
 # -- results ---------------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class PerssonResult:
@@ -268,6 +302,8 @@ class PerssonResult:
         A*(p), Eq. (1).
     mean_gap : ndarray
         u(p), Eq. (2) (m): separation of the mean planes, comparable with the BEM mean gap.
+    stiffness : ndarray
+        K(p) = -dp/du, Eq. (4) (Pa/m): the BEM's dp/dDelta of a periodic surface.
     rms_gradient : float
         gbar from the PSD (-).
     rms_height : float
@@ -292,17 +328,19 @@ class PerssonResult:
     kappa: float
     ndim: int
     references: tuple = REFERENCES
+    stiffness: np.ndarray = None
 
     def records(self) -> list:
         """One JSON-safe dict per pressure (keys as in results.json)."""
         return [{"mean_pressure": float(p), "persson_area_fraction": float(a),
-                 "persson_mean_gap": float(u)}
-                for p, a, u in zip(self.mean_pressure, self.area_fraction, self.mean_gap)]
+                 "persson_mean_gap": float(u), "persson_stiffness": float(k)}
+                for p, a, u, k in zip(self.mean_pressure, self.area_fraction, self.mean_gap,
+                                      self.stiffness)]
 
 
 def persson(source, e_star, mean_pressure, *, gamma=GAMMA_DEFAULT,
             kappa=KAPPA_PERSSON) -> PerssonResult:
-    """Persson's A*(p) and u(p) for a surface or profile (or its PSD), Eqs. (1)-(3).
+    """Persson's A*(p), u(p) and K(p) for a surface or profile (or its PSD), Eqs. (1)-(4).
 
     Parameters
     ----------
@@ -332,4 +370,5 @@ def persson(source, e_star, mean_pressure, *, gamma=GAMMA_DEFAULT,
     return PerssonResult(mean_pressure=p, area_fraction=area_fraction(gbar, e_star, p, kappa),
                          mean_gap=u, rms_gradient=gbar, rms_height=float(np.sqrt(power.sum())),
                          u0=u0, e_star=float(e_star), gamma=float(gamma), kappa=float(kappa),
-                         ndim=psd.ndim)
+                         ndim=psd.ndim,
+                         stiffness=normal_stiffness(q, power, e_star, p, gamma, q2=q2))
