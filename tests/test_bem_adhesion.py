@@ -736,3 +736,11 @@ def test_the_pull_off_does_not_depend_on_the_unloading_step():
     assert -1.0 <= min(s.load for _, s in out) <= -1.0 + 0.05 ** 2
     assert all(init > d for d, init in calls)       # each continued from the larger approach
     assert len(calls) <= 2 * 4
+
+
+def test_a_flat_surface_without_approaches_is_said_flat():
+    """n_steps on a flat surface gave approaches 0, 0, 0 and the message "deltas must be
+    strictly increasing" (a user's review): it now says the surface is flat."""
+    flat = Surface(np.zeros((16, 16)), 1e-4, periodic=True)
+    with pytest.raises(InputError, match="the surface is flat"):
+        adhesive_sweep(flat, Material(1e6, 0.3), AdhesionLaw("exp", 0.01, 1e-8), n_steps=3)

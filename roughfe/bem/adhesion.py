@@ -417,6 +417,9 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     if deltas is None:
         from .sweep import default_deltas
         n_steps = Loading(n_steps=n_steps).n_steps     # checked, default 20
+        if np.ptp(surface.heights) == 0.0:   # it said "deltas must be strictly increasing"
+            raise InputError("the surface is flat (constant heights): its height range "
+                             "gives no approaches for n_steps; give the approaches (m)")
         periodic = surface.periodic and kernel in ("auto", "spectral")
         deltas = default_deltas(surface, n_steps + periodic, periodic)[:n_steps]
     elif n_steps is not None:
