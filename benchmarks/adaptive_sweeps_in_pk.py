@@ -34,7 +34,6 @@ Usage (from the repository root; numba: Debian's python3-numba)::
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
@@ -244,43 +243,11 @@ class Adaptive:
             self._fixed.missed()
 
 
-HOOK = """        if EDGE[0] is not None and res > EDGE[0].until:
-            ctl = EDGE[0]
-            ctl.observe(it, res, p, u, us, bf)
-            if ctl.due(it - 1 - ctl.count, res):
-                if us != 1.0:
-                    u *= us
-                    us = 1.0
-                fn = apply_single if single else apply
-                y = buffer("y", np.float64)
-                if ctl.block is None:
-                    y.fill(0.0)
-                    y[0] = 1.0
-                    ctl.set_block(product(fn, y, y))
-                est = ctl.changes(p, u, bf, y)
-                if est is not None and est[0] < 0 and ctl.pays(est[1]):
-                    slope = est[0]
-                    r = product(fn, y, buffer("r", np.float32 if single else np.float64))
-                    curvature = ctl.curvature(y, r)
-                    step = min(1.0, -slope / curvature) if curvature > 0 else 0.0
-                    if step > 0:
-                        _axpy(p, step, y)
-                        np.maximum(p, 0.0, out=p)
-                        _rescale_to_load(p, target, upper)
-                        _axpy(u, step, r)
-                        ctl.made()
-                        exact = False
-                        if ctl.restart:
-                            gz_old = 0.0
-                        S = par.flatnonzero(p)
-                        continue
-                ctl.missed()
-"""
 
 
 def hooked_pk():
     """``roughfe.bem.pk`` with this script's hook (``EDGE[0]`` the controller)."""
-    return edge.hooked_pk(HOOK, "pk_adaptive")
+    return edge.hooked_pk(edge.HOOK, "pk_adaptive")
 
 
 _PK = []
@@ -369,11 +336,7 @@ def run(n, hurst, seed, loads, mode, kappa=KAPPA, restart=True, patience=3, log=
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--n", type=int, nargs="+", default=[1024])
-    ap.add_argument("--hurst", type=float, default=0.5)
-    ap.add_argument("--seeds", type=int, nargs="+", default=[1])
-    ap.add_argument("--loads", type=float, nargs="+", default=[0.005, 0.01, 0.05, 0.1])
+    ap = edge.case_parser(__doc__.splitlines()[0])
     ap.add_argument("--modes", nargs="+", default=["prod", "coarse"],
                     help="prod, coarse (the rule), adaptive (per-pass energy rule), "
                          "fixed (edge_sweeps_in_pk schedule), probe (prod + logs)")

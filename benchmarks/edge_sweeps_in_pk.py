@@ -200,12 +200,25 @@ class EdgeSweeps:
     applied to a unit load at the origin) and the change (:meth:`changes`).
     ``count``: sweeps made (each counts as an iteration of the solve)."""
 
+    #: the hook's controller interface (:data:`HOOK`, shared with
+    #: adaptive_sweeps_in_pk.py): no residual floor of its own, every sweep worth its
+    #: product, and a CG restart after each
+    until = float("-inf")
+    restart = True
+
     def __init__(self, shape, kernel):
         self.shape, self.kernel = tuple(int(n) for n in shape), kernel
         self.block = None
         self.count = 0           # sweeps made
         self._tries = 0          # sweeps asked for (a sweep with no edge window is none)
         self._last = -1
+
+    def observe(self, *state):
+        """Nothing to learn from the CG's iterations (the adaptive controller does)."""
+
+    def pays(self, predicted) -> bool:
+        """Every sweep with a descent is made."""
+        return True
 
     def due(self, k, res) -> bool:
         """A sweep before the CG iteration ``k`` (from 0) at the KKT residual ``res``."""
@@ -241,12 +254,13 @@ class EdgeSweeps:
 
     def changes(self, p, u, h, out):
         """The sweep's change dp into ``out`` (zeroed here; float32 in the solver's
-        single-precision phase) and its slope dp . (u - h) (float64, from the unrounded
-        change), or None when no window holds a contact edge."""
+        single-precision phase) and ``(slope, None)``, its slope dp . (u - h) (float64,
+        from the unrounded change) and no predicted decrease, or None when no window
+        holds a contact edge."""
         out.fill(0.0)
         n0, n1 = self.shape
         solved, slope = self.kernel(self.block, p, u, h, n0, n1, self._offset(), INNER, out)
-        return float(slope) if solved else None
+        return (float(slope), None) if solved else None
 
     def curvature(self, dp, hdp):
         """dp . H dp (float64) of the change ``dp`` and its product ``hdp`` (the float32
@@ -258,33 +272,41 @@ class EdgeSweeps:
         self.count += 1
 
 
-#: the hook, put into the Polonsky-Keer loop before its stall watch
-HOOK = """        if EDGE[0] is not None and EDGE[0].due(it - 1 - EDGE[0].count, res):
-            edge_sweeps = EDGE[0]
-            if us != 1.0:
-                u *= us
-                us = 1.0
-            fn = apply_single if single else apply
-            y = buffer("y", np.float64)
-            if edge_sweeps.block is None:
-                y.fill(0.0)
-                y[0] = 1.0
-                edge_sweeps.set_block(product(fn, y, y))
-            slope = edge_sweeps.changes(p, u, bf, y)
-            if slope is not None and slope < 0:
-                r = product(fn, y, buffer("r", np.float32 if single else np.float64))
-                curvature = edge_sweeps.curvature(y, r)
-                step = min(1.0, -slope / curvature) if curvature > 0 else 0.0
-                if step > 0:
-                    _axpy(p, step, y)
-                    np.maximum(p, 0.0, out=p)
-                    _rescale_to_load(p, target, upper)
-                    _axpy(u, step, r)
-                    edge_sweeps.made()
-                    exact, gz_old = False, 0.0
-                    S = par.flatnonzero(p)
-                    continue
-            edge_sweeps.missed()
+#: the hook, put into the Polonsky-Keer loop before its stall watch; ``EDGE[0]`` is the
+#: controller (:class:`EdgeSweeps`, or adaptive_sweeps_in_pk.py's): ``until`` (no sweep
+#: at or below that residual), ``observe``, ``due``, ``changes`` -> (slope, predicted
+#: decrease) or None, ``pays``, ``curvature``, ``made``, ``missed``, ``restart``
+HOOK = """        if EDGE[0] is not None and res > EDGE[0].until:
+            ctl = EDGE[0]
+            ctl.observe(it, res, p, u, us, bf)
+            if ctl.due(it - 1 - ctl.count, res):
+                if us != 1.0:
+                    u *= us
+                    us = 1.0
+                fn = apply_single if single else apply
+                y = buffer("y", np.float64)
+                if ctl.block is None:
+                    y.fill(0.0)
+                    y[0] = 1.0
+                    ctl.set_block(product(fn, y, y))
+                est = ctl.changes(p, u, bf, y)
+                if est is not None and est[0] < 0 and ctl.pays(est[1]):
+                    slope = est[0]
+                    r = product(fn, y, buffer("r", np.float32 if single else np.float64))
+                    curvature = ctl.curvature(y, r)
+                    step = min(1.0, -slope / curvature) if curvature > 0 else 0.0
+                    if step > 0:
+                        _axpy(p, step, y)
+                        np.maximum(p, 0.0, out=p)
+                        _rescale_to_load(p, target, upper)
+                        _axpy(u, step, r)
+                        ctl.made()
+                        exact = False
+                        if ctl.restart:
+                            gz_old = 0.0
+                        S = par.flatnonzero(p)
+                        continue
+                ctl.missed()
 """
 
 
@@ -336,13 +358,19 @@ def run(n, hurst, seed, loads, sweeps_on):
     return out
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def case_parser(description) -> argparse.ArgumentParser:
+    """The options of a measured case: --n, --hurst, --seeds, --loads (also used by
+    adaptive_sweeps_in_pk.py)."""
+    ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--n", type=int, nargs="+", default=[1024])
     ap.add_argument("--hurst", type=float, default=0.5)
     ap.add_argument("--seeds", type=int, nargs="+", default=[1])
     ap.add_argument("--loads", type=float, nargs="+", default=[0.005, 0.01, 0.05, 0.1])
-    a = ap.parse_args(argv)
+    return ap
+
+
+def main(argv=None) -> int:
+    a = case_parser(__doc__.splitlines()[0]).parse_args(argv)
     if _kernel() is None:       # a research script: nothing to measure is no failure
         print("numba is not importable: nothing to measure")
         return 0
