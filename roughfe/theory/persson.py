@@ -58,9 +58,9 @@ order-of-magnitude statement (the ratio u0 / (gamma h_rms) depends on the spectr
 docs/theory/07_adhesion_persson.md); Eq. (3) is what the theory gives.
 
 Normal contact stiffness (Persson 2007; Akarapu, Sharp & Robbins 2011)
---------------------------------------------------------------------
+-----------------------------------------------------------------------
 ``K = -dp/du``: the derivative of Eq. (2), ``dJ/dy = -(2/sqrt(pi)) exp(-y^2) [gamma + 3
-(1 - gamma) erf(y)^2] / y`` with ``y = w p / E*``, gives
+(1 - gamma) erf(y)^2] / y`` with ``y = w p / E*``, gives::
 
     K(p) = p / D(p),                                                                 (4)
     D(p) = (2/sqrt(pi)) sum_k (1/4) |q_k| C_k weight_k w_k exp(-y_k^2) [gamma + 3 (1 -
