@@ -803,9 +803,9 @@ def test_contact_command_runs_the_fem_on_a_profile(tmp_path, capsys):
         assert abs(f["area_fraction"] - b["area_fraction"]) <= 2 / prof.shape[0] + 1e-12
     capsys.readouterr()
     assert main(["contact", *common, "--method", "fem", "--kernel", "strip", "--tol",
-                 "1e-8", "-o", str(tmp_path / "x")]) == 2
+                 "1e-8", "--mirror", "-o", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
-    assert "--method fem does not take --kernel, --tol" in err
+    assert "--method fem does not take --mirror, --kernel, --tol" in err
     save_surface(Surface(np.outer(prof.heights[:64], np.ones(64)), (1e-4, 1e-4)),
                  tmp_path / "s.npz")
     assert main(["contact", str(tmp_path / "s.npz"), "--method", "fem", "-o",

@@ -80,11 +80,11 @@ def register(subparsers) -> None:
     num.add_argument("--method", default="bem", choices=("bem", "fem"),
                      help="bem: the boundary-element solver (production); fem: the dolfinx "
                           "plane-strain FEM body meshed by gmsh below a PROFILE (the "
-                          "cross-validation solver, minutes instead of seconds). The FEM "
+                          "cross-validation solver, slower than the BEM). The FEM "
                           "solves the evenly mirrored profile's problem: compare it with "
                           "the BEM's --mirror. With fem: --steps, --pressure or --delta "
-                          "only (no --hardness, --adhesion, --unload, --kernel, --solver, "
-                          "--coarse-correction, --tol)")
+                          "only (no --mirror, --hardness, --adhesion, --unload, --kernel, "
+                          "--solver, --coarse-correction, --tol)")
     num.add_argument("--kernel", default="auto", choices=("auto",) + KERNELS,
                      help="influence operator: auto = spectral if periodic, else strip for "
                           "profiles and love for surfaces; 'thesis' = Eq. 2.4")
@@ -283,7 +283,8 @@ def _method_options(args, tol) -> dict:
     if args.method == "bem":
         return dict(kernel=args.kernel, solver=args.solver, tol=tol, unload=args.unload,
                     hardness=args.hardness, coarse_correction=COARSE[args.coarse_correction])
-    given = [flag for flag, on in (("--hardness", args.hardness is not None),
+    given = [flag for flag, on in (("--mirror", args.mirror),   # the FEM mirrors itself
+                                   ("--hardness", args.hardness is not None),
                                    ("--unload", args.unload),
                                    ("--kernel", args.kernel != "auto"),
                                    ("--solver", args.solver != "auto"),
