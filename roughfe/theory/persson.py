@@ -215,6 +215,31 @@ def area_fraction(rms_gradient, e_star, mean_pressure, kappa=KAPPA_PERSSON):
     return scipy.special.erf(0.5 * k * np.sqrt(np.pi) * p / (e * g))
 
 
+def _checked_spectrum(q, power, q2=None):
+    """``(q, q2, power)`` of :func:`mean_separation` and :func:`normal_stiffness`, checked
+    (1D, one length, q >= 0 increasing, power >= 0; q2 default q^2) and without the
+    values that carry no power (:func:`_with_power`)."""
+    q = check_real_array("q (wavenumbers)", q, unit="rad/m")
+    power = check_real_array("power", power, unit="m^2")
+    if q.ndim != 1 or q.shape != power.shape:
+        raise InputError(f"q and power must be 1D arrays of the same length, got shapes "
+                         f"{q.shape} and {power.shape}")
+    if q.min(initial=0.0) < 0 or power.min(initial=0.0) < 0 or np.any(np.diff(q) < 0):
+        raise InputError("q (rad/m) must be finite, >= 0 and increasing, and power (m^2) "
+                         "finite and >= 0")
+    q2 = q * q if q2 is None else check_real_array("q2", q2, unit="rad^2/m^2")
+    if q2.shape != q.shape:
+        raise InputError(f"q2 must have the shape of q {q.shape}, got {q2.shape}")
+    return _with_power(q, q2, power)
+
+
+def _gap_modes(q, q2, power):
+    """``(w_k, weight_k)`` of Eq. (2): ``w = sqrt(2 / m(q))`` (m(q) the cumulative
+    gradient moment) and ``weight = |q| C w / 4`` (m per unit J)."""
+    w = np.sqrt(2.0 / _cumulative_gradient(q2, power))
+    return w, 0.25 * q * power * w
+
+
 def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=0.0,
                     q2=None):
     """Persson's mean separation u(p) (m), Eq. (2), from the roughness with |q| > q_min.
@@ -248,24 +273,12 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
     gamma = _check_gamma(gamma)
     p = _pressures(mean_pressure)
     q_min = check_finite_nonnegative("q_min (rad/m)", q_min)
-    q = check_real_array("q (wavenumbers)", q, unit="rad/m")
-    power = check_real_array("power", power, unit="m^2")
-    if q.ndim != 1 or q.shape != power.shape:
-        raise InputError(f"q and power must be 1D arrays of the same length, got shapes "
-                         f"{q.shape} and {power.shape}")
-    if q.min(initial=0.0) < 0 or power.min(initial=0.0) < 0 or np.any(np.diff(q) < 0):
-        raise InputError("q (rad/m) must be finite, >= 0 and increasing, and power (m^2) "
-                         "finite and >= 0")
-    q2 = q * q if q2 is None else check_real_array("q2", q2, unit="rad^2/m^2")
-    if q2.shape != q.shape:
-        raise InputError(f"q2 must have the shape of q {q.shape}, got {q2.shape}")
-    q, q2, power = _with_power(q, q2, power)
+    q, q2, power = _checked_spectrum(q, power, q2)
     sel = q > q_min
     q, q2, power = q[sel], q2[sel], power[sel]
     if q.size == 0:
         return np.zeros(p.shape)
-    w = np.sqrt(2.0 / _cumulative_gradient(q2, power))
-    weight = 0.25 * q * power * w                                   # m per unit J
+    w, weight = _gap_modes(q, q2, power)
     return j_function(np.outer(p, w / e), gamma) @ weight
 
 
@@ -275,15 +288,7 @@ def normal_stiffness(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q2=No
     e = check_finite_positive("e_star (Pa)", e_star)
     gamma = _check_gamma(gamma)
     p = _pressures(mean_pressure)
-    q = check_real_array("q (wavenumbers)", q, unit="rad/m")
-    power = check_real_array("power", power, unit="m^2")
-    q2 = q * q if q2 is None else check_real_array("q2", q2, unit="rad^2/m^2")
-    if q.ndim != 1 or q.shape != power.shape or q2.shape != q.shape:
-        raise InputError(f"q, power and q2 must be 1D arrays of one length, got shapes "
-                         f"{q.shape}, {power.shape} and {q2.shape}")
-    q, q2, power = _with_power(q, q2, power)
-    w = np.sqrt(2.0 / _cumulative_gradient(q2, power))
-    weight = 0.25 * q * power * w
+    w, weight = _gap_modes(*_checked_spectrum(q, power, q2))
     y = np.outer(p, w / e)
     kernel = np.exp(-y ** 2) * (gamma + 3 * (1 - gamma) * scipy.special.erf(y) ** 2)
     return p / ((2 / np.sqrt(np.pi)) * (kernel @ weight))
@@ -365,8 +370,8 @@ def persson(source, e_star, mean_pressure, *, gamma=GAMMA_DEFAULT,
     p = _pressures(mean_pressure)
     gbar = float(np.sqrt(np.sum(q2 * power)))          # <|grad h|^2>^1/2, every mode
     u = mean_separation(q, power, e_star, p, gamma, q2=q2)
-    w = np.sqrt(2.0 / _cumulative_gradient(q2, power))
-    u0 = float(gamma / (2 * np.sqrt(np.pi)) * np.sum(q * power * w))
+    weight = _gap_modes(q, q2, power)[1]
+    u0 = float(2 * gamma / np.sqrt(np.pi) * np.sum(weight))      # Eq. (3)
     return PerssonResult(mean_pressure=p, area_fraction=area_fraction(gbar, e_star, p, kappa),
                          mean_gap=u, rms_gradient=gbar, rms_height=float(np.sqrt(power.sum())),
                          u0=u0, e_star=float(e_star), gamma=float(gamma), kappa=float(kappa),
