@@ -175,6 +175,12 @@ def _fractional_grid_size(t):
             "--n: expected an integer >= 1")
 
 
+def _two_point_grid(t):
+    # a 2-point axis has only its Nyquist mode: "grid too small", not a wavenumber ordering
+    return (["generate", "spectral", "--n", "2", "-o", str(t / "s.npz")],
+            "grid too small: 2x2 points")
+
+
 CASES = [_truncated_npz, _output_is_a_file, _output_not_writable, _output_foreign_folder,
          _generate_existing_file, _genome_example_existing_file, _huge_grid, _genome_h_string,
          _genome_m_fraction, _genome_h_bool, _npz_as_genome, _steps_zero,
@@ -183,7 +189,7 @@ CASES = [_truncated_npz, _output_is_a_file, _output_not_writable, _output_foreig
          _study_into_a_foreign_folder, _tol_zero,
          _empty_npy, _directory_as_input, _db_build_workers_zero, _negative_young_modulus,
          _negative_poisson_exponent, _leak_delta_and_pressure, _negative_seed,
-         _fractional_grid_size]
+         _fractional_grid_size, _two_point_grid]
 
 
 def _snapshot(root):

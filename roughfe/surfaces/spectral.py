@@ -71,6 +71,11 @@ def _synthesise(ndim, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_s
     q_roll = q_min if q_roll is None else check_finite_positive("q_roll (rad/m)", q_roll)
     q_short = q_nyq if q_short is None else check_finite_positive("q_short (rad/m)", q_short)
     q_long = 0.0 if q_long is None else check_finite_nonnegative("q_long (rad/m)", q_long)
+    if q_nyq <= q_min and q_short == q_nyq:
+        raise InputError(f"grid too small: {'x'.join(map(str, shape))} points have no Fourier "
+                         f"mode between the lowest wavenumber 2 pi/L = {q_min:.6g} rad/m and the "
+                         f"Nyquist wavenumber {q_nyq:.6g} rad/m; use at least 3 points per axis "
+                         "(or give q_short explicitly on a strip)")
     if not (0 <= q_long <= q_roll < q_short):
         raise InputError(f"wavenumbers must satisfy 0 <= q_long <= q_roll < q_short (rad/m), got "
                          f"q_long={q_long!r}, q_roll={q_roll!r}, q_short={q_short!r}")
