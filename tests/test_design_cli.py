@@ -36,6 +36,9 @@ def test_db_and_design_commands(tmp_path, capsys):
         assert (out / name).is_file(), name
     report = json.loads((out / "result.json").read_text())
     settings = db.DatabaseSettings.from_dict(report["settings"])
+    # curves.csv says how its K was taken, as the database did ("fd" here)
+    assert (out / "curves.csv").read_text().startswith(
+        f"pressure_Pa,K_{settings.stiffness}_Pa_per_m,A,")
     target = Target.from_dict(report["targets"][0])
     design = de.Design.from_dict(json.loads((out / "design.json").read_text()))
     s = de.rescore(design, [target], settings)[0]

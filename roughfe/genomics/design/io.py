@@ -54,7 +54,9 @@ def write_design_result(result: DesignResult, settings: DatabaseSettings, outdir
     the design is one genome; for several, ``genome_partK.json``: part K as a genome with
     its weight and the overall scale in A), ``profile.npz`` (native surface file of the
     designed profile; ``surface.npz`` for a surface design, :func:`heights_name`),
-    ``curves.csv`` (p, targets, K, A) and ``stages.csv`` (similarity per candidate and
+    ``curves.csv`` (p, targets, K, A; the K column says how K was taken,
+    ``K_fd_Pa_per_m`` (differences over the sweep's steps) or ``K_exact_Pa_per_m`` (the
+    tangent at a fixed contact set), as ``settings.stiffness``) and ``stages.csv`` (similarity per candidate and
     GCMMA stage). The returned paths are keyed by file stem (``"profile"`` or
     ``"surface"`` for the heights).
     """
@@ -73,7 +75,7 @@ def write_design_result(result: DesignResult, settings: DatabaseSettings, outdir
     kind = heights_name(best.design.dim)
     paths[kind] = save_surface(best.design.surface(), out / f"{kind}.npz")
     c = best.curve
-    cols = ["pressure_Pa", "K_Pa_per_m", "A"]
+    cols = ["pressure_Pa", f"K_{settings.stiffness}_Pa_per_m", "A"]
     data = [c.pressure, c.stiffness, c.area_fraction]
     for t in result.objective.targets:
         cols.append(f"target_{t.name}_{t.quantity}")
