@@ -233,3 +233,48 @@ def test_design_curves_title_is_whole_and_keeps_the_verdict(drawn):
     for t in (title, result.message):
         fig = drawn(design_plot, "plot_design_curves", [result], title=t)
         assert _inside(fig, fig._suptitle) and "NOT matched" in fig._suptitle.get_text()
+
+
+# -- surface PSD figure (roughfe demo) -------------------------------------------------------
+def _laid_surface(lay):
+    """A Gaussian H = 0.8 spectral surface (128^2, L = 100 um, rms 0.1 um) plus a cosine
+    lay of amplitude ``lay`` (m) at q = 10 (2 pi / L): the lay's annulus sits far above the
+    power law, as the grooves of x3p-2.x3p."""
+    from roughfe.surfaces import Surface, spectral_surface
+    s = spectral_surface(128, 1e-4, 0.8, rms_height=1e-7, rng=0)
+    x = np.arange(128) * 1e-4 / 128
+    return Surface(s.heights + lay * np.cos(2 * np.pi * 10 * x / 1e-4)[:, None], s.size,
+                   periodic=True)
+
+
+@pytest.mark.parametrize("lay", [0.0, 5e-8])
+def test_the_psd_fit_line_lies_on_its_data(drawn, lay):
+    """The demo's measured PSD drew the fitted line 3.5x above its data: the Whittle level
+    is a mean that the lay's annuli set (not a normalisation: the fit and the figure read
+    one PowerSpectrum). On a power law the line is the fit's own; with a lay it is the
+    fitted slope at the data's median, and the values that set the Whittle level are
+    ringed."""
+    from roughfe.plotting import surfaces as surface_plot
+    from roughfe.surfaces import fit_hurst, power_spectrum
+    from roughfe.surfaces.psd_fit import fit_points
+    s = _laid_surface(lay)
+    psd, fit = power_spectrum(s), fit_hurst(s)
+    fig = drawn(surface_plot, "plot_psd", {"s": psd}, fits={"s": fit})
+    line = next(ln for ln in fig.axes[0].get_lines() if ln.get_label().startswith("fit:"))
+    q, c = line.get_xdata(), line.get_ydata()
+    slope = np.polyfit(np.log(q), np.log(c), 1)[0]
+    assert slope == pytest.approx(fit.slope, abs=1e-9)
+    sel, _ = fit_points(psd, fit.q_range)
+    drawn_level = np.median(psd.C[sel] / (c[0] * (psd.q[sel] / q[0]) ** slope))
+    whittle_level = np.median(psd.C[sel] / (fit.prefactor * psd.q[sel] ** fit.slope))
+    rings = [ln for ln in fig.axes[0].get_lines() if "Whittle level" in ln.get_label()
+             and not ln.get_label().startswith("fit:")]
+    if lay == 0.0:          # a power law: the Whittle line itself, through the data
+        assert whittle_level == pytest.approx(1.0, abs=0.1)
+        assert drawn_level == pytest.approx(whittle_level, abs=1e-9) and not rings
+    else:                   # the lay: Whittle 2.2x above the data, the drawn line on it
+        assert whittle_level < 0.5
+        assert drawn_level == pytest.approx(1.0, abs=1e-9)
+        # the lay's annulus (its mean |q|: 1 % above 2 pi 10 / L)
+        assert rings and rings[0].get_xdata()[0] == pytest.approx(2 * np.pi * 10 / 1e-4,
+                                                                  rel=0.02, abs=0)

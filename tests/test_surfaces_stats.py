@@ -192,3 +192,16 @@ def test_statistics_are_json_safe():
     assert '"rms_height"' in text
     assert st.rms_height == pytest.approx(rms_height(_noise_surface((32, 32), 1e-4, False)),
                                           rel=1e-6, abs=0)
+
+
+def test_fit_points_are_the_values_and_weights_of_the_whittle_prefactor():
+    """fit_level reads the fit's own values: A = sum(w c q^-s) / sum(w) over fit_points."""
+    from roughfe.surfaces import spectral_surface
+    from roughfe.surfaces.psd_fit import fit_level, fit_points
+    s = spectral_surface(64, 1e-4, 0.6, rms_height=1e-6, rng=3)
+    psd, fit = power_spectrum(s), fit_hurst(s)
+    sel, w = fit_points(psd, fit.q_range)
+    assert sel.sum() == fit.npoints
+    a = np.sum(w * psd.C[sel] * psd.q[sel] ** -fit.slope) / np.sum(w)
+    assert a == pytest.approx(fit.prefactor, rel=1e-12, abs=0)
+    assert 0.8 < fit_level(psd, fit).median_ratio < 1.25     # a power law: on its data

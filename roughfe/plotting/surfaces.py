@@ -85,18 +85,26 @@ def plot_profile(surface, path, title=None, axis=0):
     return save_figure(fig, path)
 
 
-def _not_one_power_law(psd, fit) -> str:
-    """A legend note when the data sit off the fitted line: the median of data / fit
-    over the fit's range outside [0.5, 2] (the Whittle prefactor is the weighted mean
-    of C q^-s, which the few long waves dominate when the spectrum is not one power
-    law: x3p-2.x3p, median 0.29)."""
-    sel = (psd.q >= fit.q_range[0]) & (psd.q <= fit.q_range[1]) & (psd.C > 0)
-    if not sel.any():
-        return ""
-    ratio = float(np.median(psd.C[sel] / (fit.prefactor * psd.q[sel] ** fit.slope)))
-    if 0.5 <= ratio <= 2.0:
-        return ""
-    return f"\n(median data/fit {ratio:.2g}: not one power law)"
+def _fit_line(ax, psd, fit):
+    """The fitted power law over its ``q_range``, dashed. Where the data are not one power
+    law (median data/line outside [0.5, 2]: :func:`roughfe.surfaces.psd_fit.fit_level`)
+    the fitted slope is drawn at the data's median level, and the values that set the
+    Whittle level are ringed (x3p-2.x3p: the line lay 3.5x above its data, set by three
+    annuli of the grooves; a user's review)."""
+    from ..surfaces.psd_fit import fit_level
+    level = fit_level(psd, fit)
+    shift = level.median_ratio if not 0.5 <= level.median_ratio <= 2.0 else 1.0
+    qf = np.geomspace(*fit.q_range, 20)
+    label = f"fit: H = {fit.hurst:.3f}, D = {fit.fractal_dimension:.3f}"
+    if shift != 1.0:
+        label += (f"\ndrawn at the data's median: the Whittle level is {1 / shift:.2g}x "
+                  f"that\n(not one power law)")
+    ax.loglog(qf, shift * fit.prefactor * qf ** fit.slope, "k--", lw=1, label=label)
+    if shift != 1.0 and level.peak_q.size:
+        waves = 2 * np.pi / level.peak_q * UM
+        ax.loglog(level.peak_q, level.peak_C, "o", mfc="none", mec="C3", ms=8,
+                  label=f"{level.peak_q.size} values carry {level.peak_share:.0%} of the "
+                        f"Whittle level\n(wavelengths {waves.min():.2g}-{waves.max():.2g} um)")
 
 
 def plot_psd(spectra, path, title=None, fits=None):
@@ -109,7 +117,8 @@ def plot_psd(spectra, path, title=None, fits=None):
     path : str or Path
         PNG file.
     fits : mapping of label -> HurstFit, optional
-        Drawn as dashed power laws over their ``q_range`` with the fitted H.
+        Drawn as dashed power laws over their ``q_range`` with the fitted H (at the
+        data's median level when they are not one power law: :func:`_fit_line`).
     """
     fig, ax = new_figure(figsize=(6, 4.5))
     units = set()
@@ -118,10 +127,7 @@ def plot_psd(spectra, path, title=None, fits=None):
         ax.loglog(psd.q, psd.C, ".", ms=3, label=label)
         fit = (fits or {}).get(label)
         if fit is not None and fit.success:
-            qf = np.geomspace(*fit.q_range, 20)
-            ax.loglog(qf, fit.prefactor * qf ** fit.slope, "k--", lw=1,
-                      label=f"fit: H = {fit.hurst:.3f}, D = {fit.fractal_dimension:.3f}"
-                            + _not_one_power_law(psd, fit))
+            _fit_line(ax, psd, fit)
     ax.set_xlabel("wavenumber q (rad/m)")
     unit = "m$^4$" if units == {2} else ("m$^3$" if units == {1} else "m$^3$ or m$^4$")
     ax.set_ylabel(f"PSD C(q) ({unit})")

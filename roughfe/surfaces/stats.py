@@ -405,20 +405,17 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     if not (0 < qlo < qhi):
         raise InputError(f"q_range must satisfy 0 < q_min < q_max (rad/m), got {q_range!r}")
     psd = power_spectrum(surface, window=window)
-    # modes with round-off power (a band-limited surface beyond its cut-off q_s) are not
-    # part of any power law: kept, they pulled the slope steeper and H up (+0.075 on
-    # profiles, +0.1 on surfaces with q_s below pi / 2dx; round 2, session 22)
-    floor = PSD_ROUNDOFF * float(psd.C.max()) if psd.C.size else 0.0
-    sel = (psd.q >= qlo) & (psd.q <= qhi) & (psd.C > floor)
+    from .psd_fit import fit_points      # (it imports this module)
+    sel, weight = fit_points(psd, (qlo, qhi))
     n = int(sel.sum())
     if n < 3:
         return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
                         f"only {n} PSD points in q_range; widen it")
-    q, c, w = psd.q[sel], psd.C[sel], psd.weight[sel]
+    q, c = psd.q[sel], psd.C[sel]
     if q[-1] <= q[0] * 10 ** 0.1:
         return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
                         "q_range spans less than 0.1 decade of PSD points; widen it")
-    slope, prefactor = _whittle_power_law(q, c, w / q ** surface.ndim)
+    slope, prefactor = _whittle_power_law(q, c, weight)
     d = surface.ndim
     hurst = -slope / 2 - 1 if d == 2 else (-slope - 1) / 2
     ok = 0 < hurst < 1
