@@ -72,6 +72,57 @@ def test_an_unloading_branch_detached_at_every_step_is_a_note_not_an_empty_entry
     assert "BEM (unloading)" in _lines(fig.axes[0])
     assert not fig.axes[0].get_legend().get_title().get_text()
 
+def _labelled_ticks(fig, axis):
+    """The tick labels with text that lie inside the axis' view (after a draw)."""
+    fig.canvas.draw()
+    lo, hi = sorted(axis.get_view_interval())
+    return [t.get_text() for t, v in zip(axis.get_ticklabels(), axis.get_ticklocs())
+            if t.get_text() and lo <= v <= hi]
+
+
+def test_a_log_axis_within_a_decade_has_two_labels_or_more(drawn):
+    """A K panel from 0.55 to 1.8 MPa/um (a sphere with a hardness) showed "10^0" alone:
+    each log axis of the contact figure labels two ticks or more, as plain numbers."""
+    p = np.array([1e5, 2e5, 4e5, 8e5])
+    k = np.array([0.55, 0.9, 1.4, 1.8]) * 1e12
+    fig = drawn(contact_plot, "plot_area_stiffness", _records(p, p * 1e-12, k))
+    for ax in fig.axes[:3]:
+        for axis in (ax.xaxis, ax.yaxis):
+            if axis.get_scale() == "log":
+                labels = _labelled_ticks(fig, axis)
+                assert len(labels) >= 2, (ax.get_title(), labels)
+    k_labels = _labelled_ticks(fig, fig.axes[1].yaxis)
+    assert "1" in k_labels and all(float(t) > 0 for t in k_labels)     # plain numbers
+
+
+def test_a_tensile_only_adhesive_run_draws_its_states(drawn):
+    """An adhesive run that never reaches compression (p < 0 at every step) drew three
+    empty log panels; its states are drawn on linear axes, and the panels say why."""
+    p = -np.array([5e4, 4.7e4, 4.3e4])
+    recs = _records(p, np.array([1, 2, 4]) * 5e-9, np.full(3, np.nan))
+    for r, a, kfd in zip(recs, (0.096, 0.1, 0.11), (5.7e11, 4.6e11, 4.0e11)):
+        r.update(area_fraction=a, stiffness=None, stiffness_fd=kfd)
+    fig = drawn(contact_plot, "plot_area_stiffness", recs)
+    for ax in fig.axes[:3]:
+        assert ax.get_xscale() == ax.get_yscale() == "linear"
+        assert len(ax.get_lines()[0].get_xdata()) == 3
+        assert "no state in compression" in ax.get_legend().get_title().get_text()
+    np.testing.assert_allclose(_lines(fig.axes[0])["BEM"].get_ydata(), [0.096, 0.1, 0.11])
+
+
+def test_the_plastic_stiffness_steps_are_labelled(drawn):
+    """With a hardness K is that of the points below it and jumps as grid points yield:
+    the steps with plastic flow are marked and the legend says why K steps there."""
+    p = np.array([1e5, 2e5, 4e5, 8e5])
+    recs = _records(p, p * 1e-12, np.array([1.0, 1.2, 1.2, 0.9]) * 1e12)
+    for r, f in zip(recs, (0.0, 0.0, 0.05, 0.2)):
+        r["plastic_area_fraction"] = f
+    fig = drawn(contact_plot, "plot_area_stiffness", recs)
+    flow = [ln for ln in fig.axes[1].get_lines() if ln.get_label().startswith("plastic flow")]
+    assert len(flow) == 1 and "grid points yield" in flow[0].get_label()
+    np.testing.assert_allclose(flow[0].get_xdata(), [0.4, 0.8])
+
+
 # -- design PSD figure ---------------------------------------------------------------------
 def _three_ridge_design():
     """A periodic 2D design (64 x 64, L = 100 um) of one genome with three ridges at 0, 90

@@ -36,6 +36,29 @@ def save_figure(fig, path, dpi=150) -> Path:
     return path
 
 
+def readable_log_ticks(ax) -> None:
+    """Label at least two ticks on each log axis of ``ax`` (call it when the data are
+    drawn): an axis spanning less than two powers of ten showed a single label (a K
+    panel from 35 to 725 MPa/um: "10^2" alone; a user's review). Such an axis is
+    labelled at 1, 2, 5 x 10^k, or at every integer multiple when that still gives fewer
+    than two, as plain numbers (3 significant digits)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        if axis.get_scale() != "log" or not 0 < min(lo, hi):
+            continue
+        lo, hi = sorted((lo, hi))
+        if np.floor(np.log10(hi)) - np.ceil(np.log10(lo)) >= 1:
+            continue                          # two powers of ten or more: labelled
+        for subs in ((1.0, 2.0, 5.0), np.arange(1.0, 10.0)):
+            ticks = LogLocator(base=10, subs=subs).tick_values(lo, hi)
+            if np.count_nonzero((ticks >= lo) & (ticks <= hi)) >= 2:
+                break
+        axis.set_major_locator(LogLocator(base=10, subs=subs))
+        axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+        axis.set_minor_formatter(NullFormatter())
+
+
 def offscreen_plotter(window_size=(1000, 800), **kwargs):
     """A ``pyvista.Plotter`` that renders off-screen (no display needed).
 

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from .common import (add_triad, block_centres, block_means, block_sums, decimation_note,
-                     new_figure, offscreen_plotter, render_blocks, save_figure,
-                     save_screenshot, side_bar)
+                     new_figure, offscreen_plotter, readable_log_ticks, render_blocks,
+                     save_figure, save_screenshot, side_bar)
 
 UM = 1e6
 MPA = 1e-6
@@ -16,6 +16,11 @@ MPA = 1e-6
 
 def _column(steps, key):
     return np.array([np.nan if s[key] is None else s[key] for s in steps], float)
+
+
+def _column_or_zero(steps, key):
+    """``key`` of every record, 0 where a record lacks it or holds None."""
+    return np.array([s.get(key) or 0.0 for s in steps], float)
 
 
 def _theory(steps, key):
@@ -105,6 +110,12 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     # states in compression with contact (a detached or tensile adhesive state has no
     # place on log axes: roughfe contact draws those in adhesion_load_approach.png)
     ok = (p > 0) & (a > 0)
+    # an adhesive run that never reaches compression drew three empty panels (a user's
+    # review): its states with contact on linear axes instead (p < 0), said in the panels
+    tensile = not ok.any() and bool((a > 0).any())
+    if tensile:
+        ok = np.isfinite(p) & (a > 0)
+    loglog = {ax: (ax.plot if tensile else ax.loglog) for ax in (ax1, ax2)}
     a_th = _theory(steps, "persson_area_fraction")
     u_th = _theory(steps, "persson_mean_gap")
     gap = _column(steps, "mean_gap") * UM
@@ -112,15 +123,17 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     order = np.argsort(p[theory])
     for on, mk, tag, _ in branches:     # a branch with no point gets no legend entry
         if (ok & on).any():
-            ax1.loglog(p[ok & on], a[ok & on], mk, ms=4, label=method + tag)
+            loglog[ax1](p[ok & on], a[ok & on], mk, ms=4, label=method + tag)
         okg = ok & on & (gap > 0)
         if okg.any():
-            ax3.semilogx(p[okg], gap[okg], mk, ms=4, label=method + tag)
+            (ax3.plot if tensile else ax3.semilogx)(p[okg], gap[okg], mk, ms=4,
+                                                    label=method + tag)
     if a_th is not None:
         ax1.loglog(p[theory][order], a_th[theory][order], "-", label="Persson (2001)")
     if u_th is not None:
         ax3.semilogx(p[theory][order], u_th[theory][order] * UM, "-", label="Persson (2007)")
-    note = _branch_note(a, ok, unl)
+    note = (_branch_note(a, ok, unl) if not tensile else
+            "no state in compression: the tensile\nstates (p < 0) on linear axes")
     for ax in (ax1, ax3):
         _legend(ax, note)
     ax3.set_xlabel("mean pressure p (MPa)")
@@ -132,12 +145,20 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     ax1.set_title("contact area A(p)")
     ax1.grid(True, which="both", alpha=0.3)
     for on, mk, tag, ls in branches:
-        ok2 = _along(p, ok & on & np.isfinite(k) & (k > 0))
+        ok2 = _along(p, ok & on & np.isfinite(k) & ((k > 0) | tensile))
         if ok2.size:
-            ax2.loglog(p[ok2], k[ok2], mk + ls, ms=4, label="exact (fixed contact set)" + tag)
-        ok3 = _along(p, ok & on & np.isfinite(kfd) & (kfd > 0))
+            loglog[ax2](p[ok2], k[ok2], mk + ls, ms=4,
+                        label="exact (fixed contact set)" + tag)
+        ok3 = _along(p, ok & on & np.isfinite(kfd) & ((kfd > 0) | tensile))
         if ok3.size:
-            ax2.loglog(p[ok3], kfd[ok3], "x" + ls, ms=5, label="central differences" + tag)
+            loglog[ax2](p[ok3], kfd[ok3], "x" + ls, ms=5, label="central differences" + tag)
+    # with a hardness K is that of the points below it: it jumps as whole grid points
+    # yield (a staircase nobody explained; a user's review), so its steps are marked
+    flow = ok & np.isfinite(k) & (k > 0) & (_column_or_zero(steps, "plastic_area_fraction") > 0)
+    if flow.any():
+        ax2.loglog(p[flow], k[flow], "s", ms=7, color="k", mfc="none", mew=0.8,
+                   label="plastic flow: K of the points below the hardness\n(it jumps as "
+                         "whole grid points yield)")
     k_th = _theory(steps, "persson_stiffness")
     # below full contact only: there K -> inf (the BEM's is inf, not drawn), and a
     # theory point there squashed the panel's range by 6 decades
@@ -154,7 +175,12 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     ax2.set_ylabel("K = dp/dDelta (MPa/um)")
     ax2.set_title("contact stiffness K(p), Eq. 2.7")
     ax2.grid(True, which="both", alpha=0.3)
-    _legend(ax2, note)
+    _legend(ax2, note if not tensile or ax2.get_lines() else
+            note + "\nK: none of them has one (adhesion)")
+    for ax in (ax1, ax2, ax3):
+        readable_log_ticks(ax)
+        if tensile:               # five labels of p fit beside each other
+            ax.locator_params(axis="x", nbins=5)
     if title:
         fig.suptitle(title)
     return save_figure(fig, path)
