@@ -184,3 +184,20 @@ def test_load_balance_on_a_hertz_contact_is_the_exact_ring():
         load_balance(res, -1.0)
     with pytest.raises(InputError, match="below the range"):
         load_balance(res, 1e-15)
+
+
+def test_a_sphere_is_one_asperity_not_a_verdict_of_equation_10():
+    """A sphere cap (R = 1 mm on a 64 um window: d_rep = 1.6 x the window) got "in domain"
+    and a bare Eq. (10) verdict, read as a prediction; the criterion is a mean field over
+    many repulsive patches. The rough test surface (d_rep 0.15 x the window) keeps its."""
+    sphere = sphere_cap(64, 64e-6, 1e-3)
+    st = pastewka_robbins(sphere, 2.1e8, 0.05, 2e-8)
+    assert st.range_over_edge_gap < 0.1                      # the edge-gap test alone passed
+    assert st.single_asperity and st.in_domain is False
+    assert st.patch_over_window == pytest.approx(1.6, abs=0.05)
+    assert st.describe()["single_asperity"] is True
+    assert "not a prediction: one asperity" in st.verdict()
+    assert f"mu = {st.tabor_parameter:.3g}" in st.verdict()
+    rough = pastewka_robbins(_surface(), 1.33e6, 1e-4, 1e-10)
+    assert not rough.single_asperity and rough.patch_over_window < 0.2
+    assert "one asperity" not in rough.verdict()

@@ -84,6 +84,11 @@ PERIMETER_FACTOR = {2: 2.0, 1: 1.0}
 #: Upper limit of Delta_r / g0 for the criterion's assumptions (Monti, Sanner & Pastewka
 #: 2021; the authors' group's examples): above it the verdict is outside its domain
 RANGE_OVER_EDGE_GAP_LIMIT = 0.1
+#: Smallest d_rep / (smallest lateral size) of one asperity: the repulsive patch of Eq. (10)
+#: spans half the window or more (a sphere cap: 1.6; one cosine wave: 0.64; self-affine
+#: and banded surfaces 0.02-0.16, a band of 4 waves 0.57), so the window holds too few
+#: contacts for the mean field of many patches
+SINGLE_ASPERITY_PATCH = 0.5
 
 REFERENCES = (
     "Pastewka L., Robbins M.O. (2014) Proc. Natl. Acad. Sci. USA 111:3298-3303, Eq. (10) "
@@ -113,11 +118,18 @@ class Stickiness:
         analogue, Eq. (2) with c_1, n_1: the paper has no 1D criterion).
     in_domain : bool or None
         Surface: ``range_over_edge_gap < RANGE_OVER_EDGE_GAP_LIMIT`` (0.1), the stated
-        domain of Eq. (10); outside it the verdict is not a prediction (measured on a
-        narrow band: Eq. (10) underestimates the stickiness 6.5x there, docs/theory/07).
-        The other domain condition there, a wide self-affine band, is not known from a
-        surface alone and not checked. None for a profile: the strip analogue has no
-        stated domain.
+        domain of Eq. (10), and not ``single_asperity``; outside it the verdict is not a
+        prediction (measured on a narrow band: Eq. (10) underestimates the stickiness
+        6.5x there, docs/theory/07). The other domain condition there, a wide
+        self-affine band, is not known from a surface alone and not checked. A profile:
+        False for a single asperity, else None (the strip analogue has no stated domain).
+    single_asperity : bool
+        ``patch_over_window >= SINGLE_ASPERITY_PATCH``: one asperity (a sphere, a
+        cylinder, one wave), whose adhesion is a single contact's (JKR-DMT, the Tabor
+        parameter and the pull-off), not the many-patch mean field of Eq. (10) (a
+        sphere's verdict was "in domain", read as a prediction; a user's review).
+    patch_over_window : float
+        ``d_rep`` over the smallest lateral size of the surface (-).
     kappa_ratio : float
         Mean-field ``kappa / kappa_rep = 1 / (1 - S)`` (-), negative when sticky.
     rms_slope, rms_curvature : float
@@ -153,6 +165,8 @@ class Stickiness:
     sticky: bool
     published: bool
     in_domain: bool | None
+    single_asperity: bool
+    patch_over_window: float
     kappa_ratio: float
     rms_slope: float
     rms_curvature: float
@@ -185,6 +199,12 @@ class Stickiness:
         which = "Eq. 10" if self.published else "strip analogue (not published)"
         text = (f"Pastewka-Robbins C = {self.criterion:.3g} ({which}, sticky if < 1) "
                 f"({'sticky' if self.sticky else 'not sticky'}")
+        if self.single_asperity:
+            return text + (f"; not a prediction: one asperity, its repulsive patch d_rep "
+                           f"= {self.patch_over_window:.2g} x the window, where the "
+                           f"criterion is a mean field over many contacts; a single "
+                           f"contact's adhesion is told by its Tabor parameter, mu = "
+                           f"{self.tabor_parameter:.3g}, and the pull-off)")
         if self.in_domain is False:
             text += (f"; outside its domain: Delta_r/g0 = {self.range_over_edge_gap:.2g} "
                      f"> {RANGE_OVER_EDGE_GAP_LIMIT:g}")
@@ -334,9 +354,13 @@ def pastewka_robbins(surface: Surface, e_star, work, interaction_range, *,
     s = 1.0 / c
     d_rep = 4.0 * slope / curv
     edge = float(dr / (16.0 / 3.0 * slope * slope / curv))
+    patch = float(d_rep / min(surface.size))
+    single = patch >= SINGLE_ASPERITY_PATCH
     return Stickiness(criterion=float(c), stickiness=float(s), sticky=bool(c < 1.0),
                       published=published,
-                      in_domain=bool(edge < RANGE_OVER_EDGE_GAP_LIMIT) if published else None,
+                      in_domain=(False if single else bool(edge < RANGE_OVER_EDGE_GAP_LIMIT)
+                                 if published else None),
+                      single_asperity=bool(single), patch_over_window=patch,
                       kappa_ratio=float(1.0 / (1.0 - s)) if s != 1.0 else float("inf"),
                       rms_slope=slope, rms_curvature=curv, contact_diameter=float(d_rep),
                       ring_width=float(ring), ring_over_half_width=float(2.0 * ring / d_rep),
