@@ -329,3 +329,32 @@ def test_the_psd_fit_line_lies_on_its_data(drawn, lay):
         # the lay's annulus (its mean |q|: 1 % above 2 pi 10 / L)
         assert rings and rings[0].get_xdata()[0] == pytest.approx(2 * np.pi * 10 / 1e-4,
                                                                   rel=0.02, abs=0)
+
+
+# -- FEM mesh render ---------------------------------------------------------------------------
+def test_the_fem_mesh_render_is_cut_along_a_straight_line(tmp_path):
+    """The render kept whole cells by their centres: a saw-tooth lower edge the mesh does
+    not have (a user's review). The shown mesh ends on the straight line y = -0.33 W,
+    across the whole width, in mm, and the picture has axes (it renders)."""
+    from roughfe.plotting.fem import render_deformed_mesh, shown_mesh
+    nx, ny, w = 21, 41, 1e-3                      # a 1 mm x 2 mm body of triangles
+    x, y = np.meshgrid(np.linspace(0, w, nx), np.linspace(-2 * w, 0, ny), indexing="ij")
+    pts = np.column_stack([x.ravel(), y.ravel()])
+    i, j = np.meshgrid(np.arange(nx - 1), np.arange(ny - 1), indexing="ij")
+    a = (i * ny + j).ravel()
+    cells = np.vstack([np.column_stack([a, a + ny, a + 1]),
+                       np.column_stack([a + ny, a + ny + 1, a + 1])])
+    disp = np.zeros_like(pts)
+    disp[:, 1] = -1e-8 * np.exp(pts[:, 1] / w)
+    fields = {"points": pts, "cells": cells, "displacement": disp,
+              "stress_yy": -1e6 * np.ones(len(cells))}
+    # the cut between two rows of nodes (-0.30 and -0.35 mm)
+    grid, unit, scale, mag, y_cut = shown_mesh(fields, top_fraction=0.33)
+    assert unit == "mm" and scale == 1e3 and y_cut == pytest.approx(-0.33, abs=1e-12)
+    ys, xs = grid.points[:, 1], grid.points[:, 0]
+    assert ys.min() == pytest.approx(y_cut, abs=1e-9)            # nothing below the cut
+    edge = np.abs(ys - y_cut) < 1e-9
+    assert xs[edge].min() == pytest.approx(0, abs=1e-9) and xs[edge].max() == pytest.approx(
+        1.0, abs=1e-9)
+    assert render_deformed_mesh(fields, tmp_path / "m.png",
+                                window_size=(400, 300)).stat().st_size > 5000

@@ -4,7 +4,8 @@
 * :func:`plot_pressures` -- pressure along the profile at a few loads, BEM vs FEM.
 * :func:`plot_westergaard` -- contact half-width error and pressure vs Westergaard.
 * :func:`render_deformed_mesh` -- pyvista off-screen picture of the deformed FEM mesh
-  coloured by sigma_yy (from the FEM ``ContactResult.fields``).
+  coloured by sigma_yy (from the FEM ``ContactResult.fields``), with x and y axes in mm
+  or um; :func:`shown_mesh` is the part it draws.
 """
 from __future__ import annotations
 
@@ -13,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from .._runtime import load_render_backend, render_in_fresh_process
-from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
+from .common import (new_figure, offscreen_plotter, readable_log_ticks, save_figure,
+                     save_screenshot, side_bar)
 
 _STYLES = ("-", "--", ":", "-.", (0, (5, 1)), (0, (1, 3)))
 
@@ -43,6 +45,7 @@ def plot_area_stiffness(curves, path, title="") -> Path:
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
+        readable_log_ticks(ax)
     if title:
         fig.suptitle(title)
     return save_figure(fig, path)
@@ -120,9 +123,9 @@ def render_deformed_mesh(fields, path, *, magnification=None, top_fraction=0.35,
         Displacement magnification; default makes the largest displacement 3 % of the
         body width.
     top_fraction : float
-        Only cells within ``top_fraction * W`` of the top are shown (the stresses of a
-        rough contact are confined near the surface); the caption says so, with the
-        body's depth.
+        The mesh is shown down to ``top_fraction * W`` below the top, cut along a
+        straight line (the stresses of a rough contact are confined near the surface);
+        the caption says so, with the body's depth.
     title : str, optional
         First caption line (e.g. the load of the state shown).
 
@@ -146,39 +149,58 @@ def _render_arrays(*, path, magnification, top_fraction, window_size, title=None
     return _render(fields, Path(path), magnification, top_fraction, tuple(window_size), title)
 
 
-def _render(fields, path, magnification, top_fraction, window_size, title=None) -> Path:
-    plotter = offscreen_plotter(window_size=window_size)
+def shown_mesh(fields, magnification=None, top_fraction=0.35):
+    """The part of the deformed FEM mesh :func:`render_deformed_mesh` draws, as a pyvista
+    grid in display units: points ``(x + m u_x, y + m u_y)`` in mm (um for a body
+    narrower than 1 mm), ``sigma_yy (MPa)`` per cell, clipped along the straight line
+    ``y = top - top_fraction W`` (cells kept whole by their centres drew a saw-tooth
+    lower edge the mesh does not have; a user's review). Returns ``(grid, unit, scale,
+    magnification, y_cut)``, ``y_cut`` in display units."""
     import pyvista as pv
 
     pts = np.asarray(fields["points"], float)
     disp = np.asarray(fields["displacement"], float)
-    cells = np.asarray(fields["cells"], np.int64)
+    cells = np.asarray(fields["cells"], np.int64).reshape(-1, 3)
     width = np.ptp(pts[:, 0])
     if magnification is None:
         umax = np.abs(disp).max()
         magnification = 0.03 * width / umax if umax > 0 else 1.0
+    unit, scale = ("mm", 1e3) if width >= 1e-3 else ("um", 1e6)
     pts3 = np.zeros((pts.shape[0], 3))
-    pts3[:, :2] = (pts + magnification * disp) / width
-    y_top = pts[:, 1].max()
-    keep = pts[cells, 1].mean(axis=1) > y_top - top_fraction * width
-    cells = cells[keep]
-    used, cells = np.unique(cells, return_inverse=True)
-    cells = cells.reshape(-1, 3)
-    pts3 = pts3[used]
+    pts3[:, :2] = (pts + magnification * disp) * scale
     conn = np.hstack([np.full((cells.shape[0], 1), 3), cells]).ravel()
-    grid = pv.UnstructuredGrid(conn, np.full(cells.shape[0], pv.CellType.TRIANGLE, np.uint8), pts3)
+    grid = pv.UnstructuredGrid(conn, np.full(cells.shape[0], pv.CellType.TRIANGLE, np.uint8),
+                               pts3)
+    grid.cell_data["sigma_yy (MPa)"] = np.asarray(fields["stress_yy"]) / 1e6
+    y_cut = (pts[:, 1].max() - top_fraction * width) * scale
+    return (grid.clip(normal="y", origin=(0.0, y_cut, 0.0), invert=False), unit, scale,
+            magnification, y_cut)
+
+
+def _render(fields, path, magnification, top_fraction, window_size, title=None) -> Path:
+    plotter = offscreen_plotter(window_size=window_size)
+    shown, unit, scale, magnification, y_cut = shown_mesh(fields, magnification, top_fraction)
+    pts = np.asarray(fields["points"], float)
+    width = np.ptp(pts[:, 0])
     name = "sigma_yy (MPa)"
-    grid.cell_data[name] = np.asarray(fields["stress_yy"])[keep] / 1e6
-    lo = float(np.percentile(grid.cell_data[name], 1))
-    plotter.add_mesh(grid, scalars=name, cmap="viridis", clim=(lo, 0.0),
-                     show_edges=cells.shape[0] < 6000,                # edges hide fine meshes
-                     edge_color="grey", line_width=0.2, scalar_bar_args={"title": name})
-    depth = float(np.ptp(pts[:, 1])) / width
-    caption = (f"deformed mesh, the top {top_fraction:g} W of a body {depth:.3g} W deep "
-               f"(W = {width:.3g} m); displacements x{magnification:.3g}; x right, y up, "
-               f"coordinates / W")
+    lo = float(np.percentile(shown.cell_data[name], 1))
+    plotter.add_mesh(shown, scalars=name, cmap="viridis", clim=(lo, 0.0),
+                     show_edges=shown.n_cells < 6000,                 # edges hide fine meshes
+                     edge_color="grey", line_width=0.2, scalar_bar_args=side_bar(name))
+    # axes from the body's left edge and its undeformed top to the cut
+    x0 = pts[:, 0].min() * scale
+    plotter.show_bounds(bounds=(x0, x0 + width * scale, y_cut, pts[:, 1].max() * scale, 0, 0),
+                        xtitle=f"x ({unit})", ytitle=f"y ({unit})",
+                        ticks="outside", location="front", show_zaxis=False,
+                        show_zlabels=False, n_xlabels=6, n_ylabels=3, fmt="%.3g",
+                        color="black", font_size=10)
+    caption = (f"deformed mesh (displacements x{magnification:.3g}), cut at y = "
+               f"{y_cut:.3g} {unit}: the top {top_fraction:g} W of a body "
+               f"{np.ptp(pts[:, 1]) * scale:.3g} {unit} deep, W = {width * scale:.3g} "
+               f"{unit}; y = 0 is the undeformed top")
     plotter.add_text(caption if not title else f"{title}\n{caption}", font_size=10)
+    plotter.set_background("white")
     plotter.view_xy()
     plotter.reset_camera()
-    plotter.camera.zoom(1.6)
+    plotter.camera.zoom(1.3)
     return save_screenshot(plotter, path)
