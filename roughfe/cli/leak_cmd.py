@@ -22,8 +22,8 @@ from ..bem.interface_law import resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
-from .plausibility import (check_critical_gaps, check_load_magnitudes, check_solution,
-                           persson_basis)
+from .plausibility import (check_critical_gaps, check_fluid_load, check_load_magnitudes,
+                           check_solution, persson_basis)
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, contact_physics_from_args,
@@ -170,6 +170,11 @@ def _leak(args) -> int:
                   f"{fmt_or_dash(s.get('critical_gap'), '.3e'):>10}")
         print(_VOLUME_NOTE + "; fluid, trap: the external load's share carried by the fluid "
               "and by its trapped pockets")
+        lifted = [f"{s['external_pressure']:.4g}" for s in steps if s["fsi_state"] == "lift-off"]
+        if lifted:      # said on the table's '-' (a seals review: nothing explained it)
+            print(f"lift-off at p_ext = {', '.join(lifted)} Pa: the fluid pressure alone "
+                  f"carries the external load, the surfaces separate and the seal is open "
+                  f"(no contact; no finite leak rate of this model)")
         persson_basis(args, surface, persson)
         print(f"wrote {len(written)} files in {out}")
         return 0 if sweep.success else 1
@@ -190,6 +195,7 @@ def _leak(args) -> int:
     print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
           f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is linear in both")
     check_critical_gaps(args, steps)
+    check_fluid_load(args, steps, p_in, p_out)
     persson_basis(args, surface, persson)
     print(f"wrote {len(written)} files in {out}")
     return 0 if sweep.success else 1

@@ -82,9 +82,28 @@ class CoupledSweep:
             rec.update(r.record())
             rec["leak_rate"] = r.leak_rate
             if lk is not None:
-                rec[f"leak_rate_{lk.directions[0]}"] = r.leak_rate
+                d = lk.directions[0]
+                rec[f"leak_rate_{d}"] = r.leak_rate
+                # the parallel-plate gap of the coupled leak rate (the network analysis
+                # solves no Reynolds, so it left None: a seals review)
+                rec["hydraulic_aperture"] = rec[f"hydraulic_aperture_{d}"] = \
+                    _coupled_aperture(r, self.surface.size, d)
             out.append(rec)
         return out
+
+
+def _coupled_aperture(result, size, direction):
+    """``(12 mu |Q| L / (W |p_in - p_out|))^(1/3)`` (m) of a coupled step: the gap of the
+    parallel plates that leak as much (reversed flow by its magnitude); None without a
+    leak rate or a pressure drop."""
+    from .reynolds import hydraulic_aperture
+
+    drop = abs(result.inlet_pressure - result.outlet_pressure)
+    if result.leak_rate is None or drop == 0:
+        return None
+    length, width = size if direction == "x" else size[::-1]
+    return hydraulic_aperture(abs(result.leak_rate), mu=result.mu, pressure_drop=drop,
+                              flow_length=length, width=width)
 
 
 def coupled_leakage_sweep(surface: Surface, material, external_pressures, *,
