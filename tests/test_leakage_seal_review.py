@@ -106,3 +106,19 @@ def test_one_size_value_on_a_non_square_grid_is_said(tmp_path, capsys):
     np.save(tmp_path / "sq.npy", h[:16])
     assert main(["info", str(tmp_path / "sq.npy"), "--size", "1e-5"]) == 0
     assert "--size" not in capsys.readouterr().err
+
+
+def test_leak_rate_scales_as_drop_over_viscosity_as_the_table_says(tmp_path, capsys, surface):
+    """The table's note said 'Q is linear in both' (drop and viscosity): Q ~ dp / mu."""
+    import json
+    path = save_surface(surface, tmp_path / "s.npz")
+    q = {}
+    for mu, dp in ((1e-3, 1e3), (2e-3, 1e3), (1e-3, 3e3)):
+        out = tmp_path / f"o_{mu:g}_{dp:g}"
+        assert main(["leak", str(path), "--pressure", "1e6", "--E", "1e9", "--nu", "0.3",
+                     "--mu", str(mu), "--pressure-drop", str(dp), "--no-figures",
+                     "-o", str(out)]) == 0
+        q[mu, dp] = json.loads((out / "results.json").read_text())["steps"][0]["leak_rate_x"]
+    assert "Q is proportional to the drop and to 1/mu" in capsys.readouterr().out
+    assert q[2e-3, 1e3] == pytest.approx(q[1e-3, 1e3] / 2, rel=1e-8, abs=0)
+    assert q[1e-3, 3e3] == pytest.approx(q[1e-3, 1e3] * 3, rel=1e-8, abs=0)

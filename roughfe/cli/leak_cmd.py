@@ -193,7 +193,8 @@ def _leak(args) -> int:
              else args.direction)
     print(_VOLUME_NOTE)
     print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
-          f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is linear in both")
+          f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is proportional to the "
+          f"drop and to 1/mu")
     check_critical_gaps(args, steps)
     check_fluid_load(args, steps, p_in, p_out)
     persson_basis(args, surface, persson)
