@@ -122,3 +122,22 @@ def test_leak_rate_scales_as_drop_over_viscosity_as_the_table_says(tmp_path, cap
     assert "Q is proportional to the drop and to 1/mu" in capsys.readouterr().out
     assert q[2e-3, 1e3] == pytest.approx(q[1e-3, 1e3] / 2, rel=1e-8, abs=0)
     assert q[1e-3, 3e3] == pytest.approx(q[1e-3, 1e3] * 3, rel=1e-8, abs=0)
+
+
+def test_pockets_above_the_external_pressure_are_said(capsys):
+    """Incompressible pockets held by the contact reached 6.5 GPa at 1.5 GPa external
+    pressure (a 64^2 crop of opd-1) without a word; pockets below p_ext are quiet."""
+    from roughfe.cli.plausibility import check_pocket_pressures
+    steps = [{"step": 0, "external_pressure": 3e8, "pocket_pressures": [2e7, 1e7]},
+             {"step": 1, "external_pressure": 1.5e9,
+              "pocket_pressures": [6.5e9, 2e7, 3e9]},
+             {"step": 2, "external_pressure": 1e7, "pocket_pressures": []}]
+    check_pocket_pressures(Namespace(command="leak", bulk_modulus=None), steps)
+    err = capsys.readouterr().err
+    assert err.count("warning") == 1 and "step 1: sealed pockets above the external" in err
+    assert "(step 1: 2 of 3, up to 6.5e+09 Pa = 4.33 x p_ext)" in err
+    assert "--bulk-modulus 2.2e9" in err
+    check_pocket_pressures(Namespace(command="leak", bulk_modulus=2.2e9), steps)
+    assert "a liquid of bulk modulus 2.2e+09 Pa" in capsys.readouterr().err
+    check_pocket_pressures(Namespace(command="leak", bulk_modulus=None), steps[::2])
+    assert capsys.readouterr().err == ""

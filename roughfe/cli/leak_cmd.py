@@ -23,7 +23,7 @@ from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
 from .plausibility import (check_critical_gaps, check_fluid_load, check_load_magnitudes,
-                           check_solution, persson_basis)
+                           check_pocket_pressures, check_solution, persson_basis)
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option, add_material_options,
                       add_output_folder, add_run_options, add_runner_options,
                       add_surface_options, contact_physics_from_args,
@@ -175,6 +175,7 @@ def _leak(args) -> int:
             print(f"lift-off at p_ext = {', '.join(lifted)} Pa: the fluid pressure alone "
                   f"carries the external load, the surfaces separate and the seal is open "
                   f"(no contact; no finite leak rate of this model)")
+        check_pocket_pressures(args, steps)
         persson_basis(args, surface, persson)
         print(f"wrote {len(written)} files in {out}")
         return 0 if sweep.success else 1
