@@ -289,3 +289,46 @@ def test_bounded_load_control_keeps_u_equal_to_h_p(seed, load, hp):
     assert r.nit <= 40
     assert r.mean_pressure == pytest.approx(load, rel=1e-12) and r.pressure.max() <= hp
     assert r.residual <= 1e-10
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_imposed_approach_between_full_contact_and_full_flow(seed):
+    # H_p = 5 E* gbar: the peaks yield only near the elastic full contact. Between
+    # Delta = max h - mean h and max h - min h every point touches and the mean pressure
+    # is fixed by the few plastic points alone; the primal CG diverged there (NaN
+    # pressures returned as converged) or crawled to 20000 iterations at the first
+    # approaches of both seeds (round 2, session 31). Each state must be the
+    # load-controlled one at the mean pressure it returns (an independent path), and the
+    # load must rise with the approach.
+    surf, hp = rough(64, seed), 5.0
+    h = surf.heights
+    top, ptp = float(h.max() - h.mean()), float(np.ptp(h))
+    loads = []
+    for t in (0.125, 0.25, 0.5, 0.875):
+        d = top + t * (ptp - top)
+        r = solve_contact(surf, UNIT, delta=d, hardness=hp)
+        assert np.all(np.isfinite(r.pressure)) and r.success and r.residual <= 1e-9
+        assert r.area_fraction == 1.0 and 0 < r.plastic_area_fraction < 1
+        ref = solve_contact(surf, UNIT, mean_pressure=r.mean_pressure, hardness=hp)
+        assert ref.delta == pytest.approx(d, rel=1e-8, abs=0)
+        assert np.max(np.abs(r.pressure - ref.pressure)) <= 1e-7 * hp
+        loads.append(r.mean_pressure)
+    assert np.all(np.diff(loads) > 0) and loads[-1] < hp
+    # at max h - mean h exactly every P in [p_full, H_p - max p'] holds the approach:
+    # the least one, in full contact with no point at the cap
+    r = solve_contact(surf, UNIT, delta=top, hardness=hp)
+    assert r.area_fraction == 1.0 and r.plastic_area_fraction == 0.0
+    assert r.pressure.min() == pytest.approx(0.0, abs=1e-12 * hp) and r.pressure.max() < hp
+
+
+def test_a_diverged_iteration_is_never_a_converged_residual():
+    # NaN pressures had a residual of 0 (the zero-total rule of the complementarity
+    # term): a diverged solve was returned as converged
+    from roughfe.bem.solvers import kkt_residual
+    p, w = np.array([1.0, np.nan]), np.array([0.0, 1.0])
+    assert kkt_residual(p, w, 1.0) == np.inf
+    assert kkt_residual(p, w, 1.0, upper=2.0) == np.inf
+    assert kkt_residual(np.array([1.0, 0.0]), np.array([0.0, np.inf]), 1.0) == np.inf
+    rows = kkt_residual(np.array([[1.0, 0.0], [1.0, np.nan]]), np.zeros((2, 2)), 1.0,
+                        axis=1)
+    assert rows[0] == 0.0 and rows[1] == np.inf

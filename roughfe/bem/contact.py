@@ -30,7 +30,7 @@ from ..model import ContactResult, Material
 from .operators import (WORKERS, InfluenceOperator, _irfftn_owned, check_kernel_name,
                         influence_operator)
 from .approach import MAX_START_AREA, approach_by_load, approach_start
-from .periodic import periodic_bounded_displacement, periodic_gap_control
+from .periodic import periodic_bounded_displacement, periodic_full_contact, periodic_gap_control
 from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
 from .contact_checks import (_check_coarse_correction, _check_hardness, _check_surface,
                              _check_target, _check_tol)
@@ -241,18 +241,6 @@ def _elastic_approach(surface, material, op, h, hmax, scale, delta, tol, max_ite
     return dataclasses.replace(out, nit=out.nit + spent), 10 * tol     # every one counted
 
 
-def _periodic_full_contact(op, h):
-    """Zero-mean pressure p' with H p' = h - mean h (exact: the spectral stiffness).
-
-    The half-spectrum of h divided by the compliance spectrum in place (its only zero is
-    the mean mode, set to zero): no zero-mean copy of h and no cached float64 stiffness
-    spectrum (two fields fewer in memory while a load-controlled solve runs)."""
-    hh = scipy.fft.rfftn(h, workers=WORKERS)
-    hh.flat[0] = 0.0
-    np.divide(hh, op.spectrum, out=hh, where=op.spectrum > 0)
-    return _irfftn_owned(hh, h.shape)
-
-
 def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pressure=None,
                   kernel: str = "auto", solver: str = "auto", tol: float = 1e-10,
                   max_iter: Optional[int] = None, initial=None,
@@ -372,7 +360,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
                 f"impose a mean_pressure to go beyond it")
         if delta is not None and delta >= delta_full * (1 - 1e-12) \
                 or mean_pressure is not None:
-            p0 = _periodic_full_contact(op, h)
+            p0 = periodic_full_contact(op, h)
             p_full = -float(p0.min())
             capped = hardness is not None and float(p0.max()) + max(p_full, mean_pressure
                                                                     or 0.0) > hardness

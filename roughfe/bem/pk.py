@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 
 from . import _parallel as par
-from ..errors import InputError
+from ..errors import InputError, NoConvergenceError
 from .directions import _StallWatch, _bind_lower, _descent_guard
 from .operators import FFTWorkspace
 from .pk_passes import (_axpy, _gap_mask, _gap_take, _load_increment,  # noqa: F401
@@ -300,6 +300,11 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         else:                 # the largest penetration, anywhere
             feas = max(0.0, d - gmin)
         res = float(relative_residual(comp, feas, sp, scale))
+        if res == np.inf:     # NaN or inf in p or u: the iteration diverged
+            raise NoConvergenceError(
+                f"Polonsky-Keer CG diverged at iteration {it}: non-finite pressure or "
+                f"displacement", result=SolverOutput(p.reshape(shape), u.reshape(shape),
+                                                     np.nan, it, res, "pk", products))
         moved = None if approach is None else approach(res, d - offset)
         if moved is not None:         # an imposed approach: the load moves (docstring)
             extra, target = float(moved) * n - target, float(moved) * n

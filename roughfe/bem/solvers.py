@@ -76,8 +76,14 @@ def relative_residual(comp, feas, total, scale):
     """The relative KKT residual of Eq. 2.5-2.6 from its parts (module docstring):
     max(comp / (total scale), feas / scale) with ``comp`` = sum p |w| (Pa m), ``feas``
     the largest interpenetration (m), ``total`` = sum p (Pa; 0 gives a complementarity
-    term of 0) and ``scale`` (m)."""
-    return np.maximum(ratio_or_zero(comp, total * scale), feas / scale)
+    term of 0) and ``scale`` (m). A non-finite part (a diverged iteration: NaN or inf in
+    p or u) gives inf, never a residual that reads as converged (NaN pressures had given
+    0 through the zero-total rule; round 2, session 31)."""
+    res = np.maximum(ratio_or_zero(comp, total * scale), feas / scale)
+    finite = np.isfinite(comp) & np.isfinite(feas) & np.isfinite(total)
+    if np.ndim(res) == 0:
+        return res if finite else np.inf
+    return np.where(finite, res, np.inf)
 
 
 def pr_beta(numerator, gz_old):
