@@ -85,6 +85,40 @@ def test_amplitude_genes_are_unbiased_for_many_chromosomes():
     assert abs(h / H - 1) < 0.01 and abs(a / A - 1) < 0.08
 
 
+def test_gene_errors_are_the_spread_of_repeated_realisations():
+    # the Fisher-information errors of ln A and H against the spread of the ML genes over
+    # 400 random WM phase sets (M = 8 ridges, 29 chromosomes): the u_n of M ridges have
+    # variance 1 - 1/M, below the Exp(1) model's 1, so the measured spread sits a little
+    # below the prediction (sqrt(7/8) = 0.94 expected), never far above it
+    from roughfe.genomics.sequencing import amplitude_gene_errors
+    rng = np.random.default_rng(3)
+    A, H, gamma, lam, M = 1.0, 0.75, 1.5, 1e-3, 8
+    n = np.arange(1, 30)
+    G = A * np.sqrt(np.log(gamma) / M) * (2 * np.pi / lam) ** -H
+    fits = []
+    for _ in range(400):
+        phi = rng.uniform(0, 2 * np.pi, size=(M, n.size))
+        c = G * gamma ** ((1 - n) * H) * np.abs(np.exp(1j * phi).sum(0))
+        fits.append(amplitude_genes(n, c, gamma, lam))
+    fits = np.array(fits)
+    se_lna, se_h = amplitude_gene_errors(n, c, gamma, lam)
+    assert 0.8 < np.std(fits[:, 1]) / se_h < 1.1
+    assert 0.8 < np.std(np.log(fits[:, 0])) / se_lna < 1.1
+    # H is a slope over the chromosome numbers: twice as many chromosomes (twice the span
+    # of n) cut its error by more than half (~2^1.5)
+    assert amplitude_gene_errors(np.arange(1, 59), np.ones(58), gamma, lam)[1] < se_h / 2
+
+
+def test_sequencing_reports_its_gene_errors(table1):
+    _, _, res = table1
+    assert abs(res.genome.H - 0.75) < 3 * res.H_stderr and res.H_stderr < 0.1
+    assert abs(np.log(res.genome.A)) < 3 * res.lnA_stderr
+    lo, hi = res.M_support
+    assert lo <= 8 <= hi                                    # Table 1 has M = 8
+    report = res.report()
+    assert report["H_stderr"] == res.H_stderr and report["M_support"] == [lo, hi]
+
+
 def test_phases_reproduce_the_sums_and_M_likelihood_separates_extremes():
     rng = np.random.default_rng(1)
     target = np.array([0.3 + 0.1j, -2.5 + 1j, 7.9 + 0j, 0j])

@@ -127,6 +127,13 @@ def _print_sequencing(res):
     for k, (L, r, e) in enumerate(zip(res.lengths, res.ranges, res.rms_errors)):
         print(f"  acquisition {k + 1}: L = {L:.6g} m, n = {r[0]}..{r[1]}, relative rms error "
               f"{_percent_or_undefined(e)}")
+    if math.isfinite(res.H_stderr):
+        support = ("" if res.M_support is None else
+                   f"; M = {res.M_support[0]}..{res.M_support[1]} within the likelihood "
+                   f"interval (~95 %)")
+        print(f"  1-sigma errors (Fisher information, {res.n.size} chromosomes): H +- "
+              f"{res.H_stderr:.2g}, ln A +- {res.lnA_stderr:.2g} (A within a factor "
+              f"{math.exp(res.lnA_stderr):.3g}){support}")
     print(f"  PSD-only estimates (thesis): gamma = {res.gamma_psd:.5g}, H (peak slope) = {res.H_psd:.4g}")
     print(f"  {'success' if res.success else 'FAILED quality check'}: {res.message}")
 

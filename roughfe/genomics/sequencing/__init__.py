@@ -69,8 +69,8 @@ Surfaces (2D MWM, issue 15): :mod:`.surface_data` (acquisitions, peaks, ridge di
 and :mod:`.surface_result` (genes, misfits, result).
 """
 from .acquisitions import MIN_NODES, Acquisition, acquisitions_from_surfaces
-from .genes import (amplitude_genes, peak_slope_H, phases_with_sums, ridge_likelihood,
-                    variance_amplitude)
+from .genes import (amplitude_gene_errors, amplitude_genes, peak_slope_H, phases_with_sums,
+                    ridge_likelihood, ridge_support, variance_amplitude)
 from .lattice import comb_periods, label_q1, lattice_from_period
 from .peaks import SpectrumPeaks, refine_peaks, spectrum_peaks, upper_hull
 from .profile import sequence_profiles
@@ -80,6 +80,7 @@ from .surface_data import SurfaceAcquisition, SurfacePeaks, surface_acquisitions
 from .zd import ZdRidgeFit, thesis_zd_fit
 
 __all__ = ["MIN_NODES", "Acquisition", "acquisitions_from_surfaces", "amplitude_genes",
+           "amplitude_gene_errors", "ridge_support",
            "peak_slope_H", "phases_with_sums", "ridge_likelihood", "variance_amplitude",
            "comb_periods", "label_q1", "lattice_from_period", "SpectrumPeaks", "refine_peaks",
            "spectrum_peaks", "upper_hull",

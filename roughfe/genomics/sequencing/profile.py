@@ -13,7 +13,8 @@ from ...errors import InputError, check_int
 from ...surfaces.wm import resolve_rng
 from ..genome import Genome, profile_heights
 from .acquisitions import Acquisition, acquisitions_from_surfaces, check_controls
-from .genes import (H_SEARCH, M_VALUES, amplitude_genes, peak_slope_H, phases_with_sums,
+from .genes import (H_SEARCH, M_VALUES, amplitude_gene_errors, amplitude_genes,
+                    peak_slope_H, phases_with_sums, ridge_support,
                     ridge_likelihood, variance_amplitude)
 from .lattice import (bic, coarser_lattices, comb_periods, design_matrix, fit_lattice, label_q1,
                       lattice_from_period, line_columns, lattice_ranges, round_off_cost, solve_linear,
@@ -201,6 +202,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
 
     # 5. genes
     A, H = amplitude_genes(n, amps, gamma, lam1)
+    errors = amplitude_gene_errors(n, amps, gamma, lam1)
     m_values = M_VALUES
     g1 = Genome(A=A, H=H, gamma=gamma, lambda1=lam1, phases=np.zeros((1, n.size)), n_first=int(n[0]))
     unit = g1.prefactor * gamma ** ((1.0 - n) * H)       # G(M=1) gamma^((1-n)H)
@@ -265,6 +267,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         ranges=ranges, lengths=np.array([a.length for a in acqs]), rms_errors=rms,
         x=[a.x for a in acqs], heights=[a.z for a in acqs], fitted=fitted, zd_x=zd_x, zd=zd,
         zd_fit=zd_fit, spectra=spectra, gamma_psd=gamma_psd, H_psd=peak_slope_H(spectra, lq1, lg),
-        M_loglik=loglik, offsets=offsets, tilts=tilts, A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1),
+        M_loglik=loglik, M_support=ridge_support(loglik, m_values),
+        lnA_stderr=errors[0], H_stderr=errors[1], offsets=offsets, tilts=tilts, A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1),
                                                gamma, lam1, H),
         seed=int(seed), elapsed=time.perf_counter() - t0)

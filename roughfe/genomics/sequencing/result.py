@@ -23,6 +23,8 @@ REPORT_UNITS = {"A": "m^(1-H)", "H": "1", "gamma": "1", "lambda1": "m",
                 "zd_rms": "m", "zd_rms_error": "1 (relative)", "gamma_psd": "1",
                 "H_psd": "1", "A0_variance": "m^(1-H)", "M_loglik": "1 (log-likelihood, one per M_values)",
                 "M_values": "1 (number of ridges M of each M_loglik)",
+                "lnA_stderr": "1 (standard error of ln A)", "H_stderr": "1",
+                "M_support": "1 (smallest and largest M within 1.92 of the best log-likelihood)",
                 "nit": "1 (residual evaluations)", "elapsed_s": "s"}
 
 
@@ -70,6 +72,12 @@ class SequencingResult:
     tilts : ndarray
         Slope of each acquisition's fitted line (m/m, coarsest first): the line a
         levelled profile lost (``heights`` are the data less it too; round 2, session 29).
+    lnA_stderr, H_stderr : float
+        Standard errors (1 sigma) of ln A and H from the Fisher information of their
+        likelihood (:func:`~.genes.amplitude_gene_errors`; NaN when not computed).
+    M_support : tuple of int or None
+        The range of M within 1.92 of the best log-likelihood (about 95 %,
+        :func:`~.genes.ridge_support`): M is weakly identifiable.
     A0 : float
         Amplitude from the height variance of the coarsest acquisition (Eq. 3.13), for
         comparison with the maximum-likelihood A.
@@ -101,6 +109,9 @@ class SequencingResult:
     offsets: np.ndarray = field(default_factory=lambda: np.zeros(0))
     tilts: np.ndarray = field(default_factory=lambda: np.zeros(0))
     A0: float = float("nan")
+    lnA_stderr: float = float("nan")
+    H_stderr: float = float("nan")
+    M_support: Optional[tuple] = None
     seed: Optional[int] = None
     elapsed: float = 0.0
     references: tuple = field(default=("thesis Sec. 3.3.1, Eq. 3.5-3.16",))
@@ -136,4 +147,6 @@ class SequencingResult:
                 "gamma_psd": self.gamma_psd, "H_psd": self.H_psd, "A0_variance": self.A0,
                 "M_loglik": to_jsonable(self.M_loglik),
                 "M_values": list(M_VALUES[:len(self.M_loglik)]),
+                "lnA_stderr": self.lnA_stderr, "H_stderr": self.H_stderr,
+                "M_support": None if self.M_support is None else list(self.M_support),
                 "seed": self.seed, "elapsed_s": self.elapsed, "units": dict(REPORT_UNITS)}
