@@ -298,6 +298,12 @@ def test_match_spectrum_restores_a_genome_whose_hurst_exponent_moved(surface_db)
     assert matched.success and matched.nit == res.nit + 4     # strict before, 2 in _finish, after
     assert rescore_at_target_pressures(matched.best.design, [tk], SETTINGS)[0] == \
         matched.best.at_targets[0]
+    # a matched database genome added as a candidate ran no GCMMA stage: its stages say so
+    # (NaN; stages.csv wrote the matched score under the GCMMA 1 and 2 headers)
+    added = match_spectrum(res, target.surface(), SETTINGS, entries=entries, n_entries=1)
+    new = [c for c in added.candidates if len(c.stages) == 3 and np.isnan(c.stages[1])]
+    assert len(new) == 1 and np.isnan(new[0].stages[2]) and np.isfinite(new[0].stages[0])
+    assert new[0].origin.endswith("(spectrum)") and 0 < new[0].scores[0] <= 1
 
 
 def test_ridge_keys_scale_every_wave_on_its_own():

@@ -5,6 +5,8 @@ y_t1, y_t2, y_t3, or the K(p), A(p) of a given (measured) surface, as CSV for a 
 settings."""
 from __future__ import annotations
 
+import math
+
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -172,7 +174,7 @@ def _run(args) -> int:
     print(result.message)
     for k, c in enumerate(result.candidates, 1):
         print(f"  ({k}) {c.origin:>16}  GCMMA 0/1/2{'/3' if len(c.stages) > 3 else ''}: "
-              + " ".join(f"{s:.4f}" for s in c.stages)
+              + " ".join("-" if math.isnan(s) else f"{s:.4f}" for s in c.stages)
               + "  per target: " + " ".join(f"{s:.4f}" for s in c.scores))
     print("best design solved at the target pressures (no interpolation): "
           + " ".join(f"{s:.4f}" for s in strict))

@@ -3,6 +3,8 @@ design set to the power spectrum of a given target surface, a stage beyond the t
 between its GCMMA stages and :func:`~.search.search_at_target_pressures`."""
 from __future__ import annotations
 
+import math
+
 import time
 from dataclasses import replace
 
@@ -102,7 +104,9 @@ def match_spectrum(result: DesignResult, surface, settings: DatabaseSettings, *,
     when that raises its strict score (solved at the target pressures), and the
     ``n_entries`` best genomes of ``entries`` by Alg. 3 on the first target, spectrum
     matched, added as candidates of their own (their stages: the genome's Alg. 3 score,
-    then twice the matched design's score, no GCMMA stage having run). Four
+    then NaN for GCMMA 1 and 2, which did not run; stages.csv wrote the matched design's
+    score there, under GCMMA headers, until round 2, session 31; its score is the
+    candidate's ``scores``). Four
     counted sweeps per candidate (three when it was already scored at the target
     pressures), three per added genome. Run it before :func:`search_at_target_pressures`,
     which then searches the phases and (``amplitudes=True``) the per-chromosome weights
@@ -129,8 +133,7 @@ def match_spectrum(result: DesignResult, surface, settings: DatabaseSettings, *,
             new = _finish(spectrum_matched(entry_design(e, settings), surface,
                                                     directional), (s0[i],),
                           objective, evaluate, (), (), e.label + " (spectrum)")
-            s1 = combined_score(new.scores)
-            out.append(replace(new, stages=(float(s0[i]), s1, s1),
+            out.append(replace(new, stages=(float(s0[i]), math.nan, math.nan),
                                at_targets=_at_targets(new.design, objective, settings,
                                                       evaluate)))
     out.sort(key=lambda c: -combined_score(c.at_targets))
