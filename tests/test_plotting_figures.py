@@ -358,3 +358,64 @@ def test_the_fem_mesh_render_is_cut_along_a_straight_line(tmp_path):
         1.0, abs=1e-9)
     assert render_deformed_mesh(fields, tmp_path / "m.png",
                                 window_size=(400, 300)).stat().st_size > 5000
+
+
+def _leak_steps():
+    """Five one-way steps as x3p-2 (a 256^2 crop, steel) gave them: a lay along y, so x
+    seals first (A* 0.41) while y still flows; both sealed at A* 0.57. Persson's
+    per-direction estimates differ 6x (the window's W/L only)."""
+    a = [0.018, 0.059, 0.187, 0.406, 0.572]
+    qx = [1.27e-19, 1.64e-20, 7.85e-24, 0.0, 0.0]
+    qy = [1.74e-19, 7.65e-20, 2.37e-20, 2.01e-21, 0.0]
+    px = [3.2e-19, 7.3e-20, 2.6e-21, 8.8e-27, 0.0]
+    return [{"area_fraction": ai, "leak_rate_x": x, "leak_rate_y": y,
+             "persson_leak_rate_x": p, "persson_leak_rate_y": p / 6.07,
+             "persson_leak_rate": p * (1 + 1 / 6.07) / 2, "free_volume_star": 1.0 - ai,
+             "percolating_volume_star": 0.9 - ai, "trapped_volume_star": 0.1}
+            for ai, x, y, p in zip(a, qx, qy, px)]
+
+
+def test_steps_figure_draws_sealing_and_persson_per_direction(drawn):
+    """A seals review of ``roughfe leak``'s steps.png: the y curve was dashed under a title
+    "dashed lines: sealed steps"; a grey vertical line marked A* 0.41 "sealed" where only
+    x was (y flowed); and one Persson line, the mean of x and y, which differ 6x. Now
+    both Reynolds curves are solid, each direction's Persson estimate is dotted in its
+    colour, and a step sealed along a direction gets a triangle in that direction's
+    colour: x at 0.41 and 0.57, y at 0.57 only; no vertical line, no averaged Persson."""
+    from roughfe.plotting import leakage
+    fig = drawn(leakage, "steps_figure", _leak_steps())
+    ax = fig.axes[0]
+    lines = _lines(ax)
+    rx, ry = lines["Reynolds, x"], lines["Reynolds, y"]
+    assert rx.get_linestyle() == ry.get_linestyle() == "-"
+    assert rx.get_color() != ry.get_color()
+    for d, reynolds in (("x", rx), ("y", ry)):
+        persson = lines[f"Persson (critical junction), {d}"]
+        assert persson.get_linestyle() == ":" and persson.get_color() == reynolds.get_color()
+    assert lines["Persson (critical junction), y"].get_ydata()[0] == pytest.approx(
+        3.2e-19 / 6.07, rel=1e-12, abs=0)
+    assert list(lines["sealed along x (Q$_x$ = 0)"].get_xdata()) == [0.406, 0.572]
+    assert list(lines["sealed along y (Q$_y$ = 0)"].get_xdata()) == [0.572]
+    assert lines["sealed along x (Q$_x$ = 0)"].get_color() == rx.get_color()
+    assert not any("mean" in label for label in lines)
+    # no vertical marker lines: every line but the sealed marks has one point per step
+    assert all(len(ln.get_xdata()) == 5 for label, ln in lines.items()
+               if not label.startswith("sealed"))
+    assert "dashed" not in ax.get_title() and "W/L" in ax.get_title()
+
+
+def test_network_key_says_red_is_sealed_on_every_map():
+    """The network map's key said "red: trapped" when every trapped cell was sealed and
+    "red: sealed ... pink: dead end" otherwise: red is now "sealed" whenever the map
+    splits the trapped cells (zero dead ends included), and "trapped" only on a map that
+    does not split them, which says so."""
+    from roughfe.plotting.leakage import network_key
+    all_sealed = network_key(10, 80, 10, 10)
+    some = network_key(10, 80, 10, 4)
+    for key in (all_sealed, some):
+        assert "red: sealed" in key and "red: trapped" not in key
+    assert "pink: dead end, open to the flow (0)" in all_sealed
+    assert "red: sealed (4)" in some and "pink: dead end, open to the flow (6)" in some
+    unsplit = network_key(10, 80, 10)
+    assert "red: trapped (10; sealed and dead ends not told apart)" in unsplit
+    assert "pink" not in unsplit

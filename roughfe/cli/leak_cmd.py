@@ -204,7 +204,8 @@ def _leak(args) -> int:
 
 
 def _leak_fsi(args, surface, material, out, p_in, p_out):
-    """``roughfe leak --fsi``: the coupled sweep, its fields and figures; results.json last."""
+    """``roughfe leak --fsi``: the coupled sweep, its fields and maps (``steps.png`` is drawn
+    by the caller, after Persson's theory is added to the steps; results.json last)."""
     from ..leakage.fsi_sweep import coupled_leakage_sweep
     from ..plotting import leakage as figs
 
@@ -248,8 +249,6 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
             out / "figures" / f"step_{k:03d}_fluid_pressure.png",
             title=f"fluid pressure (Pa), two-way coupled, contact grey\n{tag}", at="cells",
             clim=(min(p_in, p_out), max(p_in, p_out))))     # pockets above: magenta
-    if not args.no_figures:
-        written.append(figs.steps_figure(steps, out / "figures" / "steps.png"))
     return sweep, steps, written
 
 
@@ -318,6 +317,8 @@ def _leak_run(args, surface, material, out):
                         pressure_drop=abs(p_in - p_out) or None, viscosity=args.mu,
                         direction=args.direction)
         steps = theory["steps"]
+        if not args.no_figures:     # with Persson's leak rate beside the coupled one
+            written.append(figs.steps_figure(steps, out / "figures" / "steps.png"))
         written.append(write_json(out / "results.json", {
             "inputs": base, "steps": steps, "units": _units(steps),
             "persson": theory["persson"]}))

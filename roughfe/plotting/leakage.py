@@ -134,6 +134,7 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
     blue = np.stack([1.0 - 0.85 * t, 1.0 - 0.6 * t, np.ones_like(t)], axis=-1)
     rgb[percolating] = blue[percolating]
     trapped = np.asarray(trapped, bool)
+    split = sealed is not None
     sealed = trapped if sealed is None else trapped & np.asarray(sealed, bool)
     rgb[trapped] = (1.0, 0.62, 0.72)            # dead ends open to the flow
     rgb[sealed] = (0.85, 0.1, 0.1)
@@ -151,13 +152,22 @@ def network_map(gap, percolating, trapped, size, path, *, title="free-volume net
         pts = np.array([[(x + half[0]) * UM, (y + half[1]) * UM, 0.5] for x, y in junctions])
         pl.add_points(pts, color="yellow", point_size=22, render_points_as_spheres=True)
         legend += ("  " if legend else "\n") + "yellow: critical junction"
-    n_p, n_t, n_c = int(np.sum(percolating)), int(np.sum(trapped)), int(
-        g.size - np.sum(percolating) - np.sum(trapped))
-    n_s = int(np.sum(sealed))
-    kinds = (f"red: trapped ({n_t})" if n_s == n_t else
-             f"red: sealed ({n_s})  pink: dead end ({n_t - n_s})")
-    return _finish(pl, f"{title}\nblack: contact ({n_c})  white-blue: percolating ({n_p})  "
-                       f"{kinds}{legend}", path, size)
+    n_p, n_t = int(np.sum(percolating)), int(np.sum(trapped))
+    key = network_key(g.size - n_p - n_t, n_p, n_t, int(np.sum(sealed)) if split else None)
+    return _finish(pl, f"{title}\n{key}{legend}", path, size)
+
+
+def network_key(n_contact, n_percolating, n_trapped, n_sealed=None) -> str:
+    """The colour key of :func:`network_map` (cell counts): red means one thing on every
+    map. With ``n_sealed`` (the map splits the trapped cells) red is sealed and pink the
+    dead ends, zeros included; without it red is every trapped cell, and the key says
+    they are not split. Until round 2, session 31 a map whose trapped cells were all
+    sealed said "red: trapped" and the others "red: sealed" (a seals review)."""
+    head = f"black: contact ({n_contact})  white-blue: percolating ({n_percolating})"
+    if n_sealed is None:
+        return f"{head}\nred: trapped ({n_trapped}; sealed and dead ends not told apart)"
+    return (f"{head}\nred: sealed ({n_sealed})  pink: dead end, open to the flow "
+            f"({n_trapped - n_sealed})")
 
 
 def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="cells",
@@ -211,11 +221,19 @@ def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
 
 def steps_figure(steps, path):
     """Leak rate and volumes over the load steps of ``roughfe leak`` (results.json steps);
-    with ``persson_leak_rate`` in the records also Lorenz & Persson's critical-junction
-    estimate beside the Reynolds leak rates, and with ``leak_rate_one_way`` (``--fsi``)
-    the one-way leak rate beside the coupled one and a third panel of load shares.
-    Sealed steps (Q = 0) are marked on the axis, not dropped; steps without a contact
-    area (a coupled lift-off) are named below the leak rates."""
+    with ``persson_leak_rate_<d>`` in the records also Lorenz & Persson's critical-junction
+    estimate beside the Reynolds leak rate of each direction, and with
+    ``leak_rate_one_way`` (``--fsi``) the one-way leak rate beside the coupled one and a
+    third panel of load shares. Steps without a contact area (a coupled lift-off) are
+    named below the leak rates.
+
+    The leak-rate panel (a seals review, round 2, session 31): each direction has one
+    colour, Reynolds solid with markers, Persson dotted (its x and y differ only by the
+    window's W/L: the theory is isotropic); a step sealed along a direction (Q = 0, no
+    point on the log axis) gets a down triangle of that direction's colour at the
+    bottom, so that a step sealed along x alone is not drawn as sealed."""
+    from matplotlib.transforms import blended_transform_factory
+
     skipped = [s.get("external_pressure", np.nan) for s in steps
                if s.get("area_fraction") is None]
     steps = [s for s in steps if s.get("area_fraction") is not None]
@@ -223,20 +241,36 @@ def steps_figure(steps, path):
     coupled = any(s.get("leak_rate_one_way") is not None for s in steps)
     fig, axes = new_figure(1, 3 if coupled else 2, figsize=(15 if coupled else 10, 4))
     ax1, ax2 = axes[0], axes[1]
-    series = [("leak_rate_x", "o-", "x"), ("leak_rate_y", "s--", "y")]
+    bottom = blended_transform_factory(ax1.transData, ax1.transAxes)
+    reynolds = "Reynolds, two-way coupled" if coupled else "Reynolds"
+    drawn = []
+    # the sealed triangles of x below those of y: a step sealed along both shows both
+    for d, colour, marker, low in (("x", "C0", "o", 0.03), ("y", "C1", "s", 0.08)):
+        q = [s.get(f"leak_rate_{d}") for s in steps]
+        if all(v is None for v in q):
+            continue
+        drawn += _positive(q)
+        ax1.semilogy(a, _positive(q), f"{marker}-", color=colour, label=f"{reynolds}, {d}")
+        zero = np.array([v is not None and v <= 0 for v in q])
+        if zero.any():
+            ax1.plot(a[zero], np.full(zero.sum(), low), "v", color=colour, ms=9,
+                     transform=bottom, clip_on=False, label=f"sealed along {d} (Q$_{d}$ = 0)")
+        p = [s.get(f"persson_leak_rate_{d}") for s in steps]
+        if any(v is not None for v in p):
+            drawn += _positive(p)
+            ax1.semilogy(a, _positive(p), ":", color=colour, lw=1.8,
+                         label=f"Persson (critical junction), {d}")
+    if not any(f"persson_leak_rate_{d}" in s for s in steps for d in "xy"):
+        p = [s.get("persson_leak_rate") for s in steps]   # records without the directions
+        if any(v is not None for v in p):
+            drawn += _positive(p)
+            ax1.semilogy(a, _positive(p), "k:", label="Persson (critical junction), "
+                                                      "mean over directions")
     if coupled:
-        series.append(("leak_rate_one_way", "^:", "one-way (rigid gap)"))
-    series.append(("persson_leak_rate", "k:", "critical junction (Persson)"))
-    sealed = np.zeros(a.shape, bool)
-    for key, mk, label in series:
-        q = [s.get(key) for s in steps]
-        if any(v is not None for v in q):
-            ax1.semilogy(a, [np.nan if v is None or v <= 0 else v for v in q], mk, label=label)
-            if key.startswith("leak_rate_") and key != "leak_rate_one_way":
-                sealed |= np.array([v is not None and v <= 0 for v in q])
-    for x in a[sealed]:
-        ax1.axvline(x, color="0.6", lw=0.8, ls="--")
-    if sealed.size and sealed.all():               # no positive rate: an empty log axis
+        q = [s.get("leak_rate_one_way") for s in steps]
+        drawn += _positive(q)
+        ax1.semilogy(a, _positive(q), "^-.", color="0.45", label="one-way (rigid gap)")
+    if not np.isfinite(drawn).any():               # no positive rate: an empty log axis
         ax1.text(0.5, 0.5, "every step sealed: Q = 0", transform=ax1.transAxes,
                  ha="center", va="center")
         ax1.set_yticks([])
@@ -246,9 +280,14 @@ def steps_figure(steps, path):
                      xycoords="axes fraction", fontsize=7, color="0.3")
     ax1.set_xlabel("A* = A_r / A_n")
     ax1.set_ylabel("leak rate Q (m$^3$/s)")
-    ax1.set_title("leak rate" + (" (dashed lines: sealed steps, Q = 0)" if sealed.any() else ""),
-                  fontsize=10)
-    ax1.legend(title="flow", fontsize=8)
+    persson = {d: any(s.get(f"persson_leak_rate{d}") is not None for s in steps)
+               for d in ("", "_x", "_y")}
+    ax1.set_title("leak rate" + (": Reynolds solid, Persson dotted" if any(persson.values())
+                                 else "") + ("\n(Persson is isotropic: its x and y differ by "
+                                             "the window's W/L only)"
+                                             if persson["_x"] and persson["_y"] else ""),
+                  fontsize=9)
+    ax1.legend(title="flow", fontsize=7, title_fontsize=8)
     vols = {}
     for key, label in (("free_volume_star", "V*"), ("percolating_volume_star", "V$_p$*"),
                        ("trapped_volume_star", "$\\bar V_p$*")):
@@ -277,6 +316,11 @@ def steps_figure(steps, path):
         axes[2].set_title("load shares (two-way coupled)", fontsize=10)
         axes[2].legend(fontsize=8)
     return save_figure(fig, path)
+
+
+def _positive(values):
+    """Leak rates for a log axis: None and Q <= 0 (sealed) as NaN, no point."""
+    return [np.nan if v is None or v <= 0 else float(v) for v in values]
 
 
 def _by(curves, key):
