@@ -341,3 +341,51 @@ def test_leak_draws_the_maps_of_the_end_steps_unless_asked_for_all():
     assert drawn == {"ends": [0, 4], "all": [0, 1, 2, 3, 4]}
     assert _maps_of(Namespace(no_figures=False, maps="ends"), 0, 1)
     assert not any(_maps_of(Namespace(no_figures=True, maps="all"), k, 5) for k in range(5))
+
+
+def test_leak_warns_that_persson_is_isotropic_on_a_surface_with_a_lay(tmp_path, capsys):
+    """A seals review: on x3p-2 (a machined lay) Persson's leak rate fell 10^5-10^6 x
+    below the Reynolds rate along the grooves without a word. Grooves along y (Str 0.09)
+    now get the "anisotropic" note in results.json and on stderr, with the Str that
+    results.json carries; an isotropic RMD surface (Str 0.73) gets its Str and no note."""
+    from roughfe.cli import main
+    from roughfe.surfaces.surface import Surface
+    n, rng = 33, np.random.default_rng(2)
+    h = (1e-6 * np.sin(2 * np.pi * 3 * np.arange(n) / n)[:, None]
+         + 1e-7 * rng.standard_normal((n, n)))
+    grooved = save_surface(Surface(h, (1e-4, 1e-4), periodic=False), tmp_path / "g.npz")
+    iso = save_surface(rmd_surface(5, 2.3, 1e-4, rng=5), tmp_path / "iso.npz")
+    runs = {}
+    for name, path in (("grooved", grooved), ("iso", iso)):
+        assert main(["leak", str(path), "--E", "1e9", "--nu", "0.3", "--pressure", "1e7",
+                     "--no-figures", "-o", str(tmp_path / name)]) == 0
+        runs[name] = (json.loads((tmp_path / name / "results.json").read_text())["persson"],
+                      capsys.readouterr().err)
+    info, err = runs["grooved"]
+    assert info["texture_aspect_ratio"] == pytest.approx(0.0934, abs=1e-3)
+    assert info["lay_angle"] == pytest.approx(90.0, abs=1.0)
+    assert info["anisotropic"].split(":")[0] == "the surface has a lay"
+    assert f"Str = {info['texture_aspect_ratio']:.3g}" in err
+    assert "Persson's theory assumes an isotropic surface" in err
+    info, err = runs["iso"]
+    assert info["texture_aspect_ratio"] > 0.5 and "anisotropic" not in info
+    assert "has a lay" not in err
+
+
+def test_leak_at_the_theory_s_full_contact_prints_no_numpy_warning(tmp_path, capsys):
+    """At 0.8 E* on a smooth 16^2 window Persson's u(p) is 0 to double precision and
+    K = -dp/du infinite: numpy's "divide by zero encountered in divide" reached the user
+    (a 16^2 crop of x3p-2 at 2e11 Pa). Now K is inf, null in results.json, whose unit
+    says what null means, and stderr has no numpy warning."""
+    from roughfe.cli import main
+    from roughfe.surfaces.surface import Surface
+    h = 1e-8 * np.random.default_rng(2).standard_normal((16, 16))
+    path = save_surface(Surface(h, (1e-4, 1e-4), periodic=False), tmp_path / "s.npz")
+    main(["leak", str(path), "--E", "1e9", "--nu", "0.3", "--pressure", "8e8",
+          "--no-figures", "-o", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert "divide" not in err and "RuntimeWarning" not in err
+    res = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert res["steps"][0]["persson_mean_gap"] == 0.0
+    assert res["steps"][0]["persson_stiffness"] is None
+    assert "null: infinite" in res["persson"]["units"]["persson_stiffness"]

@@ -426,3 +426,47 @@ def test_stiffness_is_minus_the_derivative_of_the_mean_gap(surface):
     steps = beside(surface, E_STAR, sweep.to_records())["steps"]
     assert [s["persson_stiffness"] for s in steps] == pytest.approx(list(th.stiffness),
                                                                     rel=1e-12, abs=0)
+
+
+def test_stiffness_at_the_theory_s_full_contact_is_infinite_without_a_numpy_warning(surface):
+    """At p ~ E* every mode of Eq. (2) is closed: u = 0 and -du/dp underflow to 0 in
+    double precision and K = -dp/du is infinite. ``roughfe leak`` on a 16^2 crop of x3p-2
+    at 2e11 Pa (E* 2.3e11 Pa) printed numpy's "divide by zero encountered in divide";
+    K is now inf there (null in results.json), and finite, as before, below."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")              # any numpy RuntimeWarning fails
+        theory = persson(surface, E_STAR, [1e6, 1e9])
+    assert theory.mean_gap[1] == 0.0 and theory.area_fraction[1] == pytest.approx(1.0, abs=1e-12)
+    assert theory.stiffness[1] == np.inf
+    assert 0 < theory.stiffness[0] < np.inf
+
+
+def test_beside_says_when_the_surface_has_a_lay(surface):
+    """Persson's theory takes the radially averaged PSD: an isotropic surface. Grooves
+    along y (x3p-2 has Str 0.026; its Persson leak rate fell 10^5-10^6 x below Reynolds
+    along them at 3 GPa, a seals review) get Str, the lay's direction and an "anisotropic"
+    note naming the leak rates when a leak rate is evaluated; the isotropic surface of
+    this module (Str 0.24, above the limit) gets its Str and no note."""
+    from roughfe.surfaces.texture import texture_aspect_ratio
+    from roughfe.theory.beside import ANISOTROPIC_STR
+    steps = [{"mean_pressure": 1e6}]
+    info = beside(surface, E_STAR, steps)["persson"]
+    assert info["texture_aspect_ratio"] == texture_aspect_ratio(surface).ratio
+    assert info["texture_aspect_ratio"] > ANISOTROPIC_STR and "anisotropic" not in info
+    n = surface.shape[0]
+    rng = np.random.default_rng(1)
+    x = np.arange(n) / n
+    h = 1e-6 * np.sin(2 * np.pi * 8 * x)[:, None] + 1e-8 * rng.standard_normal((n, n))
+    grooved = Surface(h, surface.size, periodic=True)
+    leak = beside(grooved, E_STAR, steps, pressure_drop=1.0, viscosity=1e-3,
+                  direction="both")["persson"]
+    assert leak["texture_aspect_ratio"] < ANISOTROPIC_STR
+    # periodic grooves stay correlated to the end of the (circular) autocorrelation on the
+    # rays within a few degrees of them: the lay's direction is known to those degrees
+    assert leak["lay_angle"] == pytest.approx(90.0, abs=5.0)
+    note = leak["anisotropic"]
+    assert f"Str = {leak['texture_aspect_ratio']:.3g}" in note and "isotropic" in note
+    assert "persson_leak_rate_x/_y" in note and "leak_rate_x/_y" in note
+    contact = beside(grooved, E_STAR, steps)["persson"]["anisotropic"]
+    assert "A*(p), u(p) and K(p)" in contact and "leak" not in contact

@@ -161,7 +161,10 @@ def persson_basis(args, surface, persson: dict) -> None:
     gradient of the surface's PSD, which can differ from the finite-difference rms slope
     of ``roughfe info`` (2x on sur-2: a user's review, round 2, session 29) -- and warn
     when the heights are far from Gaussian, the theory's surface
-    (:data:`roughfe.theory.beside.NON_GAUSSIAN`). ``persson``: the ``"persson"`` block of
+    (:data:`roughfe.theory.beside.NON_GAUSSIAN`) or have a lay (texture aspect ratio
+    below :data:`roughfe.theory.beside.ANISOTROPIC_STR`: the theory's surface is
+    isotropic; x3p-2 at 3 GPa, steel: Persson's leak rate along the grooves 4.8e5 x below
+    Reynolds', a seals review, round 2, session 31). ``persson``: the ``"persson"`` block of
     :func:`roughfe.theory.beside` (nothing is said without its ``rms_gradient``)."""
     if persson.get("rms_gradient") is None:
         return
@@ -169,8 +172,9 @@ def persson_basis(args, surface, persson: dict) -> None:
     print(f"Persson's theory beside the results (persson_* in results.json) takes gbar = "
           f"{persson['rms_gradient']:.3g}, the rms gradient of the surface's PSD{window}; "
           f"its rms slope by finite differences (roughfe info) is {_slope(surface):.3g}")
-    if persson.get("non_gaussian"):
-        warn(args, persson["non_gaussian"])
+    for note in ("non_gaussian", "anisotropic"):
+        if persson.get(note):
+            warn(args, persson[note])
 
 
 def _slope(surface) -> float:

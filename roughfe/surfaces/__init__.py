@@ -4,7 +4,8 @@ Generators (each takes ``rng`` = Generator or seed and records the seed):
 :func:`rmd_surface`/:func:`rmd_profile` (thesis Sec. 2.1.1), :func:`wm_profile`
 (Eq. 2.1), :func:`mwm_surface` (Eq. 2.2/3.17), :func:`spectral_surface`/
 :func:`spectral_profile` (Fourier filtering). I/O: :func:`load_surface`,
-:func:`save_surface`. Statistics: :mod:`roughfe.surfaces.stats`.
+:func:`save_surface`. Statistics: :mod:`roughfe.surfaces.stats`; texture direction
+(ISO 25178-2 Str): :mod:`roughfe.surfaces.texture`.
 """
 from .io import load_surface, save_surface
 from .rmd import rmd_profile, rmd_surface

@@ -68,6 +68,17 @@ NOT_EVALUATED = {
 #: round 2, session 29), and plu-1 (kurtosis 9.2) the next.
 NON_GAUSSIAN = {"skewness": 2.0, "kurtosis": 20.0}
 
+#: texture aspect ratio Str (ISO 25178-2, :mod:`roughfe.surfaces.texture`) below which a
+#: surface is said to have a lay that the theory's isotropic PSD misses. Isotropic
+#: self-affine windows (H 0.3 and 0.8, 32^2-256^2, periodic and not, 160 per grid) had
+#: Str 0.197-0.26 at the lowest (a window's few long waves align by chance), median
+#: 0.45-0.61; measured lays are below: x3p-2 (machined) 0.026 (0.079 on a 256^2 crop,
+#: 0.12 on 64^2), where Persson's leak rate fell 10^5-10^6 x below the Reynolds rate along
+#: the grooves at 3 GPa (a seals review, round 2, session 31), and plu-1 with its plane
+#: removed 0.105, sealed across its lay and open along it at A* 0.23. (ISO calls Str < 0.3
+#: strongly directional: too many isotropic windows for a warning.)
+ANISOTROPIC_STR = 0.15
+
 
 def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, direction="x",
            gamma=GAMMA_DEFAULT, adhesive=False) -> dict:
@@ -105,7 +116,9 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         positive finite pressure (no theory at zero load) and plastic ones get None.
         ``"persson"``: the sweep-level facts (gamma, kappa, rms gradient, u0 in m,
         percolation threshold, units, references; for a Surface the heights' skewness
-        and kurtosis, and a ``"non_gaussian"`` note beyond :data:`NON_GAUSSIAN`), with :data:`NOT_PLASTIC` and
+        and kurtosis, and a ``"non_gaussian"`` note beyond :data:`NON_GAUSSIAN`; for a 2D
+        one its ``texture_aspect_ratio`` Str and ``lay_angle`` (degrees from x), and an
+        ``"anisotropic"`` note below :data:`ANISOTROPIC_STR`), with :data:`NOT_PLASTIC` and
         ``plastic_steps`` (their indices) when steps were left out as plastic.
     """
     psd = None if _no_spectrum(source) else _spectrum(source)
@@ -143,13 +156,15 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         out.append(rec)
     info = {"gamma": theory.gamma, "kappa": theory.kappa, "rms_gradient": theory.rms_gradient,
             "u0": theory.u0, "units": {"persson_mean_gap": "m", "u0": "m",
-                                       "persson_stiffness": "Pa/m (K = -dp/du)",
+                                       "persson_stiffness": "Pa/m (K = -dp/du; null: infinite, "
+                                                            "the theory's full contact u = 0)",
                                        "persson_leak_rate": "m^3/s"},
             "references": list(REFERENCES)}
     if pressure_drop is not None:
         info["percolation_threshold"] = PERCOLATION_THRESHOLD
     if isinstance(source, Surface):
         info.update(_height_distribution(source))
+        info.update(_texture(source, leak=pressure_drop is not None))
     if any(plastic):
         info.update(NOT_PLASTIC, plastic_steps=[k for k, pl in enumerate(plastic) if pl])
     return {"steps": out, "persson": info}
@@ -167,6 +182,32 @@ def _height_distribution(surface) -> dict:
             f"the heights are far from Gaussian (skewness {skew:.3g}, kurtosis {kurt:.3g}; "
             f"a Gaussian surface has 0 and 3): Persson's theory takes a Gaussian surface of "
             f"this PSD and does not apply here; read the simulation, not the theory")
+    return out
+
+
+def _texture(surface, leak) -> dict:
+    """Str of a 2D surface (``texture_aspect_ratio``, ``lay_angle`` in degrees from x) and,
+    below :data:`ANISOTROPIC_STR`, an ``"anisotropic"`` note: the theory takes the radial
+    average of the PSD, an isotropic surface, so its A*(p), u(p) and (``leak``) its
+    critical-junction leak rate, the same along x and y but for the window's W/L, do not
+    see the lay. Nothing for a profile, a flat surface or a grid too small for Str."""
+    from ..surfaces.texture import texture_aspect_ratio
+    if surface.ndim != 2 or min(surface.shape) < 2 or not np.ptp(surface.heights) > 0:
+        return {}
+    tex = texture_aspect_ratio(surface)
+    out = {"texture_aspect_ratio": tex.ratio, "lay_angle": tex.lay_angle}
+    if tex.ratio < ANISOTROPIC_STR:
+        what = ("its critical-junction leak rate (persson_leak_rate_x/_y differ only by the "
+                "window's W/L) cannot tell the flow along the lay from the flow across it and "
+                "can miss the Reynolds leak rates (leak_rate_x/_y) by orders of magnitude: "
+                "read those" if leak else
+                "read its A*(p), u(p) and K(p) as those of the direction-averaged PSD")
+        out["anisotropic"] = (
+            f"the surface has a lay: texture aspect ratio Str = {tex.ratio:.3g} (ISO 25178-2, "
+            f"< {ANISOTROPIC_STR:g}; 1: isotropic), heights correlated over "
+            f"{tex.longest:.3g} m along {tex.lay_angle:.0f} deg from x and {tex.shortest:.3g} m "
+            f"across{' or more' if tex.bounded else ''}; Persson's theory assumes an "
+            f"isotropic surface (the radially averaged PSD): {what}")
     return out
 
 

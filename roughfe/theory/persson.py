@@ -284,14 +284,21 @@ def mean_separation(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q_min=
 
 def normal_stiffness(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q2=None):
     """Persson's normal contact stiffness K(p) = -dp/du (Pa/m), Eq. (4): the derivative of
-    :func:`mean_separation` (same arguments, every |q|), ``p / u0`` at small p."""
+    :func:`mean_separation` (same arguments, every |q|), ``p / u0`` at small p.
+
+    At the theory's full contact -du/dp = (2/sqrt(pi)) sum weight exp(-y^2) (...) with
+    y = p w / E* underflows to 0 in double precision (every mode closed: u = 0 and
+    A* = 1 there too; a 16^2 crop of x3p-2 at 2e11 Pa, E* = 2.3e11 Pa), and K = -dp/du
+    is infinite: those pressures get ``inf`` (written null in results.json), not a
+    division by zero (whose numpy warning reached the user until round 2, session 31)."""
     e = check_finite_positive("e_star (Pa)", e_star)
     gamma = _check_gamma(gamma)
     p = _pressures(mean_pressure)
     w, weight = _gap_modes(*_checked_spectrum(q, power, q2))
     y = np.outer(p, w / e)
     kernel = np.exp(-y ** 2) * (gamma + 3 * (1 - gamma) * scipy.special.erf(y) ** 2)
-    return p / ((2 / np.sqrt(np.pi)) * (kernel @ weight))
+    compliance = (2 / np.sqrt(np.pi)) * (kernel @ weight)          # -du/dp (m/Pa)
+    return np.divide(p, compliance, out=np.full(p.shape, np.inf), where=compliance > 0)
 
 
 # -- results ---------------------------------------------------------------------------------
@@ -308,7 +315,9 @@ class PerssonResult:
     mean_gap : ndarray
         u(p), Eq. (2) (m): separation of the mean planes, comparable with the BEM mean gap.
     stiffness : ndarray
-        K(p) = -dp/du, Eq. (4) (Pa/m): the BEM's dp/dDelta of a periodic surface.
+        K(p) = -dp/du, Eq. (4) (Pa/m): the BEM's dp/dDelta of a periodic surface; inf
+        at the theory's full contact (u = 0 in double precision:
+        :func:`normal_stiffness`).
     rms_gradient : float
         gbar from the PSD (-).
     rms_height : float
