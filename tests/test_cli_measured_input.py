@@ -188,3 +188,25 @@ def test_an_option_of_another_command_is_named_by_the_command(tmp_path, capsys):
     assert err == ("roughfe leak: error: unrecognized arguments: --mirror (see `roughfe leak "
                    "--help`)\n")
     assert not (tmp_path / "o").exists()
+
+
+def test_periodic_given_to_a_window_that_does_not_join_up_is_warned(tmp_path, capsys):
+    # a 64^2 window cut from a 256^2 periodic surface (H = 0.8) jumps across its edges by
+    # ~20x the neighbour step: --periodic makes that seam a ridge; the whole periodic
+    # surface joins up (about 1x) and is not warned of
+    whole = spectral_surface(256, 4e-4, 0.8, rms_height=1e-6, rng=2)
+    window = Surface(whole.heights[:64, :64] - whole.heights[:64, :64].mean(), 1e-4,
+                     periodic=False)
+    small = spectral_surface(64, 1e-4, 0.8, rms_height=1e-6, rng=2)
+    for name, surf, warned in (("window", window, True), ("periodic", small, False)):
+        path = save_surface(surf, tmp_path / f"{name}.npz")
+        capsys.readouterr()
+        assert main(["contact", str(path), "--periodic", "--pressure", "1e5",
+                     "--no-figures", "-o", str(tmp_path / name)]) == 0
+        err = capsys.readouterr().err
+        assert ("jump across the period's edges" in err) is warned, err
+    # without --periodic the window is solved as what its file says: no seam
+    path = tmp_path / "window.npz"
+    assert main(["contact", str(path), "--pressure", "1e5", "--no-figures", "-o",
+                 str(tmp_path / "w2")]) == 0
+    assert "jump across" not in capsys.readouterr().err

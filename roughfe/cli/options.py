@@ -152,12 +152,15 @@ def surface_from_args(args):
     ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
     command has that option."""
     surface = surface_file(args, args.surface)
-    from .plausibility import warn_tilt, warn_units
+    from .plausibility import warn_seam, warn_tilt, warn_units
     warn_units(args, surface)
     detrend = getattr(args, "detrend", "none")
     if detrend == "mean" and not surface.periodic:
         warn_tilt(args, surface)
-    return surface if detrend == "none" else surface.detrended(detrend)
+    surface = surface if detrend == "none" else surface.detrended(detrend)
+    if getattr(args, "periodic", None) is True:
+        warn_seam(args, surface)
+    return surface
 
 
 def mirrored_if_asked(args, surface):
