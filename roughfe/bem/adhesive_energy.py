@@ -78,12 +78,16 @@ class AdhesiveEnergy:
         self._spread = value
         self._ramp = None if value is None else self.law.cell_ramp(value)
 
-    def law_at(self, g):
+    def law_at(self, g, rows=None):
         """``(phi, phi')`` of the interface law at the gap ``g`` (m), cell-averaged with
-        the current spread."""
+        the current spread; ``rows`` (a slice of the grid's first axis): ``g`` is the gap
+        of those rows only (the blocks of :func:`roughfe.bem.adhesive_cg.adhesive_pcg`)."""
         if self._ramp is None:
             return self.law.evaluate(g)
-        return self.law.evaluate(g, ramp=self._ramp)
+        if rows is None:
+            return self.law.evaluate(g, ramp=self._ramp)
+        g1, width = self._ramp
+        return self.law.evaluate(g, ramp=(g1[rows], width[rows]))
 
     def cell_spread(self, x):
         """Half-range of the gap across each cell (m), ``|grad g| dx / 2`` by central
