@@ -76,7 +76,7 @@ from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
 from .adhesive_cg import adhesive_pcg
 from .adhesive_energy import AdhesiveEnergy
-from .adhesive_pull_off import refine_pull_off
+from .adhesive_pull_off import refine_pull_off, tensile_floor
 from .adhesive_rules import check_adhesive_run
 from .adhesive_start import continued_start, elastic_start
 from .interface_law import LAWS, AdhesionLaw, check_resolution, resolution
@@ -348,8 +348,10 @@ class AdhesiveSweep:
         ``unloading`` (and ``sweep.unloading`` the per-step branch, 1.0 on unloading).
     pull_off_force : float
         Most tensile load of the unloading branch (N for surfaces, N/m for profiles;
-        negative), NaN without unloading: that of this load path (independent of the
-        step, more tensile the larger the largest loading approach).
+        negative), NaN without unloading, 0 when no load of the branch is tensile beyond
+        round-off (:func:`~roughfe.bem.adhesive_pull_off.tensile_floor`): that of this
+        load path (independent of the step, more tensile the larger the largest loading
+        approach).
     pull_off_pressure : float
         The same as a mean pressure (Pa).
     detached : bool
@@ -477,17 +479,19 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
                 low = min(loads) if loads else float("inf")
                 d -= h
                 prev = unload_to(d)
-                if prev.n_contact == 0 and min(loads) < 0 and prev.load > 1e-3 * min(loads):
-                    detached = True
+                tensile = min(loads) < -tensile_floor(loads)   # not round-off
+                if prev.n_contact == 0 and (not tensile or prev.load > 1e-3 * min(loads)):
+                    detached = True        # separated (without a tensile state: pull 0)
                     break
                 h = step if prev.load < low else growth * h
             # the most tensile state between samples (refine_pull_off): bisected steps
             # around the minimum, down to a quarter of the law's range
-            top = deltas.size - 1
-            branch = refine_pull_off(list(zip(imposed[top:], results[top:])), unloaded,
-                                     0.25 * law.range)
-            results[top:] = [state for _, state in branch]
-            pull = float(min(state.load for _, state in branch))
+            top, pull = deltas.size - 1, 0.0
+            if min(loads) < -tensile_floor(loads):
+                branch = refine_pull_off(list(zip(imposed[top:], results[top:])), unloaded,
+                                         0.25 * law.range)
+                results[top:] = [state for _, state in branch]
+                pull = float(min(state.load for _, state in branch))
     sweep = SweepResult.from_results(results, rms_slope=rms_slope(surface),
                                      length=surface.size[0])
     return AdhesiveSweep(sweep=sweep, pull_off_force=pull,

@@ -217,10 +217,14 @@ def _run(args) -> int:
                  f"{share[0]:.2f}..{share[-1]:.2f}")
               + " (derived.window_compliance, bulk_share in results.json)")
     if adhesive is not None:
-        pull = (f"pull-off force {adhesive.pull_off_force:.4e} "
-                + ("(detached)" if adhesive.detached else
-                   "(NOT detached: a bound; trace further with --max-unload-steps N, "
-                   "more than the default 4 x the loading steps)")
+        limit = (f"{args.max_unload_steps}" if args.max_unload_steps is not None else
+                 "the default 4 x the loading steps")
+        pull = (("no tensile state: the surfaces separated without a pull-off force (0)"
+                 if adhesive.pull_off_force == 0 and adhesive.detached else
+                 f"pull-off force {adhesive.pull_off_force:.4e} "
+                 + ("(detached)" if adhesive.detached else
+                    f"(NOT detached: a bound; trace further with --max-unload-steps N, "
+                    f"more than {limit})"))
                 if args.unload else "pull-off force not traced (--unload traces it)")
         print(f"{pull}; " + (stickiness.verdict() if stickiness is not None else
                              "Pastewka-Robbins stickiness not evaluated: "
