@@ -41,6 +41,9 @@ def test_the_summary_line_and_a_plan_without_estimate():
         f"55 BEM sweeps of 20 steps on 512 x 512 points (2 at a time): roughly "
         f"{low:.0f} s to {high / 60:.0f} min (a rough guess, extrapolated from one timed "
         f"sweep of a 64 x 64 crop by the number of points)")
+    # both ends rounding to one duration: one number, not "roughly 1 s to 1 s"
+    tiny = SweepPlan(1, 3, (32, 32), 2, 1e-4, (32, 32))
+    assert ": about 1 s (a rough guess" in tiny.summary()
     none = SweepPlan(55, 20, (512, 512), 2, float("nan"), (64, 64))
     assert none.summary().endswith(": time not estimated (the calibration sweep did not run)")
 
@@ -59,7 +62,8 @@ def test_the_command_prints_the_plan_before_the_sweeps(tmp_path, capsys, monkeyp
                  "--E", "1e9", "--no-figures", "-o", str(tmp_path / "out")]) == 0
     nit = json.loads((tmp_path / "out" / "mechanics.json").read_text())["nit"]
     assert said_before[0].startswith(f"mechanics: {nit} BEM sweeps of 4 steps on "
-                                     f"32 x 32 points (2 at a time): roughly ")
+                                     f"32 x 32 points (2 at a time): ")
+    assert said_before[0].split(": ")[2].startswith(("roughly ", "about "))
     assert "rough guess" in said_before[0]
     capsys.readouterr()
     assert main(["genome", "chromosomes", str(path), "--gamma", "2", "--steps", "4",

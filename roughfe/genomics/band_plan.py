@@ -90,9 +90,10 @@ class SweepPlan:
         if not np.isfinite(t):
             return f"{head}: time not estimated (the calibration sweep did not run)"
         crop = " x ".join(map(str, self.calibration_shape))
-        return (f"{head}: roughly {_duration(t / SPREAD)} to {_duration(t * SPREAD)} (a "
-                f"rough guess, extrapolated from one timed sweep of a {crop} crop by the "
-                f"number of points)")
+        lo, hi = _duration(t / SPREAD), _duration(t * SPREAD)
+        span = f"about {lo}" if lo == hi else f"roughly {lo} to {hi}"
+        return (f"{head}: {span} (a rough guess, extrapolated from one timed sweep of a "
+                f"{crop} crop by the number of points)")
 
 
 def _crop(surface: Surface, side: int) -> Surface:
