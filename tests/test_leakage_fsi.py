@@ -100,6 +100,8 @@ def test_coupled_records_use_the_one_way_contact_scalars(surface):
     assert rec["free_volume_star"] == pytest.approx(rec["mean_gap"] / sigma, rel=1e-12, abs=0)
     assert rec["separation_star"] == pytest.approx(rec["mean_plane_separation"] / sigma,
                                                    rel=1e-12, abs=0)
+    # the contact solve's own verdict, as in the one-way records (it was left out)
+    assert rec["contact_success"] is bool(r.contact.success) is True
 
 
 def test_reversed_flow_is_the_mirror_image(surface, flowing):

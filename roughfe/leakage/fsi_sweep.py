@@ -76,7 +76,8 @@ class CoupledSweep:
                 separation = float(h.max() - h.mean() - r.approach)
                 rec.update(delta=r.approach, mean_plane_separation=separation,
                            free_volume_star=float(r.contact.mean_gap / sigma),
-                           separation_star=separation / sigma)
+                           separation_star=separation / sigma,
+                           contact_success=bool(r.contact.success))   # as one-way records
             if lk is not None:
                 rec.update(lk.record())
             rec.update(r.record())
