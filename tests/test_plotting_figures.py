@@ -419,3 +419,21 @@ def test_network_key_says_red_is_sealed_on_every_map():
     unsplit = network_key(10, 80, 10)
     assert "red: trapped (10; sealed and dead ends not told apart)" in unsplit
     assert "pink" not in unsplit
+
+
+def test_a_volume_of_zero_is_marked_not_dropped_on_the_log_axis(drawn):
+    """steps.png's volume panel is logarithmic when the trapped volume is decades below
+    the free one; a percolating volume of 0 (sealed) was drawn as a line diving to the
+    axis' foot. It is now left out of its line and marked at the foot in its colour."""
+    from roughfe.plotting import leakage
+    steps = _leak_steps()
+    for s, vp in zip(steps, (0.5, 0.2, 0.05, 0.0, 0.0)):
+        s.update(percolating_volume_star=vp, trapped_volume_star=1e-4)
+    ax = drawn(leakage, "steps_figure", steps).axes[1]
+    assert ax.get_yscale() == "log"
+    lines = _lines(ax)
+    vp = lines["V$_p$*"].get_ydata()
+    assert np.all(np.isnan(vp[3:])) and np.all(vp[:3] > 0)
+    mark = lines["V$_p$* = 0"]
+    assert list(mark.get_xdata()) == [0.406, 0.572]
+    assert mark.get_color() == lines["V$_p$*"].get_color()

@@ -294,11 +294,18 @@ def steps_figure(steps, path):
         vals = [s.get(key) for s in steps]
         if all(v is not None for v in vals):
             vols[label] = np.array(vals, float)
-    for k, (label, vals) in enumerate(vols.items()):   # V* wide below: V* = V_p* + trapped
-        ax2.plot(a, vals, "o-", label=label, **({"lw": 4, "ms": 9, "alpha": 0.45} if k == 0
-                                                else {}))
     positive = [v[v > 0] for v in vols.values() if np.any(v > 0)]
-    if positive and max(v.max() for v in positive) > 100 * min(v.min() for v in positive):
+    log = bool(positive) and max(v.max() for v in positive) > 100 * min(v.min()
+                                                                      for v in positive)
+    for k, (label, vals) in enumerate(vols.items()):   # V* wide below: V* = V_p* + trapped
+        zero = vals <= 0
+        line, = ax2.plot(a, np.where(zero, np.nan, vals) if log else vals, "o-", label=label,
+                         **({"lw": 4, "ms": 9, "alpha": 0.45} if k == 0 else {}))
+        if log and zero.any():  # no logarithm: a volume of 0 (sealed) as a mark at the foot
+            ax2.plot(np.asarray(a)[zero], np.zeros(int(zero.sum())), "v", ms=7, clip_on=False,
+                     color=line.get_color(), transform=ax2.get_xaxis_transform(),
+                     label=f"{label} = 0")
+    if log:
         ax2.set_yscale("log")      # the trapped volume is decades below the free one
     ax2.set_xlabel("A* = A_r / A_n")
     ax2.set_ylabel("dimensionless volume")
