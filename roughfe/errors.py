@@ -80,7 +80,9 @@ def check_finite_positive(name, value):
     try:
         v = float(_number(value))
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be a positive number, got {value!r}") from None
+        # a Material where a modulus is asked for (persson(surface, material, p)): say how
+        hint = "; pass its .E_star (Pa)" if hasattr(value, "E_star") else ""
+        raise InputError(f"{name} must be a positive number, got {value!r}{hint}") from None
     if not (v > 0.0 and v < float("inf")):
         raise InputError(f"{name} must be finite and > 0, got {value!r}")
     return v

@@ -98,3 +98,59 @@ class Frozen:
         for key, value in state.items():
             object.__setattr__(self, key, value)
         freeze_fields(self)
+
+
+def read_only_arrays(obj, copy: bool = False) -> None:
+    """Make every numpy array field of the dataclass instance ``obj`` read-only, copying
+    it first when ``copy`` (for arrays the producer or the caller may still write to);
+    containers and other values are left as they are (unlike :func:`freeze_fields`)."""
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if isinstance(value, np.ndarray):
+            if copy:
+                value = value.copy()
+                object.__setattr__(obj, f.name, value)
+            value.setflags(write=False)
+
+
+class ReadOnlyArrays:
+    """Base of frozen dataclasses whose array fields stay read-only after unpickling
+    (pickle does not keep numpy's ``writeable`` flag), their containers untouched."""
+
+    def __setstate__(self, state):
+        for key, value in state.items():
+            object.__setattr__(self, key, value)
+        read_only_arrays(self)
+
+
+def compact_repr(self) -> str:
+    """A one-line ``__repr__`` for a result dataclass (assign ``__repr__ = compact_repr``
+    in the class): arrays as ``array(shape, dtype)``, 1D arrays of at most 10 values (the
+    steps of a sweep) by their values, sequences of arrays or results by their length
+    and type, mappings of arrays or results by their keys and value types, other fields
+    as usual; optional fields left at None and fields with ``repr=False`` are left out.
+    (The dataclass repr printed every array: 3-18 kB for one 128^2 contact or leakage
+    result, 83 kB for a sequencing result.)"""
+    parts = []
+    for f in dataclasses.fields(self):
+        if not f.repr:
+            continue
+        v = getattr(self, f.name)
+        if v is None and f.default is None:        # an optional field not computed
+            continue
+        if isinstance(v, np.ndarray) and v.ndim == 1 and v.size <= 10:   # per-step values
+            text = "array(" + np.array2string(v, precision=4, separator=", ",
+                                              max_line_width=10 ** 6) + ")"
+        elif isinstance(v, np.ndarray):
+            text = f"array(shape={v.shape}, dtype={v.dtype})"
+        elif isinstance(v, (tuple, list)) and v and (isinstance(v[0], np.ndarray)
+                                                     or dataclasses.is_dataclass(v[0])):
+            text = f"<{len(v)} x {type(v[0]).__name__}>"
+        elif isinstance(v, Mapping) and any(isinstance(x, np.ndarray)
+                                            or dataclasses.is_dataclass(x) for x in v.values()):
+            text = "{" + ", ".join(f"{k!r}: <{type(x).__name__}>" for k, x in v.items()) + "}"
+        else:
+            text = repr(v)
+        parts.append(f"{f.name}={text}")
+    return f"{type(self).__name__}({', '.join(parts)})"
+

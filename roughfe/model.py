@@ -45,7 +45,7 @@ from typing import Any, Mapping, Optional
 import numpy as np
 
 from .errors import InputError, check_finite_positive
-from .frozen import Frozen, freeze_fields
+from .frozen import Frozen, compact_repr, freeze_fields
 from .writers import json_scalars, to_jsonable
 
 #: The one default material of every command and study analysis: the thesis' E* = 210 MPa
@@ -399,6 +399,8 @@ class ContactResult(Frozen):
     unloading: Optional[bool] = None
     adhesive_area_fraction: Optional[float] = None
 
+    __repr__ = compact_repr          # one line: fields as shape and dtype, unset optionals left out
+
     def __post_init__(self):
         freeze_fields(self)
         object.__setattr__(self, "success", bool(self.residual <= self.tolerance))
@@ -534,6 +536,8 @@ class SweepResult(Frozen):
     delta_applied: Optional[np.ndarray] = None
     plastic_area_fraction: Optional[np.ndarray] = None
     unloading: Optional[np.ndarray] = None
+
+    __repr__ = compact_repr          # one line: arrays as shape and dtype, results counted
 
     @classmethod
     def from_results(cls, results, *, rms_slope: float, length: float) -> "SweepResult":

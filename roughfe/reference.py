@@ -25,6 +25,11 @@ import numpy as np
 
 from .errors import InputError, check_finite_positive
 
+__all__ = ["westergaard", "WestergaardSolution", "hertz_sphere", "hertz_cylinder", "HertzSolution",
+           "uniform_strip_displacement", "uniform_rectangle_displacement",
+           "uniform_cell_displacement_grid", "maugis_parameter", "maugis_load", "maugis_pull_off",
+           "REFERENCES_WESTERGAARD", "REFERENCES_HERTZ", "REFERENCES_LOVE", "REFERENCES_MAUGIS"]
+
 REFERENCES_WESTERGAARD = ("Westergaard H.M. (1939) J. Appl. Mech. 6:A49-A53",
                           "Johnson K.L. (1985) Contact Mechanics, Sec. 13.2")
 REFERENCES_HERTZ = ("Hertz H. (1882) J. reine angew. Math. 92:156-171",
@@ -137,7 +142,9 @@ class HertzSolution:
         Sphere: delta = a^2/R = (9 P^2 / (16 R E*^2))^(1/3) (m). Cylinder: NaN (a 2D
         half-plane approach depends on the displacement reference).
     stiffness : float
-        Sphere: dP/d delta = 2 E* a (N/m). Cylinder: NaN.
+        Sphere: dP/d delta = 2 E* a (N/m). Cylinder: NaN. A force per length, unlike
+        :attr:`roughfe.model.ContactResult.stiffness` (d p / d Delta, Pa/m): compare it
+        with ``result.stiffness * surface.nominal_area``.
     """
 
     kind: str

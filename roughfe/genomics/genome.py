@@ -54,10 +54,15 @@ from typing import Any, Mapping, Optional
 import numpy as np
 
 from ..errors import FileFormatError, InputError, check_finite_positive, check_int
-from ..frozen import FrozenMapping
+from ..frozen import FrozenMapping, ReadOnlyArrays
 from ..surfaces.surface import Surface
 from ..surfaces.wm import resolve_rng, wm_series
 from ..writers import write_json
+
+__all__ = ["Genome", "save_genome", "load_genome", "random_genome", "table1_genome", "realize",
+           "realize_surface", "chromosome_range", "node_coordinates", "chromosome_heights",
+           "profile_heights", "chromosome_indices", "surface_heights", "observation_coordinates",
+           "GENOME_FORMAT", "GENOME_VERSION", "DEFAULT_NODES", "SCALES"]
 
 GENOME_FORMAT = "roughfe-genome"
 GENOME_VERSION = 1
@@ -85,7 +90,7 @@ def _as_angle_vector(name, value, m):
 
 
 @dataclass(frozen=True, eq=False)
-class Genome:
+class Genome(ReadOnlyArrays):
     """Genes of a rough profile or surface: the truncated MWM function of Eq. (3.1).
 
     Parameters

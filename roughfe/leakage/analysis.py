@@ -15,7 +15,7 @@ import numpy as np
 from .. import progress
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive, check_instance,
                       check_real_array)
-from ..frozen import FrozenMapping
+from ..frozen import FrozenMapping, compact_repr
 from ..model import ContactResult
 from .junction import CriticalConstriction, critical_constriction
 from .network import NetworkResult, free_volume_network
@@ -70,6 +70,8 @@ class LeakageResult:
     pressure_drop: float
     size: tuple
     references: tuple = REFERENCES
+
+    __repr__ = compact_repr          # one line: the network and flows by their types
 
     def __post_init__(self):
         for name in ("flows", "constrictions"):
@@ -248,6 +250,8 @@ class LeakageSweep:
 
     contacts: tuple
     leakages: tuple
+
+    __repr__ = compact_repr
 
     @property
     def success(self) -> bool:

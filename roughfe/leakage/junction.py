@@ -38,11 +38,12 @@ from scipy.sparse.csgraph import breadth_first_order
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
                       check_real_array, check_spacing)
+from ..frozen import ReadOnlyArrays, read_only_arrays
 from .components import components_reaching
 
 
 @dataclass(frozen=True, eq=False)
-class CriticalConstriction:
+class CriticalConstriction(ReadOnlyArrays):
     """Bottleneck of the open network along one flow direction.
 
     Attributes
@@ -78,6 +79,9 @@ class CriticalConstriction:
     path: np.ndarray
     channel: np.ndarray
     channel_factor: float
+
+    def __post_init__(self):       # read-only copies: a result never changes
+        read_only_arrays(self, copy=True)
 
     def leak_rate_junction(self, *, mu: float, pressure_drop: float, length: float,
                            width: float) -> Optional[float]:

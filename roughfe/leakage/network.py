@@ -71,7 +71,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
                       check_real_array, check_spacing)
-from ..frozen import FrozenMapping
+from ..frozen import FrozenMapping, ReadOnlyArrays, compact_repr, read_only_arrays
 from .components import components_reaching
 
 _AXES = {"x": 0, "y": 1}
@@ -79,7 +79,7 @@ CORNER_RULES = ("saddle", "closed")
 
 
 @dataclass(frozen=True, eq=False)
-class DirectionalNetwork:
+class DirectionalNetwork(ReadOnlyArrays):
     """Cross-section/channel network for one flow direction (Alg. 1).
 
     Attributes
@@ -114,13 +114,18 @@ class DirectionalNetwork:
     n_rejected_diagonals: int
     n_backbone_sections: int
 
+    __repr__ = compact_repr
+
+    def __post_init__(self):       # read-only copies: a result never changes
+        read_only_arrays(self, copy=True)
+
     @property
     def n_sections(self) -> int:
         return int(self.section.max() + 1) if self.section.size else 0
 
 
 @dataclass(frozen=True, eq=False)
-class NetworkResult:
+class NetworkResult(ReadOnlyArrays):
     """Free volume and its percolating/trapped parts (Eq. 2.8, 2.15, 2.16).
 
     Volumes are in m^3; the ``*_star`` values are divided by ``L^2 sigma`` (nominal
@@ -164,8 +169,11 @@ class NetworkResult:
     sealed_volume: Optional[float] = None
     sealed_volume_star: Optional[float] = None
 
+    __repr__ = compact_repr
+
     def __post_init__(self):
         object.__setattr__(self, "directions", FrozenMapping(self.directions))
+        read_only_arrays(self, copy=True)       # a result never changes
 
     def percolates(self, direction: str) -> Optional[bool]:
         """Whether the network percolates along ``direction`` (None: not analysed)."""

@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import (FlowImbalanceWarning, InputError, check_finite_nonnegative,
                       check_finite_positive)
 from ..fem.reynolds import check_reynolds_data, solve_reynolds_fe
+from ..frozen import ReadOnlyArrays, compact_repr, read_only_arrays
 from .finite_volume import solve_reynolds_fv
 
 SCHEMES = ("fv", "fe")
@@ -39,7 +40,7 @@ FLOW_IMBALANCE_TOL = 1e-6
 
 
 @dataclass(frozen=True, eq=False)
-class ReynoldsResult:
+class ReynoldsResult(ReadOnlyArrays):
     """Steady Reynolds flow through a gap field (Eq. 2.12).
 
     Attributes
@@ -92,6 +93,11 @@ class ReynoldsResult:
     success: bool
     message: str
     nit: int
+
+    __repr__ = compact_repr
+
+    def __post_init__(self):       # read-only copies: a result never changes
+        read_only_arrays(self, copy=True)
 
     @property
     def pressure_at(self) -> str:

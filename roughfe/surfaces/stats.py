@@ -50,6 +50,7 @@ import numpy as np
 import scipy.optimize
 
 from ..errors import InputError, check_finite_positive, check_instance
+from ..frozen import ReadOnlyArrays, read_only_arrays
 from .surface import Surface
 
 
@@ -144,8 +145,8 @@ def _default_window(surface, window):
 
 
 # -- PSD -----------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class PowerSpectrum:
+@dataclass(frozen=True, eq=False)      # arrays: == compared them and raised ValueError
+class PowerSpectrum(ReadOnlyArrays):
     """One-sided view of a (radially averaged) PSD; see the module docstring.
 
     Attributes
@@ -173,6 +174,9 @@ class PowerSpectrum:
     ndim: int
     window: str
     q2: Optional[np.ndarray] = None
+
+    def __post_init__(self):       # read-only copies: a result never changes
+        read_only_arrays(self, copy=True)
 
     @property
     def mean_square(self) -> float:

@@ -24,7 +24,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..errors import InputError, check_int, check_real_array
-from ..frozen import FrozenMapping
+from ..frozen import FrozenMapping, ReadOnlyArrays
 
 
 def _as_size(size, ndim):
@@ -47,7 +47,7 @@ def _as_size(size, ndim):
 
 
 @dataclass(frozen=True, eq=False)
-class Surface:
+class Surface(ReadOnlyArrays):
     """A rough profile or surface: heights in metres on a regular grid.
 
     Parameters

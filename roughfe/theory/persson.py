@@ -83,6 +83,7 @@ import scipy.special
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
                       check_real_array)
+from ..frozen import ReadOnlyArrays, compact_repr, read_only_arrays
 from ..surfaces.stats import PowerSpectrum, power_spectrum
 from ..surfaces.surface import Surface
 
@@ -303,7 +304,7 @@ def normal_stiffness(q, power, e_star, mean_pressure, gamma=GAMMA_DEFAULT, q2=No
 
 # -- results ---------------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
-class PerssonResult:
+class PerssonResult(ReadOnlyArrays):
     """Persson's theory for one surface at a set of mean pressures (SI).
 
     Attributes
@@ -343,6 +344,11 @@ class PerssonResult:
     ndim: int
     references: tuple = REFERENCES
     stiffness: np.ndarray = None
+
+    __repr__ = compact_repr
+
+    def __post_init__(self):       # read-only copies: a result never changes
+        read_only_arrays(self, copy=True)
 
     def records(self) -> list:
         """One JSON-safe dict per pressure (keys as in results.json)."""

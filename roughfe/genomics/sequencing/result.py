@@ -7,7 +7,7 @@ from typing import Optional
 import numpy as np
 
 from ...writers import to_jsonable
-from ...frozen import freeze_containers
+from ...frozen import compact_repr, freeze_containers
 from ..genome import Genome
 from .genes import M_VALUES
 from .lattice import round_off_cost
@@ -115,6 +115,8 @@ class SequencingResult:
     seed: Optional[int] = None
     elapsed: float = 0.0
     references: tuple = field(default=("thesis Sec. 3.3.1, Eq. 3.5-3.16",))
+
+    __repr__ = compact_repr          # one line (the full arrays ran to ~80k characters)
 
     def __post_init__(self):
         freeze_containers(self)
