@@ -137,3 +137,12 @@ def test_sphere_cap_is_found_beside_the_other_generators():
     from roughfe.surfaces.shapes import sphere_cap
 
     assert "sphere_cap" in surfaces.__all__ and surfaces.sphere_cap is sphere_cap
+
+
+def test_leakage_of_contact_names_an_unknown_option_and_the_viscosity(case):
+    """It raised Python's TypeError naming analyse_leakage, which the user never called;
+    theory.critical_junction's ``viscosity`` is ``mu`` here."""
+    step = case[2].results[1]
+    with pytest.raises(InputError, match=r"\['viscosity'\] for leakage_of_contact.*is mu"):
+        leakage_of_contact(step, viscosity=1e-3, pressure_drop=1e5)
+    assert leakage_of_contact(step, mu=1e-3, pressure_drop=1e5).leak_rate > 0

@@ -7,6 +7,7 @@ example the fields of a :class:`roughfe.model.ContactResult`, see
 """
 from __future__ import annotations
 
+import inspect
 from dataclasses import dataclass
 from typing import Mapping, Optional
 
@@ -232,6 +233,13 @@ def leakage_of_contact(contact_result, **kwargs) -> LeakageResult:
                    "a roughfe.model.ContactResult (solve_contact, response)")
     if np.ndim(contact_result.gap) != 2:
         raise InputError("leakage needs a 2D surface; got a contact result of a profile")
+    allowed = [k for k in inspect.signature(analyse_leakage).parameters
+               if k not in ("gap", "contact", "spacing")]
+    unknown = sorted(set(kwargs) - set(allowed))
+    if unknown:    # theory's critical_junction says viscosity; here it is mu (Pa s)
+        hint = "; the viscosity (Pa s) is mu" if "viscosity" in unknown else ""
+        raise InputError(f"unknown option(s) {unknown} for leakage_of_contact; allowed: "
+                         f"{allowed}{hint}")
     kwargs.setdefault("periodic", bool(contact_result.periodic))
     kwargs.setdefault("sigma", float(contact_result.rms_height))
     return analyse_leakage(contact_result.gap, contact_result.contact,
