@@ -80,8 +80,8 @@ class CriticalConstriction(ReadOnlyArrays):
     channel: np.ndarray
     channel_factor: float
 
-    def __post_init__(self):       # read-only copies: a result never changes
-        read_only_arrays(self, copy=True)
+    def __post_init__(self):       # a result never changes: its arrays read-only
+        read_only_arrays(self)     # in place (copies: +0.45 GB at 4096^2 Reynolds)
 
     def leak_rate_junction(self, *, mu: float, pressure_drop: float, length: float,
                            width: float) -> Optional[float]:

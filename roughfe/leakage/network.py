@@ -116,8 +116,8 @@ class DirectionalNetwork(ReadOnlyArrays):
 
     __repr__ = compact_repr
 
-    def __post_init__(self):       # read-only copies: a result never changes
-        read_only_arrays(self, copy=True)
+    def __post_init__(self):       # a result never changes: its arrays read-only
+        read_only_arrays(self)     # in place (copies: +0.45 GB at 4096^2 Reynolds)
 
     @property
     def n_sections(self) -> int:
@@ -173,7 +173,7 @@ class NetworkResult(ReadOnlyArrays):
 
     def __post_init__(self):
         object.__setattr__(self, "directions", FrozenMapping(self.directions))
-        read_only_arrays(self, copy=True)       # a result never changes
+        read_only_arrays(self)     # in place, as ContactResult's fields
 
     def percolates(self, direction: str) -> Optional[bool]:
         """Whether the network percolates along ``direction`` (None: not analysed)."""

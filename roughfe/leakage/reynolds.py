@@ -96,8 +96,8 @@ class ReynoldsResult(ReadOnlyArrays):
 
     __repr__ = compact_repr
 
-    def __post_init__(self):       # read-only copies: a result never changes
-        read_only_arrays(self, copy=True)
+    def __post_init__(self):       # a result never changes: its arrays read-only
+        read_only_arrays(self)     # in place (copies: +0.45 GB at 4096^2 Reynolds)
 
     @property
     def pressure_at(self) -> str:

@@ -175,8 +175,8 @@ class PowerSpectrum(ReadOnlyArrays):
     window: str
     q2: Optional[np.ndarray] = None
 
-    def __post_init__(self):       # read-only copies: a result never changes
-        read_only_arrays(self, copy=True)
+    def __post_init__(self):       # a result never changes: its arrays read-only
+        read_only_arrays(self)     # in place (copies: +0.45 GB at 4096^2 Reynolds)
 
     @property
     def mean_square(self) -> float:
