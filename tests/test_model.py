@@ -257,3 +257,33 @@ def test_one_results_file_schema_for_bem_and_fem(bem_and_fem, tmp_path):
     assert set(ref["steps"][0]) < set(fem["steps"][0])
     assert set(fem["steps"][0]) - set(ref["steps"][0]) == {"delta_applied",
                                                            "layer_compliance"}
+
+
+def test_fields_h5_reads_back_what_was_written(tmp_path):
+    # write_fields_h5 had no reader (a scripting user's review): the fields, the per-frame
+    # response and the units come back as written, read-only; a foreign file is refused
+    pytest.importorskip("h5py")
+    from roughfe.bem import contact_sweep
+    from roughfe.bem.output import read_fields_h5, write_fields_h5
+    from roughfe.errors import FileFormatError
+    from roughfe.surfaces.spectral import spectral_surface
+
+    surf = spectral_surface(32, 1e-4, 0.8, rms_height=1e-6, rng=3)
+    sweep = contact_sweep(surf, Material(1e9, 0.3), n_steps=3, hardness=2e7)
+    back = read_fields_h5(write_fields_h5(tmp_path / "fields.h5", sweep))
+    for name in ("pressure", "gap", "contact", "plastic_displacement"):
+        assert np.array_equal(back[name], np.stack([getattr(r, name) for r in sweep.results]))
+        assert not back[name].flags.writeable
+    assert np.array_equal(back["delta"], [r.delta for r in sweep.results])
+    assert np.array_equal(back["stiffness"], sweep.stiffness)
+    assert back.units["pressure"] == "Pa" and back.units["gap"] == "m"
+    assert back.attrs["size_m"] == list(surf.size) and back.attrs["periodic"] is True
+    assert back.attrs["e_star_Pa"] == sweep.e_star and back.attrs["method"] == "bem"
+    import h5py
+    with h5py.File(tmp_path / "other.h5", "w") as f:
+        f["x"] = np.zeros(3)
+    with pytest.raises(FileFormatError, match="no dataset pressure, gap, delta"):
+        read_fields_h5(tmp_path / "other.h5")
+    (tmp_path / "text.h5").write_text("not hdf5")
+    with pytest.raises(FileFormatError, match="not an HDF5 file"):
+        read_fields_h5(tmp_path / "text.h5")

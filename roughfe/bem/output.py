@@ -14,14 +14,18 @@ BEM or the FEM (:func:`roughfe.response.response`).
   load: K is then mostly the window's flat-punch bulk stiffness).
 * ``fields.h5``: datasets ``pressure`` (Pa) and ``gap`` (m) of shape
   ``(frame, *grid)``, ``contact`` (bool) and ``delta`` (m) per frame, with the grid
-  size/spacing as attributes (the "frame" layout of Tamaas/ContactMechanics dumps).
+  size/spacing as attributes (the "frame" layout of Tamaas/ContactMechanics dumps);
+  :func:`read_fields_h5` reads it back.
 """
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import FileFormatError
+from ..frozen import FrozenMapping
 from ..writers import atomic_path, write_json
 from ..model import SweepResult
 from .window import window_report
@@ -115,3 +119,58 @@ def write_fields_h5(path, sweep: SweepResult, compression: str = "gzip"):
                 ds = f.create_dataset("unloading", data=np.asarray(sweep.unloading, float))
                 ds.attrs["unit"] = "1 on the unloading branch, 0 on loading"
     return path
+
+
+@dataclass(frozen=True, eq=False)
+class ContactFields:
+    """A ``fields.h5`` read back (:func:`read_fields_h5`).
+
+    Attributes
+    ----------
+    data : Mapping[str, ndarray]
+        Every dataset by name, read-only: ``pressure`` (Pa), ``gap`` (m), ``contact`` of
+        shape ``(frame, *grid)``, and ``delta``, ``mean_pressure``, ``stiffness``,
+        ``area_fraction``, ``mean_gap`` (and ``plastic_displacement``, ``unloading`` when
+        written) as written by :func:`write_fields_h5`.
+    units : Mapping[str, str]
+        The ``unit`` attribute of each dataset.
+    attrs : Mapping[str, object]
+        The file's attributes (``size_m``, ``spacing_m``, ``periodic``, ``method``,
+        ``kernel``, ``dimensions``, ``e_star_Pa``).
+    """
+
+    data: FrozenMapping
+    units: FrozenMapping
+    attrs: FrozenMapping
+
+    def __getitem__(self, name):
+        return self.data[name]
+
+
+def read_fields_h5(path) -> ContactFields:
+    """Read a ``fields.h5`` of :func:`write_fields_h5` (``roughfe contact``) back: the
+    datasets as read-only arrays with their units, and the file's attributes. A file
+    that is not such a file is a :class:`~roughfe.errors.FileFormatError` naming what is
+    missing."""
+    import h5py
+
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise FileFormatError(f"{path} is not an HDF5 file of roughfe contact fields "
+                              f"({exc})") from None
+    with f:
+        missing = [k for k in ("pressure", "gap", "delta") if k not in f]
+        if missing:
+            raise FileFormatError(f"{path}: no dataset {', '.join(missing)}: not a fields.h5 "
+                                  f"of roughfe contact (datasets: {', '.join(f) or 'none'})")
+        data, units = {}, {}
+        for name, ds in f.items():
+            arr = ds[()]
+            arr.setflags(write=False)
+            data[name] = arr
+            units[name] = str(ds.attrs.get("unit", ""))
+        attrs = {k: (v.tolist() if isinstance(v, np.ndarray) else
+                     v.item() if isinstance(v, np.generic) else v)
+                 for k, v in f.attrs.items()}
+    return ContactFields(FrozenMapping(data), FrozenMapping(units), FrozenMapping(attrs))
