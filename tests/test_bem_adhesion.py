@@ -765,3 +765,52 @@ def test_a_branch_without_tensile_state_has_no_pull_off():
     unloading = np.flatnonzero(sw.sweep.unloading)
     assert sw.sweep.results[unloading[-1]].n_contact == 0
     assert sw.sweep.results[unloading[-2]].n_contact > 0
+
+
+@pytest.mark.slow
+def test_a_narrow_ramp_on_summits_of_the_grid_scale_needs_the_cells_stiffness(
+        topographies_dir):
+    """Round 2, session 31. A 192^2 window of di-1.di (Love kernel, E* = 210 MPa,
+    w = 0.05 J/m^2, h0 = 2 nm: 13.5 zone cells; its summits stand 0.27 nm rms off their
+    neighbours), cold solves with the same flat at 0.317 of di-1's peak-to-valley height.
+    On the measured grid one patch has jumped in with the ramps s = 0.2 and 0.5 and not
+    with the default 0.05 (measured A* 0.124 against 0.187, its jump-in 0.32 nm of
+    approach late; 0.21 / 0.15 nm at s = 0.2 / 0.5); on the 2x Fourier refinement (27
+    zone cells) all three give A* = 0.1701 (and on the 4x one the jump-in approaches of
+    the 2x grid). The rule asks the cell's stiffness E*/(c dx) to exceed the ramp's
+    sigma0/(s h0) there: (pi/4)/s c = 17.6 cells at s = 0.05."""
+    from roughfe.bem.interface_law import cell_relief, check_resolution, resolution
+    from roughfe.surfaces.io import load_surface
+    full = load_surface(topographies_dir / "di-1.di")
+    h_full = full.heights
+    plane = h_full.max() - 0.317 * (h_full.max() - h_full.min())
+    mirror = full.mirrored()
+    mat = Material(2.1e8, 0.0)
+    laws = [AdhesionLaw("md", 0.05, 2e-9, smoothing=s) for s in (0.05, 0.2, 0.5)]
+    area = {}
+    for f in (1, 2):
+        grid = mirror if f == 1 else mirror.resampled((mirror.shape[0] * f,) * 2)
+        s = Surface(grid.heights[224 * f:416 * f, 288 * f:480 * f], 192 * full.spacing[0],
+                    periodic=False)
+        relief = cell_relief(s.heights)
+        assert relief == pytest.approx(0.27e-9 / f ** 1.4, rel=0.1)
+        r = resolution(laws[0], mat.E_star, s.spacing, 1.12, relief)
+        assert r["process_zone_cells"] == pytest.approx(13.5 * f, abs=0.1 * f)
+        assert r["threshold_cells"] == pytest.approx(np.pi / 4 / 0.05 * 1.12, abs=1e-9)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", ResolutionWarning)
+            for law in laws[1:]:      # resolved on both grids
+                assert check_resolution(law, mat.E_star, s.spacing, 1.12, relief)
+            if f == 2:
+                assert check_resolution(laws[0], mat.E_star, s.spacing, 1.12, relief)
+        if f == 1:
+            with pytest.warns(ResolutionWarning, match=r"needs at least 18.*smoothing 0.5"):
+                solve_adhesive(s, mat, laws[0], delta=s.heights.max() - plane)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ResolutionWarning)
+            area[f] = [solve_adhesive(s, mat, law, delta=s.heights.max() - plane).area_fraction
+                       for law in laws]
+    assert area[1][0] < area[1][1] - 0.05
+    assert area[1][1] == pytest.approx(area[1][2], abs=2e-3)
+    assert max(area[2]) - min(area[2]) < 1e-3
+    assert area[2][0] == pytest.approx(0.1701, abs=1e-3)

@@ -226,7 +226,9 @@ def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
 
     el = run("elastic")
     # (a range of half the peak-to-valley height: the law's process zone, 25.8 um, spans
-    # 4.2 grid spacings; resolved, roughfe.bem.interface_law.check_resolution)
+    # 4.2 grid spacings; roughfe.bem.interface_law.check_resolution: not enough for the
+    # default ramp on summits that stand off this 17^2 grid by more than half of it,
+    # round 2 session 31)
     rng = str(0.5 * np.ptp(s.heights))
     adh = run("adhesive", "--adhesion", "md", "--work-of-adhesion", "5", "--range", rng)
     hp = 0.3 * max(st["mean_pressure"] for st in el["steps"]) / el["steps"][-1]["area_fraction"]
@@ -238,11 +240,16 @@ def test_leak_takes_the_contact_physics_options(tmp_path, capsys):
     zone = np.pi / 4 * e_star * 5.0 / (5.0 / float(rng)) ** 2
     assert res["process_zone"] == pytest.approx(zone, rel=1e-12, abs=0)
     assert res["grid_spacing"] == pytest.approx(max(s.spacing), rel=1e-12, abs=0)
-    assert res["resolved"] and res["process_zone_cells"] == pytest.approx(
-        zone / max(s.spacing), rel=1e-12)
-    # the Maugis-Dugdale law on a surface needs 2.7 cell compliances (about 3 cells)
+    assert res["process_zone_cells"] == pytest.approx(zone / max(s.spacing), rel=1e-12,
+                                                      abs=0)
+    # the Maugis-Dugdale law on a surface needs 2.7 cell compliances (about 3 cells), and
+    # (pi/4)/s of them where the summits stand off the grid by more than half the ramp
+    # s h0 / 2 (the cell relief, recorded)
     assert res["cell_compliance"] == pytest.approx(1.11, abs=0.02)
-    assert res["threshold_cells"] == pytest.approx(2.7 * res["cell_compliance"], rel=1e-12)
+    assert res["cell_relief"] > 0.5 * 0.05 * float(rng)
+    assert res["threshold_cells"] == pytest.approx(np.pi / 4 / 0.05 * res["cell_compliance"],
+                                                   rel=1e-12, abs=0)
+    assert not res["resolved"]
     assert "adhesion_resolution" not in el["inputs"]
     # the (non-adhesive) Persson theory beside the elastic steps only, not the adhesive ones
     assert all(st["persson_leak_rate"] is not None for st in el["steps"])

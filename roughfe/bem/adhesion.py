@@ -79,7 +79,7 @@ from .adhesive_energy import AdhesiveEnergy
 from .adhesive_pull_off import refine_pull_off, tensile_floor
 from .adhesive_rules import check_adhesive_run
 from .adhesive_start import continued_start, elastic_start
-from .interface_law import LAWS, AdhesionLaw, check_resolution, resolution
+from .interface_law import LAWS, AdhesionLaw, cell_relief, check_resolution, resolution
 
 __all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "cell_compliance",
            "check_adhesive_objects", "solve_adhesive"]
@@ -215,8 +215,8 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
                              f"it None (got spring={spring!r})")
         spring = check_finite_positive("spring (stiffness of the mean-gap spring, Pa/m)",
                                        spring)
-    check_resolution(law, material.E_star, surface.spacing,
-                     cell_compliance(surface, material.E_star, kernel))
+    check_resolution(law, material.E_star, surface.spacing, cell_compliance(
+        surface, material.E_star, kernel), cell_relief(surface.heights))
     _check_below_full_contact(surface, op.periodic, d)
     h = surface.heights
     c = float(h.max()) - h - d
@@ -439,7 +439,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     op = _operator(surface.shape, surface.size, material.E_star, _choose_kernel(surface, kernel))
     _check_below_full_contact(surface, op.periodic, float(deltas.max()))
     grid = (law, material.E_star, surface.spacing,
-            cell_compliance(surface, material.E_star, kernel))
+            cell_compliance(surface, material.E_star, kernel), cell_relief(surface.heights))
     check_resolution(*grid)   # once for the sweep
     with warnings.catch_warnings():       # not again at every step
         warnings.simplefilter("ignore", ResolutionWarning)

@@ -30,7 +30,8 @@ strip; :meth:`AdhesionLaw.process_zone`). When it is far below the grid spacing 
 cell is an independent bistable spring: the pull-off and the hysteresis then depend on
 the grid and on the steps of the continuation, and :func:`check_resolution` warns below
 the zone the law needs on the grid (:meth:`AdhesionLaw.resolution_cells`: one spacing
-for the exponential law on a surface, three for Maugis-Dugdale, more on profiles)
+for the exponential law on a surface, three for Maugis-Dugdale, more on profiles and
+where summits stand off the grid by more than the ramp)
 (:class:`~roughfe.errors.ResolutionWarning`). Measured on a rough 32^2 periodic contact
 (docs/theory/07_adhesion_persson.md, "The continuation's predictor and the process
 zone"): with the zone at 3.4 and 0.42 grid spacings the pull-off does not depend on the
@@ -123,12 +124,15 @@ class AdhesionLaw:
         half the length. Measured on Johnson's adhesive sinusoid (tests)."""
         return float(np.pi / 4 * e_star * self.work / self.max_traction ** 2)
 
-    def resolution_cells(self, cell_compliance: float, ndim: int) -> float:
+    def resolution_cells(self, cell_compliance: float, ndim: int,
+                         relief: float | None = None) -> float:
         """The least process zone, in grid spacings, that resolves this law on a grid
         whose cell has the self-compliance ``cell_compliance`` (its centre displacement
         under a uniform pressure on it, in p dx / E*: the influence operator's diagonal
         H_ii E*/dx; :data:`SQUARE_CELL_COMPLIANCE` on a surface, 3-7 on a profile,
-        growing as log n) in ``ndim`` dimensions.
+        growing as log n) in ``ndim`` dimensions; ``relief`` (m, surfaces,
+        :func:`cell_relief`; None: smooth) how far the heights stand off their
+        neighbours.
 
         * exponential: c / 1.12 (:data:`PROCESS_ZONE_CELLS` = 1.0 on a square cell of a
           surface). The cell's stiffness E*/(c dx) must exceed the law's peak stiffness
@@ -141,6 +145,16 @@ class AdhesionLaw:
           widens it where the gap varies across a cell: measured on Maugis' sphere
           (lambda 1-3, s = 0.05-0.5), +5.6 % pull-off and 6 % hysteresis at 1.0 cell,
           +0.9-1.0 % and 0.7-1.5 % at 3.1-3.5 cells, the same for every s <= 0.2.
+          Where the heights stand off their neighbours by more than half the ramp
+          (``relief``, :func:`cell_relief`, above ``max(s, 0.05) h0 / 2``) the cell
+          average, linear across a cell, cannot widen the ramp on a summit: there it asks
+          ``max(2.7, (pi/4) / max(s, 0.05)) c``, the cell's stiffness E*/(c dx) at least
+          the ramp's sigma0/(s h0). Measured (round 2, session 31) on a 192^2 window of
+          di-1.di (relief 0.27 nm, h0 = 2 nm, 13.5 zone cells) and its Fourier
+          refinements: the approach at which a patch jumps in is 0.32 / 0.21 / 0.15 nm
+          late at s = 0.05 / 0.2 / 0.5 on the measured grid, converged on the 2x grid
+          (27 cells) for every s; Maugis' sphere (relief < 0.012 h0) jumps in where its
+          apex meets the ramp's outer edge at every grid from 1.2 cells.
         * Maugis-Dugdale on a profile: max(3.2, 0.6 / max(s, 0.05)) c. On Johnson's
           sinusoid the hysteresis where the state is unique (positive approach) falls
           below 1 % of the pull-off at about 16, 20-32, 32 and 64 cells for s = 0.5, 0.2,
@@ -153,9 +167,11 @@ class AdhesionLaw:
         c = float(cell_compliance)
         if self.kind == "exp":
             return PROCESS_ZONE_CELLS / SQUARE_CELL_COMPLIANCE * c
+        s = max(self.smoothing, 0.05)
         if ndim >= 2:
-            return 2.7 * c
-        return max(3.2, 0.6 / max(self.smoothing, 0.05)) * c
+            summits = relief is not None and relief > 0.5 * s * self.range
+            return max(2.7, np.pi / 4 / s) * c if summits else 2.7 * c
+        return max(3.2, 0.6 / s) * c
 
     def cell_ramp(self, spread):
         """``(g1, width)`` (m, per point): the start and width of the ramp that the
@@ -215,15 +231,29 @@ class AdhesionLaw:
                 "smoothing": self.smoothing if self.kind == "md" else None}
 
 
+def cell_relief(heights) -> float | None:
+    """The rms (m) of the heights less the mean of their four neighbours (interior
+    points of a surface; None for a profile): how far summits and pits stand off the
+    grid around them, the measure of :meth:`AdhesionLaw.resolution_cells` (0.27 nm on
+    di-1.di, 0.10 / 0.029 nm on its 2x / 4x Fourier refinements; 0.012 h0 on Maugis'
+    sphere at 48^2)."""
+    h = np.asarray(heights, float)
+    if h.ndim < 2 or min(h.shape) < 3:
+        return None
+    d = h[1:-1, 1:-1] - 0.25 * (h[2:, 1:-1] + h[:-2, 1:-1] + h[1:-1, 2:] + h[1:-1, :-2])
+    return float(np.sqrt(np.mean(d * d)))
+
+
 def resolution(law: AdhesionLaw, e_star: float, spacing,
-               cell_compliance: float | None = None) -> dict:
+               cell_compliance: float | None = None, relief: float | None = None) -> dict:
     """The law's process zone against the grid, JSON-safe (the provenance a result file
     keeps beside the warning of :func:`check_resolution`): ``process_zone`` (m,
     :meth:`AdhesionLaw.process_zone`), ``grid_spacing`` (m, the largest of ``spacing``,
     one per axis), ``process_zone_cells`` (their ratio), ``cell_compliance`` (the
     operator's diagonal H_ii E*/dx; default :data:`SQUARE_CELL_COMPLIANCE` on a surface,
-    required for a profile), ``threshold_cells`` (:meth:`AdhesionLaw.resolution_cells`)
-    and ``resolved`` (ratio >= threshold)."""
+    required for a profile), ``cell_relief`` (m, :func:`cell_relief`, or None),
+    ``threshold_cells`` (:meth:`AdhesionLaw.resolution_cells`) and ``resolved``
+    (ratio >= threshold)."""
     zone = law.process_zone(e_star)
     spacing = np.atleast_1d(np.asarray(spacing, float))
     dx, ndim = float(np.max(spacing)), spacing.size
@@ -232,27 +262,32 @@ def resolution(law: AdhesionLaw, e_star: float, spacing,
             raise InputError("the resolution of a law on a profile needs the cell's "
                              "compliance (the influence operator's diagonal H_ii E*/dx)")
         cell_compliance = SQUARE_CELL_COMPLIANCE
-    need = law.resolution_cells(cell_compliance, ndim)
+    relief = None if relief is None else float(relief)
+    need = law.resolution_cells(cell_compliance, ndim, relief)
     return {"process_zone": zone, "grid_spacing": dx, "process_zone_cells": zone / dx,
-            "cell_compliance": float(cell_compliance), "threshold_cells": need,
+            "cell_compliance": float(cell_compliance), "cell_relief": relief,
+            "threshold_cells": need,
             "resolved": bool(zone >= need * dx)}
 
 
 def check_resolution(law: AdhesionLaw, e_star: float, spacing,
-                     cell_compliance: float | None = None) -> bool:
+                     cell_compliance: float | None = None,
+                     relief: float | None = None) -> bool:
     """Warn (:class:`~roughfe.errors.ResolutionWarning`) when the law's process zone
     (:meth:`AdhesionLaw.process_zone`) spans fewer grid spacings than the law needs
     (:meth:`AdhesionLaw.resolution_cells`, :func:`resolution` for the arguments);
     returns True when it is resolved."""
-    r = resolution(law, e_star, spacing, cell_compliance)
+    r = resolution(law, e_star, spacing, cell_compliance, relief)
     if r["resolved"]:
         return True
     zone, dx, need = r["process_zone"], r["grid_spacing"], r["threshold_cells"]
-    # a Maugis-Dugdale law on a profile is set by its ramp: a wider one resolves sooner
+    # a Maugis-Dugdale law on a profile or on summits is set by its ramp: a wider one
+    # resolves sooner
     wider = (AdhesionLaw("md", law.work, law.range, smoothing=0.5)
              if law.kind == "md" and law.smoothing < 0.5 else None)
     easier = (None if wider is None else
-              wider.resolution_cells(r["cell_compliance"], np.size(spacing)))
+              wider.resolution_cells(r["cell_compliance"], np.size(spacing),
+                                     r["cell_relief"]))
     hint = (f", or the ramp smoothing 0.5 (smoothing=, roughfe --smoothing; needs "
             f"{easier:.2g} spacings)"
             if easier is not None and easier < 0.9 * need else "")

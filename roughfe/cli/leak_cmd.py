@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bem.interface_law import resolution
+from ..bem.interface_law import cell_relief, resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import atomic_path, write_json
@@ -304,7 +304,7 @@ def _leak_run(args, surface, material, out):
         from ..bem.adhesion import cell_compliance
         base["adhesion_resolution"] = resolution(
             physics["adhesion"], material.E_star, surface.spacing,
-            cell_compliance(surface, material.E_star))
+            cell_compliance(surface, material.E_star), cell_relief(surface.heights))
     if args.fsi:
         if physics["adhesion"] is not None or physics["hardness"] is not None \
                 or physics["unload"]:
