@@ -79,7 +79,6 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 sys.path.insert(0, str(HERE))
 
-import roughfe.bem.contact as contact  # noqa: E402
 from roughfe.bem import Material, solve_contact  # noqa: E402
 from roughfe.bem.coarse_start import _coarse_start, _coarse_surface  # noqa: E402
 from roughfe.bem.contact import _cg_preconditioner, _operator  # noqa: E402
@@ -259,17 +258,9 @@ def fmg_start(levels, nu1, nu2, coarse_tol, coarse_iter, load):
     return P
 
 
-CALLS = []
-_pk_orig = contact.polonsky_keer
+from _pk_log import install  # noqa: E402  (benchmarks/_pk_log.py)
 
-
-def _pk_logged(apply, b, *args, **kw):
-    out = _pk_orig(apply, b, *args, **kw)
-    CALLS.append((b.size, out.n_products, out.nit))
-    return out
-
-
-contact.polonsky_keer = _pk_logged
+CALLS = install()     # (grid points, products, nit) of every polonsky_keer call
 
 
 def production(surface, load, initial=None):

@@ -40,22 +40,13 @@ from roughfe.surfaces.spectral import spectral_surface  # noqa: E402
 
 MAT = Material(1.0, 0.0)
 NPROD = [0]
-CALLS = []          # (grid points, products, nit) of every polonsky_keer call
 DTYPE = [np.float64]
 EDGE_ONLY = [False]
 NWIN = []
 
-import roughfe.bem.contact as _contact  # noqa: E402
-_pk_orig = _contact.polonsky_keer
+from _pk_log import install  # noqa: E402  (benchmarks/_pk_log.py)
 
-
-def _pk_logged(apply, b, *args, **kw):
-    out = _pk_orig(apply, b, *args, **kw)
-    CALLS.append((b.size, out.n_products, out.nit))
-    return out
-
-
-_contact.polonsky_keer = _pk_logged
+CALLS = install()   # (grid points, products, nit) of every polonsky_keer call
 
 
 def conv_eq(calls, n_fine):
