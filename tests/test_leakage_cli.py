@@ -35,6 +35,9 @@ def test_leak_command_writes_results_fields_and_figures(tmp_path):
     assert len(steps) == 2 and STEP_KEYS <= set(steps[0])
     assert steps[0]["percolates_y"] is None            # not analysed
     assert set(res["units"]) == set(steps[0])          # every key has its unit
+    # the persson block's meaning of a null K, not the bare "Pa/m" of the suffix rule
+    assert res["units"]["persson_stiffness"] == res["persson"]["units"]["persson_stiffness"]
+    assert "null: infinite" in res["units"]["persson_stiffness"]
     for st in steps:     # the sealed part of the trapped (non-percolating) volume
         assert 0 <= st["sealed_volume"] <= st["trapped_volume"]
     assert "stiffness" not in steps[0]                 # not computed: no null read as inf

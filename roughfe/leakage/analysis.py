@@ -18,6 +18,7 @@ from ..errors import (InputError, check_finite_nonnegative, check_finite_positiv
                       check_real_array)
 from ..frozen import FrozenMapping, compact_repr
 from ..model import ContactResult
+from ..theory.beside import UNITS as PERSSON_UNITS
 from .junction import CriticalConstriction, critical_constriction
 from .network import NetworkResult, free_volume_network
 from .reynolds import ReynoldsResult, reynolds_flow
@@ -342,6 +343,7 @@ _RECORD_UNITS = {
     "external_pressure": "Pa", "contact_area": "m^2", "n_contact": "count",
     "mean_gap": "m", "mean_plane_separation": "m", "residual": "1 (relative KKT residual)",
     "iterations": "count", "separation_star": "1 (d / sigma)", "contact_success": "bool",
+    "persson_stiffness": PERSSON_UNITS["persson_stiffness"],
     "hydraulic_aperture": "m", "percolates": "bool", "percolates_reynolds": "bool",
     "flow_imbalance": "1 (|inlet flow - outlet flow| / leak rate)", "reynolds_nit": "count",
     "critical_position": "m (x, y of the junction centre)", "critical_width": "m",

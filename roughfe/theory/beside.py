@@ -80,6 +80,14 @@ NON_GAUSSIAN = {"skewness": 2.0, "kurtosis": 20.0}
 ANISOTROPIC_STR = 0.15
 
 
+#: units of Persson's step keys and of ``u0`` (the ``persson`` block's ``units``; the
+#: step units of ``roughfe leak`` take ``persson_stiffness``'s from here)
+UNITS = {"persson_mean_gap": "m", "u0": "m",
+         "persson_stiffness": "Pa/m (K = -dp/du; null: infinite, the theory's full "
+                              "contact u = 0)",
+         "persson_leak_rate": "m^3/s"}
+
+
 def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, direction="x",
            gamma=GAMMA_DEFAULT, adhesive=False) -> dict:
     """Persson's theory at the mean pressure of each simulation step (results.json).
@@ -155,10 +163,7 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         j += k
         out.append(rec)
     info = {"gamma": theory.gamma, "kappa": theory.kappa, "rms_gradient": theory.rms_gradient,
-            "u0": theory.u0, "units": {"persson_mean_gap": "m", "u0": "m",
-                                       "persson_stiffness": "Pa/m (K = -dp/du; null: infinite, "
-                                                            "the theory's full contact u = 0)",
-                                       "persson_leak_rate": "m^3/s"},
+            "u0": theory.u0, "units": dict(UNITS),
             "references": list(REFERENCES)}
     if pressure_drop is not None:
         info["percolation_threshold"] = PERCOLATION_THRESHOLD
