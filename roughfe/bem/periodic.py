@@ -100,7 +100,8 @@ def bounded_approach_by_load(op, h, hmax, scale, delta, tol, max_iter, hardness,
     if delta >= hmax - float(h.min()):   # every point plastic: p = H_p, u = 0 (zero mean)
         return SolverOutput(np.full(h.shape, float(hardness)), np.zeros(h.shape), delta, 0,
                             0.0, "closed form")
-    lo, last = 0.0, np.zeros(h.shape)
+    # the bracket's lower end: P (Pa), Delta(P) - delta (m) and the first solve's start
+    lo, f_lo, last = 0.0, hmax - float(h.max()) - delta, None      # first contact
     p0 = periodic_full_contact(op, h)
     onset = float(hardness) - float(p0.max())    # the first point yields in full contact
     if onset >= -float(p0.min()) and delta >= hmax - float(h.mean()):
@@ -109,7 +110,7 @@ def bounded_approach_by_load(op, h, hmax, scale, delta, tol, max_iter, hardness,
             # elastic closed form of solve_contact takes it
             p0 -= float(p0.min())
             return SolverOutput(p0, h - float(h.mean()), delta, 0, 0.0, "closed form")
-        lo, last = onset, p0 + onset             # Delta(lo) = max h - mean h < delta
+        lo, f_lo, last = onset, hmax - float(h.mean()) - delta, p0 + onset   # f_lo < 0
     del p0
     state = {"nit": 0, "products": 0, "solves": 0, "out": None, "res": np.inf}
 
@@ -128,7 +129,6 @@ def bounded_approach_by_load(op, h, hmax, scale, delta, tol, max_iter, hardness,
             raise _Solved
         return out.delta - delta
 
-    f_lo = (hmax - float(h.max()) if lo == 0.0 else hmax - float(h.mean())) - delta
     f_hi = hmax - float(h.min()) - delta         # P = H_p: every point plastic
     try:
         scipy.optimize.brentq(lambda P: f_lo if P == lo else f_hi if P == hardness
