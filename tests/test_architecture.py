@@ -5,6 +5,10 @@ optim -> surfaces -> model -> theory -> bem -> fem -> response -> leakage -> gen
 (errors, writers, reference, caching, frozen, _runtime, progress and validation are the base
 layer, importable from anywhere; model.py holds the contract types shared by bem and fem,
 response.py the one dispatch to them.)
+roughfe/__init__.py is the users' namespace, outside the layers: at module level it imports
+the standard library only, it reaches the layers lazily through its one table (PEP 562;
+plotting and cli not among them), and no library module imports a name through it (each
+imports from the module that defines the name, so the layer of that module is checked).
 optim holds generic optimisers without physics (the one GCMMA driver).
 No library module is over MAX_LINES lines unless ``LONG_MODULES`` states why.
 dolfinx, petsc4py, mpi4py.futures aside, gmsh and ufl are imported only inside roughfe/fem.
@@ -53,7 +57,10 @@ def _imports(path):
             for alias in node.names:
                 yield node.lineno, alias.name
         elif isinstance(node, ast.ImportFrom):
-            if node.level == 0:
+            if node.level == 0 and node.module == "roughfe":
+                for alias in node.names:       # from roughfe import X: X's own layer
+                    yield node.lineno, f"roughfe.{alias.name}"
+            elif node.level == 0:
                 yield node.lineno, node.module or ""
             else:
                 base = list(rel[:-1])
@@ -67,7 +74,14 @@ def _imports(path):
                     yield node.lineno, mod
 
 
+def _namespace():
+    """The top-level table: name -> defining module, and the lazy submodules."""
+    import roughfe
+    return roughfe._EXPORTS, roughfe._SUBMODULES
+
+
 def test_imports_flow_one_way():
+    exports, _ = _namespace()
     bad = []
     for path in sorted(PKG.rglob("*.py")):
         rel = path.relative_to(PKG).parts
@@ -81,12 +95,30 @@ def test_imports_flow_one_way():
             if top != "roughfe" or mod == "roughfe":
                 continue
             target = mod.split(".")[1]
+            if target in exports:
+                bad.append(f"{path.relative_to(PKG.parent)}:{lineno} imports {target} through "
+                           f"the top-level namespace; import it from {exports[target]}")
+                continue
             if target in BASE or target == "__version__":
                 continue
             other, _ = _layer([target])
             if other > me:
                 bad.append(f"{path.relative_to(PKG.parent)}:{lineno} imports {mod} (rightward)")
     assert not bad, "backward imports:\n" + "\n".join(bad)
+
+
+def test_top_level_namespace_is_lazy_and_stays_left_of_plotting_and_cli():
+    exports, submodules = _namespace()
+    tree = ast.parse((PKG / "__init__.py").read_text())
+    eager = [f"line {node.lineno}" for node in tree.body
+             if isinstance(node, ast.ImportFrom) and (node.level or node.module == "roughfe"
+                                                     or node.module.startswith("roughfe."))
+             or isinstance(node, ast.Import) and any(a.name.startswith("roughfe")
+                                                     for a in node.names)]
+    assert not eager, f"roughfe/__init__.py imports roughfe modules eagerly at {eager}"
+    reached = {m.split(".")[1] for m in exports.values()} | set(submodules)
+    assert reached <= set(ORDER) | BASE - {"__init__"}, reached - set(ORDER) - BASE
+    assert not reached & {"plotting", "cli"}, "nothing imports plotting or cli (STYLE.md (a))"
 
 
 def test_no_module_is_over_the_line_limit():
