@@ -475,6 +475,8 @@ def central_differences(x, y, branch=None):
 #: Per-step arrays of a sweep, taken from the ContactResult fields of the same name.
 _SWEEP_SERIES = ("delta", "mean_pressure", "load", "area_fraction", "stiffness", "mean_gap",
                  "mean_plane_separation", "free_volume_star")
+#: Optional values of a whole sweep (SweepResult.from_results' keywords), not per step.
+_SWEEP_WHOLE = ("pull_off_force", "pull_off_pressure", "detached")
 
 
 @dataclass(frozen=True, eq=False)
@@ -511,6 +513,11 @@ class SweepResult(Frozen):
         BEM with a hardness: plastic area fraction per step.
     unloading : ndarray or None
         BEM sweeps with a branch: 1.0 on the unloading branch, 0.0 on loading.
+    pull_off_force, pull_off_pressure, detached : float, float, bool or None
+        Adhesive sweeps with an unloading branch (None otherwise): the most tensile load
+        of that branch (N, N/m for profiles; 0 when none is tensile), as a mean pressure
+        (Pa), and whether the branch reached separation (False: the force is a bound);
+        :class:`roughfe.bem.adhesion.AdhesiveSweep`.
 
     All arrays are read-only.
     """
@@ -536,11 +543,16 @@ class SweepResult(Frozen):
     delta_applied: Optional[np.ndarray] = None
     plastic_area_fraction: Optional[np.ndarray] = None
     unloading: Optional[np.ndarray] = None
+    # -- optional values of the whole sweep (not per step; from_results' keywords) --
+    pull_off_force: Optional[float] = None
+    pull_off_pressure: Optional[float] = None
+    detached: Optional[bool] = None
 
     __repr__ = compact_repr          # one line: arrays as shape and dtype, results counted
 
     @classmethod
-    def from_results(cls, results, *, rms_slope: float, length: float) -> "SweepResult":
+    def from_results(cls, results, *, rms_slope: float, length: float,
+                     **whole) -> "SweepResult":
         """Build a sweep from its steps (the one place the step arrays are made).
 
         Parameters
@@ -551,14 +563,20 @@ class SweepResult(Frozen):
             gbar of the surface (for ``pressure_star``).
         length : float
             L in P* = p L / (E* sigma) (m).
+        **whole
+            Values of the whole sweep (:data:`_SWEEP_WHOLE`: the pull-off of an
+            adhesive unloading branch).
         """
         results = tuple(results)
+        if set(whole) - set(_SWEEP_WHOLE):
+            raise InputError(f"from_results takes {_SWEEP_WHOLE} beside the steps, got "
+                             f"{sorted(whole)}")
         if not results or not all(isinstance(r, ContactResult) for r in results):
             raise InputError("a SweepResult needs at least one ContactResult")
         arr = {k: np.array([getattr(r, k) for r in results], float) for k in _SWEEP_SERIES}
         optional = {}
         for f in dataclasses.fields(cls):
-            if f.default is None:
+            if f.default is None and f.name not in _SWEEP_WHOLE:
                 vals = [getattr(r, f.name, None) for r in results]
                 if all(_is_number(v) for v in vals):
                     optional[f.name] = np.array(vals, float)
@@ -568,7 +586,7 @@ class SweepResult(Frozen):
             stars = {"load_star": pm * float(length) / (e * sigma),
                      "pressure_star": pm / (e * float(rms_slope)),
                      "separation_star": arr["mean_plane_separation"] / sigma}
-        return cls(results=results, **arr, **optional, **stars,
+        return cls(results=results, **arr, **optional, **stars, **whole,
                    n_contact=np.array([r.n_contact for r in results], dtype=np.int64),
                    stiffness_fd=central_differences(arr["delta"], pm,
                                                     optional.get("unloading")),

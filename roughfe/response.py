@@ -75,7 +75,9 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
     -------
     SweepResult
         One :class:`roughfe.model.ContactResult` per step, the same fields from both
-        methods.
+        methods; with ``adhesion`` and ``unload`` also ``pull_off_force`` (N, N/m for a
+        profile), ``pull_off_pressure`` (Pa) and ``detached`` (False: the force is a
+        bound), those of :func:`roughfe.bem.adhesion.adhesive_sweep`.
 
     Raises
     ------

@@ -814,3 +814,33 @@ def test_a_narrow_ramp_on_summits_of_the_grid_scale_needs_the_cells_stiffness(
     assert area[1][1] == pytest.approx(area[1][2], abs=2e-3)
     assert max(area[2]) - min(area[2]) < 1e-3
     assert area[2][0] == pytest.approx(0.1701, abs=1e-3)
+
+
+def test_response_carries_the_pull_off_of_the_adhesive_sweep():
+    """Round 2, session 32: ``response(..., adhesion=law, unload=True)`` returned the
+    sweep of the adhesive continuation without its pull-off force (the solver computed
+    it; a user of the one entry point had to re-read it off the loads, unrefined). The
+    sweep now carries the pull-off and whether the branch detached, the same as the
+    direct adhesive_sweep, and None where no unloading branch was traced."""
+    from roughfe.model import Loading
+    from roughfe.response import response
+    law = md_law(1.0)
+    surface = sphere(32, 0.3)
+    deltas = np.linspace(0.0, 0.3, 4) * D_SCALE     # (Loading takes no negative ones)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ResolutionWarning)
+        direct = adhesive_sweep(surface, MAT, law, deltas, unload=True)
+        swept = response(surface, MAT, Loading(deltas=deltas), adhesion=law, unload=True)
+        loaded = response(surface, MAT, Loading(deltas=deltas), adhesion=law)
+    assert direct.detached and swept.detached is True
+    # the same continuation: the same most tensile load of the (refined) branch
+    assert swept.pull_off_force == pytest.approx(direct.pull_off_force, rel=1e-9, abs=0)
+    assert swept.pull_off_force == pytest.approx(min(swept.load), rel=1e-12, abs=0)
+    assert swept.pull_off_force < 0
+    assert swept.pull_off_pressure == pytest.approx(
+        swept.pull_off_force / surface.nominal_area, rel=1e-12, abs=0)
+    # the sphere's pull-off, within the coarse grid's error of Maugis' (lambda = 1)
+    assert swept.pull_off_force / (np.pi * W * R) == pytest.approx(maugis_pull_off(1.0),
+                                                                   rel=0.1, abs=0)
+    assert loaded.pull_off_force is None and loaded.detached is None
+    assert direct.sweep.pull_off_force == swept.pull_off_force

@@ -345,7 +345,8 @@ class AdhesiveSweep:
     ----------
     sweep : SweepResult
         Every step in order (loading, then unloading); each ContactResult has
-        ``unloading`` (and ``sweep.unloading`` the per-step branch, 1.0 on unloading).
+        ``unloading`` (``sweep.unloading`` per step, 1.0 on unloading); with ``unload``
+        it carries the three values below too.
     pull_off_force : float
         Most tensile load of the unloading branch (N for surfaces, N/m for profiles;
         negative), NaN without unloading, 0 when no load of the branch is tensile beyond
@@ -492,8 +493,8 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
                                          0.25 * law.range)
                 results[top:] = [state for _, state in branch]
                 pull = float(min(state.load for _, state in branch))
+    whole = dict(pull_off_force=pull, pull_off_pressure=pull / surface.nominal_area,
+                 detached=detached)       # the sweep carries them when they were traced
     sweep = SweepResult.from_results(results, rms_slope=rms_slope(surface),
-                                     length=surface.size[0])
-    return AdhesiveSweep(sweep=sweep, pull_off_force=pull,
-                         pull_off_pressure=pull / surface.nominal_area, detached=detached,
-                         law=law, resolution=resolution(*grid))
+                                     length=surface.size[0], **(whole if unload else {}))
+    return AdhesiveSweep(sweep=sweep, law=law, resolution=resolution(*grid), **whole)
