@@ -46,6 +46,24 @@ def _as_size(size, ndim):
     return tuple(float(s) for s in sizes)
 
 
+def _per_axis(name, value, ndim, what):
+    """``value`` as one ``(start, stop)`` or None per axis (a profile may give one pair
+    bare), or an InputError saying the expected form."""
+    form = "(start, stop)" if ndim == 1 else "((x_start, x_stop), (y_start, y_stop))"
+    if value is None:
+        return (None,) * ndim
+    try:
+        items = list(value)
+        if ndim == 1 and len(items) == 2 and all(v is None or np.ndim(v) == 0 for v in items):
+            items = [items]
+        pairs = tuple(None if v is None else tuple(v) for v in items)
+    except TypeError:
+        pairs = None
+    if pairs is None or len(pairs) != ndim or any(p is not None and len(p) != 2 for p in pairs):
+        raise InputError(f"{name} must be {form} ({what}; None for a whole axis), got {value!r}")
+    return pairs
+
+
 @dataclass(frozen=True, eq=False)
 class Surface(ReadOnlyArrays):
     """A rough profile or surface: heights in metres on a regular grid.
@@ -195,6 +213,90 @@ class Surface(ReadOnlyArrays):
         h = np.fft.ifftn(out).real * (np.prod(shape) / np.prod(self.shape))
         return Surface(h, self.size, periodic=True,
                        metadata={**self.metadata, "resampled_from": list(self.shape)})
+
+    def cropped(self, index=None, extent=None) -> "Surface":
+        """A rectangular window of the grid, by index ranges or by physical extents.
+
+        Parameters
+        ----------
+        index : (start, stop) per axis, optional
+            Half-open index ranges ``start <= i < stop`` (``0 <= start < stop <= n``, at
+            least 2 points), as Python slices without steps or negative indices. A
+            profile takes one pair; a surface ``((i0, i1), (j0, j1))``, None for a whole
+            axis.
+        extent : (start, stop) per axis, optional
+            Physical ranges in metres on :meth:`coordinates` (``0 <= start < stop <=
+            size``): the window holds the points whose cell centres lie in
+            ``[start, stop)``, so a range of ``m`` spacings holds ``m`` points.
+
+        Returns
+        -------
+        Surface
+            The heights of the window, ``size = points * spacing`` per axis (the spacing
+            is kept), **non-periodic** (a window of a periodic surface does not repeat
+            with its own size). Metadata ``window``: ``[start, stop]`` per axis in the
+            grid of the surface first cropped (a crop of a crop records one window),
+            ``window_of_shape``: that grid's shape.
+
+        Raises
+        ------
+        InputError
+            Neither or both of ``index``/``extent``; a range outside the axis, reversed,
+            or of fewer than 2 points (the message names the axis and what is allowed).
+        """
+        if (index is None) == (extent is None):
+            raise InputError("cropped() takes index=... (points) or extent=... (metres), "
+                             "one of them")
+        ranges = []
+        if index is not None:
+            for axis, (pair, n) in enumerate(zip(_per_axis("index", index, self.ndim,
+                                                           "point indices"), self.shape)):
+                if pair is None:
+                    ranges.append((0, n))
+                    continue
+                start, stop = (check_int(f"index[{axis}] {w} (axis {axis} has {n} points, "
+                                         f"0..{n})", v, 0) for w, v in zip(("start", "stop"), pair))
+                if not (stop <= n and stop - start >= 2):
+                    raise InputError(
+                        f"index[{axis}] = ({start}, {stop}) is not a window of axis {axis}: "
+                        f"allowed 0 <= start < stop <= {n} (its points) with stop - start "
+                        f">= 2 (a surface needs 2 points per axis)")
+                ranges.append((start, stop))
+        else:
+            pairs = _per_axis("extent", extent, self.ndim, "metres")
+            for axis, (pair, n, d, length) in enumerate(zip(pairs, self.shape, self.spacing,
+                                                            self.size)):
+                if pair is None:
+                    ranges.append((0, n))
+                    continue
+                lo, hi = (float(np.asarray(v, dtype=float)) if np.ndim(v) == 0 else np.nan
+                          for v in pair)
+                if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi
+                        and hi <= length * (1 + 1e-12)):
+                    raise InputError(f"extent[{axis}] must satisfy 0 <= start < stop <= "
+                                     f"{length:.6g} m (the size of axis {axis}), got {pair!r}")
+                # points whose centres i*d lie in [lo, hi); 1e-9 of a cell absorbs the
+                # round-off of a bound given as a multiple of the spacing
+                start, stop = (min(int(np.ceil(v / d - 1e-9)), n) for v in (lo, hi))
+                if stop - start < 2:
+                    raise InputError(
+                        f"extent[{axis}] = {pair!r} m holds {stop - start} point(s) of axis "
+                        f"{axis} (spacing {d:.6g} m); a window needs at least 2 (any extent "
+                        f"of 2 spacings, {2 * d:.6g} m, holds 2)")
+                ranges.append((start, stop))
+        h = self.heights[tuple(slice(a, b) for a, b in ranges)]
+        size = tuple((b - a) * d for (a, b), d in zip(ranges, self.spacing))
+        outer = self.metadata.get("window")
+        first = self.metadata.get("window_of_shape")
+        if (outer is not None and first is not None
+                and [b - a for a, b in outer] == list(self.shape)):
+            # a crop of a crop (on the same grid): one window in the first grid
+            ranges = [(a + o[0], b + o[0]) for (a, b), o in zip(ranges, outer)]
+        else:
+            first = self.shape
+        metadata = {**self.metadata, "window": [list(r) for r in ranges],
+                    "window_of_shape": list(first)}
+        return Surface(h, size, periodic=False, metadata=metadata)
 
     def __repr__(self):
         kind = "profile" if self.ndim == 1 else "surface"
