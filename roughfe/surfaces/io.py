@@ -33,7 +33,9 @@ Instrument files are converted to SI: lengths and heights are rescaled from the 
 stored in the file to metres. A file that gives no unit (an ``.xyz`` or ``.asc`` table
 of numbers) is read as metres, lengths and heights alike: ``metadata["unit_in_file"]``
 is then :data:`ASSUMED_UNIT`, and the command line prints a note saying so. Missing (undefined) points are filled by SurfaceTopography's
-harmonic interpolation and their number recorded in ``metadata["filled_points"]``; the
+harmonic interpolation and their number recorded in ``metadata["filled_points"]``; they
+include the points a file marks as not measured whose marker the reader returns as a
+height (a ``.sur``'s ``zmin - 2``: :mod:`roughfe.surfaces.nonmeasured`); the
 channel read in ``metadata["channel"]`` and the file's channels in
 ``metadata["channels"]``.
 """
@@ -49,6 +51,7 @@ import numpy as np
 
 from ..errors import FileFormatError, InputError, RoughfeError
 from ..writers import atomic_path, to_jsonable
+from .nonmeasured import masked, nonmeasured_mask
 from .probe import open_instrument, quietly, quote_error, warn_if_shorter_than_announced
 from .surface import Surface
 
@@ -290,6 +293,9 @@ def _instrument_surface(reader, path, size, periodic, channel):
         kwargs["unit"] = "m"
         unit = ASSUMED_UNIT
     topo = reader.topography(**kwargs)
+    marked = nonmeasured_mask(reader, topo)      # a marker the reader kept as a height
+    if marked is not None:
+        topo = masked(topo, marked)
     filled = 0
     if topo.has_undefined_data:
         filled = int(np.ma.getmaskarray(topo.heights()).sum())
