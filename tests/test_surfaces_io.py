@@ -219,3 +219,23 @@ def test_sur_nonmeasured_points_are_filled_not_read_as_heights(topographies_dir)
     # the README's rms height is the one with the markers read as heights
     assert float(np.std(metres)) == pytest.approx(31.2e-9, rel=0.01, abs=0)
     assert rms_height(s) < 0.6 * float(np.std(metres))
+
+
+@pytest.mark.parametrize("suffix", [".npy", ".txt", ".csv"])
+def test_plain_matrix_with_missing_points_names_the_file_and_the_points(tmp_path, suffix):
+    """NaN in a plain matrix (missing points) or a 1-point matrix: the error names the file,
+    the count and where (it said 'heights must be finite' / 'got shape (1,)' of a (1, 1)
+    matrix, without the file)."""
+    h = np.arange(12.0).reshape(4, 3) * 1e-9
+    h[2, 1] = h[3, 0] = np.nan
+    path = tmp_path / f"gaps{suffix}"
+    if suffix == ".npy":
+        np.save(path, h)
+    else:
+        np.savetxt(path, h, delimiter="," if suffix == ".csv" else " ")
+    with pytest.raises(InputError, match=rf"gaps\{suffix}: 2 of 12 heights are not finite.*"
+                                         r"first at index \(2, 1\).*fill them"):
+        load_surface(path, size=1e-6)
+    np.save(tmp_path / "one.npy", np.zeros((1, 1)))
+    with pytest.raises(InputError, match=r"one\.npy: a matrix of shape \(1, 1\) holds 1 "):
+        load_surface(tmp_path / "one.npy", size=1e-6)

@@ -179,8 +179,19 @@ def _plain_surface(heights, path, size, periodic):
             f"{path}: a plain height matrix has no physical size; give size=(LX[, LY]) in metres "
             f"(command line: --size LX [LY])")
     heights = np.asarray(heights)
+    if heights.ndim in (1, 2) and heights.size < 2:
+        raise InputError(f"{path}: a matrix of shape {heights.shape} holds {heights.size} "
+                         f"height(s); a profile needs at least 2 points, a surface 2 x 2")
     if heights.ndim == 2 and 1 in heights.shape:
         heights = heights.ravel()
+    if np.issubdtype(heights.dtype, np.floating) and not np.isfinite(heights).all():
+        bad = ~np.isfinite(heights)
+        first = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise InputError(
+            f"{path}: {int(bad.sum())} of {heights.size} heights are not finite (NaN or "
+            f"inf: missing points?), first at index {first}; a plain matrix is read as it "
+            f"is: fill them first (instrument files' undefined points are filled by "
+            f"harmonic interpolation on reading)")
     return Surface(heights, size, bool(periodic) if periodic is not None else False,
                    {"source": str(path), "reader": "plain matrix"})
 
