@@ -113,7 +113,7 @@ def test_angle_clusters_wrap_around_pi():
 def test_bad_acquisitions_name_the_mismatch():
     g, (a1, a2), _ = _genome(5)
     prof = realize(g, length=L1, n_nodes=N)
-    with pytest.raises(InputError, match="2D acquisitions only"):
+    with pytest.raises(InputError, match="surface sequencer takes 2D surfaces only"):
         sequence_surfaces([a1, prof])
     with pytest.raises(InputError, match="same N x N"):
         sequence_surfaces([a1, realize_surface(g, L1 / 2, N + 8)])

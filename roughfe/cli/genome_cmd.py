@@ -160,8 +160,11 @@ def _sequence(args) -> int:
     if dims == [2]:
         return _sequence_surfaces(args, surfaces)
     if dims != [1]:
+        from ..genomics.sequencing.acquisitions import PROFILE_PATH, SURFACE_PATH
         raise InputError("acquisitions mix profiles (1D) and surfaces (2D): "
-                         + ", ".join(f"{p} is {s.ndim}D" for p, s in zip(args.profiles, surfaces)))
+                         + ", ".join(f"{p} is {s.ndim}D" for p, s in zip(args.profiles, surfaces))
+                         + f"; sequence them apart: {PROFILE_PATH}; {SURFACE_PATH}; a row of a "
+                           f"measured surface as profiles: `roughfe genome natural FILE`")
     return _sequence_profiles(args, surfaces)
 
 

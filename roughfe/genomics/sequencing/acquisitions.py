@@ -50,20 +50,72 @@ def check_controls(rms_tolerance, n_restarts):
             check_int("n_restarts (comb periods tried)", n_restarts, 1))
 
 
+#: what to do with data a sequencer does not take, named in its InputError
+PROFILE_PATH = ("2 or more nested profiles (1D) go to sequence_profiles (CLI `roughfe genome "
+                "sequence P1.npz P2.npz`, e.g. realised by `roughfe genome realize GENOME.json "
+                "--scale 10x` and `--scale 20x`)")
+SURFACE_PATH = ("square N x N windows (2D) of equal spacings go to sequence_surfaces (a "
+                "surface genome's `roughfe genome realize`; CLI `roughfe genome sequence "
+                "S1.npz [S2.npz ...]`)")
+ROWS_PATH = ("a measured surface or profile is sequenced as nested windows of its central "
+             "row (roughfe.genomics.natural.sequence_measured, CLI `roughfe genome natural "
+             "FILE`), or take a row yourself as a profile (Surface(s.heights[:, j], "
+             "s.size[0]), a column: s.heights[i, :]); the band chromosomes of any surface "
+             "or profile: `roughfe genome chromosomes FILE`")
+
+
+def check_kind(surfaces, ndim: int) -> list:
+    """The acquisitions as a list of Surfaces of ``ndim`` dimensions (1: the profile
+    sequencer, 2: the surface sequencer), non-periodic; else an InputError that says what
+    was given, what the sequencer takes and what to do instead.
+
+    A periodic flag marks heights that are not a window of Eq. 3.1/3.17 with the node
+    convention the sequencers model: a generated periodic surface (Fourier filtering,
+    resampling) or the periodic realisation of a surface database or design
+    (:mod:`roughfe.genomics.periodic`, wavevectors rounded to the torus lattice). Such a
+    realisation of a resolvable surface genome failed after 3.6 s with "not a WM surface"
+    (48^2, measured in round 2, session 32)."""
+    surfaces = list(surfaces)
+    for k, s in enumerate(surfaces):
+        check_instance(f"acquisition {k}", s, Surface, "a roughfe Surface")
+    dims = [s.ndim for s in surfaces]
+    if any(d != ndim for d in dims):
+        k = next(k for k, d in enumerate(dims) if d != ndim)
+        given = (f"acquisition {k} is a {surfaces[k].shape[0]} x {surfaces[k].shape[1]} "
+                 f"surface (2D)" if dims[k] == 2 else
+                 f"acquisition {k} is a profile (1D) of {surfaces[k].shape[0]} nodes")
+        mix = " (a mix of profiles and surfaces)" if len(set(dims)) > 1 else ""
+        kind = "profiles (1D)" if ndim == 1 else "2D surfaces"
+        raise InputError(f"{given}{mix}: the {'profile' if ndim == 1 else 'surface'} "
+                         f"sequencer takes {kind} only. {PROFILE_PATH}; {SURFACE_PATH}; "
+                         f"{ROWS_PATH}")
+    for k, s in enumerate(surfaces):
+        if s.periodic:
+            raise InputError(
+                f"acquisition {k} is periodic: the sequencers take non-periodic windows of "
+                f"Eq. 3.1 (profiles) or Eq. 3.17 (surfaces), node N//2 at the origin, "
+                f"spacing L/(N-1). A periodic surface of a genome database or design "
+                f"(`db build --dim 2`, `design`) rounds its wavevectors onto the period's "
+                f"lattice and is no such window: its genome is the design's "
+                f"genome_partK.json (or the database's). A generated periodic surface has "
+                f"no genome; {ROWS_PATH}. If the heights are a non-periodic window after "
+                f"all, save them as a non-periodic Surface (Surface(heights, size, periodic=False))")
+    return surfaces
+
+
 def acquisitions_from_surfaces(surfaces) -> list:
     """Check nested acquisitions and return them sorted from coarsest to finest.
 
-    Raises InputError for: fewer than 2 profiles, 2D data, different N, fewer than
+    Raises InputError for: fewer than 2 profiles, 2D or periodic data (:func:`check_kind`), different N, fewer than
     ``MIN_NODES`` nodes, a flat profile, equal lengths, windows that are not nested around x = 0, or
     scales that do not overlap (the finer window shorter than two coarse spacings).
     """
-    surfaces = list(surfaces)
+    surfaces = check_kind(surfaces, 1)
     if len(surfaces) < 2:
-        raise InputError(f"sequencing needs at least 2 nested acquisitions, got {len(surfaces)}")
-    for k, s in enumerate(surfaces):
-        check_instance(f"acquisition {k}", s, Surface, "a roughfe Surface")
-        if s.ndim != 1:
-            raise InputError(f"acquisition {k} must be a profile (1D heights), got shape {s.shape}")
+        raise InputError(f"profile sequencing needs at least 2 nested acquisitions (Sec. "
+                         f"3.3.1: gamma is read from the overlap of two scales), got "
+                         f"{len(surfaces)}. Realise a genome at two scales (`roughfe genome "
+                         f"realize GENOME.json --scale 10x`, `--scale 20x`); {ROWS_PATH}")
     sizes = {s.shape[0] for s in surfaces}
     if len(sizes) != 1:
         raise InputError(f"all acquisitions must have the same number of nodes N (Sec. 3.2: N = 512 "

@@ -14,9 +14,9 @@ import scipy.sparse.linalg
 from scipy.ndimage import maximum_filter
 from scipy.signal.windows import blackmanharris
 
-from ...errors import InputError, check_instance
+from ...errors import InputError
 from ...surfaces.surface import Surface
-from .acquisitions import MIN_NODES
+from .acquisitions import MIN_NODES, ROWS_PATH, check_kind
 
 #: zero-padding factor of the periodogram
 PAD = 4
@@ -57,27 +57,25 @@ def surface_acquisitions(surfaces, valid=None) -> list:
     undefined points of measured acquisitions (a :class:`Surface` holds finite heights
     only: readers fill undefined points, ``metadata["filled_points"]``); they are left out.
 
-    Raises InputError (one message naming the mismatch) for: a profile among them (mixing
-    1D and 2D), different N, non-square grids or unequal spacings, fewer than
+    Raises InputError (one message naming the mismatch and what to do) for: a profile
+    among them or a periodic surface (:func:`~.acquisitions.check_kind`), different N, non-square grids or unequal spacings, fewer than
     ``MIN_NODES`` nodes, a flat or all-undefined acquisition, equal lengths, or windows that
     are not nested around the origin.
     """
-    surfaces = list(surfaces)
+    surfaces = check_kind(surfaces, 2)
     if not surfaces:
-        raise InputError("sequencing needs at least one acquisition")
-    for k, s in enumerate(surfaces):
-        check_instance(f"acquisition {k}", s, Surface, "a roughfe Surface")
-    dims = sorted({s.ndim for s in surfaces})
-    if dims != [2]:
-        raise InputError(f"surface sequencing needs 2D acquisitions only; got dimensions "
-                         f"{[s.ndim for s in surfaces]} (profiles: roughfe.genomics.sequencing)")
+        raise InputError("surface sequencing needs at least one acquisition (an N x N "
+                         "window), got none")
     shapes = {s.shape for s in surfaces}
     if len(shapes) != 1:
         raise InputError(f"all acquisitions must have the same N x N nodes, got "
                          f"{[s.shape for s in surfaces]}")
     n, n2 = shapes.pop()
     if n != n2:
-        raise InputError(f"acquisitions must be square (N x N nodes), got {n} x {n2}")
+        raise InputError(f"acquisitions must be square (N x N nodes), got {n} x {n2}: the "
+                         f"surface sequencer models N x N windows of Eq. 3.17. Crop a "
+                         f"square window (Surface.cropped(index=((0, {min(n, n2)}), (0, "
+                         f"{min(n, n2)})))), or {ROWS_PATH}")
     if n < MIN_NODES:
         raise InputError(f"too few points: {n} x {n} nodes, at least {MIN_NODES} per axis")
     if valid is None:
@@ -91,7 +89,8 @@ def surface_acquisitions(surfaces, valid=None) -> list:
         dx, dy = s.spacing
         if abs(dx / dy - 1) > 1e-9:
             raise InputError(f"acquisition {k} has spacings {dx:g} m and {dy:g} m: the node "
-                             f"convention needs equal spacings on both axes")
+                             f"convention of the surface sequencer needs equal spacings on "
+                             f"both axes; {ROWS_PATH}")
         z = np.array(s.heights, dtype=float)
         if mask is not None:
             mask = np.asarray(mask)
