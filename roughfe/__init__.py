@@ -61,6 +61,10 @@ def __getattr__(name):
     if name in _SUBMODULES:
         return _import_module(f"{__name__}.{name}")
     module = _EXPORTS.get(name)
+    if module is None and _is_submodule(name):
+        # ``from . import progress`` asks here before it imports the submodule: say no,
+        # cheaply (no suggestions: difflib's import is the CLI's start-up time)
+        raise AttributeError(f"module 'roughfe' has no attribute {name!r}")
     if module is None:
         import difflib
         # a reader/writer asked for by another verb first (read_surface -> load_surface)
@@ -76,6 +80,14 @@ def __getattr__(name):
     value = getattr(_import_module(module), name)
     globals()[name] = value            # later look-ups skip __getattr__
     return value
+
+
+def _is_submodule(name) -> bool:
+    """Whether ``name`` is a module or package file of roughfe (not yet imported)."""
+    from os import path
+    here = path.dirname(__file__)
+    return (path.isfile(path.join(here, f"{name}.py"))
+            or path.isfile(path.join(here, name, "__init__.py")))
 
 
 def __dir__():
