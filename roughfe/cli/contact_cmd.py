@@ -113,7 +113,7 @@ def _run(args) -> int:
     check_load_magnitudes(surface, material, args.pressure, args.delta)
     law = contact_physics_from_args(args)["adhesion"]
     folder = output_folder_of(args, "contact")  # checked now, taken when writing
-    adhesive = None
+    adhesive = maugis = None
     tol = args.tol if args.tol is not None else (1e-10 if law is None else 1e-5)
     if args.max_unload_steps is not None and (law is None or not args.unload):
         raise InputError("--max-unload-steps bounds the adhesive unloading branch: it needs "
@@ -153,13 +153,20 @@ def _run(args) -> int:
         # the process zone against the grid (the ResolutionWarning's numbers, kept)
         doc["derived"]["resolution"] = adhesive.resolution
         doc["derived"]["units"].update(process_zone="m", grid_spacing="m")
+        cap = doc["derived"]["persson"].get("single_asperity")
         try:
+            if cap is not None:     # a random-roughness criterion, like Persson's theory
+                raise InputError(f"one smooth asperity ({cap['shape']}): the criterion is "
+                                 f"that of a random rough surface")
             stickiness = pastewka_robbins(surface, material.E_star, law.work, law.range)
             doc["derived"]["stickiness"] = stickiness.describe()
         except InputError as exc:   # e.g. a 2 x N strip: no curvature; the solve stands
             stickiness = None       # (it raised after the solve and wrote nothing)
             doc["derived"]["stickiness"] = {"theory": "Pastewka-Robbins (2014)",
                                             "evaluated": False, "why": str(exc)}
+        maugis = _maugis_sphere(cap, law, material)
+        if maugis is not None:
+            doc["derived"]["maugis_sphere"] = maugis
     name = Path(args.surface).name + (" (mirrored)" if args.mirror else "")
     with folder as out:
         write_fields_h5(out / "fields.h5", sweep)
@@ -175,7 +182,9 @@ def _run(args) -> int:
             if adhesive is not None:
                 from ..plotting.contact import plot_adhesion
                 plot_adhesion(doc["steps"], out / "adhesion_load_approach.png",
-                              pull_off_force=adhesive.pull_off_force,
+                              pull_off_force=adhesive.pull_off_force, reference=None if
+                              maugis is None else (maugis["pull_off_force"],
+                                                   "Maugis (1992) sphere"),
                               title=f"{name}, {law.kind}: w = {law.work:.3g} "
                                     f"J/m^2, range {law.range:.3g} m")
             last = sweep.results[_shown_step(sweep.area_fraction)]
@@ -191,9 +200,12 @@ def _run(args) -> int:
     print(f"{args.method.upper()}, E = {material.E:.4g} Pa, nu = {material.nu:g}, "
           f"E* = E / (1 - nu^2) = {material.E_star:.4g} Pa (--E, --nu)")
     plastic = args.hardness is not None      # the plastic share of A* beside it
+    cap = doc["derived"]["persson"].get("single_asperity")
+    theory = "hertz" if cap is not None else "persson"
     print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} "
           + (f"{'A*plastic':>9s} " if plastic else "")
-          + f"{'K (Pa/m)':>12s} {'gap (m)':>12s} {'nit':>5s} {'A* Persson':>10s}")
+          + f"{'K (Pa/m)':>12s} {'gap (m)':>12s} {'nit':>5s} "
+          + f"{'A* ' + theory.capitalize():>10s}")
     for s, k, t in zip(sweep.to_records(), sweep.stiffness, doc["steps"]):
         # inf at full periodic contact; "-" where it was not computed (adhesion)
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
@@ -201,8 +213,17 @@ def _run(args) -> int:
               else "")
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
               f"{pl}{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
-              f"{fmt_or_dash(t.get('persson_area_fraction'), '.3g'):>10s}")
+              f"{fmt_or_dash(t.get(theory + '_area_fraction'), '.3g'):>10s}")
     persson_basis(args, surface, doc["derived"]["persson"])
+    if cap is not None:
+        print(f"one smooth asperity ({cap['shape']}, principal radii "
+              f"{', '.join(f'{r:.4g}' for r in cap['radii'])} m): Persson's random-roughness "
+              f"theory does not apply; "
+              + ("Maugis' sphere (derived.maugis_sphere)" if maugis is not None else
+                 "the adhesive single-asperity theory is not evaluated for this law"
+                 if adhesive is not None else
+                 "Hertz's A* and K beside the results (hertz_* in results.json)"
+                 if cap["radius"] is not None else "no Hertz line (not round)"))
     if args.mirror:
         print("--mirror: the fields and the load, contact area and contact count are of the "
               "mirrored period (2 (n - 1) points per axis, "
@@ -261,6 +282,20 @@ def _shown_step(area_fraction) -> int:
     partial = np.flatnonzero(a < 1.0)
     pool = partial if partial.size else np.arange(a.size)
     return int(pool[len(pool) - 1 - int(np.argmax(a[pool][::-1]))])
+
+
+def _maugis_sphere(cap, law, material):
+    """Maugis' pull-off (load control; Maugis 1992) of a Maugis-Dugdale ``law`` on a
+    sphere ``cap`` (:func:`roughfe.theory.asperity.single_asperity`), else None."""
+    if cap is None or cap["shape"] != "sphere" or law.kind != "md":
+        return None
+    from ..reference import maugis_parameter, maugis_pull_off
+    lam = maugis_parameter(cap["radius"], material.E_star, law.work, law.max_traction)
+    force = maugis_pull_off(lam) * np.pi * law.work * cap["radius"]
+    return {"lambda": lam, "radius": cap["radius"], "pull_off_force": force,
+            "note": "Maugis (1992) sphere, load control, sharp Dugdale step: the theory "
+                    "of this contact (a grid of few cells per Dugdale zone reads a "
+                    "more tensile pull-off; docs/theory/07)"}
 
 
 def _adhesive_sweep(args, surface, material, law, tol):

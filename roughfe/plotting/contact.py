@@ -64,7 +64,8 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8). Records
     with ``persson_area_fraction`` / ``persson_mean_gap`` (:func:`roughfe.theory.beside`)
     get Persson's curves drawn beside the BEM points (and ``persson_stiffness`` its K =
-    -dp/du in the K panel). With the ``window_compliance`` C
+    -dp/du in the K panel); records of one smooth cap get Hertz's A* and K instead
+    (``hertz_area_fraction``, ``hertz_stiffness``; :mod:`roughfe.theory.asperity`). With the ``window_compliance`` C
     (m/Pa) of a non-periodic window, the K panel marks the window's bulk stiffness 1/C,
     the ceiling K approaches whatever the roughness (:mod:`roughfe.bem.window`).
     ``method`` labels the solver's points ("BEM", or "FEM" for ``contact --method fem``).
@@ -132,6 +133,16 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
         ax1.loglog(p[theory][order], a_th[theory][order], "-", label="Persson (2001)")
     if u_th is not None:
         ax3.semilogx(p[theory][order], u_th[theory][order] * UM, "-", label="Persson (2007)")
+    # one smooth cap (theory.asperity): Hertz's curves in place of Persson's
+    hertz = {ax: _theory(steps, key) for ax, key in ((ax1, "hertz_area_fraction"),
+                                                      (ax2, "hertz_stiffness"))}
+    for ax, curve in hertz.items():
+        sel = theory & np.isfinite(curve) if curve is not None else None
+        if sel is not None and sel.any():
+            by_p = np.argsort(p[sel])
+            scale = 1.0 if ax is ax1 else MPA * 1e-6
+            ax.loglog(p[sel][by_p], curve[sel][by_p] * scale, "--",
+                      label="Hertz (1882), one smooth asperity")
     note = (_branch_note(a, ok, unl) if not tensile else
             "no state in compression: the tensile\nstates (p < 0) on linear axes")
     for ax in (ax1, ax3):
@@ -186,7 +197,7 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     return save_figure(fig, path)
 
 
-def plot_adhesion(steps, path, pull_off_force=None, title=None):
+def plot_adhesion(steps, path, pull_off_force=None, title=None, reference=None):
     """Adhesive contact: load and contact area against the approach, loading and
     unloading branches (the hysteresis loop), the pull-off force marked.
 
@@ -198,6 +209,8 @@ def plot_adhesion(steps, path, pull_off_force=None, title=None):
         PNG to write.
     pull_off_force : float, optional
         Most tensile load of the unloading branch (same unit as ``load``).
+    reference : (float, str), optional
+        A theory's pull-off (same unit) and its label, e.g. Maugis' for a sphere.
     """
     d = _column(steps, "delta") * UM
     f = _column(steps, "load")
@@ -217,6 +230,9 @@ def plot_adhesion(steps, path, pull_off_force=None, title=None):
         if tension > 0 and np.nanmax(np.abs(f)) > 20 * tension:
             ax1.set_yscale("symlog", linthresh=2 * tension)
             ax1.set_ylim(bottom=-4 * tension)
+    if reference is not None and np.isfinite(reference[0]):
+        ax1.axhline(reference[0], color="C3", lw=0.8, ls="--",
+                    label=f"{reference[1]} {reference[0]:.3g}")
     ax1.axhline(0.0, color="0.5", lw=0.5)
     ax1.set_xlabel("approach Delta (um)")
     ax1.set_ylabel("load (N, or N/m for profiles)")

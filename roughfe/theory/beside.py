@@ -13,6 +13,10 @@ It is elastic as well: a step with plastic flow (a hardness run, ``plastic_area_
 unloading branch), are not the elastic contact of the surface's PSD, so those steps get
 None and ``"persson"`` says why (:data:`NOT_PLASTIC`).
 
+It is the theory of a random surface of many asperities: on one smooth cap (a sphere,
+:func:`roughfe.theory.asperity.single_asperity`) no step gets it, the elastic steps get
+Hertz's instead (``hertz_*`` keys) and ``"persson"`` says why (:data:`NOT_RANDOM`).
+
 It needs the surface's PSD: a non-periodic surface's is taken with a Hann window, which
 is zero on a side of fewer than 3 points, so on such a grid (a 2 x N strip) no step gets
 the theory and ``"persson"`` says why (:data:`NOT_EVALUATED`); the simulation's own
@@ -27,6 +31,8 @@ import numpy as np
 from ..errors import InputError
 from ..surfaces.stats import HANN_MIN_POINTS, height_moments
 from ..surfaces.surface import Surface
+from .asperity import NOT_RANDOM, beside_hertz, single_asperity
+from .asperity import REFERENCES as ASPERITY_REFERENCES
 from .junction import _geometry_factor, critical_junction
 from .persson import GAMMA_DEFAULT, PERCOLATION_THRESHOLD, REFERENCES, _spectrum, persson
 
@@ -135,6 +141,9 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     dirs = ("x", "y") if direction == "both" else (direction,)
     factors = {d: _geometry_factor(source, d) for d in dirs}
     pressures = [_number_of(k, s, "mean_pressure", "(Pa)") for k, s in enumerate(steps)]
+    shape = single_asperity(source) if isinstance(source, Surface) else None
+    if shape is not None:       # one smooth cap: Hertz's theory, not Persson's
+        return _beside_asperity(source, shape, e_star, steps, pressures, adhesive)
     if adhesive:
         return {"steps": [dict(s) for s in steps], "persson": dict(NOT_ADHESIVE)}
     if psd is None:
@@ -173,6 +182,22 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     if any(plastic):
         info.update(NOT_PLASTIC, plastic_steps=[k for k, pl in enumerate(plastic) if pl])
     return {"steps": out, "persson": info}
+
+
+def _beside_asperity(surface, shape, e_star, steps, pressures, adhesive) -> dict:
+    """:func:`beside` for one smooth cap (:func:`~roughfe.theory.asperity.single_asperity`):
+    no ``persson_*`` keys, ``hertz_*`` keys on the elastic non-adhesive steps and
+    :data:`~roughfe.theory.asperity.NOT_RANDOM` with the cap's shape as ``"persson"``."""
+    info = dict(NOT_RANDOM, single_asperity=shape, references=list(ASPERITY_REFERENCES))
+    if adhesive:
+        return {"steps": [dict(s) for s in steps], "persson": info}
+    plastic = _plastic_from(steps)
+    hertz = beside_hertz(surface, shape, e_star,
+                         [None if pl else p for p, pl in zip(pressures, plastic)])
+    if any(plastic):
+        info.update(NOT_PLASTIC, plastic_steps=[k for k, pl in enumerate(plastic) if pl])
+    info["units"] = {"hertz_area_fraction": "-", "hertz_stiffness": "Pa/m (dp/dDelta)"}
+    return {"steps": [{**s, **h} for s, h in zip(steps, hertz)], "persson": info}
 
 
 def _height_distribution(surface) -> dict:
