@@ -26,6 +26,8 @@ QUADRIC_FIT = 0.99
 #: principal radii within this ratio are a sphere of radius sqrt(R1 R2) (Hertz's
 #: equivalent radius of a slightly elliptic contact); beyond it no Hertz line is drawn
 ROUND = 1.1
+#: the cap fit samples at most this many points per axis (every step-th point)
+FIT_POINTS = 256
 
 REFERENCES = ("Hertz H. (1882) J. reine angew. Math. 92:156-171",
               "Johnson K.L. (1985) Contact Mechanics, Cambridge University Press, Sec. 4.2")
@@ -51,8 +53,13 @@ def single_asperity(surface):
     "fit": the explained fraction of the variance}``."""
     if surface.periodic or min(surface.shape) < 3 or not np.ptp(surface.heights) > 0:
         return None
-    h = np.asarray(surface.heights, float).ravel()
-    axes = [(np.arange(n) - (n - 1) / 2) * d for n, d in zip(surface.shape, surface.spacing)]
+    # the fit on every step-th point per axis (at most FIT_POINTS per axis): a quadric
+    # needs few points, and the full grid's design matrix would be 6 n^2 doubles
+    step = [max(1, -(-n // FIT_POINTS)) for n in surface.shape]
+    h = np.asarray(surface.heights[tuple(slice(None, None, s) for s in step)], float)
+    axes = [(np.arange(0, n, s) - (n - 1) / 2) * d
+            for n, s, d in zip(surface.shape, step, surface.spacing)]
+    h = h.ravel()
     x = [g.ravel() for g in np.meshgrid(*axes, indexing="ij")]
     if surface.ndim == 1:
         cols = [np.ones_like(x[0]), x[0], x[0] ** 2]
