@@ -74,7 +74,10 @@ def warn_tilt(args, surface) -> None:
 #: Largest rms height jump across a period's edge, in units of the rms step between
 #: neighbouring points along that axis, before :func:`warn_seam` warns. Periodic
 #: surfaces give 0.8-1.2 (spectral, 128^2, H = 0.3 and 0.8); windows cut from them 3.9-41;
-#: the measured files with their plane removed 2.6-72 (opd-1 4.2, sur-2 9.0, x3p-2 15)
+#: the measured files with their plane removed 1.4-72 (opd-1 4.2, sur-2 2.8, x3p-2 15;
+#: sur-2 re-measured after the .sur reader fix, round 2, session 32: 9.0 with its
+#: non-measured points read as heights; now below the limit, so --periodic on sur-2 is
+#: not warned of)
 SEAM_LIMIT = 3.0
 
 
@@ -188,7 +191,8 @@ def check_solution(args, surface, results, material) -> None:
 def persson_basis(args, surface, persson: dict) -> None:
     """Say (stdout) which slope Persson's theory beside the results took -- the rms
     gradient of the surface's PSD, which can differ from the finite-difference rms slope
-    of ``roughfe info`` (2x on sur-2: a user's review, round 2, session 29) -- and warn
+    of ``roughfe info`` (2x on sur-2 as read then, a user's review, round 2, session 29;
+    1.5x since the .sur reader fix, round 2, session 32) -- and warn
     when the heights are far from Gaussian, the theory's surface
     (:data:`roughfe.theory.beside.NON_GAUSSIAN`) or have a lay (texture aspect ratio
     below :data:`roughfe.theory.beside.ANISOTROPIC_STR`: the theory's surface is
