@@ -382,7 +382,7 @@ def test_beside_evaluates_no_theory_where_the_grid_has_no_psd():
 def test_beside_says_when_the_heights_are_far_from_gaussian(surface):
     """The theory's surface is Gaussian. A Gaussian surface gets its skewness and
     kurtosis (near 0 and 3) and no note; the same surface with a few deep pits (sur-2 has
-    skewness -30: its BEM A* was 20-50x the theory's, a user's review) gets the
+    skewness -15: its BEM A* is 3-12x the theory's) gets the
     "non_gaussian" note, with its numbers, beside the theory it still evaluates."""
     from roughfe.theory.beside import NON_GAUSSIAN
     steps = [{"mean_pressure": 1e-3}]
