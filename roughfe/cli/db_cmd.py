@@ -114,7 +114,8 @@ def _map(args) -> int:
     rows = summary_table(args.database)
     if not rows:
         from ..errors import InputError
-        raise InputError(f"the genome database {args.database} holds no genomes")
+        raise InputError(f"the genome database {args.database} holds no genomes; add "
+                         f"genomes with `roughfe db build` or `roughfe db extend`")
     with output_folder_of(args, "db map") as out:
         a = plot_genetic_map(rows, out / "genetic_map.png")
         b = plot_map_summary(rows, out / "genetic_map_summary.png")

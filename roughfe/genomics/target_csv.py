@@ -66,6 +66,32 @@ def _is_pressure_name(name) -> bool:
     return re.match(r"(mean[ _-]?)?(p|pressure)(?![a-z])", name.lower()) is not None
 
 
+#: units a header may name that are not the file's (pressure in Pa, K in Pa/m, A a
+#: fraction): the reader takes numbers as they are, so a header 'pressure_MPa' was read in
+#: Pa (a design for pressures 1e6 times lower, session 32)
+_OTHER_PRESSURE = re.compile(r"(?<![a-z])(hpa|kpa|mpa|gpa|m?bar|psi|ksi|atm|torr|n/mm(\^?2|²)?)"
+                             r"(?![a-z])")
+_OTHER_VALUE = re.compile(r"%|(?<![a-z])(percent|hpa|kpa|mpa|gpa|n/mm(\^?[23]|[²³])?|mm|um|µm|"
+                          r"nm)(?![a-z])")
+
+
+def _check_units(path, k, text, cells):
+    """A FileFormatError when the header names a unit the file is not read in: the
+    pressure in anything but Pa, K in anything but Pa/m, A in percent."""
+    p, v = (c.lower() for c in cells)
+    m = _OTHER_PRESSURE.search(p)
+    if m:
+        raise FileFormatError(f"{path}: line {k}: the header {text!r} gives the pressure in "
+                              f"{m.group(0)!r}; a target CSV is read in SI: pressure in Pa "
+                              f"(convert the column, e.g. MPa x 1e6, and name it "
+                              f"'pressure_Pa')")
+    m = _OTHER_VALUE.search(v)
+    if m:
+        raise FileFormatError(f"{path}: line {k}: the header {text!r} gives the value in "
+                              f"{m.group(0)!r}; a target CSV is read in SI: K in Pa/m, A as a "
+                              f"fraction 0 < A <= 1 (not percent); convert the column")
+
+
 def _named_quantity(path, k, text, name):
     """The quantity a header's value column names: K for a leading ``K``/``k`` token
     (``K [Pa/m]``, ``K_Pa_per_m``) or the word ``stiffness`` anywhere (``stiffness per
@@ -98,6 +124,7 @@ def _check_header(path, k, text, cells):
         raise FileFormatError(f"{path}: line {k}: the header {text!r} does not name the "
                               f"pressure first{swapped}; the columns are pressure (Pa) then "
                               f"value, e.g. 'pressure_Pa,value' or 'p,K'")
+    _check_units(path, k, text, cells)
     return _named_quantity(path, k, text, cells[1])
 
 
@@ -124,7 +151,9 @@ def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> 
     ``#`` are skipped anywhere; one header line of non-numeric names may precede the
     first data row (a line with a number in it is data: ``1e7,1e11x`` is an error, not a
     header), and it must name two columns, the pressure first (``pressure_Pa,value``,
-    ``p,K``, ``p [Pa],A``); every other line must be two numbers (empty cells after them,
+    ``p,K``, ``p [Pa],A``) and name no unit other than Pa, Pa/m or a fraction
+    (``pressure_MPa``, ``K [MPa/um]``, ``A [%]`` are errors: the numbers are read as
+    given, in SI); every other line must be two numbers (empty cells after them,
     a trailing comma, are ignored; a third value is an error), else the error names the
     line and its content. An area target must be a fraction, 0 < A <= 1 (:class:`Target`).
     The quantity is the one the file names: in its ``# name: <label> (unit) vs pressure

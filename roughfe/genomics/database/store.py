@@ -346,7 +346,9 @@ def load_entries(path, *, labels_=None, where=None, params=()) -> list:
         con.close()
     if not rows:
         raise InputError(f"the genome database {path} holds no genomes"
-                         + (f" matching {labels_ or where!r}" if (labels_ or where) else ""))
+                         + (f" matching {labels_ or where!r}" if (labels_ or where) else
+                            "; add genomes with `roughfe db build DB` (a Sobol design) or "
+                            "`roughfe db extend DB GENOME.json ...`"))
     return [_entry(r, settings) for r in rows]
 
 

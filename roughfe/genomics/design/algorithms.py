@@ -30,7 +30,7 @@ from ..similarity import ResponseCurve, Target, similarity, split_ranges
 from .model import Design, combine, entry_design
 from .objective import SELECTION, Evaluator, Objective, combined_score, verdict
 from .stages import GcmmaOptions, optimise_phases
-from .targets import rescore_at_target_pressures
+from .targets import check_design_inputs, rescore_at_target_pressures
 
 METHODS = ("sog", "gco", "cco", "mcco")
 #: largest difference allowed between a candidate's reported scores (its curve stretched
@@ -480,10 +480,9 @@ def _at_targets(design, objective, settings, evaluate):
 
 def run_design(method: str, entries, targets, settings: DatabaseSettings, *, pbar=None,
                evaluate=None, options: GcmmaOptions = GcmmaOptions(), **kw) -> DesignResult:
-    """Dispatch to :func:`sog`, :func:`gco`, :func:`cco` or :func:`mcco` (the CLI entry)."""
-    targets = list(targets)
-    if method not in METHODS:
-        raise InputError(f"method must be one of {METHODS}, got {method!r}")
+    """Dispatch to :func:`sog`, :func:`gco`, :func:`cco` or :func:`mcco` (the CLI entry),
+    the inputs checked first (:func:`~.targets.check_design_inputs`)."""
+    targets = check_design_inputs(method, METHODS, entries, targets, settings)
     if method == "mcco":
         if len(targets) != 2:
             raise InputError("mcco needs two targets: K(p) (--target) and A(p) (--second-target)")

@@ -20,6 +20,68 @@ from .model import Design, DesignPart
 from .objective import Evaluator, Objective
 
 
+#: a target whose values differ from every database genome's (after Eq. 4.2) by more than
+#: this factor at half its points or more is in other units, of another quantity, or of
+#: another material than the database: no design can approach it (a K target of 0.05 Pa/m,
+#: an area given as K, crashed GCMMA's subproblem with a singular matrix; session 32)
+UNIT_FACTOR = 1e3
+
+
+def check_strict_targets(targets) -> None:
+    """A stiffness target needs at least 3 points with p > 0: the score solved at the
+    target pressures (:func:`score_at_target_pressures`, the verdict of every design)
+    takes K by central differences over them, and two points give one secant, the
+    derivative at neither (a 2-point K target ran every design stage, then failed with
+    "response curve stiffness has non-finite values: [nan nan]")."""
+    for t in targets:
+        if t.quantity == "K" and t.pressure.size < 3:
+            raise InputError(f"the stiffness target {t.name} has {t.pressure.size} points "
+                             f"with p > 0 (points at p = 0 are dropped); a design is scored "
+                             f"with K by central differences over the target pressures, "
+                             f"which needs at least 3: give 3 or more (pressure, K) points")
+
+
+def check_target_units(entries, targets, settings: DatabaseSettings) -> None:
+    """An InputError when every database genome's K or A (after Eq. 4.2, at the target's
+    pressures) differs from a target by more than :data:`UNIT_FACTOR` at half its points
+    or more: the target is in other units (pressure in Pa, K in Pa/m, A a fraction), of
+    the other quantity, or of another material than the database (E* fixes K). The
+    message gives the database's range there."""
+    for t in targets:
+        ratios, values = [], []
+        for e in entries:
+            y = e.curve.to_target_range(t.p_max).at(t.pressure, t.quantity)
+            ok = y > 0
+            if ok.any():
+                ratios.append(np.median(np.abs(np.log10(y[ok] / t.values[ok]))))
+                values.append(y[ok])
+        if not ratios or min(ratios) <= np.log10(UNIT_FACTOR):
+            continue
+        lo, hi = (f(np.concatenate(values)) for f in (np.min, np.max))
+        label, unit = {"K": ("stiffness K", "Pa/m"), "A": ("area fraction A", "-")}[t.quantity]
+        raise InputError(
+            f"target {t.name} ({label}, {t.values.min():.3g}..{t.values.max():.3g} {unit} at "
+            f"{t.pressure[0]:.3g}..{t.pressure[-1]:.3g} Pa) is more than a factor "
+            f"{UNIT_FACTOR:g} from every genome of the database at half its points or more "
+            f"(theirs: {lo:.3g}..{hi:.3g} {unit} there, after Eq. 4.2, E* = "
+            f"{settings.youngs_modulus / (1 - settings.poisson ** 2):.3g} Pa): check its units "
+            f"(pressure in Pa, K in Pa/m, A a fraction 0 < A <= 1), its quantity (--quantity "
+            f"K or A) and the material (a database of the target's E: `roughfe db build --E`)")
+
+
+def check_design_inputs(method, methods, entries, targets, settings) -> list:
+    """The targets as a list, after the checks a design needs before any stage runs:
+    ``method`` one of ``methods``, :func:`check_strict_targets` and
+    :func:`check_target_units` (against the database ``entries``, when there are any)."""
+    targets = list(targets)
+    if method not in methods:
+        raise InputError(f"method must be one of {methods}, got {method!r}")
+    check_strict_targets(targets)
+    if entries:
+        check_target_units(entries, targets, settings)
+    return targets
+
+
 def rescore(design: Design, targets, settings: DatabaseSettings, response=None) -> tuple:
     """Independent check: realise a saved design, run a fresh BEM sweep *without* any
     rescaling and return the similarity per target (must equal the reported scores)."""
@@ -54,6 +116,7 @@ def score_at_target_pressures(surface, targets, settings: DatabaseSettings) -> t
     central differences over those steps as the target's K over its own steps.
     """
     targets = list(targets)
+    check_strict_targets(targets)
     mat = Material(settings.youngs_modulus, settings.poisson)
     delta = top_approach(surface, settings.kernel, settings.top_fraction)
     top = response(surface, mat, Loading(delta=delta), kernel=settings.kernel,
