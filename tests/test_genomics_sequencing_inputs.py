@@ -74,7 +74,7 @@ def test_a_periodic_realisation_is_refused_before_any_fit(surface_case, profiles
     with pytest.raises(InputError) as e:
         sequence_surfaces([torus])
     msg = str(e.value)
-    assert "acquisition 0 is periodic" in msg and "genome_partK.json" in msg
+    assert "acquisition 0 is periodic" in msg and "genome.json" in msg
     assert "periodic=False" in msg
     flagged = [Surface(p.heights, p.size, periodic=True, metadata=p.metadata)
                for p in profiles]

@@ -33,7 +33,8 @@ from .options import (add_material_options, add_output_folder, add_run_options,
 
 
 #: defaults of a surface database (``--dim 2``) where they differ from the thesis profiles:
-#: a 64 x 64 periodic grid (about 5 s CPU per genome of 3 ridges), approaches up to 0.8 of
+#: a 64 x 64 periodic grid (about 1.5 s CPU per genome of 3 ridges, 2.5 s wall; measured
+#: in round 2, session 32 on the first 2 Sobol genomes), approaches up to 0.8 of
 #: full contact (K of a periodic surface diverges at full contact)
 SURFACE_DEFAULTS = {"nodes": 64, "top_fraction": 0.8}
 

@@ -96,8 +96,9 @@ def check_kind(surfaces, ndim: int) -> list:
                 f"Eq. 3.1 (profiles) or Eq. 3.17 (surfaces), node N//2 at the origin, "
                 f"spacing L/(N-1). A periodic surface of a genome database or design "
                 f"(`db build --dim 2`, `design`) rounds its wavevectors onto the period's "
-                f"lattice and is no such window: its genome is the design's "
-                f"genome_partK.json (or the database's). A generated periodic surface has "
+                f"lattice and is no such window: its genome is the design's genome.json "
+                f"(genome_partK.json per part) or the database's. A generated periodic "
+                f"surface has "
                 f"no genome; {ROWS_PATH}. If the heights are a non-periodic window after "
                 f"all, save them as a non-periodic Surface (Surface(heights, size, periodic=False))")
     return surfaces
