@@ -33,7 +33,9 @@ with the contact traction t from one of two solvers:
   the term diagonal, ``kappa w_i <u_y,i - g_i>_+`` with trapezoidal weights w_i (dx, and
   dx/2 at the ends), which is what is assembled here (no form recompilation per step).
   Newton (SNES ``newtonls``, line search ``basic``, no divergence test) with the exact
-  generalized Jacobian.
+  generalized Jacobian, each step started on the obstacle (so that SNES's relative test
+  sees the elastic residual, not kappa times a penetration). A sweep that penetrates by
+  more than 1e-3 of its approach warns (:func:`roughfe.fem.limits.warn_penetration`).
 
 Everything is solved in non-dimensional units (coordinates / W, displacements / height
 range, E = 1): the SNES VI active-set test uses absolute tolerances, and displacements of
@@ -59,14 +61,15 @@ from typing import Literal, Mapping
 import numpy as np
 
 from ..errors import (InputError, NoConvergenceError, check_finite_nonnegative,
-                      check_finite_positive, check_instance, check_int, check_real_array)
+                      check_finite_positive, check_in_open_interval, check_instance,
+                      check_int, check_real_array)
 from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
 from .elasticity import (VOLUMETRIC, atol_scale, lame, nodal_average, stiffness_matrix,
                          volumetric_form)
-from .limits import warn_locking
+from .limits import warn_locking, warn_penetration
 from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
 from .petsc_tools import (LU_MUMPS, PrefixedOptions, check_snes, fresh_pc_on_resize,
                           unique_prefix)
@@ -76,6 +79,9 @@ METHODS = ("vi", "penalty")
 _KSP_PREFIXES = ("ksp_", "pc_", "mg_", "mat_")
 #: Load control: relative tolerance on the mean pressure of a step.
 LOAD_RTOL = 1e-6
+#: The largest ``penalty_factor`` k (kappa = k E / dx): above it the round-off of the
+#: penalty term is the error (FemSolverOptions).
+MAX_PENALTY = 1e8
 REFERENCES = ("Benson S.J., Munson T.S. (2006) Optim. Methods Softw. 21:155-168 (SNES VI)",
               "Wriggers P. (2006) Computational Contact Mechanics, Springer (penalty)",
               "Johnson K.L. (1985) Contact Mechanics, Sec. 13.2 (Westergaard)")
@@ -99,7 +105,7 @@ class FemSolverOptions:
     method : {"vi", "penalty"}
         SNES variational inequality or penalty + Newton.
     penalty_factor : float
-        k in kappa = k E / delta (1e3-1e4 recommended).
+        k in kappa = k E / delta (1e3-1e4 recommended; at most :data:`MAX_PENALTY`).
     rtol, atol : float
         SNES relative / absolute residual tolerances (non-dimensional residual). Above
         nu = 0.45 ``atol`` is scaled by (lambda + 2 mu) / its value at nu = 0.45
@@ -117,7 +123,7 @@ class FemSolverOptions:
         built, a key PETSc never reads (a misspelling, or ``ksp_rtol`` with the default
         ``ksp_type preonly``) after the first solve that takes a Newton step (steps
         without contact take none and set up no linear solver)
-        (:class:`roughfe.fem.petsc_tools.PrefixedOptions`).
+        (:class:`roughfe.fem.petsc_tools.PrefixedOptions`). ``rtol`` lies in (0, 1).
     volumetric : {"auto", "element", "nodal"}
         The volumetric term of the stiffness (:mod:`roughfe.fem.elasticity`):
         ``"element"`` exact on the P1 triangles (locks as nu -> 1/2), ``"nodal"`` on the
@@ -142,8 +148,13 @@ class FemSolverOptions:
         if self.volumetric not in VOLUMETRIC:
             raise InputError(f"volumetric must be one of {VOLUMETRIC}, got "
                              f"{self.volumetric!r}")
-        check_finite_positive("penalty_factor", self.penalty_factor)
-        check_finite_positive("rtol (SNES relative tolerance)", self.rtol)
+        if check_finite_positive("penalty_factor", self.penalty_factor) > MAX_PENALTY:
+            raise InputError(
+                f"penalty_factor must be <= {MAX_PENALTY:g} (1e3-1e4 recommended), got "
+                f"{self.penalty_factor!r}: the penalty stiffness k E / dx swamps the body's "
+                f"in round-off (cosine, 17 nodes: p off by 2e-6 at 1e10, 4e-4 at 1e12, 1 % "
+                f"at 1e14); use method='vi' for the exact constraint")
+        check_in_open_interval("rtol (SNES relative tolerance)", self.rtol, 0.0, 1.0)
         check_finite_nonnegative("atol (SNES absolute tolerance)", self.atol)
         check_int("max_it (SNES iterations per step)", self.max_it, 1)
         if self.petsc_options is not None:
@@ -253,7 +264,10 @@ class _ContactProblem:
 
         if self.options.method == "penalty":
             self.K.copy(J, structure=J.Structure.SAME_NONZERO_PATTERN)
-            active = (x.array_r[self.top_dofs] > self.bound).astype(float)
+            # (>=: a vertex on the obstacle, where the penalty starts, is active, an
+            # element of the generalized Jacobian there; with > the first step from
+            # the projected start of ``solve`` was a wasted free-body step)
+            active = (x.array_r[self.top_dofs] >= self.bound).astype(float)
             d = J.createVecLeft()
             try:        # petsc4py queues a dropped Vec of a non-self comm for a
                         # PETSc.garbage_cleanup() nobody calls: once per Newton step
@@ -320,6 +334,13 @@ class _ContactProblem:
         if self.options.method == "vi":
             self.upper.array[self.top_dofs] = self.bound
             self.snes.setVariableBounds(self.lower, self.upper)
+        else:
+            # start on the obstacle, as the VI does (it projects on its bounds): from a
+            # penetrating start |F(x_0)| is kappa times the penetration, and SNES's
+            # relative test rtol |F(x_0)| then passed after one step (cosine, 33 nodes:
+            # p 54 % high at k = 1e4, rtol = 1e-3; 1.9 % at k = 1e8, default rtol)
+            top = self.x.array[self.top_dofs]
+            self.x.array[self.top_dofs] = np.minimum(top, self.bound)
         what = (f"FEM contact ({self.options.method}, {self.pmesh.formulation}) at "
                 f"imposed delta = {float(delta):.6g} m")
         try:
@@ -726,6 +747,8 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
         raise NoConvergenceError(str(exc), result=results) from None
     finally:
         problem.destroy()
+    if options.method == "penalty":
+        warn_penetration(results, options.penalty_factor)
     return SweepResult.from_results(results, rms_slope=problem.rms_slope, length=pmesh.width)
 
 

@@ -21,6 +21,10 @@ Two approximations of :mod:`roughfe.fem.contact` do not go away with the mesh si
   body is stiffer than the half-plane. Below :data:`HALF_PLANE_DEPTH` W a
   ResolutionWarning names the measured error; a body thinner than the top element size dx
   cannot be meshed with triangles of that size and is refused (:class:`InputError`).
+* **Mesh size.** A body of more than :data:`MAX_TRIANGLES` triangles (estimated before
+  gmsh runs, :func:`estimated_triangles`) is refused: a deep body or a small
+  ``size_max`` asked gmsh for 7e7 triangles, and gmsh stopped to ask on the terminal
+  whether to continue (a batch job waited there for ever).
 
 Measured (the tables below): a cosine half period (lambda = 1 mm, g = 1 um, W =
 lambda/2; growth 0.1), FEM-VI against the periodic BEM of the mirrored profile at the
@@ -98,6 +102,69 @@ def warn_locking(nu: float, stacklevel: int = 3) -> None:
         f"FemSolverOptions(volumetric='nodal') (the default 'auto' above {LOCKING_NU}: "
         f"{_measured(NODAL_ERRORS[-1], 'nu = ')} on the cosine, 1-4 % low on measured "
         f"lines of 257 nodes) or method='bem'",
+        ResolutionWarning, stacklevel=stacklevel)
+
+
+#: The most triangles of a FEM body (estimated, :func:`estimated_triangles`). Measured:
+#: 2.1e5 triangles (65 top nodes, depth 5000 W) took 0.8 GB and 12 s for one VI step
+#: with MUMPS LU; memory and time grow at least linearly from there.
+MAX_TRIANGLES = 2_000_000
+
+
+def estimated_triangles(width: float, depth: float, dx: float, growth: float,
+                        size_max: float) -> float:
+    """Triangles gmsh makes for the body of :func:`roughfe.fem.mesh_profile`: equilateral
+    triangles (4 / (sqrt(3) s^2) per unit area) of the size ``s(d) = min(dx + growth d,
+    size_max)`` at the distance ``d`` below the top, over the ``width x depth`` body.
+    Measured against gmsh: 0.6-1.0 of its count (an underestimate; 0.9-1.0 at growth
+    <= 0.1)."""
+    size_max = max(size_max, dx)
+    graded = min(depth, (size_max - dx) / growth)       # depth where s reaches size_max
+    per_width = (1.0 / dx - 1.0 / (dx + growth * graded)) / growth \
+        + (depth - graded) / size_max ** 2
+    return 4.0 / 3.0 ** 0.5 * width * per_width
+
+
+def check_mesh_size(width: float, depth: float, dx: float, growth: float,
+                    size_max: float) -> float:
+    """The estimated triangle count of the body; an InputError above
+    :data:`MAX_TRIANGLES` naming the arguments that set it."""
+    n = estimated_triangles(width, depth, dx, growth, size_max)
+    if n > MAX_TRIANGLES:
+        raise InputError(
+            f"the FEM body would have about {n:.3g} triangles, more than the "
+            f"{MAX_TRIANGLES:.3g} allowed (2.1e5 took 0.8 GB and 12 s per step): depth = "
+            f"{depth:.3g} m = {depth / width:.3g} W, size_max = {size_max:.3g} m, growth = "
+            f"{growth:g}, dx = {dx:.3g} m over W = {width:.3g} m; omit depth and size_max "
+            f"(2 W and W/4), raise growth (<= 1) or take fewer profile samples")
+    return n
+
+
+#: Penalty penetration, as a fraction of the imposed approach, above which a penalty
+#: sweep warns: the pressure is low by about 0.7-0.9 times that fraction (cosine, 17 and
+#: 129 nodes, penalty_factor 0.01-1e8 against the VI).
+PENETRATION_RTOL = 1e-3
+
+
+def warn_penetration(results, penalty_factor: float, stacklevel: int = 3) -> None:
+    """ResolutionWarning when the penalty solutions ``results`` (ContactResults) let the
+    body into the obstacle by more than :data:`PENETRATION_RTOL` of their imposed
+    approach (``delta_applied``): a penalty factor too small for the load."""
+    worst, step = 0.0, None
+    for k, r in enumerate(results):
+        if r.delta_applied > 0:
+            ratio = max(-float(r.gap.min()), 0.0) / r.delta_applied
+            if ratio > worst:
+                worst, step = ratio, k
+    if worst <= PENETRATION_RTOL:
+        return
+    r = results[step]
+    warnings.warn(
+        f"penalty_factor = {penalty_factor:g} lets the body into the obstacle by "
+        f"{-float(r.gap.min()):.3g} m at step {step} (imposed approach "
+        f"{r.delta_applied:.3g} m), {worst:.3g} of the approach (allowed "
+        f"{PENETRATION_RTOL:g}): the pressure is low by about that fraction; raise "
+        f"penalty_factor (1e3-1e4 recommended, at most 1e8) or use method='vi'",
         ResolutionWarning, stacklevel=stacklevel)
 
 

@@ -35,7 +35,7 @@ from ..errors import InputError, check_finite_positive, check_instance
 from ..surfaces import Surface
 from ..frozen import FrozenMapping
 from ..writers import atomic_path, output_file
-from .limits import check_depth
+from .limits import check_depth, check_mesh_size
 from .petsc_tools import ensure_jit_cache
 
 FACET_TAGS = {"top": 1, "bottom": 2, "left": 3, "right": 4}
@@ -161,11 +161,15 @@ def mesh_profile(surface: Surface, *, depth: float | None = None, growth: float 
     if formulation == "profile" and -depth >= top_y.min():
         raise InputError(f"depth {depth!r} m does not reach below the lowest profile point")
     check_depth(depth, width, dx, depth + float(top_y.min()))
+    check_mesh_size(width, depth + float(top_y.max()), dx, growth, size_max)
 
     files = {}
     gmsh.initialize()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
+        # never stop to ask on the terminal ("Do you really want to continue?" on a
+        # large mesh: a batch job waited there for ever); the size is checked above
+        gmsh.option.setNumber("General.ExpertMode", 1)
         gmsh.model.add(name)
         if comm.rank == 0:
             geo = gmsh.model.geo
