@@ -370,13 +370,15 @@ def test_pull_off_is_that_of_the_load_path_independent_of_the_step():
     of the step size, dependent on the maximum approach (the preload dependence of a
     displacement-controlled experiment)."""
     # Loaded to 0.6 of max h - mean h, the most tensile state of the unloading branch is
-    # its start, the largest approach (-80.65 kPa), whatever the step: the pull-off is
+    # its start, the largest approach (-80.12 kPa), whatever the step: the pull-off is
     # the same at 3, 5 and 9 loading points to the solver's tolerance. Until round 2,
     # session 21 the branch's loads left that start out, and the pull-off read -77.57,
     # -78.94, -79.74 kPa, creeping towards it as the step shrank (taken then for
     # first-order convergence). Below the tensile strength sigma0 = w / rho. Loaded to
-    # 0.2, 0.4 and 0.8 of it instead, the pull-off is -76.15, -78.12 and -83.25 kPa:
-    # deeper loading, more tension (docs/theory/07_adhesion_persson.md).
+    # 0.2, 0.4 and 0.8 of it instead, the pull-off is -75.81, -77.73 and -83.14 kPa:
+    # deeper loading, more tension (docs/theory/07_adhesion_persson.md; until round 2,
+    # session 32, with each state pbar / k0 off its approach: -76.15, -78.12, -80.65,
+    # -83.25 kPa).
     s, mat = _peel_case()
     top = float(s.heights.max() - s.heights.mean())
     runs = [adhesive_sweep(s, mat, RESOLVED_EXP, np.linspace(0.1, 0.6, k) * top,
@@ -456,17 +458,20 @@ def _pull_off_on_refined_grids(law, sizes):
 
 def test_rough_pull_off_converges_under_grid_refinement_only_when_the_zone_is_resolved():
     # One rough cell on 32^2, 64^2, 128^2 (the same band-limited surface). A law whose
-    # process zone spans 3.4, 6.7, 13.4 spacings: first-order convergence (measured -79235,
-    # -79030, -78926 Pa: differences 205, 104 Pa). The law of the old peel-off test (zone
-    # 6.7e-4 of a spacing on 32^2): no convergence (-6.70, -4.61, -3.07 MPa on the same
-    # grids, measured; 32^2 and 64^2 here).
+    # process zone spans 3.4, 6.7, 13.4 spacings: first-order convergence (measured
+    # -80123.9, -80117.0, -80113.7 Pa: differences 7.0, 3.3 Pa). The law of the old
+    # peel-off test (zone 6.7e-4 of a spacing on 32^2): no convergence (-3.94, -4.43,
+    # -2.87 MPa on the same grids, measured; 32^2 and 64^2 here). Until round 2, session
+    # 32 the machine spring's compliance put each state pbar / k0 off its approach, k0
+    # growing as 1 / dx: the resolved values read -79235, -79030, -78926 Pa (differences
+    # 205, 104 Pa), the unresolved -6.70, -4.61, -3.07 MPa.
     p = _pull_off_on_refined_grids(RESOLVED_EXP, (32, 64, 128))
     d1, d2 = p[1] - p[0], p[2] - p[1]
     assert np.sign(d1) == np.sign(d2) and abs(d2) <= 0.6 * abs(d1)
-    assert abs(d2) <= 2e-3 * abs(p[2])
+    assert abs(d2) <= 2e-4 * abs(p[2])
     with pytest.warns(ResolutionWarning):
         q = _pull_off_on_refined_grids(AdhesionLaw("exp", 0.02, 2e-9), (32, 64))
-    assert abs(q[1] / q[0] - 1) > 0.2
+    assert abs(q[1] / q[0] - 1) > 100 * abs(p[1] / p[0] - 1)     # 0.13 against 8.7e-5
 
 
 def test_an_unresolved_process_zone_is_a_warning_that_names_the_lengths():
@@ -652,7 +657,11 @@ def test_the_adhesive_cg_hands_a_stalled_jump_in_to_lbfgsb():
     alone = solve_adhesive(s, mat, law, delta=-0.35 * amp, initial=open_state,
                            solver="lbfgsb")
     assert jumped.nit < 2000 and jumped.n_contact > 0.15 * n
-    assert jumped.mean_pressure == pytest.approx(alone.mean_pressure, rel=1e-4)
+    # both stop within the traction tolerance 1e-5 S (S = sigma0 here); the mean pressure
+    # is 4 % of S, so 1e-4 of it (2.4e-6 S, held under the mean-gap spring until round
+    # 2, session 32) asked for more than the solves give: measured 6.4e-6 S apart
+    assert jumped.mean_pressure == pytest.approx(alone.mean_pressure, rel=0,
+                                                 abs=1e-5 * law.max_traction)
     assert jumped.mean_pressure < -0.18 * np.pi * amp * mat.E_star   # tensile: attached
 
 

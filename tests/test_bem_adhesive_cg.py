@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from roughfe.bem import adhesion
+from roughfe.bem import adhesive_minimise
 from roughfe.bem.adhesion import AdhesionLaw, solve_adhesive
 from roughfe.model import Material
 from roughfe.surfaces.shapes import sphere_cap
@@ -34,14 +34,14 @@ def test_the_cg_reports_the_residual_of_the_state_it_returns(kind, tol, monkeypa
     # running Ku off the state's: it must neither stop on such a residual nor stall
     # above a tight tolerance and hand over to L-BFGS-B
     calls = []
-    pcg = adhesion.adhesive_pcg
+    pcg = adhesive_minimise.adhesive_pcg
 
     def watched(energy, x, tol_, max_iter):
         out = pcg(energy, x, tol_, max_iter)
         calls.append((out[2], energy.residual(out[0]), out[3]))
         return out
 
-    monkeypatch.setattr(adhesion, "adhesive_pcg", watched)
+    monkeypatch.setattr(adhesive_minimise, "adhesive_pcg", watched)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")          # the coarse sphere's ResolutionWarning
         for surface, mat, law, delta in _cases(kind):

@@ -39,8 +39,10 @@ energy and its gradient cost two FFTs:
   Delta fixes the mean gap (mean u = 0, see :mod:`roughfe.bem.operators`); it is
   imposed through a stiff "machine" spring on the mean gap, ``k0/2 (mean g - gbar)^2``
   with ``k0`` = 10x the stiffest elastic mode, whose force is the mean pressure
-  ``pbar = k0 (mean g - gbar)``. Every reported state is an exact equilibrium at the
-  Delta it reports (``delta`` = max h - mean h - mean g, within pbar/k0 of the target).
+  ``pbar = k0 (mean g - gbar)``; its rest length ``gbar`` is moved until the mean gap
+  is the imposed one (an augmented Lagrangian, :mod:`roughfe.bem.adhesive_minimise`):
+  every reported state is an equilibrium at the imposed Delta, the same for every k0
+  (until round 2, session 32 it sat pbar/k0 off it, and could jump into full contact).
 * non-periodic (``"strip"``, ``"love"``, ``"thesis"``): the DC-FFT operator lives on the
   zero-padded grid, where it is a positive definite circulant (all eigenvalues > 0,
   checked), so K is its exact inverse there. The unknowns are the gap on the grid and
@@ -65,7 +67,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.optimize
 
 from ..errors import (InputError, NoConvergenceError, ResolutionWarning,
                       check_finite_positive, check_in_open_interval, check_instance,
@@ -74,8 +75,9 @@ from ..model import ContactResult, Loading, Material, SweepResult
 from ..surfaces.stats import rms_height, rms_slope
 from ..surfaces.surface import Surface
 from .contact import _choose_kernel, _operator
-from .adhesive_cg import adhesive_pcg
 from .adhesive_energy import AdhesiveEnergy
+from .adhesive_minimise import (MAX_SPREAD_PASSES, SOLVERS,  # noqa: F401
+                                mean_gap_tolerance, minimise)
 from .adhesive_pull_off import refine_pull_off, tensile_floor
 from .adhesive_rules import check_adhesive_run
 from .adhesive_start import continued_start, elastic_start
@@ -170,8 +172,9 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
         Iterations (CG and L-BFGS-B together).
     spring : float, optional
         Periodic only: stiffness k0 (Pa/m, finite and > 0) of the spring imposing the
-        mean gap; default 10x the stiffest elastic mode. Refused with a non-periodic
-        kernel, which has no such spring.
+        mean gap (the penalty of an augmented Lagrangian: the state does not depend on
+        it); default 10x the stiffest elastic mode. Refused with a non-periodic kernel,
+        which has no such spring.
     unloading : bool
         The branch stored in the result (``ContactResult.unloading``).
     cell_average : bool
@@ -193,7 +196,9 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     InputError
         Bad input.
     NoConvergenceError
-        The residual stayed above ``tol``; ``result`` holds the last state.
+        The residual stayed above ``tol``, or (periodic) the mean gap missed the imposed
+        approach (:func:`~roughfe.bem.adhesive_minimise.mean_gap_tolerance`); ``result``
+        holds the last state.
 
     Warns
     -----
@@ -232,12 +237,7 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
     averaged = bool(cell_average) and law.kind == "md"
     if averaged:
         energy.spread = energy.cell_spread(x0)
-    nit, x = 0, x0
-    for _ in range(MAX_SPREAD_PASSES):
-        x, k, r, message = _minimise(energy, x, tol, int(max_iter) - nit, solver)
-        nit += k
-        if not averaged or not r <= tol or not _update_spread(energy, x, law):
-            break
+    x, nit, r, message, miss = minimise(energy, x0, law, tol, max_iter, solver, averaged)
     out = _adhesive_result(surface, material, op, law, energy, x, d, r, tol, nit,
                            bool(unloading), solver)
     if not r <= tol:          # (a NaN residual is not converged)
@@ -245,30 +245,13 @@ def solve_adhesive(surface: Surface, material: Material, law: AdhesionLaw, *, de
             f"adhesive solver ({solver}) did not converge: traction residual {r:.3e} "
             f"(relative to {scale:.3e} Pa) after {nit} iterations ({message}), tolerance "
             f"{tol:.1e}", result=out)
+    if op.periodic and not abs(miss) <= mean_gap_tolerance(energy, tol):
+        raise NoConvergenceError(
+            f"adhesive solver ({solver}): the imposed approach delta = {d:.6g} m was not "
+            f"met: the state's mean gap is off by {miss:.3e} m (tolerance "
+            f"{mean_gap_tolerance(energy, tol):.1e} m) after {nit} iterations; "
+            f"result.delta is its approach", result=out)
     return out
-
-
-def _minimise(energy, x, tol, max_iter, solver):
-    """``(x, iterations, residual, message)``: the preconditioned CG (``"pcg"``), which
-    hands over to L-BFGS-B from its last iterate if it stops above ``tol`` (a
-    non-convex stall), or L-BFGS-B alone (``"lbfgsb"``)."""
-    nit, message = 0, ""
-    if solver == "pcg":
-        x, nit, r, message = adhesive_pcg(energy, x, tol, max_iter)
-        r = energy.residual(x)
-        if r <= tol or nit >= max_iter:
-            return x, nit, r, message
-    for _ in range(4):       # restarts with a fresh quasi-Newton memory (round-off stalls)
-        res = scipy.optimize.minimize(energy, x, jac=True, method="L-BFGS-B",
-                                      bounds=energy.bounds(),
-                                      options={"maxiter": max_iter - nit, "maxcor": 10,
-                                               "ftol": 0.0, "gtol": tol,
-                                               "maxfun": 2 * max_iter})
-        x, nit, message = res.x, nit + int(res.nit), str(res.message)
-        r = energy.residual(x)
-        if r <= tol or nit >= max_iter:
-            break
-    return x, nit, r, message
 
 
 def cell_compliance(surface: Surface, e_star: float, kernel: str = "auto") -> float:
@@ -279,28 +262,6 @@ def cell_compliance(surface: Surface, e_star: float, kernel: str = "auto") -> fl
     kernel = _choose_kernel(surface, kernel)
     op = _operator(surface.shape, surface.size, float(e_star), kernel)
     return float(op.diagonal * op.e_star / max(surface.spacing))
-
-
-#: Minimisers of :func:`solve_adhesive`.
-SOLVERS = ("pcg", "lbfgsb")
-#: At most this many solves with the cell spread of the previous one (cell-averaged law).
-MAX_SPREAD_PASSES = 3
-
-
-def _update_spread(energy, x, law) -> bool:
-    """Set the cell spread of the solution ``x``; True when it moved by more than 10 %
-    of the ramp half-width on a cell whose gap lies in the ramp (the solve must then be
-    repeated with it)."""
-    new = energy.cell_spread(x)
-    old = energy.spread
-    g = energy.split(x)[0]
-    floor = 0.5 * law.smoothing * law.range
-    half = np.clip(np.maximum(new, old), floor, law.range)
-    ramp = np.abs(g - law.range) <= half
-    energy.spread = new
-    if not ramp.any():
-        return False
-    return bool(np.max(np.abs(new - old)[ramp]) > 0.1 * max(float(half[ramp].min()), floor))
 
 
 def _adhesive_result(surface, material, op, law, energy, x, delta, resid, tol, nit,
@@ -381,7 +342,7 @@ class AdhesiveSweep:
 def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, deltas=None, *,
                    n_steps=None, unload: bool = False, max_unload_steps=None,
                    unload_growth: float = 2.0, kernel: str = "auto", tol: float = 1e-5,
-                   max_iter: int = 20000) -> AdhesiveSweep:
+                   max_iter: int = 20000, spring=None) -> AdhesiveSweep:
     """Continuation in the approach: loading through ``deltas`` and, with ``unload``,
     back down past them until the surfaces separate (see the module docstring).
 
@@ -448,7 +409,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
         prev = None
         for d in deltas:
             prev = solve_adhesive(surface, material, law, delta=d, kernel=kernel, initial=prev,
-                                  tol=tol, max_iter=max_iter, unloading=False)
+                                  tol=tol, max_iter=max_iter, spring=spring, unloading=False)
             results.append(prev)
         pull, detached = float("nan"), False
         if unload:
@@ -464,7 +425,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
             def unloaded(d, initial):
                 return solve_adhesive(surface, material, law, delta=d, kernel=kernel,
                                       initial=initial, tol=tol, max_iter=max_iter,
-                                      unloading=True)
+                                      spring=spring, unloading=True)
 
             def unload_to(d):
                 state = unloaded(d, prev)

@@ -31,7 +31,8 @@ measured AFM surface di-1.di (512^2, Love kernel, padded torus 1024^2, single th
 the same iterations (+-4 %), pressures within 6e-7 of the traction scale, 1.2-1.4x less CPU
 (docs/theory/07_adhesion_persson.md, "Speed"). The periodic mean gap is held by the
 machine spring of :class:`roughfe.bem.adhesive_energy.AdhesiveEnergy`, whose stiffness
-k0 is the preconditioner of the uniform mode.
+k0 is the preconditioner of the uniform mode (and whose rest length
+:mod:`roughfe.bem.adhesive_minimise` moves between solves to meet the imposed mean gap).
 """
 from __future__ import annotations
 

@@ -22,7 +22,9 @@ class AdhesiveEnergy:
         if op.periodic:
             self.kspec = op.inverse_spectrum()
             self.k0 = spring if spring is not None else 10.0 * float(self.kspec.max())
-            self.gbar = float(c.mean())
+            self.target = float(c.mean())     # the imposed mean gap (m)
+            self.gbar = self.target           # the spring's rest length (m; moved by
+            #                                   roughfe.bem.adhesive_minimise to meet it)
             self.shape = c.shape
         else:
             self.kspec = 1.0 / op.spectrum.real

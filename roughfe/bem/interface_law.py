@@ -21,8 +21,8 @@ it: uniform over ``g -+ delta``, ``delta = |grad g| dx / 2`` (central difference
 the uniform spread with the variance of the linear field), which is the ramp above with
 the half-width ``max(delta, s h0 / 2)`` (at most h0): w is kept exactly and the zone end
 is located inside the cell. delta is taken from the previous state and updated after
-each converged solve (at most ``roughfe.bem.adhesion.MAX_SPREAD_PASSES`` solves; again
-only when it moved by more than 10 % of the ramp on a cell in the ramp).
+each converged solve (at most ``roughfe.bem.adhesive_minimise.MAX_SPREAD_PASSES``
+solves; again only when it moved by more than 10 % of the ramp on a cell in the ramp).
 
 Resolution: the law acts over a cohesive (process) zone at the edge of each contact
 patch, of length ``(pi/4) E* w / sigma0^2`` at a crack front (the Dugdale-Barenblatt
