@@ -131,11 +131,12 @@ def _number(name, value, what):
     return v
 
 
-def _check_delta(name, value):
-    v = _number(name, value, "a number of metres >= 0")
-    if not (math.isfinite(v) and v >= 0.0):
-        raise InputError(f"{name} (approach from first contact, m) must be finite and >= 0, "
-                         f"got {value!r}")
+def _check_delta(name, value, apart=False):
+    """The approach ``value`` (m) as a float: finite, and >= 0 unless ``apart``."""
+    v = _number(name, value, "a number of metres" + ("" if apart else " >= 0"))
+    if not (math.isfinite(v) and (apart or v >= 0.0)):
+        raise InputError(f"{name} (approach from first contact, m) must be finite"
+                         f"{'' if apart else ' and >= 0'}, got {value!r}")
     return v
 
 
@@ -163,7 +164,8 @@ class Loading:
     Parameters
     ----------
     delta : float, optional
-        One imposed approach Delta >= 0 from first contact (m), Eq. 2.5.
+        One imposed approach Delta from first contact (m), Eq. 2.5; negative (apart)
+        only with adhesion (:meth:`require_contact`).
     mean_pressure : float, optional
         One imposed mean pressure p > 0 over the nominal area (Pa), Eq. 2.6.
     n_steps : int, optional
@@ -172,7 +174,8 @@ class Loading:
         k / (n_steps + 1) of it, k = 1..n_steps: :func:`~roughfe.bem.adhesion.adhesive_sweep`),
         as in the thesis. The default when nothing is given: ``Loading()`` is 20 steps.
     deltas : sequence of float, optional
-        A sweep over these approaches (m), solved in the order given.
+        A sweep over these approaches (m), solved in the order given; negative ones as
+        for ``delta``.
     pressures : sequence of float, optional
         A sweep over these mean pressures (Pa), solved in the order given.
 
@@ -181,8 +184,8 @@ class Loading:
     Raises
     ------
     InputError
-        More than one kind given, or a value that is not finite, negative (approach),
-        not positive (pressure), not an integer >= 1 (``n_steps``) or an empty sequence.
+        More than one kind given, or a value that is not finite, not positive
+        (pressure), not an integer >= 1 (``n_steps``) or an empty sequence.
     """
 
     delta: Optional[float] = None
@@ -202,7 +205,7 @@ class Loading:
         if not given:
             set_("n_steps", self.DEFAULT_STEPS)
         elif self.delta is not None:
-            set_("delta", _check_delta("delta", self.delta))
+            set_("delta", _check_delta("delta", self.delta, apart=True))
         elif self.mean_pressure is not None:
             set_("mean_pressure", _check_pressure("mean_pressure", self.mean_pressure))
         elif self.n_steps is not None:
@@ -214,7 +217,8 @@ class Loading:
                 raise InputError(f"n_steps must be an integer >= 1, got {n!r}")
             set_("n_steps", int(n))
         elif self.deltas is not None:
-            set_("deltas", _check_series("deltas", self.deltas, _check_delta))
+            set_("deltas", _check_series("deltas", self.deltas,
+                                         lambda k, v: _check_delta(k, v, apart=True)))
         else:
             set_("pressures", _check_series("pressures", self.pressures, _check_pressure))
 
@@ -227,6 +231,19 @@ class Loading:
     def controls_pressure(self) -> bool:
         """True for load control (mean_pressure / pressures), False for approaches."""
         return self.kind in ("mean_pressure", "pressures")
+
+    def require_contact(self) -> None:
+        """Raise :class:`InputError` if an approach is negative: the surfaces then stand
+        apart, a state only an attraction makes a problem of (``response(...,
+        adhesion=law)``, whose loading can start apart and jump in); the non-adhesive
+        solvers have no contact to solve there."""
+        values = {"delta": (self.delta,), "deltas": self.deltas}.get(self.kind, ())
+        for k, v in enumerate(values):
+            if v < 0.0:
+                name = "delta" if self.kind == "delta" else f"deltas[{k}]"
+                raise InputError(f"{name} = {v!r} m is a negative approach (the surfaces "
+                                 f"apart): meaningful with adhesion only (response(..., "
+                                 f"adhesion=law)); without it give approaches >= 0")
 
     def sweep_arguments(self) -> dict:
         """The keyword arguments of :func:`roughfe.bem.contact_sweep` for this loading:

@@ -45,7 +45,8 @@ def response(surface: Surface, material: Material, loading: Optional[Loading] = 
         E (Pa) and nu of the elastic body (the rough surface is rigid).
     loading : Loading, optional
         What to impose; default ``Loading()``: 20 equispaced approaches (Eq. 2.5). A
-        single ``delta`` / ``mean_pressure`` is a one-step sweep.
+        single ``delta`` / ``mean_pressure`` is a one-step sweep. Negative approaches
+        (apart) only with ``adhesion``, whose loading can start apart and jump in.
     method : {"bem", "fem"}
         ``"bem"``: :func:`roughfe.bem.contact_sweep` (the production solver).
         ``"fem"``: :func:`roughfe.fem.fem_contact_sweep` on a gmsh body below the profile,
@@ -129,6 +130,7 @@ def _fem_response(surface, material, loading, options) -> SweepResult:
         raise InputError(f"method='fem' needs a 1D profile (plane strain), got a surface of "
                          f"shape {surface.shape}")
     _check_surface(surface)            # the BEM's words (n_steps gave no approaches)
+    loading.require_contact()          # approaches apart: adhesion only (the BEM's)
     if loading.kind == "n_steps":
         imposed = {"deltas": default_deltas(mirrored_profile(surface), loading.n_steps,
                                             periodic=True)}

@@ -117,11 +117,11 @@ def test_response_bem_is_contact_sweep():
 
 
 @pytest.mark.parametrize("kwargs, match", [
-    ({"delta": -1e-6}, "delta"), ({"delta": float("nan")}, "delta"),
+    ({"delta": float("nan")}, "delta"),
     ({"delta": "1e-6"}, "delta"), ({"mean_pressure": 0.0}, "mean_pressure"),
     ({"mean_pressure": True}, "mean_pressure"), ({"n_steps": 0}, "n_steps"),
     ({"n_steps": 8.5}, "n_steps"), ({"n_steps": True}, "n_steps"),
-    ({"deltas": []}, "deltas"), ({"deltas": [1e-6, -1e-6]}, r"deltas\[1\]"),
+    ({"deltas": []}, "deltas"), ({"deltas": [1e-6, float("nan")]}, r"deltas\[1\]"),
     ({"deltas": [[1e-6]]}, "deltas"), ({"pressures": [1e5, float("inf")]}, "pressures"),
     ({"deltas": 1e-6}, "deltas"),
     ({"delta": 1e-6, "mean_pressure": 1e5}, "ONE of"),
@@ -129,6 +129,33 @@ def test_response_bem_is_contact_sweep():
 def test_loading_rejects_bad_input(kwargs, match):
     with pytest.raises(InputError, match=match):
         Loading(**kwargs)
+
+
+def test_approaches_apart_are_for_adhesion_only():
+    """Round 2, session 32: Loading refused negative approaches, so response(...,
+    adhesion=law) could not start apart and jump in as roughfe contact --adhesion can.
+    Loading takes them; the non-adhesive BEM and the FEM refuse them by name, the
+    adhesive continuation starts out of contact and jumps in."""
+    from roughfe.bem.adhesion import AdhesionLaw
+    from roughfe.surfaces.spectral import spectral_surface
+    assert Loading(delta=-1e-6).delta == -1e-6
+    loading = Loading(deltas=[-1e-6, -2e-9, 4e-9])
+    surf = spectral_surface(16, 1e-5, 0.8, rms_height=1e-8, rng=3)
+    mat = Material(1e6, 0.5)
+    with pytest.raises(InputError, match=r"deltas\[0\] = -1e-06 m is a negative approach.*"
+                                         r"adhesion"):
+        response(surf, mat, loading)
+    with pytest.raises(InputError, match=r"delta = -1e-06 m is a negative approach"):
+        response(_profile_of(surf), mat, Loading(delta=-1e-6), method="fem")
+    sw = response(surf, mat, loading, adhesion=AdhesionLaw("exp", 0.01, 1e-7))
+    # the imposed approaches, to the mean-gap tolerance (~1e-14 m here)
+    np.testing.assert_allclose(sw.delta, loading.deltas, rtol=0, atol=1e-12)
+    assert sw.n_contact[0] == 0 and sw.n_contact[-1] > 0 and sw.load[-1] < 0
+
+
+def _profile_of(surf):
+    """A profile (row 0) of ``surf``."""
+    return Surface(surf.heights[0], surf.size[0], periodic=True)
 
 
 def test_loading_is_frozen_and_describes_itself():

@@ -92,7 +92,8 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
         Number of equispaced approaches (default 20, as in the thesis) when neither
         ``deltas`` nor ``pressures`` is given.
     deltas : sequence of float, optional
-        Approaches Delta >= 0 (m), solved in the order given.
+        Approaches Delta >= 0 (m), solved in the order given (negative ones, apart:
+        :func:`roughfe.bem.adhesion.adhesive_sweep`).
     pressures : sequence of float, optional
         Mean pressures > 0 (Pa), solved in the order given.
     hardness : float, optional
@@ -107,6 +108,7 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     loading = (Loading(deltas=deltas) if deltas is not None else
                Loading(pressures=pressures) if pressures is not None else
                Loading(n_steps=n_steps))
+    loading.require_contact()      # approaches apart: adhesion only (adhesive_sweep)
     if loading.kind == "n_steps":
         periodic = surface.periodic and kernel in ("auto", "spectral")
         deltas = default_deltas(surface, loading.n_steps, periodic)
