@@ -147,6 +147,33 @@ def test_contact_cli_adhesion_unload_pull_off(tmp_path):
     assert doc["derived"]["persson"]["single_asperity"]["shape"] == "sphere"
 
 
+def test_contact_cli_gives_no_window_note_on_one_smooth_asperity(tmp_path, capsys):
+    """Round 2, session 32: the note that K of a non-periodic window is mostly its
+    flat-punch bulk stiffness, "not a property of the roughness", was printed for a
+    sphere too, whose half-space deflection is Hertz's own: the BEM's K there is Hertz's
+    2 E* a / A_n (within 2 %). A rough window keeps it (test_bem_window)."""
+    path = _sphere_file(tmp_path, n=32, length=0.21)
+    out = tmp_path / "sph"
+    assert main(["contact", str(path), "--E", "1", "--nu", "0", "--delta", "1e-3", "4e-3",
+                 "--no-figures", "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "bulk stiffness of the measured window" not in err and "flat punch" not in err
+    doc = json.loads((out / "results.json").read_text())
+    assert doc["derived"]["stiffness_compliance"][-1] > 0.5     # the note's threshold
+    last = doc["steps"][-1]
+    assert last["stiffness"] == pytest.approx(last["hertz_stiffness"], rel=0.03, abs=0)
+
+
+def test_contact_cli_takes_approaches_apart_with_adhesion_only(tmp_path, capsys):
+    # Loading takes negative approaches since round 2, session 32 (response(...,
+    # adhesion=law) can start apart); without adhesion they are refused in the flags' words
+    path = _sphere_file(tmp_path, n=8)
+    assert main(["contact", str(path), "--E", "1", "--delta", "-1e-3", "1e-3",
+                 "-o", str(tmp_path / "x")]) == 2
+    assert ("--delta[0] = -0.001 m is a negative approach (the surfaces apart): meaningful "
+            "with adhesion only (--adhesion)") in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("extra, message", [
     (["--adhesion", "md"], "needs --work-of-adhesion"),
     (["--work-of-adhesion", "0.1"], "need --adhesion"),

@@ -264,7 +264,8 @@ _FLAGS = (("solver='pk'", "--solver pk"), ("solver 'dense'", "--solver dense"),
           ("load control (mean_pressure)", "load control (--pressure)"),
           ("kernel 'spectral'", "--kernel spectral"),
           ("(Surface(..., periodic=True))", "(without --non-periodic)"),
-          ("use 'strip'/'love' otherwise", "use --kernel strip/love otherwise"))
+          ("use 'strip'/'love' otherwise", "use --kernel strip/love otherwise"),
+          ("(response(..., adhesion=law))", "(--adhesion)"), ("deltas[", "--delta["))
 
 
 def _in_flags(message: str) -> str:
@@ -341,10 +342,20 @@ def contact_document(sweep, surface, material, inputs: dict, *, adhesive=False) 
     inputs and Persson's theory beside every step (``persson_*`` keys, ``derived.persson``);
     for an ``adhesive`` sweep no step gets the (non-adhesive) theory and
     ``derived.persson`` says so (:data:`roughfe.theory.beside.NOT_ADHESIVE`), nor does a
-    step with plastic flow or one after it (:data:`roughfe.theory.beside.NOT_PLASTIC`)."""
-    doc = sweep_document(sweep, {"surface": inputs.get("surface"),
-                                 "shape": list(surface.shape), "size": list(surface.size),
-                                 "periodic": surface.periodic, **inputs})
+    step with plastic flow or one after it (:data:`roughfe.theory.beside.NOT_PLASTIC`).
+    On one smooth asperity (:func:`roughfe.theory.asperity.single_asperity`) the window
+    note is not given: the half-space's deflection is Hertz's own, and K matches his."""
+    import warnings
+
+    from ..errors import WindowStiffnessWarning
+    from ..theory.asperity import single_asperity
+    with warnings.catch_warnings():
+        if single_asperity(surface) is not None:
+            warnings.simplefilter("ignore", WindowStiffnessWarning)
+        doc = sweep_document(sweep, {"surface": inputs.get("surface"),
+                                     "shape": list(surface.shape),
+                                     "size": list(surface.size),
+                                     "periodic": surface.periodic, **inputs})
     theory = beside(surface, material.E_star, doc["steps"], adhesive=adhesive)
     doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
     return doc
