@@ -248,6 +248,13 @@ def test_bad_material_and_surfaces():
             Material(E, nu)
     with pytest.raises(ValueError, match="flat"):
         solve_contact(Surface(np.ones(32), 1.0), MAT, delta=0.0)
+    # heights far below an atom are flat too: 1e-200 m had passed as rough and ended in
+    # a ZeroDivisionError (periodic) or a PK residual of 1e176 (non-periodic)
+    tiny = 1e-200 * np.random.default_rng(0).standard_normal((16, 16))
+    for periodic in (True, False):
+        with pytest.raises(InputError, match=r"flat \(height range [0-9.]+e-200 m"):
+            solve_contact(Surface(tiny, (1e-3, 1e-3), periodic=periodic), MAT,
+                          mean_pressure=1e5)
     with pytest.raises(ValueError):
         Surface(np.array([0.0, np.nan, 1.0]), 1.0)
     with pytest.raises(ValueError, match="periodic"):
