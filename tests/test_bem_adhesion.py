@@ -460,8 +460,9 @@ def test_rough_pull_off_converges_under_grid_refinement_only_when_the_zone_is_re
     # One rough cell on 32^2, 64^2, 128^2 (the same band-limited surface). A law whose
     # process zone spans 3.4, 6.7, 13.4 spacings: first-order convergence (measured
     # -80123.9, -80117.0, -80113.7 Pa: differences 7.0, 3.3 Pa). The law of the old
-    # peel-off test (zone 6.7e-4 of a spacing on 32^2): no convergence (-3.94, -4.43,
-    # -2.87 MPa on the same grids, measured; 32^2 and 64^2 here). Until round 2, session
+    # peel-off test (zone 6.7e-4 of a spacing on 32^2): no convergence (-4.65, -4.62,
+    # -3.05 MPa on the same grids, measured; -3.94, -4.43, -2.87 from the rest length at
+    # the target, earlier in session 32). Until round 2, session
     # 32 the machine spring's compliance put each state pbar / k0 off its approach, k0
     # growing as 1 / dx: the resolved values read -79235, -79030, -78926 Pa (differences
     # 205, 104 Pa), the unresolved -6.70, -4.61, -3.07 MPa.
@@ -470,8 +471,11 @@ def test_rough_pull_off_converges_under_grid_refinement_only_when_the_zone_is_re
     assert np.sign(d1) == np.sign(d2) and abs(d2) <= 0.6 * abs(d1)
     assert abs(d2) <= 2e-4 * abs(p[2])
     with pytest.warns(ResolutionWarning):
-        q = _pull_off_on_refined_grids(AdhesionLaw("exp", 0.02, 2e-9), (32, 64))
-    assert abs(q[1] / q[0] - 1) > 100 * abs(p[1] / p[0] - 1)     # 0.13 against 8.7e-5
+        q = _pull_off_on_refined_grids(AdhesionLaw("exp", 0.02, 2e-9), (32, 64, 128))
+    # the spread over the three grids: 0.52 against 1.3e-4 (two grids can agree by
+    # chance: -4.65 and -4.62 MPa on 32^2 and 64^2 since the state start of session 32)
+    spread = lambda v: float(np.ptp(v) / np.max(np.abs(v)))
+    assert spread(q) > 100 * spread(p)
 
 
 def test_an_unresolved_process_zone_is_a_warning_that_names_the_lengths():

@@ -85,5 +85,7 @@ def test_an_interface_that_jumps_past_the_spring_is_held_by_a_stiffer_one():
         warnings.simplefilter("ignore", ResolutionWarning)
         for f in (0.1, 0.3, 0.5):
             prev = solve_adhesive(s, mat, law, delta=f * top, initial=prev)
-            assert prev.delta == pytest.approx(f * top, rel=0, abs=1e-6 * top)
+            # the solver's contract: mean_gap_tolerance, 0.01 tol S / k_max = 1.1e-13 m
+            # = 4.4e-6 of top here (the old code missed by up to 20 % of its approach)
+            assert prev.delta == pytest.approx(f * top, rel=0, abs=1e-5 * top)
             assert 0 < prev.area_fraction < 1
