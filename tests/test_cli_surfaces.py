@@ -115,3 +115,36 @@ def test_demo_writes_index_and_nonblank_figures(tmp_path):
         assert _nonblank(tmp_path / png), png
     stats = json.loads((tmp_path / "rmd_statistics.json").read_text())
     assert stats["fractal_dimension"] == pytest.approx(2.3, abs=0.1)
+
+
+def test_info_hurst_range_row_option_and_note(tmp_path, capsys):
+    """info prints the fitted wavenumber range, takes --hurst-q-range (rad/m), prints the
+    fit's note when the range is not one power law, and on a grid too small for the
+    default range says why instead of an inverted range (round 2, session 32)."""
+    out = tmp_path / "s.npz"
+    assert main(["generate", "spectral", "--n", "64", "--seed", "1", "--no-figures",
+                 "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["info", str(out), "--json", "--hurst-q-range", "2e5", "1e6"]) == 0
+    stats = json.loads(capsys.readouterr().out)["statistics"]
+    assert stats["hurst_q_range"] == pytest.approx([2e5, 1e6], rel=1e-12, abs=0)
+    assert main(["info", str(out), "--hurst-q-range", "1e6", "2e5"]) == 2
+    assert "--hurst-q-range" in capsys.readouterr().err
+    assert main(["info", str(out)]) == 0
+    row = next(line for line in capsys.readouterr().out.splitlines()
+               if line.startswith("Hurst fit range"))
+    low, high = (float(v) for v in row.split()[4:7:2])
+    assert low < high and row.endswith("rad/um")
+    small = tmp_path / "small.npz"
+    main(["generate", "spectral", "--n", "16", "--seed", "1", "--no-figures", "-o", str(small)])
+    capsys.readouterr()
+    assert main(["info", str(small)]) == 0
+    text = capsys.readouterr().out
+    assert "grid too small" in text and "--hurst-q-range" in text
+    assert "Hurst fit range q            n/a" in text
+
+
+def test_info_notes_a_curved_psd(topographies_dir, capsys):
+    assert main(["info", str(topographies_dir / "opd-1.opd"), "--detrend", "plane"]) == 0
+    note = [line for line in capsys.readouterr().out.splitlines() if line.startswith("note:")]
+    assert len(note) == 1 and "not one power law" in note[0] and "--hurst-q-range" in note[0]

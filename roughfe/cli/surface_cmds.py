@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import check_memory
+from ..errors import InputError, check_memory
 from .options import (add_detrend_option, add_output_file, add_run_options,
                       add_surface_options, nonnegative_int, output_file_of, positive_float,
                       positive_int, print_surface_notes, surface_from_args)
@@ -25,6 +25,7 @@ _TABLE = (
     ("nayak_alpha", "Nayak bandwidth alpha", "-", 1.0),
     ("hurst", "Hurst exponent (PSD fit)", "-", 1.0),
     ("fractal_dimension", "fractal dimension D", "-", 1.0),
+    ("hurst_q_range", "Hurst fit range q", "rad/um", 1e-6),
 )
 
 
@@ -34,7 +35,7 @@ STATISTICS_UNITS = {"shape": "points", "size": "m", "mean": "m", "rms_height": "
                     "skewness": "1", "kurtosis": "1", "m0": "m^2", "m2": "1", "m4": "1/m^2",
                     "nayak_alpha": "1", "hurst": "1 (meaningful when hurst_success)",
                     "fractal_dimension": "1 (meaningful when hurst_success)",
-                    "hurst_q_range": "rad/m"}
+                    "hurst_q_range": "rad/m", "hurst_message": "text"}
 
 
 def format_table(stats: dict) -> str:
@@ -43,21 +44,29 @@ def format_table(stats: dict) -> str:
     for key, label, unit, scale in _TABLE:
         v = stats[key]
         if key in ("hurst", "fractal_dimension") and not stats["hurst_success"]:
-            if v is None:
-                lines.append(f"{label:<28s} n/a (too few PSD points to fit)")
+            if v is None:        # the fit's own reason (too few points, grid too small)
+                why = stats.get("hurst_message", "").split(";")[0] or "too few PSD points"
+                lines.append(f"{label:<28s} n/a (" + ("no Hurst exponent" if key !=
+                             "hurst" else f"{why}; give --hurst-q-range") + ")")
                 continue
             lines.append(f"{label:<28s} n/a (PSD fit gives H = {stats['hurst']:.3g}, "
                          f"outside (0, 1))")
             continue
-        if v is None:
-            text = "n/a"
+        if v is None or (isinstance(v, list) and None in v):
+            text, unit = "n/a", ""
         elif scale is None:
             text = " x ".join(str(x) for x in v) if isinstance(v, list) else str(v)
+        elif key == "hurst_q_range":
+            text = " - ".join(f"{x * scale:.4g}" for x in v)
         elif isinstance(v, list):
             text = " x ".join(f"{x * scale:.6g}" for x in v)
         else:
             text = f"{v * scale:.6g}"
         lines.append(f"{label:<28s} {text} {unit}".rstrip())
+    message = stats.get("hurst_message", "")
+    note = message.partition("; ")[2] if "not one power law" in message else ""
+    if note:             # split_fit: the range is not one power law
+        lines.append(f"note: Hurst fit: {note}")
     return "\n".join(lines)
 
 
@@ -65,7 +74,11 @@ def _info(args) -> int:
     from ..surfaces.stats import surface_statistics
     from ..writers import to_json_text
     surface = surface_from_args(args)
-    stats = surface_statistics(surface).as_dict()
+    q_range = None if args.hurst_q_range is None else tuple(args.hurst_q_range)
+    if q_range is not None and not q_range[0] < q_range[1]:
+        raise InputError(f"--hurst-q-range QMIN QMAX needs QMIN < QMAX (rad/m), got "
+                         f"{q_range[0]:g} {q_range[1]:g}")
+    stats = surface_statistics(surface, q_range=q_range).as_dict()
     if args.json:
         units = {k: v for k, v in STATISTICS_UNITS.items() if k in stats}
         print(to_json_text({"file": str(args.surface), "statistics": stats, "units": units,
@@ -250,5 +263,10 @@ def register(sub):
                                    "curvature, spectral moments, Nayak alpha, Hurst exponent.")
     add_surface_options(p)
     add_detrend_option(p)
+    p.add_argument("--hurst-q-range", type=positive_float, nargs=2, metavar=("QMIN", "QMAX"),
+                   default=None,
+                   help="angular wavenumbers (rad/m) bounding the Hurst fit (default "
+                        "8 pi / L to pi / (2 dx)); restrict it to the self-affine range "
+                        "when the table notes that the PSD is not one power law")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(func=_info)

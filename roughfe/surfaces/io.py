@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import warnings
 import zipfile
 import zlib
 from pathlib import Path
@@ -275,7 +276,32 @@ def _read_instrument(path, size, periodic, channel):
             f"{path}: SurfaceTopography's {reader.format()!r} reader failed on this file's "
             f"data; is it damaged or truncated? ({quote_error(exc)})") from exc
     warn_if_shorter_than_announced(path, reader.format())
+    if "size_in_file" in surface.metadata:      # (outside quietly(), which keeps warnings)
+        _warn_if_size_overridden(path, size, surface.metadata["size_in_file"])
     return surface
+
+
+#: A given size within this relative difference of the file's is the file's: float32
+#: lengths (6e-8) or a size typed with 4 digits (<= 5e-4), below the ~1 % lateral
+#: calibration uncertainty of profilometers.
+SIZE_RTOL = 1e-3
+
+
+def _warn_if_size_overridden(path, size, file_size):
+    """Warn that ``size`` (m) replaces the calibrated lateral scale ``file_size`` (m) of an
+    instrument file: silent until round 2, session 32 (only ``metadata["size_in_file"]``
+    kept the file's)."""
+    given = np.atleast_1d(np.asarray(size, dtype=float))
+    given = np.broadcast_to(given, (len(file_size),)) if given.size == 1 else given
+    if given.shape == (len(file_size),) and np.allclose(given, file_size, rtol=SIZE_RTOL,
+                                                        atol=0.0):
+        return
+    um = " x ".join(f"{s * 1e6:.6g}" for s in file_size)
+    warnings.warn(f"{path}: the size given ({' x '.join(f'{s * 1e6:.6g}' for s in given)} "
+                  f"um) replaces the file's own physical size ({um} um): every length, slope "
+                  f"and wavenumber then follows the given size; leave size/--size out to "
+                  f"keep the file's (metadata['size_in_file'] records it)", UserWarning,
+                  stacklevel=4)
 
 
 def _instrument_surface(reader, path, size, periodic, channel):

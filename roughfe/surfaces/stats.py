@@ -319,7 +319,9 @@ class HurstFit:
 
     ``hurst`` from ``slope = -(1 + 2H)`` (profile) or ``-2(1 + H)`` (surface);
     ``fractal_dimension = d + 1 - H``. ``success`` is False when fewer than 3 PSD points
-    fall in the range or H leaves (0, 1) (the surface is then not self-affine there).
+    fall in the range or H leaves (0, 1) (the surface is then not self-affine there);
+    ``q_range`` is NaN when no range was fitted. ``message`` adds the note of
+    :func:`~roughfe.surfaces.psd_fit.split_fit` when the range is not one power law.
     """
 
     hurst: float
@@ -396,10 +398,10 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     _check_surface(surface)
     if q_range is None:
         qlo, qhi = 4 * 2 * np.pi / max(surface.size), np.pi / (2 * max(surface.spacing))
-        if qlo >= qhi:
-            return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), 0, False,
-                            "grid too small for the default q_range (needs > 16 points per "
-                            "side); give q_range")
+        if qlo >= qhi:      # (it reported this empty range, low > high, as q_range)
+            return HurstFit(np.nan, np.nan, np.nan, np.nan, (np.nan, np.nan), 0, False,
+                            f"grid too small for the default q_range: 8 pi / L = {qlo:.3g} is not "
+                            f"below pi / (2 dx) = {qhi:.3g} rad/m (needs > 16 points per side); give q_range")
         q_range = (qlo, qhi)
     try:
         qlo, qhi = (float(v) for v in q_range)
@@ -409,7 +411,7 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     if not (0 < qlo < qhi):
         raise InputError(f"q_range must satisfy 0 < q_min < q_max (rad/m), got {q_range!r}")
     psd = power_spectrum(surface, window=window)
-    from .psd_fit import fit_points      # (it imports this module)
+    from .psd_fit import fit_points, split_fit      # (it imports this module)
     sel, weight = fit_points(psd, (qlo, qhi))
     n = int(sel.sum())
     if n < 3:
@@ -423,9 +425,10 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     d = surface.ndim
     hurst = -slope / 2 - 1 if d == 2 else (-slope - 1) / 2
     ok = 0 < hurst < 1
+    note = split_fit(psd, (qlo, qhi), surface.size).note     # "" when one power law
     return HurstFit(float(hurst), float(d + 1 - hurst), float(slope), float(prefactor),
-                    (qlo, qhi), n, bool(ok),
-                    "fit converged" if ok else f"H = {hurst:.3f} outside (0, 1): not self-affine")
+                    (qlo, qhi), n, bool(ok), ("fit converged" if ok else f"H = {hurst:.3f} "
+                    "outside (0, 1): not self-affine") + (f"; {note}" if note else ""))
 
 
 # -- everything at once ------------------------------------------------------------------
@@ -456,6 +459,7 @@ class SurfaceStatistics:
     fractal_dimension: float
     hurst_q_range: tuple
     hurst_success: bool
+    hurst_message: str = ""       # HurstFit.message: why not, or a range not one power law
 
     def as_dict(self) -> dict:
         """JSON-safe dict (NaN becomes None: :func:`roughfe.writers.to_jsonable`)."""
@@ -490,4 +494,4 @@ def surface_statistics(surface: Surface, q_range=None) -> SurfaceStatistics:
         skewness=skewness, kurtosis=kurtosis,
         m0=m0, m2=m2, m4=m4, nayak_alpha=m0 * m4 / m2 ** 2 if m2 > 0 else float("nan"),
         hurst=fit.hurst, fractal_dimension=fit.fractal_dimension, hurst_q_range=fit.q_range,
-        hurst_success=fit.success)
+        hurst_success=fit.success, hurst_message=fit.message)
