@@ -371,6 +371,10 @@ class ContactResult(Frozen):
         The branch of the step: False on loading, True on unloading.
     adhesive_area_fraction : float, BEM adhesion
         Fraction of the nominal area under tensile (adhesive) traction.
+    patch_width : float, BEM and FEM (not adhesion)
+        Load-weighted width of the contact patches in grid points (NaN without contact);
+        below ``roughfe.bem.patches.MIN_PATCH_POINTS`` the grid does not resolve them
+        (:func:`roughfe.bem.patches.resolution_note`).
 
     With adhesion (:mod:`roughfe.bem.adhesion`) ``pressure`` is the total interface
     traction and is negative (tensile) in the interaction zone; ``contact`` marks g = 0.
@@ -415,6 +419,7 @@ class ContactResult(Frozen):
     plastic_displacement: Optional[np.ndarray] = None
     unloading: Optional[bool] = None
     adhesive_area_fraction: Optional[float] = None
+    patch_width: Optional[float] = None
 
     __repr__ = compact_repr          # one line: fields as shape and dtype, unset optionals left out
 
@@ -530,6 +535,8 @@ class SweepResult(Frozen):
         BEM with a hardness: plastic area fraction per step.
     unloading : ndarray or None
         BEM sweeps with a branch: 1.0 on the unloading branch, 0.0 on loading.
+    patch_width : ndarray or None
+        Load-weighted contact patch width per step (grid points; see ContactResult).
     pull_off_force, pull_off_pressure, detached : float, float, bool or None
         Adhesive sweeps with an unloading branch (None otherwise): the most tensile load
         of that branch (N, N/m for profiles; 0 when none is tensile), as a mean pressure
@@ -560,6 +567,7 @@ class SweepResult(Frozen):
     delta_applied: Optional[np.ndarray] = None
     plastic_area_fraction: Optional[np.ndarray] = None
     unloading: Optional[np.ndarray] = None
+    patch_width: Optional[np.ndarray] = None
     # -- optional values of the whole sweep (not per step; from_results' keywords) --
     pull_off_force: Optional[float] = None
     pull_off_pressure: Optional[float] = None

@@ -31,7 +31,7 @@ def test_contact_cli_writes_results_fields_and_figures(tmp_path):
                              "n_contact",
                              "stiffness", "stiffness_fd", "mean_gap", "mean_plane_separation",
                              "free_volume", "free_volume_star", "iterations", "residual",
-                             "persson_area_fraction", "persson_mean_gap", "persson_stiffness"}
+                             "patch_width", "persson_area_fraction", "persson_mean_gap", "persson_stiffness"}
     # every dimensional record key has its unit (contact_area had none: read as a fraction)
     units = doc["derived"]["units"]
     assert units["contact_area"].startswith("m^2") and units["mean_gap"] == "m"

@@ -196,7 +196,8 @@ def test_sweep_stiffness_exact_vs_finite_differences_and_records():
     assert list(recs[0]) == ["delta", "load", "mean_pressure", "area_fraction", "contact_area",
                              "n_contact",
                              "stiffness", "stiffness_fd", "mean_gap", "mean_plane_separation",
-                             "free_volume", "free_volume_star", "iterations", "residual"]
+                             "free_volume", "free_volume_star", "iterations", "residual",
+                             "patch_width"]
     # V = mean gap * A_n, the free volume of Eq. 2.8
     r = sweep.results[5]
     assert r.free_volume == pytest.approx(r.mean_gap * 1e-4, rel=1e-12, abs=0)

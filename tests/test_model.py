@@ -60,8 +60,8 @@ def test_bem_and_fem_return_one_type_with_one_field_set(bem_and_fem):
     assert fem.delta_applied is not None and ref.delta_applied is None
     # one results.json record schema: the BEM keys, then the FEM's optional numbers
     rf, rb = fem.to_records()[0], ref.to_records()[0]
-    assert tuple(rb) == RECORD_KEYS
-    assert tuple(rf) == RECORD_KEYS + ("delta_applied", "layer_compliance")
+    assert tuple(rb) == RECORD_KEYS + ("patch_width",)
+    assert tuple(rf) == RECORD_KEYS + ("delta_applied", "layer_compliance", "patch_width")
 
 
 @pytest.mark.fem
@@ -230,7 +230,7 @@ def test_optional_field_is_one_line():
     # a step without the value: no array, and the records of the BEM stay as they were
     mixed = Sweep.from_results([steps[0], Result(**init)], rms_slope=1.0, length=1e-3)
     assert mixed.example_quantity is None
-    assert tuple(mixed.to_records()[1]) == RECORD_KEYS
+    assert tuple(mixed.to_records()[1]) == RECORD_KEYS + ("patch_width",)
 
 
 @pytest.mark.fem

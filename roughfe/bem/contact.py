@@ -36,6 +36,7 @@ from .contact_checks import (_check_coarse_correction, _check_hardness, _check_s
                              _check_target, _check_tol)
 from .deflation import BlockDeflation
 from .padded_deflation import PaddedBlockDeflation
+from .patches import patch_width
 from .pk import polonsky_keer
 from .solvers import SolverOutput, dense_solve
 from .stiffness import exact_stiffness
@@ -461,7 +462,8 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
         solver=out.solver, e_star=material.E_star, rms_height=sigma,
         size=tuple(surface.size), spacing=tuple(surface.spacing),
         periodic=op.periodic, references=REFERENCES + op.references, method="bem",
-        plastic_area_fraction=plastic_fraction, plastic_displacement=plastic)
+        plastic_area_fraction=plastic_fraction, plastic_displacement=plastic,
+        patch_width=patch_width(contact, p, periodic=op.periodic))
 
 
 def surface_displacement(surface: Surface, material: Material, traction,

@@ -27,8 +27,8 @@ from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5
 from ..theory import beside, pastewka_robbins
 from ..writers import write_json
-from .plausibility import (MIN_CONTACT_POINTS, check_load_magnitudes, check_solution,
-                           persson_basis)
+from ..bem.patches import MIN_PATCH_POINTS, resolution_note
+from .plausibility import check_load_magnitudes, check_solution, persson_basis
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, contact_physics_from_args,
@@ -205,7 +205,7 @@ def _run(args) -> int:
     print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} "
           + (f"{'A*plastic':>9s} " if plastic else "")
           + f"{'K (Pa/m)':>12s} {'gap (m)':>12s} {'nit':>5s} "
-          + f"{'A* ' + theory.capitalize():>10s}")
+          + f"{'A* ' + theory.capitalize():>10s} {'patch':>6s}")
     for s, k, t in zip(sweep.to_records(), sweep.stiffness, doc["steps"]):
         # inf at full periodic contact; "-" where it was not computed (adhesion)
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
@@ -213,7 +213,10 @@ def _run(args) -> int:
               else "")
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
               f"{pl}{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
-              f"{fmt_or_dash(t.get(theory + '_area_fraction'), '.3g'):>10s}")
+              f"{fmt_or_dash(t.get(theory + '_area_fraction'), '.3g'):>10s} "
+              f"{fmt_or_dash(s.get('patch_width'), '.3g'):>6s}")
+    print(f"patch: load-weighted width of the contact patches in grid points (patch_width in "
+          f"results.json; below {MIN_PATCH_POINTS:g} not resolved)")
     persson_basis(args, surface, doc["derived"]["persson"])
     if cap is not None:
         print(f"one smooth asperity ({cap['shape']}, principal radii "
@@ -437,8 +440,7 @@ def section_contact(outdir: Path, context: dict) -> str:
         f"{fmt_or_dash(doc['steps'][i].get('persson_area_fraction'), '.4f')} | "
         f"{sweep.load_star[i]:.3f} | {r.stiffness * 1e-12:.4g} | {r.mean_gap * 1e6:.4f} | "
         f"{r.free_volume_star:.3f} | {r.nit} |"
-        + (f" contact on {r.n_contact} points (< {MIN_CONTACT_POINTS}): not resolved |"
-           if 0 < r.n_contact < MIN_CONTACT_POINTS else " |")
+        + (f" {resolution_note(r.patch_width)} |" if resolution_note(r.patch_width) else " |")
         for i, r in ((i, sweep.results[i]) for i in picks))
     needed = THESIS_FIG7["P_star"] * kappa / THESIS_FIG7["A_star"]
     # realisation scatter: the same generator, seeds 1-5, at Delta = h_s

@@ -69,7 +69,7 @@ from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
 from .elasticity import (VOLUMETRIC, atol_scale, lame, nodal_average, stiffness_matrix,
                          volumetric_form)
-from .limits import warn_locking, warn_penetration
+from .limits import patch_width, warn_locking, warn_sweep
 from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
 from .petsc_tools import (LU_MUMPS, PrefixedOptions, check_snes, fresh_pc_on_resize,
                           unique_prefix)
@@ -512,8 +512,8 @@ class _ContactProblem:
             residual=float(self.snes.getFunctionNorm()), tolerance=self._tolerance(),
             kernel=None, solver=f"fem-{self.options.method}", formulation=pm.formulation,
             e_star=mat.E_star, rms_height=sigma, size=(W,), spacing=(pm.element_size,),
-            periodic=False, references=REFERENCES, method="fem",
-            fields=self._fields() if keep_fields else None)
+            periodic=False, references=REFERENCES, method="fem", fields=self._fields()
+            if keep_fields else None, patch_width=patch_width(contact, force, mirrored_ends=True))
 
     def _tolerance(self) -> float:
         """The SNES residual test of the last solve: max(atol, rtol * |F(x_0)|)."""
@@ -747,8 +747,7 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
         raise NoConvergenceError(str(exc), result=results) from None
     finally:
         problem.destroy()
-    if options.method == "penalty":
-        warn_penetration(results, options.penalty_factor)
+    warn_sweep(results, options)            # penalty penetration; unresolved contact patches
     return SweepResult.from_results(results, rms_slope=problem.rms_slope, length=pmesh.width)
 
 

@@ -341,6 +341,7 @@ def _leakage_of_step(k, contact, leak_kwargs):
 _RECORD_UNITS = {
     "step": "index (from 0)", "delta": "m", "load": "N", "mean_pressure": "Pa",
     "external_pressure": "Pa", "contact_area": "m^2", "n_contact": "count",
+    "patch_width": "grid points (load-weighted contact patch width)",
     "mean_gap": "m", "mean_plane_separation": "m", "residual": "1 (relative KKT residual)",
     "iterations": "count", "separation_star": "1 (d / sigma)", "contact_success": "bool",
     "persson_stiffness": PERSSON_UNITS["persson_stiffness"],
