@@ -23,7 +23,7 @@ import warnings
 
 from .. import progress
 from ..errors import RoughfeError, Terminated
-from .options import ProgressBars, RoughfeParser, show_progress
+from .options import ProgressBars, RoughfeParser, command_name, show_progress
 
 # module -> the commands it registers (explicit and ordered; no import-time magic)
 SUBCOMMANDS = {
@@ -127,9 +127,7 @@ def main(argv=None) -> int:
         return _reader_left()
     if extra:    # said by the command that did not know them (argparse's top parser
         # said "roughfe: ... (see `roughfe --help`)" for `roughfe leak ... --mirror`)
-        cmd = " ".join(["roughfe"] + [str(getattr(args, k)) for k in (
-            "command", "genome_command", "db_command", "study_command")
-            if getattr(args, k, None)])
+        cmd = command_name(args)
         print(f"{cmd}: error: unrecognized arguments: {' '.join(extra)} (see `{cmd} "
               f"--help`)", file=sys.stderr)
         return 2
@@ -138,8 +136,7 @@ def main(argv=None) -> int:
     if getattr(args, "renders_with_dolfinx", False) and not getattr(args, "no_figures", False):
         from .._runtime import load_render_backend
         load_render_backend()  # vtk before dolfinx: this command solves with dolfinx and draws
-    name = " ".join(str(getattr(args, k)) for k in ("command", "genome_command", "db_command",
-                                                     "study_command") if getattr(args, k, None))
+    name = command_name(args).removeprefix("roughfe ")
     quiet = open(os.devnull, "w") if getattr(args, "quiet", False) else None
     bars = ProgressBars() if show_progress(args) else None
     try:

@@ -19,6 +19,7 @@ from .options import (add_detrend_option, add_material_options, add_output_file,
 from ..genomics.genome import SCALES
 from ..genomics.natural import DEFAULT_FRACTIONS
 from .chromosomes_cmd import _chromosomes
+from .natural_cmd import _natural
 
 def _print_genome(g, prefix="  "):
     print(f"{prefix}A = {g.A:.6g} m^(1-H)   H = {g.H:.6g}   gamma = {g.gamma:.8g}   "
@@ -254,43 +255,6 @@ def _mechanics(args) -> int:
     return 0 if ok else 1          # a BEM sweep that did not converge: a check missed
 
 
-def _natural(args) -> int:
-    from ..genomics.genome import save_genome
-    from ..genomics.natural import sequence_measured
-    from ..surfaces.io import save_surface
-    from ..writers import write_json
-    surface = surface_from_args(args)
-    material = material_from_args(args)
-    folder = output_folder_of(args, "genome natural")
-    res = sequence_measured(surface, fractions=args.fractions, n_nodes=args.nodes,
-                            seed=args.seed, kernels=args.kernels, n_steps=args.steps,
-                            rms_tolerance=args.tolerance, youngs_modulus=material.E_star)
-    with folder as out:
-        stem = Path(args.surface).stem
-        for k, a in enumerate(res.acquisitions):
-            save_surface(a, out / f"{stem}_acq{k + 1}.npz")
-        if not args.no_figures:
-            from ..plotting import genomics as gp
-            _sequence_figures(res.sequencing, out, f"{stem}_")
-            if res.curves:
-                gp.plot_measured_vs_sequenced(res.curves, out / f"{stem}_curves.png",
-                                              title=f"{stem}: measured vs sequenced")
-        save_genome(res.sequencing.genome, out / f"{stem}_genome.json")
-        write_json(out / f"{stem}_report.json", res.report())
-    _print_sequencing(res.sequencing)
-    print("  measured samples per acquisition: "
-          + ", ".join(str(a.metadata["measured_points"]) for a in res.acquisitions))
-    for k, v in res.curves.items():
-        d = v["difference"]
-        if "note" in d:
-            print(f"  {k} kernel: A(p), K(p) not compared: {d['note']}")
-        else:
-            print(f"  {k} kernel: A(p) differs by up to {100 * d['A']:.3g} %, "
-                  f"K(p) by {100 * d['K']:.3g} %")
-    print(f"outputs -> {out}")
-    return 0 if res.success or not args.strict else 1
-
-
 def _validity(args) -> int:
     from ..genomics.chromosomes import validity_monte_carlo
     from ..plotting import genomics as gp
@@ -398,17 +362,25 @@ def register(sub):
     add_run_options(p)
     p.set_defaults(func=_mechanics)
 
-    p = gs.add_parser("natural", help="sequence the central row of a measured topography (Sec. 3.4.2)",
-                      description="Sequence the central row of a measured topography (thesis "
-                                  "Sec. 3.4.2): nested acquisitions, their genome and report, "
-                                  "and the measured vs sequenced A(p), K(p). The row is "
-                                  "levelled by its own least-squares line (an instrument "
-                                  "tilt or a removed plane changes nothing), so there is no "
-                                  "--detrend.")
+    p = gs.add_parser("natural", help="sequence a row of a measured topography (Sec. 3.4.2)",
+                      description="Sequence one row of a measured topography (thesis "
+                                  "Sec. 3.4.2; default the central row along x) or a "
+                                  "profile: nested windows of it (its own samples, every "
+                                  "s-th where a window holds more than --nodes), their "
+                                  "genome and report, and the measured vs sequenced A(p), "
+                                  "K(p). A profile realised from a genome is sequenced back "
+                                  "exactly. The row is levelled by its own least-squares "
+                                  "line (an instrument tilt or a removed plane changes "
+                                  "nothing), so there is no --detrend.")
     add_surface_options(p)
+    p.add_argument("--axis", choices=("x", "y"), default="x",
+                   help="direction of the row: along x (heights[:, j]) or y (heights[i, :])")
+    p.add_argument("--row", type=nonnegative_int, default=None, metavar="INDEX",
+                   help="index of the row across --axis (0-based; default the central one)")
     p.add_argument("--fractions", type=positive_float, nargs="+", default=list(DEFAULT_FRACTIONS),
                    help="nested window lengths as fractions of the row")
-    p.add_argument("--nodes", type=positive_int, default=512, help="nodes per acquisition")
+    p.add_argument("--nodes", type=positive_int, default=512,
+                   help="largest number of nodes per acquisition")
     p.add_argument("--seed", type=nonnegative_int, default=0,
                    help="seed of the M likelihood and phase draws")
     _add_response_options(p, "*", "BEM kernels for A(p), K(p) (none: sequencing only)")

@@ -429,9 +429,22 @@ class ProgressBars:
         self.bars.clear()
 
 
+#: the attributes that name a command's words (a command, then its subcommand)
+COMMAND_WORDS = ("command", "genome_command", "db_command", "study_command")
+
+
+def command_name(args) -> str:
+    """The command as typed, subcommand included (``roughfe genome chromosomes``): the
+    prefix of every error and warning line of the command."""
+    return " ".join(["roughfe"] + [str(getattr(args, k)) for k in COMMAND_WORDS
+                                   if getattr(args, k, None)])
+
+
 def warn(args, message: str) -> None:
-    """One warning line on stderr (``roughfe CMD: warning: ...``), even with --quiet."""
-    print(f"roughfe {args.command}: warning: {message}", file=sys.stderr)
+    """One warning line on stderr (``roughfe CMD [SUBCMD]: warning: ...``), even with
+    --quiet. Until round 2, session 32 it named the command only (``roughfe genome:
+    warning``), while the errors and the library's warnings named the subcommand."""
+    print(f"{command_name(args)}: warning: {message}", file=sys.stderr)
 
 
 def add_runner_options(parser) -> None:

@@ -21,12 +21,16 @@ LEVELLED_TOLERANCE = 1e-6
 class Acquisition:
     """One acquisition: node abscissae x (m), heights z (m), observation length L = (N-1) dx;
     ``levelled``: its least-squares line was removed (:func:`is_levelled`), so the
-    sequencer fits the line back (:func:`~.lattice.design_matrix`)."""
+    sequencer fits the line back (:func:`~.lattice.design_matrix`); ``window``: a window
+    of the coarsest acquisition's own profile (its sampled nodes, not a realisation of its
+    own), so it also holds the coarsest one's long chromosomes
+    (:func:`~.lattice.lattice_ranges`)."""
 
     x: np.ndarray
     z: np.ndarray
     length: float
     levelled: bool = False
+    window: bool = False
 
 
 def is_levelled(x, z) -> bool:
@@ -104,12 +108,26 @@ def check_kind(surfaces, ndim: int) -> list:
     return surfaces
 
 
-def acquisitions_from_surfaces(surfaces) -> list:
+def is_row_window(surface) -> bool:
+    """True for an acquisition of :func:`roughfe.genomics.natural.nested_acquisitions`
+    (``metadata["window_of_row"]``): nodes taken from one measured row."""
+    return bool(surface.metadata.get("window_of_row", False))
+
+
+def acquisitions_from_surfaces(surfaces, windows=None) -> list:
     """Check nested acquisitions and return them sorted from coarsest to finest.
 
-    Raises InputError for: fewer than 2 profiles, 2D or periodic data (:func:`check_kind`), different N, fewer than
-    ``MIN_NODES`` nodes, a flat profile, equal lengths, windows that are not nested around x = 0, or
-    scales that do not overlap (the finer window shorter than two coarse spacings).
+    ``windows`` True: the acquisitions are windows of one sampled profile (the nested
+    acquisitions of a measured row, :func:`roughfe.genomics.natural.nested_acquisitions`):
+    each may have its own N, and every one holds the long chromosomes of the coarsest
+    (:attr:`Acquisition.window`). None: True when every acquisition says so
+    (:func:`is_row_window`), so that `genome sequence` on the saved acquisitions of
+    `genome natural` sequences them as `natural` did.
+
+    Raises InputError for: fewer than 2 profiles, 2D or periodic data (:func:`check_kind`),
+    different N (unless ``windows``), fewer than ``MIN_NODES`` nodes, a flat profile, equal
+    lengths, windows that are not nested around x = 0, or scales that do not overlap (the
+    finer window shorter than two coarse spacings).
     """
     surfaces = check_kind(surfaces, 1)
     if len(surfaces) < 2:
@@ -117,13 +135,15 @@ def acquisitions_from_surfaces(surfaces) -> list:
                          f"3.3.1: gamma is read from the overlap of two scales), got "
                          f"{len(surfaces)}. Realise a genome at two scales (`roughfe genome "
                          f"realize GENOME.json --scale 10x`, `--scale 20x`); {ROWS_PATH}")
+    if windows is None:
+        windows = all(is_row_window(s) for s in surfaces)
     sizes = {s.shape[0] for s in surfaces}
-    if len(sizes) != 1:
+    if len(sizes) != 1 and not windows:
         raise InputError(f"all acquisitions must have the same number of nodes N (Sec. 3.2: N = 512 "
                          f"at every scale), got N = {[s.shape[0] for s in surfaces]}")
-    n = sizes.pop()
-    if n < MIN_NODES:
-        raise InputError(f"too few points: N = {n} nodes per acquisition, at least {MIN_NODES} are needed")
+    if min(sizes) < MIN_NODES:
+        raise InputError(f"too few points: N = {min(sizes)} nodes per acquisition, at least "
+                         f"{MIN_NODES} are needed")
     acq = []
     for k, s in enumerate(surfaces):
         if np.ptp(s.heights) == 0:
@@ -131,7 +151,8 @@ def acquisitions_from_surfaces(surfaces) -> list:
                              f"there is no roughness to sequence")
         x = observation_coordinates(s)
         z = np.asarray(s.heights, dtype=float)
-        acq.append(Acquisition(x, z, float((n - 1) * s.spacing[0]), is_levelled(x, z)))
+        acq.append(Acquisition(x, z, float((z.size - 1) * s.spacing[0]), is_levelled(x, z),
+                               bool(windows)))
     acq.sort(key=lambda a: -a.length)
     for a, b in zip(acq, acq[1:]):
         if not b.length < a.length * (1 - 1e-9):
@@ -142,7 +163,7 @@ def acquisitions_from_surfaces(surfaces) -> list:
             raise InputError(f"acquisition of length {b.length:.6g} m ([{b.x[0]:.4g}, {b.x[-1]:.4g}] m) is "
                              f"not nested inside the one of length {a.length:.6g} m "
                              f"([{a.x[0]:.4g}, {a.x[-1]:.4g}] m)")
-        dx = a.length / (n - 1)
+        dx = a.length / (a.z.size - 1)
         if b.length <= 2 * dx:
             raise InputError(f"non-overlapping scales: the finer window {b.length:.4g} m is not longer than "
                              f"two spacings {2 * dx:.4g} m of the coarser acquisition, so they share no "

@@ -158,22 +158,41 @@ def bic(cost, rows, unknowns, floor):
 
 
 # -- step 4: variable projection -----------------------------------------------------------
-def lattice_ranges(log_q1, log_gamma, acqs, n_nodes):
+def lattice_ranges(log_q1, log_gamma, acqs):
+    """The chromosome range (n_s, n_f) of each acquisition, Eq. (3.5) with its own L and N.
+    A window of the coarsest acquisition's profile (:attr:`.acquisitions.Acquisition.window`)
+    starts at the coarsest one's n_s: it holds those long waves, while a realisation of
+    its own window (Eq. 3.5) does not (a window of a Table 1 profile at L/5 without
+    chromosomes 1-4 misfit by 0.5 % and its fit was an overfit)."""
     lam1 = 2 * math.pi / math.exp(log_q1)
-    return [chromosome_range(math.exp(log_gamma), lam1, a.length, n_nodes) for a in acqs]
+    out = [chromosome_range(math.exp(log_gamma), lam1, a.length, a.z.size) for a in acqs]
+    return [(out[0][0], r[1]) if a.window else r for a, r in zip(acqs, out)]
+
+
+def tilt_columns(acqs) -> list:
+    """The tilt unknown of each acquisition (0, 1, ... after the offsets), or -1 for none:
+    one for each levelled acquisition (:attr:`.acquisitions.Acquisition.levelled`), or
+    one *shared* by windows of one row (:attr:`.acquisitions.Acquisition.window`: the
+    row lost one line, its least-squares one, before it was cut into windows; a realised
+    Table 1 profile misfit its windows by 6e-7 without it). The shared tilt is set by the
+    full row, not by each short window (the free tilts of session 29)."""
+    if acqs and all(a.window for a in acqs):
+        return [0] * len(acqs)
+    return list(np.cumsum([bool(a.levelled) for a in acqs]) * [bool(a.levelled) for a in acqs] - 1)
 
 
 def line_columns(acqs) -> int:
     """The unknowns of the acquisitions' lines in :func:`design_matrix`: an offset for
-    each, and a tilt for each levelled one (:attr:`.acquisitions.Acquisition.levelled`)."""
-    return len(acqs) + sum(bool(a.levelled) for a in acqs)
+    each, then the tilts of :func:`tilt_columns`."""
+    return len(acqs) + max(tilt_columns(acqs), default=-1) + 1
 
 
 def design_matrix(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
     """The linear model of the stacked acquisitions (Eq. 3.12-3.16): for each chromosome
     n the columns ``1 - cos(q_n x)`` and ``sin(q_n x)`` (the real and imaginary parts of
     its phasor sum), then a constant column per acquisition (its height offset), then a
-    linear column per *levelled* acquisition (its tilt).
+    linear column per *levelled* acquisition (its tilt), or one shared by windows of one
+    row (:func:`tilt_columns`).
 
     The genome's profile is zero at x = 0 (Eq. 3.1); a measured or mean-removed profile
     is not, and without the offsets the fit bends the chromosomes to absorb it
@@ -189,7 +208,7 @@ def design_matrix(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
     hi = max(r[1] for r in ranges) if n_cap is None else min(n_cap, max(r[1] for r in ranges))
     n = np.arange(lo, hi + 1)
     q = np.exp(log_q1 + (n - 1) * log_gamma)
-    tilt_col = np.cumsum([bool(a.levelled) for a in acqs]) - 1 + len(acqs)
+    tilt_col = tilt_columns(acqs)
     blocks = []
     for k, (a, (ns, nf), w) in enumerate(zip(acqs, ranges, weights)):
         on = (n >= ns) & (n <= nf)
@@ -198,8 +217,8 @@ def design_matrix(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
         m[:, 0:2 * n.size:2] = np.where(on, 1.0 - np.cos(arg), 0.0)
         m[:, 1:2 * n.size:2] = np.where(on, np.sin(arg), 0.0)
         m[:, 2 * n.size + k] = 1.0
-        if a.levelled:
-            m[:, 2 * n.size + tilt_col[k]] = a.x
+        if tilt_col[k] >= 0:
+            m[:, 2 * n.size + len(acqs) + tilt_col[k]] = a.x
         blocks.append(m * w)
     return n, np.vstack(blocks)
 
@@ -281,7 +300,7 @@ def _continuation(p, first, hi, acqs, ranges, weights, rhs, budget):
     return p, nit
 
 
-def fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600, continuation=True):
+def fit_lattice(log_q1, log_gamma, acqs, weights, rhs, budget=600, continuation=True):
     """Variable projection with continuation in the highest chromosome index.
 
     First a local fit of the full model from the PSD estimate (enough when the refined
@@ -296,7 +315,7 @@ def fit_lattice(log_q1, log_gamma, acqs, n_nodes, weights, rhs, budget=600, cont
     unmodelled shorter waves still carry most of the misfit at the first cap); the
     lower final residual wins.
     """
-    ranges = lattice_ranges(log_q1, log_gamma, acqs, n_nodes)
+    ranges = lattice_ranges(log_q1, log_gamma, acqs)
     lo = min(r[0] for r in ranges)
     hi = max(r[1] for r in ranges)
     p0 = np.array([log_q1, log_gamma])

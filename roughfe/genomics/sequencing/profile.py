@@ -16,7 +16,7 @@ from .acquisitions import Acquisition, acquisitions_from_surfaces, check_control
 from .genes import (H_SEARCH, M_VALUES, amplitude_gene_errors, amplitude_genes,
                     peak_slope_H, phases_with_sums, ridge_support,
                     ridge_likelihood, variance_amplitude)
-from .lattice import (bic, coarser_lattices, comb_periods, design_matrix, fit_lattice, label_q1,
+from .lattice import (bic, coarser_lattices, comb_periods, design_matrix, fit_lattice, label_q1, tilt_columns,
                       lattice_from_period, line_columns, lattice_ranges, round_off_cost, solve_linear,
                       vp_residual)
 from .peaks import spectrum_peaks
@@ -38,7 +38,7 @@ def _rel_rms(z, fit):
     return math.sqrt(float(np.mean((z - fit) ** 2))) / rz if rz > 0 else math.inf
 
 
-def _labelled(p, acqs, n_nodes, weights, rhs):
+def _labelled(p, acqs, weights, rhs):
     """(bic, (ln q1, ln gamma), ranges, rss) of the fitted lattice ``p`` under the label of
     least BIC (:func:`~.lattice.bic`) among those compatible with n_s = 1 for the coarsest
     acquisition (Eq. 3.5: lambda1 in [L_1, gamma L_1), or one lattice step off it at the
@@ -57,7 +57,7 @@ def _labelled(p, acqs, n_nodes, weights, rhs):
         if shift and not (acqs[0].length * (1 - 1e-6) <= lam1
                           < math.exp(cand[1]) * acqs[0].length * (1 + 1e-6)):
             continue
-        ranges = lattice_ranges(cand[0], cand[1], acqs, n_nodes)
+        ranges = lattice_ranges(cand[0], cand[1], acqs)
         if shift and ranges[0][0] != 1:
             continue
         r = vp_residual(cand, acqs, ranges, weights, rhs, None)
@@ -69,7 +69,7 @@ def _labelled(p, acqs, n_nodes, weights, rhs):
     return best
 
 
-def _settle(best, acqs, n_nodes, weights, rhs, good):
+def _settle(best, acqs, weights, rhs, good):
     """A fit within the tolerance (``rss <= good``) may stand for a coarser lattice: a
     lattice gamma^(1/k) holds the data's lattice gamma as every k-th chromosome and fits
     as well, the others empty (WM data: their amplitudes at round-off; measured, random
@@ -89,7 +89,7 @@ def _settle(best, acqs, n_nodes, weights, rhs, good):
     trial = []
     for start in coarser_lattices(np.array([lq1, lg]), min(r[0] for r in ranges),
                                   acqs[0].length, k_max=K_MAX, gamma_max=10.0):
-        out = _labelled(start, acqs, n_nodes, weights, rhs)
+        out = _labelled(start, acqs, weights, rhs)
         if out is not None:
             trial.append(out)
     if not trial:
@@ -98,13 +98,14 @@ def _settle(best, acqs, n_nodes, weights, rhs, good):
     exact = 1e-20 * float(rhs @ rhs)
     if best[3] < exact <= start_rss:
         return best, len(trial)      # an exact fit whose coarser lattices miss waves
-    p, k = fit_lattice(start[0], start[1], acqs, n_nodes, weights, rhs, continuation=False)
-    alt = _labelled(p, acqs, n_nodes, weights, rhs)
+    p, k = fit_lattice(start[0], start[1], acqs, weights, rhs, continuation=False)
+    alt = _labelled(p, acqs, weights, rhs)
     nit = k + len(trial)
     return (alt if alt is not None and alt[0] < best[0] else best), nit
 
 
-def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restarts=3) -> SequencingResult:
+def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restarts=3,
+                      windows=None) -> SequencingResult:
     """Sequence the genome of a profile from nested acquisitions (Sec. 3.3.1).
 
     Parameters
@@ -122,6 +123,11 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     n_restarts : int
         Number of comb periods (gamma candidates) tried; the lowest BIC wins, and a fit
         within ``rms_tolerance`` is also tried on its coarser lattices (:func:`_settle`).
+    windows : bool, optional
+        True: the acquisitions are windows of one sampled profile (any N each; each holds
+        the coarsest one's long chromosomes), as :func:`roughfe.genomics.natural.
+        nested_acquisitions` makes them; None: read from their metadata
+        (:func:`~.acquisitions.acquisitions_from_surfaces`).
 
     Returns
     -------
@@ -138,7 +144,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     if M is not None:
         M = check_int("M (number of ridges; None: maximum likelihood)", M, 1)
     rng = resolve_rng(seed, "seed")[0]
-    acqs = acquisitions_from_surfaces(surfaces)
+    acqs = acquisitions_from_surfaces(surfaces, windows)
     n_nodes = acqs[0].z.size
     weights = [1.0 / max(math.sqrt(float(np.mean(a.z ** 2))), 1e-300) for a in acqs]
     rhs = np.concatenate([a.z * w for a, w in zip(acqs, weights)])
@@ -166,9 +172,9 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         lq1, lg = lattice_from_period(log_q, period, ref, acqs[0].length, bins, groups)
         if not (math.log(1.0 + 1e-3) < lg < math.log(10.0)):
             continue
-        p, k = fit_lattice(lq1, lg, acqs, n_nodes, weights, rhs)
+        p, k = fit_lattice(lq1, lg, acqs, weights, rhs)
         nit += k
-        out = _labelled(p, acqs, n_nodes, weights, rhs)
+        out = _labelled(p, acqs, weights, rhs)
         if out is not None and (best is None or out[0] < best[0]):
             best = out
         if best is not None and best[3] < exact:
@@ -176,7 +182,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     if best is None:
         raise InputError("sequencing found no admissible wavenumber lattice (gamma in (1, 10]) in the PSD "
                          "peaks; the acquisitions are not WM-like")
-    best, k = _settle(best, acqs, n_nodes, weights, rhs, rms_tolerance ** 2 * float(rhs @ rhs))
+    best, k = _settle(best, acqs, weights, rhs, rms_tolerance ** 2 * float(rhs @ rhs))
     nit += k
     _, (lq1, lg), ranges, _ = best
     # final polish of the full model with the final chromosome ranges
@@ -185,7 +191,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
                         x_scale=np.array([1e-5, 1e-5]), diff_step=1e-11, max_nfev=100,
                         xtol=1e-15, ftol=1e-15, gtol=1e-15)
     nit += pol.nfev + 2 * (pol.njev or 0)
-    if 2 * pol.cost < float(r0 @ r0) and lattice_ranges(pol.x[0], pol.x[1], acqs, n_nodes) == ranges:
+    if 2 * pol.cost < float(r0 @ r0) and lattice_ranges(pol.x[0], pol.x[1], acqs) == ranges:
         lq1, lg = pol.x
     gamma, lam1 = math.exp(lg), 2 * math.pi / math.exp(lq1)
     n, mat = design_matrix(lq1, lg, acqs, ranges, weights)
@@ -194,9 +200,9 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     # the acquisitions' height offsets (their heights at x = 0 off the genome's zero) and
     # tilts (the line a levelled profile lost)
     offsets = coef[2 * n.size:2 * n.size + len(acqs)]
-    tilts = np.zeros(len(acqs))
-    tilts[[a.levelled for a in acqs]] = coef[2 * n.size + len(acqs):]
-    acqs = [Acquisition(a.x, a.z - off - tilt * a.x, a.length)
+    tilts = np.array([coef[2 * n.size + len(acqs) + c] if c >= 0 else 0.0
+                      for c in tilt_columns(acqs)])
+    acqs = [Acquisition(a.x, a.z - off - tilt * a.x, a.length, window=a.window)
             for a, off, tilt in zip(acqs, offsets, tilts)]
     amps, thetas = np.abs(cvec), np.angle(cvec)
 
