@@ -449,12 +449,14 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
     if compute_stiffness:
         K = 0.0 if contact.any() and not stiff_set.any() else \
             exact_stiffness(op, solver, stiff_set, w, scale)
+    del w                       # the label grid of patch_width takes its place
+    width = patch_width(contact, p, periodic=op.periodic)
     return ContactResult(
         pressure=p, displacement=u, gap=gap, contact=contact, delta=float(d),
         load=pm * A, mean_pressure=pm, area_fraction=nc / n,
         contact_area=nc * surface.cell_area, n_contact=nc, mean_gap=mean_gap,
         mean_plane_separation=float(h.max() - h.mean() - d),
-        free_volume=float(gap[gap > 0].sum()) * surface.cell_area,
+        free_volume=float(gap.sum()) * surface.cell_area,       # gap >= 0 everywhere
         free_volume_star=mean_gap / sigma, stiffness=K,
         message=("full contact" if nc == n else "converged") + f" ({out.solver})",
         nit=int(out.nit), residual=float(out.residual), tolerance=float(tolerance),
@@ -463,7 +465,7 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
         size=tuple(surface.size), spacing=tuple(surface.spacing),
         periodic=op.periodic, references=REFERENCES + op.references, method="bem",
         plastic_area_fraction=plastic_fraction, plastic_displacement=plastic,
-        patch_width=patch_width(contact, p, periodic=op.periodic))
+        patch_width=width)
 
 
 def surface_displacement(surface: Surface, material: Material, traction,
