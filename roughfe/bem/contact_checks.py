@@ -17,26 +17,23 @@ from .coarse_start import COARSE_START_MIN
 TOL_FLOOR = 100 * float(np.finfo(float).eps)
 
 
-#: a height range below this fraction of the surface's largest side is flat (1e-15 m on a
-#: 1 mm window, far below an atom): heights of 1e-200 m had passed as rough and ended in
-#: a ZeroDivisionError (periodic) or a PK residual of 1e176 (non-periodic), round 2,
-#: session 32
-FLAT_RANGE = 1e-12
-
-
 def is_flat(surface) -> bool:
-    """Whether the heights of ``surface`` span less than :data:`FLAT_RANGE` of its
-    largest side (a flat on a flat: uniform contact, no rough-contact problem)."""
-    return not float(np.ptp(surface.heights)) > FLAT_RANGE * float(max(surface.size))
+    """Whether the heights of ``surface`` are flat for the solver: constant, or so small
+    that their mean square underflows (rms height 0 in float64, e.g. 1e-200 m: that had
+    passed as rough and ended in a ZeroDivisionError (periodic) or a PK residual of 1e176
+    (non-periodic), round 2, session 32). Physically tiny but representable heights are
+    solved (the genomics' chromosome whose waves cancel, 3e-22 m on a 1 mm profile, is
+    judged flat by its own rule, :func:`roughfe.genomics.macro_micro.is_flat`)."""
+    h = surface.heights
+    return not float(np.ptp(h)) > 0.0 or not float(np.mean(np.square(h - h.mean()))) > 0.0
 
 
 def _check_surface(surface):
     check_instance("surface", surface, Surface, "a roughfe Surface")
     if is_flat(surface):
-        raise InputError(f"the surface is flat (height range {np.ptp(surface.heights):.3g} m, "
-                         f"below {FLAT_RANGE:g} of its largest side {max(surface.size):.3g} "
-                         f"m): contact of a flat on a flat is uniform and has no "
-                         f"rough-contact solution")
+        raise InputError(f"the surface is flat (height range {np.ptp(surface.heights):.3g} m: "
+                         f"constant, or below what float64 can square): contact of a flat "
+                         f"on a flat is uniform and has no rough-contact solution")
 
 
 def _check_tol(tol) -> float:
