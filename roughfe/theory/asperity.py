@@ -32,7 +32,7 @@ FIT_POINTS = 256
 REFERENCES = ("Hertz H. (1882) J. reine angew. Math. 92:156-171",
               "Johnson K.L. (1985) Contact Mechanics, Cambridge University Press, Sec. 4.2")
 
-#: the ``persson`` block of a single asperity: no step carries persson_* values
+#: the ``persson`` block of a single asperity: no step carries ``persson_*`` values
 NOT_RANDOM = {
     "theory": "not applicable: one smooth asperity",
     "note": "Persson's theory is that of a random rough surface of many asperities, from "
