@@ -209,7 +209,11 @@ def test_profiles_with_height_offsets_are_sequenced_exactly(table1):
 @pytest.mark.slow
 def test_genome_natural_strict_exits_1_when_the_quality_check_fails(topographies_dir, tmp_path):
     # `genome natural` exited 0 after "FAILED quality check" and had no --strict (unlike
-    # `genome sequence`); plu-1's row is not WM-like (rms errors 22-28 %)
+    # `genome sequence`); plu-1's row is not WM-like (rms errors 22-28 % on the old
+    # interpolated windows; 34-38 % on its own samples). After cc2d28a it was reported
+    # "success" with rms errors 1e-4..5e-4 and H = 2.05: misfits measured against the
+    # heights less a fitted tilt of 0.18 m/m (traded against chromosomes of 2.2e-4 m on
+    # a row of 1.8e-8 m rms); now against the data as given
     from roughfe.cli import main
     args = ["genome", "natural", str(topographies_dir / "plu-1.plu"), "--nodes", "128",
             "--kernels", "--no-figures"]
@@ -217,6 +221,10 @@ def test_genome_natural_strict_exits_1_when_the_quality_check_fails(topographies
     assert main(args + ["--strict", "-o", str(tmp_path / "b")]) == 1
     report = json.loads(next((tmp_path / "b").glob("*_report.json")).read_text())
     assert report["sequencing"]["success"] is False
+    assert min(report["sequencing"]["rms_errors"]) > 0.3
+    message = report["sequencing"]["message"]
+    assert message.startswith("not a genome: chromosome amplitudes up to"), message
+    assert "(waves that cancel: an overfit); not WM-like: relative rms error" in message
 
 
 def _random_case(seed, n_nodes=64):
