@@ -115,6 +115,21 @@ def test_demo_writes_index_and_nonblank_figures(tmp_path):
         assert _nonblank(tmp_path / png), png
     stats = json.loads((tmp_path / "rmd_statistics.json").read_text())
     assert stats["fractal_dimension"] == pytest.approx(2.3, abs=0.1)
+    assert "Note on H" not in index           # one power law: no note beside H
+
+
+def test_demo_table_notes_a_psd_that_is_not_one_power_law(topographies_dir):
+    """The demo's statistics table says what `roughfe info` says when the fit range is
+    not one power law (x3p-2, plane removed: H -0.92 below 8.8e5 rad/m, 0.94 above;
+    round 2, session 32), and nothing on a self-affine surface."""
+    from roughfe.cli.demo_cmd import _stats_table
+    from roughfe.surfaces import load_surface, spectral_surface, surface_statistics
+    s = spectral_surface(128, 1e-4, 0.8, rms_height=1e-6, rng=2)
+    assert "Note on H" not in _stats_table(surface_statistics(s))
+    measured = load_surface(topographies_dir / "x3p-2.x3p").detrended("plane")
+    table = _stats_table(surface_statistics(measured))
+    assert "Note on H: the PSD is not one power law" in table
+    assert "--hurst-q-range" in table
 
 
 def test_info_hurst_range_row_option_and_note(tmp_path, capsys):

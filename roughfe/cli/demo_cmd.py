@@ -13,6 +13,7 @@ from pathlib import Path
 
 from ..surfaces.io import load_surface, save_surface, topographies_folder
 from ..surfaces.rmd import rmd_surface
+from ..surfaces.psd_fit import range_note
 from ..surfaces.stats import fit_hurst, power_spectrum, surface_statistics
 from ..writers import write_json, write_text
 from .options import add_output_folder, add_run_options, output_folder_of
@@ -31,7 +32,9 @@ def _stats_table(stats) -> str:
             ("Nayak bandwidth alpha", f"{stats.nayak_alpha:.4g}"),
             ("Hurst exponent H (PSD fit)", f"{stats.hurst:.3f}"),
             ("fractal dimension D = 3 - H", f"{stats.fractal_dimension:.3f}"))
-    return "| quantity | value |\n|---|---|\n" + "\n".join(f"| {a} | {b} |" for a, b in rows)
+    table = "| quantity | value |\n|---|---|\n" + "\n".join(f"| {a} | {b} |" for a, b in rows)
+    note = range_note(stats.hurst_message)          # a PSD that is not one power law
+    return table + (f"\n\nNote on H: {note}." if note else "")
 
 
 def _figures(surface, outdir, stem, title):

@@ -63,8 +63,8 @@ def format_table(stats: dict) -> str:
         else:
             text = f"{v * scale:.6g}"
         lines.append(f"{label:<28s} {text} {unit}".rstrip())
-    message = stats.get("hurst_message", "")
-    note = message.partition("; ")[2] if "not one power law" in message else ""
+    from ..surfaces.psd_fit import range_note
+    note = range_note(stats.get("hurst_message", ""))
     if note:             # split_fit: the range is not one power law
         lines.append(f"note: Hurst fit: {note}")
     return "\n".join(lines)

@@ -158,3 +158,10 @@ def split_fit(psd: PowerSpectrum, q_range, size) -> SplitFit:
         note += ("; the fitted H depends on the range: fit the range that is self-affine "
                  "(q_range=, roughfe info --hurst-q-range QMIN QMAX)")
     return SplitFit(split, low, elow, high, ehigh, note)
+
+
+def range_note(message: str) -> str:
+    """The note of :func:`split_fit` inside a fit's ``message`` (``HurstFit.message``,
+    ``SurfaceStatistics.hurst_message``), or "" when the range was one power law: what
+    ``roughfe info`` and the demo report print beside H."""
+    return message.partition("; ")[2] if "not one power law" in message else ""
