@@ -138,8 +138,9 @@ def measured_section(natural: dict) -> list:
                  "progression) does not describe these measured rows: measured spectra are "
                  "continuous, so the discrete lattice leaves 10-40 % of the rms height "
                  "unexplained and the sequenced genes (H, A) are not physical Hurst/amplitude "
-                 "values. The finest window (1/5 of the row) holds only ~110-150 measured "
-                 "samples interpolated onto 512 nodes.", ""]
+                 "values. Each window is the row's own samples (the finest, 1/5 of the "
+                 "row, only its ~110-150 samples: nothing is interpolated since round 2, "
+                 "session 32), so the fit has no more data there than the row holds.", ""]
 
 
 def mechanics_section(mech: dict) -> list:
