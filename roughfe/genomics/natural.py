@@ -22,7 +22,10 @@ box filter). Those nodes sat between the samples and the finer windows were
 interpolations of 256 and 102 samples on 512 nodes: a realised Table 1 profile came back
 with gamma = 1.145, H = 1.81, 59 chromosomes and "not a genome: ... an overfit" (0.45-0.52 %
 misfit), where it is now exact. A stride above 1 takes every s-th sample without an
-anti-aliasing filter, as Eq. 3.1 is evaluated at the nodes (its short chromosomes alias).
+anti-aliasing filter, as Eq. 3.1 is evaluated at the nodes (its short chromosomes alias);
+the sequencer models every window of the row up to the row's finest chromosome, so the
+aliased ones are fitted where they are, not left as misfit (a Table 1 row of 256 samples
+sequenced with 128 nodes: misfits 1-5.5 % -> 1e-13, round 2, session 32).
 
 Each acquisition is detrended by the least-squares line of the *full* row (the WM
 function of Eq. 3.1 has no tilt) and shifted so that Z(0) = 0 at the common centre node

@@ -163,10 +163,14 @@ def lattice_ranges(log_q1, log_gamma, acqs):
     A window of the coarsest acquisition's profile (:attr:`.acquisitions.Acquisition.window`)
     starts at the coarsest one's n_s: it holds those long waves, while a realisation of
     its own window (Eq. 3.5) does not (a window of a Table 1 profile at L/5 without
-    chromosomes 1-4 misfit by 0.5 % and its fit was an overfit)."""
+    chromosomes 1-4 misfit by 0.5 % and its fit was an overfit). It also ends at the
+    row's finest n_f: a window sampled at a stride above 1 holds the row's short
+    chromosomes aliased on its nodes (Eq. 3.1 evaluated there), which its own Eq. 3.5
+    range left as misfit (1-5.5 % on Table 1 rows at stride 2; 1e-13 now)."""
     lam1 = 2 * math.pi / math.exp(log_q1)
     out = [chromosome_range(math.exp(log_gamma), lam1, a.length, a.z.size) for a in acqs]
-    return [(out[0][0], r[1]) if a.window else r for a, r in zip(acqs, out)]
+    top = max((r[1] for a, r in zip(acqs, out) if a.window), default=0)
+    return [(out[0][0], top) if a.window else r for a, r in zip(acqs, out)]
 
 
 def tilt_columns(acqs) -> list:
