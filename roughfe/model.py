@@ -371,7 +371,7 @@ class ContactResult(Frozen):
         The branch of the step: False on loading, True on unloading.
     adhesive_area_fraction : float, BEM adhesion
         Fraction of the nominal area under tensile (adhesive) traction.
-    patch_width : float, BEM and FEM (not adhesion)
+    patch_width : float, BEM (with adhesion: the patches of g = 0) and FEM
         Load-weighted width of the contact patches in grid points (NaN without contact);
         below ``roughfe.bem.patches.MIN_PATCH_POINTS`` the grid does not resolve them
         (:func:`roughfe.bem.patches.resolution_note`).

@@ -81,6 +81,7 @@ from .adhesive_minimise import (MAX_SPREAD_PASSES, SOLVERS,  # noqa: F401
 from .adhesive_pull_off import refine_pull_off, tensile_floor
 from .adhesive_rules import check_adhesive_run
 from .adhesive_start import continued_start, elastic_start
+from .patches import patch_width
 from .interface_law import LAWS, AdhesionLaw, cell_relief, check_resolution, resolution
 
 __all__ = ["LAWS", "AdhesionLaw", "AdhesiveSweep", "adhesive_sweep", "cell_compliance",
@@ -295,7 +296,8 @@ def _adhesive_result(surface, material, op, law, energy, x, delta, resid, tol, n
         solver=f"adhesive-{solver}-{law.kind}", e_star=material.E_star, rms_height=sigma,
         size=tuple(surface.size), spacing=tuple(surface.spacing), periodic=op.periodic,
         references=REFERENCES + op.references, method="bem", unloading=unloading,
-        adhesive_area_fraction=float(np.count_nonzero(p < 0)) / n, fields=fields)
+        adhesive_area_fraction=float(np.count_nonzero(p < 0)) / n, fields=fields,
+        patch_width=patch_width(contact, p, periodic=op.periodic))
 
 
 @dataclass(frozen=True, eq=False)
