@@ -81,6 +81,7 @@ from .adhesive_minimise import (MAX_SPREAD_PASSES, SOLVERS,  # noqa: F401
 from .adhesive_pull_off import refine_pull_off, tensile_floor
 from .adhesive_rules import check_adhesive_run
 from .adhesive_start import continued_start, elastic_start
+from .contact_checks import is_flat
 from .patches import patch_width
 from .interface_law import LAWS, AdhesionLaw, cell_relief, check_resolution, resolution
 
@@ -383,7 +384,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     if deltas is None:
         from .sweep import default_deltas
         n_steps = Loading(n_steps=n_steps).n_steps     # checked, default 20
-        if np.ptp(surface.heights) == 0.0:   # it said "deltas must be strictly increasing"
+        if is_flat(surface):      # (the BEM's rule) it said "deltas must be strictly increasing"
             raise InputError("the surface is flat (constant heights): its height range "
                              "gives no approaches for n_steps; give the approaches (m)")
         periodic = surface.periodic and kernel in ("auto", "spectral")
