@@ -37,9 +37,18 @@ What was measured against the periodic BEM (round 2, session 28, and its review)
   where ``"element"`` is within 0.6 %. It converges under refinement (nu = 0.46, one
   line: -5.0, -3.5, -1.4 % at 129, 257, 513 nodes).
 * The pair is not inf-sup stable (the inf-sup constant falls with h, unlike a
-  Taylor-Hood pair): as nu -> 1/2 the nodal contact pressure carries a node-to-node
-  oscillation of 1-2 % of its peak on ~25 contact nodes (nu = 0.49999, 129 nodes),
-  which decreases with h. The mean pressure and K are not affected by it.
+  Taylor-Hood pair). Measured on the Westergaard cosine (round 2, session 33; docs/theory/
+  03_fem_validation.md): its nodal pressure lambda theta, internal and not returned, has
+  the checkerboard, 10-32 % of the peak contact pressure at nu = 0.49999 (1-4 % at nu =
+  0.3), not falling with h. What is returned stays reliable, so nothing warns:
+  the contact pressure's node-to-node oscillation (inside 0.8 of the contact half-width)
+  is 4.3, 1.9, 2.5, 0.7, 0.5 % of the peak at 33, 65, 129, 257, 513 nodes (nu = 0.3:
+  1.7, 0.9, 0.4, 0.2, 0.1 %), the same from nu = 0.4999 to 0.4999999 (bounded as nu ->
+  1/2); the kept sigma_yy (:func:`roughfe.fem.contact.cell_stress_yy`, theta averaged
+  over the triangle) is as close to the half-plane's as the element form's at nu = 0.3
+  (0.4-1.5 % rms of the peak in the top W/4); the mean pressure and K are not affected
+  (tests/test_fem_incompressible.py). Do not compute a pressure from lambda div u of
+  the returned displacement.
 
 ``"auto"`` (the default of :class:`roughfe.fem.FemSolverOptions`) takes ``"nodal"`` above
 :data:`roughfe.fem.limits.LOCKING_NU` = 0.45 and ``"element"`` up to it: there the
