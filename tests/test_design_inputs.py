@@ -71,6 +71,45 @@ def test_a_target_in_other_units_than_the_database_is_refused(database):
     assert res.best.scores[0] < 0
 
 
+def _never(design):
+    raise AssertionError("a design stage ran (a BEM sweep was asked for) before the check")
+
+
+def test_every_design_method_checks_its_inputs_when_called_directly(database):
+    """The checks ran only in run_design (round 2, session 33): a direct sog/gco/cco/mcco
+    call with a 2-point K target, or a target 1e6 below every genome, went into the
+    stages. Each method now refuses both before its first BEM sweep (``evaluate`` fails
+    if it is called), with the message of run_design; and the batched strict scoring
+    refuses a 2-point K target (it scored every design -inf, silently)."""
+    _, entries = database
+    c = _curve(entries)
+    good_k = Target(c.pressure[[3, 6, 9]], c.stiffness[[3, 6, 9]], "K", "good")
+    good_a = Target(c.pressure, c.area_fraction, "A", "area")
+    bad = {"at least 3": Target(c.pressure[[4, 9]], c.stiffness[[4, 9]], "K", "two"),
+           "more than a factor 1000": Target(c.pressure, 1e-6 * c.stiffness, "K", "units")}
+    pbar = float(c.pressure[5])
+    for match, target in bad.items():
+        calls = {"sog": lambda: de.sog(entries, target, SETTINGS, evaluate=_never, options=FAST),
+                 "gco": lambda: de.gco(entries, target, pbar, SETTINGS, evaluate=_never,
+                                       options=FAST),
+                 "cco": lambda: de.cco(entries, target, pbar, SETTINGS, evaluate=_never,
+                                       options=FAST),
+                 "mcco": lambda: de.mcco(entries, target, good_a, SETTINGS, evaluate=_never,
+                                         options=FAST)}
+        for method, call in calls.items():
+            with pytest.raises(InputError, match=match):
+                call()
+    off_a = Target(c.pressure, 1e-4 * c.area_fraction, "A", "area in 1e-4")
+    with pytest.raises(InputError, match="target area in 1e-4 .*more than a factor 1000"):
+        de.mcco(entries, good_k, off_a, SETTINGS, evaluate=_never, options=FAST)
+    with pytest.raises(InputError, match="database is empty"):
+        de.sog([], good_k, SETTINGS, evaluate=_never, options=FAST)
+    design = de.entry_design(entries[0], SETTINGS)
+    with pytest.raises(InputError, match="at least 3"):
+        de.score_batch_at_target_pressures([design, design], [bad["at least 3"]], SETTINGS)
+    assert np.isfinite(de.score_batch_at_target_pressures([design], [good_k], SETTINGS)).all()
+
+
 @pytest.mark.parametrize("header, said", [("pressure_MPa,value", "'mpa'"),
                                           ("p_kPa,K", "'kpa'"),
                                           ("p [Pa],K [MPa/um]", "'mpa'"),

@@ -229,12 +229,6 @@ def _result(method, cands, objective, pbar, dbs, n_cross, n_above, passed, evalu
                         evaluate.n_sweeps, time.perf_counter() - t0)
 
 
-def _check_entries(entries):
-    if not entries:
-        raise InputError("the genome database is empty: build it first ('roughfe db build')")
-    return list(entries), {e.label: e for e in entries}
-
-
 def sog(entries, target: Target, settings: DatabaseSettings, *, evaluate=None,
         options: GcmmaOptions = GcmmaOptions(), n_best: int = 3) -> DesignResult:
     """Simple Optimisation of Genes (Alg. 4).
@@ -244,7 +238,7 @@ def sog(entries, target: Target, settings: DatabaseSettings, *, evaluate=None,
     ``n_it_sog`` iterations), then on their micro-scale phases (stage 2).
     """
     t0 = time.perf_counter()
-    entries, by_label = _check_entries(entries)
+    entries, by_label = check_design_inputs(entries, [target], settings)
     evaluate = evaluate or Evaluator(settings)
     objective = Objective((target,))
     s = score_database(entries, target)
@@ -316,7 +310,7 @@ def _two_range_cross_over(method, entries, target, pbar, settings, evaluate, opt
     """Algs. 5 and 6: U1/U2 on the two pressure ranges, the crossed pairs of
     ``chromosomes(entry)`` (None = all), then GCMMA stages 1 and 2."""
     t0 = time.perf_counter()
-    entries, by_label = _check_entries(entries)
+    entries, by_label = check_design_inputs(entries, [target], settings)
     pbar = target.check_pbar(pbar)
     evaluate = evaluate or Evaluator(settings)
     objective = Objective((target,))
@@ -383,7 +377,7 @@ def mcco(entries, target_k: Target, target_a: Target, settings: DatabaseSettings
     if target_k.quantity != "K" or target_a.quantity != "A":
         raise InputError(f"M-CCO needs a K(p) target and an A(p) target, got "
                          f"{target_k.quantity!r} and {target_a.quantity!r}")
-    entries, by_label = _check_entries(entries)
+    entries, by_label = check_design_inputs(entries, [target_k, target_a], settings)
     evaluate = evaluate or Evaluator(settings)
     objective = Objective((target_k, target_a))
     s1, s2 = score_database(entries, target_k), score_database(entries, target_a)
@@ -480,9 +474,11 @@ def _at_targets(design, objective, settings, evaluate):
 
 def run_design(method: str, entries, targets, settings: DatabaseSettings, *, pbar=None,
                evaluate=None, options: GcmmaOptions = GcmmaOptions(), **kw) -> DesignResult:
-    """Dispatch to :func:`sog`, :func:`gco`, :func:`cco` or :func:`mcco` (the CLI entry),
-    the inputs checked first (:func:`~.targets.check_design_inputs`)."""
-    targets = check_design_inputs(method, METHODS, entries, targets, settings)
+    """Dispatch to :func:`sog`, :func:`gco`, :func:`cco` or :func:`mcco` (the CLI entry);
+    each checks its inputs before any stage (:func:`~.targets.check_design_inputs`)."""
+    if method not in METHODS:
+        raise InputError(f"method must be one of {METHODS}, got {method!r}")
+    targets = list(targets)
     if method == "mcco":
         if len(targets) != 2:
             raise InputError("mcco needs two targets: K(p) (--target) and A(p) (--second-target)")

@@ -69,17 +69,21 @@ def check_target_units(entries, targets, settings: DatabaseSettings) -> None:
             f"K or A) and the material (a database of the target's E: `roughfe db build --E`)")
 
 
-def check_design_inputs(method, methods, entries, targets, settings) -> list:
-    """The targets as a list, after the checks a design needs before any stage runs:
-    ``method`` one of ``methods``, :func:`check_strict_targets` and
-    :func:`check_target_units` (against the database ``entries``, when there are any)."""
-    targets = list(targets)
-    if method not in methods:
-        raise InputError(f"method must be one of {methods}, got {method!r}")
+def check_design_inputs(entries, targets, settings: DatabaseSettings) -> tuple:
+    """``(entries, entries by label)``: the database ``entries`` as a list and a dict,
+    after the checks a design needs before any stage runs: a non-empty database,
+    :func:`check_strict_targets` and :func:`check_target_units` on ``targets``. Every
+    design method runs them first (:func:`~.algorithms.sog`, :func:`~.algorithms.gco`,
+    :func:`~.algorithms.cco`, :func:`~.algorithms.mcco`, and so
+    :func:`~.algorithms.run_design` and the CLI): until round 2, session 33 only
+    ``run_design`` did, and a direct ``sog(entries, target, settings)`` with a 2-point K
+    target ran every stage, then failed on NaN."""
+    entries, targets = list(entries), list(targets)
+    if not entries:
+        raise InputError("the genome database is empty: build it first ('roughfe db build')")
     check_strict_targets(targets)
-    if entries:
-        check_target_units(entries, targets, settings)
-    return targets
+    check_target_units(entries, targets, settings)
+    return entries, {e.label: e for e in entries}
 
 
 def rescore(design: Design, targets, settings: DatabaseSettings, response=None) -> tuple:
@@ -184,6 +188,8 @@ def score_batch(designs, targets, settings: DatabaseSettings, scoring=SCORINGS) 
     scoring = tuple(scoring)
     if not scoring or any(k not in SCORINGS for k in scoring):
         raise InputError(f"scoring must name some of {SCORINGS}, got {scoring!r}")
+    if "strict" in scoring:         # a 2-point K target scored every design -inf, silently
+        check_strict_targets(targets)
     if not designs:
         return {k: np.zeros((0, len(targets))) for k in scoring}
     out = {}
