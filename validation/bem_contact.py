@@ -26,8 +26,24 @@ from roughfe.validation import fraction, report_title, skipped, targets_markdown
 from roughfe.writers import write_json, write_text
 
 MAT = Material(1.0e9, 0.3)
-TARGETS = {"westergaard_width_1024": 5e-3, "westergaard_gap_1024": 5e-3, "hertz_256": 2e-2,
-           "line_2048": 1e-2, "dense_vs_pk": 1e-8, "tamaas": 1e-3}
+#: the references' E* = E / (1 - nu^2) (plane strain, rigid indenter), written out here and
+#: not read from ``MAT.E_star``: the solver takes its E* from the Material, so a reference
+#: computed from the same property could not see an error in it (an E/(1 - nu) or a factor
+#: 2 in ``Material.E_star`` passed every row of this study until round 2, session 33)
+E_STAR = 1.0e9 / (1.0 - 0.3 ** 2)
+#: relative tolerances, each above the discretisation error measured at its resolution
+#: (full run, session 33; the report's tables hold every level): Westergaard half-width
+#: from the edge law 0.011-0.124 % at 1024 points, mean gap 2.3e-6-1.8e-5 at 1024 (8.1e-4
+#: at 256); Hertz sphere at 256^2: contact radius (whole cells) 0.59 %, load and peak
+#: pressure 8.1e-5 / 5.9e-5 (2.4e-4 / 2.7e-4 at 128^2), stiffness 0.22 % (0.43 % at
+#: 128^2); Hertz line at 2048 points: half-width (whole cells) 0.089 %, peak pressure
+#: 1.4e-6 (5.3e-5 at 512). Until session 33 the mean gap had 0.5 %, and load, peak and
+#: stiffness shared the radius' 2 % (line: the half-width's 1 %), so an error of 1 % in
+#: E* or in a kernel passed them.
+TARGETS = {"westergaard_width_1024": 5e-3, "westergaard_gap_1024": 1e-4,
+           "hertz_radius_256": 2e-2, "hertz_load_peak_256": 1e-3, "hertz_stiffness_256": 5e-3,
+           "line_width_2048": 1e-2, "line_peak_2048": 1e-4, "dense_vs_pk": 1e-8,
+           "tamaas": 1e-3}
 
 
 def _sinusoid(n, lam=1e-3, g=1e-6):
@@ -44,10 +60,10 @@ def _edge_half_width(pressure, dx):
 
 def westergaard_cases(ns=(64, 256, 1024, 4096, 8192)):
     rows = []
-    p_star = np.pi * MAT.E_star * 1e-6 / 1e-3
+    p_star = np.pi * E_STAR * 1e-6 / 1e-3
     for n in ns:
         for s in (0.1, 0.3, 0.6, 0.9):
-            ref = westergaard(1e-6, 1e-3, MAT.E_star, s * p_star)
+            ref = westergaard(1e-6, 1e-3, E_STAR, s * p_star)
             r = solve_contact(_sinusoid(n), MAT, mean_pressure=ref.mean_pressure)
             rows.append({"n": n, "s": s, "A": r.area_fraction, "A_ref": ref.area_fraction,
                          "width_err": abs(r.area_fraction / ref.area_fraction - 1),
@@ -61,7 +77,7 @@ def westergaard_cases(ns=(64, 256, 1024, 4096, 8192)):
 def hertz_cases(ns=(128, 256, 512)):
     rows = []
     R, L, delta = 1e-2, 1e-3, 1.5e-6
-    ref = hertz_sphere(R, MAT.E_star, approach=delta)
+    ref = hertz_sphere(R, E_STAR, approach=delta)
     for n in ns:
         x = (np.arange(n) - n // 2) * L / n
         X, Y = np.meshgrid(x, x, indexing="ij")
@@ -82,7 +98,7 @@ def line_cases(ns=(512, 2048, 8192)):
     for n in ns:
         x = (np.arange(n) - n // 2) * L / n
         r = solve_contact(Surface(-x ** 2 / (2 * R), L), MAT, mean_pressure=2e5)
-        ref = hertz_cylinder(R, MAT.E_star, r.load)
+        ref = hertz_cylinder(R, E_STAR, r.load)
         rows.append({"n": n, "width_err": abs(r.contact_area / 2 / ref.contact_radius - 1),
                      "peak_err": abs(r.pressure.max() / ref.peak_pressure - 1)})
     return rows
@@ -150,21 +166,28 @@ def main(outdir: Path, quick: bool = False) -> bool:
     measured = {
         "westergaard_width_1024": max(r["edge_width_err"] for r in w if r["n"] == 1024),
         "westergaard_gap_1024": max(r["gap_err"] for r in w if r["n"] == 1024),
-        "hertz_256": max(v for r in h if r["n"] == 256 for k, v in r.items()
-                         if k.endswith("_err")),
-        "line_2048": max(v for r in line if r["n"] == 2048 for k, v in r.items()
-                         if k.endswith("_err")),
+        "hertz_radius_256": max(r["radius_err"] for r in h if r["n"] == 256),
+        "hertz_load_peak_256": max(max(r["load_err"], r["peak_err"]) for r in h
+                                   if r["n"] == 256),
+        "hertz_stiffness_256": max(r["stiffness_err"] for r in h if r["n"] == 256),
+        "line_width_2048": max(r["width_err"] for r in line if r["n"] == 2048),
+        "line_peak_2048": max(r["peak_err"] for r in line if r["n"] == 2048),
         "dense_vs_pk": max(r["max_rel_diff"] for r in sol),
     }
     if tam is not None:
         measured["tamaas"] = max(tam["A_rel"], tam["gap_rel"])
     labels = {"westergaard_width_1024": "Westergaard half-width (1024 points per wavelength)",
               "westergaard_gap_1024": "Westergaard mean gap (1024 points per wavelength)",
-              "hertz_256": "Hertz sphere radius, load, peak pressure, stiffness (256^2)",
-              "line_2048": "Hertz line half-width and peak pressure (2048 points)",
+              "hertz_radius_256": "Hertz sphere contact radius, whole cells (256^2)",
+              "hertz_load_peak_256": "Hertz sphere load and peak pressure (256^2)",
+              "hertz_stiffness_256": "Hertz sphere stiffness (256^2)",
+              "line_width_2048": "Hertz line half-width, whole cells (2048 points)",
+              "line_peak_2048": "Hertz line peak pressure (2048 points)",
               "dense_vs_pk": "dense pivoting vs PCG pressures (32^2)",
               "tamaas": "A* and mean gap vs Tamaas 2.8 (256^2)"}
-    targets = [within(labels[k], v, TARGETS[k], "relative error, worst over the cases")
+    closed_form = "; E* = E/(1 - nu^2) of the closed form written out (E_STAR)"
+    targets = [within(labels[k], v, TARGETS[k], "relative error, worst over the cases"
+                      + ("" if k == "dense_vs_pk" else closed_form))
                for k, v in measured.items()]
     checks = {k: t.met for k, t in zip(measured, targets)}
     if tam is None:                            # a target not run: said and counted
@@ -203,7 +226,14 @@ def main(outdir: Path, quick: bool = False) -> bool:
           + (table([tam], list(tam)) if tam else
              "not run: --quick leaves Tamaas out (the full validation runs it)" if quick
              else "tamaas not importable: skipped")
-          + "\n\n## Targets\n\n" + targets_markdown(targets))
+          + "\n\n## Targets\n\n" + targets_markdown(targets)
+          + "\nEvery tolerance lies above the discretisation error measured at its "
+          "resolution (the tables above; the values are in the comment of `TARGETS` in "
+          "validation/bem_contact.py). Quantities counted in whole cells (A*, the Hertz "
+          "radius, the line half-width) carry about one cell per contact edge; the others "
+          "converge fast and have tolerances that an error of 1 % in E* or a kernel "
+          "exceeds. The closed forms take E* = E/(1 - nu^2) computed in the script, not "
+          "the Material's E_star that the solver uses.\n")
     write_text(outdir / "bem_contact.md", md)
     return all(checks.values())
 

@@ -11,8 +11,10 @@ validation none of whose scripts ran has ``"met": null``: never "met". A target 
 was to check and did not (an optional tool such as Tamaas or ``mpirun`` missing, a case
 ``--quick`` leaves out) is its :func:`roughfe.validation.skipped` row: printed as "not
 run", listed in ``not_run`` (``"script: target"``; a whole script by its name) and
-``all_met`` false; the exit code is 1 only for a target NOT met. A row merely reported
-beside the targets (:func:`roughfe.validation.reported`) is not counted. They are readable
+``all_met`` false; the exit code is 1 only for a target NOT met (a script whose
+``main`` returns True while one of its rows is NOT met is a failed study). A row
+merely reported beside the targets (:func:`roughfe.validation.reported`) is not
+counted. They are readable
 physics scripts that compare roughfe with analytic solutions, FEM and the literature;
 they need the repository checkout (they are not installed modules).
 
@@ -116,6 +118,9 @@ def run_validation(name: str, outdir: Path, quick: bool = False) -> dict:
             ok = bool(module.main(Path(outdir),
                                   **({"quick": True} if quick and takes_quick else {})))
             rows = _targets(outdir, script, ok)
+            # the verdict follows the rows too: a row NOT met is never a met study, even
+            # when the script's own return value missed it
+            ok = ok and not any(r.get("met") is False for r in rows)
         except Exception as exc:   # noqa: BLE001 -- reported as a failed row, others still run
             ok = False
             rows = [Target(f"{script}: ran to the end", "no error",
