@@ -93,7 +93,9 @@ def _fluid_pressures(args):
 FIELD_UNITS = {"gap": "m", "contact": "1", "pressure_contact": "Pa", "fluid_pressure": "Pa",
                "flux": "m^2/s (volume flux per unit width, per cell: x, y components)",
                "percolating": "1", "trapped": "1", "sealed": "1",
-               "pockets": "pocket label (0: none)",
+               "pockets": "pocket number per cell: k >= 1 the k-th of the step's "
+                          "pocket_pressures / pocket_volumes in results.json (largest "
+                          "first), 0 none",
                "widest_path": "cell indices (n, 2)", "parent_channel": "cell indices",
                "size_m": "m", "spacing_m": "m"}
 
@@ -193,9 +195,18 @@ def _leak(args) -> int:
     along = ("x and y (results.json leak_rate is their mean)" if args.direction == "both"
              else args.direction)
     print(_VOLUME_NOTE)
-    print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
-          f"(--pressure-drop) and viscosity {args.mu:g} Pa s (--mu); Q is proportional to the "
-          f"drop and to 1/mu")
+    # the flags the drop came from; no Q line without the Reynolds solve (it described a
+    # drop of 1 Pa beside columns of '-': a review, round 2, session 33)
+    given = ("--inlet-pressure - --outlet-pressure" if args.inlet_pressure is not None
+             else "--pressure-drop")
+    if args.no_reynolds:
+        print("Q: not solved (--no-reynolds); results.json keeps the critical-junction and "
+              "Persson leak rates at the pressure drop "
+              f"{p_in - p_out:g} Pa ({given}) and viscosity {args.mu:g} Pa s (--mu)")
+    else:
+        print(f"Q: leak rate along {along} at the pressure drop {p_in - p_out:g} Pa "
+              f"({given}) and viscosity {args.mu:g} Pa s (--mu); Q is proportional to the "
+              f"drop and to 1/mu")
     check_critical_gaps(args, steps)
     check_fluid_load(args, steps, p_in, p_out)
     persson_basis(args, surface, persson)
@@ -226,7 +237,10 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
     steps = sweep.records()
     written = []
     for k, (r, lk) in enumerate(zip(sweep.results, sweep.leakages)):
-        arrays = {"fluid_pressure": r.fluid_pressure, "pockets": r.fluid_state.pockets.labels}
+        # numbered as results.json's pocket lists, 0 elsewhere (it saved the internal
+        # labels, -1 elsewhere and 0 the first pocket, under the unit "0: none"; none at
+        # all with --trapped-fluid film, whose drained pockets the lists report)
+        arrays = {"fluid_pressure": r.fluid_pressure, "pockets": r.pocket_labels}
         if r.contact is not None:      # the one-way sweep's contact and network arrays
             arrays.update(_contact_network_arrays(r.contact, lk), flux=r.flow.flux)
         path = _write_step_npz(out / "fields" / f"step_{k:03d}.npz", arrays, surface)

@@ -344,6 +344,7 @@ _RECORD_UNITS = {
     "patch_width": "grid points (load-weighted contact patch width)",
     "mean_gap": "m", "mean_plane_separation": "m", "residual": "1 (relative KKT residual)",
     "iterations": "count", "separation_star": "1 (d / sigma)", "contact_success": "bool",
+    "unloading": "bool (a step of the unloading path, --unload)",
     "persson_stiffness": PERSSON_UNITS["persson_stiffness"],
     "hydraulic_aperture": "m", "percolates": "bool", "percolates_reynolds": "bool",
     "flow_imbalance": "1 (|inlet flow - outlet flow| / leak rate)", "reynolds_nit": "count",

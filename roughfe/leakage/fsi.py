@@ -165,6 +165,10 @@ class CoupledResult:
         step is another quantity: the free volume of the components reaching no edge).
     pocket_pressures, pocket_volumes : tuple of float
         Pressure (Pa) and fluid volume (m^3) of each pocket, largest pocket first.
+    pocket_labels : ndarray of int
+        Per cell: ``k >= 1`` in the k-th pocket of ``pocket_pressures`` (largest first),
+        0 elsewhere (all 0 at lift-off). With ``"film"`` the drained pockets that those
+        lists report (the reference for the next step, ``fluid_state.pockets``, has none).
     pockets_new, pockets_released, pockets_merged, pocket_passes : int
         Pockets that hold no liquid of the previous state (sealed off from the flowing
         film in this step, or, on unloading, cavities opened in this step among contact
@@ -201,6 +205,7 @@ class CoupledResult:
     pocket_volume: float
     pocket_pressures: tuple
     pocket_volumes: tuple
+    pocket_labels: np.ndarray
     pockets_new: int
     pockets_released: int
     pockets_merged: int
@@ -436,6 +441,7 @@ def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residu
             fluid_load_fraction=float(p_f.mean() / p_ext), contact_load_fraction=0.0,
             trapped_load_fraction=0.0,
             pocket_volume=0.0, pocket_pressures=(), pocket_volumes=(),
+            pocket_labels=np.zeros(p_f.shape, dtype=np.int32),
             fluid_state=FluidState(pressure=p_f, pockets=Pockets.none(p_f.shape)), **common)
     c, sol = last["contact"], last["flow"]
     gap = np.where(c.contact, 0.0, c.gap)
@@ -444,11 +450,15 @@ def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residu
     n = report.n if report is not None else 0
     in_pocket = lab >= 0
     pocket_p, pocket_v = [], []
+    numbered = np.zeros(gap.shape, dtype=np.int32)    # 1.. in the order of the lists
     if n:
         area = np.bincount(lab[in_pocket], minlength=n)
         order = np.argsort(-area, kind="stable")
         pocket_p = (np.bincount(lab[in_pocket], fluid[in_pocket], n) / area)[order]
         pocket_v = (np.bincount(lab[in_pocket], gap[in_pocket], n) * cell)[order]
+        rank = np.empty(n, dtype=np.int32)
+        rank[order] = np.arange(1, n + 1, dtype=np.int32)
+        numbered[in_pocket] = rank[lab[in_pocket]]
     nxt = last.get("next")
     return CoupledResult(
         state=state, contact=c, approach=float(c.delta - last["shift"]), flow=sol,
@@ -458,7 +468,7 @@ def _result(state, last, fluid, p_ext, p_in, p_out, mu, one_way, it, res, residu
         trapped_load_fraction=float(fluid[in_pocket].sum() / fluid.size / p_ext),
         pocket_volume=float(gap[in_pocket].sum() * cell),
         pocket_pressures=tuple(float(v) for v in pocket_p),
-        pocket_volumes=tuple(float(v) for v in pocket_v),
+        pocket_volumes=tuple(float(v) for v in pocket_v), pocket_labels=numbered,
         fluid_state=FluidState(pressure=fluid,
                                pockets=nxt if nxt is not None else Pockets.none(gap.shape)),
         **common)

@@ -89,8 +89,22 @@ class CoupledSweep:
                 # solves no Reynolds, so it left None: a seals review)
                 rec["hydraulic_aperture"] = rec[f"hydraulic_aperture_{d}"] = \
                     _coupled_aperture(r, self.surface.size, d)
+                # the coupled Reynolds solve's own report, as the one-way records give it
+                # (null here: the network analysis above solves none)
+                rec.update(_flow_report(r.flow, d))
             out.append(rec)
         return out
+
+
+def _flow_report(flow, direction) -> dict:
+    """``percolates_reynolds_<d>``, ``flow_imbalance_<d>`` (``|inlet - outlet| / |Q|``,
+    None without through-flow) and ``reynolds_nit_<d>`` of a coupled step's FV solution."""
+    imbalance = None
+    if flow.percolates and flow.leak_rate != 0.0:
+        imbalance = abs(flow.inlet_flow - flow.outlet_flow) / abs(flow.leak_rate)
+    return {f"percolates_reynolds_{direction}": bool(flow.percolates),
+            f"flow_imbalance_{direction}": imbalance,
+            f"reynolds_nit_{direction}": int(flow.nit)}
 
 
 def _coupled_aperture(result, size, direction):

@@ -112,7 +112,11 @@ class ChannelCoupledResult:
     flow : ChannelFlow
         Reynolds solution on the coupled gap.
     approach : float
-        Half-plane approach Delta (m; negative: clearance); solved for under load control.
+        Half-plane approach Delta (m; negative: clearance) of ``gap``, so that ``gap =
+        max h - h - approach + displacement`` where open; solved for under load control,
+        where a ``"closed"`` state is the channel at closure (its approach a lower bound:
+        the contact that would carry the rest of the load is not solved) and a
+        ``"lift-off"`` state the trial channel of no equilibrium.
     external_pressure : float or None
         ``p_ext`` (Pa) under load control, None under position control.
     inlet_pressure, outlet_pressure, mu : float
@@ -348,14 +352,20 @@ def coupled_channel(profile: Surface, material: Material, approach: Optional[flo
                 # no open balance: report the channel at closure (touching at its throat;
                 # the contact that would carry the rest of the load is not solved) or, at
                 # lift-off, the trial channel (no equilibrium)
+                # `at`: the approach of the gap reported (it was the last balanced one, or
+                # 0 before any: the closed channel's gap and approach disagreed, 0.29 um
+                # on the 65-node wavy channel of tests/test_leakage_output_review.py)
                 lifted = isinstance(exc, _LiftOff)
                 gap = gap if lifted else shape - shape.min()
                 last.update(body=c, gap=gap, flow=channel_flow(gap, dx, **flow_args),
-                            state="lift-off" if lifted else "closed")
+                            state="lift-off" if lifted else "closed",
+                            at=trial if lifted else float(shape.min()))
                 raise
             gap = shape - last["approach"]
+            trial = last["approach"]
         flow = channel_flow(gap, dx, **flow_args)
-        last.update(body=c, gap=gap, flow=flow, state="closed" if flow.closed else "open")
+        last.update(body=c, gap=gap, flow=flow, state="closed" if flow.closed else "open",
+                    at=trial)
         if flow.closed:
             raise _Closed()
         return flow.pressure
@@ -425,7 +435,7 @@ def _result(method, last, p_ext, mu, one_way, it, res, residuals):
     return ChannelCoupledResult(
         method=method, state=state, x=flow.x, gap=gap,
         displacement=np.asarray(c.displacement)[:n].copy(), fluid_pressure=flow.pressure,
-        flow=flow, approach=float(last["approach"]), external_pressure=p_ext,
+        flow=flow, approach=float(last["at"]), external_pressure=p_ext,
         inlet_pressure=flow.inlet_pressure, outlet_pressure=flow.outlet_pressure, mu=mu,
         leak_rate=None if lifted else flow.leak_rate, one_way_leak_rate=one_way,
         mean_gap=None if lifted else trapezoid_mean(gap),
