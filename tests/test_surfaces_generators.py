@@ -110,8 +110,9 @@ def test_mwm_peaks_at_qn_with_eq_317_amplitudes():
     np.testing.assert_allclose(4 * power[0, k], amps[1] ** 2, rtol=1e-9)
     ratio = power[k[1:], 0] / power[k[:-1], 0]
     np.testing.assert_allclose(ratio, gamma ** (-2 * hurst), rtol=1e-9)
-    # log in Eq. 2.2 is base 10
-    a0 = 3e-6 * np.sqrt(np.log10(2) / 2) * (2 * np.pi / length) ** -hurst
+    # log in Eq. 2.2 is the natural one (Ausloos-Berman, Yan-Komvopoulos; base 10 until
+    # round 2, session 33, after the thesis' remark below Eq. 2.2)
+    a0 = 3e-6 * np.sqrt(np.log(2) / 2) * (2 * np.pi / length) ** -hurst
     assert amps[0, 0] == pytest.approx(a0, rel=1e-6, abs=0)
 
 

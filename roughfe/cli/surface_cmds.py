@@ -122,7 +122,8 @@ def _make_spectral(a):
     rms_h = a.rms_height if (a.rms_height is not None or a.rms_slope is not None) else 1e-6
     return make(a.n, a.length, a.hurst, rms_height=rms_h,
                 rms_slope=a.rms_slope, q_long=a.q_long, q_roll=a.q_roll, q_short=a.q_short,
-                amplitudes="fixed" if a.fixed_amplitudes else "gaussian", rng=a.seed)
+                amplitudes="fixed" if a.fixed_amplitudes else "gaussian", rng=a.seed,
+                match=a.match)
 
 
 def _grid_points(a) -> tuple:
@@ -245,7 +246,7 @@ def _register_generate(sub):
     m = common("spectral", "periodic self-affine surface by Fourier filtering", _make_spectral)
     m.add_argument("--n", type=positive_int, default=256, help="grid points per side")
     m.add_argument("--length", type=positive_float, default=1e-4, help="period (m)")
-    m.add_argument("--hurst", type=float, default=0.8, help="Hurst exponent in (0,1)")
+    m.add_argument("--hurst", type=float, default=0.8, help="Hurst exponent in (0,1]")
     m.add_argument("--rms-slope", type=float, default=None,
                    help="target rms slope instead of rms height (1 um if neither)")
     m.add_argument("--q-long", type=float, default=None, help="q_l cut-off (rad/m)")
@@ -253,6 +254,10 @@ def _register_generate(sub):
     m.add_argument("--q-short", type=float, default=None, help="q_s cut-off (rad/m)")
     m.add_argument("--fixed-amplitudes", action="store_true",
                    help="random phases only (PSD exactly the target)")
+    m.add_argument("--match", choices=("realisation", "expectation"), default="realisation",
+                   help="meet the rms target on this surface exactly (default), or in the "
+                        "ensemble mean with the mean PSD exactly the target (Gaussian "
+                        "amplitudes: the default inflates the mean short-wave PSD)")
     m.add_argument("--profile", action="store_true", help="a 1D profile instead of a surface")
 
 

@@ -19,9 +19,11 @@ Surface, grid ``(2**m + 1)**2``, Hurst exponent ``H = 3 - D``:
    ``C(q) ~ q**(-2(1+H))``. Each level is one vectorised numpy operation.
 
 The thesis text states the variance as ``sigma_1^2 = sigma_0^2 / 2**((3-D)/2)`` with
-``sigma_0^2 = 1/sqrt(0.09)``: that is the reduction of one half-step (``2**(-H/2)`` on
-the standard deviation, i.e. ``2**(-H)`` on the variance, is Peitgen-Saupe's) written
-loosely, and the dimensionless ``sigma_0`` fixes no physical height. Here ``sigma0`` is a
+``sigma_0^2 = 1/sqrt(0.09)``: that is Peitgen-Saupe's factor of one half-step on the
+*standard deviation* (``2**(-H/2)``) written as a factor on the variance. Taken
+literally the variance would fall by ``2**(-H)`` per level instead of ``2**(-2H)``, a
+surface of Hurst exponent ``H/2`` (``D`` too large by ``H/2``); roughfe follows Peitgen &
+Saupe. The dimensionless ``sigma_0`` fixes no physical height. Here ``sigma0`` is a
 length in metres, and ``rms_height`` optionally rescales the result to an exact rms
 height (about the mean) -- the physically meaningful input.
 
@@ -30,10 +32,30 @@ Size convention: the thesis' ``L`` spans the ``2**m + 1`` nodes end to end (spac
 ``size = n * spacing``, so the returned ``size = (2**m + 1) * L / 2**m``. RMD surfaces
 are not periodic.
 
-Profile (``rmd_profile``, ``2**m + 1`` points, ``H = 2 - D``): the end points get
-N(0, sigma0^2); at level ``k`` every midpoint gets the mean of its two neighbours plus
-N(0, delta_k^2), ``delta_k^2 = sigma0^2 (1 - 2**(2H-2)) / 2**(2Hk)`` (MidPointFM1D: the
-displacement variance that gives exact fractional-Brownian increments across scales).
+Profile (``rmd_profile``, ``2**m + 1`` points, ``H = 2 - D``): ``X(0) = 0`` and
+``X(L) ~ N(0, sigma0^2)``; at level ``k`` every midpoint gets the mean of its two
+neighbours plus N(0, delta_k^2), ``delta_k^2 = sigma0^2 (1 - 2**(2H-2)) / 2**(2Hk)``
+(MidPointFM1D). That displacement variance is what makes the increments between
+neighbours of every level exactly fractional-Brownian,
+``Var(X(t + L/2**k) - X(t)) = sigma0^2 2**(-2Hk)``:
+``Var((X_b - X_a)/2 + D_k) = sigma0^2 2**(-2Hk) [2**(2H)/4 + 1 - 2**(2H-2)]``. It needs
+the end-to-end increment to have variance ``sigma0^2``; until round 2, session 33 both
+ends were drawn independently (``2 sigma0^2``), which added ``sigma0^2 4**(-k)`` at level
+``k``: the increment variance over ``2**(-2Hk)`` was 1.96 / 1.70 / 1.53 / 1.39 / 1.27
+for k = 0..4 at H = 0.8 (2000 profiles), a coarse-scale excess that bent the structure
+function (1.00 at every level now).
+
+Known artefacts (why Peitgen & Saupe offer "random successive additions"; measured on
+200-400 surfaces of 129**2, docs/theory/01_surfaces.md): the surface is not stationary.
+The statistics of a node depend on the level that made it: x-increments along the odd
+columns (every node of which the last level made) have 0.86 times the variance of those
+along the even columns at H = 0.8 (0.96 at H = 0.5). Near the boundary, where the square
+step averages three neighbours, they differ too: x-increments along the edge y = 0 are
+1.22 times the median, those from the first row to the second 0.82 (H = 0.8). The
+diamond-square increments are fractional-Brownian only approximately: the structure
+function's local exponent runs 0.59-0.71 for H = 0.8 and 0.43-0.46 for H = 0.5, and the
+PSD fit of 257**2 surfaces gives 0.76 and 0.46 (means of 20). For an exactly self-affine,
+stationary surface use :func:`~roughfe.surfaces.spectral.spectral_surface`.
 """
 from __future__ import annotations
 
@@ -167,7 +189,7 @@ def rmd_profile(m, fractal_dimension, length, rng=None, rms_height=None, sigma0=
     hurst = 2.0 - d
     n = 2 ** m + 1
     z = np.zeros(n)
-    z[[0, -1]] = sigma0 * gen.standard_normal(2)
+    z[-1] = sigma0 * gen.standard_normal()      # X(0) = 0: Var(X(L) - X(0)) = sigma0^2
     delta = sigma0 * np.sqrt(1.0 - 2.0 ** (2 * hurst - 2))
     step = n - 1
     while step > 1:
