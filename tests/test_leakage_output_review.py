@@ -6,7 +6,8 @@
   order) and, with ``--trapped-fluid film``, no pocket at all. Checked cell by cell: the
   fluid pressure and the gap volume of pocket k are the k-th entries of results.json.
 * the coupled records carry the Reynolds solve's own report (percolation verdict, in/out
-  imbalance, iterations): they were null, so network and flow could not be compared.
+  imbalance, iterations): they were null, so network and flow could not be compared; the
+  units of the solid's keys with ``--fsi`` say that they are its effective pressure.
 * the 1D coupling under load control reports the approach of the gap it returns: a closed
   channel reported the last balanced approach (0 before any), 17 nm off its gap.
 * a Reynolds flow imbalance can be the linear solver's tolerance, not only round-off.
@@ -63,6 +64,14 @@ def test_fsi_pocket_map_numbers_the_pockets_of_results_json(tmp_path, surface, t
     assert step["percolates_reynolds_x"] is step["percolates_x"] is True
     assert step["flow_imbalance_x"] is not None and step["flow_imbalance_x"] < 1e-6
     assert step["reynolds_nit_x"] >= 1
+    # the contact keys are the solid's effective pressure (said "Pa" / "N" only): on top of
+    # the fluid pressure they carry the external load
+    units = json.loads(str(fields["units"]))
+    assert "effective" in units["pressure_contact"]
+    assert "effective" in json.loads((out / "results.json").read_text())["units"][
+        "mean_pressure"]
+    total = fields["pressure_contact"] + pf
+    assert total.mean() == pytest.approx(step["external_pressure"], rel=1e-8, abs=0)
 
 
 def wavy(n):

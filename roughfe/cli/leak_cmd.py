@@ -100,14 +100,26 @@ FIELD_UNITS = {"gap": "m", "contact": "1", "pressure_contact": "Pa", "fluid_pres
                "size_m": "m", "spacing_m": "m"}
 
 
-def _write_step_npz(path, arrays: dict, surface) -> Path:
+#: what the contact keys mean with ``--fsi`` (the solid carries the effective pressure on top
+#: of the fluid's, roughfe.leakage.fsi): the npz and results.json said "Pa" and "N" only
+FSI_UNITS = {
+    "pressure_contact": "Pa (the solid's effective contact pressure on top of the fluid "
+                        "pressure: a contact cell's normal traction is pressure_contact + "
+                        "fluid_pressure)",
+    "mean_pressure": "Pa (the solid's effective pressure: external_pressure - mean fluid "
+                     "pressure)",
+    "load": "N (carried by the solid's effective pressure)"}
+
+
+def _write_step_npz(path, arrays: dict, surface, units=None) -> Path:
     """One step's fields, with the grid (``size_m``, ``spacing_m``) and ``units`` (a JSON
-    object: array name -> unit) so that the file is read without results.json."""
+    object: array name -> unit; ``units`` overrides :data:`FIELD_UNITS` by name) so that
+    the file is read without results.json."""
     import json
     arrays = {**arrays, "size_m": np.asarray(surface.size, float),
               "spacing_m": np.asarray(surface.spacing, float)}
-    units = {k: next((u for pre, u in FIELD_UNITS.items() if k.startswith(pre)), "")
-             for k in arrays}
+    units = {k: (units or {}).get(k) or next(
+        (u for pre, u in FIELD_UNITS.items() if k.startswith(pre)), "") for k in arrays}
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
             np.savez_compressed(fh, units=np.array(json.dumps(units)), **arrays)
@@ -243,7 +255,8 @@ def _leak_fsi(args, surface, material, out, p_in, p_out):
         arrays = {"fluid_pressure": r.fluid_pressure, "pockets": r.pocket_labels}
         if r.contact is not None:      # the one-way sweep's contact and network arrays
             arrays.update(_contact_network_arrays(r.contact, lk), flux=r.flow.flux)
-        path = _write_step_npz(out / "fields" / f"step_{k:03d}.npz", arrays, surface)
+        path = _write_step_npz(out / "fields" / f"step_{k:03d}.npz", arrays, surface,
+                               units=FSI_UNITS)
         written.append(path)
         if not _maps_of(args, k, len(sweep.results)) or r.contact is None:
             continue
@@ -279,10 +292,14 @@ def _maps_of(args, k, n) -> bool:
     return not args.no_figures and (args.maps == "all" or k in (0, n - 1))
 
 
-def _units(steps) -> dict:
-    """results.json ``units``: the unit of every step key (:func:`record_units`)."""
+def _units(steps, fsi: bool = False) -> dict:
+    """results.json ``units``: the unit of every step key (:func:`record_units`; with
+    ``fsi`` the solid's keys as :data:`FSI_UNITS` says)."""
     from ..leakage.analysis import record_units
-    return record_units(dict.fromkeys(k for s in steps for k in s))
+    units = record_units(dict.fromkeys(k for s in steps for k in s))
+    if fsi:
+        units.update({k: v for k, v in FSI_UNITS.items() if k in units})
+    return units
 
 
 def _leak_run(args, surface, material, out):
@@ -334,7 +351,7 @@ def _leak_run(args, surface, material, out):
         if not args.no_figures:     # with Persson's leak rate beside the coupled one
             written.append(figs.steps_figure(steps, out / "figures" / "steps.png"))
         written.append(write_json(out / "results.json", {
-            "inputs": base, "steps": steps, "units": _units(steps),
+            "inputs": base, "steps": steps, "units": _units(steps, fsi=True),
             "persson": theory["persson"]}))
         return sweep, steps, written, theory["persson"]
     dp = p_in - p_out
