@@ -470,3 +470,23 @@ def test_beside_says_when_the_surface_has_a_lay(surface):
     assert "persson_leak_rate_x/_y" in note and "leak_rate_x/_y" in note
     contact = beside(grooved, E_STAR, steps)["persson"]["anisotropic"]
     assert "A*(p), u(p) and K(p)" in contact and "leak" not in contact
+
+
+def test_beside_says_when_the_texture_aspect_ratio_is_only_a_bound():
+    """One wave across a periodic cell has an infinite lay (Str = 0), but the circular
+    autocorrelation ends at half the period: Str reads 0.40, an upper bound above the
+    anisotropy limit. The theory's block says so ("texture_bounded") instead of passing
+    the surface as isotropic; an isotropic random cell and a measured-like grooved one
+    (Str below the limit) get no such note."""
+    from roughfe.theory.beside import ANISOTROPIC_STR
+    n = 32
+    x = np.arange(n) / n
+    wave = Surface(1e-6 * np.cos(2 * np.pi * x)[:, None] * np.ones((1, n)), (1e-4, 1e-4),
+                   periodic=True)
+    info = beside(wave, E_STAR, [{"mean_pressure": 1e6}])["persson"]
+    assert info["texture_aspect_ratio"] >= ANISOTROPIC_STR and "anisotropic" not in info
+    note = info["texture_bounded"]
+    assert f"Str = {info['texture_aspect_ratio']:.3g}" in note and "upper bound" in note
+    rng = np.random.default_rng(3)
+    noise = Surface(1e-8 * rng.standard_normal((n, n)), (1e-4, 1e-4), periodic=True)
+    assert "texture_bounded" not in beside(noise, E_STAR, [{"mean_pressure": 1e6}])["persson"]

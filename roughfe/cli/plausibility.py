@@ -203,7 +203,7 @@ def persson_basis(args, surface, persson: dict) -> None:
     print(f"Persson's theory beside the results (persson_* in results.json) takes gbar = "
           f"{persson['rms_gradient']:.3g}, the rms gradient of the surface's PSD{window}; "
           f"its rms slope by finite differences (roughfe info) is {_slope(surface):.3g}")
-    for note in ("non_gaussian", "anisotropic"):
+    for note in ("non_gaussian", "anisotropic", "texture_bounded"):
         if persson.get(note):
             warn(args, persson[note])
 
