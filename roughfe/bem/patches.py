@@ -14,6 +14,14 @@ points and the load at an imposed approach are off by several % and converge slo
 (a symmetric random profile with its contact on one node: the FEM was -4.6, -3.6 and
 -3.1 % below the BEM at 33, 65 and 129 nodes; measured against Westergaard and Hertz in
 docs/theory/02_bem_contact.md, section "Resolution of the contact patches").
+
+A resolved width does not bound the grid's error of a rough surface (round 2, session
+33): solved again on the same surface refined 2x and 4x (band-limited), A* by counting
+fell by 10-20 % at widths 7-25 on di-1.di and on surfaces rough to the grid scale, by
+3-5 % on surfaces smooth there; no rule on one solution (this width, the share of
+single-point patches, the perimeter per contact point) gave that error within a factor
+3. It is measured, not predicted: :mod:`roughfe.bem.grid_check` (``roughfe contact
+--grid-check``; docs/theory/02, "Discretisation error at a fixed surface").
 """
 from __future__ import annotations
 

@@ -29,6 +29,7 @@ from ..theory import beside, pastewka_robbins
 from ..writers import write_json
 from ..bem.patches import MIN_PATCH_POINTS, resolution_note
 from .plausibility import check_load_magnitudes, check_solution, persson_basis
+from .contact_grid import add_grid_check_option, grid_check_of_args, print_grid_check
 from .options import (ADHESION_WORDS, add_contact_physics_options, add_detrend_option,
                       add_material_options, add_output_folder, add_run_options,
                       add_surface_options, contact_physics_from_args,
@@ -102,6 +103,7 @@ def register(subparsers) -> None:
                      help="relative KKT residual at which a load step is converged, in "
                           "(0, 1) (default 1e-10); with --adhesion the traction residual "
                           "(default 1e-5)")
+    add_grid_check_option(num)
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_run)
@@ -133,6 +135,8 @@ def _run(args) -> int:
         adhesive = _adhesive_sweep(args, surface, material, law, tol)
         sweep = adhesive.sweep
     check_solution(args, surface, sweep.results, material)
+    grid = grid_check_of_args(args, surface, material, sweep, law, tol,
+                              options if law is None else {})
     r0 = sweep.results[0]
     inputs = {"surface": str(args.surface),
               "E": material.E, "nu": material.nu, "E_star": material.E_star,
@@ -141,9 +145,11 @@ def _run(args) -> int:
               "coarse_correction": args.coarse_correction,
               "control": "pressure" if args.pressure else "delta",
               "hardness": args.hardness, "unload": args.unload,
-              "detrend": args.detrend, "mirror": args.mirror,
+              "detrend": args.detrend, "mirror": args.mirror, "grid_check": args.grid_check,
               "metadata": dict(surface.metadata)}
     doc = contact_document(sweep, surface, material, inputs, adhesive=adhesive is not None)
+    if grid is not None:
+        doc["derived"]["grid_check"] = grid.describe()
     if adhesive is not None:
         doc["inputs"]["adhesion"] = law.describe()
         doc["derived"]["pull_off_force"] = adhesive.pull_off_force
@@ -216,7 +222,9 @@ def _run(args) -> int:
               f"{fmt_or_dash(t.get(theory + '_area_fraction'), '.3g'):>10s} "
               f"{fmt_or_dash(s.get('patch_width'), '.3g'):>6s}")
     print(f"patch: load-weighted width of the contact patches in grid points (patch_width in "
-          f"results.json; below {MIN_PATCH_POINTS:g} not resolved)")
+          f"results.json; below {MIN_PATCH_POINTS:g} not resolved; a resolved width does not "
+          f"bound the grid's error of A*: --grid-check measures it)")
+    print_grid_check(args, grid)
     persson_basis(args, surface, doc["derived"]["persson"])
     if cap is not None:
         print(f"one smooth asperity ({cap['shape']}, principal radii "

@@ -5,9 +5,10 @@ Generators (each takes ``rng`` = Generator or seed and records the seed):
 (Eq. 2.1), :func:`mwm_surface` (Eq. 2.2/3.17), :func:`spectral_surface`/
 :func:`spectral_profile` (Fourier filtering). A smooth reference shape (no seed):
 :func:`sphere_cap`, the parabolic sphere of Hertz's and Maugis' solutions
-(:mod:`roughfe.reference`). I/O: :func:`load_surface`,
-:func:`save_surface`. Statistics: :mod:`roughfe.surfaces.stats`; texture direction
-(ISO 25178-2 Str): :mod:`roughfe.surfaces.texture`.
+(:mod:`roughfe.reference`). The same surface on a finer grid (band-limited, no new
+roughness): ``Surface.refined`` (:mod:`roughfe.surfaces.resample`). I/O:
+:func:`load_surface`, :func:`save_surface`. Statistics: :mod:`roughfe.surfaces.stats`;
+texture direction (ISO 25178-2 Str): :mod:`roughfe.surfaces.texture`.
 """
 from .io import load_surface, save_surface
 from .rmd import rmd_profile, rmd_surface

@@ -214,6 +214,14 @@ class Surface(ReadOnlyArrays):
         return Surface(h, self.size, periodic=True,
                        metadata={**self.metadata, "resampled_from": list(self.shape)})
 
+    def refined(self, factor: int) -> "Surface":
+        """The same surface ``factor`` times finer per axis (integer >= 1): the
+        band-limited (Fourier) interpolant of the samples, no new roughness; a
+        non-periodic window through its even mirror image, keeping its footprint
+        (:func:`roughfe.surfaces.resample.refined`, which says how)."""
+        from .resample import refined
+        return refined(self, factor)
+
     def cropped(self, index=None, extent=None) -> "Surface":
         """A rectangular window of the grid, by index ranges or by physical extents.
 
