@@ -41,7 +41,8 @@ def grid_check_of_args(args, surface, material, sweep, law, tol, options):
     from ..bem.grid_check import grid_check
     if law is not None:
         return grid_check(surface, material, sweep, adhesion=law, unload=args.unload,
-                          kernel=args.kernel, tol=tol)
+                          kernel=args.kernel, tol=tol,
+                          max_unload_steps=args.max_unload_steps)
     return grid_check(surface, material, sweep,
                       **{k: v for k, v in options.items() if k != "unload"})
 
