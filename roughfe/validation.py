@@ -135,12 +135,16 @@ def report_title(title: str, quick: bool = False, reduced: str = "") -> str:
 
 
 def targets_markdown(rows) -> str:
-    """The rows as a Markdown table (target | criterion | measured | status | reason)."""
+    """The rows as a Markdown table (target | criterion | measured | status | reason); a
+    ``|`` inside a cell (``|p256 / p128 - 1|``) is escaped, so it cannot split the row."""
+    def cell(text):
+        return str(text).replace("|", "\\|").replace("\n", " ")
     lines = ["| target | criterion | measured | status | reason |", "|---|---|---|---|---|"]
     for t in rows:
         status = ("**not run**" if is_skipped(t) else "not checked" if t.met is None
                   else "met" if t.met else "**NOT met**")
-        lines.append(f"| {t.name} | {t.target} | {t.measured} | {status} | {t.reason} |")
+        lines.append("| " + " | ".join(cell(c) for c in (t.name, t.target, t.measured, status,
+                                                          t.reason)) + " |")
     return "\n".join(lines) + "\n"
 
 

@@ -184,7 +184,9 @@ def test_fem_validation_without_mpirun_keeps_the_mpi_target_as_not_run():
     was dropped from the targets, so nothing said the check had not run)."""
     from roughfe.validation import is_skipped
     bem_vs_fem = _script("bem_vs_fem")
-    west = {"max_width_error_fem": 1e-3, "max_width_error_bem": 1e-3, "n_nodes": 129}
+    west = {"max_width_error_fem": 1e-3, "max_width_error_bem": 1e-3, "n_nodes": 129,
+            "mean_gap_error_fem": 1e-3, "mean_gap_error_bem": 1e-5, "stiffness_error_fem": 1e-3,
+            "stiffness_error_bem": 1e-3, "pressure_fem_over_bem": [4e-4, 5e-4]}
     rows = bem_vs_fem.target_rows(west, {}, {"ok": None, "note": "mpirun not found"})
     assert [r.name for r in rows if is_skipped(r)] == [
         "FEM-VI: 2 MPI ranks vs serial (p, A*, K): not run"]
@@ -207,7 +209,9 @@ def test_the_database_cost_row_is_reported_not_met():
                         "td_last_K_deviation": 0.0, "td_last_A_deviation": 0.0}},
         designs=[], db_info={"n_nodes": 16, "cpu_per_genome_s": float("nan"), "computed": 0},
         x3p={"window": {"series_deviation_max": 0.01, "K_range": [1.0, 2.0],
-                        "compliance_m_per_Pa": 1e-9}})
+                        "compliance_m_per_Pa": 1e-9}},
+        west={"wave": [2, 1], "n": 256, "eta": 2.0, "one_minus_s_K": 5e-4,
+              "one_minus_s_A": 0.04})
     cost = [r for r in rows if r.name.startswith("surface database cost per genome")]
     assert len(cost) == 1 and cost[0].met is None and not is_skipped(cost[0])
     assert "reported, not a target" in cost[0].reason
@@ -229,7 +233,9 @@ def test_the_sum_of_all_bands_row_can_fail():
             mech=mech, designs=[], db_info={"n_nodes": 16, "cpu_per_genome_s": 1.0,
                                             "computed": 0},
             x3p={"window": {"series_deviation_max": 0.01, "K_range": [1.0, 2.0],
-                            "compliance_m_per_Pa": 1e-9}})
+                            "compliance_m_per_Pa": 1e-9}},
+            west={"wave": [2, 1], "n": 256, "eta": 2.0, "one_minus_s_K": 5e-4,
+                  "one_minus_s_A": 0.04})
         return next(r for r in rows if r.name.startswith("measured files: TD sum"))
     honest = (1.0 - 1.1e-16, 3.2e-10)          # x3p-2 at 47^2, 8 steps (measured)
     assert row(honest, honest).met
@@ -304,7 +310,10 @@ def test_the_mpi_row_needs_two_ranks(monkeypatch):
     two = bem_vs_fem.mpi_case()
     assert two["ok"] is True and two["max_rel_diff"] == 0.0
     row = bem_vs_fem.target_rows({"max_width_error_fem": 1e-3, "max_width_error_bem": 1e-3,
-                                  "n_nodes": 129}, {}, single)[-1]
+                                  "n_nodes": 129, "mean_gap_error_fem": 1e-3,
+                                  "mean_gap_error_bem": 1e-5, "stiffness_error_fem": 1e-3,
+                                  "stiffness_error_bem": 1e-3,
+                                  "pressure_fem_over_bem": [4e-4, 5e-4]}, {}, single)[-1]
     assert row.met is False and "not a parallel run" in row.reason
 
 

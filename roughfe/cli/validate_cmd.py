@@ -58,7 +58,7 @@ VALIDATIONS = {
     "surface-genomics": ("surface_genomics",),
 }
 #: scripts without a reduced case, left out of ``--quick``
-NOT_QUICK = {"fem_convergence", "adhesion_maugis",
+NOT_QUICK = {"fem_convergence",
              "surface_genomics"}   # its reduced case takes ~30 s CPU, over the 30 s budget
 
 
