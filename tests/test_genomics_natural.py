@@ -12,6 +12,7 @@ from roughfe.errors import InputError
 from roughfe.genomics.chromosomes import reduced_chromosome
 from roughfe.genomics.genome import realize, table1_genome
 from roughfe.genomics.natural import measured_row, nested_acquisitions, sequence_measured
+from roughfe.genomics.sequencing import variance_amplitude
 from roughfe.surfaces.surface import Surface
 
 
@@ -43,6 +44,17 @@ def test_a_realised_table1_profile_is_sequenced_back_by_the_natural_path(seed):
     np.testing.assert_allclose(seq.amplitudes, true, rtol=1e-7)
     assert abs(seq.genome.H - g.H) < 3 * seq.H_stderr
     assert abs(math.log(seq.genome.A / g.A)) < 3 * seq.lnA_stderr
+    # the row's line is fitted back within its bound, far inside it (a WM row)
+    assert "at its bound" not in res.message
+    # A0 (Eq. 3.13) of the coarsest window as given, the yardstick of the misfits; it was
+    # taken of the heights less the fitted tilt, i.e. with the row's line put back, which
+    # is no data (round 2, session 33)
+    n0 = np.arange(seq.ranges[0][0], seq.ranges[0][1] + 1)
+    given = variance_amplitude(res.acquisitions[0].heights, n0, seq.genome.gamma,
+                               seq.genome.lambda1, seq.genome.H)
+    assert seq.A0 == pytest.approx(given, rel=1e-12, abs=0)
+    assert seq.A0 < variance_amplitude(seq.heights[0], n0, seq.genome.gamma,
+                                       seq.genome.lambda1, seq.genome.H)
 
 
 def test_the_row_and_axis_pick_the_line():

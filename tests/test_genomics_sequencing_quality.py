@@ -1,6 +1,7 @@
 """The quality check of profile sequencing (round 2, session 32): misfits against the data
 as given, and nodes held out of the fit (roughfe.genomics.sequencing.holdout) to tell a
 genome from an overfit."""
+import dataclasses
 import math
 import re
 
@@ -12,7 +13,8 @@ from roughfe.genomics.sequencing import sequence_profiles
 from roughfe.genomics.sequencing.acquisitions import acquisitions_from_surfaces
 from roughfe.genomics.sequencing.holdout import (HOLD_OUT_FOLDS, held_out_errors,
                                                  position_folds)
-from roughfe.genomics.sequencing.lattice import design_matrix, lattice_ranges, solve_linear
+from roughfe.genomics.sequencing.lattice import (design_matrix, lattice_ranges, solve_linear,
+                                                 solve_model, tilt_bound)
 
 
 def _stacked(acqs):
@@ -83,12 +85,59 @@ def _row(topographies_dir, name):
     return acq, sequence_profiles(acq, windows=True)
 
 
+def _line_within_its_bound(acq, res, old_tilt):
+    """The line shared by the windows of a measured row (round 2, session 33): it traded
+    with the longest chromosomes (``old_tilt`` m/m before); now at most its bound, a rise
+    of 13.1 times the largest height over half the row, and a fit that needs it there is
+    no genome."""
+    bound = tilt_bound(acquisitions_from_surfaces(acq, True))
+    assert bound < 0.02 * abs(old_tilt)
+    assert np.all(res.tilts == res.tilts[0]) and abs(res.tilts[0]) <= bound * (1 + 1e-12)
+    assert ("the line shared by the windows is at its bound" in res.message) == \
+        (abs(res.tilts[0]) >= bound * (1 - 1e-9))
+
+
+def test_the_shared_tilt_is_the_least_squares_within_its_bound():
+    """The windows of one row share the line the row lost. On a lattice of many long
+    chromosomes (gamma 1.2, 1.1) a line is nearly in their span and the free fit of a
+    white-noise row put it at 3e7 and 7e6 times its bound (tilt_bound), the chromosomes
+    cancelling it. The fit keeps the free tilt where it is within the bound (gamma 1.5)
+    and is otherwise the least misfit of every tilt allowed: the bound."""
+    from roughfe.genomics.natural import nested_acquisitions
+    from roughfe.surfaces.surface import Surface
+    row = Surface(np.random.default_rng(0).standard_normal(256) * 1e-8, 1e-3, periodic=False)
+    acqs = acquisitions_from_surfaces(nested_acquisitions(row, n_nodes=256), True)
+    weights, rhs = _stacked(acqs)
+    bound = tilt_bound(acqs)
+    assert bound == pytest.approx(13.1 * max(np.abs(a.z - a.z.mean()).max() for a in acqs)
+                                  / (acqs[0].length / 2), rel=1e-12, abs=0)
+    lq1 = math.log(2 * math.pi / (1.2 * acqs[0].length))
+    for gamma, free_within in ((1.5, True), (1.2, False), (1.1, False)):
+        _, mat = design_matrix(lq1, math.log(gamma), acqs,
+                               lattice_ranges(lq1, math.log(gamma), acqs), weights)
+        free, fit = solve_linear(mat, rhs), solve_model(mat, rhs, acqs)
+        assert bool(abs(free[-1]) <= bound) is free_within
+        cost = float(np.sum((rhs - mat @ fit) ** 2))
+        if free_within:
+            np.testing.assert_allclose(fit, free, rtol=1e-9, atol=1e-9 * np.abs(free).max())
+            continue
+        assert abs(free[-1]) > 1e6 * bound and fit[-1] == pytest.approx(np.sign(free[-1]) * bound, rel=1e-12, abs=0)
+        # every allowed tilt, the other unknowns refitted: none fits better (the misfit
+        # of these near-singular fits, cond ~1e16, is reproducible to ~1e-7 only)
+        for t in np.linspace(-bound, bound, 21):
+            rest = solve_linear(mat[:, :-1], rhs - t * mat[:, -1])
+            assert cost <= float(np.sum((rhs - mat @ np.append(rest, t)) ** 2)) * (1 + 1e-6)
+    # acquisitions that are not windows of one row share no line: nothing is bounded
+    assert tilt_bound([dataclasses.replace(a, window=False) for a in acqs]) == math.inf
+
+
 def test_misfits_are_measured_against_the_data_as_given(topographies_dir):
     """plu-1's central row (--nodes 128) was "sequenced" with rms errors 1e-4..5e-4,
     H = 2.05: relative to its heights less the fitted tilt (0.18 m/m, traded against
     chromosomes of 2.2e-4 m; 6.5e-5 m rms on a row of 1.8e-8 m rms). Against the data
     the misfit is 0.37, and the amplitudes are 4000 times its heights."""
     acq, res = _row(topographies_dir, "plu-1.plu")
+    _line_within_its_bound(acq, res, 0.105)
     for a, h, fit, off, tilt, e in zip(acq, res.heights, res.fitted, res.offsets, res.tilts,
                                        res.rms_errors):
         x = a.metadata["x0"] + np.arange(a.shape[0]) * a.spacing[0]
@@ -107,6 +156,7 @@ def test_di1_row_is_an_overfit_of_its_held_out_nodes(topographies_dir):
     the row's finest chromosome) on windows of 85-103 nodes; the nodes held out of the
     fit are missed by 15 % (12 %) on the coarsest window: an overfit."""
     acq, res = _row(topographies_dir, "di-1.di")
+    _line_within_its_bound(acq, res, 4.8e5)
     assert not res.success
     assert np.all(res.rms_errors < 0.05), res.rms_errors
     assert res.held_out_errors[0] > 0.05 > res.rms_errors[0]

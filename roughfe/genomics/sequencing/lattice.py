@@ -11,6 +11,15 @@ from scipy.optimize import least_squares
 
 from ..genome import chromosome_range
 
+#: a chromosome amplitude this many times the largest height of the acquisitions is a fit
+#: of waves that cancel (an overfit), not a genome (WM fits stay below 1); the shared
+#: line of the windows of one row is bounded by the same factor (:func:`tilt_bound`)
+OVERFIT_FACTOR = 10.0
+#: the largest rise, over half a window of length L, of the least-squares line of one
+#: wave c [cos(theta) - cos(q x + theta)] per unit amplitude c: 3 (sin a - a cos a) / a^2
+#: at a = q L / 2 = 2.0816 (theta = pi / 2), 1.3085, rounded up
+LINE_PER_AMPLITUDE = 1.31
+
 
 def comb_periods(log_q, weights=None, gamma_range=(1.05, 4.0), n_grid=6000, n_best=3):
     """Candidate ln(gamma): periods T of a comb fitted to the peak abscissae ln q (Eq. 3.6).
@@ -177,9 +186,20 @@ def tilt_columns(acqs) -> list:
     """The tilt unknown of each acquisition (0, 1, ... after the offsets), or -1 for none:
     one for each levelled acquisition (:attr:`.acquisitions.Acquisition.levelled`), or
     one *shared* by windows of one row (:attr:`.acquisitions.Acquisition.window`: the
-    row lost one line, its least-squares one, before it was cut into windows; a realised
-    Table 1 profile misfit its windows by 6e-7 without it). The shared tilt is set by the
-    full row, not by each short window (the free tilts of session 29)."""
+    row lost one line, its least-squares one, before it was cut into windows). The shared
+    tilt is set by the full row, not by each short window (the free tilts of session 29),
+    and bounded (:func:`tilt_bound`, :func:`solve_model`).
+
+    Without it a realised Table 1 row (256 samples, seeds 0 and 1) came back as
+    gamma^(1/3), exact (a finer lattice makes the line of its long chromosomes), and as
+    gamma 1.22 with a misfit of 1.5e-8 (measured in round 2, session 33): removing the
+    row's line once and fitting none is no exact model of a levelled row. Unbounded, it
+    reached 3e3-5e5 m/m on measured rows (di-1, x3p-2, opd-1, ``--nodes 128``): a line
+    lies nearly in the span of the long chromosomes of the fine lattices these fits end
+    on (gamma 1.17-1.19: the design is singular to cond 1e16-1e17 with or without it),
+    so the fit traded it against them. A model levelled as the data were (each
+    chromosome column less its least-squares line over the row, no tilt unknown) is the
+    same model, as ill-conditioned (cond 8.5e16 against 9.3e16, di-1)."""
     if acqs and all(a.window for a in acqs):
         return [0] * len(acqs)
     return list(np.cumsum([bool(a.levelled) for a in acqs]) * [bool(a.levelled) for a in acqs] - 1)
@@ -206,7 +226,8 @@ def design_matrix(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
     fitted only where the data say a line was removed (its own least-squares line is zero
     to round-off): a free tilt on every acquisition is nearly collinear with the longest
     chromosome's sine over a window shorter than its wavelength, and on measured rows
-    (``genome natural``) it traded them into waves of 1e4 x the heights. Returns
+    (``genome natural``) it traded them into waves of 1e4 x the heights. The tilt shared
+    by the windows of one row is solved within its bound by :func:`solve_model`. Returns
     (n, matrix); the last :func:`line_columns` unknowns are the offsets, then the tilts."""
     lo = min(r[0] for r in ranges)
     hi = max(r[1] for r in ranges) if n_cap is None else min(n_cap, max(r[1] for r in ranges))
@@ -232,12 +253,54 @@ def solve_linear(mat, rhs):
     scale[scale == 0] = 1.0
     coef, *_ = scipy_lstsq(mat / scale, rhs, cond=1e-12, lapack_driver="gelsy",
                            check_finite=False)   # pivoted QR: ~3x faster than SVD here
-    return coef / scale
+    return coef / (scale if coef.ndim == 1 else scale[:, None])
+
+
+def tilt_bound(acqs) -> float:
+    """Largest |tilt| (m/m) of the line shared by the windows of one row
+    (:func:`tilt_columns`): the steepest line one chromosome of the largest amplitude
+    the amplitude guard of :func:`~.profile.sequence_profiles` admits
+    (:data:`OVERFIT_FACTOR` times the largest height of the acquisitions as given, about
+    their means) can carry over the coarsest window, whose rise over half of it is at
+    most :data:`LINE_PER_AMPLITUDE` times that amplitude; inf for other acquisitions.
+
+    A WM row's own line stays far inside it: at most 3.9 times the largest height (the
+    bound: 13.1) on 2700 realised rows (Table 1 and random genomes, gamma 1.1-2.5, N
+    128-512, three lengths; measured in round 2, session 33). Exact WM data are
+    therefore fitted as without the bound; a fit that needs the line at it is trading
+    it against waves that cancel (reported as not a genome)."""
+    if not (acqs and all(a.window for a in acqs)):
+        return math.inf
+    z_scale = max(float(np.max(np.abs(a.z - a.z.mean()))) for a in acqs)
+    return LINE_PER_AMPLITUDE * OVERFIT_FACTOR * z_scale / (0.5 * acqs[0].length)
+
+
+def solve_model(mat, rhs, acqs, solver=solve_linear):
+    """The coefficients of :func:`design_matrix` (columns ``mat``, weighted heights
+    ``rhs``) by least squares (``solver``), the shared tilt of the windows of one row
+    (its last column) within :func:`tilt_bound`.
+
+    The other columns R are solved for two right-hand sides at once (one factorisation):
+    R x1 = rhs and R x2 = t-column, so that the misfit at a tilt t is |r1 - t r2|^2
+    (r1, r2 their residuals), a convex quadratic least at t = r1.r2 / r2.r2 (the free
+    fit); the tilt is that value clipped to the bound (the exact bounded least squares
+    for one bounded unknown; 0 when the tilt column lies in the span of the others), the
+    rest x1 - t x2."""
+    bound = tilt_bound(acqs)
+    if not math.isfinite(bound):
+        return solver(mat, rhs)
+    rest, col = mat[:, :-1], mat[:, -1]
+    x = solver(rest, np.column_stack([rhs, col]))
+    r1, r2 = rhs - rest @ x[:, 0], col - rest @ x[:, 1]
+    d = float(r2 @ r2)
+    tilt = float(r1 @ r2) / d if d > 0 else 0.0
+    tilt = min(max(tilt, -bound), bound) if math.isfinite(tilt) else tilt
+    return np.append(x[:, 0] - tilt * x[:, 1], tilt)
 
 
 def vp_residual(params, acqs, ranges, weights, rhs, n_cap):
     n, mat = design_matrix(params[0], params[1], acqs, ranges, weights, n_cap)
-    coef = solve_linear(mat, rhs)
+    coef = solve_model(mat, rhs, acqs)
     return rhs - mat @ coef
 
 
@@ -250,19 +313,27 @@ def _first_cap(log_q1, log_gamma, lo, hi, coarse_length, cycles=30.0):
     return min(cap, hi)
 
 
-def _projected_cost(mat, rhs):
-    """||rhs - P rhs||^2 by the normal equations (fast; accurate enough to rank a grid)."""
+def _normal_solve(mat, rhs):
+    """Least squares by the normal equations (fast; accurate enough to rank a grid);
+    NaN coefficients when the Gram matrix is singular."""
     scale = np.linalg.norm(mat, axis=0)
     scale[scale == 0] = 1.0
     a = mat / scale
     gram = a.T @ a
-    b = a.T @ rhs
     gram[np.diag_indices_from(gram)] += 1e-10 * max(float(np.trace(gram)) / gram.shape[0], 1e-300)
     try:
-        c = np.linalg.solve(gram, b)
+        coef = np.linalg.solve(gram, a.T @ rhs)
     except np.linalg.LinAlgError:
-        return float("inf")
-    return float(rhs @ rhs - b @ c)
+        return np.full((mat.shape[1],) + rhs.shape[1:], np.nan)
+    return coef / (scale if coef.ndim == 1 else scale[:, None])
+
+
+def _projected_cost(mat, rhs, acqs):
+    """||rhs - mat c||^2 of the normal-equation fit (:func:`solve_model`); inf when
+    singular."""
+    r = rhs - mat @ solve_model(mat, rhs, acqs, _normal_solve)
+    cost = float(r @ r)
+    return cost if math.isfinite(cost) else float("inf")
 
 
 def _scan(p, cap, acqs, ranges, weights, rhs, span=(0.015, 0.03), shape=(31, 13)):
@@ -280,7 +351,7 @@ def _scan(p, cap, acqs, ranges, weights, rhs, span=(0.015, 0.03), shape=(31, 13)
             if cand[1] <= 0:
                 continue
             _, mat = design_matrix(cand[0], cand[1], acqs, ranges, weights, cap)
-            c = _projected_cost(mat, rhs)
+            c = _projected_cost(mat, rhs, acqs)
             if c < best[0]:
                 best = (c, cand)
     return best[1], shape[0] * shape[1]

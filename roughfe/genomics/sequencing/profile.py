@@ -16,17 +16,15 @@ from .acquisitions import Acquisition, acquisitions_from_surfaces, check_control
 from .genes import (H_SEARCH, M_VALUES, amplitude_gene_errors, amplitude_genes,
                     peak_slope_H, phases_with_sums, ridge_support,
                     ridge_likelihood, variance_amplitude)
-from .lattice import (bic, coarser_lattices, comb_periods, design_matrix, fit_lattice, label_q1, tilt_columns,
-                      lattice_from_period, line_columns, lattice_ranges, round_off_cost, solve_linear,
-                      vp_residual)
-from .holdout import HOLD_OUT_FOLDS, held_out_errors
+from .lattice import (LINE_PER_AMPLITUDE, OVERFIT_FACTOR, bic, coarser_lattices, comb_periods,
+                      design_matrix, fit_lattice, label_q1, lattice_from_period,
+                      lattice_ranges, line_columns, round_off_cost, solve_model, tilt_bound,
+                      tilt_columns, vp_residual)
+from .holdout import held_out_errors, overfit_reason
 from .peaks import spectrum_peaks
 from .result import SequencingResult
 
 
-#: a chromosome amplitude this many times the largest height of the acquisitions is a fit
-#: of waves that cancel (an overfit), not a genome (WM fits stay below 1)
-OVERFIT_FACTOR = 10.0
 #: largest k of the coarser lattices gamma^k tried on a fit within the tolerance
 #: (:func:`_settle`): 1.05^24 = 3.2, so every sub-lattice down to the comb's lowest
 #: candidate (1.05) of a lattice up to 3.2 is covered, in at most 299 linear solves
@@ -197,7 +195,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         lq1, lg = pol.x
     gamma, lam1 = math.exp(lg), 2 * math.pi / math.exp(lq1)
     n, mat = design_matrix(lq1, lg, acqs, ranges, weights)
-    coef = solve_linear(mat, rhs)
+    coef = solve_model(mat, rhs, acqs)
     cvec = coef[0:2 * n.size:2] + 1j * coef[1:2 * n.size:2]
     # the acquisitions' height offsets (their heights at x = 0 off the genome's zero) and
     # tilts (the line a levelled profile lost)
@@ -273,13 +271,13 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     if float(np.max(amps)) > OVERFIT_FACTOR * z_scale:
         reasons.append(f"chromosome amplitudes up to {float(np.max(amps)):.3g} m on "
                        f"acquisitions of at most {z_scale:.3g} m (waves that cancel: an overfit)")
+    if tilts.size and abs(tilts[0]) >= (1 - 1e-9) * tilt_bound(given):
+        reasons.append(f"the line shared by the windows is at its bound, {tilts[0]:.3g} m/m "
+                       f"(rising over half the row by {LINE_PER_AMPLITUDE * OVERFIT_FACTOR:.3g} "
+                       f"times the largest height: the longest chromosomes trade with it)")
     if ok and float(np.max(held_out)) > rms_tolerance:
-        i = int(np.argmax(held_out))
-        reasons.append(
-            f"an overfit: {2 * (ranges[i][1] - ranges[i][0] + 1)} chromosome unknowns on "
-            f"{given[i].z.size} nodes (acquisition {i + 1}); its nodes held out of the fit "
-            f"({HOLD_OUT_FOLDS} folds by position) are missed by {held_out[i]:.3g} "
-            f"(relative rms), the fitted ones by {rms[i]:.3g}")
+        reasons.append(overfit_reason(held_out, rms, [2 * (r[1] - r[0] + 1) for r in ranges],
+                                      [g.z.size for g in given]))
     if reasons:
         ok = False
         messages.insert(0, "not a genome: " + "; ".join(reasons))
@@ -296,5 +294,5 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         M_loglik=loglik, M_support=ridge_support(loglik, m_values),
         lnA_stderr=errors[0], H_stderr=errors[1], offsets=offsets, tilts=tilts,
         held_out_errors=held_out,
-        A0=variance_amplitude(acqs[0].z, np.arange(ranges[0][0], ranges[0][1] + 1), gamma, lam1, H),
+        A0=variance_amplitude(given[0].z, np.arange(ranges[0][0], ranges[0][1] + 1), gamma, lam1, H),
         seed=int(seed), elapsed=time.perf_counter() - t0)

@@ -78,7 +78,9 @@ class SequencingResult:
         e.g. the mean a mean-removed profile lost; ``heights`` are the data less it.
     tilts : ndarray
         Slope of each acquisition's fitted line (m/m, coarsest first): the line a
-        levelled profile lost (``heights`` are the data less it too; round 2, session 29).
+        levelled profile lost (``heights`` are the data less it too; round 2, session 29);
+        for the windows of one row one shared tilt within
+        :func:`~.lattice.tilt_bound` (round 2, session 33).
     lnA_stderr, H_stderr : float
         Standard errors (1 sigma) of ln A and H from the Fisher information of their
         likelihood (:func:`~.genes.amplitude_gene_errors`; NaN when not computed).
@@ -86,8 +88,11 @@ class SequencingResult:
         The range of M within 1.92 of the best log-likelihood (about 95 %,
         :func:`~.genes.ridge_support`): M is weakly identifiable.
     A0 : float
-        Amplitude from the height variance of the coarsest acquisition (Eq. 3.13), for
-        comparison with the maximum-likelihood A.
+        Amplitude from the height variance of the coarsest acquisition as given (Eq.
+        3.13), for comparison with the maximum-likelihood A. The fitted offset and tilt
+        are unknowns of the model, not data: they are not put back (until round 2,
+        session 33 the variance was of the heights less the fitted tilt, on measured
+        rows a line of 3e3-5e5 m/m: A0 up to 9e13).
     seed : int or None
     elapsed : float
         Wall time (s).

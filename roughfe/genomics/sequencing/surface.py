@@ -79,8 +79,9 @@ from .lattice import (bic, coarser_lattices, comb_periods, label_q1, lattice_fro
 from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, noise_variance,
                            surface_acquisitions, surface_peaks)
 from .surface_grid import GridModel
+from .holdout import overfit_reason
 from .surface_result import (SurfaceSequencingResult, failure, genes_from_fit,
-                             genome_residual, plane_free_misfits)
+                             genome_residual, held_out_misfits, plane_free_misfits)
 
 
 #: nodes (over all acquisitions) used by the nonlinear fit; the final solve uses every node
@@ -447,8 +448,17 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
            f"amplitude: {', '.join(f'{e:.3g}' for e in fit_errs)})")
     if not ok:
         msg += f" > {rms_tolerance:g}: not reproduced (the surface is not WM-like or noisy)"
+    # a small misfit is no genome when the waves reproduce any heights: the nodes held
+    # out of the fit (:mod:`.holdout`) are then missed by far more than the fitted ones
+    held_out = held_out_misfits(model, p, ranges)
+    if ok and float(np.max(held_out)) > rms_tolerance:
+        ok = False
+        waves = [2 * int(np.sum((sol["nn"] >= ns) & (sol["nn"] <= nf))) for ns, nf in ranges]
+        msg = ("not a genome: " + overfit_reason(held_out, fit_errs, waves,
+                                                 np.bincount(model.block), "wave")
+               + "; " + msg)
     return SurfaceSequencingResult(
         genome=genome, success=ok, message=msg, nit=nit, ranges=[tuple(r) for r in ranges],
         lengths=np.array([a.length for a in acqs]), rms_errors=errs,
         amplitudes=g["amplitudes"], peaks=peaks, elapsed=time.perf_counter() - t0,
-        signal_rms=signal, fit_rms_errors=fit_errs)
+        signal_rms=signal, fit_rms_errors=fit_errs, held_out_errors=held_out)

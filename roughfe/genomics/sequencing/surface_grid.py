@@ -100,8 +100,9 @@ class GridModel:
         """Re(sum_b c_b F_b) on the grid for weights c (..., W + 3): (..., N, N)."""
         return ((fx * weights[..., None, :]) @ fy.T).real
 
-    def _gram(self, k, fx, fy, n_waves, n_cols):
-        """Real Gram matrix A_k^T A_k over the valid nodes of acquisition k."""
+    def _gram(self, k, fx, fy, n_waves, n_cols, bad=None):
+        """Real Gram matrix A_k^T A_k over the valid nodes of acquisition k (those not in
+        ``bad``, the (x, y) indices of the nodes left out; default the undefined ones)."""
         sp = (fx.T @ fx) * (fy.T @ fy)                      # sum e_a e_b
         sm = (fx.conj().T @ fx) * (fy.conj().T @ fy)        # sum conj(e_a) e_b
         w = n_waves
@@ -114,14 +115,27 @@ class GridModel:
         cross = 0.5 * (sp + sm).imag[fi, :w]                      # sum Re(F_a) Im(e_b)
         gram[np.ix_(re, im)] = cross
         gram[np.ix_(im, re)] = cross.T
-        bx, by = self.grids[k]["bad"]
+        bx, by = self.grids[k]["bad"] if bad is None else bad
         if bx.size:
             rows = self._real(k, fx[bx] * fy[by], w, n_cols)
             gram -= rows.T @ rows
         return gram
 
-    def solve(self, p, ranges, cap=None, exact=False):
-        """Linear least squares for the wave and plane coefficients at the lattice ``p``.
+    def _kept(self, keep):
+        """The grids with only the rows ``keep`` (bool per row, in the order of :attr:`z`)
+        valid: the others are left out as undefined nodes are."""
+        out = []
+        for k, g in enumerate(self.grids):
+            ok = g["ok"].copy()
+            ok[ok] = keep[self.block == k]
+            out.append(dict(g, ok=ok, z0=np.where(ok, g["z0"], 0.0), bad=np.nonzero(~ok)))
+        return out
+
+    def solve(self, p, ranges, cap=None, exact=False, keep=None):
+        """Linear least squares for the wave and plane coefficients at the lattice ``p``
+        (fitted to the rows ``keep`` only when given: bool per row, the others left out
+        as undefined nodes are, for the held-out nodes of :mod:`.holdout`; ``resid`` is
+        then over the kept rows).
 
         Normal equations with a Cholesky factor of the column-scaled Gram matrix (plane
         waves of distinct wavevectors are nearly orthogonal, so it is well conditioned; a
@@ -137,7 +151,9 @@ class GridModel:
         n_cols = 2 * w + 3 * len(self.acqs)
         fac = [self._factors(k, q, theta_w, (nn >= ns) & (nn <= nf))
                for k, (ns, nf) in enumerate(ranges)]
-        gram = sum(self._gram(k, fx, fy, w, n_cols) for k, (fx, fy) in enumerate(fac))
+        grids = self.grids if keep is None else self._kept(keep)
+        gram = sum(self._gram(k, fx, fy, w, n_cols, grids[k]["bad"])
+                   for k, (fx, fy) in enumerate(fac))
         norm = np.sqrt(np.clip(np.diag(gram), 0.0, None))    # round-off: undefined nodes
         norm[norm == 0] = 1.0
         gram = gram / np.outer(norm, norm)
@@ -152,16 +168,24 @@ class GridModel:
 
         def residual(coef):
             return [np.where(g["ok"], g["z0"] - self._evaluate(fx, fy, self._weights(k, coef, w)),
-                             0.0) for k, (g, (fx, fy)) in enumerate(zip(self.grids, fac))]
+                             0.0) for k, (g, (fx, fy)) in enumerate(zip(grids, fac))]
 
-        coef = lsq([g["z0"] for g in self.grids])
+        coef = lsq([g["z0"] for g in grids])
         res = residual(coef)
         for _ in range(2 if exact else 1):
             coef = coef + lsq(res)
             res = residual(coef)
-        resid = np.concatenate([r[g["ok"]] for r, g in zip(res, self.grids)])
+        resid = np.concatenate([r[g["ok"]] for r, g in zip(res, grids)])
         return dict(nn=nn, mm=mm, q=q, theta_w=theta_w, coef=coef, resid=resid, fac=fac,
                     lsq=lsq, gram=gram * np.outer(norm, norm))
+
+    def node_coordinates(self):
+        """(x, y) of every row (valid node, in the order of :attr:`z`), m: (rows, 2)."""
+        out = []
+        for g in self.grids:
+            ix, iy = np.nonzero(g["ok"])
+            out.append(np.column_stack([g["x"][ix], g["y"][iy]]))
+        return np.vstack(out)
 
     def heights(self, p, ranges, coef):
         """The model's heights (waves and planes) for the coefficients ``coef`` (real
