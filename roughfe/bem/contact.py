@@ -138,8 +138,12 @@ def _choose_kernel(surface: Surface, kernel: str) -> str:
 def _choose_solver(n_points: int, op: InfluenceOperator, solver: str,
                    bounded: bool = False) -> str:
     if check_solver_name(solver) == "auto":
-        if bounded:   # the dense bounded path is BVLS, which needs a definite operator
-            return "nnls" if n_points <= DENSE_MAX_POINTS and not op.periodic else "pk"
+        if bounded:
+            # the dense bounded path (BVLS) is the slower one at every size measured: a
+            # 10-load cycle on 64 / 512-point profiles and a 22^2 patch took 0.09 / 16.6 /
+            # 11.3 s against pk's 0.06 / 0.07 / 0.15 s, the same states (pressures within
+            # 1e-8 H_p; round 2, session 33). DENSE_MAX_POINTS was measured for pivoting
+            return "pk"
         return "dense" if n_points <= DENSE_MAX_POINTS else "pk"
     if bounded and solver == "dense":
         raise InputError("solver 'dense' (block principal pivoting) has no hardness bound; "
@@ -275,7 +279,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         "dense": block principal pivoting on the dense matrix (warm-startable);
         "nnls": Bemporad & Paggi's Cholesky + scipy NNLS (non-periodic kernels);
         "pk": matrix-free Polonsky-Keer CG with FFT products. "auto": dense up to
-        ``DENSE_MAX_POINTS`` points, pk above.
+        ``DENSE_MAX_POINTS`` points, pk above; pk at every size with a ``hardness``.
     tol : float
         Relative KKT residual to reach.
     max_iter : int, optional
@@ -289,7 +293,8 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
         Indentation hardness H_p (Pa), finite and > 0: the pressure cap of a perfectly
         plastic interface. Points at p = H_p flow: there the rigid surface
         interpenetrates the elastic one by the plastic (permanent) displacement. The
-        dense path is bounded least squares (``solver="nnls"``, non-periodic kernels).
+        dense path, on request, is bounded least squares (``solver="nnls"``, non-periodic
+        kernels; 30-250x slower than pk from 512 points or a 22^2 patch up).
         A periodic surface in displacement control is solved by the bounded
         Polonsky-Keer CG on ``0 <= p <= H_p`` directly: the box makes that problem well
         posed (the minimum of 1/2 p.Hp - p.(b + Delta) over a compact set; the mean

@@ -367,7 +367,8 @@ def contact_document(sweep, surface, material, inputs: dict, *, adhesive=False) 
                                      "shape": list(surface.shape),
                                      "size": list(surface.size),
                                      "periodic": surface.periodic, **inputs})
-    theory = beside(surface, material.E_star, doc["steps"], adhesive=adhesive)
+    theory = beside(surface, material.E_star, doc["steps"], adhesive=adhesive,
+                    hardness=inputs.get("hardness"))
     doc["steps"], doc["derived"]["persson"] = theory["steps"], theory["persson"]
     return doc
 

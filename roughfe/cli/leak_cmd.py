@@ -361,7 +361,7 @@ def _leak_run(args, surface, material, out):
     check_solution(args, surface, sweep.contacts, material)
     theory = beside(surface, material.E_star, sweep.records(), pressure_drop=dp,
                     viscosity=args.mu, direction=args.direction,
-                    adhesive=physics["adhesion"] is not None)
+                    adhesive=physics["adhesion"] is not None, hardness=physics["hardness"])
     steps = theory["steps"]
     inputs = {**base, "reynolds": not args.no_reynolds,
               "references": list(sweep.leakages[0].references)}

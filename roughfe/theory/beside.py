@@ -11,7 +11,10 @@ of the adhesive contact, and ``beside(..., adhesive=True)`` evaluates none
 It is elastic as well: a step with plastic flow (a hardness run, ``plastic_area_fraction``
 > 0) and every step after it, on a surface recessed by the plastic displacement (the
 unloading branch), are not the elastic contact of the surface's PSD, so those steps get
-None and ``"persson"`` says why (:data:`NOT_PLASTIC`).
+None and ``"persson"`` says why (:data:`NOT_PLASTIC`). Given the run's ``hardness``, the
+steps of the first loading get Persson's elastoplastic areas instead
+(:mod:`roughfe.theory.plastic`: the real and the plastic area fraction, measured against
+the BEM in docs/theory/07_adhesion_persson.md).
 
 It is the theory of a random surface of many asperities: on one smooth cap (a sphere,
 :func:`roughfe.theory.asperity.single_asperity`) no step gets it, the elastic steps get
@@ -35,6 +38,7 @@ from .asperity import NOT_RANDOM, beside_hertz, single_asperity
 from .asperity import REFERENCES as ASPERITY_REFERENCES
 from .junction import _geometry_factor, critical_junction
 from .persson import GAMMA_DEFAULT, PERCOLATION_THRESHOLD, REFERENCES, _spectrum, persson
+from .plastic import beside_elastoplastic
 
 #: ``"persson"`` of an adhesive run: no step gets ``persson_*`` keys, and this says why
 NOT_ADHESIVE = {
@@ -53,7 +57,9 @@ NOT_PLASTIC = {
             "plastic flow (plastic_area_fraction > 0), and every step after it (on the "
             "surface recessed by the plastic displacement, e.g. the unloading branch), "
             "is not the elastic contact of this PSD, so its persson_* values are None "
-            "(docs/theory/07_adhesion_persson.md)",
+            "(with the run's hardness the first loading's steps carry Persson's "
+            "elastoplastic areas, persson_elastoplastic_area_fraction and "
+            "persson_plastic_area_fraction; docs/theory/07_adhesion_persson.md)",
 }
 
 
@@ -97,7 +103,7 @@ UNITS = {"persson_mean_gap": "m", "u0": "m",
 
 
 def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, direction="x",
-           gamma=GAMMA_DEFAULT, adhesive=False) -> dict:
+           gamma=GAMMA_DEFAULT, adhesive=False, hardness=None) -> dict:
     """Persson's theory at the mean pressure of each simulation step (results.json).
 
     Parameters
@@ -122,6 +128,11 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         evaluated; ``"steps"`` are plain copies and ``"persson"`` is :data:`NOT_ADHESIVE`.
         So are they, with ``"persson"`` :data:`NOT_EVALUATED`, for a non-periodic surface
         with fewer than 3 points on a side (no Hann-windowed PSD).
+    hardness : float, optional
+        H (Pa) of a run with a perfectly plastic interface: every step also gets Persson's
+        elastoplastic areas (:func:`roughfe.theory.plastic.beside_elastoplastic`:
+        ``persson_elastoplastic_area_fraction``, ``persson_plastic_area_fraction``; None
+        from the first unloading step on) and ``"persson"`` an ``"elastoplastic"`` block.
 
     Returns
     -------
@@ -183,6 +194,11 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         info.update(_texture(source, leak=pressure_drop is not None))
     if any(plastic):
         info.update(NOT_PLASTIC, plastic_steps=[k for k, pl in enumerate(plastic) if pl])
+    if hardness is not None:       # the elastoplastic areas beside the first loading
+        extra, info["elastoplastic"] = beside_elastoplastic(
+            psd, e_star, pressures, [bool(s.get("unloading")) for s in steps], hardness)
+        for rec, more in zip(out, extra):
+            rec.update(more)
     return {"steps": out, "persson": info}
 
 
