@@ -117,6 +117,9 @@ def test_capped_hertz_against_the_axisymmetric_reference(fraction):
     assert b.solver == "pk" and b.pressure.max() == hp
     assert b.delta == pytest.approx(delta, rel=2e-3, abs=0)
     assert b.contact_area == pytest.approx(np.pi * a_ref ** 2, rel=0.04, abs=0)
+    # wider than the elastic contact on the same grid, which carries the load on less
+    el = solve_contact(surf, MAT, mean_pressure=P / L ** 2)
+    assert b.contact_area > 1.02 * el.contact_area and el.pressure.max() > hp
     assert b.plastic_area_fraction * L ** 2 == pytest.approx(np.pi * c_ref ** 2, rel=0.03, abs=0)
     assert b.plastic_displacement.max() == pytest.approx(plastic[0], rel=5e-3, abs=0)
     # inside the plastic disc the pressure is the cap, exactly
@@ -254,17 +257,63 @@ def test_residual_deformation_after_full_unloading_is_the_plastic_displacement()
 
 
 # -- load and displacement control ---------------------------------------------------------
-@pytest.mark.parametrize("hp", [0.3, 0.1])
-def test_non_periodic_displacement_and_load_control_agree(hp):
-    # the same state reached both ways reads the same (measured: Delta 8e-12, pressures
-    # 7e-9 H_p, identical plastic area and stiffness)
-    surf = rough(64, 2, periodic=False)
-    d = 0.4 * float(np.ptp(surf.heights))
+@pytest.mark.parametrize("periodic, frac, hp", [(False, 0.4, 0.3), (False, 0.4, 0.1),
+                                                 (True, 0.3, 0.1), (True, 1.2, 0.1)])
+def test_displacement_and_load_control_agree(periodic, frac, hp):
+    # the same state reached both ways reads the same: the plastic area and the stiffness
+    # (the loading tangent of the points below the cap) included. Measured: Delta 8e-12,
+    # pressures 7e-9 H_p, identical plastic area and K (non-periodic; the approach as a
+    # fraction of max h - min h); periodic (a fraction of max h - mean h, 1.2: beyond the
+    # elastic full contact, A* 0.76 of which 0.756 plastic) identical plastic area and K
+    surf = rough(64, 2 if not periodic else 1, periodic=periodic)
+    h = surf.heights
+    d = frac * float(np.ptp(h) if not periodic else h.max() - h.mean())
     a = solve_contact(surf, UNIT, delta=d, hardness=hp)
     b = solve_contact(surf, UNIT, mean_pressure=a.mean_pressure, hardness=hp)
     _check_bounds(a, hp)
     _check_bounds(b, hp)
-    assert b.delta == pytest.approx(d, rel=1e-9, abs=0)
-    assert np.max(np.abs(a.pressure - b.pressure)) <= 1e-7 * hp
+    assert b.delta == pytest.approx(d, rel=1e-7, abs=0)
+    assert np.max(np.abs(a.pressure - b.pressure)) <= 1e-6 * hp
     assert a.plastic_area_fraction == b.plastic_area_fraction > 0
-    assert a.stiffness == pytest.approx(b.stiffness, rel=1e-8, abs=0)
+    assert a.stiffness == pytest.approx(b.stiffness, rel=1e-6, abs=0)
+
+
+def test_periodic_and_non_periodic_kernels_see_the_same_flow():
+    # an isolated capped sphere (a = L/8): the same contact and plastic area on both
+    # kernels (measured 128^2: areas equal, plastic within 0.8 %); the periodic K is
+    # larger by the images' compliance, as without a cap (1.44 elastic, 1.36-1.40 capped)
+    R, P = 1e-2, 0.1
+    ref = hertz_sphere(R, MAT.E_star, load=P)
+    L = 8 * ref.contact_radius
+    ks = []
+    for hp in (None, 0.5 * ref.peak_pressure):
+        per, npr = (solve_contact(_sphere(64, L, R, periodic)[0], MAT, mean_pressure=P / L ** 2,
+                                  hardness=hp) for periodic in (True, False))
+        assert per.kernel == "spectral" and npr.kernel == "love"
+        assert per.n_contact == npr.n_contact
+        if hp is not None:
+            assert per.plastic_area_fraction == pytest.approx(npr.plastic_area_fraction,
+                                                              rel=0.02, abs=0)
+        ks.append(per.stiffness / npr.stiffness)
+    assert 1.2 < ks[1] < ks[0] < 1.6
+
+
+def test_the_fem_has_no_hardness():
+    # the FEM is the elastic cross-check: a hardness there is refused by name
+    from roughfe.model import Loading
+    from roughfe.response import response
+    from roughfe.surfaces.spectral import spectral_profile
+    prof = spectral_profile(64, 1e-4, 0.8, rms_height=1e-6, rng=1)
+    with pytest.raises(ValueError, match="hardness"):
+        response(prof, MAT, Loading(pressures=[1e6]), method="fem", hardness=1e7)
+
+
+def test_contact_cli_refuses_a_hardness_with_the_fem(tmp_path, capsys):
+    from roughfe.cli import main
+    from roughfe.surfaces.io import save_surface
+    from roughfe.surfaces.spectral import spectral_profile
+    path = save_surface(spectral_profile(64, 1e-4, 0.8, rms_height=1e-6, rng=1),
+                        tmp_path / "p.npz")
+    assert main(["contact", str(path), "--method", "fem", "--pressure", "1e6",
+                 "--hardness", "1e7", "-o", str(tmp_path / "o")]) == 2
+    assert "--hardness" in capsys.readouterr().err
