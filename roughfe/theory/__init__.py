@@ -2,6 +2,8 @@
 
 * :func:`persson` -> :class:`PerssonResult`: Persson's A*(p) and mean separation u(p).
 * :func:`critical_junction` -> :class:`CriticalJunction`: Lorenz & Persson's leak rate.
+* :func:`elastoplastic_area` -> :class:`ElastoplasticArea`: Persson's elastic and plastic
+  area of a perfectly plastic interface of hardness H (:mod:`roughfe.theory.plastic`).
 * :func:`pastewka_robbins` -> :class:`Stickiness`: the stickiness criterion of a rough
   adhesive contact (Pastewka & Robbins 2014); :func:`load_balance` -> :class:`LoadBalance`:
   its load balance with the attractive area measured on a solved non-adhesive contact.
@@ -12,6 +14,7 @@ their consumers, which draw the theory beside their results.
 """
 from .beside import beside
 from .junction import CriticalJunction, critical_junction
+from .plastic import ElastoplasticArea, elastoplastic_area
 from .persson import (GAMMA_DEFAULT, KAPPA_PERSSON, PERCOLATION_THRESHOLD, PerssonResult,
                       area_fraction, mean_separation, persson)
 from .stickiness import LoadBalance, Stickiness, load_balance, pastewka_robbins
@@ -19,4 +22,4 @@ from .stickiness import LoadBalance, Stickiness, load_balance, pastewka_robbins
 __all__ = ["persson", "beside", "PerssonResult", "critical_junction", "CriticalJunction",
            "area_fraction", "mean_separation", "KAPPA_PERSSON", "GAMMA_DEFAULT",
            "PERCOLATION_THRESHOLD", "pastewka_robbins", "Stickiness", "load_balance",
-           "LoadBalance"]
+           "LoadBalance", "elastoplastic_area", "ElastoplasticArea"]

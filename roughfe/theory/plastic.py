@@ -51,7 +51,7 @@ from ..frozen import ReadOnlyArrays, compact_repr, read_only_arrays
 from .persson import _arrays, _pressures, _spectrum
 
 #: s = tau / H^2 below which the image sum is used, above it the sine series (at
-#: s = 0.02 the series needs 14 terms to 1e-17 and the images 3 pairs)
+#: s = 0.02 the series needs 16 terms to 1e-17, the images 7 pairs, k = -3..3)
 IMAGE_BELOW = 0.02
 
 REFERENCES = (
