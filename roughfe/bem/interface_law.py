@@ -98,6 +98,13 @@ class AdhesionLaw:
         if not s < 1.0:
             raise InputError(f"smoothing must be in [0, 1), got {self.smoothing!r}")
         object.__setattr__(self, "smoothing", s)
+        with np.errstate(over="ignore", under="ignore"):   # the process zone takes sigma0^2
+            sigma0 = np.float64(self.work) / np.float64(self.range)
+            if not 0.0 < sigma0 * sigma0 < np.inf:         # (range 1e308: ZeroDivisionError)
+                raise InputError(f"the law's traction w / range = {float(sigma0):.3g} Pa (w = "
+                                 f"{self.work!r} J/m^2, range = {self.range!r} m) is beyond "
+                                 f"the floating-point range: give w in J/m^2 and the range "
+                                 f"in m")
 
     @property
     def max_traction(self) -> float:

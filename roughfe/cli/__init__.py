@@ -152,8 +152,9 @@ def main(argv=None) -> int:
             return int(args.func(args) or 0)
     except RoughfeError as exc:
         message = str(exc)
-    except MemoryError as exc:
-        message = f"not enough memory ({exc or 'allocation failed'})"
+    except MemoryError as exc:   # Python's own MemoryError has no text: say what failed
+        message = (f"not enough memory ({str(exc) or 'an allocation failed'}): an option "
+                   "asks for more than this machine has; lower a grid size or a count")
     except BrokenPipeError:       # the reader of stdout left (`| head`)
         return _reader_left()
     except OSError as exc:

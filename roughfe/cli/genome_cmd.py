@@ -340,8 +340,9 @@ def register(sub):
                    help="seed of the M likelihood and the phase draws")
     p.add_argument("--ridges", type=positive_int, default=None,
                    help="impose M (default: maximum likelihood)")
-    p.add_argument("--tolerance", type=positive_float, default=0.05,
-                   help="relative rms error below which a profile counts as WM-like")
+    p.add_argument("--tolerance", type=unit_fraction, default=0.05,
+                   help="relative rms error below which a profile counts as WM-like, in "
+                        "(0, 1)")
     p.add_argument("--strict", action="store_true", help="exit 1 when the quality check fails")
     add_output_folder(p)
     add_run_options(p)
@@ -384,8 +385,9 @@ def register(sub):
     p.add_argument("--seed", type=nonnegative_int, default=0,
                    help="seed of the M likelihood and phase draws")
     _add_response_options(p, "*", "BEM kernels for A(p), K(p) (none: sequencing only)")
-    p.add_argument("--tolerance", type=positive_float, default=0.05,
-                   help="relative rms error below which a profile counts as WM-like")
+    p.add_argument("--tolerance", type=unit_fraction, default=0.05,
+                   help="relative rms error below which a profile counts as WM-like, in "
+                        "(0, 1)")
     p.add_argument("--strict", action="store_true",
                    help="exit 1 when the quality check fails (as genome sequence)")
     add_output_folder(p)

@@ -322,12 +322,20 @@ def add_contact_physics_options(parser, unload_help: str = None) -> None:
 def contact_physics_from_args(args) -> dict:
     """``{"adhesion": AdhesionLaw or None, "hardness": float or None, "unload": bool}``
     of :func:`add_contact_physics_options` (the keyword options of
-    :func:`roughfe.response.response`); --hardness with --adhesion is one clear error."""
+    :func:`roughfe.response.response`); --hardness with --adhesion is one clear error, and
+    so is a negative --delta without --adhesion (in the flags' words, for both commands)."""
     law = adhesion_from_args(args)
     if law is not None:
         from ..bem.adhesive_rules import check_adhesive_run
         check_adhesive_run(hardness=args.hardness, deltas=getattr(args, "delta", None),
                            words=ADHESION_WORDS)
+    else:   # said here for both commands (leak said the library's "deltas[0] ... response(")
+        from ..errors import InputError
+        for k, v in enumerate(getattr(args, "delta", None) or ()):
+            if v < 0.0:
+                raise InputError(f"--delta[{k}] = {v!r} m is a negative approach (the surfaces"
+                                 " apart): meaningful with adhesion only (--adhesion); without"
+                                 " it give approaches >= 0")
     return {"adhesion": law, "hardness": args.hardness, "unload": bool(args.unload)}
 
 

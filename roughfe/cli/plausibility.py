@@ -126,10 +126,11 @@ def check_load_magnitudes(surface, material, pressures=None, deltas=None) -> Non
                 f"E = {material.E:.4g} Pa, nu = {material.nu:g}): the elastic half-space "
                 f"needs p << E* (its strains are ~ p / E*); is --E in Pa?")
     if deltas is not None and len(deltas):
-        d, length = max(abs(float(v)) for v in deltas), min(surface.size)
-        if d > length:
+        d = max((float(v) for v in deltas), key=abs)     # signed, as given (adhesion: < 0)
+        length = min(surface.size)
+        if abs(d) > length:
             raise InputError(
-                f"approach {d:.4g} m is {d / length:.3g} x the smallest lateral size "
+                f"approach {d:.4g} m is {abs(d) / length:.3g} x the smallest lateral size "
                 f"{length:.4g} m of the surface: a strain above 1, beyond the elastic "
                 f"half-space; is --delta in metres?")
 

@@ -128,8 +128,9 @@ def _make_spectral(a):
 
 def _grid_points(a) -> tuple:
     """Points per axis of the requested grid (for the memory check before generating)."""
-    if a.model == "rmd":
-        n = 2 ** a.m + 1
+    if a.model == "rmd":  # m checked first (the bounds of rmd_profile, rmd_surface):
+        from ..surfaces.rmd import _check_m     # 2 ** 99999999999 alone ran for minutes
+        n = 2 ** _check_m(a.m, mmax=24 if a.profile else 13) + 1
         return (n,) if a.profile else (n, n)
     return (a.n,) if a.model == "wm" or getattr(a, "profile", False) else (a.n, a.n)
 

@@ -45,11 +45,20 @@ def available_cores() -> int:
         return os.cpu_count() or 1
 
 
+#: Most worker processes of a pool: each holds pipes (file descriptors, 1024 by default per
+#: process) and a LocalCluster starts them all at once. (Up to round 2, session 33 there was
+#: no bound: --workers 99999999999 ended in a traceback, "Python int too large to convert
+#: to C int", from multiprocessing's semaphore.)
+MAX_WORKERS = 1024
+
+
 def _check_workers(workers):
     if workers is None:
         return None
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise InputError(f"workers must be an integer >= 1, got {workers!r}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or \
+            not 1 <= workers <= MAX_WORKERS:
+        raise InputError(f"workers must be an integer in 1..{MAX_WORKERS} (this machine has "
+                         f"{available_cores()} cores), got {workers!r}")
     return workers
 
 

@@ -156,7 +156,12 @@ def _synthesise(ndim, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_s
     scale = target / achieved
     h *= scale
     # h~ = scale sqrt(shape) xi / N = sqrt(C0 shape dq^d) xi
-    c0 = scale ** 2 / npts ** 2 / float(np.prod([2 * np.pi / s for s in size]))
+    with np.errstate(over="ignore"):    # (a Python float overflowed: a traceback)
+        c0 = float(np.float64(scale) ** 2 / npts ** 2 / np.prod([2 * np.pi / s for s in size]))
+    if not np.isfinite(c0):
+        raise InputError(f"{'rms_height (m)' if rms_slope is None else 'rms_slope'} = "
+                         f"{target!r} scales the heights by {scale:.3g}: their power spectrum "
+                         f"(C0) lies beyond the floating-point range")
     meta = {"generator": "spectral", "hurst": hurst, "q_long": q_long, "q_roll": q_roll,
             "q_short": q_short, "amplitudes": amplitudes, "match": match,
             "rms_height_target": rms_height, "rms_slope_target": rms_slope, "C0": c0,

@@ -341,6 +341,11 @@ def mwm_surface(n, length, hurst, gamma=1.5, wavelength=None, n_range=None, ridg
     gamma, hurst = _check_gamma_hurst(gamma, hurst)
     amplitude = check_finite_positive("amplitude A (m^(1-H))", amplitude)
     if n_range is None:
+        if not wavelength <= MAX_WAVE_LENGTHS * length:   # (1e308 overflowed the index)
+            raise InputError(f"wavelength lambda {wavelength:.4g} m is more than "
+                             f"{MAX_WAVE_LENGTHS:.0e} times the length L = {length:.4g} m: "
+                             "the default n_range starts at waves that are constants over "
+                             "the grid (lost in round-off); shorten it or give n_range")
         n_f = 1 + _nyquist_index(np.pi * n / length * float(wavelength) / (2 * np.pi), gamma)
         n_range = (1, max(n_f, 1))
     amps, q = mwm_coefficients(hurst, gamma, wavelength, n_range, ridges, amplitude, anisotropy)

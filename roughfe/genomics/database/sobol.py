@@ -49,11 +49,14 @@ class SobolDesign:
             raise InputError(f"dim must be 1 (profiles) or 2 (surfaces), got {self.dim!r}")
         if int(self.n_ridges) < 1 or int(self.n_ridges) > 100:
             raise InputError(f"n_ridges must lie in 1..100, got {self.n_ridges!r}")
-        for name in ("anisotropy_range", "hurst_range"):
-            lo, hi = getattr(self, name)
-            if not (0 < lo <= hi and np.isfinite(hi)):
-                raise InputError(f"{name} must be 0 < low <= high, got "
-                                 f"{getattr(self, name)!r}")
+        lo, hi = self.anisotropy_range
+        if not (0 < lo <= hi and np.isfinite(hi)):
+            raise InputError(f"anisotropy_range must be 0 < low <= high, got "
+                             f"{self.anisotropy_range!r}")
+        lo, hi = self.hurst_range     # a Genome's H is <= 3 (a high H failed every task,
+        if not (0 < lo <= hi <= 3.0):  # and the task's text filled the error line)
+            raise InputError(f"hurst_range must be 0 < low <= high <= 3 (the genome's H), "
+                             f"got {self.hurst_range!r}")
 
     @property
     def rows(self) -> int:
@@ -81,8 +84,9 @@ class SobolDesign:
         from scipy.stats import qmc
         m = int(np.ceil(np.log2(max(self.n_pairs, 2))))
         u = qmc.Sobol(d=2, scramble=self.scramble, seed=self.seed).random_base2(m)[: self.n_pairs]
-        return qmc.scale(u, [self.gamma_range[0], self.hurst_range[0]],
-                         [self.gamma_range[1], self.hurst_range[1]])
+        lo = np.array([self.gamma_range[0], self.hurst_range[0]])
+        hi = np.array([self.gamma_range[1], self.hurst_range[1]])
+        return u * (hi - lo) + lo     # qmc.scale's formula; it refused low == high (one H)
 
     def phase_vectors(self) -> np.ndarray:
         """Phase vectors (rad), shape (n_vectors, n_phases + n_extra); for surfaces
