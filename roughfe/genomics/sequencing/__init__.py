@@ -65,7 +65,8 @@ Modules: :mod:`.acquisitions` (checks), :mod:`.peaks` (step 1), :mod:`.lattice` 
 2-4), :mod:`.genes` (step 5), :mod:`.result`, :mod:`.profile` (the driver,
 :func:`sequence_profiles`) and :mod:`.zd` (the thesis's Z_d fit, for the record).
 Surfaces (2D MWM, issue 15): :mod:`.surface_data` (acquisitions, peaks, ridge directions),
-:mod:`.surface_grid` (the grid model of the fit), :mod:`.surface` (:func:`sequence_surfaces`)
+:mod:`.surface_grid` (the grid model of the fit), :mod:`.surface_fit` (the nonlinear fit
+and the band of chromosomes the data hold), :mod:`.surface` (:func:`sequence_surfaces`)
 and :mod:`.surface_result` (genes, misfits, result).
 """
 from .acquisitions import MIN_NODES, Acquisition, acquisitions_from_surfaces

@@ -31,8 +31,12 @@ Conventions
   coarsest acquisition L_1, so that its first chromosome is n = 1. (Any lambda1 gamma^k
   with the indices shifted by k and A rescaled describes the same heights.)
 * The genome is band-limited: its phase matrix spans exactly the chromosomes present in
-  the data (n_first..n_last, Eq. 3.5 over all acquisitions); the sequencer never invents
-  chromosomes above the data's band.
+  the data (n_first..n_last): those of Eq. 3.5 over all acquisitions, less the empty
+  ones at either end of that band (:func:`~.surface_fit.present_band`; data need not
+  reach Eq. 3.5's wavelength of one node spacing: ``mwm_surface`` stops below the
+  Nyquist wavenumber). The sequencer never invents chromosomes outside the data's band;
+  it does not extend it either: a wave longer than gamma L_1 (an ``n_range`` of
+  ``mwm_surface`` from 0 or below) is outside Eq. 3.5 and not modelled.
 
 Steps (:func:`sequence_surfaces`)
 ---------------------------------
@@ -47,14 +51,18 @@ Steps (:func:`sequence_surfaces`)
    (ln q1, ln gamma, theta_1..theta_M) are refined by Levenberg-Marquardt with the
    Kaufman Jacobian, in continuation over the highest chromosome fitted; every product
    is separable on the tensor grids of the acquisitions (:class:`.surface_grid.GridModel`);
-   among the gamma candidates the lowest BIC wins (:func:`_bic`). The search stops at the
+   among the gamma candidates the lowest BIC wins (:func:`fit_bic`). The search stops at the
    first candidate that fits the data to round-off or down to its white-noise floor (the
    noise variance read from the periodogram's high-q plateau, :func:`_noise_floor`) with
    every chromosome above the noise: no other candidate, continuation or added ridge can
    fit better than the noise allows (measured, 512^2 pair, 1 % noise, seeds 0-4: 4.4-32.5 s
-   CPU before, 0.9-2.6 s after, the same genes). A fit within the tolerance with an empty
-   chromosome may be a sub-lattice gamma^(1/k) fit: it is also tried on the coarser
-   lattices (:func:`~.lattice.coarser_lattices`), the lower BIC wins.
+   CPU before, 0.9-2.6 s after, the same genes). A fit within the tolerance loses the
+   empty chromosomes at the ends of its band and is refitted with exact linear solves
+   (:func:`~.surface_fit.polish`; the search's solves carry a small diagonal that keeps
+   its landscape smooth, :func:`~.surface_grid._factor`). A fit within the tolerance
+   with an empty chromosome inside its band may be a sub-lattice gamma^(1/k) fit: it is
+   also tried on the coarser lattices (:func:`~.lattice.coarser_lattices`), the lower
+   BIC wins.
 5. Genes: b_mn, phi_mn from the coefficients; (ln G, H, ln alpha) by least squares on
    ln b_mn weighted by b_mn^2, refined to the least height misfit of the genome with the
    fitted phases; A from G (Eq. 3.1) (:mod:`.surface_result`, with the misfits and the
@@ -69,15 +77,14 @@ import math
 import time
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ... import progress
 from ..genome import Genome
 from .acquisitions import check_controls
-from .lattice import (bic, coarser_lattices, comb_periods, label_q1, lattice_from_period,
-                      round_off_cost)
+from .lattice import coarser_lattices, comb_periods, lattice_from_period, round_off_cost
 from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, noise_variance,
                            surface_acquisitions, surface_peaks)
+from .surface_fit import fit_bic, fit_model, polish
 from .surface_grid import GridModel
 from .holdout import overfit_reason
 from .surface_result import (SurfaceSequencingResult, failure, genes_from_fit,
@@ -102,59 +109,6 @@ SIGNIFICANCE = 5.0
 #: 256^2, H = 0.3 and 0.8, 4 seeds), whose 17-31 "ridges" of periodogram maxima made the
 #: fit run for more than 12 minutes before it failed
 MIN_COMB_COHERENCE = 0.5
-
-
-def _fit(model, p0, budget=60, continuation=True):
-    """Levenberg-Marquardt on (ln q1, ln gamma, theta), with continuation in the cap.
-
-    ``continuation=False``: a direct fit of the whole model (enough when the peaks put
-    every wave in the basin). ``continuation=True`` (the caller tried the direct fit and it
-    did not reproduce the data to round-off): the fit from ``p0`` adds the chromosomes a
-    few at a time (the basin in ln gamma shrinks like 1/n).
-    """
-    nit = 0
-    ranges = model.ranges(p0[0], p0[1])
-    lo = min(r[0] for r in ranges)
-    hi = max(r[1] for r in ranges)
-    caps = list(range(min(lo + 3, hi), hi + 1)) if continuation else [hi]
-    if len(caps) > 5:
-        caps = sorted(set(np.linspace(caps[0], hi, 5).round().astype(int).tolist()))
-    p = np.asarray(p0, float)
-    for cap in caps:
-        cache = {}
-
-        def sol(x):
-            key = x.tobytes()
-            if key not in cache:
-                cache.clear()
-                cache[key] = model.solve(x, ranges, cap)
-            return cache[key]
-
-        res = least_squares(lambda x: sol(x)["resid"] / model.scale, p,
-                            jac=lambda x: model.jacobian(x, sol(x)) / model.scale,
-                            method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                            max_nfev=budget if cap == caps[-1] else 10)
-        nit += res.nfev
-        p = res.x
-        if p[1] <= 0:
-            raise ValueError("gamma <= 1")
-        p[0] = label_q1(p[0], p[1], model.acqs[0].length)    # n_s = 1 for L_1 (Eq. 3.5)
-        new = model.ranges(p[0], p[1])
-        if new != ranges:            # the lattice moved across an Eq. 3.5 boundary
-            ranges = new
-    return p, ranges, nit
-
-
-def _bic(model, cost, sol, p):
-    """Bayesian information criterion (:func:`~.lattice.bic`, lower is better) of a fit,
-    unknowns = the wave and plane coefficients and the lattice. (Measured, 1 % noise,
-    gamma = 1.6: by the lowest cost gamma^(1/3) won with the misfit at the noise level, H
-    and A wrong.)"""
-    unknowns = 2 * sol["nn"].size + 3 * len(model.acqs) + len(p)
-    # two fits exact to round-off (the sequencers' one definition) tie: the lattice with
-    # fewer unknowns wins (measured: a floor of 1e-32 z.z, below the ~1e-29 the solve
-    # reaches, let round-off pick sqrt(gamma) for gamma in 3 of 136 noise-free genomes)
-    return bic(cost, model.z.size, unknowns, round_off_cost(model.z @ model.z))
 
 
 def _chromosome_presence(sol, ratio=1e-6, noise=0.0):
@@ -245,7 +199,7 @@ def _add_missing_ridges(model, full, p, ranges, sol, done, max_new=8):
         strength = np.bincount(labels, weights=pw)
         new = centres[int(np.argmax(strength))]
         try:
-            p_new, r_new, k = _fit(model, np.append(p, new), continuation=False)
+            p_new, r_new, k = fit_model(model, np.append(p, new), continuation=False)
             s_new = model.solve(p_new, r_new)
         except (np.linalg.LinAlgError, ValueError):
             break
@@ -331,7 +285,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     good = max(tiny, rms_tolerance ** 2 * float(model.z @ model.z))   # within the tolerance
 
     def score(out):
-        return _bic(model, out[0], out[3], out[1])
+        return fit_bic(model, out[0], out[3], out[1])
 
     def settle(out):
         """A fit within the tolerance with an empty chromosome may stand for a coarser
@@ -360,21 +314,25 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
 
     def prune(p, ranges, sol, nit):
         """Drop merged ridges and ridges with no lattice waves (:func:`_weak_ridges`) and
-        refit: (cost, p, ranges, sol, nit)."""
+        refit; a fit within the tolerance then loses the empty chromosomes at the ends of
+        its band and is refitted with exact solves (:func:`polish`; poor fits are left
+        alone, as in :func:`settle`): (cost, p, ranges, sol, nit)."""
         p = _merge_duplicate_ridges(p)
         weak = _weak_ridges(sol, p.size - 2) if p.size == sol["mm"].max() + 3 else []
         if len(weak) and len(weak) < p.size - 2 or p.size != sol["mm"].max() + 3:
             # a direction with no lattice waves, or two ridges fitted onto one
-            p, ranges, k = _fit(model, np.delete(p, 2 + np.asarray(weak, int)),
+            p, ranges, k = fit_model(model, np.delete(p, 2 + np.asarray(weak, int)),
                                 continuation=False)
             nit += k
             sol = model.solve(p, ranges)
+        if float(sol["resid"] @ sol["resid"]) <= good:
+            p, ranges, sol, nit = polish(model, p, ranges, sol, nit)
         return float(sol["resid"] @ sol["resid"]), p, ranges, sol, nit
 
     def attempt(p0, continuation, coarsen=True):
         """Fit from p0, :func:`prune`, then (``coarsen``) :func:`settle`:
         (cost, p, ranges, sol, nit)."""
-        p, ranges, nit = _fit(model, p0, continuation=continuation)
+        p, ranges, nit = fit_model(model, p0, continuation=continuation)
         out = prune(p, ranges, model.solve(p, ranges), nit)
         return settle(out) if coarsen else out
 

@@ -9,8 +9,50 @@ import math
 
 import numpy as np
 import scipy.linalg
+import scipy.linalg.lapack
 
 from ..genome import chromosome_range
+
+
+#: the diagonal (times the number of columns) added to the column-scaled Gram matrix of
+#: the nonlinear fit's solves, and of an exact solve when it is too ill-conditioned to
+#: solve (:data:`MAX_COND`)
+RIDGE = 1e-13
+#: the largest condition number (1-norm estimate, LAPACK dpocon) of the column-scaled Gram
+#: matrix that an exact solve (:meth:`GridModel.solve`) solves as it is: its two refinement
+#: steps, each contracting the error by about cond x 1.1e-16, then reach round-off
+MAX_COND = 1e15
+
+
+def _factor(gram, ridge=True):
+    """Cholesky factor (``scipy.linalg.cho_factor``) of the column-scaled Gram matrix, with
+    the diagonal :data:`RIDGE` times its size added (``ridge``), or (``ridge=False``, the
+    exact solves) only when its condition number exceeds :data:`MAX_COND` or the
+    factorisation fails (two ridges merging, chromosomes collinear).
+
+    The diagonal keeps the nonlinear fit's landscape smooth where the model is singular
+    (merging ridges, fine sub-lattices); it also bounds the fit's accuracy by the
+    directions below it, which the refinement steps contract by only 0.99 each. The 10
+    ridges of an ``mwm_surface`` (its longest waves span the window) make a full-rank
+    Gram matrix of cond 3e13 (1-norm estimate 6-7e13 at 64^2-256^2; smallest eigenvalue
+    1.4e-13 under the 1.8e-11 added): with the diagonal, the fit at the true lattice
+    misfits by 1.6e-7 and its genes are H 0.7036 and A 1.049e-6 for 0.7 and 1e-6; solved
+    as it is, 3.9e-15 and H, A to 2e-10. Until round 2, session 33 the exact solves added
+    it too. The nonlinear fit keeps it: solved as they are, its poor fits (one ridge
+    found, cost 7 %) ended on another sub-lattice (gamma^(1/8) for gamma^(1/4)), beyond
+    the coarser lattices tried, and a test genome was lost. (14 ridges make the Gram
+    matrix singular to working precision: their longest waves are not told apart by the
+    heights.)"""
+    if not ridge:
+        try:
+            chol = scipy.linalg.cho_factor(gram)
+            rcond, info = scipy.linalg.lapack.dpocon(
+                chol[0], float(np.abs(gram).sum(axis=0).max()), uplo="L" if chol[1] else "U")
+            if info == 0 and rcond * MAX_COND > 1.0:
+                return chol
+        except np.linalg.LinAlgError:
+            pass
+    return scipy.linalg.cho_factor(gram + RIDGE * gram.shape[0] * np.eye(gram.shape[0]))
 
 
 class GridModel:
@@ -138,8 +180,11 @@ class GridModel:
         then over the kept rows).
 
         Normal equations with a Cholesky factor of the column-scaled Gram matrix (plane
-        waves of distinct wavevectors are nearly orthogonal, so it is well conditioned; a
-        ridge duplicated by the fit makes it singular: LinAlgError). The residual is
+        waves of distinct wavevectors are nearly orthogonal, so it is mostly well
+        conditioned; many ridges whose longest waves span the window are not, cond 3e13
+        with 10 ridges; a ridge duplicated by the fit makes it singular), with a small
+        diagonal added except in an exact solve (``exact``) that does not need it
+        (:func:`_factor`). The residual is
         evaluated on the grid, and one step of iterative refinement (``exact``: two)
         restores the accuracy of a backward-stable solver: noise-free data are fitted to
         round-off (relative cost ~1e-29, not the ~1e-20 floor of the plain normal
@@ -157,8 +202,7 @@ class GridModel:
         norm = np.sqrt(np.clip(np.diag(gram), 0.0, None))    # round-off: undefined nodes
         norm[norm == 0] = 1.0
         gram = gram / np.outer(norm, norm)
-        gram[np.diag_indices_from(gram)] += 1e-13 * n_cols        # two ridges merging
-        chol = scipy.linalg.cho_factor(gram)
+        chol = _factor(gram, ridge=not exact)
 
         def lsq(fields):
             """G^-1 A^T f for grid fields f (per acquisition: (..., N, N))."""

@@ -123,7 +123,8 @@ class SurfaceSequencingResult:
     nit : int
         Residual evaluations of the nonlinear fit.
     ranges : list of (int, int)
-        Eq. 3.5 chromosome range per acquisition, coarsest first.
+        Chromosome range per acquisition, coarsest first: Eq. 3.5's, less the empty
+        chromosomes at either end of the band (:func:`~.surface_fit.present_band`).
     lengths, rms_errors : ndarray
         Observation lengths (m) and relative rms misfits per acquisition of the returned
         genome realised on the acquisition's nodes (about the best plane, as the fit
