@@ -127,3 +127,74 @@ def test_a_memory_error_without_text_is_still_said(monkeypatch, tmp_path, capsys
     line = _refused(capsys, ["generate", "wm", "--no-figures", "-o", str(tmp_path / "m.npz")],
                     "not enough memory (an allocation failed)")
     assert "()" not in line
+
+
+def test_fem_contact_refuses_grid_check_before_it_solves(tmp_path, capsys):
+    # was refused after the whole FEM sweep had run (6-10 s; the refusal came from the
+    # grid check that follows the sweep)
+    path = tmp_path / "p.npz"
+    assert main(["generate", "wm", "--n", "256", "--seed", "1", "--no-figures",
+                 "-o", str(path)]) == 0
+    _refused(capsys, ["contact", str(path), "--method", "fem", "--grid-check", "--steps", "2",
+                      "--no-figures", "-o", str(tmp_path / "f")],
+             "--method fem does not take --grid-check")
+    assert not (tmp_path / "f").exists()
+
+
+def test_dolfinx_import_leaves_warnings_to_warnings(tmp_path):
+    # importing ffcx (with dolfinx) calls logging.captureWarnings(True): roughfe's warnings
+    # of `contact --method fem` were printed as "WARNING:py.warnings:FILE:LINE: ..." and a
+    # source line, past the command's one-line printer
+    import subprocess
+    import sys
+    code = ("import warnings; from roughfe.fem.petsc_tools import ensure_jit_cache; "
+            "ensure_jit_cache(); import dolfinx, dolfinx.fem.petsc; "
+            "print(warnings.showwarning.__module__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=tmp_path, check=True).stdout.split()
+    assert out == ["warnings"]
+
+
+def test_db_build_does_not_take_over_a_small_file_of_other_content(tmp_path, capsys):
+    # SQLite took a 1-byte file for an empty database and wrote a genome database over it
+    notes = tmp_path / "notes"
+    notes.write_bytes(b"x")
+    _refused(capsys, ["db", "build", str(notes), "--limit", "1", "--nodes", "64", "--steps",
+                      "5", "--workers", "1"], "not an SQLite file", "give a new file name")
+    assert notes.read_bytes() == b"x" and not (tmp_path / "notes.study").exists()
+
+
+@pytest.mark.parametrize("size", ["1e-300", "1e300"])
+def test_a_lateral_size_outside_any_topography_is_refused(surface32, capsys, size):
+    # 1e-300 m: a ValueError traceback from np.bincount (the PSD); 1e300 m: rms slope
+    # exactly 0 and Nayak alpha null (the squares underflow), exit 0
+    _refused(capsys, ["info", str(surface32), "--size", size, "--json"],
+             f"size[0] = {float(size):g} m", "1e-12 m to 1e+06 m")
+
+
+def test_a_study_task_refused_says_the_reason_first(tmp_path, capsys):
+    # the line was "analysis 'leakage', task {...every parameter...}: D ... got 3.0"
+    line = _refused(capsys, ["leak-study", "--D", "3", "--m", "3", "--surfaces", "1",
+                             "--steps", "2", "--workers", "1", "--no-figures",
+                             "-o", str(tmp_path / "ls")], "got 3.0")
+    assert line.startswith("roughfe leak-study: error: D (fractal dimension) must lie")
+
+
+@pytest.mark.parametrize("cmd", ["mechanics", "natural"])
+def test_genome_curves_need_three_steps(tmp_path, capsys, cmd):
+    # K(p) is differenced over the steps: 2 ended in "response curve stiffness has
+    # non-finite values: [nan nan]", 1 in "... need the same length >= 2, got 1, 1, 1"
+    _refused(capsys, ["genome", cmd, str(tmp_path / "any"), "--steps", "2",
+                      "-o", str(tmp_path / "o")], "--steps", "an integer >= 3", "'2'")
+
+
+def test_validity_with_a_million_ridges_is_refused_at_once(tmp_path):
+    # ran for days (M = 2 .. 10^6, pair arrays of M^2 / 2 per M); in a subprocess with a
+    # timeout, so that a regression fails instead of hanging
+    import subprocess
+    import sys
+    proc = subprocess.run([sys.executable, "-m", "roughfe", "genome", "validity", "--trials",
+                           "10", "--max-ridges", "1000000", "-o", str(tmp_path / "v.png")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert "M = 1000000 ridges x 10 trials needs" in proc.stderr

@@ -336,7 +336,7 @@ def _method_options(args, tol) -> dict:
                     hardness=args.hardness, coarse_correction=COARSE[args.coarse_correction])
     given = [flag for flag, on in (("--mirror", args.mirror),   # the FEM mirrors itself
                                    ("--hardness", args.hardness is not None),
-                                   ("--unload", args.unload),
+                                   ("--unload", args.unload), ("--grid-check", args.grid_check),
                                    ("--kernel", args.kernel != "auto"),
                                    ("--solver", args.solver != "auto"),
                                    ("--coarse-correction", args.coarse_correction != "auto"),

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from .options import (add_detrend_option, add_material_options, add_output_file,
                       add_output_folder, add_run_options, add_surface_options, at_least_two,
+                      at_least_three,
                       material_from_args, nonnegative_int, output_file_of,
                       output_folder_of, positive_float, positive_int, surface_from_args,
                       unit_fraction, warn)
@@ -281,8 +282,9 @@ def _add_response_options(p, nargs, kernels_help):
     p.add_argument("--kernels", nargs=nargs, choices=("thesis", "strip"),
                    default=["thesis", "strip"], help=kernels_help)
     add_material_options(p)
-    p.add_argument("--steps", type=positive_int, default=20,
-                   help="equal approaches up to the peak-valley amplitude")
+    p.add_argument("--steps", type=at_least_three, default=20,
+                   help="equal approaches up to the peak-valley amplitude, >= 3 (K is "
+                        "differenced over them)")
 
 
 def register(sub):

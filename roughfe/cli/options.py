@@ -19,7 +19,8 @@ everywhere:
 * :func:`add_run_options` -- ``--no-figures`` and ``--quiet`` (no progress bar, no
   summary on stdout; errors still go to stderr).
 * :func:`positive_int`, :func:`positive_float`, :func:`nonnegative_int` -- argparse
-  types that reject 0/negative values at parse time (exit 2, one line).
+  types that reject 0/negative values at parse time (exit 2, one line); likewise
+  :func:`at_least_two`, :func:`at_least_three`, :func:`unit_fraction`.
 
 :class:`RoughfeParser` shows every default in ``--help``, accepts negative numbers as
 option values (``--E -1e9`` reaches the validator: "E must be > 0") and prints parse
@@ -99,6 +100,8 @@ def _check(kind, test, what):
 
 positive_int = _check(int, lambda v: v >= 1, "an integer >= 1")
 at_least_two = _check(int, lambda v: v >= 2, "an integer >= 2")
+#: the approaches of a K(p) curve: K is differenced over them (2 gave NaN, 1 no curve)
+at_least_three = _check(int, lambda v: v >= 3, "an integer >= 3")
 nonnegative_int = _check(int, lambda v: v >= 0, "an integer >= 0")
 positive_float = _check(float, lambda v: 0.0 < v < float("inf"), "a finite number > 0")
 nonnegative_float = _check(float, lambda v: 0.0 <= v < float("inf"), "a finite number >= 0")

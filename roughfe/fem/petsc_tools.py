@@ -20,6 +20,7 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import InputError, NoConvergenceError
+from .warning_capture import warnings_back_from_logging
 
 _COUNTER = itertools.count()
 
@@ -35,7 +36,7 @@ def ensure_jit_cache() -> None:
     Nothing is changed when the cache is writable or dolfinx is already loaded.
     """
     if "dolfinx" in sys.modules:
-        return
+        return warnings_back_from_logging()
     base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
     try:
         base.mkdir(parents=True, exist_ok=True)
@@ -43,6 +44,7 @@ def ensure_jit_cache() -> None:
             pass
     except OSError:
         os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="roughfe-jit-cache-")
+    warnings_back_from_logging()     # ffcx's import hands warnings to logging: undone
 
 
 def unique_prefix(name: str) -> str:

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_memory
 from .genome import DEFAULT_NODES, Genome, chromosome_heights, node_coordinates
 
 
@@ -106,6 +106,9 @@ def validity_monte_carlo(M_values=tuple(range(2, 21)), n_trials=1000, *, rng) ->
         raise InputError(f"M_values must be integers >= 1, got {list(M_values)!r}")
     if int(n_trials) < 1:
         raise InputError(f"n_trials must be >= 1, got {n_trials!r}")
+    m_max = int(ms.max())   # phases and the three pair arrays of the largest M (a million
+    check_memory(f"M = {m_max} ridges x {int(n_trials)} trials",  # ridges ran for days)
+                 8.0 * int(n_trials) * (m_max + 1.5 * m_max * (m_max - 1)))
     valid, arccos_ok, worst = [], [], 0.0
     for m in ms:
         phi = gen.uniform(0, 2 * np.pi, size=(int(n_trials), int(m)))

@@ -153,8 +153,10 @@ def check_parameters(name: str, params) -> None:
     values = {k: v for k, v in bound.arguments.items() if k != "seed"}
     try:
         check(**values)
-    except InputError as exc:
-        raise InputError(f"analysis {name!r}, task {dict(params)}: {exc}") from None
+    except InputError as exc:     # the reason first; a task's 30-phase lists cut short
+        task = repr(dict(params))  # (the line was the whole task, then the reason)
+        task = task if len(task) <= 240 else task[:240] + " ...}"
+        raise InputError(f"{exc} (analysis {name!r}, task {task})") from None
 
 
 def as_records(value, name: str) -> list[dict]:

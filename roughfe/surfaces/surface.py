@@ -27,9 +27,16 @@ from ..errors import InputError, check_int, check_real_array
 from ..frozen import FrozenMapping, ReadOnlyArrays
 
 
+#: The lateral sizes a topography may have (m): 1 pm (below an atom) to 1000 km. Outside,
+#: the wavenumbers' and slopes' squares and fourth powers (PSD, spectral moments, the BEM
+#: kernels) under- or overflow: --size 1e-300 was a traceback from np.bincount, 1e300 an
+#: rms slope of exactly 0 and a null Nayak alpha, and the BEM did not converge.
+SIZE_RANGE = (1e-12, 1e6)
+
+
 def _as_size(size, ndim):
     """``size`` (m: one number, or one per axis) as a tuple of ``ndim`` finite, positive
-    floats, or an InputError naming what is wrong."""
+    floats within :data:`SIZE_RANGE`, or an InputError naming what is wrong."""
     try:
         sizes = np.atleast_1d(np.asarray(size, dtype=float)).ravel()
     except (TypeError, ValueError):
@@ -43,6 +50,10 @@ def _as_size(size, ndim):
     for k, s in enumerate(sizes):
         if not (np.isfinite(s) and s > 0):
             raise InputError(f"size[{k}] must be finite and > 0 (metres), got {s!r}")
+        if not SIZE_RANGE[0] <= s <= SIZE_RANGE[1]:
+            raise InputError(f"size[{k}] = {s:g} m is no lateral size of a topography: "
+                             f"allowed are {SIZE_RANGE[0]:g} m to {SIZE_RANGE[1]:g} m (a "
+                             f"length in another unit?)")
     return tuple(float(s) for s in sizes)
 
 

@@ -91,6 +91,12 @@ def connect(path, *, create=False) -> sqlite3.Connection:
                             " (build it with 'roughfe db build')"))
     if not create:
         return _connect_read_only(path)
+    if path.is_file() and path.stat().st_size:   # SQLite took a 1-byte file as empty and
+        with open(path, "rb") as fh:             # overwrote it (round 2, session 33)
+            if fh.read(16) != b"SQLite format 3\x00":
+                raise FileFormatError(f"{path} is not a roughfe genome database (not an SQLite "
+                                      f"file: {path.stat().st_size} bytes of other content); "
+                                      "give a new file name")
     path.parent.mkdir(parents=True, exist_ok=True)
     try:       # created by us with 0666 & ~umask (SQLite's own default is 0644)
         os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
