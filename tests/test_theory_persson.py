@@ -488,5 +488,15 @@ def test_beside_says_when_the_texture_aspect_ratio_is_only_a_bound():
     note = info["texture_bounded"]
     assert f"Str = {info['texture_aspect_ratio']:.3g}" in note and "upper bound" in note
     rng = np.random.default_rng(3)
+    noisy = Surface(wave.heights + 3e-7 * rng.standard_normal((n, n)), wave.size,
+                    periodic=True)
+    assert "texture_bounded" in beside(noisy, E_STAR, [{"mean_pressure": 1e6}])["persson"]
     noise = Surface(1e-8 * rng.standard_normal((n, n)), (1e-4, 1e-4), periodic=True)
     assert "texture_bounded" not in beside(noise, E_STAR, [{"mean_pressure": 1e6}])["persson"]
+    # an isotropic self-affine cell without roll-off: its slowest direction reaches the
+    # half period (Str bounded) but decorrelates; no note
+    from roughfe.surfaces.spectral import spectral_surface
+    from roughfe.surfaces.texture import texture_aspect_ratio
+    cell = spectral_surface(128, (1e-4, 1e-4), 0.8, rms_height=1e-6, rng=0)
+    assert texture_aspect_ratio(cell).bounded
+    assert "texture_bounded" not in beside(cell, E_STAR, [{"mean_pressure": 1e6}])["persson"]

@@ -36,6 +36,11 @@ from .surface import Surface
 ACF_LEVEL = 0.2
 #: most points a side of the autocorrelation's grid (:func:`_autocorrelation`)
 MAX_POINTS = 1024
+#: ``persistence`` at or above which a direction is called correlated across the whole reach
+#: (a lay longer than the cell): one wave across a 32^2 cell with 30 % noise keeps 0.83,
+#: 60 isotropic self-affine periodic cells (64^2-256^2, H 0.3 / 0.8, no roll-off) at most
+#: 0.68 (round 2, session 33)
+LAY_PERSISTENCE = 0.75
 
 
 @dataclass(frozen=True)
@@ -55,6 +60,12 @@ class TextureAspect:
     bounded : bool
         The slowest direction reached the end of the autocorrelation (the window or half
         the period) before falling to :data:`ACF_LEVEL`: Str is an upper bound.
+    persistence : float
+        The largest, over directions, of the smallest autocorrelation along the direction
+        up to the end of the reach: 1 for one wave across a periodic cell (its crests never
+        decorrelate), near :data:`ACF_LEVEL` for a bounded isotropic cell whose slowest
+        direction just failed to fall below it. At or above :data:`LAY_PERSISTENCE` with
+        ``bounded``, the cell holds a lay longer than itself that Str cannot measure.
     """
 
     ratio: float
@@ -62,6 +73,7 @@ class TextureAspect:
     longest: float
     lay_angle: float
     bounded: bool
+    persistence: float
 
 
 def _autocorrelation(surface):
@@ -131,6 +143,8 @@ def texture_aspect_ratio(surface: Surface, n_angles: int = 180) -> TextureAspect
     frac = np.clip((v0 - ACF_LEVEL) / np.where(v0 > v1, v0 - v1, 1.0), 0.0, 1.0)
     length = np.where(first >= 1, r[k - 1] + frac * step, length)
     slow = int(np.argmax(length))
+    persistence = float(np.where(inside, values, np.inf).min(axis=1).max())
     return TextureAspect(ratio=float(length.min() / length.max()),
                          shortest=float(length.min()), longest=float(length[slow]),
-                         lay_angle=float(np.degrees(theta[slow])), bounded=bool(first[slow] < 0))
+                         lay_angle=float(np.degrees(theta[slow])), bounded=bool(first[slow] < 0),
+                         persistence=persistence)

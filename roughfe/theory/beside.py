@@ -239,10 +239,12 @@ def _texture(surface, leak) -> dict:
     average of the PSD, an isotropic surface, so its A*(p), u(p) and (``leak``) its
     critical-junction leak rate, the same along x and y but for the window's W/L, do not
     see the lay. A ``"texture_bounded"`` note where Str is only an upper bound that is not
-    below the limit (a periodic cell whose heights stay correlated over its half period in
-    one direction: one wave across a 32^2 cell reads Str 0.40, where the lay is infinite).
+    below the limit and one direction stays correlated above
+    :data:`~roughfe.surfaces.texture.LAY_PERSISTENCE` over the cell's half period (one wave
+    across a 32^2 cell reads Str 0.40, where the lay is infinite; an isotropic self-affine
+    cell without roll-off is often bounded too, but its directions decorrelate).
     Nothing for a profile, a flat surface or a grid too small for Str."""
-    from ..surfaces.texture import texture_aspect_ratio
+    from ..surfaces.texture import LAY_PERSISTENCE, texture_aspect_ratio
     if surface.ndim != 2 or min(surface.shape) < 2 or not np.ptp(surface.heights) > 0:
         return {}
     tex = texture_aspect_ratio(surface)
@@ -259,13 +261,13 @@ def _texture(surface, leak) -> dict:
             f"{tex.longest:.3g} m along {tex.lay_angle:.0f} deg from x and {tex.shortest:.3g} m "
             f"across{' or more' if tex.bounded else ''}; Persson's theory assumes an "
             f"isotropic surface (the radially averaged PSD): {what}")
-    elif tex.bounded:
+    elif tex.bounded and tex.persistence >= LAY_PERSISTENCE:
         out["texture_bounded"] = (
-            f"the texture aspect ratio Str = {tex.ratio:.3g} is only an upper bound: along "
-            f"{tex.lay_angle:.0f} deg from x the heights stay correlated to the end of the "
-            f"periodic cell's half period ({tex.longest:.3g} m), so a lay longer than the "
-            f"cell (one wave across it, grooves as long as it) is not measured and the "
-            f"surface may be anisotropic; Persson's theory assumes an isotropic surface")
+            f"the texture aspect ratio Str = {tex.ratio:.3g} is only an upper bound: in one "
+            f"direction the heights stay correlated (autocorrelation >= {tex.persistence:.2f}) "
+            f"over the whole half period of the periodic cell, a lay longer than the cell "
+            f"(one wave across it, grooves as long as it) that Str cannot measure; the "
+            f"surface is probably anisotropic, and Persson's theory assumes an isotropic one")
     return out
 
 
