@@ -123,6 +123,24 @@ def test_the_plastic_stiffness_steps_are_labelled(drawn):
     np.testing.assert_allclose(flow[0].get_xdata(), [0.4, 0.8])
 
 
+def test_persson_elastoplastic_areas_are_drawn_beside_the_plastic_area(drawn):
+    """With a hardness, Persson's elastoplastic total and plastic areas (theory.plastic,
+    first loading only) are drawn in the A* panel beside the BEM's plastic area, in order
+    of p; the unloading step carries none and adds no point to the theory lines."""
+    p = np.array([1e5, 4e5, 2e5, 1e6])
+    recs = _records(p, p * 1e-12, np.full(4, 1e12), unloading=[0, 0, 0, 1])
+    for r, ep, pl, bem in zip(recs, (0.02, 0.05, 0.03, None), (0.01, 0.04, 0.02, None),
+                              (0.0, 0.03, 0.01, 0.03)):
+        r.update(persson_elastoplastic_area_fraction=ep, persson_plastic_area_fraction=pl,
+                 plastic_area_fraction=bem)
+    fig = drawn(contact_plot, "plot_area_stiffness", recs)
+    lines = _lines(fig.axes[0])
+    np.testing.assert_allclose(lines["Persson, with hardness"].get_xdata(), [0.1, 0.2, 0.4])
+    np.testing.assert_allclose(lines["Persson, with hardness"].get_ydata(), [0.02, 0.03, 0.05])
+    np.testing.assert_allclose(lines["Persson plastic area"].get_ydata(), [0.01, 0.02, 0.04])
+    np.testing.assert_allclose(sorted(lines["BEM plastic area"].get_ydata()), [0.01, 0.03, 0.03])
+
+
 # -- design PSD figure ---------------------------------------------------------------------
 def _three_ridge_design():
     """A periodic 2D design (64 x 64, L = 100 um) of one genome with three ridges at 0, 90

@@ -64,7 +64,8 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     u(p), and with ``rms_height`` sigma (m) also V*(d/sigma) (thesis Fig. 8). Records
     with ``persson_area_fraction`` / ``persson_mean_gap`` (:func:`roughfe.theory.beside`)
     get Persson's curves drawn beside the BEM points (and ``persson_stiffness`` its K =
-    -dp/du in the K panel); records of one smooth cap get Hertz's A* and K instead
+    -dp/du in the K panel; with a hardness ``persson_elastoplastic_area_fraction`` and
+    ``persson_plastic_area_fraction`` beside the BEM's A* and ``plastic_area_fraction``); records of one smooth cap get Hertz's A* and K instead
     (``hertz_area_fraction``, ``hertz_stiffness``; :mod:`roughfe.theory.asperity`). With the ``window_compliance`` C
     (m/Pa) of a non-periodic window, the K panel marks the window's bulk stiffness 1/C,
     the ceiling K approaches whatever the roughness (:mod:`roughfe.bem.window`).
@@ -133,6 +134,23 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
         ax1.loglog(p[theory][order], a_th[theory][order], "-", label="Persson (2001)")
     if u_th is not None:
         ax3.semilogx(p[theory][order], u_th[theory][order] * UM, "-", label="Persson (2007)")
+    # with a hardness: Persson's elastoplastic areas (theory.plastic, first loading only)
+    # beside the BEM's total and plastic areas (a hardness review: they were written to
+    # results.json but drawn nowhere)
+    a_ep = _theory(steps, "persson_elastoplastic_area_fraction")
+    a_pl = _theory(steps, "persson_plastic_area_fraction")
+    if a_ep is not None:
+        sel = theory & np.isfinite(a_ep) & (a_ep > 0)
+        by_p = np.argsort(p[sel])
+        ax1.loglog(p[sel][by_p], a_ep[sel][by_p], "-.", label="Persson, with hardness")
+        pl_bem = _column_or_zero(steps, "plastic_area_fraction")
+        on = ok & (pl_bem > 0)
+        if on.any():
+            ax1.loglog(p[on], pl_bem[on], "s", ms=4, mfc="none", label=method + " plastic area")
+        sel = sel & np.isfinite(a_pl) & (a_pl > 0)
+        if sel.any():
+            by_p = np.argsort(p[sel])
+            ax1.loglog(p[sel][by_p], a_pl[sel][by_p], ":", label="Persson plastic area")
     # one smooth cap (theory.asperity): Hertz's curves in place of Persson's
     hertz = {ax: _theory(steps, key) for ax, key in ((ax1, "hertz_area_fraction"),
                                                       (ax2, "hertz_stiffness"))}
