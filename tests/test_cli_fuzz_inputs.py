@@ -198,3 +198,18 @@ def test_validity_with_a_million_ridges_is_refused_at_once(tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2
     assert "M = 1000000 ridges x 10 trials needs" in proc.stderr
+
+
+def test_ctrl_c_while_the_command_loads_is_one_line_and_exit_130(tmp_path):
+    # a Ctrl-C in the first 0.1-0.5 s (numpy, scipy and the command's modules importing)
+    # was a KeyboardInterrupt traceback and exit 1 or -2: the command line now imports no
+    # numpy itself, and main() catches it while it builds the command's parser
+    import subprocess
+    import sys
+    code = ("import sys, roughfe.cli as c; numpy = 'numpy' in sys.modules\n"
+            "def boom(command=None): raise KeyboardInterrupt\n"
+            "c.build_parser = boom; rc = c.main(['info', 'x.npz']); print(numpy, rc)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=120)
+    assert proc.stdout.split() == ["False", "130"]
+    assert proc.stderr == "roughfe: interrupted\n"

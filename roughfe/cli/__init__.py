@@ -88,6 +88,12 @@ def _reader_left() -> int:
     return 141
 
 
+def _interrupted(name: str) -> int:
+    """Ctrl-C before the command ran (its modules loading): one line, exit 130."""
+    print(f"{name}: interrupted", file=sys.stderr)
+    return 130
+
+
 def _raise_terminated(signum, frame):
     """SIGTERM handler: stop as after Ctrl-C (:class:`~roughfe.errors.Terminated`). A
     second SIGTERM during the clean-up ends the process at once (default action)."""
@@ -118,7 +124,10 @@ def main(argv=None) -> int:
     ``roughfe CMD: interrupted`` on stderr; 141 the reader of stdout left, as with
     SIGPIPE). The library's warnings are printed as one line ``roughfe CMD: warning: ...``."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    parser = build_parser(_command_of(argv))
+    try:
+        parser = build_parser(_command_of(argv))
+    except KeyboardInterrupt:   # Ctrl-C while the command's modules load: nothing written
+        return _interrupted("roughfe")    # (was a traceback through numpy's import)
     try:
         args, extra = parser.parse_known_args(argv)
     except SystemExit as exc:  # --help, --version, or a parse error (one line, exit 2)
@@ -135,7 +144,10 @@ def main(argv=None) -> int:
     python_signals_for_petsc()   # a closed stdout is exit 141, not PETSc's abort (exit 59)
     if getattr(args, "renders_with_dolfinx", False) and not getattr(args, "no_figures", False):
         from .._runtime import load_render_backend
-        load_render_backend()  # vtk before dolfinx: this command solves with dolfinx and draws
+        try:
+            load_render_backend()  # vtk before dolfinx: this command solves with dolfinx, draws
+        except KeyboardInterrupt:
+            return _interrupted(command_name(args))
     name = command_name(args).removeprefix("roughfe ")
     quiet = open(os.devnull, "w") if getattr(args, "quiet", False) else None
     bars = ProgressBars() if show_progress(args) else None

@@ -33,10 +33,9 @@ import re
 import sys
 import textwrap
 
-from ..model import DEFAULT_E, DEFAULT_NU
-
 #: DEFAULT_E, DEFAULT_NU: the one default material, defined in :mod:`roughfe.model` (shared
-#: with the study analyses) and imported above.
+#: with the study analyses), imported where the options are made: importing the command
+#: line imports no numpy (a Ctrl-C in that import was a traceback, round 2, session 33).
 #: Default of --detrend in info, contact and leak.
 DEFAULT_DETREND = "mean"
 DETRENDS = ("none", "mean", "plane")
@@ -248,6 +247,7 @@ def add_material_options(parser, title: str = "material (elastic half-space)") -
 
     The old spellings ``--youngs-modulus``/``--poisson`` are accepted with a warning.
     """
+    from ..model import DEFAULT_E, DEFAULT_NU
     group = parser.add_argument_group(title)
     group.add_argument("--E", type=float, default=DEFAULT_E, metavar="PA",
                        help="Young's modulus E in Pa")
