@@ -172,6 +172,20 @@ def test_a_lateral_size_outside_any_topography_is_refused(surface32, capsys, siz
              f"size[0] = {float(size):g} m", "1e-12 m to 1e+06 m")
 
 
+@pytest.mark.parametrize("model", ["rmd", "wm", "mwm"])
+def test_generate_checks_the_length_before_it_generates(tmp_path, capsys, model):
+    # --length 1e308: "heights must be finite: ... = nan" (rmd: "size[0] ... got inf")
+    _refused(capsys, ["generate", model, "--length", "1e308", "--no-figures",
+                      "-o", str(tmp_path / "g.npz")], "--length 1e+308 m", "1e-12 m to 1e+06 m")
+
+
+def test_leak_study_length_is_checked_before_the_tasks_run(tmp_path, capsys):
+    # --length 1e308 failed every task on the workers: "no task of the study ... finished"
+    _refused(capsys, ["leak-study", "--D", "2.3", "--m", "3", "--surfaces", "1", "--steps",
+                      "2", "--workers", "1", "--length", "1e308", "--no-figures",
+                      "-o", str(tmp_path / "ls")], "1e+308 m is no lateral size", "'L': 1e+308")
+
+
 def test_a_study_task_refused_says_the_reason_first(tmp_path, capsys):
     # the line was "analysis 'leakage', task {...every parameter...}: D ... got 3.0"
     line = _refused(capsys, ["leak-study", "--D", "3", "--m", "3", "--surfaces", "1",

@@ -169,6 +169,11 @@ def _generate(args) -> int:
     stale = out.exists() and png.is_file() and _figure_of(out) == png.name
     if not args.no_figures:
         output_file(png, overwrite=args.overwrite)
+    from ..surfaces.surface import _as_size
+    try:                          # the one size range (1e308 gave NaN heights first)
+        _as_size(args.length, 1)
+    except InputError as exc:
+        raise InputError(f"--length {args.length:g} m: {exc}") from None
     shape = _grid_points(args)
     check_memory(f"a {' x '.join(map(str, shape))} grid", 8.0 * float(np.prod(shape)))
     surface = args.make(args)

@@ -143,6 +143,8 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     _check_m(m)
     check_int("n_steps", n_steps, 1)
     check_finite_positive("L (m)", L)
+    from ..surfaces.surface import _as_size
+    _as_size(L, 1)      # the surfaces' size range (1e308 failed every task on the workers)
     check_finite_positive("mu (Pa s)", mu)
     if not isinstance(reynolds, (bool, np.bool_)):
         raise InputError(f"reynolds must be true or false, got {reynolds!r}")
