@@ -169,14 +169,14 @@ def test_a_lateral_size_outside_any_topography_is_refused(surface32, capsys, siz
     # 1e-300 m: a ValueError traceback from np.bincount (the PSD); 1e300 m: rms slope
     # exactly 0 and Nayak alpha null (the squares underflow), exit 0
     _refused(capsys, ["info", str(surface32), "--size", size, "--json"],
-             f"size[0] = {float(size):g} m", "1e-12 m to 1e+06 m")
+             f"size[0] = {float(size):g} m", "1e-15 m to 1e+06 m")
 
 
 @pytest.mark.parametrize("model", ["rmd", "wm", "mwm"])
 def test_generate_checks_the_length_before_it_generates(tmp_path, capsys, model):
     # --length 1e308: "heights must be finite: ... = nan" (rmd: "size[0] ... got inf")
     _refused(capsys, ["generate", model, "--length", "1e308", "--no-figures",
-                      "-o", str(tmp_path / "g.npz")], "--length 1e+308 m", "1e-12 m to 1e+06 m")
+                      "-o", str(tmp_path / "g.npz")], "--length 1e+308 m", "1e-15 m to 1e+06 m")
 
 
 def test_leak_study_length_is_checked_before_the_tasks_run(tmp_path, capsys):

@@ -27,11 +27,11 @@ from ..errors import InputError, check_int, check_real_array
 from ..frozen import FrozenMapping, ReadOnlyArrays
 
 
-#: The lateral sizes a topography may have (m): 1 pm (below an atom) to 1000 km. Outside,
+#: The lateral sizes a topography may have (m): 1 fm (far below an atom) to 1000 km. Outside,
 #: the wavenumbers' and slopes' squares and fourth powers (PSD, spectral moments, the BEM
 #: kernels) under- or overflow: --size 1e-300 was a traceback from np.bincount, 1e300 an
 #: rms slope of exactly 0 and a null Nayak alpha, and the BEM did not converge.
-SIZE_RANGE = (1e-12, 1e6)
+SIZE_RANGE = (1e-15, 1e6)
 
 
 def _as_size(size, ndim):
