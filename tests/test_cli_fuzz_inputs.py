@@ -227,3 +227,11 @@ def test_ctrl_c_while_the_command_loads_is_one_line_and_exit_130(tmp_path):
                           cwd=tmp_path, timeout=120)
     assert proc.stdout.split() == ["False", "130"]
     assert proc.stderr == "roughfe: interrupted\n"
+
+
+def test_leak_study_with_no_finished_task_says_the_first_error(tmp_path, capsys):
+    # said only "no task of the study ... finished; see `roughfe study status ...`"
+    line = _refused(capsys, ["leak-study", "--D", "2.3", "--m", "3", "--surfaces", "1",
+                             "--steps", "2", "--workers", "1", "--E", "1e308", "--no-figures",
+                             "-o", str(tmp_path / "ls")], "no task of the study", "(task 0: ")
+    assert "did not converge" in line

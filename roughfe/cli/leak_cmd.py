@@ -398,7 +398,7 @@ def _leak_run(args, surface, material, out):
 def _leak_study(args) -> int:
     from ..leakage.study import study_grid, summarise
     from ..plotting import leakage as figs
-    from ..study import run_study, spec_from_mapping, table_rows
+    from ..study import run_study, spec_from_mapping, study_status, table_rows
     from ..study.store import study_lock
 
     out = Path(args.output)
@@ -417,8 +417,10 @@ def _leak_study(args) -> int:
                         log=log_of(args), derived=("summary.json", "figures"))
     with study_lock(out, "`roughfe leak-study`"):      # no run changes the results meanwhile
         _, rows, missing = table_rows(out)
-        if not rows:
-            raise InputError(f"no task of the study in {out} finished; "
+        if not rows:    # the first task's error said here (only `study status` said it)
+            fails = study_status(out).failures
+            why = f" (task {fails[0][0]}: {fails[0][2]})" if fails else ""
+            raise InputError(f"no task of the study in {out} finished{why}; "
                              f"see `roughfe study status {out}`")
         result = summarise(rows)
         # the settings every curve belongs to (Q is at this pressure drop and viscosity;
