@@ -235,3 +235,22 @@ def test_leak_study_with_no_finished_task_says_the_first_error(tmp_path, capsys)
                              "--steps", "2", "--workers", "1", "--E", "1e308", "--no-figures",
                              "-o", str(tmp_path / "ls")], "no task of the study", "(task 0: ")
     assert "did not converge" in line
+
+
+def test_generate_interrupted_while_drawing_leaves_no_old_figure(tmp_path, monkeypatch,
+                                                                 capsys):
+    # generate --overwrite stopped by Ctrl-C while it drew the figure left the replaced
+    # surface's PNG beside the new .npz (whose metadata names that PNG as its figure)
+    out = tmp_path / "w.npz"
+    assert main(["generate", "wm", "--n", "256", "--seed", "1", "-o", str(out)]) == 0
+    assert (tmp_path / "w.png").is_file()
+    import roughfe.plotting.surfaces as plots
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(plots, "plot_profile", interrupted)
+    assert main(["generate", "wm", "--n", "256", "--seed", "2", "-o", str(out),
+                 "--overwrite"]) == 130
+    from roughfe.surfaces.io import load_surface
+    assert load_surface(out).metadata["seed"] == 2         # the new surface, complete
+    assert not (tmp_path / "w.png").exists()                # and no picture of the old one

@@ -182,10 +182,12 @@ def _generate(args) -> int:
     if not args.no_figures:
         surface = surface.with_heights(surface.heights, figure=png.name)
     save_surface(surface, out)
+    if png.is_file() and (stale or not args.no_figures):
+        png.unlink()  # the old picture never stands beside the new surface (a Ctrl-C while
+        #               the new one was drawn left it, named in the new .npz's metadata)
     print(f"wrote {out}: {surface!r}, rms height {rms_height(surface) * 1e6:.4g} um, "
           f"seed {surface.metadata.get('seed')}")
     if args.no_figures and stale:
-        png.unlink()      # the old surface's picture must not stand beside the new one
         print(f"removed {png} (the figure of the surface this file replaced)")
     if not args.no_figures:
         from ..plotting.surfaces import plot_profile, render_surface
