@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..bem.grid_check import GRID_CHANGE_LIMIT, GRID_CHECK_FACTOR, QUANTITIES
-from ..errors import InputError
 from .options import warn
 
 
@@ -35,9 +34,8 @@ def grid_check_of_args(args, surface, material, sweep, law, tol, options):
     refined surface; an adhesive sweep (``law``) with its kernel and tolerance."""
     if not getattr(args, "grid_check", False):
         return None
-    if args.method != "bem":
-        raise InputError("--grid-check solves the BEM on the refined surface; a FEM "
-                         "sweep's grid is its mesh (--method bem)")
+    # --method fem refuses --grid-check with the other BEM-only flags (contact_cmd's
+    # _method_options, before any solve)
     from ..bem.grid_check import grid_check
     if law is not None:
         return grid_check(surface, material, sweep, adhesion=law, unload=args.unload,
