@@ -254,3 +254,27 @@ def test_generate_interrupted_while_drawing_leaves_no_old_figure(tmp_path, monke
     from roughfe.surfaces.io import load_surface
     assert load_surface(out).metadata["seed"] == 2         # the new surface, complete
     assert not (tmp_path / "w.png").exists()                # and no picture of the old one
+
+
+def test_renders_hold_ctrl_c_until_the_picture_is_drawn(tmp_path):
+    # Ctrl-C inside vtk (generate rmd --m 11 at 1.5-1.75 s) was an ImportError traceback,
+    # a ValueError from an empty mesh (vtk swallows the KeyboardInterrupt of its Python
+    # callback) or a segmentation fault: every pyvista render holds it until it returns
+    import signal
+
+    from roughfe.plotting import bands, common, contact, fem, leakage, surfaces
+    for render in (surfaces.render_surface, contact.render_contact, leakage.network_map,
+                   leakage.pressure_map, leakage.flux_map, bands.render_band_sums,
+                   fem._render):
+        assert render.__wrapped__, render           # decorated with holds_interrupts
+    steps = []
+
+    @common.holds_interrupts
+    def drawing():
+        signal.raise_signal(signal.SIGINT)           # Ctrl-C in the middle of the render
+        steps.append("after the signal")
+        return "picture"
+    with pytest.raises(KeyboardInterrupt):
+        drawing()
+    assert steps == ["after the signal"]             # the render finished first
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

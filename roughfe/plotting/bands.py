@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import new_figure, offscreen_plotter, save_figure, save_screenshot
+from .common import (holds_interrupts, load_pyvista, new_figure, offscreen_plotter,
+                     save_figure, save_screenshot)
 
 _UM, _MPA = 1e6, 1e-6
 #: largest number of grid points per axis drawn in a render (larger grids are strided)
@@ -36,6 +37,7 @@ def _pick(n, max_panels):
     return np.unique(np.round(np.linspace(0, n - 1, max_panels)).astype(int))
 
 
+@holds_interrupts
 def render_band_sums(bands, path, which: str = "td", max_panels: int = 6) -> Path:
     """Renders (2D) or line plots (profiles) of ``which`` in {"td", "bu", "chromosomes"}.
 
@@ -61,7 +63,7 @@ def render_band_sums(bands, path, which: str = "td", max_panels: int = 6) -> Pat
             ax.set_title(labels[k], fontsize=9)
         np.atleast_1d(axes)[-1].set_xlabel("x (um)")
         return save_figure(fig, path)
-    import pyvista as pv
+    pv = load_pyvista()
     stride = [max(1, int(np.ceil(n / RENDER_MAX_POINTS))) for n in surf.shape]
     x, y = (c[::s] * _UM for c, s in zip(surf.coordinates(), stride))
     xx, yy = np.meshgrid(x, y, indexing="ij")

@@ -6,6 +6,7 @@ written atomically through :func:`roughfe.writers.atomic_path`.
 """
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import matplotlib
@@ -15,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from .._runtime import headless_environment  # noqa: E402
+from .._runtime import headless_environment, interrupts_held  # noqa: E402
 from ..writers import atomic_path  # noqa: E402
 
 
@@ -63,12 +64,36 @@ def offscreen_plotter(window_size=(1000, 800), **kwargs):
     """A ``pyvista.Plotter`` that renders off-screen (no display needed).
 
     Sets the headless defaults (:func:`roughfe._runtime.headless_environment`) before
-    pyvista is imported.
+    pyvista is imported (:func:`load_pyvista`).
     """
-    headless_environment()
-    import pyvista as pv
+    pv = load_pyvista()
     pv.OFF_SCREEN = True
     return pv.Plotter(off_screen=True, window_size=list(window_size), **kwargs)
+
+
+def load_pyvista():
+    """pyvista, headless (:func:`roughfe._runtime.headless_environment`), imported with
+    Ctrl-C held (:func:`roughfe._runtime.interrupts_held`; see :func:`holds_interrupts`)."""
+    headless_environment()
+    with interrupts_held():
+        import pyvista as pv
+        import pyvista.plotting  # noqa: F401
+    return pv
+
+
+def holds_interrupts(render):
+    """Decorator of a function that renders with pyvista: Ctrl-C (and SIGTERM) is held
+    until it returns, then delivered (:func:`roughfe._runtime.interrupts_held`). A
+    KeyboardInterrupt inside vtk was an ImportError traceback (its lazy module loading),
+    an empty mesh and a ValueError in add_mesh (raised in a vtkPythonAlgorithm callback,
+    which vtk logs and swallows) or a segmentation fault (``generate rmd --m 11``
+    interrupted at 1.5-1.75 s; round 2, session 33). A render takes seconds (block means
+    above MAX_RENDER_POINTS)."""
+    @functools.wraps(render)
+    def held(*args, **kwargs):
+        with interrupts_held():
+            return render(*args, **kwargs)
+    return held
 
 
 def side_bar(title, x=0.88, y=0.15):

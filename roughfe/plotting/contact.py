@@ -7,8 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from .common import (add_triad, block_centres, block_means, block_sums, decimation_note,
-                     new_figure, offscreen_plotter, readable_log_ticks, render_blocks,
-                     save_figure, save_screenshot, side_bar)
+                     holds_interrupts, load_pyvista, new_figure, offscreen_plotter,
+                     readable_log_ticks, render_blocks, save_figure, save_screenshot,
+                     side_bar)
 
 UM = 1e6
 MPA = 1e-6
@@ -304,6 +305,7 @@ def plot_profile_state(heights, result, path, title=None):
     return save_figure(fig, path)
 
 
+@holds_interrupts
 def render_contact(heights, result, path, title=None, exaggeration=None,
                    window_size=(1000, 800)):
     """Off-screen render of the deformed rough surface z = h - u (- u_pl with a hardness)
@@ -316,7 +318,7 @@ def render_contact(heights, result, path, title=None, exaggeration=None,
     means (z; the mean contact pressure where at least half a block is in contact), as
     the label says: contact spots smaller than a block are not seen (A* is in the label).
     """
-    import pyvista as pv
+    pv = load_pyvista()
 
     h = np.asarray(heights)
     if h.ndim != 2:

@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from .._runtime import load_render_backend, render_in_fresh_process
-from .common import (new_figure, offscreen_plotter, readable_log_ticks, save_figure,
-                     save_screenshot, side_bar)
+from .common import (holds_interrupts, load_pyvista, new_figure, offscreen_plotter,
+                     readable_log_ticks, save_figure, save_screenshot, side_bar)
 
 _STYLES = ("-", "--", ":", "-.", (0, (5, 1)), (0, (1, 3)))
 
@@ -156,7 +156,7 @@ def shown_mesh(fields, magnification=None, top_fraction=0.35):
     ``y = top - top_fraction W`` (cells kept whole by their centres drew a saw-tooth
     lower edge the mesh does not have; a user's review). Returns ``(grid, unit, scale,
     magnification, y_cut)``, ``y_cut`` in display units."""
-    import pyvista as pv
+    pv = load_pyvista()
 
     pts = np.asarray(fields["points"], float)
     disp = np.asarray(fields["displacement"], float)
@@ -177,6 +177,7 @@ def shown_mesh(fields, magnification=None, top_fraction=0.35):
             magnification, y_cut)
 
 
+@holds_interrupts
 def _render(fields, path, magnification, top_fraction, window_size, title=None) -> Path:
     plotter = offscreen_plotter(window_size=window_size)
     shown, unit, scale, magnification, y_cut = shown_mesh(fields, magnification, top_fraction)

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from .._runtime import load_render_backend, render_in_fresh_process
-from .common import new_figure, offscreen_plotter, save_figure, save_screenshot, side_bar
+from .common import (holds_interrupts, load_pyvista, new_figure, offscreen_plotter,
+                     save_figure, save_screenshot, side_bar)
 
 UM = 1e6
 
@@ -25,7 +26,7 @@ def _render_elsewhere(name, arrays, **kwargs) -> Path:
 
 
 def _image(shape, size):
-    import pyvista as pv
+    pv = load_pyvista()
     nx, ny = shape
     return pv.ImageData(dimensions=(nx + 1, ny + 1, 1),
                         spacing=(size[0] / nx * UM, size[1] / ny * UM, 1.0))
@@ -94,6 +95,7 @@ def _finish(plotter, title, path, size, right=1.0):
     return save_screenshot(plotter, path)
 
 
+@holds_interrupts
 def network_map(gap, percolating, trapped, size, path, *, title="free-volume network",
                 widest_path=None, junctions=None, sealed=None):
     """Gap map with contact black, percolating cells white to blue (by gap) and trapped
@@ -170,6 +172,7 @@ def network_key(n_contact, n_percolating, n_trapped, n_sealed=None) -> str:
             f"({n_trapped - n_sealed})")
 
 
+@holds_interrupts
 def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="cells",
                  clim=None):
     """Fluid pressure per cell (``at="cells"``, FV) or at the cell corners (``"nodes"``,
@@ -201,6 +204,7 @@ def pressure_map(pressure, size, path, *, title="Reynolds pressure (Pa)", at="ce
     return _finish(pl, title, path, size, right=_BAR_X - 0.01)
 
 
+@holds_interrupts
 def flux_map(flux_magnitude, size, path, *, title="flux magnitude (m^2/s)"):
     """Cell flux magnitude on a log colour scale (cells without flow: black)."""
     if not load_render_backend():

@@ -7,13 +7,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import (add_triad, block_centres, block_means, decimation_note, new_figure,
-                     offscreen_plotter, render_blocks, save_figure, save_screenshot,
-                     side_bar)
+from .common import (add_triad, block_centres, block_means, decimation_note,
+                     holds_interrupts, load_pyvista, new_figure, offscreen_plotter,
+                     render_blocks, save_figure, save_screenshot, side_bar)
 
 UM = 1e6   # metres -> micrometres
 
 
+@holds_interrupts
 def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
                    window_size=(1000, 800)):
     """Off-screen 3D render of a surface warped by its height, with a colour bar in um.
@@ -36,7 +37,7 @@ def render_surface(surface, path, title=None, exaggeration=None, cmap="viridis",
     -------
     Path
     """
-    import pyvista as pv
+    pv = load_pyvista()
 
     if surface.ndim != 2:
         raise ValueError(f"render_surface needs a 2D surface, got a profile {surface.shape}")
