@@ -31,6 +31,12 @@ def test_elastic_and_rigid_plastic_limits():
     soft = elastoplastic_area(s, 1.0, p[:2], 0.02)
     np.testing.assert_allclose(soft.plastic_area_fraction, p[:2] / 0.02, rtol=1e-9)
     assert np.all(soft.elastic_area_fraction < 1e-9)
+    # a hardness near the float limit (contact --hardness 1e308) is the elastic theory, not
+    # an OverflowError of H ** 2 or NaN from images at infinity (CLI fuzzing, session 33)
+    with np.errstate(over="raise", invalid="raise"):
+        huge = elastoplastic_area(s, 1.0, p, 1e308)
+    np.testing.assert_allclose(huge.elastic_area_fraction, erf(np.sqrt(2) * p), rtol=1e-12)
+    assert np.all(huge.plastic_area_fraction == 0.0)
 
 
 @pytest.mark.parametrize("s", [0.002, 0.01, 0.02, 0.05, 0.2])

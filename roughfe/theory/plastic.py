@@ -125,17 +125,21 @@ def _images(p, hardness, std):
     """(A_el, int_0^H sigma P dsigma) by the method of images: P = sum_k g(sigma - p -
     2kH) - g(sigma + p - 2kH), g the normal density of standard deviation ``std``."""
     k = np.arange(-(2 + int(np.ceil(4 * std / hardness))), 3 + int(np.ceil(4 * std / hardness)))
-    c_plus = p[:, None] + 2 * k * hardness
-    c_minus = -p[:, None] + 2 * k * hardness
+    with np.errstate(over="ignore"):     # a hardness near the float limit: far images inf
+        c_plus = p[:, None] + 2 * k * hardness
+        c_minus = -p[:, None] + 2 * k * hardness
 
     def moments(c):      # int_0^H g(sigma - c) dsigma and int_0^H sigma g(sigma - c) dsigma
+        far = ~np.isfinite(c)                     # an image at infinity carries nothing
+        c = np.where(far, 0.0, c)
         hi, lo = (hardness - c) / std, -c / std
         mass = 0.5 * (scipy.special.erf(hi / np.sqrt(2)) - scipy.special.erf(lo / np.sqrt(2)))
         dens = (np.exp(-lo ** 2 / 2) - np.exp(-hi ** 2 / 2)) / np.sqrt(2 * np.pi)
-        return mass, c * mass + std * dens
+        return np.where(far, 0.0, mass), np.where(far, 0.0, c * mass + std * dens)
 
-    m0p, m1p = moments(c_plus)
-    m0m, m1m = moments(c_minus)
+    with np.errstate(over="ignore"):     # (H / std)^2 beyond the float range: exp(-inf) = 0
+        m0p, m1p = moments(c_plus)
+        m0m, m1m = moments(c_minus)
     return (m0p - m0m).sum(axis=1), (m1p - m1m).sum(axis=1)
 
 
@@ -166,7 +170,7 @@ def elastoplastic_area(source, e_star, mean_pressure, hardness) -> Elastoplastic
     _, q2, power = _arrays(_spectrum(source))
     gbar = float(np.sqrt(np.sum(q2 * power)))
     tau = (e * gbar) ** 2 / 8.0
-    s = tau / H ** 2
+    s = (np.sqrt(tau) / H) ** 2       # H ** 2 overflows a float beyond 1.3e154 Pa
     if s < IMAGE_BELOW:
         elastic, first = _images(p, H, np.sqrt(2 * tau))
         plastic = (p - first) / H
