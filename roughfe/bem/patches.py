@@ -20,8 +20,8 @@ A resolved width does not bound the grid's error of a rough surface (round 2, se
 fell by 10-20 % at widths 7-25 on di-1.di and on surfaces rough to the grid scale, by
 3-5 % on surfaces smooth there; no rule on one solution (this width, the share of
 single-point patches, the perimeter per contact point) gave that error within a factor
-3. It is measured, not predicted: :mod:`roughfe.bem.grid_check` (``roughfe contact
---grid-check``; docs/theory/02, "Discretisation error at a fixed surface").
+3. It is measured, not predicted: :mod:`roughfe.bem.grid_check` (the contact command's
+``--grid-check``; docs/theory/02, "Discretisation error at a fixed surface").
 """
 from __future__ import annotations
 
