@@ -125,7 +125,7 @@ def test_bad_input_is_an_input_error(kw):
         elastoplastic_area(rough(16), args["e_star"], 0.1, args["hardness"])
 
 
-def test_contact_cli_writes_the_elastoplastic_theory_beside_a_hardness_run(tmp_path):
+def test_contact_cli_writes_the_elastoplastic_theory_beside_a_hardness_run(tmp_path, capsys):
     import json
 
     from roughfe.cli import main
@@ -143,3 +143,8 @@ def test_contact_cli_writes_the_elastoplastic_theory_beside_a_hardness_run(tmp_p
         list(th.plastic_area_fraction) + [None], rel=1e-9, abs=0)
     assert steps[1]["plastic_area_fraction"] > 0
     assert doc["derived"]["persson"]["elastoplastic"]["hardness"] == 5e7
+    # the printed table's theory column is the elastoplastic A* (it printed "-")
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()
+            if line.strip()[:1].isdigit()]
+    shown = [float(r[-2]) for r in rows[:2]]
+    assert shown == pytest.approx(list(th.area_fraction), rel=2e-3)

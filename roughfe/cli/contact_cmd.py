@@ -213,13 +213,14 @@ def _run(args) -> int:
           + f"{'K (Pa/m)':>12s} {'gap (m)':>12s} {'nit':>5s} "
           + f"{'A* ' + theory.capitalize():>10s} {'patch':>6s}")
     for s, k, t in zip(sweep.to_records(), sweep.stiffness, doc["steps"]):
-        # inf at full periodic contact; "-" where it was not computed (adhesion)
+        # inf at full periodic contact; "-" where it was not computed (adhesion); A* theory:
+        # Persson's elastoplastic one where a hardness gave it (first loading)
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
         pl = (f"{fmt_or_dash(t.get('plastic_area_fraction'), '.3g'):>9s} " if plastic
               else "")
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
               f"{pl}{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
-              f"{fmt_or_dash(t.get(theory + '_area_fraction'), '.3g'):>10s} "
+              f"{fmt_or_dash(t.get('persson_elastoplastic_area_fraction') or t.get(theory + '_area_fraction'), '.3g'):>10s} "
               f"{fmt_or_dash(s.get('patch_width'), '.3g'):>6s}")
     print(f"patch: load-weighted width of the contact patches in grid points (patch_width in "
           f"results.json; below {MIN_PATCH_POINTS:g} not resolved; a resolved width does not "
