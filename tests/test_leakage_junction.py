@@ -150,3 +150,55 @@ def test_empty_and_clipped_negative_gaps_are_refused():
     g[3, :] = -5e-6                      # interpenetrating: became a 1 nm film with h_min
     with pytest.raises(InputError, match="finite and >= 0"):
         reynolds_flow(g, (1e-6, 1e-6), h_min=1e-9)
+
+
+def _channel_with_neck(row, col=(5, 8), shape=(20, 12)):
+    """A straight 3-cell channel along x (columns ``col``) of 1 um in contact, closing to
+    10-12 nm across row ``row``: the junction is (row, col[1] - 1), u_c = 12 nm."""
+    g = np.zeros(shape)
+    g[:, col[0]:col[1]] = UM
+    g[row, col[0]:col[1]] = np.linspace(0.010, 0.012, col[1] - col[0]) * UM
+    return g
+
+
+@pytest.mark.parametrize("row, at_edge", [(0, True), (1, True), (2, False), (10, False),
+                                          (17, False), (18, True), (19, True)])
+def test_a_junction_at_the_cut_of_a_window_is_flagged(row, at_edge):
+    # the neck closing at the inlet or outlet row (or the next) of a non-periodic window
+    # may be the cut's; the same neck inside the window is the surface's
+    g = _channel_with_neck(row)
+    c = critical_constriction(g, (UM, UM), direction="x", periodic=False)
+    assert c.junction == (row, 7) and c.critical_gap == pytest.approx(0.012 * UM, abs=0)
+    assert c.at_edge is at_edge and c.record()["critical_at_edge"] is at_edge
+    # a periodic window has no cut: never flagged, the same junction
+    p = critical_constriction(g, (UM, UM), direction="x", periodic=True)
+    assert p.junction == (row, 7) and p.at_edge is False
+
+
+@pytest.mark.parametrize("col, at_edge", [((0, 3), True), ((1, 4), True), ((2, 5), False),
+                                          ((9, 12), True), ((8, 11), True), ((7, 10), False)])
+def test_a_junction_against_a_side_wall_is_flagged(col, at_edge):
+    # the neck in the middle row, its widest cell (the junction) on the wall side of a
+    # channel along a non-periodic side wall (the real surface may go round it beyond the
+    # wall); the transposed field along y agrees
+    g = _channel_with_neck(10, col=col)
+    jc = col[0] if col[0] < 6 else col[1] - 1          # the cell nearest the wall
+    g[10, col[0]:col[1]] = 0.010 * UM
+    g[10, jc] = 0.012 * UM
+    c = critical_constriction(g, (UM, UM), direction="x", periodic=False)
+    assert c.junction == (10, jc) and c.at_edge is at_edge
+    t = critical_constriction(g.T, (UM, UM), direction="y", periodic=False)
+    assert t.junction == (jc, 10) and t.at_edge is at_edge
+    assert not critical_constriction(g, (UM, UM), direction="x", periodic=True).at_edge
+
+
+def test_at_edge_reaches_the_records_per_direction():
+    g = _channel_with_neck(19)
+    rec = analyse_leakage(g, None, (UM, UM), direction="x", reynolds=False).record()
+    assert rec["critical_at_edge_x"] is True and rec["critical_at_edge"] is True
+    assert rec["critical_at_edge_y"] is None        # not analysed (no junction: None)
+    sealed = np.zeros((8, 8))
+    sealed[:, 3] = UM
+    sealed[4, 3] = 0.0
+    rec = analyse_leakage(sealed, None, (UM, UM), direction="x", reynolds=False).record()
+    assert rec["critical_at_edge_x"] is None        # no percolation, no junction

@@ -31,6 +31,12 @@ REFERENCES = (
 )
 
 
+#: the keys of :meth:`roughfe.leakage.junction.CriticalConstriction.record`, per direction
+#: (``_x``, ``_y``) and, unsuffixed, the first analysed direction's
+_JUNCTION_KEYS = ("critical_gap", "critical_position", "critical_width",
+                  "parent_channel_length", "critical_at_edge")
+
+
 def _direction_list(direction) -> tuple:
     if direction == "both":
         return ("x", "y")
@@ -104,8 +110,9 @@ class LeakageResult:
         ``percolates_<d>`` is the network verdict (its corner rule);
         ``leak_rate_critical_junction`` (unsuffixed) is the mean of the per-direction
         junction leak rates, as ``leak_rate``; the unsuffixed ``critical_gap``,
-        ``critical_position``, ``critical_width`` and ``parent_channel_length`` are the
-        first analysed direction's junction (``_x``/``_y`` keys for each);
+        ``critical_position``, ``critical_width``, ``parent_channel_length`` and
+        ``critical_at_edge`` (the junction within one cell of a non-periodic window edge)
+        are the first analysed direction's junction (``_x``/``_y`` keys for each);
         ``percolates_reynolds_<d>`` the one of the Reynolds scheme (FV: face neighbours;
         FE: Q1 corner conduction); ``flow_imbalance_<d>`` its
         ``|inlet - outlet| / |leak rate|`` (above 1e-6 a boundary flow is round-off,
@@ -140,8 +147,7 @@ class LeakageResult:
             rec[f"reynolds_nit_{d}"] = None if flow is None else flow.nit
             con = self.constrictions.get(d)
             for key, val in (con.record() if con is not None else
-                             dict.fromkeys(("critical_gap", "critical_position",
-                                            "critical_width", "parent_channel_length"))).items():
+                             dict.fromkeys(_JUNCTION_KEYS)).items():
                 rec[f"{key}_{d}"] = val
             rec[f"leak_rate_critical_junction_{d}"] = (
                 None if con is None else con.leak_rate_junction(
@@ -151,8 +157,7 @@ class LeakageResult:
         # directions (the first direction's alone read "sealed", 0, beside a positive Q
         # that flowed along y); the geometry of the first direction's junction
         first = self.directions[0]
-        for key in ("critical_gap", "critical_position", "critical_width",
-                    "parent_channel_length"):
+        for key in _JUNCTION_KEYS:
             rec[key] = rec[f"{key}_{first}"]
         rates = [rec[f"leak_rate_critical_junction_{d}"] for d in self.directions]
         rec["leak_rate_critical_junction"] = (
@@ -349,6 +354,8 @@ _RECORD_UNITS = {
     "hydraulic_aperture": "m", "percolates": "bool", "percolates_reynolds": "bool",
     "flow_imbalance": "1 (|inlet flow - outlet flow| / leak rate)", "reynolds_nit": "count",
     "critical_position": "m (x, y of the junction centre)", "critical_width": "m",
+    "critical_at_edge": "bool (the junction lies within one cell of a non-periodic window's "
+                        "edge: the constriction may be the cut's, not the surface's)",
     "parent_channel_length": "m", "fsi_state": "label", "coupled_iterations": "count",
     "stiffness": "Pa/m", "trapped_fluid": "label (pocket law)", "bulk_modulus": "Pa",
     "leak_rate_coupled": "m^3/s", "pocket_pressures": "Pa (one per pocket)",

@@ -22,6 +22,12 @@ face-connected, the connectivity of the default finite-volume Reynolds scheme):
   ``h^3`` is within a factor 8 of the junction's); ``parent_channel_length`` is its length
   along the path (m). The thesis names these two sizes as future work without a
   definition; these are ours, stated here and in docs/theory/04b_leakage_ii.md.
+* **At the edge** (``at_edge``): on a non-periodic window (a measured crop), a junction
+  whose cell lies within :data:`EDGE_CELLS` cell of any of the four window edges. The
+  constriction there may be an artefact of the cut: beyond the edge the real surface can
+  go round it (a wall of the window) or open into it (the inlet or outlet reservoir), so
+  ``u_c``, the width and the junction leak rate are then the window's, not the
+  surface's. A periodic window has no cut and never flags.
 * ``leak_rate_junction`` = ``(W/L) u_c^3 dp / (12 mu)``: Lorenz & Persson's (2009)
   critical-junction formula (Eq. 5 there) with the *measured* ``u_c``, beside the
   Reynolds leak rate and beside the PSD-based estimate of
@@ -40,6 +46,11 @@ from ..errors import (InputError, check_finite_nonnegative, check_finite_positiv
                       check_real_array, check_spacing)
 from ..frozen import ReadOnlyArrays, read_only_arrays
 from .components import components_reaching
+
+#: a junction within this many cells of a non-periodic window edge is ``at_edge`` (0: the
+#: edge row or column only; 1: also the next one, where a channel closing at the cut
+#: still narrows; the x3p-2 128^2 crop's y junction was in the last row, round 2, s. 33)
+EDGE_CELLS = 1
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,6 +78,10 @@ class CriticalConstriction(ReadOnlyArrays):
         Cells of the parent channel (a stretch of ``path``).
     channel_factor : float
         Parent-channel threshold (gap < factor u_c).
+    at_edge : bool
+        The junction lies within :data:`EDGE_CELLS` cell of a window edge of a
+        non-periodic gap (module docstring): the constriction may be the cut's, not the
+        surface's. False without a junction and on periodic gaps.
     """
 
     direction: str
@@ -79,6 +94,7 @@ class CriticalConstriction(ReadOnlyArrays):
     path: np.ndarray
     channel: np.ndarray
     channel_factor: float
+    at_edge: bool = False
 
     def __post_init__(self):       # a result never changes: its arrays read-only
         read_only_arrays(self)     # in place (copies: +0.45 GB at 4096^2 Reynolds)
@@ -99,11 +115,12 @@ class CriticalConstriction(ReadOnlyArrays):
 
     def record(self) -> dict:
         """JSON-safe scalars: ``critical_gap``, ``critical_position``, ``critical_width``,
-        ``parent_channel_length``."""
+        ``parent_channel_length``, ``critical_at_edge`` (None without a junction)."""
         return {"critical_gap": self.critical_gap,
                 "critical_position": None if self.position is None else list(self.position),
                 "critical_width": self.width,
-                "parent_channel_length": self.parent_channel_length}
+                "parent_channel_length": self.parent_channel_length,
+                "critical_at_edge": None if self.junction is None else bool(self.at_edge)}
 
 
 def _percolates(g_flow, u, periodic):
@@ -155,6 +172,8 @@ def critical_constriction(gap, spacing, *, direction: str = "x", periodic: bool 
     Returns
     -------
     CriticalConstriction
+        With ``at_edge`` when ``periodic`` is False and the junction lies within
+        :data:`EDGE_CELLS` cell of an edge.
     """
     g = check_real_array("gap", gap, 2)
     if min(g.shape) < 1 or g.min() < 0:
@@ -206,6 +225,9 @@ def critical_constriction(gap, spacing, *, direction: str = "x", periodic: bool 
     along = np.concatenate([along[:1] if along.size else [True], along])
     length = float(np.where(along, dl, dt)[a:b + 1].sum())
     centre = (i * dl, j * dt)           # the cell centres of Surface.coordinates()
+    # the distance to the nearest edge; a periodic window has none (its walls wrap, and
+    # its inlet and outlet cut nothing: the surface beyond them is the window itself)
+    at_edge = not periodic and min(i, j, gf.shape[0] - 1 - i, gf.shape[1] - 1 - j) <= EDGE_CELLS
     if direction == "y":
         path, seg = path[:, ::-1], seg[:, ::-1]
         i, j = j, i
@@ -214,7 +236,8 @@ def critical_constriction(gap, spacing, *, direction: str = "x", periodic: bool 
                                 junction=(i, j), position=tuple(float(c) for c in centre),
                                 width=float(width), parent_channel_length=length,
                                 path=np.ascontiguousarray(path),
-                                channel=np.ascontiguousarray(seg), channel_factor=factor)
+                                channel=np.ascontiguousarray(seg), channel_factor=factor,
+                                at_edge=bool(at_edge))
 
 
 def _run_length(row: np.ndarray, pos: int, periodic: bool) -> int:
