@@ -399,3 +399,31 @@ def test_leak_at_the_theory_s_full_contact_prints_no_numpy_warning(tmp_path, cap
     assert res["steps"][0]["persson_mean_gap"] == 0.0
     assert res["steps"][0]["persson_stiffness"] is None
     assert "null: infinite" in res["persson"]["units"]["persson_stiffness"]
+
+
+def test_leak_says_which_junctions_lie_at_the_edge_of_a_window(tmp_path, capsys):
+    # a non-periodic window: the printed line names exactly the steps and directions that
+    # results.json flags critical_at_edge (the spectral seed-1 32^2 surface, read
+    # non-periodic: the y junctions at the window's edge at both approaches); the same
+    # surface periodic has no cut and flags none
+    from roughfe.cli import main
+    path = tmp_path / "s.npz"
+    assert main(["generate", "spectral", "--n", "32", "--seed", "1", "--no-figures",
+                 "-o", str(path)]) == 0
+    flagged = {}
+    for periodic in ("--non-periodic", "--periodic"):
+        out = tmp_path / periodic
+        capsys.readouterr()
+        assert main(["leak", str(path), periodic, "--delta", "1e-7", "2e-7", "--no-figures",
+                     "-o", str(out)]) == 0
+        printed = [ln for ln in capsys.readouterr().out.splitlines()
+                   if ln.startswith("junction at the window's edge")]
+        res = json.loads((out / "results.json").read_text())
+        assert res["units"]["critical_at_edge_x"].startswith("bool")
+        flagged[periodic] = [
+            f"{s['step']} ({', '.join(d for d in 'xy' if s[f'critical_at_edge_{d}'])})"
+            for s in res["steps"] if s["critical_at_edge_x"] or s["critical_at_edge_y"]]
+        assert bool(printed) == bool(flagged[periodic])
+        if printed:
+            assert f"steps {', '.join(flagged[periodic])}:" in printed[0]
+    assert flagged == {"--non-periodic": ["0 (y)", "1 (y)"], "--periodic": []}

@@ -16,6 +16,12 @@ Both solve with CG + BoomerAMG and return the leak rate, the hydraulic aperture 
 pressure and flux fields as a frozen :class:`ReynoldsResult`. The flux per unit width is
 Eq. 2.11 divided by the (constant) density, ``q = h U/2 - h^3/(12 mu) grad p`` (m^2/s),
 at the cell centres.
+
+Without wall motion the flow is linear in the drop and in ``1/mu``: :func:`reynolds_flow`
+solves at a unit drop and viscosity and scales the result (:func:`times_ratio`), so that
+the hydraulic aperture and the flow imbalance do not depend on them and no drop or
+viscosity that a float holds overflows inside the solve; a leak rate beyond the float
+range itself is refused (:func:`check_leak_scale`).
 """
 from __future__ import annotations
 
@@ -139,6 +145,42 @@ def hydraulic_aperture(leak_rate: float, *, mu: float, pressure_drop: float,
     return float(np.cbrt(max(leak_rate, 0.0) * 12.0 * mu * flow_length / (width * dp)))
 
 
+def times_ratio(value, numerator: float, denominator: float):
+    """``value * numerator / denominator`` without an intermediate overflow or underflow.
+
+    The three are split into mantissa and binary exponent (``frexp``) and the product is
+    rebuilt once (``ldexp``): finite whenever the result is, rounded as a product of three
+    floats; ``inf`` or 0 only where the result itself is beyond the float range. ``value``
+    may be an array.
+    """
+    mv, ev = np.frexp(value)
+    mn, en = np.frexp(float(numerator))
+    md, ed = np.frexp(float(denominator))
+    with np.errstate(over="ignore", under="ignore"):
+        out = np.ldexp(mv * mn / md, ev + (en - ed))
+    return out if np.ndim(out) else float(out)
+
+
+def check_leak_scale(conductance: float, pressure_drop: float, mu: float) -> float:
+    """The leak rate ``Q = C dp / mu`` (m^3/s) of a gap of conductance ``C`` (m^3, the leak
+    rate at a unit drop and viscosity); :class:`~roughfe.errors.InputError` when ``Q > 0``
+    is beyond the normal float range (it overflowed to a null, or underflowed to 0 or to
+    a subnormal that keeps few digits), naming the range of ``dp / mu`` this gap allows."""
+    q = times_ratio(conductance, pressure_drop, mu)
+    info = np.finfo(float)
+    if conductance > 0 and not (info.tiny <= q <= info.max):
+        with np.errstate(over="ignore"):
+            low, high = info.tiny / conductance, info.max / conductance
+        allowed = (f"from {low:.3g} to {high:.3g} 1/s" if np.isfinite(high)
+                   else f"from {low:.3g} 1/s up")
+        raise InputError(
+            f"pressure_drop = {pressure_drop:g} Pa with mu = {mu:g} Pa s: the leak rate "
+            f"Q = C dp / mu (C = {conductance:.4g} m^3, this gap's leak rate at a unit drop "
+            f"and viscosity) {'overflows' if q > 1 else 'underflows'} the float range; "
+            f"this gap allows dp / mu {allowed}")
+    return q
+
+
 def cell_flux(pressure, gap, spacing, *, mu: float, wall_velocity=(0.0, 0.0)) -> np.ndarray:
     """Flux per unit width at the cell centres, ``q = h U/2 - h^3/(12 mu) grad p`` (Eq. 2.11).
 
@@ -214,26 +256,37 @@ def reynolds_flow(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         raise InputError("pressure_drop is 0 and there is no wall velocity: nothing drives the flow")
     h_min = check_finite_nonnegative("h_min (m)", h_min)
     h = np.maximum(g, h_min) if h_min > 0 else g
+    # without wall motion the flow is linear in the drop and in 1/mu: solved at a unit drop
+    # and viscosity (the pressure a fraction of the drop) and scaled, so that no drop or
+    # viscosity a float holds overflows or underflows inside the solve (--pressure-drop
+    # 1e308: the dissipation dp^2 overflowed, Q and h_eff null; --mu 1e308: h_eff 0)
+    unit = dp > 0 and not np.any(u != 0)
+    mu_s, p_in_s, p_out_s = (1.0, 1.0, 0.0) if unit else (mu, p_out + dp, p_out)
     if scheme == "fv":
-        sol = solve_reynolds_fv(h, spacing, direction=direction, mu=mu, p_in=p_out + dp,
-                                p_out=p_out, periodic=periodic, wall_velocity=wall_velocity,
+        sol = solve_reynolds_fv(h, spacing, direction=direction, mu=mu_s, p_in=p_in_s,
+                                p_out=p_out_s, periodic=periodic, wall_velocity=wall_velocity,
                                 petsc_options=petsc_options)
         leak, flux = sol.leak_rate, sol.flux
     else:
-        sol = solve_reynolds_fe(h, spacing, direction=direction, mu=mu, p_in=p_out + dp,
-                                p_out=p_out, periodic=periodic, wall_velocity=wall_velocity,
+        sol = solve_reynolds_fe(h, spacing, direction=direction, mu=mu_s, p_in=p_in_s,
+                                p_out=p_out_s, periodic=periodic, wall_velocity=wall_velocity,
                                 petsc_options=petsc_options)
         leak = sol.flow_rate
-        flux = cell_flux(sol.pressure_pinned, h, spacing, mu=mu, wall_velocity=wall_velocity)
+        flux = cell_flux(sol.pressure_pinned, h, spacing, mu=mu_s, wall_velocity=wall_velocity)
     nx, ny = h.shape
     lengths = (nx * spacing[0], ny * spacing[1])
     axis = 0 if direction == "x" else 1
     flow_length, width = lengths[axis], lengths[1 - axis]
-    aperture = (hydraulic_aperture(leak, mu=mu, pressure_drop=dp,
+    aperture = (hydraulic_aperture(leak, mu=mu_s, pressure_drop=1.0 if unit else dp,
                                    flow_length=flow_length, width=width) if dp > 0 else None)
+    pressure, q_in, q_out = sol.pressure, sol.inlet_flow, sol.outlet_flow
+    if unit:
+        leak = check_leak_scale(leak, dp, mu)       # refused when Q is beyond the floats
+        pressure = p_out + dp * pressure
+        flux, q_in, q_out = (times_ratio(v, dp, mu) for v in (flux, q_in, q_out))
     result = ReynoldsResult(
-        direction=direction, scheme=scheme, leak_rate=leak, hydraulic_aperture=aperture,
-        inlet_flow=sol.inlet_flow, outlet_flow=sol.outlet_flow, pressure=sol.pressure,
+        direction=direction, scheme=scheme, leak_rate=float(leak), hydraulic_aperture=aperture,
+        inlet_flow=float(q_in), outlet_flow=float(q_out), pressure=pressure,
         flux=flux, percolates=sol.percolates, pressure_drop=dp, mu=float(mu),
         flow_length=flow_length, width=width, success=sol.success, message=sol.message,
         nit=sol.nit)
