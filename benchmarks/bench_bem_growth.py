@@ -72,8 +72,8 @@ def refinement_case(base, n, hurst, seed, loads):
     """The surface of the ``base`` grid, resampled on ``n`` points per side."""
     from roughfe.surfaces.spectral import spectral_surface
     c0 = time.process_time()
-    # resampled at every n, the base grid included: its Nyquist modes are dropped there
-    # too, so every n carries exactly the same continuous surface
+    # resampled at every n (the base grid: the identity); spectral_surface leaves the
+    # Nyquist modes empty, so every n carries exactly the same continuous surface
     s = spectral_surface(base, 1.0, hurst, rms_slope=1.0, rng=seed).resampled((n, n))
     nit, area = _solve_loads(s, loads)
     return {"kind": "refinement", "base": base, "n": n, "hurst": hurst, "seed": seed,

@@ -197,33 +197,18 @@ class Surface(ReadOnlyArrays):
 
     def resampled(self, shape) -> "Surface":
         """The band-limited Fourier interpolant of a periodic surface on another grid of
-        the same size (``shape`` points per axis).
+        the same size (``shape`` points per axis, integers >= 2).
 
-        The discrete spectrum is kept for the wavenumbers both grids resolve,
-        ``|k| < min(n, m)/2`` per axis, and zero beyond (the Nyquist modes, which a real
-        field cannot carry with a phase, are dropped); coarsening therefore low-passes the
-        heights to the new grid's Nyquist wavenumber instead of aliasing them as thinning
-        would. The mean height is kept exactly. Metadata ``resampled_from`` (old shape).
+        Waves both grids resolve are kept, waves beyond the coarser grid's Nyquist
+        wavenumber removed (coarsening low-passes instead of aliasing as thinning would);
+        the Nyquist mode of an even grid is the cosine the samples see, split between
+        ``+-n/2`` on refinement (the old samples are kept where the nodes coincide) and
+        joined from ``+-m/2`` on coarsening; the mean height is kept exactly
+        (:func:`roughfe.surfaces.resample.resampled`, which says why). Metadata
+        ``resampled_from`` (old shape).
         """
-        if not self.periodic:
-            raise InputError("resampled() is the Fourier interpolant of a periodic surface; "
-                             "mirror a non-periodic window first (Surface.mirrored)")
-        given = (shape,) if np.ndim(shape) == 0 else tuple(shape)
-        if len(given) != self.ndim:
-            raise InputError(f"resampled shape must have {self.ndim} entries >= 2, got {shape}")
-        shape = tuple(check_int(f"resampled shape[{k}] (points along axis {k})", m, 2)
-                      for k, m in enumerate(given))
-        spec = np.fft.fftn(self.heights)
-        out = np.zeros(shape, dtype=complex)
-        index = []
-        for n, m in zip(self.shape, shape):
-            k = np.arange(-((min(n, m) - 1) // 2), (min(n, m) - 1) // 2 + 1)
-            index.append(k)
-        grids = np.ix_(*index)
-        out[grids] = spec[grids]
-        h = np.fft.ifftn(out).real * (np.prod(shape) / np.prod(self.shape))
-        return Surface(h, self.size, periodic=True,
-                       metadata={**self.metadata, "resampled_from": list(self.shape)})
+        from .resample import resampled
+        return resampled(self, shape)
 
     def refined(self, factor: int) -> "Surface":
         """The same surface ``factor`` times finer per axis (integer >= 1): the
