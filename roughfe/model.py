@@ -232,18 +232,25 @@ class Loading:
         """True for load control (mean_pressure / pressures), False for approaches."""
         return self.kind in ("mean_pressure", "pressures")
 
-    def require_contact(self) -> None:
+    def require_contact(self, words=None) -> None:
         """Raise :class:`InputError` if an approach is negative: the surfaces then stand
         apart, a state only an attraction makes a problem of (``response(...,
         adhesion=law)``, whose loading can start apart and jump in); the non-adhesive
-        solvers have no contact to solve there."""
+        solvers have no contact to solve there.
+
+        ``words`` maps the names in the message (``delta``, ``deltas``, ``adhesion``) to
+        a front end's own, as for :func:`roughfe.bem.adhesive_rules.check_adhesive_run`
+        (the command line passes ``--delta`` and ``--adhesion``); by default they are the
+        library's keyword arguments."""
+        say = {"adhesion": "response(..., adhesion=law)", **(words or {})}
         values = {"delta": (self.delta,), "deltas": self.deltas}.get(self.kind, ())
         for k, v in enumerate(values):
             if v < 0.0:
-                name = "delta" if self.kind == "delta" else f"deltas[{k}]"
+                name = say.get(self.kind, self.kind) + ("" if self.kind == "delta"
+                                                        else f"[{k}]")
                 raise InputError(f"{name} = {v!r} m is a negative approach (the surfaces "
-                                 f"apart): meaningful with adhesion only (response(..., "
-                                 f"adhesion=law)); without it give approaches >= 0")
+                                 f"apart): meaningful with adhesion only ({say['adhesion']}"
+                                 f"); without it give approaches >= 0")
 
     def sweep_arguments(self) -> dict:
         """The keyword arguments of :func:`roughfe.bem.contact_sweep` for this loading:

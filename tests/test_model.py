@@ -147,6 +147,15 @@ def test_approaches_apart_are_for_adhesion_only():
         response(surf, mat, loading)
     with pytest.raises(InputError, match=r"delta = -1e-06 m is a negative approach"):
         response(_profile_of(surf), mat, Loading(delta=-1e-6), method="fem")
+    # a front end's words (round 2, session 34: the command line said it with a copy of
+    # this check): every name of the message, none of the library's left
+    with pytest.raises(InputError, match=r"^--delta\[1\] = -2e-09 m is a negative approach "
+                                         r"\(the surfaces apart\): meaningful with adhesion "
+                                         r"only \(--adhesion\)") as err:
+        Loading(deltas=[1e-9, -2e-9]).require_contact(
+            words={"deltas": "--delta", "adhesion": "--adhesion"})
+    assert "response(" not in str(err.value) and "deltas" not in str(err.value)
+    Loading(deltas=[0.0, 1e-9]).require_contact(words={"deltas": "--delta"})
     sw = response(surf, mat, loading, adhesion=AdhesionLaw("exp", 0.01, 1e-7))
     # the imposed approaches, to the mean-gap tolerance (~1e-14 m here)
     np.testing.assert_allclose(sw.delta, loading.deltas, rtol=0, atol=1e-12)

@@ -328,17 +328,13 @@ def contact_physics_from_args(args) -> dict:
     :func:`roughfe.response.response`); --hardness with --adhesion is one clear error, and
     so is a negative --delta without --adhesion (in the flags' words, for both commands)."""
     law = adhesion_from_args(args)
+    deltas = getattr(args, "delta", None)
     if law is not None:
         from ..bem.adhesive_rules import check_adhesive_run
-        check_adhesive_run(hardness=args.hardness, deltas=getattr(args, "delta", None),
-                           words=ADHESION_WORDS)
-    else:   # said here for both commands (leak said the library's "deltas[0] ... response(")
-        from ..errors import InputError
-        for k, v in enumerate(getattr(args, "delta", None) or ()):
-            if v < 0.0:
-                raise InputError(f"--delta[{k}] = {v!r} m is a negative approach (the surfaces"
-                                 " apart): meaningful with adhesion only (--adhesion); without"
-                                 " it give approaches >= 0")
+        check_adhesive_run(hardness=args.hardness, deltas=deltas, words=ADHESION_WORDS)
+    elif deltas:    # said here for both commands (leak said "deltas[0] ... response(")
+        from ..model import Loading
+        Loading(deltas=deltas).require_contact(words=ADHESION_WORDS)
     return {"adhesion": law, "hardness": args.hardness, "unload": bool(args.unload)}
 
 
