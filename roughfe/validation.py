@@ -43,6 +43,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .errors import InputError
+from .writers import finite_or_none
 
 #: Orders outside this range are taken as "not in the asymptotic range".
 ORDER_RANGE = (0.5, 4.0)
@@ -65,8 +66,7 @@ class Target:
     def to_dict(self) -> dict:
         d = asdict(self)
         d["met"] = None if self.met is None else bool(self.met)
-        if d["value"] is not None:
-            d["value"] = float(d["value"]) if math.isfinite(d["value"]) else None
+        d["value"] = finite_or_none(d["value"])
         return d
 
 
@@ -192,8 +192,7 @@ class Richardson:
     method: str
 
     def to_dict(self) -> dict:
-        def clean(v):
-            return float(v) if np.isfinite(v) else None
+        clean = finite_or_none
         return {"values": [clean(v) for v in self.values], "ratio": self.ratio,
                 "orders": [clean(v) for v in self.orders], "order": clean(self.order),
                 "asymptotic": self.asymptotic, "limit": clean(self.limit),

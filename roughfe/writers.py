@@ -127,7 +127,7 @@ def to_jsonable(obj):
     if isinstance(obj, int):
         return int(obj)
     if isinstance(obj, float):
-        return float(obj) if math.isfinite(obj) else None
+        return finite_or_none(obj)
     if isinstance(obj, np.ndarray):
         if np.iscomplexobj(obj):
             raise TypeError(f"a complex array {obj.shape} has no JSON form")
@@ -150,6 +150,17 @@ def to_jsonable(obj):
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return to_jsonable({f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)})
     raise TypeError(f"object of type {type(obj).__name__} is not JSON serialisable")
+
+
+def finite_or_none(value):
+    """``float(value)`` when ``value`` is a finite number (a Python or numpy scalar), else
+    ``None``: the number rule of :func:`to_jsonable` for one value (NaN and infinities are
+    undefined values, JSON ``null``; ``None`` stays ``None``). The one place of the
+    idiom; modules that write JSON-safe summaries by hand use it."""
+    if value is None:
+        return None
+    v = float(value)
+    return v if math.isfinite(v) else None
 
 
 def to_json_text(data, indent=2) -> str:

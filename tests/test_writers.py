@@ -1,6 +1,7 @@
 """roughfe.writers: file modes, the one JSON rule, temporary names, output-folder ownership."""
 import json
 import os
+import re
 import stat
 import subprocess
 import sys
@@ -11,7 +12,8 @@ import pytest
 
 from roughfe.errors import InputError
 from roughfe.writers import (OWNER_FILE, UNFINISHED_FILE, OutputFolder, atomic_path,
-                             output_file, to_json_text, to_jsonable, write_json, write_text)
+                             finite_or_none, output_file, to_json_text, to_jsonable,
+                             write_json, write_text)
 
 
 @pytest.fixture
@@ -43,6 +45,22 @@ def test_to_jsonable_is_the_one_rule():
         to_jsonable(np.array([1j]))
     with pytest.raises(TypeError):
         to_jsonable(object())
+
+
+def test_finite_or_none_is_the_number_rule_in_one_place():
+    """Round 2, session 34: the grid check, the window report and the validation rows
+    each had their own copy of ``float(x) if isfinite(x) else None``."""
+    assert [finite_or_none(v) for v in (1.5, np.float32(0.5), np.int64(3), np.array(2.0),
+                                        np.nan, -np.inf, np.float64("inf"), None)] == \
+        [1.5, 0.5, 3.0, 2.0, None, None, None, None]
+    assert type(finite_or_none(np.float32(0.5))) is float
+    with pytest.raises(TypeError):
+        finite_or_none(1j)
+    idiom = re.compile(r"if (np|math|numpy)\.isfinite\([^()]*\) else None")
+    root = Path(__file__).resolve().parents[1] / "roughfe"
+    copies = [str(p.relative_to(root)) for p in root.rglob("*.py")
+              if p.name != "writers.py" and idiom.search(p.read_text())]
+    assert not copies, f"use roughfe.writers.finite_or_none in {copies}"
 
 
 def test_a_legal_249_character_name_is_written_and_no_temporary_is_left(tmp_path):

@@ -40,6 +40,7 @@ from ..frozen import Frozen, compact_repr
 from ..model import Material, SweepResult
 from ..surfaces.resample import refined
 from ..surfaces.surface import Surface
+from ..writers import finite_or_none
 
 #: relative change of A*, K, the mean gap, the pull-off (fine over coarse less 1) or the
 #: adhesive mean pressure above which the grid check says that the grid does not resolve
@@ -140,9 +141,9 @@ class GridCheck(Frozen):
                 if q == "pull_off_pressure":
                     continue
                 c = self.change(q)[i]
-                row[q] = _finite(self.coarse[q][i])
-                row[q + "_fine"] = _finite(self.fine[q][i])
-                row[q + "_change"] = _finite(c)
+                row[q] = finite_or_none(self.coarse[q][i])
+                row[q + "_fine"] = finite_or_none(self.fine[q][i])
+                row[q + "_change"] = finite_or_none(c)
             steps.append(row)
         out = {"factor": self.factor, "shape": list(self.shape), "limit": self.limit,
                "method": "band-limited (Fourier) refinement of the same surface, "
@@ -152,15 +153,11 @@ class GridCheck(Frozen):
                                   for q, (c, k) in self.largest().items()},
                "flagged": self.flagged, "note": self.note()}
         if "pull_off_pressure" in self.coarse:
-            out["pull_off_pressure"] = _finite(self.coarse["pull_off_pressure"])
-            out["pull_off_pressure_fine"] = _finite(self.fine["pull_off_pressure"])
-            out["pull_off_pressure_change"] = _finite(self.change("pull_off_pressure")[0])
+            out["pull_off_pressure"] = finite_or_none(self.coarse["pull_off_pressure"])
+            out["pull_off_pressure_fine"] = finite_or_none(self.fine["pull_off_pressure"])
+            out["pull_off_pressure_change"] = finite_or_none(
+                self.change("pull_off_pressure")[0])
         return out
-
-
-def _finite(v):
-    v = float(np.asarray(v).ravel()[0]) if np.ndim(v) else float(v)
-    return v if np.isfinite(v) else None
 
 
 def grid_check(surface: Surface, material: Material, sweep: SweepResult, *,

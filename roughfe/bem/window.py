@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import WindowStiffnessWarning
 from ..model import Material
+from ..writers import finite_or_none
 
 #: K C above which :func:`window_report` warns (at the largest load): the bulk of the
 #: window then takes more than half of the compliance 1/K
@@ -105,6 +106,6 @@ def window_report(sweep) -> dict:
                 stacklevel=2)
 
     def listed(a):
-        return [float(v) if np.isfinite(v) else None for v in a]
+        return [finite_or_none(v) for v in a]
     return {"window_compliance": c, "bulk_share": listed(share),
             "stiffness_compliance": listed(kc)}
