@@ -94,3 +94,18 @@ def test_leak_rate_scales_with_the_drop_over_the_viscosity(surface32, tmp_path):
         assert s["hydraulic_aperture"] == base["hydraulic_aperture"] > 0
         # |in - out| / Q ~ 1e-10 from the scaled boundary flows: their rounding, 1e-16 of Q
         assert s["flow_imbalance_x"] == pytest.approx(base["flow_imbalance_x"], rel=1e-4, abs=0)
+
+
+def test_junction_leak_rate_is_scaled_as_the_reynolds_one():
+    # (W/L) u_c^3 dp / (12 mu) at the float limits: was 0.0 in silence at mu 1e308
+    from roughfe.leakage import critical_constriction
+    g = np.full((N, 12), H)
+    c = critical_constriction(g, (DX, DX), direction="x")
+    kw = dict(length=N * DX, width=12 * DX)
+    exact = 12 / N * H**3 / 12.0
+    for dp, mu in ((1.0, 1.0), (1e300, 1e-3), (1.0, 1e250)):
+        assert c.leak_rate_junction(mu=mu, pressure_drop=dp, **kw) == pytest.approx(
+            exact * (dp / mu), rel=1e-12, abs=0)
+    assert c.leak_rate_junction(mu=1.0, pressure_drop=0.0, **kw) == 0.0
+    with pytest.raises(InputError, match="underflows"):
+        c.leak_rate_junction(mu=1e308, pressure_drop=1.0, **kw)

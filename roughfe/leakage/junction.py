@@ -103,7 +103,9 @@ class CriticalConstriction(ReadOnlyArrays):
                            width: float) -> Optional[float]:
         """``(W/L) u_c^3 dp / (12 mu)`` (m^3/s) with the measured ``u_c``; 0 if sealed.
 
-        ``length`` and ``width`` are the domain's size along and across the flow (m).
+        ``length`` and ``width`` are the domain's size along and across the flow (m). A
+        rate beyond the normal float range is an InputError
+        (:func:`roughfe.leakage.reynolds.check_leak_scale`).
         """
         mu = check_finite_positive("mu (Pa s)", mu)
         pressure_drop = check_finite_nonnegative("pressure_drop (Pa)", pressure_drop)
@@ -111,7 +113,11 @@ class CriticalConstriction(ReadOnlyArrays):
         width = check_finite_positive("width (m)", width)
         if not self.percolates:
             return 0.0
-        return float(width / length * self.critical_gap ** 3 * pressure_drop / (12.0 * mu))
+        # linear in dp / mu: scaled as the Reynolds leak rate (a drop or viscosity near the
+        # float limits gave 0 or inf in silence; InputError beyond the floats)
+        from .reynolds import check_leak_scale
+        return check_leak_scale(width / length * self.critical_gap ** 3 / 12.0,
+                                pressure_drop, mu)
 
     def record(self) -> dict:
         """JSON-safe scalars: ``critical_gap``, ``critical_position``, ``critical_width``,

@@ -163,12 +163,12 @@ def times_ratio(value, numerator: float, denominator: float):
 
 def check_leak_scale(conductance: float, pressure_drop: float, mu: float) -> float:
     """The leak rate ``Q = C dp / mu`` (m^3/s) of a gap of conductance ``C`` (m^3, the leak
-    rate at a unit drop and viscosity); :class:`~roughfe.errors.InputError` when ``Q > 0``
+    rate at a unit drop and viscosity); :class:`~roughfe.errors.InputError` when ``Q != 0``
     is beyond the normal float range (it overflowed to a null, or underflowed to 0 or to
     a subnormal that keeps few digits), naming the range of ``dp / mu`` this gap allows."""
     q = times_ratio(conductance, pressure_drop, mu)
     info = np.finfo(float)
-    if conductance > 0 and not (info.tiny <= q <= info.max):
+    if conductance > 0 and pressure_drop != 0 and not (info.tiny <= abs(q) <= info.max):
         with np.errstate(over="ignore"):
             low, high = info.tiny / conductance, info.max / conductance
         allowed = (f"from {low:.3g} to {high:.3g} 1/s" if np.isfinite(high)
@@ -176,7 +176,7 @@ def check_leak_scale(conductance: float, pressure_drop: float, mu: float) -> flo
         raise InputError(
             f"pressure_drop = {pressure_drop:g} Pa with mu = {mu:g} Pa s: the leak rate "
             f"Q = C dp / mu (C = {conductance:.4g} m^3, this gap's leak rate at a unit drop "
-            f"and viscosity) {'overflows' if q > 1 else 'underflows'} the float range; "
+            f"and viscosity) {'overflows' if abs(q) > 1 else 'underflows'} the float range; "
             f"this gap allows dp / mu {allowed}")
     return q
 
