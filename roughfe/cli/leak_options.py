@@ -72,11 +72,12 @@ def add_coupling_options(p):
                          "the external pressure (contact + fluid); one flow direction")
     fs.add_argument("--inlet-pressure", type=absolute_pressure_type, default=None,
                     metavar="PI",
-                    help="absolute inlet pressure in Pa (with --outlet-pressure; instead of "
-                         "--pressure-drop; PI < PO reverses the flow with --fsi)")
+                    help=f"absolute inlet pressure in Pa, 0 to {PRESSURE_RANGE[1]:g} (with "
+                         f"--outlet-pressure; instead of --pressure-drop; PI < PO reverses "
+                         f"the flow with --fsi)")
     fs.add_argument("--outlet-pressure", type=absolute_pressure_type, default=None,
                     metavar="PO",
-                    help="absolute outlet pressure in Pa")
+                    help=f"absolute outlet pressure in Pa, 0 to {PRESSURE_RANGE[1]:g}")
     fs.add_argument("--trapped-fluid", choices=("volume", "pressure", "film"),
                     default=None,
                     help="with --fsi: pockets sealed by contact: 'volume' keep their liquid "
