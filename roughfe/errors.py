@@ -102,16 +102,36 @@ def check_finite_nonnegative(name, value):
     return v
 
 
-def check_in_open_interval(name, value, low, high):
-    """Return ``float(value)`` or raise :class:`InputError` unless low < value < high (a
-    number: not a string, not a bool)."""
+#: the ends of an interval that :func:`check_in_interval` includes, and how it is written
+INTERVAL_ENDS = {"neither": "({}, {})", "left": "[{}, {})", "right": "({}, {}]",
+                 "both": "[{}, {}]"}
+
+
+def check_in_interval(name, value, low, high, closed="neither"):
+    """Return ``float(value)`` or raise :class:`InputError` unless it lies between ``low``
+    and ``high``, the ends included as ``closed`` says: ``"neither"`` (low, high),
+    ``"left"`` [low, high), ``"right"`` (low, high], ``"both"`` [low, high] (a number:
+    not a string, not a bool; NaN lies in no interval). The message names the value and
+    the interval, the ends written as given (pass ``0, 1`` for "(0, 1]")."""
+    if closed not in INTERVAL_ENDS:
+        raise ValueError(f"closed must be one of {tuple(INTERVAL_ENDS)}, got {closed!r}")
+    interval = INTERVAL_ENDS[closed].format(low, high)
     try:
         v = float(_number(value))
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number in ({low}, {high}), got {value!r}") from None
-    if not (low < v < high):
-        raise InputError(f"{name} must lie in the open interval ({low}, {high}), got {value!r}")
+        raise InputError(f"{name} must be a number in {interval}, got {value!r}") from None
+    above = v >= low if closed in ("left", "both") else v > low
+    below = v <= high if closed in ("right", "both") else v < high
+    if not (above and below):
+        where = "the open interval " if closed == "neither" else ""
+        raise InputError(f"{name} must lie in {where}{interval}, got {value!r}")
     return v
+
+
+def check_in_open_interval(name, value, low, high):
+    """Return ``float(value)`` or raise :class:`InputError` unless low < value < high (a
+    number: not a string, not a bool): :func:`check_in_interval` with both ends out."""
+    return check_in_interval(name, value, low, high, "neither")
 
 
 def check_int(name, value, minimum):

@@ -48,7 +48,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
-from ..errors import InputError, check_finite_positive, check_instance, check_memory
+from ..errors import (InputError, check_finite_positive, check_in_interval, check_instance,
+                      check_memory)
 from ..surfaces.stats import angular_wavevectors
 from ..surfaces.surface import Surface
 
@@ -79,13 +80,7 @@ def genome_q1(gamma: float, lambda1: float) -> float:
 
 
 def _check_gamma(gamma):
-    try:
-        g = float(gamma)
-    except (TypeError, ValueError):
-        raise InputError(f"gamma (band ratio) must be a number in (1, 10], got {gamma!r}") from None
-    if not (1.0 < g <= 10.0):
-        raise InputError(f"gamma (band ratio) must lie in (1, 10], got {gamma!r}")
-    return g
+    return check_in_interval("gamma (band ratio)", gamma, 1, 10, "right")
 
 
 def wavevector_magnitude(shape, size, transform: str = "fft") -> np.ndarray:

@@ -53,7 +53,8 @@ from typing import Any, Mapping, Optional
 
 import numpy as np
 
-from ..errors import FileFormatError, InputError, check_finite_positive, check_int
+from ..errors import (FileFormatError, InputError, check_finite_positive, check_in_interval,
+                      check_int)
 from ..frozen import FrozenMapping, ReadOnlyArrays
 from ..surfaces.surface import Surface
 from ..surfaces.wm import resolve_rng, wm_series
@@ -129,14 +130,9 @@ class Genome(ReadOnlyArrays):
     def __post_init__(self):
         set_ = object.__setattr__
         set_(self, "A", check_finite_positive("A (amplitude gene, m^(1-H))", self.A))
-        h = float(self.H)
-        if not (0.0 < h <= 3.0):
-            raise InputError(f"H (scaling exponent) must lie in (0, 3], got {self.H!r}")
-        set_(self, "H", h)
-        g = float(self.gamma)
-        if not (1.0 < g <= 10.0):
-            raise InputError(f"gamma (frequency density, Eq. 3.6) must lie in (1, 10], got {self.gamma!r}")
-        set_(self, "gamma", g)
+        set_(self, "H", check_in_interval("H (scaling exponent)", self.H, 0, 3, "right"))
+        set_(self, "gamma", check_in_interval("gamma (frequency density, Eq. 3.6)",
+                                              self.gamma, 1, 10, "right"))
         set_(self, "lambda1", check_finite_positive("lambda1 (reference wavelength, m)", self.lambda1))
         try:
             phi = np.array(self.phases, dtype=float, copy=True)

@@ -47,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
-                      check_int)
+                      check_in_interval, check_int)
 from .stats import angular_wavevectors, periodic_moment, rfft_full_sum
 from .surface import Surface, _as_size
 from .wm import resolve_rng
@@ -76,21 +76,10 @@ def _shape_and_size(n, size, ndim):
     return shape, _as_size(size, ndim)
 
 
-def _check_hurst(hurst):
-    """``float(hurst)`` or an :class:`InputError` unless ``0 < H <= 1``."""
-    try:
-        h = check_finite_positive("hurst H", hurst)
-    except InputError:
-        h = None
-    if h is None or h > 1.0:
-        raise InputError(f"hurst H must lie in (0, 1], got {hurst!r}")
-    return h
-
-
 def _synthesise(ndim, n, size, hurst, rms_height, rms_slope, q_long, q_roll, q_short,
                 amplitudes, rng, match):
     shape, size = _shape_and_size(n, size, ndim)
-    hurst = _check_hurst(hurst)
+    hurst = check_in_interval("hurst H", hurst, 0, 1, closed="right")
     if (rms_height is None) == (rms_slope is None):
         raise InputError("give exactly one of rms_height (m) and rms_slope (-), "
                          f"got rms_height={rms_height!r}, rms_slope={rms_slope!r}")

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import (InputError, check_finite_positive, check_in_open_interval, check_int,
+from ..errors import (InputError, check_finite_positive, check_in_interval, check_int,
                       check_real_array)
 from .surface import Surface
 
@@ -110,14 +110,9 @@ def _grid(n, length, ndim):
 
 
 def _check_gamma_hurst(gamma, hurst):
-    try:
-        gamma = float(gamma)
-    except (TypeError, ValueError):
-        raise InputError(f"gamma (frequency density) must be a number > 1, "
-                         f"got {gamma!r}") from None
-    if not (np.isfinite(gamma) and gamma > 1):
-        raise InputError(f"gamma (frequency density) must be > 1, got {gamma!r}")
-    return gamma, check_in_open_interval("hurst H", hurst, 0.0, 1.0)
+    """``(gamma, H)`` as floats: ``gamma > 1`` (finite), ``0 < H < 1``; or InputError."""
+    return (check_in_interval("gamma (frequency density)", gamma, 1, np.inf),
+            check_in_interval("hurst H", hurst, 0, 1))
 
 
 def _int_pair(name, value, lower="first", upper="second"):

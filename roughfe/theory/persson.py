@@ -82,7 +82,7 @@ import numpy as np
 import scipy.special
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
-                      check_real_array)
+                      check_in_interval, check_real_array)
 from ..frozen import ReadOnlyArrays, compact_repr, read_only_arrays
 from ..surfaces.stats import PowerSpectrum, power_spectrum
 from ..surfaces.surface import Surface
@@ -138,14 +138,8 @@ def _check_gamma(gamma) -> float:
     """``gamma`` of Persson's elastic-energy factor ``S = gamma + (1 - gamma) P^2``
     (Persson 2007), in (0, 1]: S lies between gamma at small contact and 1 at full
     contact, and J(y) of Eq. (2) is positive; otherwise :class:`InputError`."""
-    try:
-        g = float(gamma) if not isinstance(gamma, (str, bytes, bool)) else float("nan")
-    except (TypeError, ValueError):
-        g = float("nan")
-    if not 0.0 < g <= 1.0:
-        raise InputError(f"gamma (Persson's elastic-energy factor S = gamma + (1 - gamma) "
-                         f"P^2) must lie in (0, 1], got {gamma!r}")
-    return g
+    return check_in_interval("gamma (Persson's elastic-energy factor S = gamma + "
+                             "(1 - gamma) P^2)", gamma, 0, 1, "right")
 
 
 def _cumulative_gradient(q2, power):

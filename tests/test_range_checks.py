@@ -1,0 +1,66 @@
+"""One range checker (roughfe.errors.check_in_interval, round 2, session 34): the Hurst
+exponents and frequency densities of the generators, the genome and the band analysis,
+and Persson's gamma, were each checked by a hand-rolled copy (some took "0.5" as text,
+some True as 1.0). The ends each one includes are kept."""
+import numpy as np
+import pytest
+
+from roughfe.errors import InputError, check_in_interval, check_in_open_interval
+from roughfe.genomics.bands import genome_q1
+from roughfe.genomics.genome import Genome
+from roughfe.surfaces import spectral_profile, wm_profile
+
+
+@pytest.mark.parametrize("closed, inside, outside", [
+    ("neither", (0.5,), (0, 1)),
+    ("left", (0, 0.5), (1,)),
+    ("right", (0.5, 1), (0,)),
+    ("both", (0, 0.5, 1), (-1e-300, 1.0000001)),
+])
+def test_the_ends_of_an_interval(closed, inside, outside):
+    written = {"neither": r"\(0, 1\)", "left": r"\[0, 1\)", "right": r"\(0, 1\]",
+               "both": r"\[0, 1\]"}[closed]
+    for v in inside:
+        assert check_in_interval("x", v, 0, 1, closed) == v
+    for v in (*outside, np.nan, np.inf, -np.inf):
+        with pytest.raises(InputError, match=rf"^x must lie in .*{written}, got "):
+            check_in_interval("x", v, 0, 1, closed)
+    for v in ("0.5", True, None, [0.5]):
+        with pytest.raises(InputError, match=rf"^x must be a number in {written}, got "):
+            check_in_interval("x", v, 0, 1, closed)
+    assert type(check_in_interval("x", np.float32(0.5), 0, 1, closed)) is float
+
+
+def test_the_open_interval_keeps_its_words():
+    with pytest.raises(InputError, match=r"^tol must lie in the open interval \(0.0, 1.0\), "
+                                         r"got 1.0$"):
+        check_in_open_interval("tol", 1.0, 0.0, 1.0)
+    with pytest.raises(ValueError, match="closed"):
+        check_in_interval("x", 0.5, 0, 1, "open")
+
+
+def test_each_model_keeps_its_own_interval():
+    # spectral: H in (0, 1] (H = 1 is the smooth limit); WM: H in (0, 1), gamma > 1
+    assert spectral_profile(16, 1.0, 1.0, rms_height=1.0, rng=0).metadata["hurst"] == 1.0
+    with pytest.raises(InputError, match=r"hurst H must lie in \(0, 1\], got 0"):
+        spectral_profile(16, 1.0, 0, rms_height=1.0)
+    with pytest.raises(InputError, match=r"hurst H must lie in the open interval \(0, 1\), "
+                                         r"got 1.0"):
+        wm_profile(64, 1.0, 1.0)
+    for gamma in (1.0, np.inf, "2"):
+        with pytest.raises(InputError, match=r"gamma \(frequency density\) must .* in .*"
+                                             r"\(1, inf\)"):
+            wm_profile(64, 1.0, 0.5, gamma=gamma)
+    # the genome: H in (0, 3], gamma in (1, 10]; the band analysis: gamma in (1, 10]
+    g = Genome(A=1.0, H=3, gamma=10, lambda1=1e-3, phases=np.zeros((2, 3)))
+    assert (g.H, g.gamma) == (3.0, 10.0) and type(g.H) is float
+    for bad, match in (({"H": True}, r"H \(scaling exponent\) must be a number in \(0, 3\]"),
+                       ({"H": 3.01}, r"H \(scaling exponent\) must lie in \(0, 3\]"),
+                       ({"gamma": 1}, r"gamma \(frequency density, Eq. 3.6\) must lie in "
+                                      r"\(1, 10\], got 1$")):
+        with pytest.raises(InputError, match=match):
+            Genome(**{"A": 1.0, "H": 0.7, "gamma": 1.5, "lambda1": 1e-3,
+                      "phases": np.zeros((2, 3)), **bad})
+    assert genome_q1(10, 1.0) == pytest.approx(2 * np.pi / np.sqrt(10))
+    with pytest.raises(InputError, match=r"gamma \(band ratio\) must lie in \(1, 10\]"):
+        genome_q1(10.5, 1.0)
