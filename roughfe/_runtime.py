@@ -13,15 +13,21 @@ is loaded only by a process that will render:
   loaded, or dolfinx not loaded (then importing pyvista now is safe).
 * :func:`render_in_fresh_process` -- the fallback when it is not: call a plotting
   function in a fresh interpreter that never loads dolfinx.
+* :func:`writer_prefix`, :func:`remove_dead_writers_files` -- the writer's machine and
+  pid in the name of a temporary file, so that a later write removes the temporaries of
+  writers that no longer run (a SIGKILL during a write leaves one).
 
 Nothing here imports matplotlib, pyvista or dolfinx at import time.
 """
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
+import re
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -128,3 +134,53 @@ def render_in_fresh_process(module: str, function: str, arrays: dict, **kwargs) 
         if proc.returncode != 0:
             raise RuntimeError(f"rendering in a fresh process ({module}.{function}) failed: "
                                f"{proc.stderr[-2000:]}")
+
+
+# -- temporaries of writers that no longer run -----------------------------------------
+def machine_tag() -> str:
+    """8 hex digits naming this machine and pid namespace (hostname and the namespace's
+    inode): a pid in a file name is judged only where it was given out (not on another
+    host of a shared file system, nor in another container)."""
+    try:
+        namespace = os.stat("/proc/self/ns/pid").st_ino
+    except OSError:  # pragma: no cover - non-Linux
+        namespace = 0
+    return hashlib.sha1(f"{socket.gethostname()}:{namespace}".encode()).hexdigest()[:8]
+
+
+def writer_prefix(prefix: str) -> str:
+    """``PREFIX<machine tag>-<pid>-``: the start of a temporary name of this process."""
+    return f"{prefix}{machine_tag()}-{os.getpid()}-"
+
+
+def pid_alive(pid: int) -> bool:
+    """False only when no process ``pid`` exists here (signal 0 tests, sends nothing)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True               # another user's process, or a pid we cannot judge: kept
+    return True
+
+
+def remove_dead_writers_files(folder, prefix: str) -> list:
+    """Remove the files in ``folder`` named by :func:`writer_prefix` (``prefix`` then 8
+    random characters and ``.tmp``) whose writer, on this machine, no longer runs: a
+    SIGKILL or a power loss during a write leaves its temporary (never the final name).
+    Files of live writers, of other machines and of the older form without a pid (before
+    round 2, session 34) stay. A pid that was given out again keeps the file (a leftover
+    stays, nothing live is lost). Returns the paths removed; housekeeping, so a folder that
+    cannot be listed or a file that went meanwhile is no error."""
+    name = re.compile(rf"^{re.escape(prefix)}([0-9a-f]{{8}})-(\d+)-[A-Za-z0-9_]{{8}}\.tmp")
+    tag, removed = machine_tag(), []
+    with contextlib.suppress(OSError), os.scandir(folder) as entries:
+        for entry in entries:
+            match = name.match(entry.name)
+            if (match is None or match.group(1) != tag or pid_alive(int(match.group(2)))
+                    or not entry.is_file(follow_symlinks=False)):
+                continue
+            with contextlib.suppress(OSError):
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+    return removed

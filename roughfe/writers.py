@@ -28,12 +28,16 @@ from pathlib import Path
 
 import numpy as np
 
+from ._runtime import remove_dead_writers_files, writer_prefix
 from .errors import InputError
 
-#: Prefix of every temporary file (``.roughfe-<8 random characters>.tmp<suffix>``): short,
-#: so that a target name of any legal length (255 bytes) still has a legal temporary name.
+#: Prefix of every temporary file (``.roughfe-<tag>-<pid>-<8 random characters>.tmp<suffix>``,
+#: :func:`roughfe._runtime.writer_prefix`): short, so that a target name of any legal
+#: length (255 bytes) still has a legal temporary name.
 TMP_PREFIX = ".roughfe-"
 _MAX_TMP_SUFFIX = 16
+#: folders already cleared of dead writers' temporaries by this process
+_SWEPT = set()
 
 
 def current_umask() -> int:
@@ -74,8 +78,13 @@ def atomic_path(path, suffix=None):
     suffix = path.suffix if suffix is None else suffix
     if len(suffix) > _MAX_TMP_SUFFIX:
         suffix = ""
+    folder = os.path.abspath(path.parent)
+    if folder not in _SWEPT:   # a killed writer's temporary goes (once per folder and process)
+        _SWEPT.add(folder)
+        remove_dead_writers_files(folder, TMP_PREFIX)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=TMP_PREFIX, suffix=f".tmp{suffix}", dir=path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=writer_prefix(TMP_PREFIX), suffix=f".tmp{suffix}",
+                                   dir=path.parent)
     except OSError as exc:
         raise InputError(f"cannot write in {path.parent}: {exc.strerror}") from None
     os.close(fd)

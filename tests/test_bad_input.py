@@ -152,7 +152,7 @@ def _db_build_workers_zero(t):
 
 def _negative_young_modulus(t):
     return (["contact", str(_surface(t)), "--E", "-1e9", "-o", str(t / "o")],
-            "E (Young's modulus, Pa) must be finite and > 0")
+            "argument --E: must be a Young's modulus from 0.001 Pa to 1e+15 Pa, got '-1e9'")
 
 
 def _negative_poisson_exponent(t):

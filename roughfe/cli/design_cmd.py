@@ -12,10 +12,15 @@ from dataclasses import replace
 from pathlib import Path
 
 from .options import (add_output_folder, add_run_options, add_surface_options, surface_file,
-                      nonnegative_float, nonnegative_int,
+                      int_in, nonnegative_float, nonnegative_int,
                       output_folder_of, positive_float, positive_int)
 
 BUILTIN = ("y_t1", "y_t2", "y_t3")
+#: upper bounds of the stage budgets (none until round 2, session 34: 99999999999 ran as
+#: asked). Measured costs (docs/theory/06_design.md, N = 512): the thesis stages are 5 (sog)
+#: or 3 GCMMA iterations; --refine 3 was ~900 BEM sweeps; --search 400 with 4 starts 4890
+#: sweeps in 219 s. Each bound is 20-250 x the largest budget measured.
+MAX_ITERATIONS, MAX_REFINE, MAX_SEARCH, MAX_SEARCH_STARTS = 100, 100, 100000, 100
 #: the numeric ``--global-*`` flags (GlobalSearchOptions): flag, type, default, metavar, help
 GLOBAL_FLAGS = (
     ("--global-eval", positive_int, 20000, "N",
@@ -66,6 +71,10 @@ def _dependent_options(args):
              bool(args.match_spectrum)),
             ("match_directions", "--match-directions", False, "--match-spectrum SURFACE",
              bool(args.match_spectrum))]
+    rows += [(dest, flag, None, "--match-spectrum SURFACE (an option of its file)",
+              bool(args.match_spectrum))
+             for dest, flag in (("size", "--size"), ("channel", "--channel"),
+                                ("periodic", "--periodic/--non-periodic"))]
     globals_ = [(flag, default) for flag, _, default, _, _ in GLOBAL_FLAGS]
     globals_ += [("--global-score", "strict"), ("--global-waves", False)]
     rows += [(flag[2:].replace("-", "_"), flag, default, "--global cmaes",
@@ -83,7 +92,7 @@ def _check_options(args):
     args.gradient = args.gradient or ("fd" if args.formulation == "thesis" else "exact")
     for dest, flag, default, needs, present in _dependent_options(args):
         value = getattr(args, dest)
-        if value is not None and value is not False and not present:
+        if value is not None and (value is not False or dest == "periodic") and not present:
             raise InputError(f"{flag} needs {needs}; it was given without, where it means "
                              f"nothing")
         if value is None:
@@ -98,6 +107,29 @@ def _with_p_top(target, p_top):
     except InputError as exc:
         raise InputError(f"--target-p-top {p_top:g} for the target {target.name}: "
                          f"{exc}") from None
+
+
+#: largest p_max^t / E* of a design's target (Eq. 4.2 rescales the amplitude to reach it):
+#: the thesis' own targets reach 1.7 E* (warned of, plausibility.check_target_pressure);
+#: 1e3 E* is a strain of ~1000, no elastic contact (--target-p-top 1e308 was a non-
+#: convergence line of the dense solver, 1e20 a design of rms slope 4.5e12, exit 0)
+MAX_P_TOP_RATIO = 1e3
+
+
+def _check_p_top(args, targets, settings) -> None:
+    """Refuse a target whose p_max^t exceeds :data:`MAX_P_TOP_RATIO` x the database's E*,
+    naming ``--target-p-top`` when it gave the pressure."""
+    from ..errors import InputError
+    from ..model import Material
+    e_star = Material(settings.youngs_modulus, settings.poisson).E_star
+    for t in targets:
+        if t.p_max > MAX_P_TOP_RATIO * e_star:
+            what = (f"--target-p-top {args.target_p_top:g} Pa" if args.target_p_top
+                    is not None else f"the last pressure {t.p_max:.4g} Pa of --target "
+                                     f"{t.name}")
+            raise InputError(f"{what} is {t.p_max / e_star:.3g} x the database's E* = "
+                             f"{e_star:.4g} Pa: allowed is at most {MAX_P_TOP_RATIO:g} x E* "
+                             f"(a strain p / E* far beyond any elastic contact; Pa?)")
 
 
 def _run(args) -> int:
@@ -129,6 +161,7 @@ def _run(args) -> int:
         targets.reverse()
     if args.target_p_top is not None:       # Eq. 4.2's p_max^t beyond the last points
         targets = [_with_p_top(t, args.target_p_top) for t in targets]
+    _check_p_top(args, targets, settings)
     options = GcmmaOptions(bound=args.bound, formulation=args.formulation, eps=args.eps,
                            gradient=args.gradient,
                            **({"n_it_sog": args.iterations, "n_it_cross": args.iterations}
@@ -194,10 +227,32 @@ def _run(args) -> int:
     return 0
 
 
+#: ``design-targets`` options of its ``--surface`` FILE: (dest, flag, default); given
+#: without --surface they were ignored in silence (round 2, session 33)
+SURFACE_TARGET_OPTIONS = (("detrend", "--detrend", "plane"), ("boundary", "--boundary", "auto"),
+                          ("resolution", "--resolution", "design"), ("size", "--size", None),
+                          ("periodic", "--periodic/--non-periodic", None),
+                          ("channel", "--channel", None))
+
+
+def _check_target_options(args) -> None:
+    """Refuse an option of ``--surface`` given without it, where it means nothing (as
+    :func:`_check_options` does for ``design``), then set the defaults (parsed as None)."""
+    from ..errors import InputError
+    for dest, flag, default in SURFACE_TARGET_OPTIONS:
+        if getattr(args, dest) is None:
+            setattr(args, dest, default)
+        elif args.surface is None:
+            raise InputError(f"{flag} needs --surface FILE (the curves of a given surface); "
+                             f"it was given without, where it means nothing (the thesis' "
+                             f"targets are the database's)")
+
+
 def _targets(args) -> int:
     from ..genomics.database import read_settings
     from ..genomics.design import surface_targets, thesis_targets
     from ..genomics.target_csv import write_target_csv
+    _check_target_options(args)     # before the database is read
     settings = read_settings(args.db)
     if args.surface:
         surface = surface_file(args, args.surface)
@@ -266,8 +321,9 @@ def register(sub):
                         "'matched', from the scores solved at the target pressures), as "
                         "`genome sequence --strict`; the result is written all the same")
     g = p.add_argument_group("GCMMA options")
-    g.add_argument("--iterations", type=positive_int, default=None,
-                   help="outer GCMMA iterations of stage 1 (default: thesis, 5 sog / 3 others)")
+    g.add_argument("--iterations", type=int_in(1, MAX_ITERATIONS), default=None,
+                   help=f"outer GCMMA iterations of stage 1, 1..{MAX_ITERATIONS} (default: "
+                        f"thesis, 5 sog / 3 others)")
     g.add_argument("--bound", choices=("start", "period"), default="start",
                    help="phase box: +-10%% of the start value (thesis) or of 2 pi")
     g.add_argument("--formulation", choices=("minimax", "thesis"), default="minimax",
@@ -279,16 +335,19 @@ def register(sub):
     g.add_argument("--eps", type=positive_float, default=None,
                    help="finite-difference step in units of the phase box (finite "
                         "differences only; default 0.02)")
-    g.add_argument("--refine", type=nonnegative_int, default=0, metavar="ROUNDS",
-                   help="extra stage beyond the thesis: ROUNDS x 15 GCMMA iterations on all "
-                        "phases, box (+-10%% of 2 pi) re-centred each round (0: off)")
-    g.add_argument("--search", type=nonnegative_int, default=0, metavar="SWEEPS",
-                   help="extra stage beyond the thesis, after --refine: a (1+1) evolution "
-                        "strategy on all phases and part weights maximising the score solved "
-                        "at the target pressures, SWEEPS BEM sweeps per candidate (0: off)")
-    g.add_argument("--search-starts", type=positive_int, default=None, metavar="K",
-                   help="--search: K independent runs per candidate (deterministic seeds), "
-                        "the best kept")
+    g.add_argument("--refine", type=int_in(0, MAX_REFINE), default=0, metavar="ROUNDS",
+                   help=f"extra stage beyond the thesis: ROUNDS x 15 GCMMA iterations on all "
+                        f"phases, box (+-10%% of 2 pi) re-centred each round (0: off; at most "
+                        f"{MAX_REFINE})")
+    g.add_argument("--search", type=int_in(0, MAX_SEARCH), default=0, metavar="SWEEPS",
+                   help=f"extra stage beyond the thesis, after --refine: a (1+1) evolution "
+                        f"strategy on all phases and part weights maximising the score solved "
+                        f"at the target pressures, SWEEPS BEM sweeps per candidate (0: off; at "
+                        f"most {MAX_SEARCH})")
+    g.add_argument("--search-starts", type=int_in(1, MAX_SEARCH_STARTS), default=None,
+                   metavar="K",
+                   help=f"--search: K independent runs per candidate (deterministic seeds), "
+                        f"the best kept (1..{MAX_SEARCH_STARTS})")
     g.add_argument("--search-amplitudes", nargs="?", const="chromosome", default=None,
                    choices=("part", "chromosome", "wave"), metavar="KIND",
                    help="--search amplitude variables (+-30%%): part (each part's weight, "
@@ -337,18 +396,18 @@ def register(sub):
                         "file 'roughfe info' reads, e.g. a measured topography) from its own "
                         "BEM sweep with the database's E, nu and steps; writes NAME_K.csv "
                         "and NAME_A.csv")
-    t.add_argument("--detrend", choices=("none", "mean", "plane"), default="plane",
-                   help="detrending of --surface before the BEM")
-    t.add_argument("--boundary", choices=("auto", "periodic", "window"), default="auto",
+    t.add_argument("--detrend", choices=("none", "mean", "plane"), default=None,
+                   help="detrending of --surface before the BEM (default: plane)")
+    t.add_argument("--boundary", choices=("auto", "periodic", "window"), default=None,
                    help="a non-periodic --surface: its evenly mirrored window with the "
                         "periodic BEM, or the window alone on the half-space (its K then "
                         "includes the window's bulk compliance); auto: the designs' own "
                         "setting, periodic on a surface database (--dim 2), window on a "
-                        "profile database")
-    t.add_argument("--resolution", choices=("design", "full"), default="design",
+                        "profile database (default: auto)")
+    t.add_argument("--resolution", choices=("design", "full"), default=None,
                    help="a periodic target on a surface database: resampled onto the "
                         "database spacing L/N (the band the designs hold) or at the file's "
-                        "own sampling")
+                        "own sampling (default: design)")
     add_surface_options(t, positional=False)      # of --surface's file
     add_output_folder(t)
     add_run_options(t, figures=False)

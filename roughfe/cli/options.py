@@ -7,8 +7,8 @@ everywhere:
   ``--non-periodic`` (exclusive), ``--channel``; :func:`surface_from_args` reads it.
 * :func:`add_detrend_option` -- ``--detrend none|mean|plane``, default ``mean`` (a
   warning when it leaves a tilt of more than 95 % of the variance of a non-periodic surface).
-* :func:`add_material_options` -- ``--E`` (Pa) and ``--nu`` (-), default the thesis'
-  E* = 210 MPa (E = 210 MPa, nu = 0); :func:`material_from_args`.
+* :func:`add_material_options` -- ``--E`` (Pa, within :data:`E_RANGE`) and ``--nu`` (-),
+  default the thesis' E* = 210 MPa (E = 210 MPa, nu = 0); :func:`material_from_args`.
 * :func:`add_output_folder` -- ``-o/--output OUTDIR`` (a FOLDER whenever a command writes
   several files) and ``--overwrite``; :func:`output_folder_of` applies the ownership
   contract of :func:`roughfe.writers.output_folder`. :func:`add_output_file` for
@@ -23,8 +23,8 @@ everywhere:
   :func:`at_least_two`, :func:`at_least_three`, :func:`unit_fraction`.
 
 :class:`RoughfeParser` shows every default in ``--help``, accepts negative numbers as
-option values (``--E -1e9`` reaches the validator: "E must be > 0") and prints parse
-errors on one line.
+option values (``--nu -1.5`` reaches the validator: "nu ... must lie in (-1, 0.5]") and prints
+parse errors on one line.
 """
 from __future__ import annotations
 
@@ -106,6 +106,21 @@ positive_float = _check(float, lambda v: 0.0 < v < float("inf"), "a finite numbe
 nonnegative_float = _check(float, lambda v: 0.0 <= v < float("inf"), "a finite number >= 0")
 #: a relative tolerance: 1 or more asks nothing of a solver (its start is accepted)
 unit_fraction = _check(float, lambda v: 0.0 < v < 1.0, "a number in (0, 1)")
+
+
+def int_in(low: int, high: int):
+    """An argparse type: an integer in ``low..high`` (a count whose cost grows with it)."""
+    return _check(int, lambda v: low <= v <= high, f"an integer in {low}..{high}")
+
+
+#: Young's moduli E (Pa) that ``--E`` accepts: three decades beyond the softest solids
+#: (gels, ~1 Pa) and the stiffest (diamond, 1.2e12 Pa), so that dimensionless runs (E* = 1)
+#: pass. Every solver is linear in E* (it solves p / E*), so the range is no limit of the
+#: method; it refuses what is a slip (1e308 or 1e-300 overflowed or underflowed the
+#: pressures: a non-convergence line that did not name E, round 2, session 33).
+E_RANGE = (1e-3, 1e15)
+youngs_modulus = _check(float, lambda v: E_RANGE[0] <= v <= E_RANGE[1],
+                        f"a Young's modulus from {E_RANGE[0]:g} Pa to {E_RANGE[1]:g} Pa")
 
 
 # -- surfaces ------------------------------------------------------------------------------
@@ -243,17 +258,18 @@ class _Deprecated(argparse.Action):
 
 
 def add_material_options(parser, title: str = "material (elastic half-space)") -> None:
-    """``--E`` (Pa) and ``--nu`` (-) with the one default (thesis E* = 210 MPa).
+    """``--E`` (Pa, within :data:`E_RANGE`) and ``--nu`` (-) with the one default (thesis
+    E* = 210 MPa).
 
     The old spellings ``--youngs-modulus``/``--poisson`` are accepted with a warning.
     """
     from ..model import DEFAULT_E, DEFAULT_NU
     group = parser.add_argument_group(title)
-    group.add_argument("--E", type=float, default=DEFAULT_E, metavar="PA",
-                       help="Young's modulus E in Pa")
+    group.add_argument("--E", type=youngs_modulus, default=DEFAULT_E, metavar="PA",
+                       help=f"Young's modulus E in Pa, {E_RANGE[0]:g} to {E_RANGE[1]:g}")
     group.add_argument("--nu", type=float, default=DEFAULT_NU, metavar="NU",
                        help="Poisson's ratio nu, in (-1, 0.5]; E* = E / (1 - nu^2)")
-    group.add_argument("--youngs-modulus", dest="E", type=float, action=_Deprecated,
+    group.add_argument("--youngs-modulus", dest="E", type=youngs_modulus, action=_Deprecated,
                        new="--E", help=argparse.SUPPRESS)
     group.add_argument("--poisson", dest="nu", type=float, action=_Deprecated, new="--nu",
                        help=argparse.SUPPRESS)

@@ -126,6 +126,45 @@ def _make_spectral(a):
                 match=a.match)
 
 
+def _check_rms_height(a) -> None:
+    """``--rms-height`` within the one range of topography lengths (1 fm to 1000 km,
+    :data:`~roughfe.surfaces.surface.SIZE_RANGE`), before anything is generated (1e308 gave
+    "heights must be finite ... = inf" and 1e-300 heights of rms 0, neither naming it)."""
+    from ..surfaces.surface import SIZE_RANGE
+    if a.rms_height is not None and not SIZE_RANGE[0] <= a.rms_height <= SIZE_RANGE[1]:
+        raise InputError(f"--rms-height {a.rms_height:g} m: allowed are {SIZE_RANGE[0]:g} m "
+                         f"to {SIZE_RANGE[1]:g} m (the range of lengths of a topography; a "
+                         f"height in another unit?)")
+
+
+#: the unit of ``--amplitude`` A of each WM model (Eq. 2.1: m; Eq. 3.17: m^(1-H))
+_AMPLITUDE_UNIT = {"wm": "m", "mwm": "m^(1-H)"}
+
+
+def _made(a):
+    """``a.make(a)``; a WM profile's or surface's rms height checked within the range of
+    :func:`_check_rms_height` and said in the words of ``--amplitude``, the A that sets it
+    (1e308 gave "heights must be finite", 1e200 a file of rms height inf, exit 0)."""
+    from ..surfaces.surface import SIZE_RANGE
+    unit = _AMPLITUDE_UNIT.get(a.model)
+    try:
+        surface = a.make(a)
+    except InputError as exc:
+        if unit and str(exc).startswith("heights must be finite"):
+            raise InputError(f"--amplitude {a.amplitude:g} {unit}: the heights overflow the "
+                             f"floating-point range ({exc})") from None
+        raise
+    if unit:
+        with np.errstate(over="ignore", invalid="ignore"):
+            h = surface.heights - np.mean(surface.heights)
+            rms = float(np.sqrt(np.mean(h * h)))
+        if not SIZE_RANGE[0] <= rms <= SIZE_RANGE[1]:
+            raise InputError(f"--amplitude {a.amplitude:g} {unit} gives heights of rms "
+                             f"{rms:.3g} m: allowed are {SIZE_RANGE[0]:g} m to "
+                             f"{SIZE_RANGE[1]:g} m (the range of lengths of a topography)")
+    return surface
+
+
 def _grid_points(a) -> tuple:
     """Points per axis of the requested grid (for the memory check before generating)."""
     if a.model == "rmd":  # m checked first (the bounds of rmd_profile, rmd_surface):
@@ -174,9 +213,10 @@ def _generate(args) -> int:
         _as_size(args.length, 1)
     except InputError as exc:
         raise InputError(f"--length {args.length:g} m: {exc}") from None
+    _check_rms_height(args)
     shape = _grid_points(args)
     check_memory(f"a {' x '.join(map(str, shape))} grid", 8.0 * float(np.prod(shape)))
-    surface = args.make(args)
+    surface = _made(args)
     if args.rms_height is not None and args.model in ("wm", "mwm"):
         surface = _rescaled_wm(surface, args.rms_height)
     if not args.no_figures:

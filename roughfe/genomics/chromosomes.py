@@ -93,6 +93,13 @@ class ValidityResult:
     references: tuple = field(default=("thesis Eq. 3.8-3.10, Fig. 29",))
 
 
+def _check_validity_memory(m_max: int, n_trials) -> None:
+    """The phases and the three pair arrays of the largest M (8 bytes each) fit in memory
+    (a million ridges ran for days)."""
+    check_memory(f"M = {m_max} ridges x {int(n_trials)} trials",
+                 8.0 * int(n_trials) * (m_max + 1.5 * m_max * (m_max - 1)))
+
+
 def validity_monte_carlo(M_values=tuple(range(2, 21)), n_trials=1000, *, rng) -> ValidityResult:
     """Fraction of random phase sets satisfying Eq. (3.10), per number of ridges M (Fig. 29).
 
@@ -101,14 +108,14 @@ def validity_monte_carlo(M_values=tuple(range(2, 21)), n_trials=1000, *, rng) ->
     """
     seed = int(rng) if isinstance(rng, (int, np.integer)) else None
     gen = np.random.default_rng(rng)
+    if int(n_trials) < 1:
+        raise InputError(f"n_trials must be >= 1, got {n_trials!r}")
+    if isinstance(M_values, range) and len(M_values):   # sized before it is listed (a
+        _check_validity_memory(max(M_values[0], M_values[-1]), n_trials)  # range to 10^11)
     ms = np.asarray(list(M_values), dtype=int)
     if ms.size == 0 or ms.min() < 1:
         raise InputError(f"M_values must be integers >= 1, got {list(M_values)!r}")
-    if int(n_trials) < 1:
-        raise InputError(f"n_trials must be >= 1, got {n_trials!r}")
-    m_max = int(ms.max())   # phases and the three pair arrays of the largest M (a million
-    check_memory(f"M = {m_max} ridges x {int(n_trials)} trials",  # ridges ran for days)
-                 8.0 * int(n_trials) * (m_max + 1.5 * m_max * (m_max - 1)))
+    _check_validity_memory(int(ms.max()), n_trials)
     valid, arccos_ok, worst = [], [], 0.0
     for m in ms:
         phi = gen.uniform(0, 2 * np.pi, size=(int(n_trials), int(m)))

@@ -219,14 +219,22 @@ def summarise(records: Iterable[dict]) -> dict:
                             "disagreements": disagreements}}
 
 
+#: most replicas (surfaces per D and m) of :func:`study_grid`: 500 x the thesis' 20 (at
+#: the thesis' m = 8, one task is a BEM sweep of seconds to minutes); 10^11 built the
+#: list of replicas first and ended in "not enough memory" (round 2, session 33)
+MAX_SURFACES = 10000
+
+
 def study_grid(D: Optional[Iterable[float]] = None, m: Optional[Iterable[int]] = None,
                n_surfaces: int = 2) -> dict:
     """The study spec grid of Sec. 2.4: D, m and ``replica`` (one seed per replica,
     the same across D and m). Defaults: the thesis' D and m; ``n_surfaces`` replicas
-    (the thesis uses 20)."""
+    (the thesis uses 20; at most :data:`MAX_SURFACES`)."""
     n = int(n_surfaces)
-    if n < 1:
-        raise InputError(f"n_surfaces must be >= 1, got {n_surfaces!r}")
+    if not 1 <= n <= MAX_SURFACES:
+        raise InputError(f"n_surfaces (surfaces per D and m; `roughfe leak-study "
+                         f"--surfaces`) must be an integer in 1..{MAX_SURFACES} (the thesis "
+                         f"used 20), got {n_surfaces!r}")
     return {"D": [float(d) for d in (THESIS_D if D is None else D)],
             "m": [int(k) for k in (THESIS_M if m is None else m)],
             "replica": list(range(n))}
