@@ -382,6 +382,10 @@ class ContactResult(Frozen):
         Load-weighted width of the contact patches in grid points (NaN without contact);
         below ``roughfe.bem.patches.MIN_PATCH_POINTS`` the grid does not resolve them
         (:func:`roughfe.bem.patches.resolution_note`).
+    rim_width : float, BEM with a hardness
+        Mean width of the elastic rim around the plastic zone in grid points (NaN
+        without flow); below ``roughfe.bem.patches.MIN_RIM_POINTS`` the loading
+        stiffness depends on the grid (:func:`roughfe.bem.patches.rim_note`).
 
     With adhesion (:mod:`roughfe.bem.adhesion`) ``pressure`` is the total interface
     traction and is negative (tensile) in the interaction zone; ``contact`` marks g = 0.
@@ -427,6 +431,7 @@ class ContactResult(Frozen):
     unloading: Optional[bool] = None
     adhesive_area_fraction: Optional[float] = None
     patch_width: Optional[float] = None
+    rim_width: Optional[float] = None
 
     __repr__ = compact_repr          # one line: fields as shape and dtype, unset optionals left out
 

@@ -26,11 +26,21 @@ FEM_SOLVER_OPTIONS = ("solver", "penalty_factor", "rtol", "atol", "max_it", "pet
 FEM_OPTIONS = FEM_MESH_OPTIONS + FEM_SOLVER_OPTIONS + ("keep_fields",)
 
 
+#: why the FEM refuses an option of the BEM (said after the list of allowed options)
+FEM_REFUSES = {
+    "hardness": "the FEM has no plastic interface (it is the frictionless elastic "
+                "cross-check of the BEM): a hardness needs method='bem' "
+                "(roughfe.bem.solve_contact(..., hardness=))",
+}
+
+
 def _check_options(method, options, allowed):
     unknown = sorted(set(options) - set(allowed))
     if unknown:
+        why = "".join(f"; {k}: {FEM_REFUSES[k]}" for k in unknown
+                      if method == "fem" and k in FEM_REFUSES)
         raise InputError(f"unknown option(s) {unknown} for method={method!r}; allowed: "
-                         f"{list(allowed)}")
+                         f"{list(allowed)}{why}")
 
 
 def response(surface: Surface, material: Material, loading: Optional[Loading] = None,

@@ -36,7 +36,7 @@ from .contact_checks import (_check_coarse_correction, _check_hardness, _check_s
                              _check_target, _check_tol)
 from .deflation import BlockDeflation
 from .padded_deflation import PaddedBlockDeflation
-from .patches import patch_width
+from .patches import patch_width, rim_width
 from .pk import polonsky_keer
 from .solvers import SolverOutput, dense_solve
 from .stiffness import exact_stiffness
@@ -432,7 +432,7 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
     # closed-form full contact at the least pressure: one point has p = 0 and g = 0
     contact = p > 0 if out.solver != "closed form" else np.ones(p.shape, bool)
     gap = np.where(contact, 0.0, np.maximum(w, 0.0))
-    plastic_fraction = None
+    plastic_fraction = rim = None
     if hardness is not None:
         band = max(YIELD_RTOL, min(100.0 * tolerance, YIELD_BAND_MAX))
         flowing = contact & (p >= hardness * (1.0 - band))
@@ -442,6 +442,7 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
         plastic.setflags(write=False)
         # the stiffness: saturated points carry a fixed pressure and do not respond
         stiff_set = contact & ~flowing
+        rim = rim_width(contact, flowing, periodic=op.periodic)
     else:
         stiff_set = contact
     n = p.size
@@ -470,7 +471,7 @@ def _result(surface, material, op, solver, out, scale, compute_stiffness, tolera
         size=tuple(surface.size), spacing=tuple(surface.spacing),
         periodic=op.periodic, references=REFERENCES + op.references, method="bem",
         plastic_area_fraction=plastic_fraction, plastic_displacement=plastic,
-        patch_width=width)
+        patch_width=width, rim_width=rim)
 
 
 def surface_displacement(surface: Surface, material: Material, traction,

@@ -1,5 +1,7 @@
 """Whether the grid resolves the contact patches of a result: one rule for the BEM and the
-FEM (:func:`patch_width`, :func:`resolution_note`).
+FEM (:func:`patch_width`, :func:`resolution_note`); with a hardness, whether it resolves
+the elastic rim around the plastic zone, on which the loading stiffness rests
+(:func:`rim_width`, :func:`rim_note`).
 
 A contact patch is a connected set of contact points (a run of nodes on a profile; a
 4-connected set of cells on a surface; across the period's edges when periodic, and
@@ -108,3 +110,71 @@ def resolution_note(width) -> str | None:
         return None
     return (f"contact patches of width {width:.3g} grid points (load-weighted; fewer than "
             f"{MIN_PATCH_POINTS:g}): not resolved, the load, A* and K depend on the grid")
+
+
+#: elastic rim (grid points, :func:`rim_width`) around a plastic zone below which the
+#: loading stiffness K of a hardness run is said to depend on the grid. K is that of the
+#: contact points below the cap (the flowing ones do not respond); where the plastic
+#: zone meets the free surface across less than a cell it rests on a few rim points.
+#: Measured on a sphere (R = 10 mm, P = 0.1 N, E* = 1.1 GPa) against the axisymmetric
+#: reference (:mod:`roughfe.theory.capped_hertz`) at 64^2 / 128^2 / 256^2: capped at
+#: 0.2 p0 rims 0.09 / 0.16 / 0.17 and K 0.92 / 1.38 / 1.31 of the reference; at 0.3 p0
+#: 0.32 / 0.29 / 0.28 and 1.24 / 1.21 / 1.08; at 0.5 p0 0.68 / 0.82 / 1.0 and K within
+#: 1.1 %; at 0.8 p0 (32^2-128^2) 2.4-4 and within 1.3 %. (A rule at 2 points, the
+#: first guess, fired at 0.5 p0, where K was right.) On self-affine surfaces capped at
+#: 0.1-0.3 E* gbar (rims 0.12-0.68) K moved 2-11 % between 64^2, 128^2 and 256^2
+#: (round 2, session 34, docs/theory/02b)
+MIN_RIM_POINTS = 0.5
+#: rims are counted up to this many grid points (wider ones count as this wide)
+RIM_COUNT = 4
+
+
+def _grow(mask, periodic, diagonal):
+    """``mask`` grown by one grid point (4- or, ``diagonal``, 8-neighbours on a surface;
+    across the period's edges when ``periodic``, else not beyond the grid)."""
+    out = mask.copy()
+    shifts = [tuple(int(i == ax) * s for i in range(mask.ndim))
+              for ax in range(mask.ndim) for s in (-1, 1)]
+    if diagonal and mask.ndim == 2:
+        shifts += [(i, j) for i in (-1, 1) for j in (-1, 1)]
+    for shift in shifts:
+        if periodic:
+            out |= np.roll(mask, shift, axis=tuple(range(mask.ndim)))
+            continue
+        src = tuple(slice(max(-s, 0), mask.shape[k] - max(s, 0)) for k, s in enumerate(shift))
+        dst = tuple(slice(max(s, 0), mask.shape[k] - max(-s, 0)) for k, s in enumerate(shift))
+        out[dst] |= mask[src]
+    return out
+
+
+def rim_width(contact, flowing, *, periodic: bool = False) -> float:
+    """Mean width in grid points of the elastic rim around the plastic zone of a
+    hardness result (NaN without flow): for each point of the zone's border (a flowing
+    point with a 4-neighbour that does not flow), the number of contact points not at
+    the cap between it and the nearest point out of contact, counted by growing the
+    free area one point at a time (4- and 8-neighbours in turn: an octagonal distance,
+    within 8 % of the Euclidean one) up to :data:`RIM_COUNT`. On a capped sphere it is
+    the rim a - c in grid points; a zone that borders the free surface scores 0.
+    ``flowing``: the contact points at p = H_p. Cost: a few boolean passes over the grid."""
+    contact, flowing = np.asarray(contact, bool), np.asarray(flowing, bool)
+    if not flowing.any():
+        return float("nan")
+    border = flowing & _grow(~flowing, periodic, False)
+    if not border.any():          # the whole grid flows: no rim, no border to the free area
+        return 0.0 if flowing.all() else float(RIM_COUNT)
+    reached, width = ~contact, np.full(int(border.sum()), float(RIM_COUNT))
+    for k in range(RIM_COUNT):
+        reached = _grow(reached, periodic, diagonal=k % 2 == 1)
+        first = reached[border] & (width == RIM_COUNT)
+        width[first] = k
+    return float(width.mean())
+
+
+def rim_note(width) -> str | None:
+    """The note of a hardness result whose elastic rim is thinner than
+    :data:`MIN_RIM_POINTS` (None when wider, or without flow)."""
+    if width is None or not np.isfinite(width) or width >= MIN_RIM_POINTS:
+        return None
+    return (f"elastic rim around the plastic zone {width:.2g} grid points wide (fewer than "
+            f"{MIN_RIM_POINTS:g}): the loading stiffness K, of the few points below the "
+            f"hardness there, depends on the grid (--grid-check measures it)")

@@ -25,7 +25,7 @@ from ..model import Loading, Material
 from ..response import response
 from ..bem.contact import SOLVERS
 from ..bem.output import sweep_document, write_fields_h5
-from ..theory import beside, pastewka_robbins
+from ..theory import beside, pastewka_robbins, theory_area_fraction
 from ..writers import write_json
 from ..bem.patches import MIN_PATCH_POINTS, resolution_note
 from .plausibility import check_load_magnitudes, check_solution, persson_basis
@@ -214,13 +214,13 @@ def _run(args) -> int:
           + f"{'A* ' + theory.capitalize():>10s} {'patch':>6s}")
     for s, k, t in zip(sweep.to_records(), sweep.stiffness, doc["steps"]):
         # inf at full periodic contact; "-" where it was not computed (adhesion); A* theory:
-        # Persson's elastoplastic one where a hardness gave it (first loading)
+        # with a hardness the plastic interface's (first loading), theory_area_fraction
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
         pl = (f"{fmt_or_dash(t.get('plastic_area_fraction'), '.3g'):>9s} " if plastic
               else "")
         print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
               f"{pl}{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
-              f"{fmt_or_dash(t.get('persson_elastoplastic_area_fraction') or t.get(theory + '_area_fraction'), '.3g'):>10s} "
+              f"{fmt_or_dash(theory_area_fraction(t), '.3g'):>10s} "
               f"{fmt_or_dash(s.get('patch_width'), '.3g'):>6s}")
     print(f"patch: load-weighted width of the contact patches in grid points (patch_width in "
           f"results.json; below {MIN_PATCH_POINTS:g} not resolved; a resolved width does not "
@@ -234,7 +234,7 @@ def _run(args) -> int:
               + ("Maugis' sphere (derived.maugis_sphere)" if maugis is not None else
                  "the adhesive single-asperity theory is not evaluated for this law"
                  if adhesive is not None else
-                 "Hertz's A* and K beside the results (hertz_* in results.json)"
+                 "Hertz's A* and K beside the results (hertz_*, capped_hertz_* in results.json)"
                  if cap["radius"] is not None else "no Hertz line (not round)"))
     if args.mirror:
         print("--mirror: the fields and the load, contact area and contact count are of the "

@@ -154,7 +154,10 @@ def check_solution(args, surface, results, material) -> None:
     points and said nothing of a profile's contact on 1-3 nodes). ``results``: the steps'
     ContactResults; steps are numbered from 0, as in results.json, the ``leak`` table and
     the fields' frames. The last three from a user's review (round 2, session 29: di-1 at
-    1 GPa reached 2.9 E* locally, and its 10 MPa step had 29 contact points)."""
+    1 GPa reached 2.9 E* locally, and its 10 MPa step had 29 contact points). With a
+    hardness also steps whose elastic rim around the plastic zone is narrower than
+    :data:`roughfe.bem.patches.MIN_RIM_POINTS` grid points (``rim_width``: K depends on
+    the grid; round 2, session 34)."""
     results = list(results)
     if not results:
         return
@@ -177,14 +180,15 @@ def check_solution(args, surface, results, material) -> None:
         warn(args, f"the local contact pressure reaches {peak:.3g} Pa = {peak / e_star:.3g} E* "
                    f"(step {k}): local strains of order one, beyond linear elasticity; "
                    f"a real material yields first (--hardness)")
-    from ..bem.patches import resolution_note
-    few = [(i, r.patch_width) for i, r in enumerate(results) if resolution_note(r.patch_width)]
-    if few:
-        more = ", ..." if len(few) > 6 else ""
-        warn(args, f"step{'s' if len(few) > 1 else ''} "
-                   f"{', '.join(str(i) for i, _ in few[:6])}{more}: "
-                   f"{resolution_note(few[0][1])}"
-                   + (f" (step {few[0][0]})" if len(few) > 1 else ""))
+    from ..bem.patches import resolution_note, rim_note
+    for note, key in ((resolution_note, "patch_width"), (rim_note, "rim_width")):
+        few = [(i, getattr(r, key, None)) for i, r in enumerate(results)
+               if note(getattr(r, key, None))]
+        if few:
+            more = ", ..." if len(few) > 6 else ""
+            warn(args, f"step{'s' if len(few) > 1 else ''} "
+                       f"{', '.join(str(i) for i, _ in few[:6])}{more}: {note(few[0][1])}"
+                       + (f" (step {few[0][0]})" if len(few) > 1 else ""))
 
 
 def persson_basis(args, surface, persson: dict) -> None:

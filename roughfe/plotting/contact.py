@@ -67,7 +67,9 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
     get Persson's curves drawn beside the BEM points (and ``persson_stiffness`` its K =
     -dp/du in the K panel; with a hardness ``persson_elastoplastic_area_fraction`` and
     ``persson_plastic_area_fraction`` beside the BEM's A* and ``plastic_area_fraction``); records of one smooth cap get Hertz's A* and K instead
-    (``hertz_area_fraction``, ``hertz_stiffness``; :mod:`roughfe.theory.asperity`). With the ``window_compliance`` C
+    (``hertz_area_fraction``, ``hertz_stiffness``; :mod:`roughfe.theory.asperity`), and
+    with a hardness on a sphere the capped Hertz reference's A*, area at H_p and K
+    (``capped_hertz_*``, :mod:`roughfe.theory.capped_hertz`). With the ``window_compliance`` C
     (m/Pa) of a non-periodic window, the K panel marks the window's bulk stiffness 1/C,
     the ceiling K approaches whatever the roughness (:mod:`roughfe.bem.window`).
     ``method`` labels the solver's points ("BEM", or "FEM" for ``contact --method fem``).
@@ -144,24 +146,31 @@ def plot_area_stiffness(steps, path, title=None, rms_height=None, window_complia
         sel = theory & np.isfinite(a_ep) & (a_ep > 0)
         by_p = np.argsort(p[sel])
         ax1.loglog(p[sel][by_p], a_ep[sel][by_p], "-.", label="Persson, with hardness")
-        pl_bem = _column_or_zero(steps, "plastic_area_fraction")
-        on = ok & (pl_bem > 0)
-        if on.any():
-            ax1.loglog(p[on], pl_bem[on], "s", ms=4, mfc="none", label=method + " plastic area")
         sel = sel & np.isfinite(a_pl) & (a_pl > 0)
         if sel.any():
             by_p = np.argsort(p[sel])
             ax1.loglog(p[sel][by_p], a_pl[sel][by_p], ":", label="Persson plastic area")
-    # one smooth cap (theory.asperity): Hertz's curves in place of Persson's
-    hertz = {ax: _theory(steps, key) for ax, key in ((ax1, "hertz_area_fraction"),
-                                                      (ax2, "hertz_stiffness"))}
-    for ax, curve in hertz.items():
-        sel = theory & np.isfinite(curve) if curve is not None else None
+    # the BEM's plastic area beside a theory's (Persson's, or the capped sphere's)
+    pl_bem = _column_or_zero(steps, "plastic_area_fraction")
+    on = ok & (pl_bem > 0)
+    if on.any() and (a_ep is not None or _theory(steps, "capped_hertz_area_fraction")
+                     is not None):
+        ax1.loglog(p[on], pl_bem[on], "s", ms=4, mfc="none", label=method + " plastic area")
+    # one smooth cap (theory.asperity): Hertz's curves in place of Persson's, and with a
+    # hardness on a sphere the capped Hertz reference (theory.capped_hertz)
+    capped = "Hertz capped at the hardness (rings)"
+    for ax, key, style, label in (
+            (ax1, "hertz_area_fraction", "--", "Hertz (1882), one smooth asperity"),
+            (ax2, "hertz_stiffness", "--", "Hertz (1882), one smooth asperity"),
+            (ax1, "capped_hertz_area_fraction", "-.", capped),
+            (ax1, "capped_hertz_plastic_area_fraction", ":", capped + ": area at H_p"),
+            (ax2, "capped_hertz_stiffness", "-.", capped)):
+        curve = _theory(steps, key)
+        sel = theory & np.isfinite(curve) & (curve > 0) if curve is not None else None
         if sel is not None and sel.any():
             by_p = np.argsort(p[sel])
             scale = 1.0 if ax is ax1 else MPA * 1e-6
-            ax.loglog(p[sel][by_p], curve[sel][by_p] * scale, "--",
-                      label="Hertz (1882), one smooth asperity")
+            ax.loglog(p[sel][by_p], curve[sel][by_p] * scale, style, label=label)
     note = (_branch_note(a, ok, unl) if not tensile else
             "no state in compression: the tensile\nstates (p < 0) on linear axes")
     for ax in (ax1, ax3):

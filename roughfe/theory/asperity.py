@@ -50,7 +50,9 @@ def single_asperity(surface):
     their least-squares plane leaves (a tilted measured file is mostly its plane).
     Returns ``{"shape": "sphere" | "ellipsoid" | "cylinder", "radius": R (m; sqrt(R1 R2)
     for a surface, None for an ellipsoid beyond :data:`ROUND`), "radii": [R1, R2] (m),
-    "fit": the explained fraction of the variance}``."""
+    "fit": the explained fraction of the variance, "summit_gap": the fitted cap's summit
+    above the highest grid point (m; ``sphere_cap``: dx^2 / (4 R), its summit between
+    four points)}``."""
     if surface.periodic or min(surface.shape) < 3 or not np.ptp(surface.heights) > 0:
         return None
     # the fit on every step-th point per axis (at most FIT_POINTS per axis): a quadric
@@ -76,12 +78,17 @@ def single_asperity(surface):
     if fit < QUADRIC_FIT or not np.all(curv < 0):
         return None
     radii = sorted(float(-1 / k) for k in curv)
+    # the quadric's summit c0 + g.x*/2 (x* = -hess^-1 g) above the highest grid point: the
+    # BEM counts the approach from that point, Hertz from the summit
+    g = coef[1:surface.ndim + 1]
+    gap = float(coef[0] - 0.5 * g @ np.linalg.solve(hess, g) - surface.heights.max())
     if surface.ndim == 1:
-        return {"shape": "cylinder", "radius": radii[0], "radii": radii, "fit": fit}
+        return {"shape": "cylinder", "radius": radii[0], "radii": radii, "fit": fit,
+                "summit_gap": gap}
     round_ = radii[1] <= ROUND * radii[0]
     return {"shape": "sphere" if round_ else "ellipsoid",
             "radius": float(np.sqrt(radii[0] * radii[1])) if round_ else None,
-            "radii": radii, "fit": fit}
+            "radii": radii, "fit": fit, "summit_gap": gap}
 
 
 def beside_hertz(surface, shape, e_star, pressures):

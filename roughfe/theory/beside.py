@@ -36,6 +36,7 @@ from ..surfaces.stats import HANN_MIN_POINTS, height_moments
 from ..surfaces.surface import Surface
 from .asperity import NOT_RANDOM, beside_hertz, single_asperity
 from .asperity import REFERENCES as ASPERITY_REFERENCES
+from .capped_hertz import beside_capped_hertz
 from .junction import _geometry_factor, critical_junction
 from .persson import GAMMA_DEFAULT, PERCOLATION_THRESHOLD, REFERENCES, _spectrum, persson
 from .plastic import beside_elastoplastic
@@ -61,6 +62,11 @@ NOT_PLASTIC = {
             "elastoplastic areas, persson_elastoplastic_area_fraction and "
             "persson_plastic_area_fraction; docs/theory/07_adhesion_persson.md)",
 }
+
+#: ``plastic_note`` of a single asperity's ``"persson"`` block when a step had plastic flow
+HERTZ_NOT_PLASTIC = ("Hertz's contact is elastic: a step with plastic flow and every step "
+                     "after it get hertz_* None; a sphere's first loading carries the capped "
+                     "Hertz reference instead (capped_hertz_* keys, the capped_hertz block)")
 
 
 #: ``"persson"`` of a grid whose PSD cannot be taken (``grid`` is added: its shape); no
@@ -156,7 +162,7 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     pressures = [_number_of(k, s, "mean_pressure", "(Pa)") for k, s in enumerate(steps)]
     shape = single_asperity(source) if isinstance(source, Surface) else None
     if shape is not None:       # one smooth cap: Hertz's theory, not Persson's
-        return _beside_asperity(source, shape, e_star, steps, pressures, adhesive)
+        return _beside_asperity(source, shape, e_star, steps, pressures, adhesive, hardness)
     if adhesive:
         return {"steps": [dict(s) for s in steps], "persson": dict(NOT_ADHESIVE)}
     if psd is None:
@@ -202,20 +208,41 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
     return {"steps": out, "persson": info}
 
 
-def _beside_asperity(surface, shape, e_star, steps, pressures, adhesive) -> dict:
+def _beside_asperity(surface, shape, e_star, steps, pressures, adhesive, hardness) -> dict:
     """:func:`beside` for one smooth cap (:func:`~roughfe.theory.asperity.single_asperity`):
     no ``persson_*`` keys, ``hertz_*`` keys on the elastic non-adhesive steps and
-    :data:`~roughfe.theory.asperity.NOT_RANDOM` with the cap's shape as ``"persson"``."""
+    :data:`~roughfe.theory.asperity.NOT_RANDOM` with the cap's shape as ``"persson"``;
+    with a ``hardness`` also the capped Hertz reference on the first loading
+    (``capped_hertz_*`` keys, :func:`roughfe.theory.capped_hertz.beside_capped_hertz`;
+    None for an ellipsoid or a cylinder, whose ``"capped_hertz"`` block says why)."""
     info = dict(NOT_RANDOM, single_asperity=shape, references=list(ASPERITY_REFERENCES))
     if adhesive:
         return {"steps": [dict(s) for s in steps], "persson": info}
     plastic = _plastic_from(steps)
     hertz = beside_hertz(surface, shape, e_star,
                          [None if pl else p for p, pl in zip(pressures, plastic)])
-    if any(plastic):
-        info.update(NOT_PLASTIC, plastic_steps=[k for k, pl in enumerate(plastic) if pl])
+    if any(plastic):     # NOT_PLASTIC's note is Persson's: it would replace NOT_RANDOM's
+        info.update(plasticity=NOT_PLASTIC["plasticity"], plastic_note=HERTZ_NOT_PLASTIC,
+                    plastic_steps=[k for k, pl in enumerate(plastic) if pl])
     info["units"] = {"hertz_area_fraction": "-", "hertz_stiffness": "Pa/m (dp/dDelta)"}
+    if hardness is not None:
+        capped, info["capped_hertz"] = beside_capped_hertz(
+            surface, shape, e_star, pressures, [bool(s.get("unloading")) for s in steps],
+            hardness)
+        hertz = [{**h, **c} for h, c in zip(hertz, capped)]
     return {"steps": [{**s, **h} for s, h in zip(steps, hertz)], "persson": info}
+
+
+def theory_area_fraction(record):
+    """The theory's A* (-) of a step record of :func:`beside`, the one a table shows beside
+    the simulation's: with a hardness the theory of the plastic interface (Persson's
+    elastoplastic area, the capped Hertz sphere's) where the step has it, else the
+    elastic one (Persson's or Hertz's); None where none is given."""
+    for key in ("persson_elastoplastic_area_fraction", "capped_hertz_area_fraction",
+                "persson_area_fraction", "hertz_area_fraction"):
+        if record.get(key) is not None:
+            return record[key]
+    return None
 
 
 def _height_distribution(surface) -> dict:

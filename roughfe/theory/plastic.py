@@ -195,6 +195,19 @@ ELASTOPLASTIC_NOTE = (
     "(docs/theory/07_adhesion_persson.md)")
 
 
+def first_loading(pressures, unloading, hardness):
+    """Per step (in path order): it is on the first loading from the virgin surface, the
+    one load path of a theory with no unloading branch: the mean pressure (Pa or None)
+    has not yet fallen, no step so far is flagged ``unloading``, and 0 < p < H (Pa)."""
+    ok, peak, fell = [], 0.0, False
+    for p, down in zip(pressures, unloading):
+        fell = fell or bool(down) or (p is not None and np.isfinite(p) and p < peak)
+        good = p is not None and np.isfinite(p) and 0 < p < hardness and not fell
+        peak = max(peak, p) if good else peak
+        ok.append(good)
+    return ok
+
+
 def beside_elastoplastic(source, e_star, pressures, unloading, hardness):
     """The elastoplastic areas of :func:`elastoplastic_area` beside a load path.
 
@@ -205,12 +218,7 @@ def beside_elastoplastic(source, e_star, pressures, unloading, hardness):
     and ``persson_plastic_area_fraction``, and the ``"elastoplastic"`` facts (H, the
     note, references)."""
     H = check_finite_positive("hardness (Pa, the yield pressure of the interface)", hardness)
-    ok, peak, fell = [], 0.0, False
-    for p, down in zip(pressures, unloading):
-        fell = fell or bool(down) or (p is not None and np.isfinite(p) and p < peak)
-        good = p is not None and np.isfinite(p) and 0 < p < H and not fell
-        peak = max(peak, p) if good else peak
-        ok.append(good)
+    ok = first_loading(pressures, unloading, H)
     theory = (elastoplastic_area(source, e_star, [p for p, k in zip(pressures, ok) if k], H)
               if any(ok) else None)
     records, j = [], 0
