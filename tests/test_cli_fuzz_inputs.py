@@ -230,15 +230,27 @@ def test_ctrl_c_while_the_command_loads_is_one_line_and_exit_130(tmp_path):
     assert proc.stderr == "roughfe: interrupted\n"
 
 
-def test_leak_study_with_no_finished_task_says_the_first_error(tmp_path, capsys):
+def test_leak_study_with_no_finished_task_says_the_first_error(tmp_path, monkeypatch, capsys):
     # said only "no task of the study ... finished; see `roughfe study status ...`" (found
-    # with --E 1e308, now refused by the option; --length 1e6 passes the command's check
-    # but the RMD surface of m = 3 spans 9/8 L, beyond the size range, in every task)
+    # with --E 1e308, now refused by the option; the leak options that failed every task
+    # are checked before submitting): here the spawned workers die importing the BEM (a
+    # bad ROUGHFE_THREADS that this process, which imported it, never reads again)
+    import roughfe.bem._parallel  # noqa: F401
+    monkeypatch.setenv("ROUGHFE_THREADS", "none")
     line = _refused(capsys, ["leak-study", "--D", "2.3", "--m", "3", "--surfaces", "1",
-                             "--steps", "2", "--workers", "1", "--length", "1e6",
-                             "--no-figures", "-o", str(tmp_path / "ls")],
-                    "no task of the study", "(task 0: ")
-    assert "InputError: size[0]" in line
+                             "--steps", "2", "--workers", "1", "--no-figures",
+                             "-o", str(tmp_path / "ls")], "no task of the study", "(task 0: ")
+    assert "worker lost" in line
+
+
+def test_leak_study_checks_the_span_of_its_rmd_surfaces(tmp_path, capsys):
+    # --length 1e6 passed the size check of L, but the RMD surface spans (2^m + 1) / 2^m L:
+    # every task failed on the workers ("size[0] = 1.125e+06 m is no lateral size")
+    _refused(capsys, ["leak-study", "--D", "2.3", "--m", "3", "--surfaces", "1", "--steps",
+                      "2", "--workers", "1", "--length", "1e6", "--no-figures",
+                      "-o", str(tmp_path / "ls")], "L = 1e+06 m with m = 3",
+             "spans (2^m + 1) / 2^m L = 1.125e+06 m")
+    assert not (tmp_path / "ls").exists()
 
 
 def test_generate_interrupted_while_drawing_leaves_no_old_figure(tmp_path, monkeypatch,

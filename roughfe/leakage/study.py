@@ -22,7 +22,7 @@ from ..bem import Material
 from ..errors import InputError
 from ..surfaces.rmd import rmd_surface
 from ..surfaces.stats import spectral_moments
-from ..surfaces.surface import Surface
+from ..surfaces.surface import SIZE_RANGE, Surface
 from .analysis import leakage_sweep
 
 #: thesis values (Sec. 2.4): fractal dimensions and resolutions
@@ -145,6 +145,10 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     check_finite_positive("L (m)", L)
     from ..surfaces.surface import _as_size
     _as_size(L, 1)      # the surfaces' size range (1e308 failed every task on the workers)
+    span = L * (2 ** m + 1) / 2 ** m        # the RMD nodes' size, (2^m + 1) L / 2^m
+    if span > SIZE_RANGE[1]:                # L = 1e6 m passed and failed every task
+        raise InputError(f"L = {L:g} m with m = {m}: the RMD surface spans (2^m + 1) / 2^m L "
+                         f"= {span:g} m, beyond the largest lateral size {SIZE_RANGE[1]:g} m")
     check_finite_positive("mu (Pa s)", mu)
     if not isinstance(reynolds, (bool, np.bool_)):
         raise InputError(f"reynolds must be true or false, got {reynolds!r}")
