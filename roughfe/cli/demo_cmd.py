@@ -30,7 +30,8 @@ def _stats_table(stats) -> str:
             ("spectral moments m0, m2, m4",
              f"{stats.m0:.4g} m^2, {stats.m2:.4g}, {stats.m4:.4g} 1/m^2"),
             ("Nayak bandwidth alpha", f"{stats.nayak_alpha:.4g}"),
-            ("Hurst exponent H (PSD fit)", f"{stats.hurst:.3f}"),
+            ("Hurst exponent H (PSD fit, +- standard error)",
+             f"{stats.hurst:.3f} +- {stats.hurst_error:.3f}"),
             ("fractal dimension D = 3 - H", f"{stats.fractal_dimension:.3f}"))
     table = "| quantity | value |\n|---|---|\n" + "\n".join(f"| {a} | {b} |" for a, b in rows)
     note = range_note(stats.hurst_message)          # a PSD that is not one power law

@@ -23,7 +23,7 @@ _TABLE = (
     ("m2", "spectral moment m2", "-", 1.0),
     ("m4", "spectral moment m4", "1/um^2", 1e-12),
     ("nayak_alpha", "Nayak bandwidth alpha", "-", 1.0),
-    ("hurst", "Hurst exponent (PSD fit)", "-", 1.0),
+    ("hurst", "Hurst exponent (PSD fit)", "- (+- its standard error)", 1.0),
     ("fractal_dimension", "fractal dimension D", "-", 1.0),
     ("hurst_q_range", "Hurst fit range q", "rad/um", 1e-6),
 )
@@ -35,7 +35,8 @@ STATISTICS_UNITS = {"shape": "points", "size": "m", "mean": "m", "rms_height": "
                     "skewness": "1", "kurtosis": "1", "m0": "m^2", "m2": "1", "m4": "1/m^2",
                     "nayak_alpha": "1", "hurst": "1 (meaningful when hurst_success)",
                     "fractal_dimension": "1 (meaningful when hurst_success)",
-                    "hurst_q_range": "rad/m", "hurst_message": "text"}
+                    "hurst_q_range": "rad/m", "hurst_message": "text",
+                    "hurst_error": "1 (standard error of hurst, Gaussian surface)"}
 
 
 def format_table(stats: dict) -> str:
@@ -62,6 +63,8 @@ def format_table(stats: dict) -> str:
             text = " x ".join(f"{x * scale:.6g}" for x in v)
         else:
             text = f"{v * scale:.6g}"
+            if key == "hurst" and stats.get("hurst_error") is not None:
+                text += f" +- {stats['hurst_error']:.2g}"
         lines.append(f"{label:<28s} {text} {unit}".rstrip())
     from ..surfaces.psd_fit import range_note
     note = range_note(stats.get("hurst_message", ""))

@@ -131,7 +131,7 @@ def plot_psd(spectra, path, title=None, fits=None):
             _fit_line(ax, psd, fit)
     ax.set_xlabel("wavenumber q (rad/m)")
     unit = "m$^4$" if units == {2} else ("m$^3$" if units == {1} else "m$^3$ or m$^4$")
-    ax.set_ylabel(f"PSD C(q) ({unit})")
+    ax.set_ylabel(f"PSD C(q) ({unit}, Persson's normalisation)")   # (2 pi)^-d x ST's
     ax.set_title(title or "power spectral density")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)

@@ -17,8 +17,45 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.optimize
 
 from .stats import PSD_ROUNDOFF, PowerSpectrum
+
+
+def whittle_power_law(q, c, weight):
+    """Slope s and prefactor A of ``C = A q**s`` by the weighted Whittle likelihood.
+
+    Minimises ``sum_i weight_i [ln(A q_i^s) + c_i / (A q_i^s)]`` over A and s, with
+    ``weight`` the number of Fourier modes behind each PSD value ``c_i`` times the
+    weight given to each mode. A is then ``sum weight c q^-s / sum weight`` and the
+    profile likelihood in s, ``ln(sum weight c q^-s) + s <ln q>``, is convex (a
+    log-sum-exp plus a linear term): a bounded scalar minimisation finds it.
+
+    Why not least squares on log C: a periodogram value of a Gaussian surface is an
+    exponential variable, and the log of the mean of k of them is biased low by
+    ln k - psi(k) (0.58 for k = 1). The few modes per logarithmic bin at the low-q end
+    of a profile flatten a log-log fit: H = 0.8 fitted as 0.74 on average over 200
+    seeds of 1024-point profiles. The Whittle score equations are unbiased for any
+    weights (E[c_i] = A q_i^s), and working with C itself, not its logarithm, keeps the
+    empty bins between the lines of a Weierstrass-Mandelbrot spectrum from dragging the
+    fit (H = 0.3 and 0.5 fitted as 0.79 and 0.99 by the binned log-log fit).
+    """
+    lq = np.log(q)
+    lw = np.log(weight * c)              # c > 0 by the caller's selection
+    wbar = float(np.sum(weight * lq) / np.sum(weight))
+    shift = float(lq.mean())
+
+    def objective(s):
+        z = lw - s * (lq - shift)
+        zmax = float(z.max())
+        return zmax + float(np.log(np.sum(np.exp(z - zmax)))) + s * (wbar - shift)
+
+    best = scipy.optimize.minimize_scalar(objective, bounds=(-12.0, 4.0), method="bounded",
+                                          options={"xatol": 1e-10})
+    s = float(best.x)
+    prefactor = float(np.sum(weight * c * np.exp(-s * lq)) / np.sum(weight))
+    return s, prefactor
+
 
 #: A PSD value that carries at least this share of the Whittle level ``sum(w c q^-s)``
 #: is reported as one that sets it (:attr:`FitLevel.peak_q`).
@@ -110,18 +147,37 @@ class SplitFit:
     note: str
 
 
-def _half_fit(psd, q, c, weight, modes):
-    """H and its standard error of the Whittle power law of these values."""
-    from .stats import _whittle_power_law
-    slope, _ = _whittle_power_law(q, c, weight)
+def independent_modes(psd: PowerSpectrum, sel, size) -> np.ndarray:
+    """Independent Fourier modes behind the PSD values ``psd[sel]`` of a surface of
+    physical ``size`` (m): half the modes (those at q and -q are one)."""
+    cell = float(np.prod([2 * np.pi / s for s in np.atleast_1d(size)]))
+    return psd.weight[sel] / (2 * cell)
+
+
+def hurst_error(psd: PowerSpectrum, q, weight, modes) -> float:
+    """Standard error (-) of the Whittle H fitted to the PSD values at ``q`` (rad/m) with
+    Whittle weights ``weight`` (:func:`fit_points`) and ``modes`` independent modes each
+    (:func:`independent_modes`): the score's sandwich variance for a Gaussian surface
+    (each mode's periodogram an exponential variable), times :data:`HANN_VARIANCE` per
+    axis with the Hann window. It is the statistical error only; a spectrum that is not
+    one power law adds a systematic one (:func:`split_fit`). Measured against the scatter
+    of 40 seeds (H = 0.8): 0.036 predicted / 0.037 observed (4096-point periodic
+    profiles), 0.083 / 0.075 (1024-point windowed crops), 0.029 / 0.031 (256^2 periodic),
+    0.093 / 0.081 (128^2 windowed crops)."""
     x = np.log(q)
     dx = x - np.sum(weight * x) / np.sum(weight)
     # score sum w (c/mu - 1)(x - xbar): Var(c/mu) = 1/modes; derivative -sum w dx^2
     var = np.sum(weight ** 2 * dx ** 2 / modes) / np.sum(weight * dx ** 2) ** 2
     if psd.window == "hann":
         var *= HANN_VARIANCE ** psd.ndim
+    return float(np.sqrt(var) / 2)          # dH = ds / 2 (1D and 2D)
+
+
+def _half_fit(psd, q, c, weight, modes):
+    """H and its standard error of the Whittle power law of these values."""
+    slope, _ = whittle_power_law(q, c, weight)
     hurst = -slope / 2 - 1 if psd.ndim == 2 else (-slope - 1) / 2
-    return float(hurst), float(np.sqrt(var) / 2)          # dH = ds / 2 (1D and 2D)
+    return float(hurst), hurst_error(psd, q, weight, modes)
 
 
 def split_fit(psd: PowerSpectrum, q_range, size) -> SplitFit:
@@ -138,8 +194,7 @@ def split_fit(psd: PowerSpectrum, q_range, size) -> SplitFit:
     """
     sel, weight = fit_points(psd, q_range)
     q, c = psd.q[sel], psd.C[sel]
-    cell = float(np.prod([2 * np.pi / s for s in np.atleast_1d(size)]))
-    modes = psd.weight[sel] / (2 * cell)      # independent modes: q and -q are one
+    modes = independent_modes(psd, sel, size)
     split = float(np.sqrt(q[0] * q[-1])) if q.size else float("nan")
     halves = []
     for part in (q < split, q >= split):

@@ -37,7 +37,8 @@ to zero (their slope is undefined). The result is periodic with period ``size``.
   ensemble mean of the mean square height (slope), not by each realisation.
 
 With ``amplitudes="fixed"`` the two coincide. ``metadata["C0"]`` records the ``C0`` used
-(m**4 surface, m**3 profile; the PSD normalisation of :mod:`.stats`).
+(m**4 surface, m**3 profile; the PSD normalisation of :mod:`.stats`, Persson's:
+``(2 pi)**d C0`` is the prefactor in SurfaceTopography's and contact.engineering's).
 
 ``H = 1`` is allowed (``C ~ q**-(d+2)``, the smooth limit; Persson's theory and Tamaas
 take H in (0, 1]); ``H <= 0`` or ``H > 1`` is refused.

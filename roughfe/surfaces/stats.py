@@ -24,9 +24,16 @@ the Nyquist wavenumber; ``N_bin dqx dqy`` for an annulus), so that
 heights, and for the heights themselves only in expectation over stationary data (white
 noise: 1.00); a window shorter than the data's long waves sees less: the mean square of
 the PSD is 0.54 of the variance of 512-point windows of H = 0.8 profiles (0.91 after a
-line is removed), 0.17-1.3 on the five measured files (docs/theory/01). This is the convention of
-Jacobs, Junge & Pastewka (Surf. Topogr. Metrol. Prop. 5, 013001, 2017) and of
-SurfaceTopography and Tamaas.
+line is removed), 0.17-1.3 on the five measured files (docs/theory/01).
+
+This is Persson's convention (Persson et al., J. Phys.: Condens. Matter 17, R1, 2005:
+``<h^2> = integral C d^2q``), the one of :mod:`roughfe.theory.persson`. Jacobs, Junge &
+Pastewka (Surf. Topogr. Metrol. Prop. 5, 013001, 2017), SurfaceTopography and
+contact.engineering take the continuous transform ``int h(x) exp(-i q x) dx`` and
+``C = |.|^2 / L`` (``/ A``), with ``<h^2> = (1/pi) int_0^inf C dq`` (profile) and
+``(1/2 pi) int_0^inf q C dq`` (surface): the same units, values ``(2 pi)^d`` times ours
+(6.28 for a profile, 39.5 for a surface; :attr:`PowerSpectrum.C_jacobs`). Until round 2,
+session 34 this docstring called ours their convention.
 
 Spectral moments follow Nayak (1971) for an isotropic surface, ``m_n`` being the moments
 of a profile cut in any direction: profile ``m_n = sum q^n |h~|^2``; surface
@@ -47,7 +54,6 @@ from dataclasses import asdict, dataclass
 from typing import Optional
 
 import numpy as np
-import scipy.optimize
 
 from ..errors import InputError, check_finite_positive, check_instance
 from ..frozen import ReadOnlyArrays, read_only_arrays
@@ -154,7 +160,8 @@ class PowerSpectrum(ReadOnlyArrays):
     q : ndarray
         Angular wavenumbers > 0 (rad/m); for surfaces the mean ``|q|`` of each annulus.
     C : ndarray
-        PSD values: m^3 (profile) or m^4 (surface).
+        PSD values: m^3 (profile) or m^4 (surface), Persson's normalisation
+        (``(2 pi)^-ndim`` times SurfaceTopography's: :attr:`C_jacobs`).
     weight : ndarray
         q-space measure of each value (rad/m or rad^2/m^2): ``sum(C*weight) = <h^2>``.
     ndim : int
@@ -183,6 +190,13 @@ class PowerSpectrum(ReadOnlyArrays):
         """``sum(C * weight)``: the mean-square height (m^2) by Parseval; exact for
         periodic data, of the windowed heights with a window (module docstring)."""
         return float(np.sum(self.C * self.weight))
+
+    @property
+    def C_jacobs(self) -> np.ndarray:
+        """``C`` in the convention of Jacobs, Junge & Pastewka (2017), SurfaceTopography
+        and contact.engineering (m^3 or m^4): ``(2 pi)^ndim C`` (module docstring); the
+        values to compare with their PSD at the same ``q``."""
+        return (2 * np.pi) ** self.ndim * self.C
 
     @property
     def q_squared(self) -> np.ndarray:
@@ -322,6 +336,8 @@ class HurstFit:
     fall in the range or H leaves (0, 1) (the surface is then not self-affine there);
     ``q_range`` is NaN when no range was fitted. ``message`` adds the note of
     :func:`~roughfe.surfaces.psd_fit.split_fit` when the range is not one power law.
+    ``hurst_error`` is the standard error of ``hurst`` (-) for a Gaussian self-affine
+    surface (:func:`~roughfe.surfaces.psd_fit.hurst_error`; NaN without a fit).
     """
 
     hurst: float
@@ -332,41 +348,7 @@ class HurstFit:
     npoints: int
     success: bool
     message: str
-
-
-def _whittle_power_law(q, c, weight):
-    """Slope s and prefactor A of ``C = A q**s`` by the weighted Whittle likelihood.
-
-    Minimises ``sum_i weight_i [ln(A q_i^s) + c_i / (A q_i^s)]`` over A and s, with
-    ``weight`` the number of Fourier modes behind each PSD value ``c_i`` times the
-    weight given to each mode. A is then ``sum weight c q^-s / sum weight`` and the
-    profile likelihood in s, ``ln(sum weight c q^-s) + s <ln q>``, is convex (a
-    log-sum-exp plus a linear term): a bounded scalar minimisation finds it.
-
-    Why not least squares on log C: a periodogram value of a Gaussian surface is an
-    exponential variable, and the log of the mean of k of them is biased low by
-    ln k - psi(k) (0.58 for k = 1). The few modes per logarithmic bin at the low-q end
-    of a profile flatten a log-log fit: H = 0.8 fitted as 0.74 on average over 200
-    seeds of 1024-point profiles. The Whittle score equations are unbiased for any
-    weights (E[c_i] = A q_i^s), and working with C itself, not its logarithm, keeps the
-    empty bins between the lines of a Weierstrass-Mandelbrot spectrum from dragging the
-    fit (H = 0.3 and 0.5 fitted as 0.79 and 0.99 by the binned log-log fit).
-    """
-    lq = np.log(q)
-    lw = np.log(weight * c)              # c > 0 by the caller's selection
-    wbar = float(np.sum(weight * lq) / np.sum(weight))
-    shift = float(lq.mean())
-
-    def objective(s):
-        z = lw - s * (lq - shift)
-        zmax = float(z.max())
-        return zmax + float(np.log(np.sum(np.exp(z - zmax)))) + s * (wbar - shift)
-
-    best = scipy.optimize.minimize_scalar(objective, bounds=(-12.0, 4.0), method="bounded",
-                                          options={"xatol": 1e-10})
-    s = float(best.x)
-    prefactor = float(np.sum(weight * c * np.exp(-s * lq)) / np.sum(weight))
-    return s, prefactor
+    hurst_error: float = float("nan")
 
 
 #: PSD values below this fraction of the spectrum's largest are round-off of the heights
@@ -377,8 +359,10 @@ PSD_ROUNDOFF = 1e-20
 
 def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     """Fit the Hurst exponent on the (radially averaged) PSD: a power law ``C = A q^s``
-    by the weighted Whittle likelihood (:func:`_whittle_power_law`), each decade of q
-    weighted alike.
+    by the weighted Whittle likelihood
+    (:func:`~roughfe.surfaces.psd_fit.whittle_power_law`), each decade of q weighted
+    alike; ``hurst_error`` is its statistical error
+    (:func:`~roughfe.surfaces.psd_fit.hurst_error`).
 
     Parameters
     ----------
@@ -411,7 +395,8 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     if not (0 < qlo < qhi):
         raise InputError(f"q_range must satisfy 0 < q_min < q_max (rad/m), got {q_range!r}")
     psd = power_spectrum(surface, window=window)
-    from .psd_fit import fit_points, split_fit      # (it imports this module)
+    from .psd_fit import (fit_points, hurst_error, independent_modes, split_fit,
+                          whittle_power_law)        # (they import this module)
     sel, weight = fit_points(psd, (qlo, qhi))
     n = int(sel.sum())
     if n < 3:
@@ -421,14 +406,15 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
     if q[-1] <= q[0] * 10 ** 0.1:
         return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
                         "q_range spans less than 0.1 decade of PSD points; widen it")
-    slope, prefactor = _whittle_power_law(q, c, weight)
+    slope, prefactor = whittle_power_law(q, c, weight)
     d = surface.ndim
     hurst = -slope / 2 - 1 if d == 2 else (-slope - 1) / 2
     ok = 0 < hurst < 1
     note = split_fit(psd, (qlo, qhi), surface.size).note     # "" when one power law
     return HurstFit(float(hurst), float(d + 1 - hurst), float(slope), float(prefactor),
                     (qlo, qhi), n, bool(ok), ("fit converged" if ok else f"H = {hurst:.3f} "
-                    "outside (0, 1): not self-affine") + (f"; {note}" if note else ""))
+                    "outside (0, 1): not self-affine") + (f"; {note}" if note else ""),
+                    hurst_error(psd, q, weight, independent_modes(psd, sel, surface.size)))
 
 
 # -- everything at once ------------------------------------------------------------------
@@ -460,6 +446,7 @@ class SurfaceStatistics:
     hurst_q_range: tuple
     hurst_success: bool
     hurst_message: str = ""       # HurstFit.message: why not, or a range not one power law
+    hurst_error: float = float("nan")     # HurstFit.hurst_error: its standard error
 
     def as_dict(self) -> dict:
         """JSON-safe dict (NaN becomes None: :func:`roughfe.writers.to_jsonable`)."""
@@ -494,4 +481,4 @@ def surface_statistics(surface: Surface, q_range=None) -> SurfaceStatistics:
         skewness=skewness, kurtosis=kurtosis,
         m0=m0, m2=m2, m4=m4, nayak_alpha=m0 * m4 / m2 ** 2 if m2 > 0 else float("nan"),
         hurst=fit.hurst, fractal_dimension=fit.fractal_dimension, hurst_q_range=fit.q_range,
-        hurst_success=fit.success, hurst_message=fit.message)
+        hurst_success=fit.success, hurst_message=fit.message, hurst_error=fit.hurst_error)
