@@ -12,6 +12,11 @@ imports from the module that defines the name, so the layer of that module is ch
 optim holds generic optimisers without physics (the one GCMMA driver).
 No library module is over MAX_LINES lines unless ``LONG_MODULES`` states why.
 dolfinx, petsc4py, mpi4py.futures aside, gmsh and ufl are imported only inside roughfe/fem.
+
+validation/ holds the studies of ``roughfe validate`` (each named in its table) and their
+helper modules (``_*.py``: imported by a study, never a study themselves); both are held
+to MAX_LINES, a study imports helpers and the library but never another study, and none
+imports dolfinx & co. directly (they reach the FEM through roughfe.fem).
 """
 import ast
 from pathlib import Path
@@ -19,6 +24,7 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "roughfe"
+VALIDATION = PKG.parent / "validation"
 ORDER = ["errors", "writers", "reference", "optim", "surfaces", "model", "theory", "bem", "fem",
          "response", "leakage", "genomics", "study", "plotting", "cli"]
 BASE = {"errors", "writers", "reference", "caching", "frozen", "_runtime", "progress",
@@ -126,3 +132,55 @@ def test_no_module_is_over_the_line_limit():
             for p in sorted(PKG.rglob("*.py"))}
     over = {k: n for k, n in long.items() if n > MAX_LINES and k not in LONG_MODULES}
     assert not over, f"modules over {MAX_LINES} lines (split them by idea): {over}"
+
+
+# -- validation/: studies and their helper modules ----------------------------------------
+def _validation_modules():
+    """(studies, helpers): the stems of validation/*.py, split by the leading ``_``."""
+    stems = [p.stem for p in sorted(VALIDATION.glob("*.py"))]
+    return ({s for s in stems if not s.startswith("_")}, {s for s in stems if s.startswith("_")})
+
+
+def _top_level_imports(path):
+    """(line, top-level module name) of every import of ``path`` (absolute imports)."""
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, ast.Import):
+            yield from ((node.lineno, a.name.split(".")[0]) for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            yield node.lineno, node.module.split(".")[0]
+
+
+def test_no_validation_module_is_over_the_line_limit():
+    long = {p.name: len(p.read_text().splitlines()) for p in sorted(VALIDATION.glob("*.py"))}
+    over = {k: n for k, n in long.items() if n > MAX_LINES}
+    assert long and not over, (f"validation modules over {MAX_LINES} lines (split the study "
+                               f"into its script and helper modules _*.py): {over}")
+
+
+def test_validation_studies_import_helpers_and_the_library_not_each_other():
+    studies, helpers = _validation_modules()
+    bad, used = [], set()
+    for path in sorted(VALIDATION.glob("*.py")):
+        for lineno, top in _top_level_imports(path):
+            used.add(top)
+            if top in studies:
+                bad.append(f"validation/{path.name}:{lineno} imports the study {top} (move "
+                           "what it shares into a helper module _*.py)")
+            if top in FEM_ONLY:
+                bad.append(f"validation/{path.name}:{lineno} imports {top} (go through "
+                           "roughfe.fem)")
+        if path.stem in helpers and any(isinstance(n, ast.FunctionDef) and n.name == "main"
+                                        for n in ast.parse(path.read_text()).body):
+            bad.append(f"validation/{path.name} defines main: a helper is not a study")
+    bad += [f"validation/{h}.py is imported by no study" for h in sorted(helpers - used)]
+    assert not bad, "\n".join(bad)
+
+
+def test_every_validation_study_is_run_by_roughfe_validate():
+    """A study that no ``roughfe validate NAME`` names is never run nor paged (docs/generate.py
+    pages the validation/*.py without a leading ``_``), and a name must point at a study."""
+    from roughfe.cli.validate_cmd import VALIDATIONS
+    studies, _ = _validation_modules()
+    named = {script for scripts in VALIDATIONS.values() for script in scripts}
+    assert studies == named, (f"studies no validation runs: {sorted(studies - named)}; "
+                              f"names without a study: {sorted(named - studies)}")

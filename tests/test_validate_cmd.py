@@ -291,6 +291,7 @@ def test_the_mpi_row_needs_two_ranks(monkeypatch):
     COMM_WORLD of size 1) both runs are serial and equal by construction: not met (it was
     met with a difference of 0)."""
     import json
+    import shutil
     import subprocess
     from types import SimpleNamespace
     bem_vs_fem = _script("bem_vs_fem")
@@ -301,7 +302,7 @@ def test_the_mpi_row_needs_two_ranks(monkeypatch):
         line = json.dumps({"p": [1.0, 2.0], "A": [0.1, 0.2], "K": [3.0, 4.0],
                            "ranks": launched["size"] if "-n" in cmd else 1})
         return SimpleNamespace(returncode=0, stdout=line + "\n", stderr="")
-    monkeypatch.setattr(bem_vs_fem.shutil, "which", lambda name: "/usr/bin/mpirun")
+    monkeypatch.setattr(shutil, "which", lambda name: "/usr/bin/mpirun")
     monkeypatch.setattr(subprocess, "run", run)
     single = bem_vs_fem.mpi_case()
     assert single["ok"] is False and "not a parallel run" in single["note"]

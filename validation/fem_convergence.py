@@ -66,7 +66,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bem_vs_fem import MATERIAL, rmd_profile_case, subcell_area, table1_profile  # noqa: E402
+from _fem_cases import MATERIAL, rmd_profile_case, subcell_area, table1_profile  # noqa: E402
 
 from roughfe.bem import contact_sweep  # noqa: E402
 from roughfe.fem import fem_contact_sweep, mesh_profile, mirrored_profile  # noqa: E402

@@ -50,128 +50,40 @@ of :mod:`roughfe.validation`).
 from __future__ import annotations
 
 import json
-import resource
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import scipy.optimize
 
 from roughfe.genomics import database as gdb
-from roughfe.genomics.band_mechanics import band_macro_micro, band_mechanics
-from roughfe.genomics.bands import band_chromosomes
-from roughfe.genomics.mechanics import curve_difference
-from roughfe.genomics.design import (Design, GcmmaOptions, GlobalSearchOptions,
-                                     combined_score, match_spectrum,
-                                     run_design,
-                                     search_at_target_pressures, search_global,
-                                     surface_targets, target_surface, thesis_targets,
-                                     window_compliance)
-from roughfe.genomics.sequencing import sequence_surfaces
-from roughfe.genomics.sequencing.surface_data import resolvable_surface_genome
-from roughfe.errors import InputError
+from roughfe.genomics.design import (Design, GlobalSearchOptions, combined_score,
+                                     target_surface, thesis_targets)
 from roughfe.genomics.design.targets import score_at_target_pressures
 from roughfe.genomics.similarity import Target as ResponseTarget
-from roughfe.model import DEFAULT_E
 from roughfe.surfaces import Surface
-from roughfe.surfaces.io import load_surface, save_surface, topographies_folder
+from roughfe.surfaces.io import load_surface, save_surface
 from roughfe.validation import Target, percent, report_title, reported, targets_markdown
 from roughfe.writers import write_json, write_text
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from design_study import strict_scores_of_surface  # noqa: E402
+from _design_checks import strict_scores_of_surface  # noqa: E402
+from _surface_cases import (TOPOGRAPHIES, _cpu, _thinned, measured_mechanics,  # noqa: E402
+                            measured_targets, noise_table, recovery, surface_database)
+# GLOBAL is read from the study by tests/test_surface_genomics_study.py
+from _surface_design_chain import (DIRECTIONAL, GLOBAL, SEARCH, SEARCH_LONG,  # noqa: E402, F401
+                                   design_chain)
 
-TOPOGRAPHIES = topographies_folder()
 MEASURED = ("x3p-2.x3p", "sur-2.sur", "opd-1.opd", "plu-1.plu", "di-1.di")
-N_SEQ, L1 = 48, 1e-3
-NOISE = (0.001, 0.01, 0.03)
 GOAL_S, GOAL_F, RUN_CPU_S = 0.98, 0.9, 1800.0
+
 #: x3p-2 (650 x 650) is solved on every fourth point (163 x 163, same size) as a target
 X3P_POINTS = 163
 #: nodes per side of the surface database (the cost of the whole study is set by the
 #: shared 2-core machine: see the docs page), Sobol points (x 2 phase matrices) and the
 #: H range: x3p-2 has H = 0.22-0.32, below the thesis range [0.5, 1.5]
 DB_NODES, DB_POINTS, DB_HURST = 64, 24, (0.1, 1.5)
-#: measured targets: database genomes added as spectrum-matched starts (match_spectrum)
-SPECTRUM_STARTS = 3
-#: search sweeps per candidate (one (1+1)-ES run each) where a larger budget paid, one run
-#: each (docs/theory/surface-design.md): y_t1 CCO 0.966 -> 0.986 (goal met), x3p-2 M-CCO
-#: (per-wave matching) f 0.700 -> 0.777 at 300 sweeps; every other run keeps SEARCH sweeps
-#: (y_t1 M-CCO 300: 0.808, no gain; x3p-2 SOG 300: 0.933 -> 0.955, still NOT met, left
-#: out to keep the study's CPU near 10 min)
-SEARCH, SEARCH_LONG = 100, {("y_t1", "cco"): 300, ("x3p-2", "mcco"): 300}
-#: the global stage after the search (``design.search_global``: IPOP-CMA-ES on the batched
-#: strict score, phases and part weights +-30 %: the search's amplitudes=True has split
-#: the design into one part per chromosome, so these are the chromosome amplitudes):
-#: strict evaluations per run, for the runs the search leaves below their goal. Measured
-#: (one run each, x3p-2 SOG from its 100-sweep search, docs/theory/surface-design.md):
-#: 0.933 -> 0.964 at 1990 evaluations, 0.978 at 4993 (the (1+1)-ES saturates at 0.955);
-#: x3p-2 M-CCO keeps its 300 search sweeps before this stage (SEARCH_LONG). About 55 s
-#: CPU per 1000 batched evaluations at 64 x 64 (x3p-2 GCO: see GLOBAL_POPSIZE). Session 7
-#: (one run each from the study's start, seed 0, sigma 0.5, ~37 ms CPU per evaluation):
-#: x3p-2 SOG 0.9784 at 5000, 0.9819 at 6000, 0.9834 at 7000, 0.9842 at 8000 (goal met);
-#: x3p-2 CCO with part weights 0.9266 -> 0.9632 at 5000, 0.9646 at 8000 (levels off);
-#: with chromosome amplitudes x exp(+-0.6) (GLOBAL_AMPLITUDES) 0.9791 at 5000, 0.9805 at
-#: 6000, 0.9815 at 7000, 0.9822 at 8000 (goal met; 265 s CPU). Session 8 (x3p-2 M-CCO,
-#: stand-alone run of this chain, from its 300-sweep search f 0.7773, sigma 0.2, x
-#: exp(+-0.6)): f 0.8206 at 1000, 0.8477 at 2000, 0.8561 at 3000, 0.8576 at 4000, 0.8601
-#: at 5000, 0.8607 at 6000 (s_K 0.9554, s_A 0.9009; 196 s CPU for the stage, ~+110 s
-#: against 2000), still NOT the goal 0.9: the budget is the one lever that paid. Its
-#: highest peak, measured as the lever (design.crest_phases, a crest-factor step on the
-#: phases, and GlobalSearchOptions.peak, a z_max penalty; 2000 evaluations each): crest
-#: step before the stage 0.7872, before the search 0.7921, penalty 1.0 / 0.3 per rms above
-#: the target's z_max 2.714: 0.8186 / 0.8446, a second 2000 from the best 0.8477 (none
-#: better): not adopted (docs/theory/surface-design.md, session 8). Session 9: with the
-#: modulation variable (GLOBAL_MODULATION) the same 6000 give 0.9085
-GLOBAL = {("x3p-2", "sog"): 8000, ("x3p-2", "cco"): 8000, ("x3p-2", "mcco"): 6000,
-          ("y_t1", "mcco"): 4000, ("x3p-2", "gco"): 8000}
-#: the global stage's first CMA-ES step (rad for the phases; ``GlobalSearchOptions.sigma``)
-#: where it is not the default 0.5: M-CCO starts from the search's optimum, and a step
-#: of 0.5 rad leaves its basin (measured 2026-11-23, y_t1 M-CCO from the 100-sweep
-#: search f 0.827, docs/theory/surface-design.md): sigma 0.5 f 0.8445 at 2000
-#: evaluations, 0.870 at 4000; sigma 0.2 0.890 at 2000, 0.913 at 3000, 0.921 at 4000;
-#: x3p-2 M-CCO from its 300-sweep search f 0.7773: sigma 0.5 found nothing better in 2000
-#: evaluations (session 5), sigma 0.2 0.7824 at 1000, 0.8083 at 2000 (0.826 at 4000)
-GLOBAL_SIGMA = {("y_t1", "mcco"): 0.2, ("x3p-2", "mcco"): 0.2}
-#: the global stage's amplitude variables where they are not the default part weights
-#: +-30 % (``GlobalSearchOptions.amplitudes``: every chromosome's amplitude on a log scale,
-#: a_n0 exp(+-X tanh v)). Measured (session 7, x3p-2 M-CCO from its 300-sweep search f
-#: 0.7773, sigma 0.2, 2000 evaluations, one run each): part weights +-30 % f 0.8083 (the
-#: session-6 study), chromosome amplitudes x exp(+-0.6) 0.8477 (s_K 0.953, s_A 0.889;
-#: 0.8576 at 4000), x exp(+-1.0) 0.8247 (s_K 0.949, s_A 0.869), wave amplitudes x
-#: exp(+-0.3) 0.8041 (s_K 0.915, s_A 0.879); x3p-2 CCO (sigma 0.5, from its 100-sweep
-#: search 0.9266): part weights 0.9632 at 5000, x exp(+-0.6) 0.9791 at 5000 (see GLOBAL)
-GLOBAL_AMPLITUDES = {("x3p-2", "mcco"): 0.6, ("x3p-2", "cco"): 0.6, ("x3p-2", "gco"): 0.6}
-#: the global stage's first population where it is not 4 + 3 ln n (13 for the 24 variables
-#: of an x3p-2 design; ``GlobalSearchOptions.popsize``). x3p-2 GCO (session 8, one run each
-#: from the study's start 0.9281, seed 0, sigma 0.5, 8000 evaluations, ~38 ms CPU each,
-#: docs/theory/surface-design.md): with lambda 13 a run's best is one lucky early sample
-#: (x exp(+-0.6): 0.9357 at evaluation 469, population median 0.79) that the population
-#: does not pass within 10 + 30 n / lambda = 66 generations, so the run stops and IPOP
-#: restarts from the start: part weights +-30 % 0.9391 (at evaluation 196; 4 runs, nothing
-#: better), x exp(+-0.6) 0.9357 to 4000 (run 1 stopped at 1353), 0.9676 at 8000 (run 2,
-#: lambda 26, climbing from 4000);
-#: x exp(+-0.6) with lambda 26 from the start: one run, 0.9456 at 2000, 0.9725 at 4000,
-#: 0.9791 at 6000, 0.9822 at 7000, 0.9842 at 8000 (goal met; 311 s CPU). NOT robust:
-#: seeds 1 and 2 with lambda 26 give 0.9684 and 0.9471 (seed 1 with lambda 13: 0.9416)
-GLOBAL_POPSIZE = {("x3p-2", "gco"): 26}
-#: the global stage's modulation variable (``GlobalSearchOptions.modulation``: the depth of
-#: the short waves' modulation by the long-wave height, design.modulated_heights, beyond
-#: the MWM model) where it is used. Why (session 9, x3p-2, single solves): the target's
-#: short-wave part (|q| > q_N / 2) has 0.79 of its rms on the highest 10 % of its
-#: long-wave part (design.crest_roughness), a sum of plane waves (the 0.8607 design) 0.99;
-#: made uniform, the target's A*(p_max) falls 0.428 -> 0.368 (cuts 0.25 / 0.75: 0.377 /
-#: 0.388), the design's level. Measured (one run each from the 300-sweep search f 0.7773,
-#: sigma 0.2, x exp(+-0.6), seed 0, 2000 evaluations): without 0.8477, with +-0.5 0.8732
-#: (s_K 0.9296, s_A 0.9393, epsilon 0.22); the other levers of session 9 gave less
-#: (docs/theory/surface-design.md). With GLOBAL's 6000: f 0.8197 at 1000, 0.8732 at 2000,
-#: 0.8884 at 3000, 0.9007 at 4000, 0.9069 at 5000, 0.9085 at 6000 (s_K 0.9482, s_A
-#: 0.9582, epsilon 0.253; 220 s CPU for the stage), goal met at seed 0; seeds 1-4: 0.9176,
-#: 0.8499 (epsilon stays ~0), 0.9156, 0.9050 (without the modulation seeds 0-2: 0.8607,
-#: 0.8488, 0.8518); +-0.25 / +-1.0 at 2000: 0.8510 / 0.8540
-GLOBAL_MODULATION = {("x3p-2", "mcco"): 0.5}
 #: the TD sum of all bands against the complete surface (swept as its own surface by
 #: band_mechanics; it was the complete surface's own curve, c_n = 1 by construction).
 #: Their heights differ by the reconstruction error e (the "bands sum to the surface" row:
@@ -199,185 +111,6 @@ SUM_CURVE_TOL = {"c": 1e-12, "K": 1e-6}
 #: the same to 3 digits. Tolerances just above the 256^2 numbers
 WESTERGAARD_WAVE, WESTERGAARD_NODES = (2, 1), 256
 WESTERGAARD_SCORE = {"K": 6e-4, "A": 0.045}
-#: measured targets: runs whose spectrum matching is per wave (match_spectrum
-#: directional=True): x3p-2 M-CCO f 0.621 -> 0.700 (SOG 0.933 -> 0.885: kept per chromosome)
-DIRECTIONAL = {("x3p-2", "mcco")}
-
-
-def _cpu():
-    r = resource.getrusage(resource.RUSAGE_SELF)
-    return r.ru_utime + r.ru_stime
-
-
-def _genome(seed):
-    return resolvable_surface_genome(seed, length=L1, n_nodes=N_SEQ)
-
-
-def _wrapped(a):
-    return np.abs(np.angle(np.exp(1j * np.asarray(a))))
-
-
-def recovery(seeds):
-    rows = []
-    for seed in seeds:
-        g, acq, _ = _genome(seed)
-        t0 = _cpu()
-        r = sequence_surfaces(acq)
-        s = r.genome
-        row = {"seed": seed, "success": bool(r.success), "cpu_s": _cpu() - t0,
-               "M_exact": bool(s is not None and s.M == g.M)}
-        if row["M_exact"]:
-            truth = g.phase_columns(np.arange(s.n_first, s.n_last + 1))
-            row.update({
-                "gene_error": max(abs(s.gamma / g.gamma - 1), abs(s.lambda1 / g.lambda1 - 1),
-                                  abs(s.A / g.A - 1), abs(s.H - g.H),
-                                  float(np.max(np.abs(s.anisotropy / g.anisotropy - 1)))),
-                "angle_error_rad": float(np.max(_wrapped(s.angles - g.angles))),
-                "phase_error_rad": float(np.max(_wrapped(s.phases - truth))),
-                "rms_error": float(np.max(r.rms_errors))})
-        rows.append(row)
-    return rows
-
-
-def noise_table(seeds):
-    rows = []
-    for level in NOISE:
-        for seed in seeds:
-            g, acq, rng = _genome(seed)
-            noisy = [a.with_heights(a.heights + level * a.heights.std() * rng.normal(size=a.shape))
-                     for a in acq]
-            r = sequence_surfaces(noisy)
-            s = r.genome
-            ok = s is not None and s.M == g.M
-            rows.append({"noise": level, "seed": seed, "M_exact": bool(ok),
-                         "angle_error_deg": float(np.degrees(np.max(_wrapped(s.angles - g.angles))))
-                         if ok else None,
-                         "gamma_error": abs(s.gamma / g.gamma - 1) if s is not None else None,
-                         # the noise as a share of the heights about their plane, the
-                         # misfit's denominator (sequence_surfaces' signal_rms)
-                         "misfit_over_noise": float(np.max(
-                             r.rms_errors * r.signal_rms / (level * np.array(
-                                 [a.heights.std() for a in acq])))) if s is not None
-                         else None,
-                         "success": bool(r.success)})
-    return rows
-
-
-def _thinned(surface, n_max):
-    step = [max(1, int(np.ceil(n / n_max))) for n in surface.shape]
-    h = surface.heights[::step[0], ::step[1]]
-    return Surface(h, (h.shape[0] * surface.spacing[0] * step[0],
-                       h.shape[1] * surface.spacing[1] * step[1]), periodic=False,
-                   metadata={"thinned_by": step})
-
-
-def measured_mechanics(names, n_max=96, n_steps=10):
-    out = {}
-    for name in names:
-        path = TOPOGRAPHIES / name
-        if not path.is_file():
-            out[name] = {"skipped": f"{path} not found"}
-            continue
-        s = _thinned(load_surface(path), n_max)
-        t0 = _cpu()
-        bands = band_chromosomes(s, 2 ** 0.5, detrend="plane")
-        err = float(np.max(np.abs(bands.chromosomes.sum(axis=0) - bands.surface.heights))
-                    / np.ptp(bands.surface.heights))
-        mech = band_mechanics(bands, youngs_modulus=DEFAULT_E, n_steps=n_steps)
-        mm = band_macro_micro(mech)
-        last = mech.td_curves[-1]       # the sum of all bands, its own sweep
-        dev = (curve_difference(mech.complete, last) if last is not None
-               else {"K": np.nan, "A": np.nan})
-        out[name] = {"shape": list(s.shape), "n_bands": int(bands.n_chromosomes),
-                     "sum_error": err, "c_td_last": float(mech.c_td["K"][-1]),
-                     "td_last_K_deviation": dev["K"], "td_last_A_deviation": dev["A"],
-                     "c_chromosome_K": [None if not np.isfinite(v) else float(v)
-                                        for v in mech.c_chromosome["K"]],
-                     "macro": list(mm.macro), "micro": list(mm.micro),
-                     "partition": sorted(mm.macro + mm.micro) == [int(i) for i in bands.indices],
-                     "sweeps": int(mech.nit), "cpu_s": _cpu() - t0}
-    return out
-
-
-def surface_database(path: Path, length, n_pairs, n_vectors, n_nodes=64, n_steps=10,
-                     hurst_range=(0.5, 1.5)):
-    settings = gdb.DatabaseSettings(length=length, n_nodes=n_nodes, youngs_modulus=DEFAULT_E,
-                                    n_steps=n_steps, dim=2, top_fraction=0.8)
-    design = gdb.SobolDesign(dim=2, n_pairs=n_pairs, n_vectors=n_vectors, n_ridges=3,
-                             hurst_range=tuple(hurst_range))
-    have = set()
-    if path.is_file():
-        con = gdb.connect(path)
-        try:
-            if gdb.read_settings(con) == settings:
-                gdb.write_design(con, design)       # InputError: built with another design
-                have = set(gdb.labels(con))
-        except InputError:
-            have = set()
-        finally:
-            con.close()
-        if not have:
-            path.unlink()
-    todo = [t for t in gdb.sobol_tasks(design) if t["label"] not in have]
-    t0 = _cpu()
-    records = [gdb.genome_entry_task(**t, **settings.to_dict()) for t in todo]
-    cpu = _cpu() - t0
-    con = gdb.connect(path, create=True)
-    try:
-        gdb.write_settings(con, settings)
-        gdb.write_design(con, design)
-        gdb.insert_records(con, records)
-    finally:
-        con.close()
-    return settings, {"n_genomes": len(have) + len(records), "computed": len(records),
-                      "n_nodes": n_nodes, "hurst_range": list(hurst_range),
-                      "cpu_s": cpu, "cpu_per_genome_s": cpu / max(len(records), 1)}
-
-
-def measured_targets(measured, settings):
-    """K(p), A(p) targets of a measured window in the designs' periodic setting (the
-    evenly mirrored window, :func:`surface_targets` ``boundary="periodic"``), and, as a
-    check of why, the window alone on the half-space: its K against the series law
-    ``1/K_window = 1/K_periodic + C`` with the window's bulk compliance C."""
-    t0 = _cpu()
-    tk, ta, curve = surface_targets(measured, settings, name="x3p-2", boundary="periodic")
-    cpu = _cpu() - t0
-    t0 = _cpu()
-    _, _, win = surface_targets(measured, settings, name="x3p-2", boundary="window")
-    cpu_window = _cpu() - t0
-    c = window_compliance(measured.detrended("plane"), settings.youngs_modulus,
-                          settings.poisson)
-    # like with like: the mirrored window at the window's own sampling (not the design
-    # spacing), read at the window's pressures (it reaches further: 0.8 of full contact)
-    t0 = _cpu()
-    _, _, full = surface_targets(measured, settings, name="x3p-2", resolution="full")
-    cpu_full = _cpu() - t0
-    # for the series law the periodic K(p) on 24 steps to 0.95 of full contact, so that
-    # reading it at the window's pressures adds no interpolation error of note
-    dense = replace(settings, n_steps=24, top_fraction=0.95)
-    _, _, fine = surface_targets(measured, dense, name="x3p-2", resolution="full")
-    sel = win.pressure <= fine.p_max
-    k_per = np.exp(np.interp(np.log(win.pressure[sel]), np.log(fine.pressure),
-                             np.log(fine.stiffness)))
-    series = 1.0 / (1.0 / k_per + c)
-    dev = np.abs(series[1:] / win.stiffness[sel][1:] - 1.0)
-    return tk, ta, {"shape": list(measured.shape), "size_m": list(measured.size),
-                    "solved_shape": list(tk.metadata["solved_shape"]),
-                    "solved_size_m": list(tk.metadata["solved_size_m"]),
-                    "p_max": curve.p_max, "A_at_p_max": float(curve.area_fraction[-1]),
-                    "K_range": [float(curve.stiffness[0]), float(curve.stiffness[-1])],
-                    "cpu_s": cpu,
-                    "full_resolution": {"solved_shape": [2 * (n - 1) for n in measured.shape],
-                                        "p_max": full.p_max,
-                                        "A_at_p_max": float(full.area_fraction[-1]),
-                                        "K_range": [float(full.stiffness[0]),
-                                                    float(full.stiffness[-1])],
-                                        "cpu_s": cpu_full},
-                    "window": {"p_max": win.p_max, "A_at_p_max": float(win.area_fraction[-1]),
-                               "K_range": [float(win.stiffness[0]), float(win.stiffness[-1])],
-                               "compliance_m_per_Pa": c,
-                               "series_deviation_max": float(dev.max()),
-                               "cpu_s": cpu_window}}
 
 
 def westergaard_scoring(settings, wave=WESTERGAARD_WAVE, n=WESTERGAARD_NODES, stretch=2.0,
@@ -416,41 +149,12 @@ def westergaard_scoring(settings, wave=WESTERGAARD_WAVE, n=WESTERGAARD_NODES, st
             "one_minus_s_A": 1.0 - scores[1], "cpu_s": _cpu() - t0}
 
 
-def design_chain(entries, settings, targets, pbar, tag, method, surface=None, sweeps=SEARCH,
-                 quick=False):
-    """One design run of the study (also timed by benchmarks/bench_surface_design.py):
-    ``run_design``, then for a measured target (``surface``) :func:`match_spectrum`, the
-    search at the target pressures (``sweeps`` per candidate) and, for the runs in GLOBAL,
-    the global stage with the study's constants. Returns the result and the global
-    stage's settings (``global_evaluations`` 0 when it was not run)."""
-    res = run_design(method, entries, targets, settings, pbar=pbar,
-                     options=GcmmaOptions(bound="period"))
-    if surface is not None:
-        res = match_spectrum(res, surface, settings, entries=entries,
-                             n_entries=SPECTRUM_STARTS,
-                             directional=(tag, method) in DIRECTIONAL)
-    res = search_at_target_pressures(res, settings, n_eval=sweeps, amplitudes=True)
-    n_global = min(GLOBAL.get((tag, method), 0), 12 if quick else np.inf)
-    sigma = GLOBAL_SIGMA.get((tag, method), GlobalSearchOptions.sigma)
-    amplitudes = GLOBAL_AMPLITUDES.get((tag, method), GlobalSearchOptions.amplitudes)
-    # quick: the default population (26 would not fit its 12 evaluations)
-    popsize = 0 if quick else GLOBAL_POPSIZE.get((tag, method), GlobalSearchOptions.popsize)
-    modulation = GLOBAL_MODULATION.get((tag, method), GlobalSearchOptions.modulation)
-    if n_global:
-        res = search_global(res, settings, n_eval=n_global, sigma=sigma,
-                            amplitudes=amplitudes, popsize=popsize, modulation=modulation)
-    return res, {"global_evaluations": n_global,
-                 "global_sigma": sigma if n_global else None,
-                 "global_amplitudes": amplitudes if n_global else None,
-                 "global_popsize": popsize if n_global else None,
-                 "global_modulation": modulation if n_global else None}
-
-
 def design_runs(entries, settings, targets_k, target_a, pbar, search, outdir, tag,
                 surface=None, long=None, quick=False):
     """SOG/GCO/CCO on K, M-CCO on K and A (:func:`design_chain` each, ``search`` sweeps
     per candidate or ``long[method]`` where given), every design saved and re-scored from
-    its saved heights (``design_study.strict_scores_of_surface``: contact_sweep, Eq. 4.2,
+    its saved heights (``strict_scores_of_surface`` of the design study's checks,
+    ``validation/_design_checks.py``: contact_sweep, Eq. 4.2,
     K, A and Eq. 4.1 written out, not through the design package; the BEM solver is the
     same, so this checks the scoring and the saved design, not the BEM)."""
     rows = []
