@@ -56,13 +56,18 @@ Steps (:func:`sequence_profiles`)
    comb offers only such sub-lattices: a fit within ``rms_tolerance`` is therefore also
    tried on its coarser lattices gamma^k (k = 2..24, as the 2D sequencer does) and the
    lower BIC wins.
+   The final fit on the chosen lattice (and the fits of the held-out nodes) is damped
+   where the data cannot resolve it (:mod:`.regularise`: Tikhonov at lambda = the
+   least-squares noise level over the data's height), so that nearly collinear long
+   chromosomes do not carry waves that cancel; least squares ranks the lattices.
 5. Genes A, H (maximum likelihood on c_n, M-free), M, phases; Z_d = Z_1 - Z_2 at the
    common nodes; relative rms errors of the realisations of the sequenced genome; a
    quality report (success is False, with a message, when the relative rms error of any
    acquisition exceeds ``rms_tolerance``: the profile is not WM-like).
 
 Modules: :mod:`.acquisitions` (checks), :mod:`.peaks` (step 1), :mod:`.lattice` (steps
-2-4), :mod:`.genes` (step 5), :mod:`.result`, :mod:`.profile` (the driver,
+2-4), :mod:`.regularise` (the damped final fit), :mod:`.holdout` (held-out nodes),
+:mod:`.genes` (step 5), :mod:`.result`, :mod:`.profile` (the driver,
 :func:`sequence_profiles`) and :mod:`.zd` (the thesis's Z_d fit, for the record).
 Surfaces (2D MWM, issue 15): :mod:`.surface_data` (acquisitions, peaks, ridge directions),
 :mod:`.surface_grid` (the grid model of the fit), :mod:`.surface_fit` (the nonlinear fit

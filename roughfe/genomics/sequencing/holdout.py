@@ -73,16 +73,19 @@ def held_out_residual(rhs, fold, predict) -> np.ndarray:
 
 
 def held_out_errors(log_q1, log_gamma, acqs, ranges, weights, rhs,
-                    folds=HOLD_OUT_FOLDS) -> np.ndarray:
+                    folds=HOLD_OUT_FOLDS, regularise=True) -> np.ndarray:
     """Relative rms error of each profile acquisition's nodes predicted by the fits that
     left them out (:func:`position_folds`), the lattice (``log_q1``, ``log_gamma``,
     ``ranges``) fixed: rms(Z_i - Z_i^held-out) / rms(Z_i), as ``rms_errors``
     (``weights`` are 1 / rms(Z_i), ``rhs`` the weighted stacked heights, as in
     :func:`~.lattice.design_matrix`; each fit bounds the shared tilt of the windows of
-    one row as the sequencer does, :func:`~.lattice.solve_model`)."""
+    one row as the sequencer does, :func:`~.lattice.solve_model`, and, with
+    ``regularise``, is damped where its data cannot resolve it as the sequencer's final
+    fit is, :mod:`.regularise`)."""
     _, mat = design_matrix(log_q1, log_gamma, acqs, ranges, weights)
     err = held_out_residual(rhs, position_folds(acqs, folds),
-                            lambda keep: mat @ solve_model(mat[keep], rhs[keep], acqs))
+                            lambda keep: mat @ solve_model(mat[keep], rhs[keep], acqs,
+                                                           regularise=regularise))
     ends = np.cumsum([0] + [a.z.size for a in acqs])
     return np.array([math.sqrt(float(np.mean(err[i:j] ** 2))) for i, j in zip(ends, ends[1:])])
 

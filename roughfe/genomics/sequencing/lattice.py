@@ -7,13 +7,15 @@ import math
 
 import numpy as np
 from scipy.linalg import lstsq as scipy_lstsq
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, lsq_linear
 
 from ..genome import chromosome_range
+from .regularise import damped_system, resolution_damping
 
 #: a chromosome amplitude this many times the largest height of the acquisitions is a fit
-#: of waves that cancel (an overfit), not a genome (WM fits stay below 1); the shared
-#: line of the windows of one row is bounded by the same factor (:func:`tilt_bound`)
+#: of waves that cancel (an overfit), not a genome (WM fits stay below 1); the
+#: tilts (the line of the windows of one row, a levelled profile's) are bounded by the
+#: same factor (:func:`tilt_bounds`)
 OVERFIT_FACTOR = 10.0
 #: the largest rise, over half a window of length L, of the least-squares line of one
 #: wave c [cos(theta) - cos(q x + theta)] per unit amplitude c: 3 (sin a - a cos a) / a^2
@@ -227,8 +229,9 @@ def design_matrix(log_q1, log_gamma, acqs, ranges, weights, n_cap=None):
     to round-off): a free tilt on every acquisition is nearly collinear with the longest
     chromosome's sine over a window shorter than its wavelength, and on measured rows
     (``genome natural``) it traded them into waves of 1e4 x the heights. The tilt shared
-    by the windows of one row is solved within its bound by :func:`solve_model`. Returns
-    (n, matrix); the last :func:`line_columns` unknowns are the offsets, then the tilts."""
+    by the windows of one row and those of levelled profiles are solved within their
+    bounds by :func:`solve_model`. Returns (n, matrix); the last :func:`line_columns`
+    unknowns are the offsets, then the tilts."""
     lo = min(r[0] for r in ranges)
     hi = max(r[1] for r in ranges) if n_cap is None else min(n_cap, max(r[1] for r in ranges))
     n = np.arange(lo, hi + 1)
@@ -256,46 +259,86 @@ def solve_linear(mat, rhs):
     return coef / (scale if coef.ndim == 1 else scale[:, None])
 
 
-def tilt_bound(acqs) -> float:
-    """Largest |tilt| (m/m) of the line shared by the windows of one row
-    (:func:`tilt_columns`): the steepest line one chromosome of the largest amplitude
-    the amplitude guard of :func:`~.profile.sequence_profiles` admits
-    (:data:`OVERFIT_FACTOR` times the largest height of the acquisitions as given, about
-    their means) can carry over the coarsest window, whose rise over half of it is at
-    most :data:`LINE_PER_AMPLITUDE` times that amplitude; inf for other acquisitions.
+def tilt_bounds(acqs) -> np.ndarray:
+    """Largest |tilt| (m/m) of each tilt unknown (:func:`tilt_columns`): the steepest line
+    one chromosome of the largest amplitude the amplitude guard of
+    :func:`~.profile.sequence_profiles` admits (:data:`OVERFIT_FACTOR` times the largest
+    height of the acquisitions as given, about their means) can carry over the window of
+    the acquisition (the coarsest of those sharing the unknown), whose rise over half of
+    it is at most :data:`LINE_PER_AMPLITUDE` times that amplitude.
 
     A WM row's own line stays far inside it: at most 3.9 times the largest height (the
     bound: 13.1) on 2700 realised rows (Table 1 and random genomes, gamma 1.1-2.5, N
     128-512, three lengths; measured in round 2, session 33). Exact WM data are
     therefore fitted as without the bound; a fit that needs the line at it is trading
-    it against waves that cancel (reported as not a genome)."""
+    it against waves that cancel (reported as not a genome). The tilt of a levelled
+    acquisition (the line a profilometer removed, of its own window) is bounded the same
+    way since round 2, session 34 (before: free)."""
+    cols = tilt_columns(acqs)
+    out = np.full(max(cols, default=-1) + 1, math.inf)
+    if out.size:
+        z_scale = max(float(np.max(np.abs(a.z - a.z.mean()))) for a in acqs)
+        for a, c in zip(acqs, cols):
+            if c >= 0:
+                out[c] = min(out[c], LINE_PER_AMPLITUDE * OVERFIT_FACTOR * z_scale
+                             / (0.5 * a.length))
+    return out
+
+
+def tilt_bound(acqs) -> float:
+    """Largest |tilt| (m/m) of the line shared by the windows of one row
+    (:func:`tilt_columns`, :func:`tilt_bounds`); inf for other acquisitions."""
     if not (acqs and all(a.window for a in acqs)):
         return math.inf
-    z_scale = max(float(np.max(np.abs(a.z - a.z.mean()))) for a in acqs)
-    return LINE_PER_AMPLITUDE * OVERFIT_FACTOR * z_scale / (0.5 * acqs[0].length)
+    return float(tilt_bounds(acqs)[0])
 
 
-def solve_model(mat, rhs, acqs, solver=solve_linear):
+def _bounded_tilts(r1, r2, bounds):
+    """The tilts t within +-``bounds`` of least |r1 - r2 t|^2 (``r1`` the residual of the
+    heights and ``r2`` those of the tilt columns, the other unknowns projected out): for
+    one tilt the free minimiser clipped (0 when its column lies in the span of the
+    others), for several the exact bounded least squares (``scipy.optimize.lsq_linear``,
+    BVLS, on the columns scaled to unit norm)."""
+    if bounds.size == 1:
+        d = float(r2[:, 0] @ r2[:, 0])
+        t = float(r1 @ r2[:, 0]) / d if d > 0 else 0.0
+        return np.array([min(max(t, -bounds[0]), bounds[0]) if math.isfinite(t) else t])
+    scale = np.linalg.norm(r2, axis=0)
+    scale[scale == 0] = 1.0
+    free = np.linalg.lstsq(r2 / scale, r1, rcond=None)[0] / scale
+    if np.all(np.abs(free) <= bounds):
+        return free                                          # the bounds are not active
+    top = np.maximum(bounds * scale, 1e-300)                 # a zero bound: t = 0
+    fit = lsq_linear(r2 / scale, r1, bounds=(-top, top), method="bvls")
+    return fit.x / scale
+
+
+def solve_model(mat, rhs, acqs, solver=solve_linear, regularise=False):
     """The coefficients of :func:`design_matrix` (columns ``mat``, weighted heights
-    ``rhs``) by least squares (``solver``), the shared tilt of the windows of one row
-    (its last column) within :func:`tilt_bound`.
+    ``rhs``) by least squares (``solver``), the tilts (its last columns) within
+    :func:`tilt_bounds`; with ``regularise``, damped where the data cannot resolve them
+    (:mod:`.regularise`: Tikhonov at the lambda of the least-squares fit's misfit, the
+    same bounds on the tilts).
 
-    The other columns R are solved for two right-hand sides at once (one factorisation):
-    R x1 = rhs and R x2 = t-column, so that the misfit at a tilt t is |r1 - t r2|^2
-    (r1, r2 their residuals), a convex quadratic least at t = r1.r2 / r2.r2 (the free
-    fit); the tilt is that value clipped to the bound (the exact bounded least squares
-    for one bounded unknown; 0 when the tilt column lies in the span of the others), the
-    rest x1 - t x2."""
-    bound = tilt_bound(acqs)
-    if not math.isfinite(bound):
-        return solver(mat, rhs)
-    rest, col = mat[:, :-1], mat[:, -1]
-    x = solver(rest, np.column_stack([rhs, col]))
-    r1, r2 = rhs - rest @ x[:, 0], col - rest @ x[:, 1]
-    d = float(r2 @ r2)
-    tilt = float(r1 @ r2) / d if d > 0 else 0.0
-    tilt = min(max(tilt, -bound), bound) if math.isfinite(tilt) else tilt
-    return np.append(x[:, 0] - tilt * x[:, 1], tilt)
+    The other columns R are solved for the heights and the tilt columns at once (one
+    factorisation): R x1 = rhs and R X2 = tilt columns, so that the misfit at tilts t is
+    |r1 - r2 t|^2 (r1, r2 their residuals), a convex quadratic; the tilts are its least
+    within the bounds (:func:`_bounded_tilts`: exact bounded least squares), the rest
+    x1 - X2 t. Regularised, the same on the stacked system [mat; lambda D] x = [rhs; 0]
+    (:func:`~.regularise.damped_system`), which is least squares too."""
+    bounds = tilt_bounds(acqs)
+    if not bounds.size:
+        coef = solver(mat, rhs)
+    else:
+        k = bounds.size
+        rest, cols = mat[:, :-k], mat[:, -k:]
+        x = solver(rest, np.column_stack([rhs, cols]))
+        tilts = _bounded_tilts(rhs - rest @ x[:, 0], cols - rest @ x[:, 1:], bounds)
+        coef = np.concatenate([x[:, 0] - x[:, 1:] @ tilts, tilts])
+    damping = resolution_damping(mat, rhs, coef) if regularise else 0.0
+    if damping > 0.0:
+        return solve_model(*damped_system(mat, rhs, damping), acqs, solver)
+    return coef
 
 
 def vp_residual(params, acqs, ranges, weights, rhs, n_cap):

@@ -18,7 +18,7 @@ from .genes import (H_SEARCH, M_VALUES, amplitude_gene_errors, amplitude_genes,
                     ridge_likelihood, variance_amplitude)
 from .lattice import (LINE_PER_AMPLITUDE, OVERFIT_FACTOR, bic, coarser_lattices, comb_periods,
                       design_matrix, fit_lattice, label_q1, lattice_from_period,
-                      lattice_ranges, line_columns, round_off_cost, solve_model, tilt_bound,
+                      lattice_ranges, line_columns, round_off_cost, solve_model, tilt_bounds,
                       tilt_columns, vp_residual)
 from .holdout import held_out_errors, overfit_reason
 from .peaks import spectrum_peaks
@@ -30,6 +30,9 @@ from .result import SequencingResult
 #: candidate (1.05) of a lattice up to 3.2 is covered, in at most 299 linear solves
 #: (measured: Table 1 at 0.1 % and 1 % noise came out as 1.5^(1/7), seeds 1 and 5)
 K_MAX = 24
+#: the final fit and its held-out fits are damped where the data cannot resolve them
+#: (:mod:`.regularise`); False: least squares, as until round 2, session 33
+REGULARISE = True
 
 
 def _rel_rms(residual, z):
@@ -195,7 +198,11 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
         lq1, lg = pol.x
     gamma, lam1 = math.exp(lg), 2 * math.pi / math.exp(lq1)
     n, mat = design_matrix(lq1, lg, acqs, ranges, weights)
-    coef = solve_model(mat, rhs, acqs)
+    # damped where the data cannot resolve it (:mod:`.regularise`): least squares ranks
+    # the lattices above, but its coefficients along the directions the data do not
+    # resolve (the long chromosomes of fine lattices and the line, collinear) are not
+    # the data's (measured rows: waves of 0.4-7 m that cancel)
+    coef = solve_model(mat, rhs, acqs, regularise=REGULARISE)
     cvec = coef[0:2 * n.size:2] + 1j * coef[1:2 * n.size:2]
     # the acquisitions' height offsets (their heights at x = 0 off the genome's zero) and
     # tilts (the line a levelled profile lost)
@@ -261,7 +268,8 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     # of 2.9 m on a profile of 15 nm rms, off by 1e8 on windows it was not fitted to).
     # Its nodes held out of the fit (:mod:`.holdout`) are missed by far more than the
     # tolerance; a genome predicts them to about its misfit
-    held_out = held_out_errors(lq1, lg, given, ranges, weights, rhs)
+    held_out = held_out_errors(lq1, lg, given, ranges, weights, rhs,
+                               regularise=REGULARISE)
     z_scale = max(float(np.max(np.abs(a.z - a.z.mean()))) for a in given)
     at_bound = not (H_SEARCH[0] * (1 + 1e-6) < H < H_SEARCH[1] * (1 - 1e-6))
     reasons = []
@@ -271,10 +279,18 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     if float(np.max(amps)) > OVERFIT_FACTOR * z_scale:
         reasons.append(f"chromosome amplitudes up to {float(np.max(amps)):.3g} m on "
                        f"acquisitions of at most {z_scale:.3g} m (waves that cancel: an overfit)")
-    if tilts.size and abs(tilts[0]) >= (1 - 1e-9) * tilt_bound(given):
+    bounds, rise = tilt_bounds(given), LINE_PER_AMPLITUDE * OVERFIT_FACTOR
+    at = [i for i, c in enumerate(tilt_columns(given))
+          if c >= 0 and abs(tilts[i]) >= (1 - 1e-9) * bounds[c]]
+    if at and all(a.window for a in given):
         reasons.append(f"the line shared by the windows is at its bound, {tilts[0]:.3g} m/m "
-                       f"(rising over half the row by {LINE_PER_AMPLITUDE * OVERFIT_FACTOR:.3g} "
+                       f"(rising over half the row by {rise:.3g} "
                        f"times the largest height: the longest chromosomes trade with it)")
+    elif at:
+        reasons.append("the line of acquisition " + ", ".join(
+            f"{i + 1} is at its bound, {tilts[i]:.3g} m/m" for i in at)
+            + f" (rising over half its window by {rise:.3g} times the largest height: the "
+            f"longest chromosomes trade with it)")
     if ok and float(np.max(held_out)) > rms_tolerance:
         reasons.append(overfit_reason(held_out, rms, [2 * (r[1] - r[0] + 1) for r in ranges],
                                       [g.z.size for g in given]))

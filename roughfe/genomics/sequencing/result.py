@@ -45,7 +45,8 @@ class SequencingResult:
     n : ndarray of int
         Chromosome indices fitted (union over acquisitions).
     amplitudes, phases : ndarray
-        c_n (m) and theta_n (rad) of the reduced chromosomes (Eq. 3.7-3.8).
+        c_n (m) and theta_n (rad) of the reduced chromosomes (Eq. 3.7-3.8), of the fit
+        damped where the data cannot resolve it (:mod:`.regularise`).
     ranges : list of (int, int)
         (n_s, n_f) per acquisition, coarsest first (Eq. 3.5).
     lengths : ndarray
@@ -54,8 +55,8 @@ class SequencingResult:
         rms(Z_i - Z_i^seq) / rms(Z_i) per acquisition (relative, -), Z_i the heights as
         given (the fitted offset and tilt are part of the model, not of the yardstick).
     held_out_errors : ndarray
-        The same for each node predicted by the linear fit on the sequenced lattice
-        that left its position out (:func:`~.holdout.held_out_errors`, 5 folds): about
+        The same for each node predicted by the (damped) linear fit on the sequenced
+        lattice that left its position out (:func:`~.holdout.held_out_errors`, 5 folds): about
         ``rms_errors`` for a genome, far more for an overfit (a fit within the tolerance
         whose held-out errors exceed it is "not a genome: an overfit").
     x, heights, fitted : list of ndarray
@@ -79,8 +80,9 @@ class SequencingResult:
     tilts : ndarray
         Slope of each acquisition's fitted line (m/m, coarsest first): the line a
         levelled profile lost (``heights`` are the data less it too; round 2, session 29);
-        for the windows of one row one shared tilt within
-        :func:`~.lattice.tilt_bound` (round 2, session 33).
+        for the windows of one row one shared tilt; each within
+        :func:`~.lattice.tilt_bounds` (the shared one since round 2, session 33, a
+        levelled profile's since session 34).
     lnA_stderr, H_stderr : float
         Standard errors (1 sigma) of ln A and H from the Fisher information of their
         likelihood (:func:`~.genes.amplitude_gene_errors`; NaN when not computed).
