@@ -4,6 +4,7 @@ Every exception is a subclass of a builtin so that callers that expect ``ValueEr
 (bad input) or ``RuntimeError`` (a solver that did not converge) keep working.
 """
 import operator
+import sys
 
 
 class RoughfeError(Exception):
@@ -132,6 +133,48 @@ def check_in_open_interval(name, value, low, high):
     """Return ``float(value)`` or raise :class:`InputError` unless low < value < high (a
     number: not a string, not a bool): :func:`check_in_interval` with both ends out."""
     return check_in_interval(name, value, low, high, "neither")
+
+
+def times_ratio(value, numerator: float, denominator: float):
+    """``value * numerator / denominator`` without an intermediate overflow or underflow.
+
+    The three are split into mantissa and binary exponent (``frexp``) and the product is
+    rebuilt once (``ldexp``): finite whenever the result is, rounded as a product of three
+    floats; ``inf`` or 0 only where the result itself is beyond the float range. ``value``
+    may be an array.
+    """
+    import numpy as np          # here: importing the command line imports no numpy
+
+    mv, ev = np.frexp(value)
+    mn, en = np.frexp(float(numerator))
+    md, ed = np.frexp(float(denominator))
+    with np.errstate(over="ignore", under="ignore"):
+        out = np.ldexp(mv * mn / md, ev + (en - ed))
+    return out if np.ndim(out) else float(out)
+
+
+def check_leak_scale(conductance: float, pressure_drop: float, mu: float) -> float:
+    """The leak rate ``Q = C dp / mu`` (m^3/s) of a gap of conductance ``C`` (m^3, the leak
+    rate at a unit drop and viscosity); :class:`InputError` when ``Q != 0`` is beyond the
+    normal float range (it overflowed to a null, or underflowed to 0 or to a subnormal
+    that keeps few digits), naming the range of ``dp / mu`` this gap allows. One rule for
+    every leak rate linear in ``dp / mu``: the Reynolds solves
+    (:mod:`roughfe.leakage.reynolds`, the coupled one of :mod:`roughfe.leakage.fsi`), the
+    critical junction of a gap field and Lorenz & Persson's (:mod:`roughfe.theory.junction`).
+    """
+    q = times_ratio(conductance, pressure_drop, mu)
+    tiny, top = sys.float_info.min, sys.float_info.max
+    if conductance > 0 and pressure_drop != 0 and not (tiny <= abs(q) <= top):
+        c = float(conductance)                                # Python floats: no warning
+        low, high = tiny / c, top / c                         # high: inf for C < 1
+        allowed = (f"from {low:.3g} to {high:.3g} 1/s" if high < float("inf")
+                   else f"from {low:.3g} 1/s up")
+        raise InputError(
+            f"pressure_drop = {pressure_drop:g} Pa with mu = {mu:g} Pa s: the leak rate "
+            f"Q = C dp / mu (C = {conductance:.4g} m^3, this gap's leak rate at a unit drop "
+            f"and viscosity) {'overflows' if abs(q) > 1 else 'underflows'} the float range; "
+            f"this gap allows dp / mu {allowed}")
+    return q
 
 
 def check_int(name, value, minimum):

@@ -278,8 +278,9 @@ def test_unloading_reopens_pockets_and_section6_states_hold(surface, kw):
 def test_reynolds_solves_warm_started_from_the_last_pressure(surface, flowing, monkeypatch):
     """Each Reynolds solve of the coupling loop starts from the previous finite-volume
     pressure: the coupled state is the one of cold solves (to the tolerances) and the
-    loop spends fewer CG iterations on Reynolds."""
-    from roughfe.leakage import fsi
+    loop spends fewer CG iterations on Reynolds (the loop's solves go through
+    reynolds.scaled_reynolds_fv, at a unit drop and viscosity)."""
+    from roughfe.leakage import reynolds
     its = {}
 
     def counting(key, cold):
@@ -289,9 +290,9 @@ def test_reynolds_solves_warm_started_from_the_last_pressure(surface, flowing, m
             return sol
         return solve
 
-    monkeypatch.setattr(fsi, "solve_reynolds_fv", counting("warm", False))
+    monkeypatch.setattr(reynolds, "solve_reynolds_fv", counting("warm", False))
     warm = coupled_leakage(surface, MAT, P_EXT, p_in=2e7, p_out=0.0)
-    monkeypatch.setattr(fsi, "solve_reynolds_fv", counting("cold", True))
+    monkeypatch.setattr(reynolds, "solve_reynolds_fv", counting("cold", True))
     cold = coupled_leakage(surface, MAT, P_EXT, p_in=2e7, p_out=0.0)
     assert warm.coupled_iterations == flowing.coupled_iterations
     assert warm.leak_rate == pytest.approx(cold.leak_rate, rel=1e-7, abs=0)

@@ -109,3 +109,77 @@ def test_junction_leak_rate_is_scaled_as_the_reynolds_one():
     assert c.leak_rate_junction(mu=1.0, pressure_drop=0.0, **kw) == 0.0
     with pytest.raises(InputError, match="underflows"):
         c.leak_rate_junction(mu=1e308, pressure_drop=1.0, **kw)
+
+
+# -- the same rule beyond reynolds_flow (round 2, session 34, helper "left") ------------------
+def test_scaled_fv_solve_at_absolute_pressures_any_drop_and_viscosity():
+    # the raw FV solve of the two-way coupling, at absolute pressures: parallel plates are
+    # exact, the pressure linear from p_in to p_out; reversed flow and no flow allowed
+    from roughfe.leakage.reynolds import scaled_reynolds_fv
+    gap = np.full((N, 12), H)
+    x = (np.arange(N) + 0.5) / N
+    for p_in, p_out, mu in ((2e7, 0.0, 1e-3), (1e300, 0.0, 1e-3), (0.0, 3e300, 1e250),
+                            (5.0, 1.0, 1e-300)):
+        sol = scaled_reynolds_fv(gap, (DX, DX), mu=mu, p_in=p_in, p_out=p_out)
+        exact = times_ratio(H**3 * 12 / (12.0 * N), p_in - p_out, mu)
+        assert sol.leak_rate == pytest.approx(exact, rel=1e-9, abs=0)
+        assert sol.inlet_flow == pytest.approx(exact, rel=1e-9, abs=0)
+        assert np.allclose(sol.pressure[:, 5], p_in + (p_out - p_in) * x, rtol=1e-9, atol=0)
+    still = scaled_reynolds_fv(gap, (DX, DX), mu=1e-300, p_in=7.0, p_out=7.0)
+    assert still.leak_rate == 0.0 and np.all(still.pressure == 7.0) and not still.flux.any()
+
+
+@pytest.fixture(scope="module")
+def coupled_case():
+    from roughfe.model import Material
+    from roughfe.surfaces.spectral import spectral_surface
+    return spectral_surface(16, 1e-4, 0.8, rms_height=1e-6, rng=4), Material(1e9, 0.3)
+
+
+def test_coupled_leakage_at_any_viscosity(coupled_case):
+    # the fluid pressure of the two-way coupling does not depend on mu, its leak rates are
+    # 1/mu (was: mu 1e250 a leak rate of 0.0 and a fluid load fraction of 0.042 instead of
+    # 0.468 from underflowed transmissibilities, in silence; mu 1e-300 a NaN Reynolds solve,
+    # a NoConvergenceError); a leak rate beyond the floats is an InputError
+    from roughfe.leakage.fsi import coupled_leakage
+    surface, mat = coupled_case
+    runs = {mu: coupled_leakage(surface, mat, 3e7, p_in=2e7, p_out=0.0, mu=mu)
+            for mu in (1e-3, 1e250, 1e-300)}
+    base = runs[1e-3]
+    assert base.state == "contact" and base.leak_rate > 0
+    for mu, r in runs.items():
+        assert r.fluid_load_fraction == pytest.approx(base.fluid_load_fraction, rel=1e-12,
+                                                      abs=0)
+        np.testing.assert_allclose(r.fluid_pressure, base.fluid_pressure, rtol=1e-12, atol=0)
+        assert r.leak_rate == pytest.approx(times_ratio(base.leak_rate, 1e-3, mu), rel=1e-12,
+                                            abs=0)
+    with pytest.raises(InputError, match=r"mu = 1e\+300 Pa s: the leak rate .* underflows"):
+        coupled_leakage(surface, mat, 3e7, p_in=2e7, p_out=0.0, mu=1e300)
+
+
+def test_persson_junction_leak_rate_at_any_drop_and_viscosity():
+    # Eq. (5) Q = (Ly/Lx) u_c^3 / 12 dp / eta: dp 1e300 Pa with eta 1e-20 Pa s was inf (the
+    # product dp / eta overflowed first), dp 1e-308 Pa 0.0 m^3/s (underflowed), in silence
+    from roughfe.surfaces.spectral import spectral_surface
+    from roughfe.theory import critical_junction
+    s = spectral_surface(64, 1e-3, 0.8, rms_height=1e-6, rng=3)
+    unit = critical_junction(s, 1e9, 1e6, 1.0, 1.0)
+    assert not unit.sealed and unit.leak_rate == pytest.approx(unit.u_c**3 / 12, rel=1e-14,
+                                                               abs=0)
+    far = critical_junction(s, 1e9, 1e6, 1e300, 1e-20)
+    assert far.u_c == unit.u_c
+    assert far.leak_rate == pytest.approx(times_ratio(unit.leak_rate, 1e300, 1e-20),
+                                          rel=1e-14, abs=0)
+    assert np.isfinite(far.leak_rate) and far.leak_rate > 1e250
+    with pytest.raises(InputError, match=r"underflows the float range; this gap allows "
+                                         r"dp / mu from"):
+        critical_junction(s, 1e9, 1e6, 1e-308, 1e-3)
+
+
+def test_finite_volume_leak_rate_shortcut_is_scaled():
+    # the public shortcut solved at the given mu: 0.0 at mu 1e250, inf at dp 1e300
+    from roughfe.leakage import finite_volume_leak_rate
+    gap = np.full((N, 12), H)
+    for dp, mu in ((1.0, 1.0), (1e300, 1e-3), (1.0, 1e250)):
+        assert finite_volume_leak_rate(gap, (DX, DX), mu=mu, pressure_drop=dp) == \
+            pytest.approx(H**3 * 12 / (12.0 * N) * (dp / mu), rel=1e-9, abs=0)

@@ -64,3 +64,18 @@ def test_one_refused_full_step_does_not_stop_the_loop():
     damped = anderson_fixed_point(G, np.zeros(3), tol=1e-12, max_iter=200, memory=0,
                                   relaxation=0.5)
     assert damped.converged and np.allclose(damped.x, 1.0, rtol=0, atol=1e-10)
+
+
+def test_the_residual_norm_holds_at_any_scale_of_the_field():
+    # G(x) = s (A x/s + b) for s = 2^+-600 is the same map in other units: the same
+    # iterates times s, bit for bit (powers of two scale exactly), and the same residuals.
+    # Was: the 2-norm's squares overflowed at s = 2^600 (~4e180: inf norms, a NaN residual,
+    # max_iter) and underflowed at 2^-600 (a zero norm: "converged" at the first iterate)
+    G, exact = _linear_map()
+    ref = anderson_fixed_point(G, np.zeros(exact.size), tol=1e-10, max_iter=200, memory=10)
+    for s in (2.0 ** 600, 2.0 ** -600):
+        fp = anderson_fixed_point(lambda x, s=s: s * G(x / s), np.zeros(exact.size), tol=1e-10,
+                                  max_iter=200, memory=10)
+        assert fp.status == ref.status == "converged" and fp.iterations == ref.iterations
+        assert fp.residuals == ref.residuals
+        assert np.array_equal(fp.x, s * ref.x)

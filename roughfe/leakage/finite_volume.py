@@ -444,8 +444,11 @@ def finite_volume_leak_rate(gap, spacing, *, direction: str = "x", mu: float = 1
                             pressure_drop: float = 1.0, periodic: bool = False) -> float:
     """Leak rate ``Q`` (m^3/s) of Eq. 2.12 by cell-centred finite volumes (shortcut).
 
-    ``pressure_drop = p_in - p_out`` in Pa (> 0); see :func:`solve_reynolds_fv`.
+    ``pressure_drop = p_in - p_out`` in Pa (> 0); see :func:`solve_reynolds_fv`. Solved at
+    a unit drop and viscosity and scaled (:func:`roughfe.leakage.reynolds.scaled_reynolds_fv`:
+    mu = 1e308 Pa s gave 0.0, a drop of 1e300 Pa inf).
     """
+    from .reynolds import scaled_reynolds_fv      # reynolds imports this module
     dp = check_finite_positive("pressure_drop", pressure_drop)
-    return solve_reynolds_fv(gap, spacing, direction=direction, mu=mu, p_in=dp, p_out=0.0,
-                             periodic=periodic).leak_rate
+    return scaled_reynolds_fv(gap, spacing, direction=direction, mu=mu, p_in=dp, p_out=0.0,
+                              periodic=periodic).leak_rate

@@ -18,7 +18,9 @@ displacement ``u = H (p_c + p_f)``, and
   pressure ``mean(p_c) = p_ext - mean(p_f)`` (the existing BEM solver,
   :func:`roughfe.bem.solve_contact`, warm-started);
 * the fluid pressure is the Reynolds solution (Eq. 2.12, cell-centred finite volumes,
-  :mod:`roughfe.leakage.finite_volume`) on the gap regularised by a film of
+  :mod:`roughfe.leakage.finite_volume`, solved at a unit drop and viscosity and scaled:
+  :func:`roughfe.leakage.reynolds.scaled_reynolds_fv`; the pressure does not depend on
+  ``mu``, the leak rates are ``1/mu``) on the gap regularised by a film of
   ``h_reg`` (default ``1e-3`` times the rms height) in the contact cells, and the
   trapped-pocket pressure (below) in the pockets. The film conducts ``(h_reg/h)^3 ~ 1e-9``
   of an open cell: it leaves the open-film pressure unchanged to that order, defines the
@@ -95,8 +97,9 @@ from ..errors import InputError, NoConvergenceError, check_finite_positive, chec
 from ..optim.anderson import RejectedIterate, anderson_fixed_point, check_options
 from ..surfaces import Surface
 from .channel import check_absolute_pressures
-from .finite_volume import FVSolution, reynolds_fv_solver, solve_reynolds_fv
+from .finite_volume import FVSolution, reynolds_fv_solver
 from .pockets import SEALED, TRAPPED_MODELS, PocketNewton, Pockets, transfer
+from .reynolds import scaled_reynolds_fv
 
 REFERENCES = (
     "Anderson acceleration: Walker & Ni, SIAM J. Numer. Anal. 49 (2011) 1715",
@@ -346,7 +349,7 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
                           tol=contact_tol, compute_stiffness=False,
                           initial=last["contact"].pressure)
         gap = np.where(c.contact, 0.0, c.gap)
-        last["fluid"] = y = solve_reynolds_fv(
+        last["fluid"] = y = scaled_reynolds_fv(
             np.maximum(gap, h_reg), spacing, direction=direction, mu=mu, p_in=p_in, p_out=p_out,
             periodic=surface.periodic, initial=last["fluid"], solver=krylov).pressure
         if frozen.n:
@@ -357,8 +360,8 @@ def coupled_leakage(surface: Surface, material, external_pressure: float, *,
         return y
 
     def _flow(gap):
-        return solve_reynolds_fv(gap, spacing, direction=direction, mu=mu, p_in=p_in,
-                                 p_out=p_out, periodic=surface.periodic, initial=last["fluid"])
+        return scaled_reynolds_fv(gap, spacing, direction=direction, mu=mu, p_in=p_in,
+                                  p_out=p_out, periodic=surface.periodic, initial=last["fluid"])
 
     # one Reynolds solver for the loop: every cell is live, so it keeps its AMG hierarchy
     with reynolds_fv_solver() as krylov:

@@ -43,7 +43,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import breadth_first_order
 
 from ..errors import (InputError, check_finite_nonnegative, check_finite_positive,
-                      check_real_array, check_spacing)
+                      check_leak_scale, check_real_array, check_spacing)
 from ..frozen import ReadOnlyArrays, read_only_arrays
 from .components import components_reaching
 
@@ -105,7 +105,7 @@ class CriticalConstriction(ReadOnlyArrays):
 
         ``length`` and ``width`` are the domain's size along and across the flow (m). A
         rate beyond the normal float range is an InputError
-        (:func:`roughfe.leakage.reynolds.check_leak_scale`).
+        (:func:`roughfe.errors.check_leak_scale`).
         """
         mu = check_finite_positive("mu (Pa s)", mu)
         pressure_drop = check_finite_nonnegative("pressure_drop (Pa)", pressure_drop)
@@ -115,7 +115,6 @@ class CriticalConstriction(ReadOnlyArrays):
             return 0.0
         # linear in dp / mu: scaled as the Reynolds leak rate (a drop or viscosity near the
         # float limits gave 0 or inf in silence; InputError beyond the floats)
-        from .reynolds import check_leak_scale
         return check_leak_scale(width / length * self.critical_gap ** 3 / 12.0,
                                 pressure_drop, mu)
 

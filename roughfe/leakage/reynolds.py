@@ -18,24 +18,26 @@ Eq. 2.11 divided by the (constant) density, ``q = h U/2 - h^3/(12 mu) grad p`` (
 at the cell centres.
 
 Without wall motion the flow is linear in the drop and in ``1/mu``: :func:`reynolds_flow`
-solves at a unit drop and viscosity and scales the result (:func:`times_ratio`), so that
-the hydraulic aperture and the flow imbalance do not depend on them and no drop or
+solves at a unit drop and viscosity and scales the result (:func:`from_unit_drop`), so
+that the hydraulic aperture and the flow imbalance do not depend on them and no drop or
 viscosity that a float holds overflows inside the solve; a leak rate beyond the float
-range itself is refused (:func:`check_leak_scale`).
+range itself is refused (:func:`roughfe.errors.check_leak_scale`).
+:func:`scaled_reynolds_fv` is the same for the raw finite-volume solve at absolute
+pressures (the two-way coupling, :mod:`roughfe.leakage.fsi`).
 """
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Mapping, Optional
 
 import numpy as np
 
 from ..errors import (FlowImbalanceWarning, InputError, check_finite_nonnegative,
-                      check_finite_positive)
+                      check_finite_positive, check_leak_scale, check_real_array, times_ratio)
 from ..fem.reynolds import check_reynolds_data, solve_reynolds_fe
 from ..frozen import ReadOnlyArrays, compact_repr, read_only_arrays
-from .finite_volume import solve_reynolds_fv
+from .finite_volume import FVSolution, solve_reynolds_fv
 
 SCHEMES = ("fv", "fe")
 
@@ -145,40 +147,46 @@ def hydraulic_aperture(leak_rate: float, *, mu: float, pressure_drop: float,
     return float(np.cbrt(max(leak_rate, 0.0) * 12.0 * mu * flow_length / (width * dp)))
 
 
-def times_ratio(value, numerator: float, denominator: float):
-    """``value * numerator / denominator`` without an intermediate overflow or underflow.
+def from_unit_drop(p_out: float, pressure_drop: float, mu: float, pressure, leak_rate, *flows):
+    """A Reynolds solution without wall motion at ``p_in = 1``, ``p_out = 0`` and ``mu = 1``
+    scaled to the drop ``dp`` (Pa) and viscosity ``mu`` (Pa s): Eq. 2.12 is linear in the
+    pressure and ``q = -h^3 / (12 mu) grad p``, so the pressure is ``p_out + dp p`` and every
+    flow (leak rate, boundary flows, flux fields: m^3/s or m^2/s) is times ``dp / mu``
+    (:func:`roughfe.errors.times_ratio`; the leak rate through
+    :func:`roughfe.errors.check_leak_scale`). Returns ``(pressure, leak_rate, *flows)``."""
+    return (p_out + pressure_drop * pressure, check_leak_scale(leak_rate, pressure_drop, mu),
+            *(times_ratio(v, pressure_drop, mu) for v in flows))
 
-    The three are split into mantissa and binary exponent (``frexp``) and the product is
-    rebuilt once (``ldexp``): finite whenever the result is, rounded as a product of three
-    floats; ``inf`` or 0 only where the result itself is beyond the float range. ``value``
-    may be an array.
+
+def scaled_reynolds_fv(gap, spacing, *, mu: float, p_in: float, p_out: float,
+                       initial=None, **options) -> FVSolution:
+    """:func:`~roughfe.leakage.finite_volume.solve_reynolds_fv` without wall motion at any
+    pressures and viscosity a float holds: solved at a unit drop and viscosity and scaled
+    (:func:`from_unit_drop`), as :func:`reynolds_flow` does. ``p_in < p_out`` (reversed
+    flow) and ``p_in = p_out`` (no flow: the pressure ``p_out`` on the live cells, no
+    flux) are allowed. ``initial`` (Pa, absolute) starts the CG as there; ``options``:
+    ``direction``, ``periodic``, ``petsc_options``, ``solver``.
+
+    Solved at the given ``mu`` and pressures, a viscosity of 1e300 Pa s gave a leak rate of
+    0 and a pressure field of underflowed transmissibilities, 1e-300 Pa s a NaN solve, a
+    drop of 1e200 Pa an overflowed dissipation (round 2, session 34). A leak rate beyond
+    the normal float range is an :class:`~roughfe.errors.InputError`.
     """
-    mv, ev = np.frexp(value)
-    mn, en = np.frexp(float(numerator))
-    md, ed = np.frexp(float(denominator))
-    with np.errstate(over="ignore", under="ignore"):
-        out = np.ldexp(mv * mn / md, ev + (en - ed))
-    return out if np.ndim(out) else float(out)
-
-
-def check_leak_scale(conductance: float, pressure_drop: float, mu: float) -> float:
-    """The leak rate ``Q = C dp / mu`` (m^3/s) of a gap of conductance ``C`` (m^3, the leak
-    rate at a unit drop and viscosity); :class:`~roughfe.errors.InputError` when ``Q != 0``
-    is beyond the normal float range (it overflowed to a null, or underflowed to 0 or to
-    a subnormal that keeps few digits), naming the range of ``dp / mu`` this gap allows."""
-    q = times_ratio(conductance, pressure_drop, mu)
-    info = np.finfo(float)
-    if conductance > 0 and pressure_drop != 0 and not (info.tiny <= abs(q) <= info.max):
-        with np.errstate(over="ignore"):
-            low, high = info.tiny / conductance, info.max / conductance
-        allowed = (f"from {low:.3g} to {high:.3g} 1/s" if np.isfinite(high)
-                   else f"from {low:.3g} 1/s up")
-        raise InputError(
-            f"pressure_drop = {pressure_drop:g} Pa with mu = {mu:g} Pa s: the leak rate "
-            f"Q = C dp / mu (C = {conductance:.4g} m^3, this gap's leak rate at a unit drop "
-            f"and viscosity) {'overflows' if abs(q) > 1 else 'underflows'} the float range; "
-            f"this gap allows dp / mu {allowed}")
-    return q
+    g, _, mu, _ = check_reynolds_data(gap, spacing, mu, p_in, p_out,
+                                      options.get("direction", "x"), (0.0, 0.0))
+    dp = float(p_in) - float(p_out)
+    if not np.isfinite(dp):
+        raise InputError(f"p_in - p_out must be finite (Pa), got {p_in!r} - {p_out!r}")
+    if initial is not None:     # the start in the unit solve's scale (NaN kept)
+        initial = check_real_array("initial pressure", initial, unit="Pa", allow_nan=True)
+        initial = times_ratio(initial - float(p_out), 1.0, dp) if dp else initial - p_out
+    unit = solve_reynolds_fv(g, spacing, mu=1.0, p_in=1.0 if dp else 0.0, p_out=0.0,
+                             initial=initial, **options)
+    pressure, leak, flux, q_in, q_out = from_unit_drop(
+        float(p_out), dp, mu, unit.pressure, unit.leak_rate, unit.flux, unit.inlet_flow,
+        unit.outlet_flow)
+    return replace(unit, pressure=pressure, flux=flux, inlet_flow=float(q_in),
+                   outlet_flow=float(q_out), leak_rate=float(leak))
 
 
 def cell_flux(pressure, gap, spacing, *, mu: float, wall_velocity=(0.0, 0.0)) -> np.ndarray:
@@ -280,10 +288,9 @@ def reynolds_flow(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
     aperture = (hydraulic_aperture(leak, mu=mu_s, pressure_drop=1.0 if unit else dp,
                                    flow_length=flow_length, width=width) if dp > 0 else None)
     pressure, q_in, q_out = sol.pressure, sol.inlet_flow, sol.outlet_flow
-    if unit:
-        leak = check_leak_scale(leak, dp, mu)       # refused when Q is beyond the floats
-        pressure = p_out + dp * pressure
-        flux, q_in, q_out = (times_ratio(v, dp, mu) for v in (flux, q_in, q_out))
+    if unit:                                    # refused when Q is beyond the floats
+        pressure, leak, flux, q_in, q_out = from_unit_drop(p_out, dp, mu, pressure, leak,
+                                                           flux, q_in, q_out)
     result = ReynoldsResult(
         direction=direction, scheme=scheme, leak_rate=float(leak), hydraulic_aperture=aperture,
         inlet_flow=float(q_in), outlet_flow=float(q_out), pressure=pressure,

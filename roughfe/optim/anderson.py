@@ -126,7 +126,7 @@ def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
     status: Optional[str] = None
     while status is None:
         r = gx - x
-        res = float(np.linalg.norm(r) / max(np.linalg.norm(gx), floor, 1e-300))
+        res = float(_norm(r) / max(_norm(gx), floor, 1e-300))
         residuals.append(res)
         if res <= tol:
             status = "converged"
@@ -157,6 +157,14 @@ def anderson_fixed_point(G: Callable[[np.ndarray], np.ndarray], x0, gx0=None, *,
                 x, gx = step
     return FixedPoint(x=x, gx=gx, status=status, iterations=it, residual=residuals[-1],
                       residuals=tuple(residuals))
+
+
+def _norm(v) -> float:
+    """The 2-norm of ``v`` computed on ``v / max|v|`` (as BLAS nrm2 scales): its squares
+    neither overflow nor underflow (a field of 1e200 Pa gave an inf norm and a NaN
+    residual, one of 1e-190 Pa a zero norm and a fixed point at the first iterate)."""
+    top = float(np.max(np.abs(v))) if np.size(v) else 0.0
+    return top * float(np.linalg.norm(v / top)) if 0.0 < top < np.inf else top
 
 
 def _damped_step(G, x, r, refused, relaxation, backoff) -> tuple:

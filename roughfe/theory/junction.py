@@ -29,7 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.special
 
-from ..errors import InputError, check_finite_positive, check_in_open_interval
+from ..errors import (InputError, check_finite_positive, check_in_open_interval,
+                      check_leak_scale)
 from ..surfaces.surface import Surface
 from .persson import (GAMMA_DEFAULT, PERCOLATION_THRESHOLD, REFERENCES, _arrays, _pressures,
                       _spectrum, mean_separation)
@@ -88,6 +89,16 @@ def _geometry_factor(source, direction: str = "x") -> float:
         lx, ly = source.size
         return ly / lx if direction == "x" else lx / ly
     return 1.0
+
+
+def _leak_rate(geometry_factor, u_c, pressure_drop, viscosity) -> float:
+    """Eq. (5), ``Q = (Ly/Lx) u_c^3 / 12 * Delta P / eta`` (m^3/s), the ratio
+    ``Delta P / eta`` applied last without an intermediate overflow
+    (:func:`roughfe.errors.check_leak_scale`, the rule of the Reynolds leak rates): written
+    as one product, Delta P = 1e300 Pa with eta = 1e-20 Pa s gave inf for a Q of 5e299
+    m^3/s (64^2 surface, 1 MPa); a Q beyond the normal floats (Delta P 1e-308 Pa: 0.0 or
+    a subnormal) is an InputError naming the Delta P / eta the junction allows."""
+    return check_leak_scale(geometry_factor * u_c ** 3 / 12.0, pressure_drop, viscosity)
 
 
 def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *,
@@ -156,7 +167,7 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
         q_c, a_c = float(q[0]), threshold
         p_c = p / a_c
         u_c = float(mean_separation(q, power, e, p_c, gamma, q2=q2)[0])
-        leak = geometry_factor * dp / eta * u_c ** 3 / 12.0
+        leak = _leak_rate(geometry_factor, u_c, dp, eta)
         return CriticalJunction(q_c=q_c, area_fraction_c=a_c, pressure_c=p_c, u_c=u_c,
                                 leak_rate=leak, sealed=False, **common)
     else:   # log-linear interpolation of A(q) between the bracketing wavenumbers
@@ -165,6 +176,6 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
         a_c = threshold
     p_c = p / a_c
     u_c = float(mean_separation(q, power, e, p_c, gamma, q_min=q_c, q2=q2)[0])
-    leak = geometry_factor * dp / eta * u_c ** 3 / 12.0
+    leak = _leak_rate(geometry_factor, u_c, dp, eta)
     return CriticalJunction(q_c=q_c, area_fraction_c=a_c, pressure_c=p_c, u_c=u_c,
                             leak_rate=leak, sealed=False, **common)
