@@ -44,7 +44,7 @@ from typing import Any, Mapping, Optional
 
 import numpy as np
 
-from .errors import InputError, check_finite_positive
+from .errors import InputError, check_finite_positive, check_in_interval
 from .frozen import Frozen, compact_repr, freeze_fields
 from .writers import json_scalars, to_jsonable
 
@@ -62,15 +62,12 @@ __all__ = ["DEFAULT_E", "DEFAULT_NU", "Material", "composite", "Loading", "Conta
 
 # -- material -----------------------------------------------------------------------------
 def _check_nu(name, nu):
-    if isinstance(nu, bool):
-        raise InputError(f"{name} must be a number in (-1, 0.5], got {nu!r}")
-    try:
-        v = float(nu)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number in (-1, 0.5], got {nu!r}") from None
-    if not (-1.0 < v <= 0.5):
-        raise InputError(f"{name} (Poisson's ratio) must lie in (-1, 0.5], got {nu!r}")
-    return v
+    """Poisson's ratio of an isotropic elastic solid, -1 < nu <= 1/2 (a number; text such as
+    "0.3" and bools refused): the shear modulus E / (2 (1 + nu)) and the bulk modulus
+    E / (3 (1 - 2 nu)) are positive for -1 < nu < 1/2, and 1/2 is the incompressible
+    limit (E* = 4 E / 3), which the BEM takes and the FEM body refuses
+    (:mod:`roughfe.fem.contact`: its Lame lambda is infinite there)."""
+    return check_in_interval(f"{name} (Poisson's ratio)", nu, -1, 0.5, "right")
 
 
 @dataclass(frozen=True)

@@ -184,7 +184,7 @@ def test_contact_cli_takes_approaches_apart_with_adhesion_only(tmp_path, capsys)
     (["--adhesion", "exp", "--work-of-adhesion", "0.1", "--range", "1e-9", "--smoothing",
       "0.5"], "--smoothing is the ramp of the Maugis-Dugdale law"),
     (["--adhesion", "md", "--work-of-adhesion", "0.1", "--range", "1e-9", "--smoothing",
-      "1.5"], "--smoothing must be in [0, 1), got 1.5"),
+      "1.5"], "--smoothing must lie in [0, 1), got 1.5"),
     (["--smoothing", "0.5"], "need --adhesion"),
     (["--adhesion", "md", "--work-of-adhesion", "0.1", "--range", "1e-9", "--delta", "3e-8",
       "2e-8", "--unload"], "--delta (the approaches of the --adhesion loading branch, m) "

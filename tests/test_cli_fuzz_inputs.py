@@ -108,7 +108,7 @@ def test_db_build_hurst_range_is_checked_against_the_genome_range(tmp_path, caps
     # LO == HI (one H), accepted by the check, a scipy ValueError traceback (qmc.scale)
     _refused(capsys, ["db", "build", str(tmp_path / "d.sqlite"), "--limit", "1", "--nodes",
                       "64", "--steps", "5", "--workers", "1", "--hurst-range", "1", "1e308"],
-             "hurst_range must be 0 < low <= high <= 3", "1e+308")
+             "hurst_range high (the genome's H) must lie in (0, 3]", "1e+308")
     assert main(["db", "build", str(tmp_path / "h.sqlite"), "--limit", "2", "--nodes", "64",
                  "--steps", "5", "--workers", "1", "--hurst-range", "0.8", "0.8",
                  "--quiet"]) == 0

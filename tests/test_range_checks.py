@@ -64,3 +64,53 @@ def test_each_model_keeps_its_own_interval():
     assert genome_q1(10, 1.0) == pytest.approx(2 * np.pi / np.sqrt(10))
     with pytest.raises(InputError, match=r"gamma \(band ratio\) must lie in \(1, 10\]"):
         genome_q1(10.5, 1.0)
+
+
+# -- round 2, session 34 (helper "left"): Poisson's ratio, the MD smoothing, Sobol ranges ----
+def test_poissons_ratio_is_a_number_of_an_isotropic_solid():
+    # -1 < nu <= 1/2: shear and bulk moduli positive below 1/2, 1/2 the incompressible limit
+    # (E* = 4E/3; the FEM body refuses it itself). Text ran as a number ("0.3" -> 0.3)
+    from roughfe.model import Material, composite
+    assert Material(1e9, 0.5).E_star == pytest.approx(4e9 / 3, rel=1e-15, abs=0)
+    assert Material(1e9, -0.999).nu == -0.999 and type(Material(1e9, 0).nu) is float
+    for bad in ("0.3", True, None):
+        with pytest.raises(InputError, match=r"^nu \(Poisson's ratio\) must be a number in "
+                                             r"\(-1, 0.5\], got "):
+            Material(1e9, bad)
+    for bad in (-1, 0.5000001, np.nan):
+        with pytest.raises(InputError, match=r"^nu \(Poisson's ratio\) must lie in "
+                                             r"\(-1, 0.5\], got "):
+            Material(1e9, bad)
+    with pytest.raises(InputError, match=r"^nu2 \(Poisson's ratio\) must be a number in "):
+        composite(1e9, 0.3, 2e9, "0.2")
+
+
+def test_maugis_dugdale_smoothing_in_its_interval():
+    from roughfe.bem.interface_law import AdhesionLaw
+    assert AdhesionLaw("md", 0.1, 1e-9, smoothing=0).smoothing == 0.0
+    for bad in (1, -0.1, np.nan, "0.1"):
+        with pytest.raises(InputError, match=r"^smoothing \(the Maugis-Dugdale ramp, a fraction "
+                                             r"of the range\) must .*\[0, 1\), got "):
+            AdhesionLaw("md", 0.1, 1e-9, smoothing=bad)
+
+
+def test_sobol_ranges_lie_in_the_genomes_intervals():
+    # gamma_range was not checked (a gamma <= 1 failed its tasks in the build), a text
+    # end was a TypeError, one number a ValueError; each end is now checked as the Genome
+    # checks it: gamma (1, 10], H (0, 3], anisotropy (0, inf); low == high is one value
+    from roughfe.genomics.database import SobolDesign
+    d = SobolDesign(hurst_range=[1, 1], gamma_range=(1.5, 10))
+    assert d.hurst_range == (1.0, 1.0) and d.gamma_range == (1.5, 10.0)
+    assert np.all(d.pairs()[:, 1] == 1.0)
+    for kw, match in (({"gamma_range": (0.5, 2.0)},
+                       r"^gamma_range low \(the genome's gamma\) must lie in \(1, 10\], got 0.5$"),
+                      ({"gamma_range": (1.2, 11)}, r"^gamma_range high .* \(1, 10\], got 11$"),
+                      ({"hurst_range": (1, 1e308)},
+                       r"^hurst_range high \(the genome's H\) must lie in \(0, 3\], got 1e\+308"),
+                      ({"hurst_range": ("0.5", 1.0)}, r"^hurst_range low .* must be a number in"),
+                      ({"hurst_range": (0.5,)}, r"^hurst_range must be two numbers \(low, high\)"),
+                      ({"hurst_range": (1.0, 0.2)}, r"^hurst_range must have low <= high"),
+                      ({"anisotropy_range": (0.5, np.inf)},
+                       r"^anisotropy_range high .* open interval \(0, inf\), got inf$")):
+        with pytest.raises(InputError, match=match):
+            SobolDesign(**kw)

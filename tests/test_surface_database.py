@@ -271,7 +271,7 @@ def test_surface_db_and_design_commands(tmp_path, capsys, monkeypatch):
     assert "top_fraction" in capsys.readouterr().err
     assert main(["db", "build", str(tmp_path / "x.sqlite"), "--dim", "2",
                  "--hurst-range", "1.0", "0.2"]) == 2
-    assert "hurst_range must be 0 < low <= high" in capsys.readouterr().err
+    assert "hurst_range must have low <= high, got (1.0, 0.2)" in capsys.readouterr().err
 
 
 def test_match_spectrum_restores_a_genome_whose_hurst_exponent_moved(surface_db):

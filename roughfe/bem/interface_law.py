@@ -47,8 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import (InputError, ResolutionWarning, check_finite_nonnegative,
-                      check_finite_positive)
+from ..errors import (InputError, ResolutionWarning, check_finite_positive,
+                      check_in_interval)
 
 LAWS = ("md", "exp")
 
@@ -93,11 +93,9 @@ class AdhesionLaw:
             "work of adhesion w (J/m^2)", self.work))
         object.__setattr__(self, "range", check_finite_positive(
             "range of adhesion (m)", self.range))
-        s = check_finite_nonnegative("smoothing (the Maugis-Dugdale ramp, a fraction of "
-                                     "the range in [0, 1))", self.smoothing)
-        if not s < 1.0:
-            raise InputError(f"smoothing must be in [0, 1), got {self.smoothing!r}")
-        object.__setattr__(self, "smoothing", s)
+        object.__setattr__(self, "smoothing", check_in_interval(
+            "smoothing (the Maugis-Dugdale ramp, a fraction of the range)", self.smoothing,
+            0, 1, "left"))
         with np.errstate(over="ignore", under="ignore"):   # the process zone takes sigma0^2
             sigma0 = np.float64(self.work) / np.float64(self.range)
             if not 0.0 < sigma0 * sigma0 < np.inf:         # (range 1e308: ZeroDivisionError)

@@ -302,7 +302,7 @@ def add_adhesion_options(parser) -> None:
 def adhesion_from_args(args):
     """The :class:`roughfe.bem.adhesion.AdhesionLaw` of the options, or None without them."""
     from ..bem.adhesion import AdhesionLaw
-    from ..errors import InputError
+    from ..errors import InputError, check_in_interval
     given = [args.work_of_adhesion is not None, args.range is not None]
     smoothing = getattr(args, "smoothing", None)
     if args.adhesion is None:
@@ -318,8 +318,7 @@ def adhesion_from_args(args):
     if args.adhesion != "md":
         raise InputError("--smoothing is the ramp of the Maugis-Dugdale law: it needs "
                          "--adhesion md")
-    if not 0.0 <= smoothing < 1.0:
-        raise InputError(f"--smoothing must be in [0, 1), got {smoothing!r}")
+    smoothing = check_in_interval("--smoothing", smoothing, 0, 1, "left")
     return AdhesionLaw("md", args.work_of_adhesion, args.range, smoothing=smoothing)
 
 

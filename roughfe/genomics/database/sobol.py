@@ -5,7 +5,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_in_interval
 
 
 @dataclass(frozen=True)
@@ -49,14 +49,14 @@ class SobolDesign:
             raise InputError(f"dim must be 1 (profiles) or 2 (surfaces), got {self.dim!r}")
         if int(self.n_ridges) < 1 or int(self.n_ridges) > 100:
             raise InputError(f"n_ridges must lie in 1..100, got {self.n_ridges!r}")
-        lo, hi = self.anisotropy_range
-        if not (0 < lo <= hi and np.isfinite(hi)):
-            raise InputError(f"anisotropy_range must be 0 < low <= high, got "
-                             f"{self.anisotropy_range!r}")
-        lo, hi = self.hurst_range     # a Genome's H is <= 3 (a high H failed every task,
-        if not (0 < lo <= hi <= 3.0):  # and the task's text filled the error line)
-            raise InputError(f"hurst_range must be 0 < low <= high <= 3 (the genome's H), "
-                             f"got {self.hurst_range!r}")
+        # each end within the Genome's own interval (a gamma or H outside it failed its
+        # tasks, and the task's text filled the error line); low == high is one value
+        for name, what, low, high, closed in (
+                ("gamma_range", "the genome's gamma", 1, 10, "right"),
+                ("hurst_range", "the genome's H", 0, 3, "right"),
+                ("anisotropy_range", "ridge amplitude factors", 0, float("inf"), "neither")):
+            object.__setattr__(self, name, _check_range(name, what, getattr(self, name), low,
+                                                        high, closed))
 
     @property
     def rows(self) -> int:
@@ -133,6 +133,21 @@ class SobolDesign:
             if key in d:
                 d[key] = tuple(d[key])
         return cls(**d)
+
+
+def _check_range(name, what, pair, low, high, closed) -> tuple:
+    """``(lo, hi)`` as floats, or :class:`~roughfe.errors.InputError`: two numbers, each in
+    the interval of ``low`` and ``high`` that ``closed`` names
+    (:func:`roughfe.errors.check_in_interval`), ``lo <= hi``."""
+    try:
+        lo, hi = pair
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be two numbers (low, high), got {pair!r}") from None
+    lo, hi = (check_in_interval(f"{name} {end} ({what})", v, low, high, closed)
+              for end, v in (("low", lo), ("high", hi)))
+    if lo > hi:
+        raise InputError(f"{name} must have low <= high, got {pair!r}")
+    return lo, hi
 
 
 def sobol_tasks(design: SobolDesign, limit=None) -> list:
