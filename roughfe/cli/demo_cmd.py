@@ -13,6 +13,7 @@ from pathlib import Path
 
 from ..surfaces.io import load_surface, save_surface, topographies_folder
 from ..surfaces.rmd import rmd_surface
+from ..surfaces.line_psd import line_spectra
 from ..surfaces.psd_fit import range_note
 from ..surfaces.stats import fit_hurst, power_spectrum, surface_statistics
 from ..writers import write_json, write_text
@@ -43,7 +44,8 @@ def _figures(surface, outdir, stem, title):
     render = render_surface(surface, outdir / f"{stem}_render.png", title=title)
     fit = fit_hurst(surface)
     psd = plot_psd({title: power_spectrum(surface)}, outdir / f"{stem}_psd.png",
-                   title=f"{title}: radially averaged PSD", fits={title: fit})
+                   title=f"{title}: radially averaged PSD", fits={title: fit},
+                   lines=line_spectra(surface))
     return render.name, psd.name
 
 

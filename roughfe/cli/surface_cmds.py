@@ -16,6 +16,7 @@ _TABLE = (
     ("rms_height", "rms height Sq/Rq", "um", 1e6),
     ("peak_to_valley", "peak-to-valley", "um", 1e6),
     ("rms_slope", "rms slope", "-", 1.0),
+    ("rms_slope_iso", "rms slope Sdq/Rdq (ISO 7-pt)", "-", 1.0),
     ("rms_curvature", "rms curvature", "1/um", 1e-6),
     ("skewness", "skewness", "-", 1.0),
     ("kurtosis", "kurtosis", "-", 1.0),
@@ -31,7 +32,7 @@ _TABLE = (
 
 #: SI units of the statistics in ``info --json`` ("1": dimensionless)
 STATISTICS_UNITS = {"shape": "points", "size": "m", "mean": "m", "rms_height": "m",
-                    "rms_slope": "1", "rms_curvature": "1/m", "peak_to_valley": "m",
+                    "rms_slope": "1", "rms_slope_iso": "1", "rms_curvature": "1/m", "peak_to_valley": "m",
                     "skewness": "1", "kurtosis": "1", "m0": "m^2", "m2": "1", "m4": "1/m^2",
                     "nayak_alpha": "1", "hurst": "1 (meaningful when hurst_success)",
                     "fractal_dimension": "1 (meaningful when hurst_success)",
@@ -73,15 +74,42 @@ def format_table(stats: dict) -> str:
     return "\n".join(lines)
 
 
+def write_psd(surface, path, title: str):
+    """``info --psd``: the PSD (radially averaged for a map) and, for a map, the mean 1D
+    PSDs along x and y (:mod:`roughfe.surfaces.line_psd`) as CSV rows ``kind, q, C,
+    C_jacobs, weight`` (SI; C in Persson's normalisation, C_jacobs = (2 pi)^d C is
+    SurfaceTopography's / contact.engineering's) or as a PNG figure."""
+    from ..surfaces.line_psd import line_spectra
+    from ..surfaces.stats import fit_hurst, power_spectrum
+    from ..writers import write_text
+    main = "radial" if surface.ndim == 2 else "profile"
+    spectra = {main: power_spectrum(surface), **line_spectra(surface)}
+    if path.suffix.lower() == ".png":
+        from ..plotting.surfaces import plot_psd
+        lines = {k: v for k, v in spectra.items() if k != main}
+        return plot_psd({main: spectra[main]}, path, title=f"{title}: PSD",
+                        fits={main: fit_hurst(surface)}, lines=lines)
+    rows = ["kind,q (rad/m),C (m^3 or m^4; Persson),C_jacobs (m^3 or m^4; "
+            "SurfaceTopography),weight (rad/m or rad^2/m^2),window"]
+    for kind, p in spectra.items():
+        rows += [f"{kind.replace('along ', '')},{q:.10g},{c:.10g},{cj:.10g},{w:.10g},{p.window}"
+                 for q, c, cj, w in zip(p.q, p.C, p.C_jacobs, p.weight)]
+    return write_text(path, "\n".join(rows) + "\n")
+
+
 def _info(args) -> int:
     from ..surfaces.stats import surface_statistics
-    from ..writers import to_json_text
+    from ..writers import output_file, to_json_text
     surface = surface_from_args(args)
     q_range = None if args.hurst_q_range is None else tuple(args.hurst_q_range)
     if q_range is not None and not q_range[0] < q_range[1]:
         raise InputError(f"--hurst-q-range QMIN QMAX needs QMIN < QMAX (rad/m), got "
                          f"{q_range[0]:g} {q_range[1]:g}")
+    psd_path = None if args.psd is None else output_file(args.psd, overwrite=args.overwrite,
+                                                         suffixes=(".csv", ".png"))
     stats = surface_statistics(surface, q_range=q_range).as_dict()
+    if psd_path is not None:
+        write_psd(surface, psd_path, str(args.surface))
     if args.json:
         units = {k: v for k, v in STATISTICS_UNITS.items() if k in stats}
         print(to_json_text({"file": str(args.surface), "statistics": stats, "units": units,
@@ -325,4 +353,9 @@ def register(sub):
                         "8 pi / L to pi / (2 dx)); restrict it to the self-affine range "
                         "when the table notes that the PSD is not one power law")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument("--psd", metavar="FILE", default=None,
+                   help="also write the PSD (radially averaged for a map) and a map's mean "
+                        "1D PSDs along x and y: .csv (q, C in Persson's normalisation, "
+                        "C_jacobs = SurfaceTopography's / contact.engineering's) or .png")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --psd file")
     p.set_defaults(func=_info)

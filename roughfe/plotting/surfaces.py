@@ -108,7 +108,7 @@ def _fit_line(ax, psd, fit):
                         f"Whittle level\n(wavelengths {waves.min():.2g}-{waves.max():.2g} um)")
 
 
-def plot_psd(spectra, path, title=None, fits=None):
+def plot_psd(spectra, path, title=None, fits=None, lines=None):
     """Log-log plot of power spectra.
 
     Parameters
@@ -120,8 +120,14 @@ def plot_psd(spectra, path, title=None, fits=None):
     fits : mapping of label -> HurstFit, optional
         Drawn as dashed power laws over their ``q_range`` with the fitted H (at the
         data's median level when they are not one power law: :func:`_fit_line`).
+    lines : mapping of label -> PowerSpectrum, optional
+        1D PSDs along x and y of a map
+        (:func:`roughfe.surfaces.line_psd.line_power_spectrum`), drawn in a second
+        panel (m^3: not on the 2D PSD's axis).
     """
-    fig, ax = new_figure(figsize=(6, 4.5))
+    fig, axes = new_figure(1, 2 if lines else 1, figsize=(11, 4.5) if lines else (6, 4.5),
+                           squeeze=False)
+    ax = axes[0, 0]
     units = set()
     for label, psd in spectra.items():
         units.add(psd.ndim)
@@ -129,10 +135,20 @@ def plot_psd(spectra, path, title=None, fits=None):
         fit = (fits or {}).get(label)
         if fit is not None and fit.success:
             _fit_line(ax, psd, fit)
-    ax.set_xlabel("wavenumber q (rad/m)")
     unit = "m$^4$" if units == {2} else ("m$^3$" if units == {1} else "m$^3$ or m$^4$")
-    ax.set_ylabel(f"PSD C(q) ({unit}, Persson's normalisation)")   # (2 pi)^-d x ST's
-    ax.set_title(title or "power spectral density")
+    _psd_axes(ax, f"PSD C(q) ({unit}, Persson's normalisation)",   # (2 pi)^-d x ST's
+              title or "power spectral density")
+    if lines:
+        for label, psd in lines.items():
+            axes[0, 1].loglog(psd.q, psd.C, ".", ms=3, label=label)
+        _psd_axes(axes[0, 1], "1D PSD C(q) (m$^3$, Persson's normalisation)",
+                  "mean PSD of the lines along x and along y")
+    return save_figure(fig, path)
+
+
+def _psd_axes(ax, ylabel, title):
+    ax.set_xlabel("wavenumber q (rad/m)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
-    return save_figure(fig, path)

@@ -57,6 +57,7 @@ import numpy as np
 
 from ..errors import InputError, check_finite_positive, check_instance
 from ..frozen import ReadOnlyArrays, read_only_arrays
+from .iso_slope import rms_slope_iso
 from .surface import Surface
 
 
@@ -204,6 +205,18 @@ class PowerSpectrum(ReadOnlyArrays):
         return self.q ** 2 if self.q2 is None else self.q2
 
 
+def line_spectrum(power, n: int, length: float, label: str) -> PowerSpectrum:
+    """Profile PSD from ``power`` = ``|h~(k)|^2`` at ``k = 0 .. n // 2`` of lines of ``n``
+    points and ``length`` (m): ``C = power / dq`` at ``q = k dq > 0``, ``dq = 2 pi / L``,
+    weight ``2 dq`` (``dq`` for an even grid's Nyquist coefficient: no mirror image)."""
+    dq = 2 * np.pi / length
+    k = np.arange(1, n // 2 + 1)
+    weight = np.full(k.size, 2 * dq)
+    if n % 2 == 0:
+        weight[-1] = dq
+    return PowerSpectrum(q=k * dq, C=power[k] / dq, weight=weight, ndim=1, window=label)
+
+
 def power_spectrum(surface: Surface, window="auto", bin_width=None) -> PowerSpectrum:
     """PSD of a profile, or radially averaged PSD of a surface (normalisation above).
 
@@ -228,12 +241,7 @@ def power_spectrum(surface: Surface, window="auto", bin_width=None) -> PowerSpec
     power, qs = _fourier_power(surface, window)
     label = "none" if window is None else window
     if surface.ndim == 1:
-        n, dq = power.size, 2 * np.pi / surface.size[0]
-        k = np.arange(1, n // 2 + 1)
-        weight = np.full(k.size, 2 * dq)
-        if n % 2 == 0:
-            weight[-1] = dq            # the Nyquist coefficient has no mirror image
-        return PowerSpectrum(q=k * dq, C=power[k] / dq, weight=weight, ndim=1, window=label)
+        return line_spectrum(power[: power.size // 2 + 1], power.size, surface.size[0], label)
     cell = float(np.prod([2 * np.pi / s for s in surface.size]))
     qabs = np.sqrt(qs[0] ** 2 + qs[1] ** 2).ravel()
     p = power.ravel()
@@ -286,7 +294,8 @@ def rms_slope(surface: Surface) -> float:
 
     Periodic data: exact derivative of the Fourier interpolant (``sqrt(m2)`` for a
     profile, ``sqrt(2 m2)`` for a surface). Non-periodic data: forward differences (the
-    spectral derivative would see the jump at the edge).
+    spectral derivative would see the jump at the edge). ISO 4287's Rdq / Sdq (7-point
+    derivative): :func:`~roughfe.surfaces.iso_slope.rms_slope_iso`.
     """
     _check_surface(surface)
     if surface.periodic:
@@ -447,6 +456,7 @@ class SurfaceStatistics:
     hurst_success: bool
     hurst_message: str = ""       # HurstFit.message: why not, or a range not one power law
     hurst_error: float = float("nan")     # HurstFit.hurst_error: its standard error
+    rms_slope_iso: float = float("nan")   # Rdq/Sdq, ISO 7-point derivative (iso_slope)
 
     def as_dict(self) -> dict:
         """JSON-safe dict (NaN becomes None: :func:`roughfe.writers.to_jsonable`)."""
@@ -481,4 +491,5 @@ def surface_statistics(surface: Surface, q_range=None) -> SurfaceStatistics:
         skewness=skewness, kurtosis=kurtosis,
         m0=m0, m2=m2, m4=m4, nayak_alpha=m0 * m4 / m2 ** 2 if m2 > 0 else float("nan"),
         hurst=fit.hurst, fractal_dimension=fit.fractal_dimension, hurst_q_range=fit.q_range,
-        hurst_success=fit.success, hurst_message=fit.message, hurst_error=fit.hurst_error)
+        hurst_success=fit.success, hurst_message=fit.message, hurst_error=fit.hurst_error,
+        rms_slope_iso=rms_slope_iso(surface))
