@@ -451,3 +451,30 @@ def test_a_killed_writers_temporary_is_removed_by_the_next_write(tmp_path, capsy
     finally:
         live.kill()
         live.wait()
+
+
+@pytest.mark.parametrize("model", ["wm", "mwm"])
+def test_wm_amplitude_overflow_is_one_error_line_without_numpy_warnings(tmp_path, capsys,
+                                                                        model):
+    # wm --amplitude 1e308 printed three numpy warnings (overflow in reduce and matmul,
+    # invalid value in subtract) before its error line (round 2, session 34)
+    capsys.readouterr()
+    out = tmp_path / "g.npz"
+    assert main(["generate", model, "--n", "64", "--amplitude", "1e308", "--no-figures",
+                 "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--amplitude 1e+308" in err, err
+    assert "warning" not in err and not out.exists()
+
+
+@pytest.mark.parametrize("option, bound", [("--global-eval", "2..1000000"),
+                                           ("--global-popsize", "0..10000"),
+                                           ("--global-candidates", "1..100"),
+                                           ("--global-rounds", "1..100")])
+def test_design_global_budgets_are_bounded(tmp_path, capsys, option, bound):
+    # ran as asked: 99999999999 evaluations / population / candidates / rounds (no upper
+    # bound; the stage budgets got theirs in 9a415d2)
+    _refused(capsys, ["design", "--db", str(tmp_path / "none.sqlite"), "--target", "y_t1",
+                      "--method", "mcco", "--global", "cmaes", option, "99999999999", "-o",
+                      str(tmp_path / "d")], f"argument {option}", f"an integer in {bound}",
+             "'99999999999'")

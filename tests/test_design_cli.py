@@ -164,7 +164,7 @@ def test_design_command_reports_bad_input(tmp_path, capsys):
                              ("--global-amplitudes", "3", "amplitudes <= 2"),
                              ("--global-genes", "1.5", "genes < 1"),
                              ("--global-modulation", "2.5", "modulation <= 2"),
-                             ("--global-rounds", "0", ">= 1"),
+                             ("--global-rounds", "0", "an integer in 1..100"),
                              ("--global-score", "best", "score must be one of")):
         assert main(["design", "--db", str(path), "--target", str(bad), "--method", "sog",
                      "--global", "cmaes", flag, value, "-o", str(tmp_path / "o")]) == 2

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from .options import (add_output_folder, add_run_options, add_surface_options, surface_file,
                       int_in, nonnegative_float, nonnegative_int,
-                      output_folder_of, positive_float, positive_int)
+                      output_folder_of, positive_float)
 
 BUILTIN = ("y_t1", "y_t2", "y_t3")
 #: upper bounds of the stage budgets (none until round 2, session 34: 99999999999 ran as
@@ -21,18 +21,27 @@ BUILTIN = ("y_t1", "y_t2", "y_t3")
 #: or 3 GCMMA iterations; --refine 3 was ~900 BEM sweeps; --search 400 with 4 starts 4890
 #: sweeps in 219 s. Each bound is 20-250 x the largest budget measured.
 MAX_ITERATIONS, MAX_REFINE, MAX_SEARCH, MAX_SEARCH_STARTS = 100, 100, 100000, 100
+#: upper bounds of the ``--global`` budgets (none until round 2, session 34, helper char2).
+#: Measured (docs/theory/06_design.md, N = 512, ~11 ms per strict evaluation): 20000
+#: evaluations per round (225 s), 2 rounds, 1 candidate, first population up to 88.
+#: 1e6 evaluations are ~3 h per candidate and round; the others 50-100 x the measured.
+MAX_GLOBAL_EVAL, MAX_GLOBAL_POPSIZE, MAX_GLOBAL_CANDIDATES, MAX_GLOBAL_ROUNDS = \
+    1000000, 10000, 100, 100
 #: the numeric ``--global-*`` flags (GlobalSearchOptions): flag, type, default, metavar, help
 GLOBAL_FLAGS = (
-    ("--global-eval", positive_int, 20000, "N",
-     "strict evaluations per searched candidate and round"),
+    ("--global-eval", int_in(2, MAX_GLOBAL_EVAL), 20000, "N",
+     f"strict evaluations per searched candidate and round, 2..{MAX_GLOBAL_EVAL}"),
     ("--global-amplitudes", nonnegative_float, 0.0, "X",
      "every chromosome's amplitude a variable too, within exp(+-X) of its start (log "
      "scale, X <= 2; 0: part weights +-30%%)"),
-    ("--global-popsize", nonnegative_int, 0, "L",
-     "population of the first CMA-ES run, doubled at each restart (0: 4 + 3 ln n)"),
-    ("--global-candidates", positive_int, 1, "K", "search the K best candidates (by strict f)"),
-    ("--global-rounds", positive_int, 1, "R",
-     "R IPOP-CMA-ES runs, each from the best design of the one before (N evaluations each)"),
+    ("--global-popsize", int_in(0, MAX_GLOBAL_POPSIZE), 0, "L",
+     "population of the first CMA-ES run, doubled at each restart (0: 4 + 3 ln n), "
+     f"0..{MAX_GLOBAL_POPSIZE}"),
+    ("--global-candidates", int_in(1, MAX_GLOBAL_CANDIDATES), 1, "K",
+     f"search the K best candidates (by strict f), 1..{MAX_GLOBAL_CANDIDATES}"),
+    ("--global-rounds", int_in(1, MAX_GLOBAL_ROUNDS), 1, "R",
+     "R IPOP-CMA-ES runs, each from the best design of the one before (N evaluations "
+     f"each), 1..{MAX_GLOBAL_ROUNDS}"),
     ("--global-genes", nonnegative_float, 0.0, "X",
      "every part's gamma, H, lambda1 a variable too, within +-X (fraction, < 1) of its "
      "start (0: off)"),

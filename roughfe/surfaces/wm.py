@@ -68,16 +68,21 @@ def wm_series(coords, amplitudes, wavenumbers, phases, angles=None, chunk=1 << 2
         x = np.asarray(coords, dtype=float)
         out_shape = x.shape
         x = x.ravel()
-    offset = float(np.sum(amplitudes * np.cos(phases)))
     out = np.empty(x.size)
     block = max(1, int(chunk) // max(q.size, 1))
-    for start in range(0, x.size, block):
-        sl = slice(start, start + block)
-        acc = np.zeros(x[sl].size)
-        for m in range(amplitudes.shape[0]):          # M ridges (<= ~20): small loop
-            s = x[sl] if not surface else x[sl] * np.cos(angles[m]) + y[sl] * np.sin(angles[m])
-            acc += np.cos(np.multiply.outer(s, q) + phases[m]) @ amplitudes[m]
-        out[sl] = offset - acc
+    # amplitudes near the float range overflow the sums to inf / nan: no numpy warnings
+    # (generate wm --amplitude 1e308 printed three before its error), the heights'
+    # finiteness check (Surface: "heights must be finite") says it
+    with np.errstate(over="ignore", invalid="ignore"):
+        offset = float(np.sum(amplitudes * np.cos(phases)))
+        for start in range(0, x.size, block):
+            sl = slice(start, start + block)
+            acc = np.zeros(x[sl].size)
+            for m in range(amplitudes.shape[0]):          # M ridges (<= ~20): small loop
+                s = (x[sl] if not surface else
+                     x[sl] * np.cos(angles[m]) + y[sl] * np.sin(angles[m]))
+                acc += np.cos(np.multiply.outer(s, q) + phases[m]) @ amplitudes[m]
+            out[sl] = offset - acc
     return out.reshape(out_shape)
 
 
