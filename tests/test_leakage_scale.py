@@ -183,3 +183,16 @@ def test_finite_volume_leak_rate_shortcut_is_scaled():
     for dp, mu in ((1.0, 1.0), (1e300, 1e-3), (1.0, 1e250)):
         assert finite_volume_leak_rate(gap, (DX, DX), mu=mu, pressure_drop=dp) == \
             pytest.approx(H**3 * 12 / (12.0 * N) * (dp / mu), rel=1e-9, abs=0)
+
+
+def test_channel_flow_flux_at_any_viscosity():
+    # exact on a uniform channel: q = g^3 dp / (12 mu L) (m^2/s); 12 mu R overflowed at mu
+    # 1e300 on a 10 nm gap: a flux of 0.0 in silence (the true 8e-311 is below the floats)
+    from roughfe.leakage.channel import channel_flow
+    g, n, dx = 1e-8, 11, 1e-6
+    for dp, mu in ((1.0, 1e-3), (1e300, 1e-3), (1e-20, 1e-300)):
+        f = channel_flow(np.full(n, g), dx, p_in=dp, p_out=0.0, mu=mu)
+        assert f.leak_rate == pytest.approx(times_ratio(g**3 / (12 * (n - 1) * dx), dp, mu),
+                                            rel=1e-12, abs=0)
+    with pytest.raises(InputError, match="underflows the float range"):
+        channel_flow(np.full(n, g), dx, p_in=1.0, p_out=0.0, mu=1e300)

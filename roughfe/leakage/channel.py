@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, check_finite_positive, check_real_array
+from ..errors import InputError, check_finite_positive, check_leak_scale, check_real_array
 
 
 @dataclass(frozen=True, eq=False)
@@ -137,5 +137,9 @@ def channel_flow(gap, spacing: float, *, p_in: float, p_out: float,
     seg = dx * (g0 + g1) / (2.0 * g0 ** 2 * g1 ** 2)
     cum = np.concatenate([[0.0], np.cumsum(seg)])
     R = float(cum[-1])
-    p = p_in - (p_in - p_out) * cum / R
-    return ChannelFlow(x, g, p, (p_in - p_out) / (12.0 * mu * R), R, False, p_in, p_out, mu)
+    p = p_in - (p_in - p_out) * (cum / R)        # cum / R in [0, 1]: no overflow
+    # q = (1 / (12 R)) (p_in - p_out) / mu, the ratio last (errors.check_leak_scale: 12 mu R
+    # overflowed to a leak rate of 0.0 in silence at mu 1e300 on a 10 nm gap; one beyond the
+    # floats is an InputError)
+    q = check_leak_scale(1.0 / (12.0 * R), p_in - p_out, mu)
+    return ChannelFlow(x, g, p, q, R, False, p_in, p_out, mu)
