@@ -478,3 +478,13 @@ def test_design_global_budgets_are_bounded(tmp_path, capsys, option, bound):
                       "--method", "mcco", "--global", "cmaes", option, "99999999999", "-o",
                       str(tmp_path / "d")], f"argument {option}", f"an integer in {bound}",
              "'99999999999'")
+
+
+@pytest.mark.parametrize("option, bound", [("--spectrum-starts", "0..100"),
+                                           ("--pool", "0..100")])
+def test_design_spectrum_starts_and_pool_are_bounded(tmp_path, capsys, option, bound):
+    # ran as asked: 99999999999 spectrum-matched starts / pool genomes (round 2, session 34)
+    _refused(capsys, ["design", "--db", str(tmp_path / "none.sqlite"), "--target", "y_t1",
+                      "--method", "mcco", option, "99999999999", "-o",
+                      str(tmp_path / "d")], f"argument {option}", f"an integer in {bound}",
+             "'99999999999'")

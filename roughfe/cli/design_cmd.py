@@ -11,9 +11,9 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .options import (add_output_folder, add_run_options, add_surface_options, surface_file,
-                      int_in, nonnegative_float, nonnegative_int,
-                      output_folder_of, positive_float)
+from .options import (DETRENDS, add_output_folder, add_run_options, add_surface_options,
+                      surface_file, int_in, nonnegative_float, output_folder_of,
+                      positive_float)
 
 BUILTIN = ("y_t1", "y_t2", "y_t3")
 #: upper bounds of the stage budgets (none until round 2, session 34: 99999999999 ran as
@@ -27,6 +27,13 @@ MAX_ITERATIONS, MAX_REFINE, MAX_SEARCH, MAX_SEARCH_STARTS = 100, 100, 100000, 10
 #: 1e6 evaluations are ~3 h per candidate and round; the others 50-100 x the measured.
 MAX_GLOBAL_EVAL, MAX_GLOBAL_POPSIZE, MAX_GLOBAL_CANDIDATES, MAX_GLOBAL_ROUNDS = \
     1000000, 10000, 100, 100
+#: upper bounds of ``--spectrum-starts`` and ``--pool`` (none until round 2, session 34,
+#: helper char3: 99999999999 ran as asked). --spectrum-starts K adds K candidates of three
+#: counted BEM sweeps each (match_spectrum), every one searched again by --search, as
+#: --search-starts (bound 100 there); the default and largest measured is 3. --pool 8 made
+#: 378 cross-overs instead of 9 (docs/theory/06_design.md), ~6 K^2: 100 is ~60000, and
+#: beyond the database's genomes a larger K adds none.
+MAX_SPECTRUM_STARTS, MAX_POOL = 100, 100
 #: the numeric ``--global-*`` flags (GlobalSearchOptions): flag, type, default, metavar, help
 GLOBAL_FLAGS = (
     ("--global-eval", int_in(2, MAX_GLOBAL_EVAL), 20000, "N",
@@ -381,17 +388,18 @@ def register(sub):
                         "--search: set every chromosome's amplitude to the band rms of this "
                         "(measured) topography, prepared as 'design-targets --surface' "
                         "does by default (plane removed, mirrored, database spacing)")
-    g.add_argument("--spectrum-starts", type=nonnegative_int, default=None, metavar="K",
+    g.add_argument("--spectrum-starts", type=int_in(0, MAX_SPECTRUM_STARTS), default=None,
+                   metavar="K",
                    help="--match-spectrum: also start from the K best database genomes, "
-                        "spectrum matched")
+                        f"spectrum matched (0..{MAX_SPECTRUM_STARTS})")
     g.add_argument("--match-directions", action="store_true",
                    help="--match-spectrum per wave: every (ridge, chromosome) wave gets the "
                         "rms of the target's modes nearest to it in log q and direction "
                         "(default: one rms per chromosome)")
-    p.add_argument("--pool", type=nonnegative_int, default=None, metavar="K",
+    p.add_argument("--pool", type=int_in(0, MAX_POOL), default=None, metavar="K",
                    help="mcco, beyond the thesis: start pool of the K best genomes of each "
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "
-                        "(0: the thesis sets)")
+                        f"(0: the thesis sets; 0..{MAX_POOL})")
     add_surface_options(p, positional=False)      # of --match-spectrum's file
     add_output_folder(p)
     add_run_options(p)
@@ -405,8 +413,9 @@ def register(sub):
                         "file 'roughfe info' reads, e.g. a measured topography) from its own "
                         "BEM sweep with the database's E, nu and steps; writes NAME_K.csv "
                         "and NAME_A.csv")
-    t.add_argument("--detrend", choices=("none", "mean", "plane"), default=None,
-                   help="detrending of --surface before the BEM (default: plane)")
+    t.add_argument("--detrend", choices=DETRENDS, default=None,
+                   help="detrending of --surface before the BEM (default: plane; lines / "
+                        "lines-tilt: each scan line along x levelled, as roughfe info)")
     t.add_argument("--boundary", choices=("auto", "periodic", "window"), default=None,
                    help="a non-periodic --surface: its evenly mirrored window with the "
                         "periodic BEM, or the window alone on the half-space (its K then "

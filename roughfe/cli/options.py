@@ -5,8 +5,9 @@ everywhere:
 
 * :func:`add_surface_options` -- ``SURFACE``, ``--size LX [LY]``, ``--periodic`` |
   ``--non-periodic`` (exclusive), ``--channel``; :func:`surface_from_args` reads it.
-* :func:`add_detrend_option` -- ``--detrend none|mean|plane``, default ``mean`` (a
-  warning when it leaves a tilt of more than 95 % of the variance of a non-periodic surface).
+* :func:`add_detrend_option` -- ``--detrend none|mean|plane|lines|lines-tilt``, default
+  ``mean`` (a warning when it leaves a tilt of more than 95 % of the variance of a
+  non-periodic surface, and when a map's scan lines look offset from each other).
 * :func:`add_material_options` -- ``--E`` (Pa, within :data:`E_RANGE`) and ``--nu`` (-),
   default the thesis' E* = 210 MPa (E = 210 MPa, nu = 0); :func:`material_from_args`.
 * :func:`add_output_folder` -- ``-o/--output OUTDIR`` (a FOLDER whenever a command writes
@@ -38,7 +39,7 @@ import textwrap
 #: line imports no numpy (a Ctrl-C in that import was a traceback, round 2, session 33).
 #: Default of --detrend in info, contact and leak.
 DEFAULT_DETREND = "mean"
-DETRENDS = ("none", "mean", "plane")
+DETRENDS = ("none", "mean", "plane", "lines", "lines-tilt")
 
 # a number, also negative and in exponent form: -1, -1.5, -.5, -1e9, -1.5E-3, -inf, -nan
 _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
@@ -169,11 +170,13 @@ def surface_from_args(args):
     ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
     command has that option."""
     surface = surface_file(args, args.surface)
-    from .plausibility import warn_seam, warn_tilt, warn_units
+    from .plausibility import warn_scan_lines, warn_seam, warn_tilt, warn_units
     warn_units(args, surface)
     detrend = getattr(args, "detrend", "none")
     if detrend == "mean" and not surface.periodic:
         warn_tilt(args, surface)
+    if detrend in ("none", "mean", "plane"):
+        warn_scan_lines(args, surface)
     surface = surface if detrend == "none" else surface.detrended(detrend)
     if getattr(args, "periodic", None) is True:
         warn_seam(args, surface)
@@ -231,8 +234,8 @@ def print_surface_notes(args, surface, channel: bool = False) -> None:
 
 
 def add_detrend_option(parser, default: str = DEFAULT_DETREND) -> None:
-    """``--detrend none|mean|plane``; the default is ``mean``, or the library's own
-    default of the command's function where that differs (``genome chromosomes``:
+    """``--detrend none|mean|plane|lines|lines-tilt``; the default is ``mean``, or the
+    library's own default of the command's function where that differs (``genome chromosomes``:
     ``plane``, as :func:`roughfe.genomics.bands.band_chromosomes`)."""
     parser.add_argument(
         "--detrend", choices=DETRENDS, default=default,
@@ -240,7 +243,10 @@ def add_detrend_option(parser, default: str = DEFAULT_DETREND) -> None:
              "analysis (measured topographies usually need 'plane'; on a periodic surface "
              "'plane' removes the mean only: its mean slope is zero); 'mean' on a "
              "non-periodic surface whose plane carries more than 95 %% of the height "
-             "variance warns")
+             "variance warns. 'lines' / 'lines-tilt' level each scan line along x (AFM "
+             "'align rows'): its mean / least-squares line; for scan-line artefacts only "
+             "(they also remove the real roughness at q_x = 0); a map whose lines look "
+             "offset warns")
 
 
 # -- material ------------------------------------------------------------------------------

@@ -55,7 +55,7 @@ from ..surfaces.surface import Surface
 
 #: default band ratio gamma of a measured surface (two bands per octave)
 DEFAULT_GAMMA = float(np.sqrt(2.0))
-DETREND_MODES = ("none", "mean", "plane")
+DETREND_MODES = ("none", "mean", "plane", "lines", "lines-tilt")   # Surface.detrended
 TRANSFORMS = ("auto", "fft", "dct")
 #: relative slack when a wavevector lies on a band edge (it goes to the upper band)
 _EDGE_SLACK = 1e-9

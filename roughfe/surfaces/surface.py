@@ -162,6 +162,10 @@ class Surface(ReadOnlyArrays):
         (the integral of a derivative over a period), and the least-squares plane of its
         samples is a spurious tilt whose removal breaks the periodicity (a step at the
         edges, +47 % rms slope by spectral derivatives on a 128^2 H = 0.8 surface).
+
+        ``"lines"`` / ``"lines-tilt"`` level each scan line along x (``heights[:, j]``) by
+        its mean / least-squares line, for scan-line artefacts of AFM maps only (they
+        remove real roughness too): :func:`roughfe.surfaces.scan_lines.level_lines`.
         """
         h = self.heights
         if mode == "mean" or (mode == "plane" and self.periodic):
@@ -176,7 +180,11 @@ class Surface(ReadOnlyArrays):
             a = np.column_stack([np.ones(h.size)] + [c.ravel() for c in coords])
             coef, *_ = np.linalg.lstsq(a, h.ravel(), rcond=None)
             return self.with_heights(h - (a @ coef).reshape(h.shape), detrend="plane")
-        raise InputError(f"detrend mode must be 'mean' or 'plane', got {mode!r}")
+        if mode in ("lines", "lines-tilt"):
+            from .scan_lines import level_lines
+            return level_lines(self, tilt=mode == "lines-tilt")
+        raise InputError(f"detrend mode must be 'mean', 'plane', 'lines' or 'lines-tilt', "
+                         f"got {mode!r}")
 
     def mirrored(self) -> "Surface":
         """The evenly mirrored window: a periodic surface (or profile) of period

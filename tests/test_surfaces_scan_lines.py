@@ -1,0 +1,144 @@
+"""Scan-line levelling (``detrended("lines" | "lines-tilt")``) and the scan-line check
+(:mod:`roughfe.surfaces.scan_lines`, round 2, session 34): exact removal of injected line
+offsets and tilts, exactly the q_x = 0 Fourier modes of a periodic map, surfaces without
+offsets unchanged up to the removed means, and the check's false-alarm / detection
+behaviour on spectral surfaces and the measured AFM file di-1."""
+import warnings
+
+import numpy as np
+import pytest
+
+from roughfe.cli import main
+from roughfe.errors import InputError
+from roughfe.surfaces import Surface, save_surface, spectral_profile, spectral_surface
+from roughfe.surfaces.scan_lines import scan_line_check
+
+
+def _map(n=(96, 64), hurst=0.7, seed=0, periodic=True):
+    s = spectral_surface(n, (1e-6, 1e-6 * n[1] / n[0]), hurst, rms_height=1e-8, rng=seed)
+    return s if periodic else Surface(s.heights, s.size, False, s.metadata)
+
+
+def _offsets(surface, share=0.06, seed=1, tilt=0.0):
+    """Heights plus independent per-line offsets (and tilts along x) of rms ``share`` of
+    the rms height; returns (new surface, added field)."""
+    rng = np.random.default_rng(seed)
+    nx, ny = surface.shape
+    sq = surface.heights.std()
+    x = (np.arange(nx) - (nx - 1) / 2) / nx
+    field = (share * sq * rng.standard_normal(ny))[None, :] \
+        + tilt * sq * np.outer(x, rng.standard_normal(ny))
+    return surface.with_heights(surface.heights + field), field
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_lines_removes_injected_offsets_exactly(periodic):
+    s = _map(periodic=periodic)
+    noisy, _ = _offsets(s, share=0.5)
+    a, b = noisy.detrended("lines").heights, s.detrended("lines").heights
+    assert np.max(np.abs(a - b)) < 1e-12 * s.heights.std()
+    # each line's mean is zero, and nothing else moved: the result differs from the
+    # original by one constant per line (its mean)
+    assert np.max(np.abs(a.mean(axis=0))) < 1e-12 * s.heights.std()
+    diff = s.heights - a
+    assert np.max(np.abs(diff - diff[:1, :])) < 1e-12 * s.heights.std()
+
+
+def test_lines_tilt_removes_injected_offsets_and_tilts_exactly():
+    s = _map(periodic=False)
+    noisy, _ = _offsets(s, share=0.5, tilt=2.0)
+    a, b = noisy.detrended("lines-tilt").heights, s.detrended("lines-tilt").heights
+    assert np.max(np.abs(a - b)) < 1e-11 * s.heights.std()
+    x = np.arange(s.shape[0]) - (s.shape[0] - 1) / 2
+    assert np.max(np.abs(a.mean(axis=0))) < 1e-12 * s.heights.std()
+    assert np.max(np.abs(x @ a)) < 1e-9 * s.heights.std()          # no slope left per line
+    assert noisy.detrended("lines-tilt").metadata["detrend"] == "lines-tilt"
+
+
+def test_lines_removes_exactly_the_qx0_modes_of_a_periodic_map():
+    # Parseval: the levelled map's spectrum is the original's with the column q_x = 0
+    # set to zero, so its mean square is the original's less the power at q_x = 0
+    s = _map(periodic=True)
+    f0, f1 = np.fft.fft2(s.heights), np.fft.fft2(s.detrended("lines").heights)
+    assert np.max(np.abs(f1[0, :])) < 1e-12 * np.max(np.abs(f0))
+    assert np.allclose(f1[1:, :], f0[1:, :], rtol=0, atol=1e-12 * np.max(np.abs(f0)))
+    lost = np.sum(np.abs(f0[0, :]) ** 2) / s.heights.size ** 2
+    assert np.mean(s.detrended("lines").heights ** 2) == pytest.approx(
+        np.mean(s.heights ** 2) - lost, rel=1e-12, abs=0)
+
+
+def test_surfaces_without_offsets_are_unchanged():
+    s = _map(periodic=False)
+    level = s.with_heights(s.heights - s.heights.mean(axis=0, keepdims=True))
+    assert np.array_equal(level.detrended("lines").heights, level.heights) or np.max(
+        np.abs(level.detrended("lines").heights - level.heights)) < 1e-15 * s.heights.std()
+    flat = level.detrended("lines-tilt")
+    again = flat.detrended("lines-tilt")
+    assert np.max(np.abs(again.heights - flat.heights)) < 1e-13 * s.heights.std()
+
+
+def test_lines_tilt_of_a_periodic_map_removes_the_means_only():
+    s = _map(periodic=True)
+    t = s.detrended("lines-tilt")
+    assert np.array_equal(t.heights, s.detrended("lines").heights)
+    assert t.metadata["detrend"] == "lines-tilt (periodic: lines)"
+
+
+def test_a_profile_has_no_lines_to_level():
+    p = spectral_profile(64, 1e-6, 0.7, rms_height=1e-8, rng=0)
+    with pytest.raises(InputError, match="2D map of scan lines"):
+        p.detrended("lines")
+    assert scan_line_check(p) is None
+
+
+def test_check_no_false_alarm_on_isotropic_surfaces_and_fires_with_offsets():
+    # the threshold's justification (module docstring), 20 seeds over H 0.3-0.9 at
+    # 128^2 (the full measurement: 800 maps, 32-512, H 0.3-1, with and without roll-off)
+    ratios = []
+    for seed in range(20):
+        s = spectral_surface(128, 1e-6, 0.3 + 0.6 * seed / 19, rms_height=1e-8, rng=seed)
+        c = scan_line_check(s)
+        assert not c.fires and c.note() == ""
+        ratios.append(c.ratio)
+        # the same check with a mean or a plane removed (second differences)
+        assert scan_line_check(s.detrended("mean")).ratio == pytest.approx(c.ratio, rel=1e-9, abs=0)
+    assert max(ratios) < 0.6 * scan_line_check(s).threshold
+    s = spectral_surface(256, 1e-6, 0.8, rms_height=1e-8, rng=3)
+    noisy, _ = _offsets(s, share=0.06)
+    c = scan_line_check(noisy)
+    assert c.fires and "--detrend lines" in c.note()
+    assert not scan_line_check(noisy.detrended("lines")).fires
+    # tilted along x and y: the plane does not change the ratio
+    tilted = noisy.with_heights(noisy.heights + 1e-7 * np.add.outer(
+        np.arange(256) / 256, np.arange(256) / 256))
+    assert scan_line_check(tilted).ratio == pytest.approx(c.ratio, rel=1e-6, abs=0)
+
+
+def test_check_on_the_measured_files(topographies_dir):
+    # only the AFM scan di-1 fires (ratio 11.2); the others 0.04-0.11 (threshold 0.25)
+    from roughfe.surfaces import load_surface
+    fired = {}
+    for name in ("di-1.di", "opd-1.opd", "plu-1.plu", "sur-2.sur", "x3p-2.x3p"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            s = load_surface(topographies_dir / name, **({"channel": 0} if name.endswith(
+                ".di") else {}))
+        fired[name] = scan_line_check(s).fires
+    assert fired == {"di-1.di": True, "opd-1.opd": False, "plu-1.plu": False,
+                     "sur-2.sur": False, "x3p-2.x3p": False}
+
+
+def test_cli_info_warns_of_offset_lines_and_levels_them(tmp_path, capsys):
+    s = spectral_surface(128, 1e-6, 0.8, rms_height=1e-8, rng=2)
+    noisy, _ = _offsets(s, share=0.2)
+    for name, surf in (("clean.npz", s), ("lines.npz", noisy)):
+        save_surface(surf, tmp_path / name)
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "clean.npz")]) == 0
+    assert "scan lines" not in capsys.readouterr().err
+    assert main(["info", str(tmp_path / "lines.npz")]) == 0
+    err = capsys.readouterr().err
+    assert "warning: the scan lines along x" in err and "--detrend lines" in err
+    assert main(["info", str(tmp_path / "lines.npz"), "--detrend", "lines", "--json"]) == 0
+    out = capsys.readouterr()
+    assert "scan lines" not in out.err and '"detrend": "lines"' in out.out
