@@ -63,11 +63,14 @@ Steps (:func:`sequence_profiles`)
 5. Genes A, H (maximum likelihood on c_n, M-free), M, phases; Z_d = Z_1 - Z_2 at the
    common nodes; relative rms errors of the realisations of the sequenced genome; a
    quality report (success is False, with a message, when the relative rms error of any
-   acquisition exceeds ``rms_tolerance``: the profile is not WM-like).
+   acquisition exceeds ``rms_tolerance``: the profile is not WM-like; when the nodes held
+   out of the fit are missed by more, :mod:`.holdout`: an overfit; or when the two
+   halves of the data give other genes, :mod:`.reproduce`: not reproducible).
 
 Modules: :mod:`.acquisitions` (checks), :mod:`.peaks` (step 1), :mod:`.lattice` (steps
-2-4), :mod:`.regularise` (the damped final fit), :mod:`.holdout` (held-out nodes),
-:mod:`.genes` (step 5), :mod:`.result`, :mod:`.profile` (the driver,
+2-4), :mod:`.search` (steps 1-4 and the final fit, as one call), :mod:`.regularise` (the
+damped final fit), :mod:`.holdout` (held-out nodes), :mod:`.reproduce` (the genes of the
+two halves), :mod:`.genes` (step 5), :mod:`.result`, :mod:`.profile` (the driver,
 :func:`sequence_profiles`) and :mod:`.zd` (the thesis's Z_d fit, for the record).
 Surfaces (2D MWM, issue 15): :mod:`.surface_data` (acquisitions, peaks, ridge directions),
 :mod:`.surface_grid` (the grid model of the fit), :mod:`.surface_fit` (the nonlinear fit

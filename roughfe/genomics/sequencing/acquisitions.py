@@ -24,13 +24,28 @@ class Acquisition:
     sequencer fits the line back (:func:`~.lattice.design_matrix`); ``window``: a window
     of the coarsest acquisition's own profile (its sampled nodes, not a realisation of its
     own), so it also holds the coarsest one's long chromosomes
-    (:func:`~.lattice.lattice_ranges`)."""
+    (:func:`~.lattice.lattice_ranges`); ``nodes``: 0, or the N of the acquisition of
+    length ``length`` whose nodes these are a part of (a half of them, :mod:`.reproduce`):
+    the model (Eq. 3.5 ranges, the label of lambda1, the tilt bound) is then that
+    acquisition's, the PSD that of the nodes given (:attr:`span`)."""
 
     x: np.ndarray
     z: np.ndarray
     length: float
     levelled: bool = False
     window: bool = False
+    nodes: int = 0
+
+    @property
+    def model_nodes(self) -> int:
+        """N of Eq. 3.5 (the nodes of the whole acquisition)."""
+        return self.nodes or self.z.size
+
+    @property
+    def span(self) -> float:
+        """Length (m) spanned by the nodes given: ``length``, or (their number - 1) times
+        their spacing for a part of an acquisition."""
+        return self.length if not self.nodes else (self.z.size - 1) * float(self.x[1] - self.x[0])
 
 
 def is_levelled(x, z) -> bool:

@@ -179,7 +179,7 @@ def lattice_ranges(log_q1, log_gamma, acqs):
     chromosomes aliased on its nodes (Eq. 3.1 evaluated there), which its own Eq. 3.5
     range left as misfit (1-5.5 % on Table 1 rows at stride 2; 1e-13 now)."""
     lam1 = 2 * math.pi / math.exp(log_q1)
-    out = [chromosome_range(math.exp(log_gamma), lam1, a.length, a.z.size) for a in acqs]
+    out = [chromosome_range(math.exp(log_gamma), lam1, a.length, a.model_nodes) for a in acqs]
     top = max((r[1] for a, r in zip(acqs, out) if a.window), default=0)
     return [(out[0][0], top) if a.window else r for a, r in zip(acqs, out)]
 

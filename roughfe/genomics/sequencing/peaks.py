@@ -53,7 +53,7 @@ def spectrum_peaks(acq: Acquisition, min_bin=4, prominence=2.0) -> SpectrumPeaks
     three bins around it.
     """
     n = acq.z.size
-    spec = power_spectrum(Surface(acq.z, n * acq.length / (n - 1)), window="hann")
+    spec = power_spectrum(Surface(acq.z, n * acq.span / (n - 1)), window="hann")
     q, C = spec.q, np.maximum(spec.C, np.finfo(float).tiny)
     logc = np.log(C)
     hull = upper_hull(q, C)

@@ -20,6 +20,9 @@ REPORT_UNITS = {"A": "m^(1-H)", "H": "1", "gamma": "1", "lambda1": "m",
                 "ranges": "1 (chromosome numbers n_s, n_f)",
                 "rms_errors": "1 (relative: rms(Z - Z_seq) / rms(Z))",
                 "held_out_errors": "1 (relative: rms(Z - Z_held-out) / rms(Z))", "offsets": "m",
+                "reproducibility": ("genes of the two halves (gamma, H, H_stderr: 1; A: "
+                                    "m^(1-H); lambda1: m; misfit: 1, relative); "
+                                    "lattice_offset: 1 (lattice steps)"),
                 "tilts": "1 (m/m)",
                 "zd_rms": "m", "zd_rms_error": "1 (relative)", "gamma_psd": "1",
                 "H_psd": "1", "A0_variance": "m^(1-H)", "M_loglik": "1 (log-likelihood, one per M_values)",
@@ -89,6 +92,11 @@ class SequencingResult:
     M_support : tuple of int or None
         The range of M within 1.92 of the best log-likelihood (about 95 %,
         :func:`~.genes.ridge_support`): M is weakly identifiable.
+    reproducibility : Reproducibility or None
+        The genes of the left and right halves of the data, each sequenced from scratch,
+        and whether they agree (:mod:`.reproduce`; "not a genome: the genes are not
+        reproducible" when not; round 2, session 34). None: not run (the fit failed an
+        earlier test).
     A0 : float
         Amplitude from the height variance of the coarsest acquisition as given (Eq.
         3.13), for comparison with the maximum-likelihood A. The fitted offset and tilt
@@ -123,6 +131,7 @@ class SequencingResult:
     offsets: np.ndarray = field(default_factory=lambda: np.zeros(0))
     tilts: np.ndarray = field(default_factory=lambda: np.zeros(0))
     held_out_errors: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    reproducibility: Optional[object] = None
     A0: float = float("nan")
     lnA_stderr: float = float("nan")
     H_stderr: float = float("nan")
@@ -159,6 +168,8 @@ class SequencingResult:
                 "lengths": self.lengths.tolist(), "ranges": [list(r) for r in self.ranges],
                 "rms_errors": self.rms_errors.tolist(), "offsets": self.offsets.tolist(),
                 "tilts": self.tilts.tolist(), "held_out_errors": self.held_out_errors.tolist(),
+                "reproducibility": (None if self.reproducibility is None
+                                    else self.reproducibility.report()),
                 "zd_rms": float(np.sqrt(np.mean(self.zd ** 2))) if self.zd.size else None,
                 "zd_rms_error": self.zd_rms_error(),
                 "gamma_psd": self.gamma_psd, "H_psd": self.H_psd, "A0_variance": self.A0,
