@@ -74,3 +74,23 @@ def deflations_made(monkeypatch):
             return _original(op, block, **options)
         monkeypatch.setattr(contact, name, make)
     return made
+
+
+@pytest.fixture
+def spectral_file(tmp_path):
+    """``spectral_file(n, seed)``: the path of an n^2 periodic spectral surface (.npz)
+    written by ``roughfe generate spectral`` in the test's folder."""
+    from roughfe.cli import main
+
+    def write(n, seed):
+        path = tmp_path / f"s{n}_{seed}.npz"
+        assert main(["generate", "spectral", "--n", str(n), "--seed", str(seed),
+                     "--no-figures", "-o", str(path)]) == 0
+        return path
+    return write
+
+
+@pytest.fixture
+def surface32(spectral_file):
+    """A 32^2 periodic spectral surface file, seed 1."""
+    return spectral_file(32, 1)

@@ -12,14 +12,6 @@ from roughfe.cli import main
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "studies"
 
 
-@pytest.fixture
-def surface32(tmp_path):
-    path = tmp_path / "s32.npz"
-    assert main(["generate", "spectral", "--n", "32", "--seed", "1", "--no-figures",
-                 "-o", str(path)]) == 0
-    return path
-
-
 def _refused(capsys, argv, *phrases):
     """``roughfe ARGV`` exits 2 with one error line holding every phrase, no traceback."""
     capsys.readouterr()

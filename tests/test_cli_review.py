@@ -13,11 +13,8 @@ from roughfe.writers import OWNER_FILE, OutputFolder, write_text
 
 
 @pytest.fixture
-def surface64(tmp_path):
-    path = tmp_path / "s64.npz"
-    assert main(["generate", "spectral", "--n", "64", "--seed", "3", "--no-figures",
-                 "-o", str(path)]) == 0
-    return path
+def surface64(spectral_file):
+    return spectral_file(64, 3)
 
 
 def _error(capsys):

@@ -48,14 +48,6 @@ def test_times_ratio_keeps_what_the_naive_product_loses():
     assert times_ratio(np.array([2.0, -4.0]), 3.0, 2.0).tolist() == [3.0, -6.0]
 
 
-@pytest.fixture
-def surface32(tmp_path):
-    path = tmp_path / "s32.npz"
-    assert main(["generate", "spectral", "--n", "32", "--seed", "1", "--no-figures",
-                 "-o", str(path)]) == 0
-    return path
-
-
 @pytest.mark.parametrize("flags, phrases", [
     (["--pressure-drop", "1e308"], ["--pressure-drop", "1e308", "1e-06 Pa to 1e+12 Pa"]),
     (["--pressure-drop", "1e-308"], ["--pressure-drop", "1e-308", "1e-06 Pa to 1e+12 Pa"]),
