@@ -69,10 +69,16 @@ class FlowImbalanceWarning(RuntimeWarning):
     what the leak rate rests on)."""
 
 
+def _is_bool(value) -> bool:
+    """True for a Python bool and for a numpy boolean (``np.True_``, a bool array), which
+    ``isinstance(value, bool)`` misses and ``float()`` / ``operator.index()`` take as 1."""
+    return isinstance(value, bool) or getattr(getattr(value, "dtype", None), "kind", "") == "b"
+
+
 def _number(value):
-    """``value``, or a TypeError for text and bools, which ``float()`` would take ("2.3" in
-    a study spec ran, under a key of its own, beside 2.3)."""
-    if isinstance(value, (str, bytes, bool)):
+    """``value``, or a TypeError for text and bools (numpy's too), which ``float()`` would
+    take ("2.3" in a study spec ran, under a key of its own, beside 2.3)."""
+    if isinstance(value, (str, bytes)) or _is_bool(value):
         raise TypeError(value)
     return value
 
@@ -179,9 +185,10 @@ def check_leak_scale(conductance: float, pressure_drop: float, mu: float) -> flo
 
 def check_int(name, value, minimum):
     """Return ``int(value)`` or raise :class:`InputError` unless it is an integer (a Python
-    or numpy integer, not a bool and not a float such as 3.5 or 4.0) >= ``minimum``."""
+    or numpy integer, not a bool, numpy's included, and not a float such as 3.5 or 4.0)
+    >= ``minimum``."""
     try:
-        v = None if isinstance(value, bool) else operator.index(value)
+        v = None if _is_bool(value) else operator.index(value)
     except TypeError:
         v = None
     if v is None or v < minimum:

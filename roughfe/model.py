@@ -110,10 +110,11 @@ def composite(E1, nu1, E2, nu2) -> Material:
     """
     m1 = Material(E1, nu1)
     nu2 = _check_nu("nu2", nu2)
-    E2 = float(E2)
+    # a number as Material's E (text such as "7e10" ran as one), inf allowed: rigid
+    E2 = check_in_interval("E2 (Young's modulus, Pa; inf: rigid)", E2, 0, float("inf"),
+                           "right")
     if E2 == float("inf"):
         return Material(m1.E_star, 0.0)
-    E2 = check_finite_positive("E2 (Young's modulus, Pa)", E2)
     return Material(1.0 / (1.0 / m1.E_star + (1.0 - nu2 ** 2) / E2), 0.0)
 
 

@@ -2,6 +2,8 @@
 exponents and frequency densities of the generators, the genome and the band analysis,
 and Persson's gamma, were each checked by a hand-rolled copy (some took "0.5" as text,
 some True as 1.0). The ends each one includes are kept."""
+import re
+
 import numpy as np
 import pytest
 
@@ -114,3 +116,60 @@ def test_sobol_ranges_lie_in_the_genomes_intervals():
                        r"^anisotropy_range high .* open interval \(0, inf\), got inf$")):
         with pytest.raises(InputError, match=match):
             SobolDesign(**kw)
+
+
+# -- round 2, session 34 (helper "small"): numpy booleans, composite's E2, n_ridges ---------
+@pytest.mark.parametrize("flag", [np.True_, np.bool_(False), np.array(True)])
+def test_numpy_booleans_are_refused_as_bools_are(flag):
+    # isinstance(np.True_, bool) is False: float(np.True_) = 1.0 passed every range check
+    # (and operator.index(np.True_) = 1 the integer check) as a number
+    from roughfe.errors import check_finite_nonnegative, check_finite_positive, check_int
+    from roughfe.model import Material
+    for check, match in ((lambda v: check_in_interval("x", v, 0, 1, "both"),
+                          r"^x must be a number in \[0, 1\], got "),
+                         (lambda v: check_finite_positive("x", v),
+                          r"^x must be a positive number, got "),
+                         (lambda v: check_finite_nonnegative("x", v),
+                          r"^x must be a finite number >= 0, got "),
+                         (lambda v: check_int("x", v, 0), r"^x must be an integer >= 0, got "),
+                         (lambda v: Material(1e9, v), r"^nu \(Poisson's ratio\) must be a "
+                                                      r"number in \(-1, 0.5\], got "),
+                         (lambda v: Material(v, 0.3), r"^E \(Young's modulus, Pa\) must be "
+                                                      r"a positive number, got ")):
+        with pytest.raises(InputError, match=match + r".*" + re.escape(repr(flag)) + "$"):
+            check(flag)
+    # numpy numbers that are not bools still pass
+    assert check_in_interval("x", np.float64(0.5), 0, 1) == 0.5
+    assert check_int("x", np.int64(3), 0) == 3 and type(check_int("x", np.int64(3), 0)) is int
+
+
+def test_composite_refuses_text_for_E2_as_material_does():
+    # E2 went through float(): "7e10" ran as 7e10 (Material refuses text for E)
+    from roughfe.model import composite
+    for bad in ("7e10", True, np.True_, None):
+        with pytest.raises(InputError, match=r"^E2 \(Young's modulus, Pa; inf: rigid\) must "
+                                             r"be a number in \(0, inf\], got "):
+            composite(1e9, 0.3, bad, 0.3)
+    for bad in (0, -7e10, np.nan):
+        with pytest.raises(InputError, match=r"^E2 .* must lie in \(0, inf\], got "):
+            composite(1e9, 0.3, bad, 0.3)
+    # Johnson Eq. 4.22, and the rigid limit E2 = inf: E* of the first body alone
+    e1, e2 = 1e9, 7e10
+    expected = 1.0 / ((1 - 0.3 ** 2) / e1 + (1 - 0.2 ** 2) / e2)
+    assert composite(e1, 0.3, e2, 0.2).E_star == pytest.approx(expected, rel=1e-15, abs=0)
+    assert composite(e1, 0.3, np.inf, 0.2).E_star == pytest.approx(e1 / (1 - 0.09), rel=1e-15,
+                                                                   abs=0)
+
+
+def test_sobol_n_ridges_is_an_integer():
+    # int(self.n_ridges) took "3" (3 ridges, stored in the design as the text "3") and
+    # ran 2.5 as 2 ridges (stored as 2.5); numpy integers are kept as Python ints
+    from roughfe.genomics.database import SobolDesign
+    d = SobolDesign(dim=2, n_ridges=np.int64(2), n_pairs=2, n_vectors=1)
+    assert d.n_ridges == 2 and type(d.n_ridges) is int and d.genes().shape == (2, 6)
+    for bad in ("3", 2.5, 3.0, True, np.True_, 0):
+        with pytest.raises(InputError, match=r"^n_ridges \(ridges per genome, 1..100\) must be "
+                                             r"an integer >= 1, got "):
+            SobolDesign(dim=2, n_ridges=bad)
+    with pytest.raises(InputError, match=r"^n_ridges must lie in 1..100, got 101$"):
+        SobolDesign(dim=2, n_ridges=101)

@@ -5,7 +5,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ...errors import InputError, check_in_interval
+from ...errors import InputError, check_in_interval, check_int
 
 
 @dataclass(frozen=True)
@@ -47,8 +47,11 @@ class SobolDesign:
     def __post_init__(self):
         if self.dim not in (1, 2):
             raise InputError(f"dim must be 1 (profiles) or 2 (surfaces), got {self.dim!r}")
-        if int(self.n_ridges) < 1 or int(self.n_ridges) > 100:
+        # an integer (text "3" ran as 3, 2.5 as 2 ridges): check_int, then the upper end
+        n_ridges = check_int("n_ridges (ridges per genome, 1..100)", self.n_ridges, 1)
+        if n_ridges > 100:
             raise InputError(f"n_ridges must lie in 1..100, got {self.n_ridges!r}")
+        object.__setattr__(self, "n_ridges", n_ridges)
         # each end within the Genome's own interval (a gamma or H outside it failed its
         # tasks, and the task's text filled the error line); low == high is one value
         for name, what, low, high, closed in (
