@@ -142,3 +142,38 @@ def test_cli_info_warns_of_offset_lines_and_levels_them(tmp_path, capsys):
     assert main(["info", str(tmp_path / "lines.npz"), "--detrend", "lines", "--json"]) == 0
     out = capsys.readouterr()
     assert "scan lines" not in out.err and '"detrend": "lines"' in out.out
+
+
+def test_info_json_and_table_carry_the_scan_line_check(tmp_path, capsys, topographies_dir):
+    """`info --json` gave the check only as a stderr warning (round 2, session 34): its
+    ``scan_lines`` block now carries R, the threshold and the verdict. di-1 (AFM) fires
+    (R 11.2, line means jumping by 6 % of the rms height), x3p-2 does not (0.11); R is
+    the same with the plane removed (second differences) and about 0 once the lines
+    are levelled; a profile has no lines (null)."""
+    import json
+
+    def info(path, *extra):
+        assert main(["info", str(path), "--json", *extra]) == 0
+        return json.loads(capsys.readouterr().out)["scan_lines"]
+
+    di = info(topographies_dir / "di-1.di")
+    assert di["fires"] is True and di["threshold"] == 0.25
+    assert di["ratio"] == pytest.approx(11.18, rel=1e-3, abs=0)
+    assert di["line_jump"] / di["rms_height"] == pytest.approx(0.0617, rel=1e-2, abs=0)
+    assert di["units"] == {"ratio": "1", "threshold": "1", "line_jump": "m",
+                           "rms_height": "m"}
+    assert info(topographies_dir / "di-1.di", "--detrend", "plane")["ratio"] == pytest.approx(
+        di["ratio"], rel=1e-9, abs=0)
+    levelled = info(topographies_dir / "di-1.di", "--detrend", "lines")
+    assert levelled["fires"] is False and levelled["ratio"] < 1e-9
+    x3p = info(topographies_dir / "x3p-2.x3p")
+    assert x3p["fires"] is False and x3p["ratio"] == pytest.approx(0.1075, rel=1e-3, abs=0)
+    save_surface(spectral_profile(256, 1e-4, 0.7, rms_height=1e-6, rng=0),
+                 tmp_path / "p.npz")
+    assert info(tmp_path / "p.npz") is None
+    assert main(["info", str(topographies_dir / "di-1.di")]) == 0
+    assert ("scan-line check R            11.2 > 0.25: the scan lines look offset "
+            "(--detrend lines)") in capsys.readouterr().out
+    assert main(["info", str(topographies_dir / "x3p-2.x3p")]) == 0
+    assert "scan-line check R            0.108 <= 0.25: no scan-line offsets" in \
+        capsys.readouterr().out

@@ -40,6 +40,32 @@ STATISTICS_UNITS = {"shape": "points", "size": "m", "mean": "m", "rms_height": "
                     "hurst_error": "1 (standard error of hurst, Gaussian surface)"}
 
 
+#: SI units of the ``scan_lines`` block of ``info --json``
+SCAN_LINE_UNITS = {"ratio": "1", "threshold": "1", "line_jump": "m", "rms_height": "m"}
+
+
+def scan_line_block(surface):
+    """``info``'s ``scan_lines``: :func:`roughfe.surfaces.scan_lines.scan_line_check` of the
+    heights the statistics describe (after ``--detrend``: the same R under none, mean and
+    plane, about 0 after lines), as ``ratio``, ``threshold``, ``fires``, ``line_jump`` and
+    ``rms_height`` with their ``units``; None where the check does not apply (a profile,
+    fewer than 3 lines)."""
+    from dataclasses import asdict
+
+    from ..surfaces.scan_lines import scan_line_check
+    check = scan_line_check(surface)
+    return None if check is None else {**asdict(check), "units": dict(SCAN_LINE_UNITS)}
+
+
+def scan_line_row(block) -> str:
+    """The table row of :func:`scan_line_block` (``""`` when it is None)."""
+    if block is None:
+        return ""
+    verdict = ("> {:.3g}: the scan lines look offset (--detrend lines)" if block["fires"]
+               else "<= {:.3g}: no scan-line offsets").format(block["threshold"])
+    return f"{'scan-line check R':<28s} {block['ratio']:.3g} {verdict}"
+
+
 def format_table(stats: dict) -> str:
     """Plain-text table of a ``SurfaceStatistics.as_dict()``."""
     lines = []
@@ -110,14 +136,17 @@ def _info(args) -> int:
     stats = surface_statistics(surface, q_range=q_range).as_dict()
     if psd_path is not None:
         write_psd(surface, psd_path, str(args.surface))
+    scan_lines = scan_line_block(surface)
     if args.json:
         units = {k: v for k, v in STATISTICS_UNITS.items() if k in stats}
         print(to_json_text({"file": str(args.surface), "statistics": stats, "units": units,
-                            "metadata": dict(surface.metadata)}))
+                            "scan_lines": scan_lines, "metadata": dict(surface.metadata)}))
     else:
         print(f"{args.surface}: {surface!r}")
         print_surface_notes(args, surface, channel=True)
         print(format_table(stats))
+        if scan_lines is not None:
+            print(scan_line_row(scan_lines))
     return 0
 
 
