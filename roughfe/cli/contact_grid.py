@@ -34,8 +34,8 @@ def grid_check_of_args(args, surface, material, sweep, law, tol, options):
     refined surface; an adhesive sweep (``law``) with its kernel and tolerance."""
     if not getattr(args, "grid_check", False):
         return None
-    # --method fem refuses --grid-check with the other BEM-only flags (contact_cmd's
-    # _method_options, before any solve)
+    # --method fem refuses --grid-check with the other BEM-only flags
+    # (contact_options.method_options, before any solve)
     from ..bem.grid_check import grid_check
     if law is not None:
         return grid_check(surface, material, sweep, adhesion=law, unload=args.unload,

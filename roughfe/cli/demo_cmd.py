@@ -82,7 +82,7 @@ def section_measured(outdir: Path, context: dict) -> str:
             f"{_stats_table(stats)}\n\n![measured surface]({render})\n\n![PSD]({psd})\n")
 
 
-from .contact_cmd import section_contact  # noqa: E402  (BEM contact sweep section)
+from .contact_demo import section_contact  # noqa: E402  (BEM contact sweep section)
 
 SECTIONS = (section_surface, section_measured, section_contact)
 
