@@ -173,3 +173,44 @@ def test_sobol_n_ridges_is_an_integer():
             SobolDesign(dim=2, n_ridges=bad)
     with pytest.raises(InputError, match=r"^n_ridges must lie in 1..100, got 101$"):
         SobolDesign(dim=2, n_ridges=101)
+
+
+# -- round 2, session 34 (helper "misc"): the other integers of SobolDesign, sobol_tasks --
+def test_sobol_design_integers_and_task_limit_are_checked():
+    # a float or text (n_pairs=2.5, 3.0, "3"; seed=3.0) passed the constructor and failed
+    # in pairs()/phase_vectors() with a bare TypeError or ValueError, seed=-1 in numpy,
+    # n_phases = n_extra = 0 with an OverflowError; dim=True ran as 1; limit=2.5 kept 2
+    # genomes and limit="3" kept 3 (int(limit))
+    from roughfe.genomics.database import SobolDesign, sobol_tasks
+    for name, minimum, what in (("n_pairs", 1, r"\(gamma, H\) points"),
+                                ("n_vectors", 1, "phase vectors"),
+                                ("n_phases", 1, "phases per vector"),
+                                ("n_extra", 0, "extra phases per vector"),
+                                ("seed", 0, "Sobol scrambling seed")):
+        for bad in (2.5, "3", 3.0, True, np.True_, None, minimum - 1):
+            with pytest.raises(InputError, match=rf"^{name} \({what}\) must be an integer "
+                                                 rf">= {minimum}, got {re.escape(repr(bad))}$"):
+                SobolDesign(**{name: bad})
+    for bad in (True, 1.0, 3, "1"):
+        with pytest.raises(InputError, match=r"^dim must be 1 \(profiles\) or 2 \(surfaces\), "
+                                             rf"got {re.escape(repr(bad))}$"):
+            SobolDesign(dim=bad)
+    with pytest.raises(InputError, match=r"^n_pairs must be at most 2\*\*30 = 1073741824 "):
+        SobolDesign(n_pairs=2 ** 30 + 1)
+    with pytest.raises(InputError, match=r"^n_vectors \* \(n_phases \+ n_extra\) \* ridges "
+                                         r"must be at most 2\*\*30 .*got 1073741825$"):
+        SobolDesign(dim=2, n_ridges=1, n_vectors=1, n_phases=2 ** 30, n_extra=1)
+    # numpy integers are kept as Python ints; the smallest design runs: one pair, one
+    # vector of one phase, no extra phases, seed 0 (the thesis' own pair count is 20)
+    d = SobolDesign(n_pairs=np.int64(1), n_vectors=np.int32(1), n_phases=1, n_extra=0,
+                    seed=np.uint8(0))
+    assert all(type(getattr(d, k)) is int for k in ("n_pairs", "n_vectors", "seed"))
+    assert d.pairs().shape == (1, 2) and d.phase_vectors().shape == (1, 1)
+    tasks = sobol_tasks(SobolDesign(n_pairs=2, n_vectors=2))
+    assert len(tasks) == 4
+    assert [t["label"] for t in sobol_tasks(SobolDesign(n_pairs=2, n_vectors=2),
+                                            np.int64(3))] == ["1-1", "1-2", "2-1"]
+    for bad in (2.5, "3", 0, True, -1):
+        with pytest.raises(InputError, match=r"^limit \(genomes to build\) must be an integer "
+                                             rf">= 1, got {re.escape(repr(bad))}$"):
+            sobol_tasks(SobolDesign(n_pairs=2, n_vectors=2), bad)

@@ -7,6 +7,8 @@ import numpy as np
 
 from ...errors import InputError, check_in_interval, check_int
 
+_SOBOL_MAX = 2 ** 30    # scipy.stats.qmc.Sobol: at most 2**30 distinct points
+
 
 @dataclass(frozen=True)
 class SobolDesign:
@@ -30,6 +32,12 @@ class SobolDesign:
     anisotropy. A phase "vector" is then an (M, n_phases + n_extra) matrix taken
     sequentially from the 1-D phase sequence (row by row). ``dim = 1`` is the thesis
     design above, unchanged.
+
+    Integers (:func:`roughfe.errors.check_int`; a bool, text or a float is refused):
+    ``n_pairs``, ``n_vectors``, ``n_phases`` >= 1, ``n_extra`` >= 0, ``seed`` >= 0
+    (``seed + 1`` seeds the phases), ``n_ridges`` 1..100; the Sobol sequences hold at most
+    2**30 points, so ``n_pairs`` and the phase count ``n_vectors * (n_phases + n_extra) *
+    rows`` are at most 2**30.
     """
 
     n_pairs: int = 20
@@ -45,13 +53,32 @@ class SobolDesign:
     anisotropy_range: tuple = (0.5, 2.0)
 
     def __post_init__(self):
-        if self.dim not in (1, 2):
+        try:                    # an integer: True and 1.0 passed "in (1, 2)" as 1
+            dim = check_int("dim", self.dim, 1)
+        except InputError:
+            dim = None
+        if dim not in (1, 2):
             raise InputError(f"dim must be 1 (profiles) or 2 (surfaces), got {self.dim!r}")
-        # an integer (text "3" ran as 3, 2.5 as 2 ridges): check_int, then the upper end
-        n_ridges = check_int("n_ridges (ridges per genome, 1..100)", self.n_ridges, 1)
-        if n_ridges > 100:
+        object.__setattr__(self, "dim", dim)
+        # integers (n_ridges: text "3" ran as 3, 2.5 as 2 ridges; the others: a float or
+        # text failed later with a bare TypeError, a negative seed with numpy's
+        # ValueError, no phases at all with an OverflowError): check_int, upper ends
+        for name, what, minimum in (("n_pairs", "(gamma, H) points", 1),
+                                    ("n_vectors", "phase vectors", 1),
+                                    ("n_phases", "phases per vector", 1),
+                                    ("n_extra", "extra phases per vector", 0),
+                                    ("seed", "Sobol scrambling seed", 0),
+                                    ("n_ridges", "ridges per genome, 1..100", 1)):
+            object.__setattr__(self, name, check_int(f"{name} ({what})",
+                                                     getattr(self, name), minimum))
+        if self.n_ridges > 100:
             raise InputError(f"n_ridges must lie in 1..100, got {self.n_ridges!r}")
-        object.__setattr__(self, "n_ridges", n_ridges)
+        n_phase_values = self.n_vectors * (self.n_phases + self.n_extra) * self.rows
+        for name, count in (("n_pairs", self.n_pairs),
+                            ("n_vectors * (n_phases + n_extra) * ridges", n_phase_values)):
+            if count > _SOBOL_MAX:
+                raise InputError(f"{name} must be at most 2**30 = {_SOBOL_MAX} (the points "
+                                 f"of a Sobol sequence), got {count}")
         # each end within the Genome's own interval (a gamma or H outside it failed its
         # tasks, and the task's text filled the error line); low == high is one value
         for name, what, low, high, closed in (
@@ -156,8 +183,11 @@ def _check_range(name, what, pair, low, high, closed) -> tuple:
 def sobol_tasks(design: SobolDesign, limit=None) -> list:
     """:func:`genome_entry_task` arguments (label, source, gamma, hurst, phases) per genome.
 
-    ``limit`` keeps the first genomes of the design (a reduced database); it must be >= 1.
+    ``limit`` keeps the first genomes of the design (a reduced database); an integer >= 1
+    (:func:`roughfe.errors.check_int`; 2.5 and "3" are refused).
     """
+    if limit is not None:       # int(limit) ran 2.5 as 2 genomes and "3" as 3
+        limit = check_int("limit (genomes to build)", limit, 1)
     tasks = []
     for row in design.tasks():
         lab, g, h, phi = row[:4]
@@ -168,7 +198,5 @@ def sobol_tasks(design: SobolDesign, limit=None) -> list:
             task["anisotropy"] = [float(v) for v in row[5]]
         tasks.append(task)
     if limit is not None:
-        if int(limit) < 1:
-            raise InputError(f"limit must be >= 1 genome, got {limit!r}")
-        tasks = tasks[: int(limit)]
+        tasks = tasks[:limit]
     return tasks
