@@ -68,6 +68,39 @@ def test_contact_on_a_tilted_window_warns(tmp_path, capsys):
     assert capsys.readouterr().err.count("--detrend mean keeps the tilt") == 1
 
 
+def test_detrend_lines_on_a_map_tilted_along_x_warns(tmp_path, capsys):
+    """--detrend lines (round 2, session 34) levels each scan line's mean: a tilt along y
+    goes, one along x stays, and the tilt warning spoke only for --detrend mean (plu-1
+    with --detrend lines: its plane along x 99.996 % of the levelled map's variance, in
+    silence)."""
+    rough = spectral_surface(32, 1e-4, 0.8, rms_height=1e-7, rng=5)
+    x = np.arange(32) * rough.spacing[0]
+    for name, slope_x, slope_y in (("x.npz", 0.02, 0.0), ("xy.npz", 0.02, 0.03),
+                                   ("y.npz", 0.0, 0.03)):
+        surface = Surface(rough.heights + slope_x * x[:, None] + slope_y * x[None, :],
+                          rough.size, periodic=False)
+        path = save_surface(surface, tmp_path / name)
+        assert main(["info", str(path), "--detrend", "lines"]) == 0
+        err = capsys.readouterr().err
+        if slope_x == 0:      # the lines' means took the tilt along y: nothing to say
+            assert "tilt" not in err
+            continue
+        assert err.count("warning: --detrend lines keeps the tilt along x") == 1
+        assert "--detrend lines-tilt" in err
+        levelled = surface.detrended("lines")
+        shown = [float(v) for v in re.findall(r"rms height ([\d.e+-]+) m with the lines "
+                                              r"levelled, ([\d.e+-]+) m with the plane "
+                                              r"removed too", err)[0]]
+        assert shown[0] == pytest.approx(rms_height(levelled), rel=1e-3)
+        assert shown[1] == pytest.approx(rms_height(levelled.detrended("plane")), rel=1e-3)
+        # the plane left is the tilt along x alone: the same whatever the tilt along y
+        window = Surface(rough.heights, rough.size, periodic=False)
+        assert shown[1] == pytest.approx(rms_height(window.detrended("lines").detrended(
+            "plane")), rel=1e-3)
+        assert main(["info", str(path), "--detrend", "lines-tilt"]) == 0
+        assert "warning" not in capsys.readouterr().err
+
+
 def test_info_names_the_channel_read_and_the_filled_points(topographies_dir, capsys):
     """`info` said neither which of di-1's two 'Height' channels it read nor that opd-1
     had 116 undefined points filled (only --json's metadata did)."""

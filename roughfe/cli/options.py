@@ -173,8 +173,8 @@ def surface_from_args(args):
     from .plausibility import warn_scan_lines, warn_seam, warn_tilt, warn_units
     warn_units(args, surface)
     detrend = getattr(args, "detrend", "none")
-    if detrend == "mean" and not surface.periodic:
-        warn_tilt(args, surface)
+    if detrend in ("mean", "lines") and not surface.periodic:
+        warn_tilt(args, surface, detrend)
     if detrend in ("none", "mean", "plane"):
         warn_scan_lines(args, surface)
     surface = surface if detrend == "none" else surface.detrended(detrend)
