@@ -190,3 +190,19 @@ def test_contact_cli_on_a_capped_sphere(tmp_path, capsys):
     row = [line for line in out.splitlines() if line.strip().startswith(
         f"{last['delta']:.4e}")][0]
     assert f"{last['capped_hertz_area_fraction']:.3g}" in row.split()[-2]
+    # and the capped reference's approach beside the BEM's delta, on every step of the
+    # first loading (session 34: it was in results.json only), said under the table
+    head = [line for line in out.splitlines() if line.split()[:2] == ["delta", "(m)"]][0]
+    assert head.split()[2:4] == ["delta", "Hertz"]
+    for step in doc["steps"]:
+        cells = [line for line in out.splitlines() if line.strip().startswith(
+            f"{step['delta']:.4e}")][0].split()
+        assert step["capped_hertz_approach"] is not None
+        assert cells[1] == f"{step['capped_hertz_approach']:.4e}"
+        assert float(cells[1]) == pytest.approx(step["delta"], rel=0.03, abs=0)
+    assert "capped_hertz_approach in results.json" in out
+    # an elastic run has no such column (hertz_* carry no approach)
+    assert main(["contact", str(path), "--E", "1e9", "--nu", "0.3", "--pressure", str(p),
+                 "--no-figures", "-o", str(tmp_path / "e")]) == 0
+    out = capsys.readouterr().out
+    assert "delta Hertz" not in out and "capped_hertz_approach" not in out

@@ -22,7 +22,10 @@ def print_summary(args, surface, material, sweep, doc, grid=None, *, adhesive=No
     plastic = args.hardness is not None      # the plastic share of A* beside it
     cap = doc["derived"]["persson"].get("single_asperity")
     theory = "hertz" if cap is not None else "persson"
-    print(f"{'delta (m)':>12s} {'p (Pa)':>12s} {'A*':>8s} "
+    # a sphere's hardness run: the capped Hertz approach beside delta (first loading)
+    capped = any(t.get("capped_hertz_approach") is not None for t in doc["steps"])
+    print(f"{'delta (m)':>12s} " + (f"{'delta Hertz':>12s} " if capped else "")
+          + f"{'p (Pa)':>12s} {'A*':>8s} "
           + (f"{'A*plastic':>9s} " if plastic else "")
           + f"{'K (Pa/m)':>12s} {'gap (m)':>12s} {'nit':>5s} "
           + f"{'A* ' + theory.capitalize():>10s} {'patch':>6s}")
@@ -32,13 +35,20 @@ def print_summary(args, surface, material, sweep, doc, grid=None, *, adhesive=No
         k = f"{k:12.4e}" if not np.isnan(k) else f"{'-':>12s}"
         pl = (f"{fmt_or_dash(t.get('plastic_area_fraction'), '.3g'):>9s} " if plastic
               else "")
-        print(f"{s['delta']:12.4e} {s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
+        ref = (f"{fmt_or_dash(t.get('capped_hertz_approach'), '.4e'):>12s} " if capped
+               else "")
+        print(f"{s['delta']:12.4e} {ref}{s['mean_pressure']:12.4e} {s['area_fraction']:8.3g} "
               f"{pl}{k} {s['mean_gap']:12.4e} {s['iterations']:5d} "
               f"{fmt_or_dash(theory_area_fraction(t), '.3g'):>10s} "
               f"{fmt_or_dash(s.get('patch_width'), '.3g'):>6s}")
     print(f"patch: load-weighted width of the contact patches in grid points (patch_width in "
           f"results.json; below {MIN_PATCH_POINTS:g} not resolved; a resolved width does not "
           f"bound the grid's error of A*: --grid-check measures it)")
+    if capped:
+        print(f"delta Hertz: the approach of Hertz's sphere capped at the hardness H_p = "
+              f"{args.hardness:.4g} Pa at the step's load, counted from the highest grid "
+              f"point as delta is (capped_hertz_approach in results.json; first loading "
+              f"only; A* Hertz is its A*)")
     print_grid_check(args, grid)
     persson_basis(args, surface, doc["derived"]["persson"])
     if cap is not None:
