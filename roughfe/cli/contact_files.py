@@ -13,7 +13,7 @@ from ..theory import beside
 def write_contact_files(out, sweep, doc, surface, material, *, name, method, figures=True,
                         adhesive=None, law=None, maugis=None) -> list:
     """fields.h5 and (``figures``) the figures of a contact sweep in the folder ``out``;
-    the paths written, results.json first (:func:`roughfe.cli.contact_cmd` writes it last,
+    the paths written, results.json first (:mod:`roughfe.cli.contact_cmd` writes it last,
     when the run is complete)."""
     write_fields_h5(out / "fields.h5", sweep)
     written = [out / "results.json", out / "fields.h5"]
