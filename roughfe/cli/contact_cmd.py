@@ -27,9 +27,9 @@ from ..model import Loading
 from ..response import response
 from ..theory import pastewka_robbins
 from ..writers import write_json
-from .contact_demo import section_contact  # noqa: F401  (roughfe.cli.demo_cmd's section)
+from .contact_demo import section_contact  # noqa: F401  (its name before the split)
 from .contact_files import contact_document, write_contact_files
-from .contact_files import shown_step as _shown_step  # noqa: F401  (tests' name)
+from .contact_files import shown_step as _shown_step  # noqa: F401  (its name before the split)
 from .contact_grid import grid_check_of_args
 from .contact_options import DEFAULT_STEPS, add_contact_arguments, in_flags, method_options
 from .contact_table import print_summary
