@@ -177,3 +177,59 @@ def test_info_json_and_table_carry_the_scan_line_check(tmp_path, capsys, topogra
     assert main(["info", str(topographies_dir / "x3p-2.x3p")]) == 0
     assert "scan-line check R            0.108 <= 0.25: no scan-line offsets" in \
         capsys.readouterr().out
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_scan_axis_y_on_the_transposed_map_is_the_same(periodic):
+    """A map scanned along y (lines heights[i, :]) had to be transposed before
+    levelling and the check (round 2, session 34: axis / scan_axis "y"): its result is
+    the transpose of the map's along x, with the metadata scan_axis = "y" kept."""
+    s = _map(periodic=periodic)                    # 96 x 64, square cells
+    noisy, _ = _offsets(s, share=0.2, tilt=0.0 if periodic else 1.0)
+    t = Surface(noisy.heights.T, noisy.size[::-1], periodic, noisy.metadata)
+    sq = s.heights.std()
+    for mode in ("lines", "lines-tilt"):
+        a, b = noisy.detrended(mode), t.detrended(mode, scan_axis="y")
+        assert np.max(np.abs(b.heights - a.heights.T)) < 1e-13 * sq
+        assert b.metadata["scan_axis"] == "y" and b.metadata["detrend"] == a.metadata["detrend"]
+        # the metadata makes y the default: levelling again changes nothing
+        assert np.max(np.abs(b.detrended(mode).heights - b.heights)) < 1e-13 * sq
+        assert "scan_axis" not in a.metadata
+    cx, cy = scan_line_check(noisy), scan_line_check(t, axis="y")
+    assert cx.fires and cy.fires and (cx.axis, cy.axis) == ("x", "y")
+    for key in ("ratio", "threshold", "line_jump", "rms_height"):
+        assert getattr(cy, key) == pytest.approx(getattr(cx, key), rel=1e-12, abs=0)
+    assert "scan lines along y (heights[i, :])" in cy.note() and "q_y = 0" in cy.note()
+    # along x the transposed map's offsets lie along each line: no line-mean jumps
+    assert not scan_line_check(t).fires
+    with pytest.raises(InputError, match=r"^scan axis must be 'x' .* or 'y' .*, got 'z'$"):
+        t.detrended("lines", scan_axis="z")
+
+
+def test_cli_scan_axis_y_gives_the_transposed_maps_numbers(tmp_path, capsys):
+    import json
+    s = _map(periodic=False)
+    noisy, _ = _offsets(s, share=0.2, tilt=1.0)
+    t = Surface(noisy.heights.T, noisy.size[::-1], False, noisy.metadata)
+    save_surface(noisy, tmp_path / "x.npz")
+    save_surface(t, tmp_path / "y.npz")
+    capsys.readouterr()
+
+    def info(name, *extra):
+        assert main(["info", str(tmp_path / name), "--json", *extra]) == 0
+        out = capsys.readouterr()
+        return json.loads(out.out), out.err
+
+    (dx, err_x), (dy, err_y) = info("x.npz"), info("y.npz", "--scan-axis", "y")
+    assert "scan lines along x" in err_x and "scan lines along y" in err_y
+    assert dy["scan_lines"]["axis"] == "y" and dx["scan_lines"]["axis"] == "x"
+    assert dy["scan_lines"]["ratio"] == pytest.approx(dx["scan_lines"]["ratio"], rel=1e-9,
+                                                      abs=0)
+    assert "scan lines" not in info("y.npz")[1]        # along x: nothing to see
+    for mode in ("lines", "lines-tilt"):
+        (lx, _), (ly, _) = info("x.npz", "--detrend", mode), info(
+            "y.npz", "--detrend", mode, "--scan-axis", "y")
+        for key in ("rms_height", "rms_slope", "rms_curvature", "peak_to_valley"):
+            assert ly["statistics"][key] == pytest.approx(lx["statistics"][key], rel=1e-9,
+                                                          abs=0)
+        assert ly["scan_lines"]["ratio"] < 1e-9 and ly["metadata"]["scan_axis"] == "y"

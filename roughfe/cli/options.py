@@ -7,7 +7,8 @@ everywhere:
   ``--non-periodic`` (exclusive), ``--channel``; :func:`surface_from_args` reads it.
 * :func:`add_detrend_option` -- ``--detrend none|mean|plane|lines|lines-tilt``, default
   ``mean`` (a warning when it leaves a tilt of more than 95 % of the variance of a
-  non-periodic surface, and when a map's scan lines look offset from each other).
+  non-periodic surface, and when a map's scan lines look offset from each other), and
+  ``--scan-axis x|y`` (the axis the scan lines run along, default x).
 * :func:`add_material_options` -- ``--E`` (Pa, within :data:`E_RANGE`) and ``--nu`` (-),
   default the thesis' E* = 210 MPa (E = 210 MPa, nu = 0); :func:`material_from_args`.
 * :func:`add_output_folder` -- ``-o/--output OUTDIR`` (a FOLDER whenever a command writes
@@ -170,6 +171,8 @@ def surface_from_args(args):
     ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
     command has that option."""
     surface = surface_file(args, args.surface)
+    if getattr(args, "scan_axis", "x") == "y" and surface.ndim == 2:   # read by the
+        surface = surface.with_heights(surface.heights, scan_axis="y")  # levelling, check
     from .plausibility import warn_scan_lines, warn_seam, warn_tilt, warn_units
     warn_units(args, surface)
     detrend = getattr(args, "detrend", "none")
@@ -247,6 +250,11 @@ def add_detrend_option(parser, default: str = DEFAULT_DETREND) -> None:
              "'align rows'): its mean / least-squares line; for scan-line artefacts only "
              "(they also remove the real roughness at q_x = 0); a map whose lines look "
              "offset warns")
+    parser.add_argument(
+        "--scan-axis", choices=("x", "y"), default="x",
+        help="the axis of the fast-scan lines, for --detrend lines / lines-tilt and the "
+             "scan-line check: x (heights[:, j], an AFM map as the .di reader gives it) or "
+             "y (heights[i, :], a map scanned along y, no transposing needed)")
 
 
 # -- material ------------------------------------------------------------------------------

@@ -60,9 +60,10 @@ def warn_tilt(args, surface, detrend: str = "mean") -> None:
     ``--detrend mean`` (the default) then solves a tilted plane (plu-1: rms 2.834 um
     with the mean removed, 18.3 nm with the plane removed; contact A* 0.0069 instead of
     0.037 at 9.4 kPa). With ``detrend="lines"`` the same share of the line-levelled map
-    (each scan line's mean removed, which takes out the tilt along y but keeps the one
-    along x): plu-1 0.99996, as with the mean; 240 RMD and spectral windows without a
-    tilt at most 0.91 (round 2, session 34)."""
+    (each scan line's mean removed, which takes out the tilt across the lines but keeps
+    the one along them, x unless the metadata's ``scan_axis`` is y): plu-1 0.99996, as
+    with the mean; 240 RMD and spectral windows without a tilt at most 0.91 (round 2,
+    session 34)."""
     from ..surfaces.stats import rms_height
 
     kept = surface.detrended("lines") if detrend == "lines" else surface
@@ -71,7 +72,9 @@ def warn_tilt(args, surface, detrend: str = "mean") -> None:
     if share <= TILT_SHARE_LIMIT:
         return
     if detrend == "lines":
-        warn(args, f"--detrend lines keeps the tilt along x of this non-periodic surface "
+        from ..surfaces.scan_lines import scan_axis_of
+        warn(args, f"--detrend lines keeps the tilt along {scan_axis_of(surface)} of this "
+                   f"non-periodic surface "
                    f"(it levels each scan line's mean, not its slope): the least-squares "
                    f"plane of the levelled map carries {100 * share:.5g} % of its height "
                    f"variance (rms height {rms_kept:.4g} m with the lines levelled, "

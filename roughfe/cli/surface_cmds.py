@@ -47,9 +47,9 @@ SCAN_LINE_UNITS = {"ratio": "1", "threshold": "1", "line_jump": "m", "rms_height
 def scan_line_block(surface):
     """``info``'s ``scan_lines``: :func:`roughfe.surfaces.scan_lines.scan_line_check` of the
     heights the statistics describe (after ``--detrend``: the same R under none, mean and
-    plane, about 0 after lines), as ``ratio``, ``threshold``, ``fires``, ``line_jump`` and
-    ``rms_height`` with their ``units``; None where the check does not apply (a profile,
-    fewer than 3 lines)."""
+    plane, about 0 after lines), as ``ratio``, ``threshold``, ``fires``, ``line_jump``,
+    ``rms_height`` and ``axis`` (``"x"`` or ``"y"``, ``--scan-axis``) with their
+    ``units``; None where the check does not apply (a profile, fewer than 3 lines)."""
     from dataclasses import asdict
 
     from ..surfaces.scan_lines import scan_line_check

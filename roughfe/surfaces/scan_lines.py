@@ -12,7 +12,10 @@ x; :mod:`roughfe.surfaces.surface`). SurfaceTopography's Bruker/Veeco ``.di`` re
 which reads the AFM files, returns the file's lines (``samps/line`` points each) as
 these columns (it transposes the stored array: ``heights = fliplr(raw.T)``), so a
 ``.di``'s scan lines are ``heights[:, j]``. Other formats store what the instrument
-wrote; for a map scanned along y, transpose the heights first.
+wrote; a map scanned along y (lines ``heights[i, :]``) is levelled and checked along y
+with ``axis="y"`` (``Surface.detrended(mode, scan_axis="y")``, ``--scan-axis y``; the
+surface's metadata ``scan_axis = "y"`` makes it the default): the same as the
+transposed map along x (tested).
 
 Levelling (:func:`level_lines`, ``Surface.detrended("lines")`` / ``("lines-tilt")``),
 what Gwyddion's "align rows" and instrument software do (with the mean, not the median):
@@ -76,26 +79,55 @@ FAST_AXIS = 0
 FLOOR, SCALE = 0.25, 4.0
 #: levelling modes of :func:`level_lines` (``Surface.detrended`` names)
 LINE_MODES = ("lines", "lines-tilt")
+#: the axes the fast-scan lines can run along: x (``heights[:, j]``, the default) or y
+#: (``heights[i, :]``)
+SCAN_AXES = ("x", "y")
 
 
-def level_lines(surface: Surface, tilt: bool = False) -> Surface:
-    """``surface`` with each fast-scan line's (``heights[:, j]``) mean removed, or with
-    ``tilt`` its least-squares straight line (module docstring: what that removes; on a
-    periodic map the means only). A profile (1D) is one line: an InputError (use
-    ``"mean"`` or ``"plane"``). Heights in m; metadata ``detrend`` says which."""
+def scan_axis_of(surface: Surface, axis=None) -> str:
+    """The axis the fast-scan lines of ``surface`` run along, ``"x"`` or ``"y"``:
+    ``axis`` when given, else the surface's metadata ``scan_axis`` (a map read with
+    ``--scan-axis y``), else ``"x"``; anything else is an InputError."""
+    name = surface.metadata.get("scan_axis", "x") if axis is None else axis
+    if not isinstance(name, str) or name not in SCAN_AXES:
+        raise InputError(f"scan axis must be 'x' (lines heights[:, j]) or 'y' (lines "
+                         f"heights[i, :]), got {name!r}")
+    return name
+
+
+def _along_x(surface: Surface, axis):
+    """(heights with the scan lines as columns, the spacing along and across the lines,
+    the axis name): the map itself for lines along x, its transpose for lines along y."""
+    name = scan_axis_of(surface, axis)
+    dx, dy = surface.spacing
+    return (surface.heights, (dx, dy), name) if name == "x" else \
+        (surface.heights.T, (dy, dx), name)
+
+
+def level_lines(surface: Surface, tilt: bool = False, axis=None) -> Surface:
+    """``surface`` with each fast-scan line's mean removed, or with ``tilt`` its
+    least-squares straight line (module docstring: what that removes; on a periodic map
+    the means only). The lines run along ``axis`` (:func:`scan_axis_of`: ``"x"``,
+    ``heights[:, j]``, by default; ``"y"``, ``heights[i, :]``, levels the transpose and
+    sets the metadata ``scan_axis = "y"``). A profile (1D) is one line: an InputError
+    (use ``"mean"`` or ``"plane"``). Heights in m; metadata ``detrend`` says which."""
     if surface.ndim != 2:
         raise InputError(f"line levelling needs a 2D map of scan lines, got a profile "
                          f"(shape {surface.shape}); use detrend 'mean' or 'plane'")
-    h = surface.heights
+    h, _, name = _along_x(surface, axis)
     out = h - h.mean(axis=FAST_AXIS, keepdims=True)
     if not tilt:
-        return surface.with_heights(out, detrend="lines")
-    if surface.periodic:
-        return surface.with_heights(out, detrend="lines-tilt (periodic: lines)")
-    x = np.arange(h.shape[FAST_AXIS], dtype=float)
-    x = (x - x.mean()) / h.shape[FAST_AXIS]      # centred, per length: O(1) at any scale
-    slopes = (x @ out) / (x @ x)                  # each line's least-squares slope
-    return surface.with_heights(out - np.outer(x, slopes), detrend="lines-tilt")
+        detrend = "lines"
+    elif surface.periodic:
+        detrend = "lines-tilt (periodic: lines)"
+    else:
+        x = np.arange(h.shape[FAST_AXIS], dtype=float)
+        x = (x - x.mean()) / h.shape[FAST_AXIS]  # centred, per length: O(1) at any scale
+        slopes = (x @ out) / (x @ x)              # each line's least-squares slope
+        out, detrend = out - np.outer(x, slopes), "lines-tilt"
+    if name == "x":
+        return surface.with_heights(out, detrend=detrend)
+    return surface.with_heights(out.T, detrend=detrend, scan_axis="y")
 
 
 @dataclass(frozen=True)
@@ -114,6 +146,8 @@ class ScanLineCheck:
         rms jump of the line means between neighbouring lines, ``rms(m_{j+1} - m_j)`` (m).
     rms_height : float
         rms height about the mean (m), for scale.
+    axis : str
+        The axis the scan lines run along, ``"x"`` or ``"y"`` (:func:`scan_axis_of`).
     """
 
     ratio: float
@@ -121,28 +155,32 @@ class ScanLineCheck:
     fires: bool
     line_jump: float
     rms_height: float
+    axis: str = "x"
 
     def note(self) -> str:
         """One line suggesting ``--detrend lines`` when the check fires, else ``""``."""
         if not self.fires:
             return ""
-        return (f"the scan lines along x (heights[:, j]) look offset from each other: their "
+        line, other = ("heights[:, j]", "y") if self.axis == "x" else ("heights[i, :]", "x")
+        return (f"the scan lines along {self.axis} ({line}) look offset from each other: their "
                 f"means jump by {self.line_jump:.3g} m rms from line to line "
                 f"({100 * self.line_jump / self.rms_height:.2g} % of the rms height; "
                 f"line-to-line curvature of the means {self.ratio:.3g}x the within-line "
                 f"one at the same lag, > {self.threshold:.3g}): if that is a scan-line "
                 f"artefact (drift, tip changes), level each line with --detrend lines (or "
-                f"lines-tilt); it also removes the real roughness along y at q_x = 0")
+                f"lines-tilt); it also removes the real roughness along {other} at "
+                f"q_{self.axis} = 0" + ("" if self.axis == "y" else
+                                         " (a map scanned along y: --scan-axis y)"))
 
 
-def scan_line_check(surface: Surface):
+def scan_line_check(surface: Surface, axis=None):
     """The scan-line artefact check of a 2D map (module docstring), or ``None`` when it
     does not apply: a profile, fewer than 3 lines, or lines too short for a second
-    difference at the line spacing (``n_x < 2 round(dy / dx) + 1``)."""
+    difference at the line spacing (``n_x < 2 round(dy / dx) + 1``). The lines run along
+    ``axis`` (:func:`scan_axis_of`; ``"y"``: the check of the transposed map)."""
     if surface.ndim != 2:
         return None
-    h = surface.heights
-    dx, dy = surface.spacing
+    h, (dx, dy), name = _along_x(surface, axis)
     k = max(1, int(round(dy / dx)))
     nx, ny = h.shape
     if ny < 3 or nx < 2 * k + 1:
@@ -155,4 +193,5 @@ def scan_line_check(surface: Surface):
     return ScanLineCheck(ratio=float(ratio), threshold=float(threshold),
                          fires=bool(ratio > threshold),
                          line_jump=float(np.sqrt(np.mean(np.diff(means) ** 2))),
-                         rms_height=float(np.sqrt(np.mean((h - h.mean()) ** 2))))
+                         rms_height=float(np.sqrt(np.mean((h - h.mean()) ** 2))),
+                         axis=name)

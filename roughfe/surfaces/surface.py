@@ -153,7 +153,7 @@ class Surface(ReadOnlyArrays):
         """Heights multiplied by ``factor`` (same grid)."""
         return self.with_heights(self.heights * float(factor))
 
-    def detrended(self, mode: str = "mean") -> "Surface":
+    def detrended(self, mode: str = "mean", scan_axis=None) -> "Surface":
         """Remove the mean (``"mean"``) or the least-squares plane/line (``"plane"``; fitted
         on coordinates centred and divided by the size, so the same at any unit of length).
 
@@ -165,7 +165,9 @@ class Surface(ReadOnlyArrays):
 
         ``"lines"`` / ``"lines-tilt"`` level each scan line along x (``heights[:, j]``) by
         its mean / least-squares line, for scan-line artefacts of AFM maps only (they
-        remove real roughness too): :func:`roughfe.surfaces.scan_lines.level_lines`.
+        remove real roughness too): :func:`roughfe.surfaces.scan_lines.level_lines`;
+        ``scan_axis="y"`` (or the metadata ``scan_axis = "y"``) levels the lines along y
+        (``heights[i, :]``); the other modes ignore ``scan_axis``.
         """
         h = self.heights
         if mode == "mean" or (mode == "plane" and self.periodic):
@@ -182,7 +184,7 @@ class Surface(ReadOnlyArrays):
             return self.with_heights(h - (a @ coef).reshape(h.shape), detrend="plane")
         if mode in ("lines", "lines-tilt"):
             from .scan_lines import level_lines
-            return level_lines(self, tilt=mode == "lines-tilt")
+            return level_lines(self, tilt=mode == "lines-tilt", axis=scan_axis)
         raise InputError(f"detrend mode must be 'mean', 'plane', 'lines' or 'lines-tilt', "
                          f"got {mode!r}")
 
