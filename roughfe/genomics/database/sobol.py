@@ -36,8 +36,8 @@ class SobolDesign:
     Integers (:func:`roughfe.errors.check_int`; a bool, text or a float is refused):
     ``n_pairs``, ``n_vectors``, ``n_phases`` >= 1, ``n_extra`` >= 0, ``seed`` >= 0
     (``seed + 1`` seeds the phases), ``n_ridges`` 1..100; the Sobol sequences hold at most
-    2**30 points, so ``n_pairs`` and the phase count ``n_vectors * (n_phases + n_extra) *
-    rows`` are at most 2**30.
+    2**30 points, so ``n_pairs`` and the phase count (``n_vectors`` times
+    ``n_phases + n_extra`` times the ridges) are at most 2**30.
     """
 
     n_pairs: int = 20
