@@ -246,10 +246,10 @@ def add_detrend_option(parser, default: str = DEFAULT_DETREND) -> None:
              "analysis (measured topographies usually need 'plane'; on a periodic surface "
              "'plane' removes the mean only: its mean slope is zero); 'mean' on a "
              "non-periodic surface whose plane carries more than 95 %% of the height "
-             "variance warns. 'lines' / 'lines-tilt' level each scan line along x (AFM "
-             "'align rows'): its mean / least-squares line; for scan-line artefacts only "
-             "(they also remove the real roughness at q_x = 0); a map whose lines look "
-             "offset warns")
+             "variance warns. 'lines' / 'lines-tilt' level each scan line (along x, or "
+             "--scan-axis; AFM 'align rows'): its mean / least-squares line; for scan-line "
+             "artefacts only (they also remove the real roughness across the lines at zero "
+             "wavenumber along them); a map whose lines look offset warns")
     parser.add_argument(
         "--scan-axis", choices=("x", "y"), default="x",
         help="the axis of the fast-scan lines, for --detrend lines / lines-tilt and the "
