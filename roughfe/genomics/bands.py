@@ -128,7 +128,9 @@ class BandChromosomes:
     n_bins : ndarray of int, shape (n_c,)
         Number of transform bins in each band (0: an empty band, flat chromosome).
     detrend : str
-        Detrending applied before the decomposition ("none", "mean" or "plane").
+        Detrending applied before the decomposition ("none", "mean", "plane", "lines"
+        or "lines-tilt"; ``roughfe genome chromosomes`` records its ``--detrend``, done on
+        reading, before ``--mirror``).
     transform : str
         "fft" (periodic surfaces) or "dct" (non-periodic windows), see the module notes.
     """
@@ -176,6 +178,11 @@ def _detrended(surface: Surface, detrend: str) -> Surface:
         raise InputError(f"detrend must be one of {DETREND_MODES}, got {detrend!r}")
     if detrend == "none":
         return surface
+    if detrend in ("lines", "lines-tilt") and surface.metadata.get("mirrored"):
+        raise InputError(f"detrend={detrend!r} levels the measured scan lines; this surface "
+                         "is a mirrored window, whose lines are not those: level before "
+                         "mirroring (surface.detrended('lines').mirrored()) and pass "
+                         "detrend='mean'")
     return surface.detrended(detrend)
 
 
@@ -211,9 +218,13 @@ def band_chromosomes(surface: Surface, gamma: float = DEFAULT_GAMMA, *, q1=None,
     q1 : float, optional
         A band edge (rad/m); default the smallest non-zero bin of the transform. Use
         :func:`genome_q1` to centre a genome's WM wavenumbers in their bands.
-    detrend : {"plane", "mean", "none"}
-        Removed before the decomposition (the mean must go: q = 0 belongs to no band;
-        with "none" a non-zero mean is an error).
+    detrend : {"plane", "mean", "none", "lines", "lines-tilt"}
+        Removed before the decomposition by :meth:`Surface.detrended` (the mean must go:
+        q = 0 belongs to no band; with "none" a non-zero mean is an error). "lines" /
+        "lines-tilt" level each scan line (along the metadata's ``scan_axis``, default
+        x) of a measured map; a mirrored window (metadata ``mirrored``) is refused with
+        them, as its lines are not the measured ones: level, mirror, then pass "mean"
+        (as ``roughfe genome chromosomes --mirror`` does).
     transform : {"auto", "fft", "dct"}
         "auto": the FFT for a periodic surface, the DCT (mirrored window) otherwise.
 
