@@ -397,7 +397,8 @@ def test_design_target_pressure_far_beyond_e_star_is_refused(tiny_db, tmp_path, 
 
 @pytest.mark.parametrize("extra", [["--resolution", "full"], ["--size", "1e-4"],
                                    ["--detrend", "none"], ["--boundary", "window"],
-                                   ["--non-periodic"], ["--channel", "1"]])
+                                   ["--non-periodic"], ["--channel", "1"],
+                                   ["--scan-axis", "y"]])
 def test_design_targets_options_of_a_surface_need_the_surface(tiny_db, tmp_path, capsys,
                                                               extra):
     # accepted silently: the thesis' targets were written and the option ignored

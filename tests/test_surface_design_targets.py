@@ -195,3 +195,38 @@ def test_a_surface_database_refuses_a_profile_target(tmp_path, capsys):
     assert re.search(message, capsys.readouterr().err)
     with pytest.raises(InputError, match=message):
         target_surface(Surface(np.ones(64), 1e-4), settings)
+
+
+def test_design_targets_scan_axis_y_gives_the_transposed_maps_targets(tmp_path):
+    """`design-targets --surface` levelled scan lines along x only (no --scan-axis until
+    round 2, session 35, as info, contact, leak and genome chromosomes had): a map scanned
+    along y, given with --scan-axis y, now gives the targets of its transpose along x."""
+    from roughfe.cli import main
+    from roughfe.genomics.database.store import connect, write_settings
+    from roughfe.genomics.target_csv import read_target_csv
+    from roughfe.surfaces import spectral_surface
+    from roughfe.surfaces.io import save_surface
+    path = tmp_path / "s.sqlite"
+    con = connect(path, create=True)
+    write_settings(con, db.DatabaseSettings(length=1e-6, n_nodes=16, dim=2, n_steps=5,
+                                            top_fraction=0.8))
+    con.commit()
+    con.close()
+    rng = np.random.default_rng(3)
+    h = spectral_surface((48, 32), (1e-6, 2e-6 / 3), 0.7, rms_height=1e-8, rng=1).heights
+    h = h + 3e-9 * rng.standard_normal(32)[None, :]               # offsets of lines along x
+    save_surface(Surface(h, (1e-6, 2e-6 / 3), False), tmp_path / "x.npz")
+    save_surface(Surface(h.T, (2e-6 / 3, 1e-6), False), tmp_path / "y.npz")
+
+    def targets(name, *extra):
+        out = tmp_path / f"t_{name}_{len(extra)}"
+        assert main(["design-targets", "--db", str(path), "--surface", str(tmp_path / name),
+                     "--detrend", "lines", *extra, "-o", str(out)]) == 0
+        return [read_target_csv(out / f"{name[0]}_{q}.csv") for q in "KA"]
+
+    along_x = targets("x.npz")
+    for a, b in zip(along_x, targets("y.npz", "--scan-axis", "y")):
+        assert np.allclose(b.pressure, a.pressure, rtol=1e-9, atol=0)
+        assert np.allclose(b.values, a.values, rtol=1e-9, atol=0)
+    wrong = targets("y.npz")                      # the lines levelled across the scan
+    assert not np.allclose(wrong[1].values, along_x[1].values, rtol=1e-3, atol=0)

@@ -23,7 +23,7 @@ import warnings
 
 from .. import progress
 from ..errors import RoughfeError, Terminated
-from .options import ProgressBars, RoughfeParser, command_name, show_progress
+from .options import RoughfeParser, command_name, show_progress
 
 # module -> the commands it registers (explicit and ordered; no import-time magic)
 SUBCOMMANDS = {
@@ -37,6 +37,36 @@ SUBCOMMANDS = {
     "db_cmd": ("db",),
     "design_cmd": ("design", "design-targets"),
 }
+
+
+class ProgressBars:
+    """A :mod:`roughfe.progress` listener: one tqdm bar on stderr per running loop
+    (nested loops, e.g. the BEM load steps of each design candidate, stack)."""
+
+    def __init__(self):
+        self.bars = {}
+
+    def __call__(self, description, done, total):
+        from tqdm import tqdm
+
+        bar = self.bars.get(description)
+        if done == 0:
+            if bar is not None:
+                bar.close()
+            self.bars[description] = tqdm(total=total, desc=description, file=sys.stderr,
+                                          leave=False, dynamic_ncols=True,
+                                          position=len(self.bars))
+            return
+        if bar is not None:
+            bar.update(done - bar.n)
+            if total is not None and done >= total:
+                bar.close()
+                del self.bars[description]
+
+    def close(self):
+        for bar in self.bars.values():
+            bar.close()
+        self.bars.clear()
 
 
 def build_parser(command: str | None = None) -> RoughfeParser:

@@ -11,9 +11,9 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from .options import (DETRENDS, add_output_folder, add_run_options, add_surface_options,
-                      surface_file, int_in, nonnegative_float, output_folder_of,
-                      positive_float)
+from .options import (DETRENDS, add_output_folder, add_run_options, add_scan_axis_option,
+                      add_surface_options, surface_file, int_in, nonnegative_float,
+                      output_folder_of, positive_float)
 
 BUILTIN = ("y_t1", "y_t2", "y_t3")
 #: upper bounds of the stage budgets (none until round 2, session 34: 99999999999 ran as
@@ -248,7 +248,7 @@ def _run(args) -> int:
 SURFACE_TARGET_OPTIONS = (("detrend", "--detrend", "plane"), ("boundary", "--boundary", "auto"),
                           ("resolution", "--resolution", "design"), ("size", "--size", None),
                           ("periodic", "--periodic/--non-periodic", None),
-                          ("channel", "--channel", None))
+                          ("channel", "--channel", None), ("scan_axis", "--scan-axis", "x"))
 
 
 def _check_target_options(args) -> None:
@@ -415,7 +415,9 @@ def register(sub):
                         "and NAME_A.csv")
     t.add_argument("--detrend", choices=DETRENDS, default=None,
                    help="detrending of --surface before the BEM (default: plane; lines / "
-                        "lines-tilt: each scan line along x levelled, as roughfe info)")
+                        "lines-tilt: each scan line along x, or --scan-axis, levelled, as "
+                        "roughfe info)")
+    add_scan_axis_option(t, default=None)         # of --surface's file (default: x)
     t.add_argument("--boundary", choices=("auto", "periodic", "window"), default=None,
                    help="a non-periodic --surface: its evenly mirrored window with the "
                         "periodic BEM, or the window alone on the half-space (its K then "

@@ -8,7 +8,8 @@ everywhere:
 * :func:`add_detrend_option` -- ``--detrend none|mean|plane|lines|lines-tilt``, default
   ``mean`` (a warning when it leaves a tilt of more than 95 % of the variance of a
   non-periodic surface, and when a map's scan lines look offset from each other), and
-  ``--scan-axis x|y`` (the axis the scan lines run along, default x).
+  ``--scan-axis x|y`` (:func:`add_scan_axis_option`: the axis the scan lines run along,
+  default x; ``design-targets`` adds it alone, beside its own ``--detrend``).
 * :func:`add_material_options` -- ``--E`` (Pa, within :data:`E_RANGE`) and ``--nu`` (-),
   default the thesis' E* = 210 MPa (E = 210 MPa, nu = 0); :func:`material_from_args`.
 * :func:`add_output_folder` -- ``-o/--output OUTDIR`` (a FOLDER whenever a command writes
@@ -153,8 +154,8 @@ def add_surface_options(parser, positional: bool = True) -> None:
 
 
 def surface_file(args, path):
-    """The surface file ``path`` with ``--size``/``--periodic``/``--channel`` applied (the
-    options of :func:`add_surface_options`)."""
+    """The surface file ``path`` with ``--size``/``--periodic``/``--channel`` (the options
+    of :func:`add_surface_options`) and ``--scan-axis`` (metadata ``scan_axis``) applied."""
     from ..errors import InputError
     from ..surfaces.io import load_surface
 
@@ -163,7 +164,9 @@ def surface_file(args, path):
         raise InputError(f"--size takes one or two lengths in metres, got {size}")
     if size is not None and len(size) == 1:
         size = size[0]
-    return load_surface(path, size=size, periodic=args.periodic, channel=args.channel)
+    surface = load_surface(path, size=size, periodic=args.periodic, channel=args.channel)
+    y = getattr(args, "scan_axis", None) == "y" and surface.ndim == 2   # read by the
+    return surface.with_heights(surface.heights, scan_axis="y") if y else surface  # levelling
 
 
 def surface_from_args(args):
@@ -171,8 +174,6 @@ def surface_from_args(args):
     ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
     command has that option."""
     surface = surface_file(args, args.surface)
-    if getattr(args, "scan_axis", "x") == "y" and surface.ndim == 2:   # read by the
-        surface = surface.with_heights(surface.heights, scan_axis="y")  # levelling, check
     from .plausibility import warn_scan_lines, warn_seam, warn_tilt, warn_units
     warn_units(args, surface)
     detrend = getattr(args, "detrend", "none")
@@ -250,11 +251,16 @@ def add_detrend_option(parser, default: str = DEFAULT_DETREND) -> None:
              "--scan-axis; AFM 'align rows'): its mean / least-squares line; for scan-line "
              "artefacts only (they also remove the real roughness across the lines at zero "
              "wavenumber along them); a map whose lines look offset warns")
-    parser.add_argument(
-        "--scan-axis", choices=("x", "y"), default="x",
-        help="the axis of the fast-scan lines, for --detrend lines / lines-tilt and the "
-             "scan-line check: x (heights[:, j], an AFM map as the .di reader gives it) or "
-             "y (heights[i, :], a map scanned along y, no transposing needed)")
+    add_scan_axis_option(parser)
+
+
+def add_scan_axis_option(parser, default="x") -> None:
+    """``--scan-axis x|y``, applied by :func:`surface_file` (``design-targets``: None)."""
+    parser.add_argument("--scan-axis", choices=("x", "y"), default=default, help=(
+        "the axis of the fast-scan lines, for --detrend lines / lines-tilt (and the "
+        "scan-line check): x (heights[:, j], an AFM map as the .di reader gives it) or "
+        "y (heights[i, :], a map scanned along y, no transposing needed)"
+        + ("" if default else " (default: x)")))
 
 
 # -- material ------------------------------------------------------------------------------
@@ -433,36 +439,6 @@ def log_of(args):
 def show_progress(args) -> bool:
     """True when a progress bar should be drawn: stderr is a terminal and no ``--quiet``."""
     return not getattr(args, "quiet", False) and sys.stderr.isatty()
-
-
-class ProgressBars:
-    """A :mod:`roughfe.progress` listener: one tqdm bar on stderr per running loop
-    (nested loops, e.g. the BEM load steps of each design candidate, stack)."""
-
-    def __init__(self):
-        self.bars = {}
-
-    def __call__(self, description, done, total):
-        from tqdm import tqdm
-
-        bar = self.bars.get(description)
-        if done == 0:
-            if bar is not None:
-                bar.close()
-            self.bars[description] = tqdm(total=total, desc=description, file=sys.stderr,
-                                          leave=False, dynamic_ncols=True,
-                                          position=len(self.bars))
-            return
-        if bar is not None:
-            bar.update(done - bar.n)
-            if total is not None and done >= total:
-                bar.close()
-                del self.bars[description]
-
-    def close(self):
-        for bar in self.bars.values():
-            bar.close()
-        self.bars.clear()
 
 
 #: the attributes that name a command's words (a command, then its subcommand)
