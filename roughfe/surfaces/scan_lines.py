@@ -10,8 +10,9 @@ the Hurst exponent, the rms slope and the contact.
 Convention: the fast-scan lines are the profiles along x, ``heights[:, j]`` (axis 0 is
 x; :mod:`roughfe.surfaces.surface`). SurfaceTopography's Bruker/Veeco ``.di`` reader,
 which reads the AFM files, returns the file's lines (``samps/line`` points each) as
-these columns (it transposes the stored array: ``heights = fliplr(raw.T)``), so a
-``.di``'s scan lines are ``heights[:, j]``. Other formats store what the instrument
+these columns (it transposes the stored array: ``heights = fliplr(raw.T)``; on a
+non-square map roughfe puts its scrambled lines back, :mod:`roughfe.surfaces.layout`), so
+a ``.di``'s scan lines are ``heights[:, j]``. Other formats store what the instrument
 wrote; a map scanned along y (lines ``heights[i, :]``) is levelled and checked along y
 with ``axis="y"`` (``Surface.detrended(mode, scan_axis="y")``, ``--scan-axis y``; the
 surface's metadata ``scan_axis = "y"`` makes it the default): the same as the
