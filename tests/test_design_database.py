@@ -1,5 +1,6 @@
 """Genome database: Sobol design, Alg. 2 records, resumable SQLite build, extend, errors."""
 import json
+import re
 import sqlite3
 from pathlib import Path
 
@@ -342,3 +343,37 @@ def test_a_profile_database_refuses_a_surface_genome(tmp_path):
     assert db.labels(con) == []
     con.close()
     assert not (tmp_path / "p.sqlite.study").exists()
+
+
+def test_make_genome_takes_int_seeds_only_as_scalars():
+    """make_genome ran a float scalar 3.0 (and "3", True) as the int seed 3 (1), and a 3.5
+    as one phase; a scalar is now a seed only as an integer >= 0 (Python or numpy)."""
+    tiny = db.DatabaseSettings(n_nodes=32)
+    ref = db.make_genome(1.7, 0.9, 3, tiny).phases
+    for seed in (np.int64(3), np.uint16(3), np.array(3)):
+        np.testing.assert_array_equal(db.make_genome(1.7, 0.9, seed, tiny).phases, ref)
+    for bad in (3.0, np.float64(3.0), 3.5, True, np.bool_(True), "3", -1):
+        with pytest.raises(InputError, match=r"^phases \(an int seed; else a phase vector in "
+                                             r"rad, M = 1, or a matrix of M rows\) must be "
+                                             rf"an integer >= 0, got {re.escape(repr(bad))}$"):
+            db.make_genome(1.7, 0.9, bad, tiny)
+    np.testing.assert_array_equal(db.make_genome(1.7, 0.9, ref[0], tiny).phases, ref)
+
+
+def test_a_sobol_design_short_of_phases_is_refused_before_the_build(tmp_path):
+    """A design with fewer phases than its smallest gamma realises failed genome by genome
+    at build time ("needs 1 x 28 phases", inside each task); the build now refuses it
+    first, naming the gamma, the phases needed and those given, and creates no file."""
+    design, settings = db.SobolDesign(n_phases=5, n_extra=0), db.DatabaseSettings(n_nodes=256)
+    gamma = design.pairs()[:, 0].min()
+    from roughfe.genomics.database.task import realised_range
+    n_s, n_f = realised_range(gamma, settings)
+    assert n_f - n_s + 1 == int(np.log(255) / np.log(gamma)) + 1 == 28      # Eq. (3.5)
+    message = (rf"^gamma = {gamma:.6g} \(the design's smallest; gamma_range 1.2 \.\. 2\) "
+               r"realises 28 chromosomes at N = 256, .* needs 28 phases per ridge; the "
+               r"design gives n_phases \+ n_extra = 5 \+ 0 = 5: raise n_extra to at least 23")
+    from roughfe.study import build_genome_db
+    with pytest.raises(InputError, match=message):
+        build_genome_db(tmp_path / "x.sqlite", settings, design, progress=False, workers=1)
+    assert not (tmp_path / "x.sqlite").exists()
+    db.SobolDesign(n_phases=5, n_extra=23).check_phases(settings)       # exactly enough

@@ -110,6 +110,7 @@ def build_genome_db(db_path, settings=None, design=None, *, limit=None, executor
 
     settings = gdb.DatabaseSettings() if settings is None else settings
     design = gdb.SobolDesign() if design is None else design
+    design.check_phases(settings)                   # before the file or any task
     tasks = gdb.sobol_tasks(design, limit)
     with gdb.new_file_removed_on_error(db_path):   # a refused build leaves no new file
         con = gdb.connect(db_path, create=True)

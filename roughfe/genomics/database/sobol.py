@@ -136,6 +136,27 @@ class SobolDesign:
                                             base + (k + 1) * extra].reshape(self.rows, -1)
         return out[:, 0, :] if self.dim == 1 else out
 
+    def check_phases(self, settings) -> None:
+        """InputError unless each genome of the design has the phases it realises at
+        ``settings`` (a :class:`DatabaseSettings`): a genome of gamma realises
+        ``n_f - n_s + 1`` chromosomes (:func:`~roughfe.genomics.database.task.realised_range`,
+        more for a smaller gamma), one phase each per ridge, and the design gives
+        ``n_phases + n_extra``. Until round 2, session 35 such a genome failed at build
+        time, in its task; :func:`roughfe.study.build_genome_db` checks before any runs."""
+        from .task import realised_range
+        gammas = (self.pairs() if self.dim == 1 else self.genes())[:, 0]
+        counts = [n_f - n_s + 1 for n_s, n_f in (realised_range(g, settings) for g in gammas)]
+        k = max(range(len(counts)), key=lambda i: (counts[i], -gammas[i]))
+        given = self.n_phases + self.n_extra
+        if counts[k] > given:
+            raise InputError(
+                f"gamma = {gammas[k]:.6g} (the design's smallest; gamma_range "
+                f"{self.gamma_range[0]:g} .. {self.gamma_range[1]:g}) realises {counts[k]} "
+                f"chromosomes at N = {settings.n_nodes}, L = {settings.length:g} m and needs "
+                f"{counts[k]} phases per ridge; the design gives n_phases + n_extra = "
+                f"{self.n_phases} + {self.n_extra} = {given}: raise n_extra to at least "
+                f"{counts[k] - self.n_phases}, or the low end of gamma_range")
+
     def tasks(self):
         """``(label, gamma, H, phases)`` for every genome (surfaces: ``(label, gamma, H,
         phases, angles, anisotropy)``), labels ``"i-k"`` (1-based)."""

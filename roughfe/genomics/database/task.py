@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_int
 from ..genome import Genome, chromosome_range
 from ..macro_micro import macro_micro
 from ..periodic import periodic_chromosome_range
@@ -94,6 +94,16 @@ def _with_metadata(genome, **facts):
     return Genome.from_dict(d)
 
 
+def realised_range(gamma, settings: DatabaseSettings, lambda1=None):
+    """``(n_s, n_f)``: the chromosomes a genome of ``gamma`` (and ``lambda1``, m; default
+    the length L) realises at ``settings``: Eq. (3.5) for profiles (``dim == 1``), the
+    periodic range (:func:`roughfe.genomics.periodic.periodic_chromosome_range`) for
+    surfaces. :func:`make_genome` needs ``n_f - n_s + 1`` phases per ridge."""
+    lam = settings.length if lambda1 is None else float(lambda1)
+    window = periodic_chromosome_range if settings.dim == 2 else chromosome_range
+    return window(float(gamma), lam, settings.length, settings.n_nodes)
+
+
 def make_genome(gamma, hurst, phases, settings: DatabaseSettings, *, amplitude=1.0,
                 lambda1=None, angles=None, anisotropy=None):
     """A genome with exactly the chromosomes realised at ``settings``.
@@ -103,21 +113,19 @@ def make_genome(gamma, hurst, phases, settings: DatabaseSettings, *, amplitude=1
     factors ``anisotropy`` (default 1), the chromosomes of the periodic range
     (:func:`roughfe.genomics.periodic.periodic_chromosome_range`). ``phases`` is a
     vector (M = 1) or a matrix with M rows (their first n_c entries are used), or an int
-    seed (uniform phases in [0, 2 pi) from ``numpy.random.default_rng(seed)``).
+    seed >= 0 (uniform phases in [0, 2 pi) from ``numpy.random.default_rng(seed)``; a
+    Python or numpy integer). A scalar that is not an integer (3.0, 3.5, a bool) is
+    refused: until round 2, session 35 a float 3.0 ran as seed 3.
     """
     lam = settings.length if lambda1 is None else float(lambda1)
-    if settings.dim == 2:
-        if angles is None:
-            raise InputError("a surface database genome (dim 2) needs ridge angles")
-        n_s, n_f = periodic_chromosome_range(float(gamma), lam, settings.length,
-                                             settings.n_nodes)
-        m = len(np.atleast_1d(angles))
-    else:
-        n_s, n_f = chromosome_range(float(gamma), lam, settings.length, settings.n_nodes)
-        m = 1
+    if settings.dim == 2 and angles is None:
+        raise InputError("a surface database genome (dim 2) needs ridge angles")
+    m = len(np.atleast_1d(angles)) if settings.dim == 2 else 1
+    n_s, n_f = realised_range(gamma, settings, lam)
     n_c = n_f - n_s + 1
-    if np.isscalar(phases) and float(phases) == int(phases):
-        phi = np.random.default_rng(int(phases)).uniform(0, 2 * np.pi, (m, n_c))
+    seed = _seed_or_none(phases)
+    if seed is not None:
+        phi = np.random.default_rng(seed).uniform(0, 2 * np.pi, (m, n_c))
     else:
         phi = np.atleast_2d(np.asarray(phases, dtype=float))
         if phi.shape[0] != m or phi.shape[1] < n_c:
@@ -126,3 +134,14 @@ def make_genome(gamma, hurst, phases, settings: DatabaseSettings, *, amplitude=1
         phi = phi[:, :n_c]
     return Genome(A=float(amplitude), H=float(hurst), gamma=float(gamma), lambda1=lam,
                   phases=phi, n_first=n_s, angles=angles, anisotropy=anisotropy)
+
+
+
+def _seed_or_none(phases):
+    """The int seed that a scalar ``phases`` is, None for a phase vector or matrix;
+    InputError for a scalar that is no integer >= 0 (:func:`~roughfe.errors.check_int`):
+    a float (3.0 is no seed, and one phase is no vector), a bool, text."""
+    if np.ndim(phases) != 0:
+        return None
+    return check_int("phases (an int seed; else a phase vector in rad, M = 1, or a matrix "
+                     "of M rows)", phases, 0)
