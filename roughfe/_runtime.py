@@ -22,6 +22,7 @@ Nothing here imports matplotlib, pyvista or dolfinx at import time.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import json
 import os
@@ -137,10 +138,18 @@ def render_in_fresh_process(module: str, function: str, arrays: dict, **kwargs) 
 
 
 # -- temporaries of writers that no longer run -----------------------------------------
+@functools.lru_cache(maxsize=None)
 def machine_tag() -> str:
     """8 hex digits naming this machine and pid namespace (hostname and the namespace's
     inode): a pid in a file name is judged only where it was given out (not on another
-    host of a shared file system, nor in another container)."""
+    host of a shared file system, nor in another container).
+
+    Computed once per process and cached (every temporary file's name has it). Safe
+    across fork: a forked child (multiprocessing, the study executors) inherits the cache
+    and is in the same pid namespace on the same host, so its tag is the same. Only a
+    process that moves its children to a new pid namespace (``unshare(CLONE_NEWPID)``,
+    ``setns``) and then forks without exec would hand them a stale tag; roughfe does
+    neither."""
     try:
         namespace = os.stat("/proc/self/ns/pid").st_ino
     except OSError:  # pragma: no cover - non-Linux

@@ -153,3 +153,28 @@ def test_python_signals_for_petsc_keeps_the_users_options():
     assert env["PETSC_OPTIONS"].split() == ["-log_view", "-no_signal_handler"]
     assert python_signals_for_petsc(dict(env))["PETSC_OPTIONS"] == env["PETSC_OPTIONS"]
     assert python_signals_for_petsc({})["PETSC_OPTIONS"] == "-no_signal_handler"
+
+
+def test_machine_tag_is_computed_once_and_the_same_after_fork():
+    """machine_tag (in every temporary file's name) hashed the hostname on each write;
+    it is cached now (internal: no number or name changes). The cached tag is the one a
+    fresh computation gives, here and in a forked child (same host, same pid namespace)."""
+    import os
+    from roughfe._runtime import machine_tag, writer_prefix
+    tag = machine_tag()
+    assert tag == machine_tag.__wrapped__() and len(tag) == 8
+    hits = machine_tag.cache_info().hits
+    assert writer_prefix("p").startswith(f"p{tag}-{os.getpid()}-")
+    assert machine_tag.cache_info().hits == hits + 1
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:            # the child: a fresh computation, reported through the pipe
+        try:
+            os.write(write, machine_tag.__wrapped__().encode())
+        finally:
+            os._exit(0)
+    os.close(write)
+    with os.fdopen(read) as pipe:
+        child = pipe.read()
+    os.waitpid(pid, 0)
+    assert child == tag
