@@ -156,3 +156,20 @@ def test_non_square_files_are_continuous_along_both_axes(name):
     other = h.T.reshape(-1).reshape(nx, ny).T                  # lines of ny points
     assert max(rough) < 0.5                                    # 0.0014-0.48 measured
     assert np.diff(other, axis=1).std() / h.std() > 0.9        # 0.98-1.50 measured
+
+
+def test_di1_fast_axis_is_x_trace_and_retrace_are_offset_along_x():
+    # the trace and retrace sweeps of a line run in opposite directions along the fast
+    # axis: their offset (the piezo's hysteresis, a delay) lies along it (theory/01)
+    path = _need("di-1.di")
+    trace = load_surface(path, channel=0).detrended("lines-tilt").heights
+    retrace = load_surface(path, channel=1).detrended("lines-tilt").heights
+    inner = (slice(16, -16), slice(16, -16))
+    a = trace[inner]
+
+    def corr(sx, sy):
+        b = np.roll(np.roll(retrace, sx, 0), sy, 1)[inner]
+        return (a * b).sum() / np.sqrt((a * a).sum() * (b * b).sum())
+    best = max((corr(sx, sy), sx, sy) for sx in range(-8, 9) for sy in range(-3, 4))
+    assert best[1:] == (6, 1)                   # 6 samples along x, 1 line along y
+    assert best[0] > 0.998 > corr(0, 0)
