@@ -18,10 +18,11 @@ DATA = topographies_folder()
 LSB = 65.536 / 65536 * 20e-9
 
 
-def write_di(path, block, scan_nm):
-    """A Nanoscope (V7) .di file of one height channel: ``block`` (int16, shape
-    ``(lines, samps/line)``, the lines in file order), scan size ``scan_nm`` = (along
-    the line, across the lines) in nm."""
+def write_di(path, block, scan_nm, bpp=2):
+    """A Nanoscope (V7) .di file of one height channel: ``block`` (shape ``(lines,
+    samps/line)``, the lines in file order, in LSB of 16 bits; stored as int16, or as
+    int32 times 65536 with ``bpp=4``), scan size ``scan_nm`` = (along the line, across
+    the lines) in nm."""
     ny, nx = block.shape
     offset = 8192
     header = [r"\*File list", r"\Version: 0x07200000", r"\Data length: 8192",
@@ -29,7 +30,7 @@ def write_di(path, block, scan_nm):
               r"\*Scanner list", r"\@Sens. Zsens: V 20.00000 nm/V",
               r"\*Ciao scan list", r"\Samps/line: %d" % nx, r"\Lines: %d" % ny,
               r"\*Ciao image list", r"\Data offset: %d" % offset,
-              r"\Data length: %d" % (2 * nx * ny), r"\Bytes/pixel: 2",
+              r"\Data length: %d" % (bpp * nx * ny), r"\Bytes/pixel: %d" % bpp,
               r"\Samps/line: %d" % nx, r"\Number of lines: %d" % ny,
               r"\Scan Size: %g %g nm" % tuple(scan_nm), r"\Line Direction: Trace",
               r'\@2:Image Data: S [Height] "Height"',
@@ -38,7 +39,8 @@ def write_di(path, block, scan_nm):
     text = ("\r\n".join(header) + "\r\n").encode("latin-1")
     with open(path, "wb") as fh:
         fh.write(text + b"\x1a" * (offset - len(text)))
-        fh.write(np.asarray(block, dtype="<i2").tobytes())
+        values = np.asarray(block) * (65536 if bpp == 4 else 1)
+        fh.write(values.astype("<i2" if bpp == 2 else "<i4").tobytes())
 
 
 def sloped_block(nx, ny, slope=40):
@@ -48,14 +50,16 @@ def sloped_block(nx, ny, slope=40):
     return slope * np.arange(nx)[None, :] + (37 * k ** 2) % 101
 
 
-@pytest.mark.parametrize("nx, ny, scan", [(16, 8, (400.0, 200.0)), (8, 16, (100.0, 300.0)),
-                                          (24, 10, (600.0, 600.0))])
-def test_non_square_di_keeps_its_scan_lines_along_x(tmp_path, nx, ny, scan):
+@pytest.mark.parametrize("nx, ny, scan, bpp", [(16, 8, (400.0, 200.0), 2),
+                                               (8, 16, (100.0, 300.0), 2),
+                                               (24, 10, (600.0, 600.0), 2),
+                                               (16, 8, (400.0, 200.0), 4)])
+def test_non_square_di_keeps_its_scan_lines_along_x(tmp_path, nx, ny, scan, bpp):
     # round 2, session 35: SurfaceTopography's DIReader gave a (ny, nx) grid, the size
     # along the lines on the axis of the lines and each line's points scattered over rows
     block = sloped_block(nx, ny)
     path = tmp_path / "rect.di"
-    write_di(path, block, scan)
+    write_di(path, block, scan, bpp)
     surface = load_surface(path)
     assert surface.shape == (nx, ny)
     assert surface.size == pytest.approx((scan[0] * 1e-9, scan[1] * 1e-9), rel=1e-12,
