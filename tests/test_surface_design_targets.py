@@ -230,3 +230,42 @@ def test_design_targets_scan_axis_y_gives_the_transposed_maps_targets(tmp_path):
         assert np.allclose(b.values, a.values, rtol=1e-9, atol=0)
     wrong = targets("y.npz")                      # the lines levelled across the scan
     assert not np.allclose(wrong[1].values, along_x[1].values, rtol=1e-3, atol=0)
+
+
+def test_design_targets_warns_of_offset_scan_lines_and_a_kept_tilt(tmp_path, capsys):
+    """`design-targets --surface` read its file without the warnings of info, contact and
+    leak (round 2, session 35): a measured map with offset scan lines, or with an
+    instrument tilt kept by --detrend mean, gave targets without a word. Both now warn
+    (the one path, plausibility.plausible_surface); levelled lines and a removed plane
+    do not."""
+    from roughfe.cli import main
+    from roughfe.genomics.database.store import connect, write_settings
+    from roughfe.surfaces import spectral_surface
+    from roughfe.surfaces.io import save_surface
+    path = tmp_path / "s.sqlite"
+    con = connect(path, create=True)
+    write_settings(con, db.DatabaseSettings(length=1e-6, n_nodes=16, dim=2, n_steps=4,
+                                            top_fraction=0.8))
+    con.commit()
+    con.close()
+    size = (1e-6, 2e-6 / 3)
+    h = spectral_surface((48, 32), size, 0.7, rms_height=1e-8, rng=1).heights
+    lines = h + 3e-9 * np.random.default_rng(3).standard_normal(32)[None, :]
+    x, y = np.meshgrid(np.arange(48), np.arange(32), indexing="ij")
+    tilted = h + 3e-9 * (x + 0.5 * y)                     # rms of the plane ~ 4 um x Sq
+    save_surface(Surface(lines, size, False), tmp_path / "lines.npz")
+    save_surface(Surface(tilted, size, False), tmp_path / "tilted.npz")
+
+    def err(name, *extra):
+        capsys.readouterr()
+        assert main(["design-targets", "--db", str(path), "--surface", str(tmp_path / name),
+                     *extra, "-o", str(tmp_path / f"t_{name}_{len(extra)}")]) == 0
+        return capsys.readouterr().err
+
+    offset = "warning: the scan lines along x (heights[:, j]) look offset"
+    assert offset in err("lines.npz")                          # default --detrend plane
+    assert offset not in err("lines.npz", "--detrend", "lines")
+    assert "scan lines" not in err("lines.npz", "--scan-axis", "y")  # rows i: no offsets
+    kept = "warning: --detrend mean keeps the tilt of this non-periodic surface"
+    assert kept in err("tilted.npz", "--detrend", "mean")
+    assert kept not in err("tilted.npz")                       # the plane removed

@@ -272,8 +272,9 @@ def _targets(args) -> int:
     settings = read_settings(args.db)
     if args.surface:
         surface = surface_file(args, args.surface)
-        from .plausibility import check_target_surface
-        check_target_surface(args, surface, settings)
+        from .plausibility import check_target_surface, plausible_surface
+        plausible_surface(args, surface, args.detrend)     # its warnings; the library
+        check_target_surface(args, surface, settings)      # (target_surface) detrends
         name = Path(args.surface).stem.replace(" ", "_")
         tk, ta, curve = surface_targets(surface, settings, name=name, detrend=args.detrend,
                                         boundary=args.boundary, resolution=args.resolution)

@@ -172,19 +172,11 @@ def surface_file(args, path):
 def surface_from_args(args):
     """The :class:`~roughfe.surfaces.surface.Surface` named by ``args.surface`` with
     ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
-    command has that option."""
+    command has that option, after the plausibility warnings
+    (:func:`roughfe.cli.plausibility.plausible_surface`)."""
+    from .plausibility import plausible_surface
     surface = surface_file(args, args.surface)
-    from .plausibility import warn_scan_lines, warn_seam, warn_tilt, warn_units
-    warn_units(args, surface)
-    detrend = getattr(args, "detrend", "none")
-    if detrend in ("mean", "lines") and not surface.periodic:
-        warn_tilt(args, surface, detrend)
-    if detrend in ("none", "mean", "plane"):
-        warn_scan_lines(args, surface)
-    surface = surface if detrend == "none" else surface.detrended(detrend)
-    if getattr(args, "periodic", None) is True:
-        warn_seam(args, surface)
-    return surface
+    return plausible_surface(args, surface, getattr(args, "detrend", "none"))
 
 
 def mirrored_if_asked(args, surface):

@@ -122,17 +122,41 @@ def warn_seam(args, surface) -> None:
 
 
 def warn_scan_lines(args, surface) -> None:
-    """Warn (once, stderr) when the scan lines along x of a map look offset from each
-    other (:func:`roughfe.surfaces.scan_lines.scan_line_check`: the line means' second
-    differences over the within-line ones at the same lag, above ``max(0.25, 4 /
-    sqrt(n_x))``; none of 800 spectral surfaces, H 0.3-1, n 32-512, fired) and suggest
-    ``--detrend lines``. Of the five measured files only di-1 (an AFM scan) fires: 11.2
+    """Warn (once, stderr) when the scan lines of a map look offset from each other
+    (:func:`roughfe.surfaces.scan_lines.scan_line_check`: the line means' second
+    differences over the within-line ones at the same lag, above
+    ``max(0.25, 4 / sqrt(n))`` with n the points per line; none of 800 spectral
+    surfaces, H 0.3-1, n 32-512, fired) and suggest ``--detrend lines``. The lines run along x, or along y
+    when the surface's metadata ``scan_axis`` is y (``--scan-axis y``); the warning
+    names the axis. Of the five measured files only di-1 (an AFM scan) fires: 11.2
     (the others 0.04-0.11)."""
     from ..surfaces.scan_lines import scan_line_check
 
     check = scan_line_check(surface)
     if check is not None and check.fires:
         warn(args, check.note())
+
+
+def plausible_surface(args, surface, detrend: str = "none"):
+    """``surface`` as its file gave it, detrended by ``detrend`` (a ``--detrend`` mode),
+    after the warnings of a read surface: a unit mistake (:func:`warn_units`), an
+    instrument tilt kept by ``mean`` or ``lines`` on a non-periodic surface
+    (:func:`warn_tilt`), scan-line offsets left by ``none``, ``mean`` or ``plane``
+    (:func:`warn_scan_lines`) and, with ``--periodic``, a seam in the detrended heights
+    (:func:`warn_seam`). The one path of these warnings: the commands that read
+    :func:`roughfe.cli.options.surface_from_args` (info, contact, leak, natural, genome
+    chromosomes) and ``design-targets --surface``, which detrends in the library
+    (:func:`roughfe.genomics.design.targets.target_surface`) and took none of them
+    until round 2, session 35."""
+    warn_units(args, surface)
+    if detrend in ("mean", "lines") and not surface.periodic:
+        warn_tilt(args, surface, detrend)
+    if detrend in ("none", "mean", "plane"):
+        warn_scan_lines(args, surface)
+    surface = surface if detrend == "none" else surface.detrended(detrend)
+    if getattr(args, "periodic", None) is True:
+        warn_seam(args, surface)
+    return surface
 
 
 #: Largest approach Delta / lateral size L before :func:`check_solution` warns.
