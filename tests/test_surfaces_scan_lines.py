@@ -258,3 +258,41 @@ def test_genome_chromosomes_mirror_levels_the_measured_lines_once(tmp_path, mode
     with pytest.raises(InputError, match=r"^detrend='lines' levels the measured scan lines; "
                                          r"this surface is a mirrored window"):
         band_chromosomes(noisy.mirrored(), detrend="lines")
+
+
+def test_band_chromosomes_knows_a_mirrored_map_without_its_metadata(tmp_path):
+    """band_chromosomes refused line levelling of a mirrored window by its metadata
+    ``mirrored`` only (round 2, session 35): the mirrored heights in a new Surface (a
+    library user's rebuild, or a .npy read back) had the mirrored map's lines levelled in
+    silence. Surface.mirrored() builds a map even about its first row and column bit for
+    bit, which band_chromosomes now reads too; no spectral map, periodic or not, and no
+    map even along one axis only is taken for one."""
+    from roughfe.genomics.bands import _is_even_mirror, band_chromosomes
+    from roughfe.surfaces.io import load_surface
+    noisy, _ = _offsets(_map(periodic=False), share=0.2, tilt=1.0)
+    m = noisy.mirrored()
+    np.save(tmp_path / "m.npy", m.heights)
+    for s in (Surface(m.heights, m.size, True),                  # the metadata lost
+              Surface(m.heights - 3e-9, m.size, False),          # shifted, flagged a window
+              load_surface(tmp_path / "m.npy", size=m.size, periodic=True)):
+        assert "mirrored" not in s.metadata
+        for mode in ("lines", "lines-tilt"):
+            with pytest.raises(InputError, match=r"^detrend='lines(-tilt)?' levels the "
+                                                 r"measured scan lines; this surface is a "
+                                                 r"mirrored window"):
+                band_chromosomes(s, detrend=mode)
+    # the path the error names: level the window, mirror, remove the mean
+    levelled = noisy.detrended("lines").mirrored()
+    bands = band_chromosomes(Surface(levelled.heights, m.size, True), detrend="mean")
+    h = levelled.heights - levelled.heights.mean()
+    assert np.max(np.abs(bands.chromosomes.sum(0) - h)) < 1e-12 * h.std()
+    # no false alarm: random maps of even and odd sizes, and ridges (even along y only)
+    for seed in range(200):
+        n = (16 + 2 * (seed % 5), 12 + (seed % 3))
+        s = _map(n, hurst=0.3 + 0.5 * (seed % 2), seed=seed, periodic=seed % 4 < 2)
+        assert not _is_even_mirror(s.heights), seed
+    ridges = Surface(np.repeat(_map(periodic=False).heights[:, :1], 64, axis=1), (1e-6, 1e-6),
+                     True)
+    assert not _is_even_mirror(ridges.heights)
+    band_chromosomes(ridges, detrend="lines")
+    assert _is_even_mirror(m.heights) and not _is_even_mirror(noisy.heights)
