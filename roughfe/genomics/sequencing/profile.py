@@ -16,7 +16,7 @@ from .genes import (H_SEARCH, M_VALUES, amplitude_gene_errors, amplitude_genes,
                     ridge_likelihood, variance_amplitude)
 from .lattice import LINE_PER_AMPLITUDE, OVERFIT_FACTOR, tilt_bounds, tilt_columns
 from .holdout import held_out_errors, overfit_reason
-from .reproduce import reproducibility
+from .reproduce import model_slope, reproducibility
 from .result import SequencingResult
 from .search import REGULARISE, fit_profile_model
 
@@ -169,7 +169,7 @@ def sequence_profiles(surfaces, *, seed=0, M=None, rms_tolerance=0.05, n_restart
     # every other test (a dense lattice passes them on a rough row: di-1's)
     repro = None
     if REPRODUCE and ok and not reasons:
-        repro = reproducibility(given, rms_tolerance, (lq1, lg))
+        repro = reproducibility(given, rms_tolerance, (lq1, lg), model_slope(fit))
         if not repro.reproducible:
             reasons.append(repro.reason)
     if reasons:

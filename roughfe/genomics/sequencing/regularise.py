@@ -65,11 +65,20 @@ def resolution_damping(mat, rhs, coef, prior=PRIOR_SCALE) -> float:
     damping) when the fit has no rows to spare (p >= m: no misfit measures the noise)
     or the data are zero."""
     m, p = mat.shape
-    b = math.sqrt(float(rhs @ rhs))
-    if m <= p or b == 0.0:
-        return 0.0
     r = rhs - mat @ coef
-    return math.sqrt(float(r @ r) / (m - p)) / (prior * b)
+    return noise_damping(float(r @ r), m, p, math.sqrt(float(rhs @ rhs)), prior)
+
+
+def noise_damping(rss, rows, unknowns, rhs_norm, prior=PRIOR_SCALE) -> float:
+    """lambda = sigma / (``prior`` ``rhs_norm``) with sigma^2 = ``rss`` / (``rows`` -
+    ``unknowns``): the damping of a least-squares fit of ``unknowns`` coefficients to
+    ``rows`` data of norm ``rhs_norm`` that left the residual sum of squares ``rss``
+    (module notes; the profile fit, :func:`resolution_damping`, and the surface fit,
+    :meth:`~.surface_grid.GridModel.solve`). 0 (no damping) when the fit has no rows to
+    spare (``unknowns`` >= ``rows``: no misfit measures the noise) or the data are zero."""
+    if rows <= unknowns or rhs_norm == 0.0:
+        return 0.0
+    return math.sqrt(rss / (rows - unknowns)) / (prior * rhs_norm)
 
 
 def damped_system(mat, rhs, damping):

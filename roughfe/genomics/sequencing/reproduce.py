@@ -47,6 +47,12 @@ any measured row was looked at, round 2, session 34):
   halves of one realisation share its chromosome sums, so they agree far better (exact:
   to round-off).
 
+The rms slope of each half's chromosome sum (:func:`model_slope`) is reported
+against the whole's (``slope_ratios``) as information, not as a rule: measured in
+round 2, session 35 (docs/theory/05_genomics.md), it reaches 12.6 times the whole's
+(halves against each other: 2.16) on noisy WM rows whose genes are reproducible, and
+di-1's nested row (3.2 and 1.8; 1.77) lies inside that scatter.
+
 A half that cannot be sequenced (no lattice: an InputError) makes the genes not
 reproducible. The test needs :data:`MIN_HALF_NODES` nodes in a half of the coarsest
 acquisition; with fewer it is not run (``tested`` False, said in the report).
@@ -76,7 +82,8 @@ SIDES = ("left", "right")
 @dataclass(frozen=True)
 class HalfGenes:
     """The genes of one half (``side``: "left", x < 0, or "right", x > 0): ``gamma``,
-    ``lambda1`` (m), ``H``, ``H_stderr``, ``A`` (m^(1-H)), ``misfit`` (the largest
+    ``lambda1`` (m), ``H``, ``H_stderr``, ``A`` (m^(1-H)), ``slope`` (the rms slope of
+    its chromosome sum, :func:`model_slope`, -), ``misfit`` (the largest
     relative rms error of its acquisitions, -) and ``band`` (first, last chromosome);
     ``message``: why it was not sequenced ("" when it was; then the numbers are NaN)."""
 
@@ -86,13 +93,15 @@ class HalfGenes:
     H: float = math.nan
     H_stderr: float = math.nan
     A: float = math.nan
+    slope: float = math.nan
     misfit: float = math.nan
     band: tuple = (0, -1)
     message: str = ""
 
     def report(self) -> dict:
         return {"side": self.side, "gamma": self.gamma, "lambda1": self.lambda1, "H": self.H,
-                "H_stderr": self.H_stderr, "A": self.A, "misfit": self.misfit,
+                "H_stderr": self.H_stderr, "A": self.A, "slope": self.slope,
+                "misfit": self.misfit,
                 "band": list(self.band), "message": self.message}
 
 
@@ -102,8 +111,9 @@ class Reproducibility:
     nodes per half, ``reason`` says so), ``reproducible``, the two :class:`HalfGenes`
     (``halves``), ``lattice_offset`` (the largest distance of a chromosome of one half
     from the other's lattice, lattice steps), ``H_difference`` and ``H_tolerance``
-    (:data:`H_SIGMAS` combined standard errors) and ``reason`` (the verdict's words when
-    not reproducible)."""
+    (:data:`H_SIGMAS` combined standard errors), ``slope_ratios`` (each half's
+    :func:`model_slope` over the whole's: information, no verdict) and ``reason`` (the
+    verdict's words when not reproducible)."""
 
     tested: bool
     reproducible: bool = True
@@ -111,13 +121,15 @@ class Reproducibility:
     lattice_offset: float = math.nan
     H_difference: float = math.nan
     H_tolerance: float = math.nan
+    slope_ratios: tuple = ()
     reason: str = ""
 
     def report(self) -> dict:
         return {"tested": self.tested, "reproducible": self.reproducible,
                 "halves": [h.report() for h in self.halves],
                 "lattice_offset": self.lattice_offset, "H_difference": self.H_difference,
-                "H_tolerance": self.H_tolerance, "reason": self.reason,
+                "H_tolerance": self.H_tolerance, "slope_ratios": list(self.slope_ratios),
+                "reason": self.reason,
                 "lattice_tolerance": LATTICE_TOLERANCE, "H_sigmas": H_SIGMAS}
 
 
@@ -148,7 +160,18 @@ def _half_genes(acqs, side, rms_tolerance, starts) -> HalfGenes:
     ends = np.cumsum([0] + [a.z.size for a in part])
     misfit = max(math.sqrt(float(np.mean(fit.residual[i:j] ** 2)))
                  for i, j in zip(ends, ends[1:]))
-    return HalfGenes(side, gamma, lam1, H, H_err, A, misfit, (int(fit.n[0]), int(fit.n[-1])))
+    return HalfGenes(side, gamma, lam1, H, H_err, A, model_slope(fit), misfit,
+                     (int(fit.n[0]), int(fit.n[-1])))
+
+
+def model_slope(fit) -> float:
+    """The rms slope of a fit's chromosome sum (-): sqrt(sum_n c_n^2 q_n^2 / 2), the mean
+    square of dZ/dx = sum_n c_n q_n sin(q_n x + theta_n) over a length holding many
+    cycles of its chromosomes (of incommensurate q_n: the cross terms average out);
+    ``fit``: a :class:`~.search.ProfileModel` (``n``, ``cvec`` in m, ``log_q1``,
+    ``log_gamma``)."""
+    q = np.exp(fit.log_q1 + (np.asarray(fit.n) - 1) * fit.log_gamma)
+    return math.sqrt(0.5 * float(np.sum((np.abs(fit.cvec) * q) ** 2)))
 
 
 def lattice_offset(a: HalfGenes, b: HalfGenes) -> float:
@@ -165,10 +188,11 @@ def lattice_offset(a: HalfGenes, b: HalfGenes) -> float:
     return float(np.max(np.abs(steps - np.round(steps)), initial=0.0))
 
 
-def reproducibility(acqs, rms_tolerance, lattice) -> Reproducibility:
+def reproducibility(acqs, rms_tolerance, lattice, slope=math.nan) -> Reproducibility:
     """Sequence the two halves of ``acqs`` (checked acquisitions, coarsest first) and
     compare their genes (module notes: tolerances and their basis); ``lattice``: the
-    whole's (ln q_1, ln gamma), the start of each half's lattice fit."""
+    whole's (ln q_1, ln gamma), the start of each half's lattice fit; ``slope``: the
+    whole's :func:`model_slope` (the halves' are reported over it)."""
     nodes = [int(np.sum(half_acquisitions(acqs[:1], s)[0].z.size)) for s in SIDES]
     if min(nodes) < MIN_HALF_NODES:
         return Reproducibility(False, reason=f"not tested: the halves of the coarsest "
@@ -190,4 +214,5 @@ def reproducibility(acqs, rms_tolerance, lattice) -> Reproducibility:
         f"{a.H:.3g} vs {b.H:.3g} from the left and right halves of the acquisitions; "
         f"lattices {offset:.2f} steps apart (at most {LATTICE_TOLERANCE:g}), H "
         f"{dH:.3g} apart (at most {tol_H:.3g}, {H_SIGMAS:g} standard errors))")
-    return Reproducibility(True, ok, halves, offset, dH, tol_H, reason)
+    ratios = tuple(h.slope / slope for h in halves)
+    return Reproducibility(True, ok, halves, offset, dH, tol_H, ratios, reason)

@@ -109,6 +109,10 @@ SIGNIFICANCE = 5.0
 #: 256^2, H = 0.3 and 0.8, 4 seeds), whose 17-31 "ridges" of periodogram maxima made the
 #: fit run for more than 12 minutes before it failed
 MIN_COMB_COHERENCE = 0.5
+#: the final fit and its held-out fits are damped where the data cannot resolve them, as
+#: the profile sequencer's are (:mod:`.regularise`, :meth:`~.surface_grid.GridModel.solve`);
+#: False: least squares, as until round 2, session 35
+REGULARISE = True
 
 
 def _chromosome_presence(sol, ratio=1e-6, noise=0.0):
@@ -381,7 +385,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
     if best is None:
         return failure("no gamma candidate gave a lattice fit", acqs, peaks, t0)
     _, p, ranges, _, _ = best
-    sol = full.solve(p, ranges, exact=True)
+    sol = full.solve(p, ranges, exact=True, regularise=REGULARISE)
     g = genes_from_fit(p, sol, ranges)
     if not 0.0 < g["H"] <= 3.0:        # a Genome would refuse it with a message about
         return failure(               # an H the user never gave: a failed sequencing
@@ -408,7 +412,7 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         msg += f" > {rms_tolerance:g}: not reproduced (the surface is not WM-like or noisy)"
     # a small misfit is no genome when the waves reproduce any heights: the nodes held
     # out of the fit (:mod:`.holdout`) are then missed by far more than the fitted ones
-    held_out = held_out_misfits(model, p, ranges)
+    held_out = held_out_misfits(model, p, ranges, regularise=REGULARISE)
     if ok and float(np.max(held_out)) > rms_tolerance:
         ok = False
         waves = [2 * int(np.sum((sol["nn"] >= ns) & (sol["nn"] <= nf))) for ns, nf in ranges]

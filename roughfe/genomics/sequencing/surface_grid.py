@@ -12,6 +12,8 @@ import scipy.linalg
 import scipy.linalg.lapack
 
 from ..genome import chromosome_range
+from .regularise import noise_damping
+from .surface_result import about_plane
 
 
 #: the diagonal (times the number of columns) added to the column-scaled Gram matrix of
@@ -173,7 +175,7 @@ class GridModel:
             out.append(dict(g, ok=ok, z0=np.where(ok, g["z0"], 0.0), bad=np.nonzero(~ok)))
         return out
 
-    def solve(self, p, ranges, cap=None, exact=False, keep=None):
+    def solve(self, p, ranges, cap=None, exact=False, keep=None, regularise=False):
         """Linear least squares for the wave and plane coefficients at the lattice ``p``
         (fitted to the rows ``keep`` only when given: bool per row, the others left out
         as undefined nodes are, for the held-out nodes of :mod:`.holdout`; ``resid`` is
@@ -190,6 +192,17 @@ class GridModel:
         round-off (relative cost ~1e-29, not the ~1e-20 floor of the plain normal
         equations), which the fit's "reproduced to round-off" test needs. ``gram``: the
         Gram matrix A^T A of the design (real layout), for the genes' height misfit.
+
+        ``regularise``: the least-squares fit is followed by Tikhonov's at the damping
+        lambda of its own misfit (:func:`~.regularise.noise_damping`, as the profile
+        fit's, :mod:`.regularise`, with the data's norm that of the heights about each
+        acquisition's best plane, as the misfits are taken,
+        :func:`~.surface_result.plane_free_misfits`: the planes are free unknowns, and a
+        mean or tilt of the data is no height a wave may carry): lambda^2 added to the
+        diagonal of the column-scaled Gram matrix, and each refinement step less lambda^2 times the scaled
+        coefficients (the gradient of the damped misfit), so that the steps converge to
+        the damped fit, not back to least squares. ``damping`` (lambda, 0 for a fit
+        not regularised) is returned with the solution.
         """
         nn, mm, q, theta_w = self._waves(p, ranges, cap)
         w = nn.size
@@ -202,26 +215,45 @@ class GridModel:
         norm = np.sqrt(np.clip(np.diag(gram), 0.0, None))    # round-off: undefined nodes
         norm[norm == 0] = 1.0
         gram = gram / np.outer(norm, norm)
-        chol = _factor(gram, ridge=not exact)
-
-        def lsq(fields):
-            """G^-1 A^T f for grid fields f (per acquisition: (..., N, N))."""
-            rhs = sum(self._project(k, fx, fy, f, w, n_cols)
-                      for k, ((fx, fy), f) in enumerate(zip(fac, fields)))
-            return scipy.linalg.cho_solve(chol, (rhs / norm).T).T / norm
 
         def residual(coef):
             return [np.where(g["ok"], g["z0"] - self._evaluate(fx, fy, self._weights(k, coef, w)),
                              0.0) for k, (g, (fx, fy)) in enumerate(zip(grids, fac))]
 
-        coef = lsq([g["z0"] for g in grids])
-        res = residual(coef)
-        for _ in range(2 if exact else 1):
-            coef = coef + lsq(res)
+        def fit(damping):
+            """(coef, residual fields, lsq) of the fit damped by ``damping`` (0: least
+            squares)."""
+            chol = _factor(gram + damping ** 2 * np.eye(n_cols), ridge=not exact)
+
+            def lsq(fields):
+                """G^-1 A^T f for grid fields f (per acquisition: (..., N, N))."""
+                rhs = sum(self._project(k, fx, fy, f, w, n_cols)
+                          for k, ((fx, fy), f) in enumerate(zip(fac, fields)))
+                return scipy.linalg.cho_solve(chol, (rhs / norm).T).T / norm
+
+            coef = lsq([g["z0"] for g in grids])
             res = residual(coef)
+            for _ in range(2 if exact else 1):
+                step = lsq(res)
+                if damping:
+                    step -= damping ** 2 * scipy.linalg.cho_solve(chol, norm * coef) / norm
+                coef = coef + step
+                res = residual(coef)
+            return coef, res, lsq
+
+        coef, res, lsq = fit(0.0)
+        damping = 0.0
+        if regularise:
+            data = math.sqrt(sum(float(np.sum(about_plane(g["x"], g["y"], g["ok"],
+                                                          g["z0"][g["ok"]]) ** 2))
+                                 for g in grids))
+            rss = sum(float(np.sum(r[g["ok"]] ** 2)) for r, g in zip(res, grids))
+            damping = noise_damping(rss, sum(int(g["ok"].sum()) for g in grids), n_cols, data)
+            if damping > 0.0:
+                coef, res, lsq = fit(damping)
         resid = np.concatenate([r[g["ok"]] for r, g in zip(res, grids)])
         return dict(nn=nn, mm=mm, q=q, theta_w=theta_w, coef=coef, resid=resid, fac=fac,
-                    lsq=lsq, gram=gram * np.outer(norm, norm))
+                    lsq=lsq, gram=gram * np.outer(norm, norm), damping=damping)
 
     def node_coordinates(self):
         """(x, y) of every row (valid node, in the order of :attr:`z`), m: (rows, 2)."""

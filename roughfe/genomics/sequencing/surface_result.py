@@ -237,16 +237,17 @@ def plane_free_misfits(full, resid):
     return np.array(errs), np.array(signal)
 
 
-def held_out_misfits(model, p, ranges):
+def held_out_misfits(model, p, ranges, regularise=False):
     """Relative rms misfit of each acquisition's rows of ``model`` (the GridModel of the
     nonlinear fit: every node up to ~16384 in all, else a tensor sub-grid) predicted by
     the linear fit (every wave its own amplitude, a plane per acquisition; the model's
     own solve, the other rows left out as undefined nodes) of the other folds at the
     lattice ``p``, ``ranges`` (:mod:`.holdout`: 5 folds by (x, y)), taken as
     :func:`plane_free_misfits` (about the best plane, over the signal about it); inf
-    when the other folds do not determine the waves (a singular fit)."""
+    when the other folds do not determine the waves (a singular fit). ``regularise``:
+    each fold's fit damped as the final fit is (:meth:`~.surface_grid.GridModel.solve`)."""
     def predict(keep):
-        coef = model.solve(p, ranges, exact=True, keep=keep)["coef"]
+        coef = model.solve(p, ranges, exact=True, keep=keep, regularise=regularise)["coef"]
         return np.concatenate([h[g["ok"]] for h, g in
                                zip(model.heights(p, ranges, coef), model.grids)])
 
