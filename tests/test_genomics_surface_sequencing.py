@@ -328,6 +328,12 @@ def test_a_fit_with_an_impossible_exponent_is_a_failed_sequencing(topographies_d
     rows, unknowns = damped["resid"].size, damped["coef"].size
     assert damped["resid"] @ damped["resid"] <= (1 + unknowns / (4 * (rows - unknowns))) \
         * (ls["resid"] @ ls["resid"])
+    # its two halves (x < 0, x > 0), fitted from that lattice, find other ridges (57.7 /
+    # 91.8 and 44.3 / 90.4 deg) and H (-0.25, -0.58): no genome of the surface either
+    # (the verdict fails it earlier, on H)
+    from roughfe.genomics.sequencing.surface_reproduce import surface_reproducibility
+    rep = surface_reproducibility(acqs, 128, final["p"], final["ranges"], 128)
+    assert not rep.reproducible and "the genes are not reproducible" in rep.reason
 
 
 @pytest.mark.slow

@@ -73,9 +73,11 @@ damped final fit), :mod:`.holdout` (held-out nodes), :mod:`.reproduce` (the gene
 two halves), :mod:`.genes` (step 5), :mod:`.result`, :mod:`.profile` (the driver,
 :func:`sequence_profiles`) and :mod:`.zd` (the thesis's Z_d fit, for the record).
 Surfaces (2D MWM, issue 15): :mod:`.surface_data` (acquisitions, peaks, ridge directions),
-:mod:`.surface_grid` (the grid model of the fit), :mod:`.surface_fit` (the nonlinear fit
-and the band of chromosomes the data hold), :mod:`.surface` (:func:`sequence_surfaces`)
-and :mod:`.surface_result` (genes, misfits, result).
+:mod:`.surface_grid` (the grid model of the fit; its final solve damped as the profile
+fit's, :mod:`.regularise`), :mod:`.surface_fit` (the nonlinear fit and the band of
+chromosomes the data hold), :mod:`.surface` (:func:`sequence_surfaces`),
+:mod:`.surface_result` (genes, misfits, result) and :mod:`.surface_reproduce` (the
+lattice and ridges of the two halves).
 """
 from .acquisitions import MIN_NODES, Acquisition, acquisitions_from_surfaces
 from .genes import (amplitude_gene_errors, amplitude_genes, peak_slope_H, phases_with_sums,

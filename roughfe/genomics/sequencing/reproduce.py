@@ -112,8 +112,10 @@ class Reproducibility:
     (``halves``), ``lattice_offset`` (the largest distance of a chromosome of one half
     from the other's lattice, lattice steps), ``H_difference`` and ``H_tolerance``
     (:data:`H_SIGMAS` combined standard errors), ``slope_ratios`` (each half's
-    :func:`model_slope` over the whole's: information, no verdict) and ``reason`` (the
-    verdict's words when not reproducible)."""
+    :func:`model_slope` over the whole's: information, no verdict), ``angle_difference``
+    (surfaces, :mod:`.surface_reproduce`: the largest angle between a ridge of one half
+    and the nearest of the other, rad) and ``reason`` (the verdict's words when not
+    reproducible)."""
 
     tested: bool
     reproducible: bool = True
@@ -122,6 +124,7 @@ class Reproducibility:
     H_difference: float = math.nan
     H_tolerance: float = math.nan
     slope_ratios: tuple = ()
+    angle_difference: float = math.nan
     reason: str = ""
 
     def report(self) -> dict:
@@ -129,7 +132,7 @@ class Reproducibility:
                 "halves": [h.report() for h in self.halves],
                 "lattice_offset": self.lattice_offset, "H_difference": self.H_difference,
                 "H_tolerance": self.H_tolerance, "slope_ratios": list(self.slope_ratios),
-                "reason": self.reason,
+                "angle_difference": self.angle_difference, "reason": self.reason,
                 "lattice_tolerance": LATTICE_TOLERANCE, "H_sigmas": H_SIGMAS}
 
 
@@ -215,4 +218,5 @@ def reproducibility(acqs, rms_tolerance, lattice, slope=math.nan) -> Reproducibi
         f"lattices {offset:.2f} steps apart (at most {LATTICE_TOLERANCE:g}), H "
         f"{dH:.3g} apart (at most {tol_H:.3g}, {H_SIGMAS:g} standard errors))")
     ratios = tuple(h.slope / slope for h in halves)
-    return Reproducibility(True, ok, halves, offset, dH, tol_H, ratios, reason)
+    return Reproducibility(True, ok, halves, offset, dH, tol_H, slope_ratios=ratios,
+                           reason=reason)

@@ -67,6 +67,9 @@ Steps (:func:`sequence_surfaces`)
    ln b_mn weighted by b_mn^2, refined to the least height misfit of the genome with the
    fitted phases; A from G (Eq. 3.1) (:mod:`.surface_result`, with the misfits and the
    result).
+6. Checks: the misfit of the genome; the nodes held out of the fit (an overfit,
+   :mod:`.holdout`); and, for a fit that passes them, the lattice and ridges of the two
+   halves of the data fitted again from the whole's (:mod:`.surface_reproduce`).
 Undefined points (NaN) of a measured acquisition are left out of every step. The misfit
 reported (``rms_errors``, ``success``) is that of the returned genome realised on the
 acquisitions, not of the fit (every wave its own amplitude, ``fit_rms_errors``).
@@ -87,6 +90,7 @@ from .surface_data import (ANGLE_TOL, SurfaceAcquisition, cluster_angles, noise_
 from .surface_fit import fit_bic, fit_model, polish
 from .surface_grid import GridModel
 from .holdout import overfit_reason
+from .surface_reproduce import surface_reproducibility
 from .surface_result import (SurfaceSequencingResult, failure, genes_from_fit,
                              genome_residual, held_out_misfits, plane_free_misfits)
 
@@ -113,6 +117,10 @@ MIN_COMB_COHERENCE = 0.5
 #: the profile sequencer's are (:mod:`.regularise`, :meth:`~.surface_grid.GridModel.solve`);
 #: False: least squares, as until round 2, session 35
 REGULARISE = True
+#: a fit that passes the other tests is fitted again on each half of its data and its
+#: lattice and ridges compared (:mod:`.surface_reproduce`); False: not tested, as until
+#: round 2, session 35
+REPRODUCE = True
 
 
 def _chromosome_presence(sol, ratio=1e-6, noise=0.0):
@@ -262,7 +270,8 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
             f"spectrum of an MWM surface; a genome of a measured surface is sequenced from a "
             f"profile by `roughfe genome natural`", acqs, peaks, t0)
     # the nonlinear fit on a tensor sub-grid of about FIT_ROWS nodes, the final solve on all
-    model = GridModel(acqs, n_nodes, axis_nodes=math.ceil(math.sqrt(FIT_ROWS / len(acqs))))
+    axis_nodes = math.ceil(math.sqrt(FIT_ROWS / len(acqs)))
+    model = GridModel(acqs, n_nodes, axis_nodes=axis_nodes)
     full = GridModel(acqs, n_nodes)
     # fitted to round-off, or down to the white-noise floor of the data (measured data,
     # noise): no other gamma candidate, continuation or added ridge can do better
@@ -419,8 +428,21 @@ def sequence_surfaces(surfaces, *, valid=None, rms_tolerance=0.05,
         msg = ("not a genome: " + overfit_reason(held_out, fit_errs, waves,
                                                  np.bincount(model.block), "wave")
                + "; " + msg)
+    # a genome is a property of the surface: the two halves of the data give its lattice
+    # and ridges again (:mod:`.surface_reproduce`); run on a fit that passed the others
+    repro = None
+    if REPRODUCE and ok:
+        repro = surface_reproducibility(acqs, n_nodes, p, ranges, axis_nodes)
+        if repro.reproducible:
+            msg += ("; the lattice and ridges of the two halves agree (gamma " + " / ".join(
+                f"{h.gamma:.6g}" for h in repro.halves) + f", ridges within "
+                f"{math.degrees(repro.angle_difference):.2g} deg)")
+        else:
+            ok = False
+            msg = "not a genome: " + repro.reason + "; " + msg
     return SurfaceSequencingResult(
         genome=genome, success=ok, message=msg, nit=nit, ranges=[tuple(r) for r in ranges],
         lengths=np.array([a.length for a in acqs]), rms_errors=errs,
         amplitudes=g["amplitudes"], peaks=peaks, elapsed=time.perf_counter() - t0,
-        signal_rms=signal, fit_rms_errors=fit_errs, held_out_errors=held_out)
+        signal_rms=signal, fit_rms_errors=fit_errs, held_out_errors=held_out,
+        reproducibility=repro)

@@ -146,6 +146,10 @@ class SurfaceSequencingResult:
         that left its position out (5 folds): about ``fit_rms_errors`` for a genome, far
         more for an overfit (a fit within the tolerance whose held-out misfit exceeds it
         is "not a genome: an overfit"; round 2, session 33).
+    reproducibility : Reproducibility or None
+        The lattice and ridges of the two halves of the data
+        (:mod:`~roughfe.genomics.sequencing.surface_reproduce`; a fit that fails an
+        earlier test is not tested: None).
     """
 
     genome: Optional[Genome]
@@ -162,6 +166,7 @@ class SurfaceSequencingResult:
     signal_rms: Optional[np.ndarray] = None
     fit_rms_errors: Optional[np.ndarray] = None
     held_out_errors: Optional[np.ndarray] = None
+    reproducibility: Optional[object] = None
 
     def report(self) -> dict:
         """JSON-safe summary (report.json of `genome sequence` on surfaces), with
@@ -181,6 +186,8 @@ class SurfaceSequencingResult:
                                   else [float(e) for e in self.fit_rms_errors]),
                "held_out_errors": (None if self.held_out_errors is None
                                    else [float(e) for e in self.held_out_errors]),
+               "reproducibility": (None if self.reproducibility is None
+                                   else self.reproducibility.report()),
                "elapsed_s": self.elapsed}
         units = {**REPORT_UNITS, "angles_deg": "deg", "anisotropy": "1",
                  "n_first": "1 (chromosome number)", "n_last": "1 (chromosome number)",
