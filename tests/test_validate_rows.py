@@ -163,6 +163,42 @@ def test_surface_genomics_names_what_its_reproduced_rows_check():
     assert "independent BEM run" not in src and "same BEM solver" in src
 
 
+def _design_row(target, method, f):
+    return {"target": target, "method": method, "origin": "21-2 (spectrum)",
+            "stages": [0.2], "scores_at_target_pressures": [f] * (2 if method == "mcco" else 1),
+            "f": f, "reproduced": 0.0, "cpu_s": 400.0, "bem_sweeps": 8700,
+            "search_sweeps": 100, "global_evaluations": 8000, "global_sigma": 0.5,
+            "global_amplitudes": 0.6, "global_popsize": 0, "global_modulation": 0.0,
+            "matching": "chromosome"}
+
+
+def test_x3p2_k_rows_not_met_say_the_measured_reason_and_gate_as_before():
+    """Session 35: the x3p-2 K rows NOT met since session 34 carry the measured reason (the
+    target's Nyquist line; a search limit; the target's sampling) in their reason text; a
+    met row, another target's row and the M-CCO f row do not. What is gated is unchanged:
+    s >= GOAL_S on K."""
+    sg = _script("surface_genomics")
+    designs = [_design_row("x3p-2", "sog", 0.9759), _design_row("x3p-2", "cco", 0.9822),
+               _design_row("y_t1", "gco", 0.95), _design_row("x3p-2", "mcco", 0.85)]
+    rows = sg._targets(
+        rec=[], noise=[{"noise": 0.01, "angle_error_deg": 0.1, "gamma_error": 1e-3,
+                        "M_exact": True, "misfit_over_noise": 1.0}],
+        mech={}, designs=designs, db_info={"n_nodes": 64, "cpu_per_genome_s": 1.0,
+                                           "computed": 0},
+        x3p={"window": {"series_deviation_max": 0.01, "K_range": [1.0, 2.0],
+                        "compliance_m_per_Pa": 1e-9}},
+        west={"wave": [2, 1], "n": 256, "eta": 2.0, "one_minus_s_K": 5e-4,
+              "one_minus_s_A": 0.04})
+    score = {r.name.split(":")[0]: r for r in rows
+             if r.name.endswith("at the target pressures")}
+    assert score["x3p-2 sog"].met is False and score["x3p-2 sog"].target == ">= 0.98"
+    assert score["x3p-2 sog"].reason.endswith(sg.X3P_K_MISS)
+    assert "Nyquist line" in sg.X3P_K_MISS and "search limit" in sg.X3P_K_MISS
+    assert score["x3p-2 cco"].met is True
+    for name in ("x3p-2 cco", "y_t1 gco", "x3p-2 mcco"):
+        assert sg.X3P_K_MISS not in score[name].reason
+
+
 def test_targets_markdown_escapes_a_pipe_inside_a_cell():
     """A row named "|p256 / p128 - 1|" split its Markdown table row into extra cells."""
     md = targets_markdown([Target("rough: |p256 / p128 - 1|", "<= 0.2 %", "1e-05", True)])

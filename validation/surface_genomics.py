@@ -111,6 +111,30 @@ SUM_CURVE_TOL = {"c": 1e-12, "K": 1e-6}
 #: the same to 3 digits. Tolerances just above the 256^2 numbers
 WESTERGAARD_WAVE, WESTERGAARD_NODES = (2, 1), 256
 WESTERGAARD_SCORE = {"K": 6e-4, "A": 0.045}
+#: why the x3p-2 K rows (SOG, GCO, CCO: s >= GOAL_S) are NOT met since session 34, said by
+#: their reason when they are (session 35, one run each of this study's chain on the
+#: session-34 database; docs/theory/surface-design.md, "Session 35"). The target (41 x 100)
+#: changed by its Nyquist line in y alone: Surface.resampled keeps it since 506c9a6; the old
+#: target is the new one without it to 2e-15 of its rms, K per step to 2e-9. The same chain
+#: on the old target gives SOG 0.9842032061, GCO 0.9841654508 and CCO 0.9822368650, the
+#: session-28 numbers to every digit, so nothing else moved. On the new target the global stage reaches the goal
+#: with a larger budget (one run each, seed 0, GLOBAL's other settings): SOG 0.9759 at 8000
+#: evaluations (the study's), 0.97992 at 16000, 0.98049 at 24000 (1115 s CPU for the run);
+#: CCO 0.9763 at 8000, 0.9806 at 12000, 0.98304 at 16000 (750 s); GCO's 0.9503 lies within
+#: its seed spread on the old target (0.9471-0.9842, session 8). GLOBAL is left as it is.
+#: The target's K(p) at this spacing depends on where its nodes sit: the same band-limited
+#: window on nodes moved by half a cell scores s 0.83 (y) / -0.97 (x) against it; the
+#: Nyquist line is one such term (c cos(pi t) on nodes moved by t cells)
+X3P_K_MISS = ("measured in session 35: the target moved in session 34 by its Nyquist line "
+              "in y alone (Surface.resampled keeps it since 506c9a6; 0.04 % of its "
+              "variance, K at step 1 +5.9 %; the target's own surface without the line "
+              "scores s 0.971 against it; no design carries a Nyquist line); the same chain "
+              "on the old target gives the session-28 s to every digit (SOG 0.9842, GCO "
+              "0.9842, CCO 0.9822); on this target a longer global stage meets the goal (SOG 0.9805 at "
+              "24000 global evaluations, CCO 0.9830 at 16000): a search limit, not a "
+              "ceiling of the design family; the target's K(p) itself depends on where its "
+              "41 x 100 nodes sit (the same window on nodes moved by half a cell: s 0.83 in "
+              "y, -0.97 in x against it), see docs/theory/surface-design.md, session 35")
 
 
 def westergaard_scoring(settings, wave=WESTERGAARD_WAVE, n=WESTERGAARD_NODES, stretch=2.0,
@@ -316,8 +340,10 @@ def _targets(rec, noise, mech, designs, db_info, x3p, west):
                              f"s_A {d['scores_at_target_pressures'][1]:.4f})",
                              d["f"] >= GOAL_F, _reason(d), d["f"]))
         else:
+            why = (f"{_reason(d)}; {X3P_K_MISS}" if d["target"] == "x3p-2"
+                   and d["f"] < GOAL_S else _reason(d))
             rows.append(_row(f"{label}: s on K at the target pressures", f">= {GOAL_S}",
-                             f"{d['f']:.4f}", d["f"] >= GOAL_S, _reason(d), d["f"]))
+                             f"{d['f']:.4f}", d["f"] >= GOAL_S, why, d["f"]))
         rows.append(_row(f"{label}: score reproduced from the saved heights by the "
                          "hand-written Eq. 4.1 (same BEM solver)", "<= 1e-9",
                          f"{d['reproduced']:.1e}", d["reproduced"] <= 1e-9,
