@@ -16,6 +16,17 @@ from roughfe.surfaces.io import load_surface
 E = 210e6
 
 
+def _settings_only_db(tmp_path, settings):
+    """A database file holding only ``settings`` (what design-targets reads of it)."""
+    from roughfe.genomics.database.store import connect, write_settings
+    path = tmp_path / "s.sqlite"
+    con = connect(path, create=True)
+    write_settings(con, settings)
+    con.commit()
+    con.close()
+    return path
+
+
 def test_mirrored_window_is_the_even_periodic_extension():
     rng = np.random.default_rng(3)
     h = rng.normal(size=(5, 7))
@@ -176,15 +187,10 @@ def test_a_surface_database_refuses_a_profile_target(tmp_path, capsys):
     (a line contact) for periodic 2D designs, with no error; `design --match-spectrum`
     refused the same file. Both now say so (target_surface, which both read)."""
     from roughfe.cli import main
-    from roughfe.genomics.database.store import connect, write_settings
     from roughfe.genomics.design.targets import target_surface
     from roughfe.surfaces.io import save_surface
-    path = tmp_path / "s.sqlite"
     settings = db.DatabaseSettings(length=1e-4, n_nodes=16, dim=2)
-    con = connect(path, create=True)
-    write_settings(con, settings)
-    con.commit()
-    con.close()
+    path = _settings_only_db(tmp_path, settings)
     x = np.linspace(0.0, 1e-4, 64)
     profile = save_surface(Surface(1e-7 * np.sin(2 * np.pi * 3 * x / 1e-4), 1e-4),
                            tmp_path / "profile.npz")
@@ -202,16 +208,11 @@ def test_design_targets_scan_axis_y_gives_the_transposed_maps_targets(tmp_path):
     round 2, session 35, as info, contact, leak and genome chromosomes had): a map scanned
     along y, given with --scan-axis y, now gives the targets of its transpose along x."""
     from roughfe.cli import main
-    from roughfe.genomics.database.store import connect, write_settings
     from roughfe.genomics.target_csv import read_target_csv
     from roughfe.surfaces import spectral_surface
     from roughfe.surfaces.io import save_surface
-    path = tmp_path / "s.sqlite"
-    con = connect(path, create=True)
-    write_settings(con, db.DatabaseSettings(length=1e-6, n_nodes=16, dim=2, n_steps=5,
-                                            top_fraction=0.8))
-    con.commit()
-    con.close()
+    path = _settings_only_db(tmp_path, db.DatabaseSettings(length=1e-6, n_nodes=16, dim=2,
+                                                          n_steps=5, top_fraction=0.8))
     rng = np.random.default_rng(3)
     h = spectral_surface((48, 32), (1e-6, 2e-6 / 3), 0.7, rms_height=1e-8, rng=1).heights
     h = h + 3e-9 * rng.standard_normal(32)[None, :]               # offsets of lines along x
@@ -239,15 +240,10 @@ def test_design_targets_warns_of_offset_scan_lines_and_a_kept_tilt(tmp_path, cap
     (the one path, plausibility.plausible_surface); levelled lines and a removed plane
     do not."""
     from roughfe.cli import main
-    from roughfe.genomics.database.store import connect, write_settings
     from roughfe.surfaces import spectral_surface
     from roughfe.surfaces.io import save_surface
-    path = tmp_path / "s.sqlite"
-    con = connect(path, create=True)
-    write_settings(con, db.DatabaseSettings(length=1e-6, n_nodes=16, dim=2, n_steps=4,
-                                            top_fraction=0.8))
-    con.commit()
-    con.close()
+    path = _settings_only_db(tmp_path, db.DatabaseSettings(length=1e-6, n_nodes=16, dim=2,
+                                                          n_steps=4, top_fraction=0.8))
     size = (1e-6, 2e-6 / 3)
     h = spectral_surface((48, 32), size, 0.7, rms_height=1e-8, rng=1).heights
     lines = h + 3e-9 * np.random.default_rng(3).standard_normal(32)[None, :]

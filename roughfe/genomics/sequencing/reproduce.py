@@ -177,6 +177,18 @@ def model_slope(fit) -> float:
     return math.sqrt(0.5 * float(np.sum((np.abs(fit.cvec) * q) ** 2)))
 
 
+def unfitted_halves(halves, verb: str):
+    """The "not reproducible" :class:`Reproducibility` of ``halves`` (two
+    :class:`HalfGenes`) when either half could not be ``verb`` ("sequenced", "fitted"), or
+    None when both were. One rule for the profile and the surface sequencers."""
+    failed = [h for h in halves if h.message]
+    if not failed:
+        return None
+    return Reproducibility(True, False, tuple(halves), reason=(
+        "the genes are not reproducible: the " + " and the ".join(
+            f"{h.side} half cannot be {verb} ({h.message})" for h in failed)))
+
+
 def lattice_offset(a: HalfGenes, b: HalfGenes) -> float:
     """The largest distance (in steps of the finer lattice) of a chromosome wavenumber of
     the coarser half's lattice, over its band, from the finer one's lattice (0: the same
@@ -202,11 +214,9 @@ def reproducibility(acqs, rms_tolerance, lattice, slope=math.nan) -> Reproducibi
                                f"acquisition have {min(nodes)} nodes, fewer than "
                                f"{MIN_HALF_NODES}")
     halves = tuple(_half_genes(acqs, s, rms_tolerance, (tuple(lattice),)) for s in SIDES)
-    failed = [h for h in halves if h.message]
-    if failed:
-        return Reproducibility(True, False, halves, reason=(
-            "the genes are not reproducible: the " + " and the ".join(
-                f"{h.side} half cannot be sequenced ({h.message})" for h in failed)))
+    failed = unfitted_halves(halves, "sequenced")
+    if failed is not None:
+        return failed
     a, b = halves
     offset = lattice_offset(a, b)
     dH = abs(a.H - b.H)

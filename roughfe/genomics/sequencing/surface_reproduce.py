@@ -40,7 +40,8 @@ import math
 import numpy as np
 
 from ...errors import InputError
-from .reproduce import LATTICE_TOLERANCE, SIDES, HalfGenes, Reproducibility, lattice_offset
+from .reproduce import (LATTICE_TOLERANCE, SIDES, HalfGenes, Reproducibility, lattice_offset,
+                        unfitted_halves)
 from .surface_data import ANGLE_TOL, SurfaceAcquisition
 from .surface_fit import fit_model
 from .surface_grid import GridModel
@@ -97,11 +98,9 @@ def surface_reproducibility(acqs, n_nodes, p, ranges, axis_nodes=None) -> Reprod
     band = (min(r[0] for r in ranges), max(r[1] for r in ranges))
     fits = [_half_genes(acqs, n_nodes, s, p, band, axis_nodes) for s in SIDES]
     halves = tuple(f[0] for f in fits)
-    failed = [h for h in halves if h.message]
-    if failed:
-        return Reproducibility(True, False, halves, reason=(
-            "the genes are not reproducible: the " + " and the ".join(
-                f"{h.side} half cannot be fitted ({h.message})" for h in failed)))
+    failed = unfitted_halves(halves, "fitted")
+    if failed is not None:
+        return failed
     a, b = halves
     offset = lattice_offset(a, b)
     turn = angle_offset(fits[0][1], fits[1][1])
