@@ -119,3 +119,31 @@ def test_triangle_estimate_against_gmsh_and_gmsh_never_asks(monkeypatch):
         assert 0.6 * pm.n_cells < est < 1.05 * pm.n_cells, (est, pm.n_cells)
     assert seen == [1.0, 1.0]
     assert MAX_TRIANGLES >= 1e6           # a 65k-sample profile (~1.5e6) is still meshed
+
+
+def test_the_absolute_tolerance_grows_with_the_round_off_floor_of_large_meshes(
+        coarse_mesh, monkeypatch):
+    """The residual's 2-norm stagnates at a round-off floor ~ eps |u|_2 ~ sqrt(n_dofs)
+    (measured 6.7e-14 ... 5.4e-13 from 7 246 to 390 000 DOFs; r = 16 of the RMD
+    convergence study, ~1.55 M DOFs, stopped at |F| = 1.086e-12 > atol = 1e-12). The
+    absolute tolerance is the documented rule atol sqrt(n / ATOL_REF_DOFS), at least atol:
+    unchanged below the reference size, twice it at four times the size. An atol below the
+    floor of this small mesh never converges (DIVERGED_MAX_IT); with the reference size
+    set so that the same atol is scaled above the floor, the same solve converges to the
+    default solve's pressure, and the result reports the scaled tolerance."""
+    from roughfe.errors import NoConvergenceError
+    from roughfe.fem import elasticity
+    ref = elasticity.ATOL_REF_DOFS
+    assert elasticity.atol_size_scale(ref // 10) == elasticity.atol_size_scale(ref) == 1.0
+    assert elasticity.atol_size_scale(4 * ref) == pytest.approx(2.0, rel=1e-15, abs=0)
+    applied = [0.5 * G]
+    base = fem_contact_sweep(coarse_mesh, MAT, applied_deltas=applied).results[0]
+    tiny = FemSolverOptions(rtol=1e-30, atol=1e-18, max_it=15)   # atol below the floor
+    with pytest.raises(NoConvergenceError, match="DIVERGED_MAX_IT"):
+        fem_contact_sweep(coarse_mesh, MAT, applied_deltas=applied, options=tiny)
+    n_dofs = coarse_mesh.mesh.geometry.x.shape[0] * 2
+    monkeypatch.setattr(elasticity, "ATOL_REF_DOFS", n_dofs / 1e8)   # factor 1e4
+    r = fem_contact_sweep(coarse_mesh, MAT, applied_deltas=applied, options=tiny).results[0]
+    assert r.tolerance == pytest.approx(1e-14, rel=1e-12, abs=0)
+    assert r.residual <= r.tolerance
+    assert r.mean_pressure == pytest.approx(base.mean_pressure, rel=1e-10, abs=0)

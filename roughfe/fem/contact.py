@@ -67,8 +67,8 @@ from ..frozen import FrozenMapping
 from ..model import ContactResult, Material, SweepResult
 from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
-from .elasticity import (VOLUMETRIC, atol_scale, lame, nodal_average, stiffness_matrix,
-                         volumetric_form)
+from .elasticity import (VOLUMETRIC, atol_scale, atol_size_scale, lame, nodal_average,
+                         stiffness_matrix, volumetric_form)
 from .limits import patch_width, warn_locking, warn_sweep
 from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
 from .petsc_tools import (LU_MUMPS, PrefixedOptions, check_snes, fresh_pc_on_resize,
@@ -110,7 +110,14 @@ class FemSolverOptions:
         SNES relative / absolute residual tolerances (non-dimensional residual). Above
         nu = 0.45 ``atol`` is scaled by (lambda + 2 mu) / its value at nu = 0.45
         (:func:`roughfe.fem.elasticity.atol_scale`): the residual's round-off grows with
-        the modulus, and 1e-12 is below it near nu = 1/2.
+        the modulus, and 1e-12 is below it near nu = 1/2. Above 500 000 unknowns
+        (:data:`roughfe.fem.elasticity.ATOL_REF_DOFS`) it is also scaled by
+        sqrt(n_dofs / 500 000) (:func:`roughfe.fem.elasticity.atol_size_scale`): the
+        residual's round-off floor grows like sqrt(n_dofs), measured 6.7e-14 at 7 246
+        DOFs to 5.4e-13 at 392 080 (RMD profile of ``validation/fem_convergence.py``,
+        r = 1 ... 8), and the fixed 1e-12 stopped r = 16 (~1.55 M DOFs) at
+        DIVERGED_MAX_IT with |F| = 1.086e-12. The value used is in the result's
+        ``tolerance`` (the larger of it and ``rtol |F(x_0)|``).
     max_it : int
         SNES iteration limit per load step.
     petsc_options : mapping, optional
@@ -286,7 +293,8 @@ class _ContactProblem:
         J = self.K if opt.method == "vi" else self.K.duplicate(copy=True)
         snes.setFunction(self._residual, self.r)
         snes.setJacobian(self._jacobian, J, J)
-        self.atol = opt.atol * atol_scale(self.material.nu)
+        self.atol = (opt.atol * atol_scale(self.material.nu)
+                     * atol_size_scale(self.x.getSize()))
         snes.setTolerances(rtol=opt.rtol, atol=self.atol, max_it=int(opt.max_it))
         snes.setConvergenceHistory(reset=True)       # |F(x_0)| of each solve: the tolerance
         # no divergence test (PETSc's default stops at |F| > 1e4 |F(x_0)|): a step started

@@ -95,6 +95,29 @@ def atol_scale(nu: float) -> float:
     return max(1.0, (lam + 2 * mu) / (lam0 + 2 * mu0))
 
 
+#: number of unknowns up to which the SNES absolute tolerance is not scaled with the size
+#: (:func:`atol_size_scale`): above the finest converged levels (r = 8, 392 080 DOFs) of
+#: ``validation/fem_convergence.py``, so that none of their numbers moves
+ATOL_REF_DOFS = 500_000
+
+
+def atol_size_scale(n_dofs: int) -> float:
+    """Factor on the SNES absolute tolerance of a body of ``n_dofs`` unknowns:
+    ``sqrt(n_dofs / ATOL_REF_DOFS)``, at least 1 (exactly 1 up to :data:`ATOL_REF_DOFS`).
+
+    The residual's 2-norm (non-dimensional: E = 1, u in units of the height range)
+    stagnates at a round-off floor of about 2 eps |u|_2 (eps = 2.2e-16; the entries of K
+    are O(1), its row sums ~ 11), and at a fixed geometry |u|_2 grows like sqrt(n_dofs).
+    Measured (round 2, session 35; RMD profile of ``validation/fem_convergence.py``, one
+    cold VI solve at the imposed approach 1.3889e-5 m, SNES run 6 iterations past
+    convergence): floor 6.7e-14, 1.34e-13, 2.7e-13, 5.4e-13 at r = 1, 2, 4, 8 (7 246,
+    26 240, 99 818, 392 080 DOFs; |u|_2 = 1.91 sqrt(n)): n^0.52, 1.1e-12 extrapolated to
+    r = 16 (~1.55 M DOFs), where the fixed 1e-12 stopped a step at DIVERGED_MAX_IT with
+    |F| = 1.086e-12. With this factor the default 1e-12 becomes 1.76e-12 there, 1.6x the
+    extrapolated floor (r = 8: 1.85x at the unscaled 1e-12)."""
+    return max(1.0, float(np.sqrt(n_dofs / ATOL_REF_DOFS)))
+
+
 def nodal_average(cells, areas, values, n_nodes: int):
     """The lumped L2 projection of a cell-wise constant field on continuous P1:
     ``theta_i = sum_c values_c A_c / 3 / sum_c A_c / 3`` over the triangles ``c`` at node
