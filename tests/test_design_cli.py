@@ -200,6 +200,8 @@ def test_design_command_exits_1_when_the_design_is_not_a_success(tmp_path, monke
     (["--method", "sog", "--global-score", "min"], "--global-score needs --global cmaes"),
     (["--method", "sog", "--global-waves"], "--global-waves needs --global cmaes"),
     (["--method", "sog", "--spectrum-starts", "1"], "--spectrum-starts needs --match-spectrum"),
+    (["--method", "sog", "--detrend", "lines"], "--detrend needs --match-spectrum SURFACE"),
+    (["--method", "sog", "--scan-axis", "y"], "--scan-axis needs --match-spectrum SURFACE"),
     (["--method", "sog", "--formulation", "thesis", "--gradient", "exact"],
      "--gradient exact needs --formulation minimax"),
     (["--method", "sog", "--eps", "0.01"], "--eps needs finite differences"),

@@ -306,6 +306,57 @@ def test_match_spectrum_restores_a_genome_whose_hurst_exponent_moved(surface_db)
     assert new[0].origin.endswith("(spectrum)") and 0 < new[0].scores[0] <= 1
 
 
+def test_design_match_spectrum_warns_of_its_file_as_design_targets(surface_db, tmp_path,
+                                                                    capsys, monkeypatch):
+    """`design --match-spectrum FILE` read its file without the warnings of info, contact,
+    leak and design-targets (round 2, session 36): a map with offset scan lines gave a
+    matched design without a word, and the design had no --detrend to follow the advice.
+    It now warns through the same path (plausibility.plausible_surface), before the
+    design runs; --detrend lines levels the lines (no warning, another target spectrum),
+    --scan-axis y reads the rows as the lines (not offset: no warning)."""
+    import roughfe.genomics.design as design
+    from roughfe.cli import main
+    from roughfe.genomics.design import target_surface
+    from roughfe.genomics.target_csv import write_target_csv
+    from roughfe.surfaces import Surface, load_surface, save_surface, spectral_surface
+
+    matched = []                                 # the surfaces the stage matched
+    match = design.match_spectrum
+    monkeypatch.setattr(design, "match_spectrum",
+                        lambda res, surface, *a, **k: matched.append(surface) or match(
+                            res, surface, *a, **k))
+
+    path, _ = surface_db
+    g = Genome.from_dict(db.load_entries(path)[0].genome)
+    c = Evaluator(SETTINGS)(Design((DesignPart(g, tuple(range(g.n_first, g.n_last + 1)), 1.0,
+                                               "t"),), 1.0, L, 32, "t", 2))
+    write_target_csv(tmp_path / "tK.csv", Target(c.pressure, c.stiffness, "K", "tK", {}))
+    size = (L, 2 * L / 3)
+    h = spectral_surface((48, 32), size, 0.7, rms_height=2e-7, rng=1).heights
+    h = h + 6e-8 * np.random.default_rng(3).standard_normal(32)[None, :]    # line offsets
+    save_surface(Surface(h, size, False), tmp_path / "lines.npz")
+
+    def run(*extra):
+        out = tmp_path / f"d{len(list((tmp_path).glob('d*')))}"
+        capsys.readouterr()
+        assert main(["design", "--db", str(path), "--target", str(tmp_path / "tK.csv"),
+                     "--method", "sog", "--iterations", "1", "--match-spectrum",
+                     str(tmp_path / "lines.npz"), *extra, "--no-figures", "--quiet",
+                     "-o", str(out)]) in (0, 1)
+        return capsys.readouterr().err
+
+    offset = "roughfe design: warning: the scan lines along x (heights[:, j]) look offset"
+    said = run()                                                 # default --detrend plane
+    assert offset in said and "--detrend lines" in said
+    assert "scan lines" not in run("--detrend", "lines")
+    assert "scan lines" not in run("--scan-axis", "y")           # rows i: no offsets
+    read = load_surface(tmp_path / "lines.npz")
+    assert len(matched) == 3 and not np.array_equal(matched[0].heights, matched[1].heights)
+    for got, mode in zip(matched, ("plane", "lines")):           # the file detrended so
+        np.testing.assert_array_equal(got.heights, target_surface(read, SETTINGS,
+                                                                  detrend=mode).heights)
+
+
 def test_ridge_keys_scale_every_wave_on_its_own():
     """Per-wave amplitude variables (Design.ridge_keys on one-chromosome parts): the
     surface is linear in every wave's factor alpha_m (Eq. 3.17), so setting the factors

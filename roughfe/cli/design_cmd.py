@@ -87,10 +87,12 @@ def _dependent_options(args):
              bool(args.match_spectrum)),
             ("match_directions", "--match-directions", False, "--match-spectrum SURFACE",
              bool(args.match_spectrum))]
-    rows += [(dest, flag, None, "--match-spectrum SURFACE (an option of its file)",
+    rows += [(dest, flag, default, "--match-spectrum SURFACE (an option of its file)",
               bool(args.match_spectrum))
-             for dest, flag in (("size", "--size"), ("channel", "--channel"),
-                                ("periodic", "--periodic/--non-periodic"))]
+             for dest, flag, default in (("size", "--size", None), ("channel", "--channel", None),
+                                         ("periodic", "--periodic/--non-periodic", None),
+                                         ("detrend", "--detrend", "plane"),
+                                         ("scan_axis", "--scan-axis", "x"))]
     globals_ = [(flag, default) for flag, _, default, _, _ in GLOBAL_FLAGS]
     globals_ += [("--global-score", "strict"), ("--global-waves", False)]
     rows += [(flag[2:].replace("-", "_"), flag, default, "--global cmaes",
@@ -165,6 +167,13 @@ def _run(args) -> int:
         modulation=args.global_modulation)   # checked before the database is read
     settings = read_settings(args.db)
     entries = load_entries(args.db)
+    spectrum_target = None          # the surface whose spectrum psd.png draws beside
+    if args.match_spectrum:         # read, warned of and prepared before the design runs
+        from ..genomics.design import target_surface
+        from .plausibility import plausible_surface
+        surface = surface_file(args, args.match_spectrum)
+        plausible_surface(args, surface, args.detrend)   # its warnings, as design-targets;
+        spectrum_target = target_surface(surface, settings, detrend=args.detrend)  # detrended
     cache = {}
     targets = [_target(args.target, args.quantity, settings, cache, "K")]
     if args.second_target:
@@ -188,12 +197,9 @@ def _run(args) -> int:
                             options=options, **extra)
         if args.refine:
             result = refine(result, settings, rounds=args.refine)
-        spectrum_target = None          # the surface whose spectrum psd.png draws beside
-        if args.match_spectrum:
-            from ..genomics.design import match_spectrum, target_surface
-            surface = spectrum_target = target_surface(surface_file(args, args.match_spectrum),
-                                                       settings)
-            result = match_spectrum(result, surface, settings, entries=entries,
+        if spectrum_target is not None:
+            from ..genomics.design import match_spectrum
+            result = match_spectrum(result, spectrum_target, settings, entries=entries,
                                     n_entries=args.spectrum_starts,
                                     directional=args.match_directions)
         if args.search:
@@ -388,7 +394,8 @@ def register(sub):
                    help="surface database, beyond the thesis, after --refine and before "
                         "--search: set every chromosome's amplitude to the band rms of this "
                         "(measured) topography, prepared as 'design-targets --surface' "
-                        "does by default (plane removed, mirrored, database spacing)")
+                        "does by default (--detrend, mirrored, database spacing) after the "
+                        "same warnings (offset scan lines, a kept tilt, a unit mistake)")
     g.add_argument("--spectrum-starts", type=int_in(0, MAX_SPECTRUM_STARTS), default=None,
                    metavar="K",
                    help="--match-spectrum: also start from the K best database genomes, "
@@ -402,6 +409,11 @@ def register(sub):
                         "Alg. 3 ranking, both macro/micro orders, micro amplitude x 0.5/1/2 "
                         f"(0: the thesis sets; 0..{MAX_POOL})")
     add_surface_options(p, positional=False)      # of --match-spectrum's file
+    p.add_argument("--detrend", choices=DETRENDS, default=None,
+                   help="detrending of the --match-spectrum file before its spectrum is "
+                        "taken (default: plane; lines / lines-tilt: each scan line along x, "
+                        "or --scan-axis, levelled, as design-targets --surface)")
+    add_scan_axis_option(p, default=None)         # of --match-spectrum's file (default: x)
     add_output_folder(p)
     add_run_options(p)
     p.set_defaults(func=_run)
