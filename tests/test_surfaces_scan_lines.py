@@ -267,7 +267,8 @@ def test_band_chromosomes_knows_a_mirrored_map_without_its_metadata(tmp_path):
     silence. Surface.mirrored() builds a map even about its first row and column bit for
     bit, which band_chromosomes now reads too; no spectral map, periodic or not, and no
     map even along one axis only is taken for one."""
-    from roughfe.genomics.bands import _is_even_mirror, band_chromosomes
+    from roughfe.genomics.bands import band_chromosomes
+    from roughfe.surfaces.scan_lines import is_even_mirror
     from roughfe.surfaces.io import load_surface
     noisy, _ = _offsets(_map(periodic=False), share=0.2, tilt=1.0)
     m = noisy.mirrored()
@@ -290,9 +291,9 @@ def test_band_chromosomes_knows_a_mirrored_map_without_its_metadata(tmp_path):
     for seed in range(200):
         n = (16 + 2 * (seed % 5), 12 + (seed % 3))
         s = _map(n, hurst=0.3 + 0.5 * (seed % 2), seed=seed, periodic=seed % 4 < 2)
-        assert not _is_even_mirror(s.heights), seed
+        assert not is_even_mirror(s.heights), seed
     ridges = Surface(np.repeat(_map(periodic=False).heights[:, :1], 64, axis=1), (1e-6, 1e-6),
                      True)
-    assert not _is_even_mirror(ridges.heights)
+    assert not is_even_mirror(ridges.heights)
     band_chromosomes(ridges, detrend="lines")
-    assert _is_even_mirror(m.heights) and not _is_even_mirror(noisy.heights)
+    assert is_even_mirror(m.heights) and not is_even_mirror(noisy.heights)

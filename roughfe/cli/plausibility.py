@@ -1,8 +1,8 @@
 """Physical plausibility of a command's input, checked or warned of by the commands that
-solve: heights and sizes in a wrong unit, an instrument tilt kept by ``--detrend mean`` (or along x
-by ``lines``), offset scan lines,
-loads beyond the elastic half-space (refused before the solve), and large strains
-(warned of after it, with the other limits of the model the solution reaches). Split from :mod:`roughfe.cli.options` (round 2, session 28)."""
+solve: heights and sizes in a wrong unit, an instrument tilt kept by ``--detrend mean`` (or
+``lines``), offset scan lines, a mirrored window's lines levelled, loads beyond the elastic
+half-space (refused before the solve), and large strains (warned of after it, with the other
+limits of the model the solution reaches). Split from :mod:`roughfe.cli.options` (session 28)."""
 from __future__ import annotations
 
 import numpy as np
@@ -130,11 +130,46 @@ def warn_scan_lines(args, surface) -> None:
     when the surface's metadata ``scan_axis`` is y (``--scan-axis y``); the warning
     names the axis. Of the five measured files only di-1 (an AFM scan) fires: 11.2
     (the others 0.04-0.11)."""
-    from ..surfaces.scan_lines import scan_line_check
+    from ..surfaces.scan_lines import is_mirrored, scan_line_check
 
     check = scan_line_check(surface)
     if check is not None and check.fires:
-        warn(args, check.note())
+        warn(args, check.note() + (f"; but {_mirror_words(surface)}: level the measured "
+                                   f"window before mirroring" if is_mirrored(surface) else ""))
+
+
+def _mirror_words(surface) -> str:      # what says that it is a mirrored window
+    if surface.metadata.get("mirrored"):
+        return "this map is a mirrored window (its metadata says so)"
+    n = [k // 2 + 1 for k in surface.shape]             # the window's points per axis
+    return (f"this map is a mirrored window: its heights are even about the first row and "
+            f"column bit for bit (h[i] = h[-i] along both axes), as Surface.mirrored and "
+            f"--mirror build them: a window of {n[0]} x {n[1]} points "
+            f"({' x '.join(f'{k * d:.4g}' for k, d in zip(n, surface.spacing))} m) and "
+            f"its mirror images")
+
+
+def warn_mirrored_lines(args, surface, detrend: str) -> None:
+    """Warn (once, stderr) when ``--detrend lines | lines-tilt`` levels the lines of a
+    mirrored window (:func:`roughfe.surfaces.scan_lines.is_mirrored`: its metadata, or
+    heights even about the first row and column, e.g. a ``.npy`` of a mirrored map): they
+    are measured lines joined to their mirror images. Against levelling before mirroring
+    (96 x 64 map, line offsets and tilts): ``lines`` 1.2 % of Sq off, ``lines-tilt`` 3.5 Sq
+    (the tilts kept), periodic or not. ``band_chromosomes`` refuses it (session 35); the
+    commands said nothing until round 2, session 36."""
+    from ..surfaces.scan_lines import is_mirrored, scan_axis_of
+
+    if detrend not in ("lines", "lines-tilt") or not is_mirrored(surface):
+        return
+    warn(args, f"--detrend {detrend} levels each scan line along {scan_axis_of(surface)}, "
+               f"but {_mirror_words(surface)}. Its lines are measured lines joined to their "
+               f"mirror images, not the instrument's scan lines, and levelling them is not "
+               f"the levelling of the measured ones"
+               + (" (it keeps every line's tilt: a line joined to its mirror image has "
+                  "none)" if detrend == "lines-tilt" else "")
+               + f". Level the measured window before mirroring: its own file with "
+                 f"--detrend {detrend} (and --mirror where the command has it: contact, "
+                 f"genome chromosomes); or read these heights with --detrend mean")
 
 
 def plausible_surface(args, surface, detrend: str = "none"):
@@ -142,8 +177,9 @@ def plausible_surface(args, surface, detrend: str = "none"):
     after the warnings of a read surface: a unit mistake (:func:`warn_units`), an
     instrument tilt kept by ``mean`` or ``lines`` on a non-periodic surface
     (:func:`warn_tilt`), scan-line offsets left by ``none``, ``mean`` or ``plane``
-    (:func:`warn_scan_lines`) and, with ``--periodic``, a seam in the detrended heights
-    (:func:`warn_seam`). The one path of these warnings: the commands that read
+    (:func:`warn_scan_lines`), the lines of a mirrored window levelled by ``lines`` or
+    ``lines-tilt`` (:func:`warn_mirrored_lines`) and, with ``--periodic``, a seam in the
+    detrended heights (:func:`warn_seam`). The one path of these warnings: the commands that read
     :func:`roughfe.cli.options.surface_from_args` (info, contact, leak, natural, genome
     chromosomes) and ``design-targets --surface``, which detrends in the library
     (:func:`roughfe.genomics.design.targets.target_surface`) and took none of them
@@ -153,6 +189,7 @@ def plausible_surface(args, surface, detrend: str = "none"):
         warn_tilt(args, surface, detrend)
     if detrend in ("none", "mean", "plane"):
         warn_scan_lines(args, surface)
+    warn_mirrored_lines(args, surface, detrend)
     surface = surface if detrend == "none" else surface.detrended(detrend)
     if getattr(args, "periodic", None) is True:
         warn_seam(args, surface)

@@ -50,6 +50,7 @@ import scipy.fft
 
 from ..errors import (InputError, check_finite_positive, check_in_interval, check_instance,
                       check_memory)
+from ..surfaces.scan_lines import is_mirrored
 from ..surfaces.stats import angular_wavevectors
 from ..surfaces.surface import Surface
 
@@ -173,27 +174,12 @@ class BandChromosomes:
         return self.surface.with_heights(heights)
 
 
-def _is_even_mirror(heights) -> bool:
-    """Whether a map is even about its first row and first column bit for bit,
-    ``h[i] == h[-i]`` (indices modulo n) along both axes, n even and at least 4, and not
-    flat: what :meth:`Surface.mirrored` builds (period ``2 (n - 1)``), also rebuilt into a
-    new Surface without its metadata, saved and read back, or shifted by a constant. A
-    measured or random map never is (no false alarm on 200 spectral maps, tested); a
-    mirrored map resampled or plane-levelled after mirroring is no longer exactly even,
-    and is not recognised."""
-    h = np.asarray(heights)
-    if h.ndim != 2 or any(n < 4 or n % 2 for n in h.shape) or np.ptp(h) == 0:
-        return False
-    return all(np.array_equal(h, np.roll(np.flip(h, axis), 1, axis)) for axis in (0, 1))
-
-
 def _detrended(surface: Surface, detrend: str) -> Surface:
     if detrend not in DETREND_MODES:
         raise InputError(f"detrend must be one of {DETREND_MODES}, got {detrend!r}")
     if detrend == "none":
         return surface
-    if detrend in ("lines", "lines-tilt") and (surface.metadata.get("mirrored")
-                                               or _is_even_mirror(surface.heights)):
+    if detrend in ("lines", "lines-tilt") and is_mirrored(surface):
         raise InputError(f"detrend={detrend!r} levels the measured scan lines; this surface "
                          "is a mirrored window (metadata 'mirrored', or heights even about "
                          "the first row and column, as Surface.mirrored builds them), whose "
@@ -242,7 +228,8 @@ def band_chromosomes(surface: Surface, gamma: float = DEFAULT_GAMMA, *, q1=None,
         not the measured ones: level, mirror, then pass "mean" (as
         ``roughfe genome chromosomes --mirror`` does). A mirrored window is one with the
         metadata ``mirrored`` or, without it, heights even about the first row and
-        column bit for bit (:meth:`Surface.mirrored`'s output rebuilt or read back); one
+        column bit for bit (:meth:`Surface.mirrored`'s output rebuilt or read back;
+        :func:`roughfe.surfaces.scan_lines.is_mirrored`, the CLI's check too); one
         resampled or plane-levelled after mirroring, without the metadata, is not
         recognised.
     transform : {"auto", "fft", "dct"}

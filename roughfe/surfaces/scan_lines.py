@@ -64,6 +64,15 @@ that small are within the roughness of a small map. The measured files (plane re
 di-1 (AFM) 11.2, fires; opd-1 0.064, plu-1 0.038, sur-2 0.065, x3p-2 0.11, do not.
 A lay along x (grooves parallel to the fast-scan lines) a few
 lines in wavelength can fire too: it is not distinguishable from offsets line by line.
+
+Mirrored maps (:func:`is_mirrored`): the lines of a mirrored window
+(:meth:`Surface.mirrored`, ``--mirror``) are not scan lines: along the lines half of each
+is the mirror image of a measured line, and across them half of the lines are mirror
+images of others. Levelling them is not the instrument's "align rows" (a mirrored map is
+periodic, so ``"lines-tilt"`` removes the means only and keeps every line's tilt); level
+the window, then mirror it. :func:`is_even_mirror` recognises such a map by its heights
+alone (bit-for-bit even about its first row and column), when the metadata that says so
+is lost (a ``.npy`` of a mirrored map).
 """
 from __future__ import annotations
 
@@ -103,6 +112,27 @@ def _along_x(surface: Surface, axis):
     dx, dy = surface.spacing
     return (surface.heights, (dx, dy), name) if name == "x" else \
         (surface.heights.T, (dy, dx), name)
+
+
+def is_even_mirror(heights) -> bool:
+    """Whether a map is even about its first row and first column bit for bit,
+    ``h[i] == h[-i]`` (indices modulo n) along both axes, n even and at least 4, and not
+    flat: what :meth:`Surface.mirrored` builds (period ``2 (n - 1)``), also rebuilt into a
+    new Surface without its metadata, saved and read back, or shifted by a constant. A
+    measured or random map never is (no false alarm on 200 spectral maps or on the five
+    measured files, tested); a mirrored map resampled or plane-levelled after mirroring is
+    no longer exactly even, and is not recognised. Exact and O(n) in the points."""
+    h = np.asarray(heights)
+    if h.ndim != 2 or any(n < 4 or n % 2 for n in h.shape) or np.ptp(h) == 0:
+        return False
+    return all(np.array_equal(h, np.roll(np.flip(h, axis), 1, axis)) for axis in (0, 1))
+
+
+def is_mirrored(surface: Surface) -> bool:
+    """Whether ``surface`` is a mirrored window, whose lines are not scan lines (module
+    docstring): its metadata ``mirrored`` (:meth:`Surface.mirrored`) or, without it,
+    heights even about the first row and column (:func:`is_even_mirror`)."""
+    return bool(surface.metadata.get("mirrored")) or is_even_mirror(surface.heights)
 
 
 def level_lines(surface: Surface, tilt: bool = False, axis=None) -> Surface:
