@@ -52,6 +52,17 @@ Targets (met / NOT met): per profile, the FEM and BEM limits agree within 1 % (A
 1 % (window K) at every load; at every r the FEM-BEM difference of A*, window K and mean
 gap is within the sum of the two estimated discretisation errors. The tangent K rows of
 the report are information.
+
+Resuming an interrupted level: while a level's FEM runs, its finished loads are
+checkpointed after every load (of the nine window loads) in
+``fem_convergence_levels/<profile>_r<r>.fem-partial.npz`` (:mod:`roughfe.fem.checkpoint`,
+written atomically): the finished loads' results and the displacement field the next
+load starts its Newton from (every load is warm-started from the previous one), with the
+DOF layout, loads, guesses and solver options it belongs to. ``--resume`` continues an
+unfinished level after its last finished load, with results equal bit for bit to an
+uninterrupted run's (the BEM half and the mesh are recomputed: seconds); a run without
+``--resume`` deletes the file and starts the level afresh. The file is removed once the
+level file is written; a level counts as finished only by its ``.json`` file.
 """
 from __future__ import annotations
 
@@ -70,6 +81,7 @@ from _fem_cases import MATERIAL, rmd_profile_case, subcell_area, table1_profile 
 
 from roughfe.bem import contact_sweep  # noqa: E402
 from roughfe.fem import fem_contact_sweep, mesh_profile, mirrored_profile  # noqa: E402
+from roughfe.fem.checkpoint import SweepCheckpoint  # noqa: E402
 from roughfe.plotting.common import new_figure, save_figure  # noqa: E402
 from roughfe.surfaces import Surface  # noqa: E402
 from roughfe.validation import Target, percent, richardson, targets_markdown  # noqa: E402
@@ -86,6 +98,9 @@ QUANTITIES = {"area": "A* (sub-element edges)",
 LIMIT_TARGETS = {"area": 0.01, "stiffness": 0.01}
 #: gated at every level (the tangent K is reported, not gated: see the module docstring)
 LEVEL_TARGETS = ("area", "stiffness", "mean_gap")
+#: the per-load checkpoint of an unfinished level: ``<profile>_r<r>`` + this suffix, beside
+#: the finished level files ``<profile>_r<r>.json`` (see the module docstring)
+PARTIAL_SUFFIX = ".fem-partial.npz"
 
 
 def refined(surface: Surface, r: int) -> Surface:
@@ -133,12 +148,14 @@ def window_quantities(sweep, n: int) -> dict:
             "window_stiffness_tangent": sweep.stiffness.tolist()}
 
 
-def level(surface: Surface, r: int, pressures, guesses=None) -> dict:
+def level(surface: Surface, r: int, pressures, guesses=None, checkpoint=None) -> dict:
     """BEM and FEM at refinement r, solved at :func:`load_window` of ``pressures``: A*,
     K (window secant and tangent), mean gap at ``pressures``.
 
     ``guesses``: imposed FEM approaches of a coarser level (one per window load) to start
-    the load control from.
+    the load control from. ``checkpoint``: the FEM sweep's per-load checkpoint file
+    (:mod:`roughfe.fem.checkpoint`; resumed when it holds finished loads of this level);
+    the FEM ``cpu_seconds`` then include the CPU seconds of the resumed loads.
     """
     s = refined(surface, r)
     n = s.shape[0]
@@ -150,11 +167,17 @@ def level(surface: Surface, r: int, pressures, guesses=None) -> dict:
     c0 = time.process_time()
     pm = mesh_profile(s, growth=GROWTH_1 / r)
     c_mesh = time.process_time() - c0
-    fem = fem_contact_sweep(pm, MATERIAL, pressures=loads, guesses=guesses)
+    ckpt = None if checkpoint is None else SweepCheckpoint(checkpoint)
+    fem = fem_contact_sweep(pm, MATERIAL, pressures=loads, guesses=guesses, checkpoint=ckpt)
+    if ckpt is not None and (ckpt.resumed_steps or ckpt.not_used):
+        print(f"[fem convergence] r = {r}: " + (
+            f"FEM resumed after load {ckpt.resumed_steps} of {loads.size} from {ckpt.path}"
+            if ckpt.resumed_steps else f"{ckpt.path} not used: {ckpt.not_used}"), flush=True)
     out["fem"] = {**window_quantities(fem, n), "delta_applied": fem.delta_applied.tolist(),
                   "snes_iterations": [int(x.nit) for x in fem.results],
                   "n_cells": pm.n_cells, "growth": GROWTH_1 / r, "cpu_seconds_mesh": c_mesh,
-                  "cpu_seconds": time.process_time() - c0}
+                  "cpu_seconds": time.process_time() - c0
+                  + (ckpt.resumed_cpu_seconds if ckpt else 0.0)}
     out["wall_seconds"] = time.perf_counter() - t0
     return out
 
@@ -272,9 +295,36 @@ def _settings(name: str, r: int, pressures) -> dict:
             "pressures": list(map(float, pressures))}
 
 
+def profile_levels(store: Path, name: str, surface: Surface, pressures, levels,
+                   resume: bool = False) -> list:
+    """The levels of one profile, each solved (and written to ``store``) or, with
+    ``resume``, read from its level file of the same settings; an unfinished level
+    resumes from its per-load checkpoint (see the module docstring)."""
+    lv = []
+    for r in levels:
+        path = store / f"{name}_r{r}.json"
+        settings = _settings(name, r, pressures)
+        old = json.loads(path.read_text()) if resume and path.is_file() else None
+        if old is not None and old.get("settings") == settings:
+            lv.append(old["level"])
+            print(f"[fem convergence] {name} r = {r}: reused {path}", flush=True)
+            continue
+        partial = store / f"{name}_r{r}{PARTIAL_SUFFIX}"
+        if not resume:
+            partial.unlink(missing_ok=True)     # a fresh run does not resume loads
+        lv.append(level(surface, r, pressures, lv[-1]["fem"]["delta_applied"] if lv else None,
+                        checkpoint=partial))
+        write_json(path, {"settings": settings, "level": lv[-1]})
+        partial.unlink(missing_ok=True)
+        print(f"[fem convergence] {name} r = {r}: A* BEM {lv[-1]['bem']['area']} "
+              f"FEM {lv[-1]['fem']['area']} ({lv[-1]['wall_seconds']:.0f} s wall, FEM "
+              f"{lv[-1]['fem']['cpu_seconds']:.0f} s CPU)", flush=True)
+    return lv
+
+
 def run(outdir: Path, levels=LEVELS, profiles=None, resume: bool = False) -> tuple[bool, list]:
     """The study; returns (all targets met, target rows). ``resume``: reuse the level files
-    of the same settings (see the module docstring)."""
+    of the same settings and resume an unfinished level (see the module docstring)."""
     outdir = Path(outdir)
     store = outdir / "fem_convergence_levels"
     store.mkdir(parents=True, exist_ok=True)
@@ -282,20 +332,7 @@ def run(outdir: Path, levels=LEVELS, profiles=None, resume: bool = False) -> tup
     for name in profiles or PROFILES:
         surf = PROFILES[name]()
         pressures = study_pressures(surf)
-        lv = []
-        for r in levels:
-            path = store / f"{name}_r{r}.json"
-            settings = _settings(name, r, pressures)
-            old = json.loads(path.read_text()) if resume and path.is_file() else None
-            if old is not None and old.get("settings") == settings:
-                lv.append(old["level"])
-                print(f"[fem convergence] {name} r = {r}: reused {path}", flush=True)
-                continue
-            lv.append(level(surf, r, pressures, lv[-1]["fem"]["delta_applied"] if lv else None))
-            write_json(path, {"settings": settings, "level": lv[-1]})
-            print(f"[fem convergence] {name} r = {r}: A* BEM {lv[-1]['bem']['area']} "
-                  f"FEM {lv[-1]['fem']['area']} ({lv[-1]['wall_seconds']:.0f} s wall, FEM "
-                  f"{lv[-1]['fem']['cpu_seconds']:.0f} s CPU)", flush=True)
+        lv = profile_levels(store, name, surf, pressures, levels, resume)
         analysis = analyse(lv)
         cases[name] = {"pressures": pressures.tolist(), "levels": lv, "analysis": analysis}
         rows += profile_targets(name, analysis, lv)

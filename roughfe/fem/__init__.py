@@ -5,6 +5,9 @@
 * :func:`fem_contact_sweep` -> :class:`roughfe.model.SweepResult` of
   :class:`roughfe.model.ContactResult` (the BEM's result types; ``FemSweepResult`` and
   ``FemContactResult`` are aliases of them) -- SNES VI or penalty contact with rollers.
+* :mod:`roughfe.fem.checkpoint` -- per-step checkpoint file of a sweep
+  (``fem_contact_sweep(..., checkpoint=path)``): an interrupted sweep resumes after its last
+  finished step, bit for bit.
 * :class:`FluidLoadedBody` -- that body with a known fluid pressure as the traction of its
   top (the FEM half of :func:`roughfe.leakage.coupled_channel`).
 * :func:`mirrored_profile` -- the periodic profile whose BEM solution is the reference of

@@ -69,6 +69,7 @@ from ..surfaces import Surface
 from ..surfaces.stats import rms_height, rms_slope
 from .elasticity import (VOLUMETRIC, atol_scale, atol_size_scale, lame, nodal_average,
                          stiffness_matrix, volumetric_form)
+from .checkpoint import SweepCheckpoint, sweep_key
 from .limits import patch_width, warn_locking, warn_sweep
 from .mesh import FACET_TAGS, ProfileMesh, mirrored_profile
 from .petsc_tools import (LU_MUMPS, PrefixedOptions, check_snes, fresh_pc_on_resize,
@@ -663,7 +664,7 @@ def contact_length(x, pressure, gap, contact, e_star) -> float:
 def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
                       applied_deltas=None, pressures=None, guesses=None,
                       options: FemSolverOptions | None = None,
-                      keep_fields=()) -> SweepResult:
+                      keep_fields=(), checkpoint=None) -> SweepResult:
     """Solve the FEM contact problem for increasing approaches or loads (load stepping).
 
     Each step starts from the previous solution.
@@ -694,6 +695,13 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
     keep_fields : int or iterable of int
         Indices of the steps whose full fields (mesh, displacement, sigma_yy) are kept,
         in ``[-n, n)`` for ``n`` steps (negative: from the end); others are an InputError.
+    checkpoint : path-like or :class:`roughfe.fem.checkpoint.SweepCheckpoint`, optional
+        A ``.npz`` file written after every step (the finished steps and the displacement
+        the next one starts from; serial runs). When it exists and belongs to this sweep
+        (same loads, guesses, mesh, material, options), the sweep resumes after its last
+        step, with results equal bit for bit to an uninterrupted sweep's; otherwise it
+        starts from the first step and overwrites it. The caller removes it
+        (:mod:`roughfe.fem.checkpoint`).
 
     Raises
     ------
@@ -747,10 +755,17 @@ def fem_contact_sweep(pmesh: ProfileMesh, material: Material, deltas=None, *,
             return problem.solve_mean_pressure(full[1], full[2], k in keep)
         return problem.solve_half_plane(values[k], k in keep)
 
-    results = []
+    results, key = [], None
     try:
-        for k in range(values.size):
+        if checkpoint is not None:
+            if not isinstance(checkpoint, SweepCheckpoint):
+                checkpoint = SweepCheckpoint(checkpoint)
+            key = sweep_key(problem, name, values, guesses, keep)
+            results = checkpoint.restore(problem, key)
+        for k in range(len(results), values.size):
             results.append(step(k))
+            if checkpoint is not None:
+                checkpoint.save(problem, key, results)
     except NoConvergenceError as exc:
         raise NoConvergenceError(str(exc), result=results) from None
     finally:
