@@ -92,7 +92,7 @@ def test_no_measured_file_is_taken_for_a_mirrored_window(topographies_dir, capsy
     """The five measured files as their readers give them: none is even about its first
     row and column, so --detrend lines on them says nothing of mirroring (the CLI's path,
     plausible_surface); each one's mirror image, rebuilt without its metadata, is."""
-    from roughfe.cli.plausibility import plausible_surface
+    from roughfe.cli.surface_warnings import plausible_surface
     from roughfe.surfaces import load_surface
     args = argparse.Namespace(command="info", periodic=None)
     for name in ("di-1.di", "opd-1.opd", "plu-1.plu", "sur-2.sur", "x3p-2.x3p"):

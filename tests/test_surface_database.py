@@ -311,7 +311,7 @@ def test_design_match_spectrum_warns_of_its_file_as_design_targets(surface_db, t
     """`design --match-spectrum FILE` read its file without the warnings of info, contact,
     leak and design-targets (round 2, session 36): a map with offset scan lines gave a
     matched design without a word, and the design had no --detrend to follow the advice.
-    It now warns through the same path (plausibility.plausible_surface), before the
+    It now warns through the same path (surface_warnings.plausible_surface), before the
     design runs; --detrend lines levels the lines (no warning, another target spectrum),
     --scan-axis y reads the rows as the lines (not offset: no warning)."""
     import roughfe.genomics.design as design

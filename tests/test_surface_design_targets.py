@@ -237,7 +237,7 @@ def test_design_targets_warns_of_offset_scan_lines_and_a_kept_tilt(tmp_path, cap
     """`design-targets --surface` read its file without the warnings of info, contact and
     leak (round 2, session 35): a measured map with offset scan lines, or with an
     instrument tilt kept by --detrend mean, gave targets without a word. Both now warn
-    (the one path, plausibility.plausible_surface); levelled lines and a removed plane
+    (the one path, surface_warnings.plausible_surface); levelled lines and a removed plane
     do not."""
     from roughfe.cli import main
     from roughfe.surfaces import spectral_surface

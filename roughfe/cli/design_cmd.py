@@ -170,7 +170,7 @@ def _run(args) -> int:
     spectrum_target = None          # the surface whose spectrum psd.png draws beside
     if args.match_spectrum:         # read, warned of and prepared before the design runs
         from ..genomics.design import target_surface
-        from .plausibility import plausible_surface
+        from .surface_warnings import plausible_surface
         surface = surface_file(args, args.match_spectrum)
         plausible_surface(args, surface, args.detrend)   # its warnings, as design-targets;
         spectrum_target = target_surface(surface, settings, detrend=args.detrend)  # detrended
@@ -278,7 +278,8 @@ def _targets(args) -> int:
     settings = read_settings(args.db)
     if args.surface:
         surface = surface_file(args, args.surface)
-        from .plausibility import check_target_surface, plausible_surface
+        from .plausibility import check_target_surface
+        from .surface_warnings import plausible_surface
         plausible_surface(args, surface, args.detrend)     # its warnings; the library
         check_target_surface(args, surface, settings)      # (target_surface) detrends
         name = Path(args.surface).stem.replace(" ", "_")

@@ -173,8 +173,8 @@ def surface_from_args(args):
     """The :class:`~roughfe.surfaces.surface.Surface` named by ``args.surface`` with
     ``--size``/``--periodic``/``--channel`` applied, detrended by ``--detrend`` when the
     command has that option, after the plausibility warnings
-    (:func:`roughfe.cli.plausibility.plausible_surface`)."""
-    from .plausibility import plausible_surface
+    (:func:`roughfe.cli.surface_warnings.plausible_surface`)."""
+    from .surface_warnings import plausible_surface
     surface = surface_file(args, args.surface)
     return plausible_surface(args, surface, getattr(args, "detrend", "none"))
 
