@@ -105,3 +105,33 @@ def test_no_measured_file_is_taken_for_a_mirrored_window(topographies_dir, capsy
         assert "mirrored" not in capsys.readouterr().err, name
         m = s.mirrored()
         assert is_even_mirror(m.heights) and is_mirrored(Surface(m.heights, m.size, False))
+
+
+def test_info_table_row_gives_the_warnings_advice_on_a_mirrored_window(tmp_path, capsys):
+    """`info`'s table row of the scan-line check advised "(--detrend lines)" on a mirrored
+    window too (round 2, session 36), where the warning on stderr says that levelling its
+    lines is wrong: it now gives the warning's advice, level the measured window before
+    mirroring, also under --detrend plane, whose levelled heights are no longer even bit
+    for bit (the row judges the map as read, as the warning does). The window itself keeps
+    "(--detrend lines)"."""
+    w = _window()
+    m = w.mirrored()
+    np.save(tmp_path / "m.npy", m.heights)
+    save_surface(w, tmp_path / "w.npz")
+    size = ["--size", repr(m.size[0]), repr(m.size[1])]
+
+    def row(*argv):
+        capsys.readouterr()
+        assert main(["info", *map(str, argv)]) == 0
+        out = capsys.readouterr()
+        lines = [x for x in out.out.splitlines() if x.startswith("scan-line check R")]
+        assert len(lines) == 1
+        return lines[0], out.err
+
+    for mode in ("mean", "plane"):
+        said, err = row(tmp_path / "m.npy", "--detrend", mode, *size)
+        assert "the scan lines look offset (a mirrored window: level the measured window " \
+               "before mirroring)" in said and "--detrend lines" not in said
+        assert "level the measured window before mirroring" in err
+    said, _ = row(tmp_path / "w.npz")
+    assert said.endswith("the scan lines look offset (--detrend lines)")

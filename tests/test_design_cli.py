@@ -230,3 +230,32 @@ def test_design_option_defaults_are_kept():
                 args.spectrum_starts, args.pool, args.global_eval, args.global_score,
                 args.global_waves) == (gradient, 0.02, 1, "part", 3, 0, 20000, "strict",
                                        False)
+
+
+def test_match_spectrum_on_a_profile_database_is_refused_before_the_design(tmp_path, capsys,
+                                                                           monkeypatch):
+    """`design --match-spectrum FILE` on a profile database (dim 1) ran the whole design,
+    then stopped in spectrum_matched ("mirror a measured window first", which no file can
+    help: a profile database designs profiles). Refused now before the design runs, a
+    2D file and a profile alike, naming the database's dim (round 2, session 36)."""
+    from roughfe.surfaces import save_surface, spectral_profile, spectral_surface
+    settings = db.DatabaseSettings(length=1e-4, n_nodes=64, dim=1, n_steps=6)
+    sobol = db.SobolDesign(dim=1, n_pairs=1, n_vectors=1)
+    con = db.connect(tmp_path / "db.sqlite", create=True)
+    db.write_settings(con, settings)
+    db.write_design(con, sobol)
+    db.insert_records(con, [db.genome_entry_task(**t, **settings.to_dict())
+                            for t in db.sobol_tasks(sobol)])
+    con.close()
+    save_surface(spectral_surface(32, 1e-4, 0.7, rms_height=1e-7, rng=1), tmp_path / "s.npz")
+    save_surface(spectral_profile(64, 1e-4, 0.7, rms_height=1e-7, rng=1), tmp_path / "p.npz")
+    ran = []
+    monkeypatch.setattr(de, "run_design", lambda *a, **k: ran.append(1) or 1 / 0)
+    for name in ("s.npz", "p.npz"):
+        assert main(["design", "--db", str(tmp_path / "db.sqlite"), "--target", "y_t1",
+                     "--method", "sog", "--iterations", "1", "--match-spectrum",
+                     str(tmp_path / name), "--no-figures", "-o", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err
+        assert "--match-spectrum needs a surface database (dim 2" in err
+        assert "is a profile database (dim 1)" in err
+    assert not ran and not (tmp_path / "o").exists()

@@ -171,9 +171,22 @@ def _run(args) -> int:
     if args.match_spectrum:         # read, warned of and prepared before the design runs
         from ..genomics.design import target_surface
         from .surface_warnings import plausible_surface
+        if settings.dim != 2:       # refused by spectrum_matched only after the design
+            raise InputError(f"--match-spectrum needs a surface database (dim 2: periodic "
+                             f"2D designs, whose chromosomes take the file's band rms); "
+                             f"{args.db} is a profile database (dim 1)")
         surface = surface_file(args, args.match_spectrum)
         plausible_surface(args, surface, args.detrend)   # its warnings, as design-targets;
         spectrum_target = target_surface(surface, settings, detrend=args.detrend)  # detrended
+        # Not check_target_surface (design-targets): its size warning is about the file's
+        # own K(p) and A(p) as the targets (the longest waves and a window's bulk
+        # compliance at its size), while here the targets are --target's curves and the
+        # file gives only the rms of its Fourier modes, each to the chromosome nearest in
+        # log q, by wavenumber, not by length; its 2D-on-a-profile-database case is
+        # refused above. The file's size sets only the wavenumbers it covers: its modes of
+        # wavelength above L go to the longest chromosome (spectral windows of L, mirrored:
+        # 0.5-22 % of the mean square, H 0.3-0.9; of 2 L: 27-84 %; x3p-2 on the L = 260 um
+        # of docs/theory/surface-design.md: 0.02 %), not warned of (round 2, session 36)
     cache = {}
     targets = [_target(args.target, args.quantity, settings, cache, "K")]
     if args.second_target:

@@ -6,7 +6,7 @@ import numpy as np
 from ..errors import InputError, check_memory
 from .options import (add_detrend_option, add_output_file, add_run_options,
                       add_surface_options, nonnegative_int, output_file_of, positive_float,
-                      positive_int, print_surface_notes, surface_from_args)
+                      positive_int, print_surface_notes, surface_file)
 
 # (key, label, unit, scale) rows of the info table
 _TABLE = (
@@ -57,12 +57,19 @@ def scan_line_block(surface):
     return None if check is None else {**asdict(check), "units": dict(SCAN_LINE_UNITS)}
 
 
-def scan_line_row(block) -> str:
-    """The table row of :func:`scan_line_block` (``""`` when it is None)."""
+def scan_line_row(block, mirrored: bool = False) -> str:
+    """The table row of :func:`scan_line_block` (``""`` when it is None). Where the check
+    fires it advises ``--detrend lines``, or, when the map as read is a ``mirrored``
+    window (:func:`roughfe.surfaces.scan_lines.is_mirrored`), to level the measured window
+    before mirroring: the advice of the stderr warnings
+    (:func:`roughfe.cli.surface_warnings.warn_scan_lines`, ``warn_mirrored_lines``);
+    the row said ``--detrend lines`` there too until round 2, session 36."""
     if block is None:
         return ""
-    verdict = ("> {:.3g}: the scan lines look offset (--detrend lines)" if block["fires"]
-               else "<= {:.3g}: no scan-line offsets").format(block["threshold"])
+    advice = ("a mirrored window: level the measured window before mirroring" if mirrored
+              else "--detrend lines")
+    verdict = (f"> {block['threshold']:.3g}: the scan lines look offset ({advice})"
+               if block["fires"] else f"<= {block['threshold']:.3g}: no scan-line offsets")
     return f"{'scan-line check R':<28s} {block['ratio']:.3g} {verdict}"
 
 
@@ -124,9 +131,13 @@ def write_psd(surface, path, title: str):
 
 
 def _info(args) -> int:
+    from ..surfaces.scan_lines import is_mirrored
     from ..surfaces.stats import surface_statistics
     from ..writers import output_file, to_json_text
-    surface = surface_from_args(args)
+    from .surface_warnings import plausible_surface
+    read = surface_file(args, args.surface)      # as read: --detrend plane breaks the
+    mirrored = is_mirrored(read)                 # evenness of a mirrored .npy
+    surface = plausible_surface(args, read, args.detrend)     # (surface_from_args)
     q_range = None if args.hurst_q_range is None else tuple(args.hurst_q_range)
     if q_range is not None and not q_range[0] < q_range[1]:
         raise InputError(f"--hurst-q-range QMIN QMAX needs QMIN < QMAX (rad/m), got "
@@ -146,7 +157,7 @@ def _info(args) -> int:
         print_surface_notes(args, surface, channel=True)
         print(format_table(stats))
         if scan_lines is not None:
-            print(scan_line_row(scan_lines))
+            print(scan_line_row(scan_lines, mirrored))
     return 0
 
 
