@@ -134,6 +134,7 @@ def _info(args) -> int:
     from ..surfaces.scan_lines import is_mirrored
     from ..surfaces.stats import surface_statistics
     from ..writers import output_file, to_json_text
+    from .info_reliability import reliability_block, reliability_row, warn_hurst_range
     from .surface_warnings import plausible_surface
     read = surface_file(args, args.surface)      # as read: --detrend plane breaks the
     mirrored = is_mirrored(read)                 # evenness of a mirrored .npy
@@ -148,16 +149,21 @@ def _info(args) -> int:
     if psd_path is not None:
         write_psd(surface, psd_path, str(args.surface))
     scan_lines = scan_line_block(surface)
+    reliability = reliability_block(args, read)         # trace vs retrace, as read
+    warn_hurst_range(args, reliability, stats["hurst_q_range"])
     if args.json:
         units = {k: v for k, v in STATISTICS_UNITS.items() if k in stats}
         print(to_json_text({"file": str(args.surface), "statistics": stats, "units": units,
-                            "scan_lines": scan_lines, "metadata": dict(surface.metadata)}))
+                            "scan_lines": scan_lines, "reliability": reliability,
+                            "metadata": dict(surface.metadata)}))
     else:
         print(f"{args.surface}: {surface!r}")
         print_surface_notes(args, surface, channel=True)
         print(format_table(stats))
         if scan_lines is not None:
             print(scan_line_row(scan_lines, mirrored))
+        if reliability is not None:
+            print(reliability_row(reliability))
     return 0
 
 

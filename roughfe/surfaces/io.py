@@ -45,8 +45,10 @@ SurfaceTopography's reader scrambles, is put back in order there
 """
 from __future__ import annotations
 
+import ast
 import datetime as _dt
 import json
+import re
 import warnings
 import zipfile
 import zlib
@@ -236,6 +238,40 @@ def channel_label(channel) -> str:
     raw = (channel.info or {}).get("raw_metadata")
     direction = raw.get("line direction") if isinstance(raw, dict) else None
     return f"{channel.index} {channel.name!r}" + (f" ({direction})" if direction else "")
+
+
+#: the two scan directions of one quantity that :func:`trace_retrace_partner` pairs
+SWEEPS = ("trace", "retrace")
+
+
+def _label_parts(label):
+    """(index, name, direction or None) of a :func:`channel_label`; None if not one."""
+    match = re.fullmatch(r"(\d+) ('.*'|\".*\")(?: \(([^()]*)\))?", str(label))
+    if match is None:
+        return None
+    try:
+        name = ast.literal_eval(match.group(2))
+    except (ValueError, SyntaxError):
+        return None
+    return int(match.group(1)), name, match.group(3)
+
+
+def trace_retrace_partner(metadata) -> "int | None":
+    """Index of the channel that holds the other sweep of the channel read, from an
+    instrument surface's ``metadata["channel"]`` and ``metadata["channels"]`` as
+    :func:`channel_label` shows them: the one channel of the same name whose direction is
+    the other of Trace / Retrace (di-1: 0 'Height' (Trace) and 1 'Height' (Retrace)).
+    None when the channel read has no such direction, or no single partner."""
+    read = metadata.get("channel")
+    labels = [_label_parts(c) for c in metadata.get("channels") or []]
+    own = next((p for p in labels if p and isinstance(read, dict)
+                and p[0] == read.get("index")), None)
+    if own is None or own[2] is None or own[2].lower() not in SWEEPS:
+        return None
+    other = SWEEPS[1 - SWEEPS.index(own[2].lower())]
+    partners = [p[0] for p in labels if p and p[1] == own[1] and p[2] is not None
+                and p[2].lower() == other]
+    return partners[0] if len(partners) == 1 else None
 
 
 def _choose_channel(reader, channel, path):
