@@ -213,6 +213,23 @@ def test_heights_or_size_in_the_wrong_unit_are_warned(tmp_path, capsys, topograp
             and "where the trace and the retrace stop agreeing" not in w] == []
 
 
+def test_the_slope_warning_judges_the_heights_the_command_uses(capsys, topographies_dir):
+    """di-1's retrace channel is tilted (its plane carries 99.2 % of the variance): rms
+    slope 1.06 as read, 0.72 with the plane removed. The slope warning judged the heights
+    as read, so ``--detrend plane`` still warned of a slope of 1.06 its analysis did not
+    have (session 36). Now the detrended heights are judged, and under ``--detrend mean``
+    the warning says that the slope is the tilt's."""
+    di = str(topographies_dir / "di-1.di")
+    assert main(["info", di, "--channel", "1", "--detrend", "plane"]) == 0
+    captured = capsys.readouterr()
+    assert "warning: rms slope" not in captured.err
+    assert "rms slope                    0.72" in captured.out
+    assert main(["info", di, "--channel", "1"]) == 0          # --detrend mean: the tilt kept
+    err = capsys.readouterr().err
+    assert err.count("warning: rms slope 1.06 > 1") == 1
+    assert "0.722 with its least-squares plane removed: the slope is the tilt's" in err
+
+
 def test_an_option_of_another_command_is_named_by_the_command(tmp_path, capsys):
     """`roughfe leak ... --mirror` (an option of `contact`) was refused by the top parser,
     "roughfe: error: unrecognized arguments: --mirror (see `roughfe --help`)": now the

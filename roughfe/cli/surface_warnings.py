@@ -28,11 +28,12 @@ SIZE_RATIO_LIMIT = 100.0
 
 
 def warn_units(args, surface) -> None:
-    """Warn (stderr) of the two unit mistakes a review found accepted without a word: an
-    rms slope above :data:`SLOPE_LIMIT` (a plain matrix of heights in um read as m had
-    rms slope 1.3e6 and ran to a mean gap of 3 m), and a ``--size`` that differs from the
-    instrument file's own size by more than :data:`SIZE_RATIO_LIMIT` (``--size 500`` for
-    500 nm on an AFM file: a 500 m scan)."""
+    """Warn (stderr) of the size mistakes a review found accepted without a word: a
+    ``--size`` that differs from the instrument file's own size by more than
+    :data:`SIZE_RATIO_LIMIT` (``--size 500`` for 500 nm on an AFM file: a 500 m scan), and
+    one ``--size`` value on a non-square grid (cells that are not square). The slope (a
+    matrix of heights in um read as m) is :func:`warn_slope`'s, judged after the
+    detrending."""
     in_file = surface.metadata.get("size_in_file")
     if in_file:
         ratio = max(max(a / b, b / a) for a, b in zip(surface.size, in_file) if a > 0 and b > 0)
@@ -48,11 +49,31 @@ def warn_units(args, surface) -> None:
                    f"a square of {size[0]:.4g} m with cells of {dx:.4g} m x {dy:.4g} m "
                    f"(aspect {max(dx, dy) / min(dx, dy):.3g}); for square cells give "
                    f"--size LX LY")
+
+
+def warn_slope(args, surface) -> None:
+    """Warn (stderr) when the rms slope of ``surface``, the heights as the command uses
+    them (after ``--detrend``), is above :data:`SLOPE_LIMIT`; far above it (100) the
+    likely unit mistake is named. On a non-periodic surface whose least-squares plane
+    brings the slope below the limit the warning says so: the slope is the tilt's. Until
+    round 2, session 36 the slope was judged on the heights as read, before the
+    detrending, so ``--detrend plane`` on a tilted scan still warned of a slope its
+    analysis did not have (di-1's retrace channel: 1.06 as read, 0.72 levelled). The
+    review that asked for it: a plain matrix of heights in um read as m had rms slope
+    1.3e6 and ran to a mean gap of 3 m."""
     slope = rms_slope_or_zero(surface)
-    if slope > SLOPE_LIMIT:
-        warn(args, f"rms slope {slope:.3g} > {SLOPE_LIMIT:g}: beyond the small slopes of the "
-                   f"elastic half-space" + (" -- far beyond: are the heights in metres and "
-                                            "the size (--size) in metres?" if slope > 100 else ""))
+    if slope <= SLOPE_LIMIT:
+        return
+    tilt = ""
+    if not surface.periodic:
+        flat = rms_slope_or_zero(surface.detrended("plane"))
+        if flat <= SLOPE_LIMIT:
+            tilt = (f"; {flat:.3g} with its least-squares plane removed: the slope is the "
+                    f"tilt's (--detrend plane if the tilt is the instrument's)")
+    warn(args, f"rms slope {slope:.3g} > {SLOPE_LIMIT:g}: beyond the small slopes of the "
+               f"elastic half-space" + tilt + (" -- far beyond: are the heights in metres "
+                                               "and the size (--size) in metres?"
+                                               if slope > 100 else ""))
 
 
 def warn_tilt(args, surface, detrend: str = "mean") -> None:
@@ -175,12 +196,13 @@ def warn_mirrored_lines(args, surface, detrend: str) -> None:
 
 def plausible_surface(args, surface, detrend: str = "none"):
     """``surface`` as its file gave it, detrended by ``detrend`` (a ``--detrend`` mode),
-    after the warnings of a read surface: a unit mistake (:func:`warn_units`), an
+    after the warnings of a read surface: a size mistake (:func:`warn_units`), an
     instrument tilt kept by ``mean`` or ``lines`` on a non-periodic surface
     (:func:`warn_tilt`), scan-line offsets left by ``none``, ``mean`` or ``plane``
     (:func:`warn_scan_lines`), the lines of a mirrored window levelled by ``lines`` or
-    ``lines-tilt`` (:func:`warn_mirrored_lines`) and, with ``--periodic``, a seam in the
-    detrended heights (:func:`warn_seam`). The one path of these warnings: the commands that read
+    ``lines-tilt`` (:func:`warn_mirrored_lines`), then on the detrended heights an rms
+    slope beyond the half-space's (:func:`warn_slope`) and, with ``--periodic``, a seam
+    (:func:`warn_seam`). The one path of these warnings: the commands that read
     :func:`roughfe.cli.options.surface_from_args` (info, contact, leak, natural, genome
     chromosomes), ``design-targets --surface``, which detrends in the library
     (:func:`roughfe.genomics.design.targets.target_surface`) and took none of them
@@ -192,6 +214,7 @@ def plausible_surface(args, surface, detrend: str = "none"):
         warn_scan_lines(args, surface)
     warn_mirrored_lines(args, surface, detrend)
     surface = surface if detrend == "none" else surface.detrended(detrend)
+    warn_slope(args, surface)
     if getattr(args, "periodic", None) is True:
         warn_seam(args, surface)
     return surface
