@@ -199,6 +199,23 @@ def test_x3p2_k_rows_not_met_say_the_measured_reason_and_gate_as_before():
         assert sg.X3P_K_MISS not in score[name].reason
 
 
+def test_a_spectrum_matched_design_row_says_no_gcmma_stage_ran_not_nan():
+    """The x3p-2 design rows of the full surface-genomics report read "GCMMA stages 0.205,
+    nan, nan" (session 36): a spectrum-matched candidate runs no GCMMA stage, its stages
+    are (Alg. 3 score, NaN, NaN) in memory and null in JSON. The reason now says so in
+    words; a design whose stages ran keeps its numbers, a missing stage reads "-"."""
+    sg = _script("surface_genomics")
+    for missing in (float("nan"), None):
+        text = sg._reason({**_design_row("x3p-2", "sog", 0.9759),
+                           "stages": [0.2053706920668028, missing, missing]})
+        assert "Alg. 3 score 0.205 (no GCMMA stage ran)" in text and "nan" not in text
+    ran = sg._reason({**_design_row("y_t1", "sog", 0.9839),
+                      "stages": [0.836212731, 0.995375970, 0.995375970]})
+    assert "GCMMA stages 0.836, 0.995, 0.995 (interpolated on the design's own steps)" in ran
+    assert "GCMMA stages 0.836, -" in sg._reason({**_design_row("y_t1", "sog", 0.98),
+                                                  "stages": [0.836, float("nan"), 0.9]})
+
+
 def test_targets_markdown_escapes_a_pipe_inside_a_cell():
     """A row named "|p256 / p128 - 1|" split its Markdown table row into extra cells."""
     md = targets_markdown([Target("rough: |p256 / p128 - 1|", "<= 0.2 %", "1e-05", True)])

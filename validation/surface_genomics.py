@@ -358,10 +358,20 @@ def _targets(rec, noise, mech, designs, db_info, x3p, west):
     return rows
 
 
+def _stages(stages):
+    """The GCMMA stages' scores as text; a spectrum-matched candidate's stages after the
+    first are NaN (None once in JSON: no GCMMA stage ran, its first is the Alg. 3 score,
+    docs/guide/03), said in words instead of "nan"."""
+    ran = [s for s in stages[1:] if s is not None and np.isfinite(s)]
+    if stages[1:] and not ran:
+        return f"Alg. 3 score {stages[0]:.3f} (no GCMMA stage ran)"
+    text = ", ".join("-" if s is None or not np.isfinite(s) else f"{s:.3f}" for s in stages)
+    return f"GCMMA stages {text} (interpolated on the design's own steps)"
+
+
 def _reason(d):
     match = f", spectrum matched per {d['matching']}" if d.get("matching") else ""
-    return (f"from {d['origin']}; GCMMA stages {', '.join(f'{s:.3f}' for s in d['stages'])} "
-            f"(interpolated on the design's own steps){match}, then the search at the target "
+    return (f"from {d['origin']}; {_stages(d['stages'])}{match}, then the search at the target "
             f"pressures ({d['search_sweeps']} sweeps per candidate)"
             + (f", then IPOP-CMA-ES ({d['global_evaluations']} strict evaluations, batched, "
                f"one run, seed {GlobalSearchOptions.seed}, sigma {d['global_sigma']:g}, "
