@@ -11,7 +11,6 @@ Budget: ~5 s CPU together (a 65-node profile; an r = 1 level of three loads, coa
 mesh).
 """
 import dataclasses
-import importlib.util
 import json
 import os
 from collections.abc import Mapping
@@ -144,12 +143,8 @@ def test_a_checkpoint_of_another_sweep_is_not_used(small_mesh, uninterrupted, tm
 # -- validation/fem_convergence.py: an interrupted level resumes -------------------------
 @pytest.fixture(scope="module")
 def study():
-    spec = importlib.util.spec_from_file_location(
-        "fem_convergence_under_test",
-        Path(__file__).resolve().parents[1] / "validation" / "fem_convergence.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    from roughfe.cli.validate_cmd import _load
+    return _load("fem_convergence")
 
 
 def _level(store: Path, name: str) -> dict:

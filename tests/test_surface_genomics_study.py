@@ -1,8 +1,6 @@
 """validation/surface_genomics.py's design chain (issue 15 §3) on a small surface
 database: every design the study saves is re-scored by an independent BEM run of its
 saved heights to the same strict scores, and the global stage runs where GLOBAL says."""
-import importlib.util
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,12 +12,8 @@ pytestmark = pytest.mark.slow
 
 
 def _study():
-    spec = importlib.util.spec_from_file_location(
-        "surface_genomics_study",
-        Path(__file__).resolve().parents[1] / "validation" / "surface_genomics.py")
-    study = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(study)
-    return study
+    from roughfe.cli.validate_cmd import _load
+    return _load("surface_genomics")
 
 
 def test_design_runs_are_reproduced_by_the_saved_heights(tmp_path, monkeypatch):
