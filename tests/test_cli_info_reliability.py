@@ -71,3 +71,49 @@ def test_a_pair_that_cannot_be_compared_is_said_in_the_row(tmp_path):
     block = reliability_block(args, load_surface(path))
     assert block["channels"] == meta["channels"] and "channel" in block["error"]
     assert reliability_row(block).startswith("trace/retrace reliable to    n/a (")
+
+
+def test_info_psd_writes_the_coherence_beside_the_psd(topographies_dir, tmp_path, capsys):
+    """--psd FILE.csv on di-1 adds FILE_coherence.csv: the curve whose crossing of 1/4 is
+    the row's q_c; an existing one is refused (nothing written) without --overwrite;
+    x3p-2 (no pair) gets no second file."""
+    import numpy as np
+    di = str(topographies_dir / "di-1.di")
+    psd = tmp_path / "p.csv"
+    assert main(["info", di, "--psd", str(psd)]) == 0
+    capsys.readouterr()
+    lines = (tmp_path / "p_coherence.csv").read_text().splitlines()
+    assert lines[0] == "q (rad/m),coherence gamma^2 (-),snr P_S/P_N (-)"
+    q, g, snr = np.array([[float(v) for v in row.split(",")] for row in lines[1:]]).T
+    assert q.size == 253 and g[0] > 0.99 and g[-1] < 0.05
+    assert np.allclose(snr, np.sqrt(g) / (1 - np.sqrt(g)), rtol=1e-5)   # 10 digits
+    last = np.flatnonzero(g >= 0.25)[-1]          # the cutoff lies between two rows
+    assert q[last] < 5.927e8 < q[last + 1]
+    # the PSD file itself is unchanged in form: its first column's kinds only
+    assert {row.split(",")[0] for row in psd.read_text().splitlines()[1:]} == {
+        "radial", "x", "y"}
+    psd.unlink()
+    assert main(["info", di, "--psd", str(psd)]) == 2   # the coherence file exists
+    assert "p_coherence.csv exists" in capsys.readouterr().err and not psd.exists()
+    assert main(["info", di, "--psd", str(psd), "--overwrite"]) == 0
+    x3p = tmp_path / "x"
+    x3p.mkdir()
+    assert main(["info", str(topographies_dir / "x3p-2.x3p"), "--psd",
+                 str(x3p / "p.csv")]) == 0
+    assert sorted(p.name for p in x3p.iterdir()) == ["p.csv"]
+
+
+def test_info_psd_figure_gets_the_coherence(topographies_dir, tmp_path, monkeypatch):
+    """--psd FILE.png hands the curve to the figure (a panel and q_c marked), and draws."""
+    import roughfe.plotting.surfaces as plotting
+    seen = {}
+    draw = plotting.plot_psd
+
+    def spy(*args, **kwargs):
+        seen["coherence"] = kwargs.get("coherence")
+        return draw(*args, **kwargs)
+    monkeypatch.setattr(plotting, "plot_psd", spy)
+    assert main(["info", str(topographies_dir / "di-1.di"), "--psd",
+                 str(tmp_path / "p.png")]) == 0
+    assert abs(seen["coherence"].q_cutoff / 5.927e8 - 1) < 2e-3
+    assert (tmp_path / "p.png").stat().st_size > 10000

@@ -10,7 +10,9 @@ theory is non-adhesive, so an adhesive run has none (``derived.persson`` says so
 values are None (``derived.persson`` says so and lists those steps). ``--mirror`` solves
 the evenly mirrored window of a non-periodic surface (:meth:`Surface.mirrored`) as a
 periodic one: a measured window's K is otherwise mostly its bulk compliance
-(``derived.window_compliance``).
+(``derived.window_compliance``). An instrument file with a trace and a retrace channel
+gets a ``note:`` line on their reliability cutoff and ``inputs.reliability``
+(:mod:`roughfe.cli.info_reliability`).
 
 The options are :mod:`roughfe.cli.contact_options`, the files
 :mod:`roughfe.cli.contact_files`, the printed table :mod:`roughfe.cli.contact_table` and
@@ -33,6 +35,7 @@ from .contact_files import shown_step as _shown_step  # noqa: F401  (its name be
 from .contact_grid import grid_check_of_args
 from .contact_options import DEFAULT_STEPS, add_contact_arguments, in_flags, method_options
 from .contact_table import print_summary
+from .info_reliability import print_reliability_note, reliability_block
 from .options import (ADHESION_WORDS, contact_physics_from_args, material_from_args,
                       mirrored_if_asked, output_folder_of, surface_from_args)
 from .plausibility import check_load_magnitudes, check_solution
@@ -50,7 +53,8 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
-    surface = mirrored_if_asked(args, surface_from_args(args))
+    read = surface_from_args(args)                      # detrended, before --mirror
+    surface = mirrored_if_asked(args, read)
     material = material_from_args(args)
     check_load_magnitudes(surface, material, args.pressure, args.delta)
     law = contact_physics_from_args(args)["adhesion"]
@@ -86,7 +90,8 @@ def _run(args) -> int:
               "control": "pressure" if args.pressure else "delta",
               "hardness": args.hardness, "unload": args.unload,
               "detrend": args.detrend, "mirror": args.mirror, "grid_check": args.grid_check,
-              "metadata": dict(surface.metadata)}
+              "metadata": dict(surface.metadata),
+              "reliability": reliability_block(args, read)}   # trace vs retrace, or None
     doc = contact_document(sweep, surface, material, inputs, adhesive=adhesive is not None)
     if grid is not None:
         doc["derived"]["grid_check"] = grid.describe()
@@ -121,6 +126,8 @@ def _run(args) -> int:
         write_json(out / "results.json", doc)  # last: the run is complete
     print_summary(args, surface, material, sweep, doc, grid, adhesive=adhesive,
                   maugis=maugis, stickiness=stickiness)
+    print_reliability_note(inputs["reliability"], read,
+                           "contact area, its patches and the gaps")
     print(f"wrote {', '.join(str(w) for w in written)}")
     return 0
 

@@ -10,7 +10,17 @@ and the lag between the sweeps. Both channels are taken as read (the coherence l
 each line itself), so the row is the same under every ``--detrend``. Where the Hurst
 fit range reaches above ``q_c`` a warning (stderr) says that the fit includes scales
 where each sweep holds more noise than surface, and how to restrict it
-(``--hurst-q-range``); the fit's default range is not changed.
+(``--hurst-q-range``); the fit's default range is not changed. ``info --psd`` adds the
+coherence curve (:func:`write_coherence`: a second CSV beside the PSD's, or a panel and
+the cutoff on its figure).
+
+``contact`` and ``leak`` on such a file print the same facts as a ``note:`` line
+(:func:`reliability_note`) and keep the block in results.json (``inputs.reliability``):
+their contact patches and gaps at the pixel scale include the scales finer than the
+cutoff. A note, not a warning: on di-1, removing those scales along the fast axis (what
+the coherence judges) moved A* by 1.5-2.9 %, K by 0.2 % and the mean gap by 0.1 % at
+8e5-2.4e7 Pa; the same scales across the lines moved A* 1.5-2.3x, but trace and retrace
+cannot judge those (docs/theory/01_surfaces.md).
 """
 from __future__ import annotations
 
@@ -25,20 +35,18 @@ from .options import surface_file, warn
 ROW = "trace/retrace reliable to"
 
 
-def reliability_block(args, read):
-    """``info --json``'s ``reliability``: the scalars of the trace/retrace coherence of
-    ``read`` (the surface as its file gave it) with its other sweep, with ``units`` and
-    ``channels``; ``error`` instead when the pair cannot be compared (the other channel
-    unreadable, too few lines); None when the file holds no trace/retrace pair of the
-    channel read (a single-channel file, a ``.npz``, a profile)."""
+def trace_retrace_of(args, read):
+    """``(block, result)``: :func:`reliability_block` and the
+    :class:`~roughfe.surfaces.reliability.TraceRetraceCoherence` it summarises (None when
+    the block is None or says why the pair cannot be compared)."""
     from ..surfaces.io import trace_retrace_partner
     from ..surfaces.reliability import SUMMARY_UNITS, trace_retrace_coherence
     meta = read.metadata
     if read.ndim != 2 or meta.get("source") != str(args.surface):
-        return None                            # the instrument file itself, as read
+        return None, None                      # the instrument file itself, as read
     partner = trace_retrace_partner(meta)
     if partner is None:
-        return None
+        return None, None
     channels = [next(c for c in meta["channels"] if c.split(" ", 1)[0] == str(i))
                 for i in (meta["channel"]["index"], partner)]
     try:
@@ -48,27 +56,84 @@ def reliability_block(args, read):
                                                        "channel": str(partner)}), args.surface)
         result = trace_retrace_coherence(read, other)
     except RoughfeError as exc:                # the other channel unreadable, too few lines
-        return {"channels": channels, "error": str(exc)}
-    return {**result.summary(), "channels": channels, "units": dict(SUMMARY_UNITS)}
+        return {"channels": channels, "error": str(exc)}, None
+    return {**result.summary(), "channels": channels, "units": dict(SUMMARY_UNITS)}, result
+
+
+def reliability_block(args, read):
+    """``info --json``'s ``reliability``: the scalars of the trace/retrace coherence of
+    ``read`` (the surface as its file gave it; a detrended one gives the same, the
+    coherence levels each line) with its other sweep, with ``units`` and ``channels``;
+    ``error`` instead when the pair cannot be compared (the other channel unreadable, too
+    few lines); None when the file holds no trace/retrace pair of the channel read (a
+    single-channel file, a ``.npz``, a profile)."""
+    return trace_retrace_of(args, read)[0]
+
+
+def _text(block) -> str:
+    """What the row says after its label."""
+    if "error" in block:
+        return f"n/a ({block['error']})"
+    lag = (f"{block['channels'][1]} is {block['channels'][0]} shifted by "
+           f"{block['lag']:.3g} samples ({block['lag_length'] * 1e6:.3g} um)")
+    if block["q_cutoff"] is None:
+        return (f"the pixel (coherence >= {block['threshold']:g} up to the Nyquist "
+                f"wavenumber along {block['axis']}); {lag}")
+    if not block["reliable_anywhere"]:
+        return (f"no wavelength (coherence < {block['threshold']:g} at every wavenumber "
+                f"along {block['axis']}: the sweeps do not agree); {lag}")
+    return (f"q < {block['q_cutoff'] * 1e-6:.4g} rad/um (wavelengths > "
+            f"{block['wavelength_cutoff'] * 1e6:.3g} um) along {block['axis']}, the fast "
+            f"axis; {lag}")
 
 
 def reliability_row(block) -> str:
     """The table row of :func:`reliability_block` (``""`` when it is None)."""
+    return "" if block is None else f"{ROW:<28s} {_text(block)}"
+
+
+def reliability_note(block, spacing, what: str) -> str:
+    """``contact``'s and ``leak``'s ``note:`` line on :func:`reliability_block` (``""``
+    when it is None): the row's facts and, when the sweeps agree only above a wavelength,
+    that ``what`` (the command's results) at the pixel scale include the finer scales;
+    ``spacing`` (m) the grid's along the fast axis. The measured effect on di-1 is in the
+    module docstring: a note, not a warning."""
     if block is None:
         return ""
-    if "error" in block:
-        return f"{ROW:<28s} n/a ({block['error']})"
-    lag = (f"{block['channels'][1]} is {block['channels'][0]} shifted by "
-           f"{block['lag']:.3g} samples ({block['lag_length'] * 1e6:.3g} um)")
-    if block["q_cutoff"] is None:
-        return (f"{ROW:<28s} the pixel (coherence >= {block['threshold']:g} up to the "
-                f"Nyquist wavenumber along {block['axis']}); {lag}")
-    if not block["reliable_anywhere"]:
-        return (f"{ROW:<28s} no wavelength (coherence < {block['threshold']:g} at every "
-                f"wavenumber along {block['axis']}: the sweeps do not agree); {lag}")
-    return (f"{ROW:<28s} q < {block['q_cutoff'] * 1e-6:.4g} rad/um (wavelengths > "
-            f"{block['wavelength_cutoff'] * 1e6:.3g} um) along {block['axis']}, the fast "
-            f"axis; {lag}")
+    note = f"note: {ROW} {_text(block)}"
+    if "error" in block or block["q_cutoff"] is None or not block["reliable_anywhere"]:
+        return note
+    return (f"{note}. The {what} at the pixel scale ({spacing * 1e6:.3g} um) include the "
+            f"scales below {block['wavelength_cutoff'] * 1e6:.3g} um "
+            f"({block['wavelength_cutoff'] / spacing:.3g} pixels), where each sweep holds "
+            f"more noise than surface along the fast axis (across the lines trace and "
+            f"retrace share their noise and cannot tell; results.json inputs.reliability; "
+            f"di-1's measured effect: docs/theory/01_surfaces.md)")
+
+
+def print_reliability_note(block, surface, what: str) -> None:
+    """Print :func:`reliability_note` of ``block`` (nothing when it is None) for the
+    command's ``surface`` (its spacing along the block's fast axis)."""
+    if block is not None:
+        print(reliability_note(block, surface.spacing[0 if block.get("axis", "x") == "x"
+                                                      else 1], what))
+
+
+def write_coherence(result, psd_path):
+    """``info --psd FILE.csv``'s second file ``FILE_coherence.csv``: rows ``q`` (rad/m),
+    ``coherence`` (gamma^2, -), ``snr`` (P_S / P_N, -; ``inf`` where gamma^2 = 1) of
+    ``result`` (a :class:`~roughfe.surfaces.reliability.TraceRetraceCoherence`); the
+    path is :func:`coherence_path`, checked before anything is written."""
+    from ..writers import write_text
+    rows = ["q (rad/m),coherence gamma^2 (-),snr P_S/P_N (-)"]
+    rows += [f"{q:.10g},{g:.10g},{r:.10g}"
+             for q, g, r in zip(result.q, result.coherence, result.snr)]
+    return write_text(coherence_path(psd_path), "\n".join(rows) + "\n")
+
+
+def coherence_path(psd_path):
+    """``FILE_coherence.csv`` beside ``info --psd FILE.csv``."""
+    return psd_path.with_name(f"{psd_path.stem}_coherence.csv")
 
 
 def warn_hurst_range(args, block, q_range) -> None:

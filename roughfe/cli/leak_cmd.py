@@ -21,6 +21,7 @@ from ..bem.interface_law import cell_relief, resolution
 from ..errors import InputError
 from ..leakage.study import THESIS_D, THESIS_M
 from ..writers import write_json
+from .info_reliability import print_reliability_note, reliability_block
 from .leak_fields import (edge_junction_note, maps_of as _maps_of, network_figure,
                           save_fields, step_units)
 from .leak_fsi import print_coupled, run_coupled
@@ -58,9 +59,13 @@ def _print_if(line):
 def _leak(args) -> int:
     surface = surface_from_args(args)
     material = material_from_args(args)
+    reliability = reliability_block(args, surface)      # trace vs retrace, or None
     with output_folder_of(args, "leak") as out:
-        sweep, steps, written, persson = _leak_run(args, surface, material, out)
+        sweep, steps, written, persson = _leak_run(args, surface, material, out,
+                                                   reliability)
     print_surface_notes(args, surface)
+    print_reliability_note(reliability, surface,
+                           "contact patches, the gaps and the junctions that set Q")
     if args.fsi:
         print_coupled(steps, _VOLUME_HEAD, _volume_cells, _VOLUME_NOTE)
         _print_if(edge_junction_note(steps))
@@ -107,8 +112,10 @@ def _leak(args) -> int:
 LEAK_ADHESION_WORDS = {**ADHESION_WORDS, "approaches": "--delta"}
 
 
-def _leak_run(args, surface, material, out):
-    """Solve and write every file of ``roughfe leak`` into ``out``; results.json last."""
+def _leak_run(args, surface, material, out, reliability=None):
+    """Solve and write every file of ``roughfe leak`` into ``out``; results.json last
+    (``reliability``: :func:`~roughfe.cli.info_reliability.reliability_block` of the
+    surface, its ``inputs.reliability``)."""
     from ..leakage import leakage_sweep
     from ..plotting import leakage as figs
     from ..theory import beside
@@ -132,7 +139,7 @@ def _leak_run(args, surface, material, out):
             "trapped_fluid": (args.trapped_fluid or "volume") if args.fsi else None,
             "bulk_modulus": args.bulk_modulus,
             "delta": args.delta,
-            "pressure": args.pressure, "detrend": args.detrend,
+            "pressure": args.pressure, "detrend": args.detrend, "reliability": reliability,
             "hardness": physics["hardness"], "unload": physics["unload"],
             "adhesion": physics["adhesion"] and physics["adhesion"].describe(),
             "units": "SI (m, Pa, Pa s, m^3/s)"}

@@ -107,11 +107,15 @@ def format_table(stats: dict) -> str:
     return "\n".join(lines)
 
 
-def write_psd(surface, path, title: str):
+def write_psd(surface, path, title: str, coherence=None):
     """``info --psd``: the PSD (radially averaged for a map) and, for a map, the mean 1D
     PSDs along x and y (:mod:`roughfe.surfaces.line_psd`) as CSV rows ``kind, q, C,
     C_jacobs, weight`` (SI; C in Persson's normalisation, C_jacobs = (2 pi)^d C is
-    SurfaceTopography's / contact.engineering's) or as a PNG figure."""
+    SurfaceTopography's / contact.engineering's) or as a PNG figure. With ``coherence``
+    (the file's trace/retrace :class:`~roughfe.surfaces.reliability.TraceRetraceCoherence`)
+    the CSV gets a second file ``FILE_coherence.csv``
+    (:func:`roughfe.cli.info_reliability.write_coherence`) and the figure a third panel
+    with the curve and the cutoff marked in every panel."""
     from ..surfaces.line_psd import line_spectra
     from ..surfaces.stats import fit_hurst, power_spectrum
     from ..writers import write_text
@@ -121,7 +125,10 @@ def write_psd(surface, path, title: str):
         from ..plotting.surfaces import plot_psd
         lines = {k: v for k, v in spectra.items() if k != main}
         return plot_psd({main: spectra[main]}, path, title=f"{title}: PSD",
-                        fits={main: fit_hurst(surface)}, lines=lines)
+                        fits={main: fit_hurst(surface)}, lines=lines, coherence=coherence)
+    if coherence is not None:
+        from .info_reliability import write_coherence
+        write_coherence(coherence, path)
     rows = ["kind,q (rad/m),C (m^3 or m^4; Persson),C_jacobs (m^3 or m^4; "
             "SurfaceTopography),weight (rad/m or rad^2/m^2),window"]
     for kind, p in spectra.items():
@@ -134,7 +141,8 @@ def _info(args) -> int:
     from ..surfaces.scan_lines import is_mirrored
     from ..surfaces.stats import surface_statistics
     from ..writers import output_file, to_json_text
-    from .info_reliability import reliability_block, reliability_row, warn_hurst_range
+    from .info_reliability import (coherence_path, reliability_row, trace_retrace_of,
+                                   warn_hurst_range)
     from .surface_warnings import plausible_surface
     read = surface_file(args, args.surface)      # as read: --detrend plane breaks the
     mirrored = is_mirrored(read)                 # evenness of a mirrored .npy
@@ -146,10 +154,12 @@ def _info(args) -> int:
     psd_path = None if args.psd is None else output_file(args.psd, overwrite=args.overwrite,
                                                          suffixes=(".csv", ".png"))
     stats = surface_statistics(surface, q_range=q_range).as_dict()
+    reliability, coherence = trace_retrace_of(args, read)     # trace vs retrace, as read
     if psd_path is not None:
-        write_psd(surface, psd_path, str(args.surface))
+        if coherence is not None and psd_path.suffix.lower() == ".csv":
+            output_file(coherence_path(psd_path), overwrite=args.overwrite)  # both checked
+        write_psd(surface, psd_path, str(args.surface), coherence)
     scan_lines = scan_line_block(surface)
-    reliability = reliability_block(args, read)         # trace vs retrace, as read
     warn_hurst_range(args, reliability, stats["hurst_q_range"])
     if args.json:
         units = {k: v for k, v in STATISTICS_UNITS.items() if k in stats}
@@ -402,6 +412,9 @@ def register(sub):
     p.add_argument("--psd", metavar="FILE", default=None,
                    help="also write the PSD (radially averaged for a map) and a map's mean "
                         "1D PSDs along x and y: .csv (q, C in Persson's normalisation, "
-                        "C_jacobs = SurfaceTopography's / contact.engineering's) or .png")
+                        "C_jacobs = SurfaceTopography's / contact.engineering's) or .png; "
+                        "a file with a trace and a retrace channel adds their coherence "
+                        "(FILE_coherence.csv beside a .csv; a panel and the cutoff on a "
+                        ".png)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --psd file")
     p.set_defaults(func=_info)

@@ -108,7 +108,7 @@ def _fit_line(ax, psd, fit):
                         f"Whittle level\n(wavelengths {waves.min():.2g}-{waves.max():.2g} um)")
 
 
-def plot_psd(spectra, path, title=None, fits=None, lines=None):
+def plot_psd(spectra, path, title=None, fits=None, lines=None, coherence=None):
     """Log-log plot of power spectra.
 
     Parameters
@@ -124,8 +124,13 @@ def plot_psd(spectra, path, title=None, fits=None, lines=None):
         1D PSDs along x and y of a map
         (:func:`roughfe.surfaces.line_psd.line_power_spectrum`), drawn in a second
         panel (m^3: not on the 2D PSD's axis).
+    coherence : TraceRetraceCoherence, optional
+        The trace/retrace coherence of the map
+        (:func:`roughfe.surfaces.reliability.trace_retrace_coherence`): drawn in a last
+        panel with its threshold, and its cutoff ``q_c`` marked in every panel.
     """
-    fig, axes = new_figure(1, 2 if lines else 1, figsize=(11, 4.5) if lines else (6, 4.5),
+    panels = 1 + bool(lines) + (coherence is not None)
+    fig, axes = new_figure(1, panels, figsize=(5.5 * panels, 4.5) if panels > 1 else (6, 4.5),
                            squeeze=False)
     ax = axes[0, 0]
     units = set()
@@ -143,7 +148,31 @@ def plot_psd(spectra, path, title=None, fits=None, lines=None):
             axes[0, 1].loglog(psd.q, psd.C, ".", ms=3, label=label)
         _psd_axes(axes[0, 1], "1D PSD C(q) (m$^3$, Persson's normalisation)",
                   "mean PSD of the lines along x and along y")
+    if coherence is not None:
+        _coherence_panel(axes[0, -1], coherence)
+        if coherence.q_cutoff is not None:
+            for a in axes[0, :-1]:
+                a.axvline(coherence.q_cutoff, color="0.4", ls=":", lw=1,
+                          label=f"trace/retrace q_c = {coherence.q_cutoff:.3g} rad/m")
+                a.legend(fontsize=8)
     return save_figure(fig, path)
+
+
+def _coherence_panel(ax, c):
+    """The trace/retrace coherence gamma^2(q) along the fast axis, its threshold and
+    cutoff (:class:`~roughfe.surfaces.reliability.TraceRetraceCoherence`)."""
+    ax.semilogx(c.q, c.coherence, ".", ms=3, label=f"gamma^2 along {c.axis} (fast axis)")
+    ax.axhline(c.threshold, color="0.4", ls="--", lw=1,
+               label=f"{c.threshold:g}: surface power = noise power")
+    if c.q_cutoff is not None:
+        ax.axvline(c.q_cutoff, color="0.4", ls=":", lw=1,
+                   label=f"q_c = {c.q_cutoff:.3g} rad/m ({c.wavelength_cutoff:.3g} m)")
+    ax.set_ylim(0, 1.02)
+    ax.set_xlabel("wavenumber q (rad/m)")
+    ax.set_ylabel("coherence gamma^2 (-)")
+    ax.set_title("trace/retrace coherence")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
 
 
 def _psd_axes(ax, ylabel, title):
