@@ -38,6 +38,17 @@ def test_info_json_has_the_reliability_block(topographies_dir, capsys):
     assert abs(block["wavelength_cutoff"] / 10.60e-9 - 1) < 2e-3
     assert block["channels"] == ["0 'Height' (Trace)", "1 'Height' (Retrace)"]
     assert block["units"]["q_cutoff"].startswith("rad/m") and block["threshold"] == 0.25
+    # the shares of the mean-square slope beyond q_c, of the analysed map (--detrend mean)
+    assert round(block["slope_share_x"], 4) == 0.0788
+    assert round(block["slope_share_y"], 4) == 0.8431
+    assert block["units"]["slope_share_y"].startswith("1 (share of the mean-square slope")
+    # --detrend lines removes the line offsets, power across the lines at all q_y
+    assert main(["info", str(topographies_dir / "di-1.di"), "--detrend", "lines",
+                 "--json"]) == 0
+    lines = json.loads(capsys.readouterr().out)["reliability"]
+    assert lines["q_cutoff"] == block["q_cutoff"]
+    assert abs(lines["slope_share_x"] / block["slope_share_x"] - 1) < 1e-9  # x lines' means
+    assert round(lines["slope_share_y"], 4) == 0.7131
 
 
 def test_no_row_without_a_trace_retrace_pair(topographies_dir, tmp_path, capsys):

@@ -10,10 +10,14 @@ import pytest
 
 from roughfe.cli import main
 from roughfe.surfaces.io import load_surface, save_surface
+from roughfe.surfaces.reliability import slope_share_above
 
 NOTE = ("note: trace/retrace reliable to q < 592.7 rad/um (wavelengths > 0.0106 um) along "
         "x, the fast axis; 1 'Height' (Retrace) is 0 'Height' (Trace) shifted by -6.79 "
         "samples")
+#: di-1 with the plane removed: most of the slope beyond q_c is across the lines
+SHARES = ("beyond it lie 7.84 % of the mean-square slope along x and 84.2 % along y "
+          "(across the lines)")
 
 
 def _results(folder):
@@ -27,11 +31,17 @@ def test_contact_on_di1_notes_the_cutoff_and_keeps_its_numbers(topographies_dir,
     assert main(["contact", str(di), *run, str(tmp_path / "di")]) == 0
     out = capsys.readouterr().out
     assert NOTE in out and "(10.9 pixels)" in out and "0.000977 um" in out
+    assert SHARES in out
     doc = _results(tmp_path / "di")
     block = doc["inputs"]["reliability"]
-    # info's block (the heights as read there, the plane removed here: the coherence
-    # levels each line, so the same to round-off)
-    assert main(["info", str(di), "--json"]) == 0
+    # the slope shares are of the map contact solves (the plane removed), along x and y
+    plane = load_surface(di).detrended("plane")
+    for axis in "xy":
+        assert block[f"slope_share_{axis}"] == pytest.approx(
+            slope_share_above(plane, block["q_cutoff"], axis), rel=1e-12, abs=0)
+    # info's block under the same --detrend (the coherence is of the heights as read, and
+    # levels each line: the same to round-off; the shares are of the detrended map)
+    assert main(["info", str(di), "--detrend", "plane", "--json"]) == 0
     info = json.loads(capsys.readouterr().out)["reliability"]
     assert block.keys() == info.keys() and abs(block["q_cutoff"] / 5.927e8 - 1) < 2e-3
     for key, value in info.items():
@@ -63,6 +73,8 @@ def test_leak_on_di1_notes_the_cutoff(topographies_dir, tmp_path, capsys):
                  "--no-reynolds", "--no-figures", "-o", str(tmp_path / "l")]) == 0
     out = capsys.readouterr().out
     assert NOTE in out and "the junctions that set Q" in out
+    assert ("beyond it lie 7.88 % of the mean-square slope along x and 84.3 % along y"
+            in out)                                   # leak's default --detrend mean
     block = _results(tmp_path / "l")["inputs"]["reliability"]
     assert block["integer_lag"] == -6 and block["channels"][1] == "1 'Height' (Retrace)"
 
@@ -87,7 +99,14 @@ def test_the_note_without_a_cutoff_gives_the_row_only():
              "reliable_anywhere": True}
     note = reliability_note(block, 1e-9, "contact area")
     assert note.startswith("note: trace/retrace reliable to the pixel (coherence >= 0.25")
-    assert "noise" not in note
+    assert "noise" not in note and "slope" not in note
+    # with a cutoff the shares are said; NaN ones (a map flat along an axis) are not
+    cut = {**block, "q_cutoff": 5e8, "wavelength_cutoff": 2 * 3.14159e-9 / 0.5,
+           "slope_share_x": 0.25, "slope_share_y": 0.5}
+    assert ("beyond it lie 25 % of the mean-square slope along x and 50 % along y "
+            "(across the lines)") in reliability_note(cut, 1e-9, "contact area")
+    assert "slope" not in reliability_note({**cut, "slope_share_y": float("nan")}, 1e-9,
+                                           "contact area")
     note = reliability_note({"channels": block["channels"], "error": "too few lines"}, 1e-9,
                             "contact area")
     assert note == "note: trace/retrace reliable to n/a (too few lines)"

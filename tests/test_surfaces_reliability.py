@@ -1,7 +1,9 @@
 """The trace/retrace reliability cutoff (roughfe.surfaces.reliability): synthetic sweeps of
 one self-affine surface with independent white noise of known level, shifted by a known
 lag; the noise-free and the pure-noise limits; the estimator's null distribution; the
-trace/retrace pairing of an instrument file's channels; di-1 (trace vs retrace)."""
+trace/retrace pairing of an instrument file's channels; di-1 (trace vs retrace). The share
+of the mean-square slope above a cutoff (slope_share_above): sums of sinusoids (exact),
+white noise (the fraction of q^2 above the cutoff), bad cutoffs."""
 import numpy as np
 import pytest
 
@@ -9,7 +11,7 @@ from roughfe.errors import InputError
 from roughfe.surfaces import Surface
 from roughfe.surfaces.io import load_surface, trace_retrace_partner
 from roughfe.surfaces.reliability import (FALSE_ALARM, THRESHOLD, minimum_lines,
-                                          trace_retrace_coherence)
+                                          slope_share_above, trace_retrace_coherence)
 from roughfe.surfaces.spectral import self_affine_psd, spectral_surface
 
 NX, NY, DX = 256, 512, 1e-9          # points per line (fast axis x), lines, spacing (m)
@@ -214,3 +216,74 @@ def test_di1_trace_and_retrace(topographies_dir):
     # the whole fast-axis band up to q_c agrees, nothing beyond 1e9 rad/m does
     assert result.coherence[result.q < 3e8].min() > 0.5
     assert result.coherence[result.q > 1e9].max() < 0.1
+
+
+def _waves(n=64, length=64e-9):
+    """A periodic map of two waves along x (amplitudes 3 and 0.5 nm, k = 3 and 20) and two
+    along y (1 and 2 nm, k = 5 and 12) on n x n points; (surface, the waves by axis as
+    (amplitude m, q rad/m))."""
+    x = np.arange(n) * length / n
+    q = 2 * np.pi / length
+    waves = {"x": ((3e-9, 3 * q), (0.5e-9, 20 * q)), "y": ((1e-9, 5 * q), (2e-9, 12 * q))}
+    (a1, q1), (a2, q2) = waves["x"]
+    (b1, p1), (b2, p2) = waves["y"]
+    h = (a1 * np.sin(q1 * x)[:, None] + a2 * np.cos(q2 * x + 0.4)[:, None]
+         + b1 * np.cos(p1 * x)[None, :] + b2 * np.sin(p2 * x + 1.1)[None, :])
+    return Surface(h, (length, length), periodic=True), waves
+
+
+def test_slope_share_of_sinusoids_is_exact():
+    """A wave a sin(q x) carries a^2 q^2 / 2 of the mean-square slope along its axis and
+    none across it: the share above a cutoff between two waves is the upper wave's."""
+    surface, waves = _waves()
+    q = 2 * np.pi / surface.size[0]
+    for axis, ((a1, q1), (a2, q2)) in waves.items():
+        upper = (a2 * q2) ** 2 / ((a1 * q1) ** 2 + (a2 * q2) ** 2)
+        for q_c in (q1 * 1.01, 0.5 * (q1 + q2), q2 * 0.99):
+            assert slope_share_above(surface, q_c, axis) == pytest.approx(
+                upper, rel=1e-12, abs=0), (axis, q_c)
+        assert slope_share_above(surface, 0.5 * q1, axis) == pytest.approx(1.0, rel=1e-12,
+                                                                           abs=0)
+        assert slope_share_above(surface, q2 * 1.01, axis) == pytest.approx(0.0, abs=1e-15)
+    # x: 0.5 nm at k 20 against 3 nm at k 3 (100 / 181); y: 2 nm at k 12 against 1 at k 5
+    exact = {"x": 100 / 181, "y": 576 / 601}
+    for axis in "xy":
+        assert slope_share_above(surface, 10 * q, axis) == pytest.approx(exact[axis],
+                                                                         rel=1e-12, abs=0)
+    # a profile is its x lines; a map flat along y has no slope there
+    profile = Surface(surface.heights[:, 0], surface.size[0], periodic=True)
+    assert slope_share_above(profile, 10 * q, "x") == pytest.approx(exact["x"], rel=1e-12,
+                                                                    abs=0)
+    flat_y = Surface(np.repeat(surface.heights[:, :1], 64, axis=1), surface.size,
+                     periodic=True)
+    assert np.isnan(slope_share_above(flat_y, 10 * q, "y"))
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_slope_share_of_white_noise_is_the_share_of_q2(periodic):
+    """White noise has a flat line PSD (also Hann-windowed, for a non-periodic map), so its
+    share above q_c is that of q^2 over the line PSD's wavenumbers; continuous:
+    1 - (q_c / q_N)^3 (0.875 at q_N / 2; the share of the heights would be 0.5)."""
+    n, dx = 256, 1e-9
+    rng = np.random.default_rng(7)
+    surface = Surface(rng.standard_normal((n, 2 * n)) * 1e-9, (n * dx, 2 * n * dx),
+                      periodic=periodic)
+    q_n = np.pi / dx
+    k = np.arange(1, n // 2 + 1)
+    q, w = 2 * np.pi * k / (n * dx), np.where(k == n // 2, 1.0, 2.0)
+    for f in (0.25, 0.5, 0.8):
+        expected = np.sum((q ** 2 * w)[q > f * q_n]) / np.sum(q ** 2 * w)
+        assert abs(expected - (1 - f ** 3)) < 0.005
+        share = slope_share_above(surface, f * q_n, "x")
+        assert share == pytest.approx(expected, abs=0.01), f
+    # across the lines the same (the y lines are 512 points long: a finer q grid)
+    assert slope_share_above(surface, 0.5 * q_n, "y") == pytest.approx(0.875, abs=0.01)
+
+
+def test_slope_share_refuses_a_bad_cutoff():
+    surface, _ = _waves()
+    for bad in (0.0, -1e8, np.nan, np.inf, "5e8", None):
+        with pytest.raises(InputError, match="q_cutoff"):
+            slope_share_above(surface, bad, "x")
+    with pytest.raises(InputError, match="direction"):
+        slope_share_above(surface, 1e8, "z")

@@ -154,7 +154,7 @@ def _info(args) -> int:
     psd_path = None if args.psd is None else output_file(args.psd, overwrite=args.overwrite,
                                                          suffixes=(".csv", ".png"))
     stats = surface_statistics(surface, q_range=q_range).as_dict()
-    reliability, coherence = trace_retrace_of(args, read)     # trace vs retrace, as read
+    reliability, coherence = trace_retrace_of(args, read, surface)   # trace vs retrace
     if psd_path is not None:
         if coherence is not None and psd_path.suffix.lower() == ".csv":
             output_file(coherence_path(psd_path), overwrite=args.overwrite)  # both checked
