@@ -72,7 +72,9 @@ def test_a_pair_that_cannot_be_compared_is_said_in_the_row(tmp_path):
     from roughfe.cli.info_reliability import reliability_block, reliability_row
     from roughfe.surfaces import Surface
     path = tmp_path / "claims.npz"
-    meta = {"source": str(path), "channel": {"index": 0, "name": "Height"},
+    table = [{"index": 0, "name": "Height", "direction": "Trace"},
+             {"index": 1, "name": "Height", "direction": "Retrace"}]
+    meta = {"source": str(path), "channel": table[0], "channel_table": table,
             "channels": ["0 'Height' (Trace)", "1 'Height' (Retrace)"]}
     surface = Surface(np.random.default_rng(0).normal(size=(64, 64)) * 1e-9, 6.4e-8,
                       periodic=False, metadata=meta)
@@ -82,6 +84,14 @@ def test_a_pair_that_cannot_be_compared_is_said_in_the_row(tmp_path):
     block = reliability_block(args, load_surface(path))
     assert block["channels"] == meta["channels"] and "channel" in block["error"]
     assert reliability_row(block).startswith("trace/retrace reliable to    n/a (")
+    # the same claim in the metadata of a roughfe before session 37 (labels only, no
+    # direction): the row says that the directions are not stored as data
+    del meta["channel_table"]
+    meta["channel"] = {"index": 0, "name": "Height"}
+    save_surface(Surface(surface.heights, surface.size, False, meta), path)
+    block = reliability_block(args, load_surface(path))
+    assert block["channels"] == meta["channels"]
+    assert "without their scan directions as data" in reliability_row(block)
 
 
 def test_info_psd_writes_the_coherence_beside_the_psd(topographies_dir, tmp_path, capsys):

@@ -7,7 +7,7 @@ import pytest
 
 from roughfe.errors import FileFormatError, InputError
 from roughfe.surfaces import Surface, load_surface, save_surface
-from roughfe.surfaces.io import READERS
+from roughfe.surfaces.io import READERS, channel_label
 from roughfe.surfaces.stats import rms_height
 
 # From ../shared/data/topographies/README.md: grid, physical size (m), rms height (m).
@@ -166,6 +166,14 @@ def test_multichannel_choice(topographies_dir):
                                          r"\(Retrace\), 2 'Phase'"):
         load_surface(path, channel="Height")
     assert first.metadata["channels"][:2] == ["0 'Height' (Trace)", "1 'Height' (Retrace)"]
+    # the scan directions as data (round 2, session 37), the labels made from them
+    assert second.metadata["channel"] == {"index": 1, "name": "Height", "direction": "Retrace"}
+    assert first.metadata["channel_table"][:3] == [
+        {"index": 0, "name": "Height", "direction": "Trace"},
+        {"index": 1, "name": "Height", "direction": "Retrace"},
+        {"index": 2, "name": "Phase", "direction": "Trace"}]
+    assert first.metadata["channels"] == [channel_label(c)
+                                          for c in first.metadata["channel_table"]]
     with pytest.raises(InputError, match="out of range"):
         load_surface(path, channel=9)
     with pytest.raises(InputError, match="no channel named"):

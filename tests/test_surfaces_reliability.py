@@ -188,18 +188,57 @@ def test_bad_input_is_refused():
         trace_retrace_coherence(few, few)
 
 
-def test_trace_and_retrace_are_paired_by_name_and_direction():
-    channels = ["0 'Height' (Trace)", "1 'Height' (Retrace)", "2 'Phase' (Trace)",
-                "3 'AmplitudeError' (Trace)"]
+def _entries(*channels):
+    """``metadata["channel_table"]`` of (index, name, direction) triples."""
+    return [{"index": i, "name": n, "direction": d} for i, n, d in channels]
 
-    def partner(index, names=channels):
-        return trace_retrace_partner({"channel": {"index": index}, "channels": names})
+
+def test_trace_and_retrace_are_paired_by_name_and_direction():
+    """From the directions stored as data on reading (metadata["channel_table"]), not
+    from the labels shown: a name with parentheses, quotes or a direction-like word in
+    it is only a name."""
+    table = _entries((0, "Height", "Trace"), (1, "Height", "Retrace"), (2, "Phase", "Trace"),
+                     (3, "AmplitudeError", "Trace"))
+
+    def partner(index, channels=table):
+        read = next(c for c in channels if c["index"] == index)
+        return trace_retrace_partner({"channel": read, "channel_table": channels})
     assert partner(0) == 1 and partner(1) == 0
     assert partner(2) is None and partner(3) is None          # no retrace of the Phase
-    assert partner(0, ["0 'Height' (Trace)", "1 'Height'"]) is None      # no direction
-    assert partner(0, channels + ["4 'Height' (Retrace)"]) is None       # two: ambiguous
-    assert partner(0, ["0 'Height (x)' (Trace)", "1 'Height (x)' (Retrace)"]) == 1
+    assert partner(0, _entries((0, "Height", "Trace"), (1, "Height", None))) is None
+    assert partner(0, table + _entries((4, "Height", "Retrace"))) is None   # ambiguous
+    assert partner(0, _entries((0, "Height (x)", "Trace"), (1, "Height (x)", "retrace"))) == 1
+    assert partner(0, _entries((0, "Height' (Trace)", None), (1, "Height' (Retrace)", None))) \
+        is None                                   # directions only in the names: none
+    assert partner(1, _entries((0, "Height", "Forward"), (1, "Height", "Backward"))) is None
     assert trace_retrace_partner({}) is None
+    assert trace_retrace_partner({"channel": {"index": 0, "name": "Raw"},
+                                  "channels": ["0 'Raw'"]}) is None   # one channel: none
+
+
+def test_labels_without_the_directions_as_data_are_refused_with_the_reason(
+        topographies_dir, tmp_path):
+    """A .npz saved from di-1 by a roughfe before session 37 has only the labels
+    (metadata["channels"]) and a channel read without "direction": its partner is not
+    parsed back from the text; the error says why and what to do. Saved now, it keeps
+    the table and finds the partner."""
+    from roughfe.surfaces.io import read_channel_label, save_surface
+    trace = load_surface(topographies_dir / "di-1.di", channel=0)
+    assert trace_retrace_partner(load_surface(save_surface(trace, tmp_path / "new.npz"))
+                                 .metadata) == 1
+    old = {k: v for k, v in trace.metadata.items() if k != "channel_table"}
+    old["channel"] = {"index": 0, "name": "Height"}
+    saved = save_surface(Surface(trace.heights, trace.size, False, old), tmp_path / "old.npz")
+    meta = load_surface(saved).metadata
+    assert meta["channels"][:2] == ["0 'Height' (Trace)", "1 'Height' (Retrace)"]
+    # what info prints of the channel read: the direction from the data, or else the label
+    assert read_channel_label(meta) == read_channel_label(trace.metadata) == \
+        "0 'Height' (Trace)"
+    with pytest.raises(InputError, match=r"di-1.di' by a roughfe before round 2, session "
+                                         r"37\) lists the file's channels as text only "
+                                         r"\(0 'Height' \(Trace\), 1 'Height' \(Retrace\).*"
+                                         r"read the instrument file again"):
+        trace_retrace_partner(meta)
 
 
 def test_di1_trace_and_retrace(topographies_dir):

@@ -1,12 +1,13 @@
 """``roughfe info``'s row "trace/retrace reliable to" and its Hurst-range warning.
 
 When the instrument file read holds the other sweep of the channel read (a trace and a
-retrace channel of the same name, as :func:`roughfe.surfaces.io.channel_label` shows
-them: di-1's 0 'Height' (Trace) and 1 'Height' (Retrace);
-:func:`roughfe.surfaces.io.trace_retrace_partner`), ``info`` reads that channel with the
-same ``--size``/``--periodic``/``--scan-axis`` and reports the reliability cutoff
-``q_c`` of :func:`roughfe.surfaces.reliability.trace_retrace_coherence`: its wavelength,
-and the lag between the sweeps. Both channels are taken as read (the coherence levels
+retrace channel of the same name, from the channels' names and scan directions that
+:func:`roughfe.surfaces.io.channel_entry` stored on reading: di-1's 0 'Height' (Trace)
+and 1 'Height' (Retrace); :func:`roughfe.surfaces.io.trace_retrace_partner`), ``info``
+reads that channel with the same ``--size``/``--periodic``/``--scan-axis`` and reports
+the reliability cutoff ``q_c`` of
+:func:`roughfe.surfaces.reliability.trace_retrace_coherence`: its wavelength, and the lag
+between the sweeps. Both channels are taken as read (the coherence levels
 each line itself), so the cutoff is the same under every ``--detrend``; the row adds how
 much of the analysed map's mean-square slope (after ``--detrend``) lies above it, along
 x and along y (:func:`slope_shares`; di-1 under ``--detrend plane``: 7.8 % along the fast
@@ -59,16 +60,19 @@ def trace_retrace_of(args, read, surface=None):
     :class:`~roughfe.surfaces.reliability.TraceRetraceCoherence` it summarises (None when
     the block is None or says why the pair cannot be compared). The coherence is of
     ``read`` and its other sweep; the slope shares of ``surface`` (default ``read``)."""
-    from ..surfaces.io import trace_retrace_partner
+    from ..surfaces.io import channel_label, trace_retrace_partner
     from ..surfaces.reliability import SUMMARY_UNITS, trace_retrace_coherence
     meta = read.metadata
     if read.ndim != 2 or meta.get("source") != str(args.surface):
         return None, None                      # the instrument file itself, as read
-    partner = trace_retrace_partner(meta)
+    try:
+        partner = trace_retrace_partner(meta)
+    except RoughfeError as exc:                # metadata of an older roughfe: labels only
+        return {"channels": list(meta.get("channels") or []), "error": str(exc)}, None
     if partner is None:
         return None, None
-    channels = [next(c for c in meta["channels"] if c.split(" ", 1)[0] == str(i))
-                for i in (meta["channel"]["index"], partner)]
+    labels = {c["index"]: channel_label(c) for c in meta["channel_table"]}
+    channels = [labels[meta["channel"]["index"]], labels[partner]]
     try:
         with warnings.catch_warnings():        # the same file: its warnings are said once
             warnings.simplefilter("ignore")

@@ -200,15 +200,13 @@ def surface_notes(surface, channel: bool = False) -> list:
     unit, so that its heights and lengths were taken as metres (``metadata
     ["unit_in_file"]`` is :data:`~roughfe.surfaces.io.ASSUMED_UNIT`; only ``--json``
     said so until round 2, session 25)."""
-    from ..surfaces.io import ASSUMED_UNIT
+    from ..surfaces.io import ASSUMED_UNIT, read_channel_label
 
     meta = surface.metadata
     lines = []
-    read = meta.get("channel")
-    if channel and isinstance(read, dict):
+    label = read_channel_label(meta)
+    if channel and label is not None:
         every = list(meta.get("channels") or [])
-        label = next((c for c in every if c.split(" ", 1)[0] == str(read["index"])),
-                     f"{read['index']} {read['name']!r}")
         lines.append(f"channel {label}" + (f"; the file has {len(every)}: "
                                            f"{', '.join(every)} (--channel INDEX)"
                                            if len(every) > 1 else ""))

@@ -36,19 +36,19 @@ is then :data:`ASSUMED_UNIT`, and the command line prints a note saying so. Miss
 harmonic interpolation and their number recorded in ``metadata["filled_points"]``; they
 include the points a file marks as not measured whose marker the reader returns as a
 height (a ``.sur``'s ``zmin - 2``: :mod:`roughfe.surfaces.nonmeasured`); the
-channel read in ``metadata["channel"]`` and the file's channels in
-``metadata["channels"]``. Every instrument format puts the file's stored lines (the fast
-axis) along x, axis 0 (checked on the five measured files against readers written by
-hand: :mod:`roughfe.surfaces.layout`); a non-square Bruker/Veeco ``.di`` map, which
+channel read in ``metadata["channel"]`` (index, name, scan direction or None:
+:func:`channel_entry`), the file's channels in ``metadata["channel_table"]`` (the same
+entries) and, as shown, in ``metadata["channels"]`` (:func:`channel_label`). Every
+instrument format puts the file's stored lines (the fast axis) along x, axis 0 (checked
+on the five measured files against readers written by hand:
+:mod:`roughfe.surfaces.layout`); a non-square Bruker/Veeco ``.di`` map, which
 SurfaceTopography's reader scrambles, is put back in order there
 (``metadata["reader_fix"]``).
 """
 from __future__ import annotations
 
-import ast
 import datetime as _dt
 import json
-import re
 import warnings
 import zipfile
 import zlib
@@ -231,52 +231,86 @@ def _read_text(path, size, periodic, channel):
 
 
 # -- SurfaceTopography (instrument files) ---------------------------------------------
-def channel_label(channel) -> str:
-    """``0 'Height'`` for a SurfaceTopography channel, with the scan direction where the
-    file gives one (``0 'Height' (Trace)``: a .di file holds trace and retrace heights
-    under one name)."""
+def channel_entry(channel) -> dict:
+    """``{"index": int, "name": str, "direction": str or None}`` of a SurfaceTopography
+    channel: the scan direction where the file gives one (its raw metadata's ``line
+    direction``: a .di file holds trace and retrace heights under one name, di-1's
+    ``"Trace"`` and ``"Retrace"``), else None. ``metadata["channel"]`` of an instrument
+    surface is the entry of the channel read, ``metadata["channel_table"]`` the file's."""
     raw = (channel.info or {}).get("raw_metadata")
     direction = raw.get("line direction") if isinstance(raw, dict) else None
-    return f"{channel.index} {channel.name!r}" + (f" ({direction})" if direction else "")
+    return {"index": int(channel.index), "name": str(channel.name),
+            "direction": None if direction is None else str(direction)}
+
+
+def channel_label(entry) -> str:
+    """``0 'Height'`` for a :func:`channel_entry`, with the scan direction where there is
+    one (``0 'Height' (Trace)``): how the channels are shown (``metadata["channels"]``,
+    ``info``, the errors that list them)."""
+    direction = entry.get("direction")
+    return f"{entry['index']} {entry['name']!r}" + (f" ({direction})" if direction else "")
+
+
+def read_channel_label(metadata) -> "str | None":
+    """:func:`channel_label` of the channel read (``metadata["channel"]``; None without
+    one). Metadata written before round 2, session 37 (a ``.npz``, results.json) has no
+    ``direction`` in it: the label at its index in ``metadata["channels"]`` (listed in
+    index order), which shows the direction as the file gave it."""
+    read = metadata.get("channel")
+    if not isinstance(read, dict):
+        return None
+    labels = metadata.get("channels") or []
+    if "direction" not in read and 0 <= read.get("index", -1) < len(labels):
+        return str(labels[read["index"]])
+    return channel_label(read)
 
 
 #: the two scan directions of one quantity that :func:`trace_retrace_partner` pairs
 SWEEPS = ("trace", "retrace")
 
 
-def _label_parts(label):
-    """(index, name, direction or None) of a :func:`channel_label`; None if not one."""
-    match = re.fullmatch(r"(\d+) ('.*'|\".*\")(?: \(([^()]*)\))?", str(label))
-    if match is None:
-        return None
-    try:
-        name = ast.literal_eval(match.group(2))
-    except (ValueError, SyntaxError):
-        return None
-    return int(match.group(1)), name, match.group(3)
-
-
 def trace_retrace_partner(metadata) -> "int | None":
     """Index of the channel that holds the other sweep of the channel read, from an
-    instrument surface's ``metadata["channel"]`` and ``metadata["channels"]`` as
-    :func:`channel_label` shows them: the one channel of the same name whose direction is
-    the other of Trace / Retrace (di-1: 0 'Height' (Trace) and 1 'Height' (Retrace)).
-    None when the channel read has no such direction, or no single partner."""
+    instrument surface's ``metadata["channel"]`` and ``metadata["channel_table"]``
+    (:func:`channel_entry`): the one channel of the same name whose direction is the
+    other of Trace / Retrace (di-1: 0 'Height' (Trace) and 1 'Height' (Retrace)). None
+    when the channel read has no such direction, or no single partner.
+
+    Raises
+    ------
+    InputError
+        Metadata of a multi-channel file written before round 2, session 37 (a ``.npz``
+        saved then): it lists the channels as text labels only, without their directions
+        as data; read the instrument file (``metadata["source"]``) again.
+    """
     read = metadata.get("channel")
-    labels = [_label_parts(c) for c in metadata.get("channels") or []]
-    own = next((p for p in labels if p and isinstance(read, dict)
-                and p[0] == read.get("index")), None)
-    if own is None or own[2] is None or own[2].lower() not in SWEEPS:
+    if not isinstance(read, dict):
         return None
-    other = SWEEPS[1 - SWEEPS.index(own[2].lower())]
-    partners = [p[0] for p in labels if p and p[1] == own[1] and p[2] is not None
-                and p[2].lower() == other]
+    table = metadata.get("channel_table")
+    if table is None:
+        labels = metadata.get("channels") or []
+        if len(labels) > 1 and "direction" not in read:
+            raise InputError(
+                f"the metadata of this surface (read from {metadata.get('source')!r} by a "
+                f"roughfe before round 2, session 37) lists the file's channels as text "
+                f"only ({', '.join(map(str, labels))}), without their scan directions as "
+                f"data: the trace/retrace partner of channel {read.get('index')} is not "
+                f"looked for in text; read the instrument file again "
+                f"(load_surface(source, channel=N))")
+        return None
+    own = read.get("direction")
+    if own is None or own.lower() not in SWEEPS:
+        return None
+    other = SWEEPS[1 - SWEEPS.index(own.lower())]
+    partners = [int(c["index"]) for c in table if c["name"] == read["name"]
+                and (c.get("direction") or "").lower() == other]
     return partners[0] if len(partners) == 1 else None
 
 
 def _choose_channel(reader, channel, path):
     channels = reader.channels
-    listed = ", ".join(channel_label(c) for c in channels)
+    labels = [channel_label(channel_entry(c)) for c in channels]
+    listed = ", ".join(labels)
     if channel is None:
         return reader.default_channel
     if isinstance(channel, str) and not channel.lstrip("-").isdigit():
@@ -288,7 +322,7 @@ def _choose_channel(reader, channel, path):
             # di-1: trace (rms 9.95 nm) and retrace (114 nm) are both 'Height'; the
             # name took the first without a word until round 2, session 24
             raise InputError(f"{path}: {len(named)} channels are named {channel!r} "
-                             f"({', '.join(channel_label(c) for c in named)}): give the "
+                             f"({', '.join(labels[channels.index(c)] for c in named)}): give the "
                              f"channel index (channel=N, --channel N); channels (index "
                              f"name) are {listed}")
         return named[0]
@@ -382,10 +416,11 @@ def _instrument_surface(reader, path, size, periodic, channel):
     heights = np.ma.getdata(topo_m.heights()).astype(float)
     file_size = tuple(float(s) for s in np.atleast_1d(topo_m.physical_sizes))
     info = topo.info or {}
+    table = [channel_entry(c) for c in reader.channels]
     metadata = {
         "source": str(path), "reader": type(reader).__name__,
-        "channel": {"index": int(ch.index), "name": str(ch.name)},
-        "channels": [channel_label(c) for c in reader.channels],
+        "channel": channel_entry(ch),
+        "channels": [channel_label(c) for c in table], "channel_table": table,
         "unit_in_file": unit, "filled_points": filled,
         "instrument": json_safe(info.get("instrument", {})),
     }
@@ -432,7 +467,8 @@ def load_surface(path, size=None, periodic=None, channel=None) -> Surface:
         default channel, usually the first height channel). A name that several channels
         share (di-1: trace and retrace 'Height') is refused: give the index. The channel
         read is ``metadata["channel"]``, every channel of the file (index, name and the
-        scan direction where the file gives one) ``metadata["channels"]``.
+        scan direction where the file gives one) ``metadata["channel_table"]``, their
+        labels ``metadata["channels"]``.
 
     Returns
     -------
