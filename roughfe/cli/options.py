@@ -26,8 +26,9 @@ everywhere:
   :func:`at_least_two`, :func:`at_least_three`, :func:`unit_fraction`.
 
 :class:`RoughfeParser` shows every default in ``--help``, accepts negative numbers as
-option values (``--nu -1.5`` reaches the validator: "nu ... must lie in (-1, 0.5]") and prints
-parse errors on one line.
+option values (``--nu -1.5`` reaches the validator: "nu ... must lie in (-1, 0.5]"), prints
+parse errors on one line and refuses an option given twice with different values
+(:mod:`roughfe.cli.repeated`).
 """
 from __future__ import annotations
 
@@ -35,6 +36,8 @@ import argparse
 import re
 import sys
 import textwrap
+
+from .repeated import GIVEN, StoreOnce, refuse_repeated
 
 #: DEFAULT_E, DEFAULT_NU: the one default material, defined in :mod:`roughfe.model` (shared
 #: with the study analyses), imported where the options are made: importing the command
@@ -81,6 +84,13 @@ class RoughfeParser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", HelpFormatter)
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = _NEGATIVE_NUMBER
+        self.register("action", None, StoreOnce)     # subparsers are RoughfeParsers too
+        self.register("action", "store", StoreOnce)
+
+    def parse_known_args(self, args=None, namespace=None):
+        args, extra = super().parse_known_args(args, namespace)
+        vars(args).pop(GIVEN, None)     # the record of refuse_repeated, not an option
+        return args, extra
 
     def error(self, message):
         """One line on stderr, exit code 2 (argparse prints usage + error)."""
@@ -264,6 +274,7 @@ class _Deprecated(argparse.Action):
     def __call__(self, parser, namespace, values, option_string=None):
         print(f"{parser.prog}: warning: {option_string} is deprecated, use {self.new}",
               file=sys.stderr)
+        refuse_repeated(parser, namespace, self.dest, option_string, values)
         setattr(namespace, self.dest, values)
 
 

@@ -1,0 +1,50 @@
+"""What a fresh-eyes audit of bad command-line input found (round 2, session 37): options
+whose second value silently replaced the first, an error that named the wrong option, a
+step count that started weeks of work, and options that were ignored. Each test fails on
+the code before its fix: one line ``roughfe CMD: error: ...`` naming the option, exit 2,
+nothing written."""
+import numpy as np
+import pytest
+
+from roughfe.cli import build_parser, main
+from roughfe.errors import InputError
+
+
+def _refused(capsys, argv, *phrases):
+    """``roughfe ARGV`` exits 2 with one error line holding every phrase, no traceback."""
+    capsys.readouterr()
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if ": error: " in line]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    for phrase in phrases:
+        assert phrase in lines[0], (phrase, lines[0])
+    return lines[0]
+
+
+def test_an_option_given_twice_with_other_values_is_refused(surface32, tmp_path, capsys):
+    # argparse kept the last value in silence: --pressure 1e6 --pressure 2e6 solved 2e6
+    # only, --size 1e-4 --size 2e-4 read the second size, --n 16 ... --n 32 made 32^2
+    out = tmp_path / "c"
+    _refused(capsys, ["contact", str(surface32), "--pressure", "1e6", "--pressure", "2e6",
+                      "--no-figures", "-o", str(out)],
+             "--pressure 1e+06 and --pressure 2e+06", "given twice")
+    assert not out.exists()
+    _refused(capsys, ["info", str(surface32), "--size", "1e-4", "--size", "2e-4"],
+             "--size 0.0001 and --size 0.0002")
+    _refused(capsys, ["generate", "spectral", "--n", "16", "--n", "32", "--no-figures",
+                      "-o", str(tmp_path / "g.npz")], "--n 16 and --n 32")
+    # the old spelling of --E stores into the same option
+    _refused(capsys, ["contact", str(surface32), "--steps", "2", "--E", "1e9",
+                      "--youngs-modulus", "2e9", "--no-figures", "-o", str(out)],
+             "--E 1e+09 and --youngs-modulus 2e+09")
+    assert not out.exists()
+
+
+def test_the_same_value_twice_passes_and_leaves_no_trace(surface32, capsys):
+    assert main(["info", str(surface32), "--size", "1e-4", "--size", "1e-4", "--json"]) == 0
+    assert '"size"' in capsys.readouterr().out
+    args, extra = build_parser("contact").parse_known_args(
+        ["contact", "s.npz", "--pressure", "1e6", "-o", "x"])
+    assert not extra and args.pressure == [1e6]
+    assert not any(k.startswith("_roughfe") for k in vars(args))
