@@ -48,3 +48,15 @@ def test_the_same_value_twice_passes_and_leaves_no_trace(surface32, capsys):
         ["contact", "s.npz", "--pressure", "1e6", "-o", "x"])
     assert not extra and args.pressure == [1e6]
     assert not any(k.startswith("_roughfe") for k in vars(args))
+
+
+def test_kernels_listed_twice_are_refused(tmp_path, capsys):
+    # genome mechanics --kernels strip strip ran the strip sweeps twice (same files)
+    assert main(["genome", "example", "-o", str(tmp_path / "g.json")]) == 0
+    _refused(capsys, ["genome", "mechanics", str(tmp_path / "g.json"), "--scale", "10x",
+                      "--kernels", "strip", "strip", "-o", str(tmp_path / "m")],
+             "--kernels: lists 'strip' more than once")
+    _refused(capsys, ["genome", "natural", str(tmp_path / "any.npz"), "--kernels", "thesis",
+                      "strip", "thesis", "-o", str(tmp_path / "n")],
+             "--kernels: lists 'thesis' more than once")
+    assert not (tmp_path / "m").exists() and not (tmp_path / "n").exists()

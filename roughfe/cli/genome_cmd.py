@@ -21,6 +21,7 @@ from ..genomics.genome import SCALES
 from ..genomics.natural import DEFAULT_FRACTIONS
 from .chromosomes_cmd import _chromosomes
 from .natural_cmd import _natural
+from .repeated import Distinct
 
 #: largest ``genome validity --max-ridges``: the Monte Carlo costs ~ M^3 x trials (M = 200
 #: at the default 1000 trials: 11 s; 500: ~3 min and 3 GB); the thesis' Fig. 29 stops at
@@ -284,7 +285,7 @@ def _length_or_scale(p, required=True, default=None):
 
 def _add_response_options(p, nargs, kernels_help):
     """``--kernels``, ``--E``/``--nu`` and ``--steps`` of the A(p), K(p) sweeps."""
-    p.add_argument("--kernels", nargs=nargs, choices=("thesis", "strip"),
+    p.add_argument("--kernels", nargs=nargs, choices=("thesis", "strip"), action=Distinct,
                    default=["thesis", "strip"], help=kernels_help)
     add_material_options(p)
     p.add_argument("--steps", type=at_least_three, default=20,

@@ -6,6 +6,8 @@ second size (found by the command-line audit of round 2, session 37). Every
 :class:`~roughfe.cli.options.RoughfeParser` stores with :class:`StoreOnce`; the old
 spellings (``--youngs-modulus`` for ``--E``) call :func:`refuse_repeated` too. The same
 value given twice passes; ``append`` options (``db extend --label``) are meant to repeat.
+:class:`Distinct` refuses a value listed twice in one option whose values name runs
+(``genome mechanics --kernels strip strip`` ran the strip sweeps twice).
 """
 from __future__ import annotations
 
@@ -37,3 +39,14 @@ class StoreOnce(argparse._StoreAction):
         refuse_repeated(parser, namespace, self.dest, option_string, values)
         super().__call__(parser, namespace, values, option_string)
 
+
+class Distinct(StoreOnce):
+    """:class:`StoreOnce` for a list of choices that each start a run: a value listed twice
+    is refused (it ran twice and wrote the same files twice)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        twice = sorted({v for v in values if values.count(v) > 1})
+        if twice:
+            parser.error(f"argument {option_string}: lists {', '.join(map(repr, twice))} "
+                         "more than once; give each value once")
+        super().__call__(parser, namespace, values, option_string)
