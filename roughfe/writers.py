@@ -458,21 +458,25 @@ def output_folder(folder, command: str, *, overwrite: bool = False,
     return OutputFolder(folder, command, overwrite=overwrite, keep_partial=keep_partial)
 
 
-def output_file(path, *, overwrite: bool = False, suffixes=None) -> Path:
+def output_file(path, *, overwrite: bool = False, suffixes=None,
+                option: str = "-o/--output") -> Path:
     """Check ``path`` as the output FILE of a command; return it as a ``Path``.
 
     Refuses a folder, a parent folder that cannot be created or written, an existing
     file unless ``overwrite``, a name longer than 255 bytes, and (with ``suffixes``,
-    lower case with the dot) another extension. Nothing is written.
+    lower case with the dot) another extension. Nothing is written. ``option`` is the
+    command-line option that named the file, for the messages (``info --psd FILE`` was
+    told "-o/--output must name a .csv or .png file" until round 2, session 37).
     """
     path = Path(path)
     if len(path.name.encode()) > 255:
         raise InputError(f"output file name is {len(path.name.encode())} bytes long; file "
                          "systems allow at most 255")
     if suffixes and path.suffix.lower() not in suffixes:
-        raise InputError(f"-o/--output must name a {' or '.join(suffixes)} file, got {str(path)!r}")
+        raise InputError(f"{option} must name a {' or '.join(suffixes)} file, got "
+                         f"{str(path)!r}")
     if path.is_dir():
-        raise InputError(f"output {path} is a folder; -o takes a file name here")
+        raise InputError(f"output {path} is a folder; {option} takes a file name here")
     if path.exists() and not overwrite:
         raise InputError(f"output file {path} exists; pass --overwrite to replace it")
     _probe_writable(path.parent)

@@ -50,6 +50,17 @@ def test_the_same_value_twice_passes_and_leaves_no_trace(surface32, capsys):
     assert not any(k.startswith("_roughfe") for k in vars(args))
 
 
+def test_info_psd_errors_name_psd(surface32, tmp_path, capsys):
+    # said "-o/--output must name a .csv or .png file": info has no -o
+    line = _refused(capsys, ["info", str(surface32), "--psd", str(tmp_path / "p.txt")],
+                    "--psd must name a .csv or .png file")
+    assert "--output" not in line
+    (tmp_path / "q.csv").mkdir()
+    line = _refused(capsys, ["info", str(surface32), "--psd", str(tmp_path / "q.csv")],
+                    "is a folder; --psd takes a file name here")
+    assert "-o takes" not in line
+
+
 def test_kernels_listed_twice_are_refused(tmp_path, capsys):
     # genome mechanics --kernels strip strip ran the strip sweeps twice (same files)
     assert main(["genome", "example", "-o", str(tmp_path / "g.json")]) == 0

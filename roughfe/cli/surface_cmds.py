@@ -151,13 +151,14 @@ def _info(args) -> int:
     if q_range is not None and not q_range[0] < q_range[1]:
         raise InputError(f"--hurst-q-range QMIN QMAX needs QMIN < QMAX (rad/m), got "
                          f"{q_range[0]:g} {q_range[1]:g}")
-    psd_path = None if args.psd is None else output_file(args.psd, overwrite=args.overwrite,
-                                                         suffixes=(".csv", ".png"))
+    psd_path = None if args.psd is None else output_file(
+        args.psd, overwrite=args.overwrite, suffixes=(".csv", ".png"), option="--psd")
     stats = surface_statistics(surface, q_range=q_range).as_dict()
     reliability, coherence = trace_retrace_of(args, read, surface)   # trace vs retrace
     if psd_path is not None:
         if coherence is not None and psd_path.suffix.lower() == ".csv":
-            output_file(coherence_path(psd_path), overwrite=args.overwrite)  # both checked
+            output_file(coherence_path(psd_path), overwrite=args.overwrite,  # both checked
+                        option="--psd (its coherence curve, beside it)")
         write_psd(surface, psd_path, str(args.surface), coherence)
     scan_lines = scan_line_block(surface)
     warn_hurst_range(args, reliability, stats["hurst_q_range"])
