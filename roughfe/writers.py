@@ -343,6 +343,9 @@ class OutputFolder:
 
     def __init__(self, folder, command: str, *, overwrite: bool = False,
                  keep_partial: bool = False):
+        if not str(folder).strip():    # `-o "$UNSET"` wrote there (round 2, session 37)
+            raise InputError(f"output must name a folder, got {str(folder)!r} (the results "
+                             "would be written into the working directory)")
         self.path = Path(folder)
         self.command = command
         self.overwrite = overwrite
@@ -432,7 +435,13 @@ def _probe_writable(folder: Path) -> None:
     A missing folder is probed by creating and removing a temporary folder in its nearest
     existing parent (permission bits alone do not tell, e.g. for root); an existing one
     by its permissions and mount flags (no probe entry: nothing in it is touched)."""
-    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    existing = next((p for p in (folder, *folder.parents) if os.path.lexists(p)), None)
+    if existing is not None and not existing.exists():
+        # a link to nothing: it passed here, and mkdir failed ("File exists") after the
+        # work (round 2, session 37)
+        raise InputError(f"cannot create output folder {folder}: {existing} is a broken "
+                         f"symbolic link (to {os.readlink(existing)}); create what it points "
+                         "to, or give another path")
     if existing is None or not existing.is_dir():
         raise InputError(f"cannot create output folder {folder}: {existing} is not a folder")
     if existing == folder:  # no probe entry (it would touch the folder's mtime)

@@ -71,3 +71,31 @@ def test_kernels_listed_twice_are_refused(tmp_path, capsys):
                       "strip", "thesis", "-o", str(tmp_path / "n")],
              "--kernels: lists 'thesis' more than once")
     assert not (tmp_path / "m").exists() and not (tmp_path / "n").exists()
+
+
+def test_a_broken_link_as_output_is_refused_before_the_work(surface32, tmp_path, capsys,
+                                                            monkeypatch):
+    # passed the check (its nearest existing parent was writable), the sweep ran, and
+    # mkdir failed afterwards: "cannot create output folder ...: File exists"
+    import roughfe.cli.contact_cmd as contact_cmd
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("solved before the output folder was checked")
+    monkeypatch.setattr(contact_cmd, "response", no_solve)
+    (tmp_path / "link").symlink_to(tmp_path / "gone")
+    for out in (tmp_path / "link", tmp_path / "link" / "sub"):
+        _refused(capsys, ["contact", str(surface32), "--steps", "2", "--no-figures",
+                          "-o", str(out)], f"{tmp_path / 'link'} is a broken symbolic link",
+                 str(tmp_path / "gone"))
+    assert not (tmp_path / "gone").exists()
+
+
+def test_an_empty_output_name_is_refused(surface32, tmp_path, capsys, monkeypatch):
+    # `-o "$OUT"` with OUT unset: contact wrote results.json and fields.h5 into the working
+    # directory when it was empty (study run already refused it)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "empty").mkdir()
+    monkeypatch.chdir(tmp_path / "empty")
+    _refused(capsys, ["contact", str(surface32), "--steps", "2", "--no-figures", "-o", ""],
+             "output must name a folder, got ''", "working directory")
+    assert not any((tmp_path / "empty").iterdir())
