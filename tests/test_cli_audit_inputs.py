@@ -61,6 +61,36 @@ def test_info_psd_errors_name_psd(surface32, tmp_path, capsys):
     assert "-o takes" not in line
 
 
+def test_steps_whose_fields_cannot_fit_are_refused_before_the_sweep(surface32, tmp_path,
+                                                                    capsys):
+    # --steps 100000000 on a 32^2 grid started: ~2 weeks (2000 steps: 24 s) towards
+    # 3.4 TB of fields and a MemoryError
+    out = tmp_path / "c"
+    _refused(capsys, ["contact", str(surface32), "--steps", "10000000000", "--no-figures",
+                      "-o", str(out)], "keeping the fields of 10000000000 load steps of a "
+             "32 x 32 grid needs", "GiB are available")
+    assert not out.exists()
+    _refused(capsys, ["contact", str(surface32), "--steps", "10000000000", "--adhesion", "md",
+                      "--work-of-adhesion", "0.01", "--range", "1e-8", "--no-figures",
+                      "-o", str(out)], "load steps of a 32 x 32 grid needs")
+    assert not out.exists()
+
+
+def test_the_library_sweeps_check_the_memory_of_their_steps():
+    from roughfe.bem import Material, contact_sweep
+    from roughfe.bem.adhesion import AdhesionLaw, adhesive_sweep
+    from roughfe.surfaces import Surface
+    x = np.arange(16) / 16
+    s = Surface(1e-6 * np.cos(2 * np.pi * x)[:, None] * np.cos(2 * np.pi * x)[None, :],
+                1e-4, periodic=True)
+    steel = Material(E=210e9, nu=0.3)
+    with pytest.raises(InputError, match="fields of 10000000000 load steps of a 16 x 16"):
+        contact_sweep(s, steel, n_steps=10 ** 10)
+    with pytest.raises(InputError, match="fields of 10000000000 load steps"):
+        adhesive_sweep(s, steel, AdhesionLaw("md", 0.01, 1e-8), n_steps=10 ** 10)
+    assert len(contact_sweep(s, steel, n_steps=2).results) == 2
+
+
 def test_kernels_listed_twice_are_refused(tmp_path, capsys):
     # genome mechanics --kernels strip strip ran the strip sweeps twice (same files)
     assert main(["genome", "example", "-o", str(tmp_path / "g.json")]) == 0

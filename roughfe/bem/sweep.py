@@ -14,14 +14,32 @@ import dataclasses
 import numpy as np
 
 from .. import progress
-from ..errors import InputError
+from ..errors import InputError, check_memory
 from ..model import RECORD_KEYS, Loading, Material, SweepResult, central_differences
 from ..surfaces.stats import rms_slope
 from ..surfaces.surface import Surface
 from .contact import _check_surface, _coarse_start, solve_contact
 
-__all__ = ["contact_sweep", "default_deltas", "SweepResult", "RECORD_KEYS",
-           "central_differences"]
+__all__ = ["contact_sweep", "default_deltas", "check_sweep_memory", "SweepResult",
+           "RECORD_KEYS", "central_differences"]
+
+#: bytes per grid point that one step of a sweep keeps: its pressure, displacement and gap
+#: (float64), contact set (bool) and, with a hardness, plastic displacement (float64)
+STEP_BYTES_PER_POINT = 4 * 8 + 1
+
+
+def check_sweep_memory(surface: Surface, n_steps: int) -> None:
+    """Raise :class:`~roughfe.errors.InputError` when the fields of ``n_steps`` steps on
+    ``surface``'s grid (every step keeps them) need more than the available memory.
+
+    Checked before the approaches are made: ``roughfe contact --steps 100000000`` on a
+    32^2 grid started, to run for about two weeks (2000 steps: 24 s) towards 3.4 TB of
+    fields and a MemoryError (round 2, session 37).
+    """
+    shape = " x ".join(map(str, surface.shape))
+    check_memory(f"keeping the fields of {n_steps} load steps of a {shape} grid",
+                 float(n_steps) * surface.heights.size * STEP_BYTES_PER_POINT)
+
 
 def default_deltas(surface: Surface, n_steps: int, periodic: bool) -> np.ndarray:
     """``n_steps`` equispaced approaches k/n * Delta_max, k = 1..n (m): Delta_max is the
@@ -109,6 +127,9 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
                Loading(pressures=pressures) if pressures is not None else
                Loading(n_steps=n_steps))
     loading.require_contact()      # approaches apart: adhesion only (adhesive_sweep)
+    n_load = (loading.n_steps if loading.kind == "n_steps" else
+              len(np.atleast_1d(getattr(loading, loading.kind))))
+    check_sweep_memory(surface, 2 * n_load - 1 if unload else n_load)
     if loading.kind == "n_steps":
         periodic = surface.periodic and kernel in ("auto", "spectral")
         deltas = default_deltas(surface, loading.n_steps, periodic)
