@@ -103,6 +103,19 @@ def test_kernels_listed_twice_are_refused(tmp_path, capsys):
     assert not (tmp_path / "m").exists() and not (tmp_path / "n").exists()
 
 
+def test_options_that_meant_nothing_are_refused(surface32, tmp_path, capsys):
+    # leak --maps all --no-figures drew nothing; db build --ridges 5 of a profile
+    # database built the usual profiles: both ignored in silence
+    _refused(capsys, ["leak", str(surface32), "--pressure", "1e6", "--maps", "all",
+                      "--no-figures", "-o", str(tmp_path / "l")], "--maps all",
+             "--no-figures draws none")
+    assert not (tmp_path / "l").exists()
+    _refused(capsys, ["db", "build", str(tmp_path / "d.sqlite"), "--limit", "1", "--nodes",
+                      "64", "--steps", "5", "--workers", "1", "--ridges", "5"],
+             "--ridges 5", "--dim 2")
+    assert not (tmp_path / "d.sqlite").exists()
+
+
 def test_a_broken_link_as_output_is_refused_before_the_work(surface32, tmp_path, capsys,
                                                             monkeypatch):
     # passed the check (its nearest existing parent was writable), the sweep ran, and

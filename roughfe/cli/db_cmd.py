@@ -68,11 +68,16 @@ def _report(args, run) -> int:
 
 
 def _build(args) -> int:
+    from ..errors import InputError
     from ..genomics.database import SobolDesign
     from ..study import build_genome_db
+    if args.ridges is not None and args.dim != 2:   # was ignored (round 2, session 37)
+        raise InputError(f"--ridges {args.ridges} sets the ridges M of a surface genome "
+                         "(--dim 2); a profile database (--dim 1) has none: give --dim 2 "
+                         "or drop --ridges")
     design = SobolDesign(seed=args.seed, scramble=not args.no_scramble, dim=args.dim,
                          hurst_range=tuple(args.hurst_range),
-                         **({"n_ridges": args.ridges} if args.dim == 2 else {}))
+                         **({"n_ridges": args.ridges} if args.ridges is not None else {}))
     run = build_genome_db(args.database, _settings(args), design, limit=args.limit,
                           **_runner(args))
     return _report(args, run)
@@ -157,8 +162,8 @@ def register(sub):
     s.add_argument("--seed", type=nonnegative_int, default=20240,
                    help="Sobol scrambling seed (recorded)")
     s.add_argument("--no-scramble", action="store_true", help="unscrambled Sobol sequences")
-    s.add_argument("--ridges", type=positive_int, default=3,
-                   help="ridges M per surface genome (--dim 2)")
+    s.add_argument("--ridges", type=positive_int, default=None,
+                   help="ridges M per surface genome (--dim 2 only; default 3)")
     s.add_argument("--hurst-range", type=positive_float, nargs=2, default=(0.5, 1.5),
                    metavar=("LO", "HI"), help="range of H in the Sobol design (thesis: 0.5 1.5; "
                    "a measured target may need lower H, e.g. x3p-2 has 0.2-0.3)")

@@ -57,6 +57,9 @@ def _print_if(line):
 
 
 def _leak(args) -> int:
+    if args.maps is not None and args.no_figures:   # was ignored (round 2, session 37)
+        raise InputError(f"--maps {args.maps} chooses the steps whose maps are drawn; "
+                         "--no-figures draws none: give one of them")
     surface = surface_from_args(args)
     material = material_from_args(args)
     reliability = reliability_block(args, surface)      # trace vs retrace, or None
@@ -255,10 +258,11 @@ def register(sub):
     add_coupling_options(p)
     add_output_folder(p)
     add_run_options(p)
-    p.add_argument("--maps", choices=("ends", "all"), default="ends",
+    p.add_argument("--maps", choices=("ends", "all"), default=None,
                    help="the per-step maps (network, pressure, flux) of the first and the "
-                        "last step (ends) or of every step (all: about 1 s per map); "
-                        "figures/steps.png draws every step in any case")
+                        "last step (ends, the default) or of every step (all: about 1 s per "
+                        "map); figures/steps.png draws every step in any case; figures, "
+                        "so not with --no-figures")
     p.set_defaults(func=_leak, renders_with_dolfinx=True)
 
     s = sub.add_parser(
