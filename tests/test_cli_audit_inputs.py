@@ -133,6 +133,15 @@ def test_a_broken_link_as_output_is_refused_before_the_work(surface32, tmp_path,
     assert not (tmp_path / "gone").exists()
 
 
+def test_a_folder_as_target_file_is_said_to_be_a_folder(tmp_path):
+    # `design --target DIR` said "target file DIR does not exist"
+    from roughfe.genomics.target_csv import read_target_csv
+    with pytest.raises(InputError, match="is a folder, not a 'pressure,value' CSV file"):
+        read_target_csv(tmp_path)
+    with pytest.raises(InputError, match="does not exist"):
+        read_target_csv(tmp_path / "none.csv")
+
+
 def test_an_empty_output_name_is_refused(surface32, tmp_path, capsys, monkeypatch):
     # `-o "$OUT"` with OUT unset: contact wrote results.json and fields.h5 into the working
     # directory when it was empty (study run already refused it)

@@ -168,6 +168,8 @@ def read_target_csv(path, quantity=None, name=None, default: Quantity = "K") -> 
     that stops before Delta = peak-valley; ``roughfe design --target-p-top`` replaces it).
     """
     path = Path(path)
+    if path.is_dir():    # said "does not exist" (round 2, session 37)
+        raise InputError(f"target file {path} is a folder, not a 'pressure,value' CSV file")
     if not path.is_file():
         raise InputError(f"target file {path} does not exist")
     if quantity is not None:
