@@ -142,6 +142,25 @@ def test_a_folder_as_target_file_is_said_to_be_a_folder(tmp_path):
         read_target_csv(tmp_path / "none.csv")
 
 
+def test_leak_at_a_pressure_below_persson_u_p_keeps_its_reynolds_rates(surface32, tmp_path,
+                                                                       capsys):
+    # `leak --pressure 1e-200` (u(p) of Persson's theory overflows below ~1e-160 Pa on this
+    # surface) failed: "pressure_drop = 1 Pa with mu = 0.001 Pa s: ... (C = inf m^3 ...)
+    # overflows the float range; this gap allows dp / mu from 0 to 0 1/s"
+    import json
+
+    from roughfe.surfaces.io import load_surface
+    from roughfe.theory.junction import critical_junction
+    out = tmp_path / "l"
+    assert main(["leak", str(surface32), "--pressure", "1e-200", "--no-figures",
+                 "-o", str(out)]) == 0
+    step = json.loads((out / "results.json").read_text())["steps"][0]
+    assert step["leak_rate"] > 0 and step["persson_mean_gap"] is None
+    assert step["persson_leak_rate"] is None and step["persson_leak_rate_x"] is None
+    with pytest.raises(InputError, match=r"p_c = 2.38e-200 Pa is below what Persson's u\(p\)"):
+        critical_junction(load_surface(surface32), 2.1e8, 1e-200, 1.0, 1e-3)
+
+
 def test_an_empty_output_name_is_refused(surface32, tmp_path, capsys, monkeypatch):
     # `-o "$OUT"` with OUT unset: contact wrote results.json and fields.h5 into the working
     # directory when it was empty (study run already refused it)

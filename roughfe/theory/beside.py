@@ -180,10 +180,11 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         rec["persson_mean_gap"] = float(theory.mean_gap[j]) if k else None
         rec["persson_stiffness"] = float(theory.stiffness[j]) if k else None
         if pressure_drop is not None:
-            # Q is linear in the geometry factor: one junction per step, scaled per direction
+            # Q is linear in the geometry factor: one junction per step, scaled per direction;
+            # none where u(p) overflows (p -> 0: `leak --pressure 1e-200` failed on it)
             unit = (critical_junction(psd, e_star, float(p), pressure_drop, viscosity,
                                       gamma=gamma, geometry_factor=1.0).leak_rate
-                    if k else None)
+                    if k and np.isfinite(theory.mean_gap[j]) else None)
             for d, f in factors.items():
                 rec[f"persson_leak_rate_{d}"] = None if unit is None else unit * f
             rec["persson_leak_rate"] = (None if unit is None else

@@ -91,13 +91,19 @@ def _geometry_factor(source, direction: str = "x") -> float:
     return 1.0
 
 
-def _leak_rate(geometry_factor, u_c, pressure_drop, viscosity) -> float:
+def _leak_rate(geometry_factor, u_c, pressure_drop, viscosity, p_c) -> float:
     """Eq. (5), ``Q = (Ly/Lx) u_c^3 / 12 * Delta P / eta`` (m^3/s), the ratio
     ``Delta P / eta`` applied last without an intermediate overflow
     (:func:`roughfe.errors.check_leak_scale`, the rule of the Reynolds leak rates): written
     as one product, Delta P = 1e300 Pa with eta = 1e-20 Pa s gave inf for a Q of 5e299
     m^3/s (64^2 surface, 1 MPa); a Q beyond the normal floats (Delta P 1e-308 Pa: 0.0 or
-    a subnormal) is an InputError naming the Delta P / eta the junction allows."""
+    a subnormal) is an InputError naming the Delta P / eta the junction allows. A u_c that
+    overflowed (p -> 0, where u(p) grows like -ln p: 1e-200 Pa on a 1 um surface) is an
+    InputError naming the pressure (it was blamed on Delta P / eta, round 2, session 37)."""
+    if not np.isfinite(u_c):
+        raise InputError(f"the junction pressure p_c = {p_c:.3g} Pa is below what Persson's "
+                         f"u(p) resolves: the mean separation there overflows (u grows like "
+                         f"-ln p as p -> 0)")
     return check_leak_scale(geometry_factor * u_c ** 3 / 12.0, pressure_drop, viscosity)
 
 
@@ -167,7 +173,7 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
         q_c, a_c = float(q[0]), threshold
         p_c = p / a_c
         u_c = float(mean_separation(q, power, e, p_c, gamma, q2=q2)[0])
-        leak = _leak_rate(geometry_factor, u_c, dp, eta)
+        leak = _leak_rate(geometry_factor, u_c, dp, eta, p_c)
         return CriticalJunction(q_c=q_c, area_fraction_c=a_c, pressure_c=p_c, u_c=u_c,
                                 leak_rate=leak, sealed=False, **common)
     else:   # log-linear interpolation of A(q) between the bracketing wavenumbers
@@ -176,6 +182,6 @@ def critical_junction(source, e_star, mean_pressure, pressure_drop, viscosity, *
         a_c = threshold
     p_c = p / a_c
     u_c = float(mean_separation(q, power, e, p_c, gamma, q_min=q_c, q2=q2)[0])
-    leak = _leak_rate(geometry_factor, u_c, dp, eta)
+    leak = _leak_rate(geometry_factor, u_c, dp, eta, p_c)
     return CriticalJunction(q_c=q_c, area_fraction_c=a_c, pressure_c=p_c, u_c=u_c,
                             leak_rate=leak, sealed=False, **common)
