@@ -183,10 +183,10 @@ def _run(args) -> int:
         # compliance at its size), while here the targets are --target's curves and the
         # file gives only the rms of its Fourier modes, each to the chromosome nearest in
         # log q, by wavenumber, not by length; its 2D-on-a-profile-database case is
-        # refused above. The file's size sets only the wavenumbers it covers: its modes of
-        # wavelength above L go to the longest chromosome (spectral windows of L, mirrored:
-        # 0.5-22 % of the mean square, H 0.3-0.9; of 2 L: 27-84 %; x3p-2 on the L = 260 um
-        # of docs/theory/surface-design.md: 0.02 %), not warned of (round 2, session 36)
+        # refused above. What the file's size does matter for: its modes of wavelength
+        # above L, which go to the longest chromosome (round 2, session 37)
+        from .plausibility import check_long_waves
+        check_long_waves(args, spectrum_target, settings)
     cache = {}
     targets = [_target(args.target, args.quantity, settings, cache, "K")]
     if args.second_target:

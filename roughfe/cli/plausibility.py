@@ -180,6 +180,54 @@ def check_target_surface(args, surface, settings) -> None:
                    f"designs of length L may not reach its curves")
 
 
+#: share of the ``--match-spectrum`` file's mean square at wavelengths longer than the
+#: database length L above which :func:`check_long_waves` warns: where the curves move by
+#: a design's tolerance (s > 0.95 of Eq. 4.1: 5 % at every target point). Measured (round
+#: 2, session 37; 2L-periodic spectral surfaces, 128^2 on the spacing L/64 of the docs'
+#: surface database, H 0.5 and 0.8, 4 seeds each, n_t = 20, top_fraction 0.8): with the
+#: modes of wavelength > L removed, K(p) after Eq. 4.2 moves by a median (over the
+#: target's steps 3-20) of 1.8-2.8 % at a share of 0.1 %, 4.3-6.6 % (mean 5.2) at 0.5 %,
+#: 6.1-9.8 % at 1 %, 15-25 % at 5 %, A(p) by 3.3-4.8 % at 0.5 % (their mean square given
+#: to the |q| = 2 pi / L modes instead, as the matching does: K 3.5-6.4 % at 0.5 %).
+#: The strict score itself falls below 0.95 already at 0.1 % (0.57-0.90: its max over
+#: the points, set by the first ones, a few contact nodes), too sensitive to set it by.
+#: The measured files at their own size as L: plu-1 0.45 % moves K by 6 %, di-1 1.7 % by
+#: 3.3 %, sur-2 9.1 % by 32 % (A 44 %), opd-1 0.04 % by 0.6 %
+LONG_WAVE_SHARE_LIMIT = 0.005
+
+
+def check_long_waves(args, surface, settings) -> None:
+    """Warn (stderr) when the ``design --match-spectrum`` surface, as the design prepared
+    it (detrended by ``--detrend``, evenly mirrored if a window, on the database grid:
+    :func:`roughfe.genomics.design.target_surface`), carries more than
+    :data:`LONG_WAVE_SHARE_LIMIT` of its mean square at wavelengths longer than the
+    database length L (:func:`roughfe.genomics.design.long_wave_share`, from the Fourier
+    modes that :func:`~roughfe.genomics.design.spectrum_matched` distributes). The designs
+    are periodic of period L and hold none of those waves: the matching gives their mean
+    square to the longest chromosome, at its own wavelength, and a target solved on the
+    file (``design-targets --surface``, on the mirrored window) keeps them. The limit is
+    the share whose removal moves K(p) by a design's tolerance, 5 % (median over the
+    target's points, spectral surfaces; 1 %: 6-10 %). Until round 2, session 37 nothing
+    was said (a mirrored window of side L: 0.5-22 % there; of 2 L:
+    27-84 %; plu-1 and sur-2 on the L = 260 um of docs/theory/surface-design.md: 59 and
+    62 %)."""
+    from ..genomics.design import long_wave_share
+    share = long_wave_share(surface, settings.length)
+    if not share > LONG_WAVE_SHARE_LIMIT:
+        return
+    warn(args, f"--match-spectrum: {100 * share:.3g} % of the file's mean square (as the "
+               f"design takes it: after --detrend, mirrored if a window, on the database "
+               f"grid) lies at wavelengths longer than the database length L = "
+               f"{settings.length:.4g} m (limit {100 * LONG_WAVE_SHARE_LIMIT:g} %): the "
+               f"designs are periodic of period L and hold none of it, so the matching "
+               f"gives it to the longest chromosome at its own wavelength, and waves of "
+               f"that share move K(p) by about a design's 5 % tolerance (s > 0.95) or more "
+               f"(median over the target's points; 1 %: 6-10 %, 5 %: 15-25 %). A database "
+               f"of length {max(surface.size):.4g} m (db build --length; the longest "
+               f"wavelength of the file as the design takes it) holds all of it; or match "
+               f"the spectrum of a window of the file at most L/2 across")
+
+
 def check_target_curve(args, target) -> None:
     """Warn (stderr) when a design target's K(p) or A(p) falls with the load: the contact
     stiffness and area of an elastic rough contact grow with it, so a falling curve is

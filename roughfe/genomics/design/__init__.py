@@ -40,7 +40,7 @@ from .objective import SELECTION, Evaluator, Objective, Verdict, combined_score,
 from .search import (AMPLITUDE_VARIABLES, GLOBAL_METHODS, GLOBAL_SCORES, GlobalSearchOptions,
                      search_at_target_pressures, search_global)
 from .sensitivities import residual_jacobian
-from .spectrum import match_spectrum, spectrum_matched
+from .spectrum import long_wave_share, match_spectrum, spectrum_matched
 from .stages import FORMULATIONS, GcmmaOptions, optimise_phases, phase_bounds
 from .targets import (TARGET_BOUNDARIES, Y_T1_GENES, Y_T1_SURFACE_GENES, rescore,
                       rescore_at_target_pressures, score_at_target_pressures, SCORINGS,
@@ -53,7 +53,7 @@ __all__ = ["METHODS", "REFERENCES", "Candidate", "DesignResult", "cco", "gco", "
            "search_global", "GLOBAL_METHODS", "GlobalSearchOptions",
            "AMPLITUDE_VARIABLES", "score_batch_at_target_pressures", "GLOBAL_SCORES",
            "SCORINGS", "score_batch", "score_batch_interpolated",
-           "match_spectrum", "spectrum_matched", "target_surface",
+           "long_wave_share", "match_spectrum", "spectrum_matched", "target_surface",
            "clipped_phases", "crest_phases", "wave_modes",
            "MODULATION_CUT", "crest_roughness", "modulated_heights", "wave_split",
            "heights_name", "result_to_dict", "write_design_result",

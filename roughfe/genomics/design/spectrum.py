@@ -10,7 +10,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_finite_positive
 from ...surfaces.stats import angular_wavevectors
 from ..bands import wavevector_magnitude
 from ..database import DatabaseSettings
@@ -54,19 +54,66 @@ def spectrum_matched(design: Design, surface, directional: bool = False) -> Desi
                          "target surface (mirror a measured window first)")
     d = design.split_chromosomes()
     q_parts = np.array([float(p.genome.wavenumber(p.chromosomes[0])) for p in d.parts])
-    power = np.abs(np.fft.fftn(surface.heights - surface.heights.mean())) ** 2
-    power /= surface.heights.size ** 2                   # Parseval: sum = mean square (m^2)
-    q = wavevector_magnitude(surface.shape, surface.size, "fft")
-    live = q > 0
-    nearest = np.argmin(np.abs(np.log(q[live])[:, None] - np.log(q_parts)[None, :]), axis=1)
-    target_ms = np.bincount(nearest, weights=power[live], minlength=len(d.parts))
+    q, power = _mode_power(surface)
+    nearest = np.argmin(np.abs(np.log(q)[:, None] - np.log(q_parts)[None, :]), axis=1)
+    target_ms = np.bincount(nearest, weights=power, minlength=len(d.parts))
     if directional:
-        return _directions_matched(d, surface, nearest, power[live])
+        return _directions_matched(d, surface, nearest, power)
     ratio = np.array([np.sqrt(target_ms[k]) / d.part_surface(k).heights.std()
                       for k in range(len(d.parts))])
     ratio = np.maximum(ratio, 1e-3 * ratio.max())
     keys = [(k, "weight") for k in range(len(d.parts))]
     return d.with_phases(keys, [p.weight * r for p, r in zip(d.parts, ratio)])
+
+
+def _mode_power(surface):
+    """``|q|`` (rad/m) and mean square ``|h~(q)|^2`` (m^2) of every Fourier mode ``q != 0``
+    of a periodic ``surface``, in the FFT's order (Parseval: they sum to the mean square
+    about the mean). The one spectrum :func:`spectrum_matched` distributes and
+    :func:`long_wave_share` judges."""
+    power = np.abs(np.fft.fftn(surface.heights - surface.heights.mean())) ** 2
+    power /= surface.heights.size ** 2                   # Parseval: sum = mean square (m^2)
+    q = wavevector_magnitude(surface.shape, surface.size, "fft")
+    live = q > 0
+    return q[live], power[live]
+
+
+def long_wave_share(surface, length: float) -> float:
+    """Share of a periodic target surface's mean square at wavelengths longer than
+    ``length``, the design period L (m)::
+
+        s_L = sum_{0 < |q| < 2 pi / L} |h~(q)|^2 / sum_{q != 0} |h~(q)|^2      (-),
+
+    over the Fourier modes of :func:`_mode_power` (the spectrum :func:`spectrum_matched`
+    distributes; a mode of wavelength L itself, ``|q| = 2 pi / L`` to 1e-9, is not
+    counted: the designs hold it). A design is periodic with period L, so it holds none
+    of these modes: :func:`spectrum_matched` gives their mean square to the chromosome
+    nearest in log q, the longest, at its own wavelength. A cosine ``a cos(q x)`` adds
+    ``a^2 / 2`` to the numerator when ``q < 2 pi / L``. A measured window of side L,
+    evenly mirrored (:func:`~.targets.target_surface`), has modes of wavelength 2 L and
+    ``sqrt(2) L``: spectral windows carried 0.5-22 % there (H 0.3-0.9), windows of 2 L
+    27-84 % (round 2, session 36).
+
+    Returns
+    -------
+    float
+        ``s_L`` in [0, 1]; NaN for a flat surface (no mean square to share).
+
+    Raises
+    ------
+    InputError
+        A non-periodic surface (mirror a measured window first, as
+        :func:`spectrum_matched`), or ``length`` not a finite positive number.
+    """
+    length = check_finite_positive("length (m)", length)
+    if not surface.periodic:
+        raise InputError("long_wave_share needs a periodic target surface, as "
+                         "spectrum_matched (mirror a measured window first)")
+    q, power = _mode_power(surface)
+    total = float(power.sum())
+    if not total > 0:
+        return float("nan")
+    return float(power[q < 2 * np.pi / length * (1 - 1e-9)].sum() / total)
 
 
 def _directions_matched(d: Design, surface, part_of, power) -> Design:
