@@ -170,3 +170,16 @@ def test_an_empty_output_name_is_refused(surface32, tmp_path, capsys, monkeypatc
     _refused(capsys, ["contact", str(surface32), "--steps", "2", "--no-figures", "-o", ""],
              "output must name a folder, got ''", "working directory")
     assert not any((tmp_path / "empty").iterdir())
+
+
+def test_natural_says_which_fraction_is_too_short(surface32, tmp_path, capsys):
+    # said the sequencer's "too few points: N = 7 nodes per acquisition, at least 32 are
+    # needed" to `--nodes 64` (the 0.2 window of a 32-sample row has 7), and "acquisitions
+    # must have different observation lengths" to `--fractions 1 1`
+    out = tmp_path / "n"
+    _refused(capsys, ["genome", "natural", str(surface32), "--nodes", "64", "--quiet",
+                      "--no-figures", "-o", str(out)],
+             "fraction 0.2 has 7 nodes", "row's 32 samples", "larger fractions or a row")
+    _refused(capsys, ["genome", "natural", str(surface32), "--fractions", "1", "1", "--quiet",
+                      "--no-figures", "-o", str(out)], "fractions must differ", "[1.0, 1.0]")
+    assert not out.exists()

@@ -54,7 +54,7 @@ from ..frozen import freeze_containers
 from ..surfaces.surface import Surface
 from .genome import DEFAULT_NODES, realize
 from .mechanics import THESIS_YOUNGS_MODULUS, curve_difference, response
-from .sequencing import SequencingResult, sequence_profiles
+from .sequencing import MIN_NODES, SequencingResult, sequence_profiles
 
 DEFAULT_FRACTIONS = (1.0, 0.5, 0.2)     # full row, central half, central fifth
 AXES = ("x", "y")
@@ -141,6 +141,9 @@ def nested_acquisitions(surface: Surface, fractions=DEFAULT_FRACTIONS, n_nodes=D
     fr = sorted((float(f) for f in fractions), reverse=True)
     if not fr or fr[0] > 1 or fr[-1] <= 0:
         raise InputError(f"fractions must lie in (0, 1], got {list(fractions)!r}")
+    if len(set(fr)) < len(fr):   # was the sequencer's "different observation lengths"
+        raise InputError(f"fractions must differ (one acquisition each), got "
+                         f"{list(fractions)!r}")
     coef = np.polyfit(x, z, 1)
     z = z - np.polyval(coef, x)
     dx = x[1] - x[0]
@@ -212,6 +215,16 @@ def sequence_measured(surface: Surface, *, fractions=DEFAULT_FRACTIONS, n_nodes=
     :func:`~roughfe.genomics.sequencing.sequence_profiles`.
     """
     acq = nested_acquisitions(surface, fractions, n_nodes, row=row, axis=axis)
+    short = [a for a in acq if a.shape[0] < MIN_NODES]
+    if short:    # sequence_profiles said "N = 7 nodes", naming no fraction (session 37)
+        a = short[-1]
+        points = a.metadata["measured_points"]
+        raise InputError(
+            f"the acquisition of fraction {a.metadata['fraction']:g} has {a.shape[0]} nodes "
+            f"({points} of the row's {measured_row(surface, row, axis)[1].size} samples, at "
+            f"most n_nodes = {n_nodes}); sequencing needs at least {MIN_NODES} per "
+            f"acquisition: give " + (f"n_nodes >= {MIN_NODES}" if points >= MIN_NODES else
+                                     "larger fractions or a row of more samples"))
     seq = sequence_profiles(acq, seed=seed, rms_tolerance=rms_tolerance, n_restarts=n_restarts,
                             windows=True)
     full = acq[0]
