@@ -81,7 +81,8 @@ def test_bad_input_is_refused_and_a_flat_surface_has_no_share():
     assert math.isnan(long_wave_share(s.with_heights(np.full(s.shape, 2e-8)), L))
 
 
-def _run_design(tmp_path, capsys, monkeypatch, surface):
+def _run_design(tmp_path, capsys, monkeypatch, surface,
+                expect="stopped before the design (test)"):
     """``design --match-spectrum`` on ``surface`` (a .npz) up to the design: the database
     holds only its settings (no genome is read) and run_design stops the command."""
     from roughfe.genomics.database.store import connect, write_settings
@@ -103,7 +104,7 @@ def _run_design(tmp_path, capsys, monkeypatch, surface):
                  "--method", "sog", "--match-spectrum", str(tmp_path / "f.npz"),
                  "--no-figures", "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
-    assert "stopped before the design (test)" in err
+    assert expect in err
     return err
 
 
@@ -123,3 +124,15 @@ def test_design_warns_of_a_file_whose_long_waves_the_designs_cannot_hold(tmp_pat
     assert f"A database of length {2 * L:.4g} m (db build --length" in err
     err = _run_design(tmp_path, capsys, monkeypatch, short)
     assert "--match-spectrum:" not in err and "warning" not in err
+
+
+def test_design_onto_a_database_too_fine_for_the_file_is_refused_at_once(tmp_path, capsys,
+                                                                         monkeypatch):
+    """A file of 2 L on a database of spacing L / N with L 1e5 times smaller than the
+    file: resampling onto it would need ~(2e5 N)^2 points; the command says so in one
+    line and exits 2 instead of allocating (it hung towards ~80 GB with x3p-2 on a 7.8 nm
+    database; round 2, session 37)."""
+    big = _short_waves()
+    big = Surface(big.heights, tuple(1e5 * s for s in big.size), periodic=True)
+    err = _run_design(tmp_path, capsys, monkeypatch, big, expect="resampling a 32 x 32 grid")
+    assert "GiB of memory" in err and "Traceback" not in err

@@ -73,3 +73,25 @@ def test_resampling_refuses_what_it_cannot_do():
         resampled(np.zeros((4, 4)), (8, 8))
     with pytest.raises(InputError, match="periodic"):
         Surface(np.zeros((4, 4)), (1.0, 1.0)).resampled((8, 8))
+
+
+def test_resampling_beyond_the_memory_is_refused_before_any_allocation(monkeypatch):
+    """A grid whose axis passes need more than the available memory is refused at once
+    with what, how much and what is free (``design --match-spectrum`` onto a 7.8 nm
+    database spacing took x3p-2 towards ~80 GB and hung; round 2, session 37). The limit
+    is the available memory: with 1 MB available a 64^2 -> 256^2 resampling (256^2 x 64
+    bytes = 4 MB) is refused and a 64^2 -> 64 x 100 one (0.4 MB) is not."""
+    import roughfe.errors as errors
+    s = Surface(np.random.default_rng(0).normal(size=(64, 64)), (1.0, 1.0), periodic=True)
+    with pytest.raises(InputError, match=r"resampling a 64 x 64 grid onto 100000 x 100000 "
+                                         r"points needs [\d.]+ GiB of memory"):
+        resampled(s, (100_000, 100_000))
+    with pytest.raises(InputError, match=r"onto 640000 x 640000 points needs"):
+        refined(s, 10_000)
+    window = Surface(s.heights, s.size, periodic=False)      # refined through its mirror
+    with pytest.raises(InputError, match=r"resampling a 126 x 126 grid onto 1260000 x "):
+        refined(window, 10_000)
+    monkeypatch.setattr(errors, "available_memory", lambda: 1_000_000)
+    with pytest.raises(InputError, match="needs 0.0 GiB of memory, 0.0 GiB are available"):
+        resampled(s, (256, 256))
+    assert resampled(s, (64, 100)).shape == (64, 100)
