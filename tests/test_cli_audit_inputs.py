@@ -183,3 +183,13 @@ def test_natural_says_which_fraction_is_too_short(surface32, tmp_path, capsys):
     _refused(capsys, ["genome", "natural", str(surface32), "--fractions", "1", "1", "--quiet",
                       "--no-figures", "-o", str(out)], "fractions must differ", "[1.0, 1.0]")
     assert not out.exists()
+
+
+def test_info_of_a_flat_surface_says_it_is_flat(tmp_path, capsys):
+    # the Hurst row said "n/a (only 0 PSD points in q_range; give --hurst-q-range)": no
+    # range helps a PSD that is zero everywhere
+    np.save(tmp_path / "flat.npy", np.zeros((32, 32)))
+    assert main(["info", str(tmp_path / "flat.npy"), "--size", "1e-4"]) == 0
+    row = [line for line in capsys.readouterr().out.splitlines()
+           if line.startswith("Hurst exponent")][0]
+    assert "the surface is flat (its PSD is zero)" in row and "--hurst-q-range" not in row

@@ -81,8 +81,9 @@ def format_table(stats: dict) -> str:
         if key in ("hurst", "fractal_dimension") and not stats["hurst_success"]:
             if v is None:        # the fit's own reason (too few points, grid too small)
                 why = stats.get("hurst_message", "").split(";")[0] or "too few PSD points"
+                hint = "" if "flat" in why else "; give --hurst-q-range"   # no range helps
                 lines.append(f"{label:<28s} n/a (" + ("no Hurst exponent" if key !=
-                             "hurst" else f"{why}; give --hurst-q-range") + ")")
+                             "hurst" else f"{why}{hint}") + ")")
                 continue
             lines.append(f"{label:<28s} n/a (PSD fit gives H = {stats['hurst']:.3g}, "
                          f"outside (0, 1))")

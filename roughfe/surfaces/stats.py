@@ -408,9 +408,10 @@ def fit_hurst(surface: Surface, q_range=None, window="auto") -> HurstFit:
                           whittle_power_law)        # (they import this module)
     sel, weight = fit_points(psd, (qlo, qhi))
     n = int(sel.sum())
-    if n < 3:
+    if n < 3:      # a flat surface said "only 0 PSD points in q_range; widen it" (s. 37)
         return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
-                        f"only {n} PSD points in q_range; widen it")
+                        f"only {n} PSD points in q_range; widen it" if np.any(psd.C > 0)
+                        else "the surface is flat (its PSD is zero): no power law to fit")
     q, c = psd.q[sel], psd.C[sel]
     if q[-1] <= q[0] * 10 ** 0.1:
         return HurstFit(np.nan, np.nan, np.nan, np.nan, (qlo, qhi), n, False,
