@@ -193,3 +193,43 @@ def test_info_of_a_flat_surface_says_it_is_flat(tmp_path, capsys):
     row = [line for line in capsys.readouterr().out.splitlines()
            if line.startswith("Hurst exponent")][0]
     assert "the surface is flat (its PSD is zero)" in row and "--hurst-q-range" not in row
+
+
+def test_a_database_without_permission_is_refused_before_the_work(tmp_path, capsys,
+                                                                  monkeypatch):
+    # a read-only database: db extend / db build computed every genome, then a traceback
+    # "sqlite3.OperationalError: attempt to write a readonly database"; an unreadable one:
+    # db list / db map / design-targets a traceback "unable to open database file"
+    import os
+    from pathlib import Path
+
+    import roughfe.study.genome_db as genome_db
+    db = tmp_path / "d.sqlite"
+    assert main(["db", "build", str(db), "--limit", "1", "--nodes", "64", "--steps", "5",
+                 "--workers", "1", "--quiet"]) == 0
+    assert main(["genome", "example", "-o", str(tmp_path / "g.json")]) == 0
+    real, denied = os.access, {"mode": os.W_OK}
+
+    def access(path, mode, *args, **kwargs):   # as for a user without the permission:
+        if Path(path) == db and mode & denied["mode"]:     # root ignores the mode bits
+            return False
+        return real(path, mode, *args, **kwargs)
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("the genomes were computed before the database was checked")
+    monkeypatch.setattr(os, "access", access)
+    monkeypatch.setattr(genome_db, "run_study", no_work)
+    db.chmod(0o444)
+    try:
+        _refused(capsys, ["db", "extend", str(db), str(tmp_path / "g.json"), "--workers", "1"],
+                 f"cannot write genome database {db}: permission denied")
+        _refused(capsys, ["db", "build", str(db), "--limit", "2", "--nodes", "64", "--steps",
+                          "5", "--workers", "1"], "cannot write genome database")
+        denied["mode"] = os.R_OK
+        db.chmod(0o000)
+        for argv in (["db", "list", str(db)], ["db", "map", str(db), "-o", str(tmp_path / "m")],
+                     ["design-targets", "--db", str(db), "-o", str(tmp_path / "t")]):
+            _refused(capsys, argv, f"cannot read genome database {db}: permission denied")
+    finally:
+        db.chmod(0o644)
+    assert not (tmp_path / "m").exists() and not (tmp_path / "t").exists()

@@ -135,6 +135,7 @@ def extend_genome_db(db_path, genomes, *, labels=None, executor="local", workers
     """
     from ..genomics import database as gdb
 
+    gdb.check_access(db_path, write=True)    # before the work, not at the inserts
     con = gdb.connect(db_path)
     try:
         tasks = gdb.extend_tasks(con, genomes, labels)

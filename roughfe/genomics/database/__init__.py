@@ -40,13 +40,13 @@ importable from ``roughfe.genomics.database``.
 """
 from .settings import THESIS_SETTINGS, DatabaseSettings, settings_from
 from .sobol import SobolDesign, sobol_tasks
-from .store import (SCHEMA_VERSION, DatabaseEntry, connect, extend_tasks, insert_records,
-                    labels, load_entries, new_file_removed_on_error, read_settings,
-                    summary_table, write_design, write_settings)
+from .store import (SCHEMA_VERSION, DatabaseEntry, check_access, connect, extend_tasks,
+                    insert_records, labels, load_entries, new_file_removed_on_error,
+                    read_settings, summary_table, write_design, write_settings)
 from .task import genome_entry_task, make_genome
 
 __all__ = ["THESIS_SETTINGS", "DatabaseSettings", "settings_from", "SobolDesign", "sobol_tasks",
-           "SCHEMA_VERSION", "DatabaseEntry", "connect", "extend_tasks", "insert_records",
-           "labels", "load_entries", "new_file_removed_on_error", "read_settings",
-           "summary_table", "write_design", "write_settings", "genome_entry_task",
-           "make_genome"]
+           "SCHEMA_VERSION", "DatabaseEntry", "check_access", "connect", "extend_tasks",
+           "insert_records", "labels", "load_entries", "new_file_removed_on_error",
+           "read_settings", "summary_table", "write_design", "write_settings",
+           "genome_entry_task", "make_genome"]

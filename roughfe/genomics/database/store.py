@@ -77,18 +77,38 @@ def _now():
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
+def check_access(path, write: bool) -> None:
+    """InputError unless the genome database ``path`` can be read (and with ``write``
+    written: the file, and its folder, where SQLite keeps its journal while it writes).
+
+    SQLite said "unable to open database file" as a traceback for a file without read
+    permission, and "attempt to write a readonly database" after `db build`/`db extend`
+    had computed every genome (round 2, session 37).
+    """
+    path = Path(path)
+    if path.is_file() and not os.access(path, os.R_OK | (os.W_OK if write else 0)):
+        raise InputError(f"cannot {'write' if write else 'read'} genome database {path}: "
+                         "permission denied")
+    folder = path.parent if str(path.parent) else Path(".")
+    if write and folder.is_dir() and not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"cannot write genome database {path}: its folder {folder} is not "
+                         "writable (SQLite writes its journal beside the file)")
+
+
 def connect(path, *, create=False) -> sqlite3.Connection:
     """Open (or with ``create=True`` create) a genome database and check its schema version.
 
     Without ``create`` the file is opened read-only and must already hold roughfe's
     tables: a foreign or empty SQLite file is reported (FileFormatError), never written.
-    A folder is an InputError in both modes.
+    A folder is an InputError in both modes, and so is a file (or, with ``create``, a
+    folder) that this process may not read or write (:func:`check_access`).
     """
     path = Path(path)
     if path.is_dir() or not (create or path.is_file()):
         raise InputError(f"genome database {path} does not exist"
                          + (" (it is a folder)" if path.is_dir() else
                             " (build it with 'roughfe db build')"))
+    check_access(path, write=create)
     if not create:
         return _connect_read_only(path)
     if path.is_file() and path.stat().st_size:   # SQLite took a 1-byte file as empty and
