@@ -233,3 +233,13 @@ def test_a_database_without_permission_is_refused_before_the_work(tmp_path, caps
     finally:
         db.chmod(0o644)
     assert not (tmp_path / "m").exists() and not (tmp_path / "t").exists()
+
+
+def test_info_psd_of_a_map_too_small_for_its_window_says_so(tmp_path, capsys):
+    # said the library's "a Hann window needs at least 3 points per side ...; use
+    # window='none'" (a keyword of power_spectrum, no option of info)
+    np.save(tmp_path / "thin.npy", np.random.default_rng(1).normal(size=(2, 32)) * 1e-6)
+    line = _refused(capsys, ["info", str(tmp_path / "thin.npy"), "--size", "1e-4", "5e-5",
+                             "--psd", str(tmp_path / "p.csv")],
+                    "--psd: a non-periodic 2 x 32 map is too small", "--periodic")
+    assert "window=" not in line and not (tmp_path / "p.csv").exists()

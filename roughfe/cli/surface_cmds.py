@@ -118,8 +118,14 @@ def write_psd(surface, path, title: str, coherence=None):
     (:func:`roughfe.cli.info_reliability.write_coherence`) and the figure a third panel
     with the curve and the cutoff marked in every panel."""
     from ..surfaces.line_psd import line_spectra
-    from ..surfaces.stats import fit_hurst, power_spectrum
+    from ..surfaces.stats import HANN_MIN_POINTS, fit_hurst, power_spectrum
     from ..writers import write_text
+    if not surface.periodic and min(surface.shape) < HANN_MIN_POINTS:
+        # said the library's "... use window='none'", no option of info (session 37)
+        raise InputError(
+            f"--psd: a non-periodic {' x '.join(map(str, surface.shape))} map is too small "
+            f"for its Hann-windowed PSD (at least {HANN_MIN_POINTS} points per side; "
+            "--periodic takes the heights unwindowed)")
     main = "radial" if surface.ndim == 2 else "profile"
     spectra = {main: power_spectrum(surface), **line_spectra(surface)}
     if path.suffix.lower() == ".png":
