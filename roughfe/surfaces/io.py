@@ -58,6 +58,7 @@ import numpy as np
 
 from ..errors import FileFormatError, InputError, RoughfeError
 from ..writers import atomic_path, to_jsonable
+from .file_checks import periodic_flag
 from .layout import DI_FIX, fix_di_lines
 from .nonmeasured import masked, nonmeasured_mask
 from .probe import open_instrument, quietly, quote_error, warn_if_shorter_than_announced
@@ -140,7 +141,8 @@ def _read_native(path, size, periodic, channel):
                     f"(reads {NATIVE_FORMAT!r} up to version {NATIVE_VERSION})")
             heights = np.array(data["heights"])
             file_size = tuple(float(s) for s in np.atleast_1d(data["size"]))
-            file_periodic = bool(data["periodic"])
+            file_periodic = periodic if periodic is not None else periodic_flag(
+                data["periodic"], path)         # an override is not read from the file
             metadata = json.loads(str(data["metadata"]))
             if not isinstance(metadata, dict):
                 raise FileFormatError(f"{path}: its metadata must be a JSON object, got "

@@ -1,0 +1,34 @@
+"""What :func:`roughfe.surfaces.io.load_surface` asks of a surface file and of the values
+read from it, before they become a :class:`~roughfe.surfaces.surface.Surface`.
+
+Found by the fresh-eyes audit of bad input (round 2, session 37): a ``.npz`` whose
+``periodic`` entry was ``"no"`` or ``0.5`` was read as periodic (by truthiness).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import FileFormatError
+
+
+def _shown(a: np.ndarray) -> str:
+    """``text 'no'``, ``float64 0.5``, ``an array of shape (2,)``: a value read from a
+    file, for an error message."""
+    if a.size != 1:
+        return f"an array of shape {a.shape}"
+    kind = {"U": "text", "S": "text", "O": "an object"}.get(a.dtype.kind, a.dtype.name)
+    return f"{kind} {a.item()!r}" if kind != "text" else f"text {str(a.item())!r}"
+
+
+def periodic_flag(value, path) -> bool:
+    """The ``periodic`` entry of a native ``.npz`` as a bool: a bool, or the integer 1 or
+    0, of one element (:func:`~roughfe.surfaces.io.save_surface` has always written
+    ``np.array(bool)``); anything else (text such as ``"no"``, ``0.5``, ``2``, several
+    values) is a :class:`FileFormatError` naming what was found."""
+    a = np.asarray(value)
+    if a.size == 1 and (a.dtype == bool or (a.dtype.kind in "iu" and a.item() in (0, 1))):
+        return bool(a.item())
+    raise FileFormatError(
+        f"{path}: its 'periodic' entry is {_shown(a)}; it must be a bool, True or False "
+        f"(the integers 1 or 0 are read as such), as save_surface writes it: give "
+        f"--periodic/--non-periodic (periodic=) to read the file as one or the other")

@@ -1,0 +1,45 @@
+"""Bad surface files that the session-37 audit of bad input found read wrongly or said
+wrongly (round 2, session 37, helper aud2): each test fails on the code before its fix."""
+import numpy as np
+import pytest
+
+from roughfe.cli import main
+from roughfe.errors import FileFormatError, InputError
+from roughfe.surfaces import Surface, load_surface, save_surface
+
+
+def _surface():
+    return Surface(np.random.default_rng(0).normal(size=(16, 16)) * 1e-6, 1e-4, False)
+
+
+def _with_periodic(tmp_path, name, value):
+    """A roughfe .npz whose 'periodic' entry is ``np.array(value)``."""
+    path = save_surface(_surface(), tmp_path / "ok.npz")
+    arrays = dict(np.load(path))
+    arrays["periodic"] = np.array(value)
+    np.savez(tmp_path / name, **arrays)
+    return tmp_path / name
+
+
+@pytest.mark.parametrize("value, shown", [("no", "text 'no'"), ("yes", "text 'yes'"),
+                                          ("True", "text 'True'"), (0.5, "float64 0.5"),
+                                          (1.0, "float64 1.0"), (2, "int64 2"),
+                                          ([True, False], "an array of shape (2,)")])
+def test_a_periodic_entry_that_is_no_bool_is_refused(tmp_path, value, shown):
+    # 'no', 'yes', 0.5 were all read as periodic (truthiness): a silently wrong reading
+    path = _with_periodic(tmp_path, "bad.npz", value)
+    with pytest.raises(FileFormatError) as info:
+        load_surface(path)
+    msg = str(info.value)
+    assert str(path) in msg and f"'periodic' entry is {shown}" in msg, msg
+    assert "True or False" in msg and "1 or 0" in msg, msg
+
+
+@pytest.mark.parametrize("value, periodic", [(True, True), (False, False), (1, True),
+                                             (0, False), (np.uint8(1), True),
+                                             ([True], True), ([0], False)])
+def test_a_periodic_entry_that_means_a_bool_is_read(tmp_path, value, periodic):
+    assert load_surface(_with_periodic(tmp_path, "p.npz", value)).periodic is periodic
+    # the --periodic/--non-periodic override is not read from the file
+    assert load_surface(_with_periodic(tmp_path, "q.npz", "no"), periodic=False).periodic \
+        is False
