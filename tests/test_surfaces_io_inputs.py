@@ -43,3 +43,40 @@ def test_a_periodic_entry_that_means_a_bool_is_read(tmp_path, value, periodic):
     # the --periodic/--non-periodic override is not read from the file
     assert load_surface(_with_periodic(tmp_path, "q.npz", "no"), periodic=False).periodic \
         is False
+
+
+def _unreadable(monkeypatch, *paths):
+    """``os.access`` answering for ``paths`` as for a user without read permission (root,
+    who runs these tests, ignores the mode bits)."""
+    import os
+    from pathlib import Path
+    real, denied = os.access, {Path(p).absolute() for p in paths}
+
+    def access(path, mode, *args, **kwargs):
+        if Path(path).absolute() in denied and mode & os.R_OK:
+            return False
+        return real(path, mode, *args, **kwargs)
+    monkeypatch.setattr(os, "access", access)
+
+
+def test_a_file_without_read_permission_is_said_to_be_unreadable(tmp_path, monkeypatch,
+                                                                  topographies_dir, capsys):
+    # as user nobody: a .npz said "truncated or not a zip archive", an .x3p "damaged or
+    # truncated? (... PermissionError ...)", a .txt "cannot read as a plain text matrix
+    # ([Errno 13] ...)", a .npy "Permission denied: X"
+    import shutil
+    files = [save_surface(_surface(), tmp_path / "s.npz"),
+             shutil.copy(topographies_dir / "x3p-2.x3p", tmp_path / "s.x3p")]
+    np.save(tmp_path / "s.npy", _surface().heights)
+    np.savetxt(tmp_path / "s.txt", _surface().heights)
+    files += [tmp_path / "s.npy", tmp_path / "s.txt"]
+    _unreadable(monkeypatch, *files)
+    for path in files:
+        with pytest.raises(InputError) as info:
+            load_surface(path, size=1e-4)
+        assert str(info.value) == f"cannot read surface file {path}: permission denied"
+    capsys.readouterr()
+    assert main(["info", str(files[0])]) == 2
+    err = capsys.readouterr().err
+    assert f"roughfe info: error: cannot read surface file {files[0]}: permission denied" \
+        in err and "Traceback" not in err and "zip" not in err

@@ -2,13 +2,42 @@
 read from it, before they become a :class:`~roughfe.surfaces.surface.Surface`.
 
 Found by the fresh-eyes audit of bad input (round 2, session 37): a ``.npz`` whose
-``periodic`` entry was ``"no"`` or ``0.5`` was read as periodic (by truthiness).
+``periodic`` entry was ``"no"`` or ``0.5`` was read as periodic (by truthiness); a file
+without read permission was said to be damaged (each reader failed in its own words).
 """
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import numpy as np
 
-from ..errors import FileFormatError
+from ..errors import FileFormatError, InputError
+
+
+def check_surface_file(path) -> Path:
+    """``path`` as a Path, or an error unless it is a file this user may read, and not
+    empty: :class:`InputError` for a missing file, a folder or a file without read
+    permission (before round 2, session 37 each reader gave its own wrong cause: a
+    ``.npz`` "truncated or not a zip archive", an ``.x3p`` "damaged or truncated?"),
+    :class:`FileFormatError` for an empty file."""
+    path = Path(path)
+    try:
+        path.stat()
+    except PermissionError:             # is_dir() and is_file() raise it too
+        raise InputError(f"cannot read surface file {path}: permission denied (on a "
+                         f"folder of its path)") from None
+    except OSError:
+        pass                            # missing: said below
+    if path.is_dir():
+        raise InputError(f"surface file {str(path)!r} is a folder, not a file")
+    if not path.is_file():
+        raise InputError(f"surface file {str(path)!r} does not exist")
+    if not os.access(path, os.R_OK):
+        raise InputError(f"cannot read surface file {path}: permission denied")
+    if path.stat().st_size == 0:
+        raise FileFormatError(f"{path}: the file is empty")
+    return path
 
 
 def _shown(a: np.ndarray) -> str:

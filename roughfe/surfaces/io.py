@@ -58,7 +58,7 @@ import numpy as np
 
 from ..errors import FileFormatError, InputError, RoughfeError
 from ..writers import atomic_path, to_jsonable
-from .file_checks import periodic_flag
+from .file_checks import check_surface_file, periodic_flag
 from .layout import DI_FIX, fix_di_lines
 from .nonmeasured import masked, nonmeasured_mask
 from .probe import open_instrument, quietly, quote_error, warn_if_shorter_than_announced
@@ -479,17 +479,11 @@ def load_surface(path, size=None, periodic=None, channel=None) -> Surface:
     Raises
     ------
     InputError
-        Missing file, missing size for a plain matrix, unknown channel.
+        Missing or unreadable file, missing size for a plain matrix, unknown channel.
     FileFormatError
         The file cannot be parsed.
     """
-    path = Path(path)
-    if path.is_dir():
-        raise InputError(f"surface file {str(path)!r} is a folder, not a file")
-    if not path.is_file():
-        raise InputError(f"surface file {str(path)!r} does not exist")
-    if path.stat().st_size == 0:
-        raise FileFormatError(f"{path}: the file is empty")
+    path = check_surface_file(path)     # a file this user may read, not empty
     suffix = path.suffix.lower()
     for suffixes, reader, _ in READERS:
         if suffixes is None or suffix in suffixes:
