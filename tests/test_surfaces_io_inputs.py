@@ -80,3 +80,25 @@ def test_a_file_without_read_permission_is_said_to_be_unreadable(tmp_path, monke
     err = capsys.readouterr().err
     assert f"roughfe info: error: cannot read surface file {files[0]}: permission denied" \
         in err and "Traceback" not in err and "zip" not in err
+
+
+def test_a_path_that_is_no_regular_file_says_what_it_is(tmp_path, capsys):
+    # `info /dev/null` said "surface file '/dev/null' does not exist"; a FIFO (which a
+    # reader would wait on) and a broken symbolic link said the same
+    import os
+    os.mkfifo(tmp_path / "pipe.npz")
+    (tmp_path / "link.npz").symlink_to(tmp_path / "gone.npz")
+    for path, what in (("/dev/null", "is a character device, not a regular file"),
+                       (tmp_path / "pipe.npz", "is a named pipe (FIFO), not a regular file"),
+                       (tmp_path / "link.npz",
+                        f"is a broken symbolic link (to {tmp_path / 'gone.npz'})")):
+        with pytest.raises(InputError) as info:
+            load_surface(path)
+        assert f"surface file {str(path)!r} {what}" in str(info.value)
+        assert "does not exist" not in str(info.value)
+    capsys.readouterr()
+    assert main(["info", "/dev/null"]) == 2
+    assert "error: surface file '/dev/null' is a character device, not a regular file" \
+        in capsys.readouterr().err
+    with pytest.raises(InputError, match="does not exist"):
+        load_surface(tmp_path / "missing.npz")

@@ -3,11 +3,13 @@ read from it, before they become a :class:`~roughfe.surfaces.surface.Surface`.
 
 Found by the fresh-eyes audit of bad input (round 2, session 37): a ``.npz`` whose
 ``periodic`` entry was ``"no"`` or ``0.5`` was read as periodic (by truthiness); a file
-without read permission was said to be damaged (each reader failed in its own words).
+without read permission was said to be damaged (each reader failed in its own words), and
+``/dev/null`` not to exist.
 """
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -15,27 +17,38 @@ import numpy as np
 from ..errors import FileFormatError, InputError
 
 
+#: what a path is that is neither a folder nor a regular file
+_NOT_REGULAR = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                (stat.S_ISFIFO, "a named pipe (FIFO)"), (stat.S_ISSOCK, "a socket"))
+
+
 def check_surface_file(path) -> Path:
-    """``path`` as a Path, or an error unless it is a file this user may read, and not
-    empty: :class:`InputError` for a missing file, a folder or a file without read
-    permission (before round 2, session 37 each reader gave its own wrong cause: a
-    ``.npz`` "truncated or not a zip archive", an ``.x3p`` "damaged or truncated?"),
-    :class:`FileFormatError` for an empty file."""
+    """``path`` as a Path, or an error unless it is a regular file this user may read, and
+    not empty: :class:`InputError` for a missing file (or a broken symbolic link), a
+    folder, a device, pipe or socket (``/dev/null`` was said not to exist), a file
+    without read permission (before round 2, session 37 each reader gave its own wrong
+    cause: a ``.npz`` "truncated or not a zip archive", an ``.x3p`` "damaged or
+    truncated?"), :class:`FileFormatError` for an empty file."""
     path = Path(path)
     try:
-        path.stat()
+        info = path.stat()
     except PermissionError:             # is_dir() and is_file() raise it too
         raise InputError(f"cannot read surface file {path}: permission denied (on a "
                          f"folder of its path)") from None
-    except OSError:
-        pass                            # missing: said below
-    if path.is_dir():
+    except OSError:                     # missing, or a path below a file
+        if path.is_symlink():
+            raise InputError(f"surface file {str(path)!r} is a broken symbolic link (to "
+                             f"{os.readlink(path)})") from None
+        raise InputError(f"surface file {str(path)!r} does not exist") from None
+    mode = info.st_mode
+    if stat.S_ISDIR(mode):
         raise InputError(f"surface file {str(path)!r} is a folder, not a file")
-    if not path.is_file():
-        raise InputError(f"surface file {str(path)!r} does not exist")
+    if not stat.S_ISREG(mode):          # /dev/null said "does not exist" (session 37)
+        kind = next((k for test, k in _NOT_REGULAR if test(mode)), "a special file")
+        raise InputError(f"surface file {str(path)!r} is {kind}, not a regular file")
     if not os.access(path, os.R_OK):
         raise InputError(f"cannot read surface file {path}: permission denied")
-    if path.stat().st_size == 0:
+    if info.st_size == 0:
         raise FileFormatError(f"{path}: the file is empty")
     return path
 
