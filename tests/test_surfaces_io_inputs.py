@@ -102,3 +102,29 @@ def test_a_path_that_is_no_regular_file_says_what_it_is(tmp_path, capsys):
         in capsys.readouterr().err
     with pytest.raises(InputError, match="does not exist"):
         load_surface(tmp_path / "missing.npz")
+
+
+@pytest.mark.parametrize("heights, what", [
+    (np.eye(4, dtype=bool), "booleans (dtype bool)"),
+    (np.eye(4) + 1j, "complex numbers (dtype complex128)"),
+    (np.array([["1", "2"], ["3", "4"]]), "text (dtype <U1)"),
+    (np.zeros(4, dtype="datetime64[s]"), "dates or times (dtype datetime64[s])")])
+def test_heights_that_are_no_real_numbers_are_refused_with_their_dtype(tmp_path, heights,
+                                                                       what):
+    # a boolean .npy was read as heights of 0 and 1 m, text of digits as their numbers;
+    # a complex one was refused without the file's name
+    np.save(tmp_path / "h.npy", heights)
+    arrays = dict(np.load(save_surface(_surface(), tmp_path / "s.npz")))
+    np.savez(tmp_path / "h.npz", **{**arrays, "heights": heights})
+    for path in (tmp_path / "h.npy", tmp_path / "h.npz"):
+        with pytest.raises(InputError) as info:
+            load_surface(path, size=1e-4)
+        msg = str(info.value)
+        assert msg.startswith(f"{path}: the heights are {what}"), msg
+        assert "integer or floating-point" in msg, msg
+
+
+def test_integer_heights_are_still_read(tmp_path):
+    np.save(tmp_path / "i.npy", np.arange(16, dtype=np.int32).reshape(4, 4))
+    s = load_surface(tmp_path / "i.npy", size=1e-4)
+    assert s.heights.dtype == float and s.heights[3, 3] == 15.0

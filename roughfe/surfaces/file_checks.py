@@ -53,6 +53,26 @@ def check_surface_file(path) -> Path:
     return path
 
 
+#: what heights of a non-numeric dtype are, by numpy's dtype kind
+_NOT_NUMBERS = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "text",
+                "O": "Python objects", "M": "dates or times", "m": "dates or times",
+                "V": "records"}
+
+
+def numeric_heights(heights, path) -> np.ndarray:
+    """``heights`` (a plain matrix or a ``.npz``'s, metres) as an array, or an
+    :class:`InputError` naming the dtype unless they are real numbers, integer or
+    floating-point: a boolean ``.npy`` was read as heights of 0 and 1 m, text of digits
+    as its numbers (round 2, session 37)."""
+    heights = np.asarray(heights)
+    if heights.dtype.kind not in "iuf":
+        what = _NOT_NUMBERS.get(heights.dtype.kind, "no numbers")
+        raise InputError(f"{path}: the heights are {what} (dtype {heights.dtype}); a "
+                         f"surface's heights are real numbers in metres, of an integer or "
+                         f"floating-point dtype (a mask or a flag map is no topography)")
+    return heights
+
+
 def _shown(a: np.ndarray) -> str:
     """``text 'no'``, ``float64 0.5``, ``an array of shape (2,)``: a value read from a
     file, for an error message."""

@@ -58,7 +58,7 @@ import numpy as np
 
 from ..errors import FileFormatError, InputError, RoughfeError
 from ..writers import atomic_path, to_jsonable
-from .file_checks import check_surface_file, periodic_flag
+from .file_checks import check_surface_file, numeric_heights, periodic_flag
 from .layout import DI_FIX, fix_di_lines
 from .nonmeasured import masked, nonmeasured_mask
 from .probe import open_instrument, quietly, quote_error, warn_if_shorter_than_announced
@@ -153,7 +153,7 @@ def _read_native(path, size, periodic, channel):
         reason = ("truncated or not a zip archive" if isinstance(exc, (zipfile.BadZipFile,
                                                                        EOFError)) else exc)
         raise FileFormatError(f"{path}: cannot read as a roughfe .npz ({reason})") from None
-    return Surface(heights, file_size if size is None else size,
+    return Surface(numeric_heights(heights, path), file_size if size is None else size,
                    file_periodic if periodic is None else periodic, metadata)
 
 
@@ -188,7 +188,7 @@ def _plain_surface(heights, path, size, periodic):
         raise InputError(
             f"{path}: a plain height matrix has no physical size; give size=(LX[, LY]) in metres "
             f"(command line: --size LX [LY])")
-    heights = np.asarray(heights)
+    heights = numeric_heights(heights, path)     # a bool .npy was heights of 0 and 1 m
     if heights.ndim in (1, 2) and heights.size < 2:
         raise InputError(f"{path}: a matrix of shape {heights.shape} holds {heights.size} "
                          f"height(s); a profile needs at least 2 points, a surface 2 x 2")
