@@ -128,3 +128,21 @@ def test_integer_heights_are_still_read(tmp_path):
     np.save(tmp_path / "i.npy", np.arange(16, dtype=np.int32).reshape(4, 4))
     s = load_surface(tmp_path / "i.npy", size=1e-4)
     assert s.heights.dtype == float and s.heights[3, 3] == 15.0
+
+
+def test_a_channel_given_with_spaces_is_read_without_them(topographies_dir, capsys):
+    # `--channel " 1"` said "no channel named ' 1'" (a shell quote or a copied table cell)
+    path = topographies_dir / "di-1.di"
+    second = load_surface(path, channel=1)
+    for given in (" 1", "1 ", "\t1\n"):
+        s = load_surface(path, channel=given)
+        assert s.metadata["channel"]["index"] == 1
+        np.testing.assert_array_equal(s.heights, second.heights)
+    with pytest.raises(InputError, match=r"2 channels are named 'Height'"):
+        load_surface(path, channel=" Height ")       # the name, stripped: shared, refused
+    with pytest.raises(InputError, match=r"channel ' ' is blank; give a channel index or "
+                                         r"name: channels \(index name\) are 0 'Height'"):
+        load_surface(path, channel=" ")
+    capsys.readouterr()
+    assert main(["info", str(path), "--channel", " 1", "--json"]) == 0
+    assert '"Retrace"' in capsys.readouterr().out

@@ -315,8 +315,13 @@ def _choose_channel(reader, channel, path):
     listed = ", ".join(labels)
     if channel is None:
         return reader.default_channel
+    if isinstance(channel, str):           # " 1" was the name ' 1' (round 2, session 37)
+        if not channel.strip():
+            raise InputError(f"{path}: channel {channel!r} is blank; give a channel index "
+                             f"or name: channels (index name) are {listed}")
+        channel = channel.strip()
     if isinstance(channel, str) and not channel.lstrip("-").isdigit():
-        named = [c for c in channels if c.name == channel]
+        named = [c for c in channels if c.name.strip() == channel]
         if not named:
             raise InputError(f"{path}: no channel named {channel!r}; channels (index name) "
                              f"are {listed}")
