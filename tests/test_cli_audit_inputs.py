@@ -243,3 +243,19 @@ def test_info_psd_of_a_map_too_small_for_its_window_says_so(tmp_path, capsys):
                              "--psd", str(tmp_path / "p.csv")],
                     "--psd: a non-periodic 2 x 32 map is too small", "--periodic")
     assert "window=" not in line and not (tmp_path / "p.csv").exists()
+
+
+def test_second_quantity_without_second_target_is_refused(tmp_path, capsys, monkeypatch):
+    # `design --second-quantity A` without --second-target was ignored: the design ran
+    # (exit 0). Refused before the database is read
+    import roughfe.genomics.database as database
+
+    def not_read(*args, **kwargs):
+        raise AssertionError("the database was read before the options were checked")
+    monkeypatch.setattr(database, "read_settings", not_read)
+    for method in ("sog", "mcco"):
+        _refused(capsys, ["design", "--db", str(tmp_path / "d.sqlite"), "--target", "y_t1",
+                          "--method", method, "--second-quantity", "A", "--no-figures",
+                          "-o", str(tmp_path / "o")],
+                 "--second-quantity needs --second-target", "where it means nothing")
+    assert not (tmp_path / "o").exists()

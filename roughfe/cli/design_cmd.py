@@ -78,6 +78,8 @@ def _dependent_options(args):
     rows = [("pbar", "--pbar", None, "--method gco or cco (Algs. 5 and 6 split the target "
              "there)", args.method in ("gco", "cco")),
             ("second_target", "--second-target", None, "--method mcco", args.method == "mcco"),
+            ("second_quantity", "--second-quantity", None, "--second-target (what its CSV "
+             "holds)", bool(args.second_target)),       # was ignored (round 2, session 37)
             ("pool", "--pool", 0, "--method mcco", args.method == "mcco"),
             ("eps", "--eps", 0.02, gcmma_fd, fd),
             ("search_starts", "--search-starts", 1, "--search SWEEPS", bool(args.search)),
