@@ -259,3 +259,24 @@ def test_second_quantity_without_second_target_is_refused(tmp_path, capsys, monk
                           "-o", str(tmp_path / "o")],
                  "--second-quantity needs --second-target", "where it means nothing")
     assert not (tmp_path / "o").exists()
+
+
+def test_a_mistyped_thesis_target_lists_the_thesis_targets(tmp_path, capsys, monkeypatch):
+    # `design --target y_t9` said "target file y_t9 does not exist", after the database
+    # was read
+    import roughfe.genomics.database as database
+
+    def not_read(*args, **kwargs):
+        raise AssertionError("the database was read before the targets were checked")
+    monkeypatch.setattr(database, "read_settings", not_read)
+    monkeypatch.chdir(tmp_path)
+    common = ["design", "--db", "d.sqlite", "--no-figures", "-o", "o"]
+    for option, spec, method in (("--target", "y_t9", "sog"), ("--target", "Y_T1", "gco"),
+                                 ("--second-target", "y_t4", "mcco")):
+        argv = common + ["--method", method, "--target", "y_t1"] if option != "--target" \
+            else common + ["--method", method]
+        _refused(capsys, argv + [option, spec],
+                 f"{option} {spec}: no thesis target of that name, and no such file",
+                 "the thesis targets are y_t1", "y_t2", "y_t3",
+                 "a 'pressure,value' CSV file is also accepted")
+    assert not (tmp_path / "o").exists()

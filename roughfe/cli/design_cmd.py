@@ -6,7 +6,7 @@ settings."""
 from __future__ import annotations
 
 import math
-
+import re
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -68,6 +68,22 @@ def _target(spec, quantity, settings, cache, default):
     return read_target_csv(spec, quantity, default=default)
 
 
+def _check_target_names(args) -> None:
+    """Refuse a ``--target``/``--second-target`` that looks like a thesis target's name
+    (y_t + digits) but is none and no file: ``--target y_t9`` said "target file y_t9 does
+    not exist", after the database was read (round 2, session 37)."""
+    from ..errors import InputError
+    for flag, spec in (("--target", args.target), ("--second-target", args.second_target)):
+        if spec is None or spec in BUILTIN or Path(spec).exists() or \
+                not re.fullmatch(r"y_t\d+", spec, re.IGNORECASE):
+            continue
+        raise InputError(f"{flag} {spec}: no thesis target of that name, and no such file; "
+                         f"the thesis targets are y_t1 (K(p) of the thesis genome), y_t2 (K "
+                         f"linear in p up to pbar, then flat) and y_t3 (A(p) of y_t1's "
+                         f"genome); a 'pressure,value' CSV file is also accepted "
+                         f"(design-targets writes such files)")
+
+
 def _dependent_options(args):
     """Rows ``(dest, flag, default, what it needs, whether args have it)`` of the options
     that mean something only with another option or method: given without it, each was
@@ -104,7 +120,8 @@ def _dependent_options(args):
 
 def _check_options(args):
     """Refuse an option given where it means nothing (:func:`_dependent_options`), then
-    set the defaults of those not given (parsed as None to tell "not given" apart)."""
+    set the defaults of those not given (parsed as None to tell "not given" apart), and a
+    mistyped thesis target (:func:`_check_target_names`)."""
     from ..errors import InputError
     if args.gradient == "exact" and args.formulation == "thesis":
         raise InputError("--gradient exact needs --formulation minimax: the thesis form "
@@ -117,6 +134,7 @@ def _check_options(args):
                              f"nothing")
         if value is None:
             setattr(args, dest, default)
+    _check_target_names(args)
 
 
 def _with_p_top(target, p_top):
