@@ -280,3 +280,29 @@ def test_a_mistyped_thesis_target_lists_the_thesis_targets(tmp_path, capsys, mon
                  "the thesis targets are y_t1", "y_t2", "y_t3",
                  "a 'pressure,value' CSV file is also accepted")
     assert not (tmp_path / "o").exists()
+
+
+def test_boundary_window_on_a_periodic_surface_is_refused(tmp_path, capsys, monkeypatch):
+    # `design-targets --surface PERIODIC --boundary window` solved the periodic surface as
+    # it is (--boundary applies to a non-periodic window only) and said nothing
+    import roughfe.genomics.design as design
+    from roughfe.surfaces import Surface, save_surface
+    db = tmp_path / "d.sqlite"
+    assert main(["db", "build", str(db), "--limit", "1", "--nodes", "64", "--steps", "5",
+                 "--workers", "1", "--quiet"]) == 0
+    x = np.arange(256) / 256
+    path = save_surface(Surface(1e-6 * np.sin(2 * np.pi * 8 * x), 1e-3, periodic=True),
+                        tmp_path / "p.npz")
+    real = design.surface_targets
+
+    def not_solved(*args, **kwargs):
+        raise AssertionError("the surface was solved before --boundary was checked")
+    monkeypatch.setattr(design, "surface_targets", not_solved)
+    _refused(capsys, ["design-targets", "--db", str(db), "--surface", str(path),
+                      "--boundary", "window", "-o", str(tmp_path / "t")],
+             "--boundary window", f"{path} is read as periodic", "--non-periodic")
+    assert not (tmp_path / "t").exists()
+    monkeypatch.setattr(design, "surface_targets", real)     # the ways out still run
+    for extra in (["--boundary", "window", "--non-periodic"], ["--boundary", "periodic"]):
+        assert main(["design-targets", "--db", str(db), "--surface", str(path), "--quiet",
+                     "--overwrite", "-o", str(tmp_path / "t")] + extra) == 0

@@ -311,6 +311,12 @@ def _targets(args) -> int:
     settings = read_settings(args.db)
     if args.surface:
         surface = surface_file(args, args.surface)
+        if args.boundary == "window" and surface.periodic:     # was ignored (session 37)
+            from ..errors import InputError
+            raise InputError(f"--boundary window solves a non-periodic --surface as its "
+                             f"window alone on the half-space; {args.surface} is read as "
+                             f"periodic, which is solved as it is (periodic BEM): leave "
+                             f"--boundary out, or give --non-periodic to take it as a window")
         from .plausibility import check_target_surface
         from .surface_warnings import plausible_surface
         plausible_surface(args, surface, args.detrend)     # its warnings; the library
@@ -470,7 +476,8 @@ def register(sub):
                         "periodic BEM, or the window alone on the half-space (its K then "
                         "includes the window's bulk compliance); auto: the designs' own "
                         "setting, periodic on a surface database (--dim 2), window on a "
-                        "profile database (default: auto)")
+                        "profile database (default: auto); a periodic --surface is solved "
+                        "as it is (window is refused for it)")
     t.add_argument("--resolution", choices=("design", "full"), default=None,
                    help="a periodic target on a surface database: resampled onto the "
                         "database spacing L/N (the band the designs hold) or at the file's "
