@@ -187,6 +187,21 @@ def check_leak_scale(conductance: float, pressure_drop: float, mu: float) -> flo
     return q
 
 
+def check_bool(name, value) -> bool:
+    """Return ``value`` as a bool or raise :class:`InputError` unless it is one: a Python
+    or numpy bool, or the integer 1 or 0 (one element of an array too). Text such as
+    ``"no"`` and numbers such as 0.5 were read by their truthiness, ``"no"`` as True
+    (round 2, session 37)."""
+    import numpy as np          # here: importing the command line imports no numpy
+
+    a = np.asarray(value) if not isinstance(value, (str, bytes)) else None
+    if a is not None and a.size == 1 and (
+            a.dtype == bool or (a.dtype.kind in "iu" and a.item() in (0, 1))):
+        return bool(a.item())
+    raise InputError(f"{name} must be a bool, True or False (or the integer 1 or 0), "
+                     f"got {value!r}")
+
+
 def check_int(name, value, minimum):
     """Return ``int(value)`` or raise :class:`InputError` unless it is an integer (a Python
     or numpy integer, not a bool, numpy's included, and not a float such as 3.5 or 4.0)

@@ -59,6 +59,22 @@ def _unreadable(monkeypatch, *paths):
     monkeypatch.setattr(os, "access", access)
 
 
+@pytest.mark.parametrize("value", ["no", "True", 0.5, 2, 1.0, None, [True, False]])
+def test_a_periodic_argument_that_is_no_bool_is_refused(tmp_path, value):
+    """From Python too: ``Surface(..., periodic="no")`` and ``load_surface(periodic=0.5)``
+    were read by truthiness ("no" as periodic); now an InputError naming the value. Fails
+    on the code before (round 2, session 37)."""
+    h = np.random.default_rng(0).normal(size=(8, 8)) * 1e-9
+    with pytest.raises(InputError, match=r"periodic must be a bool, True or False"):
+        Surface(h, (1e-6, 1e-6), periodic=value)
+    if value is not None:           # None is load_surface's "as the file says"
+        save_surface(Surface(h, (1e-6, 1e-6)), tmp_path / "s.npz")
+        with pytest.raises(InputError, match=r"periodic must be a bool"):
+            load_surface(tmp_path / "s.npz", periodic=value)
+    for good, periodic in ((True, True), (np.False_, False), (1, True), (np.int64(0), False)):
+        assert Surface(h, (1e-6, 1e-6), periodic=good).periodic is periodic
+
+
 def test_a_file_without_read_permission_is_said_to_be_unreadable(tmp_path, monkeypatch,
                                                                   topographies_dir, capsys):
     # as user nobody: a .npz said "truncated or not a zip archive", an .x3p "damaged or

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FileFormatError, InputError
+from ..errors import FileFormatError, InputError, check_bool
 
 
 #: what a path is that is neither a folder nor a regular file
@@ -88,8 +88,10 @@ def periodic_flag(value, path) -> bool:
     ``np.array(bool)``); anything else (text such as ``"no"``, ``0.5``, ``2``, several
     values) is a :class:`FileFormatError` naming what was found."""
     a = np.asarray(value)
-    if a.size == 1 and (a.dtype == bool or (a.dtype.kind in "iu" and a.item() in (0, 1))):
-        return bool(a.item())
+    try:
+        return check_bool("periodic", a)
+    except InputError:
+        pass
     raise FileFormatError(
         f"{path}: its 'periodic' entry is {_shown(a)}; it must be a bool, True or False "
         f"(the integers 1 or 0 are read as such), as save_surface writes it: give "

@@ -23,7 +23,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import InputError, check_int, check_real_array
+from ..errors import InputError, check_bool, check_int, check_real_array
 from ..frozen import FrozenMapping, ReadOnlyArrays
 
 
@@ -107,7 +107,7 @@ class Surface(ReadOnlyArrays):
         h.setflags(write=False)
         object.__setattr__(self, "heights", h)
         object.__setattr__(self, "size", _as_size(self.size, h.ndim))
-        object.__setattr__(self, "periodic", bool(self.periodic))
+        object.__setattr__(self, "periodic", check_bool("periodic", self.periodic))
         # read-only (FrozenMapping, picklable): a Surface never changes, nor do its facts
         object.__setattr__(self, "metadata", FrozenMapping(self.metadata or {}))
 
