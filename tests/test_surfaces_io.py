@@ -7,7 +7,8 @@ import pytest
 
 from roughfe.errors import FileFormatError, InputError
 from roughfe.surfaces import Surface, load_surface, save_surface
-from roughfe.surfaces.io import READERS, channel_label
+from roughfe.surfaces.channels import channel_label
+from roughfe.surfaces.io import READERS
 from roughfe.surfaces.stats import rms_height
 
 # From ../shared/data/topographies/README.md: grid, physical size (m), rms height (m).

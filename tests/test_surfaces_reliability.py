@@ -9,7 +9,8 @@ import pytest
 
 from roughfe.errors import InputError
 from roughfe.surfaces import Surface
-from roughfe.surfaces.io import load_surface, trace_retrace_partner
+from roughfe.surfaces.channels import trace_retrace_partner
+from roughfe.surfaces.io import load_surface
 from roughfe.surfaces.reliability import (FALSE_ALARM, THRESHOLD, minimum_lines,
                                           slope_share_above, trace_retrace_coherence)
 from roughfe.surfaces.spectral import self_affine_psd, spectral_surface
@@ -222,7 +223,8 @@ def test_labels_without_the_directions_as_data_are_refused_with_the_reason(
     (metadata["channels"]) and a channel read without "direction": its partner is not
     parsed back from the text; the error says why and what to do. Saved now, it keeps
     the table and finds the partner."""
-    from roughfe.surfaces.io import read_channel_label, save_surface
+    from roughfe.surfaces.channels import read_channel_label
+    from roughfe.surfaces.io import save_surface
     trace = load_surface(topographies_dir / "di-1.di", channel=0)
     assert trace_retrace_partner(load_surface(save_surface(trace, tmp_path / "new.npz"))
                                  .metadata) == 1

@@ -2,8 +2,8 @@
 
 When the instrument file read holds the other sweep of the channel read (a trace and a
 retrace channel of the same name, from the channels' names and scan directions that
-:func:`roughfe.surfaces.io.channel_entry` stored on reading: di-1's 0 'Height' (Trace)
-and 1 'Height' (Retrace); :func:`roughfe.surfaces.io.trace_retrace_partner`), ``info``
+:func:`roughfe.surfaces.channels.channel_entry` stored on reading: di-1's 0 'Height' (Trace)
+and 1 'Height' (Retrace); :func:`roughfe.surfaces.channels.trace_retrace_partner`), ``info``
 reads that channel with the same ``--size``/``--periodic``/``--scan-axis`` and reports
 the reliability cutoff ``q_c`` of
 :func:`roughfe.surfaces.reliability.trace_retrace_coherence`: its wavelength, and the lag
@@ -60,7 +60,7 @@ def trace_retrace_of(args, read, surface=None):
     :class:`~roughfe.surfaces.reliability.TraceRetraceCoherence` it summarises (None when
     the block is None or says why the pair cannot be compared). The coherence is of
     ``read`` and its other sweep; the slope shares of ``surface`` (default ``read``)."""
-    from ..surfaces.io import channel_label, trace_retrace_partner
+    from ..surfaces.channels import channel_label, trace_retrace_partner
     from ..surfaces.reliability import SUMMARY_UNITS, trace_retrace_coherence
     meta = read.metadata
     if read.ndim != 2 or meta.get("source") != str(args.surface):

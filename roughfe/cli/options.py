@@ -210,7 +210,8 @@ def surface_notes(surface, channel: bool = False) -> list:
     unit, so that its heights and lengths were taken as metres (``metadata
     ["unit_in_file"]`` is :data:`~roughfe.surfaces.io.ASSUMED_UNIT`; only ``--json``
     said so until round 2, session 25)."""
-    from ..surfaces.io import ASSUMED_UNIT, read_channel_label
+    from ..surfaces.channels import read_channel_label
+    from ..surfaces.io import ASSUMED_UNIT
 
     meta = surface.metadata
     lines = []

@@ -37,8 +37,9 @@ harmonic interpolation and their number recorded in ``metadata["filled_points"]`
 include the points a file marks as not measured whose marker the reader returns as a
 height (a ``.sur``'s ``zmin - 2``: :mod:`roughfe.surfaces.nonmeasured`); the
 channel read in ``metadata["channel"]`` (index, name, scan direction or None:
-:func:`channel_entry`), the file's channels in ``metadata["channel_table"]`` (the same
-entries) and, as shown, in ``metadata["channels"]`` (:func:`channel_label`). Every
+:func:`.channels.channel_entry`), the file's channels in ``metadata["channel_table"]``
+(the same entries) and, as shown, in ``metadata["channels"]``
+(:func:`.channels.channel_label`). Every
 instrument format puts the file's stored lines (the fast axis) along x, axis 0 (checked
 on the five measured files against readers written by hand:
 :mod:`roughfe.surfaces.layout`); a non-square Bruker/Veeco ``.di`` map, which
@@ -58,6 +59,7 @@ import numpy as np
 
 from ..errors import FileFormatError, InputError, RoughfeError
 from ..writers import atomic_path, to_jsonable
+from .channels import channel_entry, channel_label, choose_channel
 from .file_checks import check_surface_file, numeric_heights, periodic_flag
 from .layout import DI_FIX, fix_di_lines
 from .nonmeasured import masked, nonmeasured_mask
@@ -233,113 +235,6 @@ def _read_text(path, size, periodic, channel):
 
 
 # -- SurfaceTopography (instrument files) ---------------------------------------------
-def channel_entry(channel) -> dict:
-    """``{"index": int, "name": str, "direction": str or None}`` of a SurfaceTopography
-    channel: the scan direction where the file gives one (its raw metadata's ``line
-    direction``: a .di file holds trace and retrace heights under one name, di-1's
-    ``"Trace"`` and ``"Retrace"``), else None. ``metadata["channel"]`` of an instrument
-    surface is the entry of the channel read, ``metadata["channel_table"]`` the file's."""
-    raw = (channel.info or {}).get("raw_metadata")
-    direction = raw.get("line direction") if isinstance(raw, dict) else None
-    return {"index": int(channel.index), "name": str(channel.name),
-            "direction": None if direction is None else str(direction)}
-
-
-def channel_label(entry) -> str:
-    """``0 'Height'`` for a :func:`channel_entry`, with the scan direction where there is
-    one (``0 'Height' (Trace)``): how the channels are shown (``metadata["channels"]``,
-    ``info``, the errors that list them)."""
-    direction = entry.get("direction")
-    return f"{entry['index']} {entry['name']!r}" + (f" ({direction})" if direction else "")
-
-
-def read_channel_label(metadata) -> "str | None":
-    """:func:`channel_label` of the channel read (``metadata["channel"]``; None without
-    one). Metadata written before round 2, session 37 (a ``.npz``, results.json) has no
-    ``direction`` in it: the label at its index in ``metadata["channels"]`` (listed in
-    index order), which shows the direction as the file gave it."""
-    read = metadata.get("channel")
-    if not isinstance(read, dict):
-        return None
-    labels = metadata.get("channels") or []
-    if "direction" not in read and 0 <= read.get("index", -1) < len(labels):
-        return str(labels[read["index"]])
-    return channel_label(read)
-
-
-#: the two scan directions of one quantity that :func:`trace_retrace_partner` pairs
-SWEEPS = ("trace", "retrace")
-
-
-def trace_retrace_partner(metadata) -> "int | None":
-    """Index of the channel that holds the other sweep of the channel read, from an
-    instrument surface's ``metadata["channel"]`` and ``metadata["channel_table"]``
-    (:func:`channel_entry`): the one channel of the same name whose direction is the
-    other of Trace / Retrace (di-1: 0 'Height' (Trace) and 1 'Height' (Retrace)). None
-    when the channel read has no such direction, or no single partner.
-
-    Raises
-    ------
-    InputError
-        Metadata of a multi-channel file written before round 2, session 37 (a ``.npz``
-        saved then): it lists the channels as text labels only, without their directions
-        as data; read the instrument file (``metadata["source"]``) again.
-    """
-    read = metadata.get("channel")
-    if not isinstance(read, dict):
-        return None
-    table = metadata.get("channel_table")
-    if table is None:
-        labels = metadata.get("channels") or []
-        if len(labels) > 1 and "direction" not in read:
-            raise InputError(
-                f"the metadata of this surface (read from {metadata.get('source')!r} by a "
-                f"roughfe before round 2, session 37) lists the file's channels as text "
-                f"only ({', '.join(map(str, labels))}), without their scan directions as "
-                f"data: the trace/retrace partner of channel {read.get('index')} is not "
-                f"looked for in text; read the instrument file again "
-                f"(load_surface(source, channel=N))")
-        return None
-    own = read.get("direction")
-    if own is None or own.lower() not in SWEEPS:
-        return None
-    other = SWEEPS[1 - SWEEPS.index(own.lower())]
-    partners = [int(c["index"]) for c in table if c["name"] == read["name"]
-                and (c.get("direction") or "").lower() == other]
-    return partners[0] if len(partners) == 1 else None
-
-
-def _choose_channel(reader, channel, path):
-    channels = reader.channels
-    labels = [channel_label(channel_entry(c)) for c in channels]
-    listed = ", ".join(labels)
-    if channel is None:
-        return reader.default_channel
-    if isinstance(channel, str):           # " 1" was the name ' 1' (round 2, session 37)
-        if not channel.strip():
-            raise InputError(f"{path}: channel {channel!r} is blank; give a channel index "
-                             f"or name: channels (index name) are {listed}")
-        channel = channel.strip()
-    if isinstance(channel, str) and not channel.lstrip("-").isdigit():
-        named = [c for c in channels if c.name.strip() == channel]
-        if not named:
-            raise InputError(f"{path}: no channel named {channel!r}; channels (index name) "
-                             f"are {listed}")
-        if len(named) > 1:
-            # di-1: trace (rms 9.95 nm) and retrace (114 nm) are both 'Height'; the
-            # name took the first without a word until round 2, session 24
-            raise InputError(f"{path}: {len(named)} channels are named {channel!r} "
-                             f"({', '.join(labels[channels.index(c)] for c in named)}): give the "
-                             f"channel index (channel=N, --channel N); channels (index "
-                             f"name) are {listed}")
-        return named[0]
-    index = int(channel)
-    if not 0 <= index < len(channels):
-        raise InputError(f"{path}: channel index {index} out of range 0..{len(channels) - 1} "
-                         f"(channels (index name) {listed})")
-    return channels[index]
-
-
 def _read_instrument(path, size, periodic, channel):
     try:
         import SurfaceTopography  # noqa: F401
@@ -387,7 +282,7 @@ def _warn_if_size_overridden(path, size, file_size):
 
 
 def _instrument_surface(reader, path, size, periodic, channel):
-    ch = _choose_channel(reader, channel, path)
+    ch = choose_channel(reader, channel, path)
     if ch.dim not in (1, 2):
         raise FileFormatError(f"{path}: channel {ch.name!r} has dimension {ch.dim}, not 1 or 2")
     kwargs = {"channel_index": ch.index}
