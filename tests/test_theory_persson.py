@@ -126,6 +126,20 @@ def test_log_law_at_intermediate_pressures(surface):
     assert 0.2 < r.u0 / (r.gamma * r.rms_height) < 2     # Persson's "u0 ~ gamma h_rms"
 
 
+def test_the_log_law_holds_down_to_the_smallest_pressures(surface):
+    """u(p) = u(p1) - u0 ln(p / p1) exactly once every mode's y = w p / E* is below 1e-8
+    (J(y) -> (2/sqrt(pi)) [gamma (-euler_gamma - 2 ln y)/2 + 3 (1 - gamma) K(0)]): equal
+    steps in ln p give equal steps in u, of u0 per unit of ln p, finite however small p
+    is. y^2 underflowed to 0 below y ~ 1e-162, E1(0) = inf, and u was inf at 1e-200 Pa
+    (round 2, session 37); this fails on that code."""
+    p = np.array([1e-100, 1e-150, 1e-200, 1e-250, 1e-300])
+    r = persson(surface, E_STAR, p)
+    assert np.all(np.isfinite(r.mean_gap))
+    steps = np.diff(r.mean_gap)
+    assert steps == pytest.approx(np.full(4, steps[0]), rel=1e-12, abs=0)
+    assert steps[0] / np.log(1e50) == pytest.approx(r.u0, rel=1e-9, abs=0)
+
+
 def test_dimensional_analysis(surface):
     gbar = stats.rms_slope(surface)
     p = np.array([0.01, 0.1, 0.5]) * E_STAR * gbar

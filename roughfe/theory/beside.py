@@ -181,7 +181,8 @@ def beside(source, e_star, steps, *, pressure_drop=None, viscosity=None, directi
         rec["persson_stiffness"] = float(theory.stiffness[j]) if k else None
         if pressure_drop is not None:
             # Q is linear in the geometry factor: one junction per step, scaled per direction;
-            # none where u(p) overflows (p -> 0: `leak --pressure 1e-200` failed on it)
+            # none where u(p) is inf (y = w p / E* below the smallest float; up to round
+            # 2, session 37 from 1e-162: `leak --pressure 1e-200` failed on it)
             unit = (critical_junction(psd, e_star, float(p), pressure_drop, viscosity,
                                       gamma=gamma, geometry_factor=1.0).leak_rate
                     if k and np.isfinite(theory.mean_gap[j]) else None)

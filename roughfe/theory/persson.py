@@ -183,8 +183,25 @@ def j_function(y, gamma=GAMMA_DEFAULT):
         raise InputError(f"y (w p / E*) must be >= 0, got {float(y.min())!r}")
     x, k = _erf2_table()
     kk = np.interp(y, x, k, right=0.0)
-    return (2 / np.sqrt(np.pi)) * (0.5 * gamma * scipy.special.exp1(y ** 2)
+    return (2 / np.sqrt(np.pi)) * (0.5 * gamma * _exp1_of_square(y)
                                    + 3 * (1 - gamma) * kk)
+
+
+#: below this y, E1(y^2) is taken from its series -euler_gamma - 2 ln y (the next term, y^2,
+#: is below 1e-16 of it)
+_E1_SERIES_BELOW = 1e-8
+
+
+def _exp1_of_square(y):
+    """``E1(y^2)`` for y >= 0, finite for every y > 0: below :data:`_E1_SERIES_BELOW` the
+    series ``-euler_gamma - 2 ln y`` (its first omitted term y^2 < 1e-16), where y^2 itself
+    underflows to 0 for y < 1e-162 and E1(0) = inf made u(p) infinite (Persson's u grows
+    like -ln p as p -> 0: on a 1 um rms surface 85 um at 1e-100 Pa, 125 um at 1e-150 Pa,
+    and inf at 1e-200 Pa until round 2, session 37). E1(0) = inf stays (J(0) = inf)."""
+    y = np.asarray(y, dtype=float)
+    small = (y > 0) & (y < _E1_SERIES_BELOW)
+    series = -np.euler_gamma - 2.0 * np.log(np.where(small, y, 1.0))
+    return np.where(small, series, scipy.special.exp1(np.where(small, 1.0, y) ** 2))
 
 
 # -- pure functions on arrays ---------------------------------------------------------------
