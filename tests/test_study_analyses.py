@@ -100,12 +100,52 @@ def test_the_input_checks_of_the_analyses_name_the_bad_value(name, params, words
     assert words in str(info.value) and f"analysis {name!r}, task" in str(info.value)
 
 
-def test_the_input_checks_accept_the_defaults_and_do_no_work():
-    """Good values pass every check quickly (no surface is generated: m = 13 would take
-    seconds and 500 MB with RMD), and the check is the task's own first step."""
-    import time
+def test_a_task_whose_sweep_cannot_fit_in_memory_refuses_the_study_up_front(tmp_path,
+                                                                            monkeypatch):
+    """The BEM sweep's memory check (bem.sweep.check_sweep_memory) is part of the input
+    checks: n_steps = 1e10 on m = 2 failed its task on the worker after the study had
+    started (session-37 audit); now the study is refused before any task, naming the
+    task, and nothing is written. The grid is the generator's: 2**m + 1 (rmd), 2**m
+    (spectral), the database's n_nodes (genome analyses)."""
+    from roughfe import errors
 
     pytest.importorskip("roughfe.leakage.study")
+    out = tmp_path / "s"
+    study = {"study": {"analysis": "contact_sweep", "output": str(out), "max_attempts": 1},
+             "grid": {"n_steps": [2, 10 ** 10]}, "fixed": {"m": 2}}
+    with pytest.raises(InputError) as info:
+        run_study(spec_from_mapping(study), workers=1, progress=False)
+    text = str(info.value)
+    assert "keeping the fields of 10000000000 load steps of a 5 x 5 grid needs" in text
+    assert "analysis 'contact_sweep', task {'n_steps': 10000000000, 'm': 2}" in text
+    assert not out.exists()
+    for name, params, grid in [
+            ("contact_sweep", {"generator": "spectral", "m": 2}, "4 x 4"),
+            ("leakage", {"D": 2.3, "m": 3}, "9 x 9"),
+            ("genome_db", {"gamma": 1.5, "hurst": 0.7, "n_nodes": 64}, "64 grid"),
+            ("genome_entry", {"entry": {"label": "a", "gamma": 1.5, "hurst": 0.7,
+                                        "phases": 1}, "dim": 2, "n_nodes": 64},
+             "64 x 64 grid")]:
+        with pytest.raises(InputError, match=f"10000000000 load steps of a {grid}"):
+            check_parameters(name, {**params, "n_steps": 10 ** 10})
+    # the default n_steps = 10 on m = 13 (8193^2 points) keeps 22 GB of fields
+    monkeypatch.setattr(errors, "available_memory", lambda: 16 * 2 ** 30)
+    with pytest.raises(InputError, match="10 load steps of a 8193 x 8193 grid needs 20.6 GiB"):
+        check_parameters("contact_sweep", {"m": 13})
+    check_parameters("contact_sweep", {"m": 12})
+
+
+def test_the_input_checks_accept_the_defaults_and_do_no_work(monkeypatch):
+    """Good values pass every check quickly (no surface is generated: m = 13 would take
+    seconds and 500 MB with RMD), and the check is the task's own first step. (A machine
+    with 32 GiB free: the default 10 steps at m = 13 keep 22 GB of fields, refused with
+    less, as the test above shows.)"""
+    import time
+
+    from roughfe import errors
+
+    pytest.importorskip("roughfe.leakage.study")
+    monkeypatch.setattr(errors, "available_memory", lambda: 32 * 2 ** 30)
     t0 = time.perf_counter()
     check_parameters("contact_sweep", {"m": 13})
     check_parameters("leakage", {"D": 2.3, "m": 13})

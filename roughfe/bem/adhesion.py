@@ -384,7 +384,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     if deltas is None:
         from .sweep import check_sweep_memory, default_deltas
         n_steps = Loading(n_steps=n_steps).n_steps     # checked, default 20
-        check_sweep_memory(surface, n_steps)
+        check_sweep_memory(surface.shape, n_steps)
         if is_flat(surface):      # (the BEM's rule) it said "deltas must be strictly increasing"
             raise InputError("the surface is flat (constant heights): its height range "
                              "gives no approaches for n_steps; give the approaches (m)")

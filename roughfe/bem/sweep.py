@@ -28,17 +28,21 @@ __all__ = ["contact_sweep", "default_deltas", "check_sweep_memory", "SweepResult
 STEP_BYTES_PER_POINT = 4 * 8 + 1
 
 
-def check_sweep_memory(surface: Surface, n_steps: int) -> None:
-    """Raise :class:`~roughfe.errors.InputError` when the fields of ``n_steps`` steps on
-    ``surface``'s grid (every step keeps them) need more than the available memory.
+def check_sweep_memory(shape, n_steps: int) -> None:
+    """Raise :class:`~roughfe.errors.InputError` when the fields of ``n_steps`` steps on a
+    grid of ``shape`` (a surface's ``shape``; every step keeps them) need more than the
+    available memory.
 
     Checked before the approaches are made: ``roughfe contact --steps 100000000`` on a
     32^2 grid started, to run for about two weeks (2000 steps: 24 s) towards 3.4 TB of
-    fields and a MemoryError (round 2, session 37).
+    fields and a MemoryError (round 2, session 37). It takes the shape, not the surface,
+    so that a study checks its tasks before any surface is generated
+    (:func:`roughfe.study.analyses.check_parameters`).
     """
-    shape = " x ".join(map(str, surface.shape))
-    check_memory(f"keeping the fields of {n_steps} load steps of a {shape} grid",
-                 float(n_steps) * surface.heights.size * STEP_BYTES_PER_POINT)
+    shape = tuple(int(n) for n in shape)
+    check_memory(f"keeping the fields of {n_steps} load steps of a "
+                 f"{' x '.join(map(str, shape))} grid",
+                 float(n_steps) * float(np.prod(shape, dtype=float)) * STEP_BYTES_PER_POINT)
 
 
 def default_deltas(surface: Surface, n_steps: int, periodic: bool) -> np.ndarray:
@@ -129,7 +133,7 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     loading.require_contact()      # approaches apart: adhesion only (adhesive_sweep)
     n_load = (loading.n_steps if loading.kind == "n_steps" else
               len(np.atleast_1d(getattr(loading, loading.kind))))
-    check_sweep_memory(surface, 2 * n_load - 1 if unload else n_load)
+    check_sweep_memory(surface.shape, 2 * n_load - 1 if unload else n_load)
     if loading.kind == "n_steps":
         periodic = surface.periodic and kernel in ("auto", "spectral")
         deltas = default_deltas(surface, loading.n_steps, periodic)

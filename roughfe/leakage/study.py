@@ -19,6 +19,7 @@ from typing import Iterable, Optional
 import numpy as np
 
 from ..bem import Material
+from ..bem.sweep import check_sweep_memory
 from ..errors import InputError
 from ..surfaces.rmd import rmd_surface
 from ..surfaces.stats import spectral_moments
@@ -142,6 +143,7 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     check_in_open_interval("D (fractal dimension)", D, 2.0, 3.0)
     _check_m(m)
     check_int("n_steps", n_steps, 1)
+    check_sweep_memory((2 ** int(m) + 1,) * 2, int(n_steps))   # the fields the sweep keeps
     check_finite_positive("L (m)", L)
     from ..surfaces.surface import _as_size
     _as_size(L, 1)      # the surfaces' size range (1e308 failed every task on the workers)

@@ -263,8 +263,9 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
 def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height, E, nu,
                          n_steps, kernel, solver, tol):
     """The input check of :func:`contact_sweep_task` (its keywords without ``seed``):
-    the generator's parameters, the BEM vocabulary and tolerance checked, and the
-    ``(Material, Loading)`` of the sweep returned; no surface is generated."""
+    the generator's parameters, the BEM vocabulary and tolerance checked, the memory of
+    the sweep's fields on the generator's grid (:func:`roughfe.bem.sweep.check_sweep_memory`),
+    and the ``(Material, Loading)`` of the sweep returned; no surface is generated."""
     from ..bem.contact import check_solver_name
     from ..bem.operators import check_kernel_name
     from ..errors import check_finite_positive, check_in_open_interval
@@ -285,7 +286,13 @@ def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height,
     from ..surfaces.surface import Surface
     probe = Surface(np.zeros((4, 4)), float(length), periodic=generator == "spectral")
     _operator(probe.shape, probe.size, 1.0, _choose_kernel(probe, check_kernel_name(kernel)))
-    return Material(E, nu), Loading(n_steps=n_steps)
+    material, loading = Material(E, nu), Loading(n_steps=n_steps)
+    # the fields the sweep keeps, on the generator's grid (n_steps = 1e8 on m = 2 failed
+    # the task on the worker after the study started)
+    from ..bem.sweep import check_sweep_memory
+    n = 2 ** int(m) + (generator == "rmd")
+    check_sweep_memory((n, n), loading.n_steps)
+    return material, loading
 
 
 def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=None,

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...bem.sweep import check_sweep_memory
 from ...errors import InputError, check_int
 from ..genome import Genome, chromosome_range
 from ..macro_micro import macro_micro
@@ -59,10 +60,13 @@ def genome_entry_task(gamma=None, hurst=None, phases=None, *, label, source="sob
 def genome_entry_inputs(gamma=None, hurst=None, phases=None, *, amplitude=1.0, lambda1=None,
                         genome_json=None, angles=None, anisotropy=None, **settings):
     """``(DatabaseSettings, Genome)`` of :func:`genome_entry_task`'s keywords (``label``
-    and ``source`` aside): the settings and the genes checked, the genome built, nothing
-    realised or solved. The task's first step, and the input check of the study
-    analyses that run it (:mod:`roughfe.study.analyses`)."""
+    and ``source`` aside): the settings and the genes checked (and the memory of a BEM
+    sweep's fields on the database's grid), the genome built, nothing realised or
+    solved. The task's first step, and the input check of the study analyses that run
+    it (:mod:`roughfe.study.analyses`)."""
     settings = settings_from(settings)
+    # the fields every BEM sweep of Alg. 2 keeps, on the database's grid
+    check_sweep_memory((settings.n_nodes,) * settings.dim, settings.n_steps)
     if genome_json is not None:
         return settings, _fits_window(Genome.from_dict(genome_json), settings)
     if gamma is None or hurst is None or phases is None:
