@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import datetime as _dt
+import errno
 import json
 import math
 import os
@@ -215,15 +216,22 @@ def folder_lock(folder, holder: str):
     """Hold an exclusive ``flock`` on ``folder/.lock`` or raise :class:`InputError`.
 
     The OS releases the lock when the process dies, so a killed run never blocks the
-    next one. ``holder`` names the command: the holder writes it and its pid into the
-    lock file, and a refused command names the one that holds the lock (``holder``
-    itself when the file does not say).
+    next one. The holder writes ``holder`` (its command) and pid into the lock file; a
+    refused command names them. A lock file this user may not open is an InputError too.
     """
     import fcntl
 
     folder = Path(folder)
     lock = folder / LOCK_FILE
-    with open(lock, "a+") as fh:       # not "w": the holder's record stays while refused
+    try:        # "a+", not "w": the holder's record stays while refused
+        fh = open(lock, "a+")
+    except OSError as exc:   # another user's folder said "Permission denied: OUTDIR/.lock"
+        if exc.errno not in (errno.EACCES, errno.EPERM, errno.EROFS):
+            raise
+        raise InputError(f"cannot write in output folder {folder}: its lock file {lock} "
+                         f"cannot be opened for writing ({exc.strerror.lower()}; another "
+                         "user's output folder?); choose another output folder") from None
+    with fh:
         try:
             fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

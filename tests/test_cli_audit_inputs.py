@@ -309,3 +309,30 @@ def test_boundary_window_on_a_periodic_surface_is_refused(tmp_path, capsys, monk
     for extra in (["--boundary", "window", "--non-periodic"], ["--boundary", "periodic"]):
         assert main(["design-targets", "--db", str(db), "--surface", str(path), "--quiet",
                      "--overwrite", "-o", str(tmp_path / "t")] + extra) == 0
+
+
+def test_another_users_output_folder_says_what_could_not_be_done(surface32, tmp_path, capsys,
+                                                                 monkeypatch):
+    # as user nobody (runuser; root ignores the mode bits) `contact -o OUT` on root's
+    # earlier output, with or without --overwrite, said "Permission denied: OUT/.lock"
+    import builtins
+    import errno
+
+    import roughfe.writers as writers
+    out = tmp_path / "c"
+    out.mkdir()
+    (out / ".lock").write_text("`roughfe contact` (pid 1)\n")
+    real = builtins.open
+
+    def open_(path, *args, **kwargs):    # the lock file as another user's, 0644
+        if str(path).endswith(".lock"):
+            raise PermissionError(errno.EACCES, "Permission denied", str(path))
+        return real(path, *args, **kwargs)
+    monkeypatch.setattr(writers, "open", open_, raising=False)
+    for extra in ([], ["--overwrite"]):
+        _refused(capsys, ["contact", str(surface32), "--steps", "2", "--no-figures", "-o",
+                          str(out), *extra],
+                 f"cannot write in output folder {out}: its lock file {out / '.lock'} cannot "
+                 "be opened for writing (permission denied; another user's output folder?); "
+                 "choose another output folder")
+    assert sorted(p.name for p in out.iterdir()) == [".lock"]
