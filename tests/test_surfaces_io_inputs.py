@@ -1,5 +1,7 @@
 """Bad surface files that the session-37 audit of bad input found read wrongly or said
 wrongly (round 2, session 37, helper aud2): each test fails on the code before its fix."""
+import os
+
 import numpy as np
 import pytest
 
@@ -118,6 +120,36 @@ def test_a_path_that_is_no_regular_file_says_what_it_is(tmp_path, capsys):
         in capsys.readouterr().err
     with pytest.raises(InputError, match="does not exist"):
         load_surface(tmp_path / "missing.npz")
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/cpuinfo")
+                    or os.stat("/proc/cpuinfo").st_size != 0,
+                    reason="needs Linux's /proc/cpuinfo (size 0 on disk)")
+def test_a_kernel_file_of_size_0_is_no_empty_file(tmp_path, capsys, monkeypatch):
+    # `info /proc/cpuinfo` said "the file is empty": its size on disk is 0, yet reading it
+    # gives text (made by the kernel on reading). Session 37, helper aud3
+    cpu = "/proc/cpuinfo"
+    said = (f"surface file {cpu!r} is no file on disk: its size is 0 bytes, yet reading "
+            "it gives data, made on the fly (a kernel interface, as the files of /proc)")
+    with pytest.raises(InputError) as info:
+        load_surface(cpu)
+    assert said in str(info.value) and "empty" not in str(info.value)
+    capsys.readouterr()
+    assert main(["info", cpu]) == 2
+    assert f"error: {said}" in capsys.readouterr().err
+    for name in ("empty.txt", "empty.npz"):      # a file that is empty still says so
+        (tmp_path / name).write_bytes(b"")
+        with pytest.raises(FileFormatError, match=f"{name}: the file is empty"):
+            load_surface(tmp_path / name, size=1e-4)
+    real = os.read
+
+    def read(fd, n):       # as /proc/kmsg without a message: the read would wait
+        if os.readlink(f"/proc/self/fd/{fd}") == cpu:
+            raise BlockingIOError(11, "Resource temporarily unavailable")
+        return real(fd, n)
+    monkeypatch.setattr(os, "read", read)
+    with pytest.raises(InputError, match="size is 0 bytes, yet reading it waits for data"):
+        load_surface(cpu)
 
 
 @pytest.mark.parametrize("heights, what", [

@@ -3,8 +3,8 @@ read from it, before they become a :class:`~roughfe.surfaces.surface.Surface`.
 
 Found by the fresh-eyes audit of bad input (round 2, session 37): a ``.npz`` whose
 ``periodic`` entry was ``"no"`` or ``0.5`` was read as periodic (by truthiness); a file
-without read permission was said to be damaged (each reader failed in its own words), and
-``/dev/null`` not to exist.
+without read permission was said to be damaged (each reader failed in its own words),
+``/dev/null`` not to exist, and ``/proc/cpuinfo`` (size 0 on disk) to be empty.
 """
 from __future__ import annotations
 
@@ -28,7 +28,8 @@ def check_surface_file(path) -> Path:
     folder, a device, pipe or socket (``/dev/null`` was said not to exist), a file
     without read permission (before round 2, session 37 each reader gave its own wrong
     cause: a ``.npz`` "truncated or not a zip archive", an ``.x3p`` "damaged or
-    truncated?"), :class:`FileFormatError` for an empty file."""
+    truncated?"), :class:`FileFormatError` for an empty file, :class:`InputError` for a
+    file of size 0 that reading finds not empty (``/proc/cpuinfo``: no file on disk)."""
     path = Path(path)
     try:
         info = path.stat()
@@ -49,8 +50,30 @@ def check_surface_file(path) -> Path:
     if not os.access(path, os.R_OK):
         raise InputError(f"cannot read surface file {path}: permission denied")
     if info.st_size == 0:
-        raise FileFormatError(f"{path}: the file is empty")
+        _refuse_empty(path)
     return path
+
+
+def _refuse_empty(path: Path) -> None:
+    """Raise for a regular file of size 0: :class:`FileFormatError` when it is empty,
+    :class:`InputError` when reading gives data (or would wait for it) all the same: a
+    kernel interface such as ``/proc/cpuinfo``, made on reading, which was said to be
+    "empty" (round 2, session 37). One byte is read, without waiting (``O_NONBLOCK``:
+    ``/proc/kmsg`` would block)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    try:
+        data = os.read(fd, 1)
+    except BlockingIOError:
+        data = None
+    finally:
+        os.close(fd)
+    if data == b"":
+        raise FileFormatError(f"{path}: the file is empty")
+    gives = "gives data" if data else "waits for data"
+    raise InputError(f"surface file {str(path)!r} is no file on disk: its size is 0 bytes, "
+                     f"yet reading it {gives}, made on the fly (a kernel interface, as the "
+                     f"files of /proc); give a surface file (.npz, a height matrix or an "
+                     f"instrument file)")
 
 
 #: what heights of a non-numeric dtype are, by numpy's dtype kind
