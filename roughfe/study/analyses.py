@@ -254,8 +254,9 @@ def contact_sweep_task(*, seed, generator="rmd", fractal_dimension=2.3, m=6, len
     if generator == "rmd":
         surface = rmd_surface(m, fractal_dimension, length, rng=seed, rms_height=rms_height)
     else:
-        surface = spectral_surface(2 ** int(m), length, 3.0 - float(fractal_dimension),
-                                   rms_height=rms_height, rng=seed)
+        surface = spectral_surface(_grid_side(generator, m), length,
+                                   3.0 - float(fractal_dimension), rms_height=rms_height,
+                                   rng=seed)
     sweep = response(surface, material, loading, kernel=kernel, solver=solver, tol=tol)
     return [{"step": k, **record} for k, record in enumerate(sweep.to_records())]
 
@@ -290,9 +291,15 @@ def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height,
     # the fields the sweep keeps, on the generator's grid (n_steps = 1e8 on m = 2 failed
     # the task on the worker after the study started)
     from ..bem.sweep import check_sweep_memory
-    n = 2 ** int(m) + (generator == "rmd")
-    check_sweep_memory((n, n), loading.n_steps)
+    check_sweep_memory((_grid_side(generator, m),) * 2, loading.n_steps)
     return material, loading
+
+
+def _grid_side(generator, m) -> int:
+    """Points per side of :func:`contact_sweep_task`'s surface: 2^m + 1 for ``rmd``
+    (:func:`~roughfe.surfaces.rmd_surface`), 2^m for ``spectral`` (one rule for the
+    generation and the memory check of :func:`contact_sweep_inputs`)."""
+    return 2 ** int(m) + (generator == "rmd")
 
 
 def genome_db_task(*, gamma, hurst, seed, amplitude=1.0, lambda1=None, label=None,
