@@ -89,7 +89,7 @@ from ..errors import (InputError, check_finite_positive, check_in_open_interval,
                       check_instance, check_int)
 from ..frozen import ReadOnlyArrays, read_only_arrays
 from .line_psd import line_power_spectrum
-from .scan_lines import level_lines, scan_axis_of
+from .scan_lines import column_fits_removed, scan_axis_of
 from .stats import _window
 from .surface import Surface
 
@@ -205,10 +205,6 @@ def _lines_of(surface: Surface, axis: str) -> np.ndarray:
     return surface.heights if axis == "x" else surface.heights.T
 
 
-def _levelled(h: np.ndarray, length: float) -> np.ndarray:
-    """Each column's least-squares straight line removed (:func:`level_lines`)."""
-    flat = Surface(h, (length, float(h.shape[1])), periodic=False)
-    return level_lines(flat, tilt=True, axis="x").heights
 
 
 def _best_lag(a: np.ndarray, b: np.ndarray, max_lag: int) -> tuple:
@@ -352,10 +348,11 @@ def trace_retrace_coherence(first: Surface, second: Surface, axis=None,
                          f"lines, two independent noise scans reach coherence {threshold:g} "
                          f"at one of their wavenumbers with probability above "
                          f"{FALSE_ALARM:g}")
-    lag, correlation = _best_lag(_levelled(a, n_x * dx), _levelled(b, n_x * dx), max_lag)
+    lag, correlation = _best_lag(column_fits_removed(a, tilt=True),
+                                 column_fits_removed(b, tilt=True), max_lag)
     n = n_x - abs(lag)
-    a = _levelled(a[max(0, -lag): n_x - max(0, lag)], n * dx)
-    b = _levelled(b[max(0, lag): n_x - max(0, -lag)], n * dx)
+    a = column_fits_removed(a[max(0, -lag): n_x - max(0, lag)], tilt=True)
+    b = column_fits_removed(b[max(0, lag): n_x - max(0, -lag)], tilt=True)
     w = _window("hann", (n,))[:, None]
     fa, fb = np.fft.rfft(a * w, axis=0), np.fft.rfft(b * w, axis=0)
     cross = np.mean(fa * fb.conj(), axis=1)[1:]
