@@ -15,6 +15,14 @@ class InputError(RoughfeError, ValueError):
     """Bad input: the message names the argument, the value given and what is allowed."""
 
 
+class MemoryShortage(InputError):
+    """An input that needs more memory than the machine that checks it has available
+    (:func:`check_memory`): a fact about that machine as much as about the input. A
+    study whose tasks run on other machines (a remote dask scheduler) reports it as a
+    note and lets each worker check its own memory
+    (:func:`roughfe.study.runner.run_study`)."""
+
+
 class NoConvergenceError(RoughfeError, RuntimeError):
     """A solver stopped before meeting its tolerance.
 
@@ -281,7 +289,8 @@ def available_memory() -> int:
 
 
 def check_memory(what: str, n_bytes: float) -> None:
-    """Raise :class:`InputError` when ``what`` needs more than the available memory.
+    """Raise :class:`MemoryShortage` (an :class:`InputError`) when ``what`` needs more
+    than the available memory.
 
     The message gives both in GiB, e.g. "a 100000 x 100000 grid needs 74.5 GiB of
     memory, 21.3 GiB are available".
@@ -289,7 +298,7 @@ def check_memory(what: str, n_bytes: float) -> None:
     free = available_memory()
     if n_bytes > free:
         gib = 2.0 ** 30
-        raise InputError(f"{what} needs {n_bytes / gib:.1f} GiB of memory, "
+        raise MemoryShortage(f"{what} needs {n_bytes / gib:.1f} GiB of memory, "
                          f"{free / gib:.1f} GiB are available")
 
 

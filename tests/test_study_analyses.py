@@ -124,7 +124,8 @@ def test_a_task_whose_sweep_cannot_fit_in_memory_refuses_the_study_up_front(tmp_
             ("leakage", {"D": 2.3, "m": 3}, "9 x 9"),
             ("genome_db", {"gamma": 1.5, "hurst": 0.7, "n_nodes": 64}, "64 grid"),
             ("genome_entry", {"entry": {"label": "a", "gamma": 1.5, "hurst": 0.7,
-                                        "phases": 1}, "dim": 2, "n_nodes": 64},
+                                        "phases": 1, "angles": [0.3]}, "dim": 2,
+                              "n_nodes": 64},
              "64 x 64 grid")]:
         with pytest.raises(InputError, match=f"10000000000 load steps of a {grid}"):
             check_parameters(name, {**params, "n_steps": 10 ** 10})
@@ -133,6 +134,36 @@ def test_a_task_whose_sweep_cannot_fit_in_memory_refuses_the_study_up_front(tmp_
     with pytest.raises(InputError, match="10 load steps of a 8193 x 8193 grid needs 20.6 GiB"):
         check_parameters("contact_sweep", {"m": 13})
     check_parameters("contact_sweep", {"m": 12})
+
+
+def test_a_remote_scheduler_notes_this_machines_memory_shortage(monkeypatch):
+    """With a remote dask scheduler the tasks run on machines whose memory the launching
+    one cannot see (a 16 GiB login node, 256 GiB compute nodes): a task that needs more
+    than this machine has is a note, not a refusal; the worker checks again when the
+    task starts. Every other bad value is still refused up front, and the memory check
+    comes after the value checks, so a shortage never hides a bad value. Locally the
+    shortage stays a refusal."""
+    from roughfe import errors
+    from roughfe.study.runner import _check_tasks
+    from roughfe.study.spec import Task
+
+    pytest.importorskip("roughfe.leakage.study")
+    monkeypatch.setattr(errors, "available_memory", lambda: 1 * 2 ** 30)
+    big = [Task(0, {"m": 13}, 0, "a"), Task(1, {"m": 12}, 0, "b")]
+    notes = _check_tasks("contact_sweep", big, remote=True)
+    assert len(notes) == 1 and "8193 x 8193 grid needs 20.6 GiB" in notes[0]
+    assert "on this machine; the tasks run on the scheduler's workers" in notes[0]
+    with pytest.raises(errors.MemoryShortage, match="20.6 GiB of memory, 1.0 GiB"):
+        _check_tasks("contact_sweep", big, remote=False)
+    for name, params, words in [
+            ("contact_sweep", {"m": 13, "tol": 2.0}, "tol"),
+            ("leakage", {"D": 2.3, "m": 13, "mu": -1.0}, "mu"),
+            ("genome_db", {"gamma": 1.5, "hurst": 7.0, "n_nodes": 8193}, "hurst"),
+            ("genome_entry", {"entry": {"label": "a", "gamma": 1.5, "hurst": 0.7},
+                              "n_nodes": 8193}, "phases")]:
+        with pytest.raises(InputError, match=words) as info:
+            _check_tasks(name, [Task(0, params, 0, "c")], remote=True)
+        assert not isinstance(info.value, errors.MemoryShortage), (name, str(info.value))
 
 
 def test_the_input_checks_accept_the_defaults_and_do_no_work(monkeypatch):

@@ -143,7 +143,6 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     check_in_open_interval("D (fractal dimension)", D, 2.0, 3.0)
     _check_m(m)
     check_int("n_steps", n_steps, 1)
-    check_sweep_memory((2 ** int(m) + 1,) * 2, int(n_steps))   # the fields the sweep keeps
     check_finite_positive("L (m)", L)
     from ..surfaces.surface import _as_size
     _as_size(L, 1)      # the surfaces' size range (1e308 failed every task on the workers)
@@ -159,6 +158,9 @@ def leakage_inputs(*, D, m, n_steps, L, E, nu, mu, pressure_drop, reynolds, dire
     check_finite_positive("pressure_drop (Pa)", pressure_drop)
     _direction_list(direction)
     check_kernel_name(kernel)
+    # the fields the sweep keeps; last, after every check of the values (a study on a
+    # remote scheduler notes this machine's shortage and goes on: runner.run_study)
+    check_sweep_memory((2 ** int(m) + 1,) * 2, int(n_steps))
     return Material(E, nu)
 
 

@@ -156,7 +156,8 @@ def check_parameters(name: str, params) -> None:
     except InputError as exc:     # the reason first; a task's 30-phase lists cut short
         task = repr(dict(params))  # (the line was the whole task, then the reason)
         task = task if len(task) <= 240 else task[:240] + " ...}"
-        raise InputError(f"{exc} (analysis {name!r}, task {task})") from None
+        # the same kind (a MemoryShortage stays one: the runner tells it apart)
+        raise type(exc)(f"{exc} (analysis {name!r}, task {task})") from None
 
 
 def as_records(value, name: str) -> list[dict]:

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import __version__
-from ..errors import InputError
+from ..errors import InputError, MemoryShortage
 from ..writers import to_jsonable, write_json
 from . import store
 from .analyses import ANALYSES, as_records, check_parameters, resolve
@@ -147,18 +147,33 @@ class _Progress:
             self.bar.close()
 
 
-def _check_tasks(analysis: str, tasks) -> None:
+def _check_tasks(analysis: str, tasks, remote: bool = False) -> list:
     """:func:`~roughfe.study.analyses.check_parameters` on every distinct parameter set
     of ``tasks`` (the seeds aside), before anything is written or submitted: a bad value
-    anywhere in the grid fails the whole study at once, naming that task's parameters."""
+    anywhere in the grid fails the whole study at once, naming that task's parameters.
+
+    ``remote``: the tasks run on other machines (a dask scheduler's workers), whose
+    memory this machine cannot see. A task that needs more memory than this machine has
+    (:class:`~roughfe.errors.MemoryShortage`, raised by the inputs checks after every
+    check of the values) is then no refusal: its message is returned as a note (the
+    first one; the worker checks its own memory when the task starts, and a shortage
+    there fails that task with the same message). Locally it is raised."""
     from .spec import canonical_json
 
-    seen = set()
+    seen, notes = set(), []
     for t in tasks:
         key = canonical_json(t.kwargs)
         if key not in seen:
             seen.add(key)
-            check_parameters(analysis, t.kwargs)
+            try:
+                check_parameters(analysis, t.kwargs)
+            except MemoryShortage as exc:
+                if not remote:
+                    raise
+                notes = notes or [f"{exc}, on this machine; the tasks run on the "
+                                  f"scheduler's workers, which check their own memory "
+                                  f"when a task starts"]
+    return notes
 
 
 def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=True,
@@ -191,7 +206,9 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     log = log or (lambda message: None)
     t_start = time.perf_counter()
     tasks = spec.tasks()
-    _check_tasks(spec.analysis, tasks)
+    for note in _check_tasks(spec.analysis, tasks,
+                             remote=executor == "dask" and scheduler is not None):
+        warnings.warn(note, stacklevel=2)
     outdir = spec.output
     with store.study_lock(outdir) as created:
         try:

@@ -65,14 +65,18 @@ def genome_entry_inputs(gamma=None, hurst=None, phases=None, *, amplitude=1.0, l
     solved. The task's first step, and the input check of the study analyses that run
     it (:mod:`roughfe.study.analyses`)."""
     settings = settings_from(settings)
-    # the fields every BEM sweep of Alg. 2 keeps, on the database's grid
-    check_sweep_memory((settings.n_nodes,) * settings.dim, settings.n_steps)
     if genome_json is not None:
-        return settings, _fits_window(Genome.from_dict(genome_json), settings)
-    if gamma is None or hurst is None or phases is None:
+        genome = _fits_window(Genome.from_dict(genome_json), settings)
+    elif gamma is None or hurst is None or phases is None:
         raise InputError("genome_entry_task needs gamma, hurst and phases, or genome_json")
-    return settings, make_genome(gamma, hurst, phases, settings, amplitude=amplitude,
-                                 lambda1=lambda1, angles=angles, anisotropy=anisotropy)
+    else:
+        genome = make_genome(gamma, hurst, phases, settings, amplitude=amplitude,
+                             lambda1=lambda1, angles=angles, anisotropy=anisotropy)
+    # the fields every BEM sweep of Alg. 2 keeps, on the database's grid; last, after
+    # every check of the values (a study on a remote scheduler notes this machine's
+    # shortage and goes on: roughfe.study.runner.run_study)
+    check_sweep_memory((settings.n_nodes,) * settings.dim, settings.n_steps)
+    return settings, genome
 
 
 def _fits_window(genome: Genome, settings: DatabaseSettings) -> Genome:
