@@ -273,6 +273,31 @@ def test_extend_checks_labels_and_genomes_before_running(tmp_path):
     assert [e.label for e in db.load_entries(path)] == ["1-1"]
 
 
+def test_extend_leaves_the_memory_to_the_runner(tmp_path, monkeypatch):
+    """extend_tasks checks what a genome is (window, angles, labels); whether its sweep
+    fits in memory is the runner's to judge, which knows where the tasks run (a remote
+    scheduler's workers: a warning; here: refused up front, naming the task, nothing
+    added). A shortage in extend_tasks was "genome 1 of 1 cannot join this database"."""
+    from roughfe import errors
+    from roughfe.study import build_genome_db, extend_genome_db
+
+    tiny = db.DatabaseSettings(n_nodes=64, n_steps=6)
+    path = tmp_path / "g.sqlite"
+    build_genome_db(path, tiny, limit=1, workers=1, progress=False)
+    good = db.make_genome(1.7, 0.9, 11, tiny)
+    monkeypatch.setattr(errors, "available_memory", lambda: 1024.0)
+    con = db.connect(path)
+    try:
+        tasks = db.extend_tasks(con, [good])
+    finally:
+        con.close()
+    assert [t["label"] for t in tasks] == ["x-2"]
+    with pytest.raises(errors.MemoryShortage, match=r"6 load steps of a 64 grid needs .*"
+                                                    r"analysis 'genome_entry'"):
+        extend_genome_db(path, [good], workers=1, progress=False)
+    assert [e.label for e in db.load_entries(path)] == ["1-1"]
+
+
 @pytest.mark.parametrize("field, value, message", [
     ("n_nodes", 64.7, r"n_nodes must be an integer >= 16, got 64.7"),
     ("n_steps", 5.9, r"n_steps must be an integer >= 3, got 5.9"),

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import FileFormatError, InputError
+from ...errors import FileFormatError, InputError, MemoryShortage
 from ...frozen import freeze_containers
 from ...writers import to_json_text
 from ..similarity import ResponseCurve
@@ -297,6 +297,8 @@ def extend_tasks(con, genomes, labels_=None) -> list:
     for k, d in enumerate(dicts):
         try:
             genome_entry_inputs(genome_json=d, **settings.to_dict())
+        except MemoryShortage:   # the runner's to judge: it knows where the tasks run
+            pass                 # (a remote scheduler's workers; run_study checks)
         except (InputError, FileFormatError) as exc:
             raise InputError(f"genome {k + 1} of {len(dicts)} cannot join this database "
                              f"(L = {settings.length:g} m, N = {settings.n_nodes}, dim "
