@@ -68,11 +68,11 @@ def test_steps_whose_fields_cannot_fit_are_refused_before_the_sweep(surface32, t
     out = tmp_path / "c"
     _refused(capsys, ["contact", str(surface32), "--steps", "10000000000", "--no-figures",
                       "-o", str(out)], "keeping the fields of 10000000000 load steps of a "
-             "32 x 32 grid needs", "GiB are available")
+             "32 x 32 grid and solving them needs", "GiB are available")
     assert not out.exists()
     _refused(capsys, ["contact", str(surface32), "--steps", "10000000000", "--adhesion", "md",
                       "--work-of-adhesion", "0.01", "--range", "1e-8", "--no-figures",
-                      "-o", str(out)], "load steps of a 32 x 32 grid needs")
+                      "-o", str(out)], "load steps of a 32 x 32 grid and solving them")
     assert not out.exists()
 
 

@@ -292,7 +292,7 @@ def test_extend_leaves_the_memory_to_the_runner(tmp_path, monkeypatch):
     finally:
         con.close()
     assert [t["label"] for t in tasks] == ["x-2"]
-    with pytest.raises(errors.MemoryShortage, match=r"6 load steps of a 64 grid needs .*"
+    with pytest.raises(errors.MemoryShortage, match=r"6 load steps of a 64 grid and solving .*"
                                                     r"analysis 'genome_entry'"):
         extend_genome_db(path, [good], workers=1, progress=False)
     assert [e.label for e in db.load_entries(path)] == ["1-1"]

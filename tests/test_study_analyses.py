@@ -102,7 +102,7 @@ def test_the_input_checks_of_the_analyses_name_the_bad_value(name, params, words
 
 def test_a_task_whose_sweep_cannot_fit_in_memory_refuses_the_study_up_front(tmp_path,
                                                                             monkeypatch):
-    """The BEM sweep's memory check (bem.sweep.check_sweep_memory) is part of the input
+    """The BEM sweep's memory check (bem.memory.check_sweep_memory) is part of the input
     checks: n_steps = 1e10 on m = 2 failed its task on the worker after the study had
     started (session-37 audit); now the study is refused before any task, naming the
     task, and nothing is written. The grid is the generator's: 2**m + 1 (rmd), 2**m
@@ -116,7 +116,8 @@ def test_a_task_whose_sweep_cannot_fit_in_memory_refuses_the_study_up_front(tmp_
     with pytest.raises(InputError) as info:
         run_study(spec_from_mapping(study), workers=1, progress=False)
     text = str(info.value)
-    assert "keeping the fields of 10000000000 load steps of a 5 x 5 grid needs" in text
+    assert ("keeping the fields of 10000000000 load steps of a 5 x 5 grid and solving them "
+            "(non-periodic: on its zero-padded 9 x 9 FFT grid) needs") in text
     assert "analysis 'contact_sweep', task {'n_steps': 10000000000, 'm': 2}" in text
     assert not out.exists()
     for name, params, grid in [
@@ -129,10 +130,15 @@ def test_a_task_whose_sweep_cannot_fit_in_memory_refuses_the_study_up_front(tmp_
              "64 x 64 grid")]:
         with pytest.raises(InputError, match=f"10000000000 load steps of a {grid}"):
             check_parameters(name, {**params, "n_steps": 10 ** 10})
-    # the default n_steps = 10 on m = 13 (8193^2 points) keeps 22 GB of fields
-    monkeypatch.setattr(errors, "available_memory", lambda: 16 * 2 ** 30)
-    with pytest.raises(InputError, match="10 load steps of a 8193 x 8193 grid needs 20.6 GiB"):
+    # the default n_steps = 10 on m = 13 (8193^2 points) keeps 22 GB of fields, and
+    # its solve on the zero-padded 16875^2 grid needs 40 bytes a point: 31.2 GiB in all;
+    # on the periodic (spectral) 8192^2 grid 23.1 GiB
+    monkeypatch.setattr(errors, "available_memory", lambda: 24 * 2 ** 30)
+    with pytest.raises(InputError, match=r"10 load steps of a 8193 x 8193 grid and solving "
+                                         r"them \(non-periodic: on its zero-padded 16875 x "
+                                         r"16875 FFT grid\) needs 31.2 GiB"):
         check_parameters("contact_sweep", {"m": 13})
+    check_parameters("contact_sweep", {"m": 13, "generator": "spectral"})
     check_parameters("contact_sweep", {"m": 12})
 
 
@@ -151,9 +157,9 @@ def test_a_remote_scheduler_notes_this_machines_memory_shortage(monkeypatch):
     monkeypatch.setattr(errors, "available_memory", lambda: 1 * 2 ** 30)
     big = [Task(0, {"m": 13}, 0, "a"), Task(1, {"m": 12}, 0, "b")]
     notes = _check_tasks("contact_sweep", big, remote=True)
-    assert len(notes) == 1 and "8193 x 8193 grid needs 20.6 GiB" in notes[0]
+    assert len(notes) == 1 and "FFT grid) needs 31.2 GiB" in notes[0]
     assert "on this machine; the tasks run on the scheduler's workers" in notes[0]
-    with pytest.raises(errors.MemoryShortage, match="20.6 GiB of memory, 1.0 GiB"):
+    with pytest.raises(errors.MemoryShortage, match="31.2 GiB of memory, 1.0 GiB"):
         _check_tasks("contact_sweep", big, remote=False)
     for name, params, words in [
             ("contact_sweep", {"m": 13, "tol": 2.0}, "tol"),
@@ -169,8 +175,8 @@ def test_a_remote_scheduler_notes_this_machines_memory_shortage(monkeypatch):
 def test_the_input_checks_accept_the_defaults_and_do_no_work(monkeypatch):
     """Good values pass every check quickly (no surface is generated: m = 13 would take
     seconds and 500 MB with RMD), and the check is the task's own first step. (A machine
-    with 32 GiB free: the default 10 steps at m = 13 keep 22 GB of fields, refused with
-    less, as the test above shows.)"""
+    with 32 GiB free: the default 10 steps at m = 13 keep 22 GB of fields and solve on a
+    padded 16875^2 grid, 31.2 GiB, refused with less, as the test above shows.)"""
     import time
 
     from roughfe import errors

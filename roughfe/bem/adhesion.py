@@ -382,13 +382,14 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
     """
     check_adhesive_objects(surface, material, law)
     if deltas is None:
-        from .sweep import check_sweep_memory, default_deltas
+        from .memory import check_sweep_memory
+        from .sweep import default_deltas
         n_steps = Loading(n_steps=n_steps).n_steps     # checked, default 20
-        check_sweep_memory(surface.shape, n_steps)
+        periodic = surface.periodic and kernel in ("auto", "spectral")
+        check_sweep_memory(surface.shape, n_steps, periodic=periodic)
         if is_flat(surface):      # (the BEM's rule) it said "deltas must be strictly increasing"
             raise InputError("the surface is flat (constant heights): its height range "
                              "gives no approaches for n_steps; give the approaches (m)")
-        periodic = surface.periodic and kernel in ("auto", "spectral")
         deltas = default_deltas(surface, n_steps + periodic, periodic)[:n_steps]
     elif n_steps is not None:
         raise InputError(f"give deltas or n_steps, not both (got n_steps={n_steps!r})")

@@ -35,6 +35,7 @@ from .coarse_start import CORRECTION_MIN_PARTS, _coarse_start, _contact_parts
 from .contact_checks import (_check_coarse_correction, _check_hardness, _check_surface,
                              _check_target, _check_tol)
 from .deflation import BlockDeflation
+from .memory import check_solve_memory
 from .padded_deflation import PaddedBlockDeflation
 from .patches import patch_width, rim_width
 from .pk import polonsky_keer
@@ -335,6 +336,7 @@ def solve_contact(surface: Surface, material: Material, *, delta=None, mean_pres
     hardness, plastic = _check_hardness(hardness, mean_pressure, plastic_displacement,
                                         surface.shape)
     kernel = _choose_kernel(surface, kernel)
+    check_solve_memory(surface.shape, kernel == "spectral")   # before the operator
     op = _operator(surface.shape, surface.size, material.E_star, kernel)
     solver = _choose_solver(surface.heights.size, op, solver, hardness is not None)
     coarse_correction = _check_coarse_correction(coarse_correction, op, solver,

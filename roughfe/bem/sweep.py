@@ -14,36 +14,15 @@ import dataclasses
 import numpy as np
 
 from .. import progress
-from ..errors import InputError, check_memory
+from ..errors import InputError
 from ..model import RECORD_KEYS, Loading, Material, SweepResult, central_differences
 from ..surfaces.stats import rms_slope
 from ..surfaces.surface import Surface
-from .contact import _check_surface, _coarse_start, solve_contact
+from .contact import _check_surface, _choose_kernel, _coarse_start, solve_contact
+from .memory import check_sweep_memory
 
-__all__ = ["contact_sweep", "default_deltas", "check_sweep_memory", "SweepResult",
+__all__ = ["contact_sweep", "default_deltas", "SweepResult",
            "RECORD_KEYS", "central_differences"]
-
-#: bytes per grid point that one step of a sweep keeps: its pressure, displacement and gap
-#: (float64), contact set (bool) and, with a hardness, plastic displacement (float64)
-STEP_BYTES_PER_POINT = 4 * 8 + 1
-
-
-def check_sweep_memory(shape, n_steps: int) -> None:
-    """Raise :class:`~roughfe.errors.InputError` when the fields of ``n_steps`` steps on a
-    grid of ``shape`` (a surface's ``shape``; every step keeps them) need more than the
-    available memory.
-
-    Checked before the approaches are made: ``roughfe contact --steps 100000000`` on a
-    32^2 grid started, to run for about two weeks (2000 steps: 24 s) towards 3.4 TB of
-    fields and a MemoryError (round 2, session 37). It takes the shape, not the surface,
-    so that a study checks its tasks before any surface is generated
-    (:func:`roughfe.study.analyses.check_parameters`).
-    """
-    shape = tuple(int(n) for n in shape)
-    check_memory(f"keeping the fields of {n_steps} load steps of a "
-                 f"{' x '.join(map(str, shape))} grid",
-                 float(n_steps) * float(np.prod(shape, dtype=float)) * STEP_BYTES_PER_POINT)
-
 
 def default_deltas(surface: Surface, n_steps: int, periodic: bool) -> np.ndarray:
     """``n_steps`` equispaced approaches k/n * Delta_max, k = 1..n (m): Delta_max is the
@@ -133,7 +112,8 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     loading.require_contact()      # approaches apart: adhesion only (adhesive_sweep)
     n_load = (loading.n_steps if loading.kind == "n_steps" else
               len(np.atleast_1d(getattr(loading, loading.kind))))
-    check_sweep_memory(surface.shape, 2 * n_load - 1 if unload else n_load)
+    check_sweep_memory(surface.shape, 2 * n_load - 1 if unload else n_load,
+                       periodic=_choose_kernel(surface, kernel) == "spectral")
     if loading.kind == "n_steps":
         periodic = surface.periodic and kernel in ("auto", "spectral")
         deltas = default_deltas(surface, loading.n_steps, periodic)

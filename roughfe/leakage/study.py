@@ -19,7 +19,7 @@ from typing import Iterable, Optional
 import numpy as np
 
 from ..bem import Material
-from ..bem.sweep import check_sweep_memory
+from ..bem.memory import check_sweep_memory
 from ..errors import InputError
 from ..surfaces.rmd import rmd_surface
 from ..surfaces.stats import spectral_moments

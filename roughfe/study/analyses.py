@@ -266,7 +266,7 @@ def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height,
                          n_steps, kernel, solver, tol):
     """The input check of :func:`contact_sweep_task` (its keywords without ``seed``):
     the generator's parameters, the BEM vocabulary and tolerance checked, the memory of
-    the sweep's fields on the generator's grid (:func:`roughfe.bem.sweep.check_sweep_memory`),
+    the sweep's fields on the generator's grid (:func:`roughfe.bem.memory.check_sweep_memory`),
     and the ``(Material, Loading)`` of the sweep returned; no surface is generated."""
     from ..bem.contact import check_solver_name
     from ..bem.operators import check_kernel_name
@@ -291,8 +291,9 @@ def contact_sweep_inputs(*, generator, fractal_dimension, m, length, rms_height,
     material, loading = Material(E, nu), Loading(n_steps=n_steps)
     # the fields the sweep keeps, on the generator's grid (n_steps = 1e8 on m = 2 failed
     # the task on the worker after the study started)
-    from ..bem.sweep import check_sweep_memory
-    check_sweep_memory((_grid_side(generator, m),) * 2, loading.n_steps)
+    from ..bem.memory import check_sweep_memory
+    check_sweep_memory((_grid_side(generator, m),) * 2, loading.n_steps,
+                       periodic=generator == "spectral" and kernel in ("auto", "spectral"))
     return material, loading
 
 

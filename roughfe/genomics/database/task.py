@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...bem.sweep import check_sweep_memory
+from ...bem.memory import check_sweep_memory
 from ...errors import InputError, check_int
 from ..genome import Genome, chromosome_range
 from ..macro_micro import macro_micro
@@ -75,7 +75,8 @@ def genome_entry_inputs(gamma=None, hurst=None, phases=None, *, amplitude=1.0, l
     # the fields every BEM sweep of Alg. 2 keeps, on the database's grid; last, after
     # every check of the values (a study on a remote scheduler notes this machine's
     # shortage and goes on: roughfe.study.runner.run_study)
-    check_sweep_memory((settings.n_nodes,) * settings.dim, settings.n_steps)
+    check_sweep_memory((settings.n_nodes,) * settings.dim, settings.n_steps,
+                       periodic=settings.dim == 2 and settings.kernel in ("auto", "spectral"))
     return settings, genome
 
 
