@@ -717,3 +717,25 @@ def test_a_sweep_names_the_step_of_a_leakage_warning(monkeypatch):
     assert [str(w.message) for w in record if w.category is FlowImbalanceWarning] == [
         f"step 1 (p = {c.mean_pressure:.4g} Pa, Delta = {c.delta:.4g} m): inlet and outlet "
         f"flows differ"]
+
+
+def test_a_reynolds_solve_beyond_the_memory_is_refused_naming_its_unknowns(monkeypatch):
+    """A gap whose system and AMG hierarchy cannot fit was left to the OOM killer. The
+    check counts the unknowns (the cells of the components that join inlet and outlet:
+    the closed cells of the barrier are none) and refuses before PETSc sees the system;
+    with the memory it needs, the same gap solves."""
+    from roughfe import errors
+    from roughfe.leakage.finite_volume import (REYNOLDS_BYTES_PER_CELL,
+                                               REYNOLDS_BYTES_PER_UNKNOWN, solve_reynolds_fv)
+
+    g = np.full((40, 30), 1e-6)
+    g[20, :] = 0.0
+    g[20, 10:15] = 1e-6            # one opening in a closed barrier: still percolating
+    unknowns = g.size - 25          # the barrier's 25 closed cells
+    need = REYNOLDS_BYTES_PER_CELL * g.size + REYNOLDS_BYTES_PER_UNKNOWN * unknowns
+    monkeypatch.setattr(errors, "available_memory", lambda: need - 1)
+    with pytest.raises(errors.MemoryShortage,
+                       match=f"the Reynolds solve of a 40 x 30 gap \\({unknowns} unknowns\\)"):
+        solve_reynolds_fv(g, (1e-6, 1e-6))
+    monkeypatch.setattr(errors, "available_memory", lambda: need)
+    assert solve_reynolds_fv(g, (1e-6, 1e-6)).leak_rate > 0

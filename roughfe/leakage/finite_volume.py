@@ -66,7 +66,8 @@ from typing import Mapping, Optional
 
 import numpy as np
 
-from ..errors import InputError, NoConvergenceError, check_finite_positive, check_real_array
+from ..errors import (InputError, NoConvergenceError, check_finite_positive, check_memory,
+                      check_real_array)
 from ..fem.dissipation import solve_for_dissipation
 from ..fem.petsc_tools import CG_AMG, KrylovSolver, petsc_aij_csr
 from ..fem.reynolds import check_reynolds_data
@@ -78,6 +79,13 @@ from .components import components_reaching
 #: V-cycle, as CG needs) over all points instead of hypre's default symmetric sweeps with C/F
 #: ordering. Measured at 1024^2 (A* = 0.15, back to back): set-up + solve 1.7-1.8 s CPU
 #: instead of 2.5-2.6 s, 11 CG iterations instead of 10, the same leak rate to 1e-10.
+#: lower bounds of the peak memory of a solve (bytes per cell of the gap and per
+#: unknown: the CSR system and BoomerAMG's hierarchy): ru_maxrss at 2048^2 rose by 364
+#: and 291 bytes per cell with 85 % and 60 % of the cells open, i.e. ~118 per cell +
+#: ~288 per unknown (round 2, session 38); checked once the unknowns are known, so that
+#: a gap beyond the machine is an InputError, not the OOM killer
+REYNOLDS_BYTES_PER_CELL, REYNOLDS_BYTES_PER_UNKNOWN = 100, 250
+
 REYNOLDS_FV = {"pc_hypre_boomeramg_relax_type_down": "SOR/Jacobi",
                "pc_hypre_boomeramg_relax_type_up": "backward-SOR/Jacobi",
                "pc_hypre_boomeramg_no_CF": None}
@@ -219,6 +227,10 @@ def solve_reynolds_fv(gap, spacing, *, direction: str = "x", mu: float = 1e-3,
         solve = np.append(t_in_lab & t_out_lab, False)[lab]
         inlet_only = np.append(t_in_lab & ~t_out_lab, False)[lab]
     del lab
+    unknowns = int(np.count_nonzero(solve))
+    check_memory(f"the Reynolds solve of a {nl} x {nt} gap ({unknowns} unknowns)",
+                 REYNOLDS_BYTES_PER_CELL * float(g.size)
+                 + REYNOLDS_BYTES_PER_UNKNOWN * float(unknowns))
 
     # face transmissibilities (m^3/(Pa s)); T_t[:, j] joins columns j and j + 1 (with wrap,
     # the last column is the seam face); faces outside the live components carry nothing
