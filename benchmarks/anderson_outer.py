@@ -90,7 +90,6 @@ Usage (from the repository root; the runs of session 38)::
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -111,6 +110,7 @@ from roughfe.bem.solvers import relative_residual  # noqa: E402
 from roughfe.errors import NoConvergenceError  # noqa: E402
 from roughfe.optim.anderson import RejectedIterate, anderson_fixed_point  # noqa: E402
 from roughfe.surfaces.spectral import spectral_surface  # noqa: E402
+from roughfe.writers import write_json  # noqa: E402
 
 
 class Converged(Exception):
@@ -410,11 +410,14 @@ def main(argv=None):
     ap.add_argument("--show", type=int, default=12, help="trace lines printed")
     ap.add_argument("--output", type=Path, default=None)
     a = ap.parse_args(argv)
+    if min(a.n) < 256:      # the maps start from the production coarse start (2D grids)
+        ap.error(f"--n {min(a.n)}: the maps start from the production coarse start, "
+                 f"which needs at least 256 points per axis")
     rows = [run(n, a.hurst, a.seed, pm, a) for n in a.n for pm in a.load]
     if a.output is not None:
-        a.output.write_text(json.dumps(rows, indent=1))
-    return rows
+        write_json(a.output, rows)          # atomic (the house rule for results)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
