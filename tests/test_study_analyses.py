@@ -156,9 +156,10 @@ def test_a_remote_scheduler_notes_this_machines_memory_shortage(monkeypatch):
     pytest.importorskip("roughfe.leakage.study")
     monkeypatch.setattr(errors, "available_memory", lambda: 1 * 2 ** 30)
     big = [Task(0, {"m": 13}, 0, "a"), Task(1, {"m": 12}, 0, "b")]
-    notes = _check_tasks("contact_sweep", big, remote=True)
-    assert len(notes) == 1 and "FFT grid) needs 31.2 GiB" in notes[0]
-    assert "on this machine; the tasks run on the scheduler's workers" in notes[0]
+    note = _check_tasks("contact_sweep", big, remote=True)
+    assert "FFT grid) needs 31.2 GiB" in note and "4097" not in note    # the first only
+    assert "on this machine; the tasks run on the scheduler's workers" in note
+    assert _check_tasks("contact_sweep", [Task(2, {"m": 4}, 0, "s")], remote=True) is None
     with pytest.raises(errors.MemoryShortage, match="31.2 GiB of memory, 1.0 GiB"):
         _check_tasks("contact_sweep", big, remote=False)
     for name, params, words in [

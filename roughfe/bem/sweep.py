@@ -112,10 +112,9 @@ def contact_sweep(surface: Surface, material: Material, *, n_steps: int = 20, de
     loading.require_contact()      # approaches apart: adhesion only (adhesive_sweep)
     n_load = (loading.n_steps if loading.kind == "n_steps" else
               len(np.atleast_1d(getattr(loading, loading.kind))))
-    check_sweep_memory(surface.shape, 2 * n_load - 1 if unload else n_load,
-                       periodic=_choose_kernel(surface, kernel) == "spectral")
+    periodic = _choose_kernel(surface, kernel) == "spectral"     # the kernel's grid
+    check_sweep_memory(surface.shape, 2 * n_load - 1 if unload else n_load, periodic)
     if loading.kind == "n_steps":
-        periodic = surface.periodic and kernel in ("auto", "spectral")
         deltas = default_deltas(surface, loading.n_steps, periodic)
     else:
         deltas = getattr(loading, loading.kind)

@@ -22,6 +22,7 @@ import traceback
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional
 
 from .. import __version__
 from ..errors import InputError, MemoryShortage
@@ -147,7 +148,7 @@ class _Progress:
             self.bar.close()
 
 
-def _check_tasks(analysis: str, tasks, remote: bool = False) -> list:
+def _check_tasks(analysis: str, tasks, remote: bool = False) -> Optional[str]:
     """:func:`~roughfe.study.analyses.check_parameters` on every distinct parameter set
     of ``tasks`` (the seeds aside), before anything is written or submitted: a bad value
     anywhere in the grid fails the whole study at once, naming that task's parameters.
@@ -155,12 +156,12 @@ def _check_tasks(analysis: str, tasks, remote: bool = False) -> list:
     ``remote``: the tasks run on other machines (a dask scheduler's workers), whose
     memory this machine cannot see. A task that needs more memory than this machine has
     (:class:`~roughfe.errors.MemoryShortage`, raised by the inputs checks after every
-    check of the values) is then no refusal: its message is returned as a note (the
-    first one; the worker checks its own memory when the task starts, and a shortage
-    there fails that task with the same message). Locally it is raised."""
+    check of the values) is then no refusal: the first such message is returned as a
+    note (None without one; the worker checks its own memory when the task starts, and
+    a shortage there fails that task with the same message). Locally it is raised."""
     from .spec import canonical_json
 
-    seen, notes = set(), []
+    seen, note = set(), None
     for t in tasks:
         key = canonical_json(t.kwargs)
         if key not in seen:
@@ -170,10 +171,9 @@ def _check_tasks(analysis: str, tasks, remote: bool = False) -> list:
             except MemoryShortage as exc:
                 if not remote:
                     raise
-                notes = notes or [f"{exc}, on this machine; the tasks run on the "
-                                  f"scheduler's workers, which check their own memory "
-                                  f"when a task starts"]
-    return notes
+                note = note or (f"{exc}, on this machine; the tasks run on the scheduler's "
+                                f"workers, which check their own memory when a task starts")
+    return note
 
 
 def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=True,
@@ -206,8 +206,9 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     log = log or (lambda message: None)
     t_start = time.perf_counter()
     tasks = spec.tasks()
-    for note in _check_tasks(spec.analysis, tasks,
-                             remote=executor == "dask" and scheduler is not None):
+    note = _check_tasks(spec.analysis, tasks,
+                        remote=executor == "dask" and scheduler is not None)
+    if note:
         warnings.warn(note, stacklevel=2)
     outdir = spec.output
     with store.study_lock(outdir) as created:
