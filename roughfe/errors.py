@@ -299,7 +299,7 @@ def check_memory(what: str, n_bytes: float) -> None:
     if n_bytes > free:
         gib = 2.0 ** 30
         raise MemoryShortage(f"{what} needs {n_bytes / gib:.1f} GiB of memory, "
-                         f"{free / gib:.1f} GiB are available")
+                             f"{free / gib:.1f} GiB are available")
 
 
 def check_instance(name, value, cls, what):

@@ -73,12 +73,6 @@ from ..fem.petsc_tools import CG_AMG, KrylovSolver, petsc_aij_csr
 from ..fem.reynolds import check_reynolds_data
 from .components import components_reaching
 
-#: PETSc options of the finite-volume Reynolds solve, over
-#: :data:`roughfe.fem.petsc_tools.CG_AMG` (CG + BoomerAMG, rtol 1e-10 of the preconditioned
-#: residual): one forward Gauss-Seidel sweep down and one backward sweep up (a symmetric
-#: V-cycle, as CG needs) over all points instead of hypre's default symmetric sweeps with C/F
-#: ordering. Measured at 1024^2 (A* = 0.15, back to back): set-up + solve 1.7-1.8 s CPU
-#: instead of 2.5-2.6 s, 11 CG iterations instead of 10, the same leak rate to 1e-10.
 #: lower bounds of the peak memory of a solve (bytes per cell of the gap and per
 #: unknown: the CSR system and BoomerAMG's hierarchy): ru_maxrss at 2048^2 rose by 364
 #: and 291 bytes per cell with 85 % and 60 % of the cells open, i.e. ~118 per cell +
@@ -86,6 +80,12 @@ from .components import components_reaching
 #: a gap beyond the machine is an InputError, not the OOM killer
 REYNOLDS_BYTES_PER_CELL, REYNOLDS_BYTES_PER_UNKNOWN = 100, 250
 
+#: PETSc options of the finite-volume Reynolds solve, over
+#: :data:`roughfe.fem.petsc_tools.CG_AMG` (CG + BoomerAMG, rtol 1e-10 of the preconditioned
+#: residual): one forward Gauss-Seidel sweep down and one backward sweep up (a symmetric
+#: V-cycle, as CG needs) over all points instead of hypre's default symmetric sweeps with C/F
+#: ordering. Measured at 1024^2 (A* = 0.15, back to back): set-up + solve 1.7-1.8 s CPU
+#: instead of 2.5-2.6 s, 11 CG iterations instead of 10, the same leak rate to 1e-10.
 REYNOLDS_FV = {"pc_hypre_boomeramg_relax_type_down": "SOR/Jacobi",
                "pc_hypre_boomeramg_relax_type_up": "backward-SOR/Jacobi",
                "pc_hypre_boomeramg_no_CF": None}
