@@ -205,8 +205,6 @@ def _lines_of(surface: Surface, axis: str) -> np.ndarray:
     return surface.heights if axis == "x" else surface.heights.T
 
 
-
-
 def _best_lag(a: np.ndarray, b: np.ndarray, max_lag: int) -> tuple:
     """(lag, correlation): the integer ``L``, ``|L| <= max_lag``, that maximises the
     correlation coefficient of ``a[i, j]`` and ``b[i + L, j]`` over their overlap (all
