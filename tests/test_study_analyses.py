@@ -156,12 +156,13 @@ def test_a_remote_scheduler_notes_this_machines_memory_shortage(monkeypatch):
     pytest.importorskip("roughfe.leakage.study")
     monkeypatch.setattr(errors, "available_memory", lambda: 1 * 2 ** 30)
     big = [Task(0, {"m": 13}, 0, "a"), Task(1, {"m": 12}, 0, "b")]
-    note = _check_tasks("contact_sweep", big, remote=True)
+    note = _check_tasks("contact_sweep", big, remote="the scheduler's workers")
     assert "FFT grid) needs 31.2 GiB" in note and "4097" not in note    # the first only
     assert "on this machine; the tasks run on the scheduler's workers" in note
-    assert _check_tasks("contact_sweep", [Task(2, {"m": 4}, 0, "s")], remote=True) is None
+    assert _check_tasks("contact_sweep", [Task(2, {"m": 4}, 0, "s")],
+                        remote="the scheduler's workers") is None
     with pytest.raises(errors.MemoryShortage, match="31.2 GiB of memory, 1.0 GiB"):
-        _check_tasks("contact_sweep", big, remote=False)
+        _check_tasks("contact_sweep", big, remote=None)
     for name, params, words in [
             ("contact_sweep", {"m": 13, "tol": 2.0}, "tol"),
             ("leakage", {"D": 2.3, "m": 13, "mu": -1.0}, "mu"),
@@ -169,8 +170,28 @@ def test_a_remote_scheduler_notes_this_machines_memory_shortage(monkeypatch):
             ("genome_entry", {"entry": {"label": "a", "gamma": 1.5, "hurst": 0.7},
                               "n_nodes": 8193}, "phases")]:
         with pytest.raises(InputError, match=words) as info:
-            _check_tasks(name, [Task(0, params, 0, "c")], remote=True)
+            _check_tasks(name, [Task(0, params, 0, "c")], remote="the scheduler's workers")
         assert not isinstance(info.value, errors.MemoryShortage), (name, str(info.value))
+
+
+def test_mpi_ranks_and_a_dask_scheduler_are_remote_a_local_pool_is_not(monkeypatch):
+    """mpirun may place the MPI ranks on other nodes, as a dask scheduler's workers are:
+    for both a task too big for the launching machine is a note naming where the tasks
+    run (the MPI study was refused on the login node's memory before session 39); a
+    process pool and a dask LocalCluster run here, where the shortage is refused."""
+    from roughfe import errors
+    from roughfe.study.runner import _check_tasks, _remote_workers
+    from roughfe.study.spec import Task
+
+    pytest.importorskip("roughfe.leakage.study")
+    assert _remote_workers("mpi", None) == "the MPI ranks"
+    assert _remote_workers("dask", "tcp://10.0.0.1:8786") == "the scheduler's workers"
+    assert _remote_workers("dask", None) is None and _remote_workers("local", None) is None
+    monkeypatch.setattr(errors, "available_memory", lambda: 1 * 2 ** 30)
+    note = _check_tasks("contact_sweep", [Task(0, {"m": 13}, 0, "a")],
+                        remote=_remote_workers("mpi", None))
+    assert note.endswith("on this machine; the tasks run on the MPI ranks, which check "
+                         "their own memory when a task starts")
 
 
 def test_the_input_checks_accept_the_defaults_and_do_no_work(monkeypatch):

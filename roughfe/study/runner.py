@@ -148,17 +148,20 @@ class _Progress:
             self.bar.close()
 
 
-def _check_tasks(analysis: str, tasks, remote: bool = False) -> Optional[str]:
+def _check_tasks(analysis: str, tasks, remote: Optional[str] = None) -> Optional[str]:
     """:func:`~roughfe.study.analyses.check_parameters` on every distinct parameter set
     of ``tasks`` (the seeds aside), before anything is written or submitted: a bad value
     anywhere in the grid fails the whole study at once, naming that task's parameters.
 
-    ``remote``: the tasks run on other machines (a dask scheduler's workers), whose
-    memory this machine cannot see. A task that needs more memory than this machine has
-    (:class:`~roughfe.errors.MemoryShortage`, raised by the inputs checks after every
-    check of the values) is then no refusal: the first such message is returned as a
-    note (None without one; the worker checks its own memory when the task starts, and
-    a shortage there fails that task with the same message). Locally it is raised."""
+    ``remote``: where the tasks run when that may be other machines, whose memory this
+    machine cannot see ("the scheduler's workers" of a dask scheduler, "the MPI ranks":
+    ``mpirun`` may place them on other nodes; round 2, session 39, the MPI study had
+    been refused on the launching node's memory). A task that needs more memory than
+    this machine has (:class:`~roughfe.errors.MemoryShortage`, raised by the inputs
+    checks after every check of the values) is then no refusal: the first such message
+    is returned as a note (None without one; the worker checks its own memory when the
+    task starts, and a shortage there fails that task with the same message). Locally
+    (``remote`` None) it is raised."""
     from .spec import canonical_json
 
     seen, note = set(), None
@@ -169,11 +172,22 @@ def _check_tasks(analysis: str, tasks, remote: bool = False) -> Optional[str]:
             try:
                 check_parameters(analysis, t.kwargs)
             except MemoryShortage as exc:
-                if not remote:
+                if remote is None:
                     raise
-                note = note or (f"{exc}, on this machine; the tasks run on the scheduler's "
-                                f"workers, which check their own memory when a task starts")
+                note = note or (f"{exc}, on this machine; the tasks run on {remote}, which "
+                                f"check their own memory when a task starts")
     return note
+
+
+def _remote_workers(executor: str, scheduler) -> Optional[str]:
+    """Where the tasks of ``executor`` run when that may be other machines (for
+    :func:`_check_tasks`), None when they run on this one (a process pool, a dask
+    LocalCluster)."""
+    if executor == "mpi":
+        return "the MPI ranks"
+    if executor == "dask" and scheduler is not None:
+        return "the scheduler's workers"
+    return None
 
 
 def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=True,
@@ -206,8 +220,7 @@ def run_study(spec, *, executor="local", workers=None, scheduler=None, progress=
     log = log or (lambda message: None)
     t_start = time.perf_counter()
     tasks = spec.tasks()
-    note = _check_tasks(spec.analysis, tasks,
-                        remote=executor == "dask" and scheduler is not None)
+    note = _check_tasks(spec.analysis, tasks, remote=_remote_workers(executor, scheduler))
     if note:
         warnings.warn(note, stacklevel=2)
     outdir = spec.output
