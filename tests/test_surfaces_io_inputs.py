@@ -127,20 +127,35 @@ def test_a_path_that_is_no_regular_file_says_what_it_is(tmp_path, capsys):
                     reason="needs Linux's /proc/cpuinfo (size 0 on disk)")
 def test_a_kernel_file_of_size_0_is_no_empty_file(tmp_path, capsys, monkeypatch):
     # `info /proc/cpuinfo` said "the file is empty": its size on disk is 0, yet reading it
-    # gives text (made by the kernel on reading). Session 37, helper aud3
+    # gives text (made by the kernel on reading). Session 37, helper aud3. Since session
+    # 39 a file of /proc or /sys is refused without being read: reading /proc/kmsg as
+    # root took a message from the kernel's log
+    from roughfe.surfaces import file_checks
     cpu = "/proc/cpuinfo"
-    said = (f"surface file {cpu!r} is no file on disk: its size is 0 bytes, yet reading "
-            "it gives data, made on the fly (a kernel interface, as the files of /proc)")
-    with pytest.raises(InputError) as info:
-        load_surface(cpu)
-    assert said in str(info.value) and "empty" not in str(info.value)
-    capsys.readouterr()
-    assert main(["info", cpu]) == 2
-    assert f"error: {said}" in capsys.readouterr().err
+    said = (f"surface file {cpu!r} is no file on disk: a file of /proc (size 0 bytes), "
+            "made by the kernel on reading (not read)")
+    opened = os.open
+
+    def no_open(p, *args, **kwargs):
+        assert not str(p).startswith("/proc"), f"{p} was opened"
+        return opened(p, *args, **kwargs)
+    with monkeypatch.context() as m:
+        m.setattr(os, "open", no_open)
+        with pytest.raises(InputError) as info:
+            load_surface(cpu)
+        assert said in str(info.value) and "empty" not in str(info.value)
+        capsys.readouterr()
+        assert main(["info", cpu]) == 2
+        assert f"error: {said}" in capsys.readouterr().err
     for name in ("empty.txt", "empty.npz"):      # a file that is empty still says so
         (tmp_path / name).write_bytes(b"")
         with pytest.raises(FileFormatError, match=f"{name}: the file is empty"):
             load_surface(tmp_path / name, size=1e-4)
+    # elsewhere (a kernel file system mounted in another place) one byte is read
+    monkeypatch.setattr(file_checks, "KERNEL_FOLDERS", ())
+    with pytest.raises(InputError, match="its size is 0 bytes, yet reading it gives data, "
+                                         r"made on the fly \(a kernel interface"):
+        load_surface(cpu)
     real = os.read
 
     def read(fd, n):       # as /proc/kmsg without a message: the read would wait

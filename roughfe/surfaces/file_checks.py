@@ -29,7 +29,7 @@ def check_surface_file(path) -> Path:
     without read permission (before round 2, session 37 each reader gave its own wrong
     cause: a ``.npz`` "truncated or not a zip archive", an ``.x3p`` "damaged or
     truncated?"), :class:`FileFormatError` for an empty file, :class:`InputError` for a
-    file of size 0 that reading finds not empty (``/proc/cpuinfo``: no file on disk)."""
+    kernel file of size 0 (``/proc/cpuinfo``: no file on disk; :func:`_refuse_empty`)."""
     path = Path(path)
     try:
         info = path.stat()
@@ -54,12 +54,25 @@ def check_surface_file(path) -> Path:
     return path
 
 
+#: the kernel's file systems: their files are made on reading, and reading one may
+#: consume it (``/proc/kmsg`` hands each kernel message to one reader)
+KERNEL_FOLDERS = ("/proc", "/sys")
+
+
 def _refuse_empty(path: Path) -> None:
     """Raise for a regular file of size 0: :class:`FileFormatError` when it is empty,
-    :class:`InputError` when reading gives data (or would wait for it) all the same: a
-    kernel interface such as ``/proc/cpuinfo``, made on reading, which was said to be
-    "empty" (round 2, session 37). One byte is read, without waiting (``O_NONBLOCK``:
-    ``/proc/kmsg`` would block)."""
+    :class:`InputError` when it is a kernel interface, made on reading (``/proc/cpuinfo``
+    was said to be "empty", round 2, session 37). A file under :data:`KERNEL_FOLDERS` is
+    refused without reading it (reading ``/proc/kmsg`` as root took a message from the
+    kernel's log, until session 39); elsewhere (another mount of such a file system, a
+    FUSE file) one byte is read, without waiting (``O_NONBLOCK``)."""
+    give = "give a surface file (.npz, a height matrix or an instrument file)"
+    real = os.path.realpath(path)
+    kernel = [top for top in KERNEL_FOLDERS if real.startswith(top + os.sep)]
+    if kernel:
+        raise InputError(f"surface file {str(path)!r} is no file on disk: a file of "
+                         f"{kernel[0]} (size 0 bytes), made by the kernel on reading (not "
+                         f"read); {give}")
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     try:
         data = os.read(fd, 1)
@@ -72,8 +85,7 @@ def _refuse_empty(path: Path) -> None:
     gives = "gives data" if data else "waits for data"
     raise InputError(f"surface file {str(path)!r} is no file on disk: its size is 0 bytes, "
                      f"yet reading it {gives}, made on the fly (a kernel interface, as the "
-                     f"files of /proc); give a surface file (.npz, a height matrix or an "
-                     f"instrument file)")
+                     f"files of /proc); {give}")
 
 
 #: what heights of a non-numeric dtype are, by numpy's dtype kind
