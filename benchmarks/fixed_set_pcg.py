@@ -87,7 +87,6 @@ class EdgeWeighted(Fine):
 def fixed_set(surface, load, which):
     """The set I (bool mask, flat) of ``which`` (module docstring) and the coarse-to-fine
     start's pressure (flat, at the load; zero off I)."""
-    fine = Fine(surface)
     p = _coarse_start(surface, MAT, load, None, kernel="spectral").reshape(-1)
     p = p * (load * p.size / float(p.sum()))
     if which == "converged":
@@ -96,6 +95,7 @@ def fixed_set(surface, load, which):
         mask = np.asarray(res.pressure).reshape(-1) > 0
         p = np.where(mask, p, 0.0)
         return mask, p * (load * p.size / float(p.sum()))
+    fine = Fine(surface)
     g = fine.H(p) - fine.h
     w = g - float(g[p > 0].mean())
     return (p > 0) | (w < 0), p
@@ -105,10 +105,10 @@ def iterations(surface, mask, load, two_level, start=None, weight=None):
     """Iterations of the fixed-set CG to each of :data:`ETAS` (None: not in MAX_IT),
     from ``start`` (flat pressure, zero off I) or the uniform pressure on I; ``weight``
     (s, cap): the edge-weighted preconditioner D M D of :class:`EdgeWeighted`."""
+    fine = Fine(surface) if weight is None else EdgeWeighted(surface, mask, *weight)
+    I = np.flatnonzero(mask)
     counts = []
     for eta in ETAS:
-        fine = Fine(surface) if weight is None else EdgeWeighted(surface, mask, *weight)
-        I = np.flatnonzero(mask)
         if start is None:
             p = np.zeros(fine.h.size)
             p[I] = load * p.size / I.size

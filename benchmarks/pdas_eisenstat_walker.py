@@ -351,12 +351,9 @@ def pdas(surface, load, opt):
                     opt = {**opt, "eta_max": opt["eta_max"] * opt["tighten"]}
                     tighten_next = False
                     tightened += 1
-        if fallback:
-            pass
-        elif opt["forcing"] == "ew":
-            eta = forcing(r, r_prev, eta, opt)
-        else:
-            eta = forcing_changed(changed, changed_prev, int(np.count_nonzero(new)), r, opt)
+        if not fallback:
+            eta = (forcing(r, r_prev, eta, opt) if opt["forcing"] == "ew" else
+                   forcing_changed(changed, changed_prev, int(np.count_nonzero(new)), r, opt))
         r_prev, changed_prev = r, changed
         # restart: the points leaving I set to 0 (one product), p back on the load
         removed = mask & ~new
