@@ -35,6 +35,7 @@ out of sample: H = 0.5 s. 6   27 -> 34, 1.259x    28 -> 33, 1.179x    31 -> 38
 out of sample: H = 0.8 s. 6   29 -> 34, 1.172x    28 -> 31, 1.107x    26 -> 32
 extra: H = 0.8 seed 2         26 -> 32, 1.231x    27 -> 28, 1.037x    26 -> 32
 extra: H = 0.8 seed 4         27 -> 30, 1.111x    28 -> 31, 1.107x    26 -> 34
+extra: H = 0.8 s. 1, 8192^2   31 -> 38, 1.226x    31 -> 36, 1.161x    31 -> 38
 ============================  ==================  ==================  =============
 
 The rule has no constant, so nothing was fitted (the seed-5/6 runs were started before
@@ -44,7 +45,8 @@ H = 0.8, one load: 167 -> 185 (1.108x; ``scale`` 167 -> 196, 1.174x), 28-32 at 4
 and 1901 / 556 points into / out of the converged set against 8766 / 5787 and 5637 /
 549) and the set error 0.095 -> 0.015 -> 0.0024 -> 1.3e-4 of |A| against 0.095 ->
 0.021 -> 0.0050 -> 5.7e-4, but the inner solves to eta 0.03 still take 3-6 iterations
-each. Not adopted.
+each. At 8192^2 (seed 1, the last row: 4096^2 -> 8192^2) the growth sits in the first
+solves instead (9 7 6 3 3 3 4 1 against 6 6 6 4 3 3 3 at 4096^2). Not adopted.
 """
 from __future__ import annotations
 
