@@ -137,7 +137,7 @@ from roughfe.bem.deflation import BlockDeflation  # noqa: E402
 from roughfe.errors import InputError, NoConvergenceError  # noqa: E402
 from roughfe.writers import write_json  # noqa: E402
 from pdas_eisenstat_walker import (  # noqa: E402
-    CALLS, MAT, Fine, growth_surface, inner_solve, production, production_residual)
+    CALLS, MAT, Fine, beside_production, growth_surface, inner_solve, production_residual)
 from bench_bem_growth import LOADS, TOL  # noqa: E402
 
 PRECONDITIONERS = ("split", "split-d", "split1", "m", "jacobi")
@@ -377,14 +377,7 @@ def main(argv=None):
                     f"{s['conv_eq']:.1f} conv-eq, {s['cpu_s']:.1f} s, A* {s['A*']:.7f} "
                     f"(S wrong {s['identified_wrong']})")
             if not a.no_production:
-                pr = row["production"] = production(surface, load)
-                row["a_star_match"] = bool(abs(s["A*"] - pr["A*"]) <= 1e-6 * pr["A*"])
-                line += (f" | PK {pr['iterations']} its, {pr['conv_eq']:.1f} conv-eq, "
-                         f"{pr['cpu_s']:.1f} s, A* {pr['A*']:.7f} match "
-                         f"{row['a_star_match']}")
-                tot["pk"] += pr["iterations"]
-                tot["pk_conv_eq"] += pr["conv_eq"]
-                tot["pk_cpu_s"] += pr["cpu_s"]
+                line += beside_production(row, s, surface, load, tot)
             print(line, flush=True)
             print("    inner per step " + " ".join(str(st["inner"]) for st in s["steps"])
                   + " | alpha " + " ".join(f"{st['alpha']:.2f}" for st in s["steps"])

@@ -406,6 +406,18 @@ def production(surface, load):
             "fine_products": CALLS[-1][1]}
 
 
+def beside_production(row, result, surface, load, totals):
+    """Run :func:`production` on the same load, store it and the A* check (1e-6
+    relative) in ``row``, add its counts to ``totals``; the text for the row's line."""
+    pr = row["production"] = production(surface, load)
+    row["a_star_match"] = bool(abs(result["A*"] - pr["A*"]) <= 1e-6 * pr["A*"])
+    totals["pk"] += pr["iterations"]
+    totals["pk_conv_eq"] += pr["conv_eq"]
+    totals["pk_cpu_s"] += pr["cpu_s"]
+    return (f" | PK {pr['iterations']} its, {pr['conv_eq']:.1f} conv-eq, "
+            f"{pr['cpu_s']:.1f} s, A* {pr['A*']:.7f} match {row['a_star_match']}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, nargs="+", default=[1024])
@@ -464,14 +476,7 @@ def main(argv=None):
                     f"{s['outer']}, {s['products']} fine products, {s['conv_eq']:.1f} "
                     f"conv-eq, {s['cpu_s']:.1f} s, A* {s['A*']:.7f}")
             if not a.no_production:
-                pr = row["production"] = production(surface, load)
-                row["a_star_match"] = bool(abs(s["A*"] - pr["A*"]) <= 1e-6 * pr["A*"])
-                line += (f" | PK {pr['iterations']} its, {pr['conv_eq']:.1f} conv-eq, "
-                         f"{pr['cpu_s']:.1f} s, A* {pr['A*']:.7f} match "
-                         f"{row['a_star_match']}")
-                tot["pk"] += pr["iterations"]
-                tot["pk_conv_eq"] += pr["conv_eq"]
-                tot["pk_cpu_s"] += pr["cpu_s"]
+                line += beside_production(row, s, surface, load, tot)
             print(line, flush=True)
             print("    inner per outer step " + " ".join(
                 f"{st['inner']}{'pk' if st['fallback'] else ''}" for st in s["steps"])
