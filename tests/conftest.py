@@ -22,6 +22,26 @@ TOPOGRAPHIES = topographies_folder()
 SWAMPED = "pytest.approx's default abs=1e-12 swamps rel for this SI value; give abs explicitly"
 
 
+@pytest.fixture(scope="session")
+def bench_script():
+    """``bench_script(name)`` imports ``benchmarks/<name>.py`` (scripts, not a package),
+    with benchmarks/ on sys.path while it loads: the scripts import their siblings."""
+    import importlib.util
+    import sys
+    folder = REPO / "benchmarks"
+
+    def load(name):
+        sys.path.insert(0, str(folder))
+        try:
+            spec = importlib.util.spec_from_file_location(f"bench_{name}", folder / f"{name}.py")
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+        finally:
+            sys.path.remove(str(folder))
+        return module
+    return load
+
+
 def _refuse_default_abs(eq):
     """``ApproxScalar.__eq__`` that raises where pytest.approx's default ``abs = 1e-12``,
     not ``rel``, would decide the comparison. pytest keeps that abs when ``rel`` is given,

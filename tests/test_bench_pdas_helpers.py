@@ -1,20 +1,9 @@
 """The helpers of the research script benchmarks/pdas_eisenstat_walker.py (session 40):
 its restart after a set change (benchmarks/_pdas_restart.py) and its per-step trace
 against the converged set (benchmarks/_pdas_trace.py)."""
-import importlib.util
-from pathlib import Path
 
 import numpy as np
 import pytest
-
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
-
-
-def _module(name):
-    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 class _Fine:
@@ -33,8 +22,8 @@ class _Fine:
 
 
 @pytest.mark.parametrize("how", ["scale", "shift"])
-def test_restart_keeps_the_load_zero_off_the_new_set_and_u_equal_to_H_p(how):
-    restart = _module("_pdas_restart").restart
+def test_restart_keeps_the_load_zero_off_the_new_set_and_u_equal_to_H_p(how, bench_script):
+    restart = bench_script("_pdas_restart").restart
     fine = _Fine()
     rng = np.random.default_rng(4)
     mask = rng.random(256) < 0.5
@@ -50,8 +39,8 @@ def test_restart_keeps_the_load_zero_off_the_new_set_and_u_equal_to_H_p(how):
     np.testing.assert_allclose(u, fine.H(p), atol=1e-12)
 
 
-def test_shift_adds_one_constant_on_the_new_set_where_scale_multiplies():
-    restart = _module("_pdas_restart").restart
+def test_shift_adds_one_constant_on_the_new_set_where_scale_multiplies(bench_script):
+    restart = bench_script("_pdas_restart").restart
     fine = _Fine()
     mask = np.zeros(256, bool)
     mask[:100] = True
@@ -72,8 +61,8 @@ def test_shift_adds_one_constant_on_the_new_set_where_scale_multiplies():
     np.testing.assert_allclose(runs["scale"][10:100], p[10:100] * 86.0 / 91.0)
 
 
-def test_trace_splits_the_changes_by_the_edge_of_the_final_set_and_new_tiny_patches():
-    tr = _module("_pdas_trace")
+def test_trace_splits_the_changes_by_the_edge_of_the_final_set_and_new_tiny_patches(bench_script):
+    tr = bench_script("_pdas_trace")
     shape = (16, 16)
     A = np.zeros(shape, bool)
     A[4:10, 4:10] = True                            # one 6 x 6 patch ...

@@ -2,29 +2,12 @@
 the table (the Reynolds solver makes no linear solve there: Q = 0 and no KSP report), not
 a TypeError that loses every Reynolds target of a full `make bench` (1024^2 at A* = 0.40
 on 2026-11-29, after the one-sided components stopped being unknowns)."""
-import importlib.util
-import sys
-from pathlib import Path
-
 import numpy as np
 
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 
-
-def _module():
-    sys.path.insert(0, str(BENCH))            # the script imports its sibling _report
-    try:
-        spec = importlib.util.spec_from_file_location("bench_reynolds", BENCH / "bench_reynolds.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(str(BENCH))
-    return module
-
-
-def test_a_row_without_a_linear_solve_is_printed():
+def test_a_row_without_a_linear_solve_is_printed(bench_script):
     from roughfe.leakage.finite_volume import solve_reynolds_fv
-    bench = _module()
+    bench = bench_script("bench_reynolds")
     gap = np.full((16, 16), 1e-6)
     gap[8, :] = 0.0                           # a closed band across the flow (x): no percolation
     r = solve_reynolds_fv(gap, (1e-6, 1e-6), p_in=1e5, p_out=0.0, periodic=True)
