@@ -131,14 +131,13 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 sys.path.insert(0, str(HERE))
 
-from roughfe.bem.coarse_start import _coarse_start  # noqa: E402
-from roughfe.bem.contact import _pk  # noqa: E402
 from roughfe.bem.deflation import BlockDeflation  # noqa: E402
-from roughfe.errors import InputError, NoConvergenceError  # noqa: E402
+from roughfe.errors import InputError  # noqa: E402
 from roughfe.writers import write_json  # noqa: E402
 from pdas_eisenstat_walker import (  # noqa: E402
-    CALLS, MAT, Fine, beside_production, growth_surface, inner_solve, production_residual)
-from bench_bem_growth import LOADS, TOL  # noqa: E402
+    Fine, beside_production, coarse_start, growth_surface, inner_solve, pk_from,
+    production_residual)
+from bench_bem_growth import LOADS  # noqa: E402
 
 PRECONDITIONERS = ("split", "split-d", "split1", "m", "jacobi")
 FRACTION_TO_BOUNDARY = 0.995
@@ -249,10 +248,7 @@ def interior_point(surface, load, opt):
     n = fine.h.size
     target = load * n
     P = target / n
-    CALLS.clear()
-    p_c = _coarse_start(surface, MAT, load, None, kernel="spectral").reshape(-1).copy()
-    coarse_conv = sum(m / n * k for m, k, _ in CALLS)
-    p_c *= target / float(p_c.sum())
+    p_c, coarse_conv = coarse_start(surface, load, target)
     p, w, delta, u, mu0 = interior_start(fine, p_c, target, opt["mu0"])
     deflation = ({"split": BlockDeflation, "split-d": BarrierDeflation}[opt["prec"]](
         fine.op, 8, settle=1.0) if opt["prec"] in ("split", "split-d") else None)
@@ -304,18 +300,9 @@ def interior_point(surface, load, opt):
     mu_end = float(np.dot(p, w)) / n
     S = fine.c * p > w
     # the polish: production PK from p on S (its products counted)
-    q = np.where(S, p, 0.0)
-    q *= target / float(q.sum())
-    try:
-        out = _pk(fine.op, fine.h.reshape(fine.shape), fine.hmax, fine.scale, TOL,
-                  opt["max_polish"], q.reshape(fine.shape), True,
-                  BlockDeflation(fine.op, 8), mean_pressure=load)
-        converged = True
-    except NoConvergenceError as exc:
-        out, converged = exc.result, False
+    out, converged = pk_from(fine, np.where(S, p, 0.0), load, opt["max_polish"])
     pf = np.ascontiguousarray(out.pressure, dtype=float).reshape(-1)
     uf = np.ascontiguousarray(out.displacement, dtype=float).reshape(-1)
-    fine.products += int(out.n_products)
     cpu = time.process_time() - c0
     final_set = pf > 0
     return {"converged": converged, "outer": len(steps), "inner": inner_total,

@@ -267,6 +267,33 @@ def forcing(r, r_prev, eta_prev, opt):
     return max(eta, 0.5 * TOL / r)
 
 
+def coarse_start(surface, load, target):
+    """The production coarse start (to 1e-4 on the grids coarsened by 2), flat and scaled
+    to sum p = ``target`` (n P), and its conv-eq (coarse products weighted m^2 / n^2)."""
+    n = surface.heights.size
+    CALLS.clear()
+    p = _coarse_start(surface, MAT, load, None, kernel="spectral").reshape(-1).copy()
+    coarse_conv = sum(m / n * k for m, k, _ in CALLS)
+    p *= target / float(p.sum())
+    return p, coarse_conv
+
+
+def pk_from(fine, q, load, maxiter):
+    """At most ``maxiter`` production PK iterations (``contact._pk`` with its own
+    BlockDeflation, tol 1e-10) from the pressure ``q`` (>= 0, rescaled to the load in
+    place), its products added to ``fine``: (PK result, converged)."""
+    q *= load * q.size / float(q.sum())
+    try:
+        out = _pk(fine.op, fine.h.reshape(fine.shape), fine.hmax, fine.scale, TOL, maxiter,
+                  q.reshape(fine.shape), True, BlockDeflation(fine.op, 8),
+                  mean_pressure=load)
+        converged = True
+    except NoConvergenceError as exc:
+        out, converged = exc.result, False
+    fine.products += int(out.n_products)
+    return out, converged
+
+
 def forcing_changed(changed, changed_prev, set_size, r, opt):
     """The inner tolerance from the set's changes (``--forcing changed``: x = changed_k
     / |I_{k+1}|; ``changed-ratio``: x = changed_k / changed_{k-1}, 1 at the first step;
@@ -288,10 +315,7 @@ def pdas(surface, load, opt):
     fine = Fine(surface)
     n = fine.h.size
     target = load * n
-    CALLS.clear()
-    p = _coarse_start(surface, MAT, load, None, kernel="spectral").reshape(-1).copy()
-    coarse_conv = sum(m / n * k for m, k, _ in CALLS)
-    p *= target / float(p.sum())
+    p, coarse_conv = coarse_start(surface, load, target)
     u = fine.H(p)
     g = u - fine.h
     w = g - float(g[p > 0].mean())
@@ -309,16 +333,7 @@ def pdas(surface, load, opt):
         I = np.flatnonzero(mask)
         fallback = tighten_next and opt["fallback_pk"]
         if fallback:             # N production PK iterations replace this Newton step
-            q = np.maximum(p, 0.0)
-            q *= target / float(q.sum())
-            try:
-                out = _pk(fine.op, fine.h.reshape(fine.shape), fine.hmax, fine.scale, TOL,
-                          opt["fallback_pk"],
-                          q.reshape(fine.shape), True, BlockDeflation(fine.op, 8),
-                          mean_pressure=load)
-            except NoConvergenceError as exc:
-                out = exc.result
-            fine.products += int(out.n_products)
+            out, _ = pk_from(fine, np.maximum(p, 0.0), load, opt["fallback_pk"])
             pk_total += int(out.nit)
             its, res_in, capped = int(out.nit), None, False
             p = np.ascontiguousarray(out.pressure, dtype=float).reshape(-1).copy()
