@@ -34,6 +34,15 @@ def targets():
     return de.thesis_targets(SETTINGS)
 
 
+@pytest.fixture(scope="module")
+def mcco_t1_t3(entries, targets):
+    """The M-CCO design for y_t1 and y_t3 from which eight tests start their stages beyond
+    the thesis (deterministic; DesignResult is frozen and the stages return new results),
+    computed once for the module."""
+    t1, _, t3, _ = targets
+    return de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+
+
 def test_alg3_recovers_a_database_genome_at_another_amplitude(entries):
     """A target made by an independent BEM run of genome 1-2 with heights x 2.5 scores
     s = 1 against 1-2 after Eq. (4.2), and SOG picks 1-2 at GCMMA 0."""
@@ -401,13 +410,13 @@ def test_target_neighbourhood_scores_one_at_the_target_and_less_around_it(entrie
     assert any("reachable" in line for line in study.neighbourhood_lines(nb))
 
 
-def test_search_at_target_pressures_raises_the_strict_score_reproducibly(entries, targets,
-                                                                        tmp_path):
+def test_search_at_target_pressures_raises_the_strict_score_reproducibly(targets, mcco_t1_t3,
+                                                                         tmp_path):
     """The stage beyond the thesis: the M-CCO best design's f solved at the target
     pressures rises, and the saved design's strict scores equal an independent BEM run
     (the interpolated scores still equal de.rescore)."""
     t1, _, t3, _ = targets
-    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    r = mcco_t1_t3
     f0 = de.combined_score(de.rescore_at_target_pressures(r.best.design, [t1, t3], SETTINGS))
     rs = de.search_at_target_pressures(r, SETTINGS, n_eval=40, seed=1)
     c = rs.best
@@ -426,13 +435,13 @@ def test_search_at_target_pressures_raises_the_strict_score_reproducibly(entries
         de.search_at_target_pressures(r, SETTINGS, starts=0)
 
 
-def test_multi_start_and_chromosome_amplitudes(entries, targets, tmp_path):
+def test_multi_start_and_chromosome_amplitudes(entries, targets, mcco_t1_t3, tmp_path):
     """split_chromosomes realises the same heights; a 2-start search contains the 1-start
     run (the same generator, drawn on in order), so its best strict f is not lower; with
     chromosome amplitudes every chromosome is its own part and the strict scores of the
     saved design are reproduced by an independent load-controlled BEM run."""
     t1, _, t3, _ = targets
-    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    r = mcco_t1_t3
     d = r.best.design
     split = d.split_chromosomes()
     assert len(split.parts) == sum(len(p.chromosomes) for p in d.parts) > len(d.parts)
@@ -505,14 +514,14 @@ def test_batched_interpolated_scores_equal_the_single_sweep(entries, targets):
         de.score_batch(designs, [t1, t3], SETTINGS, ("exact",))
 
 
-def test_global_search_on_min_of_strict_and_interpolated(entries, targets, tmp_path):
+def test_global_search_on_min_of_strict_and_interpolated(targets, mcco_t1_t3, tmp_path):
     """search_global(score="min") maximises the smaller of the strict and the interpolated
     f: the best-so-far curve ends at min(strict f, interpolated f) of the design found,
     which is not below the start's; the saved design's strict scores equal the
     hand-written load-controlled BEM run and its interpolated scores a fresh sweep
     (rescore) to 1e-7."""
     t1, _, t3, _ = targets
-    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    r = mcco_t1_t3
     c0 = r.best
     m0 = min(de.combined_score(de.rescore_at_target_pressures(c0.design, [t1, t3], SETTINGS)),
              de.combined_score(c0.scores))
@@ -530,12 +539,12 @@ def test_global_search_on_min_of_strict_and_interpolated(entries, targets, tmp_p
     np.testing.assert_allclose(de.rescore(dd, [t1, t3], SETTINGS), saved["scores"], atol=1e-7)
 
 
-def test_global_search_raises_the_strict_score_reproducibly(entries, targets, tmp_path):
+def test_global_search_raises_the_strict_score_reproducibly(targets, mcco_t1_t3, tmp_path):
     """search_global (IPOP-CMA-ES on the batched strict score): strict f not below the
     start and above the (1+1)-ES of the same budget here; the saved design's strict
     scores equal the hand-written load-controlled BEM run; its best-so-far curve rises."""
     t1, _, t3, _ = targets
-    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    r = mcco_t1_t3
     f0 = de.combined_score(de.rescore_at_target_pressures(r.best.design, [t1, t3], SETTINGS))
     rg = de.search_global(r, SETTINGS, n_eval=300, sigma=0.5, seed=1)
     c = rg.best
@@ -555,7 +564,7 @@ def test_global_search_raises_the_strict_score_reproducibly(entries, targets, tm
         de.search_global(r, SETTINGS, method="annealing")
 
 
-def test_global_search_with_chromosome_amplitudes_bounded_and_reproduced(entries, targets,
+def test_global_search_with_chromosome_amplitudes_bounded_and_reproduced(targets, mcco_t1_t3,
                                                                          tmp_path):
     """search_global with every chromosome's amplitude a variable (log scale, x
     exp(+-0.25)): the strict f rises above the start, every chromosome of the saved design
@@ -564,7 +573,7 @@ def test_global_search_with_chromosome_amplitudes_bounded_and_reproduced(entries
     unbatched solve, and the hand-written load-controlled BEM run of the saved design.json
     reproduces the reported strict scores."""
     t1, _, t3, _ = targets
-    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    r = mcco_t1_t3
     d0 = r.best.design
     f0 = de.combined_score(de.rescore_at_target_pressures(d0, [t1, t3], SETTINGS))
     opts = de.GlobalSearchOptions(n_eval=200, sigma=0.5, amplitudes=0.25, seed=2)
@@ -635,13 +644,13 @@ def test_objective_checks_its_targets_and_pressure_range():
     assert de.Objective((t,), p_range=(1e6, 3e6)).p_range == (1e6, 3e6)
 
 
-def test_global_search_rounds_continue_from_the_best_design(entries, targets, tmp_path):
+def test_global_search_rounds_continue_from_the_best_design(targets, mcco_t1_t3, tmp_path):
     """rounds = 2: the first round is the one-round search (same seed, same draws), the
     second starts from its best design, so the strict f is not lower, the joined curve
     rises monotonically through both rounds, and the saved design's strict scores equal
     the hand-written load-controlled BEM run."""
     t1, _, t3, _ = targets
-    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    r = mcco_t1_t3
     one = de.search_global(r, SETTINGS, n_eval=120, seed=3)
     two = de.search_global(r, SETTINGS, n_eval=120, seed=3, rounds=2)
     f1, f2 = (de.combined_score(x.best.at_targets) for x in (one, two))
@@ -660,12 +669,12 @@ def test_global_search_rounds_continue_from_the_best_design(entries, targets, tm
                                saved["scores_at_target_pressures"], atol=1e-7)
 
 
-def test_global_search_with_genes_bounded_and_reproduced(entries, targets, tmp_path):
+def test_global_search_with_genes_bounded_and_reproduced(targets, mcco_t1_t3, tmp_path):
     """genes = 0.15: every part's gamma, H and lambda1 stay strictly within +-15 % of
     their start (and move), the strict f rises, and the hand-written load-controlled BEM run
     of the saved design.json reproduces its strict scores."""
     t1, _, t3, _ = targets
-    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    r = mcco_t1_t3
     f0 = de.combined_score(de.rescore_at_target_pressures(r.best.design, [t1, t3], SETTINGS))
     rg = de.search_global(r, SETTINGS, n_eval=200, seed=2, genes=0.15)
     c = rg.best
@@ -727,14 +736,14 @@ def test_design_study_yt1_without_refine_rows(entries, targets, tmp_path, monkey
     assert any("| SOG |" in line for line in free["lines"])
 
 
-def test_design_study_min_round_rows(entries, targets, tmp_path):
+def test_design_study_min_round_rows(targets, mcco_t1_t3, tmp_path):
     """validation/_design_global.min_round (the M-CCO row 'one design, min(f at p_t,
     interpolated f)'): from a strict global stage's design, the round on the min does not
     lower the min of the two f; f_min is that min of the design found, its curve ends
     there, and the report lines carry the curve table."""
     study = _design_study("global")
     t1, _, t3, _ = targets
-    r = de.mcco(entries, t1, t3, SETTINGS, options=FAST, n_best=1, max_set=2)
+    r = mcco_t1_t3
     rg = de.search_global(r, SETTINGS, n_eval=40, seed=1)
     m0 = min(de.combined_score(rg.best.at_targets), de.combined_score(rg.best.scores))
     both = study.min_round(rg, SETTINGS, de.GlobalSearchOptions(n_eval=60, seed=1, score="min"))
