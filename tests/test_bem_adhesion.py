@@ -816,13 +816,15 @@ def test_a_narrow_ramp_on_summits_of_the_grid_scale_needs_the_cells_stiffness(
                 assert check_resolution(law, mat.E_star, s.spacing, 1.12, relief)
             if f == 2:
                 assert check_resolution(laws[0], mat.E_star, s.spacing, 1.12, relief)
+        solved = {}       # the default ramp's warned solve is the first of the three
         if f == 1:
             with pytest.warns(ResolutionWarning, match=r"needs at least 18.*smoothing 0.5"):
-                solve_adhesive(s, mat, laws[0], delta=s.heights.max() - plane)
+                solved[0] = solve_adhesive(s, mat, laws[0], delta=s.heights.max() - plane)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ResolutionWarning)
-            area[f] = [solve_adhesive(s, mat, law, delta=s.heights.max() - plane).area_fraction
-                       for law in laws]
+            area[f] = [(solved.get(k) or solve_adhesive(s, mat, law,
+                                                        delta=s.heights.max() - plane)
+                        ).area_fraction for k, law in enumerate(laws)]
     assert area[1][0] < area[1][1] - 0.05
     assert area[1][1] == pytest.approx(area[1][2], abs=2e-3)
     assert max(area[2]) - min(area[2]) < 1e-3
