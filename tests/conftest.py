@@ -79,6 +79,47 @@ def topographies_dir():
     return TOPOGRAPHIES
 
 
+def same_values(a, b):
+    """Equal values: arrays element for element, dataclasses field by field, lists,
+    tuples and dicts item by item (NaN is not equal to itself: not the same)."""
+    import dataclasses
+
+    import numpy as np
+    if a is b:
+        return True
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return np.array_equal(a, b)
+    if dataclasses.is_dataclass(a) and type(a) is type(b):
+        return all(same_values(getattr(a, f.name), getattr(b, f.name))
+                   for f in dataclasses.fields(a))
+    if isinstance(a, (list, tuple)) and type(a) is type(b):
+        return len(a) == len(b) and all(same_values(x, y) for x, y in zip(a, b))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_values(a[k], b[k]) for k in a)
+    return type(a) is type(b) and a == b
+
+
+@pytest.fixture
+def computed_once():
+    """``computed_once(real, key=None)``: ``real`` computed once per distinct ``key(*args,
+    **kwargs)`` (default: the arguments), compared by :func:`same_values`; a later call
+    with an equal key gets the first call's result. For a test whose CLI runs differ only
+    in options read after (or before) an expensive call with equal arguments: monkeypatch
+    the call with it (results are frozen dataclasses)."""
+    def once(real, key=None):
+        done = []
+
+        def call(*args, **kwargs):
+            this = key(*args, **kwargs) if key else (args, kwargs)
+            for seen, out in done:
+                if same_values(seen, this):
+                    return out
+            done.append((this, real(*args, **kwargs)))
+            return done[-1][1]
+        return call
+    return once
+
+
 @pytest.fixture
 def deflations_made(monkeypatch):
     """The grid shapes of the two-level corrections the BEM solves make from now on (the

@@ -11,7 +11,11 @@ from roughfe.genomics.similarity import Target
 
 
 @pytest.mark.slow
-def test_db_and_design_commands(tmp_path, capsys):
+def test_db_and_design_commands(tmp_path, capsys, monkeypatch, computed_once):
+    # the SOG stage of the design runs below is computed once per distinct arguments: the
+    # y_t1 runs (with --search / --global, plain, --strict, --global-amplitudes) differ in
+    # what they do after it, and so do the two runs of the cut target
+    monkeypatch.setattr(de, "run_design", computed_once(de.run_design))
     path = tmp_path / "db.sqlite"
     assert main(["db", "build", str(path), "--nodes", "128", "--steps", "10", "--limit", "3",
                  "--quiet", "--workers", "1"]) == 0

@@ -1,6 +1,5 @@
 """Surface genome database and surface design (issue 15 Sec. 3): periodic realisation of a
 surface genome, 2D database rows, design on a 2D database, bad input."""
-import dataclasses
 from dataclasses import replace
 
 import numpy as np
@@ -307,39 +306,9 @@ def test_match_spectrum_restores_a_genome_whose_hurst_exponent_moved(surface_db)
     assert new[0].origin.endswith("(spectrum)") and 0 < new[0].scores[0] <= 1
 
 
-def _same(a, b):
-    """Equal values: arrays element for element, dataclasses field by field."""
-    if a is b:
-        return True
-    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        return np.array_equal(a, b)
-    if dataclasses.is_dataclass(a) and type(a) is type(b):
-        return all(_same(getattr(a, f.name), getattr(b, f.name))
-                   for f in dataclasses.fields(a))
-    if isinstance(a, (list, tuple)) and type(a) is type(b):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
-    if isinstance(a, dict) and isinstance(b, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    return type(a) is type(b) and a == b
-
-
-def _once(real, key=lambda *args, **kwargs: (args, kwargs)):
-    """``real`` computed once per distinct ``key`` of its arguments (compared by value,
-    :func:`_same`): a later call with an equal key gets the result of the first."""
-    done = []
-
-    def call(*args, **kwargs):
-        this = key(*args, **kwargs)
-        for seen, out in done:
-            if _same(seen, this):
-                return out
-        done.append((this, real(*args, **kwargs)))
-        return done[-1][1]
-    return call
-
-
 def test_design_match_spectrum_warns_of_its_file_as_design_targets(surface_db, tmp_path,
-                                                                    capsys, monkeypatch):
+                                                                    capsys, monkeypatch,
+                                                                    computed_once):
     """`design --match-spectrum FILE` read its file without the warnings of info, contact,
     leak and design-targets (round 2, session 36): a map with offset scan lines gave a
     matched design without a word, and the design had no --detrend to follow the advice.
@@ -356,9 +325,9 @@ def test_design_match_spectrum_warns_of_its_file_as_design_targets(surface_db, t
     # y match the same detrended file (the axis is read by the warnings before the design
     # and kept in the surface's metadata; match_spectrum reads the heights, size and
     # periodicity): each design and match is computed once per distinct arguments
-    monkeypatch.setattr(design, "run_design", _once(design.run_design))
+    monkeypatch.setattr(design, "run_design", computed_once(design.run_design))
     matched = []                                 # the surfaces the stage matched
-    match = _once(design.match_spectrum, lambda res, surface, *a, **k: (
+    match = computed_once(design.match_spectrum, lambda res, surface, *a, **k: (
         res, surface.heights, surface.size, surface.periodic, a, k))
     monkeypatch.setattr(design, "match_spectrum",
                         lambda res, surface, *a, **k: matched.append(surface) or match(
