@@ -46,6 +46,7 @@ PLAN = {
     "bench_bem_nonperiodic": ([[]], [["--quick"]]),
     "bench_bem_approach": ([[]], [["--quick"]]),
     "bench_bem_growth": ([[]], [["--quick"]]),
+    "bench_bem_mpi": ([["1024", "2048"]], [["--quick"]]),
     "bench_bem": ([["--sizes", "512", "1024", "2048", "--large", "4096", "8192"]],
                   [["--quick", "--tamaas-max", "0"]]),
 }

@@ -258,8 +258,7 @@ class InfluenceOperator:
         else:
             spec = scipy.fft.rfftn(self.circulant_kernel(self.precond_shape)).real
             spec = np.maximum(spec, 1e-12 * spec.max())
-        with np.errstate(divide="ignore"):
-            return np.where(spec > 0, 1.0 / np.where(spec > 0, spec, 1.0), 0.0)
+        return reciprocal_or_zero(spec)
 
     def precondition(self, v, spectrum, out=None, work=None, workers=None):
         """M v: the preconditioner of multiplier ``spectrum`` (:meth:`inverse_spectrum`,
@@ -316,6 +315,31 @@ def check_kernel_name(kernel: str) -> str:
     return kernel
 
 
+def periodic_spectrum(shape, size, e_star, columns=slice(None)) -> np.ndarray:
+    """The multiplier 2 / (E* |q|) (m/Pa) of the periodic (``"spectral"``) operator on
+    the rfft half-spectrum of a grid ``shape`` of ``size`` (m): q the angular wavevector
+    (rad/m, :func:`~roughfe.surfaces.stats.angular_wavevectors`), zero at q = 0 (zero
+    mean displacement, module docstring). ``columns`` (a slice of the half-spectrum's
+    last axis, whose full length is ``shape[-1] // 2 + 1``): only those columns, for a
+    process that holds a slab of the spectrum (:mod:`roughfe.bem.distributed`); each
+    entry is the one of the full multiplier, bit for bit."""
+    shape, ndim = tuple(shape), len(shape)
+    qs = angular_wavevectors(shape, size)
+    qs = [q[..., : shape[-1] // 2 + 1][..., columns] if a == ndim - 1 else q
+          for a, q in enumerate(qs)]
+    qmod = np.sqrt(sum(q ** 2 for q in qs))
+    with np.errstate(divide="ignore"):
+        return np.where(qmod > 0, 2.0 / (e_star * qmod), 0.0)
+
+
+def reciprocal_or_zero(spec) -> np.ndarray:
+    """1 / S where the multiplier S > 0, else 0: the preconditioner's spectrum of an
+    operator's (:meth:`InfluenceOperator.inverse_spectrum`; E* |q| / 2 of the periodic
+    one, zero at q = 0)."""
+    with np.errstate(divide="ignore"):
+        return np.where(spec > 0, 1.0 / np.where(spec > 0, spec, 1.0), 0.0)
+
+
 def padded_length(n: int, real: bool = True) -> int:
     """Points per axis of the DC-FFT padded grid of an ``n``-point axis: the first fast
     length (:func:`fast_length`) >= 2n - 1, the least grid of an exact linear
@@ -361,12 +385,8 @@ def influence_operator(shape, size, e_star, kernel="spectral") -> InfluenceOpera
     if kernel not in KERNELS:
         raise InputError(f"kernel must be one of {KERNELS} or 'auto', got {kernel!r}")
     if kernel == "spectral":
-        qs = angular_wavevectors(shape, size)
-        qs = [q[..., : shape[-1] // 2 + 1] if a == ndim - 1 else q for a, q in enumerate(qs)]
-        qmod = np.sqrt(sum(q ** 2 for q in qs))
-        with np.errstate(divide="ignore"):
-            spec = np.where(qmod > 0, 2.0 / (e_star * qmod), 0.0)
-        return InfluenceOperator(kernel, shape, spacing, True, e_star, spec)
+        return InfluenceOperator(kernel, shape, spacing, True, e_star,
+                                 periodic_spectrum(shape, size, e_star))
     padded = [padded_length(n, real=a == ndim - 1) for a, n in enumerate(shape)]
     if kernel == "strip":
         if ndim != 1:

@@ -13,6 +13,7 @@ from . import _parallel as par
 from ..errors import InputError, NoConvergenceError
 from .directions import _StallWatch, _bind_lower, _descent_guard
 from .operators import FFTWorkspace
+from .reductions import SERIAL
 from .pk_passes import (_axpy, _gap_mask, _gap_take, _load_increment,  # noqa: F401
                         _positive_at, _shift_to_load)
 from .solvers import (SolverOutput, _fail, _rescale_to_load, penetration_start, pr_beta,
@@ -40,7 +41,7 @@ def _single_until(approach, scale):
 def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=None,
                   diagonal=1.0, precond=None, tol=1e-10, max_iter=10000, offset=0.0,
                   hardness=None, overwrite_initial=False, apply_single=None,
-                  deflation=None, split=None, approach=None):
+                  deflation=None, split=None, approach=None, reduce=SERIAL):
     """Polonsky & Keer (1999) constrained CG with FFT operator products, bounded form.
 
     Solves Eq. 2.5-2.6 for ``0 <= p <= hardness`` with the gap ``w = H p - b - offset -
@@ -144,9 +145,27 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     make the gap on S as uneven as u itself (02b, session 17: 815 instead of 945
     iterations on a 1024^2 sweep).
 
+    ``reduce``: where the global reductions come from (sums, dots, means, min/max, the
+    point count and with it the load target): :data:`~roughfe.bem.reductions.SERIAL`
+    (the whole grid in this process) or a
+    :class:`~roughfe.bem.reductions.CommReductions`, for a slab of a grid distributed
+    over MPI ranks, ``b`` and every field the rank's slab, ``apply`` and ``precond``
+    the distributed products (:mod:`roughfe.bem.distributed`). Distributed: elastic
+    load control with a preconditioner only (no hardness, deflation, approach, split
+    or single-precision product; an InputError names the one given).
+
     Returns a :class:`SolverOutput`.
     """
     load = mean_pressure is not None
+    if reduce.distributed:
+        unfit = [name for name, bad in (
+            ("displacement control (delta)", not load), ("a hardness", hardness is not None),
+            ("a deflation", deflation is not None), ("an approach hook", approach is not None),
+            ("a split product", split is not None), ("apply_single", apply_single is not None),
+            ("no preconditioner", precond is None)) if bad]
+        if unfit:
+            raise InputError(f"the distributed Polonsky-Keer CG runs elastic load control "
+                             f"with a preconditioner only; got {', '.join(unfit)}")
     if approach is not None and not load:
         raise InputError("an approach hook moves the load: it needs load control "
                          "(mean_pressure)")
@@ -230,15 +249,15 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
                and initial.flags.writeable)
         p = initial.reshape(-1) if own else np.array(initial, dtype=float).reshape(-1)
         np.clip(p, 0.0, upper, out=p)
-        if load and not p.any():
+        if load and not reduce.any(p):
             p[:] = mean_pressure
     elif load:
         p = np.full(n, float(mean_pressure))
     else:
         p = penetration_start(bf + (delta + offset), diagonal, upper)
-    target = float(mean_pressure) * n if load else 0.0
+    target = float(mean_pressure) * reduce.count(n) if load else 0.0
     if load:
-        _rescale_to_load(p, target, upper)
+        _rescale_to_load(p, target, upper, reduce)
         if bounded and float(p.sum()) < target * (1 - 1e-12):
             _shift_to_load(p, target, upper)    # too few points to carry it below the cap
     # search direction, zero off F: only the input of H t, in single precision when that
@@ -274,22 +293,23 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         free_c = pS < upper if bounded else None
         if load:
             gE = gS[free_c] if bounded else gS
-            d = (float(gE.mean()) if gE.size else
-                 min(par.blocks(n, lambda i, j: _gap_mask(u, us, bf, -np.inf, mask, i, j))))
+            d = (float(reduce.mean(gE)) if reduce.size(gE) else reduce.min_of(
+                min(par.blocks(n, lambda i, j: _gap_mask(u, us, bf, -np.inf, mask, i, j)))))
         # KKT residual (module docstring), bounded form: at p = hardness only w > 0
         # violates complementarity
         wS = gS
         wS -= d               # in place: the gap w on S (gS is not needed any more)
-        sp = float(pS.sum())
+        sp = reduce.sum(pS)
         if bounded:
             comp = float(np.dot(pS[free_c], np.abs(wS[free_c])))
             comp += float(np.dot(pS[~free_c], np.maximum(wS[~free_c], 0.0)))
             fixed = S[~free_c & (wS <= 0.0)]
         else:
             np.abs(wS, out=wS)
-            comp = float(np.dot(pS, wS))
+            comp = reduce.dot(pS, wS)
         del gS, wS, pS        # the first iterations of a cold start have S = every point
-        gmin = min(par.blocks(n, lambda i, j: _gap_mask(u, us, bf, d, mask, i, j)))
+        gmin = reduce.min_of(min(par.blocks(n, lambda i, j: _gap_mask(u, us, bf, d, mask,
+                                                                      i, j))))
         if bounded:           # points at the bound may interpenetrate
             pen = par.flatnonzero(mask)
             gpen = _gap_take(u, us, bf, pen)
@@ -334,7 +354,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         gF = _gap_take(u, us, bf, F)
         gF -= d
         if load:
-            gF -= gF.mean()
+            gF -= reduce.mean(gF)
         g_old = par.take(gbuf, F)   # previous masked gradient and direction on the new F
         tF = par.take(t, F)
         par.put(gbuf, F_old, 0.0)
@@ -346,7 +366,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         if precond is not None:
             zF = par.take(M(gbuf), F)
             if load:
-                zF -= zF.mean()
+                zF -= reduce.mean(zF)
             if deflation is not None:
                 zF, gz = _descent_guard(gF, zF, deflation.correct(F, gF, zF, H_free,
                                                                   free_mask=mask,
@@ -354,8 +374,8 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         else:
             zF = gF.copy()
         if precond is None or deflation is None:
-            gz = float(np.dot(gF, zF))
-        beta = float(pr_beta(gz - float(np.dot(zF, g_old)), gz_old))
+            gz = reduce.dot(gF, zF)
+        beta = float(pr_beta(gz - reduce.dot(zF, g_old), gz_old))
         del g_old             # free-set vectors go as soon as they are used: early on F
         gz_old = gz           # can hold half the grid
         # the new direction on F, float64 (t and zF may be float32)
@@ -366,11 +386,11 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             _bind_lower(tF, positive, load)
         del positive
         par.put(t, F, tF)
-        gt = float(np.dot(gF, tF))
+        gt = reduce.dot(gF, tF)
         del gF
         if split is None:
             r = H(t, "r", single)
-            tr = float(np.dot(tF, par.take(r, F)))
+            tr = reduce.dot(tF, par.take(r, F))
             finish = None
         else:         # t . H t from the forward transform: H t only if the step is kept
             products += 1
@@ -382,7 +402,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
         tF *= tau
         pF -= tF
         del tF
-        lo, hi = float(pF.min()), float(pF.max())
+        lo, hi = reduce.min(pF), reduce.max(pF)
         clipped = lo < 0.0 or hi > upper
         if clipped:
             np.clip(pF, 0.0, upper, out=pF)
@@ -393,14 +413,14 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             # instead (Euclidean: a shift, clipped to the box), or the whole grid when F
             # cannot carry it
             carried = target - fixed.size * upper if bounded else target
-            sF = float(pF.sum())
+            sF = reduce.sum(pF)
             alpha = carried / sF if sF > 0 else 0.0
-            if sF > 0 and alpha * float(pF.max()) <= upper:
+            if sF > 0 and alpha * reduce.max(pF) <= upper:
                 pF *= alpha
             else:
                 alpha, clipped = 1.0, True
                 if not bounded:       # every pressure was clipped: spread the load on F
-                    pF[:] = carried / pF.size
+                    pF[:] = carried / reduce.size(pF)
                 elif not _shift_to_load(pF, carried, upper):
                     par.put(p, F, pF)
                     _shift_to_load(p, target, upper)

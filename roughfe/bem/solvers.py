@@ -26,6 +26,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..errors import InputError, NoConvergenceError
+from .reductions import SERIAL
 
 
 @dataclass(frozen=True, eq=False)
@@ -295,24 +296,27 @@ def dense_solve(H, b, scale, *, delta=None, mean_pressure=None, initial=None, me
 
 
 # -- load projection (dense and matrix-free solvers) ---------------------------------------
-def _rescale_to_load(p, target_sum, upper):
+def _rescale_to_load(p, target_sum, upper, reduce=SERIAL):
     """Scale the entries of ``p`` (>= 0, in place) below ``upper`` by alpha > 0 so that
     the sum, with the entries at ``upper`` kept there, equals ``target_sum``; scaled
     entries reaching ``upper`` saturate. Returns ``(alpha, saturated)``. The sum is
     concave and piecewise linear in alpha: Newton's method from the unsaturated alpha
     (below the root) increases monotonically and ends after at most as many steps as
-    saturating entries."""
+    saturating entries. ``reduce``: the sums' and maxima's
+    (:mod:`roughfe.bem.reductions`; a distributed one without ``upper`` only)."""
     if np.isfinite(upper):
+        if reduce.distributed:
+            raise InputError("the distributed rescaling to the load has no upper bound")
         below = p < upper
         target_sum -= upper * float(p.size - np.count_nonzero(below))
         q = p[below]
     else:
         below, q = None, p
-    s = float(q.sum())
+    s = reduce.sum(q)
     if s <= 0.0:
         return 1.0, False
     alpha = target_sum / s
-    saturated = alpha * float(q.max()) > upper
+    saturated = alpha * reduce.max(q) > upper
     for _ in range(q.size + 1 if saturated else 0):
         free = alpha * q < upper
         slope = float(q.sum(where=free))
