@@ -53,6 +53,31 @@ def test_the_lattice_offset_is_label_free_and_sees_other_lines():
     assert off == pytest.approx(19e-3 / math.log(gam), rel=1e-3)
 
 
+@pytest.mark.parametrize("shift, reproducible", [(0.40, False), (0.20, True)])
+def test_halves_on_lattices_apart_are_not_reproducible_with_the_same_H(monkeypatch, shift,
+                                                                        reproducible):
+    """The lattice criterion alone decides: two halves of the same gamma and H (0.01
+    apart, a tenth of the H tolerance) whose lattices are ``shift`` steps apart. di-1's
+    nested acquisitions at the default 512 nodes are refused by it alone (lattices 0.40
+    steps apart, at most 0.25; H 0.107 apart, at most 0.204: measured in round 2, session
+    41); their end-to-end test (test_an_overfit_of_a_measured_profile_is_not_a_genome)
+    runs at 256 nodes, where H differs beyond its tolerance too."""
+    import roughfe.genomics.sequencing.reproduce as reproduce
+    g = table1_genome(rng=0)
+    acqs = acquisitions_from_surfaces([realize(g, scale=s, n_nodes=128) for s in ("10x", "20x")])
+    gam, lam1 = 1.5, 1e-3
+    halves = {side: HalfGenes(side, gam, lam1 * gam ** -dn, 0.8 + 0.01 * dn / shift, 0.05,
+                              1.0, 1.0, 1e-3, (1, 20))
+              for side, dn in (("left", 0.0), ("right", shift))}   # q_1 shifted dn steps
+    monkeypatch.setattr(reproduce, "_half_genes", lambda acqs, side, *args: halves[side])
+    rep = reproduce.reproducibility(acqs, 0.05, (math.log(2 * math.pi / lam1), math.log(gam)))
+    assert rep.tested and rep.lattice_offset == pytest.approx(shift, abs=1e-9)
+    assert rep.H_difference == pytest.approx(0.01, abs=1e-12)
+    assert rep.H_difference < 0.1 * rep.H_tolerance
+    assert rep.reproducible is reproducible
+    assert (f"lattices {shift:.2f} steps apart (at most 0.25)" in rep.reason) is not reproducible
+
+
 @pytest.mark.parametrize("noise", [0.0, 0.01])
 def test_table1_genes_are_reproducible(noise):
     """Table 1 at 10x and 20x (N = 128): exact, both halves give the whole's lattice and

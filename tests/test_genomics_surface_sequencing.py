@@ -342,11 +342,18 @@ def test_an_overfit_of_a_measured_profile_is_not_a_genome(topographies_dir):
     0.1-0.3 % with 145 chromosomes, H at the end of its search interval (3) and waves of
     2.9 m on a profile of 15 nm rms, and said success; off by 1e8 on windows it was not
     fitted to. A fit at the end of the H interval, or with waves far larger than the data,
-    is not a genome."""
+    is not a genome.
+
+    Since round 2, session 34 (damped fit, halves compared) the fit passes every other
+    test and its halves refuse it: at the default 512 nodes by their lattices alone (0.40
+    steps apart, at most 0.25; 69 s of the suite's 8.5 min), here at 256 nodes (misfits
+    0.8 / 0.4 / 0.4 %; lattices 0.40 steps apart and H 0.956 vs 0.069, 0.886 apart, at
+    most 0.219; ~15 s); the lattice criterion alone: test_genomics_sequencing_reproduce.
+    Without the halves' test the 256-node fit is "sequenced" (measured)."""
     from roughfe.genomics.natural import nested_acquisitions
     from roughfe.genomics.sequencing import sequence_profiles
     from roughfe.surfaces.io import load_surface
-    acq = nested_acquisitions(load_surface(topographies_dir / "di-1.di"))
+    acq = nested_acquisitions(load_surface(topographies_dir / "di-1.di"), n_nodes=256)
     r = sequence_profiles(acq)
     assert not r.success and "not a genome" in r.message
     assert np.all(r.rms_errors < 0.05)            # the overfit itself: a tiny misfit
