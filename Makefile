@@ -20,8 +20,8 @@ env:
 	@bash tools/bootstrap.sh
 
 # make test is the CI command and runs EVERY test, slow ones included: the suite is the
-# physics coverage (analytic solutions, FEM vs BEM, studies end to end) and takes 6-9 min
-# on 2 cores with -n 2 (2011-2015 tests, sessions 39-40; measured:
+# physics coverage (analytic solutions, FEM vs BEM, studies end to end) and takes 5.5-9 min
+# on 2 cores with -n 2 (2011-2030 tests, sessions 39-41; measured:
 # docs/validation/fem-convergence.md, "Speed of make test"). The 25 slowest are printed so that a new outlier is seen. make test-fast leaves
 # out the tests marked @pytest.mark.slow (end-to-end CLI runs and studies, each several
 # seconds) for the edit-test loop; it is not a substitute for make test.
