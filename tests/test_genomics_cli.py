@@ -17,7 +17,8 @@ def test_genome_commands_end_to_end(tmp_path, capsys):
         assert main(["genome", "realize", str(g), "--scale", s, "--nodes", "128",
                      "-o", str(tmp_path / f"{s}.npz")]) == 0
     z = load_surface(tmp_path / "10x.npz")
-    assert z.shape == (128,) and z.heights[64] == 0.0
+    # Z(0) = 0 at node N//2, to the round-off of the sums (roughfe.genomics.genome)
+    assert z.shape == (128,) and abs(z.heights[64]) <= 1e-13 * np.abs(z.heights).max()
     seqdir = tmp_path / "seq"
     assert main(["genome", "sequence", str(tmp_path / "20x.npz"), str(tmp_path / "10x.npz"),
                  "-o", str(seqdir)]) == 0
