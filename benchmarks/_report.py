@@ -14,6 +14,8 @@ import resource
 import time
 from pathlib import Path
 
+import numpy as np
+
 from roughfe.writers import write_json
 
 #: 1-minute load average when this module was imported (the start of the benchmark)
@@ -72,6 +74,22 @@ def megabytes(ru_maxrss: float) -> float:
     """MB (1e6 bytes, the unit of the issue's GB limits) of a ``ru_maxrss`` (KiB on
     Linux). The benchmarks divided by 1024 (MiB) and called it MB until session 23."""
     return float(ru_maxrss) * 1024 / 1e6
+
+
+def own_peak_rss_mb() -> float:
+    """Peak RSS of this process so far (RUSAGE_SELF) in MB (:func:`megabytes`)."""
+    return megabytes(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+
+
+def median_seconds(fn, repeats: int, clock=time.process_time) -> float:
+    """Median over ``repeats`` calls of ``fn()`` of the seconds ``clock`` counts (process
+    CPU time by default; ``time.perf_counter`` for wall time)."""
+    times = []
+    for _ in range(repeats):
+        t0 = clock()
+        fn()
+        times.append(clock() - t0)
+    return float(np.median(times))
 
 def output_path(path) -> Path:
     """``path`` itself, or its file name in ``$ROUGHFE_BENCH_OUTPUT`` when that is set."""

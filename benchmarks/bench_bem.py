@@ -67,6 +67,8 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from _report import median_seconds, own_peak_rss_mb, write_report  # noqa: E402
 LOADS = (0.005, 0.01, 0.05, 0.1)
 TOL = 1e-10
 #: iteration cap of both solvers (solve_contact's default; Tamaas' own is 1000)
@@ -74,22 +76,6 @@ MAX_ITER = 20000
 
 
 # -- measurement helpers (run in the child) ------------------------------------------------
-def _peak_rss_mb() -> float:
-    """Peak RSS in MB = 1e6 bytes (the issue's GB are 1e9 bytes; ru_maxrss is KiB on
-    Linux). Until session 23 this was MiB labelled MB: 4.9 % low against the limits."""
-    from _report import megabytes  # benchmarks/_report.py
-    return megabytes(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
-
-
-def _median_cpu(fn, repeats):
-    times = []
-    for _ in range(repeats):
-        c0 = time.process_time()
-        fn()
-        times.append(time.process_time() - c0)
-    return float(np.median(times))
-
-
 def _convolution_cpu(n: int) -> float:
     """Median process CPU seconds of one float64 product u = H p of the solver on an
     n x n periodic grid (kept output array, one FFTWorkspace: what an iteration does)."""
@@ -97,7 +83,7 @@ def _convolution_cpu(n: int) -> float:
     op = influence_operator((n, n), (1.0, 1.0), 1.0)
     x = np.random.default_rng(0).standard_normal((n, n))
     out, work = np.empty_like(x), FFTWorkspace()
-    return _median_cpu(lambda: op.apply(x, out=out, work=work), 9 if n <= 2048 else 3)
+    return median_seconds(lambda: op.apply(x, out=out, work=work), 9 if n <= 2048 else 3)
 
 
 def _irfftn_cpu(n: int) -> float:
@@ -106,7 +92,7 @@ def _irfftn_cpu(n: int) -> float:
     import scipy.fft
     from roughfe.bem.operators import WORKERS
     x = np.random.default_rng(0).standard_normal((n, n))
-    return _median_cpu(lambda: scipy.fft.irfftn(scipy.fft.rfftn(x, workers=WORKERS),
+    return median_seconds(lambda: scipy.fft.irfftn(scipy.fft.rfftn(x, workers=WORKERS),
                                                 s=x.shape, workers=WORKERS),
                        7 if n <= 2048 else 3)
 
@@ -204,7 +190,7 @@ def case_elastic(n, loads, tamaas, sweep):
         out.update({"warm_cpu_s": warm_cpu, "warm_convolutions": warm_cpu / conv,
                     "warm_nit": sw.nit, "warm_A*": [float(a) for a in sw.area_fraction],
                     "warm/cold_cpu": warm_cpu / out["cold_cpu_s"]})
-    out["peak_rss_mb"] = _peak_rss_mb()
+    out["peak_rss_mb"] = own_peak_rss_mb()
     return out
 
 
@@ -233,7 +219,7 @@ def case_hardness(n, loads, hardness, tamaas):
                         "tamaas_plastic": pl_t, "|dA*|": abs(r.area_fraction - a_t),
                         "|dplastic|": abs(r.plastic_area_fraction - pl_t)})
         rows.append(row)
-    return {"n": n, "rows": rows, "peak_rss_mb": _peak_rss_mb()}
+    return {"n": n, "rows": rows, "peak_rss_mb": own_peak_rss_mb()}
 
 
 def case_large(n, pm, deflation_max=None):
@@ -241,7 +227,7 @@ def case_large(n, pm, deflation_max=None):
     if deflation_max is not None:     # the two-level correction up to this side
         contact.DEFLATION_SIDES = (contact.DEFLATION_SIDES[0], deflation_max)
     surf, cpu_g, wall_g = _timed(lambda: _surface(n))
-    rss_gen = _peak_rss_mb()
+    rss_gen = own_peak_rss_mb()
     r0 = resource.getrusage(resource.RUSAGE_SELF)
     t0 = time.thread_time()
     r, cpu, wall = _timed(lambda: solve_contact(surf, Material(1.0, 0.0), mean_pressure=pm,
@@ -256,8 +242,8 @@ def case_large(n, pm, deflation_max=None):
             "solve_system_s": r1.ru_stime - r0.ru_stime,
             "solve_page_faults": r1.ru_minflt - r0.ru_minflt,
             "solve_wall_s": wall, "solve_main_thread_cpu_s": main_cpu,
-            "peak_rss_mb": _peak_rss_mb(), **_threads_fields(),
-            "bytes_per_point": _peak_rss_mb() * 1e6 / n ** 2,
+            "peak_rss_mb": own_peak_rss_mb(), **_threads_fields(),
+            "bytes_per_point": own_peak_rss_mb() * 1e6 / n ** 2,
             "load_average": os.getloadavg()[0]}
 
 
@@ -342,8 +328,6 @@ def main(argv=None) -> int:
         args.sizes, args.large, args.hardness_size = [256, 512], [], 256
     if args.large_only:
         args.sizes = []
-    sys.path.insert(0, str(HERE))
-    from _report import write_report  # benchmarks/_report.py
 
     load0 = os.getloadavg()[0]
     print(f"load average {load0:.1f} on {os.cpu_count()} cores", flush=True)

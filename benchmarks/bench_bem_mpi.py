@@ -39,7 +39,6 @@ from __future__ import annotations
 import importlib.util
 import json
 import os
-import resource
 import shutil
 import subprocess
 import sys
@@ -50,28 +49,14 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from _report import median_seconds, own_peak_rss_mb, script_args, write_report  # noqa: E402
 LOAD = 0.05
 TOL = 1e-10
 SIZE = (1.0, 1.0)
 RUNS = ("serial-1t", "serial", "mpi-1", "mpi-2")
 #: A* of the distributed solve equal to the serial one's within this (both at tol 1e-10)
 SAME_AREA = 1e-4
-
-
-def _rss_mb():
-    sys.path.insert(0, str(HERE))
-    from _report import megabytes
-    return megabytes(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
-
-
-def _median_wall(fn, repeats=7):
-    """Median wall seconds of ``fn()`` (one FFT product) over ``repeats`` calls."""
-    times = []
-    for _ in range(repeats):
-        w0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - w0)
-    return float(np.median(times))
 
 
 def child_serial(spec):
@@ -89,11 +74,12 @@ def child_serial(spec):
     op = influence_operator(surf.shape, SIZE, 1.0)
     x = np.random.default_rng(0).standard_normal(surf.shape)
     out, work = np.empty_like(x), FFTWorkspace()
-    product = _median_wall(lambda: op.apply_unchecked(x, out=out, work=work))
+    product = median_seconds(lambda: op.apply_unchecked(x, out=out, work=work), 7,
+                             time.perf_counter)
     return {"nit": r.nit, "n_products": None, "A*": r.area_fraction,
             "mean_gap": r.mean_gap, "solve_cpu_s": cpu, "solve_wall_s": wall,
             "product_wall_s": product, "load_average": os.getloadavg()[0],
-            "threads": THREADS, "ranks": 1, "peak_rss_mb": [_rss_mb()]}
+            "threads": THREADS, "ranks": 1, "peak_rss_mb": [own_peak_rss_mb()]}
 
 
 def child_mpi(spec):
@@ -113,8 +99,9 @@ def child_mpi(spec):
     op = SlabOperator(comm, shape, SIZE, 1.0)
     x = np.random.default_rng(0).standard_normal(op.local_shape)
     out = np.empty_like(x)
-    product = _median_wall(lambda: (comm.Barrier(), op.apply(x, out=out)))
-    cpus, rss = comm.gather(cpu, root=0), comm.gather(_rss_mb(), root=0)
+    product = median_seconds(lambda: (comm.Barrier(), op.apply(x, out=out)), 7,
+                             time.perf_counter)
+    cpus, rss = comm.gather(cpu, root=0), comm.gather(own_peak_rss_mb(), root=0)
     if comm.rank:
         return None
     return {"nit": r.nit, "n_products": r.n_products, "A*": r.area_fraction,
@@ -204,8 +191,6 @@ def main(argv=None) -> int:
         if out is not None:
             print(json.dumps(out), flush=True)
         return 0
-    sys.path.insert(0, str(HERE))
-    from _report import script_args, write_report
     sizes, given = script_args(__doc__, argv, flags=("--quick",))
     sizes = [256] if "--quick" in given else sizes or [1024, 2048]
     cases, targets, skipped = [], [], []

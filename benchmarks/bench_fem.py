@@ -25,7 +25,6 @@ verdict: :func:`target_row`).
 from __future__ import annotations
 
 import os
-import resource
 import sys
 import time
 from pathlib import Path
@@ -37,7 +36,7 @@ from roughfe.fem import mesh_profile
 from roughfe.fem.contact import FemSolverOptions, _ContactProblem
 from roughfe.surfaces.rmd import rmd_profile
 
-from _report import megabytes, script_args, write_report  # benchmarks/_report.py
+from _report import own_peak_rss_mb, script_args, write_report  # benchmarks/_report.py
 
 MATERIAL = Material(E=210e9, nu=0.3)
 SOLVERS = {"mumps": {},
@@ -74,7 +73,7 @@ def one_size(m: int, solvers) -> list:
             problem.destroy()
         except Exception as exc:          # PETSc errors and non-convergence are reported
             row.update(ok=False, error=f"{type(exc).__name__}: {str(exc).splitlines()[0][:200]}")
-        row["peak_rss_mb"] = megabytes(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+        row["peak_rss_mb"] = own_peak_rss_mb()
         rows.append(row)
         print(f"{m:>3} {row['nodes']:>6} {row.get('dofs', 0):>8} {name:>9} "
               + (f"{row['step_cpu_s']:>8.2f} {row['step_wall_s']:>8.2f} {row['snes_iterations']:>4} "

@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from _report import megabytes, script_args, write_report  # benchmarks/_report.py
+from _report import own_peak_rss_mb, script_args, write_report  # benchmarks/_report.py
 
 OUT = Path(__file__).resolve().parent / "output"
 TARGETS = {2048: 10.0, 4096: 60.0}
@@ -95,7 +95,7 @@ def one_size(n):
                "amg_setup_cpu_s": setup, "cg_solve_cpu_s": solve, "nit": r.nit,
                "leak_rate": r.leak_rate,
                "balance": abs(r.inlet_flow / r.outlet_flow - 1) if r.outlet_flow else 0.0,
-               "peak_memory_gb": megabytes(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) / 1e3}
+               "peak_memory_gb": own_peak_rss_mb() / 1e3}
         if con is None:
             t0, c0 = time.perf_counter(), time.process_time()
             con = critical_constriction(g, s.spacing, periodic=True)
@@ -118,7 +118,7 @@ def coupled(n=COUPLED_N):
             "leak_rate": r.leak_rate, "one_way_leak_rate": r.one_way_leak_rate,
             "fluid_load_fraction": r.fluid_load_fraction,
             "area_fraction": r.contact.area_fraction,
-            "peak_memory_gb": megabytes(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) / 1e3}
+            "peak_memory_gb": own_peak_rss_mb() / 1e3}
 
 
 def _child(arg):
