@@ -314,7 +314,8 @@ class AdhesiveSweep:
     pull_off_force : float
         Most tensile load of the unloading branch (N for surfaces, N/m for profiles;
         negative), NaN without unloading, 0 when no load of the branch is tensile beyond
-        round-off (:func:`~roughfe.bem.adhesive_pull_off.tensile_floor`): that of this
+        what the solves resolve (``tol`` of the largest |load|,
+        :func:`~roughfe.bem.adhesive_pull_off.tensile_floor`): that of this
         load path (independent of the step, more tensile the larger the largest loading
         approach).
     pull_off_pressure : float
@@ -446,7 +447,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
                 low = min(loads) if loads else float("inf")
                 d -= h
                 prev = unload_to(d)
-                tensile = min(loads) < -tensile_floor(loads)   # not round-off
+                tensile = min(loads) < -tensile_floor(loads, tol)   # resolved
                 if prev.n_contact == 0 and (not tensile or prev.load > 1e-3 * min(loads)):
                     detached = True        # separated (without a tensile state: pull 0)
                     break
@@ -454,7 +455,7 @@ def adhesive_sweep(surface: Surface, material: Material, law: AdhesionLaw, delta
             # the most tensile state between samples (refine_pull_off): bisected steps
             # around the minimum, down to a quarter of the law's range
             top, pull = deltas.size - 1, 0.0
-            if min(loads) < -tensile_floor(loads):
+            if min(loads) < -tensile_floor(loads, tol):
                 branch = refine_pull_off(list(zip(imposed[top:], results[top:])), unloaded,
                                          0.25 * law.range)
                 results[top:] = [state for _, state in branch]

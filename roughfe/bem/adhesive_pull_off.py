@@ -21,17 +21,29 @@ import numpy as np
 
 #: halvings of the steps around the most tensile state (2 solves each)
 MAX_LEVELS = 4
-#: a load is tensile below -PULL_OFF_FLOOR times the largest |load| of the branch: the
-#: loads of separated states are round-off of the FFT products, up to ~1e-12 of the peak
-#: load (a 32^2 surface that is not sticky read a pull-off of -1.3e-13 N out of them and
-#: bisected them; a user's docs audit, round 2, session 31)
+#: a load is tensile below -max(PULL_OFF_FLOOR, tol) times the largest |load| of the
+#: branch (:func:`tensile_floor`). PULL_OFF_FLOOR is the round-off of the FFT products:
+#: the loads of separated states read up to ~1e-12 of the peak load (a 32^2 surface that
+#: is not sticky read a pull-off of -1.3e-13 N out of them and bisected them; a user's
+#: docs audit, round 2, session 31)
 PULL_OFF_FLOOR = 1e-9
 
 
-def tensile_floor(loads) -> float:
+def tensile_floor(loads, tol: float) -> float:
     """The load (N, or N/m for a profile) below whose negative a branch's load counts as
-    tensile: ``PULL_OFF_FLOOR`` times the largest |load| of ``loads``."""
-    return PULL_OFF_FLOOR * max(abs(float(v)) for v in loads)
+    tensile: ``max(PULL_OFF_FLOOR, tol)`` times the largest |load| of ``loads``.
+
+    ``tol`` is the solves' relative traction residual. A state converged to it has its
+    load only to about ``tol`` of the branch's loads: the same states solved with another
+    BLAS (OpenBLAS against the reference BLAS; round 2, session 42) read loads 6e-8 of
+    the peak apart at tol = 1e-5, and the first separated state of a surface that is not
+    sticky read -3.2e-9 N against -2.5e-11 N (2e-8 of the peak 0.146 N: the exponential
+    law's tail attraction, below what the residual resolves). With the floor at
+    PULL_OFF_FLOOR alone that state counted as tensile on one BLAS and not on the other:
+    the branch ran on and reported a pull-off of -8.7e-9 N. A pull-off smaller than
+    ``tol`` of the peak load is not resolved by the solves and is reported as 0.
+    """
+    return max(PULL_OFF_FLOOR, float(tol)) * max(abs(float(v)) for v in loads)
 
 
 def refine_pull_off(branch: list, solve, resolution: float, max_levels: int = MAX_LEVELS):
