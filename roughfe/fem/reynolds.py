@@ -74,7 +74,7 @@ from scipy.sparse.csgraph import connected_components
 from ..errors import (InputError, NoConvergenceError, check_finite_nonnegative,
                       check_finite_positive, check_real_array, check_spacing)
 from .dissipation import solve_for_dissipation
-from .petsc_tools import CG_AMG, KrylovSolver, petsc_aij
+from .petsc_tools import CG_AMG, KrylovSolver, ensure_jit_cache, petsc_aij
 
 DEFAULT_PETSC_OPTIONS = CG_AMG
 
@@ -165,6 +165,7 @@ class _GridSpace:
 def _grid(nx: int, ny: int, lx: float, ly: float) -> _Grid:
     """Mesh, spaces and index maps of an nx x ny grid (no PETSc object, nothing a solve
     mutates; the index maps are O(nx ny) integers)."""
+    ensure_jit_cache()      # before dolfinx: a writable JIT cache, warnings not in logging
     from mpi4py import MPI
     from dolfinx import fem, mesh
 
