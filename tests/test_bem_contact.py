@@ -449,30 +449,38 @@ def test_gap_controlled_sweep_continues_a_dual_solve_whose_primal_residual_is_hi
     solve that stops just below tol once left the primal KKT residual of Eq. 2.5 at
     2.8e-9 (> 10 tol) on this sweep (an RMD profile like validation/bem_vs_fem.py's at the
     FEM's approaches). The solve is continued with a tighter dual tolerance: every step
-    then meets the primal tolerance and equals a cold solve of the same approach. The
-    test counts the dual solves, so that it fails if its profile stops reaching the
-    continuation (seed 1 did after the RMD profile's X(0) = 0 fix of round 2, session
-    33; seed 4 reaches it once)."""
+    then meets the primal tolerance and equals a cold solve of the same approach.
+
+    Whether a dual solve at tol stops just above or below the primal tolerance is
+    round-off (this sweep reached the continuation once with the reference BLAS and never
+    with OpenBLAS; seed 1 stopped reaching it after the RMD fix of round 2, session 33),
+    so the test makes every dual solve at the sweep's tolerance stop early, at 1e3 x tol:
+    most steps' first dual solve (6 of 9 here) then leaves a primal residual above
+    10 tol on any BLAS and must be continued (session 42)."""
     import roughfe.bem.periodic as periodic
     from roughfe.surfaces.rmd import rmd_profile
+    tol = 1e-10                                  # contact_sweep's default
     tols = []
 
-    def counted(*args, **kwargs):
+    def early(*args, **kwargs):
         tols.append(kwargs["tol"])
+        if kwargs["tol"] >= tol:                 # a first dual solve: stopped early
+            kwargs["tol"] = 1e3 * kwargs["tol"]
         return dual(*args, **kwargs)
     dual = periodic.polonsky_keer
-    monkeypatch.setattr(periodic, "polonsky_keer", counted)
+    monkeypatch.setattr(periodic, "polonsky_keer", early)
     mirrored = rmd_profile(9, 1.5, 1e-3, rng=4, rms_height=1e-6).mirrored()
     mat = Material(E=210e9, nu=0.3)
     deltas = [1.0010288248865691e-07, 1.301454165220638e-07, 1.6926692277191175e-07,
               2.200044543552051e-07, 2.857138050975233e-07, 3.715973059605369e-07,
               4.832901685527199e-07, 6.28742852526446e-07, 8.176927952750081e-07]
-    sweep = contact_sweep(mirrored, mat, deltas=deltas, kernel="spectral")
-    assert len(tols) > len(deltas) and min(tols) < 1e-10      # a continued solve
+    sweep = contact_sweep(mirrored, mat, deltas=deltas, kernel="spectral", tol=tol)
+    continued = [t for t in tols if t < tol]
+    assert continued and max(continued) == pytest.approx(tol / 100, rel=1e-12, abs=0)
     monkeypatch.setattr(periodic, "polonsky_keer", dual)
     for d, r in zip(deltas, sweep.results):
-        assert r.success and r.residual <= 1e-9
-        cold = solve_contact(mirrored, mat, delta=d, kernel="spectral")
+        assert r.success and r.residual <= 10 * tol
+        cold = solve_contact(mirrored, mat, delta=d, kernel="spectral", tol=tol)
         assert np.array_equal(r.contact, cold.contact)
         assert np.max(np.abs(r.pressure - cold.pressure)) <= 1e-6 * np.max(cold.pressure)
 
