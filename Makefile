@@ -1,6 +1,7 @@
 # roughfe: two commands do all set-up on a fresh Debian 12 machine.
 #   make demo   installs what is missing, runs the default case, writes demo-output/
 #   make test   installs what is missing, runs the test suite
+#   make test-other-blas   the suite again on the other BLAS (OpenBLAS / reference)
 #   make validate-quick   the reduced validation cases (CI, a few minutes); make validate: all
 #   make docs   builds the documentation (docs/_build/html)
 #   make bench-quick   the benchmarks at reduced sizes (4-5 min); make bench: all, full size
@@ -14,7 +15,7 @@ export OMPI_MCA_rmaps_base_oversubscribe := 1
 
 JOBS   ?= 2
 
-.PHONY: env test test-fast demo validate validate-quick bench bench-quick docs clean
+.PHONY: env test test-fast test-other-blas demo validate validate-quick bench bench-quick docs clean
 
 env:
 	@bash tools/bootstrap.sh
@@ -34,6 +35,15 @@ test: env
 
 test-fast: env
 	$(TEST_ENV) $(PY) -m pytest -q -p no:cacheprovider -n $(JOBS) -m "not slow"
+
+# make test-other-blas: the suite on the other BLAS/LAPACK than the one numpy loads here
+# (OpenBLAS on this Debian's reference BLAS, or the reference on OpenBLAS), fetched by
+# `apt-get download` into .venv/other-blas (tools/other_blas.sh; exit 3 when it cannot be
+# had). A user's numbers must not hang on the BLAS's rounding (session 41: 11 failures).
+# TEST_ARGS narrows it, e.g. TEST_ARGS='-m "not slow"' (what .ci/run runs).
+TEST_ARGS ?=
+test-other-blas: env
+	bash tools/other_blas.sh $(TEST_ENV) $(PY) -m pytest -q -p no:cacheprovider -n $(JOBS) $(TEST_ARGS)
 
 demo: env
 	$(PY) -m roughfe.cli demo -o demo-output
