@@ -8,15 +8,17 @@ solver of :mod:`roughfe.bem.batch`) is called once per generation.
 The (mu/mu_w, lambda)-CMA-ES with cumulative step-size adaptation, rank-one and rank-mu
 covariance updates and the default strategy parameters of Hansen's tutorial (Hansen
 N. (2016) The CMA Evolution Strategy: A Tutorial, arXiv:1604.00772, Table 1 and
-Fig. 6; written from the equations there). A run stops when its step ``sigma`` times
-the largest axis of C falls below ``tol_x``, when the best value has not risen for
-``10 + 30 n / lambda`` generations, or at the budget; then it restarts from ``x0``
-with twice the population (Auger A., Hansen N. (2005) A restart CMA evolution strategy
-with increasing population size, CEC 2005, 1769-1776), until ``n_eval`` evaluations
-are spent. The best point over all runs is returned with the curve of the best value
-against the evaluations spent, and why each run stopped (``stops``: "converged" on
-``tol_x``, "stalled", or "budget" when the evaluations left could not pay for another
-generation). A value that is not finite (x0's too) counts as -inf, the worst.
+Fig. 6; written from the equations there, the samples drawn through the symmetric
+root C^(1/2) rather than B D, so that a seed's path does not depend on the BLAS). A run
+stops when its step ``sigma`` times the largest axis of C falls below ``tol_x``, when
+the best value has not risen for ``10 + 30 n / lambda`` generations, or at the budget;
+then it restarts from ``x0`` with twice the population (Auger A., Hansen N. (2005) A
+restart CMA evolution strategy with increasing population size, CEC 2005, 1769-1776),
+until ``n_eval`` evaluations are spent. The best point over all runs is returned with
+the curve of the best value against the evaluations spent, and why each run stopped
+(``stops``: "converged" on ``tol_x``, "stalled", or "budget" when the evaluations left
+could not pay for another generation). A value that is not finite (x0's too) counts as
+-inf, the worst.
 """
 from __future__ import annotations
 
@@ -51,6 +53,17 @@ class CmaResult:
     message: str = ""
 
 
+def _symmetric(Bm, d) -> np.ndarray:
+    """``B diag(d) B^T`` of the eigenvectors ``Bm`` (columns) of C: with ``d = D`` the
+    symmetric root C^(1/2), with ``d = 1/D`` C^(-1/2). Both are functions of C alone, so
+    samples ``z C^(1/2)`` (z ~ N(0, I), the distribution N(0, C) of the tutorial's
+    ``B D z``) do not depend on the signs, order or basis within a repeated eigenvalue
+    that LAPACK picks for the eigenvectors: after the first update C = (1 - c1 - cmu) I
+    + a rank <= mu + 1 term, whose repeated eigenvalue left the search's path to the
+    BLAS (reference BLAS and OpenBLAS drew other points from the second generation on)."""
+    return (Bm * d) @ Bm.T
+
+
 def _run(fun, x0, sigma0, lam, budget, rng, tol_x, best, history, spent):
     """One CMA-ES run of population ``lam`` from ``x0``; updates ``best`` = [x, f] and
     ``history`` in place and returns the evaluations it spent and why it stopped."""
@@ -72,7 +85,7 @@ def _run(fun, x0, sigma0, lam, budget, rng, tol_x, best, history, spent):
     while used + lam <= budget:
         D2, Bm = np.linalg.eigh(C)
         D = np.sqrt(np.maximum(D2, 1e-300))
-        y = (rng.standard_normal((lam, n)) * D) @ Bm.T
+        y = rng.standard_normal((lam, n)) @ _symmetric(Bm, D)
         X = m + sigma * y
         f = np.asarray(fun(X), dtype=float)
         if f.shape != (lam,):
@@ -90,7 +103,7 @@ def _run(fun, x0, sigma0, lam, budget, rng, tol_x, best, history, spent):
             stall += 1
         yw = w @ y[order[:mu]]
         m = m + sigma * yw
-        ps = (1 - cs) * ps + math.sqrt(cs * (2 - cs) * mueff) * (Bm @ ((Bm.T @ yw) / D))
+        ps = (1 - cs) * ps + math.sqrt(cs * (2 - cs) * mueff) * (_symmetric(Bm, 1 / D) @ yw)
         hs = np.linalg.norm(ps) / math.sqrt(1 - (1 - cs) ** (2 * g)) < (1.4 + 2 / (n + 1)) * chi
         pc = (1 - cc) * pc + hs * math.sqrt(cc * (2 - cc) * mueff) * yw
         ys = y[order[:mu]]
