@@ -78,18 +78,25 @@ def test_the_damping_is_the_noise_over_the_prior_height():
 @pytest.mark.parametrize("k", [1, 4])
 def test_exact_data_keep_their_exact_fit(k):
     """WM data on the genome's lattice (cond 27) and on gamma^(1/4) (cond 2e16): the
-    damping is at round-off (lambda 5e-13 on gamma^(1/4), below the 1e-12 truncation of
-    least squares), the misfit stays at round-off and the held-out nodes are predicted
-    as by least squares; on the genome's lattice the amplitudes are those of least
-    squares (on gamma^(1/4) least squares itself fixes them only to ~1e-3 of the
-    heights along its collinear directions)."""
+    damping is at round-off (lambda 5e-13 on gamma^(1/4), 8e-14 with OpenBLAS, below the
+    1e-12 truncation of least squares), the misfit stays at round-off and the held-out
+    nodes are predicted at least squares' own level: to round-off on the genome's
+    lattice, and on gamma^(1/4) to below 1e-6 of the heights (measured for both fits,
+    reference BLAS, OpenBLAS and data perturbed at 1e-15: 2.1-3.3e-7 in the 10x window,
+    1.4e-11-1.6e-10 in the 20x; either moves by 30 % (10x) or tenfold (20x) and the
+    damped fit's over least squares' by 0.87-1.56, so their agreement to 1 %, asserted
+    until round 2, session 42, was round-off; a damping of 1e-8 misses them by 1.2e-5).
+    On the genome's lattice the amplitudes are
+    those of least squares (on gamma^(1/4) least squares itself fixes them only to ~1e-3
+    of the heights along its collinear directions)."""
     mat, rhs, out = _fit(0.0, k)
     assert resolution_damping(mat, rhs, out[False]["coef"]) < 1e-12
     assert out[True]["rss"] <= 1e-20 * float(rhs @ rhs)
     assert out[True]["rss"] <= 1.01 * out[False]["rss"]
-    np.testing.assert_allclose(out[True]["held"], out[False]["held"], rtol=0.01, atol=1e-9)
+    level = 1e-12 if k == 1 else 1e-6
+    assert np.all(out[False]["held"] < level)
+    assert np.all(out[True]["held"] < level)
     if k == 1:
-        assert np.all(out[True]["held"] < 1e-12)
         np.testing.assert_allclose(out[True]["amp"], out[False]["amp"], rtol=0, atol=1e-12)
 
 

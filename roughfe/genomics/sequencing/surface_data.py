@@ -237,7 +237,12 @@ def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
     cand = np.argwhere(is_max & (power > max(floor, dynamic_range * top)))
     kx = np.where(cand[:, 0] <= m_pad // 2, cand[:, 0], cand[:, 0] - m_pad).astype(float)
     ky = cand[:, 1].astype(float)
-    keep = ~((ky == 0) & (kx < 0))            # q and -q are one wave on the q_y = 0 row
+    # q and -q are one wave on the q_y = 0 row; the zero bin is the window-weighted mean
+    # (the plane columns' share), no wave: told by its bin, not by |q| > 0 after the
+    # sub-bin offset, which its mirror-symmetric neighbours leave at round-off (0 or not
+    # by the last bits: a fit's residual gained its largest "peak", at angle 0, and the
+    # 2D sequencer a ridge there, with OpenBLAS only)
+    keep = ~((ky == 0) & (kx <= 0))
     cand, kx, ky = cand[keep], kx[keep], ky[keep]
     lp = np.log(power + 1e-300 * top)
     i, j = cand[:, 0], cand[:, 1]
@@ -247,7 +252,7 @@ def surface_peaks(acq: SurfaceAcquisition, dynamic_range=1e-9) -> SurfacePeaks:
     dq = 2 * np.pi / (m_pad * d)
     qx, qy = (kx + dx) * dq, (ky + dy) * dq
     nyq = NYQUIST_FRACTION * np.pi / d
-    inside = (np.abs(qx) < nyq) & (np.abs(qy) < nyq) & (np.hypot(qx, qy) > 0)
+    inside = (np.abs(qx) < nyq) & (np.abs(qy) < nyq)
     return SurfacePeaks(qx[inside], qy[inside], power[i, j][inside], noise)
 
 
