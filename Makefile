@@ -66,7 +66,8 @@ validate-quick: env
 # 512^2; over an hour on 2 cores, ~6.3 GB peak in the 4096^2 Reynolds solve), JSON in
 # benchmarks/output and the one table of every speed/memory target in
 # benchmarks/output/SUMMARY.md. make bench-quick:
-# reduced sizes (4-5 min on 2 cores) into benchmarks/output-quick, for smoke use.
+# reduced sizes (4-5 min on 2 cores: 268 s in session 42, after bench_surface_design's
+# quick run left out the x3p-2 design, 591 s of 802) into benchmarks/output-quick, for smoke use.
 bench:
 	@bash tools/bootstrap.sh io,design,study,test,bench
 	$(PY) benchmarks/run_all.py

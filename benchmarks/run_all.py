@@ -10,7 +10,7 @@ found as ``bench_*.py`` must have a plan (a new benchmark cannot be left out sil
 The exit status is 1 when a benchmark did not write its report (it crashed); a missed
 target is a NOT met row in the table, not a failure of the run.
 
-Full run: ``benchmarks/output``; ``--quick`` (< 3 min on 2 quiet cores, reduced sizes,
+Full run: ``benchmarks/output``; ``--quick`` (4-5 min on 2 quiet cores: 268 s in session 42; reduced sizes,
 so most targets read "not measured"): ``benchmarks/output-quick``
 (``ROUGHFE_BENCH_OUTPUT``), never overwriting the full run's JSON.
 Benchmarks print timings and ratios; they are never part of the timed test suite.
@@ -95,7 +95,7 @@ def run_one(script: Path, args, env) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="the smoke subset (< 3 min)")
+    ap.add_argument("--quick", action="store_true", help="the smoke subset (4-5 min)")
     ap.add_argument("--only", nargs="+", metavar="NAME",
                     help="run only these benchmarks (e.g. bench_cli); the summary still "
                          "covers every JSON in the output folder")
