@@ -3,7 +3,8 @@
 (round 2, session 10) and the descent guard of the coarse correction (session 12) act
 on the direction's values on the free set F only (numpy vectors), never on the iterate;
 the stall watch (session 13) drops the correction from a solve that stopped making
-progress with it."""
+progress with it; the conjugation chain (session 43) restarts a direction that has
+grown beyond what the gradients justify (any PK solve)."""
 from __future__ import annotations
 
 import collections
@@ -18,6 +19,9 @@ DESCENT_GUARD = 0.05
 #: a two-level solve whose KKT residual has not halved for this many iterations drops its
 #: coarse correction for the rest of the solve (:class:`_StallWatch`)
 STALL_WINDOW = 25
+#: the Polak-Ribiere coefficients' product since the last restart may exceed the decrease
+#: of g . z it implies by at most this factor (:class:`_ConjugationChain`)
+CONJUGATION_LIMIT = 100.0
 
 
 def _descent_guard(gF, zF, z2):
@@ -106,3 +110,41 @@ class _StallWatch:
         h = self.history
         h.append(res)
         return len(h) == h.maxlen and min(itertools.islice(h, 1, None)) > 0.5 * h[0]
+
+
+class _ConjugationChain:
+    """Restart of the CG direction when its conjugation has run away.
+
+    In linear CG the coefficients telescope: beta_1 ... beta_k = (g.z)_k / (g.z)_0 since
+    the last restart (Fletcher-Reeves' identity; Polak-Ribiere's beta equals it for a
+    quadratic on a fixed set). On a changing contact set they need not, and a set that
+    alternates between two states can make the product grow geometrically (beta ~0.2 and
+    ~6.9 in turn, measured) while g.z does not fall: the direction t = z + beta t_old
+    then grows without bound and the exact line search takes ever smaller steps along
+    it. Measured on warm-started 1D sweeps (mirrored RMD profiles, 1024-8192 points,
+    round 2, session 43): one load took 1185 iterations instead of 169, five took more
+    than 200, and the float32 product of the grown direction overflowed (NaN in the
+    FFT, numpy's "invalid value" warning). ``limit`` allows the product to exceed
+    (g.z)_k / (g.z)_0 by :data:`CONJUGATION_LIMIT` before that iteration takes beta = 0
+    (steepest preconditioned descent, a restart): it never fired on the 2D surfaces of
+    ``benchmarks/bench_bem_growth.py`` (H = 0.8 and 0.5, 256^2 to 1024^2, 4 loads: every
+    count unchanged) and brought the 1D sweeps to 169 iterations at the worst load
+    (all iterations -2.7 %, no warning). Scalars only: no pass over the grid."""
+
+    def __init__(self, limit: float = CONJUGATION_LIMIT):
+        self.limit = limit
+        self.product = 1.0
+        self.gz_start = None
+        self.restarts = 0
+
+    def beta(self, beta: float, gz: float) -> float:
+        """``beta`` for the iteration whose new g.z is ``gz``, or 0 (a restart)."""
+        if beta == 0.0 or self.gz_start is None:
+            self.product, self.gz_start = 1.0, gz
+            return beta
+        self.product *= beta
+        if self.product * self.gz_start > self.limit * gz:
+            self.restarts += 1
+            self.product, self.gz_start = 1.0, gz
+            return 0.0
+        return beta

@@ -11,7 +11,7 @@ import numpy as np
 
 from . import _parallel as par
 from ..errors import InputError, NoConvergenceError
-from .directions import _StallWatch, _bind_lower, _descent_guard
+from .directions import _ConjugationChain, _StallWatch, _bind_lower, _descent_guard
 from .operators import FFTWorkspace
 from .reductions import SERIAL
 from .pk_passes import (_axpy, _gap_mask, _gap_take, _load_increment,  # noqa: F401
@@ -270,6 +270,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
     F = np.empty(0, np.intp)
     S = np.flatnonzero(p)
     gz_old = 0.0
+    chain = _ConjugationChain()   # restarts a run-away conjugation (directions.py)
     res = np.inf
     # d is Delta + offset: the gap is g - d with g = u - b (offset folded into d: one
     # full-grid pass less per iteration); Delta = d - offset is what is returned
@@ -375,7 +376,7 @@ def polonsky_keer(apply, b, scale, *, delta=None, mean_pressure=None, initial=No
             zF = gF.copy()
         if precond is None or deflation is None:
             gz = reduce.dot(gF, zF)
-        beta = float(pr_beta(gz - reduce.dot(zF, g_old), gz_old))
+        beta = chain.beta(float(pr_beta(gz - reduce.dot(zF, g_old), gz_old)), gz)
         del g_old             # free-set vectors go as soon as they are used: early on F
         gz_old = gz           # can hold half the grid
         # the new direction on F, float64 (t and zF may be float32)
