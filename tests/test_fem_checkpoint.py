@@ -13,6 +13,7 @@ mesh).
 import dataclasses
 import json
 import os
+import sys
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -160,6 +161,7 @@ def test_an_interrupted_level_resumes_from_its_last_finished_load(study, tmp_pat
                                                                   monkeypatch):
     monkeypatch.setattr(study, "GROWTH_1", 1.0)     # a cheap level: a coarse deep mesh
     monkeypatch.setattr(study, "FRACTIONS", (0.7,))  # and one window of three loads
+    monkeypatch.setattr(sys.modules["_refinement"], "FRACTIONS", (0.7,))   # its loads' module
     name = "rmd"
     surface = study.PROFILES[name]()
     pressures = study.study_pressures(surface)

@@ -1,11 +1,13 @@
 """roughfe.validation: Richardson extrapolation and the target rows of validation/output."""
+import dataclasses
 import json
 
 import numpy as np
 import pytest
 
 from roughfe.errors import InputError
-from roughfe.validation import Target, observed_orders, richardson, within
+from roughfe.validation import (Target, judge_claim, judge_richardson, observed_orders,
+                                richardson, within)
 
 
 @pytest.mark.parametrize("order", [1.0, 1.5, 2.0])
@@ -43,7 +45,8 @@ def test_richardson_falls_back_when_the_sequence_oscillates():
     r = richardson(q)
     assert not r.asymptotic and np.isnan(r.order)
     assert r.limit == 1.1
-    assert r.uncertainty == pytest.approx(3 * 0.05)
+    # 3x the larger of the last two differences (0.15, 0.05; session 43's calibration)
+    assert r.uncertainty == pytest.approx(3 * 0.15)
     assert "not in the asymptotic range" in r.method
     assert np.isnan(observed_orders(q)[-1])
     json.dumps(r.to_dict())                          # JSON-safe (NaN -> null)
@@ -69,3 +72,33 @@ def test_target_rows_follow_the_schema():
     tiny = within("dense vs PCG", 1.82e-12, 1e-8)
     assert tiny.met and tiny.target == "<= 1e-08" and tiny.measured == "1.8e-12"
     assert json.loads(json.dumps(Target("a", "b", "c", False, value=np.inf).to_dict()))["value"] is None
+
+
+def test_a_claim_is_judged_only_where_the_reference_can_judge_it():
+    # |Q_ref - L| = 1 against a claimed 2: covered unless the reference is uncertain by > 1
+    assert judge_claim(1.0, 2.0, 0.5) == "covered"
+    assert judge_claim(1.0, 2.0, 1.0) == "covered"          # the boundary counts
+    assert judge_claim(1.0, 2.0, 1.5) == "undecided"
+    # |Q_ref - L| = 3 against 2: missed unless the reference is uncertain by >= 1
+    assert judge_claim(3.0, 2.0, 0.5) == "missed"
+    assert judge_claim(3.0, 2.0, 1.0) == "undecided"
+    for bad in ((-1.0, 1.0, 0.0), (1.0, float("nan"), 0.0), (1.0, 1.0, float("inf") * 0)):
+        with pytest.raises(InputError, match="non-negative"):
+            judge_claim(*bad)
+
+
+def test_richardson_claims_against_known_limits():
+    """An exact second-order sequence: both claims hold. The plateau of session 36's RMD
+    BEM sequence at 1744 MPa (r = 1 ... 16) against its value at r = 256 (session 43)."""
+    exact = richardson([1.0 + 0.1 * r ** -2.0 for r in (1, 2, 4, 8, 16)])
+    assert judge_richardson(exact, 1.0, 0.0) == {"limit": "covered", "levels": "covered"}
+    plateau = [0.183926, 0.197255, 0.202609, 0.204392, 0.204390]
+    est = richardson(plateau)            # fallback: 3x the larger of the last two steps
+    assert not est.asymptotic and est.uncertainty == pytest.approx(3 * 1.783e-3, abs=1e-9)
+    # the reference of r = 256 (0.204305 +- 5.4e-5) is within it
+    assert judge_richardson(est, 0.204305, 5.4e-5) == {"limit": "covered", "levels": "covered"}
+    # judged by the last difference alone (before session 43), the same claim is missed
+    last_only = dataclasses.replace(est, uncertainty=3 * 2e-6)
+    assert judge_richardson(last_only, 0.204305, 5.4e-5)["limit"] == "missed"
+    # a reference too uncertain to tell: undecided, never counted either way
+    assert judge_richardson(last_only, 0.204305, 1e-4)["limit"] == "undecided"

@@ -49,7 +49,7 @@ from .options import add_output_folder, output_folder_of
 # name on the command line -> scripts in validation/ (explicit, ordered)
 VALIDATIONS = {
     "bem": ("bem_contact",),
-    "fem": ("bem_vs_fem", "fem_convergence"),
+    "fem": ("bem_vs_fem", "richardson_calibration", "fem_convergence"),
     "sequencing": ("genomics_sequencing",),
     "design": ("design_study",),
     "leakage": ("leakage_flow",),
@@ -59,6 +59,7 @@ VALIDATIONS = {
 }
 #: scripts without a reduced case, left out of ``--quick``
 NOT_QUICK = {"fem_convergence",
+             "richardson_calibration",   # ~20 CPU min; tests/test_validation_tools.py
              "surface_genomics"}   # its reduced case takes ~30 s CPU, over the 30 s budget
 
 
