@@ -25,6 +25,19 @@ def test_richardson_recovers_limit_and_order_of_an_exact_power_law(order):
     assert np.allclose(np.array(r.errors) - r.uncertainty, true, rtol=1e-10, atol=1e-15)
 
 
+def test_richardson_uncertainty_has_the_calibrated_floor():
+    """Session 43's calibration: 3x the larger of the last two differences is the floor
+    of the uncertainty in both branches (the quarter step alone covered the known limit
+    of 30 % of the asymptotic BEM sequences)."""
+    q = [0.183926, 0.1996, 0.2030, 0.2040]          # asymptotic, order ~1.8
+    r = richardson(q)
+    assert r.asymptotic
+    floor = 3 * max(abs(q[-1] - q[-2]), abs(q[-2] - q[-3]))
+    assert r.uncertainty == pytest.approx(floor, rel=1e-12, abs=0)
+    assert r.uncertainty > 0.25 * abs(q[-1] - r.limit)
+    assert "at least 3 x the larger of the last two" in r.method
+
+
 def test_richardson_with_a_higher_order_term_bounds_the_true_error():
     """Q_h = Q + h + c h^2 with the h^2 term up to 1/8 of the h term at the finest level:
     the order is observed between 1 and 1.25, the limit is 6x closer to Q than the
