@@ -45,8 +45,9 @@ the same tangent averaged over a load range where a measurement would take it.
 
 For every method, quantity and load: observed orders and the Richardson limit of the
 finest three levels (``roughfe.validation.richardson``; fallback when not asymptotic: the
-finest value with 3x the last difference as its uncertainty), and the estimated
-discretisation error of every level, |Q_r - Q_lim| + uncertainty.
+finest value; the uncertainty at least 3x the larger of the last two differences in both
+branches since round 2, session 43, calibrated by ``richardson_calibration.py``), and the
+estimated discretisation error of every level, |Q_r - Q_lim| + uncertainty.
 
 Targets (met / NOT met): per profile, the FEM and BEM limits agree within 1 % (A*) and
 1 % (window K) at every load; at every r the FEM-BEM difference of A*, window K and mean
