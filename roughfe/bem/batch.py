@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, NoConvergenceError, check_real_array
+from .directions import _ConjugationChain
 from .operators import InfluenceOperator, influence_operator
 from .solvers import kkt_residual, penetration_start, pr_beta, step_length
 
@@ -165,6 +166,7 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
     t = np.zeros(shape)
     g_old = np.zeros(shape)
     gz_old = np.zeros(B)
+    chain = _ConjugationChain(rows=B)   # restarts a run-away conjugation, per row
     fresh = np.ones(B, bool)        # u = H p recomputed (not updated) this iteration
     d = np.zeros(B) if load else dl.copy()
     res = np.full(B, np.inf)
@@ -203,7 +205,7 @@ def solve_batch(op: InfluenceOperator, heights, *, delta=None, mean_pressure=Non
             z -= np.where(F, col(z.sum(axis=ax) / nF), 0.0)
         gz = (gF * z).sum(axis=ax)
         go = gz_old[act]
-        beta = pr_beta(gz - (z * g_old[act] * F).sum(axis=ax), go)
+        beta = chain.beta(pr_beta(gz - (z * g_old[act] * F).sum(axis=ax), go), gz, act)
         ta = np.where(F, col(beta) * t[act] + z, 0.0)
         gz_old[act] = gz
         g_old[act] = gF
