@@ -741,6 +741,10 @@ def test_design_study_yt1_without_refine_rows(entries, targets, tmp_path, monkey
     saved = json.loads((tmp_path / "yt1_sog_global" / "result.json").read_text())
     assert saved["candidates"][0]["scores_at_target_pressures"][0] == pytest.approx(w["strict"])
     assert any("| SOG |" in line for line in free["lines"])
+    sp = free["spread"]                      # seeds 1-3 of the same stage, reported
+    assert sp["method"] == "sog" and sp["seeds"] == [0, 1, 2, 3]
+    assert sp["values"]["strict s"][0] == w["strict"]
+    assert sp["values"]["interpolated s"][0] == w["interpolated"]
 
 
 def test_design_study_min_round_rows(targets, mcco_t1_t3, tmp_path):
@@ -760,3 +764,55 @@ def test_design_study_min_round_rows(targets, mcco_t1_t3, tmp_path):
     assert both["history"][-1, 1] == pytest.approx(both["f_min"], abs=1e-9)
     assert both["cpu_s"] > 0 and any("best min(f at p_t, interpolated f)" in x
                                      for x in both["lines"])
+
+
+def test_seed_spread_runs_each_further_seed_once_and_counts_the_goal():
+    """validation/_design_global.seed_spread (the y_t1 and M-CCO seed spreads): the
+    study's own seed's scores are taken as given, each of SPREAD_SEEDS is run once in
+    order, and per label the mean, median and the seeds >= goal (inclusive) are counted
+    and tabled."""
+    study = _design_study("global")
+    calls = []
+
+    def run(seed):
+        calls.append(seed)
+        return {"f": {1: 0.5, 2: 0.9, 3: 1.0}[seed], "g": 0.25 * seed, "unused": 7.0}
+
+    sp = study.seed_spread(run, {"f": 0.875, "g": 0.0}, 0, 0.9, "Spread")
+    assert calls == [1, 2, 3] and sp["seeds"] == [0, 1, 2, 3]
+    assert sp["values"] == {"f": [0.875, 0.5, 0.9, 1.0], "g": [0.0, 0.25, 0.5, 0.75]}
+    assert sp["mean"]["f"] == pytest.approx(0.81875) and sp["median"]["f"] == 0.8875
+    assert sp["n_met"] == {"f": 2, "g": 0} and sp["cpu_s"] >= 0
+    assert "| f | 0.8750 | 0.5000 | 0.9000 | 1.0000 | 0.8187 | 0.8875 | 2 of 4 |" in sp["lines"]
+    assert "seed 0's" in sp["lines"][0]
+    assert study.spread_note(sp, "f") == ("seeds 0, 1, 2, 3: f 0.8750 / 0.5000 / 0.9000 / "
+                                          "1.0000, 2 of 4 >= 0.9")
+
+
+def test_design_study_mcco_seed_spread_reruns_the_global_stage_per_seed(targets, mcco_t1_t3,
+                                                                       monkeypatch):
+    """validation/_design_multi.mcco_seed_spread (the M-CCO seed spread of validate
+    design, reported): seed 0 is the study's run, taken as given; every further seed is
+    the global stage (strict rounds, then the round on the min at the same seed) from the
+    same start, equal to that stage run on its own at that seed, and the seeds do take
+    different paths. Reduced budgets (N = 128, 40 + 60 evaluations)."""
+    multi = _design_study("multi")
+    monkeypatch.setattr(multi, "GLOBAL_EVAL", 40)
+    monkeypatch.setattr(multi, "GLOBAL_ROUNDS", 1)
+    monkeypatch.setattr(multi, "GLOBAL_MIN", de.GlobalSearchOptions(n_eval=60, score="min"))
+    rm = mcco_t1_t3
+    rg, cpu, both = multi.global_stage(rm, SETTINGS, 0)
+    assert cpu > 0 and both["result"].best.at_targets
+    sp = multi.mcco_seed_spread(rm, rg, both, SETTINGS, 0.9)
+    v = sp["values"]
+    assert sp["seeds"] == [0, 1, 2, 3] and all(len(x) == 4 for x in v.values())
+    assert {k: x[0] for k, x in v.items()} == multi.stage_scores(rg, both)
+    rg2 = de.search_global(rm, SETTINGS, n_eval=40, sigma=multi.GLOBAL_SIGMA, seed=2)
+    both2 = _design_study("global").min_round(rg2, SETTINGS, de.GlobalSearchOptions(
+        n_eval=60, seed=2, score="min"))
+    assert {k: x[2] for k, x in v.items()} == multi.stage_scores(rg2, both2)
+    assert len(set(v["f at p_t, strict stage"])) > 1          # the seed is used
+    for kind in ("f at p_t", "interpolated f"):
+        assert v[f"best {kind}"] == [max(a, b) for a, b in zip(
+            v[f"{kind}, strict stage"], v[f"{kind}, round on the min"])]
+    assert all(f"| {k} |" in "\n".join(sp["lines"]) for k in v)

@@ -1,7 +1,8 @@
 """The global stages of ``validation/design_study.py`` beyond the thesis (issue 14 section
 2): y_t1 without the refine stage (the thesis stages, then IPOP-CMA-ES on the strict
-score), the spread of its verdict over CMA-ES seeds, and one more M-CCO round on
-min(f at p_t, interpolated f). A helper module of the study, not a study of its own.
+score), the spread of a seeded stage's verdict over CMA-ES seeds (this stage's and the
+M-CCO global stage's), and one more M-CCO round on min(f at p_t, interpolated f). A
+helper module of the study, not a study of its own.
 """
 from __future__ import annotations
 
@@ -29,8 +30,9 @@ def yt1_without_refine(results, t1, settings, out: Path, goal: float) -> dict:
     strict s and the interpolated s (Eq. 4.1 as the thesis stages score it) of the best
     candidate, the thesis-stage values, CPU, and the differences to independent BEM runs
     of the saved design (hand-written load-controlled BEM for the strict s, a fresh sweep
-    for the interpolated s); ``goal``: the s the seed spread counts. Returns
-    ``{"rows": [...], "errors": [...], "lines": [...]}``."""
+    for the interpolated s); then :func:`seed_spread` of the best method's global stage
+    (``goal``: the s it counts). Returns ``{"rows": [...], "errors": [...], "spread":
+    {...}, "lines": [...]}``."""
     rows, errors = [], []
     for r in results:
         strict0 = max(de.combined_score(de.rescore_at_target_pressures(c.design, [t1], settings))
@@ -70,40 +72,67 @@ def yt1_without_refine(results, t1, settings, out: Path, goal: float) -> dict:
               f"{w['strict']:.4f} | {w['interpolated']:.4f} | {w['n_eval']} | {w['cpu_s']:.0f} "
               f"| {w['origin']} |" for w in rows]
     best = max(range(len(rows)), key=lambda k: rows[k]["strict"])
-    spread = yt1_seed_spread(results[best], rows[best]["strict"], t1, settings, goal)
+    rb = results[best]
+
+    def at_seed(seed):
+        rs = de.search_global(rb, settings, replace(YT1_GLOBAL, seed=seed))
+        return {"strict s": rs.best.at_targets[0],
+                "interpolated s": de.combined_score(rs.best.scores)}
+
+    spread = {"method": rb.method, **seed_spread(
+        at_seed, {"strict s": rows[best]["strict"], "interpolated s": rows[best]["interpolated"]},
+        YT1_GLOBAL.seed, goal, f"Seed spread of the global stage ({rb.method.upper()}, the "
+        f"best method at seed {YT1_GLOBAL.seed}; session 27 with B D z sampling: strict "
+        "0.988 / 0.941 / 0.986 / 0.970)")}
     return {"rows": rows, "errors": errors, "spread": spread,
             "lines": lines + [""] + spread["lines"]}
 
 
-#: further CMA-ES seeds of the global stage of the best method (after :data:`YT1_GLOBAL`'s)
-YT1_SPREAD_SEEDS = (1, 2, 3)
+#: further CMA-ES seeds of the study's seeded global stages (the y_t1 stage without
+#: GCMMA 3 and the M-CCO global stage), after the study's own seed: their spread
+SPREAD_SEEDS = (1, 2, 3)
 
 
-def yt1_seed_spread(result, strict0: float, t1, settings, goal: float) -> dict:
-    """The global stage of :func:`yt1_without_refine` on the same method with the seeds
-    :data:`YT1_SPREAD_SEEDS`: the y_t1 "without GCMMA 3" target is judged at seed 0 (the
-    study's seed), and this says how much of that verdict is the seed's (session 27:
-    seeds 0-3 of SOG gave 0.988 / 0.941 / 0.986 / 0.970); ``n_met`` counts the
-    seeds with s >= ``goal``. Reported, not a target.
-    Returns ``{"method", "seeds", "strict", "n_met", "cpu_s", "lines"}``."""
-    strict, cpu = [strict0], 0.0
-    for seed in YT1_SPREAD_SEEDS:
+def seed_spread(run, first: dict, seed0: int, goal: float, head: str) -> dict:
+    """How much of a seeded stage's verdict is the seed's: ``run(seed)`` runs the stage
+    at one of :data:`SPREAD_SEEDS` and returns its scores ``{label: value}`` (Eq. 4.1 s
+    or f, dimensionless) under the labels of ``first``, the scores of the study's own run
+    at seed ``seed0`` (not run again). Per label: the values (seed ``seed0`` first), the
+    mean, the median and ``n_met``, the number of seeds with a value >= ``goal``;
+    ``cpu_s``: the CPU time (s) of the further seeds. Reported, not a target: the study's
+    verdict stays seed ``seed0``'s. Returns ``{"seeds", "values", "mean", "median",
+    "n_met", "goal", "cpu_s", "lines"}`` (``head``: the sentence above the table)."""
+    values = {k: [float(v)] for k, v in first.items()}
+    cpu = 0.0
+    for seed in SPREAD_SEEDS:
         t0 = time.process_time()
-        rg = de.search_global(result, settings, replace(YT1_GLOBAL, seed=seed))
+        got = run(seed)
         cpu += time.process_time() - t0
-        strict.append(float(rg.best.at_targets[0]))
-        print(f"  {result.method} + global, seed {seed}: strict s {strict[-1]:.4f}", flush=True)
-    seeds = (YT1_GLOBAL.seed, *YT1_SPREAD_SEEDS)
-    n_met = sum(v >= goal for v in strict)
-    lines = [f"Seed spread of the global stage ({result.method.upper()}, the best method at "
-             f"seed {YT1_GLOBAL.seed}; reported, not a target: the verdict above is seed "
-             f"{YT1_GLOBAL.seed}'s; {cpu:.0f} s CPU):", "",
-             "| CMA-ES seed | " + " | ".join(map(str, seeds)) + " | mean | >= "
-             f"{goal} |", "|---" * (len(seeds) + 3) + "|",
-             "| strict s | " + " | ".join(f"{v:.4f}" for v in strict)
-             + f" | {np.mean(strict):.4f} | {n_met} of {len(strict)} |", ""]
-    return {"method": result.method, "seeds": list(seeds), "strict": strict, "n_met": n_met,
-            "cpu_s": cpu, "lines": lines}
+        for k, v in values.items():
+            v.append(float(got[k]))
+        print(f"  seed {seed}: " + ", ".join(f"{k} {v[-1]:.4f}" for k, v in values.items()),
+              flush=True)
+    seeds = [seed0, *SPREAD_SEEDS]
+    mean = {k: float(np.mean(v)) for k, v in values.items()}
+    median = {k: float(np.median(v)) for k, v in values.items()}
+    n_met = {k: int(np.count_nonzero(np.asarray(v) >= goal)) for k, v in values.items()}
+    lines = [f"{head}. Reported, not a target: the verdict above is CMA-ES seed {seed0}'s; "
+             f"{cpu:.0f} s CPU for seeds {', '.join(map(str, SPREAD_SEEDS))}.", "",
+             "| CMA-ES seed | " + " | ".join(map(str, seeds)) + f" | mean | median | >= {goal} |",
+             "|---" * (len(seeds) + 4) + "|"]
+    lines += [f"| {k} | " + " | ".join(f"{x:.4f}" for x in v) + f" | {mean[k]:.4f} | "
+              f"{median[k]:.4f} | {n_met[k]} of {len(v)} |" for k, v in values.items()]
+    return {"seeds": seeds, "values": values, "mean": mean, "median": median,
+            "n_met": n_met, "goal": goal, "cpu_s": cpu, "lines": lines + [""]}
+
+
+def spread_note(spread: dict, label: str) -> str:
+    """One line of :func:`seed_spread`'s result for the goals list: the values under
+    ``label`` per seed and how many reach the goal."""
+    v = spread["values"][label]
+    return (f"seeds {', '.join(map(str, spread['seeds']))}: {label} "
+            f"{' / '.join(f'{x:.4f}' for x in v)}, {spread['n_met'][label]} of {len(v)} "
+            f">= {spread['goal']}")
 
 
 def curve_table(hist, marks, head: str, label: str) -> list:
