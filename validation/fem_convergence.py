@@ -45,7 +45,7 @@ the same tangent averaged over a load range where a measurement would take it.
 
 For every method, quantity and load: observed orders and the Richardson limit of the
 finest three levels (``roughfe.validation.richardson``; fallback when not asymptotic: the
-finest value; the uncertainty at least 3x the larger of the last two differences in both
+finest value; the uncertainty at least 1.25x the larger of the last two differences in both
 branches since round 2, session 43, calibrated by ``richardson_calibration.py``), and the
 estimated discretisation error of every level, |Q_r - Q_lim| + uncertainty.
 
