@@ -221,7 +221,7 @@ def judge_claim(distance: float, claimed: float, reference_error: float) -> str:
     reference's error), ``"missed"`` when ``distance - reference_error > claimed`` (fails
     whatever it), ``"undecided"`` otherwise (the reference cannot judge it)."""
     if not (distance >= 0 and claimed >= 0 and reference_error >= 0):
-        raise InputError(f"judge_claim needs finite non-negative numbers, got distance "
+        raise InputError(f"judge_claim needs non-negative numbers (no NaN), got distance "
                          f"{distance!r}, claimed {claimed!r}, reference_error "
                          f"{reference_error!r}")
     if distance + reference_error <= claimed:
