@@ -199,6 +199,50 @@ def test_x3p2_k_rows_not_met_say_the_measured_reason_and_gate_as_before():
         assert sg.X3P_K_MISS not in score[name].reason
 
 
+def _surface_genomics_rows(sg, designs, quick):
+    return sg._targets(
+        rec=[{"M_exact": True, "gene_error": 1e-14, "phase_error_rad": 1e-14,
+              "angle_error_rad": 1e-14, "rms_error": 1e-15}],
+        noise=[{"noise": 0.01, "angle_error_deg": 0.1, "gamma_error": 1e-3,
+                "M_exact": True, "misfit_over_noise": 1.0}],
+        mech={"x3p-2": {"sum_error": 3e-16, "c_td_last": 1.0, "td_last_K_deviation": 3e-13,
+                        "td_last_A_deviation": 2e-14, "partition": True}},
+        designs=designs, db_info={"n_nodes": 16, "cpu_per_genome_s": 0.1, "computed": 2},
+        x3p={"window": {"series_deviation_max": 0.04, "K_range": [1.0, 2.0],
+                        "compliance_m_per_Pa": 1e-9}},
+        west={"wave": [2, 1], "n": 256, "eta": 2.0, "one_minus_s_K": 5e-4,
+              "one_minus_s_A": 0.04}, quick=quick)
+
+
+def test_surface_genomics_quick_case_judges_the_full_targets_and_leaves_the_design_goals():
+    """The reduced case (``roughfe validate surface-genomics --quick``; until session 44 the
+    whole study was "not run" in CI because its reduced designs failed the full budgets'
+    goals): every row it judges is the full run's row with the full run's target; the
+    design goals (s >= 0.98, f >= 0.9) and the design-run CPU rows, set for the full
+    budgets, are "not run" rows, never met and never NOT met; the reproduction rows stay
+    judged (a reduced design that its saved heights do not reproduce fails)."""
+    sg = _script("surface_genomics")
+    assert "surface_genomics" not in validate_cmd.NOT_QUICK
+    designs = [_design_row("y_t1", "sog", 0.83), _design_row("x3p-2", "mcco", -0.93)]
+    full = {r.name: r for r in _surface_genomics_rows(sg, designs, quick=False)}
+    quick = _surface_genomics_rows(sg, designs, quick=True)
+    ran = [r for r in quick if not is_skipped(r)]
+    assert ran and all(full[r.name].target == r.target and full[r.name].met == r.met
+                       for r in ran)
+    left = [r for r in quick if is_skipped(r)]
+    assert len(left) == 4 and all(r.met is None and "without --quick" in r.reason
+                                  for r in left)
+    assert {r.name.split(":")[1].strip() for r in left} == {
+        "s on K at the target pressures", "f on K+A at the target pressures",
+        "design run CPU"}
+    assert not any(r.met is False for r in quick)                 # the goals missed in full
+    assert sum(r.met is False for r in full.values()) == 2
+    # the reproduction rows are judged in the reduced case too
+    bad = [{**designs[0], "reproduced": 1e-6}, designs[1]]
+    failed = [r.name for r in _surface_genomics_rows(sg, bad, quick=True) if r.met is False]
+    assert failed == [next(n for n in full if n.startswith("y_t1 sog: score reproduced"))]
+
+
 def test_a_spectrum_matched_design_row_says_no_gcmma_stage_ran_not_nan():
     """The x3p-2 design rows of the full surface-genomics report read "GCMMA stages 0.205,
     nan, nan" (session 36): a spectrum-matched candidate runs no GCMMA stage, its stages

@@ -59,8 +59,7 @@ VALIDATIONS = {
 }
 #: scripts without a reduced case, left out of ``--quick``
 NOT_QUICK = {"fem_convergence",
-             "richardson_calibration",   # ~50 CPU min; tests/test_validation_tools.py
-             "surface_genomics"}   # its reduced case takes ~30 s CPU, over the 30 s budget
+             "richardson_calibration"}   # ~50 CPU min; tests/test_validation_tools.py
 
 
 def _validation_dir() -> Path:
