@@ -3,10 +3,10 @@ mechanics of the measured files, and surface design scores from a 2D genome data
 
 Run: ``roughfe validate surface-genomics`` (or ``make validate``); writes
 ``<outdir>/surface_genomics.md`` and ``surface_genomics.json`` (target rows in the schema
-of :mod:`roughfe.validation`). ``--quick`` (``make validate-quick``, CI; about 30 s CPU)
-runs the reduced case named in its report: every row of (i)-(iii), (v) and the designs'
-reproduction is the full run's target, judged; the design goals and design-run CPU rows,
-set for the full budgets, are "not run" rows (``_targets``).
+of :mod:`roughfe.validation`). ``--quick`` (``make validate-quick``, CI; 30-45 s CPU
+measured) runs the reduced case named in its report: every row of (i)-(iii), (v) and the
+designs' reproduction is the full run's target, judged; the design goals and design-run
+CPU rows, set for the full budgets, are "not run" rows (``_targets``).
 
 (i)   Exact recovery: MWM surfaces (M = 3 ridges, gamma = 1.8, H = 0.8, random lambda1,
       angles, anisotropy and phases per seed) realised at L and L/2.5 (N = 48) and
