@@ -272,7 +272,7 @@ def _row(name, target, measured, met, reason="", value=None):
 
 def _targets(rec, noise, mech, designs, db_info, x3p, west, quick=False):
     """The target rows. ``quick`` (the reduced case: a 16^2 5-step database, 5 search
-    sweeps per candidate, no global stage): the design goals (s >= GOAL_S, f >= GOAL_F)
+    sweeps per candidate, global stages capped at 12 evaluations): the design goals (s >= GOAL_S, f >= GOAL_F)
     and the design-run CPU rows are judged on the full budgets, so they are
     :func:`~roughfe.validation.skipped` rows ("not run", never met; the reduced designs'
     scores stay in the report's table); every other row is the full run's target."""
@@ -343,9 +343,9 @@ def _targets(rec, noise, mech, designs, db_info, x3p, west, quick=False):
                          v <= WESTERGAARD_SCORE[q],
                          f"reference independent of the BEM; tolerance just above {what} "
                          "(WESTERGAARD_SCORE)", v))
-    reduced = ("the reduced case's designs (16^2 database, 5 search sweeps, no global "
-               "stage) are not judged on the full budgets' goals; `roughfe validate "
-               "surface-genomics` (without --quick) runs them")
+    reduced = ("the reduced case's designs (16^2 database, 5 search sweeps, global "
+               "stages of <= 12 evaluations) are not judged on the full budgets' goals; "
+               "`roughfe validate surface-genomics` (without --quick) runs them")
     for d in designs:
         label = f"{d['target']} {d['method']}"
         if quick:
